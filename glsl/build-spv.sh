@@ -1,0 +1,18 @@
+#!/bin/sh
+# Compiles every kernel in glsl/kernels.txt into spv/ with glslang. Output is deterministic for a given glslang.
+set -eu
+cd "$(dirname "$0")/.."
+mkdir -p spv
+grep -v -e '^#' -e '^[[:space:]]*$' glsl/kernels.txt > "${TMPDIR:-/tmp}/brdfprof-kernels.$$"
+while read -r name source defines; do
+    flags=""
+    for d in $defines; do flags="$flags -D$d"; done
+    # shellcheck disable=SC2086
+    if ! out=$(glslangValidator -V --target-env vulkan1.1 $flags -o "spv/$name.spv" "glsl/$source" 2>&1); then
+        echo "$out" >&2
+        exit 1
+    fi
+    spirv-val --target-env vulkan1.1 "spv/$name.spv"
+    echo "spv/$name.spv"
+done < "${TMPDIR:-/tmp}/brdfprof-kernels.$$"
+rm -f "${TMPDIR:-/tmp}/brdfprof-kernels.$$"

@@ -1,0 +1,20 @@
+//! BRDF definitions: the term library with its f64 twins, the guards, model specs and presets.
+
+pub mod guards;
+pub mod samples;
+pub mod spec;
+pub mod terms;
+
+pub use spec::{ModelSpec, Precision, PRESETS, THESIS_MODELS};
+pub use terms::{Cosines, Metal, D, F, Vis};
+
+/// One BRDF query as the kernels receive it: world-space vectors (normalised by the kernel), perceptual
+/// roughness and an RGB F0, all in f32.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct Sample {
+    pub n: [f32; 3],
+    pub v: [f32; 3],
+    pub l: [f32; 3],
+    pub roughness: f32,
+    pub f0: [f32; 3],
+}

@@ -1,0 +1,104 @@
+//! Seeded sample sets of BRDF queries: random well-conditioned ones, and stratified grids over
+//! (roughness, NoV, NoL, azimuth). Vectors are built around a random normal so that no axis is special.
+
+use super::Sample;
+use rand::{Rng, SeedableRng};
+use rand_pcg::Pcg64;
+
+/// Unit vector with the given cosine to `n` and azimuth `phi` about it.
+pub fn around(n: [f64; 3], cos_theta: f64, phi: f64) -> [f64; 3] {
+    let (t, b) = tangent_frame(n);
+    let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
+    let (s, c) = phi.sin_cos();
+    [0, 1, 2].map(|i| sin_theta * (c * t[i] + s * b[i]) + cos_theta * n[i])
+}
+
+/// An orthonormal tangent and bitangent for unit `n` [Duff et al. 2017, "Building an Orthonormal Basis, Revisited"].
+pub fn tangent_frame(n: [f64; 3]) -> ([f64; 3], [f64; 3]) {
+    let sign = 1f64.copysign(n[2]);
+    let a = -1.0 / (sign + n[2]);
+    let b = n[0] * n[1] * a;
+    ([1.0 + sign * n[0] * n[0] * a, sign * b, -sign * n[0]], [b, sign + n[1] * n[1] * a, -n[1]])
+}
+
+fn random_unit(rng: &mut Pcg64) -> [f64; 3] {
+    let z: f64 = rng.random_range(-1.0..1.0);
+    let phi: f64 = rng.random_range(0.0..std::f64::consts::TAU);
+    let r = (1.0 - z * z).sqrt();
+    [r * phi.cos(), r * phi.sin(), z]
+}
+
+fn to_f32(v: [f64; 3]) -> [f32; 3] {
+    v.map(|x| x as f32)
+}
+
+/// `count` samples with NoV and NoL uniform in [min_cos, 1], roughness uniform in `roughness`, F0 uniform in
+/// [0, 1]^3, the normal uniform on the sphere.
+pub fn well_conditioned(count: usize, seed: u64, min_cos: f64, roughness: std::ops::Range<f64>) -> Vec<Sample> {
+    let mut rng = Pcg64::seed_from_u64(seed);
+    (0..count)
+        .map(|_| {
+            let n = random_unit(&mut rng);
+            let v = around(n, rng.random_range(min_cos..=1.0), rng.random_range(0.0..std::f64::consts::TAU));
+            let l = around(n, rng.random_range(min_cos..=1.0), rng.random_range(0.0..std::f64::consts::TAU));
+            Sample {
+                n: to_f32(n),
+                v: to_f32(v),
+                l: to_f32(l),
+                roughness: rng.random_range(roughness.clone()) as f32,
+                f0: [rng.random::<f32>(), rng.random::<f32>(), rng.random::<f32>()],
+            }
+        })
+        .collect()
+}
+
+/// A stratified set: `per_axis` strata in each of roughness (over `roughness`), NoV and NoL (over
+/// [min_cos, 1]) and the azimuth between V and L (over [0, pi]), one jittered sample per cell; F0 alternates
+/// between a dielectric's 0.04 and a coloured metal's (copper-like) from cell to cell.
+pub fn stratified(per_axis: usize, seed: u64, min_cos: f64, roughness: std::ops::Range<f64>) -> Vec<Sample> {
+    let mut rng = Pcg64::seed_from_u64(seed);
+    let k = per_axis as f64;
+    let mut out = Vec::with_capacity(per_axis.pow(4));
+    for ir in 0..per_axis {
+        for iv in 0..per_axis {
+            for il in 0..per_axis {
+                for ia in 0..per_axis {
+                    let u = |i: usize, rng: &mut Pcg64| (i as f64 + rng.random::<f64>()) / k;
+                    let r = roughness.start + (roughness.end - roughness.start) * u(ir, &mut rng);
+                    let nov = min_cos + (1.0 - min_cos) * u(iv, &mut rng);
+                    let nol = min_cos + (1.0 - min_cos) * u(il, &mut rng);
+                    let phi = std::f64::consts::PI * u(ia, &mut rng);
+                    let n = random_unit(&mut rng);
+                    let phi0: f64 = rng.random_range(0.0..std::f64::consts::TAU);
+                    let f0 = if (ir + iv + il + ia) % 2 == 0 { [0.04; 3] } else { [0.95, 0.64, 0.54] };
+                    out.push(Sample {
+                        n: to_f32(n),
+                        v: to_f32(around(n, nov, phi0)),
+                        l: to_f32(around(n, nol, phi0 + phi)),
+                        roughness: r as f32,
+                        f0,
+                    });
+                }
+            }
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::brdf::guards::dot;
+
+    #[test]
+    fn samples_have_the_cosines_asked_for() {
+        for s in well_conditioned(1000, 7, 0.05, 0.2..1.0) {
+            let (n, v, l) = (s.n.map(f64::from), s.v.map(f64::from), s.l.map(f64::from));
+            assert!(dot(n, v) >= 0.05 - 1e-6 && dot(n, l) >= 0.05 - 1e-6);
+            assert!((dot(v, v) - 1.0).abs() < 1e-6);
+            assert!((0.2..1.0).contains(&s.roughness));
+        }
+        assert_eq!(well_conditioned(10, 3, 0.05, 0.2..1.0), well_conditioned(10, 3, 0.05, 0.2..1.0));
+        assert_eq!(stratified(4, 1, 0.05, 0.1..1.0).len(), 256);
+    }
+}

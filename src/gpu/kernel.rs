@@ -1,0 +1,196 @@
+//! Compute kernels: a pipeline specialised with constants, its storage-buffer bindings, and the chunking that
+//! keeps every binding inside maxStorageBufferRange and every dispatch inside maxComputeWorkGroupCount.
+
+use super::{Buffer, DeviceInfo, Gpu};
+use crate::shaders::KernelSource;
+use anyhow::{anyhow, Context, Result};
+use ash::vk;
+
+/// Specialisation constants, in the order they are added.
+#[derive(Clone, Debug, Default)]
+pub struct SpecConstants {
+    entries: Vec<(u32, [u8; 4])>,
+}
+
+impl SpecConstants {
+    pub fn int(mut self, id: u32, value: i32) -> Self {
+        self.entries.push((id, value.to_ne_bytes()));
+        self
+    }
+    pub fn float(mut self, id: u32, value: f32) -> Self {
+        self.entries.push((id, value.to_ne_bytes()));
+        self
+    }
+    /// (id, value as u32 bits), for reports and for spirv-opt's --set-spec-const-default-value.
+    pub fn values(&self) -> Vec<(u32, [u8; 4])> {
+        self.entries.clone()
+    }
+}
+
+pub struct Kernel<'g> {
+    gpu: &'g Gpu,
+    pub name: String,
+    pub pipeline: vk::Pipeline,
+    layout: vk::PipelineLayout,
+    set_layout: vk::DescriptorSetLayout,
+    pool: vk::DescriptorPool,
+    bindings: u32,
+    push_bytes: u32,
+    /// Invocations per workgroup (local_size_x of every brdfprof kernel).
+    pub workgroup: u32,
+}
+
+/// Descriptor sets one kernel can hold at a time (one per chunk of a dispatch).
+const SETS_PER_KERNEL: u32 = 256;
+/// local_size_x of every kernel in glsl/.
+pub const WORKGROUP: u32 = 64;
+
+impl<'g> Kernel<'g> {
+    /// A pipeline for `source`, specialised, with `bindings` storage buffers and `push_bytes` of push constants.
+    pub fn new(gpu: &'g Gpu, source: &KernelSource, spec: &SpecConstants, bindings: u32, push_bytes: u32) -> Result<Self> {
+        let device = &gpu.device;
+        let words = source.words();
+        let binding_info: Vec<_> = (0..bindings)
+            .map(|b| {
+                vk::DescriptorSetLayoutBinding::default()
+                    .binding(b)
+                    .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
+                    .descriptor_count(1)
+                    .stage_flags(vk::ShaderStageFlags::COMPUTE)
+            })
+            .collect();
+        let map: Vec<_> = spec
+            .entries
+            .iter()
+            .enumerate()
+            .map(|(i, (id, _))| vk::SpecializationMapEntry { constant_id: *id, offset: 4 * i as u32, size: 4 })
+            .collect();
+        let data: Vec<u8> = spec.entries.iter().flat_map(|(_, v)| *v).collect();
+        let spec_info = vk::SpecializationInfo::default().map_entries(&map).data(&data);
+        // SAFETY: every create info and what it points to outlives its call; handles are destroyed in Drop.
+        unsafe {
+            let module = device.create_shader_module(&vk::ShaderModuleCreateInfo::default().code(&words), None)?;
+            let set_layout = device
+                .create_descriptor_set_layout(&vk::DescriptorSetLayoutCreateInfo::default().bindings(&binding_info), None)?;
+            let set_layouts = [set_layout];
+            let ranges = [vk::PushConstantRange { stage_flags: vk::ShaderStageFlags::COMPUTE, offset: 0, size: push_bytes }];
+            let mut layout_info = vk::PipelineLayoutCreateInfo::default().set_layouts(&set_layouts);
+            if push_bytes > 0 {
+                layout_info = layout_info.push_constant_ranges(&ranges);
+            }
+            let layout = device.create_pipeline_layout(&layout_info, None)?;
+            let stage = vk::PipelineShaderStageCreateInfo::default()
+                .stage(vk::ShaderStageFlags::COMPUTE)
+                .module(module)
+                .name(c"main")
+                .specialization_info(&spec_info);
+            let mut flags = vk::PipelineCreateFlags::empty();
+            if gpu.executable_properties.is_some() {
+                flags |= vk::PipelineCreateFlags::CAPTURE_STATISTICS_KHR;
+            }
+            let info = vk::ComputePipelineCreateInfo::default().stage(stage).layout(layout).flags(flags);
+            let pipeline = device
+                .create_compute_pipelines(vk::PipelineCache::null(), &[info], None)
+                .map_err(|(_, e)| anyhow!("creating the {} pipeline: {e}", source.name))?[0];
+            device.destroy_shader_module(module, None);
+            let sizes = [vk::DescriptorPoolSize { ty: vk::DescriptorType::STORAGE_BUFFER, descriptor_count: SETS_PER_KERNEL * bindings.max(1) }];
+            let pool = device.create_descriptor_pool(
+                &vk::DescriptorPoolCreateInfo::default().max_sets(SETS_PER_KERNEL).pool_sizes(&sizes),
+                None,
+            )?;
+            Ok(Kernel { gpu, name: source.name.into(), pipeline, layout, set_layout, pool, bindings, push_bytes, workgroup: WORKGROUP })
+        }
+    }
+
+    /// A descriptor set binding each `(buffer, offset, range)` window to bindings 0, 1, ...
+    pub fn bind(&self, windows: &[(&Buffer, u64, u64)]) -> Result<vk::DescriptorSet> {
+        assert_eq!(windows.len() as u32, self.bindings, "{}: wrong number of bindings", self.name);
+        let layouts = [self.set_layout];
+        let alloc = vk::DescriptorSetAllocateInfo::default().descriptor_pool(self.pool).set_layouts(&layouts);
+        // SAFETY: pool and layout belong to this kernel; the infos outlive the update.
+        unsafe {
+            let set = self
+                .gpu
+                .device
+                .allocate_descriptor_sets(&alloc)
+                .with_context(|| format!("{}: more than {SETS_PER_KERNEL} chunks bound at once", self.name))?[0];
+            let infos: Vec<[vk::DescriptorBufferInfo; 1]> =
+                windows.iter().map(|(b, offset, range)| [vk::DescriptorBufferInfo { buffer: b.buffer, offset: *offset, range: *range }]).collect();
+            let writes: Vec<_> = infos
+                .iter()
+                .enumerate()
+                .map(|(i, info)| {
+                    vk::WriteDescriptorSet::default()
+                        .dst_set(set)
+                        .dst_binding(i as u32)
+                        .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
+                        .buffer_info(info)
+                })
+                .collect();
+            self.gpu.device.update_descriptor_sets(&writes, &[]);
+            Ok(set)
+        }
+    }
+
+    /// Frees every descriptor set this kernel handed out.
+    pub fn reset_bindings(&self) -> Result<()> {
+        // SAFETY: callers only reset once the sets' submissions have completed.
+        unsafe { self.gpu.device.reset_descriptor_pool(self.pool, vk::DescriptorPoolResetFlags::empty()) }?;
+        Ok(())
+    }
+
+    /// Records a dispatch of `invocations` threads (rounded up to whole workgroups).
+    pub fn dispatch(&self, cmd: vk::CommandBuffer, set: vk::DescriptorSet, push: &[u8], invocations: u64) {
+        assert_eq!(push.len() as u32, self.push_bytes, "{}: wrong push-constant size", self.name);
+        let groups = invocations.div_ceil(self.workgroup as u64) as u32;
+        assert!(groups <= self.gpu.info.max_compute_work_group_count[0], "dispatch past maxComputeWorkGroupCount: chunk it");
+        let device = &self.gpu.device;
+        // SAFETY: cmd is recording; set and layout match this pipeline.
+        unsafe {
+            device.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline);
+            device.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.layout, 0, &[set], &[]);
+            if !push.is_empty() {
+                device.cmd_push_constants(cmd, self.layout, vk::ShaderStageFlags::COMPUTE, 0, push);
+            }
+            device.cmd_dispatch(cmd, groups, 1, 1);
+        }
+    }
+}
+
+impl Drop for Kernel<'_> {
+    fn drop(&mut self) {
+        // SAFETY: no submission using these handles is pending (every submit waits).
+        unsafe {
+            let d = &self.gpu.device;
+            d.destroy_descriptor_pool(self.pool, None);
+            d.destroy_pipeline(self.pipeline, None);
+            d.destroy_pipeline_layout(self.layout, None);
+            d.destroy_descriptor_set_layout(self.set_layout, None);
+        }
+    }
+}
+
+/// How `n` elements split into dispatches whose bindings fit maxStorageBufferRange and whose workgroup
+/// counts fit maxComputeWorkGroupCount.x.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ChunkPlan {
+    /// (first element, element count) per chunk.
+    pub chunks: Vec<(u64, u64)>,
+    pub max_chunk: u64,
+}
+
+/// Chunk sizes are multiples of this many elements, so window offsets (1024 x a stride of 16 bytes or more)
+/// meet any minStorageBufferOffsetAlignment (at most 256 bytes by the spec) and workgroups stay whole.
+const CHUNK_GRANULE: u64 = 1024;
+
+impl ChunkPlan {
+    /// `strides`: bytes per element of each bound buffer. `cap` lowers the chunk size (tests use it).
+    pub fn new(info: &DeviceInfo, n: u64, strides: &[u64], cap: Option<u64>) -> Self {
+        let by_range = strides.iter().map(|s| info.max_storage_buffer_range as u64 / s).min().unwrap_or(u64::MAX);
+        let by_groups = info.max_compute_work_group_count[0] as u64 * WORKGROUP as u64;
+        let max = by_range.min(by_groups).min(cap.unwrap_or(u64::MAX));
+        let max_chunk = (max / CHUNK_GRANULE * CHUNK_GRANULE).max(CHUNK_GRANULE);
+        let chunks = (0..n).step_by(max_chunk as usize).map(|first| (first, max_chunk.min(n - first))).collect();
+        ChunkPlan { chunks, max_chunk }
+    }
+}

@@ -1,0 +1,125 @@
+//! brdfprof's kernels as functions: `eval` (f_s per sample) and `terms` (each term per sample) on a Gpu,
+//! specialised for a model spec, over inputs of any size (chunked to the device's limits).
+
+use crate::brdf::{ModelSpec, Precision, Sample};
+use crate::gpu::{Buffer, ChunkPlan, Gpu, Kernel, MemoryKind, SpecConstants};
+use crate::shaders;
+use anyhow::{bail, Result};
+
+/// Constant ids of glsl/brdf.glsl's term selectors.
+pub fn model_constants(spec: &ModelSpec) -> SpecConstants {
+    SpecConstants::default()
+        .int(0, spec.d.id() as i32)
+        .int(1, spec.vis.id() as i32)
+        .int(2, spec.f.id() as i32)
+        .float(3, spec.gamma as f32)
+        .int(4, spec.metal.id() as i32)
+}
+
+/// The compiled kernel `base` in the spec's precision (e.g. `eval_f16`).
+pub fn source_for(base: &str, precision: Precision) -> &'static shaders::KernelSource {
+    shaders::kernel(&format!("{base}_{}", precision.name()))
+}
+
+/// Fails with a clear reason when the device cannot run the spec.
+pub fn check_support(gpu: &Gpu, spec: &ModelSpec) -> Result<()> {
+    if spec.precision == Precision::F16 && !gpu.info.shader_float16 {
+        bail!("{}: device `{}` has no shaderFloat16, so fp16 arithmetic cannot run there", spec, gpu.info.name);
+    }
+    Ok(())
+}
+
+/// Limits on one kernel run over many elements.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct RunLimits {
+    /// Elements per dispatch chunk, below what the device allows (tests use it to force chunking).
+    pub max_chunk: Option<u64>,
+}
+
+/// Host batches: at most this many bytes of input per submission, so host and device memory stay bounded
+/// whatever the input size.
+const MAX_BATCH_BYTES: u64 = 1 << 30;
+
+/// Runs an elementwise kernel (binding 0: `in_stride` bytes per element, binding 1: `out_stride`, push constant:
+/// element count) over `input`, returning the raw output bytes.
+fn run_elementwise(gpu: &Gpu, kernel: &Kernel, input: &[u8], in_stride: u64, out_stride: u64, n: u64, limits: RunLimits) -> Result<Vec<u8>> {
+    let mut output = Vec::with_capacity((n * out_stride) as usize);
+    let batch = (MAX_BATCH_BYTES.min(gpu.info.max_memory_allocation_size.max(1 << 27)) / in_stride).max(1);
+    let mut first = 0;
+    while first < n {
+        let count = batch.min(n - first);
+        let bytes = &input[(first * in_stride) as usize..((first + count) * in_stride) as usize];
+        let inputs = Buffer::with_data(gpu, bytes, MemoryKind::Device)?;
+        let outputs = Buffer::new(gpu, count * out_stride, MemoryKind::Device)?;
+        let plan = ChunkPlan::new(&gpu.info, count, &[in_stride, out_stride], limits.max_chunk);
+        let sets = plan
+            .chunks
+            .iter()
+            .map(|&(start, len)| kernel.bind(&[(&inputs, start * in_stride, len * in_stride), (&outputs, start * out_stride, len * out_stride)]))
+            .collect::<Result<Vec<_>>>()?;
+        gpu.submit(|cmd| {
+            for (set, &(_, len)) in sets.iter().zip(&plan.chunks) {
+                kernel.dispatch(cmd, *set, &(len as u32).to_ne_bytes(), len);
+            }
+        })?;
+        output.extend_from_slice(&outputs.read(0, count * out_stride)?);
+        kernel.reset_bindings()?;
+        first += count;
+    }
+    Ok(output)
+}
+
+fn pack_samples(samples: &[Sample]) -> Vec<u8> {
+    let floats: Vec<f32> = samples
+        .iter()
+        .flat_map(|s| {
+            let [nx, ny, nz] = s.n;
+            let [vx, vy, vz] = s.v;
+            let [lx, ly, lz] = s.l;
+            let [r, g, b] = s.f0;
+            [nx, ny, nz, s.roughness, vx, vy, vz, 0.0, lx, ly, lz, 0.0, r, g, b, 0.0]
+        })
+        .collect();
+    bytemuck::cast_slice(&floats).to_vec()
+}
+
+/// f_s of `spec` for every sample, evaluated on the GPU.
+pub fn eval(gpu: &Gpu, spec: &ModelSpec, samples: &[Sample], limits: RunLimits) -> Result<Vec<[f32; 3]>> {
+    check_support(gpu, spec)?;
+    let kernel = Kernel::new(gpu, source_for("eval", spec.precision), &model_constants(spec), 2, 4)?;
+    let out = run_elementwise(gpu, &kernel, &pack_samples(samples), 64, 16, samples.len() as u64, limits)?;
+    let floats: Vec<f32> = bytemuck::pod_collect_to_vec(&out);
+    Ok(floats.chunks_exact(4).map(|c| [c[0], c[1], c[2]]).collect())
+}
+
+/// Inputs of the per-term kernel: cosines as given (the kernel guards them) and roughness, F0.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TermInput {
+    pub nov: f32,
+    pub nol: f32,
+    pub noh: f32,
+    pub voh: f32,
+    pub roughness: f32,
+    pub f0: [f32; 3],
+}
+
+/// Each selected term on its own.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TermOutput {
+    pub d: f32,
+    pub vis: f32,
+    pub f: [f32; 3],
+}
+
+/// D, Vis and F of `spec` for every input, evaluated on the GPU.
+pub fn terms(gpu: &Gpu, spec: &ModelSpec, inputs: &[TermInput]) -> Result<Vec<TermOutput>> {
+    check_support(gpu, spec)?;
+    let kernel = Kernel::new(gpu, source_for("terms", spec.precision), &model_constants(spec), 2, 4)?;
+    let floats: Vec<f32> = inputs
+        .iter()
+        .flat_map(|t| [t.nov, t.nol, t.noh, t.voh, t.roughness, t.f0[0], t.f0[1], t.f0[2]])
+        .collect();
+    let out = run_elementwise(gpu, &kernel, bytemuck::cast_slice(&floats), 32, 32, inputs.len() as u64, RunLimits::default())?;
+    let floats: Vec<f32> = bytemuck::pod_collect_to_vec(&out);
+    Ok(floats.chunks_exact(8).map(|c| TermOutput { d: c[0], vis: c[1], f: [c[4], c[5], c[6]] }).collect())
+}

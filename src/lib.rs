@@ -1,0 +1,13 @@
+//! brdfprof: evaluates and profiles specular BRDFs in Vulkan compute kernels.
+//!
+//! Data flows CLI (`main.rs`) -> model spec (`brdf`) -> kernels (`kernels`, `shaders`, on `gpu`) -> the
+//! measurement protocol (`profile`) -> reports (`report`).
+
+pub mod brdf;
+pub mod gpu;
+pub mod io;
+pub mod kernels;
+pub mod profile;
+pub mod report;
+pub mod shaders;
+pub mod stats;

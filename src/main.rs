@@ -1,0 +1,247 @@
+//! The brdfprof command line: parses arguments, calls the library, prints and writes reports.
+//! Exit status: 0 success; 1 the command ran and found a problem (stability, regression); 2 bad input or
+//! anything that stopped the command from measuring.
+
+use anyhow::{anyhow, Result};
+use brdfprof::brdf::{spec, ModelSpec, Metal, D, F, Vis};
+use brdfprof::gpu::{self, Gpu, GpuOptions};
+use brdfprof::profile::{self, protocol::ProtocolOptions, ProfileOptions};
+use brdfprof::{io, kernels, report};
+use clap::{Args, Parser, Subcommand};
+use indicatif::{ProgressBar, ProgressStyle};
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::Duration;
+
+#[derive(Parser)]
+#[command(name = "brdfprof", version, about = "Evaluate and profile specular BRDFs in Vulkan compute kernels")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Args, Clone)]
+struct DeviceArgs {
+    /// Device index (see `brdfprof devices`) or a case-insensitive substring of its name.
+    /// Default: the first discrete or integrated GPU, else lavapipe.
+    #[arg(long)]
+    device: Option<String>,
+    /// Run under the Khronos validation layer and fail on any message (also BRDFPROF_VALIDATION=1).
+    #[arg(long)]
+    validate: bool,
+}
+
+impl DeviceArgs {
+    fn open(&self) -> Result<Gpu> {
+        let env = std::env::var("BRDFPROF_VALIDATION").is_ok_and(|v| !v.is_empty() && v != "0");
+        Gpu::new(&GpuOptions { device: self.device.clone(), validation: self.validate || env })
+    }
+}
+
+#[derive(Args, Clone)]
+struct ModelArgs {
+    /// Model spec: a preset (ggx, blinn, cook-torrance, burley, ue-default-lit, filament-high, filament-low)
+    /// or d=..,vis=..,f=..,precision=..; see `brdfprof models`.
+    #[arg(long = "model")]
+    models: Vec<String>,
+    /// Parameter override applied to every model, e.g. gamma=1.5 (GTR exponent), metal=copper, precision=f16.
+    #[arg(long = "param")]
+    params: Vec<String>,
+}
+
+impl ModelArgs {
+    fn specs(&self, default: &[&str]) -> Result<Vec<ModelSpec>> {
+        let names: Vec<String> = if self.models.is_empty() { default.iter().map(|s| s.to_string()).collect() } else { self.models.clone() };
+        names
+            .iter()
+            .map(|m| ModelSpec::parse(m).and_then(|s| s.with_params(&self.params)).map_err(|e| anyhow!("--model {m}: {e}")))
+            .collect()
+    }
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// List Vulkan devices with the properties that matter for profiling.
+    Devices,
+    /// List the terms (with citations) and presets that model specs can name.
+    Models,
+    /// Evaluate f_s of one model on the GPU for every row of a CSV file.
+    Eval {
+        #[command(flatten)]
+        model: ModelArgs,
+        /// CSV with columns nx,ny,nz,vx,vy,vz,lx,ly,lz,roughness,f0r,f0g,f0b (any order; others ignored).
+        #[arg(long)]
+        input: PathBuf,
+        /// CSV written with columns r,g,b, one row per input row (written atomically).
+        #[arg(long)]
+        output: PathBuf,
+        #[command(flatten)]
+        device: DeviceArgs,
+    },
+    /// Measure the cost per BRDF evaluation of models over a synthetic G-buffer lit by several lights.
+    Profile {
+        #[command(flatten)]
+        model: ModelArgs,
+        /// Directional lights per pixel (a specialisation constant: the light loop is unrolled).
+        #[arg(long, default_value_t = 8)]
+        lights: u32,
+        /// G-buffer size, WIDTHxHEIGHT.
+        #[arg(long, default_value = "1920x1080")]
+        size: String,
+        /// JSON report path (default: results/profile-<device>.json).
+        #[arg(long)]
+        json: Option<PathBuf>,
+        /// Minimum and maximum number of interleaved rounds.
+        #[arg(long, default_value_t = 12)]
+        min_rounds: usize,
+        #[arg(long, default_value_t = 400)]
+        max_rounds: usize,
+        /// Timed dispatches of each kernel per round.
+        #[arg(long, default_value_t = 3)]
+        reps: usize,
+        /// Seconds of timed rounds at most (the run also stops once every ratio is resolved).
+        #[arg(long, default_value_t = 60.0)]
+        budget: f64,
+        /// Stop when every ratio's 95% CI half-width is below this fraction of the ratio.
+        #[arg(long, default_value_t = 0.02)]
+        target_ci: f64,
+        /// Seed of the interleaving order.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        #[command(flatten)]
+        device: DeviceArgs,
+    },
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match run(cli) {
+        Ok(code) => code,
+        Err(e) => {
+            eprintln!("brdfprof: error: {e:#}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+fn run(cli: Cli) -> Result<ExitCode> {
+    match cli.command {
+        Command::Devices => devices(),
+        Command::Models => {
+            print!("{}", models_text());
+            Ok(ExitCode::SUCCESS)
+        }
+        Command::Eval { model, input, output, device } => {
+            let specs = model.specs(&[])?;
+            let [spec] = specs.as_slice() else {
+                return Err(anyhow!("eval takes exactly one --model"));
+            };
+            let samples = io::read_samples_csv(&input)?;
+            let gpu = device.open()?;
+            let values = kernels::eval(&gpu, spec, &samples, kernels::RunLimits::default())?;
+            gpu.check_validation()?;
+            io::write_atomic(&output, io::format_rgb_csv(&values).as_bytes())?;
+            eprintln!("brdfprof: {} rows of {} on {} -> {}", values.len(), spec, gpu.info.name, output.display());
+            Ok(ExitCode::SUCCESS)
+        }
+        Command::Profile { model, lights, size, json, min_rounds, max_rounds, reps, budget, target_ci, seed, device } => {
+            let models = model.specs(&spec::THESIS_MODELS)?;
+            let (width, height) = parse_size(&size)?;
+            if lights == 0 {
+                return Err(anyhow!("--lights must be at least 1"));
+            }
+            let gpu = device.open()?;
+            let options = ProfileOptions {
+                models,
+                width,
+                height,
+                lights,
+                protocol: ProtocolOptions {
+                    min_rounds: min_rounds.max(1),
+                    max_rounds: max_rounds.max(min_rounds.max(1)),
+                    reps: reps.max(1),
+                    budget: Duration::from_secs_f64(budget),
+                    seed,
+                },
+                target_rel_ci: target_ci,
+                max_chunk: None,
+            };
+            let progress = ProgressBar::new(0).with_style(
+                ProgressStyle::with_template("{spinner} {elapsed} round {pos} {msg}").expect("valid progress template"),
+            );
+            progress.enable_steady_tick(Duration::from_millis(200));
+            let result = profile::run(&gpu, &options, &progress);
+            progress.finish_and_clear();
+            let result = result?;
+            gpu.check_validation()?;
+            let path = json.unwrap_or_else(|| PathBuf::from(format!("results/profile-{}.json", report::device_slug(&gpu.info))));
+            report::write_json(&path, &result)?;
+            println!("{}\n", result.summary());
+            print!("{}", result.table().markdown());
+            println!("\nJSON: {}", path.display());
+            Ok(ExitCode::SUCCESS)
+        }
+    }
+}
+
+fn parse_size(text: &str) -> Result<(u32, u32)> {
+    let parse = || -> Option<(u32, u32)> {
+        let (w, h) = text.split_once(['x', 'X'])?;
+        Some((w.trim().parse().ok()?, h.trim().parse().ok()?))
+    };
+    match parse() {
+        Some((w, h)) if w > 0 && h > 0 => Ok((w, h)),
+        _ => Err(anyhow!("--size `{text}`: expected WIDTHxHEIGHT, e.g. 1920x1080")),
+    }
+}
+
+fn devices() -> Result<ExitCode> {
+    let infos = gpu::list_devices()?;
+    let default = gpu::select_device(&infos, None)?;
+    let mut t = report::Table::new([
+        "index", "name", "type", "driver", "API", "timestampPeriod ns", "ts bits", "maxStorageBufferRange", "maxWorkGroupCount.x", "fp16", "fp64", "exec. stats",
+    ]);
+    for d in &infos {
+        t.row([
+            format!("{}{}", d.index, if d.index == default { " (default)" } else { "" }),
+            d.name.clone(),
+            d.device_type.clone(),
+            format!("{} {} ({})", d.driver_name, d.driver_info, d.driver_version),
+            d.api_version.clone(),
+            d.timestamp_period.to_string(),
+            d.timestamp_valid_bits.to_string(),
+            d.max_storage_buffer_range.to_string(),
+            d.max_compute_work_group_count[0].to_string(),
+            d.shader_float16.to_string(),
+            d.shader_float64.to_string(),
+            d.pipeline_executable_properties.to_string(),
+        ]);
+    }
+    print!("{}", t.markdown());
+    Ok(ExitCode::SUCCESS)
+}
+
+fn models_text() -> String {
+    let mut out = String::new();
+    let mut section = |title: &str, rows: Vec<(String, String)>| {
+        let mut t = report::Table::new(["name", "source"]);
+        for (name, cite) in rows {
+            t.row([name, cite]);
+        }
+        out += &format!("{title}\n\n{}\n", t.markdown());
+    };
+    section("D (d=)", D::ALL.iter().map(|t| (t.name().to_string(), t.citation().to_string())).collect());
+    section("Visibility (vis=)", Vis::ALL.iter().map(|t| (t.name().to_string(), t.citation().to_string())).collect());
+    section("Fresnel (f=)", {
+        let mut rows: Vec<(String, String)> = F::ALL.iter().filter(|f| **f != F::Conductor).map(|t| (t.name().to_string(), t.citation().to_string())).collect();
+        rows.extend(Metal::ALL.iter().map(|m| (format!("conductor-{}", m.name()), format!("{} {}", F::Conductor.citation(), m.citation()))));
+        rows
+    });
+    section("Precision (precision=)", vec![("f32".into(), "fp32 arithmetic".into()), ("f16".into(), "fp16 arithmetic (needs shaderFloat16)".into())]);
+    section(
+        "Presets",
+        spec::PRESETS.iter().map(|p| (p.name.to_string(), format!("{} = {}", p.source, ModelSpec::preset(p.name).unwrap().canonical()))).collect(),
+    );
+    out += "Parameters: gamma=G (GTR exponent, default 1.5), metal=NAME (f82 metal, default gold).\n";
+    out
+}

@@ -1,0 +1,206 @@
+//! The measurement protocol. Every variant (a model's kernel, or the memory-only baseline) gets an untimed
+//! warm-up dispatch (lavapipe JIT-compiles a pipeline at its first dispatch). Then rounds: each round is one
+//! submission in which every variant runs `reps` times, interleaved (A B C, C A B, ...; a fresh seeded
+//! permutation per repetition), each dispatch between a barrier-fenced pair of BOTTOM_OF_PIPE timestamps.
+//! Costs are compared as ratios within a round, so the machine's drift between rounds cancels. All raw times
+//! are kept, outliers included.
+
+use super::gbuffer::{GBuffer, LIGHT_FLOATS, PIXEL_FLOATS};
+use crate::brdf::ModelSpec;
+use crate::gpu::{Buffer, ChunkPlan, Gpu, Kernel, MemoryKind, SpecConstants, Timestamps};
+use crate::kernels;
+use anyhow::Result;
+use ash::vk;
+use rand::seq::SliceRandom;
+use rand::SeedableRng;
+use serde::Serialize;
+use std::time::{Duration, Instant};
+
+/// The G-buffer, lights and output on the device, padded to whole workgroups (the kernel has no bounds check).
+pub struct Workload<'g> {
+    pixels: Buffer<'g>,
+    radiance: Buffer<'g>,
+    lights: Buffer<'g>,
+    pub light_count: u32,
+    /// Pixels in the picture (the padding is not counted in evaluations).
+    pub pixel_count: u64,
+    plan: ChunkPlan,
+}
+
+impl<'g> Workload<'g> {
+    pub fn upload(gpu: &'g Gpu, gbuffer: &GBuffer, lights: &[f32], max_chunk: Option<u64>) -> Result<Self> {
+        let n = gbuffer.pixel_count();
+        let wg = crate::gpu::WORKGROUP as u64;
+        let padded = n.div_ceil(wg) * wg;
+        let mut data = gbuffer.pixels.clone();
+        let last = data[data.len() - PIXEL_FLOATS..].to_vec();
+        for _ in n..padded {
+            data.extend_from_slice(&last);
+        }
+        let stride_in = (PIXEL_FLOATS * 4) as u64;
+        Ok(Workload {
+            pixels: Buffer::with_data(gpu, bytemuck::cast_slice(&data), MemoryKind::Device)?,
+            radiance: Buffer::new(gpu, padded * 16, MemoryKind::Device)?,
+            lights: Buffer::with_data(gpu, bytemuck::cast_slice(lights), MemoryKind::Device)?,
+            light_count: (lights.len() / LIGHT_FLOATS) as u32,
+            pixel_count: n,
+            plan: ChunkPlan::new(&gpu.info, padded, &[stride_in, 16], max_chunk),
+        })
+    }
+
+    /// BRDF evaluations per dispatch.
+    pub fn evaluations(&self) -> u64 {
+        self.pixel_count * self.light_count as u64
+    }
+
+    pub fn chunks(&self) -> usize {
+        self.plan.chunks.len()
+    }
+
+    /// The radiance written by the last dispatch (rgb per pixel), for checks.
+    pub fn radiance(&self) -> Result<Vec<[f32; 3]>> {
+        let v: Vec<f32> = self.radiance.read_as(0, self.pixel_count as usize * 4)?;
+        Ok(v.chunks_exact(4).map(|c| [c[0], c[1], c[2]]).collect())
+    }
+}
+
+/// A kernel bound to the workload, ready to dispatch.
+pub struct Variant<'g> {
+    pub label: String,
+    /// None for the memory-only baseline.
+    pub spec: Option<ModelSpec>,
+    kernel: Kernel<'g>,
+    sets: Vec<(vk::DescriptorSet, u64)>,
+}
+
+/// Constant ids of glsl/shade.comp beyond the term selectors.
+const NUM_LIGHTS_ID: u32 = 5;
+const BASELINE_ID: u32 = 6;
+
+impl<'g> Variant<'g> {
+    /// The shading kernel for `spec`, or the memory-only baseline when `spec` is None.
+    pub fn new(gpu: &'g Gpu, work: &Workload<'g>, spec: Option<&ModelSpec>) -> Result<Self> {
+        let model = spec.copied().unwrap_or_else(|| ModelSpec::preset("ggx").unwrap());
+        if let Some(s) = spec {
+            kernels::check_support(gpu, s)?;
+        }
+        let constants: SpecConstants = kernels::model_constants(&model)
+            .int(NUM_LIGHTS_ID, work.light_count as i32)
+            .int(BASELINE_ID, spec.is_none() as i32);
+        let kernel = Kernel::new(gpu, kernels::source_for("shade", model.precision), &constants, 3, 0)?;
+        let stride_in = (PIXEL_FLOATS * 4) as u64;
+        let lights_bytes = work.lights.size;
+        let sets = work
+            .plan
+            .chunks
+            .iter()
+            .map(|&(first, len)| {
+                let set = kernel.bind(&[
+                    (&work.pixels, first * stride_in, len * stride_in),
+                    (&work.radiance, first * 16, len * 16),
+                    (&work.lights, 0, lights_bytes),
+                ])?;
+                Ok((set, len))
+            })
+            .collect::<Result<Vec<_>>>()?;
+        Ok(Variant { label: spec.map_or_else(|| "baseline".to_string(), |s| s.name()), spec: spec.copied(), kernel, sets })
+    }
+
+    fn record(&self, cmd: vk::CommandBuffer) {
+        for &(set, len) in &self.sets {
+            self.kernel.dispatch(cmd, set, &[], len);
+        }
+    }
+
+    /// One untimed dispatch, then wait: compiles the pipeline on drivers that compile lazily.
+    pub fn warm_up(&self, gpu: &Gpu) -> Result<Duration> {
+        let start = Instant::now();
+        gpu.submit(|cmd| self.record(cmd))?;
+        Ok(start.elapsed())
+    }
+}
+
+#[derive(Clone, Debug)]
+pub struct ProtocolOptions {
+    pub min_rounds: usize,
+    pub max_rounds: usize,
+    /// Timed dispatches of every variant per round.
+    pub reps: usize,
+    /// Wall-clock budget for the timed rounds; the run stops after the round that exceeds it.
+    pub budget: Duration,
+    pub seed: u64,
+}
+
+/// Every timed dispatch, as measured.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct RawTimes {
+    /// ns[variant][round][rep]: dispatch time in nanoseconds.
+    pub ns: Vec<Vec<Vec<f64>>>,
+    /// The variant order of every repetition of every round.
+    pub orders: Vec<Vec<Vec<usize>>>,
+    /// Wall time of each variant's untimed warm-up dispatch (includes JIT compilation).
+    pub warmup_ms: Vec<f64>,
+    pub elapsed_s: f64,
+}
+
+impl RawTimes {
+    pub fn rounds(&self) -> usize {
+        self.orders.len()
+    }
+}
+
+/// Runs the protocol. After each round (from `min_rounds` on) `converged` sees the times so far; the run
+/// stops when it returns true, at `max_rounds`, or when the budget is spent.
+pub fn measure(
+    gpu: &Gpu,
+    variants: &[Variant],
+    options: &ProtocolOptions,
+    mut converged: impl FnMut(&RawTimes) -> bool,
+    mut on_round: impl FnMut(&RawTimes),
+) -> Result<RawTimes> {
+    let v = variants.len();
+    let mut raw = RawTimes { ns: vec![Vec::new(); v], ..Default::default() };
+    for variant in variants {
+        raw.warmup_ms.push(variant.warm_up(gpu)?.as_secs_f64() * 1e3);
+    }
+    let timestamps = Timestamps::new(gpu, (2 * v * options.reps) as u32)?;
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(options.seed);
+    let start = Instant::now();
+    for round in 0..options.max_rounds {
+        let orders: Vec<Vec<usize>> = (0..options.reps)
+            .map(|_| {
+                let mut o: Vec<usize> = (0..v).collect();
+                o.shuffle(&mut rng);
+                o
+            })
+            .collect();
+        let mut pairs = Vec::new();
+        gpu.submit(|cmd| {
+            timestamps.reset(cmd);
+            for order in &orders {
+                for &i in order {
+                    let q = pairs.len() as u32 * 2;
+                    gpu.barrier(cmd);
+                    timestamps.write(cmd, q);
+                    variants[i].record(cmd);
+                    timestamps.write(cmd, q + 1);
+                    pairs.push((q, q + 1));
+                }
+            }
+        })?;
+        let times = timestamps.intervals_ns(&pairs)?;
+        for series in raw.ns.iter_mut() {
+            series.push(Vec::with_capacity(options.reps));
+        }
+        for (k, &i) in orders.iter().flatten().enumerate() {
+            raw.ns[i][round].push(times[k]);
+        }
+        raw.orders.push(orders);
+        raw.elapsed_s = start.elapsed().as_secs_f64();
+        on_round(&raw);
+        if round + 1 >= options.min_rounds && (converged(&raw) || start.elapsed() >= options.budget) {
+            break;
+        }
+    }
+    Ok(raw)
+}

@@ -1,0 +1,129 @@
+//! Report plumbing shared by every command: Markdown tables, number formatting, the environment a run was
+//! measured in, and atomic JSON output.
+
+use crate::gpu::DeviceInfo;
+use crate::stats::Estimate;
+use anyhow::Result;
+use serde::Serialize;
+use std::collections::BTreeMap;
+use std::path::Path;
+
+/// A Markdown table.
+#[derive(Clone, Debug, Default)]
+pub struct Table {
+    pub headers: Vec<String>,
+    pub rows: Vec<Vec<String>>,
+}
+
+impl Table {
+    pub fn new<S: Into<String>>(headers: impl IntoIterator<Item = S>) -> Self {
+        Table { headers: headers.into_iter().map(Into::into).collect(), rows: Vec::new() }
+    }
+
+    pub fn row<S: Into<String>>(&mut self, cells: impl IntoIterator<Item = S>) {
+        self.rows.push(cells.into_iter().map(Into::into).collect());
+    }
+
+    pub fn markdown(&self) -> String {
+        let widths: Vec<usize> = (0..self.headers.len())
+            .map(|c| self.rows.iter().map(|r| r[c].chars().count()).chain([self.headers[c].chars().count(), 3]).max().unwrap())
+            .collect();
+        let line = |cells: &[String]| {
+            let padded: Vec<String> = cells.iter().zip(&widths).map(|(c, w)| format!("{c:<w$}")).collect();
+            format!("| {} |\n", padded.join(" | "))
+        };
+        let rule: Vec<String> = widths.iter().map(|w| "-".repeat(*w)).collect();
+        let mut out = line(&self.headers);
+        out += &line(&rule);
+        for r in &self.rows {
+            out += &line(r);
+        }
+        out
+    }
+}
+
+/// `x` with `digits` significant digits.
+pub fn sig(x: f64, digits: usize) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    let magnitude = x.abs().log10().floor() as i32;
+    let decimals = (digits as i32 - 1 - magnitude).max(0) as usize;
+    format!("{x:.decimals$}")
+}
+
+/// "median [lo, hi]".
+pub fn estimate(e: &Estimate, digits: usize) -> String {
+    format!("{} [{}, {}]", sig(e.median, digits), sig(e.lo, digits), sig(e.hi, digits))
+}
+
+/// Environment variables that change what a Vulkan driver does (Mesa, lavapipe, loader, vendors).
+pub fn driver_environment() -> BTreeMap<String, String> {
+    const PREFIXES: [&str; 9] = ["LP_", "MESA_", "GALLIUM_", "GALLIVM_", "VK_", "RADV_", "ACO_", "NV_", "__GL"];
+    std::env::vars().filter(|(k, _)| PREFIXES.iter().any(|p| k.starts_with(p))).collect()
+}
+
+/// What a report records about where it was measured.
+#[derive(Clone, Debug, Serialize)]
+pub struct Provenance {
+    pub tool: String,
+    pub unix_time: u64,
+    pub device: DeviceInfo,
+    pub mesa_version: Option<String>,
+    pub llvm_version: Option<String>,
+    pub env: BTreeMap<String, String>,
+    pub host_cpu: Option<String>,
+    pub host_threads: usize,
+}
+
+impl Provenance {
+    pub fn new(device: &DeviceInfo) -> Self {
+        let (mesa, llvm) = device.mesa_llvm();
+        let host_cpu = std::fs::read_to_string("/proc/cpuinfo")
+            .ok()
+            .and_then(|t| t.lines().find(|l| l.starts_with("model name")).and_then(|l| l.split(':').nth(1)).map(|s| s.trim().to_string()));
+        Provenance {
+            tool: format!("brdfprof {}", env!("CARGO_PKG_VERSION")),
+            unix_time: std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_secs()),
+            device: device.clone(),
+            mesa_version: mesa,
+            llvm_version: llvm,
+            env: driver_environment(),
+            host_cpu,
+            host_threads: std::thread::available_parallelism().map_or(1, |n| n.get()),
+        }
+    }
+}
+
+/// A lower-case file-name-safe form of a device name ("llvmpipe (LLVM 15.0.6, 256 bits)" -> "llvmpipe").
+pub fn device_slug(device: &DeviceInfo) -> String {
+    let first = device.name.split(['(', ',']).next().unwrap_or("device").trim().to_lowercase();
+    let slug: String = first.chars().map(|c| if c.is_ascii_alphanumeric() { c } else { '-' }).collect();
+    let slug = slug.trim_matches('-').to_string();
+    if slug.is_empty() { "device".into() } else { slug }
+}
+
+pub fn write_json(path: &Path, value: &impl Serialize) -> Result<()> {
+    let mut text = serde_json::to_string_pretty(value)?;
+    text.push('\n');
+    crate::io::write_atomic(path, text.as_bytes())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn significant_digits() {
+        assert_eq!(sig(1234.5, 3), "1234");
+        assert_eq!(sig(1.2345, 3), "1.23");
+        assert_eq!(sig(0.0012345, 3), "0.00123");
+    }
+
+    #[test]
+    fn table_is_aligned_markdown() {
+        let mut t = Table::new(["a", "long header"]);
+        t.row(["1", "2"]);
+        assert_eq!(t.markdown(), "| a   | long header |\n| --- | ----------- |\n| 1   | 2           |\n");
+    }
+}
