@@ -123,3 +123,58 @@ pub fn terms(gpu: &Gpu, spec: &ModelSpec, inputs: &[TermInput]) -> Result<Vec<Te
     let floats: Vec<f32> = bytemuck::pod_collect_to_vec(&out);
     Ok(floats.chunks_exact(8).map(|c| TermOutput { d: c[0], vis: c[1], f: [c[4], c[5], c[6]] }).collect())
 }
+
+/// One directional-albedo cell: the view cosine, perceptual roughness and F0.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AlbedoCell {
+    pub nov: f32,
+    pub roughness: f32,
+    pub f0: [f32; 3],
+}
+
+/// E(NoV, r) per channel and an estimate of its integration error: the largest channel difference between E
+/// on the full grid and E on its half-resolution subgrid (even rows and columns), which errs more.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct Albedo {
+    pub e: [f64; 3],
+    pub error: f64,
+}
+
+/// The albedo kernel's grid: ALBEDO_N azimuth rows x 3 components x ALBEDO_N columns per cell.
+pub const ALBEDO_GRID: u32 = 256;
+const ALBEDO_N_ID: u32 = 7;
+
+/// Directional albedo of `spec` for every cell, integrated on the GPU.
+pub fn albedo(gpu: &Gpu, spec: &ModelSpec, cells: &[AlbedoCell]) -> Result<Vec<Albedo>> {
+    check_support(gpu, spec)?;
+    let n = ALBEDO_GRID as u64;
+    let constants = model_constants(spec).int(ALBEDO_N_ID, n as i32);
+    let kernel = Kernel::new(gpu, source_for("albedo", spec.precision), &constants, 2, 4)?;
+    let floats: Vec<f32> = cells.iter().flat_map(|c| [c.nov, c.roughness, 0.0, 0.0, c.f0[0], c.f0[1], c.f0[2], 0.0]).collect();
+    let inputs = Buffer::with_data(gpu, bytemuck::cast_slice(&floats), MemoryKind::Device)?;
+    let mut results = Vec::with_capacity(cells.len());
+    // Cells per dispatch, within maxComputeWorkGroupCount.x.
+    let per_dispatch = (gpu.info.max_compute_work_group_count[0] as u64 * crate::gpu::WORKGROUP as u64 / n).max(1);
+    for first in (0..cells.len() as u64).step_by(per_dispatch as usize) {
+        let count = per_dispatch.min(cells.len() as u64 - first);
+        let rows = Buffer::new(gpu, count * n * 32, MemoryKind::Device)?;
+        let set = kernel.bind(&[(&inputs, first * 32, count * 32), (&rows, 0, count * n * 32)])?;
+        gpu.submit(|cmd| kernel.dispatch(cmd, set, &((count * n) as u32).to_ne_bytes(), count * n))?;
+        let v: Vec<f32> = rows.read_as(0, (count * n * 8) as usize)?;
+        for cell in v.chunks_exact(8 * n as usize) {
+            let (mut full, mut half) = ([0.0f64; 3], [0.0f64; 3]);
+            for (r, row) in cell.chunks_exact(8).enumerate() {
+                for c in 0..3 {
+                    full[c] += row[c] as f64 / n as f64;
+                    if r % 2 == 0 {
+                        half[c] += row[4 + c] as f64 / (n / 2) as f64;
+                    }
+                }
+            }
+            let error = (0..3).map(|c| (full[c] - half[c]).abs()).fold(0.0, f64::max);
+            results.push(Albedo { e: full, error });
+        }
+        kernel.reset_bindings()?;
+    }
+    Ok(results)
+}

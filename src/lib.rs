@@ -3,6 +3,7 @@
 //! Data flows CLI (`main.rs`) -> model spec (`brdf`) -> kernels (`kernels`, `shaders`, on `gpu`) -> the
 //! measurement protocol (`profile`) -> reports (`report`).
 
+pub mod accuracy;
 pub mod brdf;
 pub mod gpu;
 pub mod io;

@@ -197,23 +197,31 @@ impl ModelSpec {
 
     /// The f64 twin of `specular_brdf`: f_s for unnormalised vectors, 0 unless NoL > 0 and NoV > 0.
     pub fn eval(&self, s: &Sample) -> [f64; 3] {
-        let n = guards::safe_normalize(s.n.map(f64::from));
-        let v = guards::safe_normalize(s.v.map(f64::from));
-        let l = guards::safe_normalize(s.l.map(f64::from));
-        let h = guards::safe_normalize(guards::add(v, l));
-        let (nov, nol) = (guards::dot(n, v), guards::dot(n, l));
-        if !(nov > 0.0 && nol > 0.0) {
-            return [0.0; 3];
+        match guarded_cosines(s) {
+            Some((c, f0)) => self.from_cosines(&c, self.alpha(f64::from(s.roughness)), f0),
+            None => [0.0; 3],
         }
-        let c = Cosines {
-            nov: guards::guard_cosine(nov),
-            nol: guards::guard_cosine(nol),
-            noh: guards::guard_cosine(guards::dot(n, h)),
-            voh: guards::guard_cosine(guards::dot(v, h)),
-        };
-        let f0 = s.f0.map(|x| f64::from(x).clamp(0.0, 1.0));
-        self.from_cosines(&c, self.alpha(f64::from(s.roughness)), f0)
     }
+}
+
+/// The twin of the kernels' geometry: normalised vectors, the cosines guarded and F0 clamped to [0, 1];
+/// None when NoV <= 0 or NoL <= 0 (no light).
+pub fn guarded_cosines(s: &Sample) -> Option<(Cosines, [f64; 3])> {
+    let n = guards::safe_normalize(s.n.map(f64::from));
+    let v = guards::safe_normalize(s.v.map(f64::from));
+    let l = guards::safe_normalize(s.l.map(f64::from));
+    let h = guards::safe_normalize(guards::add(v, l));
+    let (nov, nol) = (guards::dot(n, v), guards::dot(n, l));
+    if !(nov > 0.0 && nol > 0.0) {
+        return None;
+    }
+    let c = Cosines {
+        nov: guards::guard_cosine(nov),
+        nol: guards::guard_cosine(nol),
+        noh: guards::guard_cosine(guards::dot(n, h)),
+        voh: guards::guard_cosine(guards::dot(v, h)),
+    };
+    Some((c, s.f0.map(|x| f64::from(x).clamp(0.0, 1.0))))
 }
 
 impl fmt::Display for ModelSpec {

@@ -1,0 +1,153 @@
+//! How accurate a model spec is, measured on the GPU: its numerical error (GPU result against the same
+//! formula in f64) and its error against the exact physical reference (`brdf::exact`), as max and RMS relative
+//! error over a fixed, seeded, stratified sample set, plus the error of its directional albedo.
+
+pub mod albedo;
+
+use crate::brdf::exact::{self, Lambda};
+use crate::brdf::{samples, ModelSpec, Sample, D, F};
+use crate::gpu::Gpu;
+use crate::kernels::{self, AlbedoCell, RunLimits};
+use anyhow::Result;
+use rayon::prelude::*;
+use serde::Serialize;
+use std::collections::HashMap;
+
+/// Relative error |x - reference| / max(|reference|, FLOOR), the measure used everywhere.
+pub const FLOOR: f64 = 1e-3;
+
+pub fn rel_err(x: f64, reference: f64) -> f64 {
+    let e = (x - reference).abs() / reference.abs().max(FLOOR);
+    if e.is_nan() { f64::INFINITY } else { e }
+}
+
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct ErrorStats {
+    pub max: f64,
+    pub rms: f64,
+    /// The sample with the largest error.
+    pub worst: String,
+}
+
+impl ErrorStats {
+    /// Over every channel of every sample.
+    pub fn of(samples: &[Sample], got: &[[f64; 3]], reference: &[[f64; 3]]) -> Self {
+        let mut stats = ErrorStats::default();
+        let mut sum_sq = 0.0;
+        for (i, (g, r)) in got.iter().zip(reference).enumerate() {
+            for c in 0..3 {
+                let e = rel_err(g[c], r[c]);
+                sum_sq += e * e;
+                if e > stats.max || stats.worst.is_empty() {
+                    stats.max = e;
+                    stats.worst = format!("{:?} channel {c}: {} vs {}", samples[i], g[c], r[c]);
+                }
+            }
+        }
+        stats.rms = (sum_sq / (3 * got.len()).max(1) as f64).sqrt();
+        stats
+    }
+}
+
+/// The fixed sample set: 10 strata each in roughness [0.1, 1], NoV and NoL [0.05, 1] and azimuth [0, pi]
+/// (10,000 samples, seed 2023), and the albedo cells NoV x roughness.
+pub struct SampleSet {
+    pub samples: Vec<Sample>,
+    pub cells: Vec<AlbedoCell>,
+}
+
+pub const ALBEDO_NOV: [f32; 6] = [0.1, 0.3, 0.5, 0.7, 0.9, 1.0];
+pub const ALBEDO_ROUGHNESS: [f32; 5] = [0.1, 0.25, 0.5, 0.75, 1.0];
+
+impl SampleSet {
+    pub fn standard() -> Self {
+        let cells = ALBEDO_ROUGHNESS
+            .iter()
+            .flat_map(|&roughness| ALBEDO_NOV.iter().map(move |&nov| AlbedoCell { nov, roughness, f0: [0.04; 3] }))
+            .collect();
+        SampleSet { samples: samples::stratified(10, 2023, 0.05, 0.1..1.0), cells }
+    }
+}
+
+/// What the exact reference of a spec depends on: its D (and gamma) and whether its exact Fresnel is a
+/// dielectric from F0 or a given metal. Specs differing only in Vis or in their Fresnel approximation share it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+struct ExactKey {
+    d: D,
+    gamma_bits: u64,
+    metal: Option<crate::brdf::Metal>,
+}
+
+impl ExactKey {
+    fn of(spec: &ModelSpec) -> Self {
+        let metal = matches!(spec.f, F::Conductor | F::F82).then_some(spec.metal);
+        ExactKey { d: spec.d, gamma_bits: if spec.d == D::Gtr { spec.gamma.to_bits() } else { 0 }, metal }
+    }
+}
+
+/// Exact values and albedos over a sample set, computed once per `ExactKey`.
+#[derive(Default)]
+pub struct ExactCache {
+    values: HashMap<ExactKey, Vec<[f64; 3]>>,
+    albedo: HashMap<ExactKey, Vec<[f64; 3]>>,
+}
+
+impl ExactCache {
+    fn values(&mut self, spec: &ModelSpec, set: &SampleSet) -> &Vec<[f64; 3]> {
+        self.values.entry(ExactKey::of(spec)).or_insert_with(|| set.samples.par_iter().map(|s| exact::eval(spec, s)).collect())
+    }
+
+    fn albedo(&mut self, spec: &ModelSpec, set: &SampleSet) -> &Vec<[f64; 3]> {
+        self.albedo.entry(ExactKey::of(spec)).or_insert_with(|| set.cells.par_iter().map(|cell| albedo_exact(spec, cell)).collect())
+    }
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct Accuracy {
+    /// GPU result against the same formula in f64.
+    pub numerical: ErrorStats,
+    /// GPU result against the exact physical reference: what a user of the spec gets.
+    pub vs_exact: ErrorStats,
+    /// The formula itself (f64) against the exact reference: the approximation alone.
+    pub formula_vs_exact: ErrorStats,
+    /// max over cells and channels of |E_gpu - E_exact| (absolute; albedo is in [0, 1]).
+    pub albedo_vs_exact: f64,
+    /// The largest integration-error bound of the GPU albedos.
+    pub albedo_error_bound: f64,
+}
+
+/// Measures `spec` on the GPU over `set`.
+pub fn measure(gpu: &Gpu, spec: &ModelSpec, set: &SampleSet, cache: &mut ExactCache) -> Result<Accuracy> {
+    let got: Vec<[f64; 3]> = kernels::eval(gpu, spec, &set.samples, RunLimits::default())?.iter().map(|g| g.map(f64::from)).collect();
+    let twin: Vec<[f64; 3]> = set.samples.par_iter().map(|s| spec.eval(s)).collect();
+    let exact_values = cache.values(spec, set).clone();
+    let gpu_albedo = kernels::albedo(gpu, spec, &set.cells)?;
+    let exact_albedo = cache.albedo(spec, set);
+    let albedo_vs_exact = gpu_albedo
+        .iter()
+        .zip(exact_albedo)
+        .flat_map(|(g, x)| (0..3).map(move |c| (g.e[c] - x[c]).abs()))
+        .fold(0.0, f64::max);
+    Ok(Accuracy {
+        numerical: ErrorStats::of(&set.samples, &got, &twin),
+        vs_exact: ErrorStats::of(&set.samples, &got, &exact_values),
+        formula_vs_exact: ErrorStats::of(&set.samples, &twin, &exact_values),
+        albedo_vs_exact,
+        albedo_error_bound: gpu_albedo.iter().map(|a| a.error).fold(0.0, f64::max),
+    })
+}
+
+/// E of `spec` (its own formula, f64) for one cell: the CPU reference for the GPU's albedo kernel.
+pub fn albedo_twin(spec: &ModelSpec, cell: &AlbedoCell) -> [f64; 3] {
+    let a = spec.alpha(cell.roughness as f64);
+    let f0 = cell.f0.map(|x| (x as f64).clamp(0.0, 1.0));
+    albedo::albedo_f64(&|c| spec.from_cosines(c, a, f0), cell.nov as f64, a)
+}
+
+/// E of the exact counterpart of `spec` for one cell.
+pub fn albedo_exact(spec: &ModelSpec, cell: &AlbedoCell) -> [f64; 3] {
+    let a = exact::alpha(cell.roughness as f64);
+    let lambda = Lambda::new(spec.d, a, spec.gamma);
+    let f0 = cell.f0.map(f64::from);
+    albedo::albedo_f64(&|c| exact::from_cosines(spec, &lambda, c, a, f0), cell.nov as f64, a)
+}
