@@ -5,6 +5,7 @@
 
 pub mod accuracy;
 pub mod brdf;
+pub mod chart;
 pub mod gpu;
 pub mod io;
 pub mod kernels;
@@ -12,3 +13,4 @@ pub mod profile;
 pub mod report;
 pub mod shaders;
 pub mod stats;
+pub mod sweep;

@@ -6,7 +6,7 @@ use anyhow::{anyhow, Result};
 use brdfprof::brdf::{spec, ModelSpec, Metal, D, F, Vis};
 use brdfprof::gpu::{self, Gpu, GpuOptions};
 use brdfprof::profile::{self, protocol::ProtocolOptions, ProfileOptions};
-use brdfprof::{io, kernels, report};
+use brdfprof::{io, kernels, report, sweep};
 use clap::{Args, Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::PathBuf;
@@ -59,6 +59,54 @@ impl ModelArgs {
     }
 }
 
+/// Size and protocol of a timed run, shared by `profile` and `sweep`.
+#[derive(Args, Clone)]
+struct TimingArgs {
+    /// Directional lights per pixel (a specialisation constant: the light loop is unrolled).
+    #[arg(long, default_value_t = 8)]
+    lights: u32,
+    /// Minimum and maximum number of interleaved rounds.
+    #[arg(long, default_value_t = 12)]
+    min_rounds: usize,
+    #[arg(long, default_value_t = 400)]
+    max_rounds: usize,
+    /// Seed of the interleaving order.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+}
+
+impl TimingArgs {
+    fn options(&self, models: Vec<ModelSpec>, size: &str, reps: usize, budget: f64, target_ci: f64) -> Result<ProfileOptions> {
+        let (width, height) = parse_size(size)?;
+        if self.lights == 0 {
+            return Err(anyhow!("--lights must be at least 1"));
+        }
+        let min_rounds = self.min_rounds.max(1);
+        Ok(ProfileOptions {
+            models,
+            width,
+            height,
+            lights: self.lights,
+            protocol: ProtocolOptions {
+                min_rounds,
+                max_rounds: self.max_rounds.max(min_rounds),
+                reps: reps.max(1),
+                budget: Duration::from_secs_f64(budget),
+                seed: self.seed,
+            },
+            target_rel_ci: target_ci,
+            max_chunk: None,
+        })
+    }
+}
+
+fn progress_bar() -> ProgressBar {
+    let progress = ProgressBar::new(0)
+        .with_style(ProgressStyle::with_template("{spinner} {elapsed} round {pos} {msg}").expect("valid progress template"));
+    progress.enable_steady_tick(Duration::from_millis(200));
+    progress
+}
+
 #[derive(Subcommand)]
 enum Command {
     /// List Vulkan devices with the properties that matter for profiling.
@@ -82,20 +130,11 @@ enum Command {
     Profile {
         #[command(flatten)]
         model: ModelArgs,
-        /// Directional lights per pixel (a specialisation constant: the light loop is unrolled).
-        #[arg(long, default_value_t = 8)]
-        lights: u32,
+        #[command(flatten)]
+        timing: TimingArgs,
         /// G-buffer size, WIDTHxHEIGHT.
         #[arg(long, default_value = "1920x1080")]
         size: String,
-        /// JSON report path (default: results/profile-<device>.json).
-        #[arg(long)]
-        json: Option<PathBuf>,
-        /// Minimum and maximum number of interleaved rounds.
-        #[arg(long, default_value_t = 12)]
-        min_rounds: usize,
-        #[arg(long, default_value_t = 400)]
-        max_rounds: usize,
         /// Timed dispatches of each kernel per round.
         #[arg(long, default_value_t = 3)]
         reps: usize,
@@ -105,9 +144,33 @@ enum Command {
         /// Stop when every ratio's 95% CI half-width is below this fraction of the ratio.
         #[arg(long, default_value_t = 0.02)]
         target_ci: f64,
-        /// Seed of the interleaving order.
+        /// JSON report path (default: results/profile-<device>.json).
+        #[arg(long)]
+        json: Option<PathBuf>,
+        #[command(flatten)]
+        device: DeviceArgs,
+    },
+    /// Time and measure the accuracy of many model specs in one interleaved run: table, JSON and a chart of
+    /// error against cost with the Pareto frontier, under --out (default results/).
+    Sweep {
+        /// Specs to sweep (default: every D with its sensible Vis terms and Schlick, every Fresnel on ggx,
+        /// the thesis models in fp16).
+        #[command(flatten)]
+        model: ModelArgs,
+        #[command(flatten)]
+        timing: TimingArgs,
+        #[arg(long, default_value = "512x512")]
+        size: String,
         #[arg(long, default_value_t = 1)]
-        seed: u64,
+        reps: usize,
+        #[arg(long, default_value_t = 150.0)]
+        budget: f64,
+        /// CI half-width target: 1.5% resolves neighbours 3% apart.
+        #[arg(long, default_value_t = 0.015)]
+        target_ci: f64,
+        /// Directory for sweep-<device>.md, .json and .png.
+        #[arg(long, default_value = "results")]
+        out: PathBuf,
         #[command(flatten)]
         device: DeviceArgs,
     },
@@ -144,32 +207,10 @@ fn run(cli: Cli) -> Result<ExitCode> {
             eprintln!("brdfprof: {} rows of {} on {} -> {}", values.len(), spec, gpu.info.name, output.display());
             Ok(ExitCode::SUCCESS)
         }
-        Command::Profile { model, lights, size, json, min_rounds, max_rounds, reps, budget, target_ci, seed, device } => {
-            let models = model.specs(&spec::THESIS_MODELS)?;
-            let (width, height) = parse_size(&size)?;
-            if lights == 0 {
-                return Err(anyhow!("--lights must be at least 1"));
-            }
+        Command::Profile { model, timing, size, reps, budget, target_ci, json, device } => {
+            let options = timing.options(model.specs(&spec::THESIS_MODELS)?, &size, reps, budget, target_ci)?;
             let gpu = device.open()?;
-            let options = ProfileOptions {
-                models,
-                width,
-                height,
-                lights,
-                protocol: ProtocolOptions {
-                    min_rounds: min_rounds.max(1),
-                    max_rounds: max_rounds.max(min_rounds.max(1)),
-                    reps: reps.max(1),
-                    budget: Duration::from_secs_f64(budget),
-                    seed,
-                },
-                target_rel_ci: target_ci,
-                max_chunk: None,
-            };
-            let progress = ProgressBar::new(0).with_style(
-                ProgressStyle::with_template("{spinner} {elapsed} round {pos} {msg}").expect("valid progress template"),
-            );
-            progress.enable_steady_tick(Duration::from_millis(200));
+            let progress = progress_bar();
             let result = profile::run(&gpu, &options, &progress);
             progress.finish_and_clear();
             let result = result?;
@@ -179,6 +220,24 @@ fn run(cli: Cli) -> Result<ExitCode> {
             println!("{}\n", result.summary());
             print!("{}", result.table().markdown());
             println!("\nJSON: {}", path.display());
+            Ok(ExitCode::SUCCESS)
+        }
+        Command::Sweep { model, timing, size, reps, budget, target_ci, out, device } => {
+            let models = if model.models.is_empty() { sweep::default_specs() } else { model.specs(&[])? };
+            let options = sweep::SweepOptions { profile: timing.options(models, &size, reps, budget, target_ci)? };
+            let gpu = device.open()?;
+            let progress = progress_bar();
+            let result = sweep::run(&gpu, &options, &progress);
+            progress.finish_and_clear();
+            let result = result?;
+            gpu.check_validation()?;
+            let stem = out.join(format!("sweep-{}", report::device_slug(&gpu.info)));
+            let (md, json, png) = (stem.with_extension("md"), stem.with_extension("json"), stem.with_extension("png"));
+            report::write_json(&json, &result)?;
+            io::write_atomic(&md, result.markdown().as_bytes())?;
+            result.chart(&png)?;
+            print!("{}", result.markdown());
+            println!("\nwritten: {}, {}, {}", md.display(), json.display(), png.display());
             Ok(ExitCode::SUCCESS)
         }
     }

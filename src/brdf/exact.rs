@@ -166,11 +166,14 @@ pub fn from_cosines(spec: &ModelSpec, lambda: &Lambda, c: &Cosines, a: f64, f0: 
     fresnel(spec, f0, c.voh).map(|f| dv * f)
 }
 
-/// Exact f_s for one sample (builds its Lambda; use `from_cosines` with a shared `Lambda` for many samples).
+/// Exact f_s for one sample, Lambda integrated directly (`from_cosines` with a tabulated `Lambda` is the
+/// fast path for many samples at one roughness).
 pub fn eval(spec: &ModelSpec, s: &Sample) -> [f64; 3] {
     let Some((c, f0)) = super::spec::guarded_cosines(s) else { return [0.0; 3] };
     let a = alpha(f64::from(s.roughness));
-    from_cosines(spec, &Lambda::new(spec.d, a, spec.gamma), &c, a, f0)
+    let g2 = 1.0 / (1.0 + lambda(spec.d, c.nov, a, spec.gamma) + lambda(spec.d, c.nol, a, spec.gamma));
+    let dv = spec.d.eval(c.noh, a, spec.gamma) * g2 / (4.0 * c.nol * c.nov);
+    fresnel(spec, f0, c.voh).map(|f| dv * f)
 }
 
 #[cfg(test)]

@@ -53,8 +53,10 @@ pub fn well_conditioned(count: usize, seed: u64, min_cos: f64, roughness: std::o
 }
 
 /// A stratified set: `per_axis` strata in each of roughness (over `roughness`), NoV and NoL (over
-/// [min_cos, 1]) and the azimuth between V and L (over [0, pi]), one jittered sample per cell; F0 alternates
-/// between a dielectric's 0.04 and a coloured metal's (copper-like) from cell to cell.
+/// [min_cos, 1]) and the azimuth between V and L (over [0, pi]), one jittered sample per cell. F0 is a
+/// dielectric's, so that the exact dielectric Fresnel is a physical reference for it: the channels hold water
+/// (0.02), plastic (0.04) and a gemstone (0.08), or 0.03, 0.05, 0.045 in alternate cells (metals are measured
+/// by the conductor and F82 terms, which take their metal's complex IOR instead).
 pub fn stratified(per_axis: usize, seed: u64, min_cos: f64, roughness: std::ops::Range<f64>) -> Vec<Sample> {
     let mut rng = Pcg64::seed_from_u64(seed);
     let k = per_axis as f64;
@@ -70,7 +72,7 @@ pub fn stratified(per_axis: usize, seed: u64, min_cos: f64, roughness: std::ops:
                     let phi = std::f64::consts::PI * u(ia, &mut rng);
                     let n = random_unit(&mut rng);
                     let phi0: f64 = rng.random_range(0.0..std::f64::consts::TAU);
-                    let f0 = if (ir + iv + il + ia) % 2 == 0 { [0.04; 3] } else { [0.95, 0.64, 0.54] };
+                    let f0 = if (ir + iv + il + ia) % 2 == 0 { [0.02, 0.04, 0.08] } else { [0.03, 0.05, 0.045] };
                     out.push(Sample {
                         n: to_f32(n),
                         v: to_f32(around(n, nov, phi0)),

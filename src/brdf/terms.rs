@@ -107,6 +107,43 @@ fn pow5(x: f64) -> f64 {
     x2 * x2 * x
 }
 
+/// Which microfacet family a term belongs to: Vis terms derived for one family suit the D's of that family
+/// (Walter et al. 2007 pair Blinn-Phong with Beckmann's G; Burley pairs GTR with GGX's Smith G).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Family {
+    Ggx,
+    Beckmann,
+    Sheen,
+}
+
+impl D {
+    pub fn family(self) -> Family {
+        match self {
+            D::Ggx | D::Gtr => Family::Ggx,
+            D::Beckmann | D::Blinn => Family::Beckmann,
+            D::Charlie => Family::Sheen,
+        }
+    }
+
+    /// The visibility terms that make sense with this D: those of its family and those of none.
+    pub fn sensible_visibilities(self) -> Vec<Vis> {
+        Vis::ALL.iter().copied().filter(|v| v.family().is_none_or(|f| f == self.family())).collect()
+    }
+}
+
+impl Vis {
+    /// The family a Vis term was derived for; None for terms that assume no particular D.
+    pub fn family(self) -> Option<Family> {
+        match self {
+            Vis::Implicit | Vis::Neumann | Vis::Kelemen | Vis::VCavity => None,
+            Vis::SchlickGgx | Vis::SmithGgxSeparable | Vis::SmithGgxCorrelated | Vis::SmithGgxJointApprox | Vis::SmithGgxCorrelatedFast | Vis::Hammon => {
+                Some(Family::Ggx)
+            }
+            Vis::SchlickBeckmann | Vis::SmithBeckmannSeparable | Vis::SmithBeckmannCorrelated | Vis::SmithBeckmannWalter => Some(Family::Beckmann),
+        }
+    }
+}
+
 // ---- D ----------------------------------------------------------------------------------------------
 
 impl D {

@@ -74,7 +74,7 @@ pub struct ProfileReport {
 }
 
 /// Per-round medians of a variant's dispatch times, per evaluation.
-fn per_round(raw: &RawTimes, variant: usize, evals: f64) -> Vec<f64> {
+pub fn per_round(raw: &RawTimes, variant: usize, evals: f64) -> Vec<f64> {
     raw.ns[variant].iter().map(|reps| stats::median(reps) / evals).collect()
 }
 

@@ -1,0 +1,144 @@
+//! PNG charts and images. Plotters draws into an RGB buffer (DejaVu Sans embedded, so no system fonts are
+//! needed); the `image` crate encodes it and `io::write_atomic` writes it.
+
+use anyhow::{anyhow, Result};
+use plotters::prelude::*;
+use plotters::style::FontStyle;
+use std::path::Path;
+use std::sync::Once;
+
+pub const FONT: &str = "sans-serif";
+
+fn register_font() {
+    static ONCE: Once = Once::new();
+    ONCE.call_once(|| {
+        plotters::style::register_font(FONT, FontStyle::Normal, dejavu::sans::regular()).ok();
+        plotters::style::register_font(FONT, FontStyle::Bold, dejavu::sans::bold()).ok();
+    });
+}
+
+/// Encodes an RGB8 buffer as PNG and writes it atomically.
+pub fn write_png(path: &Path, width: u32, height: u32, rgb: Vec<u8>) -> Result<()> {
+    let image = image::RgbImage::from_raw(width, height, rgb).ok_or_else(|| anyhow!("image buffer of the wrong size"))?;
+    let mut bytes = std::io::Cursor::new(Vec::new());
+    image.write_to(&mut bytes, image::ImageFormat::Png)?;
+    crate::io::write_atomic(path, bytes.get_ref())
+}
+
+/// Draws with plotters into a fresh white `width` x `height` canvas and writes it as PNG.
+pub fn render(path: &Path, width: u32, height: u32, draw: impl FnOnce(&DrawingArea<BitMapBackend, plotters::coord::Shift>) -> Result<()>) -> Result<()> {
+    register_font();
+    let mut buffer = vec![255u8; (width * height * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut buffer, (width, height)).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| anyhow!("{e}"))?;
+        draw(&root)?;
+        root.present().map_err(|e| anyhow!("{e}"))?;
+    }
+    write_png(path, width, height, buffer)
+}
+
+/// A distinct colour per group (Tableau 10).
+pub fn palette(i: usize) -> RGBColor {
+    const P: [(u8, u8, u8); 10] = [
+        (31, 119, 180), (255, 127, 14), (44, 160, 44), (214, 39, 40), (148, 103, 189),
+        (140, 86, 75), (227, 119, 194), (127, 127, 127), (188, 189, 34), (23, 190, 207),
+    ];
+    let (r, g, b) = P[i % P.len()];
+    RGBColor(r, g, b)
+}
+
+/// One labelled point of a scatter chart.
+pub struct Point {
+    pub x: f64,
+    pub y: f64,
+    pub label: String,
+    pub group: usize,
+}
+
+/// Scatter of labelled points on a log y axis, with a polyline (the Pareto frontier) drawn through `line`.
+pub fn scatter_log_y(path: &Path, title: &str, x_desc: &str, y_desc: &str, points: &[Point], line: &[(f64, f64)], legend: &[(usize, String)]) -> Result<()> {
+    let (w, h) = (2400u32, 1600u32);
+    let y_floor = 1e-8;
+    let xs = points.iter().map(|p| p.x);
+    let ys = points.iter().map(|p| p.y.max(y_floor));
+    let (x0, x1) = (xs.clone().fold(f64::INFINITY, f64::min), xs.fold(f64::NEG_INFINITY, f64::max));
+    let (y0, y1) = (ys.clone().fold(f64::INFINITY, f64::min), ys.fold(f64::NEG_INFINITY, f64::max));
+    let pad = (x1 - x0).max(1e-3) * 0.06;
+    let (x0, x1) = (x0 - pad, x1 + pad * 3.0);
+    let (y0, y1) = (y0 / 3.0, y1 * 3.0);
+    render(path, w, h, |root| {
+        let err = |e: &dyn std::fmt::Display| anyhow!("chart: {e}");
+        let mut chart = ChartBuilder::on(root)
+            .caption(title, (FONT, 34))
+            .margin(30)
+            .x_label_area_size(70)
+            .y_label_area_size(110)
+            .build_cartesian_2d(x0..x1, (y0..y1).log_scale())
+            .map_err(|e| err(&e))?;
+        chart
+            .configure_mesh()
+            .x_desc(x_desc)
+            .y_desc(y_desc)
+            .axis_desc_style((FONT, 24))
+            .label_style((FONT, 20))
+            .draw()
+            .map_err(|e| err(&e))?;
+        chart
+            .draw_series(LineSeries::new(line.iter().map(|&(x, y)| (x, y.max(y_floor))), RED.stroke_width(3)))
+            .map_err(|e| err(&e))?
+            .label("Pareto frontier")
+            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 30, y)], RED.stroke_width(3)));
+        for (group, name) in legend {
+            let colour = palette(*group);
+            chart
+                .draw_series(points.iter().filter(|p| p.group == *group).map(|p| Circle::new((p.x, p.y.max(y_floor)), 7, colour.filled())))
+                .map_err(|e| err(&e))?
+                .label(name.clone())
+                .legend(move |(x, y)| Circle::new((x + 15, y), 7, colour.filled()));
+        }
+        chart
+            .draw_series(points.iter().map(|p| {
+                EmptyElement::at((p.x, p.y.max(y_floor))) + Text::new(p.label.clone(), (10, -8), (FONT, 15).into_font().color(&palette(p.group).mix(0.95)))
+            }))
+            .map_err(|e| err(&e))?;
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperRight)
+            .label_font((FONT, 22))
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .draw()
+            .map_err(|e| err(&e))?;
+        Ok(())
+    })
+}
+
+/// Line chart: one series per (name, points), linear axes.
+pub fn lines(path: &Path, title: &str, x_desc: &str, y_desc: &str, series: &[(String, Vec<(f64, f64)>)], y_range: (f64, f64)) -> Result<()> {
+    let (x0, x1) = series
+        .iter()
+        .flat_map(|(_, p)| p.iter().map(|q| q.0))
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| (lo.min(x), hi.max(x)));
+    render(path, 1400, 900, |root| {
+        let err = |e: &dyn std::fmt::Display| anyhow!("chart: {e}");
+        let mut chart = ChartBuilder::on(root)
+            .caption(title, (FONT, 28))
+            .margin(20)
+            .x_label_area_size(60)
+            .y_label_area_size(80)
+            .build_cartesian_2d(x0..x1, y_range.0..y_range.1)
+            .map_err(|e| err(&e))?;
+        chart.configure_mesh().x_desc(x_desc).y_desc(y_desc).axis_desc_style((FONT, 20)).label_style((FONT, 16)).draw().map_err(|e| err(&e))?;
+        for (i, (name, pts)) in series.iter().enumerate() {
+            let colour = palette(i);
+            chart
+                .draw_series(LineSeries::new(pts.iter().copied(), colour.stroke_width(3)))
+                .map_err(|e| err(&e))?
+                .label(name.clone())
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 30, y)], colour.stroke_width(3)));
+        }
+        chart.configure_series_labels().label_font((FONT, 18)).background_style(WHITE.mix(0.85)).border_style(BLACK).draw().map_err(|e| err(&e))?;
+        Ok(())
+    })
+}

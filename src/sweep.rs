@@ -1,0 +1,252 @@
+//! `brdfprof sweep`: what accuracy costs in time. A set of model specs is timed in one interleaved run (the
+//! profile protocol) and measured for accuracy (`accuracy`), and the result is a table, a JSON file and a chart
+//! of error against cost with the Pareto frontier.
+
+use crate::accuracy::{self, Accuracy, ExactCache, SampleSet};
+use crate::brdf::{Metal, ModelSpec, Precision, D, F, THESIS_MODELS};
+use crate::chart::{self, Point};
+use crate::gpu::Gpu;
+use crate::profile::{self, ProfileOptions, ProfileReport};
+use crate::report::{self, Table};
+use crate::stats::{self, Estimate};
+use anyhow::Result;
+use indicatif::ProgressBar;
+use serde::Serialize;
+use std::path::Path;
+
+/// The default set: every D with each of its sensible visibility terms and Schlick's Fresnel; every Fresnel
+/// term on the `ggx` preset; the thesis models in fp16.
+pub fn default_specs() -> Vec<ModelSpec> {
+    let mut specs: Vec<ModelSpec> = Vec::new();
+    let mut push = |s: ModelSpec| {
+        if !specs.contains(&s) {
+            specs.push(s);
+        }
+    };
+    for &d in D::ALL {
+        for vis in d.sensible_visibilities() {
+            push(ModelSpec::new(d, vis, F::Schlick));
+        }
+    }
+    let ggx = ModelSpec::preset("ggx").unwrap();
+    for &f in F::ALL {
+        let metals: &[Metal] = if matches!(f, F::Conductor | F::F82) { Metal::ALL } else { &[Metal::Gold] };
+        for &metal in metals {
+            push(ModelSpec { f, metal, ..ggx });
+        }
+    }
+    for name in THESIS_MODELS {
+        push(ModelSpec { precision: Precision::F16, ..ModelSpec::preset(name).unwrap() });
+    }
+    specs
+}
+
+/// A short label for charts: the preset name where one matches, else d/vis/f.
+pub fn label(spec: &ModelSpec) -> String {
+    let name = spec.name();
+    if !name.starts_with("d=") {
+        return name.replace(",precision=f16", " f16");
+    }
+    let mut s = format!("{}/{}/{}", spec.d.name(), spec.vis.name(), spec.f_name());
+    if spec.f == F::F82 {
+        s += &format!("-{}", spec.metal.name());
+    }
+    if spec.precision == Precision::F16 {
+        s += " f16";
+    }
+    s
+}
+
+#[derive(Clone, Debug)]
+pub struct SweepOptions {
+    pub profile: ProfileOptions,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct SweepRow {
+    pub spec: String,
+    pub canonical: String,
+    pub label: String,
+    pub ns_per_eval: Estimate,
+    pub net_ns_per_eval: Option<Estimate>,
+    /// Per-round cost over the fastest spec's.
+    pub cost_vs_fastest: Estimate,
+    /// 1 + the number of specs whose cost CI lies wholly below this one's.
+    pub rank: usize,
+    /// Another spec's cost CI overlaps this one's, so the two cannot be ranked.
+    pub tied: bool,
+    pub accuracy: Accuracy,
+    /// No other spec is both cheaper (median cost) and more accurate (RMS error against the exact reference).
+    pub pareto: bool,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct SweepReport {
+    pub fastest: String,
+    /// Rows sorted by median cost.
+    pub rows: Vec<SweepRow>,
+    pub sample_set: String,
+    pub profile: ProfileReport,
+}
+
+/// Indices of the points not dominated in (cost, error), both to be minimised.
+pub fn pareto_front(points: &[(f64, f64)]) -> Vec<bool> {
+    points
+        .iter()
+        .map(|&(c, e)| !points.iter().any(|&(c2, e2)| c2 <= c && e2 <= e && (c2 < c || e2 < e)))
+        .collect()
+}
+
+pub fn run(gpu: &Gpu, options: &SweepOptions, progress: &ProgressBar) -> Result<SweepReport> {
+    let profile = profile::run(gpu, &options.profile, progress)?;
+    progress.set_message("accuracy: GPU against f64 twins and exact references");
+    let set = SampleSet::standard();
+    let mut cache = ExactCache::default();
+    let specs: Vec<(usize, ModelSpec)> = options
+        .profile
+        .models
+        .iter()
+        .map(|m| (profile.labels.iter().position(|l| *l == m.name()).expect("every spec was timed"), *m))
+        .collect();
+    let evals = profile.workload.evaluations_per_dispatch as f64;
+    let costs: Vec<Vec<f64>> = specs.iter().map(|(i, _)| profile::per_round(&profile.raw, *i, evals)).collect();
+    let medians: Vec<f64> = specs.iter().map(|(i, _)| profile.rows[*i].vs_reference.median).collect();
+    let fastest = (0..specs.len()).min_by(|&a, &b| medians[a].total_cmp(&medians[b])).unwrap();
+    let mut rows = Vec::new();
+    for (k, (i, spec)) in specs.iter().enumerate() {
+        progress.set_message(format!("accuracy {}/{}: {}", k + 1, specs.len(), spec.name()));
+        let ratio: Vec<f64> = costs[k].iter().zip(&costs[fastest]).map(|(a, f)| a / f).collect();
+        let row = &profile.rows[*i];
+        rows.push(SweepRow {
+            spec: spec.name(),
+            canonical: spec.canonical(),
+            label: label(spec),
+            ns_per_eval: row.ns_per_eval,
+            net_ns_per_eval: row.net_ns_per_eval,
+            cost_vs_fastest: stats::median_ci(&ratio, profile::LEVEL),
+            rank: 0,
+            tied: false,
+            accuracy: accuracy::measure(gpu, spec, &set, &mut cache)?,
+            pareto: false,
+        });
+    }
+    let front = pareto_front(&rows.iter().map(|r| (r.cost_vs_fastest.median, r.accuracy.vs_exact.rms)).collect::<Vec<_>>());
+    let cis: Vec<Estimate> = rows.iter().map(|r| r.cost_vs_fastest).collect();
+    for (k, row) in rows.iter_mut().enumerate() {
+        row.pareto = front[k];
+        row.rank = 1 + cis.iter().filter(|c| c.hi < cis[k].lo).count();
+        row.tied = cis.iter().enumerate().any(|(j, c)| j != k && c.overlaps(&cis[k]));
+    }
+    rows.sort_by(|a, b| a.cost_vs_fastest.median.total_cmp(&b.cost_vs_fastest.median));
+    Ok(SweepReport {
+        fastest: specs[fastest].1.name(),
+        rows,
+        sample_set: "10 strata each of roughness [0.1, 1], NoV and NoL [0.05, 1], azimuth [0, pi]; 10,000 samples, seed 2023; \
+                     dielectric F0 (0.02, 0.04, 0.08) or (0.03, 0.05, 0.045); albedo cells NoV {0.1, 0.3, 0.5, 0.7, 0.9, 1} x r \
+                     {0.1, 0.25, 0.5, 0.75, 1}, F0 0.04"
+            .into(),
+        profile,
+    })
+}
+
+impl SweepReport {
+    pub fn table(&self) -> Table {
+        let mut t = Table::new([
+            "rank", "spec", "ns/eval [95% CI]", "net ns/eval", "cost vs fastest [95% CI]", "numerical max err", "vs exact: max / RMS err", "albedo err", "Pareto",
+        ]);
+        for r in &self.rows {
+            let a = &r.accuracy;
+            t.row([
+                format!("{}{}", r.rank, if r.tied { "=" } else { "" }),
+                r.spec.clone(),
+                report::estimate(&r.ns_per_eval, 3),
+                r.net_ns_per_eval.as_ref().map_or("-".into(), |e| report::sig(e.median, 3)),
+                report::estimate(&r.cost_vs_fastest, 3),
+                format!("{:.1e}", a.numerical.max),
+                format!("{:.1e} / {:.1e}", a.vs_exact.max, a.vs_exact.rms),
+                format!("{:.1e}", a.albedo_vs_exact),
+                if r.pareto { "yes".into() } else { String::new() },
+            ]);
+        }
+        t
+    }
+
+    pub fn markdown(&self) -> String {
+        format!(
+            "# brdfprof sweep\n\n{}\n\nCost: per-round ratio to the fastest spec ({}), median and distribution-free 95% CI over {} rounds; \
+             rank = 1 + the number of specs whose CI lies wholly below; `=` marks specs whose CI overlaps another's, so they \
+             cannot be told apart. Errors are relative errors |x - ref| / max(|ref|, 1e-3) over the sample set ({}); numerical: \
+             GPU against the same formula in f64; vs exact: GPU against the exact physical model (same D, exact height-correlated \
+             Smith G2, exact Fresnel); albedo: max |E_gpu - E_exact| over the albedo cells. Pareto: no spec is both cheaper and \
+             more accurate (RMS vs exact).\n\n{}",
+            self.profile.summary(),
+            self.fastest,
+            self.profile.rounds,
+            self.sample_set,
+            self.table().markdown()
+        )
+    }
+
+    /// Approximation error (RMS vs exact, log) against cost, every point labelled, the frontier drawn.
+    pub fn chart(&self, path: &Path) -> Result<()> {
+        // Colour by D, fp16 specs apart.
+        let group = |r: &SweepRow| {
+            let spec = ModelSpec::parse(&r.canonical).unwrap();
+            if spec.precision == Precision::F16 { D::ALL.len() } else { spec.d as usize }
+        };
+        let points: Vec<Point> = self
+            .rows
+            .iter()
+            .map(|r| Point { x: r.cost_vs_fastest.median, y: r.accuracy.vs_exact.rms, label: r.label.clone(), group: group(r) })
+            .collect();
+        let mut front: Vec<(f64, f64)> = self.rows.iter().filter(|r| r.pareto).map(|r| (r.cost_vs_fastest.median, r.accuracy.vs_exact.rms)).collect();
+        front.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let mut legend: Vec<(usize, String)> = D::ALL.iter().map(|d| (*d as usize, format!("D = {}", d.name()))).collect();
+        legend.push((D::ALL.len(), "fp16".into()));
+        chart::scatter_log_y(
+            path,
+            &format!("Accuracy against cost on {} ({} evaluations per dispatch)", self.profile.provenance.device.name, self.profile.workload.evaluations_per_dispatch),
+            "cost relative to the fastest spec (median of per-round ratios)",
+            "RMS relative error against the exact physical model",
+            &points,
+            &front,
+            &legend,
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::brdf::Vis;
+
+    #[test]
+    fn default_sweep_covers_every_term() {
+        let specs = default_specs();
+        for d in D::ALL {
+            assert!(specs.iter().any(|s| s.d == *d), "{d:?}");
+        }
+        for v in Vis::ALL {
+            assert!(specs.iter().any(|s| s.vis == *v), "{v:?}");
+        }
+        for f in F::ALL {
+            for m in Metal::ALL {
+                assert!(specs.iter().any(|s| s.f == *f && (!matches!(f, F::Conductor | F::F82) || s.metal == *m)), "{f:?} {m:?}");
+            }
+        }
+        for name in THESIS_MODELS {
+            let s = ModelSpec { precision: Precision::F16, ..ModelSpec::preset(name).unwrap() };
+            assert!(specs.contains(&s));
+        }
+        let mut names: Vec<String> = specs.iter().map(|s| s.name()).collect();
+        names.sort();
+        names.dedup();
+        assert_eq!(names.len(), specs.len(), "no spec twice");
+    }
+
+    #[test]
+    fn pareto_front_keeps_only_undominated_points() {
+        let front = pareto_front(&[(1.0, 0.5), (2.0, 0.1), (1.5, 0.6), (3.0, 0.1), (0.9, 0.9)]);
+        assert_eq!(front, vec![true, true, false, false, true]);
+    }
+}
