@@ -69,27 +69,42 @@ const real INV_PI = real(0.318309886183791);
 
 real pow5(real x) { real x2 = x * x; return x2 * x2 * x; }
 
-// ---- D: normal distribution functions, D(NoH; a) with a = roughness^2 -------------------------------
+// log(1 + x) accurate to a few ulps relative for |x| < 0.05, where GLSL's log(1 + x) is not (1 + x rounds, and
+// drivers' log near 1 is only accurate in absolute terms, ~1e-7 on lavapipe): there, the Taylor series to x^6
+// (truncation below 2e-9 relative); log(1 + x) elsewhere. GLSL has no log1p.
+real log1p_accurate(real x) {
+    real series = x * (real(1) + x * (real(-1.0 / 2.0) + x * (real(1.0 / 3.0) + x * (real(-1.0 / 4.0) + x * (real(1.0 / 5.0) + x * real(-1.0 / 6.0))))));
+    return (abs(x) < real(0.05)) ? series : log(real(1) + x);
+}
 
-// GGX / Trowbridge-Reitz [Walter et al. 2007, eq. 33]: a2 / (pi (NoH^2 (a2-1) + 1)^2)
-real D_Ggx(real NoH, real a) {
+// ---- D: normal distribution functions, D(NoH; a) with a = roughness^2 -------------------------------
+// Each D also receives sin2h = 1 - NoH^2 = |N x H|^2 (Lagrange's identity), computed from the vectors: near
+// the peak 1 - NoH^2 from a rounded NoH, and NoH^2 (a2-1) + 1 at low roughness, lose most of their digits
+// (Filament's D_GGX does the same). Every use below is an exact identity of the formula it cites.
+
+// GGX / Trowbridge-Reitz [Walter et al. 2007, eq. 33]: a2 / (pi (NoH^2 (a2-1) + 1)^2),
+// with NoH^2 (a2-1) + 1 = NoH^2 a2 + sin2h.
+real D_Ggx(real NoH, real sin2h, real a) {
     real a2 = a * a;
-    real d = NoH * NoH * (a2 - real(1)) + real(1);
+    real d = NoH * NoH * a2 + sin2h;
     return a2 / (PI * d * d);
 }
 
 // Beckmann [Beckmann & Spizzichino 1963; Walter et al. 2007, eq. 25]:
-// exp((NoH^2-1) / (a2 NoH^2)) / (pi a2 NoH^4)
-real D_Beckmann(real NoH, real a) {
+// exp((NoH^2-1) / (a2 NoH^2)) / (pi a2 NoH^4), with NoH^2 - 1 = -sin2h.
+real D_Beckmann(real NoH, real sin2h, real a) {
     real a2 = a * a;
     real NoH2 = NoH * NoH;
-    return exp((NoH2 - real(1)) / (a2 * NoH2)) / (PI * a2 * NoH2 * NoH2);
+    return exp(-sin2h / (a2 * NoH2)) / (PI * a2 * NoH2 * NoH2);
 }
 
-// Normalised Blinn-Phong [Blinn 1977; m = 2/a2 - 2 from Walter et al. 2007]: (m+2)/(2 pi) NoH^m
-real D_Blinn(real NoH, real a) {
+// Normalised Blinn-Phong [Blinn 1977; m = 2/a2 - 2 from Walter et al. 2007]: (m+2)/(2 pi) NoH^m,
+// with NoH^m = exp(m/2 log(1 - sin2h)): m reaches 1e6 at the roughness floor, where a rounded NoH is useless.
+// The log stops at log(MIN_COSINE^2), as NoH stops at MIN_COSINE (so m = 0 at r = 1 gives NoH^0 = 1, not 0 x -inf).
+real D_Blinn(real NoH, real sin2h, real a) {
     real m = real(2) / (a * a) - real(2);
-    return (m + real(2)) / (real(2) * PI) * pow(NoH, m);
+    real log_noh2 = max(log1p_accurate(-sin2h), real(2.0 * log(MIN_COSINE)));
+    return (m + real(2)) / (real(2) * PI) * exp(real(0.5) * m * log_noh2);
 }
 
 // GTR normaliser c = (g-1)(a2-1) / (1 - a2^(1-g)) [Burley 2012, App. B]; g = 1: (a2-1)/ln(a2).
@@ -104,28 +119,28 @@ real gtr_normaliser(real a2, real g) {
 }
 
 // Generalized Trowbridge-Reitz [Burley 2012, App. B, eq. 4]:
-// (g-1)(a2-1) / (pi (1 - a2^(1-g)) (1 + (a2-1) NoH^2)^g); g = 1 and a2 -> 1 take their limits.
-real D_Gtr(real NoH, real a) {
+// (g-1)(a2-1) / (pi (1 - a2^(1-g)) (1 + (a2-1) NoH^2)^g); g = 1 and a2 -> 1 take their limits;
+// 1 + (a2-1) NoH^2 = NoH^2 a2 + sin2h.
+real D_Gtr(real NoH, real sin2h, real a) {
     real a2 = a * a;
     real g = real(GTR_GAMMA);
-    real t = real(1) + (a2 - real(1)) * NoH * NoH;
+    real t = NoH * NoH * a2 + sin2h;
     return gtr_normaliser(a2, g) / (PI * pow(t, g));
 }
 
-// Charlie sheen [Estevez & Kulla 2017, eq. 2]: (2 + 1/a) sin(theta_h)^(1/a) / (2 pi)
-real D_Charlie(real NoH, real a) {
+// Charlie sheen [Estevez & Kulla 2017, eq. 2]: (2 + 1/a) sin(theta_h)^(1/a) / (2 pi), sin^2 = sin2h
+real D_Charlie(real NoH, real sin2h, real a) {
     real inv_a = real(1) / a;
-    real sin2h = max(real(1) - NoH * NoH, real(0));
     return (real(2) + inv_a) * pow(sin2h, real(0.5) * inv_a) / (real(2) * PI);
 }
 
-real D_term(real NoH, real a) {
+real D_term(real NoH, real sin2h, real a) {
     switch (D_TERM) {
-    case D_GGX: return D_Ggx(NoH, a);
-    case D_BECKMANN: return D_Beckmann(NoH, a);
-    case D_BLINN: return D_Blinn(NoH, a);
-    case D_GTR: return D_Gtr(NoH, a);
-    default: return D_Charlie(NoH, a);
+    case D_GGX: return D_Ggx(NoH, sin2h, a);
+    case D_BECKMANN: return D_Beckmann(NoH, sin2h, a);
+    case D_BLINN: return D_Blinn(NoH, sin2h, a);
+    case D_GTR: return D_Gtr(NoH, sin2h, a);
+    default: return D_Charlie(NoH, sin2h, a);
     }
 }
 
@@ -368,20 +383,22 @@ real perceptual_to_alpha(float roughness) {
 
 real guard_cosine(real x) { return clamp(x, real(MIN_COSINE), real(1)); }
 
-// f_s = D Vis F from cosines already guarded (the kernels' shared core; tests call it directly).
-real3 specular_from_cosines(real NoV, real NoL, real NoH, real VoH, real a, real3 f0) {
-    return D_term(NoH, a) * Vis_term(NoV, NoL, NoH, VoH, a) * F_term(f0, VoH);
+// f_s = D Vis F from cosines already guarded and sin2h = 1 - NoH^2 (the kernels' shared core).
+real3 specular_from_cosines(real NoV, real NoL, real NoH, real VoH, real sin2h, real a, real3 f0) {
+    return D_term(NoH, sin2h, a) * Vis_term(NoV, NoL, NoH, VoH, a) * F_term(f0, VoH);
 }
 
 // f_s for unit (or zero) N, V, L; 0 unless NoL > 0 and NoV > 0 (not multiplied by NoL).
 vec3 specular_brdf_unit(vec3 N, vec3 V, vec3 L, float roughness, vec3 f0) {
     vec3 H = safe_normalize(V + L);
-    real NoV = dot(real3(N), real3(V));
-    real NoL = dot(real3(N), real3(L));
+    real3 Nr = real3(N), Hr = real3(H);
+    real NoV = dot(Nr, real3(V));
+    real NoL = dot(Nr, real3(L));
+    real3 NxH = cross(Nr, Hr);
     bool lit = NoV > real(0) && NoL > real(0);
-    real3 fs = specular_from_cosines(guard_cosine(NoV), guard_cosine(NoL), guard_cosine(dot(real3(N), real3(H))),
-                                     guard_cosine(dot(real3(V), real3(H))), perceptual_to_alpha(roughness),
-                                     real3(clamp(f0, vec3(0), vec3(1))));
+    real3 fs = specular_from_cosines(guard_cosine(NoV), guard_cosine(NoL), guard_cosine(dot(Nr, Hr)),
+                                     guard_cosine(dot(real3(V), Hr)), min(dot(NxH, NxH), real(1)),
+                                     perceptual_to_alpha(roughness), real3(clamp(f0, vec3(0), vec3(1))));
     return mix(vec3(0), vec3(fs), bvec3(lit));
 }
 

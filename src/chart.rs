@@ -142,3 +142,34 @@ pub fn lines(path: &Path, title: &str, x_desc: &str, y_desc: &str, series: &[(St
         Ok(())
     })
 }
+
+/// Line charts side by side: one panel per (title, series), linear axes, a shared y range.
+pub fn line_panels(path: &Path, title: &str, x_desc: &str, y_desc: &str, panels: &[(String, Vec<(String, Vec<(f64, f64)>)>)], y_range: (f64, f64)) -> Result<()> {
+    let width = 520 * panels.len() as u32;
+    render(path, width, 620, |root| {
+        let err = |e: &dyn std::fmt::Display| anyhow!("chart: {e}");
+        let root = root.titled(title, (FONT, 26)).map_err(|e| err(&e))?;
+        for (area, (name, series)) in root.split_evenly((1, panels.len())).iter().zip(panels) {
+            let x1 = series.iter().flat_map(|(_, p)| p.iter().map(|q| q.0)).fold(0.0, f64::max);
+            let mut chart = ChartBuilder::on(area)
+                .caption(name, (FONT, 20))
+                .margin(12)
+                .x_label_area_size(40)
+                .y_label_area_size(50)
+                .build_cartesian_2d(0.0..x1, y_range.0..y_range.1)
+                .map_err(|e| err(&e))?;
+            chart.configure_mesh().x_desc(x_desc).y_desc(y_desc).label_style((FONT, 13)).draw().map_err(|e| err(&e))?;
+            chart.draw_series(LineSeries::new([(0.0, 1.0), (x1, 1.0)], BLACK.stroke_width(1))).map_err(|e| err(&e))?;
+            for (i, (label, pts)) in series.iter().enumerate() {
+                let colour = palette(i);
+                chart
+                    .draw_series(LineSeries::new(pts.iter().copied(), colour.stroke_width(2)))
+                    .map_err(|e| err(&e))?
+                    .label(label.clone())
+                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2)));
+            }
+            chart.configure_series_labels().position(SeriesLabelPosition::LowerRight).label_font((FONT, 12)).background_style(WHITE.mix(0.8)).border_style(BLACK).draw().map_err(|e| err(&e))?;
+        }
+        Ok(())
+    })
+}

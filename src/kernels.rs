@@ -92,13 +92,14 @@ pub fn eval(gpu: &Gpu, spec: &ModelSpec, samples: &[Sample], limits: RunLimits) 
     Ok(floats.chunks_exact(4).map(|c| [c[0], c[1], c[2]]).collect())
 }
 
-/// Inputs of the per-term kernel: cosines as given (the kernel guards them) and roughness, F0.
+/// Inputs of the per-term kernel: cosines as given (the kernel guards them), sin2h = 1 - NoH^2, roughness, F0.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TermInput {
     pub nov: f32,
     pub nol: f32,
     pub noh: f32,
     pub voh: f32,
+    pub sin2h: f32,
     pub roughness: f32,
     pub f0: [f32; 3],
 }
@@ -117,9 +118,9 @@ pub fn terms(gpu: &Gpu, spec: &ModelSpec, inputs: &[TermInput]) -> Result<Vec<Te
     let kernel = Kernel::new(gpu, source_for("terms", spec.precision), &model_constants(spec), 2, 4)?;
     let floats: Vec<f32> = inputs
         .iter()
-        .flat_map(|t| [t.nov, t.nol, t.noh, t.voh, t.roughness, t.f0[0], t.f0[1], t.f0[2]])
+        .flat_map(|t| [t.nov, t.nol, t.noh, t.voh, t.roughness, t.f0[0], t.f0[1], t.f0[2], t.sin2h, 0.0, 0.0, 0.0])
         .collect();
-    let out = run_elementwise(gpu, &kernel, bytemuck::cast_slice(&floats), 32, 32, inputs.len() as u64, RunLimits::default())?;
+    let out = run_elementwise(gpu, &kernel, bytemuck::cast_slice(&floats), 48, 32, inputs.len() as u64, RunLimits::default())?;
     let floats: Vec<f32> = bytemuck::pod_collect_to_vec(&out);
     Ok(floats.chunks_exact(8).map(|c| TermOutput { d: c[0], vis: c[1], f: [c[4], c[5], c[6]] }).collect())
 }

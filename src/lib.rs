@@ -12,5 +12,6 @@ pub mod kernels;
 pub mod profile;
 pub mod report;
 pub mod shaders;
+pub mod stability;
 pub mod stats;
 pub mod sweep;

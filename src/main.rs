@@ -6,7 +6,7 @@ use anyhow::{anyhow, Result};
 use brdfprof::brdf::{spec, ModelSpec, Metal, D, F, Vis};
 use brdfprof::gpu::{self, Gpu, GpuOptions};
 use brdfprof::profile::{self, protocol::ProtocolOptions, ProfileOptions};
-use brdfprof::{io, kernels, report, sweep};
+use brdfprof::{io, kernels, report, stability, sweep};
 use clap::{Args, Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::PathBuf;
@@ -174,6 +174,21 @@ enum Command {
         #[command(flatten)]
         device: DeviceArgs,
     },
+    /// Run the hard-case catalogue, dense grids, reciprocity and energy checks on the GPU for every spec
+    /// (default: every D x Vis and every Fresnel on ggx, fp32 and fp16). Exit 1 when any spec yields NaN, Inf
+    /// or a negative value on a valid input.
+    Stability {
+        #[command(flatten)]
+        model: ModelArgs,
+        /// Skip the directional-albedo (energy) part.
+        #[arg(long)]
+        no_energy: bool,
+        /// Directory for stability-<device>.md/.json and the furnace, albedo and failure PNGs.
+        #[arg(long, default_value = "results")]
+        out: PathBuf,
+        #[command(flatten)]
+        device: DeviceArgs,
+    },
 }
 
 fn main() -> ExitCode {
@@ -239,6 +254,40 @@ fn run(cli: Cli) -> Result<ExitCode> {
             print!("{}", result.markdown());
             println!("\nwritten: {}, {}, {}", md.display(), json.display(), png.display());
             Ok(ExitCode::SUCCESS)
+        }
+        Command::Stability { model, no_energy, out, device } => {
+            let specs = if model.models.is_empty() { stability::default_specs() } else { model.specs(&[])? };
+            let gpu = device.open()?;
+            let progress = progress_bar();
+            let result = stability::run(&gpu, &stability::StabilityOptions { specs, energy: !no_energy }, &progress);
+            progress.finish_and_clear();
+            let result = result?;
+            gpu.check_validation()?;
+            let stem = out.join(format!("stability-{}", report::device_slug(&gpu.info)));
+            let mut written = vec![stem.with_extension("md"), stem.with_extension("json")];
+            report::write_json_compact(&written[1], &result)?;
+            io::write_atomic(&written[0], result.markdown().as_bytes())?;
+            let entries = result.energy_entries();
+            if !entries.is_empty() {
+                let furnace = out.join(format!("furnace-{}.png", report::device_slug(&gpu.info)));
+                let albedo = out.join(format!("albedo-{}.png", report::device_slug(&gpu.info)));
+                stability::energy::furnace_png(&furnace, &entries)?;
+                stability::energy::albedo_chart(&albedo, &entries)?;
+                written.extend([furnace, albedo]);
+            }
+            let heat = out.join(format!("stability-{}-failures.png", report::device_slug(&gpu.info)));
+            if result.heatmaps(&heat)? {
+                written.push(heat);
+            }
+            print!("{}", result.markdown());
+            println!("\nwritten: {}", written.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", "));
+            let failing = result.failing();
+            if failing.is_empty() {
+                Ok(ExitCode::SUCCESS)
+            } else {
+                eprintln!("brdfprof: {} spec(s) give NaN, Inf or negative values on valid inputs", failing.len());
+                Ok(ExitCode::from(1))
+            }
         }
     }
 }

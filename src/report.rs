@@ -103,6 +103,13 @@ pub fn device_slug(device: &DeviceInfo) -> String {
     if slug.is_empty() { "device".into() } else { slug }
 }
 
+/// Compact JSON, for reports whose numeric arrays would balloon when pretty-printed.
+pub fn write_json_compact(path: &Path, value: &impl Serialize) -> Result<()> {
+    let mut text = serde_json::to_string(value)?;
+    text.push('\n');
+    crate::io::write_atomic(path, text.as_bytes())
+}
+
 pub fn write_json(path: &Path, value: &impl Serialize) -> Result<()> {
     let mut text = serde_json::to_string_pretty(value)?;
     text.push('\n');

@@ -11,19 +11,23 @@ use rand::{Rng, SeedableRng};
 fn inputs(count: usize, seed: u64) -> Vec<TermInput> {
     let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
     (0..count)
-        .map(|_| TermInput {
-            nov: rng.random_range(0.05..=1.0),
-            nol: rng.random_range(0.05..=1.0),
-            noh: rng.random_range(0.05..=1.0),
-            voh: rng.random_range(0.05..=1.0),
-            roughness: rng.random_range(0.2..1.0),
-            f0: [rng.random(), rng.random(), rng.random()],
+        .map(|_| {
+            let noh: f32 = rng.random_range(0.05..=1.0);
+            TermInput {
+                nov: rng.random_range(0.05..=1.0),
+                nol: rng.random_range(0.05..=1.0),
+                noh,
+                voh: rng.random_range(0.05..=1.0),
+                sin2h: (1.0 - (noh as f64).powi(2)) as f32,
+                roughness: rng.random_range(0.2..1.0),
+                f0: [rng.random(), rng.random(), rng.random()],
+            }
         })
         .collect()
 }
 
 fn cosines(t: &TermInput) -> Cosines {
-    Cosines { nov: guard_cosine(t.nov as f64), nol: guard_cosine(t.nol as f64), noh: guard_cosine(t.noh as f64), voh: guard_cosine(t.voh as f64) }
+    Cosines { nov: guard_cosine(t.nov as f64), nol: guard_cosine(t.nol as f64), noh: guard_cosine(t.noh as f64), voh: guard_cosine(t.voh as f64), sin2h: t.sin2h as f64 }
 }
 
 #[test]
@@ -47,7 +51,7 @@ fn every_term_matches_its_f64_twin() {
     for &d in D::ALL {
         for gamma in if d == D::Gtr { vec![1.0, 1.5, 2.0, 2.5] } else { vec![1.5] } {
             let spec = ModelSpec { gamma, ..ModelSpec::new(d, Vis::Implicit, F::Schlick) };
-            check(format!("d={},gamma={gamma}", d.name()), spec, &|o, t| vec![(o.d as f64, d.eval(cosines(t).noh, spec.alpha(t.roughness as f64), gamma))]);
+            check(format!("d={},gamma={gamma}", d.name()), spec, &|o, t| vec![(o.d as f64, { let c = cosines(t); d.eval(c.noh, c.sin2h, spec.alpha(t.roughness as f64), gamma) })]);
         }
     }
     for &vis in Vis::ALL {

@@ -70,7 +70,7 @@ pub fn albedo_f64(f: &impl Fn(&Cosines) -> [f64; 3], nov: f64, a: f64) -> [f64; 
                 if nol <= 0.0 || voh <= 0.0 {
                     return [0.0; 3];
                 }
-                let c = Cosines { nov: guard_cosine(cos_v), nol: guard_cosine(nol), noh: guard_cosine(cos_h), voh: guard_cosine(voh) };
+                let c = Cosines { nov: guard_cosine(cos_v), nol: guard_cosine(nol), noh: guard_cosine(cos_h), voh: guard_cosine(voh), sin2h: sin_h * sin_h };
                 f(&c).map(|x| x * nol * 4.0 * voh)
             });
             // Both halves of the azimuth, and the solid-angle factor sin(theta_h).

@@ -191,14 +191,25 @@ impl ModelSpec {
 
     /// The f64 twin of `specular_from_cosines`: D Vis F from guarded cosines.
     pub fn from_cosines(&self, c: &Cosines, a: f64, f0: [f64; 3]) -> [f64; 3] {
-        let dv = self.d.eval(c.noh, a, self.gamma) * self.vis.eval(c, a);
+        let dv = self.d.eval(c.noh, c.sin2h, a, self.gamma) * self.vis.eval(c, a);
         self.f.eval(f0, c.voh, self.metal).map(|f| dv * f)
     }
 
     /// The f64 twin of `specular_brdf`: f_s for unnormalised vectors, 0 unless NoL > 0 and NoV > 0.
     pub fn eval(&self, s: &Sample) -> [f64; 3] {
-        match guarded_cosines(s) {
-            Some((c, f0)) => self.from_cosines(&c, self.alpha(f64::from(s.roughness)), f0),
+        self.eval_f64(s.n.map(f64::from), s.v.map(f64::from), s.l.map(f64::from), f64::from(s.roughness), s.f0.map(f64::from))
+    }
+
+    /// `eval` for inputs already in f64.
+    pub fn eval_f64(&self, n: [f64; 3], v: [f64; 3], l: [f64; 3], roughness: f64, f0: [f64; 3]) -> [f64; 3] {
+        let unit = guards::safe_normalize;
+        self.eval_unit(unit(n), unit(v), unit(l), roughness, f0)
+    }
+
+    /// The twin of `specular_brdf_unit`: N, V, L taken as given (the kernel's unit vectors, rounding and all).
+    pub fn eval_unit(&self, n: [f64; 3], v: [f64; 3], l: [f64; 3], roughness: f64, f0: [f64; 3]) -> [f64; 3] {
+        match guarded_cosines_unit(n, v, l, f0) {
+            Some((c, f0)) => self.from_cosines(&c, self.alpha(roughness), f0),
             None => [0.0; 3],
         }
     }
@@ -207,21 +218,30 @@ impl ModelSpec {
 /// The twin of the kernels' geometry: normalised vectors, the cosines guarded and F0 clamped to [0, 1];
 /// None when NoV <= 0 or NoL <= 0 (no light).
 pub fn guarded_cosines(s: &Sample) -> Option<(Cosines, [f64; 3])> {
-    let n = guards::safe_normalize(s.n.map(f64::from));
-    let v = guards::safe_normalize(s.v.map(f64::from));
-    let l = guards::safe_normalize(s.l.map(f64::from));
+    guarded_cosines_f64(s.n.map(f64::from), s.v.map(f64::from), s.l.map(f64::from), s.f0.map(f64::from))
+}
+
+pub fn guarded_cosines_f64(n: [f64; 3], v: [f64; 3], l: [f64; 3], f0: [f64; 3]) -> Option<(Cosines, [f64; 3])> {
+    let unit = guards::safe_normalize;
+    guarded_cosines_unit(unit(n), unit(v), unit(l), f0)
+}
+
+/// As `guarded_cosines_f64` for vectors already normalised (only H is formed and normalised here).
+pub fn guarded_cosines_unit(n: [f64; 3], v: [f64; 3], l: [f64; 3], f0: [f64; 3]) -> Option<(Cosines, [f64; 3])> {
     let h = guards::safe_normalize(guards::add(v, l));
     let (nov, nol) = (guards::dot(n, v), guards::dot(n, l));
     if !(nov > 0.0 && nol > 0.0) {
         return None;
     }
+    let nxh = guards::cross(n, h);
     let c = Cosines {
         nov: guards::guard_cosine(nov),
         nol: guards::guard_cosine(nol),
         noh: guards::guard_cosine(guards::dot(n, h)),
         voh: guards::guard_cosine(guards::dot(v, h)),
+        sin2h: guards::dot(nxh, nxh).min(1.0),
     };
-    Some((c, s.f0.map(|x| f64::from(x).clamp(0.0, 1.0))))
+    Some((c, f0.map(|x| x.clamp(0.0, 1.0))))
 }
 
 impl fmt::Display for ModelSpec {

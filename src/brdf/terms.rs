@@ -5,13 +5,15 @@
 use super::guards::{F0_MAX, GTR_SERIES_BAND, MIN_COSINE};
 use std::f64::consts::PI;
 
-/// The four cosines a term may read, already guarded (`guards::guard_cosine`).
+/// The four cosines a term may read, already guarded (`guards::guard_cosine`), and sin2h = 1 - NoH^2 computed
+/// without cancellation (|N x H|^2), which the D terms read near their peak.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Cosines {
     pub nov: f64,
     pub nol: f64,
     pub noh: f64,
     pub voh: f64,
+    pub sin2h: f64,
 }
 
 macro_rules! term_table {
@@ -147,28 +149,34 @@ impl Vis {
 // ---- D ----------------------------------------------------------------------------------------------
 
 impl D {
-    /// D(NoH) for a = roughness^2; `gamma` is read by GTR only.
-    pub fn eval(self, noh: f64, a: f64, gamma: f64) -> f64 {
+    /// D(NoH) for a = roughness^2, given sin2h = 1 - NoH^2 too; `gamma` is read by GTR only.
+    pub fn eval(self, noh: f64, sin2h: f64, a: f64, gamma: f64) -> f64 {
         match self {
-            D::Ggx => d_ggx(noh, a),
-            D::Beckmann => d_beckmann(noh, a),
-            D::Blinn => d_blinn(noh, a),
-            D::Gtr => d_gtr(noh, a, gamma),
-            D::Charlie => d_charlie(noh, a),
+            D::Ggx => d_ggx(noh, sin2h, a),
+            D::Beckmann => d_beckmann(noh, sin2h, a),
+            D::Blinn => d_blinn(noh, sin2h, a),
+            D::Gtr => d_gtr(noh, sin2h, a, gamma),
+            D::Charlie => d_charlie(sin2h, a),
         }
+    }
+
+    /// D at cos theta_h alone (sin2h = 1 - cos^2, exact enough in f64).
+    pub fn at(self, noh: f64, a: f64, gamma: f64) -> f64 {
+        self.eval(noh, (1.0 - noh * noh).max(0.0), a, gamma)
     }
 }
 
-pub fn d_ggx(noh: f64, a: f64) -> f64 {
+/// a2 / (pi (NoH^2 (a2-1) + 1)^2), the denominator as NoH^2 a2 + sin2h.
+pub fn d_ggx(noh: f64, sin2h: f64, a: f64) -> f64 {
     let a2 = a * a;
-    let d = noh * noh * (a2 - 1.0) + 1.0;
+    let d = noh * noh * a2 + sin2h;
     a2 / (PI * d * d)
 }
 
-pub fn d_beckmann(noh: f64, a: f64) -> f64 {
+pub fn d_beckmann(noh: f64, sin2h: f64, a: f64) -> f64 {
     let a2 = a * a;
     let noh2 = noh * noh;
-    ((noh2 - 1.0) / (a2 * noh2)).exp() / (PI * a2 * noh2 * noh2)
+    (-sin2h / (a2 * noh2)).exp() / (PI * a2 * noh2 * noh2)
 }
 
 /// Blinn-Phong exponent from a [Walter et al. 2007]: m = 2/a2 - 2.
@@ -176,9 +184,11 @@ pub fn blinn_exponent(a: f64) -> f64 {
     2.0 / (a * a) - 2.0
 }
 
-pub fn d_blinn(noh: f64, a: f64) -> f64 {
+/// (m+2)/(2 pi) NoH^m with NoH^m = exp(m/2 ln(1 - sin2h)), the log floored at ln(MIN_COSINE^2) as in the GLSL.
+pub fn d_blinn(_noh: f64, sin2h: f64, a: f64) -> f64 {
     let m = blinn_exponent(a);
-    (m + 2.0) / (2.0 * PI) * noh.powf(m)
+    let log_noh2 = (-sin2h).ln_1p().max(2.0 * (MIN_COSINE as f32).ln() as f64);
+    (m + 2.0) / (2.0 * PI) * (0.5 * m * log_noh2).exp()
 }
 
 /// GTR normaliser c = (g-1)(a2-1) / (1 - a2^(1-g)); g = 1: (a2-1)/ln(a2); limit 1 at a2 = 1.
@@ -201,15 +211,14 @@ pub fn gtr_series(u: f64, g: f64) -> f64 {
 /// |a2 - 1| below which the GLSL uses `gtr_series` (re-exported for the tests of that band).
 pub const GTR_BAND: f64 = GTR_SERIES_BAND;
 
-pub fn d_gtr(noh: f64, a: f64, g: f64) -> f64 {
+pub fn d_gtr(noh: f64, sin2h: f64, a: f64, g: f64) -> f64 {
     let a2 = a * a;
-    let t = 1.0 + (a2 - 1.0) * noh * noh;
+    let t = noh * noh * a2 + sin2h;
     gtr_normaliser(a2, g) / (PI * t.powf(g))
 }
 
-pub fn d_charlie(noh: f64, a: f64) -> f64 {
+pub fn d_charlie(sin2h: f64, a: f64) -> f64 {
     let inv_a = 1.0 / a;
-    let sin2h = (1.0 - noh * noh).max(0.0);
     (2.0 + inv_a) * sin2h.powf(0.5 * inv_a) / (2.0 * PI)
 }
 
@@ -217,7 +226,7 @@ pub fn d_charlie(noh: f64, a: f64) -> f64 {
 
 impl Vis {
     pub fn eval(self, c: &Cosines, a: f64) -> f64 {
-        let Cosines { nov, nol, noh, voh } = *c;
+        let Cosines { nov, nol, noh, voh, .. } = *c;
         match self {
             Vis::Implicit => 0.25,
             Vis::Neumann => 0.25 / nol.max(nov),

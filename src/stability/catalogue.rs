@@ -1,0 +1,116 @@
+//! The named catalogue of hard cases. Each is built with N = +z, so the cosines the kernel computes are exact in
+//! fp32 and the case means exactly what its name says. Expected values: the f64 twin of the spec (which
+//! applies the same guards, so it is the limit the tool defines), 0 where no light arrives, and for invalid
+//! input (NaN, Inf) any finite non-negative value: the kernel must not pass the poison on.
+
+use crate::brdf::Sample;
+use serde::Serialize;
+use std::f64::consts::PI;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub enum Expect {
+    /// The f64 twin's value (0 where it masks the light).
+    Twin,
+    /// Invalid input: any finite value >= 0.
+    FiniteNonNegative,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct HardCase {
+    pub name: String,
+    pub sample: Sample,
+    /// GTR exponent for this case (the spec's own when None).
+    pub gamma: Option<f64>,
+    pub expect: Expect,
+}
+
+/// Unit vector at cosine `cos` to +z and azimuth `phi`, in f32.
+fn dir(cos: f64, phi: f64) -> [f32; 3] {
+    let sin = (1.0 - cos * cos).max(0.0).sqrt();
+    [(sin * phi.cos()) as f32, (sin * phi.sin()) as f32, cos as f32]
+}
+
+const N: [f32; 3] = [0.0, 0.0, 1.0];
+const F0: [f32; 3] = [0.04, 0.5, 0.95];
+
+fn sample(nov: f64, nol: f64, phi: f64, roughness: f32) -> Sample {
+    Sample { n: N, v: dir(nov, 0.0), l: dir(nol, phi), roughness, f0: F0 }
+}
+
+/// V and L mirrored about N (so H = N exactly) at cosine `cos`.
+fn mirror(cos: f64, roughness: f32) -> Sample {
+    sample(cos, cos, PI, roughness)
+}
+
+pub fn hard_cases() -> Vec<HardCase> {
+    let mut cases = Vec::new();
+    let mut add = |name: &str, sample: Sample, gamma: Option<f64>, expect: Expect| {
+        cases.push(HardCase { name: name.to_string(), sample, gamma, expect });
+    };
+    use Expect::*;
+    for (label, c) in [("0", 0.0), ("1e-7", 1e-7), ("1e-4", 1e-4), ("-1e-4 (just below)", -1e-4)] {
+        add(&format!("grazing view, NoV = {label}"), sample(c, 0.7, PI / 3.0, 0.5), None, Twin);
+        add(&format!("grazing light, NoL = {label}"), sample(0.7, c, PI / 3.0, 0.5), None, Twin);
+        add(&format!("grazing view and light, NoV = NoL = {label}"), sample(c, c, PI / 3.0, 0.5), None, Twin);
+    }
+    add("back-facing light, NoL = -0.5", sample(0.7, -0.5, PI / 3.0, 0.5), None, Twin);
+    let v = dir(0.6, 0.0);
+    add("L = -V (no half vector)", Sample { l: v.map(|x| -x), ..sample(0.6, 0.6, 0.0, 0.5) }, None, Twin);
+    add("L = V", sample(0.6, 0.6, 0.0, 0.5), None, Twin);
+    add("N = H exactly", mirror(0.6, 0.5), None, Twin);
+    add("N = H at grazing, NoV = NoL = 1e-4", mirror(1e-4, 0.5), None, Twin);
+    for (label, r) in [("0", 0.0f32), ("1e-4", 1e-4), ("1e-2", 1e-2), ("fp16 smallest normal 6.1e-5", 6.103_515_6e-5), ("1", 1.0)] {
+        add(&format!("roughness {label}, N = H"), mirror(0.6, r), None, Twin);
+        add(&format!("roughness {label}, off the peak"), sample(0.6, 0.8, PI / 2.0, r), None, Twin);
+    }
+    for (label, g) in [("1", 1.0), ("1 - 1e-6", 1.0 - 1e-6), ("1 + 1e-6", 1.0 + 1e-6), ("2", 2.0)] {
+        add(&format!("GTR gamma {label}, a2 = 1 (0/0)"), mirror(0.6, 1.0), Some(g), Twin);
+        add(&format!("GTR gamma {label}, a2 = 1, off the peak"), sample(0.3, 0.9, PI / 2.0, 1.0), Some(g), Twin);
+        add(&format!("GTR gamma {label}, a2 near 1 (r = 0.99)"), sample(0.5, 0.7, PI / 4.0, 0.99), Some(g), Twin);
+    }
+    // Blinn-Phong's exponent m = 2/a2 - 2 is largest at the roughness floor: pow(NoH, m) just off the peak.
+    add("Blinn exponent at the smallest roughness, NoH just below 1", sample(0.6, 0.6001, PI, 0.0), None, Twin);
+    // Beckmann's exp((NoH^2-1)/(a2 NoH^2)) underflows far from the peak at low roughness.
+    add("Beckmann exp underflow, low roughness far off the peak", sample(0.95, 0.2, PI / 2.0, 0.05), None, Twin);
+    add("denormal normal (0, 0, 1e-40)", Sample { n: [0.0, 0.0, 1e-40], ..mirror(0.6, 0.5) }, None, Twin);
+    add("denormal view vector", Sample { v: [1e-40, 0.0, 1e-40], ..mirror(0.6, 0.5) }, None, Twin);
+    add("zero normal", Sample { n: [0.0; 3], ..mirror(0.6, 0.5) }, None, Twin);
+    add("zero view vector", Sample { v: [0.0; 3], ..mirror(0.6, 0.5) }, None, Twin);
+    add("zero light vector", Sample { l: [0.0; 3], ..mirror(0.6, 0.5) }, None, Twin);
+    for (label, scale) in [("0.5", 0.5f32), ("2", 2.0), ("1e-30", 1e-30), ("1e30", 1e30)] {
+        let s = sample(0.6, 0.8, PI / 2.0, 0.5);
+        add(&format!("vectors of length {label}"), Sample { n: s.n.map(|x| x * scale), v: s.v.map(|x| x * scale), l: s.l.map(|x| x * scale), ..s }, None, Twin);
+    }
+    add("F0 = 0", Sample { f0: [0.0; 3], ..sample(0.6, 0.8, PI / 2.0, 0.5) }, None, Twin);
+    add("F0 = 1", Sample { f0: [1.0; 3], ..sample(0.6, 0.8, PI / 2.0, 0.5) }, None, Twin);
+    add("F0 = 1 at grazing VoH", Sample { f0: [1.0; 3], ..sample(0.1, 0.1, 0.0, 0.5) }, None, Twin);
+    add("roughness 1.5 (above 1, clamped)", sample(0.6, 0.8, PI / 2.0, 1.5), None, Twin);
+    let base = sample(0.6, 0.8, PI / 2.0, 0.5);
+    add("NaN in the normal", Sample { n: [f32::NAN, 0.0, 1.0], ..base }, None, FiniteNonNegative);
+    add("Inf in the view vector", Sample { v: [0.0, f32::INFINITY, 1.0], ..base }, None, FiniteNonNegative);
+    add("-Inf in the light vector", Sample { l: [f32::NEG_INFINITY, 0.0, 1.0], ..base }, None, FiniteNonNegative);
+    add("NaN roughness", Sample { roughness: f32::NAN, ..base }, None, FiniteNonNegative);
+    add("NaN F0", Sample { f0: [f32::NAN, 0.5, 0.5], ..base }, None, FiniteNonNegative);
+    cases
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn catalogue_names_are_unique_and_cover_the_issue() {
+        let cases = hard_cases();
+        let mut names: Vec<&str> = cases.iter().map(|c| c.name.as_str()).collect();
+        names.sort();
+        let n = names.len();
+        names.dedup();
+        assert_eq!(n, names.len());
+        for needle in ["NoV = 0", "NoV = 1e-7", "NoL = 1e-4", "just below", "back-facing", "L = -V", "L = V", "N = H exactly", "roughness 0,", "roughness 1e-4", "roughness 1e-2", "fp16 smallest normal", "GTR gamma 1 - 1e-6", "GTR gamma 2", "Blinn exponent", "Beckmann exp", "denormal", "zero normal", "length 0.5", "length 2", "F0 = 0", "F0 = 1", "NaN", "Inf"] {
+            assert!(cases.iter().any(|c| c.name.contains(needle)), "no case for {needle}");
+        }
+        let m = mirror(0.6, 0.5);
+        let h = [m.v[0] + m.l[0], m.v[1] + m.l[1], m.v[2] + m.l[2]];
+        assert!(h[0].abs() < 1e-7 && h[1].abs() < 1e-7, "mirror config has H = N");
+    }
+}

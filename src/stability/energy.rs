@@ -1,0 +1,161 @@
+//! Energy: the directional albedo E(NoV, r) of every spec with F = 1, integrated on the GPU (`kernels::albedo`,
+//! with its error bound), which specs gain energy (E > 1 beyond that bound) and how much each loses at r = 1;
+//! shown as a white furnace (spheres on white: a lossless BRDF vanishes, loss shows grey, gain shows red) and
+//! as E(NoV) curves per roughness.
+
+use super::SpecStability;
+use crate::brdf::{ModelSpec, F};
+use crate::chart;
+use crate::gpu::Gpu;
+use crate::kernels::{self, AlbedoCell};
+use anyhow::{anyhow, Result};
+use indicatif::ProgressBar;
+use plotters::prelude::*;
+use serde::Serialize;
+use std::path::Path;
+
+pub const NOV: [f32; 16] = [0.02, 0.05, 0.1, 0.15, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.85, 0.9, 0.95, 0.98, 1.0];
+pub const ROUGHNESS: [f32; 5] = [0.1, 0.25, 0.5, 0.75, 1.0];
+
+#[derive(Clone, Debug, Serialize)]
+pub struct Energy {
+    /// E[r][nov] over ROUGHNESS x NOV, with F = 1 (f32 is precise enough for integrals good to 1e-3).
+    pub e: Vec<Vec<f32>>,
+    /// The largest integration-error estimate of the cells.
+    pub error_bound: f64,
+    pub max_e: f64,
+    /// (NoV, roughness) of max_e.
+    pub max_at: (f32, f32),
+    /// max_e > 1 + error_bound.
+    pub gains_energy: bool,
+    /// Hemispherical albedo 2 * integral of E(mu) mu dmu at r = 1 (1 - this is the energy lost to single scattering).
+    pub hemispherical_at_r1: f64,
+}
+
+/// The spec with F = 1 (F = none with F0 = 1): only D and Vis (and the precision) decide energy.
+pub fn white(spec: &ModelSpec) -> ModelSpec {
+    ModelSpec { f: F::None, ..*spec }
+}
+
+pub fn cells() -> Vec<AlbedoCell> {
+    ROUGHNESS.iter().flat_map(|&roughness| NOV.iter().map(move |&nov| AlbedoCell { nov, roughness, f0: [1.0; 3] })).collect()
+}
+
+pub fn energy_of(gpu: &Gpu, spec: &ModelSpec) -> Result<Energy> {
+    let albedo = kernels::albedo(gpu, &white(spec), &cells())?;
+    let e: Vec<Vec<f32>> = albedo.chunks(NOV.len()).map(|row| row.iter().map(|a| a.e[0] as f32).collect()).collect();
+    let error_bound = albedo.iter().map(|a| a.error).fold(0.0, f64::max);
+    let (mut max_e, mut max_at) = (f64::NEG_INFINITY, (0.0, 0.0));
+    for (ri, row) in e.iter().enumerate() {
+        for (vi, &x) in row.iter().enumerate() {
+            let x = x as f64;
+            if x > max_e || x.is_nan() {
+                max_e = if x.is_nan() { f64::INFINITY } else { x };
+                max_at = (NOV[vi], ROUGHNESS[ri]);
+            }
+        }
+    }
+    let last: Vec<f64> = e.last().unwrap().iter().map(|&x| x as f64).collect();
+    // Trapezoid over NoV, with E held at its first node down to NoV = 0.
+    let mut hemi = (NOV[0] as f64).powi(2) * last[0];
+    for i in 1..NOV.len() {
+        let (m0, m1) = (NOV[i - 1] as f64, NOV[i] as f64);
+        hemi += (m1 - m0) * (last[i - 1] * m0 + last[i] * m1);
+    }
+    Ok(Energy { e, error_bound, max_e, max_at, gains_energy: max_e > 1.0 + error_bound, hemispherical_at_r1: hemi })
+}
+
+/// Computes energy once per distinct white spec and attaches it to every result.
+pub fn attach(gpu: &Gpu, specs: &[ModelSpec], results: &mut [SpecStability], progress: &ProgressBar) -> Result<()> {
+    let mut done: Vec<(ModelSpec, Energy)> = Vec::new();
+    for (i, (spec, result)) in specs.iter().zip(results.iter_mut()).enumerate() {
+        progress.set_position(i as u64);
+        progress.set_message(format!("energy: {}", spec.name()));
+        let w = white(spec);
+        let energy = match done.iter().find(|(s, _)| *s == w) {
+            Some((_, e)) => e.clone(),
+            None => {
+                let e = energy_of(gpu, spec)?;
+                done.push((w, e.clone()));
+                e
+            }
+        };
+        result.energy = Some(energy);
+    }
+    Ok(())
+}
+
+fn interpolate(e: &[f32], nov: f64) -> f64 {
+    if nov <= NOV[0] as f64 {
+        return e[0] as f64;
+    }
+    for i in 1..NOV.len() {
+        let (a, b) = (NOV[i - 1] as f64, NOV[i] as f64);
+        if nov <= b {
+            let t = (nov - a) / (b - a);
+            return e[i - 1] as f64 * (1.0 - t) + e[i] as f64 * t;
+        }
+    }
+    e[NOV.len() - 1] as f64
+}
+
+/// Colour of a furnace pixel: grey (display-encoded) for E <= 1, towards red as E exceeds 1 (full red at 1.5).
+fn furnace_colour(e: f64) -> RGBColor {
+    if !e.is_finite() {
+        return RGBColor(255, 0, 255);
+    }
+    if e <= 1.0 {
+        let g = (e.max(0.0).powf(1.0 / 2.2) * 255.0).round() as u8;
+        RGBColor(g, g, g)
+    } else {
+        let t = ((e - 1.0) / 0.5).min(1.0);
+        let g = (255.0 * (1.0 - t)).round() as u8;
+        RGBColor(255, g, g)
+    }
+}
+
+/// White furnace: one row of spheres per spec (columns: roughness), on white.
+pub fn furnace_png(path: &Path, entries: &[(String, &Energy)]) -> Result<()> {
+    let (cell, label_w, header) = (64i32, 420i32, 60i32);
+    let width = (label_w + cell * ROUGHNESS.len() as i32 + 20) as u32;
+    let height = (header + cell * entries.len() as i32 + 60) as u32;
+    chart::render(path, width, height, |root| {
+        let err = |e: &dyn std::fmt::Display| anyhow!("furnace: {e}");
+        let text = |s: &str, x: i32, y: i32, size: i32| Text::new(s.to_string(), (x, y), (chart::FONT, size).into_font());
+        root.draw(&text("White furnace: E(NoV) with F = 1 (white = lossless, grey = loss, red = gain, magenta = non-finite)", 10, 10, 16)).map_err(|e| err(&e))?;
+        for (j, r) in ROUGHNESS.iter().enumerate() {
+            root.draw(&text(&format!("r = {r}"), label_w + j as i32 * cell + 8, header - 24, 16)).map_err(|e| err(&e))?;
+        }
+        for (i, (label, energy)) in entries.iter().enumerate() {
+            let y0 = header + i as i32 * cell;
+            root.draw(&text(label, 10, y0 + cell / 2 - 8, 14)).map_err(|e| err(&e))?;
+            for (j, row) in energy.e.iter().enumerate() {
+                let x0 = label_w + j as i32 * cell;
+                let radius = (cell / 2 - 4) as f64;
+                for py in 0..cell {
+                    for px in 0..cell {
+                        let (dx, dy) = ((px as f64 + 0.5 - cell as f64 / 2.0) / radius, (py as f64 + 0.5 - cell as f64 / 2.0) / radius);
+                        let d2 = dx * dx + dy * dy;
+                        if d2 < 1.0 {
+                            root.draw_pixel((x0 + px, y0 + py), &furnace_colour(interpolate(row, (1.0 - d2).sqrt()))).map_err(|e| err(&e))?;
+                        }
+                    }
+                }
+            }
+        }
+        Ok(())
+    })
+}
+
+/// E(NoV) per roughness, one panel per roughness, one line per spec.
+pub fn albedo_chart(path: &Path, entries: &[(String, &Energy)]) -> Result<()> {
+    let panels: Vec<(String, Vec<(String, Vec<(f64, f64)>)>)> = ROUGHNESS
+        .iter()
+        .enumerate()
+        .map(|(ri, r)| {
+            let series = entries.iter().map(|(label, e)| (label.clone(), NOV.iter().zip(&e.e[ri]).map(|(&v, &x)| (v as f64, (x as f64).min(4.0))).collect())).collect();
+            (format!("r = {r}"), series)
+        })
+        .collect();
+    chart::line_panels(path, "Directional albedo E(NoV) with F = 1", "NoV", "E", &panels, (0.0, 1.3))
+}

@@ -1,0 +1,507 @@
+//! `brdfprof stability`: do the kernels stay finite, non-negative and close to their f64 limits where things
+//! break? Every spec runs the catalogue of hard cases and the dense grid on the GPU; results are checked
+//! against the f64 twin within a tolerance that respects the input's conditioning; jumps the f64 model does not
+//! have are reported as discontinuities; reciprocity and energy (directional albedo with F = 1) complete it.
+
+pub mod catalogue;
+pub mod energy;
+pub mod grid;
+
+use crate::accuracy::FLOOR;
+use crate::brdf::{samples, Metal, ModelSpec, Precision, Sample, D, F, Vis};
+use crate::gpu::Gpu;
+use crate::kernels::{self, RunLimits};
+use anyhow::Result;
+use catalogue::{Expect, HardCase};
+use indicatif::ProgressBar;
+use rand::{Rng, SeedableRng};
+use rayon::prelude::*;
+use serde::Serialize;
+
+/// Every D with every Vis (Schlick Fresnel), and every Fresnel term on the `ggx` preset, in fp32 and fp16:
+/// every spec the term library offers up to the choice of Fresnel.
+pub fn default_specs() -> Vec<ModelSpec> {
+    let mut specs = Vec::new();
+    for precision in Precision::ALL {
+        for &d in D::ALL {
+            for &vis in Vis::ALL {
+                specs.push(ModelSpec { precision, ..ModelSpec::new(d, vis, F::Schlick) });
+            }
+        }
+        let ggx = ModelSpec { precision, ..ModelSpec::preset("ggx").unwrap() };
+        for &f in F::ALL {
+            let metals: &[Metal] = if matches!(f, F::Conductor | F::F82) { Metal::ALL } else { &[Metal::Gold] };
+            for &metal in metals {
+                let s = ModelSpec { f, metal, ..ggx };
+                if !specs.contains(&s) {
+                    specs.push(s);
+                }
+            }
+        }
+    }
+    specs
+}
+
+/// Absolute rounding of a unit vector's components in the kernel's arithmetic (normalising costs about an ulp
+/// of 1 on top of the component's own half ulp): 2^-23 in fp32, 2^-11 in fp16.
+fn unit_epsilon(p: Precision) -> f64 {
+    match p {
+        Precision::F32 => 2f64.powi(-23),
+        Precision::F16 => 2f64.powi(-11),
+    }
+}
+
+/// Relative tolerance of a well-conditioned result.
+fn base_tolerance(p: Precision) -> f64 {
+    match p {
+        Precision::F32 => 1e-3,
+        Precision::F16 => 2e-2,
+    }
+}
+
+/// How far the f64 result moves when the kernel's unit vectors carry the rounding of its arithmetic: the largest
+/// change over 8 random perturbations of every unit-vector component by +-epsilon (absolute; not renormalised,
+/// as the kernel adds V + L without renormalising them) and of roughness and F0 by +-epsilon (relative). Where
+/// the half vector is ill-conditioned (V near -L, |V + L| small) or a lobe is razor-thin, this is what any
+/// implementation at that precision can promise.
+fn sensitivity(spec: &ModelSpec, s: &Sample, channel: usize, epsilon: f64, seed: u64) -> f64 {
+    use crate::brdf::guards::safe_normalize;
+    let (n, v, l) = (safe_normalize(s.n.map(f64::from)), safe_normalize(s.v.map(f64::from)), safe_normalize(s.l.map(f64::from)));
+    let (r, f0) = (f64::from(s.roughness), s.f0.map(f64::from));
+    let base = spec.eval_unit(n, v, l, r, f0)[channel];
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
+    let mut sign = || if rng.random::<bool>() { 1.0 } else { -1.0 };
+    (0..8)
+        .map(|_| {
+            let mut shift = |u: [f64; 3]| u.map(|x| x + epsilon * sign());
+            let (pn, pv, pl) = (shift(n), shift(v), shift(l));
+            let pr = r * (1.0 + epsilon * sign());
+            let pf = f0.map(|x| x * (1.0 + epsilon * sign()));
+            (spec.eval_unit(pn, pv, pl, pr, pf)[channel] - base).abs()
+        })
+        .fold(0.0, f64::max)
+}
+
+/// The tolerance for one value: the base tolerance of the precision, or four times what the rounding of the
+/// kernel's unit vectors alone moves the f64 result, whichever is larger.
+pub fn tolerance(spec: &ModelSpec, s: &Sample, channel: usize, expected: f64, seed: u64) -> f64 {
+    let base = base_tolerance(spec.precision) * expected.abs().max(FLOOR);
+    base.max(4.0 * sensitivity(spec, s, channel, unit_epsilon(spec.precision), seed))
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct CaseResult {
+    pub case: String,
+    pub expected: Option<[f64; 3]>,
+    pub got: [f32; 3],
+    /// Largest |got - expected| / tolerance over the channels (NaN/Inf count as infinite).
+    pub deviation: f64,
+    pub ok: bool,
+}
+
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct Worst {
+    /// |got - expected| in units of the tolerance.
+    pub deviation: f64,
+    pub got: f32,
+    pub expected: f64,
+    pub input: String,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct SpecStability {
+    pub spec: String,
+    pub precision: String,
+    /// On valid inputs (catalogue and grid).
+    pub nan: usize,
+    pub inf: usize,
+    pub negative: usize,
+    /// Non-finite or negative results from invalid inputs (NaN/Inf in), reported, not failing.
+    pub invalid_input_poisoned: usize,
+    /// Hard cases run, and the results of those out of tolerance (or poisoned, for invalid input).
+    pub cases_run: usize,
+    pub cases_out_of_tolerance: Vec<CaseResult>,
+    /// Largest deviation per hard case, in catalogue order (for the per-case summary).
+    #[serde(skip)]
+    pub case_deviation: Vec<f64>,
+    /// Grid points out of tolerance.
+    pub grid_out_of_tolerance: usize,
+    pub worst: Worst,
+    /// Steps in f_s NoL along NoV, NoL or roughness that the f64 model does not take, at values out of tolerance.
+    pub discontinuities: usize,
+    pub discontinuity_examples: Vec<String>,
+    /// Steps the f64 model takes too, between lit points (the formula's and its guards' own).
+    pub model_jumps: usize,
+    /// max |f(v, l) - f(l, v)| / max(|f|, 1e-3) over the reciprocity samples.
+    pub reciprocity: f64,
+    /// Bad values (NaN, Inf, negative) per (NoV, roughness) grid cell, [roughness][NoV], where any.
+    #[serde(serialize_with = "sparse_cells")]
+    pub bad_cells: Option<Vec<Vec<u32>>>,
+    pub energy: Option<energy::Energy>,
+}
+
+/// Bad cells as [roughness index, NoV index, count] triples of the non-empty cells.
+fn sparse_cells<S: serde::Serializer>(cells: &Option<Vec<Vec<u32>>>, s: S) -> Result<S::Ok, S::Error> {
+    let triples: Option<Vec<[u32; 3]>> = cells.as_ref().map(|c| {
+        c.iter().enumerate().flat_map(|(r, row)| row.iter().enumerate().filter(|(_, n)| **n > 0).map(move |(v, n)| [r as u32, v as u32, *n])).collect()
+    });
+    triples.serialize(s)
+}
+
+impl SpecStability {
+    /// NaN, Inf or a negative value on a valid input.
+    pub fn fails(&self) -> bool {
+        self.nan + self.inf + self.negative > 0
+    }
+}
+
+#[derive(Clone, Debug)]
+pub struct StabilityOptions {
+    pub specs: Vec<ModelSpec>,
+    pub energy: bool,
+}
+
+/// Checks one spec: catalogue, grid, discontinuities and reciprocity (energy is added by `run`).
+pub fn check_spec(gpu: &Gpu, spec: &ModelSpec, cases: &[HardCase], grid: &[Sample], reciprocity: &[Sample]) -> Result<SpecStability> {
+    // One kernel run per distinct gamma (GTR cases may override it).
+    let mut case_out = vec![[0f32; 3]; cases.len()];
+    let mut groups: Vec<(Option<f64>, Vec<usize>)> = Vec::new();
+    for (i, c) in cases.iter().enumerate() {
+        let g = if spec.d == D::Gtr { c.gamma } else { None };
+        match groups.iter_mut().find(|(k, _)| *k == g) {
+            Some((_, v)) => v.push(i),
+            None => groups.push((g, vec![i])),
+        }
+    }
+    for (gamma, idx) in &groups {
+        let s = ModelSpec { gamma: gamma.unwrap_or(spec.gamma), ..*spec };
+        let out = kernels::eval(gpu, &s, &idx.iter().map(|&i| cases[i].sample).collect::<Vec<_>>(), RunLimits::default())?;
+        for (k, &i) in idx.iter().enumerate() {
+            case_out[i] = out[k];
+        }
+    }
+    let mut all: Vec<Sample> = grid.to_vec();
+    all.extend_from_slice(reciprocity);
+    all.extend(reciprocity.iter().map(|s| Sample { v: s.l, l: s.v, ..*s }));
+    let out = kernels::eval(gpu, spec, &all, RunLimits::default())?;
+    let (grid_out, rest) = out.split_at(grid.len());
+    let (forward, backward) = rest.split_at(reciprocity.len());
+
+    let bad = |x: f32| !x.is_finite() || x < 0.0;
+    let (mut nan, mut inf, mut negative, mut poisoned) = (0, 0, 0, 0);
+    let mut tally = |x: f32, valid: bool| {
+        if !valid {
+            poisoned += bad(x) as usize;
+        } else if x.is_nan() {
+            nan += 1;
+        } else if x.is_infinite() {
+            inf += 1;
+        } else if x < 0.0 {
+            negative += 1;
+        }
+    };
+    let mut worst = Worst::default();
+    let mut results = Vec::with_capacity(cases.len());
+    for (i, (case, got)) in cases.iter().zip(&case_out).enumerate() {
+        let valid = case.expect == Expect::Twin;
+        got.iter().for_each(|&x| tally(x, valid));
+        let s = ModelSpec { gamma: if spec.d == D::Gtr { case.gamma.unwrap_or(spec.gamma) } else { spec.gamma }, ..*spec };
+        let (expected, deviation) = if valid {
+            let e = s.eval(&case.sample);
+            let dev = (0..3)
+                .map(|c| {
+                    let d = (got[c] as f64 - e[c]).abs() / tolerance(&s, &case.sample, c, e[c], i as u64);
+                    if d.is_nan() { f64::INFINITY } else { d }
+                })
+                .fold(0.0, f64::max);
+            (Some(e), dev)
+        } else {
+            (None, if got.iter().any(|&x| bad(x)) { f64::INFINITY } else { 0.0 })
+        };
+        if valid && deviation > worst.deviation {
+            let c = (0..3).max_by(|&a, &b| (got[a] as f64 - expected.unwrap()[a]).abs().total_cmp(&(got[b] as f64 - expected.unwrap()[b]).abs())).unwrap();
+            worst = Worst { deviation, got: got[c], expected: expected.unwrap()[c], input: format!("case `{}`: {:?}", case.name, case.sample) };
+        }
+        results.push(CaseResult { case: case.name.clone(), expected, got: *got, deviation, ok: deviation <= 1.0 });
+    }
+
+    // The grid: tolerance computed only where the base tolerance is exceeded (it can only grow).
+    let twin: Vec<[f64; 3]> = grid.par_iter().map(|s| spec.eval(s)).collect();
+    let deviations: Vec<f64> = grid
+        .par_iter()
+        .enumerate()
+        .map(|(i, s)| {
+            (0..3)
+                .map(|c| {
+                    let (g, e) = (grid_out[i][c] as f64, twin[i][c]);
+                    let diff = (g - e).abs();
+                    if diff.is_nan() {
+                        return f64::INFINITY;
+                    }
+                    let base = base_tolerance(spec.precision) * e.abs().max(FLOOR);
+                    if diff <= base { diff / base } else { diff / tolerance(spec, s, c, e, i as u64) }
+                })
+                .fold(0.0, f64::max)
+        })
+        .collect();
+    let mut bad_cells = vec![vec![0u32; grid::COSINES.len()]; grid::ROUGHNESS.len()];
+    for (i, g) in grid_out.iter().enumerate() {
+        g.iter().for_each(|&x| tally(x, true));
+        if g.iter().any(|&x| bad(x)) {
+            let r = i / (grid::AZIMUTHS * grid::COSINES.len() * grid::COSINES.len());
+            let v = (i / grid::COSINES.len()) % grid::COSINES.len();
+            bad_cells[r][v] += 1;
+        }
+    }
+    let grid_out_of_tolerance = deviations.iter().filter(|d| **d > 1.0).count();
+    if let Some((i, &d)) = deviations.iter().enumerate().max_by(|a, b| a.1.total_cmp(b.1)) {
+        if d > worst.deviation {
+            let c = (0..3).max_by(|&a, &b| (grid_out[i][a] as f64 - twin[i][a]).abs().total_cmp(&(grid_out[i][b] as f64 - twin[i][b]).abs())).unwrap();
+            worst = Worst { deviation: d, got: grid_out[i][c], expected: twin[i][c], input: format!("grid: {:?}", grid[i]) };
+        }
+    }
+
+    // Steps in f_s NoL (the radiance a renderer accumulates) along NoV, NoL and roughness, channel 0.
+    let radiance = |vals: &dyn Fn(usize) -> f64, idx: &[usize]| idx.iter().map(|&i| vals(i) * (grid[i].l[2] as f64).max(0.0)).collect::<Vec<f64>>();
+    let gpu_v = |i: usize| grid_out[i][0] as f64;
+    let twin_v = |i: usize| twin[i][0];
+    let (mut discontinuities, mut model_jumps, mut examples) = (0, 0, Vec::new());
+    // A step the f64 model does not take counts only where the values it joins are not both within tolerance:
+    // inside tolerance it is rounding in an ill-conditioned corner, not a break.
+    let mut scan = |idx: Vec<usize>, axis: &str| {
+        let (g, t) = (radiance(&gpu_v, &idx), radiance(&twin_v, &idx));
+        let model = grid::jumps(&t);
+        model_jumps += model.len();
+        for j in grid::jumps(&g).into_iter().filter(|j| !model.contains(j) && (deviations[idx[*j]] > 1.0 || deviations[idx[*j + 1]] > 1.0)) {
+            discontinuities += 1;
+            if examples.len() < 5 {
+                examples.push(format!("along {axis} between {:?} and {:?}: {} -> {}", grid[idx[j]], grid[idx[j + 1]], g[j], g[j + 1]));
+            }
+        }
+    };
+    // Lit points only (cosines > 0): at 0 the light is masked by definition, a step of the spec, not a break.
+    let n = grid::COSINES.len();
+    for r in 0..grid::ROUGHNESS.len() {
+        for az in 0..grid::AZIMUTHS {
+            for k in 1..n {
+                scan((1..n).map(|v| grid::index(r, az, v, k)).collect(), "NoV");
+                scan((1..n).map(|l| grid::index(r, az, k, l)).collect(), "NoL");
+            }
+        }
+    }
+    for az in 0..grid::AZIMUTHS {
+        for v in 1..n {
+            for l in 1..n {
+                scan((0..grid::ROUGHNESS.len()).map(|r| grid::index(r, az, v, l)).collect(), "roughness");
+            }
+        }
+    }
+
+    let reciprocity = forward
+        .iter()
+        .zip(backward)
+        .flat_map(|(a, b)| (0..3).map(move |c| (a[c] as f64 - b[c] as f64).abs() / (a[c].abs().max(b[c].abs()) as f64).max(FLOOR)))
+        .fold(0.0, f64::max);
+
+    let case_deviation = results.iter().map(|r| r.deviation).collect();
+    let cases_run = results.len();
+    let cases_out_of_tolerance = results.into_iter().filter(|r| !r.ok).collect();
+    let any_bad = bad_cells.iter().flatten().any(|&n| n > 0);
+    Ok(SpecStability {
+        spec: spec.name(),
+        precision: spec.precision.name().into(),
+        nan,
+        inf,
+        negative,
+        invalid_input_poisoned: poisoned,
+        cases_run,
+        cases_out_of_tolerance,
+        case_deviation,
+        grid_out_of_tolerance,
+        worst,
+        discontinuities,
+        discontinuity_examples: examples,
+        model_jumps,
+        reciprocity,
+        bad_cells: any_bad.then_some(bad_cells),
+        energy: None,
+    })
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct StabilityReport {
+    pub provenance: crate::report::Provenance,
+    pub specs: Vec<SpecStability>,
+    pub grid_points: usize,
+    pub cases: Vec<HardCase>,
+}
+
+impl StabilityReport {
+    pub fn failing(&self) -> Vec<&SpecStability> {
+        self.specs.iter().filter(|s| s.fails()).collect()
+    }
+}
+
+pub fn run(gpu: &Gpu, options: &StabilityOptions, progress: &ProgressBar) -> Result<StabilityReport> {
+    let cases = catalogue::hard_cases();
+    let grid = grid::samples();
+    let reciprocity = samples::well_conditioned(20_000, 4, 1e-3, 0.0..1.0);
+    let mut specs = Vec::new();
+    progress.set_length(options.specs.len() as u64);
+    for (i, spec) in options.specs.iter().enumerate() {
+        progress.set_position(i as u64);
+        progress.set_message(spec.name());
+        if spec.precision == Precision::F16 && !gpu.info.shader_float16 {
+            anyhow::bail!("{spec}: device has no shaderFloat16; leave fp16 specs out");
+        }
+        specs.push(check_spec(gpu, spec, &cases, &grid, &reciprocity)?);
+    }
+    if options.energy {
+        energy::attach(gpu, &options.specs, &mut specs, progress)?;
+    }
+    Ok(StabilityReport { provenance: crate::report::Provenance::new(&gpu.info), specs, grid_points: grid.len(), cases })
+}
+
+impl StabilityReport {
+    pub fn markdown(&self) -> String {
+        use crate::report::{sig, Table};
+        let mut out = format!(
+            "# brdfprof stability\n\n{} ({}), {} specs; {} hard cases and {} grid points each.\n\n\
+             NaN/Inf/neg: results on valid inputs (a spec with any fails, and the command exits 1). Out of tolerance: cases and \
+             grid points whose result is further from the expected value (the f64 twin, which applies the same guards) than \
+             max(base, 4 x what rounding the inputs at the kernel's precision alone moves the f64 result), base = 1e-3 (fp32) \
+             or 2e-2 (fp16) relative; worst: that distance in tolerances. Jumps: steps in f_s NoL along NoV, NoL or roughness \
+             that the f64 model does not take. Reciprocity: max |f(v,l) - f(l,v)| / max(|f|, 1e-3). E: directional albedo with \
+             F = 1 (max over NoV in [0.02, 1], r in [0.1, 1]; error bound of the integration); hemi r=1: the hemispherical albedo \
+             at r = 1, so 1 - hemi is the energy single scattering loses.\n\n",
+            self.provenance.device.name,
+            self.provenance.device.driver_info,
+            self.specs.len(),
+            self.cases.len(),
+            self.grid_points
+        );
+        let mut t = Table::new(["spec", "NaN", "Inf", "neg", "cases out of tol.", "grid out of tol.", "worst (x tol.)", "jumps", "reciprocity", "max E", "hemi r=1", "verdict"]);
+        for s in &self.specs {
+            let (max_e, hemi) = s.energy.as_ref().map_or(("-".into(), "-".into()), |e| {
+                (format!("{}{} (±{:.0e})", sig(e.max_e, 3), if e.gains_energy { " gain" } else { "" }, e.error_bound), sig(e.hemispherical_at_r1, 3))
+            });
+            t.row([
+                s.spec.clone(),
+                s.nan.to_string(),
+                s.inf.to_string(),
+                s.negative.to_string(),
+                format!("{}/{}", s.cases_out_of_tolerance.len(), s.cases_run),
+                s.grid_out_of_tolerance.to_string(),
+                format!("{:.2e}", s.worst.deviation),
+                s.discontinuities.to_string(),
+                format!("{:.1e}", s.reciprocity),
+                max_e,
+                hemi,
+                if s.fails() { "FAIL".into() } else { "ok".into() },
+            ]);
+        }
+        out += &t.markdown();
+        out += "\n## Hard cases\n\nSpecs out of tolerance per case (fp32 / fp16), with the worst one.\n\n";
+        let mut c = Table::new(["case", "expected", "fp32 out", "fp16 out", "worst spec (x tol.)"]);
+        for (i, case) in self.cases.iter().enumerate() {
+            let count = |p: &str| self.specs.iter().filter(|s| s.precision == p && s.case_deviation[i] > 1.0).count();
+            let worst = self.specs.iter().max_by(|a, b| a.case_deviation[i].total_cmp(&b.case_deviation[i])).filter(|s| s.case_deviation[i] > 1.0);
+            c.row([
+                case.name.clone(),
+                match case.expect {
+                    Expect::Twin => "f64 limit (twin)".into(),
+                    Expect::FiniteNonNegative => "finite >= 0 (invalid input)".into(),
+                },
+                count("f32").to_string(),
+                count("f16").to_string(),
+                worst.map_or("-".into(), |s| format!("{} ({:.1e})", s.spec, s.case_deviation[i])),
+            ]);
+        }
+        out += &c.markdown();
+        let failing = self.failing();
+        if !failing.is_empty() {
+            out += "\n## Failing specs: first failing inputs\n\n";
+            for s in failing {
+                out += &format!("- `{}`: {} NaN, {} Inf, {} negative; worst deviation {:.2e} x tolerance at {}\n", s.spec, s.nan, s.inf, s.negative, s.worst.deviation, s.worst.input);
+            }
+        }
+        out
+    }
+
+    /// A heat map per failing spec over (NoV, roughness): bad values per grid cell.
+    pub fn heatmaps(&self, path: &std::path::Path) -> Result<bool> {
+        use plotters::prelude::*;
+        let all = self.failing();
+        if all.is_empty() {
+            return Ok(false);
+        }
+        const PANELS: usize = 24;
+        let failing: Vec<&SpecStability> = all.iter().copied().filter(|s| s.bad_cells.is_some()).take(PANELS).collect();
+        let title = if all.len() > failing.len() {
+            format!("Failing specs (first {} of {}): NaN, Inf or negative results per (NoV, roughness) grid cell", failing.len(), all.len())
+        } else {
+            "Failing specs: NaN, Inf or negative results per (NoV, roughness) grid cell".to_string()
+        };
+        let columns = 6usize.min(failing.len());
+        let rows = failing.len().div_ceil(columns);
+        let (pw, ph) = (330u32, 260u32);
+        crate::chart::render(path, pw * columns as u32, ph * rows as u32 + 40, |root| {
+            let err = |e: &dyn std::fmt::Display| anyhow::anyhow!("heat map: {e}");
+            let root = root.titled(&title, (crate::chart::FONT, 20)).map_err(|e| err(&e))?;
+            for (area, s) in root.split_evenly((rows, columns)).iter().zip(&failing) {
+                let cells = s.bad_cells.as_ref().expect("filtered above");
+                let max = cells.iter().flatten().copied().max().unwrap_or(1).max(1) as f64;
+                let mut chart = ChartBuilder::on(area)
+                    .caption(&s.spec, (crate::chart::FONT, 12))
+                    .margin(6)
+                    .x_label_area_size(28)
+                    .y_label_area_size(36)
+                    .build_cartesian_2d(0..grid::COSINES.len(), 0..grid::ROUGHNESS.len())
+                    .map_err(|e| err(&e))?;
+                chart
+                    .configure_mesh()
+                    .disable_mesh()
+                    .x_desc("NoV index")
+                    .y_desc("roughness index")
+                    .label_style((crate::chart::FONT, 10))
+                    .draw()
+                    .map_err(|e| err(&e))?;
+                chart
+                    .draw_series(cells.iter().enumerate().flat_map(|(r, row)| {
+                        row.iter().enumerate().map(move |(v, &n)| {
+                            let t = n as f64 / max;
+                            let colour = if n == 0 { RGBColor(235, 235, 235) } else { RGBColor(255, (200.0 * (1.0 - t)) as u8, (60.0 * (1.0 - t)) as u8) };
+                            Rectangle::new([(v, r), (v + 1, r + 1)], colour.filled())
+                        })
+                    }))
+                    .map_err(|e| err(&e))?;
+            }
+            Ok(())
+        })?;
+        Ok(true)
+    }
+
+    /// (label, energy) of the specs to draw, one per D/Vis/precision: all of them when at most 24, else the
+    /// presets' (the JSON and Markdown hold every spec's figures).
+    pub fn energy_entries(&self) -> Vec<(String, &energy::Energy)> {
+        let mut seen = Vec::new();
+        let mut entries = Vec::new();
+        for s in self.specs.iter().filter(|s| s.energy.is_some()) {
+            let spec = ModelSpec::parse(&s.spec).expect("names parse back");
+            let white = energy::white(&spec);
+            if !seen.contains(&white) {
+                seen.push(white);
+                let label = format!("{}/{}{}", spec.d.name(), spec.vis.name(), if spec.precision == Precision::F16 { " f16" } else { "" });
+                entries.push((label, white, s.energy.as_ref().unwrap()));
+            }
+        }
+        if entries.len() > 24 {
+            let presets: Vec<ModelSpec> = crate::brdf::PRESETS.iter().flat_map(|p| {
+                let s = ModelSpec::preset(p.name).unwrap();
+                Precision::ALL.map(|precision| energy::white(&ModelSpec { precision, ..s }))
+            }).collect();
+            entries.retain(|(_, w, _)| presets.contains(w));
+        }
+        entries.into_iter().map(|(label, _, e)| (label, e)).collect()
+    }
+}
