@@ -11,6 +11,7 @@ use crate::kernels::{self, AlbedoCell};
 use anyhow::{anyhow, Result};
 use indicatif::ProgressBar;
 use plotters::prelude::*;
+use rayon::prelude::*;
 use serde::Serialize;
 use std::path::Path;
 
@@ -30,6 +31,10 @@ pub struct Energy {
     pub gains_energy: bool,
     /// Hemispherical albedo 2 * integral of E(mu) mu dmu at r = 1 (1 - this is the energy lost to single scattering).
     pub hemispherical_at_r1: f64,
+    /// Check against the CPU's f64 integration of the same formula at r in {0.1, 0.5, 1}: the largest
+    /// |E_gpu - E_cpu| / max(1, E_cpu) over the finite cells, and how many cells were not finite.
+    pub cpu_check: f64,
+    pub cpu_check_nonfinite: usize,
 }
 
 /// The spec with F = 1 (F = none with F0 = 1): only D and Vis (and the precision) decide energy.
@@ -62,7 +67,16 @@ pub fn energy_of(gpu: &Gpu, spec: &ModelSpec) -> Result<Energy> {
         let (m0, m1) = (NOV[i - 1] as f64, NOV[i] as f64);
         hemi += (m1 - m0) * (last[i - 1] * m0 + last[i] * m1);
     }
-    Ok(Energy { e, error_bound, max_e, max_at, gains_energy: max_e > 1.0 + error_bound, hemispherical_at_r1: hemi })
+    let checked: Vec<(usize, usize)> = (0..ROUGHNESS.len()).filter(|&r| [0.1, 0.5, 1.0].contains(&ROUGHNESS[r])).flat_map(|r| (0..NOV.len()).map(move |v| (r, v))).collect();
+    let cells = cells();
+    let white = white(spec);
+    let cpu: Vec<f64> = checked.par_iter().map(|&(r, v)| crate::accuracy::albedo_twin(&white, &cells[r * NOV.len() + v])[0]).collect();
+    let (mut cpu_check, mut cpu_check_nonfinite) = (0.0f64, 0);
+    for (&(r, v), c) in checked.iter().zip(&cpu) {
+        let g = e[r][v] as f64;
+        if g.is_finite() { cpu_check = cpu_check.max((g - c).abs() / c.max(1.0)) } else { cpu_check_nonfinite += 1 }
+    }
+    Ok(Energy { e, error_bound, max_e, max_at, gains_energy: max_e > 1.0 + error_bound, hemispherical_at_r1: hemi, cpu_check, cpu_check_nonfinite })
 }
 
 /// Computes energy once per distinct white spec and attaches it to every result.

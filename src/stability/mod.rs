@@ -373,17 +373,22 @@ impl StabilityReport {
              or 2e-2 (fp16) relative; worst: that distance in tolerances. Jumps: steps in f_s NoL along NoV, NoL or roughness \
              that the f64 model does not take. Reciprocity: max |f(v,l) - f(l,v)| / max(|f|, 1e-3). E: directional albedo with \
              F = 1 (max over NoV in [0.02, 1], r in [0.1, 1]; error bound of the integration); hemi r=1: the hemispherical albedo \
-             at r = 1, so 1 - hemi is the energy single scattering loses.\n\n",
+             at r = 1, so 1 - hemi is the energy single scattering loses; E vs CPU: max |E_gpu - E_cpu| / max(1, E_cpu) against \
+             the CPU's f64 integration of the same formula at r = 0.1, 0.5, 1.\n\n",
             self.provenance.device.name,
             self.provenance.device.driver_info,
             self.specs.len(),
             self.cases.len(),
             self.grid_points
         );
-        let mut t = Table::new(["spec", "NaN", "Inf", "neg", "cases out of tol.", "grid out of tol.", "worst (x tol.)", "jumps", "reciprocity", "max E", "hemi r=1", "verdict"]);
+        let mut t = Table::new(["spec", "NaN", "Inf", "neg", "cases out of tol.", "grid out of tol.", "worst (x tol.)", "jumps", "reciprocity", "max E", "hemi r=1", "E vs CPU", "verdict"]);
         for s in &self.specs {
-            let (max_e, hemi) = s.energy.as_ref().map_or(("-".into(), "-".into()), |e| {
-                (format!("{}{} (±{:.0e})", sig(e.max_e, 3), if e.gains_energy { " gain" } else { "" }, e.error_bound), sig(e.hemispherical_at_r1, 3))
+            let (max_e, hemi, cpu) = s.energy.as_ref().map_or(("-".into(), "-".into(), "-".into()), |e| {
+                (
+                    format!("{}{} (±{:.0e})", sig(e.max_e, 3), if e.gains_energy { " gain" } else { "" }, e.error_bound),
+                    sig(e.hemispherical_at_r1, 3),
+                    format!("{:.1e}{}", e.cpu_check, if e.cpu_check_nonfinite > 0 { format!(" ({} inf)", e.cpu_check_nonfinite) } else { String::new() }),
+                )
             });
             t.row([
                 s.spec.clone(),
@@ -397,6 +402,7 @@ impl StabilityReport {
                 format!("{:.1e}", s.reciprocity),
                 max_e,
                 hemi,
+                cpu,
                 if s.fails() { "FAIL".into() } else { "ok".into() },
             ]);
         }
