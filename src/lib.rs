@@ -5,6 +5,7 @@
 
 pub mod brdf;
 pub mod gpu;
+pub mod inspect;
 pub mod io;
 pub mod kernels;
 pub mod profile;
