@@ -6,6 +6,9 @@ use anyhow::{anyhow, Result};
 use brdfprof::brdf::{spec, ModelSpec, Metal, D, F, Vis};
 use brdfprof::gpu::{self, Gpu, GpuOptions};
 use brdfprof::profile::{self, protocol::ProtocolOptions, ProfileOptions};
+use brdfprof::inspect::callgrind::CallgrindOptions;
+use brdfprof::inspect::glsl::KernelSet;
+use brdfprof::inspect::{self, InspectOptions};
 use brdfprof::{io, kernels, report};
 use clap::{Args, Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -111,6 +114,58 @@ enum Command {
         #[command(flatten)]
         device: DeviceArgs,
     },
+    /// Instruction counts of each model's specialised shading kernel: SPIR-V by class (glslang and
+    /// spirv-opt -O), naga's analysis, driver statistics, and on lavapipe the CPU instructions executed per
+    /// BRDF evaluation (callgrind).
+    Inspect {
+        #[command(flatten)]
+        model: ModelArgs,
+        #[command(flatten)]
+        inspect: InspectArgs,
+        /// JSON report path (default: results/inspect-<device>.json).
+        #[arg(long)]
+        json: Option<PathBuf>,
+        /// Markdown report path (default: results/inspect-<device>.md).
+        #[arg(long)]
+        markdown: Option<PathBuf>,
+        #[command(flatten)]
+        device: DeviceArgs,
+    },
+    #[command(name = "__callgrind-child", hide = true)]
+    CallgrindChild { request: String },
+}
+
+#[derive(Args, Clone)]
+struct InspectArgs {
+    /// Directional lights per pixel (default 8).
+    #[arg(long)]
+    lights: Option<u32>,
+    /// Compile the kernels from this GLSL directory (a copy of glsl/, with its kernels.txt) with glslang
+    /// instead of using the embedded SPIR-V.
+    #[arg(long)]
+    glsl: Option<PathBuf>,
+    /// Skip the callgrind run.
+    #[arg(long)]
+    no_callgrind: bool,
+    /// G-buffer of the callgrind dispatch, WIDTHxHEIGHT.
+    #[arg(long, default_value = "64x64")]
+    callgrind_size: String,
+}
+
+impl InspectArgs {
+    fn kernels(&self) -> Result<KernelSet> {
+        self.glsl.as_deref().map_or_else(|| Ok(KernelSet::embedded()), KernelSet::from_glsl)
+    }
+
+    fn options(&self, specs: Vec<brdfprof::brdf::ModelSpec>, lights: u32, device: &DeviceArgs) -> Result<InspectOptions> {
+        if lights == 0 {
+            return Err(anyhow!("--lights must be at least 1"));
+        }
+        let (width, height) = parse_size(&self.callgrind_size).map_err(|e| anyhow!("--callgrind-{e:#}"))?;
+        let validate = device.validate || std::env::var("BRDFPROF_VALIDATION").is_ok_and(|v| !v.is_empty() && v != "0");
+        let callgrind = (!self.no_callgrind).then(|| CallgrindOptions { width, height, device: None, validate });
+        Ok(InspectOptions { specs, lights, callgrind })
+    }
 }
 
 fn main() -> ExitCode {
@@ -179,6 +234,26 @@ fn run(cli: Cli) -> Result<ExitCode> {
             println!("{}\n", result.summary());
             print!("{}", result.table().markdown());
             println!("\nJSON: {}", path.display());
+            Ok(ExitCode::SUCCESS)
+        }
+        Command::Inspect { model, inspect, json, markdown, device } => {
+            let options = inspect.options(model.specs(&spec::THESIS_MODELS)?, inspect.lights.unwrap_or(8), &device)?;
+            let kernels = inspect.kernels()?;
+            let gpu = device.open()?;
+            let result = inspect::run(&gpu, &kernels, &options)?;
+            gpu.check_validation()?;
+            let slug = report::device_slug(&gpu.info);
+            let json = json.unwrap_or_else(|| PathBuf::from(format!("results/inspect-{slug}.json")));
+            let markdown = markdown.unwrap_or_else(|| PathBuf::from(format!("results/inspect-{slug}.md")));
+            let text = format!("{}\n\n{}", result.summary(), result.markdown());
+            report::write_json(&json, &result)?;
+            io::write_atomic(&markdown, text.as_bytes())?;
+            print!("{text}");
+            println!("JSON: {}\nMarkdown: {}", json.display(), markdown.display());
+            Ok(ExitCode::SUCCESS)
+        }
+        Command::CallgrindChild { request } => {
+            inspect::callgrind::child_main(&request)?;
             Ok(ExitCode::SUCCESS)
         }
     }
