@@ -8,6 +8,8 @@ use brdfprof::gpu::{self, Gpu, GpuOptions};
 use brdfprof::profile::{self, protocol::ProtocolOptions, ProfileOptions};
 use brdfprof::inspect::callgrind::CallgrindOptions;
 use brdfprof::inspect::glsl::KernelSet;
+use brdfprof::inspect::check::{self, CheckOptions, Thresholds};
+use brdfprof::inspect::timing::TimingOptions;
 use brdfprof::inspect::{self, InspectOptions};
 use brdfprof::{io, kernels, report};
 use clap::{Args, Parser, Subcommand};
@@ -128,6 +130,36 @@ enum Command {
         /// Markdown report path (default: results/inspect-<device>.md).
         #[arg(long)]
         markdown: Option<PathBuf>,
+        /// A `brdfprof profile` JSON report: adds callgrind's instructions per evaluation next to its ns per
+        /// evaluation, with their rank correlation.
+        #[arg(long)]
+        profile: Option<PathBuf>,
+        #[command(flatten)]
+        device: DeviceArgs,
+    },
+    /// Measures the counts and a short timing run and compares them with a saved baseline: exit 0 no
+    /// regression, 1 regression, 2 could not measure.
+    Check {
+        /// Baseline to compare with (from `check --save-baseline`).
+        #[arg(long)]
+        baseline: Option<PathBuf>,
+        /// Write this run as a baseline (atomically), whatever the comparison found.
+        #[arg(long)]
+        save_baseline: Option<PathBuf>,
+        /// Regression threshold of a statistic or a section, e.g. spirv/total=0.02, callgrind=0.005, timing=0.1
+        /// (defaults: 0.01 for counts, 0.05 for timings).
+        #[arg(long = "threshold")]
+        thresholds: Vec<String>,
+        /// Compare timings and callgrind counts even when the baseline comes from another environment.
+        #[arg(long)]
+        force: bool,
+        /// Models (default: the baseline's, else the thesis models).
+        #[command(flatten)]
+        model: ModelArgs,
+        #[command(flatten)]
+        inspect: InspectArgs,
+        #[command(flatten)]
+        timing: TimingArgs,
         #[command(flatten)]
         device: DeviceArgs,
     },
@@ -137,7 +169,7 @@ enum Command {
 
 #[derive(Args, Clone)]
 struct InspectArgs {
-    /// Directional lights per pixel (default 8).
+    /// Directional lights per pixel (default 8; `check` defaults to the baseline's).
     #[arg(long)]
     lights: Option<u32>,
     /// Compile the kernels from this GLSL directory (a copy of glsl/, with its kernels.txt) with glslang
@@ -157,15 +189,25 @@ impl InspectArgs {
         self.glsl.as_deref().map_or_else(|| Ok(KernelSet::embedded()), KernelSet::from_glsl)
     }
 
-    fn options(&self, specs: Vec<brdfprof::brdf::ModelSpec>, lights: u32, device: &DeviceArgs) -> Result<InspectOptions> {
-        if lights == 0 {
-            return Err(anyhow!("--lights must be at least 1"));
-        }
-        let (width, height) = parse_size(&self.callgrind_size).map_err(|e| anyhow!("--callgrind-{e:#}"))?;
+    /// How to run the callgrind child (None: --no-callgrind); it inherits validation from the parent.
+    fn callgrind(&self, device: &DeviceArgs) -> Result<Option<CallgrindOptions>> {
+        let (width, height) = parse_size(&self.callgrind_size).map_err(|e| anyhow!("--callgrind-{}", e.to_string().trim_start_matches("--")))?;
         let validate = device.validate || std::env::var("BRDFPROF_VALIDATION").is_ok_and(|v| !v.is_empty() && v != "0");
-        let callgrind = (!self.no_callgrind).then(|| CallgrindOptions { width, height, device: None, validate });
-        Ok(InspectOptions { specs, lights, callgrind })
+        Ok((!self.no_callgrind).then_some(CallgrindOptions { width, height, device: None, validate }))
     }
+}
+
+#[derive(Args, Clone)]
+struct TimingArgs {
+    /// Interleaved timing rounds (at least 9 for the significance test; 0 skips timing).
+    #[arg(long, default_value_t = 15)]
+    rounds: usize,
+    /// Timed dispatches of each kernel per round.
+    #[arg(long, default_value_t = 3)]
+    reps: usize,
+    /// G-buffer of the timing run, WIDTHxHEIGHT.
+    #[arg(long, default_value = "960x540")]
+    timing_size: String,
 }
 
 fn main() -> ExitCode {
@@ -236,12 +278,19 @@ fn run(cli: Cli) -> Result<ExitCode> {
             println!("\nJSON: {}", path.display());
             Ok(ExitCode::SUCCESS)
         }
-        Command::Inspect { model, inspect, json, markdown, device } => {
-            let options = inspect.options(model.specs(&spec::THESIS_MODELS)?, inspect.lights.unwrap_or(8), &device)?;
+        Command::Inspect { model, inspect, json, markdown, profile, device } => {
+            let lights = inspect.lights.unwrap_or(8);
+            if lights == 0 {
+                return Err(anyhow!("--lights must be at least 1"));
+            }
+            let options = InspectOptions { specs: model.specs(&spec::THESIS_MODELS)?, lights, callgrind: inspect.callgrind(&device)? };
             let kernels = inspect.kernels()?;
             let gpu = device.open()?;
-            let result = inspect::run(&gpu, &kernels, &options)?;
+            let mut result = inspect::run(&gpu, &kernels, &options)?;
             gpu.check_validation()?;
+            if let Some(p) = &profile {
+                result.vs_profile = Some(inspect::correlate::correlate(&result, p)?);
+            }
             let slug = report::device_slug(&gpu.info);
             let json = json.unwrap_or_else(|| PathBuf::from(format!("results/inspect-{slug}.json")));
             let markdown = markdown.unwrap_or_else(|| PathBuf::from(format!("results/inspect-{slug}.md")));
@@ -251,6 +300,22 @@ fn run(cli: Cli) -> Result<ExitCode> {
             print!("{text}");
             println!("JSON: {}\nMarkdown: {}", json.display(), markdown.display());
             Ok(ExitCode::SUCCESS)
+        }
+        Command::Check { baseline, save_baseline, thresholds, force, model, inspect, timing, device } => {
+            let (width, height) = parse_size(&timing.timing_size).map_err(|e| anyhow!("--timing-{}", e.to_string().trim_start_matches("--")))?;
+            let options = CheckOptions {
+                baseline,
+                save: save_baseline,
+                thresholds: Thresholds::parse(&thresholds)?,
+                force,
+                specs: model.specs(&[])?,
+                lights: inspect.lights,
+                callgrind: inspect.callgrind(&device)?,
+                timing: TimingOptions { width, height, lights: 0, rounds: timing.rounds, reps: timing.reps, seed: 1 },
+            };
+            let outcome = check::run(&options, &inspect.kernels()?, || device.open())?;
+            print!("{}", outcome.text);
+            Ok(ExitCode::from(outcome.exit))
         }
         Command::CallgrindChild { request } => {
             inspect::callgrind::child_main(&request)?;

@@ -5,10 +5,13 @@
 //! a short timing run) into a regression gate against a saved baseline.
 
 pub mod callgrind;
+pub mod check;
+pub mod correlate;
 pub mod driver;
 pub mod glsl;
 pub mod naga_info;
 pub mod spirv;
+pub mod timing;
 
 use crate::brdf::ModelSpec;
 use crate::gpu::{Gpu, Kernel};
@@ -68,6 +71,9 @@ pub struct InspectReport {
     /// Notes about a whole section (e.g. "not available on this device").
     pub section_notes: BTreeMap<String, String>,
     pub callgrind: Option<CallgrindRun>,
+    /// Callgrind figures next to a profile's timings (`inspect --profile FILE`).
+    #[serde(default)]
+    pub vs_profile: Option<correlate::Correlation>,
 }
 
 /// SPIR-V and naga statistics of one kernel specialised for `spec` (None: the baseline kernel).
@@ -166,6 +172,7 @@ pub fn run(gpu: &Gpu, kernels: &KernelSet, options: &InspectOptions) -> Result<I
         rows,
         section_notes,
         callgrind,
+        vs_profile: None,
     })
 }
 
@@ -263,6 +270,9 @@ impl InspectReport {
             }
             out += &t.markdown();
             out += "\n";
+        }
+        if let Some(c) = &self.vs_profile {
+            out += &format!("### Instructions vs time per evaluation\n\n{}\n", c.markdown());
         }
         out
     }
