@@ -6,8 +6,10 @@
 //! kernel the child makes an untimed dispatch (llvmpipe JIT-compiles at the first dispatch), then turns
 //! instrumentation on, zeroes the counters, dispatches again and dumps the counters under the kernel's
 //! label, through callgrind's client requests. The JIT code has no symbol, so callgrind files it under
-//! the object `???`; its Ir (instructions executed) in each dump, divided by the evaluations of the
-//! dispatch, is the figure. Everything else in the dump (the driver's dispatch and queue code) is left out.
+//! the object `???`: the anonymous functions that lavapipe's driver calls in each dump, and those they call,
+//! are the kernel. Their exclusive Ir (instructions executed), divided by the evaluations of the dispatch,
+//! is the figure. Everything else (the driver's dispatch and queue code, the per-workgroup helpers the
+//! kernel calls back into) is left out.
 
 use super::glsl::KernelSet;
 use crate::brdf::ModelSpec;
@@ -248,7 +250,7 @@ pub fn run(specs: &[ModelSpec], lights: u32, kernels: &KernelSet, options: &Call
         .map(|(dump_label, label)| {
             let jit_ir = *dumps.get(dump_label).ok_or_else(|| anyhow!("callgrind wrote no dump `{dump_label}` ({label})"))?;
             if jit_ir == 0 {
-                bail!("callgrind's dump for {label} has no instructions in `{ANONYMOUS_OBJECT}` (no JIT code found)");
+                bail!("callgrind's dump for {label} has no JIT code (no call from {DRIVER_OBJECT} into anonymous code)");
             }
             Ok(KernelIr { label, jit_ir })
         })
@@ -256,46 +258,100 @@ pub fn run(specs: &[ModelSpec], lights: u32, kernels: &KernelSet, options: &Call
     Ok(CallgrindRun { kernels, evaluations: reply.evaluations, jit_cpu_features: reply.jit_cpu_features, valgrind })
 }
 
-/// Every client-request dump in `dir`: its label -> Ir of the anonymous (JIT) object.
+/// Every client-request dump in `dir`: its label -> Ir of the JIT code.
 fn read_dumps(dir: &Path) -> Result<BTreeMap<String, u64>> {
     let mut dumps = BTreeMap::new();
     for entry in std::fs::read_dir(dir)? {
         let path = entry?.path();
         let text = std::fs::read_to_string(&path).with_context(|| format!("cannot read {}", path.display()))?;
-        let (label, ir) = parse_dump(&text).with_context(|| format!("{}", path.display()))?;
-        if let Some(label) = label.and_then(|l| l.strip_prefix("Client Request: ").map(str::to_string)) {
-            dumps.insert(label, ir);
+        let dump = parse_dump(&text).with_context(|| format!("{}", path.display()))?;
+        if let Some(label) = dump.trigger.as_deref().and_then(|l| l.strip_prefix("Client Request: ")) {
+            dumps.insert(label.to_string(), dump.jit_ir());
         }
     }
     Ok(dumps)
 }
 
-/// One callgrind output file (uncompressed names): its trigger ("desc: Trigger: ...") and the exclusive Ir
-/// of every function in the anonymous object.
-pub fn parse_dump(text: &str) -> Result<(Option<String>, u64)> {
-    let mut trigger = None;
-    let mut object = String::new();
+/// A function in a dump: (object, function name).
+type Func = (String, String);
+
+/// One callgrind output file (written with --compress-strings=no): its trigger, the exclusive Ir of every
+/// function, and the calls between functions.
+#[derive(Debug, Default)]
+pub struct Dump {
+    pub trigger: Option<String>,
+    pub exclusive: BTreeMap<Func, u64>,
+    pub calls: Vec<(Func, Func)>,
+}
+
+/// File name of lavapipe's Vulkan driver, whose compute workers call the JIT-compiled kernel.
+const DRIVER_OBJECT: &str = "libvulkan_lvp";
+
+fn file_name(object: &str) -> &str {
+    object.rsplit('/').next().unwrap_or(object)
+}
+
+impl Dump {
+    /// Exclusive Ir of the JIT code: anonymous functions that lavapipe's driver calls, and the anonymous
+    /// functions they call. Other anonymous code (e.g. a symbol-less stub that the validation layer's
+    /// allocator goes through: one instruction per dump) is not the kernel and is left out.
+    pub fn jit_ir(&self) -> u64 {
+        let mut kernel: Vec<&Func> = self
+            .calls
+            .iter()
+            .filter(|(caller, callee)| callee.0 == ANONYMOUS_OBJECT && file_name(&caller.0).starts_with(DRIVER_OBJECT))
+            .map(|(_, callee)| callee)
+            .collect();
+        let mut i = 0;
+        while i < kernel.len() {
+            let caller = kernel[i];
+            for (_, callee) in self.calls.iter().filter(|(c, callee)| c == caller && callee.0 == ANONYMOUS_OBJECT) {
+                if !kernel.contains(&callee) {
+                    kernel.push(callee);
+                }
+            }
+            i += 1;
+        }
+        kernel.sort();
+        kernel.dedup();
+        kernel.iter().map(|f| self.exclusive.get(*f).copied().unwrap_or(0)).sum()
+    }
+}
+
+/// Parses one callgrind output file.
+pub fn parse_dump(text: &str) -> Result<Dump> {
+    let mut dump = Dump::default();
+    let (mut object, mut function) = (String::new(), String::new());
+    // The target of the next `calls=` line; the called object defaults to the caller's.
+    let (mut call_object, mut call_function): (Option<String>, Option<String>) = (None, None);
     let mut after_calls = false;
-    let mut ir = 0u64;
     for line in text.lines() {
         if let Some(t) = line.strip_prefix("desc: Trigger: ") {
-            trigger = Some(t.trim().to_string());
-        } else if let Some(ob) = line.strip_prefix("ob=") {
-            object = ob.trim().to_string();
+            dump.trigger = Some(t.trim().to_string());
+        } else if let Some(v) = line.strip_prefix("ob=") {
+            object = v.trim().to_string();
+        } else if let Some(v) = line.strip_prefix("fn=") {
+            function = v.trim().to_string();
+        } else if let Some(v) = line.strip_prefix("cob=") {
+            call_object = Some(v.trim().to_string());
+        } else if let Some(v) = line.strip_prefix("cfn=") {
+            call_function = Some(v.trim().to_string());
         } else if line.starts_with("calls=") {
-            // The next cost line is the inclusive cost of a call, already counted where the callee runs.
+            let callee = call_function.take().ok_or_else(|| anyhow!("`{line}` without a cfn= line before it"))?;
+            let callee_object = call_object.take().unwrap_or_else(|| object.clone());
+            dump.calls.push(((object.clone(), function.clone()), (callee_object, callee)));
             after_calls = true;
         } else if line.starts_with(|c: char| c.is_ascii_digit() || c == '+' || c == '-' || c == '*') {
+            // The cost line after `calls=` is the call's inclusive cost: counted where the callee runs.
             if std::mem::take(&mut after_calls) {
                 continue;
             }
-            if object == ANONYMOUS_OBJECT {
-                let cost = line.split_whitespace().nth(1).ok_or_else(|| anyhow!("cost line without a cost: `{line}`"))?;
-                ir += cost.parse::<u64>().map_err(|_| anyhow!("bad cost in `{line}`"))?;
-            }
+            let cost = line.split_whitespace().nth(1).ok_or_else(|| anyhow!("cost line without a cost: `{line}`"))?;
+            let cost: u64 = cost.parse().map_err(|_| anyhow!("bad cost in `{line}`"))?;
+            *dump.exclusive.entry((object.clone(), function.clone())).or_default() += cost;
         }
     }
-    Ok((trigger, ir))
+    Ok(dump)
 }
 
 #[cfg(test)]
@@ -309,12 +365,18 @@ mod tests {
     }
 
     #[test]
-    fn parses_exclusive_cost_of_anonymous_code() {
-        let text = "version: 1\ncreator: callgrind-3.19.0\ndesc: Trigger: Client Request: brdfprof-kernel-0\n\
-                    events: Ir\nob=/usr/lib/libvulkan_lvp.so\nfn=lp_cs_tpool_worker\n0 100\ncob=???\ncfn=0x1234\ncalls=2 0\n0 900\n\
-                    ob=???\nfn=0x1234\n0 850\n0 50\ntotals: 1000\n";
-        let (trigger, ir) = parse_dump(text).unwrap();
-        assert_eq!(trigger.as_deref(), Some("Client Request: brdfprof-kernel-0"));
-        assert_eq!(ir, 900);
+    fn counts_the_anonymous_code_the_driver_calls() {
+        let text = "version: 1\ncreator: callgrind-3.19.0\ndesc: Trigger: Client Request: brdfprof-kernel-0\nevents: Ir\n\
+                    ob=/usr/lib/x86_64-linux-gnu/libvulkan_lvp.so\nfn=0x2996f0\n0 100\ncob=???\ncfn=0x1000\ncalls=64 0\n0 9999\n\
+                    ob=???\nfn=0x1000\n0 300\ncfn=0x11b0\ncalls=512 0\n0 900\n\
+                    cob=/usr/lib/x86_64-linux-gnu/libvulkan_lvp.so\ncfn=0x250da0\ncalls=64 0\n0 5000\n\
+                    fn=0x11b0\n0 850\n0 50\n\
+                    ob=/usr/lib/x86_64-linux-gnu/libstdc++.so.6\nfn=operator delete[](void*)\n0 7\ncob=???\ncfn=0x9108\ncalls=1 0\n0 1\n\
+                    ob=???\nfn=0x9108\n0 1\ntotals: 11000\n";
+        let dump = parse_dump(text).unwrap();
+        assert_eq!(dump.trigger.as_deref(), Some("Client Request: brdfprof-kernel-0"));
+        // 0x1000 (called by the driver) and 0x11b0 (called by it); not the stub reached from libstdc++, not
+        // the driver helper the kernel calls, not inclusive call costs.
+        assert_eq!(dump.jit_ir(), 300 + 850 + 50);
     }
 }

@@ -40,6 +40,9 @@ pub const TIMING_KEY: &str = "timing/cost-ratio";
 const GATED_DRIVER_KEYS: [&str; 8] =
     ["driver/registers", "driver/scalar-registers", "driver/instructions", "driver/code-bytes", "driver/spills", "driver/fills", "driver/scratch-bytes", "driver/branches"];
 
+/// The fingerprint key only a successful callgrind run can fill in (the CPU features valgrind shows the JIT).
+const JIT_FEATURES: &str = "jit-cpu-features";
+
 /// A saved run: every count, the timing ratios and the environment they were measured in.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Baseline {
@@ -162,17 +165,13 @@ pub fn environment(inspect: &InspectReport, timing: Option<&TimingRun>) -> BTree
     out.insert("naga".into(), BTreeMap::new());
     out.insert("spirv-O".into(), [("spirv-opt".to_string(), inspect.tools.get("spirv-opt").cloned().unwrap_or_default())].into());
     out.insert("driver".into(), machine(vec![]));
-    if let Some(cg) = &inspect.callgrind {
-        out.insert(
-            "callgrind".into(),
-            machine(vec![
-                ("host-cpu", host_cpu()),
-                ("jit-cpu-features", cg.jit_cpu_features.join(" ")),
-                ("valgrind", cg.valgrind.clone()),
-                ("evaluations", cg.evaluations.to_string()),
-                ("driver-env", env.join(" ")),
-            ]),
-        );
+    if !inspect.callgrind_setup.is_empty() {
+        let mut extra = vec![("host-cpu", host_cpu()), ("driver-env", env.join(" "))];
+        extra.extend(inspect.callgrind_setup.iter().map(|(k, v)| (k.as_str(), v.clone())));
+        if let Some(cg) = &inspect.callgrind {
+            extra.push((JIT_FEATURES, cg.jit_cpu_features.join(" ")));
+        }
+        out.insert("callgrind".into(), machine(extra));
     }
     if let Some(t) = timing {
         out.insert(
@@ -385,7 +384,15 @@ fn group_status(old: &Baseline, new: &Baseline, force: bool) -> Vec<(String, Gro
             let status = match (has_group(old, g), has_group(new, g)) {
                 (false, false) => GroupStatus::Absent(absent_reason(new, g)),
                 (false, true) => GroupStatus::Absent("the baseline has none".into()),
-                (true, false) if g == "callgrind" && new_note(new, g).starts_with("could not measure") => GroupStatus::NotMeasured(new_note(new, g)),
+                (true, false) if g == "callgrind" && new_note(new, g).starts_with("could not measure") => {
+                    // A failure only counts where the figures would have been comparable.
+                    let mut known = old.environment.get(g).cloned().unwrap_or_default();
+                    known.remove(JIT_FEATURES);
+                    match differences(Some(&known), new.environment.get(g)) {
+                        Some(d) if !force => GroupStatus::NotComparable(format!("{d}; besides, {}", new_note(new, g))),
+                        _ => GroupStatus::NotMeasured(new_note(new, g)),
+                    }
+                }
                 (true, false) => GroupStatus::Absent(absent_reason(new, g)),
                 (true, true) => match differences(old.environment.get(g), new.environment.get(g)) {
                     None => GroupStatus::Compared,
@@ -686,6 +693,7 @@ mod tests {
             rows,
             section_notes: BTreeMap::new(),
             callgrind: None,
+            callgrind_setup: BTreeMap::new(),
             vs_profile: None,
         };
         let mut environment = BTreeMap::new();
@@ -787,6 +795,11 @@ mod tests {
         let cmp = compare(&old, &new, &Thresholds::default(), false);
         assert_eq!(cmp.exit_code(), 2);
         assert!(cmp.report(Path::new("b.json"), &new).contains("COULD NOT MEASURE: callgrind: could not measure: valgrind crashed"));
+        // On another machine the figures would not have been compared anyway: no failure.
+        let elsewhere = baseline(vec![row("ggx", &[])], None, "another cpu");
+        let mut new_elsewhere = elsewhere.clone();
+        new_elsewhere.inspect.section_notes = new.inspect.section_notes.clone();
+        assert_eq!(compare(&old, &new_elsewhere, &Thresholds::default(), false).exit_code(), 0);
         // Skipped on purpose: not compared, no failure.
         new.inspect.section_notes.insert("callgrind/".into(), "not measured (--no-callgrind)".into());
         assert_eq!(compare(&old, &new, &Thresholds::default(), false).exit_code(), 0);

@@ -71,6 +71,10 @@ pub struct InspectReport {
     /// Notes about a whole section (e.g. "not available on this device").
     pub section_notes: BTreeMap<String, String>,
     pub callgrind: Option<CallgrindRun>,
+    /// How callgrind was run (workload, valgrind version), recorded even when the run failed; empty when it
+    /// was not attempted.
+    #[serde(default)]
+    pub callgrind_setup: BTreeMap<String, String>,
     /// Callgrind figures next to a profile's timings (`inspect --profile FILE`).
     #[serde(default)]
     pub vs_profile: Option<correlate::Correlation>,
@@ -157,7 +161,11 @@ pub fn run(gpu: &Gpu, kernels: &KernelSet, options: &InspectOptions) -> Result<I
     if kernels.glsl_dir().is_some() {
         tools.insert("glslang".into(), glsl::glslang_version().unwrap_or_else(|| "not found".into()));
     }
-    let callgrind = measure_callgrind(gpu, kernels, options, &mut rows, &mut section_notes, &mut tools);
+    let mut callgrind_setup = BTreeMap::new();
+    let callgrind = measure_callgrind(gpu, kernels, options, &mut rows, &mut section_notes, &mut callgrind_setup);
+    if let Some(v) = callgrind_setup.get("valgrind") {
+        tools.insert("valgrind".into(), v.clone());
+    }
     for key in [("callgrind/ir-per-eval"), ("callgrind/net-ir-per-eval")] {
         if !emitted.iter().any(|k| k == key) {
             emitted.push(key.to_string());
@@ -172,6 +180,7 @@ pub fn run(gpu: &Gpu, kernels: &KernelSet, options: &InspectOptions) -> Result<I
         rows,
         section_notes,
         callgrind,
+        callgrind_setup,
         vs_profile: None,
     })
 }
@@ -195,7 +204,7 @@ fn measure_callgrind(
     options: &InspectOptions,
     rows: &mut [Row],
     notes: &mut BTreeMap<String, String>,
-    tools: &mut BTreeMap<String, String>,
+    setup: &mut BTreeMap<String, String>,
 ) -> Option<CallgrindRun> {
     let Some(cg) = &options.callgrind else {
         notes.insert("callgrind/".into(), "not measured (--no-callgrind)".into());
@@ -207,12 +216,13 @@ fn measure_callgrind(
     }
     let mut cg = cg.clone();
     cg.device = Some(gpu.info.index.to_string());
+    setup.insert("workload".into(), format!("{}x{} pixels x {} lights", cg.width, cg.height, options.lights));
+    setup.insert("valgrind".into(), callgrind::valgrind_version().unwrap_or_else(|_| "not found".into()));
     match callgrind::run(&options.specs, options.lights, kernels, &cg) {
         Ok(run) => {
             for row in rows.iter_mut() {
                 row.stats.extend(run.stats(&row.model));
             }
-            tools.insert("valgrind".into(), run.valgrind.clone());
             notes.insert(
                 "callgrind/".into(),
                 format!("{}x{} pixels x {} lights = {} evaluations per dispatch, LP_NUM_THREADS=0, MESA_SHADER_CACHE_DISABLE=true", cg.width, cg.height, options.lights, run.evaluations),
