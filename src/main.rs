@@ -294,7 +294,7 @@ fn run(cli: Cli) -> Result<ExitCode> {
             let slug = report::device_slug(&gpu.info);
             let json = json.unwrap_or_else(|| PathBuf::from(format!("results/inspect-{slug}.json")));
             let markdown = markdown.unwrap_or_else(|| PathBuf::from(format!("results/inspect-{slug}.md")));
-            let text = format!("{}\n\n{}", result.summary(), result.markdown());
+            let text = format!("# brdfprof inspect\n\n{}\n\n{}", result.summary(), result.markdown());
             report::write_json(&json, &result)?;
             io::write_atomic(&markdown, text.as_bytes())?;
             print!("{text}");

@@ -15,7 +15,9 @@ pub struct CostRow {
     pub net_ir_per_eval: Option<f64>,
     pub ns_per_eval: f64,
     pub net_ns_per_eval: Option<f64>,
-    /// The profile's net cost relative to its reference (ggx), per-round median.
+    /// Net Ir relative to the reference model's net Ir.
+    pub net_ir_vs_reference: Option<f64>,
+    /// The profile's net cost relative to its reference model, per-round median.
     pub net_vs_reference: Option<f64>,
 }
 
@@ -24,6 +26,8 @@ pub struct Correlation {
     /// The profile report read.
     pub profile: String,
     pub profile_lights: u64,
+    /// The profile's reference model (ggx), which the `vs` columns divide by.
+    pub reference: String,
     pub rows: Vec<CostRow>,
     /// Spearman's rho between net Ir and net ns per evaluation over the models.
     pub spearman_net: Option<f64>,
@@ -66,8 +70,15 @@ pub fn correlate(report: &InspectReport, path: &Path) -> Result<Correlation> {
             net_ir_per_eval: row.stats.get("callgrind/net-ir-per-eval").copied(),
             ns_per_eval: ns,
             net_ns_per_eval: number(p, &["net_ns_per_eval", "median"], &file, model)?,
+            net_ir_vs_reference: None,
             net_vs_reference: number(p, &["net_vs_reference", "median"], &file, model)?,
         });
+    }
+    let reference = profile["reference"].as_str().unwrap_or("ggx").to_string();
+    if let Some(reference_ir) = out.iter().find(|r| r.model == reference).and_then(|r| r.net_ir_per_eval) {
+        for r in &mut out {
+            r.net_ir_vs_reference = r.net_ir_per_eval.map(|n| n / reference_ir);
+        }
     }
     if out.is_empty() {
         bail!("--profile {file}: no model of this report has both a callgrind figure and a profile row");
@@ -77,6 +88,7 @@ pub fn correlate(report: &InspectReport, path: &Path) -> Result<Correlation> {
     Ok(Correlation {
         profile: file,
         profile_lights: profile["workload"]["lights"].as_u64().unwrap_or(0),
+        reference,
         spearman_net: rho(&net),
         spearman_gross: rho(&gross),
         rows: out,
@@ -86,9 +98,26 @@ pub fn correlate(report: &InspectReport, path: &Path) -> Result<Correlation> {
 impl Correlation {
     pub fn markdown(&self) -> String {
         let f = |v: Option<f64>| v.map_or("-".to_string(), |v| crate::report::sig(v, 3));
-        let mut t = crate::report::Table::new(["model", "Ir/eval", "net Ir/eval", "ns/eval", "net ns/eval", "net ns vs ggx"]);
+        let reference = &self.reference;
+        let mut t = crate::report::Table::new([
+            "model".to_string(),
+            "Ir/eval".into(),
+            "net Ir/eval".into(),
+            format!("net Ir vs {reference}"),
+            "ns/eval".into(),
+            "net ns/eval".into(),
+            format!("net ns vs {reference}"),
+        ]);
         for r in &self.rows {
-            t.row([r.model.clone(), f(Some(r.ir_per_eval)), f(r.net_ir_per_eval), f(Some(r.ns_per_eval)), f(r.net_ns_per_eval), f(r.net_vs_reference)]);
+            t.row([
+                r.model.clone(),
+                f(Some(r.ir_per_eval)),
+                f(r.net_ir_per_eval),
+                f(r.net_ir_vs_reference),
+                f(Some(r.ns_per_eval)),
+                f(r.net_ns_per_eval),
+                f(r.net_vs_reference),
+            ]);
         }
         format!(
             "Timings from {} ({} lights). Spearman's rank correlation, net of the memory-only kernel (models): {}; gross (every kernel): {}.\n\n{}",
