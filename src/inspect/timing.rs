@@ -5,8 +5,8 @@
 //!
 //! The reference is the geometric mean of the models' costs in the round (with one model, the memory-only
 //! kernel's cost). Measured on this project's shared 2-core VM, five runs each at two G-buffer sizes under
-//! varying load: the round medians of ratios to the geometric mean stayed within 2.5% of each other, ratios
-//! to the memory-only kernel moved by up to 11% (its time, dominated by per-lane loads, drifts differently
+//! varying load: the round medians of ratios to the geometric mean stayed within 2% of each other, ratios
+//! to the memory-only kernel moved by up to 14% (its time, dominated by per-lane loads, drifts differently
 //! from the models' arithmetic). The price: a change that slows every model by the same factor cancels in
 //! these ratios; the instruction counts (SPIR-V, callgrind) catch that kind of change.
 
