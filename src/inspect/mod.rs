@@ -116,34 +116,37 @@ fn ordered_columns(rows: &[Row], emitted: &[String]) -> Vec<String> {
     columns
 }
 
+/// One kernel's SPIR-V, naga and driver statistics (None: the baseline kernel).
+fn kernel_row(gpu: &Gpu, kernels: &KernelSet, spec: Option<&ModelSpec>, lights: u32) -> Result<Row> {
+    crate::kernels::check_support(gpu, &shade_model(spec))?;
+    let mut row = Row {
+        model: spec.map_or_else(|| BASELINE_LABEL.to_string(), |s| s.name()),
+        spec: spec.map(|s| s.canonical()),
+        stats: BTreeMap::new(),
+        notes: BTreeMap::new(),
+    };
+    let words = kernels.shade(shade_model(spec).precision)?.words();
+    static_stats(&words, spec, lights, &mut row)?;
+    driver_stats(gpu, kernels, spec, lights, &mut row)?;
+    Ok(row)
+}
+
 /// Runs every analysis for every spec and the baseline kernel.
 pub fn run(gpu: &Gpu, kernels: &KernelSet, options: &InspectOptions) -> Result<InspectReport> {
     let mut all: Vec<Option<&ModelSpec>> = options.specs.iter().map(Some).collect();
     all.push(None);
-    let mut rows = Vec::new();
+    let mut rows = all.into_iter().map(|spec| kernel_row(gpu, kernels, spec, options.lights)).collect::<Result<Vec<_>>>()?;
+    // Column order: the SPIR-V counts in their own order (total, functions, classes, instructions by name),
+    // then the other keys (a row's map is sorted by key).
     let mut emitted: Vec<String> = Vec::new();
-    for spec in all {
-        crate::kernels::check_support(gpu, &shade_model(spec))?;
-        let mut row = Row {
-            model: spec.map_or_else(|| BASELINE_LABEL.to_string(), |s| s.name()),
-            spec: spec.map(|s| s.canonical()),
-            stats: BTreeMap::new(),
-            notes: BTreeMap::new(),
-        };
-        let words = kernels.shade(shade_model(spec).precision)?.words();
-        let mut order = Vec::new();
-        static_stats(&words, spec, options.lights, &mut row)?;
-        driver_stats(gpu, kernels, spec, options.lights, &mut row)?;
-        order.extend(row.stats.keys().cloned());
-        // Keys in the order the analyses produce them (BTreeMap sorts; the counts' own order reads better).
-        for key in spirv_key_order(&row).into_iter().chain(order) {
+    for row in &rows {
+        for key in spirv_key_order(row).into_iter().chain(row.stats.keys().cloned()) {
             if !emitted.contains(&key) {
                 emitted.push(key);
             }
         }
-        rows.push(row);
     }
-    // Every SPIR-V count is a count: a column one kernel lacks is 0 there.
+    // A class or an extended instruction that a kernel lacks counts 0 there.
     for key in emitted.iter().filter(|k| k.starts_with("spirv")) {
         for row in &mut rows {
             row.stats.entry(key.clone()).or_insert(0.0);
@@ -166,7 +169,7 @@ pub fn run(gpu: &Gpu, kernels: &KernelSet, options: &InspectOptions) -> Result<I
     if let Some(v) = callgrind_setup.get("valgrind") {
         tools.insert("valgrind".into(), v.clone());
     }
-    for key in [("callgrind/ir-per-eval"), ("callgrind/net-ir-per-eval")] {
+    for key in ["callgrind/ir-per-eval", "callgrind/net-ir-per-eval"] {
         if !emitted.iter().any(|k| k == key) {
             emitted.push(key.to_string());
         }
