@@ -3,7 +3,7 @@
 CARGO ?= cargo
 BIN := target/release/brdfprof
 
-.PHONY: setup build run test spv
+.PHONY: setup build run test spv baseline
 
 setup:
 	@sh scripts/setup.sh
@@ -21,3 +21,9 @@ test: setup
 # Recompile glsl/ into spv/ (needs glslang); commit the result.
 spv:
 	sh glsl/build-spv.sh
+
+# Re-measure the committed `check` baseline after a deliberate change to the kernels (or to spv/ after a
+# merge): prints the comparison with the old baseline, then replaces it; commit the result.
+BASELINE := results/baseline-llvmpipe.json
+baseline: build
+	$(BIN) check --baseline $(BASELINE) --save-baseline $(BASELINE); test $$? -le 1

@@ -6,6 +6,11 @@ use anyhow::{anyhow, Result};
 use brdfprof::brdf::{spec, ModelSpec, Metal, D, F, Vis};
 use brdfprof::gpu::{self, Gpu, GpuOptions};
 use brdfprof::profile::{self, protocol::ProtocolOptions, ProfileOptions};
+use brdfprof::inspect::callgrind::CallgrindOptions;
+use brdfprof::inspect::glsl::KernelSet;
+use brdfprof::inspect::check::{self, CheckOptions, Thresholds};
+use brdfprof::inspect::timing::TimingOptions;
+use brdfprof::inspect::{self, InspectOptions};
 use brdfprof::{io, kernels, report, stability, sweep};
 use clap::{Args, Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -189,6 +194,98 @@ enum Command {
         #[command(flatten)]
         device: DeviceArgs,
     },
+    /// Instruction counts of each model's specialised shading kernel: SPIR-V by class (glslang and
+    /// spirv-opt -O), naga's analysis, driver statistics, and on lavapipe the CPU instructions executed per
+    /// BRDF evaluation (callgrind).
+    Inspect {
+        #[command(flatten)]
+        model: ModelArgs,
+        #[command(flatten)]
+        inspect: InspectArgs,
+        /// JSON report path (default: results/inspect-<device>.json).
+        #[arg(long)]
+        json: Option<PathBuf>,
+        /// Markdown report path (default: results/inspect-<device>.md).
+        #[arg(long)]
+        markdown: Option<PathBuf>,
+        /// A `brdfprof profile` JSON report: adds callgrind's instructions per evaluation next to its ns per
+        /// evaluation, with their rank correlation.
+        #[arg(long)]
+        profile: Option<PathBuf>,
+        #[command(flatten)]
+        device: DeviceArgs,
+    },
+    /// Measures the counts and a short timing run and compares them with a saved baseline: exit 0 no
+    /// regression, 1 regression, 2 could not measure.
+    Check {
+        /// Baseline to compare with (from `check --save-baseline`).
+        #[arg(long)]
+        baseline: Option<PathBuf>,
+        /// Write this run as a baseline (atomically), whatever the comparison found.
+        #[arg(long)]
+        save_baseline: Option<PathBuf>,
+        /// Regression threshold of a statistic or a section, e.g. spirv/total=0.02, callgrind=0.005, timing=0.1
+        /// (defaults: 0.01 for counts, 0.05 for timings).
+        #[arg(long = "threshold")]
+        thresholds: Vec<String>,
+        /// Compare timings and callgrind counts even when the baseline comes from another environment.
+        #[arg(long)]
+        force: bool,
+        /// Models (default: the baseline's, else the thesis models).
+        #[command(flatten)]
+        model: ModelArgs,
+        #[command(flatten)]
+        inspect: InspectArgs,
+        #[command(flatten)]
+        timing: CheckTimingArgs,
+        #[command(flatten)]
+        device: DeviceArgs,
+    },
+    #[command(name = "__callgrind-child", hide = true)]
+    CallgrindChild { request: String },
+}
+
+#[derive(Args, Clone)]
+struct InspectArgs {
+    /// Directional lights per pixel (default 8; `check` defaults to the baseline's).
+    #[arg(long)]
+    lights: Option<u32>,
+    /// Compile the kernels from this GLSL directory (a copy of glsl/, with its kernels.txt) with glslang
+    /// instead of using the embedded SPIR-V.
+    #[arg(long)]
+    glsl: Option<PathBuf>,
+    /// Skip the callgrind run.
+    #[arg(long)]
+    no_callgrind: bool,
+    /// G-buffer of the callgrind dispatch, WIDTHxHEIGHT.
+    #[arg(long, default_value = "64x64")]
+    callgrind_size: String,
+}
+
+impl InspectArgs {
+    fn kernels(&self) -> Result<KernelSet> {
+        self.glsl.as_deref().map_or_else(|| Ok(KernelSet::embedded()), KernelSet::from_glsl)
+    }
+
+    /// How to run the callgrind child (None: --no-callgrind); it inherits validation from the parent.
+    fn callgrind(&self, device: &DeviceArgs) -> Result<Option<CallgrindOptions>> {
+        let (width, height) = parse_size(&self.callgrind_size).map_err(|e| anyhow!("--callgrind-{}", e.to_string().trim_start_matches("--")))?;
+        let validate = device.validate || std::env::var("BRDFPROF_VALIDATION").is_ok_and(|v| !v.is_empty() && v != "0");
+        Ok((!self.no_callgrind).then_some(CallgrindOptions { width, height, device: None, validate }))
+    }
+}
+
+#[derive(Args, Clone)]
+struct CheckTimingArgs {
+    /// Interleaved timing rounds (at least 9 for the significance test; 0 skips timing).
+    #[arg(long, default_value_t = 15)]
+    rounds: usize,
+    /// Timed dispatches of each kernel per round.
+    #[arg(long, default_value_t = 3)]
+    reps: usize,
+    /// G-buffer of the timing run, WIDTHxHEIGHT.
+    #[arg(long, default_value = "960x540")]
+    timing_size: String,
 }
 
 fn main() -> ExitCode {
@@ -288,6 +385,49 @@ fn run(cli: Cli) -> Result<ExitCode> {
                 eprintln!("brdfprof: {} spec(s) give NaN, Inf or negative values on valid inputs", failing.len());
                 Ok(ExitCode::from(1))
             }
+        }
+        Command::Inspect { model, inspect, json, markdown, profile, device } => {
+            let lights = inspect.lights.unwrap_or(8);
+            if lights == 0 {
+                return Err(anyhow!("--lights must be at least 1"));
+            }
+            let options = InspectOptions { specs: model.specs(&spec::THESIS_MODELS)?, lights, callgrind: inspect.callgrind(&device)? };
+            let kernels = inspect.kernels()?;
+            let gpu = device.open()?;
+            let mut result = inspect::run(&gpu, &kernels, &options)?;
+            gpu.check_validation()?;
+            if let Some(p) = &profile {
+                result.vs_profile = Some(inspect::correlate::correlate(&result, p)?);
+            }
+            let slug = report::device_slug(&gpu.info);
+            let json = json.unwrap_or_else(|| PathBuf::from(format!("results/inspect-{slug}.json")));
+            let markdown = markdown.unwrap_or_else(|| PathBuf::from(format!("results/inspect-{slug}.md")));
+            let text = format!("# brdfprof inspect\n\n{}\n\n{}", result.summary(), result.markdown());
+            report::write_json(&json, &result)?;
+            io::write_atomic(&markdown, text.as_bytes())?;
+            print!("{text}");
+            println!("JSON: {}\nMarkdown: {}", json.display(), markdown.display());
+            Ok(ExitCode::SUCCESS)
+        }
+        Command::Check { baseline, save_baseline, thresholds, force, model, inspect, timing, device } => {
+            let (width, height) = parse_size(&timing.timing_size).map_err(|e| anyhow!("--timing-{}", e.to_string().trim_start_matches("--")))?;
+            let options = CheckOptions {
+                baseline,
+                save: save_baseline,
+                thresholds: Thresholds::parse(&thresholds)?,
+                force,
+                specs: model.specs(&[])?,
+                lights: inspect.lights,
+                callgrind: inspect.callgrind(&device)?,
+                timing: TimingOptions { width, height, lights: 0, rounds: timing.rounds, reps: timing.reps, seed: 1 },
+            };
+            let outcome = check::run(&options, &inspect.kernels()?, || device.open())?;
+            print!("{}", outcome.text);
+            Ok(ExitCode::from(outcome.exit))
+        }
+        Command::CallgrindChild { request } => {
+            inspect::callgrind::child_main(&request)?;
+            Ok(ExitCode::SUCCESS)
         }
     }
 }

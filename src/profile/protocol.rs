@@ -9,6 +9,7 @@ use super::gbuffer::{GBuffer, LIGHT_FLOATS, PIXEL_FLOATS};
 use crate::brdf::ModelSpec;
 use crate::gpu::{Buffer, ChunkPlan, Gpu, Kernel, MemoryKind, SpecConstants, Timestamps};
 use crate::kernels;
+use crate::shaders::KernelSource;
 use anyhow::Result;
 use ash::vk;
 use rand::seq::SliceRandom;
@@ -77,17 +78,32 @@ pub struct Variant<'g> {
 const NUM_LIGHTS_ID: u32 = 5;
 const BASELINE_ID: u32 = 6;
 
+/// The model the shading kernel is specialised for: `spec`, or ggx's term selectors for the memory-only
+/// baseline (which runs none of them).
+pub fn shade_model(spec: Option<&ModelSpec>) -> ModelSpec {
+    spec.copied().unwrap_or_else(|| ModelSpec::preset("ggx").unwrap())
+}
+
+/// Every specialisation constant of glsl/shade.comp for `spec` (None: the memory-only baseline) and `lights`.
+pub fn shade_constants(spec: Option<&ModelSpec>, lights: u32) -> SpecConstants {
+    kernels::model_constants(&shade_model(spec)).int(NUM_LIGHTS_ID, lights as i32).int(BASELINE_ID, spec.is_none() as i32)
+}
+
 impl<'g> Variant<'g> {
     /// The shading kernel for `spec`, or the memory-only baseline when `spec` is None.
     pub fn new(gpu: &'g Gpu, work: &Workload<'g>, spec: Option<&ModelSpec>) -> Result<Self> {
-        let model = spec.copied().unwrap_or_else(|| ModelSpec::preset("ggx").unwrap());
+        let source = kernels::source_for("shade", shade_model(spec).precision);
+        Self::with_source(gpu, work, spec, source)
+    }
+
+    /// As `new`, with the shading kernel's SPIR-V from `source` (e.g. compiled at run time from another
+    /// GLSL directory) instead of the embedded one.
+    pub fn with_source(gpu: &'g Gpu, work: &Workload<'g>, spec: Option<&ModelSpec>, source: &KernelSource) -> Result<Self> {
         if let Some(s) = spec {
             kernels::check_support(gpu, s)?;
         }
-        let constants: SpecConstants = kernels::model_constants(&model)
-            .int(NUM_LIGHTS_ID, work.light_count as i32)
-            .int(BASELINE_ID, spec.is_none() as i32);
-        let kernel = Kernel::new(gpu, kernels::source_for("shade", model.precision), &constants, 3, 0)?;
+        let constants = shade_constants(spec, work.light_count);
+        let kernel = Kernel::new(gpu, source, &constants, 3, 0)?;
         let stride_in = (PIXEL_FLOATS * 4) as u64;
         let lights_bytes = work.lights.size;
         let sets = work

@@ -1,0 +1,131 @@
+//! Do the counts explain the timings? Joins inspect's callgrind figures (instructions per evaluation) with
+//! a `brdfprof profile` JSON report (ns per evaluation) model by model, and gives Spearman's rank correlation
+//! between them, gross and net of the memory-only kernel.
+
+use super::InspectReport;
+use crate::stats;
+use anyhow::{anyhow, bail, Context, Result};
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct CostRow {
+    pub model: String,
+    pub ir_per_eval: f64,
+    pub net_ir_per_eval: Option<f64>,
+    pub ns_per_eval: f64,
+    pub net_ns_per_eval: Option<f64>,
+    /// Net Ir relative to the reference model's net Ir.
+    pub net_ir_vs_reference: Option<f64>,
+    /// The profile's net cost relative to its reference model, per-round median.
+    pub net_vs_reference: Option<f64>,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct Correlation {
+    /// The profile report read.
+    pub profile: String,
+    pub profile_lights: u64,
+    /// The profile's reference model (ggx), which the `vs` columns divide by.
+    pub reference: String,
+    pub rows: Vec<CostRow>,
+    /// Spearman's rho between net Ir and net ns per evaluation over the models.
+    pub spearman_net: Option<f64>,
+    /// Spearman's rho between gross Ir and gross ns per evaluation over every kernel, baseline included.
+    pub spearman_gross: Option<f64>,
+}
+
+/// A number at `path` in a profile row, or a clear error.
+fn number(row: &serde_json::Value, path: &[&str], file: &str, model: &str) -> Result<Option<f64>> {
+    let mut v = row;
+    for key in path {
+        v = &v[*key];
+    }
+    match v {
+        serde_json::Value::Null => Ok(None),
+        v => v.as_f64().map(Some).ok_or_else(|| anyhow!("{file}: row `{model}`: {} is not a number", path.join("."))),
+    }
+}
+
+/// Spearman's rho, where there are at least three pairs to rank.
+fn rho(pairs: &[(f64, f64)]) -> Option<f64> {
+    (pairs.len() >= 3).then(|| stats::spearman(&pairs.iter().map(|p| p.0).collect::<Vec<_>>(), &pairs.iter().map(|p| p.1).collect::<Vec<_>>()))
+}
+
+/// Joins `report`'s callgrind figures with the profile report at `path`.
+pub fn correlate(report: &InspectReport, path: &Path) -> Result<Correlation> {
+    let file = path.display().to_string();
+    let text = std::fs::read_to_string(path).with_context(|| format!("--profile {file}: cannot read it"))?;
+    let profile: serde_json::Value = serde_json::from_str(&text).map_err(|e| anyhow!("--profile {file}: not valid JSON ({e})"))?;
+    let rows = profile["rows"].as_array().ok_or_else(|| anyhow!("--profile {file}: no `rows` array (is it a `brdfprof profile` report?)"))?;
+    let mut out = Vec::new();
+    for row in &report.rows {
+        let Some(ir) = row.stats.get("callgrind/ir-per-eval") else { continue };
+        let model = row.model.as_str();
+        let Some(p) = rows.iter().find(|r| r["model"].as_str() == Some(model)) else { continue };
+        let ns = number(p, &["ns_per_eval", "median"], &file, model)?.ok_or_else(|| anyhow!("--profile {file}: row `{model}` has no ns_per_eval"))?;
+        out.push(CostRow {
+            model: row.model.clone(),
+            ir_per_eval: *ir,
+            net_ir_per_eval: row.stats.get("callgrind/net-ir-per-eval").copied(),
+            ns_per_eval: ns,
+            net_ns_per_eval: number(p, &["net_ns_per_eval", "median"], &file, model)?,
+            net_ir_vs_reference: None,
+            net_vs_reference: number(p, &["net_vs_reference", "median"], &file, model)?,
+        });
+    }
+    let reference = profile["reference"].as_str().unwrap_or("ggx").to_string();
+    if let Some(reference_ir) = out.iter().find(|r| r.model == reference).and_then(|r| r.net_ir_per_eval) {
+        for r in &mut out {
+            r.net_ir_vs_reference = r.net_ir_per_eval.map(|n| n / reference_ir);
+        }
+    }
+    if out.is_empty() {
+        bail!("--profile {file}: no model of this report has both a callgrind figure and a profile row");
+    }
+    let net: Vec<(f64, f64)> = out.iter().filter_map(|r| Some((r.net_ir_per_eval?, r.net_ns_per_eval?))).collect();
+    let gross: Vec<(f64, f64)> = out.iter().map(|r| (r.ir_per_eval, r.ns_per_eval)).collect();
+    Ok(Correlation {
+        profile: file,
+        profile_lights: profile["workload"]["lights"].as_u64().unwrap_or(0),
+        reference,
+        spearman_net: rho(&net),
+        spearman_gross: rho(&gross),
+        rows: out,
+    })
+}
+
+impl Correlation {
+    pub fn markdown(&self) -> String {
+        let f = |v: Option<f64>| v.map_or("-".to_string(), |v| crate::report::sig(v, 3));
+        let reference = &self.reference;
+        let mut t = crate::report::Table::new([
+            "model".to_string(),
+            "Ir/eval".into(),
+            "net Ir/eval".into(),
+            format!("net Ir vs {reference}"),
+            "ns/eval".into(),
+            "net ns/eval".into(),
+            format!("net ns vs {reference}"),
+        ]);
+        for r in &self.rows {
+            t.row([
+                r.model.clone(),
+                f(Some(r.ir_per_eval)),
+                f(r.net_ir_per_eval),
+                f(r.net_ir_vs_reference),
+                f(Some(r.ns_per_eval)),
+                f(r.net_ns_per_eval),
+                f(r.net_vs_reference),
+            ]);
+        }
+        format!(
+            "Timings from {} ({} lights). Spearman's rank correlation, net of the memory-only kernel (models): {}; gross (every kernel): {}.\n\n{}",
+            self.profile,
+            self.profile_lights,
+            f(self.spearman_net),
+            f(self.spearman_gross),
+            t.markdown()
+        )
+    }
+}

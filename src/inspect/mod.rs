@@ -1,0 +1,298 @@
+//! `brdfprof inspect`: what each model's specialised shading kernel is made of and what it executes.
+//! Per model spec: SPIR-V instruction counts by class (glslang's output specialised, and after
+//! `spirv-opt -O`), naga's analysis, the driver's own statistics where it reports them, and on lavapipe the
+//! CPU instructions its JIT code executes per BRDF evaluation (callgrind). `check` turns these counts (and
+//! a short timing run) into a regression gate against a saved baseline.
+
+pub mod callgrind;
+pub mod check;
+pub mod correlate;
+pub mod driver;
+pub mod glsl;
+pub mod naga_info;
+pub mod spirv;
+pub mod timing;
+
+use crate::brdf::ModelSpec;
+use crate::gpu::{Gpu, Kernel};
+use crate::profile::protocol::{shade_constants, shade_model};
+use crate::report::{self, Provenance, Table};
+use anyhow::Result;
+use callgrind::{CallgrindOptions, CallgrindRun};
+use glsl::KernelSet;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+
+/// The row of the memory-only baseline kernel (shade.comp with BASELINE = 1).
+pub const BASELINE_LABEL: &str = "baseline";
+
+/// Statistic sections, in report order: key prefix and title.
+pub const SECTIONS: [(&str, &str); 5] = [
+    ("spirv/", "SPIR-V instructions, glslang's output specialised (frozen spec constants, dead code removed)"),
+    ("spirv-O/", "SPIR-V instructions after spirv-opt -O (the [[unroll]] light loop unrolled: about NUM_LIGHTS copies of the BRDF)"),
+    ("naga/", "naga (SPIR-V front end and validator) on the specialised module"),
+    ("driver/", "Driver statistics (VK_KHR_pipeline_executable_properties)"),
+    ("callgrind/", "Executed CPU instructions (Ir) per BRDF evaluation of lavapipe's JIT code, under callgrind"),
+];
+
+#[derive(Clone, Debug)]
+pub struct InspectOptions {
+    pub specs: Vec<ModelSpec>,
+    pub lights: u32,
+    /// None: no callgrind run.
+    pub callgrind: Option<CallgrindOptions>,
+}
+
+/// One kernel's statistics.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct Row {
+    /// The spec's name, or "baseline" for the memory-only kernel.
+    pub model: String,
+    /// Canonical spec (None for the baseline kernel).
+    pub spec: Option<String>,
+    /// Statistic key (`section/name`) -> value.
+    pub stats: BTreeMap<String, f64>,
+    /// Section -> text that is not a number (naga's verdict, why a section is missing).
+    pub notes: BTreeMap<String, String>,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct InspectReport {
+    /// Where it was measured (report::Provenance, kept as JSON so that baselines read back whatever it holds).
+    pub provenance: serde_json::Value,
+    /// Where the SPIR-V came from.
+    pub kernels: String,
+    pub lights: u32,
+    /// Tool versions (spirv-opt, glslang, valgrind).
+    pub tools: BTreeMap<String, String>,
+    /// Statistic keys in report order.
+    pub columns: Vec<String>,
+    pub rows: Vec<Row>,
+    /// Notes about a whole section (e.g. "not available on this device").
+    pub section_notes: BTreeMap<String, String>,
+    pub callgrind: Option<CallgrindRun>,
+    /// How callgrind was run (workload, valgrind version), recorded even when the run failed; empty when it
+    /// was not attempted.
+    #[serde(default)]
+    pub callgrind_setup: BTreeMap<String, String>,
+    /// Callgrind figures next to a profile's timings (`inspect --profile FILE`).
+    #[serde(default)]
+    pub vs_profile: Option<correlate::Correlation>,
+}
+
+/// SPIR-V and naga statistics of one kernel specialised for `spec` (None: the baseline kernel).
+fn static_stats(words: &[u32], spec: Option<&ModelSpec>, lights: u32, row: &mut Row) -> Result<()> {
+    let frozen = spirv::specialise(words, &shade_constants(spec, lights))?;
+    row.stats.extend(spirv::count(&frozen)?.stats("spirv"));
+    row.stats.extend(spirv::count(&spirv::optimise(&frozen)?)?.stats("spirv-O"));
+    let naga = naga_info::analyse(&frozen);
+    row.stats.extend(naga.stats());
+    row.notes.insert("naga".into(), naga.verdict());
+    Ok(())
+}
+
+/// Driver statistics of the kernel's pipeline, where the device reports them.
+fn driver_stats(gpu: &Gpu, kernels: &KernelSet, spec: Option<&ModelSpec>, lights: u32, row: &mut Row) -> Result<()> {
+    if gpu.executable_properties.is_none() {
+        return Ok(());
+    }
+    let kernel = Kernel::new(gpu, kernels.shade(shade_model(spec).precision)?, &shade_constants(spec, lights), 3, 0)?;
+    if let Some(stats) = driver::statistics(gpu, kernel.pipeline)? {
+        row.stats.extend(driver::stats(&stats));
+    }
+    Ok(())
+}
+
+/// Statistic keys in report order: sections in order, and within one, keys in the order rows first gave them.
+fn ordered_columns(rows: &[Row], emitted: &[String]) -> Vec<String> {
+    let mut columns = Vec::new();
+    for (prefix, _) in SECTIONS {
+        for key in emitted.iter().filter(|k| k.starts_with(prefix)) {
+            if !columns.contains(key) && rows.iter().any(|r| r.stats.contains_key(key)) {
+                columns.push(key.clone());
+            }
+        }
+    }
+    columns
+}
+
+/// One kernel's SPIR-V, naga and driver statistics (None: the baseline kernel).
+fn kernel_row(gpu: &Gpu, kernels: &KernelSet, spec: Option<&ModelSpec>, lights: u32) -> Result<Row> {
+    crate::kernels::check_support(gpu, &shade_model(spec))?;
+    let mut row = Row {
+        model: spec.map_or_else(|| BASELINE_LABEL.to_string(), |s| s.name()),
+        spec: spec.map(|s| s.canonical()),
+        stats: BTreeMap::new(),
+        notes: BTreeMap::new(),
+    };
+    let words = kernels.shade(shade_model(spec).precision)?.words();
+    static_stats(&words, spec, lights, &mut row)?;
+    driver_stats(gpu, kernels, spec, lights, &mut row)?;
+    Ok(row)
+}
+
+/// Runs every analysis for every spec and the baseline kernel.
+pub fn run(gpu: &Gpu, kernels: &KernelSet, options: &InspectOptions) -> Result<InspectReport> {
+    let mut all: Vec<Option<&ModelSpec>> = options.specs.iter().map(Some).collect();
+    all.push(None);
+    let mut rows = all.into_iter().map(|spec| kernel_row(gpu, kernels, spec, options.lights)).collect::<Result<Vec<_>>>()?;
+    // Column order: the SPIR-V counts in their own order (total, functions, classes, instructions by name),
+    // then the other keys (a row's map is sorted by key).
+    let mut emitted: Vec<String> = Vec::new();
+    for row in &rows {
+        for key in spirv_key_order(row).into_iter().chain(row.stats.keys().cloned()) {
+            if !emitted.contains(&key) {
+                emitted.push(key);
+            }
+        }
+    }
+    // A class or an extended instruction that a kernel lacks counts 0 there.
+    for key in emitted.iter().filter(|k| k.starts_with("spirv")) {
+        for row in &mut rows {
+            row.stats.entry(key.clone()).or_insert(0.0);
+        }
+    }
+    let mut section_notes = BTreeMap::new();
+    if gpu.executable_properties.is_none() {
+        section_notes.insert(
+            "driver/".into(),
+            format!("not available on this device ({} has no VK_KHR_pipeline_executable_properties)", gpu.info.name),
+        );
+    }
+    let mut tools = BTreeMap::new();
+    tools.insert("spirv-opt".into(), spirv::spirv_opt_version().unwrap_or_else(|| "not found".into()));
+    if kernels.glsl_dir().is_some() {
+        tools.insert("glslang".into(), glsl::glslang_version().unwrap_or_else(|| "not found".into()));
+    }
+    let mut callgrind_setup = BTreeMap::new();
+    let callgrind = measure_callgrind(gpu, kernels, options, &mut rows, &mut section_notes, &mut callgrind_setup);
+    if let Some(v) = callgrind_setup.get("valgrind") {
+        tools.insert("valgrind".into(), v.clone());
+    }
+    for key in ["callgrind/ir-per-eval", "callgrind/net-ir-per-eval"] {
+        if !emitted.iter().any(|k| k == key) {
+            emitted.push(key.to_string());
+        }
+    }
+    Ok(InspectReport {
+        provenance: serde_json::to_value(Provenance::new(&gpu.info))?,
+        kernels: kernels.describe(),
+        lights: options.lights,
+        tools,
+        columns: ordered_columns(&rows, &emitted),
+        rows,
+        section_notes,
+        callgrind,
+        callgrind_setup,
+        vs_profile: None,
+    })
+}
+
+/// The SPIR-V keys of a row in the order `Counts::stats` gives them.
+fn spirv_key_order(row: &Row) -> Vec<String> {
+    let mut keys = Vec::new();
+    for prefix in ["spirv", "spirv-O"] {
+        keys.push(format!("{prefix}/total"));
+        keys.push(format!("{prefix}/functions"));
+        keys.extend(spirv::CLASSES.iter().map(|c| format!("{prefix}/{c}")));
+        keys.extend(row.stats.keys().filter(|k| k.starts_with(&format!("{prefix}/glsl."))).cloned());
+    }
+    keys
+}
+
+/// The callgrind figures, on lavapipe only; a failure is reported in the section notes, not fatal.
+fn measure_callgrind(
+    gpu: &Gpu,
+    kernels: &KernelSet,
+    options: &InspectOptions,
+    rows: &mut [Row],
+    notes: &mut BTreeMap<String, String>,
+    setup: &mut BTreeMap<String, String>,
+) -> Option<CallgrindRun> {
+    let Some(cg) = &options.callgrind else {
+        notes.insert("callgrind/".into(), "not measured (--no-callgrind)".into());
+        return None;
+    };
+    if !is_lavapipe(&gpu.info) {
+        notes.insert("callgrind/".into(), format!("not applicable: {} is not lavapipe (llvmpipe)", gpu.info.name));
+        return None;
+    }
+    let mut cg = cg.clone();
+    cg.device = Some(gpu.info.index.to_string());
+    setup.insert("workload".into(), format!("{}x{} pixels x {} lights", cg.width, cg.height, options.lights));
+    setup.insert("valgrind".into(), callgrind::valgrind_version().unwrap_or_else(|_| "not found".into()));
+    match callgrind::run(&options.specs, options.lights, kernels, &cg) {
+        Ok(run) => {
+            for row in rows.iter_mut() {
+                row.stats.extend(run.stats(&row.model));
+            }
+            notes.insert(
+                "callgrind/".into(),
+                format!("{}x{} pixels x {} lights = {} evaluations per dispatch, LP_NUM_THREADS=0, MESA_SHADER_CACHE_DISABLE=true", cg.width, cg.height, options.lights, run.evaluations),
+            );
+            Some(run)
+        }
+        Err(e) => {
+            notes.insert("callgrind/".into(), format!("could not measure: {e:#}"));
+            None
+        }
+    }
+}
+
+/// lavapipe reports itself as "llvmpipe (LLVM ...)", a CPU device.
+pub fn is_lavapipe(info: &crate::gpu::DeviceInfo) -> bool {
+    info.is_cpu() && info.name.starts_with("llvmpipe")
+}
+
+/// Formats a statistic: whole numbers as integers, others with 4 significant digits.
+pub fn format_value(v: f64) -> String {
+    if v.fract() == 0.0 && v.abs() < 1e15 { format!("{}", v as i64) } else { report::sig(v, 4) }
+}
+
+impl InspectReport {
+    pub fn row(&self, model: &str) -> Option<&Row> {
+        self.rows.iter().find(|r| r.model == model)
+    }
+
+    /// One table per section (one row per kernel, one column per statistic), with the section's notes.
+    pub fn markdown(&self) -> String {
+        let mut out = String::new();
+        for (prefix, title) in SECTIONS {
+            let columns: Vec<&String> = self.columns.iter().filter(|c| c.starts_with(prefix)).collect();
+            out += &format!("### {title}\n\n");
+            if let Some(note) = self.section_notes.get(prefix) {
+                out += &format!("{note}\n\n");
+            }
+            let with_notes = prefix == "naga/";
+            if columns.is_empty() && !with_notes {
+                continue;
+            }
+            let mut headers = vec!["model".to_string()];
+            headers.extend(columns.iter().map(|c| c[prefix.len()..].to_string()));
+            if with_notes {
+                headers.push("result".into());
+            }
+            let mut t = Table::new(headers);
+            for row in &self.rows {
+                let mut cells = vec![row.model.clone()];
+                cells.extend(columns.iter().map(|c| row.stats.get(*c).map_or("-".into(), |v| format_value(*v))));
+                if with_notes {
+                    cells.push(row.notes.get("naga").cloned().unwrap_or_default());
+                }
+                t.row(cells);
+            }
+            out += &t.markdown();
+            out += "\n";
+        }
+        if let Some(c) = &self.vs_profile {
+            out += &format!("### Instructions vs time per evaluation\n\n{}\n", c.markdown());
+        }
+        out
+    }
+
+    /// One line saying what was inspected.
+    pub fn summary(&self) -> String {
+        let device = self.provenance["device"]["name"].as_str().unwrap_or("?");
+        format!("{device}; shade kernel, {} lights; SPIR-V {}; tools: {}", self.lights, self.kernels, self.tools.iter().map(|(k, v)| format!("{k} = {v}")).collect::<Vec<_>>().join(", "))
+    }
+}
