@@ -38,12 +38,17 @@ fn group_compared(stdout: &str, group: &str) -> bool {
     stdout.lines().any(|l| l.starts_with(&format!("| {group} ")) && l.contains("| compared"))
 }
 
+/// Timing threshold of the CI self-gate: CI shares machines, so there timing gates only a large, significant
+/// slowdown (15%); the deterministic counts (1%) are what catch a kernel that grew. `brdfprof check` run by
+/// hand keeps its 5% default.
+const CI_TIMING_THRESHOLD: &str = "timing=0.15";
+
 #[test]
 fn this_build_passes_the_committed_baseline() {
     let _serial = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
     let dir = tempfile::tempdir().unwrap();
     let saved = dir.path().join("saved.json");
-    let out = check(&["--baseline", baseline().to_str().unwrap(), "--save-baseline", saved.to_str().unwrap()], None);
+    let out = check(&["--baseline", baseline().to_str().unwrap(), "--save-baseline", saved.to_str().unwrap(), "--threshold", CI_TIMING_THRESHOLD], None);
     let (stdout, stderr) = text(&out);
     eprintln!("{stdout}");
     assert_eq!(out.status.code(), Some(0), "the build regressed against results/baseline-llvmpipe.json (after a deliberate change: `make baseline`):\n{stdout}\n{stderr}");
