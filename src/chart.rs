@@ -57,16 +57,27 @@ pub struct Point {
 }
 
 /// Scatter of labelled points on a log y axis, with a polyline (the Pareto frontier) drawn through `line`.
+/// Points whose y is not finite (a spec that overflowed) are pinned to the top edge and labelled so.
 pub fn scatter_log_y(path: &Path, title: &str, x_desc: &str, y_desc: &str, points: &[Point], line: &[(f64, f64)], legend: &[(usize, String)]) -> Result<()> {
     let (w, h) = (2400u32, 1600u32);
     let y_floor = 1e-8;
-    let xs = points.iter().map(|p| p.x);
-    let ys = points.iter().map(|p| p.y.max(y_floor));
+    let finite: Vec<&Point> = points.iter().filter(|p| p.x.is_finite() && p.y.is_finite()).collect();
+    if finite.is_empty() {
+        return Err(anyhow!("chart {}: no point with finite coordinates", path.display()));
+    }
+    let xs = points.iter().map(|p| p.x).filter(|x| x.is_finite());
+    let ys = finite.iter().map(|p| p.y.max(y_floor));
     let (x0, x1) = (xs.clone().fold(f64::INFINITY, f64::min), xs.fold(f64::NEG_INFINITY, f64::max));
     let (y0, y1) = (ys.clone().fold(f64::INFINITY, f64::min), ys.fold(f64::NEG_INFINITY, f64::max));
     let pad = (x1 - x0).max(1e-3) * 0.06;
     let (x0, x1) = (x0 - pad, x1 + pad * 3.0);
     let (y0, y1) = (y0 / 3.0, y1 * 3.0);
+    let pinned: Vec<Point> = points
+        .iter()
+        .filter(|p| p.x.is_finite())
+        .map(|p| if p.y.is_finite() { Point { x: p.x, y: p.y, label: p.label.clone(), group: p.group } } else { Point { x: p.x, y: y1 / 1.5, label: format!("{} (non-finite)", p.label), group: p.group } })
+        .collect();
+    let points = &pinned[..];
     render(path, w, h, |root| {
         let err = |e: &dyn std::fmt::Display| anyhow!("chart: {e}");
         let mut chart = ChartBuilder::on(root)
@@ -172,4 +183,22 @@ pub fn line_panels(path: &Path, title: &str, x_desc: &str, y_desc: &str, panels:
         }
         Ok(())
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn scatter_with_non_finite_points_finishes() {
+        let dir = tempfile::tempdir().unwrap();
+        let points = vec![
+            Point { x: 1.0, y: 0.1, label: "a".into(), group: 0 },
+            Point { x: 2.0, y: f64::INFINITY, label: "b".into(), group: 1 },
+            Point { x: 1.5, y: f64::NAN, label: "c".into(), group: 1 },
+        ];
+        let path = dir.path().join("s.png");
+        scatter_log_y(&path, "t", "x", "y", &points, &[(1.0, 0.1)], &[(0, "g".into())]).unwrap();
+        assert!(image::open(&path).is_ok());
+    }
 }
