@@ -86,3 +86,27 @@ pub fn scene_albedo(gpu: &Gpu, spec: &ModelSpec, switches: Switches, table: Opti
     }
     Ok(results)
 }
+
+/// Floats per sample of `glsl/scene_terms.comp`'s input (13 vec4) and output (6 vec4).
+pub const TERM_IN: usize = 52;
+pub const TERM_OUT: usize = 24;
+
+/// Every scene.glsl term on its own for each sample (layouts in glsl/scene_terms.comp), with `spec` selecting
+/// the Fresnel of `specular_anisotropic` and `table` the E table of `e_lookup`; for the tests against the twins.
+pub fn scene_terms(gpu: &Gpu, spec: &ModelSpec, table: &ETable, samples: &[[f32; TERM_IN]]) -> Result<Vec<[f32; TERM_OUT]>> {
+    let constants = kernels::model_constants(spec)
+        .int(plan::E_TABLE_MU_ID, table.mu_nodes as i32)
+        .int(plan::E_TABLE_R_ID, table.r_nodes as i32);
+    let kernel = Kernel::new(gpu, crate::shaders::kernel("scene_terms_f32"), &constants, 3, 4)?;
+    let n = samples.len() as u64;
+    let per_dispatch = gpu.info.max_compute_work_group_count[0] as u64 * crate::gpu::WORKGROUP as u64;
+    assert!(n <= per_dispatch, "scene_terms: at most {per_dispatch} samples");
+    let flat: Vec<f32> = samples.iter().flatten().copied().collect();
+    let inputs = Buffer::with_data(gpu, bytemuck::cast_slice(&flat), MemoryKind::Device)?;
+    let outputs = Buffer::new(gpu, n * TERM_OUT as u64 * 4, MemoryKind::Device)?;
+    let table_buf = Buffer::with_data(gpu, bytemuck::cast_slice(&table.values), MemoryKind::Device)?;
+    let set = kernel.bind(&[(&inputs, 0, inputs.size), (&outputs, 0, outputs.size), (&table_buf, 0, table_buf.size)])?;
+    gpu.submit(|cmd| kernel.dispatch(cmd, set, &(n as u32).to_ne_bytes(), n))?;
+    let v: Vec<f32> = outputs.read_as(0, samples.len() * TERM_OUT)?;
+    Ok(v.chunks_exact(TERM_OUT).map(|c| c.try_into().unwrap()).collect())
+}
