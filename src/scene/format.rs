@@ -33,9 +33,10 @@ pub enum GBufferSource {
     Images(ImageFiles),
 }
 
-/// Built-in geometry, ray-cast on the CPU into a G-buffer; materials are named.
+/// Built-in geometry, ray-cast on the CPU into a G-buffer; materials are named. Read through `RawProcedural`
+/// (a plain struct), so that errors inside keep their full JSON path.
 #[derive(Clone, Debug, Deserialize, Serialize)]
-#[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
+#[serde(tag = "kind", rename_all = "kebab-case", try_from = "RawProcedural")]
 pub enum Procedural {
     /// Thesis Fig. 5.2: one row of spheres per material in `rows`, `columns` roughness steps r = (c + 0.5) /
     /// columns along each row (the material's own roughness is not used here), before a backdrop of `floor`.
@@ -48,6 +49,65 @@ pub enum Procedural {
 
 fn default_columns() -> u32 {
     8
+}
+
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+pub enum ProceduralKind {
+    SphereGrid,
+    Statues,
+    OldWest,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawProcedural {
+    kind: ProceduralKind,
+    size: Size,
+    rows: Option<Vec<String>>,
+    columns: Option<u32>,
+    floor: Option<String>,
+    statues: Option<Vec<String>>,
+    ground: Option<String>,
+    walls: Option<Vec<String>>,
+    roofs: Option<String>,
+}
+
+impl TryFrom<RawProcedural> for Procedural {
+    type Error = String;
+    fn try_from(r: RawProcedural) -> Result<Self, String> {
+        let kind = match r.kind {
+            ProceduralKind::SphereGrid => "sphere-grid",
+            ProceduralKind::Statues => "statues",
+            ProceduralKind::OldWest => "old-west",
+        };
+        let allowed: &[&str] = match r.kind {
+            ProceduralKind::SphereGrid => &["rows", "columns", "floor"],
+            ProceduralKind::Statues => &["statues", "floor"],
+            ProceduralKind::OldWest => &["ground", "walls", "roofs"],
+        };
+        let given = [
+            ("rows", r.rows.is_some()), ("columns", r.columns.is_some()), ("floor", r.floor.is_some()), ("statues", r.statues.is_some()),
+            ("ground", r.ground.is_some()), ("walls", r.walls.is_some()), ("roofs", r.roofs.is_some()),
+        ];
+        if let Some((extra, _)) = given.iter().find(|(k, g)| *g && !allowed.contains(k)) {
+            return Err(format!("`{extra}` is not a field of kind {kind} (its fields: size, {})", allowed.join(", ")));
+        }
+        let need = |v: Option<String>, k: &str| v.ok_or_else(|| format!("kind {kind} needs `{k}`"));
+        let needv = |v: Option<Vec<String>>, k: &str| v.ok_or_else(|| format!("kind {kind} needs `{k}`"));
+        Ok(match r.kind {
+            ProceduralKind::SphereGrid => Procedural::SphereGrid {
+                size: r.size,
+                rows: needv(r.rows, "rows")?,
+                columns: r.columns.unwrap_or_else(default_columns),
+                floor: need(r.floor, "floor")?,
+            },
+            ProceduralKind::Statues => Procedural::Statues { size: r.size, statues: needv(r.statues, "statues")?, floor: need(r.floor, "floor")? },
+            ProceduralKind::OldWest => {
+                Procedural::OldWest { size: r.size, ground: need(r.ground, "ground")?, walls: needv(r.walls, "walls")?, roofs: need(r.roofs, "roofs")? }
+            }
+        })
+    }
 }
 
 /// Width and height in pixels, 1 to 16384 each.
@@ -118,9 +178,10 @@ fn default_fov() -> f32 {
     40.0
 }
 
-/// A light. Colours are linear RGB, multiplied by `intensity`.
+/// A light. Colours are linear RGB, multiplied by `intensity`. Read through `RawLight` (a plain struct), so
+/// that errors inside keep their full JSON path.
 #[derive(Clone, Copy, Debug, Deserialize, Serialize)]
-#[serde(tag = "type", rename_all = "kebab-case", deny_unknown_fields)]
+#[serde(tag = "type", rename_all = "kebab-case", try_from = "RawLight")]
 pub enum Light {
     /// Radiance `colour * intensity` arriving along `direction` (the direction the light travels).
     Directional { direction: [f32; 3], #[serde(default = "white")] colour: [f32; 3], #[serde(default = "one")] intensity: f32 },
@@ -143,6 +204,64 @@ pub enum Light {
     /// A sphere area light: specular by Karis' representative point with its normalisation, diffuse as a point
     /// light at the centre, 1/d^2 falloff.
     Sphere { position: [f32; 3], radius: f32, #[serde(default = "white")] colour: [f32; 3], #[serde(default = "one")] intensity: f32 },
+}
+
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+pub enum LightType {
+    Directional,
+    Point,
+    Spot,
+    Sphere,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawLight {
+    r#type: LightType,
+    direction: Option<[f32; 3]>,
+    position: Option<[f32; 3]>,
+    radius: Option<f32>,
+    inner_angle_deg: Option<f32>,
+    outer_angle_deg: Option<f32>,
+    #[serde(default = "white")]
+    colour: [f32; 3],
+    #[serde(default = "one")]
+    intensity: f32,
+}
+
+impl TryFrom<RawLight> for Light {
+    type Error = String;
+    fn try_from(r: RawLight) -> Result<Self, String> {
+        let (kind, allowed): (&str, &[&str]) = match r.r#type {
+            LightType::Directional => ("directional", &["direction"]),
+            LightType::Point => ("point", &["position"]),
+            LightType::Spot => ("spot", &["position", "direction", "inner_angle_deg", "outer_angle_deg"]),
+            LightType::Sphere => ("sphere", &["position", "radius"]),
+        };
+        let given = [
+            ("direction", r.direction.is_some()), ("position", r.position.is_some()), ("radius", r.radius.is_some()),
+            ("inner_angle_deg", r.inner_angle_deg.is_some()), ("outer_angle_deg", r.outer_angle_deg.is_some()),
+        ];
+        if let Some((extra, _)) = given.iter().find(|(k, g)| *g && !allowed.contains(k)) {
+            return Err(format!("a {kind} light has no `{extra}` (its fields: {}, colour, intensity)", allowed.join(", ")));
+        }
+        let need = |v: Option<[f32; 3]>, k: &str| v.ok_or_else(|| format!("a {kind} light needs `{k}`"));
+        let (colour, intensity) = (r.colour, r.intensity);
+        Ok(match r.r#type {
+            LightType::Directional => Light::Directional { direction: need(r.direction, "direction")?, colour, intensity },
+            LightType::Point => Light::Point { position: need(r.position, "position")?, colour, intensity },
+            LightType::Spot => Light::Spot {
+                position: need(r.position, "position")?,
+                direction: need(r.direction, "direction")?,
+                inner_angle_deg: r.inner_angle_deg.unwrap_or_else(default_inner),
+                outer_angle_deg: r.outer_angle_deg.unwrap_or_else(default_outer),
+                colour,
+                intensity,
+            },
+            LightType::Sphere => Light::Sphere { position: need(r.position, "position")?, radius: r.radius.ok_or("a sphere light needs `radius`")?, colour, intensity },
+        })
+    }
 }
 
 fn white() -> [f32; 3] {
@@ -660,6 +779,15 @@ mod tests {
         let bad = GOOD.replace(r#""model": "blinn""#, r#""model": "blinn", "colour": 1"#);
         let e = parse(&bad).unwrap_err().to_string();
         assert!(e.contains("materials[1]") && e.contains("unknown field `colour`"), "{e}");
+        let bad = GOOD.replace(r#""direction": [0, -1, -1]"#, r#""direction": [0, "x", -1]"#);
+        let e = parse(&bad).unwrap_err().to_string();
+        assert!(e.contains("lights[0].direction[1]: invalid type: string \"x\", expected f32"), "{e}");
+        let bad = GOOD.replace(r#""direction": [0, -1, -1]"#, r#""direction": [0, -1, -1], "radius": 2"#);
+        let e = parse(&bad).unwrap_err().to_string();
+        assert!(e.contains("lights[0]: a directional light has no `radius`"), "{e}");
+        let bad = GOOD.replace(r#""size": [64, 32]"#, r#""size": [64, "y"]"#);
+        let e = parse(&bad).unwrap_err().to_string();
+        assert!(e.contains("gbuffer.procedural.size[1]: invalid type"), "{e}");
         let e = parse("{").unwrap_err().to_string();
         assert!(e.contains("t.json") && e.contains("EOF"), "{e}");
     }

@@ -292,3 +292,51 @@ impl ScenePlan {
             .collect()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{gbuffer, Scene};
+
+    #[test]
+    fn fp16_without_shader_float16_is_a_clear_error() {
+        let text = r#"{"gbuffer": {"procedural": {"kind": "sphere-grid", "size": [16, 8], "rows": ["a"], "floor": "a"}},
+            "lights": [], "materials": [{"name": "a", "model": "ggx,precision=f16"}]}"#;
+        let s = Scene::parse(text, "t", Default::default(), "t.json".into()).unwrap();
+        let g = gbuffer::build(&s).unwrap();
+        let p = plan(&s, &g, None);
+        let mut info = crate::gpu::DeviceInfo {
+            index: 0, name: "no-fp16 device".into(), device_type: "cpu".into(), vendor_id: 0, device_id: 0, driver_name: String::new(),
+            driver_info: String::new(), driver_version: String::new(), api_version: String::new(), timestamp_period: 1.0,
+            timestamp_valid_bits: 64, max_storage_buffer_range: 1 << 27, max_compute_work_group_count: [65535; 3],
+            max_compute_work_group_invocations: 256, min_storage_buffer_offset_alignment: 16, max_memory_allocation_size: 1 << 30,
+            shader_float16: false, shader_float64: false, pipeline_executable_properties: false,
+        };
+        let e = p.check_device(&info).unwrap_err().to_string();
+        assert!(e.contains("fp16") && e.contains("shaderFloat16") && e.contains("no-fp16 device"), "{e}");
+        info.shader_float16 = true;
+        p.check_device(&info).unwrap();
+    }
+
+    #[test]
+    fn effects_follow_the_materials_of_each_model() {
+        let text = r#"{"gbuffer": {"procedural": {"kind": "sphere-grid", "size": [64, 24], "rows": ["a", "b", "c"], "floor": "d"}},
+            "lights": [{"type": "point", "position": [0, 0, 3]}, {"type": "directional", "direction": [0, 0, -1]}],
+            "materials": [
+              {"name": "a", "model": "ggx", "effects": {"diffuse": "lambert", "energy_compensation": true}},
+              {"name": "b", "model": "ggx", "effects": {"diffuse": "lambert"}},
+              {"name": "c", "model": "blinn", "effects": {"clear_coat": {}}},
+              {"name": "d", "model": "burley"},
+              {"name": "unused", "model": "ggx", "effects": {"anisotropy": 0.5}}]}"#;
+        let s = Scene::parse(text, "t", Default::default(), "t.json".into()).unwrap();
+        let g = gbuffer::build(&s).unwrap();
+        let p = plan(&s, &g, None);
+        let names: Vec<String> = p.kernels.iter().map(|k| k.spec.name()).collect();
+        assert_eq!(names, ["ggx", "blinn", "burley"], "one kernel per model covering pixels; the unused material adds none");
+        assert_eq!(p.kernels[0].switches, Switches { anisotropy: false, energy: 2, diffuse: 1, clear_coat: false });
+        assert_eq!(p.kernels[1].switches, Switches { clear_coat: true, ..Default::default() });
+        assert_eq!(p.kernels[2].switches, Switches::default());
+        assert_eq!((p.counts.directional, p.counts.point), (1, 1));
+        assert_eq!(&p.light_data[..3], &[0.0, 0.0, -1.0], "directional lights come first");
+    }
+}
