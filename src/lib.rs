@@ -16,3 +16,4 @@ pub mod shaders;
 pub mod stability;
 pub mod stats;
 pub mod sweep;
+pub mod scene;

@@ -11,7 +11,7 @@ use brdfprof::inspect::glsl::KernelSet;
 use brdfprof::inspect::check::{self, CheckOptions, Thresholds};
 use brdfprof::inspect::timing::TimingOptions;
 use brdfprof::inspect::{self, InspectOptions};
-use brdfprof::{io, kernels, report, stability, sweep};
+use brdfprof::{io, kernels, report, scene, stability, sweep};
 use clap::{Args, Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::PathBuf;
@@ -149,9 +149,30 @@ enum Command {
         /// Stop when every ratio's 95% CI half-width is below this fraction of the ratio.
         #[arg(long, default_value_t = 0.02)]
         target_ci: f64,
-        /// JSON report path (default: results/profile-<device>.json).
+        /// JSON report path (default: results/profile-<device>.json; with --scene results/scene-<name>-<device>.json).
         #[arg(long)]
         json: Option<PathBuf>,
+        /// Profile a scene file instead (see `brdfprof scene --explain`): what is compiled in, each kernel's
+        /// ns/pixel and each effect's cost, measured by toggling it. The G-buffer size is the scene's.
+        #[arg(long)]
+        scene: Option<PathBuf>,
+        #[command(flatten)]
+        device: DeviceArgs,
+    },
+    /// Check a scene file and say what it compiles in; --explain prints the scene format with an example.
+    Scene {
+        /// Scene file to check.
+        file: Option<PathBuf>,
+        #[arg(long)]
+        explain: bool,
+    },
+    /// Render a scene: a tone-mapped sRGB PNG per model, the comparison grid, difference heat maps against ggx
+    /// and polar lobe plots, under --out (default results/scenes/<scene name>/).
+    Render {
+        #[arg(long)]
+        scene: PathBuf,
+        #[arg(long)]
+        out: Option<PathBuf>,
         #[command(flatten)]
         device: DeviceArgs,
     },
@@ -319,7 +340,47 @@ fn run(cli: Cli) -> Result<ExitCode> {
             eprintln!("brdfprof: {} rows of {} on {} -> {}", values.len(), spec, gpu.info.name, output.display());
             Ok(ExitCode::SUCCESS)
         }
-        Command::Profile { model, timing, size, reps, budget, target_ci, json, device } => {
+        Command::Profile { scene: Some(path), timing, reps, budget, target_ci, json, device, .. } => {
+            let scene = scene::Scene::load(&path)?;
+            let protocol = timing.options(Vec::new(), "1x1", reps, budget, target_ci)?.protocol;
+            let options = scene::profile::SceneProfileOptions { protocol, target_rel_ci: target_ci, max_chunk: None };
+            let gpu = device.open()?;
+            let progress = progress_bar();
+            let result = scene::profile::run(&gpu, &scene, &options, &progress);
+            progress.finish_and_clear();
+            let result = result?;
+            gpu.check_validation()?;
+            let path = json.unwrap_or_else(|| PathBuf::from(format!("results/scene-{}-{}.json", scene.name(), report::device_slug(&gpu.info))));
+            report::write_json(&path, &result)?;
+            println!("{}\n", result.summary());
+            print!("{}", result.markdown());
+            println!("\nJSON: {}", path.display());
+            Ok(ExitCode::SUCCESS)
+        }
+        Command::Scene { file, explain } => {
+            match (file, explain) {
+                (_, true) => print!("{}", scene::explain()),
+                (Some(f), false) => print!("{}", scene::check(&f)?),
+                (None, false) => return Err(anyhow!("give a scene file to check, or --explain")),
+            }
+            Ok(ExitCode::SUCCESS)
+        }
+        Command::Render { scene: path, out, device } => {
+            let scene = scene::Scene::load(&path)?;
+            let out = out.unwrap_or_else(|| PathBuf::from("results/scenes").join(scene.name()));
+            let gpu = device.open()?;
+            let progress = progress_bar();
+            let result = scene::render::render(&gpu, &scene, &out, &progress);
+            progress.finish_and_clear();
+            let result = result?;
+            gpu.check_validation()?;
+            for n in &result.notes {
+                eprintln!("brdfprof: note: {n}");
+            }
+            println!("written: {}", result.files.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", "));
+            Ok(ExitCode::SUCCESS)
+        }
+        Command::Profile { model, timing, size, reps, budget, target_ci, json, device, scene: None } => {
             let options = timing.options(model.specs(&spec::THESIS_MODELS)?, &size, reps, budget, target_ci)?;
             let gpu = device.open()?;
             let progress = progress_bar();

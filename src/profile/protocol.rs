@@ -167,9 +167,9 @@ impl RawTimes {
 
 /// Runs the protocol. After each round (from `min_rounds` on) `converged` sees the times so far; the run
 /// stops when it returns true, at `max_rounds`, or when the budget is spent.
-pub fn measure(
+pub fn measure<V: Timed>(
     gpu: &Gpu,
-    variants: &[Variant],
+    variants: &[V],
     options: &ProtocolOptions,
     mut converged: impl FnMut(&RawTimes) -> bool,
     mut on_round: impl FnMut(&RawTimes),
@@ -219,4 +219,23 @@ pub fn measure(
         }
     }
     Ok(raw)
+}
+
+/// What the protocol can time: a variant that records its dispatches into a command buffer (the profile's
+/// `Variant`; the scene kernels of `scene::run`).
+pub trait Timed {
+    /// Records the variant's dispatches (no barriers or timestamps: `measure` adds those).
+    fn record(&self, cmd: vk::CommandBuffer);
+    /// One untimed run, then wait: compiles the pipeline on drivers that compile lazily.
+    fn warm_up(&self, gpu: &Gpu) -> Result<Duration> {
+        let start = Instant::now();
+        gpu.submit(|cmd| self.record(cmd))?;
+        Ok(start.elapsed())
+    }
+}
+
+impl Timed for Variant<'_> {
+    fn record(&self, cmd: vk::CommandBuffer) {
+        Variant::record(self, cmd)
+    }
 }

@@ -1,0 +1,794 @@
+//! The scene file: JSON read with serde through `serde_path_to_error`, so that every error names the JSON path
+//! of the problem (`materials[2].roughness: invalid type: string "x", expected f32`). Values are range-checked
+//! while they are read (the same path errors), names and combinations after (errors name the path too).
+//! `brdfprof scene --explain` prints `EXPLAIN`, the format with an example.
+
+use crate::brdf::{ModelSpec, D};
+use anyhow::{anyhow, bail, Result};
+use serde::{de, Deserialize, Deserializer, Serialize};
+use std::path::{Path, PathBuf};
+
+/// A scene as read from its file.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneFile {
+    #[serde(default)]
+    pub name: Option<String>,
+    #[serde(default)]
+    pub description: Option<String>,
+    pub gbuffer: GBufferSource,
+    /// Pinhole camera; procedural scenes have a default, image G-buffers need one (view vectors come from it).
+    #[serde(default)]
+    pub camera: Option<Camera>,
+    pub lights: Vec<Light>,
+    pub materials: Vec<Material>,
+    #[serde(default)]
+    pub render: RenderSettings,
+}
+
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(rename_all = "kebab-case", deny_unknown_fields)]
+pub enum GBufferSource {
+    Procedural(Procedural),
+    Images(ImageFiles),
+}
+
+/// Built-in geometry, ray-cast on the CPU into a G-buffer; materials are named. Read through `RawProcedural`
+/// (a plain struct), so that errors inside keep their full JSON path.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(tag = "kind", rename_all = "kebab-case", try_from = "RawProcedural")]
+pub enum Procedural {
+    /// Thesis Fig. 5.2: one row of spheres per material in `rows`, `columns` roughness steps r = (c + 0.5) /
+    /// columns along each row (the material's own roughness is not used here), before a backdrop of `floor`.
+    SphereGrid { size: Size, rows: Vec<String>, #[serde(default = "default_columns")] columns: u32, floor: String },
+    /// Thesis "metal statues": statues (pedestal, body, head) of the `statues` materials in a row on a floor.
+    Statues { size: Size, statues: Vec<String>, floor: String },
+    /// Thesis "Old West": a street of rough wooden and plaster buildings with roofs, on dirt ground.
+    OldWest { size: Size, ground: String, walls: Vec<String>, roofs: String },
+}
+
+fn default_columns() -> u32 {
+    8
+}
+
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+pub enum ProceduralKind {
+    SphereGrid,
+    Statues,
+    OldWest,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawProcedural {
+    kind: ProceduralKind,
+    size: Size,
+    rows: Option<Vec<String>>,
+    columns: Option<u32>,
+    floor: Option<String>,
+    statues: Option<Vec<String>>,
+    ground: Option<String>,
+    walls: Option<Vec<String>>,
+    roofs: Option<String>,
+}
+
+impl TryFrom<RawProcedural> for Procedural {
+    type Error = String;
+    fn try_from(r: RawProcedural) -> Result<Self, String> {
+        let kind = match r.kind {
+            ProceduralKind::SphereGrid => "sphere-grid",
+            ProceduralKind::Statues => "statues",
+            ProceduralKind::OldWest => "old-west",
+        };
+        let allowed: &[&str] = match r.kind {
+            ProceduralKind::SphereGrid => &["rows", "columns", "floor"],
+            ProceduralKind::Statues => &["statues", "floor"],
+            ProceduralKind::OldWest => &["ground", "walls", "roofs"],
+        };
+        let given = [
+            ("rows", r.rows.is_some()), ("columns", r.columns.is_some()), ("floor", r.floor.is_some()), ("statues", r.statues.is_some()),
+            ("ground", r.ground.is_some()), ("walls", r.walls.is_some()), ("roofs", r.roofs.is_some()),
+        ];
+        if let Some((extra, _)) = given.iter().find(|(k, g)| *g && !allowed.contains(k)) {
+            return Err(format!("`{extra}` is not a field of kind {kind} (its fields: size, {})", allowed.join(", ")));
+        }
+        let need = |v: Option<String>, k: &str| v.ok_or_else(|| format!("kind {kind} needs `{k}`"));
+        let needv = |v: Option<Vec<String>>, k: &str| v.ok_or_else(|| format!("kind {kind} needs `{k}`"));
+        Ok(match r.kind {
+            ProceduralKind::SphereGrid => Procedural::SphereGrid {
+                size: r.size,
+                rows: needv(r.rows, "rows")?,
+                columns: r.columns.unwrap_or_else(default_columns),
+                floor: need(r.floor, "floor")?,
+            },
+            ProceduralKind::Statues => Procedural::Statues { size: r.size, statues: needv(r.statues, "statues")?, floor: need(r.floor, "floor")? },
+            ProceduralKind::OldWest => {
+                Procedural::OldWest { size: r.size, ground: need(r.ground, "ground")?, walls: needv(r.walls, "walls")?, roofs: need(r.roofs, "roofs")? }
+            }
+        })
+    }
+}
+
+/// Width and height in pixels, 1 to 16384 each.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub struct Size(pub [u32; 2]);
+
+impl<'de> Deserialize<'de> for Size {
+    fn deserialize<Dz: Deserializer<'de>>(d: Dz) -> Result<Self, Dz::Error> {
+        let s = <[u32; 2]>::deserialize(d)?;
+        if s.iter().any(|&x| x == 0 || x > 16384) {
+            return Err(de::Error::custom(format!("size {s:?}: width and height must be 1 to 16384")));
+        }
+        Ok(Size(s))
+    }
+}
+
+/// G-buffer planes as image files, paths relative to the scene file. All must have the same size.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct ImageFiles {
+    /// Normals: PNG (8 or 16 bit, RGB) encoded n = 2c - 1 with c = value / max; EXR (float RGB) as stored.
+    /// Normalised after decoding.
+    pub normal: PathBuf,
+    /// Perceptual roughness: PNG grey (or R) c = value / max; EXR R. Default: each pixel's material's.
+    #[serde(default)]
+    pub roughness: Option<PathBuf>,
+    /// Base colour: PNG sRGB-encoded (decoded with the sRGB EOTF); EXR linear RGB. Default: the material's.
+    #[serde(default)]
+    pub base_colour: Option<PathBuf>,
+    /// Metallic: PNG grey (or R) c = value / max; EXR R. Default: the material's.
+    #[serde(default)]
+    pub metallic: Option<PathBuf>,
+    /// View-space depth (distance along the camera's forward axis): EXR R, or 16-bit PNG with `depth_range`.
+    /// Exactly one of depth and position.
+    #[serde(default)]
+    pub depth: Option<PathBuf>,
+    /// [near, far]: a PNG depth c = value / max means near + c (far - near).
+    #[serde(default)]
+    pub depth_range: Option<[f32; 2]>,
+    /// World-space position: EXR RGB.
+    #[serde(default)]
+    pub position: Option<PathBuf>,
+    /// Material per pixel: 8-bit PNG grey, value = index into `materials`, 255 = background (not shaded).
+    /// Default: every pixel is materials[0].
+    #[serde(default)]
+    pub material: Option<PathBuf>,
+    /// Tangents for anisotropy, encoded as normals. Default: a tangent frame built from the normal.
+    #[serde(default)]
+    pub tangent: Option<PathBuf>,
+}
+
+#[derive(Clone, Copy, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct Camera {
+    pub position: [f32; 3],
+    pub look_at: [f32; 3],
+    #[serde(default = "default_up")]
+    pub up: [f32; 3],
+    /// Vertical field of view, degrees (1 to 170).
+    #[serde(default = "default_fov")]
+    pub fov_y_deg: f32,
+}
+
+fn default_up() -> [f32; 3] {
+    [0.0, 1.0, 0.0]
+}
+fn default_fov() -> f32 {
+    40.0
+}
+
+/// A light. Colours are linear RGB, multiplied by `intensity`. Read through `RawLight` (a plain struct), so
+/// that errors inside keep their full JSON path.
+#[derive(Clone, Copy, Debug, Deserialize, Serialize)]
+#[serde(tag = "type", rename_all = "kebab-case", try_from = "RawLight")]
+pub enum Light {
+    /// Radiance `colour * intensity` arriving along `direction` (the direction the light travels).
+    Directional { direction: [f32; 3], #[serde(default = "white")] colour: [f32; 3], #[serde(default = "one")] intensity: f32 },
+    /// Intensity `colour * intensity` at `position`, falling off as 1/d^2.
+    Point { position: [f32; 3], #[serde(default = "white")] colour: [f32; 3], #[serde(default = "one")] intensity: f32 },
+    /// A point light restricted to a cone around `direction`: full inside `inner_angle_deg`, zero outside
+    /// `outer_angle_deg` (half-angles), smooth in between.
+    Spot {
+        position: [f32; 3],
+        direction: [f32; 3],
+        #[serde(default = "default_inner")]
+        inner_angle_deg: f32,
+        #[serde(default = "default_outer")]
+        outer_angle_deg: f32,
+        #[serde(default = "white")]
+        colour: [f32; 3],
+        #[serde(default = "one")]
+        intensity: f32,
+    },
+    /// A sphere area light: specular by Karis' representative point with its normalisation, diffuse as a point
+    /// light at the centre, 1/d^2 falloff.
+    Sphere { position: [f32; 3], radius: f32, #[serde(default = "white")] colour: [f32; 3], #[serde(default = "one")] intensity: f32 },
+}
+
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+pub enum LightType {
+    Directional,
+    Point,
+    Spot,
+    Sphere,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawLight {
+    r#type: LightType,
+    direction: Option<[f32; 3]>,
+    position: Option<[f32; 3]>,
+    radius: Option<f32>,
+    inner_angle_deg: Option<f32>,
+    outer_angle_deg: Option<f32>,
+    #[serde(default = "white")]
+    colour: [f32; 3],
+    #[serde(default = "one")]
+    intensity: f32,
+}
+
+impl TryFrom<RawLight> for Light {
+    type Error = String;
+    fn try_from(r: RawLight) -> Result<Self, String> {
+        let (kind, allowed): (&str, &[&str]) = match r.r#type {
+            LightType::Directional => ("directional", &["direction"]),
+            LightType::Point => ("point", &["position"]),
+            LightType::Spot => ("spot", &["position", "direction", "inner_angle_deg", "outer_angle_deg"]),
+            LightType::Sphere => ("sphere", &["position", "radius"]),
+        };
+        let given = [
+            ("direction", r.direction.is_some()), ("position", r.position.is_some()), ("radius", r.radius.is_some()),
+            ("inner_angle_deg", r.inner_angle_deg.is_some()), ("outer_angle_deg", r.outer_angle_deg.is_some()),
+        ];
+        if let Some((extra, _)) = given.iter().find(|(k, g)| *g && !allowed.contains(k)) {
+            return Err(format!("a {kind} light has no `{extra}` (its fields: {}, colour, intensity)", allowed.join(", ")));
+        }
+        let need = |v: Option<[f32; 3]>, k: &str| v.ok_or_else(|| format!("a {kind} light needs `{k}`"));
+        let (colour, intensity) = (r.colour, r.intensity);
+        Ok(match r.r#type {
+            LightType::Directional => Light::Directional { direction: need(r.direction, "direction")?, colour, intensity },
+            LightType::Point => Light::Point { position: need(r.position, "position")?, colour, intensity },
+            LightType::Spot => Light::Spot {
+                position: need(r.position, "position")?,
+                direction: need(r.direction, "direction")?,
+                inner_angle_deg: r.inner_angle_deg.unwrap_or_else(default_inner),
+                outer_angle_deg: r.outer_angle_deg.unwrap_or_else(default_outer),
+                colour,
+                intensity,
+            },
+            LightType::Sphere => Light::Sphere { position: need(r.position, "position")?, radius: r.radius.ok_or("a sphere light needs `radius`")?, colour, intensity },
+        })
+    }
+}
+
+fn white() -> [f32; 3] {
+    [1.0; 3]
+}
+fn one() -> f32 {
+    1.0
+}
+fn default_inner() -> f32 {
+    20.0
+}
+fn default_outer() -> f32 {
+    30.0
+}
+
+impl Light {
+    pub fn type_name(&self) -> &'static str {
+        match self {
+            Light::Directional { .. } => "directional",
+            Light::Point { .. } => "point",
+            Light::Spot { .. } => "spot",
+            Light::Sphere { .. } => "sphere",
+        }
+    }
+}
+
+/// A model spec string (`ggx`, `burley,gamma=2`, `d=ggx,vis=smith-ggx-correlated,f=schlick`), parsed on read.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Model(pub ModelSpec);
+
+impl<'de> Deserialize<'de> for Model {
+    fn deserialize<Dz: Deserializer<'de>>(d: Dz) -> Result<Self, Dz::Error> {
+        let text = String::deserialize(d)?;
+        ModelSpec::parse(&text).map(Model).map_err(de::Error::custom)
+    }
+}
+
+impl Serialize for Model {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(&self.0.name())
+    }
+}
+
+/// A number in [0, 1].
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Unit(pub f32);
+
+impl<'de> Deserialize<'de> for Unit {
+    fn deserialize<Dz: Deserializer<'de>>(d: Dz) -> Result<Self, Dz::Error> {
+        let x = f32::deserialize(d)?;
+        if !(0.0..=1.0).contains(&x) {
+            return Err(de::Error::custom(format!("{x} is outside [0, 1]")));
+        }
+        Ok(Unit(x))
+    }
+}
+
+/// An RGB colour, each channel in [0, 1].
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Colour(pub [f32; 3]);
+
+impl<'de> Deserialize<'de> for Colour {
+    fn deserialize<Dz: Deserializer<'de>>(d: Dz) -> Result<Self, Dz::Error> {
+        let c = <[f32; 3]>::deserialize(d)?;
+        if c.iter().any(|x| !(0.0..=1.0).contains(x)) {
+            return Err(de::Error::custom(format!("colour {c:?} has a channel outside [0, 1]")));
+        }
+        Ok(Colour(c))
+    }
+}
+
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct Material {
+    pub name: String,
+    /// A model spec from the term library.
+    pub model: Model,
+    #[serde(default = "grey")]
+    pub base_colour: Colour,
+    #[serde(default = "zero_unit")]
+    pub metallic: Unit,
+    #[serde(default = "half_unit")]
+    pub roughness: Unit,
+    /// GTR exponent, overriding the model's (read when d = gtr).
+    #[serde(default)]
+    pub gamma: Option<f64>,
+    #[serde(default)]
+    pub effects: Effects,
+}
+
+fn grey() -> Colour {
+    Colour([0.5; 3])
+}
+fn zero_unit() -> Unit {
+    Unit(0.0)
+}
+fn half_unit() -> Unit {
+    Unit(0.5)
+}
+
+impl Material {
+    /// The model spec with the material's gamma applied.
+    pub fn spec(&self) -> ModelSpec {
+        let mut s = self.model.0;
+        if let Some(g) = self.gamma {
+            s.gamma = g;
+        }
+        s
+    }
+}
+
+/// What a material calls for beyond the model's specular lobe.
+#[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Effects {
+    /// Anisotropic GGX strength in [-1, 1] (0: isotropic). Replaces the model's D and Vis, so needs d = ggx.
+    #[serde(default)]
+    pub anisotropy: Signed,
+    /// Multiple-scattering energy compensation (Filament's 1 + F0 (1/E - 1)).
+    #[serde(default)]
+    pub energy_compensation: bool,
+    #[serde(default)]
+    pub diffuse: DiffuseLobe,
+    #[serde(default)]
+    pub clear_coat: Option<ClearCoat>,
+}
+
+/// A number in [-1, 1].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct Signed(pub f32);
+
+impl<'de> Deserialize<'de> for Signed {
+    fn deserialize<Dz: Deserializer<'de>>(d: Dz) -> Result<Self, Dz::Error> {
+        let x = f32::deserialize(d)?;
+        if !(-1.0..=1.0).contains(&x) {
+            return Err(de::Error::custom(format!("{x} is outside [-1, 1]")));
+        }
+        Ok(Signed(x))
+    }
+}
+
+#[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[serde(rename_all = "kebab-case")]
+pub enum DiffuseLobe {
+    #[default]
+    None,
+    Lambert,
+    Burley,
+}
+
+impl DiffuseLobe {
+    /// The id the kernel reads (scene.glsl DIFFUSE / Surface.diffuse).
+    pub fn id(self) -> i32 {
+        self as i32
+    }
+    pub fn name(self) -> &'static str {
+        match self {
+            DiffuseLobe::None => "none",
+            DiffuseLobe::Lambert => "lambert",
+            DiffuseLobe::Burley => "burley",
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ClearCoat {
+    #[serde(default = "one_unit")]
+    pub strength: Unit,
+    #[serde(default = "coat_roughness")]
+    pub roughness: Unit,
+}
+
+fn one_unit() -> Unit {
+    Unit(1.0)
+}
+fn coat_roughness() -> Unit {
+    Unit(0.1)
+}
+
+/// How `brdfprof render` draws the scene.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct RenderSettings {
+    /// Radiance is multiplied by this before tone mapping.
+    #[serde(default = "one")]
+    pub exposure: f32,
+    /// Models compared: the scene is rendered once per model, every material's model replaced by it (as the
+    /// thesis switched the master material's shading model). Default: the four thesis models.
+    #[serde(default = "thesis_models")]
+    pub models: Vec<Model>,
+    /// Materials of the comparison grid (rows). Default: every material.
+    #[serde(default)]
+    pub grid: Vec<String>,
+    /// Roughness of each polar lobe panel.
+    #[serde(default = "lobe_roughness")]
+    pub lobe_roughness: Vec<Unit>,
+    /// Colour of pixels no surface covers (linear RGB, before tone mapping).
+    #[serde(default)]
+    pub background: [f32; 3],
+}
+
+fn thesis_models() -> Vec<Model> {
+    crate::brdf::THESIS_MODELS.iter().map(|m| Model(ModelSpec::preset(m).unwrap())).collect()
+}
+fn lobe_roughness() -> Vec<Unit> {
+    [0.2, 0.4, 0.6, 0.8].map(Unit).to_vec()
+}
+
+impl Default for RenderSettings {
+    fn default() -> Self {
+        RenderSettings { exposure: 1.0, models: thesis_models(), grid: Vec::new(), lobe_roughness: lobe_roughness(), background: [0.0; 3] }
+    }
+}
+
+/// A loaded, checked scene and where it came from (image paths are relative to `dir`).
+#[derive(Clone, Debug)]
+pub struct Scene {
+    pub file: SceneFile,
+    pub path: PathBuf,
+    pub dir: PathBuf,
+}
+
+impl Scene {
+    /// Reads and checks a scene file; errors name the file and the JSON path.
+    pub fn load(path: &Path) -> Result<Scene> {
+        let text = std::fs::read_to_string(path).map_err(|e| anyhow!("cannot read scene file {}: {e}", path.display()))?;
+        let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
+        Scene::parse(&text, &path.display().to_string(), dir, path.to_path_buf())
+    }
+
+    /// Parses scene JSON; `name` prefixes errors.
+    pub fn parse(text: &str, name: &str, dir: PathBuf, path: PathBuf) -> Result<Scene> {
+        let mut de = serde_json::Deserializer::from_str(text);
+        let file: SceneFile = serde_path_to_error::deserialize(&mut de).map_err(|e| {
+            let path = e.path().to_string();
+            let inner = e.into_inner();
+            if path == "." { anyhow!("{name}: {inner}") } else { anyhow!("{name}: {path}: {inner}") }
+        })?;
+        check(&file).map_err(|e| anyhow!("{name}: {e}"))?;
+        Ok(Scene { file, path, dir })
+    }
+
+    /// The scene's name: its `name`, else the file stem.
+    pub fn name(&self) -> String {
+        self.file.name.clone().unwrap_or_else(|| self.path.file_stem().map_or("scene".into(), |s| s.to_string_lossy().into_owned()))
+    }
+
+    pub fn material_index(&self, name: &str) -> Option<usize> {
+        self.file.materials.iter().position(|m| m.name == name)
+    }
+}
+
+fn finite3(v: &[f32; 3]) -> bool {
+    v.iter().all(|x| x.is_finite())
+}
+
+fn nonzero3(v: &[f32; 3]) -> bool {
+    finite3(v) && v.iter().any(|x| *x != 0.0)
+}
+
+/// Checks what serde cannot: names, references and combinations. Errors name the JSON path.
+fn check(f: &SceneFile) -> Result<()> {
+    if f.materials.is_empty() {
+        bail!("materials: a scene needs at least one material");
+    }
+    if f.materials.len() > 255 {
+        bail!("materials: at most 255 materials ({} given)", f.materials.len());
+    }
+    for (i, m) in f.materials.iter().enumerate() {
+        if f.materials[..i].iter().any(|o| o.name == m.name) {
+            bail!("materials[{i}].name: `{}` is used by an earlier material", m.name);
+        }
+        if let Some(g) = m.gamma {
+            if !(g.is_finite() && (0.0..=16.0).contains(&g)) {
+                bail!("materials[{i}].gamma: {g} is outside [0, 16]");
+            }
+        }
+        if m.effects.anisotropy.0 != 0.0 && m.model.0.d != D::Ggx {
+            bail!(
+                "materials[{i}].effects.anisotropy: anisotropic GGX replaces the model's D and Vis, so it needs d=ggx (model `{}` has d={})",
+                m.model.0.name(),
+                m.model.0.d.name()
+            );
+        }
+    }
+    let known = |name: &str| f.materials.iter().any(|m| m.name == name);
+    let need = |path: String, name: &str| -> Result<()> {
+        if known(name) { Ok(()) } else { bail!("{path}: no material named `{name}` (materials are {})", names(f)) }
+    };
+    match &f.gbuffer {
+        GBufferSource::Procedural(p) => match p {
+            Procedural::SphereGrid { rows, columns, floor, .. } => {
+                if rows.is_empty() {
+                    bail!("gbuffer.procedural.rows: at least one row");
+                }
+                for (i, r) in rows.iter().enumerate() {
+                    need(format!("gbuffer.procedural.rows[{i}]"), r)?;
+                }
+                if *columns == 0 || *columns > 64 {
+                    bail!("gbuffer.procedural.columns: {columns} is outside 1 to 64");
+                }
+                need("gbuffer.procedural.floor".into(), floor)?;
+            }
+            Procedural::Statues { statues, floor, .. } => {
+                if statues.is_empty() {
+                    bail!("gbuffer.procedural.statues: at least one statue");
+                }
+                for (i, s) in statues.iter().enumerate() {
+                    need(format!("gbuffer.procedural.statues[{i}]"), s)?;
+                }
+                need("gbuffer.procedural.floor".into(), floor)?;
+            }
+            Procedural::OldWest { ground, walls, roofs, .. } => {
+                need("gbuffer.procedural.ground".into(), ground)?;
+                if walls.is_empty() {
+                    bail!("gbuffer.procedural.walls: at least one wall material");
+                }
+                for (i, w) in walls.iter().enumerate() {
+                    need(format!("gbuffer.procedural.walls[{i}]"), w)?;
+                }
+                need("gbuffer.procedural.roofs".into(), roofs)?;
+            }
+        },
+        GBufferSource::Images(im) => {
+            if f.camera.is_none() {
+                bail!("camera: required when the G-buffer comes from images (view vectors are derived from it)");
+            }
+            match (&im.depth, &im.position) {
+                (Some(_), Some(_)) => bail!("gbuffer.images: give depth or position, not both"),
+                (None, None) => bail!("gbuffer.images: give depth or position (view vectors are derived from it)"),
+                _ => {}
+            }
+            if let Some([near, far]) = im.depth_range {
+                if !(near.is_finite() && far.is_finite() && far > near) {
+                    bail!("gbuffer.images.depth_range: [{near}, {far}] must have far > near");
+                }
+            }
+        }
+    }
+    if let Some(c) = &f.camera {
+        if !(finite3(&c.position) && finite3(&c.look_at) && nonzero3(&c.up)) {
+            bail!("camera: position, look_at and up must be finite, up non-zero");
+        }
+        if c.position == c.look_at {
+            bail!("camera.look_at: equals camera.position");
+        }
+        if !(1.0..=170.0).contains(&c.fov_y_deg) {
+            bail!("camera.fov_y_deg: {} is outside 1 to 170", c.fov_y_deg);
+        }
+    }
+    for (i, l) in f.lights.iter().enumerate() {
+        let p = format!("lights[{i}]");
+        let (colour, intensity) = match l {
+            Light::Directional { direction, colour, intensity } => {
+                if !nonzero3(direction) {
+                    bail!("{p}.direction: must be finite and non-zero");
+                }
+                (colour, intensity)
+            }
+            Light::Point { position, colour, intensity } => {
+                if !finite3(position) {
+                    bail!("{p}.position: must be finite");
+                }
+                (colour, intensity)
+            }
+            Light::Spot { position, direction, inner_angle_deg, outer_angle_deg, colour, intensity } => {
+                if !finite3(position) || !nonzero3(direction) {
+                    bail!("{p}: position must be finite and direction finite and non-zero");
+                }
+                if !(*inner_angle_deg >= 0.0 && inner_angle_deg <= outer_angle_deg && *outer_angle_deg <= 90.0) {
+                    bail!("{p}: need 0 <= inner_angle_deg ({inner_angle_deg}) <= outer_angle_deg ({outer_angle_deg}) <= 90");
+                }
+                (colour, intensity)
+            }
+            Light::Sphere { position, radius, colour, intensity } => {
+                if !finite3(position) {
+                    bail!("{p}.position: must be finite");
+                }
+                if !(radius.is_finite() && *radius > 0.0) {
+                    bail!("{p}.radius: {radius} must be positive");
+                }
+                (colour, intensity)
+            }
+        };
+        if !(colour.iter().all(|c| c.is_finite() && *c >= 0.0) && intensity.is_finite() && *intensity >= 0.0) {
+            bail!("{p}: colour and intensity must be finite and non-negative");
+        }
+    }
+    let r = &f.render;
+    if !(r.exposure.is_finite() && r.exposure > 0.0) {
+        bail!("render.exposure: {} must be positive", r.exposure);
+    }
+    if r.models.is_empty() {
+        bail!("render.models: at least one model");
+    }
+    for (i, g) in r.grid.iter().enumerate() {
+        need(format!("render.grid[{i}]"), g)?;
+    }
+    if r.lobe_roughness.is_empty() {
+        bail!("render.lobe_roughness: at least one roughness");
+    }
+    Ok(())
+}
+
+fn names(f: &SceneFile) -> String {
+    f.materials.iter().map(|m| format!("`{}`", m.name)).collect::<Vec<_>>().join(", ")
+}
+
+/// `brdfprof scene --explain`.
+pub const EXPLAIN: &str = r#"brdfprof scene files (JSON)
+
+A scene is a G-buffer (procedural, or image files), a camera, lights and materials. `brdfprof profile --scene
+FILE` times it (one kernel per model present, every light in one dispatch, per-effect costs); `brdfprof render
+--scene FILE` draws it. Errors name the JSON path of the problem (e.g. `materials[2].roughness: invalid type:
+string "x", expected f32`); image paths are relative to the scene file. Unknown keys are errors.
+
+{
+  "name": "...",                      optional; default: the file name
+  "description": "...",               optional
+  "gbuffer":                          one of:
+    {"procedural": {"kind": "sphere-grid", "size": [W, H], "rows": [MATERIAL...], "columns": 8, "floor": MATERIAL}}
+        thesis Fig. 5.2: a row of spheres per material, roughness (c + 0.5)/columns along each row
+    {"procedural": {"kind": "statues", "size": [W, H], "statues": [MATERIAL...], "floor": MATERIAL}}
+        thesis "metal statues": pedestal, body and head per statue, in a row on a floor
+    {"procedural": {"kind": "old-west", "size": [W, H], "ground": MATERIAL, "walls": [MATERIAL...], "roofs": MATERIAL}}
+        thesis "Old West": a street of buildings, low specular, rough
+    {"images": {
+        "normal": "n.png",            PNG 8/16-bit RGB, n = 2c - 1 (c = value/max); EXR float RGB as stored
+        "roughness": "r.png",         optional; PNG grey c = value/max, EXR R; default: the material's
+        "base_colour": "c.png",       optional; PNG sRGB-encoded, EXR linear; default: the material's
+        "metallic": "m.png",          optional; like roughness
+        "depth": "d.exr",             view-space depth along the camera axis: EXR R, or 16-bit PNG with
+        "depth_range": [near, far],     depth = near + c (far - near)
+        "position": "p.exr",          or world position, EXR RGB (exactly one of depth and position)
+        "material": "id.png",         optional; 8-bit grey material index, 255 = background; default: 0
+        "tangent": "t.png"            optional; encoded like normal; default: a frame built from the normal
+    }}                                sizes up to 16384 x 16384; the GPU work is chunked to the device's limits
+  "camera": {"position": [x,y,z], "look_at": [x,y,z], "up": [0,1,0], "fov_y_deg": 40}
+                                      optional for procedural G-buffers (each kind has a default), required for images
+  "lights": [                         any number, any mix; colour is linear RGB times intensity
+    {"type": "directional", "direction": [x,y,z], "colour": [1,1,1], "intensity": 1}   direction of travel
+    {"type": "point", "position": [x,y,z], "colour": [..], "intensity": I}             I / d^2
+    {"type": "spot", "position": [..], "direction": [..], "inner_angle_deg": 20, "outer_angle_deg": 30, ...}
+                                      I / d^2 times saturate((cos - cos_outer)/(cos_inner - cos_outer))^2
+    {"type": "sphere", "position": [..], "radius": R, "colour": [..], "intensity": I}
+                                      Karis 2013 representative point, normalised by (a / saturate(a + R/(2d)))^2
+  ],
+  "materials": [
+    {"name": "metal",
+     "model": "ggx",                  any model spec: a preset or d=..,vis=..,f=..[,precision=f16][,gamma=G]
+     "base_colour": [0.5,0.5,0.5], "metallic": 0, "roughness": 0.5,   F0 = mix(0.04, base_colour, metallic)
+     "gamma": 1.5,                    optional GTR exponent override
+     "effects": {
+       "anisotropy": 0,               [-1, 1]; anisotropic GGX (needs d=ggx): at = a(1+s), ab = a(1-s)
+       "energy_compensation": false,  multiple scattering: f_s (1 + F0 (1/E - 1)), E(mu, r) integrated on the GPU
+       "diffuse": "none",             none | lambert | burley; diffuse colour = base_colour (1 - metallic)
+       "clear_coat": {"strength": 1, "roughness": 0.1}   Filament's: GGX, Kelemen, Schlick F0 = 0.04, base x (1 - Fc)
+     }}
+  ],
+  "render": {                         optional
+    "exposure": 1,                    radiance multiplier before tone mapping (ACES fit, sRGB)
+    "models": ["ggx", "blinn", "cook-torrance", "burley"],   one picture per model (every material switched to it)
+    "grid": ["metal", "rubber", "black"],                    rows of the comparison grid; default: every material
+    "lobe_roughness": [0.2, 0.4, 0.6, 0.8],                  panels of the polar lobe plot
+    "background": [0, 0, 0]
+  }
+}
+
+What is compiled in: one kernel per model that covers at least one pixel; in it, each light type's loop with
+its count (specialisation constants, unrolled), and an effect only when a material of that model uses it.
+Example (scenes/sphere-grid.json):
+"#;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(text: &str) -> Result<Scene> {
+        Scene::parse(text, "t.json", PathBuf::new(), PathBuf::from("t.json"))
+    }
+
+    const GOOD: &str = r#"{"gbuffer": {"procedural": {"kind": "sphere-grid", "size": [64, 32], "rows": ["a"], "floor": "a"}},
+        "lights": [{"type": "directional", "direction": [0, -1, -1]}],
+        "materials": [{"name": "a", "model": "ggx"}, {"name": "b", "model": "blinn", "roughness": 0.3}]}"#;
+
+    #[test]
+    fn a_good_scene_parses_with_defaults() {
+        let s = parse(GOOD).unwrap();
+        assert_eq!(s.file.materials[1].roughness, Unit(0.3));
+        assert_eq!(s.file.materials[0].effects, Effects::default());
+        assert_eq!(s.file.render.models.len(), 4);
+    }
+
+    #[test]
+    fn errors_name_the_json_path() {
+        let bad = GOOD.replace(r#""roughness": 0.3"#, r#""roughness": "x""#);
+        let e = parse(&bad).unwrap_err().to_string();
+        assert!(e.contains("t.json: materials[1].roughness: invalid type: string \"x\", expected f32"), "{e}");
+        let bad = GOOD.replace(r#""roughness": 0.3"#, r#""roughness": 1.5"#);
+        let e = parse(&bad).unwrap_err().to_string();
+        assert!(e.contains("materials[1].roughness: 1.5 is outside [0, 1]"), "{e}");
+        let bad = GOOD.replace(r#""model": "blinn""#, r#""model": "phong""#);
+        let e = parse(&bad).unwrap_err().to_string();
+        assert!(e.contains("materials[1].model: unknown model `phong`"), "{e}");
+        let bad = GOOD.replace(r#""type": "directional""#, r#""type": "area""#);
+        let e = parse(&bad).unwrap_err().to_string();
+        assert!(e.contains("lights[0]") && e.contains("unknown variant `area`"), "{e}");
+        let bad = GOOD.replace(r#""rows": ["a"]"#, r#""rows": ["a", "zz"]"#);
+        let e = parse(&bad).unwrap_err().to_string();
+        assert!(e.contains("gbuffer.procedural.rows[1]: no material named `zz`"), "{e}");
+        let bad = GOOD.replace(r#""model": "blinn""#, r#""model": "blinn", "effects": {"anisotropy": 0.5}"#);
+        let e = parse(&bad).unwrap_err().to_string();
+        assert!(e.contains("materials[1].effects.anisotropy: anisotropic GGX") && e.contains("needs d=ggx"), "{e}");
+        let bad = GOOD.replace(r#""model": "blinn""#, r#""model": "blinn", "colour": 1"#);
+        let e = parse(&bad).unwrap_err().to_string();
+        assert!(e.contains("materials[1]") && e.contains("unknown field `colour`"), "{e}");
+        let bad = GOOD.replace(r#""direction": [0, -1, -1]"#, r#""direction": [0, "x", -1]"#);
+        let e = parse(&bad).unwrap_err().to_string();
+        assert!(e.contains("lights[0].direction[1]: invalid type: string \"x\", expected f32"), "{e}");
+        let bad = GOOD.replace(r#""direction": [0, -1, -1]"#, r#""direction": [0, -1, -1], "radius": 2"#);
+        let e = parse(&bad).unwrap_err().to_string();
+        assert!(e.contains("lights[0]: a directional light has no `radius`"), "{e}");
+        let bad = GOOD.replace(r#""size": [64, 32]"#, r#""size": [64, "y"]"#);
+        let e = parse(&bad).unwrap_err().to_string();
+        assert!(e.contains("gbuffer.procedural.size[1]: invalid type"), "{e}");
+        let e = parse("{").unwrap_err().to_string();
+        assert!(e.contains("t.json") && e.contains("EOF"), "{e}");
+    }
+}

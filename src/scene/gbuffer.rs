@@ -1,0 +1,488 @@
+//! The scene's G-buffer: per pixel a world position, normal, tangent, perceptual roughness, base colour,
+//! metallic and material. Procedural scenes are ray-cast on the CPU (spheres, boxes and planes); image G-buffers
+//! are decoded from PNG (8/16 bit) and EXR files, with view vectors derived from depth or position and the camera.
+
+use super::format::{Camera, GBufferSource, ImageFiles, Procedural, Scene};
+use anyhow::{anyhow, bail, Result};
+use image::DynamicImage;
+use rayon::prelude::*;
+use std::path::{Path, PathBuf};
+
+/// Material index of pixels no surface covers (not shaded).
+pub const BACKGROUND: u32 = u32::MAX;
+
+/// One G-buffer pixel.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Pixel {
+    pub position: [f32; 3],
+    pub normal: [f32; 3],
+    pub tangent: [f32; 3],
+    pub roughness: f32,
+    pub base_colour: [f32; 3],
+    pub metallic: f32,
+    pub material: u32,
+}
+
+#[derive(Clone, Debug)]
+pub struct GBuffer {
+    pub width: u32,
+    pub height: u32,
+    pub camera: Camera,
+    /// Row-major, top row first.
+    pub pixels: Vec<Pixel>,
+}
+
+impl GBuffer {
+    pub fn pixel_count(&self) -> usize {
+        self.pixels.len()
+    }
+}
+
+type V3 = [f32; 3];
+
+fn add(a: V3, b: V3) -> V3 {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+}
+fn sub(a: V3, b: V3) -> V3 {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+fn mul(a: V3, s: f32) -> V3 {
+    a.map(|x| x * s)
+}
+fn dot(a: V3, b: V3) -> f32 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+fn cross(a: V3, b: V3) -> V3 {
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+}
+fn normalize(a: V3) -> V3 {
+    let l = dot(a, a).sqrt();
+    if l > 0.0 { mul(a, 1.0 / l) } else { [0.0; 3] }
+}
+
+/// A tangent orthogonal to unit `n` [Duff et al. 2017, "Building an Orthonormal Basis, Revisited"].
+pub fn frame_tangent(n: V3) -> V3 {
+    let sign = 1f32.copysign(n[2]);
+    let a = -1.0 / (sign + n[2]);
+    let b = n[0] * n[1] * a;
+    [1.0 + sign * n[0] * n[0] * a, sign * b, -sign * n[0]]
+}
+
+/// The camera's basis and the direction through a pixel centre, scaled so that its component along the
+/// forward axis is 1 (so position = eye + dir * view depth).
+pub struct Rays {
+    eye: V3,
+    forward: V3,
+    right: V3,
+    up: V3,
+    tan_half: f32,
+    width: u32,
+    height: u32,
+}
+
+impl Rays {
+    pub fn new(camera: &Camera, width: u32, height: u32) -> Rays {
+        let forward = normalize(sub(camera.look_at, camera.position));
+        let mut right = normalize(cross(forward, camera.up));
+        if dot(right, right) == 0.0 {
+            right = frame_tangent(forward);
+        }
+        let up = cross(right, forward);
+        Rays { eye: camera.position, forward, right, up, tan_half: (camera.fov_y_deg.to_radians() * 0.5).tan(), width, height }
+    }
+
+    pub fn dir(&self, x: u32, y: u32) -> V3 {
+        let aspect = self.width as f32 / self.height as f32;
+        let sx = ((x as f32 + 0.5) / self.width as f32 * 2.0 - 1.0) * aspect * self.tan_half;
+        let sy = (1.0 - (y as f32 + 0.5) / self.height as f32 * 2.0) * self.tan_half;
+        add(self.forward, add(mul(self.right, sx), mul(self.up, sy)))
+    }
+}
+
+/// Integer hash to [0, 1) (PCG-style), so pictures are identical on every run and machine.
+fn hash01(mut x: u32) -> f32 {
+    x = x.wrapping_mul(747796405).wrapping_add(2891336453);
+    x = ((x >> ((x >> 28) + 4)) ^ x).wrapping_mul(277803737);
+    x = (x >> 22) ^ x;
+    (x >> 8) as f32 / (1u32 << 24) as f32
+}
+
+// ---- Procedural geometry ------------------------------------------------------------------------------
+
+#[derive(Clone, Copy, Debug)]
+enum Shape {
+    Sphere { centre: V3, radius: f32 },
+    /// Axis-aligned box.
+    Box { min: V3, max: V3 },
+    /// Plane through `point` facing `normal` (unit), one-sided.
+    Plane { point: V3, normal: V3 },
+}
+
+#[derive(Clone, Copy, Debug)]
+struct Object {
+    shape: Shape,
+    material: u32,
+    /// Overrides the material's roughness (the sphere grid's columns).
+    roughness: Option<f32>,
+    /// Roughness and brightness noise amplitude (rough, dirty surfaces).
+    noise: f32,
+}
+
+struct Hit {
+    t: f32,
+    normal: V3,
+    tangent: V3,
+}
+
+fn intersect(shape: &Shape, o: V3, d: V3) -> Option<Hit> {
+    match *shape {
+        Shape::Sphere { centre, radius } => {
+            let oc = sub(o, centre);
+            let (a, b, c) = (dot(d, d), dot(oc, d), dot(oc, oc) - radius * radius);
+            let disc = b * b - a * c;
+            if disc < 0.0 {
+                return None;
+            }
+            let t = (-b - disc.sqrt()) / a;
+            if t <= 1e-4 {
+                return None;
+            }
+            let n = normalize(sub(add(o, mul(d, t)), centre));
+            // Tangent along the parallels (brushed around the vertical axis).
+            let mut tangent = normalize(cross([0.0, 1.0, 0.0], n));
+            if dot(tangent, tangent) == 0.0 {
+                tangent = frame_tangent(n);
+            }
+            Some(Hit { t, normal: n, tangent })
+        }
+        Shape::Box { min, max } => {
+            let (mut t0, mut t1, mut axis, mut sign) = (f32::NEG_INFINITY, f32::INFINITY, 0, 0.0);
+            for k in 0..3 {
+                let inv = 1.0 / d[k];
+                let (mut a, mut b) = ((min[k] - o[k]) * inv, (max[k] - o[k]) * inv);
+                let s = if inv < 0.0 {
+                    std::mem::swap(&mut a, &mut b);
+                    1.0
+                } else {
+                    -1.0
+                };
+                if a > t0 {
+                    t0 = a;
+                    axis = k;
+                    sign = s;
+                }
+                t1 = t1.min(b);
+            }
+            if t0 > t1 || t0 <= 1e-4 {
+                return None;
+            }
+            let mut n = [0.0; 3];
+            n[axis] = sign;
+            let tangent = if axis == 1 { [1.0, 0.0, 0.0] } else { [0.0, 1.0, 0.0] };
+            Some(Hit { t: t0, normal: n, tangent })
+        }
+        Shape::Plane { point, normal } => {
+            let denom = dot(normal, d);
+            if denom >= 0.0 {
+                return None;
+            }
+            let t = dot(sub(point, o), normal) / denom;
+            (t > 1e-4).then(|| Hit { t, normal, tangent: frame_tangent(normal) })
+        }
+    }
+}
+
+struct Layout {
+    objects: Vec<Object>,
+    camera: Camera,
+}
+
+fn sphere(centre: V3, radius: f32, material: u32) -> Object {
+    Object { shape: Shape::Sphere { centre, radius }, material, roughness: None, noise: 0.0 }
+}
+fn cuboid(min: V3, max: V3, material: u32, noise: f32) -> Object {
+    Object { shape: Shape::Box { min, max }, material, roughness: None, noise }
+}
+fn plane(point: V3, normal: V3, material: u32, noise: f32) -> Object {
+    Object { shape: Shape::Plane { point, normal: normalize(normal) }, material, roughness: None, noise }
+}
+
+fn sphere_grid(scene: &Scene, rows: &[String], columns: u32, floor: &str, aspect: f32) -> Layout {
+    let idx = |n: &str| scene.material_index(n).unwrap() as u32;
+    let mut objects = Vec::new();
+    let n_rows = rows.len() as f32;
+    for (r, name) in rows.iter().enumerate() {
+        for c in 0..columns {
+            let x = c as f32 - (columns as f32 - 1.0) / 2.0;
+            let y = (n_rows - 1.0) / 2.0 - r as f32;
+            let mut s = sphere([x, y, 0.0], 0.45, idx(name));
+            s.roughness = Some((c as f32 + 0.5) / columns as f32);
+            objects.push(s);
+        }
+    }
+    objects.push(plane([0.0, 0.0, -0.6], [0.0, 0.0, 1.0], idx(floor), 0.0));
+    let fov = 30f32;
+    let half_h = (n_rows / 2.0 + 0.15).max((columns as f32 / 2.0 + 0.15) / aspect);
+    let dist = half_h / (fov.to_radians() / 2.0).tan() + 0.45;
+    Layout { objects, camera: Camera { position: [0.0, 0.0, dist], look_at: [0.0, 0.0, 0.0], up: [0.0, 1.0, 0.0], fov_y_deg: fov } }
+}
+
+fn statues(scene: &Scene, names: &[String], floor: &str) -> Layout {
+    let idx = |n: &str| scene.material_index(n).unwrap() as u32;
+    let mut objects = vec![plane([0.0, 0.0, 0.0], [0.0, 1.0, 0.0], idx(floor), 0.05)];
+    let n = names.len() as f32;
+    for (i, name) in names.iter().enumerate() {
+        let m = idx(name);
+        // An arc of statues facing the camera.
+        let u = if names.len() == 1 { 0.0 } else { i as f32 / (n - 1.0) - 0.5 };
+        let (x, z) = (u * 1.6 * n, -1.2 * (u * 2.0).powi(2));
+        objects.push(cuboid([x - 0.45, 0.0, z - 0.45], [x + 0.45, 0.5, z + 0.45], m, 0.0));
+        objects.push(sphere([x, 1.05, z], 0.55, m));
+        objects.push(sphere([x, 1.85, z], 0.3, m));
+        objects.push(sphere([x + 0.42, 1.3, z + 0.1], 0.17, m));
+        objects.push(sphere([x - 0.42, 1.3, z + 0.1], 0.17, m));
+    }
+    let width = 1.6 * n + 1.0;
+    Layout {
+        objects,
+        camera: Camera { position: [0.0, 2.6, width * 0.95 + 1.5], look_at: [0.0, 0.9, -0.6], up: [0.0, 1.0, 0.0], fov_y_deg: 40.0 },
+    }
+}
+
+fn old_west(scene: &Scene, ground: &str, walls: &[String], roofs: &str) -> Layout {
+    let idx = |n: &str| scene.material_index(n).unwrap() as u32;
+    let mut objects = vec![plane([0.0, 0.0, 0.0], [0.0, 1.0, 0.0], idx(ground), 0.15)];
+    let roof = idx(roofs);
+    for side in [-1.0f32, 1.0] {
+        for k in 0..6 {
+            let wall = idx(&walls[(k + (side > 0.0) as usize) % walls.len()]);
+            let z0 = -4.0 - 5.5 * k as f32;
+            let h = 3.0 + 1.4 * hash01(k as u32 * 7 + (side > 0.0) as u32);
+            let (x0, x1) = if side < 0.0 { (-10.0, -3.0) } else { (3.0, 10.0) };
+            objects.push(cuboid([x0, 0.0, z0 - 5.0], [x1, h, z0], wall, 0.12));
+            // A flat roof with an overhang over the street, and a porch post.
+            let (rx0, rx1) = if side < 0.0 { (-10.2, -2.2) } else { (2.2, 10.2) };
+            objects.push(cuboid([rx0, h, z0 - 5.2], [rx1, h + 0.25, z0 + 0.2], roof, 0.1));
+            let px = if side < 0.0 { -2.35 } else { 2.35 };
+            objects.push(cuboid([px - 0.1, 0.0, z0 - 0.1], [px + 0.1, h, z0 + 0.1], wall, 0.12));
+        }
+    }
+    // Barrels (spheres) and a water tower tank at the end of the street.
+    for (i, x) in [-2.4f32, 2.5, -2.0].iter().enumerate() {
+        objects.push(sphere([*x, 0.45, -7.0 - 9.0 * i as f32], 0.45, idx(&walls[0])));
+    }
+    objects.push(sphere([0.0, 7.0, -40.0], 3.0, roof));
+    Layout {
+        objects,
+        camera: Camera { position: [0.0, 1.7, 4.0], look_at: [0.0, 2.2, -20.0], up: [0.0, 1.0, 0.0], fov_y_deg: 55.0 },
+    }
+}
+
+fn ray_cast(scene: &Scene, layout: &Layout, camera: &Camera, width: u32, height: u32) -> Vec<Pixel> {
+    let rays = Rays::new(camera, width, height);
+    let mats = &scene.file.materials;
+    let mut pixels = vec![Pixel::default(); width as usize * height as usize];
+    pixels.par_chunks_mut(width as usize).enumerate().for_each(|(y, row)| {
+        for (x, px) in row.iter_mut().enumerate() {
+            let d = rays.dir(x as u32, y as u32);
+            let mut best: Option<(Hit, &Object)> = None;
+            for obj in &layout.objects {
+                if let Some(h) = intersect(&obj.shape, rays.eye, d) {
+                    if best.as_ref().is_none_or(|(b, _)| h.t < b.t) {
+                        best = Some((h, obj));
+                    }
+                }
+            }
+            *px = match best {
+                None => Pixel { position: add(rays.eye, mul(d, 1e4)), normal: mul(normalize(d), -1.0), material: BACKGROUND, ..Default::default() },
+                Some((h, obj)) => {
+                    let m = &mats[obj.material as usize];
+                    let id = (y as u32).wrapping_mul(width).wrapping_add(x as u32);
+                    let noise = hash01(id) - 0.5;
+                    let roughness = obj.roughness.unwrap_or(m.roughness.0);
+                    let shade = 1.0 + obj.noise * 2.0 * (hash01(id ^ 0x9e37_79b9) - 0.5);
+                    Pixel {
+                        position: add(rays.eye, mul(d, h.t)),
+                        normal: h.normal,
+                        tangent: h.tangent,
+                        roughness: (roughness + obj.noise * noise).clamp(0.0, 1.0),
+                        base_colour: m.base_colour.0.map(|c| (c * shade).clamp(0.0, 1.0)),
+                        metallic: m.metallic.0,
+                        material: obj.material,
+                    }
+                }
+            };
+        }
+    });
+    pixels
+}
+
+/// A single sphere of `material` filling a square picture (the comparison grid's tiles).
+pub fn closeup(scene: &Scene, material: u32, size: u32) -> GBuffer {
+    let layout = Layout {
+        objects: vec![sphere([0.0, 0.0, 0.0], 1.0, material)],
+        camera: Camera { position: [0.0, 0.0, 4.2], look_at: [0.0; 3], up: [0.0, 1.0, 0.0], fov_y_deg: 30.0 },
+    };
+    let pixels = ray_cast(scene, &layout, &layout.camera, size, size);
+    GBuffer { width: size, height: size, camera: layout.camera, pixels }
+}
+
+/// The scene's G-buffer.
+pub fn build(scene: &Scene) -> Result<GBuffer> {
+    match &scene.file.gbuffer {
+        GBufferSource::Procedural(p) => {
+            let (size, layout) = match p {
+                Procedural::SphereGrid { size, rows, columns, floor } => {
+                    (size.0, sphere_grid(scene, rows, *columns, floor, size.0[0] as f32 / size.0[1] as f32))
+                }
+                Procedural::Statues { size, statues: s, floor } => (size.0, statues(scene, s, floor)),
+                Procedural::OldWest { size, ground, walls, roofs } => (size.0, old_west(scene, ground, walls, roofs)),
+            };
+            let camera = scene.file.camera.unwrap_or(layout.camera);
+            let pixels = ray_cast(scene, &layout, &camera, size[0], size[1]);
+            Ok(GBuffer { width: size[0], height: size[1], camera, pixels })
+        }
+        GBufferSource::Images(files) => load_images(scene, files),
+    }
+}
+
+// ---- Image G-buffers ----------------------------------------------------------------------------------
+
+/// A decoded plane: width, height, channels (RGBA, as f32) and whether the file stored floats (EXR).
+pub struct Plane {
+    pub width: u32,
+    pub height: u32,
+    pub float: bool,
+    /// Normalised values c = value / max for integer images; as stored for float images. RGBA per pixel.
+    pub rgba: Vec<[f32; 4]>,
+    pub path: PathBuf,
+}
+
+/// Reads a PNG (8 or 16 bit) or EXR file; errors name the file.
+pub fn read_plane(path: &Path) -> Result<Plane> {
+    let reader = image::ImageReader::open(path).map_err(|e| anyhow!("cannot read image {}: {e}", path.display()))?;
+    let reader = reader.with_guessed_format().map_err(|e| anyhow!("cannot read image {}: {e}", path.display()))?;
+    let img = reader.decode().map_err(|e| anyhow!("cannot decode image {}: {e}", path.display()))?;
+    let float = matches!(img, DynamicImage::ImageRgb32F(_) | DynamicImage::ImageRgba32F(_));
+    let (width, height) = (img.width(), img.height());
+    let rgba: Vec<[f32; 4]> = img.into_rgba32f().pixels().map(|p| p.0).collect();
+    Ok(Plane { width, height, float, rgba, path: path.to_path_buf() })
+}
+
+/// The sRGB EOTF (IEC 61966-2-1): display-encoded c in [0, 1] to linear.
+pub fn srgb_to_linear(c: f32) -> f32 {
+    if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
+}
+
+fn load_images(scene: &Scene, files: &ImageFiles) -> Result<GBuffer> {
+    let camera = scene.file.camera.expect("checked: image G-buffers have a camera");
+    let open = |p: &PathBuf| read_plane(&scene.dir.join(p));
+    let normal = open(&files.normal)?;
+    let (w, h) = (normal.width, normal.height);
+    let same = |plane: Plane| -> Result<Plane> {
+        if (plane.width, plane.height) != (w, h) {
+            bail!("{} is {}x{}, but the normal image {} is {w}x{h}", plane.path.display(), plane.width, plane.height, normal.path.display());
+        }
+        Ok(plane)
+    };
+    let optional = |p: &Option<PathBuf>| p.as_ref().map(|p| open(p).and_then(same)).transpose();
+    let roughness = optional(&files.roughness)?;
+    let base = optional(&files.base_colour)?;
+    let metallic = optional(&files.metallic)?;
+    let depth = optional(&files.depth)?;
+    let position = optional(&files.position)?;
+    let material = optional(&files.material)?;
+    let tangent = optional(&files.tangent)?;
+    if let Some(d) = &depth {
+        if !d.float && files.depth_range.is_none() {
+            bail!("{}: a PNG depth needs gbuffer.images.depth_range [near, far]", d.path.display());
+        }
+    }
+    if let Some(p) = &position {
+        if !p.float {
+            bail!("{}: positions must be an EXR (float) image", p.path.display());
+        }
+    }
+    let mats = &scene.file.materials;
+    if let Some(m) = &material {
+        if let Some((i, bad)) = m.rgba.iter().enumerate().find(|(_, c)| {
+            let k = (c[0] * 255.0).round() as usize;
+            k != 255 && k >= mats.len()
+        }) {
+            bail!(
+                "{}: pixel ({}, {}) names material {} but the scene has {} materials",
+                m.path.display(),
+                i as u32 % w,
+                i as u32 / w,
+                (bad[0] * 255.0).round(),
+                mats.len()
+            );
+        }
+    }
+    let rays = Rays::new(&camera, w, h);
+    let decode_vector = |plane: &Plane, i: usize| -> V3 {
+        let c = plane.rgba[i];
+        let v = if plane.float { [c[0], c[1], c[2]] } else { [2.0 * c[0] - 1.0, 2.0 * c[1] - 1.0, 2.0 * c[2] - 1.0] };
+        normalize(v)
+    };
+    let pixels = (0..(w as usize * h as usize))
+        .into_par_iter()
+        .map(|i| {
+            let (x, y) = (i as u32 % w, i as u32 / w);
+            let mat = material.as_ref().map_or(0, |m| (m.rgba[i][0] * 255.0).round() as u32);
+            let dir = rays.dir(x, y);
+            let pos = match (&depth, &position) {
+                (Some(d), _) => {
+                    let c = d.rgba[i][0];
+                    let z = if d.float { c } else { let [near, far] = files.depth_range.unwrap(); near + c * (far - near) };
+                    add(camera.position, mul(dir, z))
+                }
+                (_, Some(p)) => [p.rgba[i][0], p.rgba[i][1], p.rgba[i][2]],
+                _ => unreachable!("checked: depth or position"),
+            };
+            if mat == 255 {
+                return Pixel { position: pos, normal: mul(normalize(dir), -1.0), material: BACKGROUND, ..Default::default() };
+            }
+            let m = &mats[mat as usize];
+            let n = decode_vector(&normal, i);
+            let t = tangent.as_ref().map(|t| decode_vector(t, i)).filter(|t| dot(*t, *t) > 0.0 && dot(*t, n).abs() < 0.999);
+            let base_colour = base.as_ref().map_or(m.base_colour.0, |b| {
+                let c = b.rgba[i];
+                if b.float { [c[0], c[1], c[2]] } else { [srgb_to_linear(c[0]), srgb_to_linear(c[1]), srgb_to_linear(c[2])] }
+            });
+            Pixel {
+                position: pos,
+                normal: n,
+                tangent: t.unwrap_or_else(|| frame_tangent(n)),
+                roughness: roughness.as_ref().map_or(m.roughness.0, |r| r.rgba[i][0].clamp(0.0, 1.0)),
+                base_colour: base_colour.map(|c| c.clamp(0.0, 1.0)),
+                metallic: metallic.as_ref().map_or(m.metallic.0, |r| r.rgba[i][0].clamp(0.0, 1.0)),
+                material: mat,
+            }
+        })
+        .collect();
+    Ok(GBuffer { width: w, height: h, camera, pixels })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn orthonormal_frame_is_orthonormal() {
+        for n in [[0.0, 0.0, 1.0], [0.0, 0.0, -1.0], normalize([1.0, 2.0, -3.0]), [1.0, 0.0, 0.0]] {
+            let t = frame_tangent(n);
+            assert!(dot(t, n).abs() < 1e-6 && (dot(t, t) - 1.0).abs() < 1e-6, "{n:?} {t:?}");
+        }
+    }
+
+    #[test]
+    fn rays_hit_a_box_and_a_plane_from_outside() {
+        let b = Shape::Box { min: [-1.0; 3], max: [1.0; 3] };
+        let h = intersect(&b, [0.0, 0.0, 5.0], [0.0, 0.0, -1.0]).unwrap();
+        assert_eq!((h.t, h.normal), (4.0, [0.0, 0.0, 1.0]));
+        let p = Shape::Plane { point: [0.0; 3], normal: [0.0, 1.0, 0.0] };
+        assert!(intersect(&p, [0.0, 1.0, 0.0], [0.0, 1.0, 0.0]).is_none());
+        assert_eq!(intersect(&p, [0.0, 1.0, 0.0], [0.0, -1.0, 0.0]).unwrap().t, 1.0);
+    }
+}

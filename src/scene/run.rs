@@ -1,0 +1,161 @@
+//! The scene on the device: per kernel of the plan its pixels (padded to whole workgroups; the kernel has no
+//! bounds check), per-pixel extras, output and E table; the lights shared. A `SceneVariant` is one kernel
+//! compiled with some switches and bound chunk by chunk (bindings within maxStorageBufferRange, dispatches within
+//! maxComputeWorkGroupCount), so a 4K or larger G-buffer runs as several dispatches of one pipeline.
+
+use super::format::Scene;
+use super::gbuffer::GBuffer;
+use super::plan::ScenePlan;
+use super::terms::{ETable, Switches};
+use super::effects;
+use crate::gpu::{Buffer, ChunkPlan, Gpu, Kernel, MemoryKind};
+use crate::kernels::{self, RunLimits};
+use crate::profile::protocol::Timed;
+use anyhow::Result;
+use ash::vk;
+
+/// Bytes per pixel of each per-pixel binding: pixels (3 vec4), output (1 vec4), extras (2 vec4).
+const PIXEL_BYTES: u64 = 48;
+const OUT_BYTES: u64 = 16;
+const EXTRA_BYTES: u64 = 32;
+
+/// One kernel's buffers.
+pub struct KernelBuffers<'g> {
+    pixels: Buffer<'g>,
+    radiance: Buffer<'g>,
+    extras: Buffer<'g>,
+    table: Buffer<'g>,
+    /// Pixels shaded (before padding).
+    pub count: u64,
+    chunks: ChunkPlan,
+}
+
+/// The scene uploaded.
+pub struct SceneWork<'g> {
+    lights: Buffer<'g>,
+    pub kernels: Vec<KernelBuffers<'g>>,
+    camera: [f32; 4],
+}
+
+/// E tables for the kernels that compile energy compensation in (None for the others).
+pub fn e_tables(gpu: &Gpu, plan: &ScenePlan) -> Result<Vec<Option<ETable>>> {
+    plan.kernels.iter().map(|k| (k.switches.energy != 0).then(|| effects::e_table(gpu, &k.spec)).transpose()).collect()
+}
+
+impl<'g> SceneWork<'g> {
+    pub fn upload(gpu: &'g Gpu, scene: &Scene, gbuffer: &GBuffer, plan: &ScenePlan, tables: &[Option<ETable>], limits: RunLimits) -> Result<Self> {
+        let wg = crate::gpu::WORKGROUP as u64;
+        let mut kernels = Vec::new();
+        for (k, kp) in plan.kernels.iter().enumerate() {
+            let n = kp.pixels.len() as u64;
+            let padded = n.div_ceil(wg).max(1) * wg;
+            let mut data: Vec<f32> = Vec::with_capacity(padded as usize * 12);
+            for &i in &kp.pixels {
+                let p = &gbuffer.pixels[i as usize];
+                let (nn, pos, b) = (p.normal, p.position, p.base_colour);
+                data.extend_from_slice(&[nn[0], nn[1], nn[2], p.roughness, pos[0], pos[1], pos[2], p.metallic, b[0], b[1], b[2], 0.0]);
+            }
+            let mut extras = plan.extras(scene, gbuffer, k);
+            for _ in n..padded {
+                let last = data[data.len() - 12..].to_vec();
+                data.extend_from_slice(&last);
+                let last = extras[extras.len() - 8..].to_vec();
+                extras.extend_from_slice(&last);
+            }
+            let table: &[f32] = tables[k].as_ref().map_or(&[1.0; 4], |t| &t.values);
+            kernels.push(KernelBuffers {
+                pixels: Buffer::with_data(gpu, bytemuck::cast_slice(&data), MemoryKind::Device)?,
+                radiance: Buffer::new(gpu, padded * OUT_BYTES, MemoryKind::Device)?,
+                extras: Buffer::with_data(gpu, bytemuck::cast_slice(&extras), MemoryKind::Device)?,
+                table: Buffer::with_data(gpu, bytemuck::cast_slice(table), MemoryKind::Device)?,
+                count: n,
+                chunks: ChunkPlan::new(&gpu.info, padded, &[PIXEL_BYTES, OUT_BYTES, EXTRA_BYTES], limits.max_chunk),
+            });
+        }
+        let light_data: &[f32] = if plan.light_data.is_empty() { &[0.0; 12] } else { &plan.light_data };
+        let c = gbuffer.camera.position;
+        Ok(SceneWork { lights: Buffer::with_data(gpu, bytemuck::cast_slice(light_data), MemoryKind::Device)?, kernels, camera: [c[0], c[1], c[2], 0.0] })
+    }
+
+    /// Pixels shaded in all kernels together.
+    pub fn pixels(&self) -> u64 {
+        self.kernels.iter().map(|k| k.count).sum()
+    }
+
+    /// Dispatches per run of kernel `k`.
+    pub fn chunks(&self, k: usize) -> usize {
+        self.kernels[k].chunks.chunks.len()
+    }
+
+    /// Radiance written by kernel `k`'s last run, one rgb per pixel of the kernel.
+    pub fn radiance(&self, k: usize) -> Result<Vec<[f32; 3]>> {
+        let kb = &self.kernels[k];
+        let v: Vec<f32> = kb.radiance.read_as(0, kb.count as usize * 4)?;
+        Ok(v.chunks_exact(4).map(|c| [c[0], c[1], c[2]]).collect())
+    }
+}
+
+/// Kernel `k` of a plan compiled with `switches`, bound to the uploaded scene.
+pub struct SceneVariant<'g> {
+    pub label: String,
+    pub kernel_index: usize,
+    pub switches: Switches,
+    kernel: Kernel<'g>,
+    sets: Vec<(vk::DescriptorSet, u64)>,
+    push: [u8; 16],
+}
+
+impl<'g> SceneVariant<'g> {
+    pub fn new(gpu: &'g Gpu, work: &SceneWork<'g>, plan: &ScenePlan, k: usize, switches: Switches, label: String) -> Result<Self> {
+        let spec = &plan.kernels[k].spec;
+        kernels::check_support(gpu, spec)?;
+        let kernel = Kernel::new(gpu, kernels::source_for("scene", spec.precision), &plan.constants(k, switches), 5, 16)?;
+        let kb = &work.kernels[k];
+        let sets = kb
+            .chunks
+            .chunks
+            .iter()
+            .map(|&(first, len)| {
+                let set = kernel.bind(&[
+                    (&kb.pixels, first * PIXEL_BYTES, len * PIXEL_BYTES),
+                    (&kb.radiance, first * OUT_BYTES, len * OUT_BYTES),
+                    (&work.lights, 0, work.lights.size),
+                    (&kb.extras, first * EXTRA_BYTES, len * EXTRA_BYTES),
+                    (&kb.table, 0, kb.table.size),
+                ])?;
+                Ok((set, len))
+            })
+            .collect::<Result<Vec<_>>>()?;
+        Ok(SceneVariant { label, kernel_index: k, switches, kernel, sets, push: bytemuck::cast(work.camera) })
+    }
+
+    /// Runs the variant once and waits.
+    pub fn run(&self, gpu: &Gpu) -> Result<()> {
+        gpu.submit(|cmd| self.record(cmd))
+    }
+}
+
+impl Timed for SceneVariant<'_> {
+    fn record(&self, cmd: vk::CommandBuffer) {
+        for &(set, len) in &self.sets {
+            self.kernel.dispatch(cmd, set, &self.push, len);
+        }
+    }
+}
+
+/// Shades the whole G-buffer (every kernel of the plan, as compiled) and returns the radiance per G-buffer
+/// pixel, row-major; pixels no surface covers get `background`.
+pub fn shade(gpu: &Gpu, scene: &Scene, gbuffer: &GBuffer, plan: &ScenePlan, tables: &[Option<ETable>], limits: RunLimits) -> Result<Vec<[f32; 3]>> {
+    plan.check_device(&gpu.info)?;
+    let work = SceneWork::upload(gpu, scene, gbuffer, plan, tables, limits)?;
+    let bg = scene.file.render.background;
+    let mut out = vec![bg; gbuffer.pixel_count()];
+    for (k, kp) in plan.kernels.iter().enumerate() {
+        let variant = SceneVariant::new(gpu, &work, plan, k, kp.switches, kp.spec.name())?;
+        variant.run(gpu)?;
+        for (&i, rgb) in kp.pixels.iter().zip(work.radiance(k)?) {
+            out[i as usize] = rgb;
+        }
+    }
+    Ok(out)
+}
