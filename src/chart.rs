@@ -57,70 +57,104 @@ pub struct Point {
 }
 
 /// Scatter of labelled points on a log y axis, with a polyline (the Pareto frontier) drawn through `line`.
-/// Points whose y is not finite (a spec that overflowed) are pinned to the top edge and labelled so.
-pub fn scatter_log_y(path: &Path, title: &str, x_desc: &str, y_desc: &str, points: &[Point], line: &[(f64, f64)], legend: &[(usize, String)]) -> Result<()> {
+/// Points whose y is not finite (a spec that overflowed) are pinned to the top edge and labelled so. Points
+/// far to the right of the rest (`split_x`: beyond it) go to a narrow side panel, so that the main panel keeps
+/// its resolution; labels are placed greedily where they overlap no other label.
+#[allow(clippy::too_many_arguments)]
+pub fn scatter_log_y(path: &Path, title: &str, x_desc: &str, y_desc: &str, points: &[Point], line: &[(f64, f64)], legend: &[(usize, String)], split_x: Option<f64>) -> Result<()> {
     let (w, h) = (2400u32, 1600u32);
     let y_floor = 1e-8;
     let finite: Vec<&Point> = points.iter().filter(|p| p.x.is_finite() && p.y.is_finite()).collect();
     if finite.is_empty() {
         return Err(anyhow!("chart {}: no point with finite coordinates", path.display()));
     }
-    let xs = points.iter().map(|p| p.x).filter(|x| x.is_finite());
     let ys = finite.iter().map(|p| p.y.max(y_floor));
-    let (x0, x1) = (xs.clone().fold(f64::INFINITY, f64::min), xs.fold(f64::NEG_INFINITY, f64::max));
-    let (y0, y1) = (ys.clone().fold(f64::INFINITY, f64::min), ys.fold(f64::NEG_INFINITY, f64::max));
-    let pad = (x1 - x0).max(1e-3) * 0.06;
-    let (x0, x1) = (x0 - pad, x1 + pad * 3.0);
-    let (y0, y1) = (y0 / 3.0, y1 * 3.0);
+    let (y0, y1) = (ys.clone().fold(f64::INFINITY, f64::min) / 3.0, ys.fold(f64::NEG_INFINITY, f64::max) * 3.0);
     let pinned: Vec<Point> = points
         .iter()
         .filter(|p| p.x.is_finite())
-        .map(|p| if p.y.is_finite() { Point { x: p.x, y: p.y, label: p.label.clone(), group: p.group } } else { Point { x: p.x, y: y1 / 1.5, label: format!("{} (non-finite)", p.label), group: p.group } })
+        .map(|p| {
+            let (y, label) = if p.y.is_finite() { (p.y.max(y_floor), p.label.clone()) } else { (y1 / 1.5, format!("{} (non-finite)", p.label)) };
+            Point { x: p.x, y, label, group: p.group }
+        })
         .collect();
-    let points = &pinned[..];
+    let split = split_x.filter(|s| pinned.iter().any(|p| p.x > *s));
+    let (main_pts, side_pts): (Vec<&Point>, Vec<&Point>) = pinned.iter().partition(|p| split.is_none_or(|s| p.x <= s));
+    let x_range = |pts: &[&Point]| {
+        let (lo, hi) = pts.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| (lo.min(p.x), hi.max(p.x)));
+        let pad = (hi - lo).max(1e-3) * 0.04;
+        (lo - pad, hi + pad * 6.0)
+    };
     render(path, w, h, |root| {
         let err = |e: &dyn std::fmt::Display| anyhow!("chart: {e}");
-        let mut chart = ChartBuilder::on(root)
-            .caption(title, (FONT, 34))
-            .margin(30)
-            .x_label_area_size(70)
-            .y_label_area_size(110)
-            .build_cartesian_2d(x0..x1, (y0..y1).log_scale())
-            .map_err(|e| err(&e))?;
-        chart
-            .configure_mesh()
-            .x_desc(x_desc)
-            .y_desc(y_desc)
-            .axis_desc_style((FONT, 24))
-            .label_style((FONT, 20))
-            .draw()
-            .map_err(|e| err(&e))?;
-        chart
-            .draw_series(LineSeries::new(line.iter().map(|&(x, y)| (x, y.max(y_floor))), RED.stroke_width(3)))
-            .map_err(|e| err(&e))?
-            .label("Pareto frontier")
-            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 30, y)], RED.stroke_width(3)));
-        for (group, name) in legend {
-            let colour = palette(*group);
+        let root = root.titled(title, (FONT, 34)).map_err(|e| err(&e))?;
+        let areas: Vec<_> = if side_pts.is_empty() { vec![root.clone()] } else {
+            let (left, right) = root.split_horizontally((w as f64 * 0.8) as u32);
+            vec![left, right]
+        };
+        let mut placed: Vec<(i32, i32, i32, i32)> = Vec::new();
+        for (k, area) in areas.iter().enumerate() {
+            let pts = if k == 0 { &main_pts } else { &side_pts };
+            let (x0, x1) = x_range(pts);
+            let mut chart = ChartBuilder::on(area)
+                .margin(30)
+                .x_label_area_size(70)
+                .y_label_area_size(if k == 0 { 110 } else { 20 })
+                .build_cartesian_2d(x0..x1, (y0..y1).log_scale())
+                .map_err(|e| err(&e))?;
             chart
-                .draw_series(points.iter().filter(|p| p.group == *group).map(|p| Circle::new((p.x, p.y.max(y_floor)), 7, colour.filled())))
-                .map_err(|e| err(&e))?
-                .label(name.clone())
-                .legend(move |(x, y)| Circle::new((x + 15, y), 7, colour.filled()));
+                .configure_mesh()
+                .x_desc(if k == 0 { x_desc } else { "" })
+                .y_desc(if k == 0 { y_desc } else { "" })
+                .y_label_formatter(&|y| format!("{y:.0e}"))
+                .axis_desc_style((FONT, 24))
+                .label_style((FONT, 20))
+                .draw()
+                .map_err(|e| err(&e))?;
+            if k == 0 {
+                chart
+                    .draw_series(LineSeries::new(line.iter().map(|&(x, y)| (x, y.max(y_floor))), RED.stroke_width(3)))
+                    .map_err(|e| err(&e))?
+                    .label("Pareto frontier")
+                    .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 30, y)], RED.stroke_width(3)));
+            }
+            for (group, name) in legend {
+                let colour = palette(*group);
+                let series = chart
+                    .draw_series(pts.iter().filter(|p| p.group == *group).map(|p| Circle::new((p.x, p.y), 7, colour.filled())))
+                    .map_err(|e| err(&e))?;
+                if k == 0 {
+                    series.label(name.clone()).legend(move |(x, y)| Circle::new((x + 15, y), 7, colour.filled()));
+                }
+            }
+            // Greedy labels: the first candidate offset whose box overlaps no placed label (and no point).
+            let (char_w, text_h) = (8, 16);
+            let mut order: Vec<&&Point> = pts.iter().collect();
+            order.sort_by(|a, b| b.y.total_cmp(&a.y));
+            for p in order {
+                let (px, py) = chart.backend_coord(&(p.x, p.y));
+                let width = char_w * p.label.chars().count() as i32;
+                let candidates = [(10, -8), (10, 10), (10, -26), (10, 28), (-10 - width, -8), (-10 - width, 10), (10, -44), (10, 46), (-10 - width, -26), (-10 - width, 28)];
+                let free = |(dx, dy): (i32, i32)| {
+                    let bx = (px + dx, py + dy - text_h / 2, px + dx + width, py + dy + text_h / 2);
+                    !placed.iter().any(|b| bx.0 < b.2 && b.0 < bx.2 && bx.1 < b.3 && b.1 < bx.3)
+                };
+                let (dx, dy) = candidates.iter().copied().find(|c| free(*c)).unwrap_or(candidates[0]);
+                placed.push((px + dx, py + dy - text_h / 2, px + dx + width, py + dy + text_h / 2));
+                area.draw(&Text::new(p.label.clone(), (px + dx - area.get_base_pixel().0, py + dy - text_h / 2 - area.get_base_pixel().1), (FONT, 15).into_font().color(&palette(p.group).mix(0.95))))
+                    .map_err(|e| err(&e))?;
+            }
+            if k == 0 {
+                chart
+                    .configure_series_labels()
+                    .position(SeriesLabelPosition::UpperRight)
+                    .label_font((FONT, 22))
+                    .background_style(WHITE.mix(0.85))
+                    .border_style(BLACK)
+                    .draw()
+                    .map_err(|e| err(&e))?;
+            }
         }
-        chart
-            .draw_series(points.iter().map(|p| {
-                EmptyElement::at((p.x, p.y.max(y_floor))) + Text::new(p.label.clone(), (10, -8), (FONT, 15).into_font().color(&palette(p.group).mix(0.95)))
-            }))
-            .map_err(|e| err(&e))?;
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .label_font((FONT, 22))
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()
-            .map_err(|e| err(&e))?;
         Ok(())
     })
 }
@@ -198,7 +232,7 @@ mod tests {
             Point { x: 1.5, y: f64::NAN, label: "c".into(), group: 1 },
         ];
         let path = dir.path().join("s.png");
-        scatter_log_y(&path, "t", "x", "y", &points, &[(1.0, 0.1)], &[(0, "g".into())]).unwrap();
+        scatter_log_y(&path, "t", "x", "y", &points, &[(1.0, 0.1)], &[(0, "g".into())], Some(1.8)).unwrap();
         assert!(image::open(&path).is_ok());
     }
 }

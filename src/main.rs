@@ -78,6 +78,10 @@ struct TimingArgs {
     /// Seed of the interleaving order.
     #[arg(long, default_value_t = 1)]
     seed: u64,
+    /// Independently compiled pipelines per kernel, all timed every round (the faster counts): guards against
+    /// one JIT compilation landing badly placed, seen to double a kernel's time on lavapipe.
+    #[arg(long, default_value_t = 2)]
+    instances: usize,
 }
 
 impl TimingArgs {
@@ -101,6 +105,7 @@ impl TimingArgs {
             },
             target_rel_ci: target_ci,
             max_chunk: None,
+            instances: self.instances.max(1),
         })
     }
 }
@@ -391,7 +396,7 @@ fn run(cli: Cli) -> Result<ExitCode> {
             let path = json.unwrap_or_else(|| PathBuf::from(format!("results/profile-{}.json", report::device_slug(&gpu.info))));
             report::write_json(&path, &result)?;
             println!("{}\n", result.summary());
-            print!("{}", result.table().markdown());
+            print!("{}{}", result.table().markdown(), result.placement_notes());
             println!("\nJSON: {}", path.display());
             Ok(ExitCode::SUCCESS)
         }

@@ -3,7 +3,7 @@
 //! of error against cost with the Pareto frontier.
 
 use crate::accuracy::{self, Accuracy, ExactCache, SampleSet};
-use crate::brdf::{Metal, ModelSpec, Precision, D, F, THESIS_MODELS};
+use crate::brdf::{Metal, ModelSpec, Precision, Vis, D, F, THESIS_MODELS};
 use crate::chart::{self, Point};
 use crate::gpu::Gpu;
 use crate::profile::{self, ProfileOptions, ProfileReport};
@@ -15,7 +15,9 @@ use serde::Serialize;
 use std::path::Path;
 
 /// The default set: every D with each of its sensible visibility terms and Schlick's Fresnel; every Fresnel
-/// term on the `ggx` preset; the thesis models in fp16.
+/// term on the `ggx` preset; the exact physical models where the library has their exact Smith term (GGX,
+/// Beckmann: exact height-correlated Smith and exact dielectric Fresnel), which anchor the frontier at zero
+/// approximation error; the thesis models in fp16.
 pub fn default_specs() -> Vec<ModelSpec> {
     let mut specs: Vec<ModelSpec> = Vec::new();
     let mut push = |s: ModelSpec| {
@@ -35,6 +37,8 @@ pub fn default_specs() -> Vec<ModelSpec> {
             push(ModelSpec { f, metal, ..ggx });
         }
     }
+    push(ModelSpec::new(D::Ggx, Vis::SmithGgxCorrelated, F::Dielectric));
+    push(ModelSpec::new(D::Beckmann, Vis::SmithBeckmannCorrelated, F::Dielectric));
     for name in THESIS_MODELS {
         push(ModelSpec { precision: Precision::F16, ..ModelSpec::preset(name).unwrap() });
     }
@@ -83,7 +87,7 @@ pub struct SweepRow {
 #[derive(Clone, Debug, Serialize)]
 pub struct SweepReport {
     pub fastest: String,
-    /// Rows sorted by median cost.
+    /// Rows sorted by rank, then median cost.
     pub rows: Vec<SweepRow>,
     pub sample_set: String,
     pub profile: ProfileReport,
@@ -137,7 +141,7 @@ pub fn run(gpu: &Gpu, options: &SweepOptions, progress: &ProgressBar) -> Result<
         row.rank = 1 + cis.iter().filter(|c| c.hi < cis[k].lo).count();
         row.tied = cis.iter().enumerate().any(|(j, c)| j != k && c.overlaps(&cis[k]));
     }
-    rows.sort_by(|a, b| a.cost_vs_fastest.median.total_cmp(&b.cost_vs_fastest.median));
+    rows.sort_by(|a, b| a.rank.cmp(&b.rank).then(a.cost_vs_fastest.median.total_cmp(&b.cost_vs_fastest.median)));
     Ok(SweepReport {
         fastest: specs[fastest].1.name(),
         rows,
@@ -178,12 +182,13 @@ impl SweepReport {
              cannot be told apart. Errors are relative errors |x - ref| / max(|ref|, 1e-3) over the sample set ({}); numerical: \
              GPU against the same formula in f64; vs exact: GPU against the exact physical model (same D, exact height-correlated \
              Smith G2, exact Fresnel); albedo: max |E_gpu - E_exact| over the albedo cells. Pareto: no spec is both cheaper and \
-             more accurate (RMS vs exact).\n\n{}",
+             more accurate (RMS vs exact).\n\n{}{}",
             self.profile.summary(),
             self.fastest,
             self.profile.rounds,
             self.sample_set,
-            self.table().markdown()
+            self.table().markdown(),
+            self.profile.placement_notes()
         )
     }
 
@@ -203,6 +208,13 @@ impl SweepReport {
         front.sort_by(|a, b| a.0.total_cmp(&b.0));
         let mut legend: Vec<(usize, String)> = D::ALL.iter().map(|d| (*d as usize, format!("D = {}", d.name()))).collect();
         legend.push((D::ALL.len(), "fp16".into()));
+        // fp16 (and anything beyond the costliest fp32 spec) goes to the side panel.
+        let split = self
+            .rows
+            .iter()
+            .filter(|r| !r.canonical.contains("precision=f16"))
+            .map(|r| r.cost_vs_fastest.median)
+            .fold(f64::NEG_INFINITY, f64::max);
         chart::scatter_log_y(
             path,
             &format!("Accuracy against cost on {} ({} evaluations per dispatch)", self.profile.provenance.device.name, self.profile.workload.evaluations_per_dispatch),
@@ -211,6 +223,7 @@ impl SweepReport {
             &points,
             &front,
             &legend,
+            Some(split * 1.02),
         )
     }
 }
@@ -218,7 +231,6 @@ impl SweepReport {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::brdf::Vis;
 
     #[test]
     fn default_sweep_covers_every_term() {

@@ -71,3 +71,37 @@ fn default_profile_is_fast_resolved_and_repeatable() {
         }
     }
 }
+
+/// The protocol times every instance of a variant each round and keeps the faster: a variant whose second
+/// instance does the work twice shows an instance spread near 2, and its times are the single-work instance's.
+#[test]
+fn protocol_keeps_the_faster_instance_and_reports_the_spread() {
+    use brdfprof::profile::gbuffer;
+    use brdfprof::profile::protocol::{self, ProtocolOptions, Timed, Variant, Workload};
+
+    struct Uneven<'g>(Variant<'g>);
+    impl Timed for Uneven<'_> {
+        fn instances(&self) -> usize {
+            2
+        }
+        fn record(&self, cmd: ash::vk::CommandBuffer, instance: usize) {
+            for _ in 0..=instance {
+                self.0.record(cmd, 0);
+            }
+        }
+    }
+
+    let gpu = common::gpu();
+    let work = Workload::upload(&gpu, &gbuffer::synthetic(256, 256), &gbuffer::lights(8), None).unwrap();
+    let ggx = brdfprof::brdf::ModelSpec::preset("ggx").unwrap();
+    let variants = [Uneven(Variant::new(&gpu, &work, Some(&ggx), 1).unwrap())];
+    let options = ProtocolOptions { min_rounds: 9, max_rounds: 9, reps: 3, budget: std::time::Duration::from_secs(60), seed: 3 };
+    let raw = protocol::measure(&gpu, &variants, &options, |_| false, |_| {}).unwrap();
+    let spread = raw.instance_spread(0);
+    assert!(spread > 1.5 && spread < 2.6, "twice the work should be about twice the time: {spread}");
+    for (round, kept) in raw.ns[0].iter().enumerate() {
+        let medians = &raw.instance_ns[0][round];
+        assert_eq!(brdfprof::stats::median(kept), medians[0].min(medians[1]), "round {round} keeps the faster instance");
+    }
+    common::assert_no_validation_messages(&gpu);
+}

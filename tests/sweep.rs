@@ -39,7 +39,9 @@ fn small_sweep_is_consistent() {
         let tied = rows.iter().enumerate().any(|(j, o)| j != i && get(o, "lo") <= get(r, "hi") && get(r, "lo") <= get(o, "hi"));
         assert_eq!(r["tied"].as_bool().unwrap(), tied);
         if i > 0 {
-            assert!(get(&rows[i - 1], "median") <= get(r, "median"), "rows sorted by cost");
+            let prev = &rows[i - 1];
+            let key = |r: &Value| (r["rank"].as_u64().unwrap(), get(r, "median"));
+            assert!(key(prev).0 < key(r).0 || key(prev).0 == key(r).0 && key(prev).1 <= key(r).1, "rows sorted by rank, then cost");
         }
     }
     let row = |name: &str| rows.iter().find(|r| r["spec"] == name).unwrap();

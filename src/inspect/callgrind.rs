@@ -15,7 +15,7 @@ use super::glsl::KernelSet;
 use crate::brdf::ModelSpec;
 use crate::gpu::{Gpu, GpuOptions};
 use crate::profile::gbuffer;
-use crate::profile::protocol::{Variant, Workload};
+use crate::profile::protocol::{Timed, Variant, Workload};
 use anyhow::{anyhow, bail, Context, Result};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -130,12 +130,12 @@ pub fn child_main(request_json: &str) -> Result<()> {
     let mut labels = Vec::new();
     for (i, spec) in all.into_iter().enumerate() {
         let source = kernels.shade(crate::profile::protocol::shade_model(spec).precision)?;
-        let variant = Variant::with_source(&gpu, &work, spec, source)?;
-        variant.warm_up(&gpu)?; // JIT compilation, not counted
+        let variant = Variant::with_source(&gpu, &work, spec, source, 1)?;
+        variant.run_once(&gpu, 0)?; // JIT compilation, not counted
         let label = format!("{DUMP_LABEL}{i}\0");
         client_request(0, request::START_INSTRUMENTATION, 0);
         client_request(0, request::ZERO_STATS, 0);
-        variant.warm_up(&gpu)?;
+        variant.run_once(&gpu, 0)?;
         client_request(0, request::DUMP_STATS_AT, label.as_ptr() as usize);
         client_request(0, request::STOP_INSTRUMENTATION, 0);
         labels.push(label.trim_end_matches('\0').to_string());

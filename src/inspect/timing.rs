@@ -76,7 +76,7 @@ pub fn run(gpu: &Gpu, kernels: &KernelSet, specs: &[ModelSpec], options: &Timing
     all.push(None);
     let variants = all
         .iter()
-        .map(|s| Variant::with_source(gpu, &work, *s, kernels.shade(shade_model(*s).precision)?))
+        .map(|s| Variant::with_source(gpu, &work, *s, kernels.shade(shade_model(*s).precision)?, 1))
         .collect::<Result<Vec<_>>>()?;
     let protocol_options = ProtocolOptions {
         min_rounds: options.rounds,

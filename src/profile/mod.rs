@@ -30,6 +30,9 @@ pub struct ProfileOptions {
     /// net ratio below twice it).
     pub target_rel_ci: f64,
     pub max_chunk: Option<u64>,
+    /// Independently compiled pipelines per kernel, all timed every round; the faster one's time counts
+    /// (see `protocol::Variant`).
+    pub instances: usize,
 }
 
 /// One row of the table.
@@ -46,6 +49,8 @@ pub struct Row {
     pub net_ns_per_eval: Option<Estimate>,
     /// (cost - baseline) / (reference cost - baseline), per round.
     pub net_vs_reference: Option<Estimate>,
+    /// Median over rounds of slowest / fastest instance: how much JIT code placement alone moved this kernel.
+    pub instance_spread: f64,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -66,6 +71,8 @@ pub struct ProfileReport {
     pub workload: WorkloadSize,
     pub rounds: usize,
     pub reps_per_round: usize,
+    /// Pipelines per kernel (see `ProfileOptions::instances`).
+    pub instances: usize,
     pub confidence_level: f64,
     pub rows: Vec<Row>,
     /// Labels of the variants, indexing `raw.ns`.
@@ -104,6 +111,7 @@ pub fn analyse(raw: &RawTimes, labels: &[String], specs: &[Option<ModelSpec>], e
                 vs_reference: stats::median_ci(&ratio, LEVEL),
                 net_ns_per_eval: net,
                 net_vs_reference: net_ratio,
+                instance_spread: raw.instance_spread(i),
             }
         })
         .collect()
@@ -132,7 +140,7 @@ pub fn run(gpu: &Gpu, options: &ProfileOptions, progress: &ProgressBar) -> Resul
     let mut specs: Vec<Option<ModelSpec>> = models.iter().copied().map(Some).collect();
     specs.push(None);
     progress.set_message("compiling kernels");
-    let variants = specs.iter().map(|s| Variant::new(gpu, &work, s.as_ref())).collect::<Result<Vec<_>>>()?;
+    let variants = specs.iter().map(|s| Variant::new(gpu, &work, s.as_ref(), options.instances)).collect::<Result<Vec<_>>>()?;
     let labels: Vec<String> = variants.iter().map(|v| v.label.clone()).collect();
     let reference = models.iter().position(|m| *m == reference_spec).unwrap();
     let baseline = Some(variants.len() - 1);
@@ -163,6 +171,7 @@ pub fn run(gpu: &Gpu, options: &ProfileOptions, progress: &ProgressBar) -> Resul
         },
         rounds: raw.rounds(),
         reps_per_round: options.protocol.reps,
+        instances: options.instances,
         confidence_level: LEVEL,
         rows,
         labels,
@@ -194,11 +203,21 @@ impl ProfileReport {
         t
     }
 
+    /// A line per kernel whose independently compiled pipelines differed by more than 10% (code placement):
+    /// its figures are the faster pipeline's.
+    pub fn placement_notes(&self) -> String {
+        self.rows
+            .iter()
+            .filter(|r| r.instance_spread > 1.10)
+            .map(|r| format!("note: {}'s {} pipelines differed by {:.0}% (median over rounds); its figures are the faster one's\n", r.model, self.instances, (r.instance_spread - 1.0) * 100.0))
+            .collect()
+    }
+
     /// One line saying what was measured.
     pub fn summary(&self) -> String {
         let w = &self.workload;
         format!(
-            "{} ({}, {}); {}x{} pixels x {} lights = {} evaluations per dispatch; {} rounds x {} reps, interleaved; {:.0} s",
+            "{} ({}, {}); {}x{} pixels x {} lights = {} evaluations per dispatch; {} rounds x {} reps x {} pipelines per kernel, interleaved; {:.0} s",
             self.provenance.device.name,
             self.provenance.device.driver_name,
             self.provenance.device.driver_info,
@@ -208,6 +227,7 @@ impl ProfileReport {
             w.evaluations_per_dispatch,
             self.rounds,
             self.reps_per_round,
+            self.instances,
             self.raw.elapsed_s
         )
     }

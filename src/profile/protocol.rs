@@ -65,13 +65,14 @@ impl<'g> Workload<'g> {
     }
 }
 
-/// A kernel bound to the workload, ready to dispatch.
+/// A kernel bound to the workload, ready to dispatch, compiled as one or more independent pipelines
+/// (instances): on lavapipe the same kernel JIT-compiled twice has been seen to run 2x slower in every round of
+/// one process (code placement), and only a second pipeline exposes that.
 pub struct Variant<'g> {
     pub label: String,
     /// None for the memory-only baseline.
     pub spec: Option<ModelSpec>,
-    kernel: Kernel<'g>,
-    sets: Vec<(vk::DescriptorSet, u64)>,
+    instances: Vec<(Kernel<'g>, Vec<(vk::DescriptorSet, u64)>)>,
 }
 
 /// Constant ids of glsl/shade.comp beyond the term selectors.
@@ -90,49 +91,42 @@ pub fn shade_constants(spec: Option<&ModelSpec>, lights: u32) -> SpecConstants {
 }
 
 impl<'g> Variant<'g> {
-    /// The shading kernel for `spec`, or the memory-only baseline when `spec` is None.
-    pub fn new(gpu: &'g Gpu, work: &Workload<'g>, spec: Option<&ModelSpec>) -> Result<Self> {
+    /// The shading kernel for `spec`, or the memory-only baseline when `spec` is None, as `instances`
+    /// independent pipelines.
+    pub fn new(gpu: &'g Gpu, work: &Workload<'g>, spec: Option<&ModelSpec>, instances: usize) -> Result<Self> {
         let source = kernels::source_for("shade", shade_model(spec).precision);
-        Self::with_source(gpu, work, spec, source)
+        Self::with_source(gpu, work, spec, source, instances)
     }
 
     /// As `new`, with the shading kernel's SPIR-V from `source` (e.g. compiled at run time from another
     /// GLSL directory) instead of the embedded one.
-    pub fn with_source(gpu: &'g Gpu, work: &Workload<'g>, spec: Option<&ModelSpec>, source: &KernelSource) -> Result<Self> {
+    pub fn with_source(gpu: &'g Gpu, work: &Workload<'g>, spec: Option<&ModelSpec>, source: &KernelSource, instances: usize) -> Result<Self> {
         if let Some(s) = spec {
             kernels::check_support(gpu, s)?;
         }
         let constants = shade_constants(spec, work.light_count);
-        let kernel = Kernel::new(gpu, source, &constants, 3, 0)?;
         let stride_in = (PIXEL_FLOATS * 4) as u64;
         let lights_bytes = work.lights.size;
-        let sets = work
-            .plan
-            .chunks
-            .iter()
-            .map(|&(first, len)| {
-                let set = kernel.bind(&[
-                    (&work.pixels, first * stride_in, len * stride_in),
-                    (&work.radiance, first * 16, len * 16),
-                    (&work.lights, 0, lights_bytes),
-                ])?;
-                Ok((set, len))
+        let instances = (0..instances.max(1))
+            .map(|_| {
+                let kernel = Kernel::new(gpu, source, &constants, 3, 0)?;
+                let sets = work
+                    .plan
+                    .chunks
+                    .iter()
+                    .map(|&(first, len)| {
+                        let set = kernel.bind(&[
+                            (&work.pixels, first * stride_in, len * stride_in),
+                            (&work.radiance, first * 16, len * 16),
+                            (&work.lights, 0, lights_bytes),
+                        ])?;
+                        Ok((set, len))
+                    })
+                    .collect::<Result<Vec<_>>>()?;
+                Ok((kernel, sets))
             })
             .collect::<Result<Vec<_>>>()?;
-        Ok(Variant { label: spec.map_or_else(|| "baseline".to_string(), |s| s.name()), spec: spec.copied(), kernel, sets })
-    }
-
-    fn record(&self, cmd: vk::CommandBuffer) {
-        for &(set, len) in &self.sets {
-            self.kernel.dispatch(cmd, set, &[], len);
-        }
-    }
-
-    /// One untimed dispatch, then wait: compiles the pipeline on drivers that compile lazily.
-    pub fn warm_up(&self, gpu: &Gpu) -> Result<Duration> {
-        let start = Instant::now();
-        gpu.submit(|cmd| self.record(cmd))?;
-        Ok(start.elapsed())
+        Ok(Variant { label: spec.map_or_else(|| "baseline".to_string(), |s| s.name()), spec: spec.copied(), instances })
     }
 }
 
@@ -150,11 +144,14 @@ pub struct ProtocolOptions {
 /// Every timed dispatch, as measured.
 #[derive(Clone, Debug, Default, Serialize)]
 pub struct RawTimes {
-    /// ns[variant][round][rep]: dispatch time in nanoseconds.
+    /// ns[variant][round][rep]: dispatch time in nanoseconds, of the variant's faster instance that round.
     pub ns: Vec<Vec<Vec<f64>>>,
-    /// The variant order of every repetition of every round.
-    pub orders: Vec<Vec<Vec<usize>>>,
-    /// Wall time of each variant's untimed warm-up dispatch (includes JIT compilation).
+    /// instance_ns[variant][round][instance]: each instance's median over its repetitions (the spread between
+    /// instances is what code placement alone costs).
+    pub instance_ns: Vec<Vec<Vec<f64>>>,
+    /// The order of every repetition of every round, as (variant, instance) pairs.
+    pub orders: Vec<Vec<Vec<(usize, usize)>>>,
+    /// Wall time of each variant's first instance's untimed warm-up dispatch (includes JIT compilation).
     pub warmup_ms: Vec<f64>,
     pub elapsed_s: f64,
 }
@@ -162,6 +159,15 @@ pub struct RawTimes {
 impl RawTimes {
     pub fn rounds(&self) -> usize {
         self.orders.len()
+    }
+
+    /// Median over rounds of (slowest instance / fastest instance) of `variant`: 1 when its pipelines agree.
+    pub fn instance_spread(&self, variant: usize) -> f64 {
+        let spreads: Vec<f64> = self.instance_ns[variant]
+            .iter()
+            .map(|r| r.iter().copied().fold(f64::NEG_INFINITY, f64::max) / r.iter().copied().fold(f64::INFINITY, f64::min))
+            .collect();
+        if spreads.is_empty() { 1.0 } else { crate::stats::median(&spreads) }
     }
 }
 
@@ -175,17 +181,21 @@ pub fn measure<V: Timed>(
     mut on_round: impl FnMut(&RawTimes),
 ) -> Result<RawTimes> {
     let v = variants.len();
-    let mut raw = RawTimes { ns: vec![Vec::new(); v], ..Default::default() };
-    for variant in variants {
-        raw.warmup_ms.push(variant.warm_up(gpu)?.as_secs_f64() * 1e3);
+    let mut raw = RawTimes { ns: vec![Vec::new(); v], instance_ns: vec![Vec::new(); v], ..Default::default() };
+    let slots: Vec<(usize, usize)> = variants.iter().enumerate().flat_map(|(i, var)| (0..var.instances()).map(move |k| (i, k))).collect();
+    for &(i, k) in &slots {
+        let warm = variants[i].run_once(gpu, k)?;
+        if k == 0 {
+            raw.warmup_ms.push(warm.as_secs_f64() * 1e3);
+        }
     }
-    let timestamps = Timestamps::new(gpu, (2 * v * options.reps) as u32)?;
+    let timestamps = Timestamps::new(gpu, (2 * slots.len() * options.reps) as u32)?;
     let mut rng = rand_pcg::Pcg64::seed_from_u64(options.seed);
     let start = Instant::now();
     for round in 0..options.max_rounds {
-        let orders: Vec<Vec<usize>> = (0..options.reps)
+        let orders: Vec<Vec<(usize, usize)>> = (0..options.reps)
             .map(|_| {
-                let mut o: Vec<usize> = (0..v).collect();
+                let mut o = slots.clone();
                 o.shuffle(&mut rng);
                 o
             })
@@ -194,22 +204,27 @@ pub fn measure<V: Timed>(
         gpu.submit(|cmd| {
             timestamps.reset(cmd);
             for order in &orders {
-                for &i in order {
+                for &(i, k) in order {
                     let q = pairs.len() as u32 * 2;
                     gpu.barrier(cmd);
                     timestamps.write(cmd, q);
-                    variants[i].record(cmd);
+                    variants[i].record(cmd, k);
                     timestamps.write(cmd, q + 1);
                     pairs.push((q, q + 1));
                 }
             }
         })?;
         let times = timestamps.intervals_ns(&pairs)?;
-        for series in raw.ns.iter_mut() {
-            series.push(Vec::with_capacity(options.reps));
+        // Per variant: each instance's repetitions; keep the faster instance's (by median) for the round.
+        let mut by_slot: Vec<Vec<Vec<f64>>> = variants.iter().map(|var| vec![Vec::new(); var.instances()]).collect();
+        for (t, &(i, k)) in times.iter().zip(orders.iter().flatten()) {
+            by_slot[i][k].push(*t);
         }
-        for (k, &i) in orders.iter().flatten().enumerate() {
-            raw.ns[i][round].push(times[k]);
+        for (i, instances) in by_slot.into_iter().enumerate() {
+            let medians: Vec<f64> = instances.iter().map(|reps| crate::stats::median(reps)).collect();
+            let fastest = (0..medians.len()).min_by(|&a, &b| medians[a].total_cmp(&medians[b])).unwrap();
+            raw.ns[i].push(instances[fastest].clone());
+            raw.instance_ns[i].push(medians);
         }
         raw.orders.push(orders);
         raw.elapsed_s = start.elapsed().as_secs_f64();
@@ -222,20 +237,33 @@ pub fn measure<V: Timed>(
 }
 
 /// What the protocol can time: a variant that records its dispatches into a command buffer (the profile's
-/// `Variant`; the scene kernels of `scene::run`).
+/// `Variant`; the scene kernels of `scene::run`), as one or more independently compiled instances. `measure`
+/// warms every instance up untimed first (lavapipe compiles a pipeline at its first dispatch).
 pub trait Timed {
-    /// Records the variant's dispatches (no barriers or timestamps: `measure` adds those).
-    fn record(&self, cmd: vk::CommandBuffer);
-    /// One untimed run, then wait: compiles the pipeline on drivers that compile lazily.
-    fn warm_up(&self, gpu: &Gpu) -> Result<Duration> {
+    /// Independently compiled pipelines of the same kernel.
+    fn instances(&self) -> usize {
+        1
+    }
+    /// Records instance `instance`'s dispatches (no barriers or timestamps: `measure` adds those).
+    fn record(&self, cmd: vk::CommandBuffer, instance: usize);
+
+    /// One untimed run of `instance`, waited for; its wall time (on lavapipe the first includes compilation).
+    fn run_once(&self, gpu: &Gpu, instance: usize) -> Result<Duration> {
         let start = Instant::now();
-        gpu.submit(|cmd| self.record(cmd))?;
+        gpu.submit(|cmd| self.record(cmd, instance))?;
         Ok(start.elapsed())
     }
 }
 
 impl Timed for Variant<'_> {
-    fn record(&self, cmd: vk::CommandBuffer) {
-        Variant::record(self, cmd)
+    fn instances(&self) -> usize {
+        self.instances.len()
+    }
+
+    fn record(&self, cmd: vk::CommandBuffer, instance: usize) {
+        let (kernel, sets) = &self.instances[instance];
+        for &(set, len) in sets {
+            kernel.dispatch(cmd, set, &[], len);
+        }
     }
 }

@@ -131,12 +131,12 @@ impl<'g> SceneVariant<'g> {
 
     /// Runs the variant once and waits.
     pub fn run(&self, gpu: &Gpu) -> Result<()> {
-        gpu.submit(|cmd| self.record(cmd))
+        gpu.submit(|cmd| self.record(cmd, 0))
     }
 }
 
 impl Timed for SceneVariant<'_> {
-    fn record(&self, cmd: vk::CommandBuffer) {
+    fn record(&self, cmd: vk::CommandBuffer, _instance: usize) {
         for &(set, len) in &self.sets {
             self.kernel.dispatch(cmd, set, &self.push, len);
         }
