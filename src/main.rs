@@ -82,6 +82,9 @@ struct TimingArgs {
     /// one JIT compilation landing badly placed, seen to double a kernel's time on lavapipe.
     #[arg(long, default_value_t = 2)]
     instances: usize,
+    /// Keep Mesa's on-disk shader cache (timed runs switch it off by default; see `fresh_compilation`).
+    #[arg(long)]
+    shader_cache: bool,
 }
 
 impl TimingArgs {
@@ -312,6 +315,21 @@ struct CheckTimingArgs {
     /// G-buffer of the timing run, WIDTHxHEIGHT.
     #[arg(long, default_value = "960x540")]
     timing_size: String,
+    /// Keep Mesa's on-disk shader cache (timed runs switch it off by default; see `fresh_compilation`).
+    #[arg(long)]
+    shader_cache: bool,
+}
+
+/// Timed runs compile every pipeline afresh (MESA_SHADER_CACHE_DISABLE=true unless the user set it or asked
+/// to keep the cache): with Mesa's on-disk shader cache a process runs binaries an earlier process compiled,
+/// and on lavapipe that moved one scene effect's cost from 0.3 to 19 ns/pixel between runs, where fresh
+/// compilation gave the same figure run after run. The variable is recorded in every report's environment.
+fn fresh_compilation(keep_cache: bool) {
+    if !keep_cache && std::env::var_os("MESA_SHADER_CACHE_DISABLE").is_none() {
+        // SAFETY: called on the main thread before any other thread exists and before the Vulkan driver,
+        // which reads the variable, is loaded.
+        unsafe { std::env::set_var("MESA_SHADER_CACHE_DISABLE", "true") };
+    }
 }
 
 fn main() -> ExitCode {
@@ -346,9 +364,10 @@ fn run(cli: Cli) -> Result<ExitCode> {
             Ok(ExitCode::SUCCESS)
         }
         Command::Profile { scene: Some(path), timing, reps, budget, target_ci, json, device, .. } => {
+            fresh_compilation(timing.shader_cache);
             let scene = scene::Scene::load(&path)?;
-            let protocol = timing.options(Vec::new(), "1x1", reps, budget, target_ci)?.protocol;
-            let options = scene::profile::SceneProfileOptions { protocol, target_rel_ci: target_ci, max_chunk: None };
+            let base = timing.options(Vec::new(), "1x1", reps, budget, target_ci)?;
+            let options = scene::profile::SceneProfileOptions { protocol: base.protocol, target_rel_ci: target_ci, max_chunk: None, instances: base.instances };
             let gpu = device.open()?;
             let progress = progress_bar();
             let result = scene::profile::run(&gpu, &scene, &options, &progress);
@@ -386,6 +405,7 @@ fn run(cli: Cli) -> Result<ExitCode> {
             Ok(ExitCode::SUCCESS)
         }
         Command::Profile { model, timing, size, reps, budget, target_ci, json, device, scene: None } => {
+            fresh_compilation(timing.shader_cache);
             let options = timing.options(model.specs(&spec::THESIS_MODELS)?, &size, reps, budget, target_ci)?;
             let gpu = device.open()?;
             let progress = progress_bar();
@@ -401,6 +421,7 @@ fn run(cli: Cli) -> Result<ExitCode> {
             Ok(ExitCode::SUCCESS)
         }
         Command::Sweep { model, timing, size, reps, budget, target_ci, out, device } => {
+            fresh_compilation(timing.shader_cache);
             let models = if model.models.is_empty() { sweep::default_specs() } else { model.specs(&[])? };
             let options = sweep::SweepOptions { profile: timing.options(models, &size, reps, budget, target_ci)? };
             let gpu = device.open()?;
@@ -411,7 +432,7 @@ fn run(cli: Cli) -> Result<ExitCode> {
             gpu.check_validation()?;
             let stem = out.join(format!("sweep-{}", report::device_slug(&gpu.info)));
             let (md, json, png) = (stem.with_extension("md"), stem.with_extension("json"), stem.with_extension("png"));
-            report::write_json(&json, &result)?;
+            report::write_json_compact(&json, &result)?;
             io::write_atomic(&md, result.markdown().as_bytes())?;
             result.chart(&png)?;
             print!("{}", result.markdown());
@@ -476,6 +497,7 @@ fn run(cli: Cli) -> Result<ExitCode> {
             Ok(ExitCode::SUCCESS)
         }
         Command::Check { baseline, save_baseline, thresholds, force, model, inspect, timing, device } => {
+            fresh_compilation(timing.shader_cache);
             let (width, height) = parse_size(&timing.timing_size).map_err(|e| anyhow!("--timing-{}", e.to_string().trim_start_matches("--")))?;
             let options = CheckOptions {
                 baseline,

@@ -26,6 +26,8 @@ pub struct SceneProfileOptions {
     /// kernel's ns/pixel.
     pub target_rel_ci: f64,
     pub max_chunk: Option<u64>,
+    /// Independently compiled pipelines per variant, all timed every round; the faster one counts.
+    pub instances: usize,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -139,10 +141,10 @@ pub fn run(gpu: &Gpu, scene: &Scene, options: &SceneProfileOptions, progress: &P
     for (k, kp) in p.kernels.iter().enumerate() {
         let name = kp.spec.name();
         slots.push(Slot { kernel: k, without: None });
-        variants.push(SceneVariant::new(gpu, &work, &p, k, kp.switches, name.clone())?);
+        variants.push(SceneVariant::new(gpu, &work, &p, k, kp.switches, name.clone(), options.instances)?);
         for e in Effect::ALL.into_iter().filter(|e| e.is_on(&kp.switches)) {
             slots.push(Slot { kernel: k, without: Some(e) });
-            variants.push(SceneVariant::new(gpu, &work, &p, k, e.off(kp.switches), format!("{name} without {}", e.name()))?);
+            variants.push(SceneVariant::new(gpu, &work, &p, k, e.off(kp.switches), format!("{name} without {}", e.name()), options.instances)?);
         }
     }
     let labels: Vec<String> = variants.iter().map(|v| v.label.clone()).collect();

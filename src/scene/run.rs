@@ -95,38 +95,44 @@ impl<'g> SceneWork<'g> {
     }
 }
 
-/// Kernel `k` of a plan compiled with `switches`, bound to the uploaded scene.
+/// Kernel `k` of a plan compiled with `switches`, bound to the uploaded scene, as one or more independently
+/// compiled pipelines (see `profile::protocol::Variant`: on lavapipe one compilation of a kernel can land
+/// badly placed, and an effect's cost is a difference of two kernels, so it would take the whole error).
 pub struct SceneVariant<'g> {
     pub label: String,
     pub kernel_index: usize,
     pub switches: Switches,
-    kernel: Kernel<'g>,
-    sets: Vec<(vk::DescriptorSet, u64)>,
+    instances: Vec<(Kernel<'g>, Vec<(vk::DescriptorSet, u64)>)>,
     push: [u8; 16],
 }
 
 impl<'g> SceneVariant<'g> {
-    pub fn new(gpu: &'g Gpu, work: &SceneWork<'g>, plan: &ScenePlan, k: usize, switches: Switches, label: String) -> Result<Self> {
+    pub fn new(gpu: &'g Gpu, work: &SceneWork<'g>, plan: &ScenePlan, k: usize, switches: Switches, label: String, instances: usize) -> Result<Self> {
         let spec = &plan.kernels[k].spec;
         kernels::check_support(gpu, spec)?;
-        let kernel = Kernel::new(gpu, kernels::source_for("scene", spec.precision), &plan.constants(k, switches), 5, 16)?;
         let kb = &work.kernels[k];
-        let sets = kb
-            .chunks
-            .chunks
-            .iter()
-            .map(|&(first, len)| {
-                let set = kernel.bind(&[
-                    (&kb.pixels, first * PIXEL_BYTES, len * PIXEL_BYTES),
-                    (&kb.radiance, first * OUT_BYTES, len * OUT_BYTES),
-                    (&work.lights, 0, work.lights.size),
-                    (&kb.extras, first * EXTRA_BYTES, len * EXTRA_BYTES),
-                    (&kb.table, 0, kb.table.size),
-                ])?;
-                Ok((set, len))
+        let instances = (0..instances.max(1))
+            .map(|_| {
+                let kernel = Kernel::new(gpu, kernels::source_for("scene", spec.precision), &plan.constants(k, switches), 5, 16)?;
+                let sets = kb
+                    .chunks
+                    .chunks
+                    .iter()
+                    .map(|&(first, len)| {
+                        let set = kernel.bind(&[
+                            (&kb.pixels, first * PIXEL_BYTES, len * PIXEL_BYTES),
+                            (&kb.radiance, first * OUT_BYTES, len * OUT_BYTES),
+                            (&work.lights, 0, work.lights.size),
+                            (&kb.extras, first * EXTRA_BYTES, len * EXTRA_BYTES),
+                            (&kb.table, 0, kb.table.size),
+                        ])?;
+                        Ok((set, len))
+                    })
+                    .collect::<Result<Vec<_>>>()?;
+                Ok((kernel, sets))
             })
             .collect::<Result<Vec<_>>>()?;
-        Ok(SceneVariant { label, kernel_index: k, switches, kernel, sets, push: bytemuck::cast(work.camera) })
+        Ok(SceneVariant { label, kernel_index: k, switches, instances, push: bytemuck::cast(work.camera) })
     }
 
     /// Runs the variant once and waits.
@@ -136,9 +142,14 @@ impl<'g> SceneVariant<'g> {
 }
 
 impl Timed for SceneVariant<'_> {
-    fn record(&self, cmd: vk::CommandBuffer, _instance: usize) {
-        for &(set, len) in &self.sets {
-            self.kernel.dispatch(cmd, set, &self.push, len);
+    fn instances(&self) -> usize {
+        self.instances.len()
+    }
+
+    fn record(&self, cmd: vk::CommandBuffer, instance: usize) {
+        let (kernel, sets) = &self.instances[instance];
+        for &(set, len) in sets {
+            kernel.dispatch(cmd, set, &self.push, len);
         }
     }
 }
@@ -151,7 +162,7 @@ pub fn shade(gpu: &Gpu, scene: &Scene, gbuffer: &GBuffer, plan: &ScenePlan, tabl
     let bg = scene.file.render.background;
     let mut out = vec![bg; gbuffer.pixel_count()];
     for (k, kp) in plan.kernels.iter().enumerate() {
-        let variant = SceneVariant::new(gpu, &work, plan, k, kp.switches, kp.spec.name())?;
+        let variant = SceneVariant::new(gpu, &work, plan, k, kp.switches, kp.spec.name(), 1)?;
         variant.run(gpu)?;
         for (&i, rgb) in kp.pixels.iter().zip(work.radiance(k)?) {
             out[i as usize] = rgb;
