@@ -99,7 +99,7 @@ real D_Beckmann(real NoH, real sin2h, real a) {
 }
 
 // Normalised Blinn-Phong [Blinn 1977; m = 2/a2 - 2 from Walter et al. 2007]: (m+2)/(2 pi) NoH^m,
-// with NoH^m = exp(m/2 log(1 - sin2h)): m reaches 1e6 at the roughness floor, where a rounded NoH is useless.
+// with NoH^m = exp(m/2 log(1 - sin2h)): m reaches 5e5 at the roughness floor, where a rounded NoH is useless.
 // The log stops at log(MIN_COSINE^2), as NoH stops at MIN_COSINE (so m = 0 at r = 1 gives NoH^0 = 1, not 0 x -inf).
 real D_Blinn(real NoH, real sin2h, real a) {
     real m = real(2) / (a * a) - real(2);

@@ -60,7 +60,7 @@ fn back_facing_rows_give_zero() {
         "nx,ny,nz,vx,vy,vz,lx,ly,lz,roughness,f0r,f0g,f0b\n0,0,1,0,0.6,0.8,0,0,-1,0.5,0.04,0.04,0.04\n0,0,1,0,0,-1,0.6,0,0.8,0.5,0.04,0.04,0.04\n0,0,2,0,1.2,1.6,0.3,0,0.4,0.5,0.04,0.04,0.04\n",
     )
     .unwrap();
-    let run = common::brdfprof().args(["eval", "--model", "ggx", "--input"]).arg(&input).arg("--output").arg(&output).output().unwrap();
+    let run = common::brdfprof().args(["eval", "--validate", "--model", "ggx", "--input"]).arg(&input).arg("--output").arg(&output).output().unwrap();
     assert!(run.status.success());
     let text = std::fs::read_to_string(&output).unwrap();
     let rows: Vec<&str> = text.lines().skip(1).collect();
@@ -88,13 +88,13 @@ fn bad_input_fails_clearly_with_exit_2_and_no_output() {
         let input = dir.path().join("in.csv");
         let output = dir.path().join("out.csv");
         std::fs::write(&input, content).unwrap();
-        let run = common::brdfprof().arg("eval").args(&args).arg("--input").arg(&input).arg("--output").arg(&output).output().unwrap();
+        let run = common::brdfprof().args(["eval", "--validate"]).args(&args).arg("--input").arg(&input).arg("--output").arg(&output).output().unwrap();
         let stderr = String::from_utf8_lossy(&run.stderr);
         assert_eq!(run.status.code(), Some(2), "{what}: exit status; stderr: {stderr}");
         assert!(stderr.contains(expected), "{what}: expected `{expected}` in: {stderr}");
         assert!(!output.exists(), "{what}: an output file was written");
     }
-    let missing = common::brdfprof().args(["eval", "--model", "ggx", "--input", "/nonexistent/in.csv", "--output"]).arg(dir.path().join("o.csv")).output().unwrap();
+    let missing = common::brdfprof().args(["eval", "--validate", "--model", "ggx", "--input", "/nonexistent/in.csv", "--output"]).arg(dir.path().join("o.csv")).output().unwrap();
     assert_eq!(missing.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&missing.stderr).contains("cannot read /nonexistent/in.csv"));
 }

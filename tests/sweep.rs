@@ -18,7 +18,7 @@ fn small_sweep_is_consistent() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{stderr}");
     assert!(!stderr.contains("validation ["), "{stderr}");
-    let stem = dir.path().join("sweep-llvmpipe");
+    let stem = common::device_file(dir.path(), "sweep-", ".md").with_extension("");
     let md = std::fs::read_to_string(stem.with_extension("md")).unwrap();
     assert!(md.contains("| rank") && md.contains("Pareto"));
     let png = image::open(stem.with_extension("png")).unwrap();

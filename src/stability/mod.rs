@@ -434,23 +434,19 @@ impl StabilityReport {
         out
     }
 
-    /// A heat map per failing spec over (NoV, roughness): bad values per grid cell.
+    /// A heat map per failing spec over (NoV, roughness): bad values per grid cell, one panel each.
     pub fn heatmaps(&self, path: &std::path::Path) -> Result<bool> {
         use plotters::prelude::*;
         let all = self.failing();
         if all.is_empty() {
             return Ok(false);
         }
-        const PANELS: usize = 24;
-        let failing: Vec<&SpecStability> = all.iter().copied().filter(|s| s.bad_cells.is_some()).take(PANELS).collect();
-        let title = if all.len() > failing.len() {
-            format!("Failing specs (first {} of {}): NaN, Inf or negative results per (NoV, roughness) grid cell", failing.len(), all.len())
-        } else {
-            "Failing specs: NaN, Inf or negative results per (NoV, roughness) grid cell".to_string()
-        };
+        // Every failing spec whose grid failed gets a panel (one that failed only in hard cases has no map).
+        let failing: Vec<&SpecStability> = all.iter().copied().filter(|s| s.bad_cells.is_some()).collect();
+        let title = format!("Failing specs ({}): NaN, Inf or negative results per (NoV, roughness) grid cell", failing.len());
         let columns = 6usize.min(failing.len());
         let rows = failing.len().div_ceil(columns);
-        let (pw, ph) = (330u32, 260u32);
+        let (pw, ph) = (300u32, 230u32);
         crate::chart::render(path, pw * columns as u32, ph * rows as u32 + 40, |root| {
             let err = |e: &dyn std::fmt::Display| anyhow::anyhow!("heat map: {e}");
             let root = root.titled(&title, (crate::chart::FONT, 20)).map_err(|e| err(&e))?;

@@ -26,6 +26,20 @@ pub fn brdfprof() -> std::process::Command {
     c
 }
 
+/// The file `dir/PREFIX<device>.EXT` a command wrote for the default device, whatever that device's name.
+pub fn device_file(dir: &std::path::Path, prefix: &str, suffix: &str) -> PathBuf {
+    let matches: Vec<PathBuf> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| {
+            let name = p.file_name().unwrap().to_string_lossy();
+            name.starts_with(prefix) && name.ends_with(suffix) && !name[prefix.len()..name.len() - suffix.len()].contains('-')
+        })
+        .collect();
+    assert_eq!(matches.len(), 1, "one {prefix}<device>{suffix} in {}: {matches:?}", dir.display());
+    matches[0].clone()
+}
+
 pub fn repo_root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
