@@ -153,13 +153,20 @@ pub fn albedo(gpu: &Gpu, spec: &ModelSpec, cells: &[AlbedoCell]) -> Result<Vec<A
     let kernel = Kernel::new(gpu, source_for("albedo", spec.precision), &constants, 2, 4)?;
     let floats: Vec<f32> = cells.iter().flat_map(|c| [c.nov, c.roughness, 0.0, 0.0, c.f0[0], c.f0[1], c.f0[2], 0.0]).collect();
     let inputs = Buffer::with_data(gpu, bytemuck::cast_slice(&floats), MemoryKind::Device)?;
-    let mut results = Vec::with_capacity(cells.len());
-    // Cells per dispatch, within maxComputeWorkGroupCount.x.
+    reduce_albedo(gpu, &kernel, cells.len(), |first, count, rows| kernel.bind(&[(&inputs, first * 32, count * 32), (rows, 0, rows.size)]))
+}
+
+/// Dispatches an albedo kernel (ALBEDO_GRID rows per cell, two vec4 out per row: the row's mean and its even
+/// columns' mean) over `cells` cells in chunks within maxComputeWorkGroupCount.x, and reduces each cell to E and
+/// its half-resolution error estimate. `bind(first cell, cells, rows buffer)` binds one chunk.
+pub fn reduce_albedo(gpu: &Gpu, kernel: &Kernel, cells: usize, bind: impl Fn(u64, u64, &Buffer) -> Result<ash::vk::DescriptorSet>) -> Result<Vec<Albedo>> {
+    let n = ALBEDO_GRID as u64;
+    let mut results = Vec::with_capacity(cells);
     let per_dispatch = (gpu.info.max_compute_work_group_count[0] as u64 * crate::gpu::WORKGROUP as u64 / n).max(1);
-    for first in (0..cells.len() as u64).step_by(per_dispatch as usize) {
-        let count = per_dispatch.min(cells.len() as u64 - first);
+    for first in (0..cells as u64).step_by(per_dispatch as usize) {
+        let count = per_dispatch.min(cells as u64 - first);
         let rows = Buffer::new(gpu, count * n * 32, MemoryKind::Device)?;
-        let set = kernel.bind(&[(&inputs, first * 32, count * 32), (&rows, 0, count * n * 32)])?;
+        let set = bind(first, count, &rows)?;
         gpu.submit(|cmd| kernel.dispatch(cmd, set, &((count * n) as u32).to_ne_bytes(), count * n))?;
         let v: Vec<f32> = rows.read_as(0, (count * n * 8) as usize)?;
         for cell in v.chunks_exact(8 * n as usize) {

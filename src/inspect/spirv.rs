@@ -128,7 +128,7 @@ pub fn spec_default_values(words: &[u32], constants: &SpecConstants) -> Result<S
 }
 
 /// Runs spirv-opt with `args` on `words` (through stdin and stdout).
-fn spirv_opt(words: &[u32], args: &[String]) -> Result<Vec<u32>> {
+pub fn spirv_opt(words: &[u32], args: &[String]) -> Result<Vec<u32>> {
     let mut child = Command::new("spirv-opt")
         .args(args)
         .args(["-", "-o", "-"])

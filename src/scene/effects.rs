@@ -61,30 +61,9 @@ pub fn scene_albedo(gpu: &Gpu, spec: &ModelSpec, switches: Switches, table: Opti
         .collect();
     let inputs = Buffer::with_data(gpu, bytemuck::cast_slice(&floats), MemoryKind::Device)?;
     let table_buf = Buffer::with_data(gpu, bytemuck::cast_slice(table.map_or(&[1.0f32; 4][..], |t| &t.values)), MemoryKind::Device)?;
-    let mut results = Vec::with_capacity(cells.len());
-    let per_dispatch = (gpu.info.max_compute_work_group_count[0] as u64 * crate::gpu::WORKGROUP as u64 / n).max(1);
-    for first in (0..cells.len() as u64).step_by(per_dispatch as usize) {
-        let count = per_dispatch.min(cells.len() as u64 - first);
-        let rows = Buffer::new(gpu, count * n * 32, MemoryKind::Device)?;
-        let set = kernel.bind(&[(&inputs, first * 48, count * 48), (&rows, 0, count * n * 32), (&table_buf, 0, table_buf.size)])?;
-        gpu.submit(|cmd| kernel.dispatch(cmd, set, &((count * n) as u32).to_ne_bytes(), count * n))?;
-        let v: Vec<f32> = rows.read_as(0, (count * n * 8) as usize)?;
-        for cell in v.chunks_exact(8 * n as usize) {
-            let (mut full, mut half) = ([0.0f64; 3], [0.0f64; 3]);
-            for (r, row) in cell.chunks_exact(8).enumerate() {
-                for c in 0..3 {
-                    full[c] += row[c] as f64 / n as f64;
-                    if r % 2 == 0 {
-                        half[c] += row[4 + c] as f64 / (n / 2) as f64;
-                    }
-                }
-            }
-            let error = (0..3).map(|c| (full[c] - half[c]).abs()).fold(0.0, f64::max);
-            results.push(Albedo { e: full, error });
-        }
-        kernel.reset_bindings()?;
-    }
-    Ok(results)
+    kernels::reduce_albedo(gpu, &kernel, cells.len(), |first, count, rows| {
+        kernel.bind(&[(&inputs, first * 48, count * 48), (rows, 0, rows.size), (&table_buf, 0, table_buf.size)])
+    })
 }
 
 /// Floats per sample of `glsl/scene_terms.comp`'s input (13 vec4) and output (6 vec4).
