@@ -2,7 +2,7 @@
 //! value of the specialisation constant that selects it) and the same citation. Adding a term means one entry
 //! in a table below and one function plus one `case` in the GLSL.
 
-use super::guards::{F0_MAX, GTR_SERIES_BAND, MIN_COSINE};
+use super::guards::{F0_MAX, MIN_COSINE};
 use std::f64::consts::PI;
 
 /// The four cosines a term may read, already guarded (`guards::guard_cosine`), and sin2h = 1 - NoH^2 computed
@@ -207,9 +207,6 @@ pub fn gtr_normaliser(a2: f64, g: f64) -> f64 {
 pub fn gtr_series(u: f64, g: f64) -> f64 {
     1.0 - g * u / 2.0 + g * (g + 1.0) * u * u / 6.0 - g * (g + 1.0) * (g + 2.0) * u * u * u / 24.0
 }
-
-/// |a2 - 1| below which the GLSL uses `gtr_series` (re-exported for the tests of that band).
-pub const GTR_BAND: f64 = GTR_SERIES_BAND;
 
 pub fn d_gtr(noh: f64, sin2h: f64, a: f64, g: f64) -> f64 {
     let a2 = a * a;

@@ -65,14 +65,61 @@ impl<'g> Workload<'g> {
     }
 }
 
-/// A kernel bound to the workload, ready to dispatch, compiled as one or more independent pipelines
-/// (instances): on lavapipe the same kernel JIT-compiled twice has been seen to run 2x slower in every round of
-/// one process (code placement), and only a second pipeline exposes that.
+/// One kernel compiled as one or more independent pipelines (instances), each bound to the same chunk
+/// windows: on lavapipe the same kernel JIT-compiled twice has been seen to run 2x slower in every round of one
+/// process (code placement), and only a second pipeline exposes that. `measure` times every instance.
+pub struct Pipelines<'g> {
+    instances: Vec<(Kernel<'g>, Vec<(vk::DescriptorSet, u64)>)>,
+    push: Vec<u8>,
+}
+
+impl<'g> Pipelines<'g> {
+    /// `count` pipelines of `source` specialised with `constants`, over `chunks` (first element, length);
+    /// `bind(kernel, first, len)` binds one chunk's windows; `push` is the push-constant block of every dispatch.
+    #[allow(clippy::too_many_arguments)]
+    pub fn compile(
+        gpu: &'g Gpu,
+        source: &KernelSource,
+        constants: &SpecConstants,
+        bindings: u32,
+        push: Vec<u8>,
+        chunks: &[(u64, u64)],
+        count: usize,
+        bind: impl Fn(&Kernel<'g>, u64, u64) -> Result<vk::DescriptorSet>,
+    ) -> Result<Self> {
+        let instances = (0..count.max(1))
+            .map(|_| {
+                let kernel = Kernel::new(gpu, source, constants, bindings, push.len() as u32)?;
+                let sets = chunks.iter().map(|&(first, len)| Ok((bind(&kernel, first, len)?, len))).collect::<Result<Vec<_>>>()?;
+                Ok((kernel, sets))
+            })
+            .collect::<Result<Vec<_>>>()?;
+        Ok(Pipelines { instances, push })
+    }
+
+    pub fn len(&self) -> usize {
+        self.instances.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.instances.is_empty()
+    }
+
+    /// Records every chunk's dispatch of pipeline `instance`.
+    pub fn record(&self, cmd: vk::CommandBuffer, instance: usize) {
+        let (kernel, sets) = &self.instances[instance];
+        for &(set, len) in sets {
+            kernel.dispatch(cmd, set, &self.push, len);
+        }
+    }
+}
+
+/// The profile's shading kernel bound to the workload, ready to dispatch.
 pub struct Variant<'g> {
     pub label: String,
     /// None for the memory-only baseline.
     pub spec: Option<ModelSpec>,
-    instances: Vec<(Kernel<'g>, Vec<(vk::DescriptorSet, u64)>)>,
+    pipelines: Pipelines<'g>,
 }
 
 /// Constant ids of glsl/shade.comp beyond the term selectors.
@@ -104,29 +151,11 @@ impl<'g> Variant<'g> {
         if let Some(s) = spec {
             kernels::check_support(gpu, s)?;
         }
-        let constants = shade_constants(spec, work.light_count);
         let stride_in = (PIXEL_FLOATS * 4) as u64;
-        let lights_bytes = work.lights.size;
-        let instances = (0..instances.max(1))
-            .map(|_| {
-                let kernel = Kernel::new(gpu, source, &constants, 3, 0)?;
-                let sets = work
-                    .plan
-                    .chunks
-                    .iter()
-                    .map(|&(first, len)| {
-                        let set = kernel.bind(&[
-                            (&work.pixels, first * stride_in, len * stride_in),
-                            (&work.radiance, first * 16, len * 16),
-                            (&work.lights, 0, lights_bytes),
-                        ])?;
-                        Ok((set, len))
-                    })
-                    .collect::<Result<Vec<_>>>()?;
-                Ok((kernel, sets))
-            })
-            .collect::<Result<Vec<_>>>()?;
-        Ok(Variant { label: spec.map_or_else(|| "baseline".to_string(), |s| s.name()), spec: spec.copied(), instances })
+        let pipelines = Pipelines::compile(gpu, source, &shade_constants(spec, work.light_count), 3, Vec::new(), &work.plan.chunks, instances, |kernel, first, len| {
+            kernel.bind(&[(&work.pixels, first * stride_in, len * stride_in), (&work.radiance, first * 16, len * 16), (&work.lights, 0, work.lights.size)])
+        })?;
+        Ok(Variant { label: spec.map_or_else(|| "baseline".to_string(), |s| s.name()), spec: spec.copied(), pipelines })
     }
 }
 
@@ -257,13 +286,10 @@ pub trait Timed {
 
 impl Timed for Variant<'_> {
     fn instances(&self) -> usize {
-        self.instances.len()
+        self.pipelines.len()
     }
 
     fn record(&self, cmd: vk::CommandBuffer, instance: usize) {
-        let (kernel, sets) = &self.instances[instance];
-        for &(set, len) in sets {
-            kernel.dispatch(cmd, set, &[], len);
-        }
+        self.pipelines.record(cmd, instance)
     }
 }

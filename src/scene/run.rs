@@ -8,9 +8,9 @@ use super::gbuffer::GBuffer;
 use super::plan::ScenePlan;
 use super::terms::{ETable, Switches};
 use super::effects;
-use crate::gpu::{Buffer, ChunkPlan, Gpu, Kernel, MemoryKind};
+use crate::gpu::{Buffer, ChunkPlan, Gpu, MemoryKind};
 use crate::kernels::{self, RunLimits};
-use crate::profile::protocol::Timed;
+use crate::profile::protocol::{Pipelines, Timed};
 use anyhow::Result;
 use ash::vk;
 
@@ -96,14 +96,13 @@ impl<'g> SceneWork<'g> {
 }
 
 /// Kernel `k` of a plan compiled with `switches`, bound to the uploaded scene, as one or more independently
-/// compiled pipelines (see `profile::protocol::Variant`: on lavapipe one compilation of a kernel can land
-/// badly placed, and an effect's cost is a difference of two kernels, so it would take the whole error).
+/// compiled pipelines (`profile::protocol::Pipelines`: an effect's cost is a difference of two kernels, so a
+/// badly placed compilation of either would take the whole error).
 pub struct SceneVariant<'g> {
     pub label: String,
     pub kernel_index: usize,
     pub switches: Switches,
-    instances: Vec<(Kernel<'g>, Vec<(vk::DescriptorSet, u64)>)>,
-    push: [u8; 16],
+    pipelines: Pipelines<'g>,
 }
 
 impl<'g> SceneVariant<'g> {
@@ -111,46 +110,28 @@ impl<'g> SceneVariant<'g> {
         let spec = &plan.kernels[k].spec;
         kernels::check_support(gpu, spec)?;
         let kb = &work.kernels[k];
-        let instances = (0..instances.max(1))
-            .map(|_| {
-                let kernel = Kernel::new(gpu, kernels::source_for("scene", spec.precision), &plan.constants(k, switches), 5, 16)?;
-                let sets = kb
-                    .chunks
-                    .chunks
-                    .iter()
-                    .map(|&(first, len)| {
-                        let set = kernel.bind(&[
-                            (&kb.pixels, first * PIXEL_BYTES, len * PIXEL_BYTES),
-                            (&kb.radiance, first * OUT_BYTES, len * OUT_BYTES),
-                            (&work.lights, 0, work.lights.size),
-                            (&kb.extras, first * EXTRA_BYTES, len * EXTRA_BYTES),
-                            (&kb.table, 0, kb.table.size),
-                        ])?;
-                        Ok((set, len))
-                    })
-                    .collect::<Result<Vec<_>>>()?;
-                Ok((kernel, sets))
-            })
-            .collect::<Result<Vec<_>>>()?;
-        Ok(SceneVariant { label, kernel_index: k, switches, instances, push: bytemuck::cast(work.camera) })
-    }
-
-    /// Runs the variant once and waits.
-    pub fn run(&self, gpu: &Gpu) -> Result<()> {
-        gpu.submit(|cmd| self.record(cmd, 0))
+        let push: [u8; 16] = bytemuck::cast(work.camera);
+        let source = kernels::source_for("scene", spec.precision);
+        let pipelines = Pipelines::compile(gpu, source, &plan.constants(k, switches), 5, push.to_vec(), &kb.chunks.chunks, instances, |kernel, first, len| {
+            kernel.bind(&[
+                (&kb.pixels, first * PIXEL_BYTES, len * PIXEL_BYTES),
+                (&kb.radiance, first * OUT_BYTES, len * OUT_BYTES),
+                (&work.lights, 0, work.lights.size),
+                (&kb.extras, first * EXTRA_BYTES, len * EXTRA_BYTES),
+                (&kb.table, 0, kb.table.size),
+            ])
+        })?;
+        Ok(SceneVariant { label, kernel_index: k, switches, pipelines })
     }
 }
 
 impl Timed for SceneVariant<'_> {
     fn instances(&self) -> usize {
-        self.instances.len()
+        self.pipelines.len()
     }
 
     fn record(&self, cmd: vk::CommandBuffer, instance: usize) {
-        let (kernel, sets) = &self.instances[instance];
-        for &(set, len) in sets {
-            kernel.dispatch(cmd, set, &self.push, len);
-        }
+        self.pipelines.record(cmd, instance)
     }
 }
 
@@ -163,7 +144,7 @@ pub fn shade(gpu: &Gpu, scene: &Scene, gbuffer: &GBuffer, plan: &ScenePlan, tabl
     let mut out = vec![bg; gbuffer.pixel_count()];
     for (k, kp) in plan.kernels.iter().enumerate() {
         let variant = SceneVariant::new(gpu, &work, plan, k, kp.switches, kp.spec.name(), 1)?;
-        variant.run(gpu)?;
+        variant.run_once(gpu, 0)?;
         for (&i, rgb) in kp.pixels.iter().zip(work.radiance(k)?) {
             out[i as usize] = rgb;
         }
