@@ -18,8 +18,9 @@ run: build
 test: setup
 	$(CARGO) test --release --locked
 
-# Recompile glsl/ into spv/ (needs glslang); commit the result.
+# Regenerate glsl/generated/ from the Rust tables and recompile glsl/ into spv/ (needs glslang); commit both.
 spv:
+	$(CARGO) run --release --locked -- __generate-glsl glsl/generated
 	sh glsl/build-spv.sh
 
 # Re-measure the committed `check` baseline after a deliberate change to the kernels (or to spv/ after a

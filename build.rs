@@ -1,10 +1,12 @@
-// Embeds every SPIR-V module listed in glsl/kernels.txt, so the binary runs without glslang.
+// Embeds every SPIR-V module listed in glsl/kernels.txt, so the binary runs without glslang, and the GLSL
+// sources themselves, from which `.brdf` models' kernels are composed at run time.
 // (Rebuilding spv/ from glsl/ is `make spv`; tests/spv_fresh.rs fails when spv/ is stale.)
 use std::{env, fs, path::Path};
 
 fn main() {
     let root = env::var("CARGO_MANIFEST_DIR").unwrap();
-    let list = Path::new(&root).join("glsl/kernels.txt");
+    let glsl = Path::new(&root).join("glsl");
+    let list = glsl.join("kernels.txt");
     println!("cargo:rerun-if-changed={}", list.display());
     let text = fs::read_to_string(&list).expect("glsl/kernels.txt");
     let mut out = String::from("pub const KERNELS: &[KernelSource] = &[\n");
@@ -24,6 +26,27 @@ fn main() {
             spv.display().to_string()
         );
     }
+    out += "];\n\n/// Every file under glsl/ (relative path, text).\npub const GLSL_FILES: &[(&str, &str)] = &[\n";
+    let mut files = Vec::new();
+    collect(&glsl, &glsl, &mut files);
+    files.sort();
+    for (rel, path) in files {
+        println!("cargo:rerun-if-changed={path}");
+        out += &format!("    ({rel:?}, include_str!({path:?})),\n");
+    }
     out += "];\n";
     fs::write(Path::new(&env::var("OUT_DIR").unwrap()).join("kernels.rs"), out).unwrap();
+}
+
+fn collect(root: &Path, dir: &Path, out: &mut Vec<(String, String)>) {
+    println!("cargo:rerun-if-changed={}", dir.display());
+    for entry in fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.is_dir() {
+            collect(root, &path, out);
+        } else if path.extension().is_some_and(|e| e == "glsl" || e == "comp" || e == "txt") {
+            let rel = path.strip_prefix(root).unwrap().to_string_lossy().replace('\\', "/");
+            out.push((rel, path.display().to_string()));
+        }
+    }
 }

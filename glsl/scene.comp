@@ -1,8 +1,8 @@
 #version 450
 // The scene kernel: one G-buffer pixel per invocation, every light of the scene in one dispatch, for one model
-// (the materials of the scene that use it). Light counts per type are specialisation constants 5..8 and each
+// (the materials of the scene that use it). Light counts per type are specialisation constants and each
 // type's loop is [[unroll]]ed (lavapipe turns rolled light loops into per-lane gathers; README "Kernel design");
-// effects are switched by constants 9..12 (scene.glsl). No early return and no bounds check: buffers are padded
+// effects are switched by constants (scene.glsl). No early return and no bounds check: buffers are padded
 // to whole workgroups.
 // Pixel: vec4 (n.xyz, roughness), vec4 (world position.xyz, metallic), vec4 (base colour.rgb, -).
 // Extras (bound always, read only when an effect needs them): vec4 (tangent.xyz, anisotropy),
@@ -17,11 +17,6 @@
 #extension GL_EXT_control_flow_attributes : require
 #define E_TABLE_BINDING 4
 #include "scene.glsl"
-
-layout(constant_id = 5) const int NUM_DIRECTIONAL = 1;
-layout(constant_id = 6) const int NUM_POINT = 0;
-layout(constant_id = 7) const int NUM_SPOT = 0;
-layout(constant_id = 8) const int NUM_SPHERE = 0;
 
 layout(local_size_x = 64) in;
 layout(std430, set = 0, binding = 0) readonly buffer Pixels { vec4 pixels[]; };

@@ -1,29 +1,22 @@
 // Scene effects and lights, on top of the specular term library (brdf.glsl). One function per term, each with
-// the source it implements; every one has an f64 twin in src/scene/terms.rs (tests/scene_terms_gpu.rs ties them).
-// Specialisation constants 9..12 switch effects in and out: with an effect's constant at 0 its code is dead and
-// the driver (and spirv-opt, tests/scene_spirv.rs) removes it, so an effect no material uses costs nothing.
+// the source it implements; every one has an f64 twin in src/scene/terms.rs (tests/scenes/terms.rs ties them).
+// Specialisation constants switch effects in and out: with an effect's constant at 0 its code is dead and
+// the driver (and spirv-opt, tests/scenes/spirv.rs) removes it, so an effect no material uses costs nothing.
 // Effects are evaluated in fp32 whatever the model's precision, except the clear coat, which reuses the library's
 // D_Ggx and Vis_Kelemen and so follows the model's precision (BRDF_F16).
 #ifndef SCENE_GLSL
 #define SCENE_GLSL
 #include "brdf.glsl"
 
-// ---- Effect switches (specialisation constants) -----------------------------------------------------
-layout(constant_id = 9) const int ANISOTROPY = 0;          // 0 off, 1 on (per-pixel strength; 0 = isotropic)
-layout(constant_id = 10) const int ENERGY_COMPENSATION = 0; // 0 off, 1 every pixel, 2 per-pixel flag
-layout(constant_id = 11) const int DIFFUSE = 0;            // 0 none, 1 Lambert, 2 Burley, 3 per-pixel choice
-layout(constant_id = 12) const int CLEAR_COAT = 0;         // 0 off, 1 on (per-pixel strength and roughness)
-layout(constant_id = 13) const int E_TABLE_MU = 32;        // E(mu, r) table: mu nodes (mu_i = (i + 0.5) / N)
-layout(constant_id = 14) const int E_TABLE_R = 16;         // r nodes (r_j = j / (M - 1))
+// The effect switches (ANISOTROPY, ENERGY_COMPENSATION, DIFFUSE, CLEAR_COAT) and the E table's size are
+// specialisation constants declared in generated/kernel_constants.glsl.
 
-const float PI_SCENE = 3.14159265358979;
 // Guards of the scene path (README "Scenes"): a light closer than MIN_LIGHT_DISTANCE (world units) is taken at
 // that distance, so inverse-square falloff stays finite [Karis 2013 uses a 1 cm floor likewise]; anisotropic
 // alphas are floored at MIN_ROUGHNESS^2 as Filament floors them [Filament, getAnisotropicRoughness].
 const float MIN_LIGHT_DISTANCE = 1e-2;
 const float CLEAR_COAT_F0 = 0.04; // Filament's clear coat: a polyurethane layer, IOR 1.5
 
-float pow5f(float x) { float x2 = x * x; return x2 * x2 * x; }
 // brdf.glsl's guard_cosine in fp32: a visible cosine clamped into [MIN_COSINE, 1].
 float guard_cos(float x) { return clamp(x, MIN_COSINE, 1.0); }
 
@@ -43,7 +36,7 @@ float D_GgxAnisotropic(float NoH, float ToH, float BoH, float at, float ab) {
     vec3 d = vec3(ab * ToH, at * BoH, a2 * NoH);
     float d2 = dot(d, d);
     float w2 = a2 / d2;
-    return a2 * w2 * w2 / PI_SCENE;
+    return a2 * w2 * w2 / PI_F32;
 }
 
 // Anisotropic Smith GGX, height-correlated [Heitz 2014, eq. 99 with the anisotropic Lambda; Filament
@@ -71,22 +64,22 @@ vec3 specular_anisotropic(vec3 N, vec3 V, vec3 L, vec3 T, vec3 B, float roughnes
 // ---- Diffuse lobes -----------------------------------------------------------------------------------
 
 // Lambert: f_d = 1/pi (times the diffuse colour).
-float Fd_Lambert() { return 1.0 / PI_SCENE; }
+float Fd_Lambert() { return 1.0 / PI_F32; }
 
 // Burley diffuse [Burley 2012, sec. 5.3, eq. 8]: (1 + (F_D90 - 1)(1 - NoL)^5)(1 + (F_D90 - 1)(1 - NoV)^5) / pi,
 // F_D90 = 0.5 + 2 r LoH^2 with r the perceptual roughness (Burley's "roughness"; Filament passes a = r^2).
 float Fd_Burley(float NoV, float NoL, float LoH, float roughness) {
     float f90 = 0.5 + 2.0 * roughness * LoH * LoH;
-    float l = 1.0 + (f90 - 1.0) * pow5f(1.0 - NoL);
-    float v = 1.0 + (f90 - 1.0) * pow5f(1.0 - NoV);
-    return l * v / PI_SCENE;
+    float l = 1.0 + (f90 - 1.0) * pow5(1.0 - NoL);
+    float v = 1.0 + (f90 - 1.0) * pow5(1.0 - NoV);
+    return l * v / PI_F32;
 }
 
 // ---- Clear coat [Filament documentation, sec. 4.9; surface_shading_model_standard.fs] -------------------
 
 // Clear coat Fresnel: Schlick with F0 = 0.04 and f90 = 1, times the coat strength.
 float clear_coat_fresnel(float LoH, float strength) {
-    return (CLEAR_COAT_F0 + (1.0 - CLEAR_COAT_F0) * pow5f(1.0 - LoH)) * strength;
+    return float(F_Schlick(real3(CLEAR_COAT_F0), real(LoH)).x) * strength;
 }
 
 // Clear coat lobe D_GGX(a_c) Vis_Kelemen(LoH) Fc, a_c = the coat's perceptual roughness squared (floored), for
@@ -98,7 +91,7 @@ float clear_coat_lobe(vec3 N, vec3 V, vec3 L, float coat_roughness, float streng
     vec3 NxH = cross(N, H);
     bool lit = dot(N, V) > 0.0 && dot(N, L) > 0.0;
     float a = float(perceptual_to_alpha(coat_roughness));
-    float lobe = float(D_Ggx(real(NoH), real(min(dot(NxH, NxH), 1.0)), real(a))) * float(Vis_Kelemen(real(LoH)))
+    float lobe = float(D_Ggx(real(NoH), real(min(dot(NxH, NxH), 1.0)), real(a))) * float(vis_kelemen(real(LoH)))
                * clear_coat_fresnel(LoH, strength);
     return lit ? lobe : 0.0;
 }

@@ -10,9 +10,6 @@
 #extension GL_EXT_control_flow_attributes : require
 #include "brdf.glsl"
 
-layout(constant_id = 5) const int NUM_LIGHTS = 8;
-layout(constant_id = 6) const int BASELINE = 0;
-
 layout(local_size_x = 64) in;
 layout(std430, set = 0, binding = 0) readonly buffer Pixels { vec4 pixels[]; };
 layout(std430, set = 0, binding = 1) buffer Radiance { vec4 radiance[]; };

@@ -5,20 +5,17 @@
 #extension GL_GOOGLE_include_directive : require
 #include "brdf.glsl"
 
-layout(local_size_x = 64) in;
-layout(std430, set = 0, binding = 0) readonly buffer Samples { vec4 samples[]; };
-layout(std430, set = 0, binding = 1) buffer Results { vec4 results[]; };
-layout(push_constant) uniform Push { uint count; } pc;
+#include "elementwise.glsl"
 
 void main() {
     uint i = gl_GlobalInvocationID.x;
     if (i >= pc.count) return;
-    vec4 c = samples[3 * i];
-    vec4 rf = samples[3 * i + 1];
-    real sin2h = real(samples[3 * i + 2].x);
+    vec4 c = inputs[3 * i];
+    vec4 rf = inputs[3 * i + 1];
+    real sin2h = real(inputs[3 * i + 2].x);
     real NoV = guard_cosine(real(c.x)), NoL = guard_cosine(real(c.y));
     real NoH = guard_cosine(real(c.z)), VoH = guard_cosine(real(c.w));
     real a = perceptual_to_alpha(rf.x);
-    results[2 * i] = vec4(float(D_term(NoH, sin2h, a)), float(Vis_term(NoV, NoL, NoH, VoH, a)), 0.0, 0.0);
-    results[2 * i + 1] = vec4(vec3(F_term(real3(rf.yzw), VoH)), 0.0);
+    outputs[2 * i] = vec4(float(D_term(NoH, sin2h, a)), float(Vis_term(NoV, NoL, NoH, VoH, a)), 0.0, 0.0);
+    outputs[2 * i + 1] = vec4(vec3(F_term(real3(rf.yzw), VoH)), 0.0);
 }

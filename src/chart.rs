@@ -1,5 +1,5 @@
 //! PNG charts and images. Plotters draws into an RGB buffer (DejaVu Sans embedded, so no system fonts are
-//! needed); the `image` crate encodes it and `io::write_atomic` writes it.
+//! needed); the `image` crate encodes it and `io::write_output` writes it.
 
 use anyhow::{anyhow, Result};
 use plotters::prelude::*;
@@ -22,7 +22,7 @@ pub fn write_png(path: &Path, width: u32, height: u32, rgb: Vec<u8>) -> Result<(
     let image = image::RgbImage::from_raw(width, height, rgb).ok_or_else(|| anyhow!("image buffer of the wrong size"))?;
     let mut bytes = std::io::Cursor::new(Vec::new());
     image.write_to(&mut bytes, image::ImageFormat::Png)?;
-    crate::io::write_atomic(path, bytes.get_ref())
+    crate::io::write_output(path, bytes.get_ref())
 }
 
 /// Draws with plotters into a fresh white `width` x `height` canvas and writes it as PNG.
@@ -48,114 +48,162 @@ pub fn palette(i: usize) -> RGBColor {
     RGBColor(r, g, b)
 }
 
-/// One labelled point of a scatter chart.
+/// One point of the accuracy-against-cost scatter: x with its confidence interval (drawn as a horizontal
+/// whisker; lo = hi = x for a deterministic cost), y, its group (colour) and label. Highlighted points carry
+/// their label next to them; the others carry a number, listed with its label in the key beside the plot.
+#[derive(Clone, Debug)]
 pub struct Point {
     pub x: f64,
+    pub x_lo: f64,
+    pub x_hi: f64,
     pub y: f64,
     pub label: String,
     pub group: usize,
+    pub highlight: bool,
 }
 
-/// Scatter of labelled points on a log y axis, with a polyline (the Pareto frontier) drawn through `line`.
-/// Points whose y is not finite (a spec that overflowed) are pinned to the top edge and labelled so. Points
-/// far to the right of the rest (`split_x`: beyond it) go to a narrow side panel, so that the main panel keeps
-/// its resolution; labels are placed greedily where they overlap no other label.
-#[allow(clippy::too_many_arguments)]
-pub fn scatter_log_y(path: &Path, title: &str, x_desc: &str, y_desc: &str, points: &[Point], line: &[(f64, f64)], legend: &[(usize, String)], split_x: Option<f64>) -> Result<()> {
-    let (w, h) = (2400u32, 1600u32);
-    let y_floor = 1e-8;
-    let finite: Vec<&Point> = points.iter().filter(|p| p.x.is_finite() && p.y.is_finite()).collect();
-    if finite.is_empty() {
-        return Err(anyhow!("chart {}: no point with finite coordinates", path.display()));
-    }
-    let ys = finite.iter().map(|p| p.y.max(y_floor));
-    let (y0, y1) = (ys.clone().fold(f64::INFINITY, f64::min) / 3.0, ys.fold(f64::NEG_INFINITY, f64::max) * 3.0);
-    let pinned: Vec<Point> = points
+/// What the scatter draws: the title and axis names, the frontier through `line`, the groups' legend, and the
+/// cost beyond which points go to a narrow side panel (so that the main panel keeps its resolution).
+pub struct Scatter<'a> {
+    pub title: &'a str,
+    pub x_desc: &'a str,
+    pub y_desc: &'a str,
+    pub line: &'a [(f64, f64)],
+    pub legend: &'a [(usize, String)],
+    pub split_x: Option<f64>,
+}
+
+const Y_FLOOR: f64 = 1e-8;
+/// Label sizes in pixels (15 px DejaVu Sans).
+const CHAR_W: i32 = 8;
+const TEXT_H: i32 = 16;
+
+/// Points as drawn: y floored at Y_FLOOR for the log axis, a non-finite y pinned to the top edge and labelled so.
+fn pinned(points: &[Point], y_top: f64) -> Vec<Point> {
+    points
         .iter()
         .filter(|p| p.x.is_finite())
         .map(|p| {
-            let (y, label) = if p.y.is_finite() { (p.y.max(y_floor), p.label.clone()) } else { (y1 / 1.5, format!("{} (non-finite)", p.label)) };
-            Point { x: p.x, y, label, group: p.group }
+            let (y, label) = if p.y.is_finite() { (p.y.max(Y_FLOOR), p.label.clone()) } else { (y_top / 1.5, format!("{} (non-finite)", p.label)) };
+            Point { y, label, ..p.clone() }
         })
-        .collect();
-    let split = split_x.filter(|s| pinned.iter().any(|p| p.x > *s));
-    let (main_pts, side_pts): (Vec<&Point>, Vec<&Point>) = pinned.iter().partition(|p| split.is_none_or(|s| p.x <= s));
-    let x_range = |pts: &[&Point]| {
-        let (lo, hi) = pts.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| (lo.min(p.x), hi.max(p.x)));
-        let pad = (hi - lo).max(1e-3) * 0.04;
-        (lo - pad, hi + pad * 6.0)
+        .collect()
+}
+
+/// The x range of `pts`, whiskers included, padded for labels.
+fn x_range(pts: &[&Point]) -> (f64, f64) {
+    let (lo, hi) = pts.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| (lo.min(p.x_lo.min(p.x)), hi.max(p.x_hi.max(p.x))));
+    let pad = (hi - lo).max(1e-3) * 0.04;
+    (lo - pad, hi + pad * 6.0)
+}
+
+/// Places a label at the first candidate offset from (px, py) whose box overlaps no placed box; returns its
+/// top-left corner.
+fn place(placed: &mut Vec<(i32, i32, i32, i32)>, (px, py): (i32, i32), width: i32) -> (i32, i32) {
+    let candidates = [(10, -8), (10, 10), (10, -26), (10, 28), (-10 - width, -8), (-10 - width, 10), (10, -44), (10, 46), (-10 - width, -26), (-10 - width, 28)];
+    let boxed = |(dx, dy): (i32, i32)| (px + dx, py + dy - TEXT_H / 2, px + dx + width, py + dy + TEXT_H / 2);
+    let free = |c: (i32, i32)| {
+        let b = boxed(c);
+        !placed.iter().any(|o| b.0 < o.2 && o.0 < b.2 && b.1 < o.3 && o.1 < b.3)
     };
-    render(path, w, h, |root| {
-        let err = |e: &dyn std::fmt::Display| anyhow!("chart: {e}");
-        let root = root.titled(title, (FONT, 34)).map_err(|e| err(&e))?;
-        let areas: Vec<_> = if side_pts.is_empty() { vec![root.clone()] } else {
-            let (left, right) = root.split_horizontally((w as f64 * 0.8) as u32);
-            vec![left, right]
-        };
-        let mut placed: Vec<(i32, i32, i32, i32)> = Vec::new();
-        for (k, area) in areas.iter().enumerate() {
-            let pts = if k == 0 { &main_pts } else { &side_pts };
-            let (x0, x1) = x_range(pts);
-            let mut chart = ChartBuilder::on(area)
-                .margin(30)
-                .x_label_area_size(70)
-                .y_label_area_size(if k == 0 { 110 } else { 20 })
-                .build_cartesian_2d(x0..x1, (y0..y1).log_scale())
-                .map_err(|e| err(&e))?;
-            chart
-                .configure_mesh()
-                .x_desc(if k == 0 { x_desc } else { "" })
-                .y_desc(if k == 0 { y_desc } else { "" })
-                .y_label_formatter(&|y| format!("{y:.0e}"))
-                .axis_desc_style((FONT, 24))
-                .label_style((FONT, 20))
-                .draw()
-                .map_err(|e| err(&e))?;
-            if k == 0 {
-                chart
-                    .draw_series(LineSeries::new(line.iter().map(|&(x, y)| (x, y.max(y_floor))), RED.stroke_width(3)))
-                    .map_err(|e| err(&e))?
-                    .label("Pareto frontier")
-                    .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 30, y)], RED.stroke_width(3)));
-            }
-            for (group, name) in legend {
-                let colour = palette(*group);
-                let series = chart
-                    .draw_series(pts.iter().filter(|p| p.group == *group).map(|p| Circle::new((p.x, p.y), 7, colour.filled())))
-                    .map_err(|e| err(&e))?;
-                if k == 0 {
-                    series.label(name.clone()).legend(move |(x, y)| Circle::new((x + 15, y), 7, colour.filled()));
-                }
-            }
-            // Greedy labels: the first candidate offset whose box overlaps no placed label (and no point).
-            let (char_w, text_h) = (8, 16);
-            let mut order: Vec<&&Point> = pts.iter().collect();
-            order.sort_by(|a, b| b.y.total_cmp(&a.y));
-            for p in order {
-                let (px, py) = chart.backend_coord(&(p.x, p.y));
-                let width = char_w * p.label.chars().count() as i32;
-                let candidates = [(10, -8), (10, 10), (10, -26), (10, 28), (-10 - width, -8), (-10 - width, 10), (10, -44), (10, 46), (-10 - width, -26), (-10 - width, 28)];
-                let free = |(dx, dy): (i32, i32)| {
-                    let bx = (px + dx, py + dy - text_h / 2, px + dx + width, py + dy + text_h / 2);
-                    !placed.iter().any(|b| bx.0 < b.2 && b.0 < bx.2 && bx.1 < b.3 && b.1 < bx.3)
-                };
-                let (dx, dy) = candidates.iter().copied().find(|c| free(*c)).unwrap_or(candidates[0]);
-                placed.push((px + dx, py + dy - text_h / 2, px + dx + width, py + dy + text_h / 2));
-                area.draw(&Text::new(p.label.clone(), (px + dx - area.get_base_pixel().0, py + dy - text_h / 2 - area.get_base_pixel().1), (FONT, 15).into_font().color(&palette(p.group).mix(0.95))))
-                    .map_err(|e| err(&e))?;
-            }
-            if k == 0 {
-                chart
-                    .configure_series_labels()
-                    .position(SeriesLabelPosition::UpperRight)
-                    .label_font((FONT, 22))
-                    .background_style(WHITE.mix(0.85))
-                    .border_style(BLACK)
-                    .draw()
-                    .map_err(|e| err(&e))?;
-            }
+    let c = candidates.iter().copied().find(|c| free(*c)).unwrap_or(candidates[0]);
+    let b = boxed(c);
+    placed.push(b);
+    (b.0, b.1)
+}
+
+type Area<'a> = DrawingArea<BitMapBackend<'a>, plotters::coord::Shift>;
+
+/// One panel: axes, the frontier (main panel), whiskers and points by group, and their labels or numbers.
+fn scatter_panel(area: &Area, spec: &Scatter, pts: &[&Point], numbers: &[(usize, &Point)], (y0, y1): (f64, f64), main: bool) -> Result<()> {
+    let err = |e: &dyn std::fmt::Display| anyhow!("chart: {e}");
+    let (x0, x1) = x_range(pts);
+    let mut chart = ChartBuilder::on(area)
+        .margin(30)
+        .x_label_area_size(70)
+        .y_label_area_size(if main { 110 } else { 20 })
+        .build_cartesian_2d(x0..x1, (y0..y1).log_scale())
+        .map_err(|e| err(&e))?;
+    chart
+        .configure_mesh()
+        .x_desc(if main { spec.x_desc } else { "" })
+        .y_desc(if main { spec.y_desc } else { "" })
+        .y_label_formatter(&|y| format!("{y:.0e}"))
+        .axis_desc_style((FONT, 24))
+        .label_style((FONT, 20))
+        .draw()
+        .map_err(|e| err(&e))?;
+    if main {
+        chart
+            .draw_series(LineSeries::new(spec.line.iter().map(|&(x, y)| (x, y.max(Y_FLOOR))), RED.stroke_width(3)))
+            .map_err(|e| err(&e))?
+            .label("Pareto frontier")
+            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 30, y)], RED.stroke_width(3)));
+    }
+    for (group, name) in spec.legend {
+        let colour = palette(*group);
+        let members: Vec<&&Point> = pts.iter().filter(|p| p.group == *group).collect();
+        chart.draw_series(members.iter().map(|p| PathElement::new(vec![(p.x_lo, p.y), (p.x_hi, p.y)], colour.stroke_width(2)))).map_err(|e| err(&e))?;
+        let series = chart.draw_series(members.iter().map(|p| Circle::new((p.x, p.y), 7, colour.filled()))).map_err(|e| err(&e))?;
+        if main {
+            series.label(name.clone()).legend(move |(x, y)| Circle::new((x + 15, y), 7, colour.filled()));
         }
-        Ok(())
+    }
+    // Labels (highlighted points) and numbers (the rest), placed greedily from the top down.
+    let mut placed: Vec<(i32, i32, i32, i32)> = Vec::new();
+    let mut order: Vec<&&Point> = pts.iter().collect();
+    order.sort_by(|a, b| b.highlight.cmp(&a.highlight).then(b.y.total_cmp(&a.y)));
+    for p in order {
+        let text = if p.highlight { p.label.clone() } else { numbers.iter().find(|(_, q)| std::ptr::eq(*q, *p)).map_or(String::new(), |(n, _)| n.to_string()) };
+        let at = chart.backend_coord(&(p.x, p.y));
+        let (x, y) = place(&mut placed, at, CHAR_W * text.chars().count() as i32);
+        let base = area.get_base_pixel();
+        let font = (FONT, if p.highlight { 16 } else { 14 }).into_font().color(&palette(p.group).mix(0.95));
+        area.draw(&Text::new(text, (x - base.0, y - base.1), font)).map_err(|e| err(&e))?;
+    }
+    if main {
+        chart.configure_series_labels().position(SeriesLabelPosition::UpperRight).label_font((FONT, 22)).background_style(WHITE.mix(0.85)).border_style(BLACK).draw().map_err(|e| err(&e))?;
+    }
+    Ok(())
+}
+
+/// The key: each numbered point's number and label, in its group's colour.
+fn scatter_key(area: &Area, numbers: &[(usize, &Point)]) -> Result<()> {
+    let err = |e: &dyn std::fmt::Display| anyhow!("chart: {e}");
+    area.draw(&Text::new("Numbered points", (10, 30), (FONT, 20).into_font())).map_err(|e| err(&e))?;
+    let line = ((area.dim_in_pixel().1 as i32 - 80) / numbers.len().max(1) as i32).clamp(10, 22);
+    for (i, (n, p)) in numbers.iter().enumerate() {
+        let font = (FONT, (line - 4).min(16)).into_font().color(&palette(p.group));
+        area.draw(&Text::new(format!("{n}  {}", p.label), (10, 60 + i as i32 * line), font)).map_err(|e| err(&e))?;
+    }
+    Ok(())
+}
+
+/// Scatter of points on a log y axis with cost whiskers, the frontier drawn, highlighted points labelled and the
+/// rest numbered with a key (so that no label overlaps another). Points whose y is not finite (a spec that
+/// overflowed) are pinned to the top edge; points beyond `split_x` go to a side panel.
+pub fn scatter_log_y(path: &Path, spec: &Scatter, points: &[Point]) -> Result<()> {
+    let (w, h) = (2400u32, 1600u32);
+    let finite: Vec<f64> = points.iter().filter(|p| p.x.is_finite() && p.y.is_finite()).map(|p| p.y.max(Y_FLOOR)).collect();
+    if finite.is_empty() {
+        return Err(anyhow!("chart {}: no point with finite coordinates", path.display()));
+    }
+    let ys = (finite.iter().copied().fold(f64::INFINITY, f64::min) / 3.0, finite.iter().copied().fold(f64::NEG_INFINITY, f64::max) * 3.0);
+    let pinned = pinned(points, ys.1);
+    let split = spec.split_x.filter(|s| pinned.iter().any(|p| p.x > *s));
+    let (main_pts, side_pts): (Vec<&Point>, Vec<&Point>) = pinned.iter().partition(|p| split.is_none_or(|s| p.x <= s));
+    let numbers: Vec<(usize, &Point)> = pinned.iter().filter(|p| !p.highlight).enumerate().map(|(i, p)| (i + 1, p)).collect();
+    render(path, w, h, |root| {
+        let root = root.titled(spec.title, (FONT, 34)).map_err(|e| anyhow!("chart: {e}"))?;
+        let (plots, key) = root.split_horizontally((w as f64 * 0.74) as u32);
+        if side_pts.is_empty() {
+            scatter_panel(&plots, spec, &main_pts, &numbers, ys, true)?;
+        } else {
+            let (left, right) = plots.split_horizontally((w as f64 * 0.58) as u32);
+            scatter_panel(&left, spec, &main_pts, &numbers, ys, true)?;
+            scatter_panel(&right, spec, &side_pts, &numbers, ys, false)?;
+        }
+        scatter_key(&key, &numbers)
     })
 }
 
@@ -226,13 +274,11 @@ mod tests {
     #[test]
     fn scatter_with_non_finite_points_finishes() {
         let dir = tempfile::tempdir().unwrap();
-        let points = vec![
-            Point { x: 1.0, y: 0.1, label: "a".into(), group: 0 },
-            Point { x: 2.0, y: f64::INFINITY, label: "b".into(), group: 1 },
-            Point { x: 1.5, y: f64::NAN, label: "c".into(), group: 1 },
-        ];
+        let point = |x: f64, y: f64, label: &str, group, highlight| Point { x, x_lo: x * 0.98, x_hi: x * 1.02, y, label: label.into(), group, highlight };
+        let points = vec![point(1.0, 0.1, "a", 0, true), point(2.0, f64::INFINITY, "b", 1, false), point(1.5, f64::NAN, "c", 1, false)];
         let path = dir.path().join("s.png");
-        scatter_log_y(&path, "t", "x", "y", &points, &[(1.0, 0.1)], &[(0, "g".into())], Some(1.8)).unwrap();
+        let spec = Scatter { title: "t", x_desc: "x", y_desc: "y", line: &[(1.0, 0.1)], legend: &[(0, "g".into())], split_x: Some(1.8) };
+        scatter_log_y(&path, &spec, &points).unwrap();
         assert!(image::open(&path).is_ok());
     }
 }

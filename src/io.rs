@@ -76,9 +76,30 @@ pub fn format_rgb_csv(rows: &[[f32; 3]]) -> String {
     out
 }
 
-/// Writes `bytes` to `path` atomically: a temporary file in the same directory, synced, then renamed over
-/// `path`. A failure leaves any existing file untouched and no temporary behind.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+/// Writes a command's named output. A regular file, or a path that does not exist yet, is written atomically:
+/// a temporary file in the same directory, synced, then renamed over it, so a failure leaves any existing file
+/// untouched and no temporary behind. A symbolic link is followed, and its target written the same way. Any
+/// other existing file (a device such as /dev/null, a FIFO) is opened and written in place, never replaced.
+pub fn write_output(path: &Path, bytes: &[u8]) -> Result<()> {
+    let target = match std::fs::symlink_metadata(path) {
+        Ok(m) if m.file_type().is_symlink() => match std::fs::canonicalize(path) {
+            Ok(t) => t,
+            Err(e) => bail!("cannot write {}: it is a symbolic link whose target cannot be resolved ({e})", path.display()),
+        },
+        _ => path.to_path_buf(),
+    };
+    match std::fs::metadata(&target) {
+        Ok(m) if m.is_dir() => bail!("cannot write {}: it is a directory", path.display()),
+        Ok(m) if !m.is_file() => {
+            let mut f = std::fs::OpenOptions::new().write(true).open(&target).with_context(|| format!("cannot open {}", path.display()))?;
+            f.write_all(bytes).and_then(|_| f.flush()).with_context(|| format!("cannot write {}", path.display()))
+        }
+        _ => write_atomic(&target, bytes),
+    }
+}
+
+/// Temp-then-rename in `path`'s directory (regular files only; `write_output` decides).
+fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     let dir = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
         _ => PathBuf::from("."),
@@ -132,8 +153,8 @@ mod tests {
     fn atomic_write_replaces_whole_file() {
         let dir = tempfile::tempdir().unwrap();
         let p = dir.path().join("out.csv");
-        write_atomic(&p, b"first").unwrap();
-        write_atomic(&p, b"second").unwrap();
+        write_output(&p, b"first").unwrap();
+        write_output(&p, b"second").unwrap();
         assert_eq!(std::fs::read(&p).unwrap(), b"second");
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1, "no temporary left behind");
     }

@@ -1,7 +1,7 @@
 //! brdfprof: evaluates and profiles specular BRDFs in Vulkan compute kernels.
 //!
-//! Data flows CLI (`main.rs`) -> model spec (`brdf`) -> kernels (`kernels`, `shaders`, on `gpu`) -> the
-//! measurement protocol (`profile`) -> reports (`report`).
+//! Data flows CLI (`main.rs`, `cli/`) -> models (`model`: a `brdf` spec) -> kernels (`kernels`, `shaders`, on
+//! `gpu`) -> the measurement protocol (`profile`) -> reports (`report`).
 
 pub mod accuracy;
 pub mod brdf;
@@ -10,6 +10,7 @@ pub mod gpu;
 pub mod inspect;
 pub mod io;
 pub mod kernels;
+pub mod model;
 pub mod profile;
 pub mod report;
 pub mod shaders;
@@ -17,3 +18,4 @@ pub mod stability;
 pub mod stats;
 pub mod sweep;
 pub mod scene;
+pub mod util;

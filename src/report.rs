@@ -107,13 +107,13 @@ pub fn device_slug(device: &DeviceInfo) -> String {
 pub fn write_json_compact(path: &Path, value: &impl Serialize) -> Result<()> {
     let mut text = serde_json::to_string(value)?;
     text.push('\n');
-    crate::io::write_atomic(path, text.as_bytes())
+    crate::io::write_output(path, text.as_bytes())
 }
 
 pub fn write_json(path: &Path, value: &impl Serialize) -> Result<()> {
     let mut text = serde_json::to_string_pretty(value)?;
     text.push('\n');
-    crate::io::write_atomic(path, text.as_bytes())
+    crate::io::write_output(path, text.as_bytes())
 }
 
 #[cfg(test)]

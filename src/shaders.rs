@@ -1,7 +1,15 @@
-//! The SPIR-V kernels, embedded at build time from `spv/` as listed in `glsl/kernels.txt`.
+//! The SPIR-V kernels: embedded at build time from `spv/` as listed in `glsl/kernels.txt`, or compiled at run
+//! time with glslang (from another GLSL directory, `--glsl DIR`, or composed for a `.brdf` model), and the
+//! GLSL sources themselves, embedded so that kernels can be composed without a checkout.
 
-/// One compiled kernel: its GLSL source (under `glsl/`), the preprocessor defines it was compiled with, and
-/// the SPIR-V that glslang produced.
+use anyhow::{anyhow, bail, Context, Result};
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::sync::{Arc, Mutex};
+
+/// One compiled kernel as the build embedded it: its GLSL source (under `glsl/`), the preprocessor defines it
+/// was compiled with, and the SPIR-V that glslang produced.
 #[derive(Debug)]
 pub struct KernelSource {
     pub name: &'static str,
@@ -12,17 +20,166 @@ pub struct KernelSource {
 
 include!(concat!(env!("OUT_DIR"), "/kernels.rs"));
 
-/// The kernel named `name` (a name from `glsl/kernels.txt`).
-pub fn kernel(name: &str) -> &'static KernelSource {
-    KERNELS
-        .iter()
-        .find(|k| k.name == name)
-        .unwrap_or_else(|| panic!("no kernel {name} in glsl/kernels.txt"))
+/// A SPIR-V module ready for `gpu::Kernel::new`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Spirv {
+    pub name: String,
+    pub words: Arc<[u32]>,
+}
+
+impl Spirv {
+    /// SPIR-V from its bytes (little-endian words, as glslang writes them).
+    pub fn from_bytes(name: &str, bytes: &[u8]) -> Result<Self> {
+        const MAGIC: u32 = 0x0723_0203;
+        if bytes.len() % 4 != 0 || bytes.len() < 20 {
+            bail!("{name}: not a SPIR-V module ({} bytes, not whole words of a header and more)", bytes.len());
+        }
+        let words: Vec<u32> = bytes.chunks_exact(4).map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect();
+        if words[0] != MAGIC {
+            bail!("{name}: not a SPIR-V module (magic number {:#010x})", words[0]);
+        }
+        Ok(Spirv { name: name.to_string(), words: words.into() })
+    }
+
+    pub fn bytes(&self) -> Vec<u8> {
+        self.words.iter().flat_map(|w| w.to_le_bytes()).collect()
+    }
+}
+
+/// The embedded kernel `name` (a name from `glsl/kernels.txt`).
+pub fn embedded(name: &str) -> Result<&'static KernelSource> {
+    KERNELS.iter().find(|k| k.name == name).ok_or_else(|| anyhow!("no kernel `{name}` in glsl/kernels.txt"))
 }
 
 impl KernelSource {
-    /// The SPIR-V as words (the embedded bytes carry no alignment guarantee).
-    pub fn words(&self) -> Vec<u32> {
-        ash::util::read_spv(&mut std::io::Cursor::new(self.spirv)).expect("embedded SPIR-V is well formed")
+    pub fn spirv(&self) -> Spirv {
+        Spirv::from_bytes(self.name, self.spirv).expect("embedded SPIR-V is well formed")
     }
+}
+
+/// glslang's flags for every kernel, as in glsl/build-spv.sh (`-D<define>` and `-o` follow).
+pub const GLSLANG_FLAGS: [&str; 3] = ["-V", "--target-env", "vulkan1.1"];
+
+/// Where the built-in kernels' SPIR-V comes from: the modules embedded from `spv/`, or a GLSL directory (a
+/// copy of glsl/ with its kernels.txt) compiled on demand, so that `inspect --glsl DIR` and `check --glsl DIR`
+/// measure an edited copy of the shaders exactly as `make spv` would have compiled it.
+pub struct Shaders {
+    glsl: Option<PathBuf>,
+    compiled: Mutex<HashMap<String, Spirv>>,
+}
+
+impl Shaders {
+    pub fn embedded() -> Self {
+        Shaders { glsl: None, compiled: Mutex::default() }
+    }
+
+    pub fn from_glsl(dir: &Path) -> Result<Self> {
+        if !dir.join("kernels.txt").is_file() {
+            bail!("--glsl {}: no kernels.txt there (expected a directory like glsl/)", dir.display());
+        }
+        Ok(Shaders { glsl: Some(dir.to_path_buf()), compiled: Mutex::default() })
+    }
+
+    pub fn glsl_dir(&self) -> Option<&Path> {
+        self.glsl.as_deref()
+    }
+
+    /// Where the SPIR-V came from, for reports.
+    pub fn describe(&self) -> String {
+        match &self.glsl {
+            None => "embedded spv/".into(),
+            Some(dir) => format!("compiled at run time from {} ({})", dir.display(), glslang_version().unwrap_or_else(|| "glslang".into())),
+        }
+    }
+
+    /// The kernel `name` of kernels.txt.
+    pub fn get(&self, name: &str) -> Result<Spirv> {
+        let Some(dir) = &self.glsl else {
+            return Ok(embedded(name)?.spirv());
+        };
+        let mut compiled = self.compiled.lock().unwrap();
+        if let Some(k) = compiled.get(name) {
+            return Ok(k.clone());
+        }
+        let (source, defines) = kernel_entry(dir, name)?;
+        let words = glslang(&dir.join(&source), &defines, &[])?;
+        let spirv = Spirv { name: name.to_string(), words: words.into() };
+        compiled.insert(name.to_string(), spirv.clone());
+        Ok(spirv)
+    }
+}
+
+/// `name`'s line in `dir/kernels.txt`: (source file, defines).
+fn kernel_entry(dir: &Path, name: &str) -> Result<(String, Vec<String>)> {
+    let list = dir.join("kernels.txt");
+    let text = std::fs::read_to_string(&list).with_context(|| format!("cannot read {}", list.display()))?;
+    for line in text.lines().map(str::trim).filter(|l| !l.is_empty() && !l.starts_with('#')) {
+        let mut fields = line.split_whitespace();
+        if fields.next() == Some(name) {
+            let source = fields.next().ok_or_else(|| anyhow!("{}: `{line}` names no source file", list.display()))?;
+            return Ok((source.to_string(), fields.map(str::to_string).collect()));
+        }
+    }
+    bail!("{} lists no kernel `{name}`", list.display())
+}
+
+/// Compiles `source` with glslang (`GLSLANG_FLAGS`, `-D` for each define, `-I` for each include directory)
+/// and returns the SPIR-V words; a failure carries glslang's own messages.
+pub fn glslang(source: &Path, defines: &[String], includes: &[&Path]) -> Result<Vec<u32>> {
+    let out_dir = tempfile::tempdir().context("cannot create a temporary directory for glslang's output")?;
+    let out = out_dir.path().join("out.spv");
+    let mut cmd = Command::new("glslangValidator");
+    cmd.args(GLSLANG_FLAGS);
+    for d in defines {
+        cmd.arg(format!("-D{d}"));
+    }
+    for i in includes {
+        cmd.arg(format!("-I{}", i.display()));
+    }
+    cmd.arg("-o").arg(&out).arg(source);
+    let result = cmd.output().map_err(|e| anyhow!("cannot run glslangValidator ({e}): install glslang-tools, or run `make setup`"))?;
+    if !result.status.success() {
+        bail!(GlslangError { source: source.to_path_buf(), log: format!("{}{}", String::from_utf8_lossy(&result.stdout), String::from_utf8_lossy(&result.stderr)) });
+    }
+    let bytes = std::fs::read(&out).with_context(|| format!("cannot read glslang's output {}", out.display()))?;
+    Ok(Spirv::from_bytes(&source.display().to_string(), &bytes)?.words.to_vec())
+}
+
+/// glslang refused a source: its log, as it printed it.
+#[derive(Debug)]
+pub struct GlslangError {
+    pub source: PathBuf,
+    pub log: String,
+}
+
+impl std::fmt::Display for GlslangError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "glslangValidator failed on {}:\n{}", self.source.display(), self.log.trim_end())
+    }
+}
+
+impl std::error::Error for GlslangError {}
+
+/// Writes the embedded glsl/ tree into `dir` (for kernels composed at run time).
+pub fn write_glsl_tree(dir: &Path) -> Result<()> {
+    for (rel, text) in GLSL_FILES {
+        let path = dir.join(rel);
+        if let Some(parent) = path.parent() {
+            std::fs::create_dir_all(parent).with_context(|| format!("cannot create {}", parent.display()))?;
+        }
+        std::fs::write(&path, text).with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    Ok(())
+}
+
+/// `glslangValidator --version`'s first line, e.g. "Glslang Version: 11:12.0.0".
+pub fn glslang_version() -> Option<String> {
+    first_line_of(Command::new("glslangValidator").arg("--version"))
+}
+
+/// The first non-empty line a tool prints, or None when it cannot run.
+pub fn first_line_of(cmd: &mut Command) -> Option<String> {
+    let out = cmd.output().ok()?;
+    let text = String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr);
+    text.lines().map(str::trim).find(|l| !l.is_empty()).map(str::to_string)
 }

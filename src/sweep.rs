@@ -3,9 +3,11 @@
 //! of error against cost with the Pareto frontier.
 
 use crate::accuracy::{self, Accuracy, ExactCache, SampleSet};
-use crate::brdf::{Metal, ModelSpec, Precision, Vis, D, F, THESIS_MODELS};
+use crate::brdf::spec::with_each_param_sample;
+use crate::brdf::{ModelSpec, Precision, Vis, D, F, THESIS_MODELS};
 use crate::chart::{self, Point};
 use crate::gpu::Gpu;
+use crate::model::Model;
 use crate::profile::{self, ProfileOptions, ProfileReport};
 use crate::report::{self, Table};
 use crate::stats::{self, Estimate};
@@ -15,9 +17,9 @@ use serde::Serialize;
 use std::path::Path;
 
 /// The default set: every D with each of its sensible visibility terms and Schlick's Fresnel; every Fresnel
-/// term on the `ggx` preset; the exact physical models where the library has their exact Smith term (GGX,
-/// Beckmann: exact height-correlated Smith and exact dielectric Fresnel), which anchor the frontier at zero
-/// approximation error; the thesis models in fp16.
+/// term on the reference preset (with each metal where it reads one); the exact physical models where the
+/// library has the exact Smith term of a D (exact height-correlated Smith and the exact dielectric Fresnel),
+/// which anchor the frontier at zero approximation error; the thesis models in fp16.
 pub fn default_specs() -> Vec<ModelSpec> {
     let mut specs: Vec<ModelSpec> = Vec::new();
     let mut push = |s: ModelSpec| {
@@ -30,15 +32,18 @@ pub fn default_specs() -> Vec<ModelSpec> {
             push(ModelSpec::new(d, vis, F::Schlick));
         }
     }
-    let ggx = ModelSpec::preset("ggx").unwrap();
+    let reference = ModelSpec::reference();
     for &f in F::ALL {
-        let metals: &[Metal] = if matches!(f, F::Conductor | F::F82) { Metal::ALL } else { &[Metal::Gold] };
-        for &metal in metals {
-            push(ModelSpec { f, metal, ..ggx });
+        for s in with_each_param_sample(ModelSpec { f, ..reference }) {
+            push(s);
         }
     }
-    push(ModelSpec::new(D::Ggx, Vis::SmithGgxCorrelated, F::Dielectric));
-    push(ModelSpec::new(D::Beckmann, Vis::SmithBeckmannCorrelated, F::Dielectric));
+    let exact_dielectric = F::ALL.iter().copied().find(|f| f.row().is_exact && f.row().reads.is_empty()).expect("the table has an exact dielectric Fresnel");
+    for &vis in Vis::ALL {
+        if let Some(d) = vis.row().exact_for {
+            push(ModelSpec::new(d, vis, exact_dielectric));
+        }
+    }
     for name in THESIS_MODELS {
         push(ModelSpec { precision: Precision::F16, ..ModelSpec::preset(name).unwrap() });
     }
@@ -46,15 +51,13 @@ pub fn default_specs() -> Vec<ModelSpec> {
 }
 
 /// A short label for charts: the preset name where one matches, else d/vis/f.
-pub fn label(spec: &ModelSpec) -> String {
+pub fn label(model: &Model) -> String {
+    let Some(spec) = model.twin() else { return model.name() };
     let name = spec.name();
     if !name.starts_with("d=") {
         return name.replace(",precision=f16", " f16");
     }
-    let mut s = format!("{}/{}/{}", spec.d.name(), spec.vis.name(), spec.f_name());
-    if spec.f == F::F82 {
-        s += &format!("-{}", spec.metal.name());
-    }
+    let mut s = format!("{}/{}/{}", spec.d.name(), spec.vis.name(), spec.f_label());
     if spec.precision == Precision::F16 {
         s += " f16";
     }
@@ -106,11 +109,11 @@ pub fn run(gpu: &Gpu, options: &SweepOptions, progress: &ProgressBar) -> Result<
     progress.set_message("accuracy: GPU against f64 twins and exact references");
     let set = SampleSet::standard();
     let mut cache = ExactCache::default();
-    let specs: Vec<(usize, ModelSpec)> = options
+    let specs: Vec<(usize, Model)> = options
         .profile
         .models
         .iter()
-        .map(|m| (profile.labels.iter().position(|l| *l == m.name()).expect("every spec was timed"), *m))
+        .map(|m| (profile.labels.iter().position(|l| *l == m.name()).expect("every spec was timed"), m.clone()))
         .collect();
     let evals = profile.workload.evaluations_per_dispatch as f64;
     let costs: Vec<Vec<f64>> = specs.iter().map(|(i, _)| profile::per_round(&profile.raw, *i, evals)).collect();
@@ -192,22 +195,41 @@ impl SweepReport {
         )
     }
 
+    /// Writes sweep-<device>.md, .json and .png under `out`; returns their paths.
+    pub fn write(&self, out: &Path, device: &str) -> Result<Vec<std::path::PathBuf>> {
+        let stem = out.join(format!("sweep-{device}"));
+        let (md, json, png) = (stem.with_extension("md"), stem.with_extension("json"), stem.with_extension("png"));
+        report::write_json_compact(&json, self)?;
+        crate::io::write_output(&md, self.markdown().as_bytes())?;
+        self.chart(&png)?;
+        Ok(vec![md, json, png])
+    }
+
     /// Approximation error (RMS vs exact, log) against cost, every point labelled, the frontier drawn.
     pub fn chart(&self, path: &Path) -> Result<()> {
         // Colour by D, fp16 specs apart.
-        let group = |r: &SweepRow| {
-            let spec = ModelSpec::parse(&r.canonical).unwrap();
-            if spec.precision == Precision::F16 { D::ALL.len() } else { spec.d as usize }
+        let group = |r: &SweepRow| match Model::parse(&r.canonical).ok().as_ref().and_then(Model::twin) {
+            Some(spec) if spec.precision == Precision::F32 => spec.d as usize,
+            _ => D::ALL.len(),
         };
+        let thesis: Vec<String> = THESIS_MODELS.iter().map(|m| m.to_string()).collect();
         let points: Vec<Point> = self
             .rows
             .iter()
-            .map(|r| Point { x: r.cost_vs_fastest.median, y: r.accuracy.vs_exact.rms, label: r.label.clone(), group: group(r) })
+            .map(|r| Point {
+                x: r.cost_vs_fastest.median,
+                x_lo: r.cost_vs_fastest.lo,
+                x_hi: r.cost_vs_fastest.hi,
+                y: r.accuracy.vs_exact.rms,
+                label: r.label.clone(),
+                group: group(r),
+                highlight: r.pareto || thesis.contains(&r.spec),
+            })
             .collect();
         let mut front: Vec<(f64, f64)> = self.rows.iter().filter(|r| r.pareto).map(|r| (r.cost_vs_fastest.median, r.accuracy.vs_exact.rms)).collect();
         front.sort_by(|a, b| a.0.total_cmp(&b.0));
         let mut legend: Vec<(usize, String)> = D::ALL.iter().map(|d| (*d as usize, format!("D = {}", d.name()))).collect();
-        legend.push((D::ALL.len(), "fp16".into()));
+        legend.push((D::ALL.len(), "fp16, other models".into()));
         // fp16 (and anything beyond the costliest fp32 spec) goes to the side panel.
         let split = self
             .rows
@@ -215,16 +237,16 @@ impl SweepReport {
             .filter(|r| !r.canonical.contains("precision=f16"))
             .map(|r| r.cost_vs_fastest.median)
             .fold(f64::NEG_INFINITY, f64::max);
-        chart::scatter_log_y(
-            path,
-            &format!("Accuracy against cost on {} ({} evaluations per dispatch)", self.profile.provenance.device.name, self.profile.workload.evaluations_per_dispatch),
-            "cost relative to the fastest spec (median of per-round ratios)",
-            "RMS relative error against the exact physical model",
-            &points,
-            &front,
-            &legend,
-            Some(split * 1.02),
-        )
+        let title = format!("Accuracy against cost on {} ({} evaluations per dispatch)", self.profile.provenance.device.name, self.profile.workload.evaluations_per_dispatch);
+        let spec = chart::Scatter {
+            title: &title,
+            x_desc: "cost relative to the fastest spec (median of per-round ratios, 95% CI whiskers)",
+            y_desc: "RMS relative error against the exact physical model",
+            line: &front,
+            legend: &legend,
+            split_x: Some(split * 1.02),
+        };
+        chart::scatter_log_y(path, &spec, &points)
     }
 }
 
@@ -242,8 +264,8 @@ mod tests {
             assert!(specs.iter().any(|s| s.vis == *v), "{v:?}");
         }
         for f in F::ALL {
-            for m in Metal::ALL {
-                assert!(specs.iter().any(|s| s.f == *f && (!matches!(f, F::Conductor | F::F82) || s.metal == *m)), "{f:?} {m:?}");
+            for variant in with_each_param_sample(ModelSpec { f: *f, ..ModelSpec::reference() }) {
+                assert!(specs.contains(&variant), "{}", variant.name());
             }
         }
         for name in THESIS_MODELS {

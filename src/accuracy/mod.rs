@@ -8,7 +8,8 @@ use crate::brdf::exact::{self, Lambda};
 use crate::brdf::{samples, ModelSpec, Sample, D, F};
 use crate::gpu::Gpu;
 use crate::kernels::{self, AlbedoCell, RunLimits};
-use anyhow::Result;
+use crate::model::Model;
+use anyhow::{anyhow, Result};
 use rayon::prelude::*;
 use serde::Serialize;
 use std::collections::HashMap;
@@ -69,19 +70,21 @@ impl SampleSet {
     }
 }
 
-/// What the exact reference of a spec depends on: its D (and gamma) and whether its exact Fresnel is a
-/// dielectric from F0 or a given metal. Specs differing only in Vis or in their Fresnel approximation share it.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+/// What the exact reference of a spec depends on: its D with the parameters it reads, and its exact Fresnel
+/// with the parameters that reads (a dielectric from F0, or a given metal). Specs differing only in Vis or in
+/// their Fresnel approximation share it.
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
 struct ExactKey {
     d: D,
-    gamma_bits: u64,
-    metal: Option<crate::brdf::Metal>,
+    f: F,
+    params: Vec<u64>,
 }
 
 impl ExactKey {
     fn of(spec: &ModelSpec) -> Self {
-        let metal = matches!(spec.f, F::Conductor | F::F82).then_some(spec.metal);
-        ExactKey { d: spec.d, gamma_bits: if spec.d == D::Gtr { spec.gamma.to_bits() } else { 0 }, metal }
+        let f = spec.exact_fresnel();
+        let reads = spec.d.row().reads.iter().chain(f.row().reads);
+        ExactKey { d: spec.d, f, params: reads.map(|&p| spec.params.get(p).bits()).collect() }
     }
 }
 
@@ -116,12 +119,13 @@ pub struct Accuracy {
     pub albedo_error_bound: f64,
 }
 
-/// Measures `spec` on the GPU over `set`.
-pub fn measure(gpu: &Gpu, spec: &ModelSpec, set: &SampleSet, cache: &mut ExactCache) -> Result<Accuracy> {
-    let got: Vec<[f64; 3]> = kernels::eval(gpu, spec, &set.samples, RunLimits::default())?.iter().map(|g| g.map(f64::from)).collect();
+/// Measures `model` on the GPU over `set` against its twin and exact reference.
+pub fn measure(gpu: &Gpu, model: &Model, set: &SampleSet, cache: &mut ExactCache) -> Result<Accuracy> {
+    let spec = model.twin().ok_or_else(|| anyhow!("{model} has no f64 twin to measure numerical error against"))?;
+    let got: Vec<[f64; 3]> = kernels::eval(gpu, model, &set.samples, RunLimits::default())?.iter().map(|g| g.map(f64::from)).collect();
     let twin: Vec<[f64; 3]> = set.samples.par_iter().map(|s| spec.eval(s)).collect();
     let exact_values = cache.values(spec, set).clone();
-    let gpu_albedo = kernels::albedo(gpu, spec, &set.cells)?;
+    let gpu_albedo = kernels::albedo(gpu, model, &set.cells)?;
     let exact_albedo = cache.albedo(spec, set);
     let albedo_vs_exact = gpu_albedo
         .iter()
@@ -147,7 +151,7 @@ pub fn albedo_twin(spec: &ModelSpec, cell: &AlbedoCell) -> [f64; 3] {
 /// E of the exact counterpart of `spec` for one cell.
 pub fn albedo_exact(spec: &ModelSpec, cell: &AlbedoCell) -> [f64; 3] {
     let a = exact::alpha(cell.roughness as f64);
-    let lambda = Lambda::new(spec.d, a, spec.gamma);
+    let lambda = Lambda::new(spec.d, a, &spec.params);
     let f0 = cell.f0.map(f64::from);
     albedo::albedo_f64(&|c| exact::from_cosines(spec, &lambda, c, a, f0), cell.nov as f64, a)
 }

@@ -9,28 +9,11 @@
 
 use super::guards::MIN_ROUGHNESS_F32;
 use super::spec::ModelSpec;
-use super::terms::{self, Cosines, D, F};
+use super::terms::{Cosines, Lobe, Params, D};
 use super::Sample;
 use std::f64::consts::{FRAC_PI_2, PI};
 
-/// GGX Smith Lambda [Walter et al. 2007; Heitz 2014, eq. 86]: (-1 + sqrt(1 + a^2 tan^2 theta)) / 2.
-pub fn lambda_ggx(cos: f64, a: f64) -> f64 {
-    if cos >= 1.0 {
-        return 0.0;
-    }
-    let tan2 = (1.0 - cos * cos) / (cos * cos);
-    0.5 * (-1.0 + (1.0 + a * a * tan2).sqrt())
-}
-
-/// Beckmann Smith Lambda [Walter et al. 2007, eq. 25]: (erf(c) - 1)/2 + exp(-c^2) / (2 c sqrt(pi)),
-/// c = 1 / (a tan theta).
-pub fn lambda_beckmann(cos: f64, a: f64) -> f64 {
-    if cos >= 1.0 {
-        return 0.0;
-    }
-    let c = cos / (a * (1.0 - cos * cos).sqrt());
-    (libm::erf(c) - 1.0) * 0.5 + (-c * c).exp() / (2.0 * PI.sqrt() * c)
-}
+pub use super::terms::{lambda_beckmann_exact as lambda_beckmann, lambda_ggx};
 
 /// Integral over azimuth of max(0, <o, m>) for polar angles theta_o (sin_o, cos_o) and theta_m (sin_m, cos_m).
 fn clipped_azimuth_integral(sin_o: f64, cos_o: f64, sin_m: f64, cos_m: f64) -> f64 {
@@ -78,14 +61,10 @@ pub fn lambda_numeric(d: impl Fn(f64) -> f64, cos: f64, a: f64) -> f64 {
     projected / cos - 1.0
 }
 
-/// Lambda of a D by the best means available.
-pub fn lambda(d: D, cos: f64, a: f64, gamma: f64) -> f64 {
-    match d {
-        D::Ggx => lambda_ggx(cos, a),
-        D::Gtr if gamma == 2.0 => lambda_ggx(cos, a),
-        D::Beckmann => lambda_beckmann(cos, a),
-        _ => lambda_numeric(|c| d.at(c, a, gamma), cos, a),
-    }
+/// Lambda of a D by the best means available: its closed form where the term table has one, else the
+/// integral of its definition.
+pub fn lambda(d: D, cos: f64, a: f64, params: &Params) -> f64 {
+    (d.row().lambda)(cos, a, params).unwrap_or_else(|| lambda_numeric(|c| d.at(c, a, params), cos, a))
 }
 
 /// Lambda of one (D, a, gamma), tabulated where it has no closed form: 1025 nodes over s = x/(1+x),
@@ -94,7 +73,7 @@ pub fn lambda(d: D, cos: f64, a: f64, gamma: f64) -> f64 {
 pub struct Lambda {
     d: D,
     a: f64,
-    gamma: f64,
+    params: Params,
     scale: f64,
     table: Option<Vec<f64>>,
 }
@@ -102,9 +81,13 @@ pub struct Lambda {
 const TABLE_NODES: usize = 1025;
 
 impl Lambda {
-    pub fn new(d: D, a: f64, gamma: f64) -> Self {
-        let closed = matches!(d, D::Ggx | D::Beckmann) || (d == D::Gtr && gamma == 2.0);
-        let scale = if d == D::Charlie { 1.0 } else { a };
+    pub fn new(d: D, a: f64, params: &Params) -> Self {
+        let params = *params;
+        let closed = (d.row().lambda)(0.5, a, &params).is_some();
+        let scale = match d.row().lobe {
+            Lobe::AroundNormal => a,
+            Lobe::Grazing => 1.0,
+        };
         let table = (!closed).then(|| {
             (0..TABLE_NODES)
                 .map(|i| {
@@ -115,7 +98,7 @@ impl Lambda {
                     }
                     let x = s / (1.0 - s);
                     let cos = 1.0 / (1.0 + (x / scale) * (x / scale)).sqrt();
-                    lambda_numeric(|c| d.at(c, a, gamma), cos, a) * (1.0 - s)
+                    lambda_numeric(|c| d.at(c, a, &params), cos, a) * (1.0 - s)
                 })
                 .collect::<Vec<f64>>()
         });
@@ -124,12 +107,12 @@ impl Lambda {
             t[n - 1] = 2.0 * t[n - 2] - t[n - 3];
             t
         });
-        Lambda { d, a, gamma, scale, table }
+        Lambda { d, a, params, scale, table }
     }
 
     pub fn at(&self, cos: f64) -> f64 {
         let Some(table) = &self.table else {
-            return lambda(self.d, cos, self.a, self.gamma);
+            return lambda(self.d, cos, self.a, &self.params);
         };
         if cos >= 1.0 {
             return 0.0;
@@ -143,13 +126,10 @@ impl Lambda {
     }
 }
 
-/// Exact Fresnel for a spec: the conductor's complex IOR for conductor and F82 specs, else the dielectric
-/// with the sample's F0.
+/// Exact Fresnel for a spec: the one its F stands for (the metal's complex IOR for the conductor terms, the
+/// dielectric with the sample's F0 otherwise).
 pub fn fresnel(spec: &ModelSpec, f0: [f64; 3], voh: f64) -> [f64; 3] {
-    match spec.f {
-        F::Conductor | F::F82 => terms::f_conductor(spec.metal, voh),
-        _ => f0.map(|f| terms::f_dielectric(f, voh)),
-    }
+    spec.exact_fresnel().eval(f0, voh, &spec.params)
 }
 
 /// a = r^2 for the exact model: the requested roughness, floored at the fp32 guard whatever the spec's
@@ -162,7 +142,7 @@ pub fn alpha(roughness: f64) -> f64 {
 /// The exact physical counterpart of `spec` from guarded cosines; `lambda` must be for this spec's D at `a`.
 pub fn from_cosines(spec: &ModelSpec, lambda: &Lambda, c: &Cosines, a: f64, f0: [f64; 3]) -> [f64; 3] {
     let g2 = 1.0 / (1.0 + lambda.at(c.nov) + lambda.at(c.nol));
-    let dv = spec.d.eval(c.noh, c.sin2h, a, spec.gamma) * g2 / (4.0 * c.nol * c.nov);
+    let dv = spec.d.eval(c.noh, c.sin2h, a, &spec.params) * g2 / (4.0 * c.nol * c.nov);
     fresnel(spec, f0, c.voh).map(|f| dv * f)
 }
 
@@ -171,8 +151,9 @@ pub fn from_cosines(spec: &ModelSpec, lambda: &Lambda, c: &Cosines, a: f64, f0: 
 pub fn eval(spec: &ModelSpec, s: &Sample) -> [f64; 3] {
     let Some((c, f0)) = super::spec::guarded_cosines(s) else { return [0.0; 3] };
     let a = alpha(f64::from(s.roughness));
-    let g2 = 1.0 / (1.0 + lambda(spec.d, c.nov, a, spec.gamma) + lambda(spec.d, c.nol, a, spec.gamma));
-    let dv = spec.d.eval(c.noh, c.sin2h, a, spec.gamma) * g2 / (4.0 * c.nol * c.nov);
+    let p = &spec.params;
+    let g2 = 1.0 / (1.0 + lambda(spec.d, c.nov, a, p) + lambda(spec.d, c.nol, a, p));
+    let dv = spec.d.eval(c.noh, c.sin2h, a, p) * g2 / (4.0 * c.nol * c.nov);
     fresnel(spec, f0, c.voh).map(|f| dv * f)
 }
 
@@ -180,26 +161,36 @@ pub fn eval(spec: &ModelSpec, s: &Sample) -> [f64; 3] {
 mod tests {
     use super::*;
 
+    use crate::brdf::spec::{with_each_param_sample, ModelSpec};
+    use crate::brdf::{F, Vis};
+
+    /// Every D with each sample of the parameters it reads.
+    fn every_d() -> Vec<ModelSpec> {
+        D::ALL.iter().flat_map(|&d| with_each_param_sample(ModelSpec::new(d, Vis::Implicit, F::None))).collect()
+    }
+
     #[test]
     fn numeric_lambda_matches_closed_forms() {
-        for a in [0.01, 0.1, 0.3, 0.7, 1.0] {
-            for cos in [0.02, 0.1, 0.3, 0.6, 0.9, 0.999] {
-                let ggx = lambda_numeric(|c| D::Ggx.at(c, a, 1.5), cos, a);
-                let beck = lambda_numeric(|c| D::Beckmann.at(c, a, 1.5), cos, a);
-                assert!((ggx - lambda_ggx(cos, a)).abs() <= 1e-6 * (1.0 + lambda_ggx(cos, a)), "GGX a={a} cos={cos}: {ggx} vs {}", lambda_ggx(cos, a));
-                assert!((beck - lambda_beckmann(cos, a)).abs() <= 1e-6 * (1.0 + lambda_beckmann(cos, a)), "Beckmann a={a} cos={cos}: {beck} vs {}", lambda_beckmann(cos, a));
+        for spec in every_d() {
+            for a in [0.01, 0.1, 0.3, 0.7, 1.0] {
+                let Some(_) = (spec.d.row().lambda)(0.5, a, &spec.params) else { continue };
+                for cos in [0.02, 0.1, 0.3, 0.6, 0.9, 0.999] {
+                    let closed = lambda(spec.d, cos, a, &spec.params);
+                    let numeric = lambda_numeric(|c| spec.d.at(c, a, &spec.params), cos, a);
+                    assert!((numeric - closed).abs() <= 1e-6 * (1.0 + closed), "{} a={a} cos={cos}: {numeric} vs {closed}", spec.name());
+                }
             }
         }
     }
 
     #[test]
     fn tables_match_direct_integration() {
-        for (d, gamma) in [(D::Blinn, 1.5), (D::Gtr, 1.5), (D::Gtr, 1.0), (D::Charlie, 1.5)] {
+        for spec in every_d().into_iter().filter(|s| (s.d.row().lambda)(0.5, 0.5, &s.params).is_none()) {
             for a in [0.01, 0.2, 0.8] {
-                let table = Lambda::new(d, a, gamma);
+                let table = Lambda::new(spec.d, a, &spec.params);
                 for cos in [0.03, 0.2, 0.5, 0.8, 0.97] {
-                    let direct = lambda_numeric(|c| d.at(c, a, gamma), cos, a);
-                    assert!((table.at(cos) - direct).abs() <= 2e-4 * (1.0 + direct), "{d:?} a={a} cos={cos}: {} vs {direct}", table.at(cos));
+                    let direct = lambda_numeric(|c| spec.d.at(c, a, &spec.params), cos, a);
+                    assert!((table.at(cos) - direct).abs() <= 2e-4 * (1.0 + direct), "{} a={a} cos={cos}: {} vs {direct}", spec.name(), table.at(cos));
                 }
             }
         }

@@ -1,5 +1,7 @@
-//! The guards every kernel applies, named once. The same constants stand at the top of `glsl/brdf.glsl`;
-//! README "Guards" says why each exists and where it comes from.
+//! The guards every kernel applies, named once. `brdf::glsl_gen` writes the same constants into the GLSL
+//! (glsl/generated.glsl); README "Guards" says why each exists and where it comes from.
+
+use glam::DVec3;
 
 /// Perceptual roughness floor in fp32 kernels: Filament's MIN_PERCEPTUAL_ROUGHNESS (highp).
 /// Below it a2 = r^4 makes D_GGX's `NoH^2 (a2-1) + 1` cancel to 0 at the peak in fp32.
@@ -16,30 +18,37 @@ pub const GTR_SERIES_BAND: f64 = 0.05;
 /// Dielectric F0 cap: the IOR (1 + sqrt F0)/(1 - sqrt F0) is infinite at F0 = 1.
 pub const F0_MAX: f64 = 0.9999;
 
+/// One guard as the GLSL declares it: name, value, and the comment that says why.
+pub struct Guard {
+    pub name: &'static str,
+    pub value: f64,
+    pub why: &'static str,
+}
+
+/// The guards the GLSL declares (MIN_ROUGHNESS, which depends on the precision, is written apart).
+pub const GLSL_GUARDS: [Guard; 4] = [
+    Guard { name: "MIN_COSINE", value: MIN_COSINE, why: "Filament MIN_N_DOT_V; NoV, NoL, NoH, VoH floor once a light is visible" },
+    Guard { name: "MIN_VECTOR", value: MIN_VECTOR, why: "FLT_MIN: a vector whose largest component is below it counts as zero" },
+    Guard { name: "GTR_SERIES_BAND", value: GTR_SERIES_BAND, why: "|a2-1| below which the GTR normaliser uses its series (0/0 at a2 = 1)" },
+    Guard { name: "F0_MAX", value: F0_MAX, why: "dielectric F0 cap: the IOR (1+sqrt F0)/(1-sqrt F0) is infinite at 1" },
+];
+
 /// Clamp of a visible cosine into [MIN_COSINE, 1].
 pub fn guard_cosine(x: f64) -> f64 {
     x.clamp(MIN_COSINE, 1.0)
 }
 
 /// Unit vector scaled by its largest component first; zero when that component is below MIN_VECTOR.
-pub fn safe_normalize(v: [f64; 3]) -> [f64; 3] {
-    let m = v[0].abs().max(v[1].abs()).max(v[2].abs());
+pub fn safe_normalize(v: DVec3) -> DVec3 {
+    let m = v.abs().max_element();
     if !(m >= MIN_VECTOR) {
-        return [0.0; 3];
+        return DVec3::ZERO;
     }
-    let u = v.map(|x| x / m);
-    let len = (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt();
-    u.map(|x| x / len)
+    let u = v / m;
+    u / u.length()
 }
 
-pub fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-pub fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
-}
-
-pub fn add(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+/// `safe_normalize` of an f32 triple, in f64.
+pub fn unit(v: [f32; 3]) -> DVec3 {
+    safe_normalize(DVec3::from(v.map(f64::from)))
 }

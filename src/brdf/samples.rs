@@ -2,34 +2,33 @@
 //! (roughness, NoV, NoL, azimuth). Vectors are built around a random normal so that no axis is special.
 
 use super::Sample;
+use glam::DVec3;
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 
 /// Unit vector with the given cosine to `n` and azimuth `phi` about it.
-pub fn around(n: [f64; 3], cos_theta: f64, phi: f64) -> [f64; 3] {
+pub fn around(n: DVec3, cos_theta: f64, phi: f64) -> DVec3 {
     let (t, b) = tangent_frame(n);
     let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
     let (s, c) = phi.sin_cos();
-    [0, 1, 2].map(|i| sin_theta * (c * t[i] + s * b[i]) + cos_theta * n[i])
+    sin_theta * (c * t + s * b) + cos_theta * n
 }
 
-/// An orthonormal tangent and bitangent for unit `n` [Duff et al. 2017, "Building an Orthonormal Basis, Revisited"].
-pub fn tangent_frame(n: [f64; 3]) -> ([f64; 3], [f64; 3]) {
-    let sign = 1f64.copysign(n[2]);
-    let a = -1.0 / (sign + n[2]);
-    let b = n[0] * n[1] * a;
-    ([1.0 + sign * n[0] * n[0] * a, sign * b, -sign * n[0]], [b, sign + n[1] * n[1] * a, -n[1]])
+/// An orthonormal tangent and bitangent for unit `n`, with (t, b, n) right-handed [Duff et al. 2017,
+/// "Building an Orthonormal Basis, Revisited", as glam's `any_orthonormal_pair`].
+pub fn tangent_frame(n: DVec3) -> (DVec3, DVec3) {
+    n.any_orthonormal_pair()
 }
 
-fn random_unit(rng: &mut Pcg64) -> [f64; 3] {
+fn random_unit(rng: &mut Pcg64) -> DVec3 {
     let z: f64 = rng.random_range(-1.0..1.0);
     let phi: f64 = rng.random_range(0.0..std::f64::consts::TAU);
     let r = (1.0 - z * z).sqrt();
-    [r * phi.cos(), r * phi.sin(), z]
+    DVec3::new(r * phi.cos(), r * phi.sin(), z)
 }
 
-fn to_f32(v: [f64; 3]) -> [f32; 3] {
-    v.map(|x| x as f32)
+fn to_f32(v: DVec3) -> [f32; 3] {
+    v.as_vec3().to_array()
 }
 
 /// `count` samples with NoV and NoL uniform in [min_cos, 1], roughness uniform in `roughness`, F0 uniform in
@@ -90,14 +89,14 @@ pub fn stratified(per_axis: usize, seed: u64, min_cos: f64, roughness: std::ops:
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::brdf::guards::dot;
 
     #[test]
     fn samples_have_the_cosines_asked_for() {
         for s in well_conditioned(1000, 7, 0.05, 0.2..1.0) {
-            let (n, v, l) = (s.n.map(f64::from), s.v.map(f64::from), s.l.map(f64::from));
-            assert!(dot(n, v) >= 0.05 - 1e-6 && dot(n, l) >= 0.05 - 1e-6);
-            assert!((dot(v, v) - 1.0).abs() < 1e-6);
+            let f = |v: [f32; 3]| DVec3::from(v.map(f64::from));
+            let (n, v, l) = (f(s.n), f(s.v), f(s.l));
+            assert!(n.dot(v) >= 0.05 - 1e-6 && n.dot(l) >= 0.05 - 1e-6);
+            assert!((v.length_squared() - 1.0).abs() < 1e-6);
             assert!((0.2..1.0).contains(&s.roughness));
         }
         assert_eq!(well_conditioned(10, 3, 0.05, 0.2..1.0), well_conditioned(10, 3, 0.05, 0.2..1.0));

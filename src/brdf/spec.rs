@@ -1,10 +1,12 @@
-//! Model specs: a D, a Vis, an F and a precision (plus GTR's gamma and the metal of conductor Fresnel),
-//! written `d=ggx,vis=smith-ggx-correlated,f=schlick,precision=f16` or as a preset (`burley`), optionally
-//! followed by overrides (`burley,gamma=2`, `ggx,precision=f16`).
+//! Model specs: a D, a Vis, an F, a precision and the values of the parameters those terms read, written
+//! `d=ggx,vis=smith-ggx-correlated,f=schlick,precision=f16` or as a preset (`burley`), optionally followed by
+//! overrides (`burley,gamma=2`, `ggx,precision=f16`). Every key is checked once: a parameter no term of the
+//! spec reads, or a key given twice, is an error.
 
 use super::guards::{self, MIN_ROUGHNESS_F16, MIN_ROUGHNESS_F32};
-use super::terms::{Cosines, D, F, Metal, Vis};
+use super::terms::{Cosines, Exact, Metal, Param, ParamKind, ParamValue, Params, D, F, Vis};
 use super::Sample;
+use glam::DVec3;
 use std::fmt;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -33,19 +35,14 @@ impl Precision {
     }
 }
 
-/// Default GTR exponent: the thesis hard-coded 1.5, the middle of Burley's [1, 2].
-pub const DEFAULT_GAMMA: f64 = 1.5;
-
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ModelSpec {
     pub d: D,
     pub vis: Vis,
     pub f: F,
     pub precision: Precision,
-    /// GTR exponent (read when d = gtr).
-    pub gamma: f64,
-    /// Metal of the conductor and F82 Fresnel terms.
-    pub metal: Metal,
+    /// Every parameter's value; only those the terms read matter (`reads`).
+    pub params: Params,
 }
 
 /// A named combination, as an engine or the thesis ships it.
@@ -70,13 +67,40 @@ pub const PRESETS: &[Preset] = &[
 /// The four models of the thesis, in its order.
 pub const THESIS_MODELS: [&str; 4] = ["ggx", "blinn", "cook-torrance", "burley"];
 
+/// The reference every cost is compared with: the thesis' (and UE's) GGX.
+pub const REFERENCE_MODEL: &str = "ggx";
+
+/// Keys of a spec besides the parameters.
+const TERM_KEYS: [&str; 4] = ["d", "vis", "f", "precision"];
+
 impl ModelSpec {
     pub fn new(d: D, vis: Vis, f: F) -> Self {
-        ModelSpec { d, vis, f, precision: Precision::F32, gamma: DEFAULT_GAMMA, metal: Metal::Gold }
+        ModelSpec { d, vis, f, precision: Precision::F32, params: Params::default() }
     }
 
     pub fn preset(name: &str) -> Option<Self> {
         PRESETS.iter().find(|p| p.name == name).map(|p| ModelSpec::new(p.d, p.vis, p.f))
+    }
+
+    /// The reference model (`REFERENCE_MODEL`).
+    pub fn reference() -> Self {
+        ModelSpec::preset(REFERENCE_MODEL).expect("the reference is a preset")
+    }
+
+    /// The parameters this spec's terms read, in `Param` order.
+    pub fn reads(&self) -> Vec<Param> {
+        let mut reads: Vec<Param> = self.d.row().reads.iter().chain(self.f.row().reads).copied().collect();
+        reads.sort();
+        reads.dedup();
+        reads
+    }
+
+    /// This spec with `p` set to `value` if one of its terms reads `p` (else unchanged).
+    pub fn with_param(mut self, p: Param, value: ParamValue) -> Self {
+        if self.reads().contains(&p) {
+            self.params.set(p, value);
+        }
+        self
     }
 
     /// Parses a spec; the error names the offending item and lists what is accepted.
@@ -85,69 +109,69 @@ impl ModelSpec {
         if text.is_empty() {
             return Err("empty model spec".into());
         }
-        let mut items = text.split(',').map(str::trim);
-        let first = items.clone().next().unwrap();
-        let mut spec = if first.contains('=') {
-            ModelSpec::new(D::Ggx, Vis::SmithGgxJointApprox, F::Schlick)
-        } else {
+        let mut items = text.split(',').map(str::trim).peekable();
+        let first = *items.peek().unwrap();
+        let preset = !first.contains('=');
+        let mut spec = if preset {
             items.next();
             ModelSpec::preset(first).ok_or_else(|| {
                 format!("unknown model `{first}`: presets are {}; or give d=..,vis=..,f=..", preset_names().join(", "))
             })?
+        } else {
+            ModelSpec::new(D::Ggx, Vis::SmithGgxJointApprox, F::Schlick)
         };
-        let (mut saw_d, mut saw_vis) = (!first.contains('='), !first.contains('='));
+        let mut seen: Vec<&str> = Vec::new();
+        let mut given: Vec<(Param, ParamValue)> = Vec::new();
         for item in items {
-            let (key, value) = item
-                .split_once('=')
-                .ok_or_else(|| format!("`{item}` in model spec `{text}` is not key=value"))?;
+            let (key, value) = item.split_once('=').ok_or_else(|| format!("`{item}` in model spec `{text}` is not key=value"))?;
             let (key, value) = (key.trim(), value.trim());
+            if seen.contains(&key) {
+                return Err(format!("`{key}` is given twice in model spec `{text}`"));
+            }
+            seen.push(key);
             match key {
-                "d" => {
-                    spec.d = D::from_name(value).ok_or_else(|| unknown("d", value, &D::names()))?;
-                    saw_d = true;
+                "d" => spec.d = D::from_name(value).ok_or_else(|| unknown("d", value, &D::names()))?,
+                "vis" => spec.vis = Vis::from_name(value).ok_or_else(|| unknown("vis", value, &Vis::names()))?,
+                "f" => spec.f = parse_f(value, &mut given)?,
+                "precision" => spec.precision = Precision::from_name(value).ok_or_else(|| unknown("precision", value, &["f32", "f16"]))?,
+                _ => {
+                    let p = Param::from_name(key).ok_or_else(|| {
+                        let keys: Vec<&str> = TERM_KEYS.into_iter().chain(Param::ALL.map(Param::name)).collect();
+                        format!("unknown key `{key}` in model spec `{text}`: keys are {}", keys.join(", "))
+                    })?;
+                    given.push((p, Params::parse_value(p, value)?));
                 }
-                "vis" => {
-                    spec.vis = Vis::from_name(value).ok_or_else(|| unknown("vis", value, &Vis::names()))?;
-                    saw_vis = true;
-                }
-                "f" => {
-                    if let Some(metal) = value.strip_prefix("conductor-") {
-                        spec.f = F::Conductor;
-                        spec.metal = Metal::from_name(metal).ok_or_else(|| unknown("metal", metal, &Metal::names()))?;
-                    } else {
-                        spec.f = F::from_name(value).filter(|f| *f != F::Conductor).ok_or_else(|| unknown("f", value, &f_names()))?;
-                    }
-                }
-                "metal" => spec.metal = Metal::from_name(value).ok_or_else(|| unknown("metal", value, &Metal::names()))?,
-                "precision" => {
-                    spec.precision = Precision::from_name(value).ok_or_else(|| unknown("precision", value, &["f32", "f16"]))?
-                }
-                "gamma" => spec.gamma = parse_gamma(value)?,
-                _ => return Err(format!("unknown key `{key}` in model spec `{text}`: keys are d, vis, f, precision, gamma, metal")),
             }
         }
-        if !saw_d || !saw_vis {
+        if !preset && !(seen.contains(&"d") && seen.contains(&"vis")) {
             return Err(format!("model spec `{text}` needs both d= and vis= (f defaults to schlick)"));
+        }
+        let reads = spec.reads();
+        for (p, value) in given {
+            if !reads.contains(&p) {
+                return Err(format!("`{}` is read by no term of model spec `{text}` (d={}, vis={}, f={})", p.name(), spec.d.name(), spec.vis.name(), spec.f.name()));
+            }
+            spec.params.set(p, value);
         }
         Ok(spec)
     }
 
-    /// Applies `key=value` overrides, as given by `--param`.
+    /// Applies `key=value` overrides, as given by `--param`: each replaces the spec's own value of that key.
     pub fn with_params(self, params: &[String]) -> Result<Self, String> {
         if params.is_empty() {
             return Ok(self);
         }
-        ModelSpec::parse(&format!("{},{}", self.canonical(), params.join(",")))
+        let overridden: Vec<&str> = params.iter().filter_map(|p| p.split_once('=').map(|(k, _)| k.trim())).collect();
+        let canonical = self.canonical();
+        let kept: Vec<&str> = canonical.split(',').filter(|item| !item.split_once('=').is_some_and(|(k, _)| overridden.contains(&k))).collect();
+        ModelSpec::parse(&format!("{},{}", kept.join(","), params.join(",")))
     }
 
-    /// The full `d=..,vis=..,f=..` form, with every parameter that matters.
+    /// The full `d=..,vis=..,f=..` form, with every parameter its terms read.
     pub fn canonical(&self) -> String {
-        let mut s = format!("d={},vis={},f={}", self.d.name(), self.vis.name(), self.f_name());
-        if self.d == D::Gtr {
-            s += &format!(",gamma={}", self.gamma);
-        }
-        if self.f == F::F82 {
-            s += &format!(",metal={}", self.metal.name());
+        let mut s = format!("d={},vis={},f={}", self.d.name(), self.vis.name(), self.f.name());
+        for p in self.reads() {
+            s += &format!(",{}={}", p.name(), self.params.get(p).text());
         }
         if self.precision != Precision::F32 {
             s += &format!(",precision={}", self.precision.name());
@@ -155,27 +179,34 @@ impl ModelSpec {
         s
     }
 
-    /// The shortest spec that parses back to this one: a preset name plus overrides where one matches.
+    /// The shortest spec that parses back to this one: a preset name plus the parameters that differ from its
+    /// defaults where a preset matches, else the canonical form.
     pub fn name(&self) -> String {
-        for p in PRESETS {
-            if (p.d, p.vis, p.f) == (self.d, self.vis, self.f) {
-                let mut s = p.name.to_string();
-                if self.d == D::Gtr && self.gamma != DEFAULT_GAMMA {
-                    s += &format!(",gamma={}", self.gamma);
-                }
-                if self.precision != Precision::F32 {
-                    s += &format!(",precision={}", self.precision.name());
-                }
-                return s;
-            }
+        let Some(p) = PRESETS.iter().find(|p| (p.d, p.vis, p.f) == (self.d, self.vis, self.f)) else {
+            return self.canonical();
+        };
+        let mut s = p.name.to_string();
+        let defaults = Params::default();
+        for param in self.reads().into_iter().filter(|&q| self.params.get(q) != defaults.get(q)) {
+            s += &format!(",{}={}", param.name(), self.params.get(param).text());
         }
-        self.canonical()
+        if self.precision != Precision::F32 {
+            s += &format!(",precision={}", self.precision.name());
+        }
+        s
     }
 
-    pub fn f_name(&self) -> String {
-        match self.f {
-            F::Conductor => format!("conductor-{}", self.metal.name()),
-            f => f.name().to_string(),
+    /// The Fresnel with its metal where it reads one (`conductor-gold`), for labels.
+    pub fn f_label(&self) -> String {
+        if self.f.row().reads.contains(&Param::Metal) { format!("{}-{}", self.f.name(), self.params.metal().name()) } else { self.f.name().to_string() }
+    }
+
+    /// The exact Fresnel this spec's F stands for, as a spec term: the metal's conductor Fresnel, or the
+    /// dielectric one.
+    pub fn exact_fresnel(&self) -> F {
+        match self.f.row().exact {
+            Exact::Conductor => F::Conductor,
+            Exact::Dielectric => F::Dielectric,
         }
     }
 
@@ -191,23 +222,23 @@ impl ModelSpec {
 
     /// The f64 twin of `specular_from_cosines`: D Vis F from guarded cosines.
     pub fn from_cosines(&self, c: &Cosines, a: f64, f0: [f64; 3]) -> [f64; 3] {
-        let dv = self.d.eval(c.noh, c.sin2h, a, self.gamma) * self.vis.eval(c, a);
-        self.f.eval(f0, c.voh, self.metal).map(|f| dv * f)
+        let dv = self.d.eval(c.noh, c.sin2h, a, &self.params) * self.vis.eval(c, a);
+        self.f.eval(f0, c.voh, &self.params).map(|f| dv * f)
     }
 
     /// The f64 twin of `specular_brdf`: f_s for unnormalised vectors, 0 unless NoL > 0 and NoV > 0.
     pub fn eval(&self, s: &Sample) -> [f64; 3] {
-        self.eval_f64(s.n.map(f64::from), s.v.map(f64::from), s.l.map(f64::from), f64::from(s.roughness), s.f0.map(f64::from))
+        self.eval_unit(guards::unit(s.n), guards::unit(s.v), guards::unit(s.l), f64::from(s.roughness), s.f0.map(f64::from))
     }
 
     /// `eval` for inputs already in f64.
-    pub fn eval_f64(&self, n: [f64; 3], v: [f64; 3], l: [f64; 3], roughness: f64, f0: [f64; 3]) -> [f64; 3] {
+    pub fn eval_f64(&self, n: DVec3, v: DVec3, l: DVec3, roughness: f64, f0: [f64; 3]) -> [f64; 3] {
         let unit = guards::safe_normalize;
         self.eval_unit(unit(n), unit(v), unit(l), roughness, f0)
     }
 
     /// The twin of `specular_brdf_unit`: N, V, L taken as given (the kernel's unit vectors, rounding and all).
-    pub fn eval_unit(&self, n: [f64; 3], v: [f64; 3], l: [f64; 3], roughness: f64, f0: [f64; 3]) -> [f64; 3] {
+    pub fn eval_unit(&self, n: DVec3, v: DVec3, l: DVec3, roughness: f64, f0: [f64; 3]) -> [f64; 3] {
         match guarded_cosines_unit(n, v, l, f0) {
             Some((c, f0)) => self.from_cosines(&c, self.alpha(roughness), f0),
             None => [0.0; 3],
@@ -215,31 +246,39 @@ impl ModelSpec {
     }
 }
 
+/// `f=NAME`, or `f=NAME-METAL` for a Fresnel term that reads the metal (`conductor-gold`).
+fn parse_f(value: &str, given: &mut Vec<(Param, ParamValue)>) -> Result<F, String> {
+    if let Some(f) = F::from_name(value) {
+        return Ok(f);
+    }
+    for f in F::ALL.iter().filter(|f| f.row().reads.contains(&Param::Metal)) {
+        if let Some(metal) = value.strip_prefix(f.name()).and_then(|m| m.strip_prefix('-')) {
+            given.push((Param::Metal, Params::parse_value(Param::Metal, metal)?));
+            return Ok(*f);
+        }
+    }
+    Err(unknown("f", value, &f_names()))
+}
+
 /// The twin of the kernels' geometry: normalised vectors, the cosines guarded and F0 clamped to [0, 1];
 /// None when NoV <= 0 or NoL <= 0 (no light).
 pub fn guarded_cosines(s: &Sample) -> Option<(Cosines, [f64; 3])> {
-    guarded_cosines_f64(s.n.map(f64::from), s.v.map(f64::from), s.l.map(f64::from), s.f0.map(f64::from))
+    guarded_cosines_unit(guards::unit(s.n), guards::unit(s.v), guards::unit(s.l), s.f0.map(f64::from))
 }
 
-pub fn guarded_cosines_f64(n: [f64; 3], v: [f64; 3], l: [f64; 3], f0: [f64; 3]) -> Option<(Cosines, [f64; 3])> {
-    let unit = guards::safe_normalize;
-    guarded_cosines_unit(unit(n), unit(v), unit(l), f0)
-}
-
-/// As `guarded_cosines_f64` for vectors already normalised (only H is formed and normalised here).
-pub fn guarded_cosines_unit(n: [f64; 3], v: [f64; 3], l: [f64; 3], f0: [f64; 3]) -> Option<(Cosines, [f64; 3])> {
-    let h = guards::safe_normalize(guards::add(v, l));
-    let (nov, nol) = (guards::dot(n, v), guards::dot(n, l));
+/// As `guarded_cosines` for vectors already normalised (only H is formed and normalised here).
+pub fn guarded_cosines_unit(n: DVec3, v: DVec3, l: DVec3, f0: [f64; 3]) -> Option<(Cosines, [f64; 3])> {
+    let h = guards::safe_normalize(v + l);
+    let (nov, nol) = (n.dot(v), n.dot(l));
     if !(nov > 0.0 && nol > 0.0) {
         return None;
     }
-    let nxh = guards::cross(n, h);
     let c = Cosines {
         nov: guards::guard_cosine(nov),
         nol: guards::guard_cosine(nol),
-        noh: guards::guard_cosine(guards::dot(n, h)),
-        voh: guards::guard_cosine(guards::dot(v, h)),
-        sin2h: guards::dot(nxh, nxh).min(1.0),
+        noh: guards::guard_cosine(n.dot(h)),
+        voh: guards::guard_cosine(v.dot(h)),
+        sin2h: n.cross(h).length_squared().min(1.0),
     };
     Some((c, f0.map(|x| x.clamp(0.0, 1.0))))
 }
@@ -254,24 +293,40 @@ pub fn preset_names() -> Vec<&'static str> {
     PRESETS.iter().map(|p| p.name).collect()
 }
 
-/// Fresnel names as specs spell them: `conductor-<metal>` for each metal.
+/// Fresnel names as specs may spell them (`NAME-<metal>` for terms that read the metal).
 pub fn f_names() -> Vec<String> {
-    let mut names: Vec<String> = F::ALL.iter().filter(|f| **f != F::Conductor).map(|f| f.name().to_string()).collect();
-    names.extend(Metal::ALL.iter().map(|m| format!("conductor-{}", m.name())));
+    let mut names: Vec<String> = F::names().into_iter().map(str::to_string).collect();
+    for f in F::ALL.iter().filter(|f| f.row().reads.contains(&Param::Metal)) {
+        names.push(format!("{}-<{}>", f.name(), Metal::names().join("|")));
+    }
     names
+}
+
+/// Every value of a parameter worth measuring: each metal, or the ends and middle of a number's stable range.
+pub fn param_samples(p: Param) -> Vec<ParamValue> {
+    match p.def().kind {
+        ParamKind::Metal => Metal::ALL.iter().map(|m| ParamValue::Metal(*m)).collect(),
+        ParamKind::Number { default, min, max, .. } => {
+            let mut v = vec![min, default, 0.5 * (min + max), max];
+            v.sort_by(f64::total_cmp);
+            v.dedup();
+            v.into_iter().map(ParamValue::Number).collect()
+        }
+    }
+}
+
+/// `spec` with each combination of `param_samples` of the parameters its terms read (just `spec` when none).
+pub fn with_each_param_sample(spec: ModelSpec) -> Vec<ModelSpec> {
+    let mut out = vec![spec];
+    for p in spec.reads() {
+        out = out.into_iter().flat_map(|s| param_samples(p).into_iter().map(move |v| s.with_param(p, v))).collect();
+    }
+    out
 }
 
 fn unknown(key: &str, value: &str, valid: &[impl AsRef<str>]) -> String {
     let valid: Vec<&str> = valid.iter().map(|v| v.as_ref()).collect();
     format!("unknown {key} `{value}`: valid are {}", valid.join(", "))
-}
-
-fn parse_gamma(value: &str) -> Result<f64, String> {
-    let g: f64 = value.parse().map_err(|_| format!("gamma `{value}` is not a number"))?;
-    if !(g.is_finite() && (0.0..=16.0).contains(&g)) {
-        return Err(format!("gamma {value} is outside [0, 16]"));
-    }
-    Ok(g)
 }
 
 #[cfg(test)]
@@ -286,11 +341,14 @@ mod tests {
             assert_eq!(ModelSpec::parse(&spec.canonical()).unwrap(), spec);
         }
         let s = ModelSpec::parse("burley,gamma=2,precision=f16").unwrap();
-        assert_eq!((s.gamma, s.precision), (2.0, Precision::F16));
+        assert_eq!((s.params.number(Param::Gamma), s.precision), (2.0, Precision::F16));
         assert_eq!(ModelSpec::parse(&s.name()).unwrap(), s);
         let c = ModelSpec::parse("d=beckmann,vis=smith-beckmann-walter,f=conductor-copper").unwrap();
-        assert_eq!((c.f, c.metal), (F::Conductor, Metal::Copper));
+        assert_eq!((c.f, c.params.metal()), (F::Conductor, Metal::Copper));
         assert_eq!(ModelSpec::parse(&c.name()).unwrap(), c);
+        assert_eq!(ModelSpec::parse("d=beckmann,vis=smith-beckmann-walter,f=conductor,metal=copper").unwrap(), c);
+        assert_eq!(ModelSpec::parse("burley").unwrap().with_params(&["gamma=2.5".into()]).unwrap().params.number(Param::Gamma), 2.5);
+        assert_eq!(ModelSpec::parse("burley,gamma=2").unwrap().with_params(&["gamma=2.5".into()]).unwrap().params.number(Param::Gamma), 2.5);
     }
 
     #[test]
@@ -298,7 +356,21 @@ mod tests {
         assert!(ModelSpec::parse("phong").unwrap_err().contains("unknown model `phong`"));
         assert!(ModelSpec::parse("d=ggx").unwrap_err().contains("needs both"));
         assert!(ModelSpec::parse("d=ggx,vis=nope").unwrap_err().contains("unknown vis `nope`"));
-        assert!(ModelSpec::parse("ggx,gamma=-1").unwrap_err().contains("outside"));
+        assert!(ModelSpec::parse("burley,gamma=-1").unwrap_err().contains("outside"));
         assert!(ModelSpec::parse("ggx,colour=red").unwrap_err().contains("unknown key `colour`"));
+        assert!(ModelSpec::parse("burley,gamma=1,gamma=2").unwrap_err().contains("given twice"));
+        assert!(ModelSpec::parse("ggx,gamma=2").unwrap_err().contains("read by no term"));
+        assert!(ModelSpec::parse("ggx,metal=gold").unwrap_err().contains("read by no term"));
+        assert!(ModelSpec::parse("ggx,f=conductor-tin").unwrap_err().contains("unknown metal `tin`"));
+    }
+
+    #[test]
+    fn each_parameter_read_is_sampled() {
+        for p in PRESETS {
+            let spec = ModelSpec::preset(p.name).unwrap();
+            let all = with_each_param_sample(spec);
+            let expected: usize = spec.reads().iter().map(|&q| param_samples(q).len()).product();
+            assert_eq!(all.len(), expected, "{}", p.name);
+        }
     }
 }

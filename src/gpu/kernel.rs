@@ -1,8 +1,7 @@
 //! Compute kernels: a pipeline specialised with constants, its storage-buffer bindings, and the chunking that
 //! keeps every binding inside maxStorageBufferRange and every dispatch inside maxComputeWorkGroupCount.
 
-use super::{Buffer, DeviceInfo, Gpu};
-use crate::shaders::KernelSource;
+use super::{Buffer, Commands, DeviceInfo, Gpu};
 use anyhow::{anyhow, Context, Result};
 use ash::vk;
 
@@ -13,12 +12,18 @@ pub struct SpecConstants {
 }
 
 impl SpecConstants {
-    pub fn int(mut self, id: u32, value: i32) -> Self {
-        self.entries.push((id, value.to_ne_bytes()));
-        self
+    /// Sets constant `id` (replacing an earlier value of the same id).
+    pub fn int(self, id: u32, value: i32) -> Self {
+        self.set(id, value.to_ne_bytes())
     }
-    pub fn float(mut self, id: u32, value: f32) -> Self {
-        self.entries.push((id, value.to_ne_bytes()));
+    pub fn float(self, id: u32, value: f32) -> Self {
+        self.set(id, value.to_ne_bytes())
+    }
+    fn set(mut self, id: u32, bytes: [u8; 4]) -> Self {
+        match self.entries.iter_mut().find(|(i, _)| *i == id) {
+            Some(e) => e.1 = bytes,
+            None => self.entries.push((id, bytes)),
+        }
         self
     }
     /// (id, value as u32 bits), for reports and for spirv-opt's --set-spec-const-default-value.
@@ -27,10 +32,14 @@ impl SpecConstants {
     }
 }
 
+/// A descriptor set: the storage-buffer windows one dispatch reads and writes.
+#[derive(Clone, Copy, Debug)]
+pub struct Bindings(vk::DescriptorSet);
+
 pub struct Kernel<'g> {
-    gpu: &'g Gpu,
+    pub(super) gpu: &'g Gpu,
     pub name: String,
-    pub pipeline: vk::Pipeline,
+    pub(super) pipeline: vk::Pipeline,
     layout: vk::PipelineLayout,
     set_layout: vk::DescriptorSetLayout,
     pool: vk::DescriptorPool,
@@ -38,6 +47,8 @@ pub struct Kernel<'g> {
     push_bytes: u32,
     /// Invocations per workgroup (local_size_x of every brdfprof kernel).
     pub workgroup: u32,
+    /// Created with CAPTURE_INTERNAL_REPRESENTATIONS (`executables` returns them).
+    pub(super) captures_ir: bool,
 }
 
 /// Descriptor sets one kernel can hold at a time (one per chunk of a dispatch).
@@ -46,10 +57,15 @@ const SETS_PER_KERNEL: u32 = 256;
 pub const WORKGROUP: u32 = 64;
 
 impl<'g> Kernel<'g> {
-    /// A pipeline for `source`, specialised, with `bindings` storage buffers and `push_bytes` of push constants.
-    pub fn new(gpu: &'g Gpu, source: &KernelSource, spec: &SpecConstants, bindings: u32, push_bytes: u32) -> Result<Self> {
+    /// A pipeline for the SPIR-V `words` (named `name` in errors), specialised, with `bindings` storage buffers
+    /// and `push_bytes` of push constants. With `capture_ir` the driver keeps its internal representations
+    /// (`PipelineExecutable::representations`).
+    pub fn new(gpu: &'g Gpu, name: &str, words: &[u32], spec: &SpecConstants, bindings: u32, push_bytes: u32) -> Result<Self> {
+        Self::with_capture(gpu, name, words, spec, bindings, push_bytes, false)
+    }
+
+    pub fn with_capture(gpu: &'g Gpu, name: &str, words: &[u32], spec: &SpecConstants, bindings: u32, push_bytes: u32, capture_ir: bool) -> Result<Self> {
         let device = &gpu.device;
-        let words = source.words();
         let binding_info: Vec<_> = (0..bindings)
             .map(|b| {
                 vk::DescriptorSetLayoutBinding::default()
@@ -69,7 +85,7 @@ impl<'g> Kernel<'g> {
         let spec_info = vk::SpecializationInfo::default().map_entries(&map).data(&data);
         // SAFETY: every create info and what it points to outlives its call; handles are destroyed in Drop.
         unsafe {
-            let module = device.create_shader_module(&vk::ShaderModuleCreateInfo::default().code(&words), None)?;
+            let module = device.create_shader_module(&vk::ShaderModuleCreateInfo::default().code(words), None)?;
             let set_layout = device
                 .create_descriptor_set_layout(&vk::DescriptorSetLayoutCreateInfo::default().bindings(&binding_info), None)?;
             let set_layouts = [set_layout];
@@ -87,23 +103,27 @@ impl<'g> Kernel<'g> {
             let mut flags = vk::PipelineCreateFlags::empty();
             if gpu.executable_properties.is_some() {
                 flags |= vk::PipelineCreateFlags::CAPTURE_STATISTICS_KHR;
+                if capture_ir {
+                    flags |= vk::PipelineCreateFlags::CAPTURE_INTERNAL_REPRESENTATIONS_KHR;
+                }
             }
             let info = vk::ComputePipelineCreateInfo::default().stage(stage).layout(layout).flags(flags);
             let pipeline = device
                 .create_compute_pipelines(vk::PipelineCache::null(), &[info], None)
-                .map_err(|(_, e)| anyhow!("creating the {} pipeline: {e}", source.name))?[0];
+                .map_err(|(_, e)| anyhow!("creating the {name} pipeline: {e}"))?[0];
             device.destroy_shader_module(module, None);
             let sizes = [vk::DescriptorPoolSize { ty: vk::DescriptorType::STORAGE_BUFFER, descriptor_count: SETS_PER_KERNEL * bindings.max(1) }];
             let pool = device.create_descriptor_pool(
                 &vk::DescriptorPoolCreateInfo::default().max_sets(SETS_PER_KERNEL).pool_sizes(&sizes),
                 None,
             )?;
-            Ok(Kernel { gpu, name: source.name.into(), pipeline, layout, set_layout, pool, bindings, push_bytes, workgroup: WORKGROUP })
+            let captures_ir = capture_ir && gpu.executable_properties.is_some();
+            Ok(Kernel { gpu, name: name.into(), pipeline, layout, set_layout, pool, bindings, push_bytes, workgroup: WORKGROUP, captures_ir })
         }
     }
 
     /// A descriptor set binding each `(buffer, offset, range)` window to bindings 0, 1, ...
-    pub fn bind(&self, windows: &[(&Buffer, u64, u64)]) -> Result<vk::DescriptorSet> {
+    pub fn bind(&self, windows: &[(&Buffer, u64, u64)]) -> Result<Bindings> {
         assert_eq!(windows.len() as u32, self.bindings, "{}: wrong number of bindings", self.name);
         let layouts = [self.set_layout];
         let alloc = vk::DescriptorSetAllocateInfo::default().descriptor_pool(self.pool).set_layouts(&layouts);
@@ -128,7 +148,7 @@ impl<'g> Kernel<'g> {
                 })
                 .collect();
             self.gpu.device.update_descriptor_sets(&writes, &[]);
-            Ok(set)
+            Ok(Bindings(set))
         }
     }
 
@@ -140,19 +160,20 @@ impl<'g> Kernel<'g> {
     }
 
     /// Records a dispatch of `invocations` threads (rounded up to whole workgroups).
-    pub fn dispatch(&self, cmd: vk::CommandBuffer, set: vk::DescriptorSet, push: &[u8], invocations: u64) {
+    pub fn dispatch(&self, cmd: &Commands, set: Bindings, push: &[u8], invocations: u64) {
         assert_eq!(push.len() as u32, self.push_bytes, "{}: wrong push-constant size", self.name);
         let groups = invocations.div_ceil(self.workgroup as u64) as u32;
         assert!(groups <= self.gpu.info.max_compute_work_group_count[0], "dispatch past maxComputeWorkGroupCount: chunk it");
         let device = &self.gpu.device;
+        let raw = cmd.raw;
         // SAFETY: cmd is recording; set and layout match this pipeline.
         unsafe {
-            device.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline);
-            device.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.layout, 0, &[set], &[]);
+            device.cmd_bind_pipeline(raw, vk::PipelineBindPoint::COMPUTE, self.pipeline);
+            device.cmd_bind_descriptor_sets(raw, vk::PipelineBindPoint::COMPUTE, self.layout, 0, &[set.0], &[]);
             if !push.is_empty() {
-                device.cmd_push_constants(cmd, self.layout, vk::ShaderStageFlags::COMPUTE, 0, push);
+                device.cmd_push_constants(raw, self.layout, vk::ShaderStageFlags::COMPUTE, 0, push);
             }
-            device.cmd_dispatch(cmd, groups, 1, 1);
+            device.cmd_dispatch(raw, groups, 1, 1);
         }
     }
 }

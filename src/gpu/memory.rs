@@ -15,7 +15,7 @@ pub enum MemoryKind {
 
 pub struct Buffer<'g> {
     gpu: &'g Gpu,
-    pub buffer: vk::Buffer,
+    pub(super) buffer: vk::Buffer,
     memory: vk::DeviceMemory,
     pub size: u64,
     mapped: Option<*mut u8>,
@@ -94,7 +94,7 @@ impl<'g> Buffer<'g> {
             staging.write(0, chunk)?;
             let region = vk::BufferCopy { src_offset: 0, dst_offset: offset + i as u64 * STAGING_BYTES, size: chunk.len() as u64 };
             // SAFETY: both buffers are live and the region lies within them.
-            self.gpu.submit(|cmd| unsafe { self.gpu.device.cmd_copy_buffer(cmd, staging.buffer, self.buffer, &[region]) })?;
+            self.gpu.submit(|cmd| unsafe { self.gpu.device.cmd_copy_buffer(cmd.raw, staging.buffer, self.buffer, &[region]) })?;
         }
         Ok(())
     }
@@ -113,7 +113,7 @@ impl<'g> Buffer<'g> {
             let n = STAGING_BYTES.min(len - done);
             let region = vk::BufferCopy { src_offset: offset + done, dst_offset: 0, size: n };
             // SAFETY: both buffers are live and the region lies within them.
-            self.gpu.submit(|cmd| unsafe { self.gpu.device.cmd_copy_buffer(cmd, self.buffer, staging.buffer, &[region]) })?;
+            self.gpu.submit(|cmd| unsafe { self.gpu.device.cmd_copy_buffer(cmd.raw, self.buffer, staging.buffer, &[region]) })?;
             out.extend_from_slice(&staging.read(0, n)?);
             done += n;
         }

@@ -1,11 +1,13 @@
 //! Vulkan plumbing: instance and device selection, validation-message capture, buffers, compute kernels,
 //! chunked dispatch and timestamp queries. Nothing here knows about BRDFs.
 
+mod driver_stats;
 mod kernel;
 mod memory;
 mod timing;
 
-pub use kernel::{ChunkPlan, Kernel, SpecConstants, WORKGROUP};
+pub use driver_stats::{DriverStat, PipelineExecutable};
+pub use kernel::{Bindings, ChunkPlan, Kernel, SpecConstants, WORKGROUP};
 pub use memory::{Buffer, MemoryKind};
 pub use timing::Timestamps;
 
@@ -66,6 +68,12 @@ impl DeviceInfo {
     pub fn is_cpu(&self) -> bool {
         self.device_type == "cpu"
     }
+
+    /// A device that compiles pipelines but cannot execute them: RADV's "Null hardware" device
+    /// (RADV_FORCE_FAMILY), whose timestampPeriod is not even finite.
+    pub fn compile_only(&self) -> bool {
+        self.name.starts_with("Null hardware") || !self.timestamp_period.is_finite()
+    }
 }
 
 /// Validation messages recorded by the debug messenger (warnings and errors of any type).
@@ -83,6 +91,14 @@ pub struct Gpu {
     queue: vk::Queue,
     command_pool: vk::CommandPool,
     memory_properties: vk::PhysicalDeviceMemoryProperties,
+    /// Whether anything was ever submitted: a compile-only device (RADV's null winsys) has no queue to wait
+    /// on, and its vkDeviceWaitIdle calls through a null pointer, so teardown waits only for real work.
+    submitted: std::sync::atomic::AtomicBool,
+}
+
+/// A command buffer being recorded (`Gpu::submit`); kernels, barriers and timestamps record into it.
+pub struct Commands {
+    raw: vk::CommandBuffer,
 }
 
 fn load_entry() -> Result<ash::Entry> {
@@ -253,8 +269,35 @@ pub fn select_device(infos: &[DeviceInfo], wanted: Option<&str>) -> Result<usize
             .position(|d| d.name.to_lowercase().contains(&needle))
             .ok_or_else(|| anyhow!("no device whose name contains `{w}`; devices are:\n{}", listing()));
     }
-    let gpu = infos.iter().position(|d| d.device_type == "discrete-gpu" || d.device_type == "integrated-gpu");
-    Ok(gpu.or_else(|| infos.iter().position(DeviceInfo::is_cpu)).unwrap_or(0))
+    let runs = |d: &&DeviceInfo| !d.compile_only();
+    let gpu = infos.iter().filter(runs).find(|d| d.device_type == "discrete-gpu" || d.device_type == "integrated-gpu");
+    let chosen = gpu.or_else(|| infos.iter().filter(runs).find(|d| d.is_cpu())).or_else(|| infos.iter().find(runs));
+    chosen.map(|d| d.index).ok_or_else(|| anyhow!("every Vulkan device here compiles only (RADV's null device); none can run kernels"))
+}
+
+/// The logical device: one compute queue, fp16 arithmetic and pipeline executable properties where available.
+fn create_device(instance: &ash::Instance, physical: vk::PhysicalDevice, family: u32, info: &DeviceInfo) -> Result<ash::Device> {
+    let priorities = [1.0f32];
+    let queues = [vk::DeviceQueueCreateInfo::default().queue_family_index(family).queue_priorities(&priorities)];
+    let mut extensions = Vec::new();
+    if info.pipeline_executable_properties {
+        extensions.push(EXECUTABLE_PROPERTIES_EXT.as_ptr());
+    }
+    let api_1_2 = vk::api_version_minor(
+        // SAFETY: physical is valid.
+        unsafe { instance.get_physical_device_properties(physical) }.api_version,
+    ) >= 2;
+    let mut f16 = vk::PhysicalDeviceShaderFloat16Int8Features::default().shader_float16(info.shader_float16);
+    let mut exec = vk::PhysicalDevicePipelineExecutablePropertiesFeaturesKHR::default().pipeline_executable_info(info.pipeline_executable_properties);
+    let mut create = vk::DeviceCreateInfo::default().queue_create_infos(&queues).enabled_extension_names(&extensions);
+    if api_1_2 && info.shader_float16 {
+        create = create.push_next(&mut f16);
+    }
+    if info.pipeline_executable_properties {
+        create = create.push_next(&mut exec);
+    }
+    // SAFETY: create info and chained structs outlive the call.
+    unsafe { instance.create_device(physical, &create, None) }.context("vkCreateDevice failed")
 }
 
 impl Gpu {
@@ -290,28 +333,7 @@ impl Gpu {
         let (family, _) = compute_queue_family(&instance, physical)
             .ok_or_else(|| anyhow!("device {} has no compute queue", info.name))?;
 
-        let priorities = [1.0f32];
-        let queues = [vk::DeviceQueueCreateInfo::default().queue_family_index(family).queue_priorities(&priorities)];
-        let mut extensions = Vec::new();
-        if info.pipeline_executable_properties {
-            extensions.push(EXECUTABLE_PROPERTIES_EXT.as_ptr());
-        }
-        let api_1_2 = vk::api_version_minor(
-            // SAFETY: physical is valid.
-            unsafe { instance.get_physical_device_properties(physical) }.api_version,
-        ) >= 2;
-        let mut f16 = vk::PhysicalDeviceShaderFloat16Int8Features::default().shader_float16(info.shader_float16);
-        let mut exec = vk::PhysicalDevicePipelineExecutablePropertiesFeaturesKHR::default()
-            .pipeline_executable_info(info.pipeline_executable_properties);
-        let mut create = vk::DeviceCreateInfo::default().queue_create_infos(&queues).enabled_extension_names(&extensions);
-        if api_1_2 && info.shader_float16 {
-            create = create.push_next(&mut f16);
-        }
-        if info.pipeline_executable_properties {
-            create = create.push_next(&mut exec);
-        }
-        // SAFETY: create info and chained structs outlive the call.
-        let device = unsafe { instance.create_device(physical, &create, None) }.context("vkCreateDevice failed")?;
+        let device = create_device(&instance, physical, family, &info)?;
         // SAFETY: family was requested with one queue.
         let queue = unsafe { device.get_device_queue(family, 0) };
         let pool_info = vk::CommandPoolCreateInfo::default()
@@ -336,6 +358,7 @@ impl Gpu {
             queue,
             command_pool,
             memory_properties,
+            submitted: std::sync::atomic::AtomicBool::new(false),
         })
     }
 
@@ -355,7 +378,11 @@ impl Gpu {
     }
 
     /// Records commands into a one-time command buffer, submits it and waits for it to finish.
-    pub fn submit<T>(&self, record: impl FnOnce(vk::CommandBuffer) -> T) -> Result<T> {
+    pub fn submit<T>(&self, record: impl FnOnce(&Commands) -> T) -> Result<T> {
+        if self.info.compile_only() {
+            bail!("{} compiles only: it cannot run kernels", self.info.name);
+        }
+        self.submitted.store(true, std::sync::atomic::Ordering::Relaxed);
         let alloc = vk::CommandBufferAllocateInfo::default()
             .command_pool(self.command_pool)
             .level(vk::CommandBufferLevel::PRIMARY)
@@ -366,7 +393,7 @@ impl Gpu {
             let cmd = self.device.allocate_command_buffers(&alloc)?[0];
             let begin = vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
             self.device.begin_command_buffer(cmd, &begin)?;
-            let out = record(cmd);
+            let out = record(&Commands { raw: cmd });
             self.device.end_command_buffer(cmd)?;
             let fence = self.device.create_fence(&vk::FenceCreateInfo::default(), None)?;
             let cmds = [cmd];
@@ -384,14 +411,14 @@ impl Gpu {
 
     /// A compute-to-compute and compute-to-transfer memory barrier: every dispatch after it sees every write
     /// before it.
-    pub fn barrier(&self, cmd: vk::CommandBuffer) {
+    pub fn barrier(&self, cmd: &Commands) {
         let barrier = vk::MemoryBarrier::default()
             .src_access_mask(vk::AccessFlags::SHADER_WRITE | vk::AccessFlags::TRANSFER_WRITE)
             .dst_access_mask(vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE | vk::AccessFlags::TRANSFER_READ);
         // SAFETY: cmd is recording.
         unsafe {
             self.device.cmd_pipeline_barrier(
-                cmd,
+                cmd.raw,
                 vk::PipelineStageFlags::COMPUTE_SHADER | vk::PipelineStageFlags::TRANSFER,
                 vk::PipelineStageFlags::COMPUTE_SHADER | vk::PipelineStageFlags::TRANSFER,
                 vk::DependencyFlags::empty(),
@@ -408,7 +435,9 @@ impl Drop for Gpu {
         // SAFETY: everything created from this device and instance is destroyed here, in order, after the
         // device is idle; the messenger's user box is freed after the messenger.
         unsafe {
-            let _ = self.device.device_wait_idle();
+            if self.submitted.load(std::sync::atomic::Ordering::Relaxed) {
+                let _ = self.device.device_wait_idle();
+            }
             self.device.destroy_command_pool(self.command_pool, None);
             self.device.destroy_device(None);
             if let Some((loader, messenger, user)) = self.debug.take() {

@@ -2,7 +2,7 @@
 //! `end - start` around a dispatch (with barriers between dispatches) is that dispatch's execution time.
 //! Ticks are masked to timestampValidBits and scaled by timestampPeriod.
 
-use super::Gpu;
+use super::{Commands, Gpu};
 use anyhow::{bail, Result};
 use ash::vk;
 
@@ -24,15 +24,15 @@ impl<'g> Timestamps<'g> {
     }
 
     /// Resets every query; record before the first `write` of a submission.
-    pub fn reset(&self, cmd: vk::CommandBuffer) {
+    pub fn reset(&self, cmd: &Commands) {
         // SAFETY: cmd is recording, outside a render pass.
-        unsafe { self.gpu.device.cmd_reset_query_pool(cmd, self.pool, 0, self.capacity) };
+        unsafe { self.gpu.device.cmd_reset_query_pool(cmd.raw, self.pool, 0, self.capacity) };
     }
 
-    pub fn write(&self, cmd: vk::CommandBuffer, index: u32) {
+    pub fn write(&self, cmd: &Commands, index: u32) {
         assert!(index < self.capacity);
         // SAFETY: cmd is recording; the query was reset in this command buffer.
-        unsafe { self.gpu.device.cmd_write_timestamp(cmd, vk::PipelineStageFlags::BOTTOM_OF_PIPE, self.pool, index) };
+        unsafe { self.gpu.device.cmd_write_timestamp(cmd.raw, vk::PipelineStageFlags::BOTTOM_OF_PIPE, self.pool, index) };
     }
 
     /// Nanoseconds between query pairs (start, end), read after the submission completed.

@@ -11,9 +11,9 @@
 //! is the figure. Everything else (the driver's dispatch and queue code, the per-workgroup helpers the
 //! kernel calls back into) is left out.
 
-use super::glsl::KernelSet;
-use crate::brdf::ModelSpec;
 use crate::gpu::{Gpu, GpuOptions};
+use crate::model::Model;
+use crate::shaders::Shaders;
 use crate::profile::gbuffer;
 use crate::profile::protocol::{Timed, Variant, Workload};
 use anyhow::{anyhow, bail, Context, Result};
@@ -76,8 +76,8 @@ fn running_on_valgrind() -> bool {
 /// What the parent asks the child to measure (passed as one JSON argument).
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct ChildRequest {
-    /// Canonical model specs; the memory-only baseline kernel is measured after them.
-    pub specs: Vec<String>,
+    /// Canonical models; the memory-only baseline kernel is measured after them.
+    pub models: Vec<String>,
     pub lights: u32,
     pub width: u32,
     pub height: u32,
@@ -118,19 +118,18 @@ pub fn child_main(request_json: &str) -> Result<()> {
     if !running_on_valgrind() {
         bail!("`brdfprof {CHILD_COMMAND}` only measures under valgrind; `brdfprof inspect` runs it there");
     }
-    let specs = req.specs.iter().map(|s| ModelSpec::parse(s).map_err(|e| anyhow!("{s}: {e}"))).collect::<Result<Vec<_>>>()?;
-    let kernels = match &req.glsl {
-        Some(dir) => KernelSet::from_glsl(dir)?,
-        None => KernelSet::embedded(),
+    let models = req.models.iter().map(|s| Model::parse(s).map_err(|e| anyhow!("{s}: {e}"))).collect::<Result<Vec<_>>>()?;
+    let shaders = match &req.glsl {
+        Some(dir) => Shaders::from_glsl(dir)?,
+        None => Shaders::embedded(),
     };
     let gpu = Gpu::new(&GpuOptions { device: req.device.clone(), validation: req.validate })?;
     let work = Workload::upload(&gpu, &gbuffer::synthetic(req.width, req.height), &gbuffer::lights(req.lights), None)?;
-    let mut all: Vec<Option<&ModelSpec>> = specs.iter().map(Some).collect();
+    let mut all: Vec<Option<&Model>> = models.iter().map(Some).collect();
     all.push(None);
     let mut labels = Vec::new();
-    for (i, spec) in all.into_iter().enumerate() {
-        let source = kernels.shade(crate::profile::protocol::shade_model(spec).precision)?;
-        let variant = Variant::with_source(&gpu, &work, spec, source, 1)?;
+    for (i, model) in all.into_iter().enumerate() {
+        let variant = Variant::new(&gpu, &work, model, &shaders, 1)?;
         variant.run_once(&gpu, 0)?; // JIT compilation, not counted
         let label = format!("{DUMP_LABEL}{i}\0");
         client_request(0, request::START_INSTRUMENTATION, 0);
@@ -197,13 +196,13 @@ impl CallgrindRun {
 
 /// `valgrind --version`, or why valgrind cannot be used.
 pub fn valgrind_version() -> Result<String> {
-    super::glsl::first_line_of(Command::new("valgrind").arg("--version"))
+    crate::shaders::first_line_of(Command::new("valgrind").arg("--version"))
         .filter(|v| v.starts_with("valgrind"))
         .ok_or_else(|| anyhow!("valgrind not found: install valgrind (Debian: `apt-get install valgrind`), or run `make setup`"))
 }
 
-/// Runs the child under callgrind and reads what it dumped. `specs` labels follow `ModelSpec::name`.
-pub fn run(specs: &[ModelSpec], lights: u32, kernels: &KernelSet, options: &CallgrindOptions) -> Result<CallgrindRun> {
+/// Runs the child under callgrind and reads what it dumped. Labels follow `Model::name`.
+pub fn run(models: &[Model], lights: u32, shaders: &Shaders, options: &CallgrindOptions) -> Result<CallgrindRun> {
     if !cfg!(target_arch = "x86_64") {
         bail!("callgrind client requests are implemented for x86-64 only");
     }
@@ -211,13 +210,13 @@ pub fn run(specs: &[ModelSpec], lights: u32, kernels: &KernelSet, options: &Call
     let dir = tempfile::tempdir().context("cannot create a directory for callgrind's output")?;
     let out_file = dir.path().join("callgrind.out");
     let req = ChildRequest {
-        specs: specs.iter().map(|s| s.canonical()).collect(),
+        models: models.iter().map(Model::canonical).collect(),
         lights,
         width: options.width,
         height: options.height,
         device: options.device.clone(),
         validate: options.validate,
-        glsl: kernels.glsl_dir().map(Path::to_path_buf),
+        glsl: shaders.glsl_dir().map(Path::to_path_buf),
     };
     let exe = std::env::current_exe().context("cannot find brdfprof's own executable")?;
     let output = Command::new("valgrind")
@@ -242,7 +241,7 @@ pub fn run(specs: &[ModelSpec], lights: u32, kernels: &KernelSet, options: &Call
         .find_map(|l| serde_json::from_str(l).ok())
         .ok_or_else(|| anyhow!("the callgrind child printed no reply; its output:\n{stdout}"))?;
     let dumps = read_dumps(dir.path())?;
-    let names: Vec<String> = specs.iter().map(ModelSpec::name).chain([super::BASELINE_LABEL.to_string()]).collect();
+    let names: Vec<String> = models.iter().map(Model::name).chain([super::BASELINE_LABEL.to_string()]).collect();
     let kernels = reply
         .labels
         .iter()

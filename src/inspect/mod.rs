@@ -8,23 +8,21 @@ pub mod callgrind;
 pub mod check;
 pub mod correlate;
 pub mod driver;
-pub mod glsl;
 pub mod naga_info;
 pub mod spirv;
 pub mod timing;
 
-use crate::brdf::ModelSpec;
-use crate::gpu::{Gpu, Kernel};
-use crate::profile::protocol::{shade_constants, shade_model};
+use crate::gpu::Gpu;
+use crate::model::{Model, ModelKernel};
+use crate::profile::protocol::shade_kernel;
 use crate::report::{self, Provenance, Table};
+use crate::shaders::Shaders;
 use anyhow::Result;
 use callgrind::{CallgrindOptions, CallgrindRun};
-use glsl::KernelSet;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
-/// The row of the memory-only baseline kernel (shade.comp with BASELINE = 1).
-pub const BASELINE_LABEL: &str = "baseline";
+pub use crate::profile::protocol::BASELINE_LABEL;
 
 /// Statistic sections, in report order: key prefix and title.
 pub const SECTIONS: [(&str, &str); 5] = [
@@ -37,7 +35,7 @@ pub const SECTIONS: [(&str, &str); 5] = [
 
 #[derive(Clone, Debug)]
 pub struct InspectOptions {
-    pub specs: Vec<ModelSpec>,
+    pub models: Vec<Model>,
     pub lights: u32,
     /// None: no callgrind run.
     pub callgrind: Option<CallgrindOptions>,
@@ -80,9 +78,9 @@ pub struct InspectReport {
     pub vs_profile: Option<correlate::Correlation>,
 }
 
-/// SPIR-V and naga statistics of one kernel specialised for `spec` (None: the baseline kernel).
-fn static_stats(words: &[u32], spec: Option<&ModelSpec>, lights: u32, row: &mut Row) -> Result<()> {
-    let frozen = spirv::specialise(words, &shade_constants(spec, lights))?;
+/// SPIR-V and naga statistics of one specialised kernel.
+fn static_stats(kernel: &ModelKernel, row: &mut Row) -> Result<()> {
+    let frozen = spirv::specialise(&kernel.spirv.words, &kernel.constants)?;
     row.stats.extend(spirv::count(&frozen)?.stats("spirv"));
     row.stats.extend(spirv::count(&spirv::optimise(&frozen)?)?.stats("spirv-O"));
     let naga = naga_info::analyse(&frozen);
@@ -92,12 +90,13 @@ fn static_stats(words: &[u32], spec: Option<&ModelSpec>, lights: u32, row: &mut 
 }
 
 /// Driver statistics of the kernel's pipeline, where the device reports them.
-fn driver_stats(gpu: &Gpu, kernels: &KernelSet, spec: Option<&ModelSpec>, lights: u32, row: &mut Row) -> Result<()> {
-    if gpu.executable_properties.is_none() {
+fn driver_stats(gpu: &Gpu, kernel: &ModelKernel, row: &mut Row) -> Result<()> {
+    if !gpu.info.pipeline_executable_properties {
         return Ok(());
     }
-    let kernel = Kernel::new(gpu, kernels.shade(shade_model(spec).precision)?, &shade_constants(spec, lights), 3, 0)?;
-    if let Some(stats) = driver::statistics(gpu, kernel.pipeline)? {
+    let pipeline = crate::kernels::kernel(gpu, &kernel.spirv, &kernel.constants, 3, 0)?;
+    if let Some(executables) = pipeline.executables()? {
+        let stats: Vec<_> = executables.into_iter().flat_map(|e| e.stats).collect();
         row.stats.extend(driver::stats(&stats));
     }
     Ok(())
@@ -117,25 +116,27 @@ fn ordered_columns(rows: &[Row], emitted: &[String]) -> Vec<String> {
 }
 
 /// One kernel's SPIR-V, naga and driver statistics (None: the baseline kernel).
-fn kernel_row(gpu: &Gpu, kernels: &KernelSet, spec: Option<&ModelSpec>, lights: u32) -> Result<Row> {
-    crate::kernels::check_support(gpu, &shade_model(spec))?;
+fn kernel_row(gpu: &Gpu, shaders: &Shaders, model: Option<&Model>, lights: u32) -> Result<Row> {
+    if let Some(m) = model {
+        m.check_support(&gpu.info)?;
+    }
     let mut row = Row {
-        model: spec.map_or_else(|| BASELINE_LABEL.to_string(), |s| s.name()),
-        spec: spec.map(|s| s.canonical()),
+        model: model.map_or_else(|| BASELINE_LABEL.to_string(), Model::name),
+        spec: model.map(Model::canonical),
         stats: BTreeMap::new(),
         notes: BTreeMap::new(),
     };
-    let words = kernels.shade(shade_model(spec).precision)?.words();
-    static_stats(&words, spec, lights, &mut row)?;
-    driver_stats(gpu, kernels, spec, lights, &mut row)?;
+    let kernel = shade_kernel(model, lights, shaders)?;
+    static_stats(&kernel, &mut row)?;
+    driver_stats(gpu, &kernel, &mut row)?;
     Ok(row)
 }
 
-/// Runs every analysis for every spec and the baseline kernel.
-pub fn run(gpu: &Gpu, kernels: &KernelSet, options: &InspectOptions) -> Result<InspectReport> {
-    let mut all: Vec<Option<&ModelSpec>> = options.specs.iter().map(Some).collect();
+/// Runs every analysis for every model and the baseline kernel.
+pub fn run(gpu: &Gpu, shaders: &Shaders, options: &InspectOptions) -> Result<InspectReport> {
+    let mut all: Vec<Option<&Model>> = options.models.iter().map(Some).collect();
     all.push(None);
-    let mut rows = all.into_iter().map(|spec| kernel_row(gpu, kernels, spec, options.lights)).collect::<Result<Vec<_>>>()?;
+    let mut rows = all.into_iter().map(|model| kernel_row(gpu, shaders, model, options.lights)).collect::<Result<Vec<_>>>()?;
     // Column order: the SPIR-V counts in their own order (total, functions, classes, instructions by name),
     // then the other keys (a row's map is sorted by key).
     let mut emitted: Vec<String> = Vec::new();
@@ -153,7 +154,7 @@ pub fn run(gpu: &Gpu, kernels: &KernelSet, options: &InspectOptions) -> Result<I
         }
     }
     let mut section_notes = BTreeMap::new();
-    if gpu.executable_properties.is_none() {
+    if !gpu.info.pipeline_executable_properties {
         section_notes.insert(
             "driver/".into(),
             format!("not available on this device ({} has no VK_KHR_pipeline_executable_properties)", gpu.info.name),
@@ -161,11 +162,11 @@ pub fn run(gpu: &Gpu, kernels: &KernelSet, options: &InspectOptions) -> Result<I
     }
     let mut tools = BTreeMap::new();
     tools.insert("spirv-opt".into(), spirv::spirv_opt_version().unwrap_or_else(|| "not found".into()));
-    if kernels.glsl_dir().is_some() {
-        tools.insert("glslang".into(), glsl::glslang_version().unwrap_or_else(|| "not found".into()));
+    if shaders.glsl_dir().is_some() {
+        tools.insert("glslang".into(), crate::shaders::glslang_version().unwrap_or_else(|| "not found".into()));
     }
     let mut callgrind_setup = BTreeMap::new();
-    let callgrind = measure_callgrind(gpu, kernels, options, &mut rows, &mut section_notes, &mut callgrind_setup);
+    let callgrind = measure_callgrind(gpu, shaders, options, &mut rows, &mut section_notes, &mut callgrind_setup);
     if let Some(v) = callgrind_setup.get("valgrind") {
         tools.insert("valgrind".into(), v.clone());
     }
@@ -176,7 +177,7 @@ pub fn run(gpu: &Gpu, kernels: &KernelSet, options: &InspectOptions) -> Result<I
     }
     Ok(InspectReport {
         provenance: serde_json::to_value(Provenance::new(&gpu.info))?,
-        kernels: kernels.describe(),
+        kernels: shaders.describe(),
         lights: options.lights,
         tools,
         columns: ordered_columns(&rows, &emitted),
@@ -203,7 +204,7 @@ fn spirv_key_order(row: &Row) -> Vec<String> {
 /// The callgrind figures, on lavapipe only; a failure is reported in the section notes, not fatal.
 fn measure_callgrind(
     gpu: &Gpu,
-    kernels: &KernelSet,
+    shaders: &Shaders,
     options: &InspectOptions,
     rows: &mut [Row],
     notes: &mut BTreeMap<String, String>,
@@ -221,7 +222,7 @@ fn measure_callgrind(
     cg.device = Some(gpu.info.index.to_string());
     setup.insert("workload".into(), format!("{}x{} pixels x {} lights", cg.width, cg.height, options.lights));
     setup.insert("valgrind".into(), callgrind::valgrind_version().unwrap_or_else(|_| "not found".into()));
-    match callgrind::run(&options.specs, options.lights, kernels, &cg) {
+    match callgrind::run(&options.models, options.lights, shaders, &cg) {
         Ok(run) => {
             for row in rows.iter_mut() {
                 row.stats.extend(run.stats(&row.model));

@@ -166,33 +166,36 @@ pub fn optimise(words: &[u32]) -> Result<Vec<u32>> {
 
 /// `spirv-opt --version`'s first line, e.g. "SPIRV-Tools v2023.1 ...".
 pub fn spirv_opt_version() -> Option<String> {
-    super::glsl::first_line_of(Command::new("spirv-opt").arg("--version"))
+    crate::shaders::first_line_of(Command::new("spirv-opt").arg("--version"))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::brdf::ModelSpec;
-    use crate::profile::protocol::shade_constants;
+    use crate::kernels::{constants, embedded};
+    use crate::model::Model;
+    use crate::profile::protocol::shade_kernel;
 
-    fn shade() -> Vec<u32> {
-        crate::shaders::kernel("shade_f32").words()
+    fn frozen(model: Option<&str>, lights: u32) -> Vec<u32> {
+        let m = model.map(|m| Model::parse(m).unwrap());
+        let k = shade_kernel(m.as_ref(), lights, embedded()).unwrap();
+        specialise(&k.spirv.words, &k.constants).unwrap()
     }
 
     #[test]
     fn spec_values_follow_the_module_types() {
-        let spec = ModelSpec::parse("burley,gamma=2").unwrap();
-        let text = spec_default_values(&shade(), &shade_constants(Some(&spec), 4)).unwrap();
+        let k = shade_kernel(Some(&Model::parse("burley,gamma=2").unwrap()), 4, embedded()).unwrap();
+        let text = spec_default_values(&k.spirv.words, &k.constants).unwrap();
         assert!(text.contains("3:2.0"), "{text}");
-        assert!(text.contains("5:4") && text.contains("6:0"), "{text}");
+        assert!(text.contains(&format!("{}:4", constants::NUM_LIGHTS.id)) && text.contains(&format!("{}:0", constants::BASELINE.id)), "{text}");
     }
 
     #[test]
     fn specialisation_keeps_only_the_selected_terms() {
-        let words = shade();
-        let ggx = count(&specialise(&words, &shade_constants(Some(&ModelSpec::preset("ggx").unwrap()), 8)).unwrap()).unwrap();
-        let burley = count(&specialise(&words, &shade_constants(Some(&ModelSpec::preset("burley").unwrap()), 8)).unwrap()).unwrap();
-        let baseline = count(&specialise(&words, &shade_constants(None, 8)).unwrap()).unwrap();
+        let words = embedded().get("shade_f32").unwrap().words.to_vec();
+        let ggx = count(&frozen(Some("ggx"), 8)).unwrap();
+        let burley = count(&frozen(Some("burley"), 8)).unwrap();
+        let baseline = count(&frozen(None, 8)).unwrap();
         let whole = count(&words).unwrap();
         // GTR's D raises to the power gamma; GGX's D has no pow.
         assert!(burley.glsl.get("Pow").copied().unwrap_or(0) > ggx.glsl.get("Pow").copied().unwrap_or(0), "{burley:?} {ggx:?}");

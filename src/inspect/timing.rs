@@ -10,12 +10,12 @@
 //! from the models' arithmetic). The price: a change that slows every model by the same factor cancels in
 //! these ratios; the instruction counts (SPIR-V, callgrind) catch that kind of change.
 
-use super::glsl::KernelSet;
 use super::BASELINE_LABEL;
-use crate::brdf::ModelSpec;
 use crate::gpu::Gpu;
+use crate::model::Model;
 use crate::profile::gbuffer;
-use crate::profile::protocol::{self, shade_model, ProtocolOptions, RawTimes, Variant, Workload};
+use crate::profile::protocol::{self, ProtocolOptions, Variant, Workload};
+use crate::shaders::Shaders;
 use crate::stats;
 use anyhow::{bail, Result};
 use serde::{Deserialize, Serialize};
@@ -61,23 +61,15 @@ pub fn reference_of(models: &[String], round_ns: &BTreeMap<String, Vec<f64>>) ->
     (format!("the geometric mean of the models' costs in the round ({})", models.join(", ")), geomean)
 }
 
-/// The per-round medians of variant `i`.
-fn round_medians(raw: &RawTimes, i: usize) -> Vec<f64> {
-    raw.ns[i].iter().map(|reps| stats::median(reps)).collect()
-}
-
 /// Times every model's shading kernel and the baseline kernel, interleaved.
-pub fn run(gpu: &Gpu, kernels: &KernelSet, specs: &[ModelSpec], options: &TimingOptions) -> Result<TimingRun> {
+pub fn run(gpu: &Gpu, shaders: &Shaders, models: &[Model], options: &TimingOptions) -> Result<TimingRun> {
     if options.rounds == 0 {
         bail!("a timing run needs at least one round");
     }
     let work = Workload::upload(gpu, &gbuffer::synthetic(options.width, options.height), &gbuffer::lights(options.lights), None)?;
-    let mut all: Vec<Option<&ModelSpec>> = specs.iter().map(Some).collect();
+    let mut all: Vec<Option<&Model>> = models.iter().map(Some).collect();
     all.push(None);
-    let variants = all
-        .iter()
-        .map(|s| Variant::with_source(gpu, &work, *s, kernels.shade(shade_model(*s).precision)?, 1))
-        .collect::<Result<Vec<_>>>()?;
+    let variants = all.iter().map(|m| Variant::new(gpu, &work, *m, shaders, 1)).collect::<Result<Vec<_>>>()?;
     let protocol_options = ProtocolOptions {
         min_rounds: options.rounds,
         max_rounds: options.rounds,
@@ -89,7 +81,7 @@ pub fn run(gpu: &Gpu, kernels: &KernelSet, specs: &[ModelSpec], options: &Timing
     let base = variants.len() - 1;
     let evals = work.evaluations() as f64;
     let label = |i: usize| if i == base { BASELINE_LABEL.to_string() } else { variants[i].label.clone() };
-    let round_ns: BTreeMap<String, Vec<f64>> = (0..variants.len()).map(|i| (label(i), round_medians(&raw, i))).collect();
+    let round_ns: BTreeMap<String, Vec<f64>> = (0..variants.len()).map(|i| (label(i), raw.round_medians(i))).collect();
     let ns_per_eval = round_ns.iter().map(|(k, t)| (k.clone(), stats::median(t) / evals)).collect();
     let models: Vec<String> = (0..base).map(label).collect();
     let (reference, reference_ns) = reference_of(&models, &round_ns);

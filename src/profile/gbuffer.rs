@@ -4,6 +4,8 @@
 //! rows (Fig. 5.2): roughness rises along a row, rows alternate metal and dielectric base colours, so every
 //! model meets the whole range of roughness, normal and view angles, and some back-facing lights.
 
+use crate::util::hash01;
+use glam::Vec3;
 use rayon::prelude::*;
 
 /// Floats per pixel: (n.xyz, roughness), (v.xyz, metallic), (base colour, 1).
@@ -24,17 +26,8 @@ impl GBuffer {
     }
 }
 
-/// Integer hash to [0, 1) (PCG-style), so the picture is identical on every run and machine.
-fn hash01(mut x: u32) -> f32 {
-    x = x.wrapping_mul(747796405).wrapping_add(2891336453);
-    x = ((x >> ((x >> 28) + 4)) ^ x).wrapping_mul(277803737);
-    x = (x >> 22) ^ x;
-    (x >> 8) as f32 / (1u32 << 24) as f32
-}
-
 fn normalize(v: [f32; 3]) -> [f32; 3] {
-    let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-    v.map(|x| x / l)
+    Vec3::from(v).normalize().to_array()
 }
 
 const SPHERE_COLUMNS: u32 = 8;

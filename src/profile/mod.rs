@@ -5,8 +5,9 @@
 pub mod gbuffer;
 pub mod protocol;
 
-use crate::brdf::ModelSpec;
 use crate::gpu::Gpu;
+use crate::model::Model;
+use crate::shaders::Shaders;
 use crate::report::{self, Provenance, Table};
 use crate::stats::{self, Estimate};
 use anyhow::Result;
@@ -14,14 +15,13 @@ use indicatif::ProgressBar;
 use protocol::{ProtocolOptions, RawTimes, Variant, Workload};
 use serde::Serialize;
 
-/// The reference every cost is compared with: the thesis' (and UE's) GGX.
-pub const REFERENCE_MODEL: &str = "ggx";
+pub use crate::brdf::spec::REFERENCE_MODEL;
 /// Confidence level of every interval.
 pub const LEVEL: f64 = 0.95;
 
 #[derive(Clone, Debug)]
 pub struct ProfileOptions {
-    pub models: Vec<ModelSpec>,
+    pub models: Vec<Model>,
     pub width: u32,
     pub height: u32,
     pub lights: u32,
@@ -82,11 +82,11 @@ pub struct ProfileReport {
 
 /// Per-round medians of a variant's dispatch times, per evaluation.
 pub fn per_round(raw: &RawTimes, variant: usize, evals: f64) -> Vec<f64> {
-    raw.ns[variant].iter().map(|reps| stats::median(reps) / evals).collect()
+    raw.round_medians(variant).iter().map(|t| t / evals).collect()
 }
 
 /// Statistics of every variant; `reference` and `baseline` index variants.
-pub fn analyse(raw: &RawTimes, labels: &[String], specs: &[Option<ModelSpec>], evals: u64, reference: usize, baseline: Option<usize>) -> Vec<Row> {
+pub fn analyse(raw: &RawTimes, labels: &[String], specs: &[Option<Model>], evals: u64, reference: usize, baseline: Option<usize>) -> Vec<Row> {
     let e = evals as f64;
     let reference_t = per_round(raw, reference, e);
     let baseline_t = baseline.map(|b| per_round(raw, b, e));
@@ -105,7 +105,7 @@ pub fn analyse(raw: &RawTimes, labels: &[String], specs: &[Option<ModelSpec>], e
             };
             Row {
                 model: labels[i].clone(),
-                spec: specs[i].map(|s| s.canonical()),
+                spec: specs[i].as_ref().map(Model::canonical),
                 ns_per_eval: ns,
                 evals_per_second: 1e9 / ns.median,
                 vs_reference: stats::median_ci(&ratio, LEVEL),
@@ -127,22 +127,23 @@ fn resolved(rows: &[Row], reference: usize, target: f64) -> bool {
 
 /// Runs the profile: the models (the reference added when missing) and the baseline, interleaved.
 pub fn run(gpu: &Gpu, options: &ProfileOptions, progress: &ProgressBar) -> Result<ProfileReport> {
-    let reference_spec = ModelSpec::preset(REFERENCE_MODEL).unwrap();
+    let reference_model = Model::reference();
     let mut models = options.models.clone();
-    if !models.contains(&reference_spec) {
-        models.insert(0, reference_spec);
+    if !models.contains(&reference_model) {
+        models.insert(0, reference_model.clone());
     }
     progress.set_message("building the G-buffer");
     let gbuffer = gbuffer::synthetic(options.width, options.height);
     let lights = gbuffer::lights(options.lights);
     let work = Workload::upload(gpu, &gbuffer, &lights, options.max_chunk)?;
     drop(gbuffer);
-    let mut specs: Vec<Option<ModelSpec>> = models.iter().copied().map(Some).collect();
+    let mut specs: Vec<Option<Model>> = models.iter().cloned().map(Some).collect();
     specs.push(None);
     progress.set_message("compiling kernels");
-    let variants = specs.iter().map(|s| Variant::new(gpu, &work, s.as_ref(), options.instances)).collect::<Result<Vec<_>>>()?;
+    let shaders = Shaders::embedded();
+    let variants = specs.iter().map(|s| Variant::new(gpu, &work, s.as_ref(), &shaders, options.instances)).collect::<Result<Vec<_>>>()?;
     let labels: Vec<String> = variants.iter().map(|v| v.label.clone()).collect();
-    let reference = models.iter().position(|m| *m == reference_spec).unwrap();
+    let reference = models.iter().position(|m| *m == reference_model).unwrap();
     let baseline = Some(variants.len() - 1);
     let evals = work.evaluations();
     progress.set_length(options.protocol.max_rounds as u64);

@@ -6,12 +6,11 @@
 //! are kept, outliers included.
 
 use super::gbuffer::{GBuffer, LIGHT_FLOATS, PIXEL_FLOATS};
-use crate::brdf::ModelSpec;
-use crate::gpu::{Buffer, ChunkPlan, Gpu, Kernel, MemoryKind, SpecConstants, Timestamps};
-use crate::kernels;
-use crate::shaders::KernelSource;
+use crate::gpu::{Bindings, Buffer, ChunkPlan, Commands, Gpu, Kernel, MemoryKind, SpecConstants, Timestamps};
+use crate::kernels::{self, constants, WithConstant};
+use crate::model::{KernelKind, Model, ModelKernel};
+use crate::shaders::{Shaders, Spirv};
 use anyhow::Result;
-use ash::vk;
 use rand::seq::SliceRandom;
 use rand::SeedableRng;
 use serde::Serialize;
@@ -69,7 +68,7 @@ impl<'g> Workload<'g> {
 /// windows: on lavapipe the same kernel JIT-compiled twice has been seen to run 2x slower in every round of one
 /// process (code placement), and only a second pipeline exposes that. `measure` times every instance.
 pub struct Pipelines<'g> {
-    instances: Vec<(Kernel<'g>, Vec<(vk::DescriptorSet, u64)>)>,
+    instances: Vec<(Kernel<'g>, Vec<(Bindings, u64)>)>,
     push: Vec<u8>,
 }
 
@@ -79,17 +78,17 @@ impl<'g> Pipelines<'g> {
     #[allow(clippy::too_many_arguments)]
     pub fn compile(
         gpu: &'g Gpu,
-        source: &KernelSource,
+        spirv: &Spirv,
         constants: &SpecConstants,
         bindings: u32,
         push: Vec<u8>,
         chunks: &[(u64, u64)],
         count: usize,
-        bind: impl Fn(&Kernel<'g>, u64, u64) -> Result<vk::DescriptorSet>,
+        bind: impl Fn(&Kernel<'g>, u64, u64) -> Result<Bindings>,
     ) -> Result<Self> {
         let instances = (0..count.max(1))
             .map(|_| {
-                let kernel = Kernel::new(gpu, source, constants, bindings, push.len() as u32)?;
+                let kernel = kernels::kernel(gpu, spirv, constants, bindings, push.len() as u32)?;
                 let sets = chunks.iter().map(|&(first, len)| Ok((bind(&kernel, first, len)?, len))).collect::<Result<Vec<_>>>()?;
                 Ok((kernel, sets))
             })
@@ -106,7 +105,7 @@ impl<'g> Pipelines<'g> {
     }
 
     /// Records every chunk's dispatch of pipeline `instance`.
-    pub fn record(&self, cmd: vk::CommandBuffer, instance: usize) {
+    pub fn record(&self, cmd: &Commands, instance: usize) {
         let (kernel, sets) = &self.instances[instance];
         for &(set, len) in sets {
             kernel.dispatch(cmd, set, &self.push, len);
@@ -118,44 +117,35 @@ impl<'g> Pipelines<'g> {
 pub struct Variant<'g> {
     pub label: String,
     /// None for the memory-only baseline.
-    pub spec: Option<ModelSpec>,
+    pub model: Option<Model>,
     pipelines: Pipelines<'g>,
 }
 
-/// Constant ids of glsl/shade.comp beyond the term selectors.
-const NUM_LIGHTS_ID: u32 = 5;
-const BASELINE_ID: u32 = 6;
+/// The label of the memory-only baseline kernel in every report.
+pub const BASELINE_LABEL: &str = "baseline";
 
-/// The model the shading kernel is specialised for: `spec`, or ggx's term selectors for the memory-only
-/// baseline (which runs none of them).
-pub fn shade_model(spec: Option<&ModelSpec>) -> ModelSpec {
-    spec.copied().unwrap_or_else(|| ModelSpec::preset("ggx").unwrap())
-}
-
-/// Every specialisation constant of glsl/shade.comp for `spec` (None: the memory-only baseline) and `lights`.
-pub fn shade_constants(spec: Option<&ModelSpec>, lights: u32) -> SpecConstants {
-    kernels::model_constants(&shade_model(spec)).int(NUM_LIGHTS_ID, lights as i32).int(BASELINE_ID, spec.is_none() as i32)
+/// glsl/shade.comp for `model` (None: the memory-only baseline, compiled with the reference model's
+/// selectors, which it never runs) and `lights`, with every specialisation constant set.
+pub fn shade_kernel(model: Option<&Model>, lights: u32, shaders: &Shaders) -> Result<ModelKernel> {
+    let reference = Model::reference();
+    let mut k = model.unwrap_or(&reference).kernel(KernelKind::Shade, shaders)?;
+    k.constants = k.constants.with(constants::NUM_LIGHTS, lights as f64).with(constants::BASELINE, model.is_none() as i32 as f64);
+    Ok(k)
 }
 
 impl<'g> Variant<'g> {
-    /// The shading kernel for `spec`, or the memory-only baseline when `spec` is None, as `instances`
-    /// independent pipelines.
-    pub fn new(gpu: &'g Gpu, work: &Workload<'g>, spec: Option<&ModelSpec>, instances: usize) -> Result<Self> {
-        let source = kernels::source_for("shade", shade_model(spec).precision);
-        Self::with_source(gpu, work, spec, source, instances)
-    }
-
-    /// As `new`, with the shading kernel's SPIR-V from `source` (e.g. compiled at run time from another
-    /// GLSL directory) instead of the embedded one.
-    pub fn with_source(gpu: &'g Gpu, work: &Workload<'g>, spec: Option<&ModelSpec>, source: &KernelSource, instances: usize) -> Result<Self> {
-        if let Some(s) = spec {
-            kernels::check_support(gpu, s)?;
+    /// The shading kernel for `model`, or the memory-only baseline when `model` is None, as `instances`
+    /// independent pipelines, from `shaders`.
+    pub fn new(gpu: &'g Gpu, work: &Workload<'g>, model: Option<&Model>, shaders: &Shaders, instances: usize) -> Result<Self> {
+        if let Some(m) = model {
+            m.check_support(&gpu.info)?;
         }
+        let k = shade_kernel(model, work.light_count, shaders)?;
         let stride_in = (PIXEL_FLOATS * 4) as u64;
-        let pipelines = Pipelines::compile(gpu, source, &shade_constants(spec, work.light_count), 3, Vec::new(), &work.plan.chunks, instances, |kernel, first, len| {
+        let pipelines = Pipelines::compile(gpu, &k.spirv, &k.constants, 3, Vec::new(), &work.plan.chunks, instances, |kernel, first, len| {
             kernel.bind(&[(&work.pixels, first * stride_in, len * stride_in), (&work.radiance, first * 16, len * 16), (&work.lights, 0, work.lights.size)])
         })?;
-        Ok(Variant { label: spec.map_or_else(|| "baseline".to_string(), |s| s.name()), spec: spec.copied(), pipelines })
+        Ok(Variant { label: model.map_or_else(|| BASELINE_LABEL.to_string(), Model::name), model: model.cloned(), pipelines })
     }
 }
 
@@ -188,6 +178,11 @@ pub struct RawTimes {
 impl RawTimes {
     pub fn rounds(&self) -> usize {
         self.orders.len()
+    }
+
+    /// The median of `variant`'s repetitions in each round: the figure every analysis starts from.
+    pub fn round_medians(&self, variant: usize) -> Vec<f64> {
+        self.ns[variant].iter().map(|reps| crate::stats::median(reps)).collect()
     }
 
     /// Median over rounds of (slowest instance / fastest instance) of `variant`: 1 when its pipelines agree.
@@ -274,7 +269,7 @@ pub trait Timed {
         1
     }
     /// Records instance `instance`'s dispatches (no barriers or timestamps: `measure` adds those).
-    fn record(&self, cmd: vk::CommandBuffer, instance: usize);
+    fn record(&self, cmd: &Commands, instance: usize);
 
     /// One untimed run of `instance`, waited for; its wall time (on lavapipe the first includes compilation).
     fn run_once(&self, gpu: &Gpu, instance: usize) -> Result<Duration> {
@@ -289,7 +284,7 @@ impl Timed for Variant<'_> {
         self.pipelines.len()
     }
 
-    fn record(&self, cmd: vk::CommandBuffer, instance: usize) {
+    fn record(&self, cmd: &Commands, instance: usize) {
         self.pipelines.record(cmd, instance)
     }
 }

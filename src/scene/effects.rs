@@ -4,15 +4,19 @@
 
 use super::plan::{self, E_TABLE_MU, E_TABLE_R};
 use super::terms::{ETable, Switches};
-use crate::brdf::{ModelSpec, F};
-use crate::gpu::{Buffer, Gpu, Kernel, MemoryKind};
-use crate::kernels::{self, Albedo, AlbedoCell};
+use crate::brdf::F;
+use crate::gpu::{Buffer, Gpu, MemoryKind};
+use crate::kernels::{self, constants, Albedo, AlbedoCell, WithConstant};
+use crate::model::{KernelKind, Model};
 use anyhow::Result;
 
-/// E(mu, r) of `spec` with F = 1 (F = none, F0 = 1) at mu_i = (i + 0.5) / E_TABLE_MU, r_j = j / (E_TABLE_R - 1),
+/// E(mu, r) of `model` with F = 1 (F = none, F0 = 1) at mu_i = (i + 0.5) / E_TABLE_MU, r_j = j / (E_TABLE_R - 1),
 /// integrated on the GPU.
-pub fn e_table(gpu: &Gpu, spec: &ModelSpec) -> Result<ETable> {
-    let white = ModelSpec { f: F::None, ..*spec };
+pub fn e_table(gpu: &Gpu, model: &Model) -> Result<ETable> {
+    let white = match model.twin() {
+        Some(spec) => Model::spec(crate::brdf::ModelSpec { f: F::None, ..*spec }),
+        None => model.clone(),
+    };
     let mut table = ETable { mu_nodes: E_TABLE_MU, r_nodes: E_TABLE_R, values: Vec::new() };
     let cells: Vec<AlbedoCell> = (0..E_TABLE_R)
         .flat_map(|j| (0..E_TABLE_MU).map(move |i| (i, j)))
@@ -36,22 +40,22 @@ pub struct FurnaceCell {
     pub diffuse: i32,
 }
 
-const ALBEDO_N_ID: u32 = 7;
-
-/// The directional albedo of the scene's shading (scene.glsl `shade`) for `spec` with `switches`, per cell,
+/// The directional albedo of the scene's shading (scene.glsl `shade`) for `model` with `switches`, per cell,
 /// integrated on the GPU with albedo.comp's estimator; `table` is E for energy compensation (when switched on).
-pub fn scene_albedo(gpu: &Gpu, spec: &ModelSpec, switches: Switches, table: Option<&ETable>, cells: &[FurnaceCell]) -> Result<Vec<Albedo>> {
-    kernels::check_support(gpu, spec)?;
-    let n = kernels::ALBEDO_GRID as u64;
-    let constants = kernels::model_constants(spec)
-        .int(plan::ANISOTROPY_ID, switches.anisotropy as i32)
-        .int(plan::ENERGY_ID, switches.energy)
-        .int(plan::DIFFUSE_ID, switches.diffuse)
-        .int(plan::CLEAR_COAT_ID, switches.clear_coat as i32)
-        .int(plan::E_TABLE_MU_ID, table.map_or(E_TABLE_MU, |t| t.mu_nodes) as i32)
-        .int(plan::E_TABLE_R_ID, table.map_or(E_TABLE_R, |t| t.r_nodes) as i32)
-        .int(ALBEDO_N_ID, n as i32);
-    let kernel = Kernel::new(gpu, kernels::source_for("scene_albedo", spec.precision), &constants, 3, 4)?;
+pub fn scene_albedo(gpu: &Gpu, model: &Model, switches: Switches, table: Option<&ETable>, cells: &[FurnaceCell]) -> Result<Vec<Albedo>> {
+    let kernel = kernels::model_kernel(
+        gpu,
+        model,
+        KernelKind::SceneAlbedo,
+        |c| {
+            plan::effect_constants(c, switches)
+                .with(constants::E_TABLE_MU, table.map_or(E_TABLE_MU, |t| t.mu_nodes) as f64)
+                .with(constants::E_TABLE_R, table.map_or(E_TABLE_R, |t| t.r_nodes) as f64)
+                .with(constants::ALBEDO_N, kernels::ALBEDO_GRID as f64)
+        },
+        3,
+        4,
+    )?;
     let floats: Vec<f32> = cells
         .iter()
         .flat_map(|c| {
@@ -70,13 +74,11 @@ pub fn scene_albedo(gpu: &Gpu, spec: &ModelSpec, switches: Switches, table: Opti
 pub const TERM_IN: usize = 52;
 pub const TERM_OUT: usize = 24;
 
-/// Every scene.glsl term on its own for each sample (layouts in glsl/scene_terms.comp), with `spec` selecting
+/// Every scene.glsl term on its own for each sample (layouts in glsl/scene_terms.comp), with `model` selecting
 /// the Fresnel of `specular_anisotropic` and `table` the E table of `e_lookup`; for the tests against the twins.
-pub fn scene_terms(gpu: &Gpu, spec: &ModelSpec, table: &ETable, samples: &[[f32; TERM_IN]]) -> Result<Vec<[f32; TERM_OUT]>> {
-    let constants = kernels::model_constants(spec)
-        .int(plan::E_TABLE_MU_ID, table.mu_nodes as i32)
-        .int(plan::E_TABLE_R_ID, table.r_nodes as i32);
-    let kernel = Kernel::new(gpu, crate::shaders::kernel("scene_terms_f32"), &constants, 3, 4)?;
+pub fn scene_terms(gpu: &Gpu, model: &Model, table: &ETable, samples: &[[f32; TERM_IN]]) -> Result<Vec<[f32; TERM_OUT]>> {
+    let extra = |c: crate::gpu::SpecConstants| c.with(constants::E_TABLE_MU, table.mu_nodes as f64).with(constants::E_TABLE_R, table.r_nodes as f64);
+    let kernel = kernels::model_kernel(gpu, model, KernelKind::SceneTerms, extra, 3, 4)?;
     let n = samples.len() as u64;
     let per_dispatch = gpu.info.max_compute_work_group_count[0] as u64 * crate::gpu::WORKGROUP as u64;
     assert!(n <= per_dispatch, "scene_terms: at most {per_dispatch} samples");

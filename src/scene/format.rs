@@ -3,7 +3,7 @@
 //! while they are read (the same path errors), names and combinations after (errors name the path too).
 //! `brdfprof scene --explain` prints `EXPLAIN`, the format with an example.
 
-use crate::brdf::{ModelSpec, D};
+use crate::model;
 use anyhow::{anyhow, bail, Result};
 use serde::{de, Deserialize, Deserializer, Serialize};
 use std::path::{Path, PathBuf};
@@ -289,19 +289,38 @@ impl Light {
 }
 
 /// A model spec string (`ggx`, `burley,gamma=2`, `d=ggx,vis=smith-ggx-correlated,f=schlick`), parsed on read.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Model(pub ModelSpec);
+#[derive(Clone, Debug, PartialEq)]
+pub struct Model(pub model::Model);
 
 impl<'de> Deserialize<'de> for Model {
     fn deserialize<Dz: Deserializer<'de>>(d: Dz) -> Result<Self, Dz::Error> {
         let text = String::deserialize(d)?;
-        ModelSpec::parse(&text).map(Model).map_err(de::Error::custom)
+        model::Model::parse(&text).map(Model).map_err(|e| de::Error::custom(format!("{e:#}")))
     }
 }
 
 impl Serialize for Model {
     fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
         s.serialize_str(&self.0.name())
+    }
+}
+
+/// A parameter value in a material's `params`: a number, a string, or a colour as [r, g, b].
+#[derive(Clone, Debug, PartialEq, Deserialize, Serialize)]
+#[serde(untagged)]
+pub enum ParamValue {
+    Number(f64),
+    Text(String),
+    Colour([f64; 3]),
+}
+
+impl ParamValue {
+    fn text(&self) -> String {
+        match self {
+            ParamValue::Number(x) => format!("{x}"),
+            ParamValue::Text(t) => t.clone(),
+            ParamValue::Colour([r, g, b]) => format!("{r},{g},{b}"),
+        }
     }
 }
 
@@ -345,7 +364,10 @@ pub struct Material {
     pub metallic: Unit,
     #[serde(default = "half_unit")]
     pub roughness: Unit,
-    /// GTR exponent, overriding the model's (read when d = gtr).
+    /// Parameters of the model, overriding its own (`{"gamma": 2}`), as `--param` does.
+    #[serde(default)]
+    pub params: std::collections::BTreeMap<String, ParamValue>,
+    /// Shorthand for `params: {"gamma": G}` (the GTR exponent).
     #[serde(default)]
     pub gamma: Option<f64>,
     #[serde(default)]
@@ -363,13 +385,23 @@ fn half_unit() -> Unit {
 }
 
 impl Material {
-    /// The model spec with the material's gamma applied.
-    pub fn spec(&self) -> ModelSpec {
-        let mut s = self.model.0;
-        if let Some(g) = self.gamma {
-            s.gamma = g;
+    /// The material's parameter overrides as `KEY=VALUE` items.
+    fn param_items(&self) -> Vec<String> {
+        let mut items: Vec<String> = self.params.iter().map(|(k, v)| format!("{k}={}", v.text())).collect();
+        items.extend(self.gamma.map(|g| format!("gamma={g}")));
+        items
+    }
+
+    /// The model with the material's parameters applied (checked when the scene is read).
+    pub fn model(&self) -> model::Model {
+        self.try_model().expect("material parameters are checked when the scene is read")
+    }
+
+    fn try_model(&self) -> Result<model::Model> {
+        if self.gamma.is_some() && self.params.contains_key("gamma") {
+            bail!("gamma is given both as `gamma` and in `params`");
         }
-        s
+        self.model.0.with_params(&self.param_items())
     }
 }
 
@@ -465,7 +497,7 @@ pub struct RenderSettings {
 }
 
 fn thesis_models() -> Vec<Model> {
-    crate::brdf::THESIS_MODELS.iter().map(|m| Model(ModelSpec::preset(m).unwrap())).collect()
+    crate::brdf::THESIS_MODELS.iter().map(|m| Model(model::Model::parse(m).expect("thesis models are presets"))).collect()
 }
 fn lobe_roughness() -> Vec<Unit> {
     [0.2, 0.4, 0.6, 0.8].map(Unit).to_vec()
@@ -525,67 +557,68 @@ fn nonzero3(v: &[f32; 3]) -> bool {
 
 /// Checks what serde cannot: names, references and combinations. Errors name the JSON path.
 fn check(f: &SceneFile) -> Result<()> {
-    if f.materials.is_empty() {
+    check_materials(&f.materials)?;
+    check_gbuffer(f)?;
+    if let Some(c) = &f.camera {
+        check_camera(c)?;
+    }
+    for (i, l) in f.lights.iter().enumerate() {
+        check_light(&format!("lights[{i}]"), l)?;
+    }
+    check_render(f)
+}
+
+/// `path: no material named ...` unless `name` is one of the scene's materials.
+fn need(f: &SceneFile, path: String, name: &str) -> Result<()> {
+    if f.materials.iter().any(|m| m.name == name) { Ok(()) } else { bail!("{path}: no material named `{name}` (materials are {})", names(f)) }
+}
+
+/// Each of `names` (at `path[i]`) must be a material; `what` says what at least one of them is.
+fn need_all(f: &SceneFile, path: &str, names: &[String], what: &str) -> Result<()> {
+    if names.is_empty() {
+        bail!("{path}: at least one {what}");
+    }
+    names.iter().enumerate().try_for_each(|(i, n)| need(f, format!("{path}[{i}]"), n))
+}
+
+fn check_materials(materials: &[Material]) -> Result<()> {
+    if materials.is_empty() {
         bail!("materials: a scene needs at least one material");
     }
-    if f.materials.len() > 255 {
-        bail!("materials: at most 255 materials ({} given)", f.materials.len());
+    if materials.len() > 255 {
+        bail!("materials: at most 255 materials ({} given)", materials.len());
     }
-    for (i, m) in f.materials.iter().enumerate() {
-        if f.materials[..i].iter().any(|o| o.name == m.name) {
+    for (i, m) in materials.iter().enumerate() {
+        if materials[..i].iter().any(|o| o.name == m.name) {
             bail!("materials[{i}].name: `{}` is used by an earlier material", m.name);
         }
-        if let Some(g) = m.gamma {
-            if !(g.is_finite() && (0.0..=16.0).contains(&g)) {
-                bail!("materials[{i}].gamma: {g} is outside [0, 16]");
-            }
-        }
-        if m.effects.anisotropy.0 != 0.0 && m.model.0.d != D::Ggx {
-            bail!(
-                "materials[{i}].effects.anisotropy: anisotropic GGX replaces the model's D and Vis, so it needs d=ggx (model `{}` has d={})",
-                m.model.0.name(),
-                m.model.0.d.name()
-            );
+        let model = m.try_model().map_err(|e| anyhow!("materials[{i}].{}: {e:#}", if m.gamma.is_some() { "gamma" } else { "params" }))?;
+        if m.effects.anisotropy.0 != 0.0 && !super::plan::takes_anisotropy(&model) {
+            bail!("materials[{i}].effects.anisotropy: anisotropic GGX replaces the model's D and Vis, so it needs d=ggx (model `{}`)", model.name());
         }
     }
-    let known = |name: &str| f.materials.iter().any(|m| m.name == name);
-    let need = |path: String, name: &str| -> Result<()> {
-        if known(name) { Ok(()) } else { bail!("{path}: no material named `{name}` (materials are {})", names(f)) }
-    };
+    Ok(())
+}
+
+fn check_gbuffer(f: &SceneFile) -> Result<()> {
+    let p = "gbuffer.procedural";
     match &f.gbuffer {
-        GBufferSource::Procedural(p) => match p {
-            Procedural::SphereGrid { rows, columns, floor, .. } => {
-                if rows.is_empty() {
-                    bail!("gbuffer.procedural.rows: at least one row");
-                }
-                for (i, r) in rows.iter().enumerate() {
-                    need(format!("gbuffer.procedural.rows[{i}]"), r)?;
-                }
-                if *columns == 0 || *columns > 64 {
-                    bail!("gbuffer.procedural.columns: {columns} is outside 1 to 64");
-                }
-                need("gbuffer.procedural.floor".into(), floor)?;
+        GBufferSource::Procedural(Procedural::SphereGrid { rows, columns, floor, .. }) => {
+            need_all(f, &format!("{p}.rows"), rows, "row")?;
+            if *columns == 0 || *columns > 64 {
+                bail!("{p}.columns: {columns} is outside 1 to 64");
             }
-            Procedural::Statues { statues, floor, .. } => {
-                if statues.is_empty() {
-                    bail!("gbuffer.procedural.statues: at least one statue");
-                }
-                for (i, s) in statues.iter().enumerate() {
-                    need(format!("gbuffer.procedural.statues[{i}]"), s)?;
-                }
-                need("gbuffer.procedural.floor".into(), floor)?;
-            }
-            Procedural::OldWest { ground, walls, roofs, .. } => {
-                need("gbuffer.procedural.ground".into(), ground)?;
-                if walls.is_empty() {
-                    bail!("gbuffer.procedural.walls: at least one wall material");
-                }
-                for (i, w) in walls.iter().enumerate() {
-                    need(format!("gbuffer.procedural.walls[{i}]"), w)?;
-                }
-                need("gbuffer.procedural.roofs".into(), roofs)?;
-            }
-        },
+            need(f, format!("{p}.floor"), floor)
+        }
+        GBufferSource::Procedural(Procedural::Statues { statues, floor, .. }) => {
+            need_all(f, &format!("{p}.statues"), statues, "statue")?;
+            need(f, format!("{p}.floor"), floor)
+        }
+        GBufferSource::Procedural(Procedural::OldWest { ground, walls, roofs, .. }) => {
+            need(f, format!("{p}.ground"), ground)?;
+            need_all(f, &format!("{p}.walls"), walls, "wall material")?;
+            need(f, format!("{p}.roofs"), roofs)
+        }
         GBufferSource::Images(im) => {
             if f.camera.is_none() {
                 bail!("camera: required when the G-buffer comes from images (view vectors are derived from it)");
@@ -600,57 +633,64 @@ fn check(f: &SceneFile) -> Result<()> {
                     bail!("gbuffer.images.depth_range: [{near}, {far}] must have far > near");
                 }
             }
+            Ok(())
         }
     }
-    if let Some(c) = &f.camera {
-        if !(finite3(&c.position) && finite3(&c.look_at) && nonzero3(&c.up)) {
-            bail!("camera: position, look_at and up must be finite, up non-zero");
-        }
-        if c.position == c.look_at {
-            bail!("camera.look_at: equals camera.position");
-        }
-        if !(1.0..=170.0).contains(&c.fov_y_deg) {
-            bail!("camera.fov_y_deg: {} is outside 1 to 170", c.fov_y_deg);
-        }
+}
+
+fn check_camera(c: &Camera) -> Result<()> {
+    if !(finite3(&c.position) && finite3(&c.look_at) && nonzero3(&c.up)) {
+        bail!("camera: position, look_at and up must be finite, up non-zero");
     }
-    for (i, l) in f.lights.iter().enumerate() {
-        let p = format!("lights[{i}]");
-        let (colour, intensity) = match l {
-            Light::Directional { direction, colour, intensity } => {
-                if !nonzero3(direction) {
-                    bail!("{p}.direction: must be finite and non-zero");
-                }
-                (colour, intensity)
-            }
-            Light::Point { position, colour, intensity } => {
-                if !finite3(position) {
-                    bail!("{p}.position: must be finite");
-                }
-                (colour, intensity)
-            }
-            Light::Spot { position, direction, inner_angle_deg, outer_angle_deg, colour, intensity } => {
-                if !finite3(position) || !nonzero3(direction) {
-                    bail!("{p}: position must be finite and direction finite and non-zero");
-                }
-                if !(*inner_angle_deg >= 0.0 && inner_angle_deg <= outer_angle_deg && *outer_angle_deg <= 90.0) {
-                    bail!("{p}: need 0 <= inner_angle_deg ({inner_angle_deg}) <= outer_angle_deg ({outer_angle_deg}) <= 90");
-                }
-                (colour, intensity)
-            }
-            Light::Sphere { position, radius, colour, intensity } => {
-                if !finite3(position) {
-                    bail!("{p}.position: must be finite");
-                }
-                if !(radius.is_finite() && *radius > 0.0) {
-                    bail!("{p}.radius: {radius} must be positive");
-                }
-                (colour, intensity)
-            }
-        };
-        if !(colour.iter().all(|c| c.is_finite() && *c >= 0.0) && intensity.is_finite() && *intensity >= 0.0) {
-            bail!("{p}: colour and intensity must be finite and non-negative");
-        }
+    if c.position == c.look_at {
+        bail!("camera.look_at: equals camera.position");
     }
+    if !(1.0..=170.0).contains(&c.fov_y_deg) {
+        bail!("camera.fov_y_deg: {} is outside 1 to 170", c.fov_y_deg);
+    }
+    Ok(())
+}
+
+fn check_light(p: &str, l: &Light) -> Result<()> {
+    let (colour, intensity) = match l {
+        Light::Directional { direction, colour, intensity } => {
+            if !nonzero3(direction) {
+                bail!("{p}.direction: must be finite and non-zero");
+            }
+            (colour, intensity)
+        }
+        Light::Point { position, colour, intensity } => {
+            if !finite3(position) {
+                bail!("{p}.position: must be finite");
+            }
+            (colour, intensity)
+        }
+        Light::Spot { position, direction, inner_angle_deg, outer_angle_deg, colour, intensity } => {
+            if !finite3(position) || !nonzero3(direction) {
+                bail!("{p}: position must be finite and direction finite and non-zero");
+            }
+            if !(*inner_angle_deg >= 0.0 && inner_angle_deg <= outer_angle_deg && *outer_angle_deg <= 90.0) {
+                bail!("{p}: need 0 <= inner_angle_deg ({inner_angle_deg}) <= outer_angle_deg ({outer_angle_deg}) <= 90");
+            }
+            (colour, intensity)
+        }
+        Light::Sphere { position, radius, colour, intensity } => {
+            if !finite3(position) {
+                bail!("{p}.position: must be finite");
+            }
+            if !(radius.is_finite() && *radius > 0.0) {
+                bail!("{p}.radius: {radius} must be positive");
+            }
+            (colour, intensity)
+        }
+    };
+    if !(colour.iter().all(|c| c.is_finite() && *c >= 0.0) && intensity.is_finite() && *intensity >= 0.0) {
+        bail!("{p}: colour and intensity must be finite and non-negative");
+    }
+    Ok(())
+}
+
+fn check_render(f: &SceneFile) -> Result<()> {
     let r = &f.render;
     if !(r.exposure.is_finite() && r.exposure > 0.0) {
         bail!("render.exposure: {} must be positive", r.exposure);
@@ -659,7 +699,7 @@ fn check(f: &SceneFile) -> Result<()> {
         bail!("render.models: at least one model");
     }
     for (i, g) in r.grid.iter().enumerate() {
-        need(format!("render.grid[{i}]"), g)?;
+        need(f, format!("render.grid[{i}]"), g)?;
     }
     if r.lobe_roughness.is_empty() {
         bail!("render.lobe_roughness: at least one roughness");
@@ -714,7 +754,7 @@ string "x", expected f32`); image paths are relative to the scene file. Unknown 
     {"name": "metal",
      "model": "ggx",                  any model spec: a preset or d=..,vis=..,f=..[,precision=f16][,gamma=G]
      "base_colour": [0.5,0.5,0.5], "metallic": 0, "roughness": 0.5,   F0 = mix(0.04, base_colour, metallic)
-     "gamma": 1.5,                    optional GTR exponent override
+     "params": {"gamma": 1.5},        optional parameter overrides of the model ("gamma": G is short for this)
      "effects": {
        "anisotropy": 0,               [-1, 1]; anisotropic GGX (needs d=ggx): at = a(1+s), ab = a(1-s)
        "energy_compensation": false,  multiple scattering: f_s (1 + F0 (1/E - 1)), E(mu, r) integrated on the GPU

@@ -3,7 +3,9 @@
 //! are decoded from PNG (8/16 bit) and EXR files, with view vectors derived from depth or position and the camera.
 
 use super::format::{Camera, GBufferSource, ImageFiles, Procedural, Scene};
+use crate::util::hash01;
 use anyhow::{anyhow, bail, Result};
+use glam::Vec3;
 use image::DynamicImage;
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
@@ -38,34 +40,12 @@ impl GBuffer {
     }
 }
 
-type V3 = [f32; 3];
+type V3 = Vec3;
 
-fn add(a: V3, b: V3) -> V3 {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-}
-fn sub(a: V3, b: V3) -> V3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-fn mul(a: V3, s: f32) -> V3 {
-    a.map(|x| x * s)
-}
-fn dot(a: V3, b: V3) -> f32 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-fn cross(a: V3, b: V3) -> V3 {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
-}
-fn normalize(a: V3) -> V3 {
-    let l = dot(a, a).sqrt();
-    if l > 0.0 { mul(a, 1.0 / l) } else { [0.0; 3] }
-}
-
-/// A tangent orthogonal to unit `n` [Duff et al. 2017, "Building an Orthonormal Basis, Revisited"].
+/// A tangent orthogonal to unit `n` [Duff et al. 2017, "Building an Orthonormal Basis, Revisited", as glam's
+/// `any_orthonormal_pair`].
 pub fn frame_tangent(n: V3) -> V3 {
-    let sign = 1f32.copysign(n[2]);
-    let a = -1.0 / (sign + n[2]);
-    let b = n[0] * n[1] * a;
-    [1.0 + sign * n[0] * n[0] * a, sign * b, -sign * n[0]]
+    n.any_orthonormal_pair().0
 }
 
 /// The camera's basis and the direction through a pixel centre, scaled so that its component along the
@@ -82,29 +62,22 @@ pub struct Rays {
 
 impl Rays {
     pub fn new(camera: &Camera, width: u32, height: u32) -> Rays {
-        let forward = normalize(sub(camera.look_at, camera.position));
-        let mut right = normalize(cross(forward, camera.up));
-        if dot(right, right) == 0.0 {
+        let eye = Vec3::from(camera.position);
+        let forward = (Vec3::from(camera.look_at) - eye).normalize_or_zero();
+        let mut right = forward.cross(Vec3::from(camera.up)).normalize_or_zero();
+        if right == Vec3::ZERO {
             right = frame_tangent(forward);
         }
-        let up = cross(right, forward);
-        Rays { eye: camera.position, forward, right, up, tan_half: (camera.fov_y_deg.to_radians() * 0.5).tan(), width, height }
+        let up = right.cross(forward);
+        Rays { eye, forward, right, up, tan_half: (camera.fov_y_deg.to_radians() * 0.5).tan(), width, height }
     }
 
     pub fn dir(&self, x: u32, y: u32) -> V3 {
         let aspect = self.width as f32 / self.height as f32;
         let sx = ((x as f32 + 0.5) / self.width as f32 * 2.0 - 1.0) * aspect * self.tan_half;
         let sy = (1.0 - (y as f32 + 0.5) / self.height as f32 * 2.0) * self.tan_half;
-        add(self.forward, add(mul(self.right, sx), mul(self.up, sy)))
+        self.forward + self.right * sx + self.up * sy
     }
-}
-
-/// Integer hash to [0, 1) (PCG-style), so pictures are identical on every run and machine.
-fn hash01(mut x: u32) -> f32 {
-    x = x.wrapping_mul(747796405).wrapping_add(2891336453);
-    x = ((x >> ((x >> 28) + 4)) ^ x).wrapping_mul(277803737);
-    x = (x >> 22) ^ x;
-    (x >> 8) as f32 / (1u32 << 24) as f32
 }
 
 // ---- Procedural geometry ------------------------------------------------------------------------------
@@ -137,8 +110,8 @@ struct Hit {
 fn intersect(shape: &Shape, o: V3, d: V3) -> Option<Hit> {
     match *shape {
         Shape::Sphere { centre, radius } => {
-            let oc = sub(o, centre);
-            let (a, b, c) = (dot(d, d), dot(oc, d), dot(oc, oc) - radius * radius);
+            let oc = o - centre;
+            let (a, b, c) = (d.dot(d), oc.dot(d), oc.dot(oc) - radius * radius);
             let disc = b * b - a * c;
             if disc < 0.0 {
                 return None;
@@ -147,10 +120,10 @@ fn intersect(shape: &Shape, o: V3, d: V3) -> Option<Hit> {
             if t <= 1e-4 {
                 return None;
             }
-            let n = normalize(sub(add(o, mul(d, t)), centre));
+            let n = (o + d * t - centre).normalize_or_zero();
             // Tangent along the parallels (brushed around the vertical axis).
-            let mut tangent = normalize(cross([0.0, 1.0, 0.0], n));
-            if dot(tangent, tangent) == 0.0 {
+            let mut tangent = Vec3::Y.cross(n).normalize_or_zero();
+            if tangent == Vec3::ZERO {
                 tangent = frame_tangent(n);
             }
             Some(Hit { t, normal: n, tangent })
@@ -176,17 +149,17 @@ fn intersect(shape: &Shape, o: V3, d: V3) -> Option<Hit> {
             if t0 > t1 || t0 <= 1e-4 {
                 return None;
             }
-            let mut n = [0.0; 3];
+            let mut n = Vec3::ZERO;
             n[axis] = sign;
-            let tangent = if axis == 1 { [1.0, 0.0, 0.0] } else { [0.0, 1.0, 0.0] };
+            let tangent = if axis == 1 { Vec3::X } else { Vec3::Y };
             Some(Hit { t: t0, normal: n, tangent })
         }
         Shape::Plane { point, normal } => {
-            let denom = dot(normal, d);
+            let denom = normal.dot(d);
             if denom >= 0.0 {
                 return None;
             }
-            let t = dot(sub(point, o), normal) / denom;
+            let t = (point - o).dot(normal) / denom;
             (t > 1e-4).then(|| Hit { t, normal, tangent: frame_tangent(normal) })
         }
     }
@@ -197,14 +170,14 @@ struct Layout {
     camera: Camera,
 }
 
-fn sphere(centre: V3, radius: f32, material: u32) -> Object {
-    Object { shape: Shape::Sphere { centre, radius }, material, roughness: None, noise: 0.0 }
+fn sphere(centre: [f32; 3], radius: f32, material: u32) -> Object {
+    Object { shape: Shape::Sphere { centre: centre.into(), radius }, material, roughness: None, noise: 0.0 }
 }
-fn cuboid(min: V3, max: V3, material: u32, noise: f32) -> Object {
-    Object { shape: Shape::Box { min, max }, material, roughness: None, noise }
+fn cuboid(min: [f32; 3], max: [f32; 3], material: u32, noise: f32) -> Object {
+    Object { shape: Shape::Box { min: min.into(), max: max.into() }, material, roughness: None, noise }
 }
-fn plane(point: V3, normal: V3, material: u32, noise: f32) -> Object {
-    Object { shape: Shape::Plane { point, normal: normalize(normal) }, material, roughness: None, noise }
+fn plane(point: [f32; 3], normal: [f32; 3], material: u32, noise: f32) -> Object {
+    Object { shape: Shape::Plane { point: point.into(), normal: Vec3::from(normal).normalize() }, material, roughness: None, noise }
 }
 
 fn sphere_grid(scene: &Scene, rows: &[String], columns: u32, floor: &str, aspect: f32) -> Layout {
@@ -294,7 +267,7 @@ fn ray_cast(scene: &Scene, layout: &Layout, camera: &Camera, width: u32, height:
                 }
             }
             *px = match best {
-                None => Pixel { position: add(rays.eye, mul(d, 1e4)), normal: mul(normalize(d), -1.0), material: BACKGROUND, ..Default::default() },
+                None => Pixel { position: (rays.eye + d * 1e4).to_array(), normal: (-d.normalize()).to_array(), material: BACKGROUND, ..Default::default() },
                 Some((h, obj)) => {
                     let m = &mats[obj.material as usize];
                     let id = (y as u32).wrapping_mul(width).wrapping_add(x as u32);
@@ -302,9 +275,9 @@ fn ray_cast(scene: &Scene, layout: &Layout, camera: &Camera, width: u32, height:
                     let roughness = obj.roughness.unwrap_or(m.roughness.0);
                     let shade = 1.0 + obj.noise * 2.0 * (hash01(id ^ 0x9e37_79b9) - 0.5);
                     Pixel {
-                        position: add(rays.eye, mul(d, h.t)),
-                        normal: h.normal,
-                        tangent: h.tangent,
+                        position: (rays.eye + d * h.t).to_array(),
+                        normal: h.normal.to_array(),
+                        tangent: h.tangent.to_array(),
                         roughness: (roughness + obj.noise * noise).clamp(0.0, 1.0),
                         base_colour: m.base_colour.0.map(|c| (c * shade).clamp(0.0, 1.0)),
                         metallic: m.metallic.0,
@@ -374,6 +347,18 @@ pub fn srgb_to_linear(c: f32) -> f32 {
     if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
 }
 
+/// Every pixel of a material image names a material of the scene (or 255: background).
+fn check_material_ids(m: &Plane, w: u32, materials: usize) -> Result<()> {
+    let bad = m.rgba.iter().enumerate().find(|(_, c)| {
+        let k = (c[0] * 255.0).round() as usize;
+        k != 255 && k >= materials
+    });
+    if let Some((i, c)) = bad {
+        bail!("{}: pixel ({}, {}) names material {} but the scene has {materials} materials", m.path.display(), i as u32 % w, i as u32 / w, (c[0] * 255.0).round());
+    }
+    Ok(())
+}
+
 fn load_images(scene: &Scene, files: &ImageFiles) -> Result<GBuffer> {
     let camera = scene.file.camera.expect("checked: image G-buffers have a camera");
     let open = |p: &PathBuf| read_plane(&scene.dir.join(p));
@@ -403,27 +388,14 @@ fn load_images(scene: &Scene, files: &ImageFiles) -> Result<GBuffer> {
             bail!("{}: positions must be an EXR (float) image", p.path.display());
         }
     }
-    let mats = &scene.file.materials;
     if let Some(m) = &material {
-        if let Some((i, bad)) = m.rgba.iter().enumerate().find(|(_, c)| {
-            let k = (c[0] * 255.0).round() as usize;
-            k != 255 && k >= mats.len()
-        }) {
-            bail!(
-                "{}: pixel ({}, {}) names material {} but the scene has {} materials",
-                m.path.display(),
-                i as u32 % w,
-                i as u32 / w,
-                (bad[0] * 255.0).round(),
-                mats.len()
-            );
-        }
+        check_material_ids(m, w, scene.file.materials.len())?;
     }
+    let mats = &scene.file.materials;
     let rays = Rays::new(&camera, w, h);
     let decode_vector = |plane: &Plane, i: usize| -> V3 {
-        let c = plane.rgba[i];
-        let v = if plane.float { [c[0], c[1], c[2]] } else { [2.0 * c[0] - 1.0, 2.0 * c[1] - 1.0, 2.0 * c[2] - 1.0] };
-        normalize(v)
+        let c = Vec3::from_slice(&plane.rgba[i][..3]);
+        if plane.float { c.normalize_or_zero() } else { (2.0 * c - Vec3::ONE).normalize_or_zero() }
     };
     let pixels = (0..(w as usize * h as usize))
         .into_par_iter()
@@ -435,25 +407,25 @@ fn load_images(scene: &Scene, files: &ImageFiles) -> Result<GBuffer> {
                 (Some(d), _) => {
                     let c = d.rgba[i][0];
                     let z = if d.float { c } else { let [near, far] = files.depth_range.unwrap(); near + c * (far - near) };
-                    add(camera.position, mul(dir, z))
+                    (Vec3::from(camera.position) + dir * z).to_array()
                 }
                 (_, Some(p)) => [p.rgba[i][0], p.rgba[i][1], p.rgba[i][2]],
                 _ => unreachable!("checked: depth or position"),
             };
             if mat == 255 {
-                return Pixel { position: pos, normal: mul(normalize(dir), -1.0), material: BACKGROUND, ..Default::default() };
+                return Pixel { position: pos, normal: (-dir.normalize()).to_array(), material: BACKGROUND, ..Default::default() };
             }
             let m = &mats[mat as usize];
             let n = decode_vector(&normal, i);
-            let t = tangent.as_ref().map(|t| decode_vector(t, i)).filter(|t| dot(*t, *t) > 0.0 && dot(*t, n).abs() < 0.999);
+            let t = tangent.as_ref().map(|t| decode_vector(t, i)).filter(|t| *t != Vec3::ZERO && t.dot(n).abs() < 0.999);
             let base_colour = base.as_ref().map_or(m.base_colour.0, |b| {
                 let c = b.rgba[i];
                 if b.float { [c[0], c[1], c[2]] } else { [srgb_to_linear(c[0]), srgb_to_linear(c[1]), srgb_to_linear(c[2])] }
             });
             Pixel {
                 position: pos,
-                normal: n,
-                tangent: t.unwrap_or_else(|| frame_tangent(n)),
+                normal: n.to_array(),
+                tangent: t.unwrap_or_else(|| frame_tangent(n)).to_array(),
                 roughness: roughness.as_ref().map_or(m.roughness.0, |r| r.rgba[i][0].clamp(0.0, 1.0)),
                 base_colour: base_colour.map(|c| c.clamp(0.0, 1.0)),
                 metallic: metallic.as_ref().map_or(m.metallic.0, |r| r.rgba[i][0].clamp(0.0, 1.0)),
@@ -470,19 +442,19 @@ mod tests {
 
     #[test]
     fn orthonormal_frame_is_orthonormal() {
-        for n in [[0.0, 0.0, 1.0], [0.0, 0.0, -1.0], normalize([1.0, 2.0, -3.0]), [1.0, 0.0, 0.0]] {
+        for n in [Vec3::Z, -Vec3::Z, Vec3::new(1.0, 2.0, -3.0).normalize(), Vec3::X] {
             let t = frame_tangent(n);
-            assert!(dot(t, n).abs() < 1e-6 && (dot(t, t) - 1.0).abs() < 1e-6, "{n:?} {t:?}");
+            assert!(t.dot(n).abs() < 1e-6 && (t.length_squared() - 1.0).abs() < 1e-6, "{n:?} {t:?}");
         }
     }
 
     #[test]
     fn rays_hit_a_box_and_a_plane_from_outside() {
-        let b = Shape::Box { min: [-1.0; 3], max: [1.0; 3] };
-        let h = intersect(&b, [0.0, 0.0, 5.0], [0.0, 0.0, -1.0]).unwrap();
-        assert_eq!((h.t, h.normal), (4.0, [0.0, 0.0, 1.0]));
-        let p = Shape::Plane { point: [0.0; 3], normal: [0.0, 1.0, 0.0] };
-        assert!(intersect(&p, [0.0, 1.0, 0.0], [0.0, 1.0, 0.0]).is_none());
-        assert_eq!(intersect(&p, [0.0, 1.0, 0.0], [0.0, -1.0, 0.0]).unwrap().t, 1.0);
+        let b = Shape::Box { min: Vec3::splat(-1.0), max: Vec3::ONE };
+        let h = intersect(&b, Vec3::new(0.0, 0.0, 5.0), -Vec3::Z).unwrap();
+        assert_eq!((h.t, h.normal), (4.0, Vec3::Z));
+        let p = Shape::Plane { point: Vec3::ZERO, normal: Vec3::Y };
+        assert!(intersect(&p, Vec3::Y, Vec3::Y).is_none());
+        assert_eq!(intersect(&p, Vec3::Y, -Vec3::Y).unwrap().t, 1.0);
     }
 }

@@ -5,23 +5,13 @@
 use super::format::{Light, Scene};
 use super::gbuffer::{GBuffer, BACKGROUND};
 use super::terms::{self, KernelLight, Switches};
-use crate::brdf::{ModelSpec, Precision, D};
 use crate::gpu::{DeviceInfo, SpecConstants};
-use crate::kernels;
-use anyhow::{bail, Result};
+use crate::kernels::constants::{self as k, Constant};
+use crate::kernels::WithConstant;
+use crate::model::Model;
+use anyhow::Result;
+use glam::DVec3;
 use serde::Serialize;
-
-/// Constant ids of glsl/scene.comp and scene.glsl beyond the model's (0..4).
-pub const NUM_DIRECTIONAL_ID: u32 = 5;
-pub const NUM_POINT_ID: u32 = 6;
-pub const NUM_SPOT_ID: u32 = 7;
-pub const NUM_SPHERE_ID: u32 = 8;
-pub const ANISOTROPY_ID: u32 = 9;
-pub const ENERGY_ID: u32 = 10;
-pub const DIFFUSE_ID: u32 = 11;
-pub const CLEAR_COAT_ID: u32 = 12;
-pub const E_TABLE_MU_ID: u32 = 13;
-pub const E_TABLE_R_ID: u32 = 14;
 
 /// The E(mu, r) table's size: mu nodes x r nodes.
 pub const E_TABLE_MU: usize = 32;
@@ -85,7 +75,7 @@ impl Effect {
 /// One kernel of the scene: a model and the pixels whose material uses it.
 #[derive(Clone, Debug)]
 pub struct KernelPlan {
-    pub spec: ModelSpec,
+    pub model: Model,
     /// Indices of the scene materials shaded by this kernel (those covering at least one pixel).
     pub materials: Vec<usize>,
     /// G-buffer indices of its pixels.
@@ -108,8 +98,7 @@ pub struct ScenePlan {
 }
 
 fn unit3(v: [f32; 3]) -> [f32; 3] {
-    let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-    v.map(|x| x / l)
+    glam::Vec3::from(v).normalize().to_array()
 }
 
 /// Packs the lights in kernel order and counts them per type.
@@ -117,7 +106,7 @@ pub fn pack_lights(lights: &[Light]) -> (LightCounts, Vec<f32>, Vec<KernelLight>
     let mut counts = LightCounts::default();
     let mut data = Vec::new();
     let mut twins = Vec::new();
-    let f64s = |v: [f32; 3]| v.map(f64::from);
+    let f64s = |v: [f32; 3]| DVec3::from(v.map(f64::from));
     for kind in ["directional", "point", "spot", "sphere"] {
         for l in lights.iter().filter(|l| l.type_name() == kind) {
             let rgb = |c: [f32; 3], i: f32| c.map(|x| x * i);
@@ -156,16 +145,16 @@ pub fn pack_lights(lights: &[Light]) -> (LightCounts, Vec<f32>, Vec<KernelLight>
 }
 
 /// The plan for `scene` over `gbuffer`; `model` replaces every material's model (for `render`'s comparison).
-pub fn plan(scene: &Scene, gbuffer: &GBuffer, model: Option<ModelSpec>) -> ScenePlan {
+pub fn plan(scene: &Scene, gbuffer: &GBuffer, model: Option<&Model>) -> ScenePlan {
     let mats = &scene.file.materials;
     let mut notes = Vec::new();
-    let specs: Vec<ModelSpec> = mats.iter().map(|m| model.unwrap_or_else(|| m.spec())).collect();
+    let specs: Vec<Model> = mats.iter().map(|m| model.cloned().unwrap_or_else(|| m.model())).collect();
     let anisotropy: Vec<f32> = mats
         .iter()
         .zip(&specs)
         .map(|(m, s)| {
             let a = m.effects.anisotropy.0;
-            if a != 0.0 && s.d != D::Ggx {
+            if a != 0.0 && !takes_anisotropy(s) {
                 notes.push(format!("material `{}`: anisotropy needs d=ggx, so it is off under {}", m.name, s.name()));
                 0.0
             } else {
@@ -182,10 +171,10 @@ pub fn plan(scene: &Scene, gbuffer: &GBuffer, model: Option<ModelSpec>) -> Scene
     let mut kernels: Vec<KernelPlan> = Vec::new();
     let mut kernel_of = vec![usize::MAX; mats.len()];
     for (i, spec) in specs.iter().enumerate().filter(|(i, _)| used[*i]) {
-        let k = match kernels.iter().position(|k| k.spec == *spec) {
+        let k = match kernels.iter().position(|k| k.model == *spec) {
             Some(k) => k,
             None => {
-                kernels.push(KernelPlan { spec: *spec, materials: Vec::new(), pixels: Vec::new(), switches: Switches::default() });
+                kernels.push(KernelPlan { model: spec.clone(), materials: Vec::new(), pixels: Vec::new(), switches: Switches::default() });
                 kernels.len() - 1
             }
         };
@@ -214,21 +203,31 @@ pub fn plan(scene: &Scene, gbuffer: &GBuffer, model: Option<ModelSpec>) -> Scene
     ScenePlan { kernels, counts, light_data, lights, anisotropy, notes }
 }
 
+/// Whether the scene kernel's anisotropic lobe can stand in for `model`'s (it extends its D).
+pub fn takes_anisotropy(model: &Model) -> bool {
+    model.twin().is_some_and(|s| s.d.row().anisotropic)
+}
+
+/// The effect switches as specialisation constants (scene.glsl), with the E table's size.
+pub fn effect_constants(c: SpecConstants, switches: Switches) -> SpecConstants {
+    let set: [(Constant, f64); 6] = [
+        (k::ANISOTROPY, switches.anisotropy as i32 as f64),
+        (k::ENERGY_COMPENSATION, switches.energy as f64),
+        (k::DIFFUSE, switches.diffuse as f64),
+        (k::CLEAR_COAT, switches.clear_coat as i32 as f64),
+        (k::E_TABLE_MU, E_TABLE_MU as f64),
+        (k::E_TABLE_R, E_TABLE_R as f64),
+    ];
+    set.into_iter().fold(c, |c, (k, v)| c.with(k, v))
+}
+
 impl ScenePlan {
-    /// Every specialisation constant of `kernels[k]` compiled with `switches`.
-    pub fn constants(&self, k: usize, switches: Switches) -> SpecConstants {
+    /// The light counts and effect switches of kernel `kernels[k]` compiled with `switches`, on top of the
+    /// model's own constants `model`.
+    pub fn constants(&self, model: SpecConstants, switches: Switches) -> SpecConstants {
         let c = &self.counts;
-        kernels::model_constants(&self.kernels[k].spec)
-            .int(NUM_DIRECTIONAL_ID, c.directional as i32)
-            .int(NUM_POINT_ID, c.point as i32)
-            .int(NUM_SPOT_ID, c.spot as i32)
-            .int(NUM_SPHERE_ID, c.sphere as i32)
-            .int(ANISOTROPY_ID, switches.anisotropy as i32)
-            .int(ENERGY_ID, switches.energy)
-            .int(DIFFUSE_ID, switches.diffuse)
-            .int(CLEAR_COAT_ID, switches.clear_coat as i32)
-            .int(E_TABLE_MU_ID, E_TABLE_MU as i32)
-            .int(E_TABLE_R_ID, E_TABLE_R as i32)
+        let lights = [(k::NUM_DIRECTIONAL, c.directional), (k::NUM_POINT, c.point), (k::NUM_SPOT, c.spot), (k::NUM_SPHERE, c.sphere)];
+        effect_constants(lights.into_iter().fold(model, |m, (k, n)| m.with(k, n as f64)), switches)
     }
 
     /// Per-pixel extras of kernel `k`: (tangent, anisotropy), (coat, coat roughness, diffuse id, energy flag).
@@ -249,16 +248,7 @@ impl ScenePlan {
 
     /// Fails with a clear reason when the device cannot run a kernel of this plan.
     pub fn check_device(&self, info: &DeviceInfo) -> Result<()> {
-        for k in &self.kernels {
-            if k.spec.precision == Precision::F16 && !info.shader_float16 {
-                bail!(
-                    "model {} asks for fp16 arithmetic, but device `{}` has no shaderFloat16; use precision=f32 for its materials",
-                    k.spec.name(),
-                    info.name
-                );
-            }
-        }
-        Ok(())
+        self.kernels.iter().try_for_each(|k| k.model.check_support(info))
     }
 
     /// What is compiled in, one line per kernel.
@@ -279,7 +269,7 @@ impl ScenePlan {
                     .collect();
                 format!(
                     "{}: {} pixels of [{}]; lights {} directional, {} point, {} spot, {} sphere; effects: {}",
-                    k.spec.name(),
+                    k.model.name(),
                     k.pixels.len(),
                     mats.join(", "),
                     c.directional,
@@ -331,7 +321,7 @@ mod tests {
         let s = Scene::parse(text, "t", Default::default(), "t.json".into()).unwrap();
         let g = gbuffer::build(&s).unwrap();
         let p = plan(&s, &g, None);
-        let names: Vec<String> = p.kernels.iter().map(|k| k.spec.name()).collect();
+        let names: Vec<String> = p.kernels.iter().map(|k| k.model.name()).collect();
         assert_eq!(names, ["ggx", "blinn", "burley"], "one kernel per model covering pixels; the unused material adds none");
         assert_eq!(p.kernels[0].switches, Switches { anisotropy: false, energy: 2, diffuse: 1, clear_coat: false });
         assert_eq!(p.kernels[1].switches, Switches { clear_coat: true, ..Default::default() });

@@ -11,6 +11,7 @@ use super::run::{self, SceneVariant, SceneWork};
 use super::spirv;
 use crate::gpu::Gpu;
 use crate::kernels::{self, RunLimits};
+use crate::model::KernelKind;
 use crate::profile::protocol::{self, ProtocolOptions, RawTimes};
 use crate::profile::LEVEL;
 use crate::report::{self, Provenance, Table};
@@ -82,10 +83,6 @@ struct Slot {
     without: Option<Effect>,
 }
 
-fn per_round(raw: &RawTimes, v: usize) -> Vec<f64> {
-    raw.ns[v].iter().map(|reps| stats::median(reps)).collect()
-}
-
 struct Analysis {
     kernels: Vec<(Estimate, Estimate)>,
     effects: Vec<(usize, Effect, Estimate, Estimate)>,
@@ -94,7 +91,7 @@ struct Analysis {
 
 fn analyse(raw: &RawTimes, slots: &[Slot], pixels: &[u64]) -> Analysis {
     let full: Vec<usize> = (0..pixels.len()).map(|k| slots.iter().position(|s| s.kernel == k && s.without.is_none()).unwrap()).collect();
-    let full_t: Vec<Vec<f64>> = full.iter().map(|&v| per_round(raw, v)).collect();
+    let full_t: Vec<Vec<f64>> = full.iter().map(|&v| raw.round_medians(v)).collect();
     let rounds = raw.rounds();
     let frame_t: Vec<f64> = (0..rounds).map(|r| full_t.iter().map(|t| t[r]).sum()).collect();
     let total_pixels: u64 = pixels.iter().sum();
@@ -110,7 +107,7 @@ fn analyse(raw: &RawTimes, slots: &[Slot], pixels: &[u64]) -> Analysis {
         .enumerate()
         .filter_map(|(v, s)| s.without.map(|e| (v, s.kernel, e)))
         .map(|(v, k, e)| {
-            let without = per_round(raw, v);
+            let without = raw.round_medians(v);
             let extra: Vec<f64> = full_t[k].iter().zip(&without).map(|(a, b)| (a - b) / pixels[k] as f64).collect();
             let frac: Vec<f64> = full_t[k].iter().zip(&without).map(|(a, b)| (a - b) / b).collect();
             (k, e, stats::median_ci(&extra, LEVEL), stats::median_ci(&frac, LEVEL))
@@ -125,6 +122,40 @@ fn resolved(a: &Analysis, target: f64) -> bool {
         && a.effects.iter().all(|(k, _, extra, _)| (extra.hi - extra.lo) / 2.0 < target * a.kernels[*k].0.median)
 }
 
+/// Every kernel of the plan as compiled and, for each effect it compiles in, without that effect.
+fn variants<'g>(gpu: &'g Gpu, work: &SceneWork<'g>, p: &ScenePlan, instances: usize) -> Result<(Vec<Slot>, Vec<SceneVariant<'g>>)> {
+    let (mut slots, mut variants) = (Vec::new(), Vec::new());
+    for (k, kp) in p.kernels.iter().enumerate() {
+        let name = kp.model.name();
+        slots.push(Slot { kernel: k, without: None });
+        variants.push(SceneVariant::new(gpu, work, p, k, kp.switches, name.clone(), instances)?);
+        for e in Effect::ALL.into_iter().filter(|e| e.is_on(&kp.switches)) {
+            slots.push(Slot { kernel: k, without: Some(e) });
+            variants.push(SceneVariant::new(gpu, work, p, k, e.off(kp.switches), format!("{name} without {}", e.name()), instances)?);
+        }
+    }
+    Ok((slots, variants))
+}
+
+/// What spirv-opt leaves of each variant, where spirv-opt is installed.
+fn instructions(p: &ScenePlan, variants: &[SceneVariant]) -> Vec<Option<usize>> {
+    if !spirv::available() {
+        return vec![None; variants.len()];
+    }
+    variants
+        .iter()
+        .map(|v| {
+            let mk = p.kernels[v.kernel_index].model.kernel(KernelKind::Scene, kernels::embedded()).ok()?;
+            spirv::specialise(&mk.spirv, &p.constants(mk.constants, v.switches)).ok().map(|s| s.instructions)
+        })
+        .collect()
+}
+
+/// The variant timing kernel `k` as planned, and without effect `e`.
+fn slot_of(slots: &[Slot], k: usize, without: Option<Effect>) -> usize {
+    slots.iter().position(|s| s.kernel == k && s.without == without).expect("every kernel and effect has a slot")
+}
+
 /// Loads the G-buffer, plans, compiles and times the scene.
 pub fn run(gpu: &Gpu, scene: &Scene, options: &SceneProfileOptions, progress: &ProgressBar) -> Result<SceneProfileReport> {
     progress.set_message("building the G-buffer");
@@ -133,21 +164,9 @@ pub fn run(gpu: &Gpu, scene: &Scene, options: &SceneProfileOptions, progress: &P
     p.check_device(&gpu.info)?;
     progress.set_message("E tables");
     let tables = run::e_tables(gpu, &p)?;
-    let limits = RunLimits { max_chunk: options.max_chunk };
-    let work = SceneWork::upload(gpu, scene, &g, &p, &tables, limits)?;
+    let work = SceneWork::upload(gpu, scene, &g, &p, &tables, RunLimits { max_chunk: options.max_chunk })?;
     progress.set_message("compiling kernels");
-    let mut slots = Vec::new();
-    let mut variants = Vec::new();
-    for (k, kp) in p.kernels.iter().enumerate() {
-        let name = kp.spec.name();
-        slots.push(Slot { kernel: k, without: None });
-        variants.push(SceneVariant::new(gpu, &work, &p, k, kp.switches, name.clone(), options.instances)?);
-        for e in Effect::ALL.into_iter().filter(|e| e.is_on(&kp.switches)) {
-            slots.push(Slot { kernel: k, without: Some(e) });
-            variants.push(SceneVariant::new(gpu, &work, &p, k, e.off(kp.switches), format!("{name} without {}", e.name()), options.instances)?);
-        }
-    }
-    let labels: Vec<String> = variants.iter().map(|v| v.label.clone()).collect();
+    let (slots, variants) = variants(gpu, &work, &p, options.instances)?;
     let pixels: Vec<u64> = work.kernels.iter().map(|k| k.count).collect();
     progress.set_length(options.protocol.max_rounds as u64);
     let raw = protocol::measure(
@@ -161,51 +180,33 @@ pub fn run(gpu: &Gpu, scene: &Scene, options: &SceneProfileOptions, progress: &P
         },
     )?;
     let a = analyse(&raw, &slots, &pixels);
-    // What spirv-opt leaves of each variant, where spirv-opt is installed.
-    let instructions: Vec<Option<usize>> = if spirv::available() {
-        variants
-            .iter()
-            .map(|v| {
-                let kp = &p.kernels[v.kernel_index];
-                spirv::specialise(kernels::source_for("scene", kp.spec.precision), &p.constants(v.kernel_index, v.switches)).ok().map(|s| s.instructions)
-            })
-            .collect()
-    } else {
-        vec![None; variants.len()]
-    };
+    let instructions = instructions(&p, &variants);
     let compiled = p.describe(scene);
     let kernels = p
         .kernels
         .iter()
         .enumerate()
-        .map(|(k, kp)| {
-            let full = slots.iter().position(|s| s.kernel == k && s.without.is_none()).unwrap();
-            KernelRow {
-                model: kp.spec.name(),
-                spec: kp.spec.canonical(),
-                materials: kp.materials.iter().map(|&i| scene.file.materials[i].name.clone()).collect(),
-                pixels: pixels[k],
-                dispatches: work.chunks(k),
-                compiled_in: compiled[k].clone(),
-                spirv_instructions: instructions[full],
-                ns_per_pixel: a.kernels[k].0,
-                frame_share: a.kernels[k].1,
-            }
+        .map(|(k, kp)| KernelRow {
+            model: kp.model.name(),
+            spec: kp.model.canonical(),
+            materials: kp.materials.iter().map(|&i| scene.file.materials[i].name.clone()).collect(),
+            pixels: pixels[k],
+            dispatches: work.chunks(k),
+            compiled_in: compiled[k].clone(),
+            spirv_instructions: instructions[slot_of(&slots, k, None)],
+            ns_per_pixel: a.kernels[k].0,
+            frame_share: a.kernels[k].1,
         })
         .collect();
     let effects = a
         .effects
         .iter()
-        .map(|&(k, e, extra, frac)| {
-            let full = slots.iter().position(|s| s.kernel == k && s.without.is_none()).unwrap();
-            let without = slots.iter().position(|s| s.kernel == k && s.without == Some(e)).unwrap();
-            EffectRow {
-                model: p.kernels[k].spec.name(),
-                effect: e.name().into(),
-                extra_ns_per_pixel: extra,
-                extra_fraction: frac,
-                extra_spirv_instructions: instructions[full].zip(instructions[without]).map(|(a, b)| a as i64 - b as i64),
-            }
+        .map(|&(k, e, extra, frac)| EffectRow {
+            model: p.kernels[k].model.name(),
+            effect: e.name().into(),
+            extra_ns_per_pixel: extra,
+            extra_fraction: frac,
+            extra_spirv_instructions: instructions[slot_of(&slots, k, None)].zip(instructions[slot_of(&slots, k, Some(e))]).map(|(a, b)| a as i64 - b as i64),
         })
         .collect();
     Ok(SceneProfileReport {
@@ -222,7 +223,7 @@ pub fn run(gpu: &Gpu, scene: &Scene, options: &SceneProfileOptions, progress: &P
         rounds: raw.rounds(),
         reps_per_round: options.protocol.reps,
         confidence_level: LEVEL,
-        labels,
+        labels: variants.iter().map(|v| v.label.clone()).collect(),
         raw,
     })
 }

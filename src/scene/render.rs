@@ -8,7 +8,8 @@ use super::format::{Light, Model, Scene};
 use super::gbuffer::{self, GBuffer};
 use super::plan;
 use super::run;
-use crate::brdf::{ModelSpec, Sample};
+use crate::brdf::Sample;
+use crate::model::Model as BrdfModel;
 use crate::chart::{self, FONT};
 use crate::gpu::Gpu;
 use crate::kernels::{self, RunLimits};
@@ -36,7 +37,7 @@ pub fn tone_map(rgb: [f32; 3], exposure: f32) -> [u8; 3] {
     rgb.map(|c| (linear_to_srgb(aces(c * exposure)) * 255.0).round() as u8)
 }
 
-fn slug(spec: &ModelSpec) -> String {
+fn slug(spec: &BrdfModel) -> String {
     spec.name().chars().map(|c| if c.is_ascii_alphanumeric() || c == '-' { c } else { '-' }).collect()
 }
 
@@ -54,7 +55,7 @@ fn label(root: &DrawingArea<BitMapBackend, plotters::coord::Shift>, text: &str, 
 }
 
 /// Renders `scene` over `g` with every material's model replaced by `model` (the scene's own models when None).
-pub fn radiance(gpu: &Gpu, scene: &Scene, g: &GBuffer, model: Option<ModelSpec>) -> Result<(Vec<[f32; 3]>, Vec<String>)> {
+pub fn radiance(gpu: &Gpu, scene: &Scene, g: &GBuffer, model: Option<&BrdfModel>) -> Result<(Vec<[f32; 3]>, Vec<String>)> {
     let p = plan::plan(scene, g, model);
     let tables = run::e_tables(gpu, &p)?;
     Ok((run::shade(gpu, scene, g, &p, &tables, RunLimits::default())?, p.notes))
@@ -75,38 +76,17 @@ pub struct Rendered {
     pub notes: Vec<String>,
 }
 
-/// Writes every picture of `scene` into `out`.
-pub fn render(gpu: &Gpu, scene: &Scene, out: &Path, progress: &ProgressBar) -> Result<Rendered> {
-    let settings = &scene.file.render;
-    let exposure = settings.exposure;
-    progress.set_message("building the G-buffer");
-    let g = gbuffer::build(scene)?;
-    let models: Vec<ModelSpec> = settings.models.iter().map(|m: &Model| m.0).collect();
-    let mut files = Vec::new();
-    let mut notes = Vec::new();
-    let mut displayed: Vec<Vec<[u8; 3]>> = Vec::new();
-    for m in &models {
-        progress.set_message(format!("rendering {}", m.name()));
-        let (hdr, n) = radiance(gpu, scene, &g, Some(*m))?;
-        notes.extend(n);
-        let px: Vec<[u8; 3]> = hdr.iter().map(|c| tone_map(*c, exposure)).collect();
-        let path = out.join(format!("{}.png", slug(m)));
-        let title = format!("{}: {} ({})", scene.name(), m.name(), m.canonical());
-        chart::render(&path, g.width, g.height, |root| {
-            blit(root, 0, 0, g.width, &px)?;
-            label(root, &title, 8, 6, 16.max(g.height as i32 / 28), WHITE)
-        })?;
-        files.push(path);
-        displayed.push(px);
-    }
-    // Difference heat maps against the reference model, in displayed luminance (what a viewer sees).
-    let reference = models.iter().position(|m| m.name() == "ggx").unwrap_or(0);
+/// Difference heat maps against the reference model, in displayed luminance (what a viewer sees), one shared
+/// scale per scene.
+fn difference_maps(g: &GBuffer, models: &[BrdfModel], displayed: &[Vec<[u8; 3]>], out: &Path) -> Result<Vec<PathBuf>> {
+    let reference = models.iter().position(|m| *m == BrdfModel::reference()).unwrap_or(0);
     let luma = |c: &[u8; 3]| (0.2126 * c[0] as f32 + 0.7152 * c[1] as f32 + 0.0722 * c[2] as f32) / 255.0;
     let diffs: Vec<(usize, Vec<f32>)> = (0..models.len())
         .filter(|&i| i != reference)
         .map(|i| (i, displayed[i].iter().zip(&displayed[reference]).map(|(a, b)| (luma(a) - luma(b)).abs()).collect()))
         .collect();
     let scale = diffs.iter().flat_map(|(_, d)| d.iter().copied()).fold(0.0f32, f32::max).max(1.0 / 255.0);
+    let mut files = Vec::new();
     for (i, d) in &diffs {
         let path = out.join(format!("diff-{}-vs-{}.png", slug(&models[*i]), slug(&models[reference])));
         let px: Vec<[u8; 3]> = d.iter().map(|x| viridis(x / scale)).collect();
@@ -121,8 +101,12 @@ pub fn render(gpu: &Gpu, scene: &Scene, out: &Path, progress: &ProgressBar) -> R
         })?;
         files.push(path);
     }
-    // The comparison grid: one sphere per material (rows) and model (columns), under a studio rig.
-    progress.set_message("comparison grid");
+    Ok(files)
+}
+
+/// The comparison grid: one sphere per material (rows) and model (columns), under a studio rig.
+fn comparison_grid(gpu: &Gpu, scene: &Scene, models: &[BrdfModel], out: &Path) -> Result<PathBuf> {
+    let settings = &scene.file.render;
     let rows: Vec<String> = if settings.grid.is_empty() { scene.file.materials.iter().map(|m| m.name.clone()).collect() } else { settings.grid.clone() };
     let mut studio = scene.clone();
     studio.file.lights = studio_lights();
@@ -133,9 +117,9 @@ pub fn render(gpu: &Gpu, scene: &Scene, out: &Path, progress: &ProgressBar) -> R
     for name in &rows {
         let index = scene.material_index(name).expect("checked: grid names a material");
         let closeup = gbuffer::closeup(&studio, index as u32, GRID_TILE);
-        for m in &models {
-            let (hdr, _) = radiance(gpu, &studio, &closeup, Some(*m))?;
-            tiles.push(hdr.iter().map(|c| tone_map(*c, exposure)).collect::<Vec<_>>());
+        for m in models {
+            let (hdr, _) = radiance(gpu, &studio, &closeup, Some(m))?;
+            tiles.push(hdr.iter().map(|c| tone_map(*c, settings.exposure)).collect::<Vec<_>>());
         }
     }
     let grid = out.join("grid.png");
@@ -152,7 +136,36 @@ pub fn render(gpu: &Gpu, scene: &Scene, out: &Path, progress: &ProgressBar) -> R
         }
         Ok(())
     })?;
-    files.push(grid);
+    Ok(grid)
+}
+
+/// Writes every picture of `scene` into `out`.
+pub fn render(gpu: &Gpu, scene: &Scene, out: &Path, progress: &ProgressBar) -> Result<Rendered> {
+    let settings = &scene.file.render;
+    let exposure = settings.exposure;
+    progress.set_message("building the G-buffer");
+    let g = gbuffer::build(scene)?;
+    let models: Vec<BrdfModel> = settings.models.iter().map(|m: &Model| m.0.clone()).collect();
+    let mut files = Vec::new();
+    let mut notes = Vec::new();
+    let mut displayed: Vec<Vec<[u8; 3]>> = Vec::new();
+    for m in &models {
+        progress.set_message(format!("rendering {}", m.name()));
+        let (hdr, n) = radiance(gpu, scene, &g, Some(m))?;
+        notes.extend(n);
+        let px: Vec<[u8; 3]> = hdr.iter().map(|c| tone_map(*c, exposure)).collect();
+        let path = out.join(format!("{}.png", slug(m)));
+        let title = format!("{}: {} ({})", scene.name(), m.name(), m.canonical());
+        chart::render(&path, g.width, g.height, |root| {
+            blit(root, 0, 0, g.width, &px)?;
+            label(root, &title, 8, 6, 16.max(g.height as i32 / 28), WHITE)
+        })?;
+        files.push(path);
+        displayed.push(px);
+    }
+    files.extend(difference_maps(&g, &models, &displayed, out)?);
+    progress.set_message("comparison grid");
+    files.push(comparison_grid(gpu, scene, &models, out)?);
     progress.set_message("lobes");
     let lobes = out.join("lobes.png");
     lobe_plot(gpu, &lobes, &models, &settings.lobe_roughness.iter().map(|u| u.0).collect::<Vec<_>>())?;
@@ -185,7 +198,7 @@ fn colour_bar(root: &DrawingArea<BitMapBackend, plotters::coord::Shift>, x0: i32
 
 /// f_s NoL in the plane of incidence, view at 45 degrees, F0 = 1 (Schlick F = 1), one panel per roughness and a
 /// curve per model, each panel normalised to its largest value; evaluated on the device.
-pub fn lobe_plot(gpu: &Gpu, path: &Path, models: &[ModelSpec], roughness: &[f32]) -> Result<()> {
+pub fn lobe_plot(gpu: &Gpu, path: &Path, models: &[BrdfModel], roughness: &[f32]) -> Result<()> {
     let theta_v = 45f64.to_radians();
     let v = [-(theta_v.sin()) as f32, 0.0, theta_v.cos() as f32];
     let angles: Vec<f64> = (0..=358).map(|i| (-89.5 + i as f64 * 0.5).to_radians()).collect();

@@ -8,11 +8,11 @@ use super::gbuffer::GBuffer;
 use super::plan::ScenePlan;
 use super::terms::{ETable, Switches};
 use super::effects;
-use crate::gpu::{Buffer, ChunkPlan, Gpu, MemoryKind};
+use crate::gpu::{Buffer, ChunkPlan, Commands, Gpu, MemoryKind};
 use crate::kernels::{self, RunLimits};
+use crate::model::KernelKind;
 use crate::profile::protocol::{Pipelines, Timed};
 use anyhow::Result;
-use ash::vk;
 
 /// Bytes per pixel of each per-pixel binding: pixels (3 vec4), output (1 vec4), extras (2 vec4).
 const PIXEL_BYTES: u64 = 48;
@@ -39,7 +39,7 @@ pub struct SceneWork<'g> {
 
 /// E tables for the kernels that compile energy compensation in (None for the others).
 pub fn e_tables(gpu: &Gpu, plan: &ScenePlan) -> Result<Vec<Option<ETable>>> {
-    plan.kernels.iter().map(|k| (k.switches.energy != 0).then(|| effects::e_table(gpu, &k.spec)).transpose()).collect()
+    plan.kernels.iter().map(|k| (k.switches.energy != 0).then(|| effects::e_table(gpu, &k.model)).transpose()).collect()
 }
 
 impl<'g> SceneWork<'g> {
@@ -107,12 +107,12 @@ pub struct SceneVariant<'g> {
 
 impl<'g> SceneVariant<'g> {
     pub fn new(gpu: &'g Gpu, work: &SceneWork<'g>, plan: &ScenePlan, k: usize, switches: Switches, label: String, instances: usize) -> Result<Self> {
-        let spec = &plan.kernels[k].spec;
-        kernels::check_support(gpu, spec)?;
+        let model = &plan.kernels[k].model;
+        model.check_support(&gpu.info)?;
         let kb = &work.kernels[k];
         let push: [u8; 16] = bytemuck::cast(work.camera);
-        let source = kernels::source_for("scene", spec.precision);
-        let pipelines = Pipelines::compile(gpu, source, &plan.constants(k, switches), 5, push.to_vec(), &kb.chunks.chunks, instances, |kernel, first, len| {
+        let mk = model.kernel(KernelKind::Scene, kernels::embedded())?;
+        let pipelines = Pipelines::compile(gpu, &mk.spirv, &plan.constants(mk.constants, switches), 5, push.to_vec(), &kb.chunks.chunks, instances, |kernel, first, len| {
             kernel.bind(&[
                 (&kb.pixels, first * PIXEL_BYTES, len * PIXEL_BYTES),
                 (&kb.radiance, first * OUT_BYTES, len * OUT_BYTES),
@@ -130,7 +130,7 @@ impl Timed for SceneVariant<'_> {
         self.pipelines.len()
     }
 
-    fn record(&self, cmd: vk::CommandBuffer, instance: usize) {
+    fn record(&self, cmd: &Commands, instance: usize) {
         self.pipelines.record(cmd, instance)
     }
 }
@@ -143,7 +143,7 @@ pub fn shade(gpu: &Gpu, scene: &Scene, gbuffer: &GBuffer, plan: &ScenePlan, tabl
     let bg = scene.file.render.background;
     let mut out = vec![bg; gbuffer.pixel_count()];
     for (k, kp) in plan.kernels.iter().enumerate() {
-        let variant = SceneVariant::new(gpu, &work, plan, k, kp.switches, kp.spec.name(), 1)?;
+        let variant = SceneVariant::new(gpu, &work, plan, k, kp.switches, kp.model.name(), 1)?;
         variant.run_once(gpu, 0)?;
         for (&i, rgb) in kp.pixels.iter().zip(work.radiance(k)?) {
             out[i as usize] = rgb;

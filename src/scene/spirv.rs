@@ -5,7 +5,7 @@
 
 use crate::gpu::SpecConstants;
 use crate::inspect::spirv::{spec_default_values, spirv_opt};
-use crate::shaders::KernelSource;
+use crate::shaders::Spirv;
 use anyhow::{anyhow, Result};
 use rspirv::dr::{self, Operand};
 use rspirv::spirv::Op;
@@ -21,12 +21,12 @@ pub struct Specialised {
 }
 
 /// Specialises `source` with `constants` and reports what is left.
-pub fn specialise(source: &KernelSource, constants: &SpecConstants) -> Result<Specialised> {
-    let words = source.words();
-    let values = spec_default_values(&words, constants)?;
+pub fn specialise(source: &Spirv, constants: &SpecConstants) -> Result<Specialised> {
+    let words = &source.words;
+    let values = spec_default_values(words, constants)?;
     let freeze: Vec<String> = ["--set-spec-const-default-value", values.as_str(), "--freeze-spec-const", "--fold-spec-const-op-composite"].map(String::from).to_vec();
     let with = |more: &[&str]| [freeze.clone(), more.iter().map(|s| s.to_string()).collect()].concat();
-    let dce = spirv_opt(&words, &with(&["--eliminate-dead-branches", "--eliminate-dead-functions", "--eliminate-dead-code-aggressive"]))?;
+    let dce = spirv_opt(words, &with(&["--eliminate-dead-branches", "--eliminate-dead-functions", "--eliminate-dead-code-aggressive"]))?;
     let dce = dr::load_words(&dce).map_err(|e| anyhow!("{}: {e}", source.name))?;
     let functions = dce
         .functions
@@ -39,7 +39,7 @@ pub fn specialise(source: &KernelSource, constants: &SpecConstants) -> Result<Sp
             })
         })
         .collect();
-    let optimised = spirv_opt(&words, &with(&["-O"]))?;
+    let optimised = spirv_opt(words, &with(&["-O"]))?;
     let optimised = dr::load_words(&optimised).map_err(|e| anyhow!("{}: {e}", source.name))?;
     let instructions = optimised.functions.iter().map(|f| f.blocks.iter().map(|b| b.instructions.len() + 1).sum::<usize>()).sum();
     Ok(Specialised { functions, instructions })

@@ -1,9 +1,11 @@
 //! f64 twins of every function of `glsl/scene.glsl` (same names, formulas and citations), and of the scene
-//! kernel's per-pixel shading built from them. tests/scene_terms_gpu.rs ties each GLSL term to its twin, and the
+//! kernel's per-pixel shading built from them. tests/scenes/terms.rs ties each GLSL term to its twin, and the
 //! whole kernel (every light type, every effect) to `shade_pixel`.
 
 use crate::brdf::guards::{self, MIN_COSINE};
+use crate::brdf::terms::{d_ggx, schlick_weight, Params};
 use crate::brdf::ModelSpec;
+use glam::DVec3;
 use std::f64::consts::PI;
 
 /// scene.glsl's MIN_LIGHT_DISTANCE: a light closer than this (world units) is taken at this distance.
@@ -11,26 +13,14 @@ pub const MIN_LIGHT_DISTANCE: f64 = 1e-2;
 /// Filament's clear coat F0 (IOR 1.5).
 pub const CLEAR_COAT_F0: f64 = 0.04;
 
-type V3 = [f64; 3];
+type V3 = DVec3;
 
-fn dot(a: V3, b: V3) -> f64 {
-    guards::dot(a, b)
-}
-fn scale(a: V3, s: f64) -> V3 {
-    a.map(|x| x * s)
-}
-fn sub(a: V3, b: V3) -> V3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-fn length(a: V3) -> f64 {
-    dot(a, a).sqrt()
-}
-fn pow5(x: f64) -> f64 {
-    let x2 = x * x;
-    x2 * x2 * x
-}
 fn guard_cos(x: f64) -> f64 {
     x.clamp(MIN_COSINE, 1.0)
+}
+
+fn rgb(v: V3) -> [f64; 3] {
+    v.to_array()
 }
 
 /// at = a (1 + s), ab = a (1 - s), floored at min_roughness^2 [Kulla & Conty 2017, as Filament].
@@ -49,24 +39,24 @@ pub fn d_ggx_anisotropic(noh: f64, toh: f64, boh: f64, at: f64, ab: f64) -> f64 
 /// 0.5 / (NoL |(at ToV, ab BoV, NoV)| + NoV |(at ToL, ab BoL, NoL)|).
 #[allow(clippy::too_many_arguments)]
 pub fn vis_smith_ggx_correlated_anisotropic(tov: f64, bov: f64, nov: f64, tol: f64, bol: f64, nol: f64, at: f64, ab: f64) -> f64 {
-    let lv = nol * length([at * tov, ab * bov, nov]);
-    let ll = nov * length([at * tol, ab * bol, nol]);
+    let lv = nol * DVec3::new(at * tov, ab * bov, nov).length();
+    let ll = nov * DVec3::new(at * tol, ab * bol, nol).length();
     0.5 / (lv + ll)
 }
 
 /// f_s with anisotropic GGX D and Vis and the spec's Fresnel (twin of `specular_anisotropic`).
 #[allow(clippy::too_many_arguments)]
 pub fn specular_anisotropic(spec: &ModelSpec, n: V3, v: V3, l: V3, t: V3, b: V3, roughness: f64, s: f64, f0: V3) -> V3 {
-    let h = guards::safe_normalize(guards::add(v, l));
-    let (nov, nol) = (dot(n, v), dot(n, l));
+    let h = guards::safe_normalize(v + l);
+    let (nov, nol) = (n.dot(v), n.dot(l));
     if !(nov > 0.0 && nol > 0.0) {
-        return [0.0; 3];
+        return DVec3::ZERO;
     }
     let (at, ab) = anisotropic_alphas(spec.alpha(roughness), s, spec.min_roughness());
     let (nv, nl) = (guard_cos(nov), guard_cos(nol));
-    let d = d_ggx_anisotropic(guard_cos(dot(n, h)), dot(t, h), dot(b, h), at, ab);
-    let vis = vis_smith_ggx_correlated_anisotropic(dot(t, v), dot(b, v), nv, dot(t, l), dot(b, l), nl, at, ab);
-    spec.f.eval(f0.map(|x| x.clamp(0.0, 1.0)), guard_cos(dot(v, h)), spec.metal).map(|f| d * vis * f)
+    let d = d_ggx_anisotropic(guard_cos(n.dot(h)), t.dot(h), b.dot(h), at, ab);
+    let vis = vis_smith_ggx_correlated_anisotropic(t.dot(v), b.dot(v), nv, t.dot(l), b.dot(l), nl, at, ab);
+    DVec3::from(spec.f.eval(rgb(f0.clamp(DVec3::ZERO, DVec3::ONE)), guard_cos(v.dot(h)), &spec.params)) * (d * vis)
 }
 
 /// Lambert: 1/pi.
@@ -78,32 +68,31 @@ pub fn fd_lambert() -> f64 {
 /// F_D90 = 0.5 + 2 r LoH^2 (r perceptual).
 pub fn fd_burley(nov: f64, nol: f64, loh: f64, roughness: f64) -> f64 {
     let f90 = 0.5 + 2.0 * roughness * loh * loh;
-    (1.0 + (f90 - 1.0) * pow5(1.0 - nol)) * (1.0 + (f90 - 1.0) * pow5(1.0 - nov)) / PI
+    (1.0 + (f90 - 1.0) * schlick_weight(nol)) * (1.0 + (f90 - 1.0) * schlick_weight(nov)) / PI
 }
 
 /// Clear coat Fresnel [Filament sec. 4.9]: Schlick with F0 = 0.04, f90 = 1, times the coat strength.
 pub fn clear_coat_fresnel(loh: f64, strength: f64) -> f64 {
-    (CLEAR_COAT_F0 + (1.0 - CLEAR_COAT_F0) * pow5(1.0 - loh)) * strength
+    crate::brdf::terms::f_schlick(CLEAR_COAT_F0, loh) * strength
 }
 
 /// Clear coat lobe D_GGX(a_c) Vis_Kelemen(LoH) Fc [Filament sec. 4.9]; 0 unless NoL > 0 and NoV > 0.
 /// `min_roughness` is the precision's roughness floor.
 pub fn clear_coat_lobe(n: V3, v: V3, l: V3, coat_roughness: f64, strength: f64, min_roughness: f64) -> f64 {
-    if !(dot(n, v) > 0.0 && dot(n, l) > 0.0) {
+    if !(n.dot(v) > 0.0 && n.dot(l) > 0.0) {
         return 0.0;
     }
-    let h = guards::safe_normalize(guards::add(v, l));
-    let noh = guard_cos(dot(n, h));
-    let loh = guard_cos(dot(l, h));
-    let nxh = guards::cross(n, h);
+    let h = guards::safe_normalize(v + l);
+    let noh = guard_cos(n.dot(h));
+    let loh = guard_cos(l.dot(h));
     let r = coat_roughness.clamp(min_roughness, 1.0);
-    let d = crate::brdf::terms::d_ggx(noh, dot(nxh, nxh).min(1.0), r * r);
+    let d = d_ggx(noh, n.cross(h).length_squared().min(1.0), r * r, &Params::default());
     d * (0.25 / (loh * loh)) * clear_coat_fresnel(loh, strength)
 }
 
 /// Filament's energy compensation factor [Filament sec. 4.7.2]: 1 + F0 (1/E - 1), per channel.
 pub fn energy_compensation(f0: V3, e: f64) -> V3 {
-    f0.map(|f| 1.0 + f * (1.0 / e - 1.0))
+    DVec3::ONE + f0 * (1.0 / e - 1.0)
 }
 
 /// 1 / max(d^2, MIN_LIGHT_DISTANCE^2).
@@ -126,9 +115,9 @@ pub fn spot_scale_offset(inner_deg: f64, outer_deg: f64) -> (f64, f64) {
 
 /// Karis 2013, eq. 11: Lc + c saturate(R / |c|), c = (Lc . r) r - Lc.
 pub fn sphere_representative_point(lc: V3, r: V3, radius: f64) -> V3 {
-    let c = sub(scale(r, dot(lc, r)), lc);
-    let t = (radius / length(c).max(1e-20)).clamp(0.0, 1.0);
-    guards::add(lc, scale(c, t))
+    let c = r * lc.dot(r) - lc;
+    let t = (radius / c.length().max(1e-20)).clamp(0.0, 1.0);
+    lc + c * t
 }
 
 /// Karis 2013, eqs. 10 and 14: (a / a')^2, a' = saturate(a + R / (2 d)).
@@ -200,22 +189,22 @@ pub fn specular_lobe(spec: &ModelSpec, sw: Switches, s: &Surface, l: V3) -> V3 {
     if sw.anisotropy && s.anisotropy != 0.0 {
         specular_anisotropic(spec, s.n, s.v, l, s.t, s.b, s.roughness, s.anisotropy, s.f0)
     } else {
-        spec.eval_unit(s.n, s.v, l, s.roughness, s.f0)
+        DVec3::from(spec.eval_unit(s.n, s.v, l, s.roughness, rgb(s.f0)))
     }
 }
 
 /// Twin of `diffuse_lobe`.
 pub fn diffuse_lobe(sw: Switches, s: &Surface, l: V3) -> f64 {
     let mode = if sw.diffuse == 3 { s.diffuse } else { sw.diffuse };
-    let (nov, nol) = (dot(s.n, s.v), dot(s.n, l));
+    let (nov, nol) = (s.n.dot(s.v), s.n.dot(l));
     if !(nov > 0.0 && nol > 0.0) {
         return 0.0;
     }
     match mode {
         1 => fd_lambert(),
         2 => {
-            let h = guards::safe_normalize(guards::add(s.v, l));
-            fd_burley(guard_cos(nov), guard_cos(nol), guard_cos(dot(l, h)), s.roughness)
+            let h = guards::safe_normalize(s.v + l);
+            fd_burley(guard_cos(nov), guard_cos(nol), guard_cos(l.dot(h)), s.roughness)
         }
         _ => 0.0,
     }
@@ -223,22 +212,20 @@ pub fn diffuse_lobe(sw: Switches, s: &Surface, l: V3) -> f64 {
 
 /// Twin of `shade`: reflected radiance per unit incident radiance.
 pub fn shade(spec: &ModelSpec, sw: Switches, s: &Surface, ld: V3, ls: V3, spec_scale: f64) -> V3 {
-    let nold = dot(s.n, ld).max(0.0);
-    let nols = dot(s.n, ls).max(0.0);
-    let fs = specular_lobe(spec, sw, s, ls);
-    let mut c: V3 = [0, 1, 2].map(|i| fs[i] * spec_scale * nols);
+    let nold = s.n.dot(ld).max(0.0);
+    let nols = s.n.dot(ls).max(0.0);
+    let mut c = specular_lobe(spec, sw, s, ls) * (spec_scale * nols);
     if sw.energy != 0 {
-        c = [0, 1, 2].map(|i| c[i] * s.energy[i]);
+        c *= s.energy;
     }
     if sw.diffuse != 0 {
-        let fd = diffuse_lobe(sw, s, ld) * nold;
-        c = [0, 1, 2].map(|i| c[i] + s.diffuse_colour[i] * fd);
+        c += s.diffuse_colour * (diffuse_lobe(sw, s, ld) * nold);
     }
     if sw.clear_coat {
-        let h = guards::safe_normalize(guards::add(s.v, ls));
-        let fc = clear_coat_fresnel(guard_cos(dot(ls, h)), s.coat);
+        let h = guards::safe_normalize(s.v + ls);
+        let fc = clear_coat_fresnel(guard_cos(ls.dot(h)), s.coat);
         let coat = clear_coat_lobe(s.n, s.v, ls, s.coat_roughness, s.coat, spec.min_roughness()) * spec_scale * nols;
-        c = c.map(|x| x * (1.0 - fc) + coat);
+        c = c * (1.0 - fc) + DVec3::splat(coat);
     }
     c
 }
@@ -255,38 +242,33 @@ pub enum KernelLight {
 /// Twin of scene.comp's light loops: the radiance reflected by `s` at world position `p`.
 pub fn shade_pixel(spec: &ModelSpec, sw: Switches, s: &Surface, p: V3, lights: &[KernelLight]) -> V3 {
     let unit = guards::safe_normalize;
-    let mut acc = [0.0; 3];
-    let mut add = |c: V3, w: V3| {
-        for i in 0..3 {
-            acc[i] += c[i] * w[i];
-        }
-    };
+    let mut acc = DVec3::ZERO;
     for light in lights {
-        match *light {
+        acc += match *light {
             KernelLight::Directional { direction, radiance } => {
-                let l = unit(scale(direction, -1.0));
-                add(shade(spec, sw, s, l, l, 1.0), radiance);
+                let l = unit(-direction);
+                shade(spec, sw, s, l, l, 1.0) * radiance
             }
             KernelLight::Point { position, intensity } => {
-                let lv = sub(position, p);
+                let lv = position - p;
                 let l = unit(lv);
-                add(shade(spec, sw, s, l, l, 1.0), scale(intensity, inverse_square(dot(lv, lv))));
+                shade(spec, sw, s, l, l, 1.0) * (intensity * inverse_square(lv.length_squared()))
             }
-            KernelLight::Spot { position, intensity, axis, scale: sc, offset } => {
-                let lv = sub(position, p);
+            KernelLight::Spot { position, intensity, axis, scale, offset } => {
+                let lv = position - p;
                 let l = unit(lv);
-                let cone = spot_cone(-dot(axis, l), sc, offset);
-                add(shade(spec, sw, s, l, l, 1.0), scale(intensity, inverse_square(dot(lv, lv)) * cone));
+                let cone = spot_cone(-axis.dot(l), scale, offset);
+                shade(spec, sw, s, l, l, 1.0) * (intensity * (inverse_square(lv.length_squared()) * cone))
             }
             KernelLight::Sphere { position, radius, intensity } => {
-                let lc = sub(position, p);
-                let d = length(lc).max(radius.max(MIN_LIGHT_DISTANCE));
-                let r = sub(scale(s.n, 2.0 * dot(s.n, s.v)), s.v);
+                let lc = position - p;
+                let d = lc.length().max(radius.max(MIN_LIGHT_DISTANCE));
+                let r = s.n * (2.0 * s.n.dot(s.v)) - s.v;
                 let ls = unit(sphere_representative_point(lc, r, radius));
                 let norm = sphere_normalisation(spec.alpha(s.roughness), radius, d);
-                add(shade(spec, sw, s, unit(lc), ls, norm), scale(intensity, inverse_square(d * d)));
+                shade(spec, sw, s, unit(lc), ls, norm) * (intensity * inverse_square(d * d))
             }
-        }
+        };
     }
     acc
 }
@@ -301,12 +283,14 @@ mod tests {
         for noh in [0.3, 0.7, 0.99] {
             let sin = (1.0f64 - noh * noh).sqrt();
             let (toh, boh) = (sin * 0.6, sin * 0.8);
-            let iso = crate::brdf::terms::d_ggx(noh, sin * sin, a);
+            let iso = d_ggx(noh, sin * sin, a, &Params::default());
             assert!((d_ggx_anisotropic(noh, toh, boh, a, a) / iso - 1.0).abs() < 1e-12);
         }
         let (nov, nol) = (0.4, 0.8);
         let c = crate::brdf::Cosines { nov, nol, noh: 0.9, voh: 0.8, sin2h: 0.19 };
-        let iso = crate::brdf::Vis::SmithGgxCorrelated.eval(&c, a);
+        // The isotropic height-correlated Smith GGX of the term table (the exact G2 of GGX).
+        let vis = crate::brdf::Vis::ALL.iter().find(|v| v.row().exact_for == Some(crate::brdf::D::Ggx)).unwrap();
+        let iso = vis.eval(&c, a);
         let (tv, tl) = ((1.0f64 - nov * nov).sqrt(), (1.0f64 - nol * nol).sqrt());
         assert!((vis_smith_ggx_correlated_anisotropic(tv, 0.0, nov, 0.0, tl, nol, a, a) / iso - 1.0).abs() < 1e-12);
     }
@@ -331,14 +315,14 @@ mod tests {
 
     #[test]
     fn representative_point_lies_on_the_sphere_or_on_the_ray() {
-        let lc = [0.0, 2.0, 0.0];
+        let lc = DVec3::new(0.0, 2.0, 0.0);
         // The ray passes through the sphere: the point is on the ray.
-        let p = sphere_representative_point(lc, [0.0, 1.0, 0.0], 0.5);
-        assert!((p[1] - 2.0).abs() < 1e-12 && p[0].abs() < 1e-12);
+        let p = sphere_representative_point(lc, DVec3::Y, 0.5);
+        assert!((p.y - 2.0).abs() < 1e-12 && p.x.abs() < 1e-12);
         // The ray misses: the point is on the sphere, closest to the ray.
-        let r = guards::safe_normalize([1.0, 1.0, 0.0]);
+        let r = guards::safe_normalize(DVec3::new(1.0, 1.0, 0.0));
         let p = sphere_representative_point(lc, r, 0.5);
-        assert!((length(sub(p, lc)) - 0.5).abs() < 1e-12);
+        assert!(((p - lc).length() - 0.5).abs() < 1e-12);
         assert!(sphere_normalisation(0.2, 0.0, 3.0) == 1.0 && sphere_normalisation(0.2, 1.0, 1.0) < 1.0);
     }
 
@@ -353,8 +337,8 @@ mod tests {
 
     #[test]
     fn energy_compensation_makes_white_lossless() {
-        let k = energy_compensation([1.0; 3], 0.8);
-        assert!((0.8 * k[0] - 1.0).abs() < 1e-12);
-        assert_eq!(energy_compensation([0.0; 3], 0.8), [1.0; 3]);
+        let k = energy_compensation(DVec3::ONE, 0.8);
+        assert!((0.8 * k.x - 1.0).abs() < 1e-12);
+        assert_eq!(energy_compensation(DVec3::ZERO, 0.8), DVec3::ONE);
     }
 }

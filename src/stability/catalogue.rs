@@ -3,6 +3,7 @@
 //! applies the same guards, so it is the limit the tool defines), 0 where no light arrives, and for invalid
 //! input (NaN, Inf) any finite non-negative value: the kernel must not pass the poison on.
 
+use crate::brdf::terms::{Param, ParamKind, ParamValue, PARAMS};
 use crate::brdf::Sample;
 use serde::Serialize;
 use std::f64::consts::PI;
@@ -19,8 +20,9 @@ pub enum Expect {
 pub struct HardCase {
     pub name: String,
     pub sample: Sample,
-    /// GTR exponent for this case (the spec's own when None).
-    pub gamma: Option<f64>,
+    /// Parameter values for this case (applied to the specs whose terms read them; the spec's own otherwise).
+    #[serde(skip)]
+    pub overrides: Vec<(Param, ParamValue)>,
     pub expect: Expect,
 }
 
@@ -42,10 +44,21 @@ fn mirror(cos: f64, roughness: f32) -> Sample {
     sample(cos, cos, PI, roughness)
 }
 
+/// `1 - 1e-6` rather than `0.999999` in case names.
+fn hard_label(x: f64) -> String {
+    let near = x.round();
+    match x - near {
+        d if d == 0.0 => format!("{near}"),
+        d if d < 0.0 => format!("{near} - {:.0e}", -d),
+        d => format!("{near} + {d:.0e}"),
+    }
+}
+
 pub fn hard_cases() -> Vec<HardCase> {
     let mut cases = Vec::new();
-    let mut add = |name: &str, sample: Sample, gamma: Option<f64>, expect: Expect| {
-        cases.push(HardCase { name: name.to_string(), sample, gamma, expect });
+    let mut add = |name: &str, sample: Sample, over: Option<(Param, f64)>, expect: Expect| {
+        let overrides = over.map(|(p, x)| (p, ParamValue::Number(x))).into_iter().collect();
+        cases.push(HardCase { name: name.to_string(), sample, overrides, expect });
     };
     use Expect::*;
     for (label, c) in [("0", 0.0), ("1e-7", 1e-7), ("1e-4", 1e-4), ("-1e-4 (just below)", -1e-4)] {
@@ -63,10 +76,19 @@ pub fn hard_cases() -> Vec<HardCase> {
         add(&format!("roughness {label}, N = H"), mirror(0.6, r), None, Twin);
         add(&format!("roughness {label}, off the peak"), sample(0.6, 0.8, PI / 2.0, r), None, Twin);
     }
-    for (label, g) in [("1", 1.0), ("1 - 1e-6", 1.0 - 1e-6), ("1 + 1e-6", 1.0 + 1e-6), ("2", 2.0)] {
-        add(&format!("GTR gamma {label}, a2 = 1 (0/0)"), mirror(0.6, 1.0), Some(g), Twin);
-        add(&format!("GTR gamma {label}, a2 = 1, off the peak"), sample(0.3, 0.9, PI / 2.0, 1.0), Some(g), Twin);
-        add(&format!("GTR gamma {label}, a2 near 1 (r = 0.99)"), sample(0.5, 0.7, PI / 4.0, 0.99), Some(g), Twin);
+    // Every number parameter at its hard values (limit forms, range ends), where the normaliser of a
+    // parameterised D is 0/0 (a2 = 1), next to it, at the peak of the narrowest lobe, and off it.
+    for def in &PARAMS {
+        let ParamKind::Number { .. } = def.kind else { continue };
+        for &g in def.hard_values {
+            let label = format!("{} {}", def.name, hard_label(g));
+            let over = Some((def.param, g));
+            add(&format!("{label}, a2 = 1 (0/0)"), mirror(0.6, 1.0), over, Twin);
+            add(&format!("{label}, a2 = 1, off the peak"), sample(0.3, 0.9, PI / 2.0, 1.0), over, Twin);
+            add(&format!("{label}, a2 near 1 (r = 0.99)"), sample(0.5, 0.7, PI / 4.0, 0.99), over, Twin);
+            add(&format!("{label}, roughness 0, N = H"), mirror(0.6, 0.0), over, Twin);
+            add(&format!("{label}, roughness 0, off the peak"), sample(0.6, 0.8, PI / 2.0, 0.0), over, Twin);
+        }
     }
     // Blinn-Phong's exponent m = 2/a2 - 2 is largest at the roughness floor: pow(NoH, m) just off the peak.
     add("Blinn exponent at the smallest roughness, NoH just below 1", sample(0.6, 0.6001, PI, 0.0), None, Twin);
@@ -106,7 +128,7 @@ mod tests {
         let n = names.len();
         names.dedup();
         assert_eq!(n, names.len());
-        for needle in ["NoV = 0", "NoV = 1e-7", "NoL = 1e-4", "just below", "back-facing", "L = -V", "L = V", "N = H exactly", "roughness 0,", "roughness 1e-4", "roughness 1e-2", "fp16 smallest normal", "GTR gamma 1 - 1e-6", "GTR gamma 2", "Blinn exponent", "Beckmann exp", "denormal", "zero normal", "length 0.5", "length 2", "F0 = 0", "F0 = 1", "NaN", "Inf"] {
+        for needle in ["NoV = 0", "NoV = 1e-7", "NoL = 1e-4", "just below", "back-facing", "L = -V", "L = V", "N = H exactly", "roughness 0,", "roughness 1e-4", "roughness 1e-2", "fp16 smallest normal", "gamma 1 - 1e-6", "gamma 2,", "Blinn exponent", "Beckmann exp", "denormal", "zero normal", "length 0.5", "length 2", "F0 = 0", "F0 = 1", "NaN", "Inf"] {
             assert!(cases.iter().any(|c| c.name.contains(needle)), "no case for {needle}");
         }
         let m = mirror(0.6, 0.5);

@@ -47,7 +47,7 @@ pub fn cells() -> Vec<AlbedoCell> {
 }
 
 pub fn energy_of(gpu: &Gpu, spec: &ModelSpec) -> Result<Energy> {
-    let albedo = kernels::albedo(gpu, &white(spec), &cells())?;
+    let albedo = kernels::albedo(gpu, &crate::model::Model::spec(white(spec)), &cells())?;
     let e: Vec<Vec<f32>> = albedo.chunks(NOV.len()).map(|row| row.iter().map(|a| a.e[0] as f32).collect()).collect();
     let error_bound = albedo.iter().map(|a| a.error).fold(0.0, f64::max);
     let (mut max_e, mut max_at) = (f64::NEG_INFINITY, (0.0, 0.0));

@@ -4,22 +4,28 @@
 //! have are reported as discontinuities; reciprocity and energy (directional albedo with F = 1) complete it.
 
 pub mod catalogue;
+mod check;
 pub mod energy;
 pub mod grid;
 
+pub use check::check_model;
+
 use crate::accuracy::FLOOR;
-use crate::brdf::{samples, Metal, ModelSpec, Precision, Sample, D, F, Vis};
+use crate::brdf::guards::unit;
+use crate::brdf::spec::with_each_param_sample;
+use crate::brdf::{samples, ModelSpec, Precision, Sample, D, F, Vis};
 use crate::gpu::Gpu;
-use crate::kernels::{self, RunLimits};
-use anyhow::Result;
+
+use crate::model::Model;
+use anyhow::{anyhow, Result};
 use catalogue::{Expect, HardCase};
 use indicatif::ProgressBar;
 use rand::{Rng, SeedableRng};
-use rayon::prelude::*;
+
 use serde::Serialize;
 
-/// Every D with every Vis (Schlick Fresnel), and every Fresnel term on the `ggx` preset, in fp32 and fp16:
-/// every spec the term library offers up to the choice of Fresnel.
+/// Every D with every Vis (Schlick Fresnel), and every Fresnel term on the reference preset (with each metal
+/// where it reads one), in fp32 and fp16: every spec the term library offers up to the choice of Fresnel.
 pub fn default_specs() -> Vec<ModelSpec> {
     let mut specs = Vec::new();
     for precision in Precision::ALL {
@@ -28,11 +34,9 @@ pub fn default_specs() -> Vec<ModelSpec> {
                 specs.push(ModelSpec { precision, ..ModelSpec::new(d, vis, F::Schlick) });
             }
         }
-        let ggx = ModelSpec { precision, ..ModelSpec::preset("ggx").unwrap() };
+        let reference = ModelSpec { precision, ..ModelSpec::reference() };
         for &f in F::ALL {
-            let metals: &[Metal] = if matches!(f, F::Conductor | F::F82) { Metal::ALL } else { &[Metal::Gold] };
-            for &metal in metals {
-                let s = ModelSpec { f, metal, ..ggx };
+            for s in with_each_param_sample(ModelSpec { f, ..reference }) {
                 if !specs.contains(&s) {
                     specs.push(s);
                 }
@@ -65,15 +69,14 @@ fn base_tolerance(p: Precision) -> f64 {
 /// the half vector is ill-conditioned (V near -L, |V + L| small) or a lobe is razor-thin, this is what any
 /// implementation at that precision can promise.
 fn sensitivity(spec: &ModelSpec, s: &Sample, channel: usize, epsilon: f64, seed: u64) -> f64 {
-    use crate::brdf::guards::safe_normalize;
-    let (n, v, l) = (safe_normalize(s.n.map(f64::from)), safe_normalize(s.v.map(f64::from)), safe_normalize(s.l.map(f64::from)));
+    let (n, v, l) = (unit(s.n), unit(s.v), unit(s.l));
     let (r, f0) = (f64::from(s.roughness), s.f0.map(f64::from));
     let base = spec.eval_unit(n, v, l, r, f0)[channel];
     let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
     let mut sign = || if rng.random::<bool>() { 1.0 } else { -1.0 };
     (0..8)
         .map(|_| {
-            let mut shift = |u: [f64; 3]| u.map(|x| x + epsilon * sign());
+            let mut shift = |u: glam::DVec3| u + glam::DVec3::new(epsilon * sign(), epsilon * sign(), epsilon * sign());
             let (pn, pv, pl) = (shift(n), shift(v), shift(l));
             let pr = r * (1.0 + epsilon * sign());
             let pf = f0.map(|x| x * (1.0 + epsilon * sign()));
@@ -112,6 +115,9 @@ pub struct Worst {
 pub struct SpecStability {
     pub spec: String,
     pub precision: String,
+    /// Whether the model has an f64 twin: without one, nothing is out of tolerance (there is nothing to be
+    /// within), and every step of the GPU's results counts as a jump.
+    pub has_twin: bool,
     /// On valid inputs (catalogue and grid).
     pub nan: usize,
     pub inf: usize,
@@ -157,175 +163,8 @@ impl SpecStability {
 
 #[derive(Clone, Debug)]
 pub struct StabilityOptions {
-    pub specs: Vec<ModelSpec>,
+    pub models: Vec<Model>,
     pub energy: bool,
-}
-
-/// Checks one spec: catalogue, grid, discontinuities and reciprocity (energy is added by `run`).
-pub fn check_spec(gpu: &Gpu, spec: &ModelSpec, cases: &[HardCase], grid: &[Sample], reciprocity: &[Sample]) -> Result<SpecStability> {
-    // One kernel run per distinct gamma (GTR cases may override it).
-    let mut case_out = vec![[0f32; 3]; cases.len()];
-    let mut groups: Vec<(Option<f64>, Vec<usize>)> = Vec::new();
-    for (i, c) in cases.iter().enumerate() {
-        let g = if spec.d == D::Gtr { c.gamma } else { None };
-        match groups.iter_mut().find(|(k, _)| *k == g) {
-            Some((_, v)) => v.push(i),
-            None => groups.push((g, vec![i])),
-        }
-    }
-    for (gamma, idx) in &groups {
-        let s = ModelSpec { gamma: gamma.unwrap_or(spec.gamma), ..*spec };
-        let out = kernels::eval(gpu, &s, &idx.iter().map(|&i| cases[i].sample).collect::<Vec<_>>(), RunLimits::default())?;
-        for (k, &i) in idx.iter().enumerate() {
-            case_out[i] = out[k];
-        }
-    }
-    let mut all: Vec<Sample> = grid.to_vec();
-    all.extend_from_slice(reciprocity);
-    all.extend(reciprocity.iter().map(|s| Sample { v: s.l, l: s.v, ..*s }));
-    let out = kernels::eval(gpu, spec, &all, RunLimits::default())?;
-    let (grid_out, rest) = out.split_at(grid.len());
-    let (forward, backward) = rest.split_at(reciprocity.len());
-
-    let bad = |x: f32| !x.is_finite() || x < 0.0;
-    let (mut nan, mut inf, mut negative, mut poisoned) = (0, 0, 0, 0);
-    let mut tally = |x: f32, valid: bool| {
-        if !valid {
-            poisoned += bad(x) as usize;
-        } else if x.is_nan() {
-            nan += 1;
-        } else if x.is_infinite() {
-            inf += 1;
-        } else if x < 0.0 {
-            negative += 1;
-        }
-    };
-    let mut worst = Worst::default();
-    let mut results = Vec::with_capacity(cases.len());
-    for (i, (case, got)) in cases.iter().zip(&case_out).enumerate() {
-        let valid = case.expect == Expect::Twin;
-        got.iter().for_each(|&x| tally(x, valid));
-        let s = ModelSpec { gamma: if spec.d == D::Gtr { case.gamma.unwrap_or(spec.gamma) } else { spec.gamma }, ..*spec };
-        let (expected, deviation) = if valid {
-            let e = s.eval(&case.sample);
-            let dev = (0..3)
-                .map(|c| {
-                    let d = (got[c] as f64 - e[c]).abs() / tolerance(&s, &case.sample, c, e[c], i as u64);
-                    if d.is_nan() { f64::INFINITY } else { d }
-                })
-                .fold(0.0, f64::max);
-            (Some(e), dev)
-        } else {
-            (None, if got.iter().any(|&x| bad(x)) { f64::INFINITY } else { 0.0 })
-        };
-        if valid && deviation > worst.deviation {
-            let c = (0..3).max_by(|&a, &b| (got[a] as f64 - expected.unwrap()[a]).abs().total_cmp(&(got[b] as f64 - expected.unwrap()[b]).abs())).unwrap();
-            worst = Worst { deviation, got: got[c], expected: expected.unwrap()[c], input: format!("case `{}`: {:?}", case.name, case.sample) };
-        }
-        results.push(CaseResult { case: case.name.clone(), expected, got: *got, deviation, ok: deviation <= 1.0 });
-    }
-
-    // The grid: tolerance computed only where the base tolerance is exceeded (it can only grow).
-    let twin: Vec<[f64; 3]> = grid.par_iter().map(|s| spec.eval(s)).collect();
-    let deviations: Vec<f64> = grid
-        .par_iter()
-        .enumerate()
-        .map(|(i, s)| {
-            (0..3)
-                .map(|c| {
-                    let (g, e) = (grid_out[i][c] as f64, twin[i][c]);
-                    let diff = (g - e).abs();
-                    if diff.is_nan() {
-                        return f64::INFINITY;
-                    }
-                    let base = base_tolerance(spec.precision) * e.abs().max(FLOOR);
-                    if diff <= base { diff / base } else { diff / tolerance(spec, s, c, e, i as u64) }
-                })
-                .fold(0.0, f64::max)
-        })
-        .collect();
-    let mut bad_cells = vec![vec![0u32; grid::COSINES.len()]; grid::ROUGHNESS.len()];
-    for (i, g) in grid_out.iter().enumerate() {
-        g.iter().for_each(|&x| tally(x, true));
-        if g.iter().any(|&x| bad(x)) {
-            let r = i / (grid::AZIMUTHS * grid::COSINES.len() * grid::COSINES.len());
-            let v = (i / grid::COSINES.len()) % grid::COSINES.len();
-            bad_cells[r][v] += 1;
-        }
-    }
-    let grid_out_of_tolerance = deviations.iter().filter(|d| **d > 1.0).count();
-    if let Some((i, &d)) = deviations.iter().enumerate().max_by(|a, b| a.1.total_cmp(b.1)) {
-        if d > worst.deviation {
-            let c = (0..3).max_by(|&a, &b| (grid_out[i][a] as f64 - twin[i][a]).abs().total_cmp(&(grid_out[i][b] as f64 - twin[i][b]).abs())).unwrap();
-            worst = Worst { deviation: d, got: grid_out[i][c], expected: twin[i][c], input: format!("grid: {:?}", grid[i]) };
-        }
-    }
-
-    // Steps in f_s NoL (the radiance a renderer accumulates) along NoV, NoL and roughness, channel 0.
-    let radiance = |vals: &dyn Fn(usize) -> f64, idx: &[usize]| idx.iter().map(|&i| vals(i) * (grid[i].l[2] as f64).max(0.0)).collect::<Vec<f64>>();
-    let gpu_v = |i: usize| grid_out[i][0] as f64;
-    let twin_v = |i: usize| twin[i][0];
-    let (mut discontinuities, mut model_jumps, mut examples) = (0, 0, Vec::new());
-    // A step the f64 model does not take counts only where the values it joins are not both within tolerance:
-    // inside tolerance it is rounding in an ill-conditioned corner, not a break.
-    let mut scan = |idx: Vec<usize>, axis: &str| {
-        let (g, t) = (radiance(&gpu_v, &idx), radiance(&twin_v, &idx));
-        let model = grid::jumps(&t);
-        model_jumps += model.len();
-        for j in grid::jumps(&g).into_iter().filter(|j| !model.contains(j) && (deviations[idx[*j]] > 1.0 || deviations[idx[*j + 1]] > 1.0)) {
-            discontinuities += 1;
-            if examples.len() < 5 {
-                examples.push(format!("along {axis} between {:?} and {:?}: {} -> {}", grid[idx[j]], grid[idx[j + 1]], g[j], g[j + 1]));
-            }
-        }
-    };
-    // Lit points only (cosines > 0): at 0 the light is masked by definition, a step of the spec, not a break.
-    let n = grid::COSINES.len();
-    for r in 0..grid::ROUGHNESS.len() {
-        for az in 0..grid::AZIMUTHS {
-            for k in 1..n {
-                scan((1..n).map(|v| grid::index(r, az, v, k)).collect(), "NoV");
-                scan((1..n).map(|l| grid::index(r, az, k, l)).collect(), "NoL");
-            }
-        }
-    }
-    for az in 0..grid::AZIMUTHS {
-        for v in 1..n {
-            for l in 1..n {
-                scan((0..grid::ROUGHNESS.len()).map(|r| grid::index(r, az, v, l)).collect(), "roughness");
-            }
-        }
-    }
-
-    let reciprocity = forward
-        .iter()
-        .zip(backward)
-        .flat_map(|(a, b)| (0..3).map(move |c| (a[c] as f64 - b[c] as f64).abs() / (a[c].abs().max(b[c].abs()) as f64).max(FLOOR)))
-        .fold(0.0, f64::max);
-
-    let case_deviation = results.iter().map(|r| r.deviation).collect();
-    let cases_run = results.len();
-    let cases_out_of_tolerance = results.into_iter().filter(|r| !r.ok).collect();
-    let any_bad = bad_cells.iter().flatten().any(|&n| n > 0);
-    Ok(SpecStability {
-        spec: spec.name(),
-        precision: spec.precision.name().into(),
-        nan,
-        inf,
-        negative,
-        invalid_input_poisoned: poisoned,
-        cases_run,
-        cases_out_of_tolerance,
-        case_deviation,
-        grid_out_of_tolerance,
-        worst,
-        discontinuities,
-        discontinuity_examples: examples,
-        model_jumps,
-        reciprocity,
-        bad_cells: any_bad.then_some(bad_cells),
-        energy: None,
-    })
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -340,6 +179,28 @@ impl StabilityReport {
     pub fn failing(&self) -> Vec<&SpecStability> {
         self.specs.iter().filter(|s| s.fails()).collect()
     }
+
+    /// Writes stability-<device>.md and .json, the furnace and albedo charts and the failures' heat map under
+    /// `out`; returns their paths.
+    pub fn write(&self, out: &std::path::Path, device: &str) -> Result<Vec<std::path::PathBuf>> {
+        let stem = out.join(format!("stability-{device}"));
+        let mut written = vec![stem.with_extension("md"), stem.with_extension("json")];
+        crate::report::write_json_compact(&written[1], self)?;
+        crate::io::write_output(&written[0], self.markdown().as_bytes())?;
+        let entries = self.energy_entries();
+        if !entries.is_empty() {
+            let furnace = out.join(format!("furnace-{device}.png"));
+            let albedo = out.join(format!("albedo-{device}.png"));
+            energy::furnace_png(&furnace, &entries)?;
+            energy::albedo_chart(&albedo, &entries)?;
+            written.extend([furnace, albedo]);
+        }
+        let heat = out.join(format!("stability-{device}-failures.png"));
+        if self.heatmaps(&heat)? {
+            written.push(heat);
+        }
+        Ok(written)
+    }
 }
 
 pub fn run(gpu: &Gpu, options: &StabilityOptions, progress: &ProgressBar) -> Result<StabilityReport> {
@@ -347,17 +208,16 @@ pub fn run(gpu: &Gpu, options: &StabilityOptions, progress: &ProgressBar) -> Res
     let grid = grid::samples();
     let reciprocity = samples::well_conditioned(20_000, 4, 1e-3, 0.0..1.0);
     let mut specs = Vec::new();
-    progress.set_length(options.specs.len() as u64);
-    for (i, spec) in options.specs.iter().enumerate() {
+    progress.set_length(options.models.len() as u64);
+    for (i, model) in options.models.iter().enumerate() {
         progress.set_position(i as u64);
-        progress.set_message(spec.name());
-        if spec.precision == Precision::F16 && !gpu.info.shader_float16 {
-            anyhow::bail!("{spec}: device has no shaderFloat16; leave fp16 specs out");
-        }
-        specs.push(check_spec(gpu, spec, &cases, &grid, &reciprocity)?);
+        progress.set_message(model.name());
+        model.check_support(&gpu.info)?;
+        specs.push(check_model(gpu, model, &cases, &grid, &reciprocity)?);
     }
     if options.energy {
-        energy::attach(gpu, &options.specs, &mut specs, progress)?;
+        let twins = options.models.iter().map(|m| m.twin().copied().ok_or_else(|| anyhow!("{m} has no f64 twin"))).collect::<Result<Vec<_>>>()?;
+        energy::attach(gpu, &twins, &mut specs, progress)?;
     }
     Ok(StabilityReport { provenance: crate::report::Provenance::new(&gpu.info), specs, grid_points: grid.len(), cases })
 }

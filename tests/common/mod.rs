@@ -1,9 +1,13 @@
 //! Helpers shared by the integration tests. Every GPU test runs on the default device (lavapipe in CI) under
-//! the Khronos validation layer and fails on any validation message.
+//! the Khronos validation layer and fails on any validation message; every CLI invocation goes through `run`.
 #![allow(dead_code)]
 
+use brdfprof::brdf::spec::with_each_param_sample;
+use brdfprof::brdf::{ModelSpec, D, F, Vis};
 use brdfprof::gpu::{Gpu, GpuOptions};
-use std::path::PathBuf;
+use brdfprof::model::Model;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
 
 pub fn gpu() -> Gpu {
     Gpu::new(&GpuOptions { device: std::env::var("BRDFPROF_TEST_DEVICE").ok(), validation: true })
@@ -20,14 +24,59 @@ pub fn rel_err(gpu: f64, reference: f64) -> f64 {
     (gpu - reference).abs() / reference.abs().max(1e-3)
 }
 
-pub fn brdfprof() -> std::process::Command {
-    let mut c = std::process::Command::new(env!("CARGO_BIN_EXE_brdfprof"));
-    c.env_remove("BRDFPROF_VALIDATION");
+/// The brdfprof binary, with the validation layer on (BRDFPROF_VALIDATION=1) and the test device.
+pub fn brdfprof() -> Command {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_brdfprof"));
+    c.env("BRDFPROF_VALIDATION", "1");
+    if let Ok(d) = std::env::var("BRDFPROF_TEST_DEVICE") {
+        c.env("BRDFPROF_TEST_DEVICE", d);
+    }
     c
 }
 
+/// What a CLI invocation did.
+pub struct Run {
+    pub code: Option<i32>,
+    pub stdout: String,
+    pub stderr: String,
+}
+
+impl Run {
+    fn of(out: Output) -> Run {
+        Run { code: out.status.code(), stdout: String::from_utf8_lossy(&out.stdout).into_owned(), stderr: String::from_utf8_lossy(&out.stderr).into_owned() }
+    }
+
+    /// Asserts exit 0 and no validation message; returns self.
+    pub fn ok(self) -> Run {
+        assert_eq!(self.code, Some(0), "exit status {:?}; stderr:\n{}", self.code, self.stderr);
+        self.no_validation()
+    }
+
+    /// Asserts exit `code` with `needle` in stderr.
+    pub fn fails(self, code: i32, needle: &str) -> Run {
+        assert_eq!(self.code, Some(code), "expected exit {code}, got {:?}; stderr:\n{}", self.code, self.stderr);
+        assert!(self.stderr.contains(needle), "expected `{needle}` in stderr:\n{}", self.stderr);
+        self.no_validation()
+    }
+
+    pub fn no_validation(self) -> Run {
+        assert!(!self.stderr.contains("validation ["), "validation messages:\n{}", self.stderr);
+        self
+    }
+}
+
+/// Runs `brdfprof ARGS` (validation on) in the current directory.
+pub fn run(args: &[&str]) -> Run {
+    Run::of(brdfprof().args(args).output().expect("brdfprof runs"))
+}
+
+/// Runs `brdfprof ARGS` (validation on) in `dir`.
+pub fn run_in(dir: &Path, args: &[&str]) -> Run {
+    Run::of(brdfprof().args(args).current_dir(dir).output().expect("brdfprof runs"))
+}
+
 /// The file `dir/PREFIX<device>.EXT` a command wrote for the default device, whatever that device's name.
-pub fn device_file(dir: &std::path::Path, prefix: &str, suffix: &str) -> PathBuf {
+pub fn device_file(dir: &Path, prefix: &str, suffix: &str) -> PathBuf {
     let matches: Vec<PathBuf> = std::fs::read_dir(dir)
         .unwrap()
         .map(|e| e.unwrap().path())
@@ -42,6 +91,16 @@ pub fn device_file(dir: &std::path::Path, prefix: &str, suffix: &str) -> PathBuf
 
 pub fn repo_root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// A model of the term library.
+pub fn model(spec: ModelSpec) -> Model {
+    Model::spec(spec)
+}
+
+/// Every D of the table, with each sample of the parameters it reads (Vis implicit, F none).
+pub fn every_d() -> Vec<ModelSpec> {
+    D::ALL.iter().flat_map(|&d| with_each_param_sample(ModelSpec::new(d, Vis::Implicit, F::None))).collect()
 }
 
 /// The largest error and where it happened.

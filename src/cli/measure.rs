@@ -1,0 +1,139 @@
+//! `brdfprof profile`, `sweep` and `stability`: the commands that run kernels and measure them.
+
+use super::{fresh_compilation, on_device, written, DeviceArgs, ModelArgs, TimingArgs};
+use anyhow::{bail, Result};
+use brdfprof::brdf::THESIS_MODELS;
+use brdfprof::model::Model;
+use brdfprof::{profile, report, scene, stability, sweep};
+use clap::Args;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+#[derive(Args)]
+pub struct ProfileArgs {
+    #[command(flatten)]
+    pub model: ModelArgs,
+    #[command(flatten)]
+    pub timing: TimingArgs,
+    /// G-buffer size, WIDTHxHEIGHT (default 1920x1080).
+    #[arg(long)]
+    pub size: Option<String>,
+    /// Timed dispatches of each kernel per round.
+    #[arg(long, default_value_t = 3)]
+    pub reps: usize,
+    /// Seconds of timed rounds at most (the run also stops once every ratio is resolved).
+    #[arg(long, default_value_t = 60.0)]
+    pub budget: f64,
+    /// Stop when every ratio's 95% CI half-width is below this fraction of the ratio.
+    #[arg(long, default_value_t = 0.02)]
+    pub target_ci: f64,
+    /// JSON report path (default: results/profile-<device>.json; with --scene results/scene-<name>-<device>.json).
+    #[arg(long)]
+    pub json: Option<PathBuf>,
+    /// Profile a scene file instead (see `brdfprof scene --explain`): what is compiled in, each kernel's
+    /// ns/pixel and each effect's cost, measured by toggling it. The G-buffer size and models are the scene's.
+    #[arg(long)]
+    pub scene: Option<PathBuf>,
+    #[command(flatten)]
+    pub device: DeviceArgs,
+}
+
+pub fn profile(args: &ProfileArgs) -> Result<ExitCode> {
+    if let Some(path) = &args.scene {
+        return profile_scene(args, path);
+    }
+    fresh_compilation(args.timing.shader_cache);
+    let size = args.size.as_deref().unwrap_or("1920x1080");
+    let options = args.timing.options(args.model.models(&THESIS_MODELS)?, size, args.reps, args.budget, args.target_ci)?;
+    let (gpu, result) = on_device(&args.device, |gpu, progress| profile::run(gpu, &options, progress))?;
+    let path = args.json.clone().unwrap_or_else(|| PathBuf::from(format!("results/profile-{}.json", report::device_slug(&gpu.info))));
+    report::write_json(&path, &result)?;
+    println!("{}\n", result.summary());
+    print!("{}{}", result.table().markdown(), result.placement_notes());
+    println!("\nJSON: {}", path.display());
+    Ok(ExitCode::SUCCESS)
+}
+
+fn profile_scene(args: &ProfileArgs, path: &std::path::Path) -> Result<ExitCode> {
+    if !args.model.models.is_empty() || !args.model.params.is_empty() {
+        bail!("--scene: the scene's materials choose the models; --model and --param do not apply (edit the scene file)");
+    }
+    if args.size.is_some() {
+        bail!("--scene: the G-buffer size is the scene's; --size does not apply");
+    }
+    fresh_compilation(args.timing.shader_cache);
+    let scene = scene::Scene::load(path)?;
+    let base = args.timing.options(Vec::new(), "1x1", args.reps, args.budget, args.target_ci)?;
+    let options = scene::profile::SceneProfileOptions { protocol: base.protocol, target_rel_ci: args.target_ci, max_chunk: None, instances: base.instances };
+    let (gpu, result) = on_device(&args.device, |gpu, progress| scene::profile::run(gpu, &scene, &options, progress))?;
+    let path = args.json.clone().unwrap_or_else(|| PathBuf::from(format!("results/scene-{}-{}.json", scene.name(), report::device_slug(&gpu.info))));
+    report::write_json(&path, &result)?;
+    println!("{}\n", result.summary());
+    print!("{}", result.markdown());
+    println!("\nJSON: {}", path.display());
+    Ok(ExitCode::SUCCESS)
+}
+
+#[derive(Args)]
+pub struct SweepArgs {
+    /// Specs to sweep (default: every D with its sensible Vis terms and Schlick, every Fresnel on ggx,
+    /// the thesis models in fp16).
+    #[command(flatten)]
+    pub model: ModelArgs,
+    #[command(flatten)]
+    pub timing: TimingArgs,
+    #[arg(long, default_value = "512x512")]
+    pub size: String,
+    #[arg(long, default_value_t = 1)]
+    pub reps: usize,
+    #[arg(long, default_value_t = 150.0)]
+    pub budget: f64,
+    /// CI half-width target: 1.5% resolves neighbours 3% apart.
+    #[arg(long, default_value_t = 0.015)]
+    pub target_ci: f64,
+    /// Directory for sweep-<device>.md, .json and .png.
+    #[arg(long, default_value = "results")]
+    pub out: PathBuf,
+    #[command(flatten)]
+    pub device: DeviceArgs,
+}
+
+pub fn sweep(args: &SweepArgs) -> Result<ExitCode> {
+    fresh_compilation(args.timing.shader_cache);
+    let models = if args.model.models.is_empty() { sweep::default_specs().into_iter().map(Model::spec).collect() } else { args.model.models(&[])? };
+    let options = sweep::SweepOptions { profile: args.timing.options(models, &args.size, args.reps, args.budget, args.target_ci)? };
+    let (gpu, result) = on_device(&args.device, |gpu, progress| sweep::run(gpu, &options, progress))?;
+    let files = result.write(&args.out, &report::device_slug(&gpu.info))?;
+    print!("{}", result.markdown());
+    println!("\n{}", written(&files));
+    Ok(ExitCode::SUCCESS)
+}
+
+#[derive(Args)]
+pub struct StabilityArgs {
+    #[command(flatten)]
+    pub model: ModelArgs,
+    /// Skip the directional-albedo (energy) part.
+    #[arg(long)]
+    pub no_energy: bool,
+    /// Directory for stability-<device>.md/.json and the furnace, albedo and failure PNGs.
+    #[arg(long, default_value = "results")]
+    pub out: PathBuf,
+    #[command(flatten)]
+    pub device: DeviceArgs,
+}
+
+pub fn stability(args: &StabilityArgs) -> Result<ExitCode> {
+    let models = if args.model.models.is_empty() { stability::default_specs().into_iter().map(Model::spec).collect() } else { args.model.models(&[])? };
+    let options = stability::StabilityOptions { models, energy: !args.no_energy };
+    let (gpu, result) = on_device(&args.device, |gpu, progress| stability::run(gpu, &options, progress))?;
+    let files = result.write(&args.out, &report::device_slug(&gpu.info))?;
+    print!("{}", result.markdown());
+    println!("\n{}", written(&files));
+    let failing = result.failing();
+    if failing.is_empty() {
+        return Ok(ExitCode::SUCCESS);
+    }
+    eprintln!("brdfprof: {} spec(s) give NaN, Inf or negative values on valid inputs", failing.len());
+    Ok(ExitCode::from(1))
+}

@@ -1,0 +1,160 @@
+//! What every command shares: the device, model and timing arguments, and the one sequence that opens the
+//! device, shows progress, runs the work and checks the validation layer.
+
+pub mod counts;
+pub mod eval;
+pub mod info;
+pub mod measure;
+pub mod scene;
+
+use anyhow::{anyhow, bail, Result};
+use brdfprof::gpu::{Gpu, GpuOptions};
+use brdfprof::model::{self, Model};
+use brdfprof::profile::protocol::ProtocolOptions;
+use brdfprof::profile::ProfileOptions;
+use clap::Args;
+use indicatif::{ProgressBar, ProgressStyle};
+use std::time::Duration;
+
+#[derive(Args, Clone)]
+pub struct DeviceArgs {
+    /// Device index (see `brdfprof devices`) or a case-insensitive substring of its name.
+    /// Default: the first discrete or integrated GPU, else lavapipe.
+    #[arg(long)]
+    pub device: Option<String>,
+    /// Run under the Khronos validation layer and fail on any message (also BRDFPROF_VALIDATION=1).
+    #[arg(long)]
+    pub validate: bool,
+}
+
+impl DeviceArgs {
+    /// Validation asked for by the flag or the environment.
+    pub fn validation(&self) -> bool {
+        self.validate || std::env::var("BRDFPROF_VALIDATION").is_ok_and(|v| !v.is_empty() && v != "0")
+    }
+
+    pub fn open(&self) -> Result<Gpu> {
+        if self.device.as_deref().is_some_and(|d| d.trim().is_empty()) {
+            bail!("--device: empty; give an index or a name substring (see `brdfprof devices`)");
+        }
+        Gpu::new(&GpuOptions { device: self.device.clone(), validation: self.validation() })
+    }
+}
+
+/// Opens the device, runs `work` with a progress bar, and fails if the validation layer said anything.
+pub fn on_device<T>(device: &DeviceArgs, work: impl FnOnce(&Gpu, &ProgressBar) -> Result<T>) -> Result<(Gpu, T)> {
+    let gpu = device.open()?;
+    let progress = ProgressBar::new(0).with_style(ProgressStyle::with_template("{spinner} {elapsed} {pos} {msg}").expect("valid progress template"));
+    progress.enable_steady_tick(Duration::from_millis(200));
+    let result = work(&gpu, &progress);
+    progress.finish_and_clear();
+    let result = result?;
+    gpu.check_validation()?;
+    Ok((gpu, result))
+}
+
+#[derive(Args, Clone)]
+pub struct ModelArgs {
+    /// Model spec: a preset (ggx, blinn, cook-torrance, burley, ue-default-lit, filament-high, filament-low)
+    /// or d=..,vis=..,f=..,precision=..; see `brdfprof models`.
+    #[arg(long = "model")]
+    pub models: Vec<String>,
+    /// Parameter override applied to every model that takes it, e.g. gamma=1.5 (GTR exponent), metal=copper,
+    /// precision=f16.
+    #[arg(long = "param")]
+    pub params: Vec<String>,
+}
+
+impl ModelArgs {
+    /// The models asked for, or `default` when none.
+    pub fn models(&self, default: &[&str]) -> Result<Vec<Model>> {
+        model::models_from_args(&self.models, &self.params, default)
+    }
+}
+
+/// Size and protocol of a timed run, shared by `profile` and `sweep`.
+#[derive(Args, Clone)]
+pub struct TimingArgs {
+    /// Directional lights per pixel (a specialisation constant: the light loop is unrolled).
+    #[arg(long, default_value_t = 8)]
+    pub lights: u32,
+    /// Minimum and maximum number of interleaved rounds.
+    #[arg(long, default_value_t = 12)]
+    pub min_rounds: usize,
+    #[arg(long, default_value_t = 400)]
+    pub max_rounds: usize,
+    /// Seed of the interleaving order.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Independently compiled pipelines per kernel, all timed every round (the faster counts): guards against
+    /// one JIT compilation landing badly placed, seen to double a kernel's time on lavapipe.
+    #[arg(long, default_value_t = 2)]
+    pub instances: usize,
+    /// Keep Mesa's on-disk shader cache (timed runs switch it off by default; see `fresh_compilation`).
+    #[arg(long)]
+    pub shader_cache: bool,
+}
+
+impl TimingArgs {
+    pub fn options(&self, models: Vec<Model>, size: &str, reps: usize, budget: f64, target_ci: f64) -> Result<ProfileOptions> {
+        let (width, height) = parse_size("--size", size)?;
+        if self.lights == 0 {
+            bail!("--lights must be at least 1");
+        }
+        let min_rounds = self.min_rounds.max(1);
+        Ok(ProfileOptions {
+            models,
+            width,
+            height,
+            lights: self.lights,
+            protocol: ProtocolOptions {
+                min_rounds,
+                max_rounds: self.max_rounds.max(min_rounds),
+                reps: reps.max(1),
+                budget: parse_budget(budget)?,
+                seed: self.seed,
+            },
+            target_rel_ci: target_ci,
+            max_chunk: None,
+            instances: self.instances.max(1),
+        })
+    }
+}
+
+/// `--budget` in seconds: positive and finite.
+pub fn parse_budget(seconds: f64) -> Result<Duration> {
+    if !(seconds.is_finite() && seconds > 0.0 && seconds <= 86_400.0) {
+        bail!("--budget {seconds}: give seconds, more than 0 and at most 86400");
+    }
+    Ok(Duration::from_secs_f64(seconds))
+}
+
+/// `WIDTHxHEIGHT`, both at least 1; `flag` names the option in errors.
+pub fn parse_size(flag: &str, text: &str) -> Result<(u32, u32)> {
+    let parse = || -> Option<(u32, u32)> {
+        let (w, h) = text.split_once(['x', 'X'])?;
+        Some((w.trim().parse().ok()?, h.trim().parse().ok()?))
+    };
+    match parse() {
+        Some((w, h)) if w > 0 && h > 0 => Ok((w, h)),
+        Some((w, h)) => Err(anyhow!("{flag} `{text}`: width and height must be at least 1 (got {w}x{h})")),
+        None => Err(anyhow!("{flag} `{text}`: expected WIDTHxHEIGHT, e.g. 1920x1080")),
+    }
+}
+
+/// Timed runs compile every pipeline afresh (MESA_SHADER_CACHE_DISABLE=true unless the user set it or asked
+/// to keep the cache): with Mesa's on-disk shader cache a process runs binaries an earlier process compiled,
+/// and on lavapipe that moved one scene effect's cost from 0.3 to 19 ns/pixel between runs, where fresh
+/// compilation gave the same figure run after run. The variable is recorded in every report's environment.
+pub fn fresh_compilation(keep_cache: bool) {
+    if !keep_cache && std::env::var_os("MESA_SHADER_CACHE_DISABLE").is_none() {
+        // SAFETY: called on the main thread before any other thread exists and before the Vulkan driver,
+        // which reads the variable, is loaded.
+        unsafe { std::env::set_var("MESA_SHADER_CACHE_DISABLE", "true") };
+    }
+}
+
+/// "written: a, b, c" for a command's outputs.
+pub fn written(paths: &[std::path::PathBuf]) -> String {
+    format!("written: {}", paths.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", "))
+}

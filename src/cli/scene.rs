@@ -1,0 +1,46 @@
+//! `brdfprof scene` and `render` (`profile --scene` is in `measure`).
+
+use super::{on_device, written, DeviceArgs};
+use anyhow::{bail, Result};
+use brdfprof::scene;
+use clap::Args;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+#[derive(Args)]
+pub struct SceneArgs {
+    /// Scene file to check.
+    pub file: Option<PathBuf>,
+    #[arg(long)]
+    pub explain: bool,
+}
+
+pub fn scene(args: &SceneArgs) -> Result<ExitCode> {
+    match (&args.file, args.explain) {
+        (_, true) => print!("{}", scene::explain()),
+        (Some(f), false) => print!("{}", scene::check(f)?),
+        (None, false) => bail!("give a scene file to check, or --explain"),
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+#[derive(Args)]
+pub struct RenderArgs {
+    #[arg(long)]
+    pub scene: PathBuf,
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    #[command(flatten)]
+    pub device: DeviceArgs,
+}
+
+pub fn render(args: &RenderArgs) -> Result<ExitCode> {
+    let scene = scene::Scene::load(&args.scene)?;
+    let out = args.out.clone().unwrap_or_else(|| PathBuf::from("results/scenes").join(scene.name()));
+    let (_, result) = on_device(&args.device, |gpu, progress| scene::render::render(gpu, &scene, &out, progress))?;
+    for n in &result.notes {
+        eprintln!("brdfprof: note: {n}");
+    }
+    println!("{}", written(&result.files));
+    Ok(ExitCode::SUCCESS)
+}

@@ -1,0 +1,218 @@
+//! Two runs compared statistic by statistic and group by group.
+
+use super::baseline::Baseline;
+use super::environment::JIT_FEATURES;
+use super::thresholds::{group_of, is_gated, Thresholds, ALPHA, GROUPS, MIN_TIMING_ROUNDS, TIMING_KEY};
+use crate::inspect::timing::TimingRun;
+use crate::stats;
+use std::collections::BTreeMap;
+
+/// How a group compares between the baseline and this run.
+#[derive(Clone, Debug, PartialEq)]
+pub enum GroupStatus {
+    Compared,
+    /// Compared although the environments differ (--force); the differences.
+    Forced(String),
+    /// Not compared; why.
+    NotComparable(String),
+    /// Neither side has figures for the group.
+    Absent(String),
+    /// The baseline has figures that this run should have measured but could not; why (exit 2).
+    NotMeasured(String),
+}
+
+/// One statistic of one model, old and new.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Change {
+    pub model: String,
+    pub key: String,
+    pub old: f64,
+    pub new: f64,
+    /// (new - old) / |old|; +inf when a statistic appears.
+    pub rel: f64,
+    pub threshold: f64,
+    pub gated: bool,
+}
+
+impl Change {
+    pub fn is_regression(&self) -> bool {
+        self.gated && self.new > self.old && self.rel > self.threshold
+    }
+}
+
+/// One model's timing ratios, old and new.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TimingChange {
+    pub model: String,
+    pub old_median: f64,
+    pub new_median: f64,
+    pub n_old: usize,
+    pub n_new: usize,
+    /// new median / old median - 1.
+    pub change: f64,
+    /// Mann-Whitney U, two-sided; None with fewer than MIN_TIMING_ROUNDS rounds on a side.
+    pub p: Option<f64>,
+    pub threshold: f64,
+}
+
+impl TimingChange {
+    pub fn significant(&self) -> bool {
+        self.p.is_some_and(|p| p < ALPHA)
+    }
+    pub fn is_regression(&self) -> bool {
+        self.significant() && self.change > self.threshold
+    }
+    pub(super) fn verdict(&self) -> &'static str {
+        match (self.p, self.significant()) {
+            (None, _) => "too few rounds to test",
+            (_, false) => "no significant change",
+            _ if self.is_regression() => "REGRESSION",
+            _ if self.change > 0.0 => "slower, within the noise threshold",
+            _ if self.change < -self.threshold => "faster",
+            _ => "faster, within the noise threshold",
+        }
+    }
+}
+
+pub struct Comparison {
+    pub groups: Vec<(String, GroupStatus)>,
+    /// Every compared statistic of every model in both runs, changed or not.
+    pub changes: Vec<Change>,
+    pub timing: Vec<TimingChange>,
+    pub timing_reference: String,
+    /// Models in only one of the runs.
+    pub only_old: Vec<String>,
+    pub only_new: Vec<String>,
+    /// Notes that do not change the verdict (e.g. naga's verdict changed).
+    pub notes: Vec<String>,
+}
+
+/// Why two fingerprints differ, or None when they match.
+fn differences(old: Option<&BTreeMap<String, String>>, new: Option<&BTreeMap<String, String>>) -> Option<String> {
+    let (empty_old, empty_new) = (BTreeMap::new(), BTreeMap::new());
+    let (old, new) = (old.unwrap_or(&empty_old), new.unwrap_or(&empty_new));
+    let none = String::from("(none)");
+    let diffs: Vec<String> = old
+        .keys()
+        .chain(new.keys())
+        .collect::<std::collections::BTreeSet<_>>()
+        .into_iter()
+        .filter(|k| old.get(*k) != new.get(*k))
+        .map(|k| format!("{k}: baseline `{}`, now `{}`", old.get(k).unwrap_or(&none), new.get(k).unwrap_or(&none)))
+        .collect();
+    (!diffs.is_empty()).then(|| diffs.join("; "))
+}
+
+fn has_group(b: &Baseline, group: &str) -> bool {
+    if group == "timing" {
+        return b.timing.is_some();
+    }
+    b.inspect.rows.iter().any(|r| r.stats.keys().any(|k| group_of(k) == group))
+}
+
+/// The status of each group.
+fn group_status(old: &Baseline, new: &Baseline, force: bool) -> Vec<(String, GroupStatus)> {
+    GROUPS
+        .iter()
+        .map(|&g| {
+            let status = match (has_group(old, g), has_group(new, g)) {
+                (false, false) => GroupStatus::Absent(absent_reason(new, g)),
+                (false, true) => GroupStatus::Absent("the baseline has none".into()),
+                (true, false) if g == "callgrind" && new_note(new, g).starts_with("could not measure") => {
+                    // A failure only counts where the figures would have been comparable.
+                    let mut known = old.environment.get(g).cloned().unwrap_or_default();
+                    known.remove(JIT_FEATURES);
+                    match differences(Some(&known), new.environment.get(g)) {
+                        Some(d) if !force => GroupStatus::NotComparable(format!("{d}; besides, {}", new_note(new, g))),
+                        _ => GroupStatus::NotMeasured(new_note(new, g)),
+                    }
+                }
+                (true, false) => GroupStatus::Absent(absent_reason(new, g)),
+                (true, true) => match differences(old.environment.get(g), new.environment.get(g)) {
+                    None => GroupStatus::Compared,
+                    Some(d) if force => GroupStatus::Forced(d),
+                    Some(d) => GroupStatus::NotComparable(d),
+                },
+            };
+            (g.to_string(), status)
+        })
+        .collect()
+}
+
+fn new_note(new: &Baseline, group: &str) -> String {
+    new.inspect.section_notes.get(&format!("{group}/")).cloned().unwrap_or_default()
+}
+
+fn absent_reason(new: &Baseline, group: &str) -> String {
+    match group {
+        "timing" if new.timing.is_none() => "not measured now (--rounds 0)".into(),
+        _ => {
+            let note = new_note(new, group);
+            if note.is_empty() { "not measured".into() } else { note }
+        }
+    }
+}
+
+pub(super) fn rel_change(old: f64, new: f64) -> f64 {
+    if old == new {
+        0.0
+    } else if old == 0.0 {
+        f64::INFINITY.copysign(new)
+    } else {
+        (new - old) / old.abs()
+    }
+}
+
+/// Compares two runs statistic by statistic.
+pub fn compare(old: &Baseline, new: &Baseline, thresholds: &Thresholds, force: bool) -> Comparison {
+    let groups = group_status(old, new, force);
+    let compared = |g: &str| groups.iter().any(|(name, s)| name == g && matches!(s, GroupStatus::Compared | GroupStatus::Forced(_)));
+    let mut changes = Vec::new();
+    let mut notes = Vec::new();
+    let new_models: Vec<&str> = new.inspect.rows.iter().map(|r| r.model.as_str()).collect();
+    let only_old = old.inspect.rows.iter().map(|r| r.model.clone()).filter(|m| !new_models.contains(&m.as_str())).collect();
+    let only_new = new.inspect.rows.iter().map(|r| r.model.clone()).filter(|m| old.inspect.row(m).is_none()).collect();
+    // Column order: the new run's, then keys only the baseline has.
+    let mut columns = new.inspect.columns.clone();
+    columns.extend(old.inspect.columns.iter().filter(|c| !new.inspect.columns.contains(c)).cloned());
+    for old_row in &old.inspect.rows {
+        let Some(new_row) = new.inspect.row(&old_row.model) else { continue };
+        for key in columns.iter().filter(|k| compared(group_of(k))) {
+            // A SPIR-V count a kernel lacks is 0; elsewhere a missing statistic was not measured.
+            let zero = key.starts_with("spirv").then_some(0.0);
+            let (Some(o), Some(n)) = (old_row.stats.get(key).copied().or(zero), new_row.stats.get(key).copied().or(zero)) else { continue };
+            changes.push(Change { model: old_row.model.clone(), key: key.clone(), old: o, new: n, rel: rel_change(o, n), threshold: thresholds.get(key), gated: is_gated(key) });
+        }
+        if compared("naga") && old_row.notes.get("naga") != new_row.notes.get("naga") {
+            notes.push(format!("{}: naga's verdict changed from `{}` to `{}` (reported only)", old_row.model, old_row.notes.get("naga").map_or("-", |s| s), new_row.notes.get("naga").map_or("-", |s| s)));
+        }
+    }
+    let timing = match (&old.timing, &new.timing, compared("timing")) {
+        (Some(o), Some(n), true) => compare_timing(o, n, thresholds),
+        _ => Vec::new(),
+    };
+    let timing_reference = new.timing.as_ref().map_or_else(String::new, |t| t.reference.clone());
+    Comparison { groups, changes, timing, timing_reference, only_old, only_new, notes }
+}
+
+fn compare_timing(old: &TimingRun, new: &TimingRun, thresholds: &Thresholds) -> Vec<TimingChange> {
+    old.ratios
+        .iter()
+        .filter_map(|(model, o)| {
+            let n = new.ratios.get(model)?;
+            let (om, nm) = (stats::median(o), stats::median(n));
+            let enough = o.len() >= MIN_TIMING_ROUNDS && n.len() >= MIN_TIMING_ROUNDS;
+            Some(TimingChange {
+                model: model.clone(),
+                old_median: om,
+                new_median: nm,
+                n_old: o.len(),
+                n_new: n.len(),
+                change: nm / om - 1.0,
+                p: enough.then(|| stats::mann_whitney_p(o, n)),
+                threshold: thresholds.get(TIMING_KEY),
+            })
+        })
+        .collect()
+}
+

@@ -1,0 +1,67 @@
+//! What each statistic group depends on: its fingerprint, compared before its figures are.
+
+use crate::inspect::callgrind;
+use crate::inspect::timing::TimingRun;
+use crate::inspect::InspectReport;
+use std::collections::BTreeMap;
+
+/// The fingerprint key only a successful callgrind run can fill in (the CPU features valgrind shows the JIT).
+pub(super) const JIT_FEATURES: &str = "jit-cpu-features";
+
+/// "vendor family F model M stepping S (model name)" from /proc/cpuinfo: the host CPU as the JIT sees it.
+pub fn host_cpu() -> String {
+    let Ok(text) = std::fs::read_to_string("/proc/cpuinfo") else { return std::env::consts::ARCH.to_string() };
+    let field = |name: &str| {
+        text.lines()
+            .find(|l| l.split(':').next().is_some_and(|k| k.trim() == name))
+            .and_then(|l| l.split_once(':'))
+            .map_or(String::from("?"), |(_, v)| v.trim().to_string())
+    };
+    format!("{} family {} model {} stepping {} ({})", field("vendor_id"), field("cpu family"), field("model"), field("stepping"), field("model name"))
+}
+
+/// What each group's figures depend on.
+pub fn environment(inspect: &InspectReport, timing: Option<&TimingRun>) -> BTreeMap<String, BTreeMap<String, String>> {
+    let p = &inspect.provenance;
+    let text = |v: &serde_json::Value| v.as_str().map(str::to_string).unwrap_or_else(|| v.to_string());
+    let device = text(&p["device"]["name"]);
+    let driver = format!("{} {} ({})", text(&p["device"]["driver_name"]), text(&p["device"]["driver_info"]), text(&p["device"]["driver_version"]));
+    let env: Vec<String> = p["env"].as_object().map(|m| m.iter().map(|(k, v)| format!("{k}={}", text(v))).collect()).unwrap_or_default();
+    let machine = |extra: Vec<(&str, String)>| -> BTreeMap<String, String> {
+        let mut m: BTreeMap<String, String> = [("device", device.clone()), ("driver", driver.clone())].into_iter().map(|(k, v)| (k.to_string(), v)).collect();
+        m.extend(extra.into_iter().map(|(k, v)| (k.to_string(), v)));
+        m
+    };
+    let mut out = BTreeMap::new();
+    out.insert("spirv".into(), BTreeMap::new());
+    out.insert("naga".into(), BTreeMap::new());
+    out.insert("spirv-O".into(), [("spirv-opt".to_string(), inspect.tools.get("spirv-opt").cloned().unwrap_or_default())].into());
+    out.insert("driver".into(), machine(vec![]));
+    if !inspect.callgrind_setup.is_empty() {
+        // Callgrind counts the instructions lavapipe's JIT emits, which depend on the Mesa and LLVM versions
+        // (device, driver), the environment, the workload, valgrind and the CPU features valgrind shows the
+        // JIT (it hides AVX-512, for one): not on the host's CPU model, so the gate holds on any host with the
+        // same features.
+        let mut extra = vec![("driver-env", env.join(" "))];
+        extra.extend(inspect.callgrind_setup.iter().map(|(k, v)| (k.as_str(), v.clone())));
+        if let Some(cg) = &inspect.callgrind {
+            extra.push((JIT_FEATURES, cg.jit_cpu_features.join(" ")));
+        }
+        out.insert("callgrind".into(), machine(extra));
+    }
+    if let Some(t) = timing {
+        out.insert(
+            "timing".into(),
+            machine(vec![
+                ("host-cpu", host_cpu()),
+                ("cpu-features", callgrind::cpu_features().join(" ")),
+                ("host-threads", text(&p["host_threads"])),
+                ("driver-env", env.join(" ")),
+                ("workload", format!("{}x{} pixels x {} lights", t.width, t.height, t.lights)),
+                ("reference", t.reference.clone()),
+            ]),
+        );
+    }
+    out
+}
+

@@ -1,0 +1,56 @@
+//! Every kernel-level specialisation constant, named once: `brdf::glsl_gen` declares them in
+//! glsl/generated/kernel_constants.glsl (included by every kernel) and the host sets them by these names.
+//! Ids 0..2 select the terms and 3..15 are the term parameters (`brdf::terms::PARAMS`); these start at 16.
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ConstantKind {
+    Int,
+    Float,
+}
+
+/// One specialisation constant: its GLSL name, id, type, default and what it means.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Constant {
+    pub name: &'static str,
+    pub id: u32,
+    pub kind: ConstantKind,
+    pub default: f64,
+    pub about: &'static str,
+}
+
+const fn int(name: &'static str, id: u32, default: i32, about: &'static str) -> Constant {
+    Constant { name, id, kind: ConstantKind::Int, default: default as f64, about }
+}
+
+pub const NUM_LIGHTS: Constant = int("NUM_LIGHTS", 16, 8, "shade.comp: directional lights per pixel");
+pub const BASELINE: Constant = int("BASELINE", 17, 0, "shade.comp: 1 = the memory-only kernel (no BRDF)");
+pub const ALBEDO_N: Constant = int("ALBEDO_N", 18, 256, "albedo estimator: columns per component and azimuth rows");
+pub const NUM_DIRECTIONAL: Constant = int("NUM_DIRECTIONAL", 19, 1, "scene.comp: directional lights");
+pub const NUM_POINT: Constant = int("NUM_POINT", 20, 0, "scene.comp: point lights");
+pub const NUM_SPOT: Constant = int("NUM_SPOT", 21, 0, "scene.comp: spot lights");
+pub const NUM_SPHERE: Constant = int("NUM_SPHERE", 22, 0, "scene.comp: sphere lights");
+pub const ANISOTROPY: Constant = int("ANISOTROPY", 23, 0, "scene effect: 0 off, 1 on (per-pixel strength; 0 = isotropic)");
+pub const ENERGY_COMPENSATION: Constant = int("ENERGY_COMPENSATION", 24, 0, "scene effect: 0 off, 1 every pixel, 2 per-pixel flag");
+pub const DIFFUSE: Constant = int("DIFFUSE", 25, 0, "scene effect: 0 none, 1 Lambert, 2 Burley, 3 per-pixel choice");
+pub const CLEAR_COAT: Constant = int("CLEAR_COAT", 26, 0, "scene effect: 0 off, 1 on (per-pixel strength and roughness)");
+pub const E_TABLE_MU: Constant = int("E_TABLE_MU", 27, 32, "E(mu, r) table: mu nodes (mu_i = (i + 0.5) / N)");
+pub const E_TABLE_R: Constant = int("E_TABLE_R", 28, 16, "E(mu, r) table: r nodes (r_j = j / (M - 1))");
+
+pub const ALL: &[Constant] =
+    &[NUM_LIGHTS, BASELINE, ALBEDO_N, NUM_DIRECTIONAL, NUM_POINT, NUM_SPOT, NUM_SPHERE, ANISOTROPY, ENERGY_COMPENSATION, DIFFUSE, CLEAR_COAT, E_TABLE_MU, E_TABLE_R];
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::brdf::terms::PARAMS;
+
+    #[test]
+    fn ids_are_unique_and_above_the_term_constants() {
+        let mut ids: Vec<u32> = ALL.iter().map(|c| c.id).chain(PARAMS.iter().map(|p| p.constant_id)).chain([0, 1, 2]).collect();
+        let n = ids.len();
+        ids.sort();
+        ids.dedup();
+        assert_eq!(ids.len(), n, "specialisation constant ids collide");
+        assert!(ALL.iter().all(|c| c.id >= 16) && PARAMS.iter().all(|p| (3..16).contains(&p.constant_id)));
+    }
+}

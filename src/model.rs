@@ -1,0 +1,180 @@
+//! The one model type every command takes. A model has a name, a precision, the kernels that evaluate it
+//! (SPIR-V plus specialisation constants, for each kind of kernel) and, where one exists, an f64 twin and an
+//! exact physical reference. A D x Vis x F spec is one constructor (`Model::spec`).
+
+use crate::brdf::terms::{ParamValue, PARAMS};
+use crate::brdf::{ModelSpec, Precision};
+use crate::gpu::{DeviceInfo, SpecConstants};
+use crate::shaders::{Shaders, Spirv};
+use anyhow::{anyhow, bail, Result};
+use std::fmt;
+
+/// The kinds of kernel a model is compiled into (the GLSL kernels of glsl/, each including brdf.glsl).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum KernelKind {
+    /// f_s per sample (`eval`, accuracy, stability).
+    Eval,
+    /// Each term on its own per sample (tests of the twins).
+    Terms,
+    /// The profiling kernel over a G-buffer and lights (`profile`, `sweep`, `inspect`, `check`).
+    Shade,
+    /// Directional albedo (`stability`, accuracy, energy compensation).
+    Albedo,
+    /// The scene kernel, with lights and effects.
+    Scene,
+    /// The scene shading's white furnace.
+    SceneAlbedo,
+    /// Every scene.glsl term on its own (tests).
+    SceneTerms,
+}
+
+impl KernelKind {
+    /// The GLSL kernel's name in glsl/kernels.txt, before its precision suffix.
+    pub fn base(self) -> &'static str {
+        match self {
+            KernelKind::Eval => "eval",
+            KernelKind::Terms => "terms",
+            KernelKind::Shade => "shade",
+            KernelKind::Albedo => "albedo",
+            KernelKind::Scene => "scene",
+            KernelKind::SceneAlbedo => "scene_albedo",
+            KernelKind::SceneTerms => "scene_terms",
+        }
+    }
+}
+
+/// A model's kernel: its SPIR-V and the specialisation constants that select the model in it (callers add
+/// their kernel's own constants).
+#[derive(Clone, Debug)]
+pub struct ModelKernel {
+    pub spirv: Spirv,
+    pub constants: SpecConstants,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum Model {
+    /// A D x Vis x F spec of the built-in term library.
+    Spec(ModelSpec),
+}
+
+impl From<ModelSpec> for Model {
+    fn from(s: ModelSpec) -> Self {
+        Model::Spec(s)
+    }
+}
+
+/// The specialisation constants that select `spec`'s terms and set the parameters they read.
+pub fn spec_constants(spec: &ModelSpec) -> SpecConstants {
+    let mut c = SpecConstants::default().int(0, spec.d.id() as i32).int(1, spec.vis.id() as i32).int(2, spec.f.id() as i32);
+    for p in &PARAMS {
+        c = match spec.params.get(p.param) {
+            ParamValue::Number(x) => c.float(p.constant_id, x as f32),
+            ParamValue::Metal(m) => c.int(p.constant_id, m.id() as i32),
+        };
+    }
+    c
+}
+
+impl Model {
+    /// A model from its spec text (see `ModelSpec::parse`).
+    pub fn parse(text: &str) -> Result<Self> {
+        ModelSpec::parse(text).map(Model::Spec).map_err(|e| anyhow!(e))
+    }
+
+    pub fn spec(spec: ModelSpec) -> Self {
+        Model::Spec(spec)
+    }
+
+    /// The reference every cost is compared with (ggx).
+    pub fn reference() -> Self {
+        Model::Spec(ModelSpec::reference())
+    }
+
+    /// The shortest name that parses back to this model.
+    pub fn name(&self) -> String {
+        match self {
+            Model::Spec(s) => s.name(),
+        }
+    }
+
+    /// The full form, with every parameter (what baselines and reports record).
+    pub fn canonical(&self) -> String {
+        match self {
+            Model::Spec(s) => s.canonical(),
+        }
+    }
+
+    pub fn precision(&self) -> Precision {
+        match self {
+            Model::Spec(s) => s.precision,
+        }
+    }
+
+    /// The f64 twin (and, through `brdf::exact`, the exact reference), where the model has one.
+    pub fn twin(&self) -> Option<&ModelSpec> {
+        match self {
+            Model::Spec(s) => Some(s),
+        }
+    }
+
+    /// Applies `key=value` overrides (`--param`).
+    pub fn with_params(&self, params: &[String]) -> Result<Self> {
+        match self {
+            Model::Spec(s) => s.with_params(params).map(Model::Spec).map_err(|e| anyhow!("{}: {e}", s.name())),
+        }
+    }
+
+    /// Whether an override key is a parameter of this model (so that `--param` skips models it does not fit).
+    pub fn takes_param(&self, key: &str) -> bool {
+        match self {
+            Model::Spec(s) => ["d", "vis", "f", "precision"].contains(&key) || s.reads().iter().any(|p| p.name() == key),
+        }
+    }
+
+    /// The kernel of `kind` that evaluates this model.
+    pub fn kernel(&self, kind: KernelKind, shaders: &Shaders) -> Result<ModelKernel> {
+        match self {
+            Model::Spec(s) => {
+                if kind == KernelKind::SceneTerms && s.precision != Precision::F32 {
+                    bail!("the scene terms kernel is compiled in fp32 only");
+                }
+                let name = if kind == KernelKind::SceneTerms { "scene_terms_f32".to_string() } else { format!("{}_{}", kind.base(), s.precision.name()) };
+                Ok(ModelKernel { spirv: shaders.get(&name)?, constants: spec_constants(s) })
+            }
+        }
+    }
+
+    /// Fails with a clear reason when the device cannot run this model's kernels.
+    pub fn check_support(&self, info: &DeviceInfo) -> Result<()> {
+        if self.precision() == Precision::F16 && !info.shader_float16 {
+            bail!("{self}: device `{}` has no shaderFloat16, so fp16 arithmetic cannot run there", info.name);
+        }
+        Ok(())
+    }
+}
+
+impl fmt::Display for Model {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.name())
+    }
+}
+
+/// The models of `--model` (or `default` when none is given), with `--param` overrides applied to each model
+/// that takes them; an override no model takes is an error.
+pub fn models_from_args(models: &[String], params: &[String], default: &[&str]) -> Result<Vec<Model>> {
+    let names: Vec<String> = if models.is_empty() { default.iter().map(|s| s.to_string()).collect() } else { models.to_vec() };
+    let parsed = names.iter().map(|m| Model::parse(m).map_err(|e| anyhow!("--model {m}: {e}"))).collect::<Result<Vec<_>>>()?;
+    for p in params {
+        let key = p.split_once('=').map(|(k, _)| k.trim()).ok_or_else(|| anyhow!("--param `{p}`: expected KEY=VALUE"))?;
+        if !parsed.iter().any(|m| m.takes_param(key)) {
+            bail!("--param {p}: no model takes `{key}` ({})", parsed.iter().map(Model::name).collect::<Vec<_>>().join(", "));
+        }
+    }
+    parsed
+        .iter()
+        .map(|m| {
+            let mine: Vec<String> = params.iter().filter(|p| p.split_once('=').is_some_and(|(k, _)| m.takes_param(k.trim()))).cloned().collect();
+            m.with_params(&mine).map_err(|e| anyhow!("--param: {e}"))
+        })
+        .collect()
+}

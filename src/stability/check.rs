@@ -1,0 +1,246 @@
+//! One model through the suite: the hard cases, the grid, steps the f64 model does not take, reciprocity.
+
+use super::catalogue::{Expect, HardCase};
+use super::{grid, tolerance, base_tolerance, CaseResult, SpecStability, Worst};
+use crate::accuracy::FLOOR;
+use crate::brdf::{ModelSpec, Sample};
+use crate::gpu::Gpu;
+use crate::kernels::{self, RunLimits};
+use crate::model::Model;
+use anyhow::Result;
+use rayon::prelude::*;
+
+/// NaN, Inf and negative results on valid inputs, and non-finite or negative ones from invalid inputs.
+#[derive(Default)]
+struct Tally {
+    nan: usize,
+    inf: usize,
+    negative: usize,
+    poisoned: usize,
+}
+
+fn bad(x: f32) -> bool {
+    !x.is_finite() || x < 0.0
+}
+
+impl Tally {
+    fn add(&mut self, x: f32, valid: bool) {
+        if !valid {
+            self.poisoned += bad(x) as usize;
+        } else if x.is_nan() {
+            self.nan += 1;
+        } else if x.is_infinite() {
+            self.inf += 1;
+        } else if x < 0.0 {
+            self.negative += 1;
+        }
+    }
+}
+
+/// The model a hard case runs: `model` with the case's parameter values where its terms read them.
+fn case_model(model: &Model, case: &HardCase) -> Model {
+    match model.twin() {
+        Some(spec) => Model::spec(case.overrides.iter().fold(*spec, |s, &(p, v)| s.with_param(p, v))),
+        None => model.clone(),
+    }
+}
+
+/// Every hard case on the GPU, one kernel run per distinct model the cases' parameter values make.
+fn run_cases(gpu: &Gpu, model: &Model, cases: &[HardCase]) -> Result<Vec<[f32; 3]>> {
+    let mut out = vec![[0f32; 3]; cases.len()];
+    let mut groups: Vec<(Model, Vec<usize>)> = Vec::new();
+    for (i, c) in cases.iter().enumerate() {
+        let m = case_model(model, c);
+        match groups.iter_mut().find(|(k, _)| *k == m) {
+            Some((_, v)) => v.push(i),
+            None => groups.push((m, vec![i])),
+        }
+    }
+    for (m, idx) in &groups {
+        let got = kernels::eval(gpu, m, &idx.iter().map(|&i| cases[i].sample).collect::<Vec<_>>(), RunLimits::default())?;
+        for (k, &i) in idx.iter().enumerate() {
+            out[i] = got[k];
+        }
+    }
+    Ok(out)
+}
+
+/// |got - expected| / tolerance, the largest over the channels (NaN counts as infinite).
+fn deviation(spec: &ModelSpec, s: &Sample, got: &[f32; 3], expected: [f64; 3], seed: u64) -> f64 {
+    (0..3)
+        .map(|c| {
+            let d = (got[c] as f64 - expected[c]).abs() / tolerance(spec, s, c, expected[c], seed);
+            if d.is_nan() { f64::INFINITY } else { d }
+        })
+        .fold(0.0, f64::max)
+}
+
+/// The channel where got and expected differ most, as a `Worst`.
+fn worst_at(deviation: f64, got: &[f32; 3], expected: [f64; 3], input: String) -> Worst {
+    let c = (0..3).max_by(|&a, &b| (got[a] as f64 - expected[a]).abs().total_cmp(&(got[b] as f64 - expected[b]).abs())).unwrap();
+    Worst { deviation, got: got[c], expected: expected[c], input }
+}
+
+/// Each case's verdict: against the twin (within tolerance) for valid input, finite and non-negative for
+/// invalid input; without a twin, valid cases are only tallied.
+fn judge_cases(model: &Model, cases: &[HardCase], out: &[[f32; 3]], tally: &mut Tally, worst: &mut Worst) -> Vec<CaseResult> {
+    cases
+        .iter()
+        .zip(out)
+        .enumerate()
+        .map(|(i, (case, got))| {
+            let valid = case.expect == Expect::Twin;
+            got.iter().for_each(|&x| tally.add(x, valid));
+            let twin = case_model(model, case).twin().copied();
+            let (expected, deviation) = match (valid, twin) {
+                (true, Some(s)) => {
+                    let e = s.eval(&case.sample);
+                    (Some(e), deviation(&s, &case.sample, got, e, i as u64))
+                }
+                (true, None) => (None, 0.0),
+                (false, _) => (None, if got.iter().any(|&x| bad(x)) { f64::INFINITY } else { 0.0 }),
+            };
+            if let (Some(e), true) = (expected, deviation > worst.deviation) {
+                *worst = worst_at(deviation, got, e, format!("case `{}`: {:?}", case.name, case.sample));
+            }
+            CaseResult { case: case.name.clone(), expected, got: *got, deviation, ok: deviation <= 1.0 }
+        })
+        .collect()
+}
+
+/// Per grid point, the deviation from the twin in tolerances (the tolerance computed only where the base
+/// tolerance is exceeded: it can only grow).
+fn grid_deviations(spec: &ModelSpec, grid: &[Sample], out: &[[f32; 3]], twin: &[[f64; 3]]) -> Vec<f64> {
+    grid.par_iter()
+        .enumerate()
+        .map(|(i, s)| {
+            (0..3)
+                .map(|c| {
+                    let (g, e) = (out[i][c] as f64, twin[i][c]);
+                    let diff = (g - e).abs();
+                    if diff.is_nan() {
+                        return f64::INFINITY;
+                    }
+                    let base = base_tolerance(spec.precision) * e.abs().max(FLOOR);
+                    if diff <= base { diff / base } else { diff / tolerance(spec, s, c, e, i as u64) }
+                })
+                .fold(0.0, f64::max)
+        })
+        .collect()
+}
+
+/// Bad values (NaN, Inf, negative) per [roughness][NoV] grid cell, all tallied.
+fn bad_cells(out: &[[f32; 3]], tally: &mut Tally) -> Vec<Vec<u32>> {
+    let mut cells = vec![vec![0u32; grid::COSINES.len()]; grid::ROUGHNESS.len()];
+    for (i, g) in out.iter().enumerate() {
+        g.iter().for_each(|&x| tally.add(x, true));
+        if g.iter().any(|&x| bad(x)) {
+            let r = i / (grid::AZIMUTHS * grid::COSINES.len() * grid::COSINES.len());
+            let v = (i / grid::COSINES.len()) % grid::COSINES.len();
+            cells[r][v] += 1;
+        }
+    }
+    cells
+}
+
+/// Steps in f_s NoL (the radiance a renderer accumulates) along NoV, NoL and roughness (channel 0, lit points
+/// only: at a cosine of 0 the light is masked by definition), which the f64 model (`twin`, where there is
+/// one) does not take, at values out of tolerance: (discontinuities, the model's own jumps, examples).
+struct Steps {
+    discontinuities: usize,
+    model_jumps: usize,
+    examples: Vec<String>,
+}
+
+fn scan_steps(grid: &[Sample], out: &[[f32; 3]], twin: Option<&[[f64; 3]]>, deviations: &[f64]) -> Steps {
+    let radiance = |vals: &dyn Fn(usize) -> f64, idx: &[usize]| idx.iter().map(|&i| vals(i) * (grid[i].l[2] as f64).max(0.0)).collect::<Vec<f64>>();
+    let mut steps = Steps { discontinuities: 0, model_jumps: 0, examples: Vec::new() };
+    let mut scan = |idx: Vec<usize>, axis: &str| {
+        let g = radiance(&|i| out[i][0] as f64, &idx);
+        let model = twin.map_or_else(Vec::new, |t| grid::jumps(&radiance(&|i| t[i][0], &idx)));
+        steps.model_jumps += model.len();
+        // Where both joined values are within tolerance of the twin, a step is rounding in an ill-conditioned
+        // corner, not a break.
+        let off = |j: usize| twin.is_none() || deviations[idx[j]] > 1.0 || deviations[idx[j + 1]] > 1.0;
+        for j in grid::jumps(&g).into_iter().filter(|j| !model.contains(j) && off(*j)) {
+            steps.discontinuities += 1;
+            if steps.examples.len() < 5 {
+                steps.examples.push(format!("along {axis} between {:?} and {:?}: {} -> {}", grid[idx[j]], grid[idx[j + 1]], g[j], g[j + 1]));
+            }
+        }
+    };
+    let n = grid::COSINES.len();
+    for r in 0..grid::ROUGHNESS.len() {
+        for az in 0..grid::AZIMUTHS {
+            for k in 1..n {
+                scan((1..n).map(|v| grid::index(r, az, v, k)).collect(), "NoV");
+                scan((1..n).map(|l| grid::index(r, az, k, l)).collect(), "NoL");
+            }
+        }
+    }
+    for az in 0..grid::AZIMUTHS {
+        for v in 1..n {
+            for l in 1..n {
+                scan((0..grid::ROUGHNESS.len()).map(|r| grid::index(r, az, v, l)).collect(), "roughness");
+            }
+        }
+    }
+    steps
+}
+
+/// max |f(v, l) - f(l, v)| / max(|f|, FLOOR).
+fn reciprocity_error(forward: &[[f32; 3]], backward: &[[f32; 3]]) -> f64 {
+    forward
+        .iter()
+        .zip(backward)
+        .flat_map(|(a, b)| (0..3).map(move |c| (a[c] as f64 - b[c] as f64).abs() / (a[c].abs().max(b[c].abs()) as f64).max(FLOOR)))
+        .fold(0.0, f64::max)
+}
+
+/// Checks one model: catalogue, grid, discontinuities and reciprocity (energy is added by `run`).
+pub fn check_model(gpu: &Gpu, model: &Model, cases: &[HardCase], grid: &[Sample], reciprocity: &[Sample]) -> Result<SpecStability> {
+    let case_out = run_cases(gpu, model, cases)?;
+    let mut all: Vec<Sample> = grid.to_vec();
+    all.extend_from_slice(reciprocity);
+    all.extend(reciprocity.iter().map(|s| Sample { v: s.l, l: s.v, ..*s }));
+    let out = kernels::eval(gpu, model, &all, RunLimits::default())?;
+    let (grid_out, rest) = out.split_at(grid.len());
+    let (forward, backward) = rest.split_at(reciprocity.len());
+
+    let (mut tally, mut worst) = (Tally::default(), Worst::default());
+    let results = judge_cases(model, cases, &case_out, &mut tally, &mut worst);
+    let spec = model.twin();
+    let twin: Option<Vec<[f64; 3]>> = spec.map(|s| grid.par_iter().map(|x| s.eval(x)).collect());
+    let deviations = match (spec, &twin) {
+        (Some(s), Some(t)) => grid_deviations(s, grid, grid_out, t),
+        _ => vec![0.0; grid.len()],
+    };
+    let cells = bad_cells(grid_out, &mut tally);
+    if let (Some(t), Some((i, &d))) = (&twin, deviations.iter().enumerate().max_by(|a, b| a.1.total_cmp(b.1))) {
+        if d > worst.deviation {
+            worst = worst_at(d, &grid_out[i], t[i], format!("grid: {:?}", grid[i]));
+        }
+    }
+    let steps = scan_steps(grid, grid_out, twin.as_deref(), &deviations);
+    let any_bad = cells.iter().flatten().any(|&n| n > 0);
+    Ok(SpecStability {
+        spec: model.name(),
+        precision: model.precision().name().into(),
+        has_twin: spec.is_some(),
+        nan: tally.nan,
+        inf: tally.inf,
+        negative: tally.negative,
+        invalid_input_poisoned: tally.poisoned,
+        cases_run: results.len(),
+        case_deviation: results.iter().map(|r| r.deviation).collect(),
+        cases_out_of_tolerance: results.into_iter().filter(|r| !r.ok).collect(),
+        grid_out_of_tolerance: deviations.iter().filter(|d| **d > 1.0).count(),
+        worst,
+        discontinuities: steps.discontinuities,
+        discontinuity_examples: steps.examples,
+        model_jumps: steps.model_jumps,
+        reciprocity: reciprocity_error(forward, backward),
+        bad_cells: any_bad.then_some(cells),
+        energy: None,
+    })
+}

@@ -1,0 +1,15 @@
+//! The term library and the kernels built on it, on the GPU against their f64 twins and exact references;
+//! the stability suite and the sweep; and the sources (spv/ and the generated GLSL) against what builds them.
+
+#[path = "../common/mod.rs"]
+mod common;
+
+mod albedo;
+mod chunking;
+mod d_normalisation;
+mod exact_reference;
+mod models;
+mod sources;
+mod stability;
+mod sweep;
+mod terms;

@@ -1,0 +1,127 @@
+//! The stability suite on lavapipe (validation layer on): every built-in spec in fp32 gives no NaN, Inf or
+//! negative value over the hard-case catalogue and the dense grid, every hard case is within tolerance of its
+//! expected value, no out-of-tolerance step, reciprocity holds. fp16 is reported; the test asserts what fp16
+//! can do: never negative, never poisoned by invalid input, finite and close on well-conditioned inputs; and
+//! the CLI exits 1 and says so where it fails. The guards are the same constants in GLSL and Rust.
+
+use crate::common;
+use brdfprof::brdf::{guards, samples, ModelSpec, Precision, PRESETS};
+use brdfprof::kernels::{self, RunLimits};
+use brdfprof::stability::{self, catalogue, grid};
+
+#[test]
+fn every_fp32_spec_is_stable_over_catalogue_and_grid() {
+    let gpu = common::gpu();
+    let cases = catalogue::hard_cases();
+    let grid = grid::samples();
+    let reciprocity = samples::well_conditioned(5_000, 4, 1e-3, 0.0..1.0);
+    let specs: Vec<ModelSpec> = stability::default_specs().into_iter().filter(|s| s.precision == Precision::F32).collect();
+    assert!(specs.len() >= 80, "every D x Vis and every Fresnel");
+    let mut problems = Vec::new();
+    for spec in &specs {
+        let r = stability::check_model(&gpu, &common::model(*spec), &cases, &grid, &reciprocity).unwrap();
+        if r.fails() {
+            problems.push(format!("{}: {} NaN, {} Inf, {} negative (worst at {})", r.spec, r.nan, r.inf, r.negative, r.worst.input));
+        }
+        for c in &r.cases_out_of_tolerance {
+            problems.push(format!("{}: case `{}` got {:?}, expected {:?} ({:.2} x tolerance)", r.spec, c.case, c.got, c.expected, c.deviation));
+        }
+        if r.grid_out_of_tolerance > 0 || r.discontinuities > 0 {
+            problems.push(format!("{}: {} grid points out of tolerance, {} steps; worst {:.2} x tolerance at {}", r.spec, r.grid_out_of_tolerance, r.discontinuities, r.worst.deviation, r.worst.input));
+        }
+        if r.invalid_input_poisoned > 0 {
+            problems.push(format!("{}: NaN/Inf input came out non-finite or negative", r.spec));
+        }
+        if r.reciprocity > 1e-4 {
+            problems.push(format!("{}: f(v,l) and f(l,v) differ by {:.1e}", r.spec, r.reciprocity));
+        }
+    }
+    assert!(problems.is_empty(), "{} problems:\n{}", problems.len(), problems.join("\n"));
+    common::assert_no_validation_messages(&gpu);
+}
+
+#[test]
+fn fp16_does_what_it_can_and_the_report_says_where_it_cannot() {
+    let gpu = common::gpu();
+    // On the well-conditioned domain of the foundation tests, every preset in fp16 is finite, non-negative and
+    // close to its f64 twin (fp16's 11-bit significand; Blinn's exponent m amplifies it most).
+    let s = samples::well_conditioned(50_000, 3, 0.05, 0.2..1.0);
+    for p in PRESETS {
+        let spec = ModelSpec { precision: Precision::F16, ..ModelSpec::preset(p.name).unwrap() };
+        let bound = match p.name {
+            "blinn" => 0.25,
+            "cook-torrance" => 0.08,
+            _ => 0.04,
+        };
+        let got = kernels::eval(&gpu, &common::model(spec), &s, RunLimits::default()).unwrap();
+        let mut worst = 0f64;
+        for (x, g) in s.iter().zip(&got) {
+            let e = spec.eval(x);
+            for c in 0..3 {
+                assert!(g[c].is_finite() && g[c] >= 0.0, "{}: {} at {x:?}", spec, g[c]);
+                worst = worst.max(common::rel_err(g[c] as f64, e[c]));
+            }
+        }
+        println!("{:16} fp16 max relative error {worst:.3e}", p.name);
+        assert!(worst <= bound, "{spec}: {worst}");
+    }
+    // Over the hard cases and the grid, fp16 may overflow; it must never go negative nor pass poison on.
+    let cases = catalogue::hard_cases();
+    let grid = grid::samples();
+    for name in ["ggx", "cook-torrance", "burley"] {
+        let spec = ModelSpec { precision: Precision::F16, ..ModelSpec::preset(name).unwrap() };
+        let r = stability::check_model(&gpu, &common::model(spec), &cases, &grid, &[]).unwrap();
+        assert_eq!((r.negative, r.invalid_input_poisoned), (0, 0), "{spec}");
+        // Every failure is visible: in the heat map of grid cells or among the failing hard cases.
+        let in_cases = r.cases_out_of_tolerance.iter().any(|c| c.got.iter().any(|x| !x.is_finite()));
+        assert!(!r.fails() || r.bad_cells.is_some() || in_cases, "{spec}: fails but shows nothing");
+    }
+    common::assert_no_validation_messages(&gpu);
+}
+
+#[test]
+fn cli_exits_1_and_reports_failing_fp16_and_0_when_stable() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = |models: &[&str]| {
+        let mut c = common::brdfprof();
+        c.args(["stability", "--validate", "--out"]).arg(dir.path());
+        for m in models {
+            c.args(["--model", m]);
+        }
+        c.output().unwrap()
+    };
+    let ok = run(&["ggx", "burley"]);
+    assert_eq!(ok.status.code(), Some(0), "{}", String::from_utf8_lossy(&ok.stderr));
+    let md = std::fs::read_to_string(common::device_file(dir.path(), "stability-", ".md")).unwrap();
+    assert!(md.contains("| ggx ") && md.contains("| ok "));
+    assert!(image::open(common::device_file(dir.path(), "furnace-", ".png")).is_ok());
+    assert!(image::open(common::device_file(dir.path(), "albedo-", ".png")).is_ok());
+    let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(common::device_file(dir.path(), "stability-", ".json")).unwrap()).unwrap();
+    let burley = json["specs"].as_array().unwrap().iter().find(|s| s["spec"] == "burley").unwrap();
+    assert!(burley["energy"]["gains_energy"].as_bool().unwrap(), "Burley's GTR with GGX's Smith G gains energy");
+
+    let failing = run(&["ggx", "ggx,precision=f16"]);
+    assert_eq!(failing.status.code(), Some(1), "{}", String::from_utf8_lossy(&failing.stderr));
+    assert!(String::from_utf8_lossy(&failing.stderr).contains("1 spec(s) give NaN, Inf or negative values"));
+    let md = std::fs::read_to_string(common::device_file(dir.path(), "stability-", ".md")).unwrap();
+    assert!(md.contains("| ggx,precision=f16") && md.contains("FAIL"));
+    let failures = std::fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().path()).find(|p| p.to_string_lossy().ends_with("-failures.png"));
+    assert!(failures.is_some_and(|p| image::open(p).is_ok()), "a heat map for the failing spec");
+}
+
+#[test]
+fn guards_are_the_same_constants_in_glsl_and_rust() {
+    let glsl = std::fs::read_to_string(common::repo_root().join("glsl/generated/brdf_table.glsl")).unwrap();
+    let constant = |name: &str, occurrence: usize| -> f64 {
+        let needle = format!("const float {name} = ");
+        let start = glsl.match_indices(&needle).nth(occurrence).unwrap_or_else(|| panic!("{name} in brdf.glsl")).0 + needle.len();
+        glsl[start..].split(';').next().unwrap().trim().parse().unwrap()
+    };
+    // MIN_ROUGHNESS appears twice: the fp16 branch first, then fp32.
+    assert_eq!(constant("MIN_ROUGHNESS", 0), guards::MIN_ROUGHNESS_F16);
+    assert_eq!(constant("MIN_ROUGHNESS", 1), guards::MIN_ROUGHNESS_F32);
+    assert_eq!(constant("MIN_COSINE", 0), guards::MIN_COSINE);
+    assert_eq!(constant("MIN_VECTOR", 0) as f32 as f64, guards::MIN_VECTOR);
+    assert_eq!(constant("GTR_SERIES_BAND", 0), guards::GTR_SERIES_BAND);
+    assert_eq!(constant("F0_MAX", 0), guards::F0_MAX);
+}

@@ -1,0 +1,121 @@
+//! The scene commands end to end: `scene --explain` and `scene FILE`; `render` writes every picture;
+//! `profile --scene` prints what is compiled in and each effect's cost with a CI, and writes the JSON; malformed
+//! scene files exit 2 with the JSON path of the problem, a missing image exits 2 naming the file, and nothing
+//! is written. (Small G-buffers and short budgets: this checks plumbing, not figures.)
+
+use crate::common;
+use serde_json::Value;
+use std::path::Path;
+
+fn run(args: &[&str]) -> (i32, String, String) {
+    let out = common::brdfprof().args(args).output().unwrap();
+    (out.status.code().unwrap_or(-1), String::from_utf8_lossy(&out.stdout).into_owned(), String::from_utf8_lossy(&out.stderr).into_owned())
+}
+
+const SMALL: &str = r#"{
+  "name": "small",
+  "gbuffer": {"procedural": {"kind": "statues", "size": [96, 54], "statues": ["brushed", "paint"], "floor": "floor"}},
+  "lights": [
+    {"type": "directional", "direction": [0.3, -1.0, -0.4]},
+    {"type": "point", "position": [-3.0, 3.0, 2.0], "intensity": 8.0},
+    {"type": "spot", "position": [0.0, 5.0, 3.0], "direction": [0.0, -1.0, -0.6], "intensity": 30.0},
+    {"type": "sphere", "position": [2.0, 2.5, 1.5], "radius": 0.4, "intensity": 10.0}
+  ],
+  "materials": [
+    {"name": "brushed", "model": "ggx", "base_colour": [0.9, 0.9, 0.92], "metallic": 1.0, "roughness": 0.35, "effects": {"anisotropy": 0.7}},
+    {"name": "paint", "model": "ggx", "base_colour": [0.5, 0.05, 0.05], "effects": {"clear_coat": {"strength": 1.0}}},
+    {"name": "floor", "model": "blinn", "roughness": 0.7, "effects": {"diffuse": "lambert", "energy_compensation": true}}
+  ],
+  "render": {"models": ["ggx", "burley"], "grid": ["paint"], "lobe_roughness": [0.5]}
+}"#;
+
+fn write(dir: &Path, name: &str, text: &str) -> String {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p.display().to_string()
+}
+
+#[test]
+fn explain_and_check() {
+    let (code, out, _) = run(&["scene", "--explain"]);
+    assert_eq!(code, 0);
+    assert!(out.contains("\"effects\"") && out.contains("representative point") && out.contains("\"sphere-grid\""), "{out}");
+    let dir = tempfile::tempdir().unwrap();
+    let f = write(dir.path(), "s.json", SMALL);
+    let (code, out, err) = run(&["scene", &f]);
+    assert_eq!(code, 0, "{err}");
+    assert!(out.contains("ggx:") && out.contains("anisotropy") && out.contains("clear-coat"), "{out}");
+    assert!(out.contains("blinn:") && out.contains("energy-compensation") && out.contains("1 sphere"), "{out}");
+}
+
+#[test]
+fn render_writes_every_picture() {
+    let dir = tempfile::tempdir().unwrap();
+    let f = write(dir.path(), "s.json", SMALL);
+    let out = dir.path().join("out");
+    let (code, stdout, err) = run(&["render", "--validate", "--scene", &f, "--out", out.to_str().unwrap()]);
+    assert_eq!(code, 0, "{err}");
+    assert!(!err.contains("validation ["), "{err}");
+    for name in ["ggx.png", "burley.png", "diff-burley-vs-ggx.png", "grid.png", "lobes.png"] {
+        let img = image::open(out.join(name)).unwrap_or_else(|e| panic!("{name}: {e}\n{stdout}"));
+        assert!(img.width() > 50 && img.height() > 50);
+    }
+    let ggx = image::open(out.join("ggx.png")).unwrap().to_rgb8();
+    assert_eq!((ggx.width(), ggx.height()), (96, 54));
+    assert!(ggx.pixels().any(|p| p.0.iter().any(|&c| c > 128)), "the render is not all dark");
+    assert!(err.contains("anisotropy needs d=ggx"), "burley renders drop anisotropy with a note: {err}");
+}
+
+#[test]
+fn profile_scene_prints_what_is_compiled_in_and_effect_costs() {
+    let dir = tempfile::tempdir().unwrap();
+    let f = write(dir.path(), "s.json", SMALL);
+    let json = dir.path().join("p.json");
+    let (code, out, err) = run(&["profile", "--validate", "--scene", &f, "--budget", "5", "--min-rounds", "6", "--json", json.to_str().unwrap()]);
+    assert_eq!(code, 0, "{err}");
+    assert!(!err.contains("validation ["), "{err}");
+    assert!(out.contains("Compiled in") && out.contains("| ggx ") && out.contains("| blinn "), "{out}");
+    for effect in ["anisotropy", "clear-coat", "diffuse", "energy-compensation"] {
+        assert!(out.contains(&format!("| {effect}")), "no cost row for {effect}:\n{out}");
+    }
+    let report: Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let effects = report["effects"].as_array().unwrap();
+    assert_eq!(effects.len(), 4);
+    for e in effects {
+        let x = &e["extra_ns_per_pixel"];
+        assert!(x["lo"].as_f64().unwrap() <= x["median"].as_f64().unwrap() && x["median"].as_f64().unwrap() <= x["hi"].as_f64().unwrap());
+    }
+    // Anisotropy (two lobes' worth of work on the brushed statue's pixels, per light) costs something measurable.
+    let aniso = effects.iter().find(|e| e["effect"] == "anisotropy").unwrap();
+    assert!(aniso["extra_spirv_instructions"].as_i64().unwrap() > 0);
+    assert_eq!(report["kernels"].as_array().unwrap().len(), 2);
+}
+
+#[test]
+fn bad_scenes_exit_2_naming_the_problem() {
+    let dir = tempfile::tempdir().unwrap();
+    let cases = [
+        (SMALL.replace(r#""roughness": 0.35"#, r#""roughness": "x""#), "materials[0].roughness: invalid type: string \"x\", expected f32"),
+        (SMALL.replace(r#""radius": 0.4"#, r#""radius": -1"#), "lights[3].radius"),
+        (SMALL.replace(r#""model": "blinn""#, r#""model": "blin""#), "materials[2].model: unknown model `blin`"),
+        (SMALL.replace(r#""floor": "floor"}}"#, r#""floor": "flor"}}"#), "gbuffer.procedural.floor: no material named `flor`"),
+        (SMALL.replace(r#""size": [96, 54]"#, r#""size": [96]"#), "gbuffer.procedural.size"),
+    ];
+    for (i, (text, expected)) in cases.iter().enumerate() {
+        let f = write(dir.path(), &format!("bad{i}.json"), text);
+        let out = dir.path().join(format!("out{i}"));
+        let (code, _, err) = run(&["render", "--scene", &f, "--out", out.to_str().unwrap()]);
+        assert_eq!(code, 2, "{expected}: {err}");
+        assert!(err.contains(expected) && err.contains(&f), "expected `{expected}` naming {f} in: {err}");
+        assert!(!out.exists(), "nothing is written for a bad scene");
+    }
+    let images = r#"{"gbuffer": {"images": {"normal": "missing-normal.png", "depth": "d.exr"}},
+        "camera": {"position": [0, 0, 5], "look_at": [0, 0, 0]}, "lights": [], "materials": [{"name": "a", "model": "ggx"}]}"#;
+    let f = write(dir.path(), "images.json", images);
+    let (code, _, err) = run(&["scene", &f]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains(&dir.path().join("missing-normal.png").display().to_string()), "{err}");
+    let (code, _, err) = run(&["profile", "--scene", &dir.path().join("nope.json").display().to_string()]);
+    assert_eq!(code, 2);
+    assert!(err.contains("nope.json"), "{err}");
+}

@@ -1,0 +1,15 @@
+//! The commands that time kernels or count their instructions under callgrind: profile, inspect and the check
+//! gate. They run one at a time (`serial`), so that no timing shares the two cores with another measurement.
+
+#[path = "../common/mod.rs"]
+mod common;
+
+mod check_gate;
+mod inspect;
+mod profile;
+
+/// Held by every test of this binary while it runs.
+pub fn serial() -> std::sync::MutexGuard<'static, ()> {
+    static SERIAL: std::sync::Mutex<()> = std::sync::Mutex::new(());
+    SERIAL.lock().unwrap_or_else(|e| e.into_inner())
+}
