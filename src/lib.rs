@@ -7,6 +7,7 @@ pub mod accuracy;
 pub mod brdf;
 pub mod chart;
 pub mod gpu;
+pub mod host;
 pub mod inspect;
 pub mod io;
 pub mod kernels;

@@ -54,6 +54,7 @@ enum Command {
 }
 
 fn main() -> ExitCode {
+    cli::command_started();
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Devices(args) => cli::info::devices(&args),

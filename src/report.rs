@@ -73,6 +73,8 @@ pub struct Provenance {
     pub llvm_version: Option<String>,
     pub env: BTreeMap<String, String>,
     pub host_cpu: Option<String>,
+    /// Family, model, stepping and vector features: lavapipe's costs are this CPU's.
+    pub cpu: crate::host::HostCpu,
     pub host_threads: usize,
 }
 
@@ -90,6 +92,7 @@ impl Provenance {
             llvm_version: llvm,
             env: driver_environment(),
             host_cpu,
+            cpu: crate::host::HostCpu::detect(),
             host_threads: std::thread::available_parallelism().map_or(1, |n| n.get()),
         }
     }

@@ -48,7 +48,11 @@ impl Spirv {
 
 /// The embedded kernel `name` (a name from `glsl/kernels.txt`).
 pub fn embedded(name: &str) -> Result<&'static KernelSource> {
-    KERNELS.iter().find(|k| k.name == name).ok_or_else(|| anyhow!("no kernel `{name}` in glsl/kernels.txt"))
+    let k = KERNELS.iter().find(|k| k.name == name).ok_or_else(|| anyhow!("no kernel `{name}` in glsl/kernels.txt"))?;
+    if k.spirv.is_empty() {
+        bail!("spv/{name}.spv was missing when brdfprof was built: run `make spv` and rebuild");
+    }
+    Ok(k)
 }
 
 impl KernelSource {

@@ -105,23 +105,31 @@ pub fn pareto_front(points: &[(f64, f64)]) -> Vec<bool> {
 }
 
 pub fn run(gpu: &Gpu, options: &SweepOptions, progress: &ProgressBar) -> Result<SweepReport> {
-    let profile = profile::run(gpu, &options.profile, progress)?;
-    progress.set_message("accuracy: GPU against f64 twins and exact references");
+    if options.profile.lights.len() != 1 {
+        anyhow::bail!("--lights: a sweep ranks specs at one light count (`brdfprof profile --lights 1,8,64` compares counts)");
+    }
+    // Accuracy first, so that the profile's budget (the whole command's) accounts for it.
     let set = SampleSet::standard();
     let mut cache = ExactCache::default();
+    let n = options.profile.models.len();
+    let mut accuracies = Vec::with_capacity(n);
+    for (k, spec) in options.profile.models.iter().enumerate() {
+        progress.set_message(format!("accuracy {}/{n}: {} against its f64 twin and exact references", k + 1, spec.name()));
+        accuracies.push(accuracy::measure(gpu, spec, &set, &mut cache)?);
+    }
+    let profile = profile::run(gpu, &options.profile, progress)?;
     let specs: Vec<(usize, Model)> = options
         .profile
         .models
         .iter()
         .map(|m| (profile.labels.iter().position(|l| *l == m.name()).expect("every spec was timed"), m.clone()))
         .collect();
-    let evals = profile.workload.evaluations_per_dispatch as f64;
+    let evals = profile.rows[0].evaluations_per_dispatch as f64;
     let costs: Vec<Vec<f64>> = specs.iter().map(|(i, _)| profile::per_round(&profile.raw, *i, evals)).collect();
     let medians: Vec<f64> = specs.iter().map(|(i, _)| profile.rows[*i].vs_reference.median).collect();
     let fastest = (0..specs.len()).min_by(|&a, &b| medians[a].total_cmp(&medians[b])).unwrap();
     let mut rows = Vec::new();
-    for (k, (i, spec)) in specs.iter().enumerate() {
-        progress.set_message(format!("accuracy {}/{}: {}", k + 1, specs.len(), spec.name()));
+    for (k, ((i, spec), accuracy)) in specs.iter().zip(accuracies).enumerate() {
         let ratio: Vec<f64> = costs[k].iter().zip(&costs[fastest]).map(|(a, f)| a / f).collect();
         let row = &profile.rows[*i];
         rows.push(SweepRow {
@@ -133,7 +141,7 @@ pub fn run(gpu: &Gpu, options: &SweepOptions, progress: &ProgressBar) -> Result<
             cost_vs_fastest: stats::median_ci(&ratio, profile::LEVEL),
             rank: 0,
             tied: false,
-            accuracy: accuracy::measure(gpu, spec, &set, &mut cache)?,
+            accuracy,
             pareto: false,
         });
     }
@@ -237,7 +245,7 @@ impl SweepReport {
             .filter(|r| !r.canonical.contains("precision=f16"))
             .map(|r| r.cost_vs_fastest.median)
             .fold(f64::NEG_INFINITY, f64::max);
-        let title = format!("Accuracy against cost on {} ({} evaluations per dispatch)", self.profile.provenance.device.name, self.profile.workload.evaluations_per_dispatch);
+        let title = format!("Accuracy against cost on {} ({} evaluations per dispatch)", self.profile.provenance.device.name, self.profile.rows[0].evaluations_per_dispatch);
         let spec = chart::Scatter {
             title: &title,
             x_desc: "cost relative to the fastest spec (median of per-round ratios, 95% CI whiskers)",

@@ -3,7 +3,7 @@
 // Kernel-level specialisation constants (src/kernels/constants.rs), declared for every kernel.
 #ifndef KERNEL_CONSTANTS_GLSL
 #define KERNEL_CONSTANTS_GLSL
-layout(constant_id = 16) const int NUM_LIGHTS = 8; // shade.comp: directional lights per pixel
+layout(constant_id = 16) const int NUM_LIGHTS = 8; // shade.glsl: directional lights per dispatch (a block of the profile's lights)
 layout(constant_id = 17) const int BASELINE = 0; // shade.comp: 1 = the memory-only kernel (no BRDF)
 layout(constant_id = 18) const int ALBEDO_N = 256; // albedo estimator: columns per component and azimuth rows
 layout(constant_id = 19) const int NUM_DIRECTIONAL = 1; // scene.comp: directional lights
@@ -16,4 +16,6 @@ layout(constant_id = 25) const int DIFFUSE = 0; // scene effect: 0 none, 1 Lambe
 layout(constant_id = 26) const int CLEAR_COAT = 0; // scene effect: 0 off, 1 on (per-pixel strength and roughness)
 layout(constant_id = 27) const int E_TABLE_MU = 32; // E(mu, r) table: mu nodes (mu_i = (i + 0.5) / N)
 layout(constant_id = 28) const int E_TABLE_R = 16; // E(mu, r) table: r nodes (r_j = j / (M - 1))
+layout(constant_id = 29) const int ACCUMULATE = 0; // shade.glsl: 1 = add to the radiance an earlier light block wrote
+#define LIGHT_BLOCK 8 // shade.glsl: lights per dispatch at most
 #endif

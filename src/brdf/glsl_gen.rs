@@ -7,7 +7,7 @@
 
 use super::guards::{GLSL_GUARDS, MIN_ROUGHNESS_F16, MIN_ROUGHNESS_F32};
 use super::terms::{Metal, ParamKind, PARAMS, D, F, Vis};
-use crate::kernels::constants::{ConstantKind, ALL as KERNEL_CONSTANTS};
+use crate::kernels::constants::{ConstantKind, ALL as KERNEL_CONSTANTS, LIGHT_BLOCK};
 
 /// Files under glsl/generated/ and their contents.
 pub fn files() -> Vec<(&'static str, String)> {
@@ -94,7 +94,7 @@ fn kernel_constants() -> String {
         };
         out += &format!("layout(constant_id = {}) const {ty} {} = {value}; // {}\n", c.id, c.name, c.about);
     }
-    out += "#endif\n";
+    out += &format!("#define LIGHT_BLOCK {LIGHT_BLOCK} // shade.glsl: lights per dispatch at most\n#endif\n");
     out
 }
 

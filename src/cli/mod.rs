@@ -75,9 +75,14 @@ impl ModelArgs {
 /// Size and protocol of a timed run, shared by `profile` and `sweep`.
 #[derive(Args, Clone)]
 pub struct TimingArgs {
-    /// Directional lights per pixel (a specialisation constant: the light loop is unrolled).
-    #[arg(long, default_value_t = 8)]
-    pub lights: u32,
+    /// Directional lights per pixel (run in blocks of 8 per dispatch, each block's loop unrolled). A
+    /// comma-separated list (e.g. 1,8,64) times every count in the same interleaved rounds.
+    #[arg(long, value_delimiter = ',', default_value = "8")]
+    pub lights: Vec<u32>,
+    /// G-buffer layout: packed as engines store it (octahedral normal, RGBA8 material and base colour, V from
+    /// the pixel and the camera, R11G11B10F out: 16 bytes in, 4 out), or float (48 bytes in, 16 out).
+    #[arg(long, value_enum, default_value = "packed")]
+    pub gbuffer: brdfprof::profile::gbuffer::GBufferFormat,
     /// Minimum and maximum number of interleaved rounds.
     #[arg(long, default_value_t = 12)]
     pub min_rounds: usize,
@@ -93,32 +98,50 @@ pub struct TimingArgs {
     /// Keep Mesa's on-disk shader cache (timed runs switch it off by default; see `fresh_compilation`).
     #[arg(long)]
     pub shader_cache: bool,
+    /// Compile the shading kernels from this GLSL directory (a copy of glsl/, with its kernels.txt) with
+    /// glslang instead of using the embedded SPIR-V: time an edited kernel against the built-in one.
+    #[arg(long)]
+    pub glsl: Option<std::path::PathBuf>,
 }
 
 impl TimingArgs {
     pub fn options(&self, models: Vec<Model>, size: &str, reps: usize, budget: f64, target_ci: f64) -> Result<ProfileOptions> {
         let (width, height) = parse_size("--size", size)?;
-        if self.lights == 0 {
-            bail!("--lights must be at least 1");
+        use brdfprof::profile::workload::MAX_LIGHTS;
+        if self.lights.iter().any(|&l| l == 0 || l > MAX_LIGHTS) {
+            bail!("--lights {}: each count must be 1 to {MAX_LIGHTS}", self.lights.iter().map(u32::to_string).collect::<Vec<_>>().join(","));
+        }
+        let mut seen = std::collections::BTreeSet::new();
+        if let Some(l) = self.lights.iter().find(|l| !seen.insert(**l)) {
+            bail!("--lights: {l} is given twice");
         }
         let min_rounds = self.min_rounds.max(1);
         Ok(ProfileOptions {
             models,
             width,
             height,
-            lights: self.lights,
+            lights: self.lights.clone(),
+            format: self.gbuffer,
             protocol: ProtocolOptions {
                 min_rounds,
                 max_rounds: self.max_rounds.max(min_rounds),
                 reps: reps.max(1),
                 budget: parse_budget(budget)?,
+                started: command_started(),
                 seed: self.seed,
             },
             target_rel_ci: target_ci,
             max_chunk: None,
             instances: self.instances.max(1),
+            glsl: self.glsl.clone(),
         })
     }
+}
+
+/// When this command began (the first call, from `main`, fixes it): `--budget` counts from here.
+pub fn command_started() -> std::time::Instant {
+    static STARTED: std::sync::OnceLock<std::time::Instant> = std::sync::OnceLock::new();
+    *STARTED.get_or_init(std::time::Instant::now)
 }
 
 /// `--budget` in seconds: positive and finite.

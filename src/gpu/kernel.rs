@@ -1,8 +1,8 @@
-//! Compute kernels: a pipeline specialised with constants, its storage-buffer bindings, and the chunking that
+//! Compute kernels: a pipeline specialised with constants, its buffer bindings, and the chunking that
 //! keeps every binding inside maxStorageBufferRange and every dispatch inside maxComputeWorkGroupCount.
 
 use super::{Buffer, Commands, DeviceInfo, Gpu};
-use anyhow::{anyhow, Context, Result};
+use anyhow::{anyhow, bail, Context, Result};
 use ash::vk;
 
 /// Specialisation constants, in the order they are added.
@@ -32,9 +32,47 @@ impl SpecConstants {
     }
 }
 
-/// A descriptor set: the storage-buffer windows one dispatch reads and writes.
+/// A descriptor set: the buffer windows one dispatch reads and writes.
 #[derive(Clone, Copy, Debug)]
 pub struct Bindings(vk::DescriptorSet);
+
+/// What a binding of a kernel is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Binding {
+    /// A storage buffer (read or written per invocation).
+    Storage,
+    /// A uniform buffer whose offset is given at each dispatch (data every invocation reads alike, e.g. one
+    /// block of lights: drivers load it as scalars).
+    UniformDynamic,
+    /// A buffer read through a typed view (`samplerBuffer` + texelFetch): the format conversion is the
+    /// texture path's, as a G-buffer render target's is.
+    TexelRead(vk::Format),
+    /// A buffer read and written through a typed view (`imageBuffer` + imageLoad/imageStore).
+    TexelStorage(vk::Format),
+}
+
+impl Binding {
+    /// `n` storage buffers.
+    pub fn storage(n: u32) -> Vec<Binding> {
+        vec![Binding::Storage; n as usize]
+    }
+
+    fn descriptor_type(self) -> vk::DescriptorType {
+        match self {
+            Binding::Storage => vk::DescriptorType::STORAGE_BUFFER,
+            Binding::UniformDynamic => vk::DescriptorType::UNIFORM_BUFFER_DYNAMIC,
+            Binding::TexelRead(_) => vk::DescriptorType::UNIFORM_TEXEL_BUFFER,
+            Binding::TexelStorage(_) => vk::DescriptorType::STORAGE_TEXEL_BUFFER,
+        }
+    }
+
+    fn texel_format(self) -> Option<vk::Format> {
+        match self {
+            Binding::TexelRead(f) | Binding::TexelStorage(f) => Some(f),
+            _ => None,
+        }
+    }
+}
 
 pub struct Kernel<'g> {
     pub(super) gpu: &'g Gpu,
@@ -43,7 +81,9 @@ pub struct Kernel<'g> {
     layout: vk::PipelineLayout,
     set_layout: vk::DescriptorSetLayout,
     pool: vk::DescriptorPool,
-    bindings: u32,
+    bindings: Vec<Binding>,
+    /// The typed views of the texel-buffer bindings handed out (destroyed with the sets).
+    views: std::cell::RefCell<Vec<vk::BufferView>>,
     push_bytes: u32,
     /// Invocations per workgroup (local_size_x of every brdfprof kernel).
     pub workgroup: u32,
@@ -57,20 +97,30 @@ const SETS_PER_KERNEL: u32 = 256;
 pub const WORKGROUP: u32 = 64;
 
 impl<'g> Kernel<'g> {
-    /// A pipeline for the SPIR-V `words` (named `name` in errors), specialised, with `bindings` storage buffers
-    /// and `push_bytes` of push constants. With `capture_ir` the driver keeps its internal representations
-    /// (`PipelineExecutable::representations`).
-    pub fn new(gpu: &'g Gpu, name: &str, words: &[u32], spec: &SpecConstants, bindings: u32, push_bytes: u32) -> Result<Self> {
+    /// A pipeline for the SPIR-V `words` (named `name` in errors), specialised, with the buffers of `bindings`
+    /// (binding 0, 1, ...) and `push_bytes` of push constants. With `capture_ir` the driver keeps its internal
+    /// representations (`PipelineExecutable::representations`).
+    pub fn new(gpu: &'g Gpu, name: &str, words: &[u32], spec: &SpecConstants, bindings: &[Binding], push_bytes: u32) -> Result<Self> {
         Self::with_capture(gpu, name, words, spec, bindings, push_bytes, false)
     }
 
-    pub fn with_capture(gpu: &'g Gpu, name: &str, words: &[u32], spec: &SpecConstants, bindings: u32, push_bytes: u32, capture_ir: bool) -> Result<Self> {
+    pub fn with_capture(gpu: &'g Gpu, name: &str, words: &[u32], spec: &SpecConstants, bindings: &[Binding], push_bytes: u32, capture_ir: bool) -> Result<Self> {
+        for b in bindings {
+            if let Some(format) = b.texel_format() {
+                let storage = matches!(b, Binding::TexelStorage(_));
+                if !gpu.texel_buffer_support(format, storage) {
+                    bail!("{name}: {} cannot use {format:?} as a {} texel buffer", gpu.info.name, if storage { "storage" } else { "uniform" });
+                }
+            }
+        }
         let device = &gpu.device;
-        let binding_info: Vec<_> = (0..bindings)
-            .map(|b| {
+        let binding_info: Vec<_> = bindings
+            .iter()
+            .enumerate()
+            .map(|(b, kind)| {
                 vk::DescriptorSetLayoutBinding::default()
-                    .binding(b)
-                    .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
+                    .binding(b as u32)
+                    .descriptor_type(kind.descriptor_type())
                     .descriptor_count(1)
                     .stage_flags(vk::ShaderStageFlags::COMPUTE)
             })
@@ -112,19 +162,26 @@ impl<'g> Kernel<'g> {
                 .create_compute_pipelines(vk::PipelineCache::null(), &[info], None)
                 .map_err(|(_, e)| anyhow!("creating the {name} pipeline: {e}"))?[0];
             device.destroy_shader_module(module, None);
-            let sizes = [vk::DescriptorPoolSize { ty: vk::DescriptorType::STORAGE_BUFFER, descriptor_count: SETS_PER_KERNEL * bindings.max(1) }];
+            let mut sizes: Vec<vk::DescriptorPoolSize> = Vec::new();
+            for b in bindings {
+                match sizes.iter_mut().find(|s| s.ty == b.descriptor_type()) {
+                    Some(s) => s.descriptor_count += SETS_PER_KERNEL,
+                    None => sizes.push(vk::DescriptorPoolSize { ty: b.descriptor_type(), descriptor_count: SETS_PER_KERNEL }),
+                }
+            }
             let pool = device.create_descriptor_pool(
                 &vk::DescriptorPoolCreateInfo::default().max_sets(SETS_PER_KERNEL).pool_sizes(&sizes),
                 None,
             )?;
             let captures_ir = capture_ir && gpu.executable_properties.is_some();
-            Ok(Kernel { gpu, name: name.into(), pipeline, layout, set_layout, pool, bindings, push_bytes, workgroup: WORKGROUP, captures_ir })
+            Ok(Kernel { gpu, name: name.into(), pipeline, layout, set_layout, pool, bindings: bindings.to_vec(), views: Default::default(), push_bytes, workgroup: WORKGROUP, captures_ir })
         }
     }
 
-    /// A descriptor set binding each `(buffer, offset, range)` window to bindings 0, 1, ...
+    /// A descriptor set binding each `(buffer, offset, range)` window to bindings 0, 1, ... (for a dynamic
+    /// uniform buffer the offset is added to the one each dispatch gives).
     pub fn bind(&self, windows: &[(&Buffer, u64, u64)]) -> Result<Bindings> {
-        assert_eq!(windows.len() as u32, self.bindings, "{}: wrong number of bindings", self.name);
+        assert_eq!(windows.len(), self.bindings.len(), "{}: wrong number of bindings", self.name);
         let layouts = [self.set_layout];
         let alloc = vk::DescriptorSetAllocateInfo::default().descriptor_pool(self.pool).set_layouts(&layouts);
         // SAFETY: pool and layout belong to this kernel; the infos outlive the update.
@@ -136,15 +193,31 @@ impl<'g> Kernel<'g> {
                 .with_context(|| format!("{}: more than {SETS_PER_KERNEL} chunks bound at once", self.name))?[0];
             let infos: Vec<[vk::DescriptorBufferInfo; 1]> =
                 windows.iter().map(|(b, offset, range)| [vk::DescriptorBufferInfo { buffer: b.buffer, offset: *offset, range: *range }]).collect();
+            let mut views = self.views.borrow_mut();
+            let texel_views: Vec<Option<[vk::BufferView; 1]>> = windows
+                .iter()
+                .zip(&self.bindings)
+                .map(|((b, offset, range), kind)| {
+                    kind.texel_format()
+                        .map(|format| {
+                            let info = vk::BufferViewCreateInfo::default().buffer(b.buffer).format(format).offset(*offset).range(*range);
+                            let view = self.gpu.device.create_buffer_view(&info, None)?;
+                            views.push(view);
+                            Ok::<_, vk::Result>([view])
+                        })
+                        .transpose()
+                })
+                .collect::<std::result::Result<_, _>>()?;
             let writes: Vec<_> = infos
                 .iter()
+                .zip(&texel_views)
                 .enumerate()
-                .map(|(i, info)| {
-                    vk::WriteDescriptorSet::default()
-                        .dst_set(set)
-                        .dst_binding(i as u32)
-                        .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
-                        .buffer_info(info)
+                .map(|(i, (info, view))| {
+                    let w = vk::WriteDescriptorSet::default().dst_set(set).dst_binding(i as u32).descriptor_type(self.bindings[i].descriptor_type());
+                    match view {
+                        Some(v) => w.texel_buffer_view(v),
+                        None => w.buffer_info(info),
+                    }
                 })
                 .collect();
             self.gpu.device.update_descriptor_sets(&writes, &[]);
@@ -155,13 +228,24 @@ impl<'g> Kernel<'g> {
     /// Frees every descriptor set this kernel handed out.
     pub fn reset_bindings(&self) -> Result<()> {
         // SAFETY: callers only reset once the sets' submissions have completed.
-        unsafe { self.gpu.device.reset_descriptor_pool(self.pool, vk::DescriptorPoolResetFlags::empty()) }?;
+        unsafe {
+            self.gpu.device.reset_descriptor_pool(self.pool, vk::DescriptorPoolResetFlags::empty())?;
+            for v in self.views.borrow_mut().drain(..) {
+                self.gpu.device.destroy_buffer_view(v, None);
+            }
+        }
         Ok(())
     }
 
     /// Records a dispatch of `invocations` threads (rounded up to whole workgroups).
     pub fn dispatch(&self, cmd: &Commands, set: Bindings, push: &[u8], invocations: u64) {
+        self.dispatch_at(cmd, set, &[], push, invocations)
+    }
+
+    /// As `dispatch`, with the offsets of the dynamic uniform buffers (in binding order).
+    pub fn dispatch_at(&self, cmd: &Commands, set: Bindings, offsets: &[u32], push: &[u8], invocations: u64) {
         assert_eq!(push.len() as u32, self.push_bytes, "{}: wrong push-constant size", self.name);
+        assert_eq!(offsets.len(), self.bindings.iter().filter(|b| **b == Binding::UniformDynamic).count(), "{}: wrong number of dynamic offsets", self.name);
         let groups = invocations.div_ceil(self.workgroup as u64) as u32;
         assert!(groups <= self.gpu.info.max_compute_work_group_count[0], "dispatch past maxComputeWorkGroupCount: chunk it");
         let device = &self.gpu.device;
@@ -169,7 +253,7 @@ impl<'g> Kernel<'g> {
         // SAFETY: cmd is recording; set and layout match this pipeline.
         unsafe {
             device.cmd_bind_pipeline(raw, vk::PipelineBindPoint::COMPUTE, self.pipeline);
-            device.cmd_bind_descriptor_sets(raw, vk::PipelineBindPoint::COMPUTE, self.layout, 0, &[set.0], &[]);
+            device.cmd_bind_descriptor_sets(raw, vk::PipelineBindPoint::COMPUTE, self.layout, 0, &[set.0], offsets);
             if !push.is_empty() {
                 device.cmd_push_constants(raw, self.layout, vk::ShaderStageFlags::COMPUTE, 0, push);
             }
@@ -184,6 +268,9 @@ impl Drop for Kernel<'_> {
         unsafe {
             let d = &self.gpu.device;
             d.destroy_descriptor_pool(self.pool, None);
+            for v in self.views.get_mut().drain(..) {
+                d.destroy_buffer_view(v, None);
+            }
             d.destroy_pipeline(self.pipeline, None);
             d.destroy_pipeline_layout(self.layout, None);
             d.destroy_descriptor_set_layout(self.set_layout, None);

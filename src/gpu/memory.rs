@@ -45,7 +45,12 @@ impl<'g> Buffer<'g> {
                 gpu.info.max_memory_allocation_size
             ));
         }
-        let usage = vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_SRC | vk::BufferUsageFlags::TRANSFER_DST;
+        // Every buffer may back a uniform or texel-buffer window too (the shading kernel's light blocks and G-buffer planes): the flag costs nothing.
+        let usage = vk::BufferUsageFlags::STORAGE_BUFFER
+            | vk::BufferUsageFlags::UNIFORM_BUFFER
+            | vk::BufferUsageFlags::UNIFORM_TEXEL_BUFFER
+            | vk::BufferUsageFlags::STORAGE_TEXEL_BUFFER
+            | vk::BufferUsageFlags::TRANSFER_SRC | vk::BufferUsageFlags::TRANSFER_DST;
         let info = vk::BufferCreateInfo::default().size(size).usage(usage).sharing_mode(vk::SharingMode::EXCLUSIVE);
         let device = &gpu.device;
         // SAFETY: all handles come from `device`; memory is bound once, before any use.

@@ -7,7 +7,7 @@ mod memory;
 mod timing;
 
 pub use driver_stats::{DriverStat, PipelineExecutable};
-pub use kernel::{Bindings, ChunkPlan, Kernel, SpecConstants, WORKGROUP};
+pub use kernel::{Binding, Bindings, ChunkPlan, Kernel, SpecConstants, WORKGROUP};
 pub use memory::{Buffer, MemoryKind};
 pub use timing::Timestamps;
 
@@ -46,6 +46,7 @@ pub struct DeviceInfo {
     /// Valid bits of timestamps on the compute queue (0: no timestamps).
     pub timestamp_valid_bits: u32,
     pub max_storage_buffer_range: u32,
+    pub max_texel_buffer_elements: u32,
     pub max_compute_work_group_count: [u32; 3],
     pub max_compute_work_group_invocations: u32,
     pub min_storage_buffer_offset_alignment: u64,
@@ -178,6 +179,7 @@ fn describe(instance: &ash::Instance, index: usize, pd: vk::PhysicalDevice) -> D
             timestamp_period: l.timestamp_period,
             timestamp_valid_bits: compute_queue_family(instance, pd).map_or(0, |(_, bits)| bits),
             max_storage_buffer_range: l.max_storage_buffer_range,
+            max_texel_buffer_elements: l.max_texel_buffer_elements,
             max_compute_work_group_count: l.max_compute_work_group_count,
             max_compute_work_group_invocations: l.max_compute_work_group_invocations,
             min_storage_buffer_offset_alignment: l.min_storage_buffer_offset_alignment,
@@ -363,6 +365,14 @@ impl Gpu {
     }
 
     /// Validation messages recorded so far (empty without validation).
+    /// Whether the device can use `format` as a uniform texel buffer (`storage`: a storage texel buffer).
+    pub fn texel_buffer_support(&self, format: vk::Format, storage: bool) -> bool {
+        // SAFETY: the physical device belongs to this instance.
+        let props = unsafe { self.instance.get_physical_device_format_properties(self.physical, format) };
+        let wanted = if storage { vk::FormatFeatureFlags::STORAGE_TEXEL_BUFFER } else { vk::FormatFeatureFlags::UNIFORM_TEXEL_BUFFER };
+        props.buffer_features.contains(wanted)
+    }
+
     pub fn validation_messages(&self) -> Vec<String> {
         self.messages.lock().unwrap().clone()
     }

@@ -15,7 +15,9 @@ use crate::gpu::{Gpu, GpuOptions};
 use crate::model::Model;
 use crate::shaders::Shaders;
 use crate::profile::gbuffer;
-use crate::profile::protocol::{Timed, Variant, Workload};
+use crate::profile::gbuffer::GBufferFormat;
+use crate::profile::protocol::Timed;
+use crate::profile::workload::{Variant, Workload};
 use anyhow::{anyhow, bail, Context, Result};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -96,21 +98,7 @@ pub struct ChildReply {
     pub jit_cpu_features: Vec<String>,
 }
 
-/// x86 features that change the code LLVM emits for llvmpipe.
-#[cfg(target_arch = "x86_64")]
-pub fn cpu_features() -> Vec<String> {
-    let mut f = Vec::new();
-    macro_rules! probe {
-        ($($name:tt),*) => { $( if std::arch::is_x86_feature_detected!($name) { f.push($name.to_string()); } )* };
-    }
-    probe!("sse4.1", "sse4.2", "popcnt", "avx", "avx2", "fma", "f16c", "bmi1", "bmi2", "avx512f", "avx512dq", "avx512bw", "avx512vl", "avx512cd");
-    f
-}
-
-#[cfg(not(target_arch = "x86_64"))]
-pub fn cpu_features() -> Vec<String> {
-    vec![std::env::consts::ARCH.to_string()]
-}
+pub use crate::host::cpu_features;
 
 /// The child: measures each kernel between client requests. Runs only under valgrind.
 pub fn child_main(request_json: &str) -> Result<()> {
@@ -124,7 +112,7 @@ pub fn child_main(request_json: &str) -> Result<()> {
         None => Shaders::embedded(),
     };
     let gpu = Gpu::new(&GpuOptions { device: req.device.clone(), validation: req.validate })?;
-    let work = Workload::upload(&gpu, &gbuffer::synthetic(req.width, req.height), &gbuffer::lights(req.lights), None)?;
+    let work = Workload::upload(&gpu, &gbuffer::synthetic(req.width, req.height, GBufferFormat::Packed), &gbuffer::lights(req.lights), None)?;
     let mut all: Vec<Option<&Model>> = models.iter().map(Some).collect();
     all.push(None);
     let mut labels = Vec::new();

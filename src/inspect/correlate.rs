@@ -62,7 +62,9 @@ pub fn correlate(report: &InspectReport, path: &Path) -> Result<Correlation> {
     for row in &report.rows {
         let Some(ir) = row.stats.get("callgrind/ir-per-eval") else { continue };
         let model = row.model.as_str();
-        let Some(p) = rows.iter().find(|r| r["model"].as_str() == Some(model)) else { continue };
+        // A profile of several light counts: the rows at the count inspect measured (older reports have one).
+        let at_lights = |r: &&serde_json::Value| r["lights"].as_u64().is_none_or(|l| l == u64::from(report.lights));
+        let Some(p) = rows.iter().filter(at_lights).find(|r| r["model"].as_str() == Some(model)) else { continue };
         let ns = number(p, &["ns_per_eval", "median"], &file, model)?.ok_or_else(|| anyhow!("--profile {file}: row `{model}` has no ns_per_eval"))?;
         out.push(CostRow {
             model: row.model.clone(),

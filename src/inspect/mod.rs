@@ -14,7 +14,8 @@ pub mod timing;
 
 use crate::gpu::Gpu;
 use crate::model::{Model, ModelKernel};
-use crate::profile::protocol::shade_kernel;
+use crate::profile::gbuffer::GBufferFormat;
+use crate::profile::workload::{self, shade_kernel, steady_block};
 use crate::report::{self, Provenance, Table};
 use crate::shaders::Shaders;
 use anyhow::Result;
@@ -22,13 +23,13 @@ use callgrind::{CallgrindOptions, CallgrindRun};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
-pub use crate::profile::protocol::BASELINE_LABEL;
+pub use crate::profile::workload::BASELINE_LABEL;
 
 /// Statistic sections, in report order: key prefix and title.
 pub const SECTIONS: [(&str, &str); 5] = [
     ("spirv/", "SPIR-V instructions, glslang's output specialised (frozen spec constants, dead code removed)"),
     ("spirv-O/", "SPIR-V instructions after spirv-opt -O (the [[unroll]] light loop unrolled: about NUM_LIGHTS copies of the BRDF)"),
-    ("naga/", "naga (SPIR-V front end and validator) on the specialised module"),
+    ("naga/", "naga (SPIR-V front end and validator) on the specialised float-G-buffer kernel (same BRDF; naga 30 reads no texel buffers)"),
     ("driver/", "Driver statistics (VK_KHR_pipeline_executable_properties)"),
     ("callgrind/", "Executed CPU instructions (Ir) per BRDF evaluation of lavapipe's JIT code, under callgrind"),
 ];
@@ -78,12 +79,13 @@ pub struct InspectReport {
     pub vs_profile: Option<correlate::Correlation>,
 }
 
-/// SPIR-V and naga statistics of one specialised kernel.
-fn static_stats(kernel: &ModelKernel, row: &mut Row) -> Result<()> {
+/// SPIR-V statistics of one specialised kernel, and naga's of `naga_kernel` (the same BRDF over the float
+/// G-buffer: naga's SPIR-V front end has no texel buffers, which the packed kernel reads).
+fn static_stats(kernel: &ModelKernel, naga_kernel: &ModelKernel, row: &mut Row) -> Result<()> {
     let frozen = spirv::specialise(&kernel.spirv.words, &kernel.constants)?;
     row.stats.extend(spirv::count(&frozen)?.stats("spirv"));
     row.stats.extend(spirv::count(&spirv::optimise(&frozen)?)?.stats("spirv-O"));
-    let naga = naga_info::analyse(&frozen);
+    let naga = naga_info::analyse(&spirv::specialise(&naga_kernel.spirv.words, &naga_kernel.constants)?);
     row.stats.extend(naga.stats());
     row.notes.insert("naga".into(), naga.verdict());
     Ok(())
@@ -94,7 +96,7 @@ fn driver_stats(gpu: &Gpu, kernel: &ModelKernel, row: &mut Row) -> Result<()> {
     if !gpu.info.pipeline_executable_properties {
         return Ok(());
     }
-    let pipeline = crate::kernels::kernel(gpu, &kernel.spirv, &kernel.constants, 3, 0)?;
+    let pipeline = crate::gpu::Kernel::new(gpu, &kernel.spirv.name, &kernel.spirv.words, &kernel.constants, &workload::bindings(GBufferFormat::Packed), workload::PUSH_BYTES)?;
     if let Some(executables) = pipeline.executables()? {
         let stats: Vec<_> = executables.into_iter().flat_map(|e| e.stats).collect();
         row.stats.extend(driver::stats(&stats));
@@ -126,8 +128,10 @@ fn kernel_row(gpu: &Gpu, shaders: &Shaders, model: Option<&Model>, lights: u32) 
         stats: BTreeMap::new(),
         notes: BTreeMap::new(),
     };
-    let kernel = shade_kernel(model, lights, shaders)?;
-    static_stats(&kernel, &mut row)?;
+    let (per_dispatch, accumulate) = steady_block(lights);
+    let kernel = shade_kernel(model, GBufferFormat::Packed, per_dispatch, accumulate, shaders)?;
+    let float_kernel = shade_kernel(model, GBufferFormat::Float, per_dispatch, accumulate, shaders)?;
+    static_stats(&kernel, &float_kernel, &mut row)?;
     driver_stats(gpu, &kernel, &mut row)?;
     Ok(row)
 }

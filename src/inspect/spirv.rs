@@ -174,17 +174,18 @@ mod tests {
     use super::*;
     use crate::kernels::{constants, embedded};
     use crate::model::Model;
-    use crate::profile::protocol::shade_kernel;
+    use crate::profile::gbuffer::GBufferFormat;
+    use crate::profile::workload::shade_kernel;
 
     fn frozen(model: Option<&str>, lights: u32) -> Vec<u32> {
         let m = model.map(|m| Model::parse(m).unwrap());
-        let k = shade_kernel(m.as_ref(), lights, embedded()).unwrap();
+        let k = shade_kernel(m.as_ref(), GBufferFormat::Packed, lights, false, embedded()).unwrap();
         specialise(&k.spirv.words, &k.constants).unwrap()
     }
 
     #[test]
     fn spec_values_follow_the_module_types() {
-        let k = shade_kernel(Some(&Model::parse("burley,gamma=2").unwrap()), 4, embedded()).unwrap();
+        let k = shade_kernel(Some(&Model::parse("burley,gamma=2").unwrap()), GBufferFormat::Packed, 4, false, embedded()).unwrap();
         let text = spec_default_values(&k.spirv.words, &k.constants).unwrap();
         assert!(text.contains("3:2.0"), "{text}");
         assert!(text.contains(&format!("{}:4", constants::NUM_LIGHTS.id)) && text.contains(&format!("{}:0", constants::BASELINE.id)), "{text}");

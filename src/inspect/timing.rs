@@ -14,7 +14,9 @@ use super::BASELINE_LABEL;
 use crate::gpu::Gpu;
 use crate::model::Model;
 use crate::profile::gbuffer;
-use crate::profile::protocol::{self, ProtocolOptions, Variant, Workload};
+use crate::profile::gbuffer::GBufferFormat;
+use crate::profile::protocol::{self, ProtocolOptions};
+use crate::profile::workload::{Variant, Workload};
 use crate::shaders::Shaders;
 use crate::stats;
 use anyhow::{bail, Result};
@@ -66,7 +68,7 @@ pub fn run(gpu: &Gpu, shaders: &Shaders, models: &[Model], options: &TimingOptio
     if options.rounds == 0 {
         bail!("a timing run needs at least one round");
     }
-    let work = Workload::upload(gpu, &gbuffer::synthetic(options.width, options.height), &gbuffer::lights(options.lights), None)?;
+    let work = Workload::upload(gpu, &gbuffer::synthetic(options.width, options.height, GBufferFormat::Packed), &gbuffer::lights(options.lights), None)?;
     let mut all: Vec<Option<&Model>> = models.iter().map(Some).collect();
     all.push(None);
     let variants = all.iter().map(|m| Variant::new(gpu, &work, *m, shaders, 1)).collect::<Result<Vec<_>>>()?;
@@ -75,6 +77,7 @@ pub fn run(gpu: &Gpu, shaders: &Shaders, models: &[Model], options: &TimingOptio
         max_rounds: options.rounds,
         reps: options.reps.max(1),
         budget: Duration::from_secs(3600),
+        started: std::time::Instant::now(),
         seed: options.seed,
     };
     let raw = protocol::measure(gpu, &variants, &protocol_options, |_| false, |_| {})?;

@@ -22,7 +22,7 @@ const fn int(name: &'static str, id: u32, default: i32, about: &'static str) -> 
     Constant { name, id, kind: ConstantKind::Int, default: default as f64, about }
 }
 
-pub const NUM_LIGHTS: Constant = int("NUM_LIGHTS", 16, 8, "shade.comp: directional lights per pixel");
+pub const NUM_LIGHTS: Constant = int("NUM_LIGHTS", 16, 8, "shade.glsl: directional lights per dispatch (a block of the profile's lights)");
 pub const BASELINE: Constant = int("BASELINE", 17, 0, "shade.comp: 1 = the memory-only kernel (no BRDF)");
 pub const ALBEDO_N: Constant = int("ALBEDO_N", 18, 256, "albedo estimator: columns per component and azimuth rows");
 pub const NUM_DIRECTIONAL: Constant = int("NUM_DIRECTIONAL", 19, 1, "scene.comp: directional lights");
@@ -35,9 +35,13 @@ pub const DIFFUSE: Constant = int("DIFFUSE", 25, 0, "scene effect: 0 none, 1 Lam
 pub const CLEAR_COAT: Constant = int("CLEAR_COAT", 26, 0, "scene effect: 0 off, 1 on (per-pixel strength and roughness)");
 pub const E_TABLE_MU: Constant = int("E_TABLE_MU", 27, 32, "E(mu, r) table: mu nodes (mu_i = (i + 0.5) / N)");
 pub const E_TABLE_R: Constant = int("E_TABLE_R", 28, 16, "E(mu, r) table: r nodes (r_j = j / (M - 1))");
+pub const ACCUMULATE: Constant = int("ACCUMULATE", 29, 0, "shade.glsl: 1 = add to the radiance an earlier light block wrote");
+
+/// Lights per dispatch of the profiling kernel at most (a compile-time size in the GLSL: `#define LIGHT_BLOCK`).
+pub const LIGHT_BLOCK: u32 = 8;
 
 pub const ALL: &[Constant] =
-    &[NUM_LIGHTS, BASELINE, ALBEDO_N, NUM_DIRECTIONAL, NUM_POINT, NUM_SPOT, NUM_SPHERE, ANISOTROPY, ENERGY_COMPENSATION, DIFFUSE, CLEAR_COAT, E_TABLE_MU, E_TABLE_R];
+    &[NUM_LIGHTS, BASELINE, ALBEDO_N, NUM_DIRECTIONAL, NUM_POINT, NUM_SPOT, NUM_SPHERE, ANISOTROPY, ENERGY_COMPENSATION, DIFFUSE, CLEAR_COAT, E_TABLE_MU, E_TABLE_R, ACCUMULATE];
 
 #[cfg(test)]
 mod tests {

@@ -4,7 +4,7 @@
 pub mod constants;
 
 use crate::brdf::Sample;
-use crate::gpu::{Bindings, Buffer, ChunkPlan, Gpu, Kernel, MemoryKind, SpecConstants};
+use crate::gpu::{Binding, Bindings, Buffer, ChunkPlan, Gpu, Kernel, MemoryKind, SpecConstants};
 use crate::model::{KernelKind, Model};
 use crate::shaders::{Shaders, Spirv};
 use anyhow::Result;
@@ -38,9 +38,9 @@ pub fn model_kernel<'g>(gpu: &'g Gpu, model: &Model, kind: KernelKind, extra: im
     kernel(gpu, &k.spirv, &extra(k.constants), bindings, push_bytes)
 }
 
-/// A pipeline of `spirv`.
+/// A pipeline of `spirv` with `bindings` storage buffers.
 pub fn kernel<'g>(gpu: &'g Gpu, spirv: &Spirv, constants: &SpecConstants, bindings: u32, push_bytes: u32) -> Result<Kernel<'g>> {
-    Kernel::new(gpu, &spirv.name, &spirv.words, constants, bindings, push_bytes)
+    Kernel::new(gpu, &spirv.name, &spirv.words, constants, &Binding::storage(bindings), push_bytes)
 }
 
 /// Limits on one kernel run over many elements.

@@ -16,8 +16,11 @@ pub enum KernelKind {
     Eval,
     /// Each term on its own per sample (tests of the twins).
     Terms,
-    /// The profiling kernel over a G-buffer and lights (`profile`, `sweep`, `inspect`, `check`).
+    /// The profiling kernel over an engine-style packed G-buffer and lights (`profile`, `sweep`, `inspect`,
+    /// `check`).
     Shade,
+    /// The profiling kernel over a float G-buffer (`profile --gbuffer float`).
+    ShadeFloat,
     /// Directional albedo (`stability`, accuracy, energy compensation).
     Albedo,
     /// The scene kernel, with lights and effects.
@@ -35,6 +38,7 @@ impl KernelKind {
             KernelKind::Eval => "eval",
             KernelKind::Terms => "terms",
             KernelKind::Shade => "shade",
+            KernelKind::ShadeFloat => "shade_float",
             KernelKind::Albedo => "albedo",
             KernelKind::Scene => "scene",
             KernelKind::SceneAlbedo => "scene_albedo",

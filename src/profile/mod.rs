@@ -4,18 +4,23 @@
 
 pub mod gbuffer;
 pub mod protocol;
+pub mod workload;
 
 use crate::gpu::Gpu;
 use crate::model::Model;
-use crate::shaders::Shaders;
 use crate::report::{self, Provenance, Table};
+use crate::shaders::Shaders;
 use crate::stats::{self, Estimate};
 use anyhow::Result;
 use indicatif::ProgressBar;
-use protocol::{ProtocolOptions, RawTimes, Variant, Workload};
+use gbuffer::GBufferFormat;
+use protocol::{ProtocolOptions, RawTimes};
+use workload::{Variant, Workload};
 use serde::Serialize;
 
 pub use crate::brdf::spec::REFERENCE_MODEL;
+/// The harness share above which `harness_warning` speaks.
+pub const HARNESS_WARNING: f64 = 0.5;
 /// Confidence level of every interval.
 pub const LEVEL: f64 = 0.95;
 
@@ -24,7 +29,9 @@ pub struct ProfileOptions {
     pub models: Vec<Model>,
     pub width: u32,
     pub height: u32,
-    pub lights: u32,
+    /// Light counts, each its own workload; all are timed in the same interleaved rounds.
+    pub lights: Vec<u32>,
+    pub format: GBufferFormat,
     pub protocol: ProtocolOptions,
     /// Stop once every ratio to the reference has a CI half-width below this fraction of the ratio (and every
     /// net ratio below twice it).
@@ -33,6 +40,8 @@ pub struct ProfileOptions {
     /// Independently compiled pipelines per kernel, all timed every round; the faster one's time counts
     /// (see `protocol::Variant`).
     pub instances: usize,
+    /// Compile the kernels from this GLSL directory instead of the embedded SPIR-V (`Shaders::from_glsl`).
+    pub glsl: Option<std::path::PathBuf>,
 }
 
 /// One row of the table.
@@ -41,6 +50,9 @@ pub struct Row {
     /// The spec's name (a preset name where one matches), or "baseline".
     pub model: String,
     pub spec: Option<String>,
+    /// Lights per pixel of this row's workload, and the evaluations one run of it makes.
+    pub lights: u32,
+    pub evaluations_per_dispatch: u64,
     pub ns_per_eval: Estimate,
     pub evals_per_second: f64,
     /// Cost / reference cost, per round.
@@ -49,6 +61,9 @@ pub struct Row {
     pub net_ns_per_eval: Option<Estimate>,
     /// (cost - baseline) / (reference cost - baseline), per round.
     pub net_vs_reference: Option<Estimate>,
+    /// baseline / cost, per round: the share of this kernel's time that the memory-only kernel (loads,
+    /// decode, light loop, stores) takes.
+    pub harness_share: Option<Estimate>,
     /// Median over rounds of slowest / fastest instance: how much JIT code placement alone moved this kernel.
     pub instance_spread: f64,
 }
@@ -58,9 +73,14 @@ pub struct WorkloadSize {
     pub width: u32,
     pub height: u32,
     pub pixels: u64,
-    pub lights: u32,
-    pub evaluations_per_dispatch: u64,
-    pub bytes_per_pixel: usize,
+    /// Every light count measured (each row says which it is).
+    pub lights: Vec<u32>,
+    /// How the G-buffer is stored, and the bytes per pixel the kernel reads and writes.
+    pub gbuffer: GBufferFormat,
+    pub bytes_per_pixel: u64,
+    pub output_bytes_per_pixel: u64,
+    /// Lights per dispatch: the profile's lights run as blocks of at most this many (`workload::light_blocks`).
+    pub light_block: u32,
     pub chunks: usize,
 }
 
@@ -85,47 +105,69 @@ pub fn per_round(raw: &RawTimes, variant: usize, evals: f64) -> Vec<f64> {
     raw.round_medians(variant).iter().map(|t| t / evals).collect()
 }
 
-/// Statistics of every variant; `reference` and `baseline` index variants.
-pub fn analyse(raw: &RawTimes, labels: &[String], specs: &[Option<Model>], evals: u64, reference: usize, baseline: Option<usize>) -> Vec<Row> {
-    let e = evals as f64;
+/// The variants of one light count: which variants of the run they are, and which of them is the reference
+/// and the baseline.
+struct Group {
+    lights: u32,
+    evaluations: u64,
+    variants: std::ops::Range<usize>,
+    reference: usize,
+    baseline: usize,
+}
+
+/// Statistics of every variant of `group`; `reference` and `baseline` index variants.
+fn analyse(raw: &RawTimes, specs: &[Option<Model>], group: &Group) -> Vec<Row> {
+    let e = group.evaluations as f64;
+    let (reference, baseline) = (group.reference, Some(group.baseline));
     let reference_t = per_round(raw, reference, e);
     let baseline_t = baseline.map(|b| per_round(raw, b, e));
-    (0..labels.len())
+    group
+        .variants
+        .clone()
         .map(|i| {
             let t = per_round(raw, i, e);
             let ratio: Vec<f64> = t.iter().zip(&reference_t).map(|(a, r)| a / r).collect();
             let ns = stats::median_ci(&t, LEVEL);
-            let (net, net_ratio) = match (&baseline_t, Some(i) != baseline) {
+            let (net, net_ratio, share) = match (&baseline_t, Some(i) != baseline) {
                 (Some(b), true) => {
                     let net: Vec<f64> = t.iter().zip(b).map(|(a, b)| a - b).collect();
                     let net_ratio: Vec<f64> = net.iter().zip(reference_t.iter().zip(b)).map(|(n, (r, b))| n / (r - b)).collect();
-                    (Some(stats::median_ci(&net, LEVEL)), Some(stats::median_ci(&net_ratio, LEVEL)))
+                    let share: Vec<f64> = b.iter().zip(&t).map(|(b, a)| b / a).collect();
+                    (Some(stats::median_ci(&net, LEVEL)), Some(stats::median_ci(&net_ratio, LEVEL)), Some(stats::median_ci(&share, LEVEL)))
                 }
-                _ => (None, None),
+                _ => (None, None, None),
             };
             Row {
-                model: labels[i].clone(),
+                model: specs[i].as_ref().map_or_else(|| workload::BASELINE_LABEL.to_string(), Model::name),
                 spec: specs[i].as_ref().map(Model::canonical),
+                lights: group.lights,
+                evaluations_per_dispatch: group.evaluations,
                 ns_per_eval: ns,
                 evals_per_second: 1e9 / ns.median,
                 vs_reference: stats::median_ci(&ratio, LEVEL),
                 net_ns_per_eval: net,
                 net_vs_reference: net_ratio,
+                harness_share: share,
                 instance_spread: raw.instance_spread(i),
             }
         })
         .collect()
 }
 
-/// True once every model's ratio is resolved to `target` (net ratios to twice that). The baseline's own
-/// ratio does not count: its noise is already inside the net ratios.
-fn resolved(rows: &[Row], reference: usize, target: f64) -> bool {
-    rows.iter().enumerate().filter(|(i, r)| *i != reference && r.spec.is_some()).all(|(_, r)| {
+/// True once every model's ratio is resolved to `target` (net ratios to twice that). The reference's and the
+/// baseline's own ratios do not count (the first is 1, the second's noise is inside the net ratios).
+fn resolved(rows: &[Row], target: f64) -> bool {
+    rows.iter().filter(|r| r.spec.is_some() && r.model != REFERENCE_MODEL).all(|r| {
         r.vs_reference.rel_half_width() < target && r.net_vs_reference.is_none_or(|n| n.rel_half_width() < 2.0 * target)
     })
 }
 
-/// Runs the profile: the models (the reference added when missing) and the baseline, interleaved.
+fn analyse_all(raw: &RawTimes, specs: &[Option<Model>], groups: &[Group]) -> Vec<Row> {
+    groups.iter().flat_map(|g| analyse(raw, specs, g)).collect()
+}
+
+/// Runs the profile: for each light count, the models (the reference added when missing) and the baseline,
+/// all interleaved in the same rounds.
 pub fn run(gpu: &Gpu, options: &ProfileOptions, progress: &ProgressBar) -> Result<ProfileReport> {
     let reference_model = Model::reference();
     let mut models = options.models.clone();
@@ -133,42 +175,50 @@ pub fn run(gpu: &Gpu, options: &ProfileOptions, progress: &ProgressBar) -> Resul
         models.insert(0, reference_model.clone());
     }
     progress.set_message("building the G-buffer");
-    let gbuffer = gbuffer::synthetic(options.width, options.height);
-    let lights = gbuffer::lights(options.lights);
-    let work = Workload::upload(gpu, &gbuffer, &lights, options.max_chunk)?;
+    let gbuffer = gbuffer::synthetic(options.width, options.height, options.format);
+    let works = options.lights.iter().map(|&l| Workload::upload(gpu, &gbuffer, &gbuffer::lights(l), options.max_chunk)).collect::<Result<Vec<_>>>()?;
     drop(gbuffer);
-    let mut specs: Vec<Option<Model>> = models.iter().cloned().map(Some).collect();
-    specs.push(None);
-    progress.set_message("compiling kernels");
-    let shaders = Shaders::embedded();
-    let variants = specs.iter().map(|s| Variant::new(gpu, &work, s.as_ref(), &shaders, options.instances)).collect::<Result<Vec<_>>>()?;
-    let labels: Vec<String> = variants.iter().map(|v| v.label.clone()).collect();
-    let reference = models.iter().position(|m| *m == reference_model).unwrap();
-    let baseline = Some(variants.len() - 1);
-    let evals = work.evaluations();
+    let from_glsl = options.glsl.as_deref().map(Shaders::from_glsl).transpose()?;
+    let shaders = from_glsl.as_ref().unwrap_or_else(|| crate::kernels::embedded());
+    let several = works.len() > 1;
+    let (mut variants, mut specs, mut labels, mut groups) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    for work in &works {
+        let first = variants.len();
+        for spec in models.iter().map(Some).chain([None]) {
+            progress.set_message(format!("compiling kernels ({} of {})", variants.len() + 1, works.len() * (models.len() + 1)));
+            let v = Variant::new(gpu, work, spec, shaders, options.instances)?;
+            labels.push(if several { format!("{} ({} lights)", v.label, work.light_count) } else { v.label.clone() });
+            variants.push(v);
+            specs.push(spec.cloned());
+        }
+        let reference = first + models.iter().position(|m| *m == reference_model).unwrap();
+        groups.push(Group { lights: work.light_count, evaluations: work.evaluations(), variants: first..variants.len(), reference, baseline: variants.len() - 1 });
+    }
     progress.set_length(options.protocol.max_rounds as u64);
     let raw = protocol::measure(
         gpu,
         &variants,
         &options.protocol,
-        |raw| resolved(&analyse(raw, &labels, &specs, evals, reference, baseline), reference, options.target_rel_ci),
+        |raw| resolved(&analyse_all(raw, &specs, &groups), options.target_rel_ci),
         |raw| {
             progress.set_position(raw.rounds() as u64);
-            progress.set_message(format!("{:.0} s", raw.elapsed_s));
+            progress.set_message(format!("{:.0} s of rounds", raw.elapsed_s));
         },
     )?;
-    let rows = analyse(&raw, &labels, &specs, evals, reference, baseline);
+    let rows = analyse_all(&raw, &specs, &groups);
     Ok(ProfileReport {
         provenance: Provenance::new(&gpu.info),
         reference: REFERENCE_MODEL.into(),
         workload: WorkloadSize {
             width: options.width,
             height: options.height,
-            pixels: work.pixel_count,
-            lights: work.light_count,
-            evaluations_per_dispatch: evals,
-            bytes_per_pixel: gbuffer::PIXEL_FLOATS * 4,
-            chunks: work.chunks(),
+            pixels: works[0].pixel_count,
+            lights: options.lights.clone(),
+            gbuffer: options.format,
+            bytes_per_pixel: options.format.bytes_in(),
+            output_bytes_per_pixel: options.format.bytes_out(),
+            light_block: workload::LIGHT_BLOCK,
+            chunks: works[0].chunks(),
         },
         rounds: raw.rounds(),
         reps_per_round: options.protocol.reps,
@@ -183,25 +233,69 @@ pub fn run(gpu: &Gpu, options: &ProfileOptions, progress: &ProgressBar) -> Resul
 impl ProfileReport {
     pub fn table(&self) -> Table {
         let r = &self.reference;
-        let mut t = Table::new([
+        let several = self.workload.lights.len() > 1;
+        let mut header = vec![
             "model".to_string(),
             "ns/eval [95% CI]".into(),
             "Meval/s".into(),
             format!("vs {r} [95% CI]"),
             "net ns/eval [95% CI]".into(),
             format!("net vs {r} [95% CI]"),
-        ]);
+            "harness share".into(),
+        ];
+        if several {
+            header.insert(1, "lights".into());
+        }
+        let mut t = Table::new(header);
         for row in &self.rows {
-            t.row([
+            let mut cells = vec![
                 row.model.clone(),
                 report::estimate(&row.ns_per_eval, 3),
                 report::sig(row.evals_per_second / 1e6, 3),
                 report::estimate(&row.vs_reference, 3),
                 row.net_ns_per_eval.as_ref().map_or("-".into(), |e| report::estimate(e, 3)),
                 row.net_vs_reference.as_ref().map_or("-".into(), |e| report::estimate(e, 3)),
-            ]);
+                row.harness_share.as_ref().map_or("-".into(), |e| format!("{:.0}%", 100.0 * e.median)),
+            ];
+            if several {
+                cells.insert(1, row.lights.to_string());
+            }
+            t.row(cells);
         }
         t
+    }
+
+    /// With several light counts: net ns/eval of each model (the baseline's gross) at each count, one column
+    /// per count, and the harness share of the reference: how the cost per light moves with the count.
+    pub fn light_table(&self) -> Option<Table> {
+        let counts = &self.workload.lights;
+        if counts.len() < 2 {
+            return None;
+        }
+        let mut header = vec!["model".to_string()];
+        header.extend(counts.iter().map(|&l| format!("{l} light{}", if l == 1 { "" } else { "s" })));
+        let mut t = Table::new(header);
+        let mut names: Vec<&str> = Vec::new();
+        for r in &self.rows {
+            if !names.contains(&r.model.as_str()) {
+                names.push(&r.model);
+            }
+        }
+        for name in names {
+            let mut cells = vec![if name == workload::BASELINE_LABEL { format!("{name} (gross)") } else { format!("{name} (net)") }];
+            for &l in counts {
+                let row = self.rows.iter().find(|r| r.model == name && r.lights == l);
+                cells.push(row.map_or("-".into(), |r| report::estimate(r.net_ns_per_eval.as_ref().unwrap_or(&r.ns_per_eval), 3)));
+            }
+            t.row(cells);
+        }
+        let mut share = vec![format!("harness share of {}", self.reference)];
+        for &l in counts {
+            let row = self.rows.iter().find(|r| r.model == self.reference && r.lights == l);
+            share.push(row.and_then(|r| r.harness_share).map_or("-".into(), |e| format!("{:.0}%", 100.0 * e.median)));
+        }
+        t.row(share);
+        Some(t)
     }
 
     /// A line per kernel whose independently compiled pipelines differed by more than 10% (code placement):
@@ -214,22 +308,47 @@ impl ProfileReport {
             .collect()
     }
 
+    /// A warning when the memory-only kernel takes more than `HARNESS_WARNING` of a model's time: then the
+    /// gross figures mostly measure loads and stores, and what helps.
+    pub fn harness_warning(&self) -> String {
+        let worst = self.rows.iter().filter_map(|r| r.harness_share.map(|s| (r, s.median))).max_by(|a, b| a.1.total_cmp(&b.1));
+        match worst {
+            Some((row, share)) if share > HARNESS_WARNING => format!(
+                "warning: the memory-only kernel is {:.0}% of {}'s time (more than {:.0}%): the gross ns/eval mostly measure the harness (G-buffer loads and decode, light loads, stores), not the BRDF. Read the net columns; raise --lights to share the per-pixel cost among more evaluations{}.\n",
+                100.0 * share,
+                row.model,
+                100.0 * HARNESS_WARNING,
+                if self.workload.gbuffer == GBufferFormat::Float { "; drop --gbuffer float (the packed G-buffer reads a third of the bytes)" } else { "" }
+            ),
+            _ => String::new(),
+        }
+    }
+
     /// One line saying what was measured.
     pub fn summary(&self) -> String {
         let w = &self.workload;
         format!(
-            "{} ({}, {}); {}x{} pixels x {} lights = {} evaluations per dispatch; {} rounds x {} reps x {} pipelines per kernel, interleaved; {:.0} s",
+            "{} ({}, {}) on {}, {}, {} threads; {}x{} pixels ({} G-buffer) x {} lights; {} rounds x {} reps x {} pipelines per kernel, interleaved; {:.1} s to set up (G-buffer, compilation, warm-up), {:.1} s of rounds, stopped: {}",
             self.provenance.device.name,
             self.provenance.device.driver_name,
             self.provenance.device.driver_info,
+            self.provenance.cpu.describe(),
+            self.provenance.cpu.vector_width(),
+            self.provenance.host_threads,
             w.width,
             w.height,
-            w.lights,
-            w.evaluations_per_dispatch,
+            w.gbuffer.name(),
+            w.lights.iter().map(u32::to_string).collect::<Vec<_>>().join(", "),
             self.rounds,
             self.reps_per_round,
             self.instances,
-            self.raw.elapsed_s
+            self.raw.setup_s,
+            self.raw.elapsed_s,
+            match self.raw.stop {
+                protocol::Stop::Converged => "every ratio resolved",
+                protocol::Stop::Budget => "--budget spent",
+                protocol::Stop::MaxRounds => "--max-rounds reached",
+            }
         )
     }
 }

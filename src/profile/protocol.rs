@@ -5,95 +5,53 @@
 //! Costs are compared as ratios within a round, so the machine's drift between rounds cancels. All raw times
 //! are kept, outliers included.
 
-use super::gbuffer::{GBuffer, LIGHT_FLOATS, PIXEL_FLOATS};
-use crate::gpu::{Bindings, Buffer, ChunkPlan, Commands, Gpu, Kernel, MemoryKind, SpecConstants, Timestamps};
-use crate::kernels::{self, constants, WithConstant};
-use crate::model::{KernelKind, Model, ModelKernel};
-use crate::shaders::{Shaders, Spirv};
+use crate::gpu::{Binding, Bindings, Commands, Gpu, Kernel, SpecConstants, Timestamps};
+use crate::shaders::Spirv;
 use anyhow::Result;
 use rand::seq::SliceRandom;
 use rand::SeedableRng;
 use serde::Serialize;
 use std::time::{Duration, Instant};
 
-/// The G-buffer, lights and output on the device, padded to whole workgroups (the kernel has no bounds check).
-pub struct Workload<'g> {
-    pixels: Buffer<'g>,
-    radiance: Buffer<'g>,
-    lights: Buffer<'g>,
-    pub light_count: u32,
-    /// Pixels in the picture (the padding is not counted in evaluations).
-    pub pixel_count: u64,
-    plan: ChunkPlan,
+/// One dispatch of a pipeline instance: which of its kernels, the bindings (with the offsets of its dynamic
+/// uniform buffers), push constants and invocations.
+pub struct Dispatch {
+    pub kernel: usize,
+    pub set: Bindings,
+    pub offsets: Vec<u32>,
+    pub push: Vec<u8>,
+    pub invocations: u64,
 }
 
-impl<'g> Workload<'g> {
-    pub fn upload(gpu: &'g Gpu, gbuffer: &GBuffer, lights: &[f32], max_chunk: Option<u64>) -> Result<Self> {
-        let n = gbuffer.pixel_count();
-        let wg = crate::gpu::WORKGROUP as u64;
-        let padded = n.div_ceil(wg) * wg;
-        let mut data = gbuffer.pixels.clone();
-        let last = data[data.len() - PIXEL_FLOATS..].to_vec();
-        for _ in n..padded {
-            data.extend_from_slice(&last);
-        }
-        let stride_in = (PIXEL_FLOATS * 4) as u64;
-        Ok(Workload {
-            pixels: Buffer::with_data(gpu, bytemuck::cast_slice(&data), MemoryKind::Device)?,
-            radiance: Buffer::new(gpu, padded * 16, MemoryKind::Device)?,
-            lights: Buffer::with_data(gpu, bytemuck::cast_slice(lights), MemoryKind::Device)?,
-            light_count: (lights.len() / LIGHT_FLOATS) as u32,
-            pixel_count: n,
-            plan: ChunkPlan::new(&gpu.info, padded, &[stride_in, 16], max_chunk),
-        })
-    }
-
-    /// BRDF evaluations per dispatch.
-    pub fn evaluations(&self) -> u64 {
-        self.pixel_count * self.light_count as u64
-    }
-
-    pub fn chunks(&self) -> usize {
-        self.plan.chunks.len()
-    }
-
-    /// The radiance written by the last dispatch (rgb per pixel), for checks.
-    pub fn radiance(&self) -> Result<Vec<[f32; 3]>> {
-        let v: Vec<f32> = self.radiance.read_as(0, self.pixel_count as usize * 4)?;
-        Ok(v.chunks_exact(4).map(|c| [c[0], c[1], c[2]]).collect())
-    }
-}
-
-/// One kernel compiled as one or more independent pipelines (instances), each bound to the same chunk
-/// windows: on lavapipe the same kernel JIT-compiled twice has been seen to run 2x slower in every round of one
-/// process (code placement), and only a second pipeline exposes that. `measure` times every instance.
+/// One piece of work compiled as one or more independent pipelines (instances): on lavapipe the same kernel
+/// JIT-compiled twice has been seen to run 2x slower in every round of one process (code placement), and only
+/// a second pipeline exposes that. An instance holds the kernels of the work and its dispatches in steps: the
+/// dispatches of a step are independent (chunks of one picture), a barrier separates steps (a step reads what
+/// the one before it wrote). `measure` times every instance.
 pub struct Pipelines<'g> {
-    instances: Vec<(Kernel<'g>, Vec<(Bindings, u64)>)>,
-    push: Vec<u8>,
+    gpu: &'g Gpu,
+    instances: Vec<(Vec<Kernel<'g>>, Vec<Vec<Dispatch>>)>,
 }
 
 impl<'g> Pipelines<'g> {
-    /// `count` pipelines of `source` specialised with `constants`, over `chunks` (first element, length);
-    /// `bind(kernel, first, len)` binds one chunk's windows; `push` is the push-constant block of every dispatch.
-    #[allow(clippy::too_many_arguments)]
+    /// `count` instances, each compiling every (SPIR-V, constants) of `kernels` and planning its steps with
+    /// `plan(kernels)`.
     pub fn compile(
         gpu: &'g Gpu,
-        spirv: &Spirv,
-        constants: &SpecConstants,
-        bindings: u32,
-        push: Vec<u8>,
-        chunks: &[(u64, u64)],
+        kernels: &[(Spirv, SpecConstants)],
+        bindings: &[Binding],
+        push_bytes: u32,
         count: usize,
-        bind: impl Fn(&Kernel<'g>, u64, u64) -> Result<Bindings>,
+        plan: impl Fn(&[Kernel<'g>]) -> Result<Vec<Vec<Dispatch>>>,
     ) -> Result<Self> {
         let instances = (0..count.max(1))
             .map(|_| {
-                let kernel = kernels::kernel(gpu, spirv, constants, bindings, push.len() as u32)?;
-                let sets = chunks.iter().map(|&(first, len)| Ok((bind(&kernel, first, len)?, len))).collect::<Result<Vec<_>>>()?;
-                Ok((kernel, sets))
+                let compiled = kernels.iter().map(|(spirv, c)| Kernel::new(gpu, &spirv.name, &spirv.words, c, bindings, push_bytes)).collect::<Result<Vec<_>>>()?;
+                let steps = plan(&compiled)?;
+                Ok((compiled, steps))
             })
             .collect::<Result<Vec<_>>>()?;
-        Ok(Pipelines { instances, push })
+        Ok(Pipelines { gpu, instances })
     }
 
     pub fn len(&self) -> usize {
@@ -104,48 +62,17 @@ impl<'g> Pipelines<'g> {
         self.instances.is_empty()
     }
 
-    /// Records every chunk's dispatch of pipeline `instance`.
+    /// Records every step of pipeline `instance`, a barrier between steps.
     pub fn record(&self, cmd: &Commands, instance: usize) {
-        let (kernel, sets) = &self.instances[instance];
-        for &(set, len) in sets {
-            kernel.dispatch(cmd, set, &self.push, len);
+        let (kernels, steps) = &self.instances[instance];
+        for (s, step) in steps.iter().enumerate() {
+            if s > 0 {
+                self.gpu.barrier(cmd);
+            }
+            for d in step {
+                kernels[d.kernel].dispatch_at(cmd, d.set, &d.offsets, &d.push, d.invocations);
+            }
         }
-    }
-}
-
-/// The profile's shading kernel bound to the workload, ready to dispatch.
-pub struct Variant<'g> {
-    pub label: String,
-    /// None for the memory-only baseline.
-    pub model: Option<Model>,
-    pipelines: Pipelines<'g>,
-}
-
-/// The label of the memory-only baseline kernel in every report.
-pub const BASELINE_LABEL: &str = "baseline";
-
-/// glsl/shade.comp for `model` (None: the memory-only baseline, compiled with the reference model's
-/// selectors, which it never runs) and `lights`, with every specialisation constant set.
-pub fn shade_kernel(model: Option<&Model>, lights: u32, shaders: &Shaders) -> Result<ModelKernel> {
-    let reference = Model::reference();
-    let mut k = model.unwrap_or(&reference).kernel(KernelKind::Shade, shaders)?;
-    k.constants = k.constants.with(constants::NUM_LIGHTS, lights as f64).with(constants::BASELINE, model.is_none() as i32 as f64);
-    Ok(k)
-}
-
-impl<'g> Variant<'g> {
-    /// The shading kernel for `model`, or the memory-only baseline when `model` is None, as `instances`
-    /// independent pipelines, from `shaders`.
-    pub fn new(gpu: &'g Gpu, work: &Workload<'g>, model: Option<&Model>, shaders: &Shaders, instances: usize) -> Result<Self> {
-        if let Some(m) = model {
-            m.check_support(&gpu.info)?;
-        }
-        let k = shade_kernel(model, work.light_count, shaders)?;
-        let stride_in = (PIXEL_FLOATS * 4) as u64;
-        let pipelines = Pipelines::compile(gpu, &k.spirv, &k.constants, 3, Vec::new(), &work.plan.chunks, instances, |kernel, first, len| {
-            kernel.bind(&[(&work.pixels, first * stride_in, len * stride_in), (&work.radiance, first * 16, len * 16), (&work.lights, 0, work.lights.size)])
-        })?;
-        Ok(Variant { label: model.map_or_else(|| BASELINE_LABEL.to_string(), Model::name), model: model.cloned(), pipelines })
     }
 }
 
@@ -155,9 +82,28 @@ pub struct ProtocolOptions {
     pub max_rounds: usize,
     /// Timed dispatches of every variant per round.
     pub reps: usize,
-    /// Wall-clock budget for the timed rounds; the run stops after the round that exceeds it.
+    /// Wall-clock budget of the whole command, counted from `started`: building the inputs, compiling and
+    /// warming up spend it too. The run stops before a round that would overrun it (once it has
+    /// `BUDGET_MIN_ROUNDS`).
     pub budget: Duration,
+    /// When the command began.
+    pub started: Instant,
     pub seed: u64,
+}
+
+/// Rounds a run keeps even past its budget: the fewest that give a ratio and a spread.
+pub const BUDGET_MIN_ROUNDS: usize = 2;
+
+/// Why the rounds stopped.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Stop {
+    /// Every figure reached its CI target.
+    Converged,
+    /// The budget ran out first.
+    #[default]
+    Budget,
+    MaxRounds,
 }
 
 /// Every timed dispatch, as measured.
@@ -172,7 +118,11 @@ pub struct RawTimes {
     pub orders: Vec<Vec<Vec<(usize, usize)>>>,
     /// Wall time of each variant's first instance's untimed warm-up dispatch (includes JIT compilation).
     pub warmup_ms: Vec<f64>,
+    /// Seconds from the command's start to the first timed round (inputs, compilation, warm-up).
+    pub setup_s: f64,
+    /// Seconds of timed rounds.
     pub elapsed_s: f64,
+    pub stop: Stop,
 }
 
 impl RawTimes {
@@ -196,7 +146,7 @@ impl RawTimes {
 }
 
 /// Runs the protocol. After each round (from `min_rounds` on) `converged` sees the times so far; the run
-/// stops when it returns true, at `max_rounds`, or when the budget is spent.
+/// stops when it returns true, at `max_rounds`, or when the budget is spent (even before `min_rounds`).
 pub fn measure<V: Timed>(
     gpu: &Gpu,
     variants: &[V],
@@ -216,7 +166,11 @@ pub fn measure<V: Timed>(
     let timestamps = Timestamps::new(gpu, (2 * slots.len() * options.reps) as u32)?;
     let mut rng = rand_pcg::Pcg64::seed_from_u64(options.seed);
     let start = Instant::now();
+    raw.setup_s = options.started.elapsed().as_secs_f64();
+    raw.stop = Stop::MaxRounds;
+    let mut slowest_round = Duration::ZERO;
     for round in 0..options.max_rounds {
+        let round_start = Instant::now();
         let orders: Vec<Vec<(usize, usize)>> = (0..options.reps)
             .map(|_| {
                 let mut o = slots.clone();
@@ -253,7 +207,14 @@ pub fn measure<V: Timed>(
         raw.orders.push(orders);
         raw.elapsed_s = start.elapsed().as_secs_f64();
         on_round(&raw);
-        if round + 1 >= options.min_rounds && (converged(&raw) || start.elapsed() >= options.budget) {
+        if round + 1 >= options.min_rounds && converged(&raw) {
+            raw.stop = Stop::Converged;
+            break;
+        }
+        // Stop before a round that would overrun the budget (as long as the slowest so far).
+        slowest_round = slowest_round.max(round_start.elapsed());
+        if round + 1 >= BUDGET_MIN_ROUNDS && options.started.elapsed() + slowest_round >= options.budget {
+            raw.stop = Stop::Budget;
             break;
         }
     }
@@ -261,8 +222,8 @@ pub fn measure<V: Timed>(
 }
 
 /// What the protocol can time: a variant that records its dispatches into a command buffer (the profile's
-/// `Variant`; the scene kernels of `scene::run`), as one or more independently compiled instances. `measure`
-/// warms every instance up untimed first (lavapipe compiles a pipeline at its first dispatch).
+/// `workload::Variant`; the scene kernels of `scene::run`), as one or more independently compiled instances.
+/// `measure` warms every instance up untimed first (lavapipe compiles a pipeline at its first dispatch).
 pub trait Timed {
     /// Independently compiled pipelines of the same kernel.
     fn instances(&self) -> usize {
@@ -279,12 +240,3 @@ pub trait Timed {
     }
 }
 
-impl Timed for Variant<'_> {
-    fn instances(&self) -> usize {
-        self.pipelines.len()
-    }
-
-    fn record(&self, cmd: &Commands, instance: usize) {
-        self.pipelines.record(cmd, instance)
-    }
-}

@@ -298,7 +298,7 @@ mod tests {
         let mut info = crate::gpu::DeviceInfo {
             index: 0, name: "no-fp16 device".into(), device_type: "cpu".into(), vendor_id: 0, device_id: 0, driver_name: String::new(),
             driver_info: String::new(), driver_version: String::new(), api_version: String::new(), timestamp_period: 1.0,
-            timestamp_valid_bits: 64, max_storage_buffer_range: 1 << 27, max_compute_work_group_count: [65535; 3],
+            timestamp_valid_bits: 64, max_storage_buffer_range: 1 << 27, max_texel_buffer_elements: 1 << 27, max_compute_work_group_count: [65535; 3],
             max_compute_work_group_invocations: 256, min_storage_buffer_offset_alignment: 16, max_memory_allocation_size: 1 << 30,
             shader_float16: false, shader_float64: false, pipeline_executable_properties: false,
         };

@@ -8,10 +8,10 @@ use super::gbuffer::GBuffer;
 use super::plan::ScenePlan;
 use super::terms::{ETable, Switches};
 use super::effects;
-use crate::gpu::{Buffer, ChunkPlan, Commands, Gpu, MemoryKind};
+use crate::gpu::{Binding, Buffer, ChunkPlan, Commands, Gpu, MemoryKind};
 use crate::kernels::{self, RunLimits};
 use crate::model::KernelKind;
-use crate::profile::protocol::{Pipelines, Timed};
+use crate::profile::protocol::{Dispatch, Pipelines, Timed};
 use anyhow::Result;
 
 /// Bytes per pixel of each per-pixel binding: pixels (3 vec4), output (1 vec4), extras (2 vec4).
@@ -112,14 +112,19 @@ impl<'g> SceneVariant<'g> {
         let kb = &work.kernels[k];
         let push: [u8; 16] = bytemuck::cast(work.camera);
         let mk = model.kernel(KernelKind::Scene, kernels::embedded())?;
-        let pipelines = Pipelines::compile(gpu, &mk.spirv, &plan.constants(mk.constants, switches), 5, push.to_vec(), &kb.chunks.chunks, instances, |kernel, first, len| {
-            kernel.bind(&[
-                (&kb.pixels, first * PIXEL_BYTES, len * PIXEL_BYTES),
-                (&kb.radiance, first * OUT_BYTES, len * OUT_BYTES),
-                (&work.lights, 0, work.lights.size),
-                (&kb.extras, first * EXTRA_BYTES, len * EXTRA_BYTES),
-                (&kb.table, 0, kb.table.size),
-            ])
+        let kernel = [(mk.spirv, plan.constants(mk.constants, switches))];
+        let pipelines = Pipelines::compile(gpu, &kernel, &Binding::storage(5), push.len() as u32, instances, |k| {
+            let chunk = |&(first, len): &(u64, u64)| -> Result<Dispatch> {
+                let set = k[0].bind(&[
+                    (&kb.pixels, first * PIXEL_BYTES, len * PIXEL_BYTES),
+                    (&kb.radiance, first * OUT_BYTES, len * OUT_BYTES),
+                    (&work.lights, 0, work.lights.size),
+                    (&kb.extras, first * EXTRA_BYTES, len * EXTRA_BYTES),
+                    (&kb.table, 0, kb.table.size),
+                ])?;
+                Ok(Dispatch { kernel: 0, set, offsets: Vec::new(), push: push.to_vec(), invocations: len })
+            };
+            Ok(vec![kb.chunks.chunks.iter().map(chunk).collect::<Result<Vec<_>>>()?])
         })?;
         Ok(SceneVariant { label, kernel_index: k, switches, pipelines })
     }

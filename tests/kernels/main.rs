@@ -9,6 +9,7 @@ mod chunking;
 mod d_normalisation;
 mod exact_reference;
 mod models;
+mod shading;
 mod sources;
 mod stability;
 mod sweep;

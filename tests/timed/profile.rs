@@ -34,8 +34,15 @@ fn profile(json: &std::path::Path) -> (Run, Duration) {
         assert!(series.as_array().unwrap().iter().all(|r| r.as_array().unwrap().len() == reps));
     }
     assert!(report["provenance"]["device"]["name"].is_string());
-    assert_eq!(report["workload"]["width"], 1920);
-    assert_eq!(report["workload"]["height"], 1080);
+    assert_eq!(report["workload"]["width"], 960);
+    assert_eq!(report["workload"]["height"], 540);
+    assert_eq!(report["workload"]["gbuffer"], "packed");
+    assert!(report["provenance"]["cpu"]["family"].is_string() && report["provenance"]["cpu"]["features"].is_array());
+    // Every model row says how much of its time the memory-only kernel takes.
+    for r in rows.iter().filter(|r| !r["spec"].is_null()) {
+        let share = r["harness_share"]["median"].as_f64().unwrap();
+        assert!(share > 0.0 && share < 1.0, "harness share {share}");
+    }
     let ratios = rows
         .iter()
         .filter(|r| !r["spec"].is_null())
@@ -56,7 +63,7 @@ fn default_profile_is_fast_resolved_and_repeatable() {
     for (run, t) in [(&a, ta), (&b, tb)] {
         assert!(t < Duration::from_secs(120), "profile took {t:?}");
         for (model, median, lo, hi) in &run.ratios {
-            assert!(["ggx", "blinn", "cook-torrance", "burley"].contains(&model.as_str()));
+            assert!(brdfprof::brdf::THESIS_MODELS.contains(&model.as_str()));
             assert!((hi - lo) / 2.0 < 0.10 * median, "{model}: ratio {median} CI [{lo}, {hi}] is wider than +-10%");
         }
     }
@@ -79,7 +86,8 @@ fn default_profile_is_fast_resolved_and_repeatable() {
 fn protocol_keeps_the_faster_instance_and_reports_the_spread() {
     let _serial = crate::serial();
     use brdfprof::profile::gbuffer;
-    use brdfprof::profile::protocol::{self, ProtocolOptions, Timed, Variant, Workload};
+    use brdfprof::profile::protocol::{self, ProtocolOptions, Timed};
+    use brdfprof::profile::workload::{Variant, Workload};
 
     struct Uneven<'g>(Variant<'g>);
     impl Timed for Uneven<'_> {
@@ -94,10 +102,10 @@ fn protocol_keeps_the_faster_instance_and_reports_the_spread() {
     }
 
     let gpu = common::gpu();
-    let work = Workload::upload(&gpu, &gbuffer::synthetic(256, 256), &gbuffer::lights(8), None).unwrap();
+    let work = Workload::upload(&gpu, &gbuffer::synthetic(256, 256, gbuffer::GBufferFormat::Packed), &gbuffer::lights(8), None).unwrap();
     let ggx = brdfprof::model::Model::reference();
     let variants = [Uneven(Variant::new(&gpu, &work, Some(&ggx), brdfprof::kernels::embedded(), 1).unwrap())];
-    let options = ProtocolOptions { min_rounds: 9, max_rounds: 9, reps: 3, budget: std::time::Duration::from_secs(60), seed: 3 };
+    let options = ProtocolOptions { min_rounds: 9, max_rounds: 9, reps: 3, budget: std::time::Duration::from_secs(60), started: std::time::Instant::now(), seed: 3 };
     let raw = protocol::measure(&gpu, &variants, &options, |_| false, |_| {}).unwrap();
     let spread = raw.instance_spread(0);
     assert!(spread > 1.5 && spread < 2.6, "twice the work should be about twice the time: {spread}");

@@ -10,14 +10,7 @@ pub(super) const JIT_FEATURES: &str = "jit-cpu-features";
 
 /// "vendor family F model M stepping S (model name)" from /proc/cpuinfo: the host CPU as the JIT sees it.
 pub fn host_cpu() -> String {
-    let Ok(text) = std::fs::read_to_string("/proc/cpuinfo") else { return std::env::consts::ARCH.to_string() };
-    let field = |name: &str| {
-        text.lines()
-            .find(|l| l.split(':').next().is_some_and(|k| k.trim() == name))
-            .and_then(|l| l.split_once(':'))
-            .map_or(String::from("?"), |(_, v)| v.trim().to_string())
-    };
-    format!("{} family {} model {} stepping {} ({})", field("vendor_id"), field("cpu family"), field("model"), field("stepping"), field("model name"))
+    crate::host::HostCpu::detect().describe()
 }
 
 /// What each group's figures depend on.

@@ -1,0 +1,71 @@
+//! The host CPU, as reports record it: lavapipe's costs are the CPU's (its JIT targets the host's vector
+//! units), so a figure without the CPU that made it cannot be compared.
+
+use serde::Serialize;
+
+/// What /proc/cpuinfo and CPUID say about the host.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct HostCpu {
+    pub vendor: String,
+    pub family: String,
+    pub model: String,
+    pub stepping: String,
+    pub model_name: String,
+    /// The vector and bit-manipulation features the JIT may use (e.g. avx2, avx512f), as CPUID reports them.
+    pub features: Vec<String>,
+}
+
+impl HostCpu {
+    pub fn detect() -> Self {
+        let text = std::fs::read_to_string("/proc/cpuinfo").unwrap_or_default();
+        let field = |name: &str| {
+            text.lines()
+                .find(|l| l.split(':').next().is_some_and(|k| k.trim() == name))
+                .and_then(|l| l.split_once(':'))
+                .map_or(String::from("?"), |(_, v)| v.trim().to_string())
+        };
+        HostCpu {
+            vendor: field("vendor_id"),
+            family: field("cpu family"),
+            model: field("model"),
+            stepping: field("stepping"),
+            model_name: field("model name"),
+            features: cpu_features(),
+        }
+    }
+
+    /// "vendor family F model M stepping S (model name)".
+    pub fn describe(&self) -> String {
+        format!("{} family {} model {} stepping {} ({})", self.vendor, self.family, self.model, self.stepping, self.model_name)
+    }
+
+    /// The widest vector extension present: "AVX-512", "AVX2", ...
+    pub fn vector_width(&self) -> &'static str {
+        let has = |f: &str| self.features.iter().any(|x| x == f);
+        if has("avx512f") {
+            "AVX-512"
+        } else if has("avx2") {
+            "AVX2"
+        } else if has("avx") {
+            "AVX"
+        } else {
+            "SSE"
+        }
+    }
+}
+
+/// The CPU features of this process' host, as `is_x86_feature_detected!` sees them.
+#[cfg(target_arch = "x86_64")]
+pub fn cpu_features() -> Vec<String> {
+    let mut f = Vec::new();
+    macro_rules! probe {
+        ($($name:tt),*) => { $( if std::arch::is_x86_feature_detected!($name) { f.push($name.to_string()); } )* };
+    }
+    probe!("sse4.1", "sse4.2", "popcnt", "avx", "avx2", "fma", "f16c", "bmi1", "bmi2", "avx512f", "avx512dq", "avx512bw", "avx512vl", "avx512cd");
+    f
+}
+
+#[cfg(not(target_arch = "x86_64"))]
+pub fn cpu_features() -> Vec<String> {
+    vec![std::env::consts::ARCH.to_string()]
+}

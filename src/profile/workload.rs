@@ -1,0 +1,242 @@
+//! The profile's work on the device: the synthetic G-buffer, the lights and the output, padded to whole
+//! workgroups (the kernel has no bounds check), and each model's shading kernel bound to them (`Variant`).
+//!
+//! A profile of L lights runs its lights in blocks of at most `LIGHT_BLOCK`, one dispatch per block, each
+//! adding to what the previous wrote: the kernel unrolls one block (so light loads are uniform scalar loads
+//! on lavapipe and the unrolled code stays small at any light count), and the cost per light stays that of a
+//! block whatever L is.
+
+use super::gbuffer::{GBuffer, GBufferFormat, LIGHT_FLOATS};
+use super::protocol::{Dispatch, Pipelines, Timed};
+use crate::gpu::{Binding, Buffer, ChunkPlan, Commands, Gpu, MemoryKind};
+use crate::kernels::{constants, WithConstant};
+use crate::model::{KernelKind, Model, ModelKernel};
+use crate::shaders::Shaders;
+use anyhow::Result;
+
+pub use crate::kernels::constants::LIGHT_BLOCK;
+
+/// The most lights a profile takes: 512 dispatches per run, 128 KiB of lights. Compilation does not grow
+/// with the count (one block kernel), the run time does.
+pub const MAX_LIGHTS: u32 = 4096;
+
+/// Bytes of one block of lights in the light buffer (std140: two vec4 per light), the dynamic offset's step.
+const BLOCK_BYTES: u64 = LIGHT_BLOCK as u64 * LIGHT_FLOATS as u64 * 4;
+
+/// The dispatches of a profile with `lights` lights: (first light, lights) per block.
+pub fn light_blocks(lights: u32) -> Vec<(u32, u32)> {
+    (0..lights.div_ceil(LIGHT_BLOCK)).map(|b| (b * LIGHT_BLOCK, LIGHT_BLOCK.min(lights - b * LIGHT_BLOCK))).collect()
+}
+
+/// The block kernel that most of a profile's dispatches run: (lights per dispatch, whether it accumulates).
+pub fn steady_block(lights: u32) -> (u32, bool) {
+    (lights.min(LIGHT_BLOCK), lights > LIGHT_BLOCK)
+}
+
+/// The G-buffer, lights and output on the device.
+pub struct Workload<'g> {
+    gbuffer: Buffer<'g>,
+    radiance: Buffer<'g>,
+    lights: Buffer<'g>,
+    pub format: GBufferFormat,
+    pub light_count: u32,
+    pub width: u32,
+    /// Pixels in the picture (the padding is not counted in evaluations).
+    pub pixel_count: u64,
+    camera: [f32; 4],
+    plan: ChunkPlan,
+}
+
+impl<'g> Workload<'g> {
+    pub fn upload(gpu: &'g Gpu, gbuffer: &GBuffer, lights: &[f32], max_chunk: Option<u64>) -> Result<Self> {
+        let count = lights.len() / LIGHT_FLOATS;
+        if count == 0 || count > MAX_LIGHTS as usize || lights.len() % LIGHT_FLOATS != 0 {
+            anyhow::bail!("{count} lights: a profile takes 1 to {MAX_LIGHTS} whole lights");
+        }
+        let n = gbuffer.pixel_count();
+        let wg = crate::gpu::WORKGROUP as u64;
+        let padded = n.div_ceil(wg) * wg;
+        let per = gbuffer.words_per_pixel();
+        let mut words = gbuffer.words.clone();
+        let last = words[words.len() - per..].to_vec();
+        for _ in n..padded {
+            words.extend_from_slice(&last);
+        }
+        let (f, c) = (gbuffer.format, gbuffer.camera);
+        // Whole blocks, so that every dispatch's window of BLOCK_BYTES lies inside the buffer.
+        let mut light_data = lights.to_vec();
+        light_data.resize(light_blocks((lights.len() / LIGHT_FLOATS) as u32).len().max(1) * BLOCK_BYTES as usize / 4, 0.0);
+        Ok(Workload {
+            gbuffer: Buffer::with_data(gpu, bytemuck::cast_slice(&words), MemoryKind::Device)?,
+            radiance: Buffer::new(gpu, padded * f.bytes_out(), MemoryKind::Device)?,
+            lights: Buffer::with_data(gpu, bytemuck::cast_slice(&light_data), MemoryKind::Device)?,
+            format: f,
+            light_count: (lights.len() / LIGHT_FLOATS) as u32,
+            width: gbuffer.width,
+            pixel_count: n,
+            camera: [c.scale[0], c.offset[0], c.scale[1], c.offset[1]],
+            plan: ChunkPlan::new(&gpu.info, padded, &[f.bytes_in(), f.bytes_out()], texel_cap(gpu, f, max_chunk)),
+        })
+    }
+
+    /// BRDF evaluations per run of a variant (every light block).
+    pub fn evaluations(&self) -> u64 {
+        self.pixel_count * self.light_count as u64
+    }
+
+    pub fn chunks(&self) -> usize {
+        self.plan.chunks.len()
+    }
+
+    /// The radiance the last run wrote (rgb per pixel), for checks.
+    pub fn radiance(&self) -> Result<Vec<[f32; 3]>> {
+        match self.format {
+            GBufferFormat::Float => {
+                let v: Vec<f32> = self.radiance.read_as(0, self.pixel_count as usize * 4)?;
+                Ok(v.chunks_exact(4).map(|c| [c[0], c[1], c[2]]).collect())
+            }
+            GBufferFormat::Packed => {
+                let v: Vec<u32> = self.radiance.read_as(0, self.pixel_count as usize)?;
+                Ok(v.into_iter().map(super::gbuffer::unpack_r11g11b10).collect())
+            }
+        }
+    }
+
+    /// The push constants of a dispatch over the chunk starting at pixel `first_pixel` (glsl/shade.glsl `Push`).
+    fn push(&self, first_pixel: u64) -> Vec<u8> {
+        let words: [u32; 8] = [first_pixel as u32, self.width, 0, 0, self.camera[0].to_bits(), self.camera[1].to_bits(), self.camera[2].to_bits(), self.camera[3].to_bits()];
+        bytemuck::cast_slice(&words).to_vec()
+    }
+}
+
+/// The packed layout's views hold at most maxTexelBufferElements pixels each: chunks no larger.
+fn texel_cap(gpu: &Gpu, format: GBufferFormat, cap: Option<u64>) -> Option<u64> {
+    match format {
+        GBufferFormat::Packed => Some(cap.unwrap_or(u64::MAX).min(gpu.info.max_texel_buffer_elements as u64)),
+        GBufferFormat::Float => cap,
+    }
+}
+
+/// Bytes of shade.glsl's push constants.
+pub const PUSH_BYTES: u32 = 32;
+/// shade.glsl's bindings: the G-buffer, the radiance, one block of lights.
+pub fn bindings(format: GBufferFormat) -> [Binding; 3] {
+    use ash::vk::Format;
+    match format {
+        GBufferFormat::Packed => [Binding::TexelRead(Format::R32G32B32A32_UINT), Binding::TexelStorage(Format::B10G11R11_UFLOAT_PACK32), Binding::UniformDynamic],
+        GBufferFormat::Float => [Binding::Storage, Binding::Storage, Binding::UniformDynamic],
+    }
+}
+
+/// The kernel of the G-buffer format.
+fn shade_kind(format: GBufferFormat) -> KernelKind {
+    match format {
+        GBufferFormat::Packed => KernelKind::Shade,
+        GBufferFormat::Float => KernelKind::ShadeFloat,
+    }
+}
+
+/// glsl/shade.glsl for `model` (None: the memory-only baseline, compiled with the reference model's selectors,
+/// which it never runs) over `format`, lighting `lights` lights per dispatch and adding to the radiance of an
+/// earlier block when `accumulate`, with every specialisation constant set.
+pub fn shade_kernel(model: Option<&Model>, format: GBufferFormat, lights: u32, accumulate: bool, shaders: &Shaders) -> Result<ModelKernel> {
+    let reference = Model::reference();
+    let mut k = model.unwrap_or(&reference).kernel(shade_kind(format), shaders)?;
+    k.constants = k
+        .constants
+        .with(constants::NUM_LIGHTS, lights as f64)
+        .with(constants::BASELINE, model.is_none() as i32 as f64)
+        .with(constants::ACCUMULATE, accumulate as i32 as f64);
+    Ok(k)
+}
+
+/// A model's shading kernel (or the memory-only baseline) bound to the workload, every light block, ready to
+/// dispatch.
+pub struct Variant<'g> {
+    pub label: String,
+    /// None for the memory-only baseline.
+    pub model: Option<Model>,
+    pipelines: Pipelines<'g>,
+}
+
+/// The label of the memory-only baseline kernel in every report.
+pub const BASELINE_LABEL: &str = "baseline";
+
+impl<'g> Variant<'g> {
+    /// The shading kernels for `model` (None: the memory-only baseline) from `shaders`, as `instances`
+    /// independent pipelines.
+    pub fn new(gpu: &'g Gpu, work: &Workload<'g>, model: Option<&Model>, shaders: &Shaders, instances: usize) -> Result<Self> {
+        if let Some(m) = model {
+            m.check_support(&gpu.info)?;
+        }
+        let blocks = light_blocks(work.light_count);
+        // One kernel per distinct (lights per dispatch, accumulate) among the blocks.
+        let mut kinds: Vec<(u32, bool)> = Vec::new();
+        let kind_of: Vec<usize> = blocks
+            .iter()
+            .enumerate()
+            .map(|(b, &(_, count))| {
+                let kind = (count, b > 0);
+                kinds.iter().position(|k| *k == kind).unwrap_or_else(|| {
+                    kinds.push(kind);
+                    kinds.len() - 1
+                })
+            })
+            .collect();
+        let compiled = kinds
+            .iter()
+            .map(|&(count, acc)| shade_kernel(model, work.format, count, acc, shaders).map(|k| (k.spirv, k.constants)))
+            .collect::<Result<Vec<_>>>()?;
+        let (f, chunks) = (work.format, &work.plan.chunks);
+        let pipelines = Pipelines::compile(gpu, &compiled, &bindings(f), PUSH_BYTES, instances, |kernels| {
+            // One set per kernel and chunk, shared by every block that kernel runs.
+            let sets = kernels
+                .iter()
+                .map(|k| {
+                    chunks
+                        .iter()
+                        .map(|&(first, len)| {
+                            k.bind(&[(&work.gbuffer, first * f.bytes_in(), len * f.bytes_in()), (&work.radiance, first * f.bytes_out(), len * f.bytes_out()), (&work.lights, 0, BLOCK_BYTES)])
+                        })
+                        .collect::<Result<Vec<_>>>()
+                })
+                .collect::<Result<Vec<_>>>()?;
+            Ok(blocks
+                .iter()
+                .zip(&kind_of)
+                .map(|(&(first_light, _), &k)| {
+                    let offsets = vec![(first_light as u64 / LIGHT_BLOCK as u64 * BLOCK_BYTES) as u32];
+                    chunks.iter().zip(&sets[k]).map(|(&(first, len), &set)| Dispatch { kernel: k, set, offsets: offsets.clone(), push: work.push(first), invocations: len }).collect()
+                })
+                .collect())
+        })?;
+        Ok(Variant { label: model.map_or_else(|| BASELINE_LABEL.to_string(), Model::name), model: model.cloned(), pipelines })
+    }
+}
+
+impl Timed for Variant<'_> {
+    fn instances(&self) -> usize {
+        self.pipelines.len()
+    }
+
+    fn record(&self, cmd: &Commands, instance: usize) {
+        self.pipelines.record(cmd, instance)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn blocks_cover_every_light_once() {
+        for lights in [1, 4, 7, 8, 9, 16, 63, 64, 65, 1024] {
+            let b = light_blocks(lights);
+            assert_eq!(b.iter().map(|x| x.1).sum::<u32>(), lights);
+            assert!(b.windows(2).all(|w| w[0].0 + w[0].1 == w[1].0) && b[0].0 == 0);
+            assert!(b.iter().all(|x| x.1 >= 1 && x.1 <= LIGHT_BLOCK));
+        }
+        assert_eq!(steady_block(4), (4, false));
+        assert_eq!(steady_block(64), (8, true));
+    }
+}
