@@ -148,8 +148,8 @@ pub fn parse_size(flag: &str, text: &str) -> Result<(u32, u32)> {
 /// compilation gave the same figure run after run. The variable is recorded in every report's environment.
 pub fn fresh_compilation(keep_cache: bool) {
     if !keep_cache && std::env::var_os("MESA_SHADER_CACHE_DISABLE").is_none() {
-        // SAFETY: called on the main thread before any other thread exists and before the Vulkan driver,
-        // which reads the variable, is loaded.
+        // SAFETY: called on the main thread before the Vulkan driver, which reads the variable, is loaded,
+        // while the only other thread is the signal handler's, which reads no environment variable.
         unsafe { std::env::set_var("MESA_SHADER_CACHE_DISABLE", "true") };
     }
 }
