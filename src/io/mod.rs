@@ -76,40 +76,58 @@ pub fn format_rgb_csv(rows: &[[f32; 3]]) -> String {
     out
 }
 
+/// Symbolic links followed at most this many times (Linux's own limit, MAXSYMLINKS).
+const MAX_LINKS: usize = 40;
+
+/// Where writing `path` writes: `path` itself, or the file its chain of symbolic links ends at, which need
+/// not exist yet (as a shell's `>` creates a dangling link's target).
+fn link_target(path: &Path) -> Result<PathBuf> {
+    let mut target = path.to_path_buf();
+    for _ in 0..MAX_LINKS {
+        match std::fs::symlink_metadata(&target) {
+            Ok(m) if m.file_type().is_symlink() => {
+                let next = std::fs::read_link(&target).with_context(|| format!("cannot read the symbolic link {}", target.display()))?;
+                target = target.parent().map_or_else(|| next.clone(), |dir| dir.join(&next));
+            }
+            _ => return Ok(target),
+        }
+    }
+    bail!("{}: more than {MAX_LINKS} symbolic links in a row (a loop?)", path.display())
+}
+
 /// Writes a command's named output. A regular file, or a path that does not exist yet, is written atomically:
-/// a temporary file in the same directory, synced, then renamed over it, so a failure leaves any existing file
-/// untouched and no temporary behind. A symbolic link is followed, and its target written the same way. Any
-/// other existing file (a device such as /dev/null, a FIFO) is opened and written in place, never replaced.
+/// a temporary file in the same directory (with the old file's permissions), synced, then renamed over it, so
+/// a failure leaves any existing file untouched and no temporary behind. A symbolic link is followed, and its
+/// target written the same way, so the link stays a link. Any other existing file (a device such as
+/// /dev/null, a FIFO) is opened and written in place, never replaced.
 pub fn write_output(path: &Path, bytes: &[u8]) -> Result<()> {
-    let target = match std::fs::symlink_metadata(path) {
-        Ok(m) if m.file_type().is_symlink() => match std::fs::canonicalize(path) {
-            Ok(t) => t,
-            Err(e) => bail!("cannot write {}: it is a symbolic link whose target cannot be resolved ({e})", path.display()),
-        },
-        _ => path.to_path_buf(),
-    };
+    crate::cleanup::park_if_interrupted();
+    let target = link_target(path)?;
     match std::fs::metadata(&target) {
         Ok(m) if m.is_dir() => bail!("cannot write {}: it is a directory", path.display()),
         Ok(m) if !m.is_file() => {
             let mut f = std::fs::OpenOptions::new().write(true).open(&target).with_context(|| format!("cannot open {}", path.display()))?;
             f.write_all(bytes).and_then(|_| f.flush()).with_context(|| format!("cannot write {}", path.display()))
         }
-        _ => write_atomic(&target, bytes),
+        Ok(m) => write_atomic(&target, bytes, Some(m.permissions())),
+        Err(_) => write_atomic(&target, bytes, None),
     }
 }
 
 /// Temp-then-rename in `path`'s directory (regular files only; `write_output` decides).
-fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    let dir = match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
+fn write_atomic(path: &Path, bytes: &[u8], permissions: Option<std::fs::Permissions>) -> Result<()> {
+    let dir = parent_dir(path);
     std::fs::create_dir_all(&dir).with_context(|| format!("cannot create directory {}", dir.display()))?;
     let file_name = path.file_name().ok_or_else(|| anyhow!("{} is not a file path", path.display()))?;
     let tmp = dir.join(format!(".{}.{}.tmp", file_name.to_string_lossy(), std::process::id()));
+    // Registered, so that an interrupted write leaves no temporary behind either.
+    let _guard = crate::cleanup::PathGuard::new(&tmp);
     let result = (|| -> Result<()> {
         let mut f = std::fs::File::create(&tmp)?;
         f.write_all(bytes)?;
+        if let Some(p) = permissions {
+            f.set_permissions(p)?;
+        }
         f.sync_all()?;
         std::fs::rename(&tmp, path)?;
         Ok(())
@@ -120,9 +138,18 @@ fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     result.with_context(|| format!("cannot write {}", path.display()))
 }
 
+/// The directory a relative or absolute file path is in (`.` for a bare name).
+fn parent_dir(path: &Path) -> PathBuf {
+    match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::os::unix::fs::{FileTypeExt, MetadataExt};
 
     const HEADER: &str = "roughness,nx,ny,nz,vx,vy,vz,lx,ly,lz,f0r,f0g,f0b,extra";
 
@@ -150,12 +177,72 @@ mod tests {
     }
 
     #[test]
-    fn atomic_write_replaces_whole_file() {
+    fn a_regular_file_is_replaced_atomically() {
         let dir = tempfile::tempdir().unwrap();
         let p = dir.path().join("out.csv");
         write_output(&p, b"first").unwrap();
+        // A hard link keeps the old file: the new content went to a new file renamed over the path, not
+        // into the old one (a reader of the old file never sees half of the new).
+        let old = dir.path().join("old-link");
+        std::fs::hard_link(&p, &old).unwrap();
+        let inode = std::fs::metadata(&p).unwrap().ino();
         write_output(&p, b"second").unwrap();
         assert_eq!(std::fs::read(&p).unwrap(), b"second");
-        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1, "no temporary left behind");
+        assert_eq!(std::fs::read(&old).unwrap(), b"first");
+        assert_ne!(std::fs::metadata(&p).unwrap().ino(), inode);
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 2, "no temporary left behind");
+    }
+
+    #[test]
+    fn permissions_of_the_replaced_file_are_kept() {
+        use std::os::unix::fs::PermissionsExt;
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("out.csv");
+        std::fs::write(&p, "x").unwrap();
+        std::fs::set_permissions(&p, std::fs::Permissions::from_mode(0o640)).unwrap();
+        write_output(&p, b"y").unwrap();
+        assert_eq!(std::fs::metadata(&p).unwrap().permissions().mode() & 0o777, 0o640);
+    }
+
+    #[test]
+    fn a_symlink_output_writes_its_target_and_stays_a_link() {
+        let dir = tempfile::tempdir().unwrap();
+        let target = dir.path().join("target.csv");
+        std::fs::write(&target, "old").unwrap();
+        let link = dir.path().join("link.csv");
+        std::os::unix::fs::symlink("target.csv", &link).unwrap();
+        write_output(&link, b"r,g,b\n").unwrap();
+        assert!(std::fs::symlink_metadata(&link).unwrap().file_type().is_symlink());
+        assert_eq!(std::fs::read(&target).unwrap(), b"r,g,b\n");
+        // A dangling link's target is created, as a shell's `>` does.
+        let dangling = dir.path().join("dangling.csv");
+        std::os::unix::fs::symlink(dir.path().join("sub/new.csv"), &dangling).unwrap();
+        write_output(&dangling, b"x").unwrap();
+        assert!(std::fs::symlink_metadata(&dangling).unwrap().file_type().is_symlink());
+        assert_eq!(std::fs::read(dir.path().join("sub/new.csv")).unwrap(), b"x");
+    }
+
+    #[test]
+    fn a_fifo_output_receives_the_bytes_and_stays_a_fifo() {
+        let dir = tempfile::tempdir().unwrap();
+        let fifo = dir.path().join("out.fifo");
+        let made = std::process::Command::new("mkfifo").arg(&fifo).status().unwrap();
+        assert!(made.success());
+        let reader = {
+            let fifo = fifo.clone();
+            std::thread::spawn(move || std::fs::read(fifo).unwrap())
+        };
+        let csv = format_rgb_csv(&[[0.5, 0.25, 1.0]]);
+        write_output(&fifo, csv.as_bytes()).unwrap();
+        assert_eq!(reader.join().unwrap(), csv.as_bytes());
+        assert!(std::fs::symlink_metadata(&fifo).unwrap().file_type().is_fifo());
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1, "no temporary beside the FIFO");
+    }
+
+    #[test]
+    fn a_directory_is_refused_by_name() {
+        let dir = tempfile::tempdir().unwrap();
+        let e = write_output(dir.path(), b"x").unwrap_err().to_string();
+        assert!(e.contains(&format!("cannot write {}: it is a directory", dir.path().display())), "{e}");
     }
 }
