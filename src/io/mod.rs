@@ -1,70 +1,13 @@
-//! Files in and out: the `eval` CSV format (errors name file, line and column), and atomic writes so that a
-//! failed run never leaves a half-written result behind.
+//! Files in and out: the `eval` CSV format (`csv`: errors name file, line and column), and atomic writes so
+//! that a failed run never leaves a half-written result behind.
 
-use crate::brdf::guards::MIN_VECTOR;
-use crate::brdf::Sample;
+pub mod csv;
+
+pub use csv::{parse_eval_csv, parse_samples_csv, read_eval_csv, read_samples_csv, EvalInput, SAMPLE_COLUMNS, TANGENT_COLUMNS};
+
 use anyhow::{anyhow, bail, Context, Result};
 use std::io::Write;
 use std::path::{Path, PathBuf};
-
-/// Columns `eval` needs, in any order; others are ignored.
-pub const SAMPLE_COLUMNS: [&str; 13] = ["nx", "ny", "nz", "vx", "vy", "vz", "lx", "ly", "lz", "roughness", "f0r", "f0g", "f0b"];
-
-/// Reads `eval` input. Every value must be a finite number, vectors non-zero, roughness and F0 in [0, 1].
-pub fn read_samples_csv(path: &Path) -> Result<Vec<Sample>> {
-    let text = std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
-    parse_samples_csv(&text, &path.display().to_string())
-}
-
-pub fn parse_samples_csv(text: &str, name: &str) -> Result<Vec<Sample>> {
-    let mut lines = text.lines().enumerate().map(|(i, l)| (i + 1, l.trim_end_matches('\r'))).filter(|(_, l)| !l.trim().is_empty());
-    let (header_line, header) = lines
-        .next()
-        .ok_or_else(|| anyhow!("{name}: empty file; expected a header with columns {}", SAMPLE_COLUMNS.join(",")))?;
-    let names: Vec<&str> = header.split(',').map(str::trim).collect();
-    let missing: Vec<&str> = SAMPLE_COLUMNS.iter().copied().filter(|c| !names.contains(c)).collect();
-    if !missing.is_empty() {
-        bail!("{name}:{header_line}: header lacks column(s) {} (needs {})", missing.join(", "), SAMPLE_COLUMNS.join(","));
-    }
-    let index: Vec<usize> = SAMPLE_COLUMNS.iter().map(|c| names.iter().position(|n| n == c).unwrap()).collect();
-    let mut samples = Vec::new();
-    for (line, row) in lines {
-        let fields: Vec<&str> = row.split(',').map(str::trim).collect();
-        if fields.len() != names.len() {
-            bail!("{name}:{line}: {} fields, but the header has {}", fields.len(), names.len());
-        }
-        let mut v = [0f32; 13];
-        for (k, &col) in index.iter().enumerate() {
-            let raw = fields[col];
-            let x: f32 = raw
-                .parse()
-                .map_err(|_| anyhow!("{name}:{line}: column {} `{}`: `{raw}` is not a number", col + 1, SAMPLE_COLUMNS[k]))?;
-            if !x.is_finite() {
-                bail!("{name}:{line}: column {} `{}`: `{raw}` is not finite", col + 1, SAMPLE_COLUMNS[k]);
-            }
-            v[k] = x;
-        }
-        for (first, label) in [(0, "n"), (3, "v"), (6, "l")] {
-            let largest = v[first..first + 3].iter().fold(0f32, |m, x| m.max(x.abs()));
-            if f64::from(largest) < MIN_VECTOR {
-                bail!("{name}:{line}: columns {label}x,{label}y,{label}z: zero-length vector");
-            }
-        }
-        for (k, what) in [(9, "roughness"), (10, "f0r"), (11, "f0g"), (12, "f0b")] {
-            if !(0.0..=1.0).contains(&v[k]) {
-                bail!("{name}:{line}: column {} `{what}`: {} is outside [0, 1]", index[k] + 1, v[k]);
-            }
-        }
-        samples.push(Sample {
-            n: [v[0], v[1], v[2]],
-            v: [v[3], v[4], v[5]],
-            l: [v[6], v[7], v[8]],
-            roughness: v[9],
-            f0: [v[10], v[11], v[12]],
-        });
-    }
-    Ok(samples)
-}
 
 /// The `eval` output: header `r,g,b`, one row per sample (shortest text that reads back to the same f32).
 pub fn format_rgb_csv(rows: &[[f32; 3]]) -> String {
@@ -150,31 +93,6 @@ fn parent_dir(path: &Path) -> PathBuf {
 mod tests {
     use super::*;
     use std::os::unix::fs::{FileTypeExt, MetadataExt};
-
-    const HEADER: &str = "roughness,nx,ny,nz,vx,vy,vz,lx,ly,lz,f0r,f0g,f0b,extra";
-
-    #[test]
-    fn columns_in_any_order_and_extra_ignored() {
-        let s = parse_samples_csv(&format!("{HEADER}\n0.5,0,0,1,0,0.6,0.8,0.6,0,0.8,0.04,0.05,0.06,hello\n"), "in.csv").unwrap();
-        assert_eq!(s.len(), 1);
-        assert_eq!((s[0].roughness, s[0].n, s[0].f0), (0.5, [0.0, 0.0, 1.0], [0.04, 0.05, 0.06]));
-    }
-
-    #[test]
-    fn errors_name_line_and_column() {
-        let e = parse_samples_csv(&format!("{HEADER}\n0.5,0,0,1,0,0.6,0.8,0.6,0,0.8,0.04,0.05,0.06,x\n0.5,0,0,1,0,abc,0.8,0.6,0,0.8,0.04,0.05,0.06,x\n"), "in.csv")
-            .unwrap_err()
-            .to_string();
-        assert!(e.contains("in.csv:3: column 6 `vy`: `abc` is not a number"), "{e}");
-        let e = parse_samples_csv("nx,ny,nz\n", "in.csv").unwrap_err().to_string();
-        assert!(e.contains("in.csv:1: header lacks column(s) vx"), "{e}");
-        let e = parse_samples_csv("\n\n", "in.csv").unwrap_err().to_string();
-        assert!(e.contains("empty file"), "{e}");
-        let e = parse_samples_csv(&format!("{HEADER}\n0.5,0,0,0,0,0.6,0.8,0.6,0,0.8,0.04,0.05,0.06,x\n"), "in.csv").unwrap_err().to_string();
-        assert!(e.contains("in.csv:2: columns nx,ny,nz: zero-length vector"), "{e}");
-        let e = parse_samples_csv(&format!("{HEADER}\nNaN,0,0,1,0,0.6,0.8,0.6,0,0.8,0.04,0.05,0.06,x\n"), "in.csv").unwrap_err().to_string();
-        assert!(e.contains("column 1 `roughness`: `NaN` is not finite"), "{e}");
-    }
 
     #[test]
     fn a_regular_file_is_replaced_atomically() {

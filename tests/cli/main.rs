@@ -5,4 +5,5 @@
 mod common;
 
 mod eval;
+mod eval_csv;
 mod signals;
