@@ -9,11 +9,13 @@ pub mod scene;
 
 use anyhow::{anyhow, bail, Result};
 use brdfprof::gpu::{Gpu, GpuOptions};
+use brdfprof::io;
 use brdfprof::model::{self, Model};
 use brdfprof::profile::protocol::ProtocolOptions;
 use brdfprof::profile::ProfileOptions;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
+use std::path::Path;
 use std::time::Duration;
 
 #[derive(Args, Clone)]
@@ -151,6 +153,15 @@ pub fn fresh_compilation(keep_cache: bool) {
         // SAFETY: called on the main thread before the Vulkan driver, which reads the variable, is loaded,
         // while the only other thread is the signal handler's, which reads no environment variable.
         unsafe { std::env::set_var("MESA_SHADER_CACHE_DISABLE", "true") };
+    }
+}
+
+/// Checks a file output given by `flag` (see `io::check_output_path`), or, when it defaults to a file in
+/// `default_dir` that is named only once the device is open, that directory.
+pub fn check_output(flag: &str, path: Option<&Path>, default_dir: &str, default_name: &str) -> Result<()> {
+    match path {
+        Some(p) => io::check_output_path(flag, p),
+        None => io::check_output_dir(&format!("{flag} (default {default_dir}/{default_name})"), Path::new(default_dir)),
     }
 }
 

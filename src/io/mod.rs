@@ -1,5 +1,6 @@
-//! Files in and out: the `eval` CSV format (`csv`: errors name file, line and column), and atomic writes so
-//! that a failed run never leaves a half-written result behind.
+//! Files in and out: the `eval` CSV format (`csv`: errors name file, line and column), output paths checked
+//! before a command measures anything, and atomic writes so that a failed run never leaves a half-written
+//! result behind.
 
 pub mod csv;
 
@@ -7,6 +8,7 @@ pub use csv::{parse_eval_csv, parse_samples_csv, read_eval_csv, read_samples_csv
 
 use anyhow::{anyhow, bail, Context, Result};
 use std::io::Write;
+use std::os::unix::ffi::OsStrExt;
 use std::path::{Path, PathBuf};
 
 /// The `eval` output: header `r,g,b`, one row per sample (shortest text that reads back to the same f32).
@@ -89,6 +91,68 @@ fn parent_dir(path: &Path) -> PathBuf {
     }
 }
 
+/// Checks, before a command measures anything, that it will be able to write the file output `path` given
+/// by `flag`: not a directory, and in a directory that exists or can be created. Errors name the flag and
+/// the path.
+pub fn check_output_path(flag: &str, path: &Path) -> Result<()> {
+    let shown = path.display();
+    if path.as_os_str().is_empty() {
+        bail!("{flag}: empty path; give a file name");
+    }
+    if path.as_os_str().as_bytes().ends_with(b"/") || path.file_name().is_none() {
+        bail!("{flag} {shown}: names a directory; give a file path");
+    }
+    let target = link_target(path).map_err(|e| anyhow!("{flag} {shown}: {e:#}"))?;
+    match std::fs::metadata(&target) {
+        Ok(m) if m.is_dir() => bail!("{flag} {shown}: is a directory; give a file path"),
+        Ok(_) => Ok(()),
+        Err(e) if missing(&e) => creatable(flag, path, &parent_dir(&target)),
+        Err(e) => bail!("{flag} {shown}: {e}"),
+    }
+}
+
+/// Checks, before a command measures anything, that the output directory `dir` given by `flag` is a
+/// directory or can be created. Errors name the flag and the path.
+pub fn check_output_dir(flag: &str, dir: &Path) -> Result<()> {
+    if dir.as_os_str().is_empty() {
+        bail!("{flag}: empty path; give a directory");
+    }
+    match std::fs::metadata(dir) {
+        Ok(m) if m.is_dir() => writable(flag, dir, dir),
+        Ok(_) => bail!("{flag} {}: exists and is not a directory", dir.display()),
+        Err(e) if missing(&e) => creatable(flag, dir, dir),
+        Err(e) => bail!("{flag} {}: {e}", dir.display()),
+    }
+}
+
+/// No such path (ENOENT), or a file where a directory should be on the way (ENOTDIR: found by `creatable`).
+fn missing(e: &std::io::Error) -> bool {
+    matches!(e.kind(), std::io::ErrorKind::NotFound | std::io::ErrorKind::NotADirectory)
+}
+
+/// `dir` exists, or its nearest existing ancestor is a directory brdfprof may write in.
+fn creatable(flag: &str, output: &Path, dir: &Path) -> Result<()> {
+    let mut d = dir.to_path_buf();
+    loop {
+        match std::fs::metadata(&d) {
+            Ok(m) if m.is_dir() => return writable(flag, output, &d),
+            Ok(_) => bail!("{flag} {}: {} is not a directory", output.display(), d.display()),
+            Err(e) if missing(&e) => d = parent_dir(&d),
+            Err(e) => bail!("{flag} {}: cannot use {}: {e}", output.display(), d.display()),
+        }
+    }
+}
+
+/// `dir` admits new entries (permissions, read-only file systems).
+fn writable(flag: &str, output: &Path, dir: &Path) -> Result<()> {
+    let c = std::ffi::CString::new(dir.as_os_str().as_bytes()).map_err(|_| anyhow!("{flag} {}: the path contains a NUL byte", output.display()))?;
+    // SAFETY: `c` is a NUL-terminated path that outlives the call.
+    if unsafe { libc::access(c.as_ptr(), libc::W_OK | libc::X_OK) } != 0 {
+        bail!("{flag} {}: cannot write in {} ({})", output.display(), dir.display(), std::io::Error::last_os_error());
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -162,5 +226,29 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let e = write_output(dir.path(), b"x").unwrap_err().to_string();
         assert!(e.contains(&format!("cannot write {}: it is a directory", dir.path().display())), "{e}");
+    }
+
+    #[test]
+    fn output_paths_are_checked_before_any_work() {
+        let dir = tempfile::tempdir().unwrap();
+        let d = dir.path();
+        let file = d.join("file");
+        std::fs::write(&file, "x").unwrap();
+        assert!(check_output_path("--json", &d.join("new.json")).is_ok());
+        assert!(check_output_path("--json", &d.join("a/b/new.json")).is_ok(), "missing directories are created on writing");
+        assert!(check_output_path("--json", &file).is_ok());
+        let e = check_output_path("--json", d).unwrap_err().to_string();
+        assert_eq!(e, format!("--json {}: is a directory; give a file path", d.display()));
+        let e = check_output_path("--out", &file.join("x.json")).unwrap_err().to_string();
+        assert_eq!(e, format!("--out {}: {} is not a directory", file.join("x.json").display(), file.display()));
+        let e = check_output_path("--json", Path::new("results/")).unwrap_err().to_string();
+        assert!(e.contains("--json results/: names a directory"), "{e}");
+        assert!(check_output_path("--json", Path::new("")).unwrap_err().to_string().contains("--json: empty path"));
+        assert!(check_output_dir("--out", d).is_ok());
+        assert!(check_output_dir("--out", &d.join("new/dir")).is_ok());
+        let e = check_output_dir("--out", &file).unwrap_err().to_string();
+        assert_eq!(e, format!("--out {}: exists and is not a directory", file.display()));
+        let e = check_output_dir("--out", &file.join("sub")).unwrap_err().to_string();
+        assert!(e.contains(&format!("{} is not a directory", file.display())), "{e}");
     }
 }

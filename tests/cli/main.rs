@@ -6,4 +6,5 @@ mod common;
 
 mod eval;
 mod eval_csv;
+mod outputs;
 mod signals;
