@@ -22,11 +22,19 @@ use std::time::Duration;
 pub struct DeviceArgs {
     /// Device index (see `brdfprof devices`) or a case-insensitive substring of its name.
     /// Default: the first discrete or integrated GPU, else lavapipe.
-    #[arg(long)]
+    #[arg(long, value_parser = device_name)]
     pub device: Option<String>,
     /// Run under the Khronos validation layer and fail on any message (also BRDFPROF_VALIDATION=1).
     #[arg(long)]
     pub validate: bool,
+}
+
+/// `--device`: an empty or blank name would match every device (a substring of each), so it is refused.
+fn device_name(text: &str) -> Result<String, String> {
+    if text.trim().is_empty() {
+        return Err("empty; give an index or a name substring (see `brdfprof devices`)".into());
+    }
+    Ok(text.to_string())
 }
 
 impl DeviceArgs {
