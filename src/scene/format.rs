@@ -537,9 +537,11 @@ impl Scene {
         Ok(Scene { file, path, dir })
     }
 
-    /// The scene's name: its `name`, else the file stem.
+    /// The scene's name (a plain file name: it names output files): its `name`, else the file stem, else
+    /// "scene".
     pub fn name(&self) -> String {
-        self.file.name.clone().unwrap_or_else(|| self.path.file_stem().map_or("scene".into(), |s| s.to_string_lossy().into_owned()))
+        let stem = || self.path.file_stem().map(|s| s.to_string_lossy().into_owned()).filter(|s| plain_name_fault(s).is_none());
+        self.file.name.clone().or_else(stem).unwrap_or_else(|| "scene".into())
     }
 
     pub fn material_index(&self, name: &str) -> Option<usize> {
@@ -555,8 +557,29 @@ fn nonzero3(v: &[f32; 3]) -> bool {
     finite3(v) && v.iter().any(|x| *x != 0.0)
 }
 
+/// Why `name` cannot be used as a file name inside an output directory, or None.
+fn plain_name_fault(name: &str) -> Option<&'static str> {
+    match name {
+        "" => Some("it is empty"),
+        "." | ".." => Some("`.` and `..` name directories"),
+        _ if name.contains('/') || name.contains('\\') => Some("it contains a path separator (`/` or `\\`)"),
+        _ if name.contains('\0') => Some("it contains a NUL character"),
+        _ => None,
+    }
+}
+
+/// `name` names output files (results/scenes/NAME/, results/scene-NAME-DEVICE.json), so it must be a plain
+/// file name: no path that escapes or reaches elsewhere.
+fn check_name(f: &SceneFile) -> Result<()> {
+    match f.name.as_deref().map(|n| (n, plain_name_fault(n))) {
+        Some((n, Some(why))) => bail!("name: {n:?} is not a plain file name: {why} (it names the scene's output files)"),
+        _ => Ok(()),
+    }
+}
+
 /// Checks what serde cannot: names, references and combinations. Errors name the JSON path.
 fn check(f: &SceneFile) -> Result<()> {
+    check_name(f)?;
     check_materials(&f.materials)?;
     check_gbuffer(f)?;
     if let Some(c) = &f.camera {
@@ -720,7 +743,7 @@ FILE` times it (one kernel per model present, every light in one dispatch, per-e
 string "x", expected f32`); image paths are relative to the scene file. Unknown keys are errors.
 
 {
-  "name": "...",                      optional; default: the file name
+  "name": "...",                      optional, a plain file name (it names outputs); default: the file's stem
   "description": "...",               optional
   "gbuffer":                          one of:
     {"procedural": {"kind": "sphere-grid", "size": [W, H], "rows": [MATERIAL...], "columns": 8, "floor": MATERIAL}}
@@ -830,5 +853,24 @@ mod tests {
         assert!(e.contains("gbuffer.procedural.size[1]: invalid type"), "{e}");
         let e = parse("{").unwrap_err().to_string();
         assert!(e.contains("t.json") && e.contains("EOF"), "{e}");
+    }
+
+    #[test]
+    fn the_name_must_be_a_plain_file_name() {
+        let named = |n: &str| GOOD.replacen('{', &format!("{{\"name\": {n},"), 1);
+        for (json, shown, why) in [
+            (r#""../../escape""#, r#""../../escape""#, "path separator"),
+            (r#""/tmp/abs""#, r#""/tmp/abs""#, "path separator"),
+            (r#""a\\b""#, r#""a\\b""#, "path separator"),
+            (r#""""#, r#""""#, "empty"),
+            (r#"".""#, r#"".""#, "name directories"),
+            (r#""..""#, r#""..""#, "name directories"),
+            (r#""a\u0000b""#, r#""a\0b""#, "NUL"),
+        ] {
+            let e = parse(&named(json)).unwrap_err().to_string();
+            assert!(e.starts_with(&format!("t.json: name: {shown} is not a plain file name")) && e.contains(why), "{json}: {e}");
+        }
+        assert_eq!(parse(&named(r#""my scene""#)).unwrap().name(), "my scene");
+        assert_eq!(parse(GOOD).unwrap().name(), "t", "default: the file stem");
     }
 }

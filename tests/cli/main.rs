@@ -8,4 +8,5 @@ mod devices;
 mod eval;
 mod eval_csv;
 mod outputs;
+mod scenes;
 mod signals;
