@@ -110,15 +110,18 @@ impl TryFrom<RawProcedural> for Procedural {
     }
 }
 
-/// Width and height in pixels, 1 to 16384 each.
+/// The largest G-buffer width or height, procedural or from images.
+pub const MAX_SIZE: u32 = 16384;
+
+/// Width and height in pixels, 1 to MAX_SIZE each.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 pub struct Size(pub [u32; 2]);
 
 impl<'de> Deserialize<'de> for Size {
     fn deserialize<Dz: Deserializer<'de>>(d: Dz) -> Result<Self, Dz::Error> {
         let s = <[u32; 2]>::deserialize(d)?;
-        if s.iter().any(|&x| x == 0 || x > 16384) {
-            return Err(de::Error::custom(format!("size {s:?}: width and height must be 1 to 16384")));
+        if s.iter().any(|&x| x == 0 || x > MAX_SIZE) {
+            return Err(de::Error::custom(format!("size {s:?}: width and height must be 1 to {MAX_SIZE}")));
         }
         Ok(Size(s))
     }
@@ -128,16 +131,16 @@ impl<'de> Deserialize<'de> for Size {
 #[derive(Clone, Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct ImageFiles {
-    /// Normals: PNG (8 or 16 bit, RGB) encoded n = 2c - 1 with c = value / max; EXR (float RGB) as stored.
+    /// Normals: PNG (8 or 16 bit, RGB or RGBA) encoded n = 2c - 1 with c = value / max; EXR (float RGB) as stored.
     /// Normalised after decoding.
     pub normal: PathBuf,
-    /// Perceptual roughness: PNG grey (or R) c = value / max; EXR R. Default: each pixel's material's.
+    /// Perceptual roughness: PNG grey (8 or 16 bit) c = value / max; EXR R. Default: each pixel's material's.
     #[serde(default)]
     pub roughness: Option<PathBuf>,
     /// Base colour: PNG sRGB-encoded (decoded with the sRGB EOTF); EXR linear RGB. Default: the material's.
     #[serde(default)]
     pub base_colour: Option<PathBuf>,
-    /// Metallic: PNG grey (or R) c = value / max; EXR R. Default: the material's.
+    /// Metallic: PNG grey (8 or 16 bit) c = value / max; EXR R. Default: the material's.
     #[serde(default)]
     pub metallic: Option<PathBuf>,
     /// View-space depth (distance along the camera's forward axis): EXR R, or 16-bit PNG with `depth_range`.
