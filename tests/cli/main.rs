@@ -7,6 +7,7 @@ mod common;
 mod devices;
 mod eval;
 mod eval_csv;
+mod fuzz;
 mod outputs;
 mod scenes;
 mod signals;
