@@ -6,6 +6,7 @@
 pub mod accuracy;
 pub mod brdf;
 pub mod chart;
+pub mod cleanup;
 pub mod gpu;
 pub mod host;
 pub mod inspect;

@@ -56,6 +56,14 @@ enum Command {
 fn main() -> ExitCode {
     cli::command_started();
     let cli = Cli::parse();
+    // The callgrind child runs under valgrind and dies with its parent; every other command cleans up on
+    // SIGINT/SIGTERM (children killed, temporary files removed, exit 130).
+    if !matches!(cli.command, Command::CallgrindChild { .. }) {
+        if let Err(e) = brdfprof::cleanup::install_signal_handler() {
+            eprintln!("brdfprof: error: {e:#}");
+            return ExitCode::from(2);
+        }
+    }
     let result = match cli.command {
         Command::Devices(args) => cli::info::devices(&args),
         Command::Models => cli::info::models(),
@@ -70,6 +78,8 @@ fn main() -> ExitCode {
         Command::CallgrindChild { request } => brdfprof::inspect::callgrind::child_main(&request).map(|_| ExitCode::SUCCESS),
         Command::GenerateGlsl { dir } => cli::info::generate_glsl(&dir),
     };
+    // An interrupted command ends with the signal handler's exit status, not its own.
+    brdfprof::cleanup::park_if_interrupted();
     match result {
         Ok(code) => code,
         Err(e) => {

@@ -130,9 +130,9 @@ fn kernel_entry(dir: &Path, name: &str) -> Result<(String, Vec<String>)> {
 /// Compiles `source` with glslang (`GLSLANG_FLAGS`, `-D` for each define, `-I` for each include directory)
 /// and returns the SPIR-V words; a failure carries glslang's own messages.
 pub fn glslang(source: &Path, defines: &[String], includes: &[&Path]) -> Result<Vec<u32>> {
-    let out_dir = tempfile::tempdir().context("cannot create a temporary directory for glslang's output")?;
+    let out_dir = crate::cleanup::TempDir::new().context("cannot create a temporary directory for glslang's output")?;
     let out = out_dir.path().join("out.spv");
-    let mut cmd = Command::new("glslangValidator");
+    let mut cmd = crate::cleanup::command("glslangValidator");
     cmd.args(GLSLANG_FLAGS);
     for d in defines {
         cmd.arg(format!("-D{d}"));
@@ -141,7 +141,7 @@ pub fn glslang(source: &Path, defines: &[String], includes: &[&Path]) -> Result<
         cmd.arg(format!("-I{}", i.display()));
     }
     cmd.arg("-o").arg(&out).arg(source);
-    let result = cmd.output().map_err(|e| anyhow!("cannot run glslangValidator ({e}): install glslang-tools, or run `make setup`"))?;
+    let result = crate::cleanup::output(&mut cmd).map_err(|e| anyhow!("cannot run glslangValidator ({e}): install glslang-tools, or run `make setup`"))?;
     if !result.status.success() {
         bail!(GlslangError { source: source.to_path_buf(), log: format!("{}{}", String::from_utf8_lossy(&result.stdout), String::from_utf8_lossy(&result.stderr)) });
     }
@@ -178,12 +178,12 @@ pub fn write_glsl_tree(dir: &Path) -> Result<()> {
 
 /// `glslangValidator --version`'s first line, e.g. "Glslang Version: 11:12.0.0".
 pub fn glslang_version() -> Option<String> {
-    first_line_of(Command::new("glslangValidator").arg("--version"))
+    first_line_of(crate::cleanup::command("glslangValidator").arg("--version"))
 }
 
 /// The first non-empty line a tool prints, or None when it cannot run.
 pub fn first_line_of(cmd: &mut Command) -> Option<String> {
-    let out = cmd.output().ok()?;
+    let out = crate::cleanup::output(cmd).ok()?;
     let text = String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr);
     text.lines().map(str::trim).find(|l| !l.is_empty()).map(str::to_string)
 }

@@ -1,6 +1,6 @@
 //! `brdfprof inspect` and `check`: instruction counts of the kernels, and the regression gate on them.
 
-use super::{fresh_compilation, on_device, parse_size, DeviceArgs, ModelArgs};
+use super::{check_output, fresh_compilation, on_device, parse_size, DeviceArgs, ModelArgs};
 use anyhow::{anyhow, bail, Result};
 use brdfprof::brdf::THESIS_MODELS;
 use brdfprof::inspect::callgrind::CallgrindOptions;
@@ -68,11 +68,14 @@ pub fn inspect(args: &InspectArgs) -> Result<ExitCode> {
     if lights == 0 {
         bail!("--lights must be at least 1");
     }
+    check_output("--json", args.json.as_deref(), "results", "inspect-<device>.json")?;
+    check_output("--markdown", args.markdown.as_deref(), "results", "inspect-<device>.md")?;
     let options = InspectOptions { models: args.model.models(&THESIS_MODELS)?, lights, callgrind: args.counts.callgrind(&args.device)? };
+    let profile = args.profile.as_deref().map(inspect::correlate::load_profile).transpose()?;
     let shaders = args.counts.shaders()?;
     let (gpu, mut result) = on_device(&args.device, |gpu, _| inspect::run(gpu, &shaders, &options))?;
-    if let Some(p) = &args.profile {
-        result.vs_profile = Some(inspect::correlate::correlate(&result, p)?);
+    if let Some(p) = &profile {
+        result.vs_profile = Some(inspect::correlate::correlate_with(&result, p)?);
     }
     let slug = report::device_slug(&gpu.info);
     let json = args.json.clone().unwrap_or_else(|| PathBuf::from(format!("results/inspect-{slug}.json")));
@@ -122,6 +125,9 @@ pub struct CheckArgs {
 }
 
 pub fn check(args: &CheckArgs) -> Result<ExitCode> {
+    if let Some(p) = &args.save_baseline {
+        io::check_output_path("--save-baseline", p)?;
+    }
     fresh_compilation(args.shader_cache);
     let (width, height) = parse_size("--timing-size", &args.timing_size)?;
     let options = CheckOptions {

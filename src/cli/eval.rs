@@ -22,6 +22,7 @@ pub struct EvalArgs {
 }
 
 pub fn eval(args: &EvalArgs) -> Result<ExitCode> {
+    io::check_output_path("--output", &args.output)?;
     let models = args.model.models(&[])?;
     let [model] = models.as_slice() else {
         bail!("eval takes exactly one --model");

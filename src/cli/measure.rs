@@ -1,10 +1,10 @@
 //! `brdfprof profile`, `sweep` and `stability`: the commands that run kernels and measure them.
 
-use super::{fresh_compilation, on_device, written, DeviceArgs, ModelArgs, TimingArgs};
+use super::{check_output, fresh_compilation, on_device, written, DeviceArgs, ModelArgs, TimingArgs};
 use anyhow::{bail, Result};
 use brdfprof::brdf::THESIS_MODELS;
 use brdfprof::model::Model;
-use brdfprof::{profile, report, scene, stability, sweep};
+use brdfprof::{io, profile, report, scene, stability, sweep};
 use clap::Args;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -44,6 +44,7 @@ pub fn profile(args: &ProfileArgs) -> Result<ExitCode> {
     if let Some(path) = &args.scene {
         return profile_scene(args, path);
     }
+    check_output("--json", args.json.as_deref(), "results", "profile-<device>.json")?;
     fresh_compilation(args.timing.shader_cache);
     let size = args.size.as_deref().unwrap_or("960x540");
     let options = args.timing.options(args.model.models(&THESIS_MODELS)?, size, args.reps, args.budget, args.target_ci)?;
@@ -67,8 +68,9 @@ fn profile_scene(args: &ProfileArgs, path: &std::path::Path) -> Result<ExitCode>
     if args.size.is_some() {
         bail!("--scene: the G-buffer size is the scene's; --size does not apply");
     }
-    fresh_compilation(args.timing.shader_cache);
     let scene = scene::Scene::load(path)?;
+    check_output("--json", args.json.as_deref(), "results", &format!("scene-{}-<device>.json", scene.name()))?;
+    fresh_compilation(args.timing.shader_cache);
     let base = args.timing.options(Vec::new(), "1x1", args.reps, args.budget, args.target_ci)?;
     let options = scene::profile::SceneProfileOptions { protocol: base.protocol, target_rel_ci: args.target_ci, max_chunk: None, instances: base.instances };
     let (gpu, result) = on_device(&args.device, |gpu, progress| scene::profile::run(gpu, &scene, &options, progress))?;
@@ -108,6 +110,7 @@ pub struct SweepArgs {
 }
 
 pub fn sweep(args: &SweepArgs) -> Result<ExitCode> {
+    io::check_output_dir("--out", &args.out)?;
     fresh_compilation(args.timing.shader_cache);
     let models = if args.model.models.is_empty() { sweep::default_specs().into_iter().map(Model::spec).collect() } else { args.model.models(&[])? };
     let options = sweep::SweepOptions { profile: args.timing.options(models, &args.size, args.reps, args.budget, args.target_ci)? };
@@ -133,6 +136,7 @@ pub struct StabilityArgs {
 }
 
 pub fn stability(args: &StabilityArgs) -> Result<ExitCode> {
+    io::check_output_dir("--out", &args.out)?;
     let models = if args.model.models.is_empty() { stability::default_specs().into_iter().map(Model::spec).collect() } else { args.model.models(&[])? };
     let options = stability::StabilityOptions { models, energy: !args.no_energy };
     let (gpu, result) = on_device(&args.device, |gpu, progress| stability::run(gpu, &options, progress))?;

@@ -9,22 +9,32 @@ pub mod scene;
 
 use anyhow::{anyhow, bail, Result};
 use brdfprof::gpu::{Gpu, GpuOptions};
+use brdfprof::io;
 use brdfprof::model::{self, Model};
 use brdfprof::profile::protocol::ProtocolOptions;
 use brdfprof::profile::ProfileOptions;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
+use std::path::Path;
 use std::time::Duration;
 
 #[derive(Args, Clone)]
 pub struct DeviceArgs {
     /// Device index (see `brdfprof devices`) or a case-insensitive substring of its name.
     /// Default: the first discrete or integrated GPU, else lavapipe.
-    #[arg(long)]
+    #[arg(long, value_parser = device_name)]
     pub device: Option<String>,
     /// Run under the Khronos validation layer and fail on any message (also BRDFPROF_VALIDATION=1).
     #[arg(long)]
     pub validate: bool,
+}
+
+/// `--device`: an empty or blank name would match every device (a substring of each), so it is refused.
+fn device_name(text: &str) -> Result<String, String> {
+    if text.trim().is_empty() {
+        return Err("empty; give an index or a name substring (see `brdfprof devices`)".into());
+    }
+    Ok(text.to_string())
 }
 
 impl DeviceArgs {
@@ -171,9 +181,18 @@ pub fn parse_size(flag: &str, text: &str) -> Result<(u32, u32)> {
 /// compilation gave the same figure run after run. The variable is recorded in every report's environment.
 pub fn fresh_compilation(keep_cache: bool) {
     if !keep_cache && std::env::var_os("MESA_SHADER_CACHE_DISABLE").is_none() {
-        // SAFETY: called on the main thread before any other thread exists and before the Vulkan driver,
-        // which reads the variable, is loaded.
+        // SAFETY: called on the main thread before the Vulkan driver, which reads the variable, is loaded,
+        // while the only other thread is the signal handler's, which reads no environment variable.
         unsafe { std::env::set_var("MESA_SHADER_CACHE_DISABLE", "true") };
+    }
+}
+
+/// Checks a file output given by `flag` (see `io::check_output_path`), or, when it defaults to a file in
+/// `default_dir` that is named only once the device is open, that directory.
+pub fn check_output(flag: &str, path: Option<&Path>, default_dir: &str, default_name: &str) -> Result<()> {
+    match path {
+        Some(p) => io::check_output_path(flag, p),
+        None => io::check_output_dir(&format!("{flag} (default {default_dir}/{default_name})"), Path::new(default_dir)),
     }
 }
 

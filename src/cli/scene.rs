@@ -2,7 +2,7 @@
 
 use super::{on_device, written, DeviceArgs};
 use anyhow::{bail, Result};
-use brdfprof::scene;
+use brdfprof::{io, scene};
 use clap::Args;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -37,6 +37,7 @@ pub struct RenderArgs {
 pub fn render(args: &RenderArgs) -> Result<ExitCode> {
     let scene = scene::Scene::load(&args.scene)?;
     let out = args.out.clone().unwrap_or_else(|| PathBuf::from("results/scenes").join(scene.name()));
+    io::check_output_dir(if args.out.is_some() { "--out" } else { "--out (default results/scenes/<scene name>)" }, &out)?;
     let (_, result) = on_device(&args.device, |gpu, progress| scene::render::render(gpu, &scene, &out, progress))?;
     for n in &result.notes {
         eprintln!("brdfprof: note: {n}");

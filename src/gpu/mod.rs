@@ -262,6 +262,10 @@ pub fn select_device(infos: &[DeviceInfo], wanted: Option<&str>) -> Result<usize
     }
     let listing = || infos.iter().map(|d| format!("  {}: {} ({})", d.index, d.name, d.device_type)).collect::<Vec<_>>().join("\n");
     if let Some(w) = wanted {
+        // Every name contains the empty string: a blank choice would silently pick device 0.
+        if w.trim().is_empty() {
+            bail!("device `{w}`: empty; give an index or a name substring (see `brdfprof devices`)");
+        }
         if let Ok(i) = w.parse::<usize>() {
             return if i < infos.len() { Ok(i) } else { bail!("no device with index {i}; devices are:\n{}", listing()) };
         }

@@ -11,6 +11,7 @@
 //! is the figure. Everything else (the driver's dispatch and queue code, the per-workgroup helpers the
 //! kernel calls back into) is left out.
 
+use crate::cleanup;
 use crate::gpu::{Gpu, GpuOptions};
 use crate::model::Model;
 use crate::shaders::Shaders;
@@ -22,7 +23,6 @@ use anyhow::{anyhow, bail, Context, Result};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 /// The hidden subcommand the child runs.
 pub const CHILD_COMMAND: &str = "__callgrind-child";
@@ -184,7 +184,7 @@ impl CallgrindRun {
 
 /// `valgrind --version`, or why valgrind cannot be used.
 pub fn valgrind_version() -> Result<String> {
-    crate::shaders::first_line_of(Command::new("valgrind").arg("--version"))
+    crate::shaders::first_line_of(cleanup::command("valgrind").arg("--version"))
         .filter(|v| v.starts_with("valgrind"))
         .ok_or_else(|| anyhow!("valgrind not found: install valgrind (Debian: `apt-get install valgrind`), or run `make setup`"))
 }
@@ -195,7 +195,8 @@ pub fn run(models: &[Model], lights: u32, shaders: &Shaders, options: &Callgrind
         bail!("callgrind client requests are implemented for x86-64 only");
     }
     let valgrind = valgrind_version()?;
-    let dir = tempfile::tempdir().context("cannot create a directory for callgrind's output")?;
+    // Registered, so that an interrupted run leaves no callgrind files behind.
+    let dir = cleanup::TempDir::new().context("cannot create a directory for callgrind's output")?;
     let out_file = dir.path().join("callgrind.out");
     let req = ChildRequest {
         models: models.iter().map(Model::canonical).collect(),
@@ -207,16 +208,16 @@ pub fn run(models: &[Model], lights: u32, shaders: &Shaders, options: &Callgrind
         glsl: shaders.glsl_dir().map(Path::to_path_buf),
     };
     let exe = std::env::current_exe().context("cannot find brdfprof's own executable")?;
-    let output = Command::new("valgrind")
-        .args(["--tool=callgrind", "--instr-atstart=no", "--dump-line=no", "--dump-instr=no", "--compress-strings=no", "--compress-pos=no"])
+    // --vgdb=no: no vgdb FIFOs in TMPDIR, which a killed valgrind would leave behind.
+    let mut cmd = cleanup::command("valgrind");
+    cmd.args(["--tool=callgrind", "--vgdb=no", "--instr-atstart=no", "--dump-line=no", "--dump-instr=no", "--compress-strings=no", "--compress-pos=no"])
         .arg(format!("--callgrind-out-file={}", out_file.display()))
         .arg(&exe)
         .arg(CHILD_COMMAND)
         .arg(serde_json::to_string(&req)?)
         .env("LP_NUM_THREADS", "0")
-        .env("MESA_SHADER_CACHE_DISABLE", "true")
-        .output()
-        .context("cannot run valgrind")?;
+        .env("MESA_SHADER_CACHE_DISABLE", "true");
+    let output = cleanup::output(&mut cmd).context("cannot run valgrind")?;
     let stdout = String::from_utf8_lossy(&output.stdout);
     let stderr = String::from_utf8_lossy(&output.stderr);
     if !output.status.success() {

@@ -52,12 +52,32 @@ fn rho(pairs: &[(f64, f64)]) -> Option<f64> {
     (pairs.len() >= 3).then(|| stats::spearman(&pairs.iter().map(|p| p.0).collect::<Vec<_>>(), &pairs.iter().map(|p| p.1).collect::<Vec<_>>()))
 }
 
-/// Joins `report`'s callgrind figures with the profile report at `path`.
-pub fn correlate(report: &InspectReport, path: &Path) -> Result<Correlation> {
+/// A `brdfprof profile` report, read (before anything is measured, so that a bad file fails at once).
+pub struct ProfileReport {
+    file: String,
+    json: serde_json::Value,
+}
+
+/// Reads the profile report at `path`: JSON with a `rows` array.
+pub fn load_profile(path: &Path) -> Result<ProfileReport> {
     let file = path.display().to_string();
     let text = std::fs::read_to_string(path).with_context(|| format!("--profile {file}: cannot read it"))?;
-    let profile: serde_json::Value = serde_json::from_str(&text).map_err(|e| anyhow!("--profile {file}: not valid JSON ({e})"))?;
-    let rows = profile["rows"].as_array().ok_or_else(|| anyhow!("--profile {file}: no `rows` array (is it a `brdfprof profile` report?)"))?;
+    let json: serde_json::Value = serde_json::from_str(&text).map_err(|e| anyhow!("--profile {file}: not valid JSON ({e})"))?;
+    if !json["rows"].is_array() {
+        bail!("--profile {file}: no `rows` array (is it a `brdfprof profile` report?)");
+    }
+    Ok(ProfileReport { file, json })
+}
+
+/// Joins `report`'s callgrind figures with the profile report at `path`.
+pub fn correlate(report: &InspectReport, path: &Path) -> Result<Correlation> {
+    correlate_with(report, &load_profile(path)?)
+}
+
+/// Joins `report`'s callgrind figures with a profile report already read.
+pub fn correlate_with(report: &InspectReport, profile: &ProfileReport) -> Result<Correlation> {
+    let (file, profile) = (profile.file.clone(), &profile.json);
+    let rows = profile["rows"].as_array().expect("checked by load_profile");
     let mut out = Vec::new();
     for row in &report.rows {
         let Some(ir) = row.stats.get("callgrind/ir-per-eval") else { continue };

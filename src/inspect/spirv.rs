@@ -9,7 +9,7 @@ use rspirv::dr::{Module, Operand};
 use rspirv::spirv::{Decoration, GlslStd450Op, Op};
 use std::collections::BTreeMap;
 use std::io::Write;
-use std::process::{Command, Stdio};
+use std::process::Stdio;
 
 /// spirv-opt passes that keep only the code a frozen specialisation runs, without optimising it further.
 pub const SPECIALISE_PASSES: [&str; 5] = ["--freeze-spec-const", "--fold-spec-const-op-composite", "--eliminate-dead-branches", "--eliminate-dead-code-aggressive", "--eliminate-dead-functions"];
@@ -129,7 +129,7 @@ pub fn spec_default_values(words: &[u32], constants: &SpecConstants) -> Result<S
 
 /// Runs spirv-opt with `args` on `words` (through stdin and stdout).
 pub fn spirv_opt(words: &[u32], args: &[String]) -> Result<Vec<u32>> {
-    let mut child = Command::new("spirv-opt")
+    let mut child = crate::cleanup::command("spirv-opt")
         .args(args)
         .args(["-", "-o", "-"])
         .stdin(Stdio::piped())
@@ -137,6 +137,7 @@ pub fn spirv_opt(words: &[u32], args: &[String]) -> Result<Vec<u32>> {
         .stderr(Stdio::piped())
         .spawn()
         .map_err(|e| anyhow!("cannot run spirv-opt ({e}): install spirv-tools, or run `make setup`"))?;
+    let _guard = crate::cleanup::ChildGuard::new(&child);
     let bytes: Vec<u8> = words.iter().flat_map(|w| w.to_le_bytes()).collect();
     let mut stdin = child.stdin.take().expect("piped stdin");
     // Written on a thread so that a large output cannot deadlock against the input.
@@ -166,7 +167,7 @@ pub fn optimise(words: &[u32]) -> Result<Vec<u32>> {
 
 /// `spirv-opt --version`'s first line, e.g. "SPIRV-Tools v2023.1 ...".
 pub fn spirv_opt_version() -> Option<String> {
-    crate::shaders::first_line_of(Command::new("spirv-opt").arg("--version"))
+    crate::shaders::first_line_of(crate::cleanup::command("spirv-opt").arg("--version"))
 }
 
 #[cfg(test)]

@@ -110,15 +110,18 @@ impl TryFrom<RawProcedural> for Procedural {
     }
 }
 
-/// Width and height in pixels, 1 to 16384 each.
+/// The largest G-buffer width or height, procedural or from images.
+pub const MAX_SIZE: u32 = 16384;
+
+/// Width and height in pixels, 1 to MAX_SIZE each.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 pub struct Size(pub [u32; 2]);
 
 impl<'de> Deserialize<'de> for Size {
     fn deserialize<Dz: Deserializer<'de>>(d: Dz) -> Result<Self, Dz::Error> {
         let s = <[u32; 2]>::deserialize(d)?;
-        if s.iter().any(|&x| x == 0 || x > 16384) {
-            return Err(de::Error::custom(format!("size {s:?}: width and height must be 1 to 16384")));
+        if s.iter().any(|&x| x == 0 || x > MAX_SIZE) {
+            return Err(de::Error::custom(format!("size {s:?}: width and height must be 1 to {MAX_SIZE}")));
         }
         Ok(Size(s))
     }
@@ -128,16 +131,16 @@ impl<'de> Deserialize<'de> for Size {
 #[derive(Clone, Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct ImageFiles {
-    /// Normals: PNG (8 or 16 bit, RGB) encoded n = 2c - 1 with c = value / max; EXR (float RGB) as stored.
+    /// Normals: PNG (8 or 16 bit, RGB or RGBA) encoded n = 2c - 1 with c = value / max; EXR (float RGB) as stored.
     /// Normalised after decoding.
     pub normal: PathBuf,
-    /// Perceptual roughness: PNG grey (or R) c = value / max; EXR R. Default: each pixel's material's.
+    /// Perceptual roughness: PNG grey (8 or 16 bit) c = value / max; EXR R. Default: each pixel's material's.
     #[serde(default)]
     pub roughness: Option<PathBuf>,
     /// Base colour: PNG sRGB-encoded (decoded with the sRGB EOTF); EXR linear RGB. Default: the material's.
     #[serde(default)]
     pub base_colour: Option<PathBuf>,
-    /// Metallic: PNG grey (or R) c = value / max; EXR R. Default: the material's.
+    /// Metallic: PNG grey (8 or 16 bit) c = value / max; EXR R. Default: the material's.
     #[serde(default)]
     pub metallic: Option<PathBuf>,
     /// View-space depth (distance along the camera's forward axis): EXR R, or 16-bit PNG with `depth_range`.
@@ -537,9 +540,11 @@ impl Scene {
         Ok(Scene { file, path, dir })
     }
 
-    /// The scene's name: its `name`, else the file stem.
+    /// The scene's name (a plain file name: it names output files): its `name`, else the file stem, else
+    /// "scene".
     pub fn name(&self) -> String {
-        self.file.name.clone().unwrap_or_else(|| self.path.file_stem().map_or("scene".into(), |s| s.to_string_lossy().into_owned()))
+        let stem = || self.path.file_stem().map(|s| s.to_string_lossy().into_owned()).filter(|s| plain_name_fault(s).is_none());
+        self.file.name.clone().or_else(stem).unwrap_or_else(|| "scene".into())
     }
 
     pub fn material_index(&self, name: &str) -> Option<usize> {
@@ -555,8 +560,29 @@ fn nonzero3(v: &[f32; 3]) -> bool {
     finite3(v) && v.iter().any(|x| *x != 0.0)
 }
 
+/// Why `name` cannot be used as a file name inside an output directory, or None.
+fn plain_name_fault(name: &str) -> Option<&'static str> {
+    match name {
+        "" => Some("it is empty"),
+        "." | ".." => Some("`.` and `..` name directories"),
+        _ if name.contains('/') || name.contains('\\') => Some("it contains a path separator (`/` or `\\`)"),
+        _ if name.contains('\0') => Some("it contains a NUL character"),
+        _ => None,
+    }
+}
+
+/// `name` names output files (results/scenes/NAME/, results/scene-NAME-DEVICE.json), so it must be a plain
+/// file name: no path that escapes or reaches elsewhere.
+fn check_name(f: &SceneFile) -> Result<()> {
+    match f.name.as_deref().map(|n| (n, plain_name_fault(n))) {
+        Some((n, Some(why))) => bail!("name: {n:?} is not a plain file name: {why} (it names the scene's output files)"),
+        _ => Ok(()),
+    }
+}
+
 /// Checks what serde cannot: names, references and combinations. Errors name the JSON path.
 fn check(f: &SceneFile) -> Result<()> {
+    check_name(f)?;
     check_materials(&f.materials)?;
     check_gbuffer(f)?;
     if let Some(c) = &f.camera {
@@ -720,7 +746,7 @@ FILE` times it (one kernel per model present, every light in one dispatch, per-e
 string "x", expected f32`); image paths are relative to the scene file. Unknown keys are errors.
 
 {
-  "name": "...",                      optional; default: the file name
+  "name": "...",                      optional, a plain file name (it names outputs); default: the file's stem
   "description": "...",               optional
   "gbuffer":                          one of:
     {"procedural": {"kind": "sphere-grid", "size": [W, H], "rows": [MATERIAL...], "columns": 8, "floor": MATERIAL}}
@@ -830,5 +856,24 @@ mod tests {
         assert!(e.contains("gbuffer.procedural.size[1]: invalid type"), "{e}");
         let e = parse("{").unwrap_err().to_string();
         assert!(e.contains("t.json") && e.contains("EOF"), "{e}");
+    }
+
+    #[test]
+    fn the_name_must_be_a_plain_file_name() {
+        let named = |n: &str| GOOD.replacen('{', &format!("{{\"name\": {n},"), 1);
+        for (json, shown, why) in [
+            (r#""../../escape""#, r#""../../escape""#, "path separator"),
+            (r#""/tmp/abs""#, r#""/tmp/abs""#, "path separator"),
+            (r#""a\\b""#, r#""a\\b""#, "path separator"),
+            (r#""""#, r#""""#, "empty"),
+            (r#"".""#, r#"".""#, "name directories"),
+            (r#""..""#, r#""..""#, "name directories"),
+            (r#""a\u0000b""#, r#""a\0b""#, "NUL"),
+        ] {
+            let e = parse(&named(json)).unwrap_err().to_string();
+            assert!(e.starts_with(&format!("t.json: name: {shown} is not a plain file name")) && e.contains(why), "{json}: {e}");
+        }
+        assert_eq!(parse(&named(r#""my scene""#)).unwrap().name(), "my scene");
+        assert_eq!(parse(GOOD).unwrap().name(), "t", "default: the file stem");
     }
 }

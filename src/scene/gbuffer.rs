@@ -2,11 +2,11 @@
 //! metallic and material. Procedural scenes are ray-cast on the CPU (spheres, boxes and planes); image G-buffers
 //! are decoded from PNG (8/16 bit) and EXR files, with view vectors derived from depth or position and the camera.
 
-use super::format::{Camera, GBufferSource, ImageFiles, Procedural, Scene};
+use super::format::{Camera, GBufferSource, ImageFiles, Procedural, Scene, MAX_SIZE};
 use crate::util::hash01;
 use anyhow::{anyhow, bail, Result};
 use glam::Vec3;
-use image::DynamicImage;
+use image::{ColorType, DynamicImage, ImageDecoder, ImageFormat};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 
@@ -331,13 +331,89 @@ pub struct Plane {
     pub path: PathBuf,
 }
 
-/// Reads a PNG (8 or 16 bit) or EXR file; errors name the file.
-pub fn read_plane(path: &Path) -> Result<Plane> {
-    let reader = image::ImageReader::open(path).map_err(|e| anyhow!("cannot read image {}: {e}", path.display()))?;
-    let reader = reader.with_guessed_format().map_err(|e| anyhow!("cannot read image {}: {e}", path.display()))?;
-    let img = reader.decode().map_err(|e| anyhow!("cannot decode image {}: {e}", path.display()))?;
-    let float = matches!(img, DynamicImage::ImageRgb32F(_) | DynamicImage::ImageRgba32F(_));
-    let (width, height) = (img.width(), img.height());
+/// What each G-buffer plane may be stored as (README "Scenes"; `scene --explain`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PlaneKind {
+    /// Normals and tangents: PNG 8/16-bit RGB (or RGBA, alpha ignored), n = 2c - 1; EXR float RGB.
+    Vector,
+    /// Roughness and metallic: PNG 8/16-bit grey (alpha ignored); EXR, R.
+    Grey,
+    /// Base colour: PNG 8/16-bit, sRGB-encoded; EXR linear.
+    Colour,
+    /// View-space depth: EXR, R; or 16-bit PNG (with `depth_range`).
+    Depth,
+    /// World-space position: EXR RGB.
+    Position,
+    /// Material index: 8-bit grey PNG.
+    MaterialId,
+}
+
+impl PlaneKind {
+    /// What the plane needs, as the error says it.
+    fn needs(self) -> &'static str {
+        match self {
+            PlaneKind::Vector => "RGB or RGBA: a PNG (8 or 16 bit) or an EXR",
+            PlaneKind::Grey => "grey: a PNG (8 or 16 bit) or an EXR (R is read)",
+            PlaneKind::Colour => "a PNG (8 or 16 bit, sRGB-encoded) or an EXR (linear)",
+            PlaneKind::Depth => "an EXR (R is read) or a 16-bit PNG",
+            PlaneKind::Position => "an EXR (float RGB)",
+            PlaneKind::MaterialId => "an 8-bit grey PNG",
+        }
+    }
+
+    fn accepts(self, float: bool, colour: ColorType) -> bool {
+        let bits = bits_per_channel(colour);
+        let rgb = colour.has_color();
+        match self {
+            PlaneKind::Vector => float || rgb,
+            PlaneKind::Grey => float || !rgb,
+            PlaneKind::Colour => true,
+            PlaneKind::Depth => float || bits == 16,
+            PlaneKind::Position => float,
+            PlaneKind::MaterialId => !float && !rgb && bits == 8,
+        }
+    }
+}
+
+fn bits_per_channel(c: ColorType) -> u16 {
+    u16::from(c.bytes_per_pixel()) * 8 / u16::from(c.channel_count())
+}
+
+/// "an 8-bit grey PNG", "a 16-bit RGBA PNG", "a float RGB EXR": what a file holds, for errors.
+fn describe(format: Option<ImageFormat>, colour: ColorType) -> String {
+    let channels = match (colour.has_color(), colour.has_alpha()) {
+        (false, false) => "grey",
+        (false, true) => "grey+alpha",
+        (true, false) => "RGB",
+        (true, true) => "RGBA",
+    };
+    let depth = if matches!(colour, ColorType::Rgb32F | ColorType::Rgba32F) { "float".to_string() } else { format!("{}-bit", bits_per_channel(colour)) };
+    let format = format.map_or("image", |f| f.extensions_str().first().copied().unwrap_or("image"));
+    let article = if depth.starts_with('8') { "an" } else { "a" };
+    format!("{article} {depth} {channels} {}", format.to_uppercase())
+}
+
+/// Reads a plane of kind `kind` (`what` names it: "normal", "depth", ...) from a PNG or EXR file. The header
+/// is checked first, against the size limit and what the plane needs, so that a file that does not fit is
+/// refused without being decoded. Errors name the file.
+pub fn read_plane(path: &Path, what: &str, kind: PlaneKind) -> Result<Plane> {
+    let shown = path.display();
+    let reader = image::ImageReader::open(path).map_err(|e| anyhow!("cannot read image {shown}: {e}"))?;
+    let mut reader = reader.with_guessed_format().map_err(|e| anyhow!("cannot read image {shown}: {e}"))?;
+    let format = reader.format();
+    // The size is checked here, from the header, instead of by the image crate's allocation limit (512 MiB,
+    // less than a 16384 x 16384 plane needs).
+    reader.no_limits();
+    let decoder = reader.into_decoder().map_err(|e| anyhow!("cannot decode image {shown}: {e}"))?;
+    let ((width, height), colour) = (decoder.dimensions(), decoder.color_type());
+    if width == 0 || height == 0 || width > MAX_SIZE || height > MAX_SIZE {
+        bail!("{shown}: the {what} image is {width}x{height}; G-buffer images must be 1 to {MAX_SIZE} pixels wide and high");
+    }
+    let float = matches!(colour, ColorType::Rgb32F | ColorType::Rgba32F);
+    if !kind.accepts(float, colour) {
+        bail!("{shown}: the {what} image must be {}; this file is {}", kind.needs(), describe(format, colour));
+    }
+    let img = DynamicImage::from_decoder(decoder).map_err(|e| anyhow!("cannot decode image {shown}: {e}"))?;
     let rgba: Vec<[f32; 4]> = img.into_rgba32f().pixels().map(|p| p.0).collect();
     Ok(Plane { width, height, float, rgba, path: path.to_path_buf() })
 }
@@ -361,8 +437,8 @@ fn check_material_ids(m: &Plane, w: u32, materials: usize) -> Result<()> {
 
 fn load_images(scene: &Scene, files: &ImageFiles) -> Result<GBuffer> {
     let camera = scene.file.camera.expect("checked: image G-buffers have a camera");
-    let open = |p: &PathBuf| read_plane(&scene.dir.join(p));
-    let normal = open(&files.normal)?;
+    let open = |p: &PathBuf, what: &str, kind: PlaneKind| read_plane(&scene.dir.join(p), what, kind);
+    let normal = open(&files.normal, "normal", PlaneKind::Vector)?;
     let (w, h) = (normal.width, normal.height);
     let same = |plane: Plane| -> Result<Plane> {
         if (plane.width, plane.height) != (w, h) {
@@ -370,22 +446,17 @@ fn load_images(scene: &Scene, files: &ImageFiles) -> Result<GBuffer> {
         }
         Ok(plane)
     };
-    let optional = |p: &Option<PathBuf>| p.as_ref().map(|p| open(p).and_then(same)).transpose();
-    let roughness = optional(&files.roughness)?;
-    let base = optional(&files.base_colour)?;
-    let metallic = optional(&files.metallic)?;
-    let depth = optional(&files.depth)?;
-    let position = optional(&files.position)?;
-    let material = optional(&files.material)?;
-    let tangent = optional(&files.tangent)?;
+    let optional = |p: &Option<PathBuf>, what: &str, kind: PlaneKind| p.as_ref().map(|p| open(p, what, kind).and_then(same)).transpose();
+    let roughness = optional(&files.roughness, "roughness", PlaneKind::Grey)?;
+    let base = optional(&files.base_colour, "base_colour", PlaneKind::Colour)?;
+    let metallic = optional(&files.metallic, "metallic", PlaneKind::Grey)?;
+    let depth = optional(&files.depth, "depth", PlaneKind::Depth)?;
+    let position = optional(&files.position, "position", PlaneKind::Position)?;
+    let material = optional(&files.material, "material", PlaneKind::MaterialId)?;
+    let tangent = optional(&files.tangent, "tangent", PlaneKind::Vector)?;
     if let Some(d) = &depth {
         if !d.float && files.depth_range.is_none() {
             bail!("{}: a PNG depth needs gbuffer.images.depth_range [near, far]", d.path.display());
-        }
-    }
-    if let Some(p) = &position {
-        if !p.float {
-            bail!("{}: positions must be an EXR (float) image", p.path.display());
         }
     }
     if let Some(m) = &material {
@@ -446,6 +517,70 @@ mod tests {
             let t = frame_tangent(n);
             assert!(t.dot(n).abs() < 1e-6 && (t.length_squared() - 1.0).abs() < 1e-6, "{n:?} {t:?}");
         }
+    }
+
+    /// A PNG of `w` x `h` grey pixels whose image data is cut short: its header is valid, its pixels are not.
+    fn png_header_only(w: u32, h: u32) -> Vec<u8> {
+        fn crc32(bytes: &[u8]) -> u32 {
+            let mut c = !0u32;
+            for &b in bytes {
+                c ^= u32::from(b);
+                for _ in 0..8 {
+                    c = if c & 1 != 0 { (c >> 1) ^ 0xEDB8_8320 } else { c >> 1 };
+                }
+            }
+            !c
+        }
+        let chunk = |out: &mut Vec<u8>, kind: &[u8], data: &[u8]| {
+            out.extend_from_slice(&(data.len() as u32).to_be_bytes());
+            let body = [kind, data].concat();
+            out.extend_from_slice(&body);
+            out.extend_from_slice(&crc32(&body).to_be_bytes());
+        };
+        let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
+        let ihdr = [&w.to_be_bytes()[..], &h.to_be_bytes(), &[8, 0, 0, 0, 0]].concat();
+        chunk(&mut png, b"IHDR", &ihdr);
+        chunk(&mut png, b"IDAT", &[0x78, 0x9c, 0x63, 0x00]);
+        chunk(&mut png, b"IEND", &[]);
+        png
+    }
+
+    #[test]
+    fn planes_are_refused_unless_stored_as_the_readme_says() {
+        use image::{ImageBuffer, Luma, Rgb};
+        let dir = tempfile::tempdir().unwrap();
+        let p = |n: &str| dir.path().join(n);
+        ImageBuffer::<Luma<u8>, _>::from_raw(2, 2, vec![1u8; 4]).unwrap().save(p("grey8.png")).unwrap();
+        ImageBuffer::<Luma<u16>, _>::from_raw(2, 2, vec![1u16; 4]).unwrap().save(p("grey16.png")).unwrap();
+        ImageBuffer::<Rgb<u8>, _>::from_raw(2, 2, vec![1u8; 12]).unwrap().save(p("rgb8.png")).unwrap();
+        ImageBuffer::<Rgb<f32>, _>::from_raw(2, 2, vec![1f32; 12]).unwrap().save(p("rgb.exr")).unwrap();
+        let refused = |file: &str, what: &str, kind: PlaneKind| read_plane(&p(file), what, kind).err().map(|e| e.to_string()).unwrap_or_default();
+        let e = refused("grey8.png", "normal", PlaneKind::Vector);
+        assert_eq!(e, format!("{}: the normal image must be RGB or RGBA: a PNG (8 or 16 bit) or an EXR; this file is an 8-bit grey PNG", p("grey8.png").display()));
+        let e = refused("grey8.png", "depth", PlaneKind::Depth);
+        assert!(e.contains("grey8.png: the depth image must be an EXR (R is read) or a 16-bit PNG; this file is an 8-bit grey PNG"), "{e}");
+        let e = refused("rgb8.png", "roughness", PlaneKind::Grey);
+        assert!(e.contains("the roughness image must be grey") && e.contains("8-bit RGB PNG"), "{e}");
+        let e = refused("grey16.png", "material", PlaneKind::MaterialId);
+        assert!(e.contains("an 8-bit grey PNG; this file is a 16-bit grey PNG"), "{e}");
+        let e = refused("grey16.png", "position", PlaneKind::Position);
+        assert!(e.contains("the position image must be an EXR"), "{e}");
+        for (file, kind) in [("rgb8.png", PlaneKind::Vector), ("rgb.exr", PlaneKind::Vector), ("grey16.png", PlaneKind::Depth), ("rgb.exr", PlaneKind::Depth), ("grey8.png", PlaneKind::Grey), ("grey8.png", PlaneKind::MaterialId), ("grey8.png", PlaneKind::Colour)] {
+            assert!(read_plane(&p(file), "plane", kind).is_ok(), "{file} as {kind:?}");
+        }
+    }
+
+    #[test]
+    fn an_image_over_the_size_limit_is_refused_from_its_header() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("huge.png");
+        // 16385 x 16385 would decode to 268 MB; the data is cut short, so only a header check can name the size.
+        std::fs::write(&path, png_header_only(MAX_SIZE + 1, MAX_SIZE + 1)).unwrap();
+        let e = read_plane(&path, "normal", PlaneKind::Vector).err().unwrap().to_string();
+        assert_eq!(e, format!("{}: the normal image is 16385x16385; G-buffer images must be 1 to 16384 pixels wide and high", path.display()));
+        std::fs::write(&path, png_header_only(MAX_SIZE, 2)).unwrap();
+        let e = read_plane(&path, "normal", PlaneKind::Grey).err().unwrap().to_string();
+        assert!(e.starts_with(&format!("cannot decode image {}", path.display())), "within the limit, the (cut) data is decoded: {e}");
     }
 
     #[test]

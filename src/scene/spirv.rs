@@ -10,7 +10,7 @@ use anyhow::{anyhow, Result};
 use rspirv::dr::{self, Operand};
 use rspirv::spirv::Op;
 use serde::Serialize;
-use std::process::{Command, Stdio};
+use std::process::Stdio;
 
 /// The specialised module: the functions left after dead-code elimination (without inlining), and the
 /// instruction count inside functions after spirv-opt -O (everything inlined).
@@ -47,5 +47,5 @@ pub fn specialise(source: &Spirv, constants: &SpecConstants) -> Result<Specialis
 
 /// True when spirv-opt can be run.
 pub fn available() -> bool {
-    Command::new("spirv-opt").arg("--version").stdout(Stdio::null()).stderr(Stdio::null()).status().is_ok_and(|s| s.success())
+    crate::cleanup::command("spirv-opt").arg("--version").stdout(Stdio::null()).stderr(Stdio::null()).status().is_ok_and(|s| s.success())
 }

@@ -1,6 +1,13 @@
-//! The command line end to end: eval's CSV round trip and its errors.
+//! The command line end to end: eval's CSV round trip and its errors, device and output checks made before
+//! anything is measured, scene names, cleanup on signals, and fuzzed inputs.
 
 #[path = "../common/mod.rs"]
 mod common;
 
+mod devices;
 mod eval;
+mod eval_csv;
+mod fuzz;
+mod outputs;
+mod scenes;
+mod signals;

@@ -1,5 +1,6 @@
 //! The baseline file: every count, the timing ratios and the environment they were measured in.
 
+use crate::inspect::callgrind::CallgrindRun;
 use crate::inspect::timing::TimingRun;
 use crate::inspect::InspectReport;
 use crate::model::Model;
@@ -36,26 +37,96 @@ pub fn load(path: &Path) -> Result<Baseline> {
     Ok(baseline)
 }
 
-/// What serde cannot check: models that parse, finite statistics, timing ratios for known models.
+/// What serde cannot check: models that parse, statistics a measurement can give (finite; counts whole and
+/// not negative), a workload that can be run, and timing figures for known models, one per round. Errors name
+/// the statistic or field and its value.
 fn validate(b: &Baseline) -> Result<()> {
+    if b.inspect.lights == 0 {
+        bail!("inspect.lights is 0; a kernel shades at least one light");
+    }
     if b.inspect.rows.is_empty() {
         bail!("no rows");
     }
-    for row in &b.inspect.rows {
+    for (i, row) in b.inspect.rows.iter().enumerate() {
+        if b.inspect.rows[..i].iter().any(|r| r.model == row.model) {
+            bail!("row `{}` appears twice", row.model);
+        }
         if let Some(s) = &row.spec {
             Model::parse(s).map_err(|e| anyhow!("row `{}`: spec `{s}`: {e}", row.model))?;
         }
-        if let Some((k, v)) = row.stats.iter().find(|(_, v)| !v.is_finite()) {
-            bail!("row `{}`: statistic {k} is {v}", row.model);
+        for (k, v) in &row.stats {
+            check_statistic(k, *v).map_err(|why| anyhow!("row `{}`: statistic {k} is {v}; {why}", row.model))?;
         }
     }
+    if let Some(cg) = &b.inspect.callgrind {
+        validate_callgrind(cg)?;
+    }
     if let Some(t) = &b.timing {
-        for (model, ratios) in &t.ratios {
-            if ratios.is_empty() || ratios.iter().any(|r| !r.is_finite() || *r <= 0.0) {
-                bail!("timing ratios of `{model}` are empty or not positive numbers");
-            }
+        validate_timing(b, t)?;
+    }
+    Ok(())
+}
+
+/// Why a statistic's value cannot come from a measurement, or Ok.
+fn check_statistic(key: &str, v: f64) -> Result<(), &'static str> {
+    // Net callgrind counts are differences, and drivers report values verbatim (`driver/<executable>/<name>`).
+    let signed = key == "callgrind/net-ir-per-eval" || key.strip_prefix("driver/").is_some_and(|k| k.contains('/'));
+    let whole = ["spirv/", "spirv-O/", "naga/"].iter().any(|p| key.starts_with(p));
+    if !v.is_finite() {
+        Err("statistics are finite")
+    } else if v < 0.0 && !signed {
+        Err("a count cannot be negative")
+    } else if whole && v.fract() != 0.0 {
+        Err("an instruction count is a whole number")
+    } else {
+        Ok(())
+    }
+}
+
+fn validate_callgrind(cg: &CallgrindRun) -> Result<()> {
+    if cg.evaluations == 0 {
+        bail!("callgrind.evaluations is 0; the measured dispatch evaluates at least once");
+    }
+    for (i, k) in cg.kernels.iter().enumerate() {
+        if k.jit_ir == 0 {
+            bail!("callgrind kernel `{}`: jit_ir is 0; a kernel executes instructions", k.label);
+        }
+        if cg.kernels[..i].iter().any(|o| o.label == k.label) {
+            bail!("callgrind kernel `{}` appears twice", k.label);
         }
     }
     Ok(())
 }
 
+fn validate_timing(b: &Baseline, t: &TimingRun) -> Result<()> {
+    for (field, v) in [("width", t.width as usize), ("height", t.height as usize), ("lights", t.lights as usize), ("rounds", t.rounds), ("reps", t.reps)] {
+        if v == 0 {
+            bail!("timing.{field} is 0; a timing run has at least 1");
+        }
+    }
+    if t.lights != b.inspect.lights {
+        bail!("timing.lights is {} but inspect.lights is {}; both come from one run", t.lights, b.inspect.lights);
+    }
+    let per_round = |what: &str, model: &str, values: &[f64]| -> Result<()> {
+        if values.len() != t.rounds {
+            bail!("timing.{what} of `{model}`: {} values for {} rounds", values.len(), t.rounds);
+        }
+        if let Some(v) = values.iter().find(|v| !(v.is_finite() && **v > 0.0)) {
+            bail!("timing.{what} of `{model}`: {v} is not a positive number");
+        }
+        Ok(())
+    };
+    for (model, ratios) in &t.ratios {
+        if b.inspect.row(model).is_none() {
+            bail!("timing.ratios: `{model}` is not a row of the baseline");
+        }
+        per_round("ratios", model, ratios)?;
+    }
+    for (kernel, ns) in &t.round_ns {
+        per_round("round_ns", kernel, ns)?;
+    }
+    if let Some((kernel, v)) = t.ns_per_eval.iter().find(|(_, v)| !(v.is_finite() && **v > 0.0)) {
+        bail!("timing.ns_per_eval of `{kernel}`: {v} is not a positive number");
+    }
+    Ok(())
+}

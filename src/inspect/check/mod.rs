@@ -281,4 +281,45 @@ mod tests {
         let e = load(&write("bad.json", &std::fs::read_to_string(&p).unwrap().replace("\"spirv/total\": 1.0", "\"spirv/total\": \"x\""))).unwrap_err().to_string();
         assert!(e.contains("corrupt") && e.contains("bad.json"), "{e}");
     }
+
+    #[test]
+    fn impossible_figures_are_refused_naming_the_statistic_and_value() {
+        let committed = Path::new(env!("CARGO_MANIFEST_DIR")).join("results/baseline-llvmpipe.json");
+        let good: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&committed).unwrap()).unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        let refused = |edit: &dyn Fn(&mut serde_json::Value)| {
+            let mut v = good.clone();
+            edit(&mut v);
+            let p = dir.path().join("b.json");
+            std::fs::write(&p, serde_json::to_string(&v).unwrap()).unwrap();
+            load(&p).err().map(|e| e.to_string()).unwrap_or_else(|| "accepted".into())
+        };
+        assert_eq!(refused(&|_| {}), "accepted");
+        let stat = |key: &'static str, x: f64| move |v: &mut serde_json::Value| v["inspect"]["rows"][0]["stats"][key] = x.into();
+        let e = refused(&stat("spirv/total", -1.0));
+        assert!(e.contains("b.json: corrupt (row `ggx`: statistic spirv/total is -1; a count cannot be negative)"), "{e}");
+        let e = refused(&stat("callgrind/ir-per-eval", -67.5));
+        assert!(e.contains("statistic callgrind/ir-per-eval is -67.5; a count cannot be negative"), "{e}");
+        let e = refused(&stat("naga/expressions", 1.5));
+        assert!(e.contains("statistic naga/expressions is 1.5; an instruction count is a whole number"), "{e}");
+        assert_eq!(refused(&stat("callgrind/net-ir-per-eval", -1.0)), "accepted", "a net count may be negative");
+        let e = refused(&|v| v["inspect"]["lights"] = 0.into());
+        assert!(e.contains("inspect.lights is 0"), "{e}");
+        let e = refused(&|v| v["inspect"]["lights"] = (-1).into());
+        assert!(e.contains("corrupt") && e.contains("-1"), "{e}");
+        let e = refused(&|v| v["inspect"]["callgrind"]["evaluations"] = 0.into());
+        assert!(e.contains("callgrind.evaluations is 0"), "{e}");
+        let e = refused(&|v| v["timing"]["reps"] = 0.into());
+        assert!(e.contains("timing.reps is 0"), "{e}");
+        let e = refused(&|v| v["timing"]["lights"] = 3.into());
+        assert!(e.contains("timing.lights is 3 but inspect.lights is 8"), "{e}");
+        let e = refused(&|v| v["timing"]["ratios"]["ggx"][2] = (-0.5).into());
+        assert!(e.contains("timing.ratios of `ggx`: -0.5 is not a positive number"), "{e}");
+        let e = refused(&|v| v["timing"]["rounds"] = 16.into());
+        assert!(e.contains("15 values for 16 rounds"), "{e}");
+        let e = refused(&|v| v["timing"]["ratios"]["phong"] = v["timing"]["ratios"]["ggx"].clone());
+        assert!(e.contains("timing.ratios: `phong` is not a row of the baseline"), "{e}");
+        let e = refused(&|v| v["timing"]["ns_per_eval"]["ggx"] = 0.into());
+        assert!(e.contains("timing.ns_per_eval of `ggx`: 0 is not a positive number"), "{e}");
+    }
 }

@@ -1,0 +1,205 @@
+//! brdfprof leaves nothing behind when it stops, however it stops. Child processes (valgrind, glslang,
+//! spirv-opt) die with it: on Linux they are spawned with PR_SET_PDEATHSIG = SIGKILL, which holds even when
+//! brdfprof itself is killed. Temporary files and directories are registered here while they exist; on
+//! SIGINT, SIGTERM or SIGHUP a handler (on its own thread, via `ctrlc`) kills the registered children, removes
+//! the registered paths and exits with status 130. Other exit paths (success, errors, panics) drop the guards,
+//! which remove their paths as usual.
+
+use anyhow::{Context, Result};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Output, Stdio};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Mutex, MutexGuard};
+use std::time::{Duration, Instant};
+
+/// Exit status after SIGINT/SIGTERM/SIGHUP (128 + SIGINT, as shells report an interrupted command).
+pub const INTERRUPTED_EXIT: i32 = 130;
+
+struct Registry {
+    children: Vec<u32>,
+    paths: Vec<PathBuf>,
+}
+
+static REGISTRY: Mutex<Registry> = Mutex::new(Registry { children: Vec::new(), paths: Vec::new() });
+static INTERRUPTED: AtomicBool = AtomicBool::new(false);
+
+/// The registry, even if a panicking thread poisoned it (it holds plain lists; nothing is half-updated).
+fn registry() -> MutexGuard<'static, Registry> {
+    REGISTRY.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Installs the SIGINT/SIGTERM/SIGHUP handler (once, from `main`).
+pub fn install_signal_handler() -> Result<()> {
+    ctrlc::set_handler(on_signal).context("cannot install the SIGINT/SIGTERM handler")
+}
+
+/// Whether a signal asked brdfprof to stop.
+pub fn interrupted() -> bool {
+    INTERRUPTED.load(Ordering::SeqCst)
+}
+
+/// Once a signal has arrived, the thread that calls this waits for the handler to exit the process, so that
+/// an interrupted command neither writes an output nor exits with its own status in the meantime.
+pub fn park_if_interrupted() {
+    while interrupted() {
+        std::thread::park_timeout(Duration::from_secs(1));
+    }
+}
+
+fn on_signal() {
+    if INTERRUPTED.swap(true, Ordering::SeqCst) {
+        return;
+    }
+    let (children, paths) = {
+        let r = registry();
+        (r.children.clone(), r.paths.clone())
+    };
+    for pid in &children {
+        kill_and_reap(*pid);
+    }
+    // After the children: none of them can write into a directory once it is gone.
+    for p in &paths {
+        remove(p);
+    }
+    eprintln!("brdfprof: interrupted; stopped {} child process(es) and removed {} temporary path(s)", children.len(), paths.len());
+    // _exit, not exit: other threads may be inside the Vulkan driver, whose exit-time teardown must not run
+    // under them. Nothing buffered is lost that matters for an interrupted run.
+    // SAFETY: _exit ends the process at once; it has no preconditions.
+    unsafe { libc::_exit(INTERRUPTED_EXIT) }
+}
+
+/// SIGKILL, then wait up to 2 s for it to be gone (so it writes nothing after the cleanup).
+fn kill_and_reap(pid: u32) {
+    let Ok(pid) = libc::pid_t::try_from(pid) else { return };
+    // SAFETY: plain system calls on a pid this process spawned and has not yet reaped (the guard is dropped
+    // only after `wait`); a pid already reaped by the waiting thread makes waitpid return -1 (ECHILD).
+    unsafe {
+        libc::kill(pid, libc::SIGKILL);
+        let start = Instant::now();
+        while start.elapsed() < Duration::from_secs(2) {
+            if libc::waitpid(pid, std::ptr::null_mut(), libc::WNOHANG) != 0 {
+                return;
+            }
+            std::thread::sleep(Duration::from_millis(10));
+        }
+    }
+}
+
+fn remove(p: &Path) {
+    match std::fs::symlink_metadata(p) {
+        Ok(m) if m.is_dir() => drop(std::fs::remove_dir_all(p)),
+        Ok(_) => drop(std::fs::remove_file(p)),
+        Err(_) => {}
+    }
+}
+
+/// A path removed by the signal handler while this guard lives (the owner removes it otherwise).
+pub struct PathGuard(PathBuf);
+
+impl PathGuard {
+    pub fn new(path: &Path) -> PathGuard {
+        registry().paths.push(path.to_path_buf());
+        PathGuard(path.to_path_buf())
+    }
+}
+
+impl Drop for PathGuard {
+    fn drop(&mut self) {
+        let mut r = registry();
+        if let Some(i) = r.paths.iter().position(|p| *p == self.0) {
+            r.paths.swap_remove(i);
+        }
+    }
+}
+
+/// A temporary directory (under TMPDIR), removed when dropped and by the signal handler.
+pub struct TempDir {
+    // Field order: the registration goes first, then the directory is removed.
+    _guard: PathGuard,
+    dir: tempfile::TempDir,
+}
+
+impl TempDir {
+    pub fn new() -> std::io::Result<TempDir> {
+        let dir = tempfile::Builder::new().prefix("brdfprof-").tempdir()?;
+        Ok(TempDir { _guard: PathGuard::new(dir.path()), dir })
+    }
+
+    pub fn path(&self) -> &Path {
+        self.dir.path()
+    }
+}
+
+/// A spawned child the signal handler kills while this guard lives; drop it only after the child is reaped.
+pub struct ChildGuard(u32);
+
+impl ChildGuard {
+    pub fn new(child: &Child) -> ChildGuard {
+        registry().children.push(child.id());
+        ChildGuard(child.id())
+    }
+}
+
+impl Drop for ChildGuard {
+    fn drop(&mut self) {
+        let mut r = registry();
+        if let Some(i) = r.children.iter().position(|p| *p == self.0) {
+            r.children.swap_remove(i);
+        }
+    }
+}
+
+/// `Command::new(program)` whose child dies with brdfprof. PR_SET_PDEATHSIG fires when the spawning thread
+/// ends, so spawn from the thread that waits for the child (as every caller here does).
+pub fn command(program: &str) -> Command {
+    let mut cmd = Command::new(program);
+    die_with_parent(&mut cmd);
+    cmd
+}
+
+#[cfg(target_os = "linux")]
+fn die_with_parent(cmd: &mut Command) {
+    use std::os::unix::process::CommandExt;
+    // SAFETY: getpid() is async-signal-safe; it runs before the fork.
+    let parent = unsafe { libc::getpid() };
+    // SAFETY: the closure runs between fork and exec and calls only async-signal-safe functions (prctl,
+    // getppid), allocating nothing.
+    unsafe {
+        cmd.pre_exec(move || {
+            if libc::prctl(libc::PR_SET_PDEATHSIG, libc::SIGKILL) == -1 {
+                return Err(std::io::Error::last_os_error());
+            }
+            // The parent may have died before prctl took effect: then no signal would come.
+            if libc::getppid() != parent {
+                return Err(std::io::Error::other("brdfprof exited before its child started"));
+            }
+            Ok(())
+        });
+    }
+}
+
+#[cfg(not(target_os = "linux"))]
+fn die_with_parent(_cmd: &mut Command) {}
+
+/// `cmd.output()`, with the child registered for the signal handler while it runs.
+pub fn output(cmd: &mut Command) -> std::io::Result<Output> {
+    let child = cmd.stdin(Stdio::null()).stdout(Stdio::piped()).stderr(Stdio::piped()).spawn()?;
+    let _guard = ChildGuard::new(&child);
+    child.wait_with_output()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn guards_register_while_they_live() {
+        let dir = TempDir::new().unwrap();
+        let path = dir.path().to_path_buf();
+        assert!(registry().paths.contains(&path));
+        drop(dir);
+        assert!(!registry().paths.contains(&path) && !path.exists());
+        let out = output(command("sh").args(["-c", "echo $PPID"])).unwrap();
+        assert_eq!(String::from_utf8_lossy(&out.stdout).trim(), std::process::id().to_string());
+    }
+}

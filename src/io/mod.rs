@@ -1,0 +1,254 @@
+//! Files in and out: the `eval` CSV format (`csv`: errors name file, line and column), output paths checked
+//! before a command measures anything, and atomic writes so that a failed run never leaves a half-written
+//! result behind.
+
+pub mod csv;
+
+pub use csv::{parse_eval_csv, parse_samples_csv, read_eval_csv, read_samples_csv, EvalInput, SAMPLE_COLUMNS, TANGENT_COLUMNS};
+
+use anyhow::{anyhow, bail, Context, Result};
+use std::io::Write;
+use std::os::unix::ffi::OsStrExt;
+use std::path::{Path, PathBuf};
+
+/// The `eval` output: header `r,g,b`, one row per sample (shortest text that reads back to the same f32).
+pub fn format_rgb_csv(rows: &[[f32; 3]]) -> String {
+    let mut out = String::with_capacity(rows.len() * 32 + 8);
+    out.push_str("r,g,b\n");
+    for [r, g, b] in rows {
+        out.push_str(&format!("{r},{g},{b}\n"));
+    }
+    out
+}
+
+/// Symbolic links followed at most this many times (Linux's own limit, MAXSYMLINKS).
+const MAX_LINKS: usize = 40;
+
+/// Where writing `path` writes: `path` itself, or the file its chain of symbolic links ends at, which need
+/// not exist yet (as a shell's `>` creates a dangling link's target).
+fn link_target(path: &Path) -> Result<PathBuf> {
+    let mut target = path.to_path_buf();
+    for _ in 0..MAX_LINKS {
+        match std::fs::symlink_metadata(&target) {
+            Ok(m) if m.file_type().is_symlink() => {
+                let next = std::fs::read_link(&target).with_context(|| format!("cannot read the symbolic link {}", target.display()))?;
+                target = target.parent().map_or_else(|| next.clone(), |dir| dir.join(&next));
+            }
+            _ => return Ok(target),
+        }
+    }
+    bail!("{}: more than {MAX_LINKS} symbolic links in a row (a loop?)", path.display())
+}
+
+/// Writes a command's named output. A regular file, or a path that does not exist yet, is written atomically:
+/// a temporary file in the same directory (with the old file's permissions), synced, then renamed over it, so
+/// a failure leaves any existing file untouched and no temporary behind. A symbolic link is followed, and its
+/// target written the same way, so the link stays a link. Any other existing file (a device such as
+/// /dev/null, a FIFO) is opened and written in place, never replaced.
+pub fn write_output(path: &Path, bytes: &[u8]) -> Result<()> {
+    crate::cleanup::park_if_interrupted();
+    let target = link_target(path)?;
+    match std::fs::metadata(&target) {
+        Ok(m) if m.is_dir() => bail!("cannot write {}: it is a directory", path.display()),
+        Ok(m) if !m.is_file() => {
+            let mut f = std::fs::OpenOptions::new().write(true).open(&target).with_context(|| format!("cannot open {}", path.display()))?;
+            f.write_all(bytes).and_then(|_| f.flush()).with_context(|| format!("cannot write {}", path.display()))
+        }
+        Ok(m) => write_atomic(&target, bytes, Some(m.permissions())),
+        Err(_) => write_atomic(&target, bytes, None),
+    }
+}
+
+/// Temp-then-rename in `path`'s directory (regular files only; `write_output` decides).
+fn write_atomic(path: &Path, bytes: &[u8], permissions: Option<std::fs::Permissions>) -> Result<()> {
+    let dir = parent_dir(path);
+    std::fs::create_dir_all(&dir).with_context(|| format!("cannot create directory {}", dir.display()))?;
+    let file_name = path.file_name().ok_or_else(|| anyhow!("{} is not a file path", path.display()))?;
+    let tmp = dir.join(format!(".{}.{}.tmp", file_name.to_string_lossy(), std::process::id()));
+    // Registered, so that an interrupted write leaves no temporary behind either.
+    let _guard = crate::cleanup::PathGuard::new(&tmp);
+    let result = (|| -> Result<()> {
+        let mut f = std::fs::File::create(&tmp)?;
+        f.write_all(bytes)?;
+        if let Some(p) = permissions {
+            f.set_permissions(p)?;
+        }
+        f.sync_all()?;
+        std::fs::rename(&tmp, path)?;
+        Ok(())
+    })();
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result.with_context(|| format!("cannot write {}", path.display()))
+}
+
+/// The directory a relative or absolute file path is in (`.` for a bare name).
+fn parent_dir(path: &Path) -> PathBuf {
+    match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    }
+}
+
+/// Checks, before a command measures anything, that it will be able to write the file output `path` given
+/// by `flag`: not a directory, and in a directory that exists or can be created. Errors name the flag and
+/// the path.
+pub fn check_output_path(flag: &str, path: &Path) -> Result<()> {
+    let shown = path.display();
+    if path.as_os_str().is_empty() {
+        bail!("{flag}: empty path; give a file name");
+    }
+    if path.as_os_str().as_bytes().ends_with(b"/") || path.file_name().is_none() {
+        bail!("{flag} {shown}: names a directory; give a file path");
+    }
+    let target = link_target(path).map_err(|e| anyhow!("{flag} {shown}: {e:#}"))?;
+    match std::fs::metadata(&target) {
+        Ok(m) if m.is_dir() => bail!("{flag} {shown}: is a directory; give a file path"),
+        Ok(_) => Ok(()),
+        Err(e) if missing(&e) => creatable(flag, path, &parent_dir(&target)),
+        Err(e) => bail!("{flag} {shown}: {e}"),
+    }
+}
+
+/// Checks, before a command measures anything, that the output directory `dir` given by `flag` is a
+/// directory or can be created. Errors name the flag and the path.
+pub fn check_output_dir(flag: &str, dir: &Path) -> Result<()> {
+    if dir.as_os_str().is_empty() {
+        bail!("{flag}: empty path; give a directory");
+    }
+    match std::fs::metadata(dir) {
+        Ok(m) if m.is_dir() => writable(flag, dir, dir),
+        Ok(_) => bail!("{flag} {}: exists and is not a directory", dir.display()),
+        Err(e) if missing(&e) => creatable(flag, dir, dir),
+        Err(e) => bail!("{flag} {}: {e}", dir.display()),
+    }
+}
+
+/// No such path (ENOENT), or a file where a directory should be on the way (ENOTDIR: found by `creatable`).
+fn missing(e: &std::io::Error) -> bool {
+    matches!(e.kind(), std::io::ErrorKind::NotFound | std::io::ErrorKind::NotADirectory)
+}
+
+/// `dir` exists, or its nearest existing ancestor is a directory brdfprof may write in.
+fn creatable(flag: &str, output: &Path, dir: &Path) -> Result<()> {
+    let mut d = dir.to_path_buf();
+    loop {
+        match std::fs::metadata(&d) {
+            Ok(m) if m.is_dir() => return writable(flag, output, &d),
+            Ok(_) => bail!("{flag} {}: {} is not a directory", output.display(), d.display()),
+            Err(e) if missing(&e) => d = parent_dir(&d),
+            Err(e) => bail!("{flag} {}: cannot use {}: {e}", output.display(), d.display()),
+        }
+    }
+}
+
+/// `dir` admits new entries (permissions, read-only file systems).
+fn writable(flag: &str, output: &Path, dir: &Path) -> Result<()> {
+    let c = std::ffi::CString::new(dir.as_os_str().as_bytes()).map_err(|_| anyhow!("{flag} {}: the path contains a NUL byte", output.display()))?;
+    // SAFETY: `c` is a NUL-terminated path that outlives the call.
+    if unsafe { libc::access(c.as_ptr(), libc::W_OK | libc::X_OK) } != 0 {
+        bail!("{flag} {}: cannot write in {} ({})", output.display(), dir.display(), std::io::Error::last_os_error());
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::os::unix::fs::{FileTypeExt, MetadataExt};
+
+    #[test]
+    fn a_regular_file_is_replaced_atomically() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("out.csv");
+        write_output(&p, b"first").unwrap();
+        // A hard link keeps the old file: the new content went to a new file renamed over the path, not
+        // into the old one (a reader of the old file never sees half of the new).
+        let old = dir.path().join("old-link");
+        std::fs::hard_link(&p, &old).unwrap();
+        let inode = std::fs::metadata(&p).unwrap().ino();
+        write_output(&p, b"second").unwrap();
+        assert_eq!(std::fs::read(&p).unwrap(), b"second");
+        assert_eq!(std::fs::read(&old).unwrap(), b"first");
+        assert_ne!(std::fs::metadata(&p).unwrap().ino(), inode);
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 2, "no temporary left behind");
+    }
+
+    #[test]
+    fn permissions_of_the_replaced_file_are_kept() {
+        use std::os::unix::fs::PermissionsExt;
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("out.csv");
+        std::fs::write(&p, "x").unwrap();
+        std::fs::set_permissions(&p, std::fs::Permissions::from_mode(0o640)).unwrap();
+        write_output(&p, b"y").unwrap();
+        assert_eq!(std::fs::metadata(&p).unwrap().permissions().mode() & 0o777, 0o640);
+    }
+
+    #[test]
+    fn a_symlink_output_writes_its_target_and_stays_a_link() {
+        let dir = tempfile::tempdir().unwrap();
+        let target = dir.path().join("target.csv");
+        std::fs::write(&target, "old").unwrap();
+        let link = dir.path().join("link.csv");
+        std::os::unix::fs::symlink("target.csv", &link).unwrap();
+        write_output(&link, b"r,g,b\n").unwrap();
+        assert!(std::fs::symlink_metadata(&link).unwrap().file_type().is_symlink());
+        assert_eq!(std::fs::read(&target).unwrap(), b"r,g,b\n");
+        // A dangling link's target is created, as a shell's `>` does.
+        let dangling = dir.path().join("dangling.csv");
+        std::os::unix::fs::symlink(dir.path().join("sub/new.csv"), &dangling).unwrap();
+        write_output(&dangling, b"x").unwrap();
+        assert!(std::fs::symlink_metadata(&dangling).unwrap().file_type().is_symlink());
+        assert_eq!(std::fs::read(dir.path().join("sub/new.csv")).unwrap(), b"x");
+    }
+
+    #[test]
+    fn a_fifo_output_receives_the_bytes_and_stays_a_fifo() {
+        let dir = tempfile::tempdir().unwrap();
+        let fifo = dir.path().join("out.fifo");
+        let made = std::process::Command::new("mkfifo").arg(&fifo).status().unwrap();
+        assert!(made.success());
+        let reader = {
+            let fifo = fifo.clone();
+            std::thread::spawn(move || std::fs::read(fifo).unwrap())
+        };
+        let csv = format_rgb_csv(&[[0.5, 0.25, 1.0]]);
+        write_output(&fifo, csv.as_bytes()).unwrap();
+        assert_eq!(reader.join().unwrap(), csv.as_bytes());
+        assert!(std::fs::symlink_metadata(&fifo).unwrap().file_type().is_fifo());
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1, "no temporary beside the FIFO");
+    }
+
+    #[test]
+    fn a_directory_is_refused_by_name() {
+        let dir = tempfile::tempdir().unwrap();
+        let e = write_output(dir.path(), b"x").unwrap_err().to_string();
+        assert!(e.contains(&format!("cannot write {}: it is a directory", dir.path().display())), "{e}");
+    }
+
+    #[test]
+    fn output_paths_are_checked_before_any_work() {
+        let dir = tempfile::tempdir().unwrap();
+        let d = dir.path();
+        let file = d.join("file");
+        std::fs::write(&file, "x").unwrap();
+        assert!(check_output_path("--json", &d.join("new.json")).is_ok());
+        assert!(check_output_path("--json", &d.join("a/b/new.json")).is_ok(), "missing directories are created on writing");
+        assert!(check_output_path("--json", &file).is_ok());
+        let e = check_output_path("--json", d).unwrap_err().to_string();
+        assert_eq!(e, format!("--json {}: is a directory; give a file path", d.display()));
+        let e = check_output_path("--out", &file.join("x.json")).unwrap_err().to_string();
+        assert_eq!(e, format!("--out {}: {} is not a directory", file.join("x.json").display(), file.display()));
+        let e = check_output_path("--json", Path::new("results/")).unwrap_err().to_string();
+        assert!(e.contains("--json results/: names a directory"), "{e}");
+        assert!(check_output_path("--json", Path::new("")).unwrap_err().to_string().contains("--json: empty path"));
+        assert!(check_output_dir("--out", d).is_ok());
+        assert!(check_output_dir("--out", &d.join("new/dir")).is_ok());
+        let e = check_output_dir("--out", &file).unwrap_err().to_string();
+        assert_eq!(e, format!("--out {}: exists and is not a directory", file.display()));
+        let e = check_output_dir("--out", &file.join("sub")).unwrap_err().to_string();
+        assert!(e.contains(&format!("{} is not a directory", file.display())), "{e}");
+    }
+}

@@ -1,0 +1,72 @@
+//! Every output path is checked before anything is measured: a directory given as a file output, a file given
+//! as an output directory, or a path under a file, fails at once with exit 2, naming the flag and the path,
+//! and nothing is written.
+
+use crate::common::{self, run_in};
+use std::path::Path;
+use std::time::{Duration, Instant};
+
+const CSV: &str = "nx,ny,nz,vx,vy,vz,lx,ly,lz,roughness,f0r,f0g,f0b\n0,0,1,0,0.6,0.8,0.6,0,0.8,0.5,0.04,0.04,0.04\n";
+
+/// Every file in `dir`, recursively, relative to it.
+fn files(dir: &Path) -> Vec<String> {
+    let mut out = Vec::new();
+    for e in std::fs::read_dir(dir).unwrap() {
+        let p = e.unwrap().path();
+        if p.is_dir() {
+            out.extend(files(&p).into_iter().map(|f| format!("{}/{f}", p.file_name().unwrap().to_string_lossy())));
+        } else {
+            out.push(p.file_name().unwrap().to_string_lossy().into_owned());
+        }
+    }
+    out.sort();
+    out
+}
+
+#[test]
+fn profile_json_naming_a_directory_fails_before_measuring() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir(dir.path().join("reports")).unwrap();
+    let start = Instant::now();
+    // The default profile (1920x1080, the four thesis models) takes minutes here; the check takes none.
+    run_in(dir.path(), &["profile", "--json", "reports"]).fails(2, "--json reports: is a directory; give a file path");
+    assert!(start.elapsed() < Duration::from_secs(30), "took {:?}: measured first?", start.elapsed());
+    assert!(files(dir.path()).is_empty());
+}
+
+#[test]
+fn every_output_flag_is_checked_first() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("in.csv"), CSV).unwrap();
+    std::fs::write(d.join("a-file"), "x").unwrap();
+    std::fs::create_dir(d.join("a-dir")).unwrap();
+    let baseline = common::repo_root().join("results/baseline-llvmpipe.json");
+    let scene = common::repo_root().join("scenes/sphere-grid.json");
+    let (baseline, scene) = (baseline.to_str().unwrap(), scene.to_str().unwrap());
+    let eval = ["eval", "--model", "ggx", "--input", "in.csv"];
+    let inspect = ["inspect", "--model", "ggx", "--no-callgrind"];
+    let check = ["check", "--baseline", baseline, "--rounds", "0", "--no-callgrind"];
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        ([&eval[..], &["--output", "a-dir"]].concat(), "--output a-dir: is a directory"),
+        ([&eval[..], &["--output", "a-file/out.csv"]].concat(), "--output a-file/out.csv: a-file is not a directory"),
+        ([&eval[..], &["--output", "new/"]].concat(), "--output new/: names a directory"),
+        (vec!["profile", "--model", "ggx", "--size", "8x8", "--json", "a-file/p.json"], "--json a-file/p.json: a-file is not a directory"),
+        (vec!["profile", "--scene", scene, "--json", "a-dir"], "--json a-dir: is a directory"),
+        (vec!["sweep", "--model", "ggx", "--size", "8x8", "--out", "a-file"], "--out a-file: exists and is not a directory"),
+        (vec!["stability", "--model", "ggx", "--out", "a-file/sub"], "--out a-file/sub: a-file is not a directory"),
+        ([&inspect[..], &["--json", "a-dir"]].concat(), "--json a-dir: is a directory"),
+        ([&inspect[..], &["--json", "i.json", "--markdown", "a-dir"]].concat(), "--markdown a-dir: is a directory"),
+        ([&check[..], &["--save-baseline", "a-dir"]].concat(), "--save-baseline a-dir: is a directory"),
+        (vec!["render", "--scene", scene, "--out", "a-file"], "--out a-file: exists and is not a directory"),
+    ];
+    for (args, expected) in &cases {
+        let start = Instant::now();
+        run_in(d, args).fails(2, expected);
+        assert!(start.elapsed() < Duration::from_secs(30), "{args:?} took {:?}", start.elapsed());
+        assert_eq!(files(d), ["a-file", "in.csv"], "{args:?} wrote something");
+    }
+    // The defaults' directory is checked too: `results` is a file here.
+    std::fs::write(d.join("results"), "x").unwrap();
+    run_in(d, &inspect).fails(2, "--json (default results/inspect-<device>.json) results: exists and is not a directory");
+}
