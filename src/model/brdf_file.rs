@@ -1127,4 +1127,23 @@ vec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) { return vec3(a(1.0) + b(1.0, 
         assert_eq!(f.remap_log(&r, log, |_| None), "dir/t.brdf:8: warning: 'k' : something odd\nERROR: composed.comp:30: 'x' : undeclared identifier\n");
         assert_eq!(split_location("C:\\a b\\c:1.comp:3: msg"), Some(("C:\\a b\\c:1.comp", 3, "msg")));
     }
+
+    /// The thesis models as .brdf files (examples/brdf/) parse, and their renamed shaders compile.
+    #[test]
+    fn example_files_parse_and_compile() {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/brdf");
+        for (name, params) in [("ggx", 2), ("blinn", 2), ("cook-torrance", 2), ("burley", 3)] {
+            let f = load(&dir.join(format!("{name}.brdf"))).unwrap();
+            assert_eq!((f.name.as_str(), f.params.len()), (name, params));
+            assert!(f.warnings.is_empty(), "{:?}", f.warnings);
+            assert_eq!(f.params[0], FileParam { name: "roughness".into(), kind: FileParamKind::Float { min: 0.0, max: 1.0, default: 0.5 }, line: f.params[0].line });
+            assert_eq!(f.params[1].kind, FileParamKind::Color { default: [0.04; 3] });
+            let r = f.renamed_shader().unwrap();
+            for host in ["PI", "pow5", "safe_normalize", "guard_cosine", "MIN_COSINE", "F_Schlick"] {
+                assert!(r.renamed.iter().any(|n| n == host), "{name}: `{host}` not renamed");
+            }
+            let (source, _) = compose(&f, true);
+            compile(&source).unwrap_or_else(|log| panic!("{name}: {log}"));
+        }
+    }
 }
