@@ -19,7 +19,8 @@
 //! ```text
 //! #version 450
 //! #extension GL_GOOGLE_cpp_style_line_directive : require   // implied by GL_GOOGLE_include_directive
-//! const float brdf_f_roughness = 0.5;                       // default_constants(), or the caller's own
+//! const float brdf_f_roughness = 0.5;                       // default_constants(); or `float brdf_f_f0;`,
+//!                                                           // a private global main sets per sample
 //! #line 12 "my.brdf"                                        // line_directive()
 //! ...the renamed shader lines...
 //! #line 40 "kernel.comp"                                     // back to the composed source's own numbering
@@ -647,9 +648,10 @@ fn struct_members(tokens: &[Token]) -> HashSet<usize> {
 // ---- Renaming and composition -----------------------------------------------------------------------
 
 impl BrdfFile {
-    /// The prefix of every renamed name: `brdf_f_`, or `brdf_f1_`, `brdf_f2_`, ... when some identifier of the
-    /// shader already starts with `brdf_f` (so no renamed name can equal a name left alone); without its final
-    /// `_` when a name starts with `_` (so no `__`, which GLSL reserves, appears).
+    /// The prefix of every renamed name: `brdf_f_`, or `brdf_f1_`, `brdf_f2_`, ... when some identifier-like word
+    /// of the shader (comments included) already starts with `brdf_f`, so that no renamed name can equal a name
+    /// left alone; without its final `_` when such a word or a parameter starts with `_`, so that no `__` (which
+    /// GLSL reserves) appears.
     fn prefix(&self) -> String {
         let runs: Vec<&str> = self.shader.iter().flat_map(|(_, l)| identifier_runs(l)).collect();
         let underscore = runs.iter().copied().chain(self.params.iter().map(|p| p.name.as_str())).any(|s| s.starts_with('_'));
