@@ -2,6 +2,8 @@
 //! (SPIR-V plus specialisation constants, for each kind of kernel) and, where one exists, an f64 twin and an
 //! exact physical reference. A D x Vis x F spec is one constructor (`Model::spec`).
 
+pub mod brdf_file;
+
 use crate::brdf::terms::{ParamValue, PARAMS};
 use crate::brdf::{ModelSpec, Precision};
 use crate::gpu::{DeviceInfo, SpecConstants};

@@ -5,6 +5,7 @@
 mod common;
 
 mod albedo;
+mod brdf_files;
 mod chunking;
 mod d_normalisation;
 mod exact_reference;
