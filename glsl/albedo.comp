@@ -28,6 +28,9 @@ void main() {
     cell_V = vec3(sqrt(max(1.0 - NoV * NoV, 0.0)), 0.0, NoV);
     cell_roughness = c.y;
     cell_f0 = inputs[2 * cell + 1].rgb;
+#ifdef BRDF_FILE
+    file_basecolor = cell_f0;
+#endif
     vec3 mean, even;
     albedo_row(cell_V, float(perceptual_to_alpha(c.y)), id % uint(ALBEDO_N), mean, even);
     outputs[2 * id] = vec4(mean, 0.0);

@@ -316,6 +316,35 @@ real3 specular_from_cosines(real NoV, real NoL, real NoH, real VoH, real sin2h, 
     return D_term(NoH, sin2h, a) * Vis_term(NoV, NoL, NoH, VoH, a) * F_term(f0, VoH);
 }
 
+#ifdef BRDF_FILE
+// A user's .brdf file composed before this library (src/model/file_model.rs): f_s is the file's BRDF(L, V, N,
+// X, Y), returned as is, with its bound parameters (BRDF_FILE_BIND) set from this call's inputs and the
+// material and tangent the kernel sets below.
+vec3 file_tangent = vec3(0.0);
+vec3 file_basecolor = vec3(0.0);
+float file_metallic = 1.0;
+
+// |t - N (N.t)|^2 / |t|^2 below which a tangent counts as parallel to N (TANGENT_PARALLEL in file_model.rs).
+const float FILE_TANGENT_PARALLEL = 1e-6;
+
+// X of the tangent frame: t made orthogonal to N, or, for t = 0 or parallel to N, the first vector of the
+// branchless orthonormal basis [Duff et al. 2017, "Building an Orthonormal Basis, Revisited", Listing 3].
+vec3 file_tangent_frame(vec3 N, vec3 t) {
+    vec3 x = t - N * dot(N, t);
+    float len2 = dot(x, x), t2 = dot(t, t);
+    if (t2 > 0.0 && len2 > FILE_TANGENT_PARALLEL * t2) return x * inversesqrt(len2);
+    float s = (N.z >= 0.0) ? 1.0 : -1.0;
+    float a = -1.0 / (s + N.z);
+    float b = N.x * N.y * a;
+    return vec3(1.0 + s * N.x * N.x * a, s * b, -s * N.x);
+}
+
+vec3 specular_brdf_unit(vec3 N, vec3 V, vec3 L, float roughness, vec3 f0) {
+    BRDF_FILE_BIND
+    vec3 X = file_tangent_frame(N, file_tangent);
+    return BRDF_FILE_FUNCTION(L, V, N, X, cross(N, X));
+}
+#else
 // f_s for unit (or zero) N, V, L; 0 unless NoL > 0 and NoV > 0 (not multiplied by NoL).
 vec3 specular_brdf_unit(vec3 N, vec3 V, vec3 L, float roughness, vec3 f0) {
     vec3 H = safe_normalize(V + L);
@@ -329,6 +358,7 @@ vec3 specular_brdf_unit(vec3 N, vec3 V, vec3 L, float roughness, vec3 f0) {
                                      perceptual_to_alpha(roughness), real3(clamp(f0, vec3(0), vec3(1))));
     return mix(vec3(0), vec3(fs), bvec3(lit));
 }
+#endif
 
 // f_s for unnormalised world-space n, v, l.
 vec3 specular_brdf(vec3 n, vec3 v, vec3 l, float roughness, vec3 f0) {

@@ -38,6 +38,10 @@ void main() {
     s.roughness = nr.w;
     s.f0 = mix(vec3(0.04), base.rgb, pm.w);
     s.diffuse_colour = base.rgb * (1.0 - pm.w);
+#ifdef BRDF_FILE
+    file_basecolor = base.rgb;
+    file_metallic = pm.w;
+#endif
     s.anisotropy = 0.0;
     s.coat = 0.0;
     s.coat_roughness = 1.0;
@@ -48,6 +52,9 @@ void main() {
         s.T = safe_normalize(t.xyz - s.N * dot(s.N, t.xyz));
         s.B = cross(s.N, s.T);
         s.anisotropy = t.w;
+#ifdef BRDF_FILE
+        file_tangent = s.T;
+#endif
     }
     if (CLEAR_COAT != 0 || DIFFUSE == 3 || ENERGY_COMPENSATION == 2) {
         vec4 e = extras[2 * i + 1];

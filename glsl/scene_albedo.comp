@@ -32,6 +32,9 @@ void main() {
     cell.B = vec3(0.0, 1.0, 0.0);
     cell.roughness = c0.y;
     cell.f0 = c1.rgb;
+#ifdef BRDF_FILE
+    file_basecolor = cell.f0;
+#endif
     cell.diffuse_colour = c2.rgb;
     cell.anisotropy = c0.z;
     cell.coat = c0.w;

@@ -70,6 +70,10 @@ Pixel load_pixel(uint i) {
     p.V = safe_normalize(vec3(-s, 1.0));
     p.roughness = b.z;
     p.f0 = mix(vec3(0.04), c.rgb, b.x);
+#ifdef BRDF_FILE
+    file_basecolor = c.rgb;
+    file_metallic = b.x;
+#endif
 #else
     vec4 nr = pixels[3 * i];
     vec4 vm = pixels[3 * i + 1];
@@ -78,6 +82,10 @@ Pixel load_pixel(uint i) {
     p.V = safe_normalize(vm.xyz);
     p.roughness = nr.w;
     p.f0 = mix(vec3(0.04), base.rgb, vm.w);
+#ifdef BRDF_FILE
+    file_basecolor = base.rgb;
+    file_metallic = vm.w;
+#endif
 #endif
     return p;
 }

@@ -114,7 +114,7 @@ impl Shaders {
 }
 
 /// `name`'s line in `dir/kernels.txt`: (source file, defines).
-fn kernel_entry(dir: &Path, name: &str) -> Result<(String, Vec<String>)> {
+pub fn kernel_entry(dir: &Path, name: &str) -> Result<(String, Vec<String>)> {
     let list = dir.join("kernels.txt");
     let text = std::fs::read_to_string(&list).with_context(|| format!("cannot read {}", list.display()))?;
     for line in text.lines().map(str::trim).filter(|l| !l.is_empty() && !l.starts_with('#')) {

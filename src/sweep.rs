@@ -52,6 +52,11 @@ pub fn default_specs() -> Vec<ModelSpec> {
 
 /// A short label for charts: the preset name where one matches, else d/vis/f.
 pub fn label(model: &Model) -> String {
+    if let Some(f) = model.file() {
+        let name = f.name();
+        let file_name = std::path::Path::new(&f.path).file_name().map_or(f.path.clone(), |n| n.to_string_lossy().into_owned());
+        return file_name + &name[f.path.len()..];
+    }
     let Some(spec) = model.twin() else { return model.name() };
     let name = spec.name();
     if !name.starts_with("d=") {
@@ -67,6 +72,8 @@ pub fn label(model: &Model) -> String {
 #[derive(Clone, Debug)]
 pub struct SweepOptions {
     pub profile: ProfileOptions,
+    /// What models without an f64 twin (`.brdf` files) are measured against (`--reference`; default ggx).
+    pub reference: Model,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -114,8 +121,9 @@ pub fn run(gpu: &Gpu, options: &SweepOptions, progress: &ProgressBar) -> Result<
     let n = options.profile.models.len();
     let mut accuracies = Vec::with_capacity(n);
     for (k, spec) in options.profile.models.iter().enumerate() {
-        progress.set_message(format!("accuracy {}/{n}: {} against its f64 twin and exact references", k + 1, spec.name()));
-        accuracies.push(accuracy::measure(gpu, spec, &set, &mut cache)?);
+        let against = if spec.twin().is_some() { "its f64 twin and exact references".to_string() } else { options.reference.name() };
+        progress.set_message(format!("accuracy {}/{n}: {} against {against}", k + 1, spec.name()));
+        accuracies.push(accuracy::measure(gpu, spec, &set, &mut cache, &options.reference)?);
     }
     let profile = profile::run(gpu, &options.profile, progress)?;
     let specs: Vec<(usize, Model)> = options
@@ -177,7 +185,7 @@ impl SweepReport {
                 report::estimate(&r.ns_per_eval, 3),
                 r.net_ns_per_eval.as_ref().map_or("-".into(), |e| report::sig(e.median, 3)),
                 report::estimate(&r.cost_vs_fastest, 3),
-                format!("{:.1e}", a.numerical.max),
+                a.numerical.as_ref().map_or_else(|| format!("- (vs {})", a.reference.as_deref().unwrap_or("?")), |n| format!("{:.1e}", n.max)),
                 format!("{:.1e} / {:.1e}", a.vs_exact.max, a.vs_exact.rms),
                 format!("{:.1e}", a.albedo_vs_exact),
                 if r.pareto { "yes".into() } else { String::new() },

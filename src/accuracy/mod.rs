@@ -9,7 +9,7 @@ use crate::brdf::{samples, ModelSpec, Sample, D, F};
 use crate::gpu::Gpu;
 use crate::kernels::{self, AlbedoCell, RunLimits};
 use crate::model::Model;
-use anyhow::{anyhow, Result};
+use anyhow::Result;
 use rayon::prelude::*;
 use serde::Serialize;
 use std::collections::HashMap;
@@ -107,37 +107,56 @@ impl ExactCache {
 
 #[derive(Clone, Debug, Serialize)]
 pub struct Accuracy {
-    /// GPU result against the same formula in f64.
-    pub numerical: ErrorStats,
-    /// GPU result against the exact physical reference: what a user of the spec gets.
+    /// GPU result against the same formula in f64 (None for a model without an f64 twin, a `.brdf` file).
+    pub numerical: Option<ErrorStats>,
+    /// GPU result against the exact physical reference: what a user of the spec gets. For a model without a
+    /// twin: against `reference`.
     pub vs_exact: ErrorStats,
-    /// The formula itself (f64) against the exact reference: the approximation alone.
-    pub formula_vs_exact: ErrorStats,
+    /// The formula itself (f64) against the exact reference: the approximation alone (None without a twin).
+    pub formula_vs_exact: Option<ErrorStats>,
     /// max over cells and channels of |E_gpu - E_exact| (absolute; albedo is in [0, 1]).
     pub albedo_vs_exact: f64,
     /// The largest integration-error bound of the GPU albedos.
     pub albedo_error_bound: f64,
+    /// What a model without a twin was measured against: a spec (its exact f64 model) or another `.brdf`
+    /// file (evaluated on the GPU); None for a model with a twin (its own exact model).
+    pub reference: Option<String>,
 }
 
-/// Measures `model` on the GPU over `set` against its twin and exact reference.
-pub fn measure(gpu: &Gpu, model: &Model, set: &SampleSet, cache: &mut ExactCache) -> Result<Accuracy> {
-    let spec = model.twin().ok_or_else(|| anyhow!("{model} has no f64 twin to measure numerical error against"))?;
+/// Measures `model` on the GPU over `set` against its twin and exact reference; a model without a twin (a
+/// `.brdf` file) against `reference`: a spec's exact model, or another file's GPU values and albedo.
+pub fn measure(gpu: &Gpu, model: &Model, set: &SampleSet, cache: &mut ExactCache, reference: &Model) -> Result<Accuracy> {
     let got: Vec<[f64; 3]> = kernels::eval(gpu, model, &set.samples, RunLimits::default())?.iter().map(|g| g.map(f64::from)).collect();
+    let gpu_albedo = kernels::albedo(gpu, model, &set.cells)?;
+    let albedo_diff = |exact: &[[f64; 3]]| gpu_albedo.iter().zip(exact).flat_map(|(g, x)| (0..3).map(move |c| (g.e[c] - x[c]).abs())).fold(0.0, f64::max);
+    let albedo_error_bound = gpu_albedo.iter().map(|a| a.error).fold(0.0, f64::max);
+    let Some(spec) = model.twin() else {
+        let (values, albedo): (Vec<[f64; 3]>, Vec<[f64; 3]>) = match reference.twin() {
+            Some(r) => (cache.values(r, set).clone(), cache.albedo(r, set).clone()),
+            None => (
+                kernels::eval(gpu, reference, &set.samples, RunLimits::default())?.iter().map(|g| g.map(f64::from)).collect(),
+                kernels::albedo(gpu, reference, &set.cells)?.iter().map(|a| a.e).collect(),
+            ),
+        };
+        return Ok(Accuracy {
+            numerical: None,
+            vs_exact: ErrorStats::of(&set.samples, &got, &values),
+            formula_vs_exact: None,
+            albedo_vs_exact: albedo_diff(&albedo),
+            albedo_error_bound,
+            reference: Some(reference.name()),
+        });
+    };
     let twin: Vec<[f64; 3]> = set.samples.par_iter().map(|s| spec.eval(s)).collect();
     let exact_values = cache.values(spec, set).clone();
-    let gpu_albedo = kernels::albedo(gpu, model, &set.cells)?;
-    let exact_albedo = cache.albedo(spec, set);
-    let albedo_vs_exact = gpu_albedo
-        .iter()
-        .zip(exact_albedo)
-        .flat_map(|(g, x)| (0..3).map(move |c| (g.e[c] - x[c]).abs()))
-        .fold(0.0, f64::max);
+    let exact_albedo = cache.albedo(spec, set).clone();
     Ok(Accuracy {
-        numerical: ErrorStats::of(&set.samples, &got, &twin),
+        numerical: Some(ErrorStats::of(&set.samples, &got, &twin)),
         vs_exact: ErrorStats::of(&set.samples, &got, &exact_values),
-        formula_vs_exact: ErrorStats::of(&set.samples, &twin, &exact_values),
-        albedo_vs_exact,
-        albedo_error_bound: gpu_albedo.iter().map(|a| a.error).fold(0.0, f64::max),
+        formula_vs_exact: Some(ErrorStats::of(&set.samples, &twin, &exact_values)),
+        albedo_vs_exact: albedo_diff(&exact_albedo),
+        albedo_error_bound,
+        reference: None,
     })
 }
 

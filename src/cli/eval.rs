@@ -2,6 +2,8 @@
 
 use super::{on_device, DeviceArgs, ModelArgs};
 use anyhow::{bail, Result};
+use brdfprof::model::file_model::Binding;
+use brdfprof::model::Model;
 use brdfprof::{io, kernels};
 use clap::Args;
 use std::path::PathBuf;
@@ -11,7 +13,10 @@ use std::process::ExitCode;
 pub struct EvalArgs {
     #[command(flatten)]
     pub model: ModelArgs,
-    /// CSV with columns nx,ny,nz,vx,vy,vz,lx,ly,lz,roughness,f0r,f0g,f0b (any order; others ignored).
+    /// CSV with columns nx,ny,nz,vx,vy,vz,lx,ly,lz,roughness,f0r,f0g,f0b (any order; others ignored). For a
+    /// .brdf model: optional tx,ty,tz (the tangent X, made orthogonal to N; Y = N x X; without them X is
+    /// Duff et al. 2017's basis), and a column named like a parameter (NAMEr,NAMEg,NAMEb for a colour) sets
+    /// it per row.
     #[arg(long)]
     pub input: PathBuf,
     /// CSV written with columns r,g,b, one row per input row (written atomically).
@@ -27,9 +32,72 @@ pub fn eval(args: &EvalArgs) -> Result<ExitCode> {
     let [model] = models.as_slice() else {
         bail!("eval takes exactly one --model");
     };
-    let samples = io::read_samples_csv(&args.input)?;
-    let (gpu, values) = on_device(&args.device, |gpu, _| kernels::eval(gpu, model, &samples, kernels::RunLimits::default()))?;
+    let shown = model.name();
+    let (model, input, rows) = read_input(model, &args.input, &args.model.params)?;
+    let extras = kernels::EvalExtras { tangents: input.tangents.as_deref(), rows: &rows.values, row_floats: rows.floats };
+    let (gpu, values) = on_device(&args.device, |gpu, _| kernels::eval_with(gpu, &model, &input.samples, &extras, kernels::RunLimits::default()))?;
     io::write_output(&args.output, io::format_rgb_csv(&values).as_bytes())?;
-    eprintln!("brdfprof: {} rows of {model} on {} -> {}", values.len(), gpu.info.name, args.output.display());
+    let bad = values.iter().filter(|v| v.iter().any(|x| !x.is_finite())).count();
+    if bad > 0 {
+        eprintln!("brdfprof: warning: {bad} of {} rows of {shown} are not finite (written as NaN or inf)", values.len());
+    }
+    eprintln!("brdfprof: {} rows of {shown} on {} -> {}", values.len(), gpu.info.name, args.output.display());
     Ok(ExitCode::SUCCESS)
+}
+
+/// Parameters read per CSV row: `floats` values per row, rows one after another.
+#[derive(Default)]
+struct RowValues {
+    values: Vec<f32>,
+    floats: usize,
+}
+
+/// The CSV's samples and tangents, and, for a `.brdf` model, the model with each parameter that has a column
+/// named like it (NAME, or NAMEr,NAMEg,NAMEb for a colour) read per row, unless `--param` sets it.
+fn read_input(model: &Model, path: &std::path::Path, params: &[String]) -> Result<(Model, io::csv::EvalInput, RowValues)> {
+    let Some(file) = model.file() else {
+        let input = io::csv::read_eval_csv(path, &[])?;
+        if input.tangents.is_some() {
+            eprintln!("brdfprof: note: {}: columns tx,ty,tz are read by .brdf models only; {model} is isotropic", path.display());
+        }
+        return Ok((model.clone(), input, RowValues::default()));
+    };
+    let columns: Vec<String> = file.file.params.iter().flat_map(|p| p.columns()).collect();
+    let input = io::csv::read_eval_csv(path, &columns.iter().map(String::as_str).collect::<Vec<_>>())?;
+    // Every parameter not bound to an input is read per row, from its column(s) or repeating its value, so that
+    // a row gives the same bits whether its value came from a column or from --param (a constant the
+    // compiler would otherwise fold, rounding differently).
+    let given = |name: &str| params.iter().any(|p| p.split_once('=').is_some_and(|(k, _)| k.trim() == name));
+    let mut per_row: Vec<(&str, Vec<Vec<f32>>)> = Vec::new();
+    let mut from_columns = Vec::new();
+    for (p, binding) in file.file.params.iter().zip(&file.bindings) {
+        let Binding::Value(value) = binding else { continue };
+        let cols: Vec<&Vec<f32>> = p.columns().iter().filter_map(|c| input.columns.iter().find(|(n, _)| n == c).map(|(_, v)| v)).collect();
+        if !cols.is_empty() && cols.len() != p.columns().len() {
+            bail!("{}: a colour parameter `{}` is set per row by all of {} or none", path.display(), p.name, p.columns().join(","));
+        }
+        let overridden = given(&p.name) || *value != p.default_value();
+        if !cols.is_empty() && overridden {
+            eprintln!("brdfprof: note: the value given for {} overrides the column(s) {} of {}", p.name, p.columns().join(","), path.display());
+        }
+        let values = if !cols.is_empty() && !overridden {
+            from_columns.push(p.name.as_str());
+            cols.into_iter().cloned().collect()
+        } else {
+            value.floats().into_iter().map(|x| vec![x; input.samples.len()]).collect()
+        };
+        per_row.push((p.name.as_str(), values));
+    }
+    let names: Vec<&str> = per_row.iter().map(|(n, _)| *n).collect();
+    let (with_rows, floats) = file.with_rows(&names);
+    let mut values = Vec::with_capacity(input.samples.len() * floats);
+    for i in 0..input.samples.len() {
+        for (_, cols) in &per_row {
+            values.extend(cols.iter().map(|c| c[i]));
+        }
+    }
+    if !from_columns.is_empty() {
+        eprintln!("brdfprof: {} set per row from {}", from_columns.join(", "), path.display());
+    }
+    Ok((Model::File(std::sync::Arc::new(with_rows)), input, RowValues { values, floats }))
 }

@@ -105,6 +105,10 @@ pub struct SweepArgs {
     /// Directory for sweep-<device>.md, .json and .png.
     #[arg(long, default_value = "results")]
     pub out: PathBuf,
+    /// What a .brdf model's accuracy is measured against: a spec (its exact f64 model) or another .brdf file
+    /// (its GPU values). Built-in specs are always measured against their own exact model.
+    #[arg(long, default_value = "ggx")]
+    pub reference: String,
     #[command(flatten)]
     pub device: DeviceArgs,
 }
@@ -113,7 +117,11 @@ pub fn sweep(args: &SweepArgs) -> Result<ExitCode> {
     io::check_output_dir("--out", &args.out)?;
     fresh_compilation(args.timing.shader_cache);
     let models = if args.model.models.is_empty() { sweep::default_specs().into_iter().map(Model::spec).collect() } else { args.model.models(&[])? };
-    let options = sweep::SweepOptions { profile: args.timing.options(models, &args.size, args.reps, args.budget, args.target_ci)? };
+    let reference = Model::parse(&args.reference).map_err(|e| anyhow::anyhow!("--reference {}: {e:#}", args.reference))?;
+    if models.iter().all(|m| m.twin().is_some()) && args.reference != "ggx" {
+        eprintln!("brdfprof: note: --reference applies to .brdf models; built-in specs are measured against their own exact model");
+    }
+    let options = sweep::SweepOptions { profile: args.timing.options(models, &args.size, args.reps, args.budget, args.target_ci)?, reference };
     let (gpu, result) = on_device(&args.device, |gpu, progress| sweep::run(gpu, &options, progress))?;
     let files = result.write(&args.out, &report::device_slug(&gpu.info))?;
     print!("{}", result.markdown());

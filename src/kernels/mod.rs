@@ -83,24 +83,51 @@ fn run_elementwise(gpu: &Gpu, kernel: &Kernel, input: &[u8], in_stride: u64, out
     Ok(output)
 }
 
-fn pack_samples(samples: &[Sample]) -> Vec<u8> {
-    let floats: Vec<f32> = samples
-        .iter()
-        .flat_map(|s| {
-            let [nx, ny, nz] = s.n;
-            let [vx, vy, vz] = s.v;
-            let [lx, ly, lz] = s.l;
-            let [r, g, b] = s.f0;
-            [nx, ny, nz, s.roughness, vx, vy, vz, 0.0, lx, ly, lz, 0.0, r, g, b, 0.0]
-        })
-        .collect();
+/// What eval.comp reads per sample besides the sample, for a `.brdf` model: its tangent (X before
+/// orthogonalisation; none: the documented basis) and `row_floats` values of the parameters set per row.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct EvalExtras<'a> {
+    pub tangents: Option<&'a [[f32; 3]]>,
+    /// `row_floats` values per sample, samples one after another (`FileModel::with_rows`).
+    pub rows: &'a [f32],
+    pub row_floats: usize,
+}
+
+impl EvalExtras<'_> {
+    /// vec4s per sample: 4, then the per-row values rounded up to whole vec4s (EVAL_STRIDE in eval.comp).
+    fn stride(&self) -> usize {
+        4 + self.row_floats.div_ceil(4)
+    }
+}
+
+fn pack_samples(samples: &[Sample], extras: &EvalExtras) -> Vec<u8> {
+    let stride = extras.stride();
+    let mut floats: Vec<f32> = Vec::with_capacity(samples.len() * stride * 4);
+    for (i, s) in samples.iter().enumerate() {
+        let [nx, ny, nz] = s.n;
+        let [vx, vy, vz] = s.v;
+        let [lx, ly, lz] = s.l;
+        let [r, g, b] = s.f0;
+        let [tx, ty, tz] = extras.tangents.map_or([0.0; 3], |t| t[i]);
+        floats.extend_from_slice(&[nx, ny, nz, s.roughness, vx, vy, vz, tx, lx, ly, lz, ty, r, g, b, tz]);
+        let row = &extras.rows[i * extras.row_floats..(i + 1) * extras.row_floats];
+        floats.extend_from_slice(row);
+        floats.resize(floats.len() + (stride - 4) * 4 - row.len(), 0.0);
+    }
     bytemuck::cast_slice(&floats).to_vec()
 }
 
 /// f_s of `model` for every sample, evaluated on the GPU.
 pub fn eval(gpu: &Gpu, model: &Model, samples: &[Sample], limits: RunLimits) -> Result<Vec<[f32; 3]>> {
+    eval_with(gpu, model, samples, &EvalExtras::default(), limits)
+}
+
+/// `eval` with a `.brdf` model's tangents and per-row parameters.
+pub fn eval_with(gpu: &Gpu, model: &Model, samples: &[Sample], extras: &EvalExtras, limits: RunLimits) -> Result<Vec<[f32; 3]>> {
+    assert_eq!(extras.rows.len(), samples.len() * extras.row_floats, "one row of parameters per sample");
     let kernel = model_kernel(gpu, model, KernelKind::Eval, |c| c, 2, 4)?;
-    let out = run_elementwise(gpu, &kernel, &pack_samples(samples), 64, 16, samples.len() as u64, limits)?;
+    let in_stride = 16 * extras.stride() as u64;
+    let out = run_elementwise(gpu, &kernel, &pack_samples(samples, extras), in_stride, 16, samples.len() as u64, limits)?;
     let floats: Vec<f32> = bytemuck::pod_collect_to_vec(&out);
     Ok(floats.chunks_exact(4).map(|c| [c[0], c[1], c[2]]).collect())
 }

@@ -1,8 +1,10 @@
 //! The one model type every command takes. A model has a name, a precision, the kernels that evaluate it
 //! (SPIR-V plus specialisation constants, for each kind of kernel) and, where one exists, an f64 twin and an
-//! exact physical reference. A D x Vis x F spec is one constructor (`Model::spec`).
+//! exact physical reference. A D x Vis x F spec is one constructor (`Model::spec`), a user's `.brdf` file the
+//! other (`Model::parse` of `PATH.brdf[,NAME=VALUE...]`).
 
 pub mod brdf_file;
+pub mod file_model;
 
 use crate::brdf::terms::{ParamValue, PARAMS};
 use crate::brdf::{ModelSpec, Precision};
@@ -10,6 +12,7 @@ use crate::gpu::{DeviceInfo, SpecConstants};
 use crate::shaders::{Shaders, Spirv};
 use anyhow::{anyhow, bail, Result};
 use std::fmt;
+use std::sync::Arc;
 
 /// The kinds of kernel a model is compiled into (the GLSL kernels of glsl/, each including brdf.glsl).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -61,6 +64,8 @@ pub struct ModelKernel {
 pub enum Model {
     /// A D x Vis x F spec of the built-in term library.
     Spec(ModelSpec),
+    /// A BRDF Explorer `.brdf` file with its parameter bindings.
+    File(Arc<file_model::FileModel>),
 }
 
 impl From<ModelSpec> for Model {
@@ -84,7 +89,18 @@ pub fn spec_constants(spec: &ModelSpec) -> SpecConstants {
 impl Model {
     /// A model from its spec text (see `ModelSpec::parse`).
     pub fn parse(text: &str) -> Result<Self> {
+        if file_model::names_a_file(text) {
+            return file_model::FileModel::parse(text).map(|f| Model::File(Arc::new(f)));
+        }
         ModelSpec::parse(text).map(Model::Spec).map_err(|e| anyhow!(e))
+    }
+
+    /// The `.brdf` file, for a file model.
+    pub fn file(&self) -> Option<&file_model::FileModel> {
+        match self {
+            Model::File(f) => Some(f),
+            Model::Spec(_) => None,
+        }
     }
 
     pub fn spec(spec: ModelSpec) -> Self {
@@ -100,6 +116,7 @@ impl Model {
     pub fn name(&self) -> String {
         match self {
             Model::Spec(s) => s.name(),
+            Model::File(f) => f.name(),
         }
     }
 
@@ -107,12 +124,15 @@ impl Model {
     pub fn canonical(&self) -> String {
         match self {
             Model::Spec(s) => s.canonical(),
+            Model::File(f) => f.canonical(),
         }
     }
 
     pub fn precision(&self) -> Precision {
         match self {
             Model::Spec(s) => s.precision,
+            // The file's GLSL is fp32, as BRDF Explorer compiled it.
+            Model::File(_) => Precision::F32,
         }
     }
 
@@ -120,6 +140,7 @@ impl Model {
     pub fn twin(&self) -> Option<&ModelSpec> {
         match self {
             Model::Spec(s) => Some(s),
+            Model::File(_) => None,
         }
     }
 
@@ -127,6 +148,7 @@ impl Model {
     pub fn with_params(&self, params: &[String]) -> Result<Self> {
         match self {
             Model::Spec(s) => s.with_params(params).map(Model::Spec).map_err(|e| anyhow!("{}: {e}", s.name())),
+            Model::File(f) => f.with_params(params).map(|f| Model::File(Arc::new(f))),
         }
     }
 
@@ -134,6 +156,7 @@ impl Model {
     pub fn takes_param(&self, key: &str) -> bool {
         match self {
             Model::Spec(s) => ["d", "vis", "f", "precision"].contains(&key) || s.reads().iter().any(|p| p.name() == key),
+            Model::File(f) => f.takes_param(key),
         }
     }
 
@@ -147,6 +170,7 @@ impl Model {
                 let name = if kind == KernelKind::SceneTerms { "scene_terms_f32".to_string() } else { format!("{}_{}", kind.base(), s.precision.name()) };
                 Ok(ModelKernel { spirv: shaders.get(&name)?, constants: spec_constants(s) })
             }
+            Model::File(f) => Ok(ModelKernel { spirv: f.kernel(kind, shaders)?, constants: SpecConstants::default() }),
         }
     }
 
@@ -173,7 +197,11 @@ pub fn models_from_args(models: &[String], params: &[String], default: &[&str]) 
     for p in params {
         let key = p.split_once('=').map(|(k, _)| k.trim()).ok_or_else(|| anyhow!("--param `{p}`: expected KEY=VALUE"))?;
         if !parsed.iter().any(|m| m.takes_param(key)) {
-            bail!("--param {p}: no model takes `{key}` ({})", parsed.iter().map(Model::name).collect::<Vec<_>>().join(", "));
+            let described = |m: &Model| match m.file() {
+                Some(f) => format!("{}, whose parameters are {}", f.path, f.file.params.iter().map(|q| q.name.as_str()).collect::<Vec<_>>().join(", ")),
+                None => m.name(),
+            };
+            bail!("--param {p}: no model takes `{key}` ({})", parsed.iter().map(described).collect::<Vec<_>>().join("; "));
         }
     }
     parsed

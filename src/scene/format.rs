@@ -298,7 +298,27 @@ pub struct Model(pub model::Model);
 impl<'de> Deserialize<'de> for Model {
     fn deserialize<Dz: Deserializer<'de>>(d: Dz) -> Result<Self, Dz::Error> {
         let text = String::deserialize(d)?;
+        let text = if model::file_model::names_a_file(&text) { relative_to_scene(&text) } else { text };
         model::Model::parse(&text).map(Model).map_err(|e| de::Error::custom(format!("{e:#}")))
+    }
+}
+
+thread_local! {
+    /// The directory of the scene file being parsed (a `.brdf` model path is relative to it).
+    static SCENE_DIR: std::cell::RefCell<PathBuf> = std::cell::RefCell::default();
+}
+
+/// A `.brdf` model text with a relative path made relative to the scene file's directory.
+fn relative_to_scene(text: &str) -> String {
+    let (path, rest) = text.split_once(',').map_or((text, None), |(p, r)| (p, Some(r)));
+    let path = Path::new(path.trim());
+    if path.is_absolute() {
+        return text.to_string();
+    }
+    let joined = SCENE_DIR.with(|d| d.borrow().join(path)).display().to_string();
+    match rest {
+        Some(r) => format!("{joined},{r}"),
+        None => joined,
     }
 }
 
@@ -530,6 +550,7 @@ impl Scene {
 
     /// Parses scene JSON; `name` prefixes errors.
     pub fn parse(text: &str, name: &str, dir: PathBuf, path: PathBuf) -> Result<Scene> {
+        SCENE_DIR.with(|d| *d.borrow_mut() = dir.clone());
         let mut de = serde_json::Deserializer::from_str(text);
         let file: SceneFile = serde_path_to_error::deserialize(&mut de).map_err(|e| {
             let path = e.path().to_string();

@@ -8,6 +8,7 @@ use crate::brdf::{ModelSpec, F};
 use crate::chart;
 use crate::gpu::Gpu;
 use crate::kernels::{self, AlbedoCell};
+use crate::model::Model;
 use anyhow::{anyhow, Result};
 use indicatif::ProgressBar;
 use plotters::prelude::*;
@@ -32,8 +33,9 @@ pub struct Energy {
     /// Hemispherical albedo 2 * integral of E(mu) mu dmu at r = 1 (1 - this is the energy lost to single scattering).
     pub hemispherical_at_r1: f64,
     /// Check against the CPU's f64 integration of the same formula at r in {0.1, 0.5, 1}: the largest
-    /// |E_gpu - E_cpu| / max(1, E_cpu) over the finite cells, and how many cells were not finite.
-    pub cpu_check: f64,
+    /// |E_gpu - E_cpu| / max(1, E_cpu) over the finite cells, and how many cells were not finite; None for a
+    /// model without an f64 twin (a `.brdf` file).
+    pub cpu_check: Option<f64>,
     pub cpu_check_nonfinite: usize,
 }
 
@@ -46,8 +48,18 @@ pub fn cells() -> Vec<AlbedoCell> {
     ROUGHNESS.iter().flat_map(|&roughness| NOV.iter().map(move |&nov| AlbedoCell { nov, roughness, f0: [1.0; 3] })).collect()
 }
 
-pub fn energy_of(gpu: &Gpu, spec: &ModelSpec) -> Result<Energy> {
-    let albedo = kernels::albedo(gpu, &crate::model::Model::spec(white(spec)), &cells())?;
+/// The model whose albedo is E: a spec with F = 1; a `.brdf` file as it is, given F0 = 1 (so F = 1 where its
+/// Fresnel is Schlick's of a parameter bound to `@f0`).
+pub fn white_model(model: &Model) -> Model {
+    match model.twin() {
+        Some(spec) => Model::spec(white(spec)),
+        None => model.clone(),
+    }
+}
+
+pub fn energy_of(gpu: &Gpu, model: &Model) -> Result<Energy> {
+    let white = white_model(model);
+    let albedo = kernels::albedo(gpu, &white, &cells())?;
     let e: Vec<Vec<f32>> = albedo.chunks(NOV.len()).map(|row| row.iter().map(|a| a.e[0] as f32).collect()).collect();
     let error_bound = albedo.iter().map(|a| a.error).fold(0.0, f64::max);
     let (mut max_e, mut max_at) = (f64::NEG_INFINITY, (0.0, 0.0));
@@ -67,25 +79,28 @@ pub fn energy_of(gpu: &Gpu, spec: &ModelSpec) -> Result<Energy> {
         let (m0, m1) = (NOV[i - 1] as f64, NOV[i] as f64);
         hemi += (m1 - m0) * (last[i - 1] * m0 + last[i] * m1);
     }
-    let checked: Vec<(usize, usize)> = (0..ROUGHNESS.len()).filter(|&r| [0.1, 0.5, 1.0].contains(&ROUGHNESS[r])).flat_map(|r| (0..NOV.len()).map(move |v| (r, v))).collect();
-    let cells = cells();
-    let white = white(spec);
-    let cpu: Vec<f64> = checked.par_iter().map(|&(r, v)| crate::accuracy::albedo_twin(&white, &cells[r * NOV.len() + v])[0]).collect();
-    let (mut cpu_check, mut cpu_check_nonfinite) = (0.0f64, 0);
-    for (&(r, v), c) in checked.iter().zip(&cpu) {
-        let g = e[r][v] as f64;
-        if g.is_finite() { cpu_check = cpu_check.max((g - c).abs() / c.max(1.0)) } else { cpu_check_nonfinite += 1 }
+    let (mut cpu_check, mut cpu_check_nonfinite) = (None, 0);
+    if let Some(white) = white.twin() {
+        let checked: Vec<(usize, usize)> = (0..ROUGHNESS.len()).filter(|&r| [0.1, 0.5, 1.0].contains(&ROUGHNESS[r])).flat_map(|r| (0..NOV.len()).map(move |v| (r, v))).collect();
+        let cells = cells();
+        let cpu: Vec<f64> = checked.par_iter().map(|&(r, v)| crate::accuracy::albedo_twin(white, &cells[r * NOV.len() + v])[0]).collect();
+        let mut worst = 0.0f64;
+        for (&(r, v), c) in checked.iter().zip(&cpu) {
+            let g = e[r][v] as f64;
+            if g.is_finite() { worst = worst.max((g - c).abs() / c.max(1.0)) } else { cpu_check_nonfinite += 1 }
+        }
+        cpu_check = Some(worst);
     }
     Ok(Energy { e, error_bound, max_e, max_at, gains_energy: max_e > 1.0 + error_bound, hemispherical_at_r1: hemi, cpu_check, cpu_check_nonfinite })
 }
 
-/// Computes energy once per distinct white spec and attaches it to every result.
-pub fn attach(gpu: &Gpu, specs: &[ModelSpec], results: &mut [SpecStability], progress: &ProgressBar) -> Result<()> {
-    let mut done: Vec<(ModelSpec, Energy)> = Vec::new();
-    for (i, (spec, result)) in specs.iter().zip(results.iter_mut()).enumerate() {
+/// Computes energy once per distinct white model and attaches it to every result.
+pub fn attach(gpu: &Gpu, models: &[Model], results: &mut [SpecStability], progress: &ProgressBar) -> Result<()> {
+    let mut done: Vec<(Model, Energy)> = Vec::new();
+    for (i, (spec, result)) in models.iter().zip(results.iter_mut()).enumerate() {
         progress.set_position(i as u64);
         progress.set_message(format!("energy: {}", spec.name()));
-        let w = white(spec);
+        let w = white_model(spec);
         let energy = match done.iter().find(|(s, _)| *s == w) {
             Some((_, e)) => e.clone(),
             None => {

@@ -17,7 +17,7 @@ use crate::brdf::{samples, ModelSpec, Precision, Sample, D, F, Vis};
 use crate::gpu::Gpu;
 
 use crate::model::Model;
-use anyhow::{anyhow, Result};
+use anyhow::Result;
 use catalogue::{Expect, HardCase};
 use indicatif::ProgressBar;
 use rand::{Rng, SeedableRng};
@@ -216,8 +216,7 @@ pub fn run(gpu: &Gpu, options: &StabilityOptions, progress: &ProgressBar) -> Res
         specs.push(check_model(gpu, model, &cases, &grid, &reciprocity)?);
     }
     if options.energy {
-        let twins = options.models.iter().map(|m| m.twin().copied().ok_or_else(|| anyhow!("{m} has no f64 twin"))).collect::<Result<Vec<_>>>()?;
-        energy::attach(gpu, &twins, &mut specs, progress)?;
+        energy::attach(gpu, &options.models, &mut specs, progress)?;
     }
     Ok(StabilityReport { provenance: crate::report::Provenance::new(&gpu.info), specs, grid_points: grid.len(), cases })
 }
@@ -234,7 +233,9 @@ impl StabilityReport {
              that the f64 model does not take. Reciprocity: max |f(v,l) - f(l,v)| / max(|f|, 1e-3). E: directional albedo with \
              F = 1 (max over NoV in [0.02, 1], r in [0.1, 1]; error bound of the integration); hemi r=1: the hemispherical albedo \
              at r = 1, so 1 - hemi is the energy single scattering loses; E vs CPU: max |E_gpu - E_cpu| / max(1, E_cpu) against \
-             the CPU's f64 integration of the same formula at r = 0.1, 0.5, 1.\n\n",
+             the CPU's f64 integration of the same formula at r = 0.1, 0.5, 1. A `.brdf` model has no f64 twin: its NaN, Inf \
+             and negative counts, invalid-input cases, reciprocity and E (its own Fresnel, given F0 = 1) are measured; \
+             tolerances and E vs CPU are not, and every jump counts (none can be told apart as the model's own).\n\n",
             self.provenance.device.name,
             self.provenance.device.driver_info,
             self.specs.len(),
@@ -247,7 +248,7 @@ impl StabilityReport {
                 (
                     format!("{}{} (±{:.0e})", sig(e.max_e, 3), if e.gains_energy { " gain" } else { "" }, e.error_bound),
                     sig(e.hemispherical_at_r1, 3),
-                    format!("{:.1e}{}", e.cpu_check, if e.cpu_check_nonfinite > 0 { format!(" ({} inf)", e.cpu_check_nonfinite) } else { String::new() }),
+                    format!("{}{}", e.cpu_check.map_or("- (no twin)".into(), |c| format!("{c:.1e}")), if e.cpu_check_nonfinite > 0 { format!(" ({} inf)", e.cpu_check_nonfinite) } else { String::new() }),
                 )
             });
             t.row([
@@ -255,9 +256,9 @@ impl StabilityReport {
                 s.nan.to_string(),
                 s.inf.to_string(),
                 s.negative.to_string(),
-                format!("{}/{}", s.cases_out_of_tolerance.len(), s.cases_run),
-                s.grid_out_of_tolerance.to_string(),
-                format!("{:.2e}", s.worst.deviation),
+                if s.has_twin { format!("{}/{}", s.cases_out_of_tolerance.len(), s.cases_run) } else { "- (no twin)".into() },
+                if s.has_twin { s.grid_out_of_tolerance.to_string() } else { "-".into() },
+                if s.has_twin { format!("{:.2e}", s.worst.deviation) } else { "-".into() },
                 s.discontinuities.to_string(),
                 format!("{:.1e}", s.reciprocity),
                 max_e,
@@ -348,8 +349,13 @@ impl StabilityReport {
     pub fn energy_entries(&self) -> Vec<(String, &energy::Energy)> {
         let mut seen = Vec::new();
         let mut entries = Vec::new();
+        let mut files = Vec::new();
         for s in self.specs.iter().filter(|s| s.energy.is_some()) {
-            let spec = ModelSpec::parse(&s.spec).expect("names parse back");
+            let Ok(spec) = ModelSpec::parse(&s.spec) else {
+                // A .brdf model: always drawn, under its own name.
+                files.push((s.spec.clone(), s.energy.as_ref().unwrap()));
+                continue;
+            };
             let white = energy::white(&spec);
             if !seen.contains(&white) {
                 seen.push(white);
@@ -364,6 +370,6 @@ impl StabilityReport {
             }).collect();
             entries.retain(|(_, w, _)| presets.contains(w));
         }
-        entries.into_iter().map(|(label, _, e)| (label, e)).collect()
+        entries.into_iter().map(|(label, _, e)| (label, e)).chain(files).collect()
     }
 }

@@ -1,0 +1,517 @@
+//! A user's `.brdf` file as a model: its parameters bound to values or to the kernels' inputs, and its shader
+//! composed into brdfprof's own kernels (eval, shade, albedo, scene) and compiled with glslang at run time.
+//!
+//! Composition: the composed source is the kernel's own GLSL (`glsl/<kind>.comp`, unchanged) with, before it,
+//! `#define BRDF_FILE`, the file's parameters as GLSL globals and the file's renamed shader (`brdf_file`).
+//! Under `BRDF_FILE`, `specular_brdf_unit` (glsl/brdf.glsl), which every kernel calls for f_s, sets the bound
+//! parameters from its inputs and returns the file's `BRDF(L, V, N, X, Y)` as is; the kernels set the tangent
+//! and the material the binding reads. A parameter bound to a value is a `const`, which the compiler folds as
+//! it folds a built-in model's specialisation constants, so the timed loop holds the file's code and nothing
+//! else. The SPIR-V is cached per composed source (so per file content) in memory and on disk.
+
+use super::brdf_file::{self, glsl_float, BrdfFile, FileParam, FileParamKind};
+use super::KernelKind;
+use crate::shaders::{self, Shaders, Spirv};
+use anyhow::{anyhow, bail, Context, Result};
+use sha2::{Digest, Sha256};
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex, OnceLock};
+
+/// The inputs a parameter can be bound to (`--param NAME=@INPUT`), per pixel or per sample.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Input {
+    /// Perceptual roughness r, as the G-buffer, the sample set and scene materials hold it.
+    Roughness,
+    /// r^2, the microfacet alpha of the built-in models.
+    Alpha,
+    /// The specular reflectance at normal incidence.
+    F0,
+    /// The base colour (where only F0 is known, as in `eval` and the albedo grid: F0).
+    BaseColor,
+    /// Metalness (where only F0 is known: 1, so that base colour = F0 is consistent).
+    Metallic,
+}
+
+impl Input {
+    pub const ALL: [Input; 5] = [Input::Roughness, Input::Alpha, Input::F0, Input::BaseColor, Input::Metallic];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Input::Roughness => "roughness",
+            Input::Alpha => "alpha",
+            Input::F0 => "f0",
+            Input::BaseColor => "basecolor",
+            Input::Metallic => "metallic",
+        }
+    }
+
+    fn is_colour(self) -> bool {
+        matches!(self, Input::F0 | Input::BaseColor)
+    }
+
+    /// The input as a GLSL expression in `specular_brdf_unit`'s scope (`roughness`, `f0`) and the globals the
+    /// kernels set (`file_basecolor`, `file_metallic`).
+    fn glsl(self) -> &'static str {
+        match self {
+            Input::Roughness => "roughness",
+            Input::Alpha => "(roughness * roughness)",
+            Input::F0 => "f0",
+            Input::BaseColor => "file_basecolor",
+            Input::Metallic => "file_metallic",
+        }
+    }
+
+    /// The input converted to a parameter of type `kind`: a colour to a float is the mean of its channels, a
+    /// float to a colour is grey. Bools cannot be bound.
+    fn glsl_as(self, kind: &FileParamKind) -> Option<String> {
+        let e = self.glsl();
+        match (kind, self.is_colour()) {
+            (FileParamKind::Float { .. }, false) | (FileParamKind::Color { .. }, true) => Some(e.to_string()),
+            (FileParamKind::Float { .. }, true) => Some(format!("dot({e}, vec3(1.0 / 3.0))")),
+            (FileParamKind::Color { .. }, false) => Some(format!("vec3({e})")),
+            (FileParamKind::Bool { .. }, _) => None,
+        }
+    }
+
+    /// The value of the input for a sample with perceptual roughness `r` and reflectance `f0` (the eval and
+    /// sample-set convention: base colour F0, metallic 1), as the GPU computes it.
+    pub fn value(self, r: f64, f0: [f64; 3]) -> [f64; 3] {
+        match self {
+            Input::Roughness => [r; 3],
+            Input::Alpha => [r * r; 3],
+            Input::F0 | Input::BaseColor => f0,
+            Input::Metallic => [1.0; 3],
+        }
+    }
+}
+
+/// A parameter's value.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Value {
+    Float(f64),
+    Bool(bool),
+    Color([f64; 3]),
+}
+
+impl Value {
+    fn glsl(&self) -> String {
+        match *self {
+            Value::Float(x) => glsl_float(x),
+            Value::Bool(b) => b.to_string(),
+            Value::Color([r, g, b]) => format!("vec3({}, {}, {})", glsl_float(r), glsl_float(g), glsl_float(b)),
+        }
+    }
+
+    /// As `--param` takes it: `0.5`, `1`, `0.9,0.6,0.3`.
+    pub fn text(&self) -> String {
+        match *self {
+            Value::Float(x) => format!("{x}"),
+            Value::Bool(b) => (b as u8).to_string(),
+            Value::Color([r, g, b]) => format!("{r},{g},{b}"),
+        }
+    }
+
+    /// The value as floats, as a per-row column holds it (a bool as 0 or 1).
+    pub fn floats(&self) -> Vec<f32> {
+        match *self {
+            Value::Float(x) => vec![x as f32],
+            Value::Bool(b) => vec![b as u8 as f32],
+            Value::Color(c) => c.iter().map(|&x| x as f32).collect(),
+        }
+    }
+}
+
+/// Where a parameter's value comes from.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Binding {
+    /// A constant: the file's default or a `--param` value.
+    Value(Value),
+    /// A kernel input, per pixel or per sample.
+    Input(Input),
+    /// Per eval row, from the CSV column(s) named like the parameter: the float at this offset of the row's
+    /// extra values.
+    Row(usize),
+}
+
+/// A `.brdf` file with a binding for each of its parameters.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FileModel {
+    pub file: BrdfFile,
+    /// The path as the user wrote it (names and messages use it).
+    pub path: String,
+    /// One per `file.params`, in order.
+    pub bindings: Vec<Binding>,
+}
+
+impl FileParam {
+    /// Parses a `--param` value for this parameter: a number, 0/1, `r,g,b`, or `@INPUT`.
+    fn parse_binding(&self, file: &str, text: &str) -> Result<Binding> {
+        let text = text.trim();
+        let fail = |why: String| anyhow!("{file}: parameter `{}` ({} at line {}): {why}", self.name, self.kind_name(), self.line);
+        if let Some(input) = text.strip_prefix('@') {
+            let i = Input::ALL.iter().copied().find(|i| i.name() == input).ok_or_else(|| {
+                fail(format!("unknown input `@{input}`; inputs are {}", Input::ALL.iter().map(|i| format!("@{}", i.name())).collect::<Vec<_>>().join(", ")))
+            })?;
+            if i.glsl_as(&self.kind).is_none() {
+                return Err(fail(format!("a bool cannot be bound to `@{input}`")));
+            }
+            return Ok(Binding::Input(i));
+        }
+        let number = |t: &str| -> Result<f64> {
+            let x: f64 = t.trim().parse().map_err(|_| fail(format!("`{t}` is not a number")))?;
+            if !x.is_finite() {
+                return Err(fail(format!("`{t}` is not finite")));
+            }
+            Ok(x)
+        };
+        let value = match self.kind {
+            FileParamKind::Float { .. } => Value::Float(number(text)?),
+            FileParamKind::Bool { .. } => match text {
+                "0" | "false" => Value::Bool(false),
+                "1" | "true" => Value::Bool(true),
+                _ => return Err(fail(format!("`{text}`: a bool is 0 or 1"))),
+            },
+            FileParamKind::Color { .. } => {
+                let parts: Vec<&str> = text.split(',').collect();
+                let [r, g, b] = parts.as_slice() else {
+                    return Err(fail(format!("`{text}`: a colour is r,g,b")));
+                };
+                Value::Color([number(r)?, number(g)?, number(b)?])
+            }
+        };
+        if let (FileParamKind::Float { min, max, .. }, Value::Float(x)) = (self.kind, value) {
+            if !(min..=max).contains(&x) {
+                eprintln!("brdfprof: warning: {file}: {} = {x} is outside the file's range [{min}, {max}] (BRDF Explorer's slider bounds); used as given", self.name);
+            }
+        }
+        Ok(Binding::Value(value))
+    }
+
+    fn kind_name(&self) -> &'static str {
+        match self.kind {
+            FileParamKind::Float { .. } => "float",
+            FileParamKind::Bool { .. } => "bool",
+            FileParamKind::Color { .. } => "color",
+        }
+    }
+
+    pub fn default_value(&self) -> Value {
+        match self.kind {
+            FileParamKind::Float { default, .. } => Value::Float(default),
+            FileParamKind::Bool { default } => Value::Bool(default),
+            FileParamKind::Color { default } => Value::Color(default),
+        }
+    }
+
+    /// The eval CSV columns that set it per row: its name, or NAMEr, NAMEg, NAMEb for a colour (as f0r,f0g,f0b).
+    pub fn columns(&self) -> Vec<String> {
+        match self.kind {
+            FileParamKind::Color { .. } => ["r", "g", "b"].iter().map(|c| format!("{}{c}", self.name)).collect(),
+            _ => vec![self.name.clone()],
+        }
+    }
+}
+
+/// Whether a model text names a `.brdf` file (its first comma-separated field ends in `.brdf`).
+pub fn names_a_file(text: &str) -> bool {
+    text.split(',').next().is_some_and(|p| p.trim().to_ascii_lowercase().ends_with(".brdf"))
+}
+
+/// `k=v` items of a model text after its path; a field without `=` continues the previous value (a colour's
+/// `r,g,b`).
+fn split_params(rest: &[&str]) -> Result<Vec<String>> {
+    let mut out: Vec<String> = Vec::new();
+    for field in rest {
+        match (field.contains('='), out.last_mut()) {
+            (true, _) => out.push(field.trim().to_string()),
+            (false, Some(last)) => *last += &format!(",{}", field.trim()),
+            (false, None) => bail!("`{field}`: expected NAME=VALUE after the file"),
+        }
+    }
+    Ok(out)
+}
+
+impl FileModel {
+    /// `PATH.brdf[,NAME=VALUE...]`: the file with its defaults, then the overrides.
+    pub fn parse(text: &str) -> Result<Self> {
+        let fields: Vec<&str> = text.split(',').collect();
+        let path = fields[0].trim();
+        let file = brdf_file::load(Path::new(path))?;
+        for w in &file.warnings {
+            eprintln!("brdfprof: warning: {w}");
+        }
+        if file.has_is_func {
+            warn_once(&format!("{path}: its isFunc section (importance sampling) is ignored: brdfprof integrates with its own estimator"));
+        }
+        let bindings = file.params.iter().map(|p| Binding::Value(p.default_value())).collect();
+        let model = FileModel { file, path: path.to_string(), bindings };
+        model.with_params(&split_params(&fields[1..])?)
+    }
+
+    pub fn takes_param(&self, name: &str) -> bool {
+        self.file.params.iter().any(|p| p.name == name)
+    }
+
+    /// Applies `NAME=VALUE` overrides; an unknown name is an error naming the file and its parameters.
+    pub fn with_params(&self, params: &[String]) -> Result<Self> {
+        let mut m = self.clone();
+        for p in params {
+            let (name, value) = p.split_once('=').ok_or_else(|| anyhow!("{}: `{p}`: expected NAME=VALUE", self.path))?;
+            let name = name.trim();
+            let k = self.file.params.iter().position(|q| q.name == name).ok_or_else(|| {
+                let known = self.file.params.iter().map(|q| q.name.as_str()).collect::<Vec<_>>();
+                anyhow!("{}: no parameter `{name}` (the file's parameters: {})", self.path, if known.is_empty() { "none".to_string() } else { known.join(", ") })
+            })?;
+            m.bindings[k] = self.file.params[k].parse_binding(&self.path, value)?;
+        }
+        Ok(m)
+    }
+
+    /// The same model with each parameter in `names` read per eval row (`Binding::Row`), at consecutive
+    /// offsets in `names`' order; returns the model and the number of floats per row.
+    pub fn with_rows(&self, names: &[&str]) -> (Self, usize) {
+        let mut m = self.clone();
+        let mut offset = 0;
+        for name in names {
+            if let Some(k) = self.file.params.iter().position(|p| p.name == *name) {
+                m.bindings[k] = Binding::Row(offset);
+                offset += self.file.params[k].columns().len();
+            }
+        }
+        (m, offset)
+    }
+
+    fn text_with(&self, all: bool) -> String {
+        let mut s = self.path.clone();
+        for (p, b) in self.file.params.iter().zip(&self.bindings) {
+            let text = match b {
+                Binding::Value(v) if all || *v != p.default_value() => v.text(),
+                Binding::Input(i) => format!("@{}", i.name()),
+                _ => continue,
+            };
+            s += &format!(",{}={text}", p.name);
+        }
+        s
+    }
+
+    /// The path with the overrides that differ from the file's defaults.
+    pub fn name(&self) -> String {
+        self.text_with(false)
+    }
+
+    /// The path with every parameter.
+    pub fn canonical(&self) -> String {
+        self.text_with(true)
+    }
+
+    /// The binding of parameter `name`.
+    pub fn binding(&self, name: &str) -> Option<Binding> {
+        self.file.params.iter().position(|p| p.name == name).map(|k| self.bindings[k])
+    }
+
+    /// The source composed for `kind`: the preamble, the file, then the kernel's own source (from `glsl/`).
+    fn compose(&self, kind: KernelKind, kernel_source: &str) -> Result<String> {
+        let renamed = self.file.renamed_shader()?;
+        let mut s = String::from("#version 450\n#extension GL_GOOGLE_include_directive : require\n#define BRDF_FILE 1\n");
+        let mut bind = Vec::new();
+        let mut rows = Vec::new();
+        let mut row_floats = 0;
+        for (p, b) in self.file.params.iter().zip(&self.bindings) {
+            let g = self.file.glsl_name(&p.name);
+            match b {
+                Binding::Value(v) => s += &format!("const {} {g} = {};\n", p.glsl_type(), v.glsl()),
+                Binding::Input(i) => {
+                    s += &format!("{} {g};\n", p.glsl_type());
+                    bind.push(format!("{g} = {};", i.glsl_as(&p.kind).expect("checked when bound")));
+                }
+                Binding::Row(offset) => {
+                    if kind != KernelKind::Eval {
+                        bail!("{}: `{}` is set per CSV row, which only eval reads", self.path, p.name);
+                    }
+                    s += &format!("{} {g};\n", p.glsl_type());
+                    let at = |k: usize| format!("inputs[(base) + {}][{}]", (offset + k) / 4, (offset + k) % 4);
+                    rows.push(match p.kind {
+                        FileParamKind::Float { .. } => format!("{g} = {};", at(0)),
+                        FileParamKind::Bool { .. } => format!("{g} = {} != 0.0;", at(0)),
+                        FileParamKind::Color { .. } => format!("{g} = vec3({}, {}, {});", at(0), at(1), at(2)),
+                    });
+                    row_floats = row_floats.max(offset + p.columns().len());
+                }
+            }
+        }
+        s += &format!("#define BRDF_FILE_BIND {}\n", bind.join(" "));
+        s += &format!("#define EVAL_STRIDE {}\n#define BRDF_FILE_ROWS(base) {}\n", 4 + row_floats.div_ceil(4), rows.join(" "));
+        s += &format!("#define BRDF_FILE_FUNCTION {}\n", self.file.glsl_name("BRDF"));
+        s += &format!("{}\n{}", self.file.line_directive(), renamed.text());
+        // The kernel's own text, numbered as in its file (its `#version` line dropped).
+        let (first, body) = kernel_source.split_once('\n').unwrap_or(("", kernel_source));
+        if !first.starts_with("#version") {
+            bail!("{}.comp does not start with #version", kind.base());
+        }
+        s += &format!("#line 2 \"{}.comp\"\n{body}", kind.base());
+        Ok(s)
+    }
+
+    /// The file's kernel of `kind`, composed with `shaders`' GLSL (the embedded tree or `--glsl DIR`) and
+    /// compiled, or taken from the cache.
+    pub fn kernel(&self, kind: KernelKind, shaders: &Shaders) -> Result<Spirv> {
+        if matches!(kind, KernelKind::Terms | KernelKind::SceneTerms) {
+            bail!("{}: a .brdf model is one function; it has no separate D, Vis and F terms", self.path);
+        }
+        let kernel_name = format!("{}_f32", kind.base());
+        let tree = GlslTree::of(shaders)?;
+        let (source_file, defines) = tree.entry(&kernel_name)?;
+        let kernel_source = std::fs::read_to_string(tree.root.join(&source_file)).with_context(|| format!("cannot read {source_file}"))?;
+        let composed = self.compose(kind, &kernel_source)?;
+        let key = cache_key(&composed, &defines, &tree.fingerprint);
+        let name = format!("{}:{}", self.file.name, kernel_name);
+        if let Some(words) = memory_cache().lock().unwrap().get(&key) {
+            return Ok(Spirv { name, words: words.clone() });
+        }
+        let words: Arc<[u32]> = match disk_cache_read(&key) {
+            Some(words) => words.into(),
+            None => {
+                let words = self.compile(&tree.root, kind, &composed, &defines)?;
+                disk_cache_write(&key, &words);
+                words.into()
+            }
+        };
+        memory_cache().lock().unwrap().insert(key, words.clone());
+        Ok(Spirv { name, words })
+    }
+
+    fn compile(&self, root: &Path, kind: KernelKind, composed: &str, defines: &[String]) -> Result<Vec<u32>> {
+        let dir = crate::cleanup::TempDir::new().context("cannot create a temporary directory for the composed kernel")?;
+        // Beside a copy of the tree, so that the kernel's `#include "brdf.glsl"` resolves as in glsl/.
+        let path = dir.path().join(format!("{}.comp", kind.base()));
+        std::fs::write(&path, composed).with_context(|| format!("cannot write {}", path.display()))?;
+        match shaders::glslang(&path, defines, &[root]) {
+            Ok(words) => Ok(words),
+            Err(e) => match e.downcast_ref::<shaders::GlslangError>() {
+                Some(g) => {
+                    let renamed = self.file.renamed_shader()?;
+                    let log = self.file.remap_log(&renamed, &g.log, |_| None);
+                    let log = if log.trim().is_empty() { g.log.clone() } else { log };
+                    bail!("{}: glslang cannot compile the file's shader into the {} kernel:\n{}", self.path, kind.base(), log.trim_end())
+                }
+                None => Err(e),
+            },
+        }
+    }
+}
+
+/// Prints `message` on stderr once per process.
+fn warn_once(message: &str) {
+    static SEEN: OnceLock<Mutex<Vec<String>>> = OnceLock::new();
+    let mut seen = SEEN.get_or_init(Mutex::default).lock().unwrap();
+    if !seen.iter().any(|m| m == message) {
+        eprintln!("brdfprof: note: {message}");
+        seen.push(message.to_string());
+    }
+}
+
+/// The GLSL the kernels are composed with: a directory holding glsl/'s tree (the embedded one, written once
+/// per process, or `--glsl DIR`), and what identifies its compiler.
+struct GlslTree {
+    root: PathBuf,
+    embedded: bool,
+    fingerprint: String,
+}
+
+impl GlslTree {
+    fn of(shaders: &Shaders) -> Result<Self> {
+        let fingerprint = format!("{} {}", env!("CARGO_PKG_VERSION"), glslang_version());
+        if let Some(dir) = shaders.glsl_dir() {
+            return Ok(GlslTree { root: dir.to_path_buf(), embedded: false, fingerprint });
+        }
+        static TREE: OnceLock<std::result::Result<crate::cleanup::TempDir, String>> = OnceLock::new();
+        let tree = TREE.get_or_init(|| {
+            let dir = crate::cleanup::TempDir::new().map_err(|e| format!("cannot create a temporary directory for glsl/: {e}"))?;
+            shaders::write_glsl_tree(dir.path()).map_err(|e| format!("{e:#}"))?;
+            Ok(dir)
+        });
+        let dir = tree.as_ref().map_err(|e| anyhow!("{e}"))?;
+        Ok(GlslTree { root: dir.path().to_path_buf(), embedded: true, fingerprint })
+    }
+
+    /// The kernel's source file and defines, as kernels.txt lists them.
+    fn entry(&self, name: &str) -> Result<(String, Vec<String>)> {
+        if self.embedded {
+            let k = shaders::embedded(name)?;
+            return Ok((k.source.to_string(), k.defines.iter().map(|d| d.to_string()).collect()));
+        }
+        shaders::kernel_entry(&self.root, name)
+    }
+}
+
+fn glslang_version() -> String {
+    static V: OnceLock<String> = OnceLock::new();
+    V.get_or_init(|| shaders::glslang_version().unwrap_or_default()).clone()
+}
+
+fn cache_key(composed: &str, defines: &[String], fingerprint: &str) -> String {
+    let mut h = Sha256::new();
+    for part in [fingerprint, &defines.join(" "), composed] {
+        h.update(part.as_bytes());
+        h.update([0]);
+    }
+    h.finalize().iter().map(|b| format!("{b:02x}")).collect()
+}
+
+fn memory_cache() -> &'static Mutex<HashMap<String, Arc<[u32]>>> {
+    static CACHE: OnceLock<Mutex<HashMap<String, Arc<[u32]>>>> = OnceLock::new();
+    CACHE.get_or_init(Mutex::default)
+}
+
+/// Where compiled `.brdf` kernels are kept between runs: `$BRDFPROF_CACHE_DIR`, else
+/// `$XDG_CACHE_HOME/brdfprof/kernels`, else `~/.cache/brdfprof/kernels`; none when `BRDFPROF_CACHE_DIR` is
+/// empty (caching off) or no home is known.
+pub fn disk_cache_dir() -> Option<PathBuf> {
+    if let Some(d) = std::env::var_os("BRDFPROF_CACHE_DIR") {
+        return (!d.is_empty()).then(|| PathBuf::from(d));
+    }
+    let base = std::env::var_os("XDG_CACHE_HOME").filter(|d| !d.is_empty()).map(PathBuf::from).or_else(|| std::env::var_os("HOME").filter(|d| !d.is_empty()).map(|h| PathBuf::from(h).join(".cache")))?;
+    Some(base.join("brdfprof").join("kernels"))
+}
+
+fn disk_cache_read(key: &str) -> Option<Vec<u32>> {
+    let bytes = std::fs::read(disk_cache_dir()?.join(format!("{key}.spv"))).ok()?;
+    Spirv::from_bytes(key, &bytes).ok().map(|s| s.words.to_vec())
+}
+
+/// Best effort: a cache that cannot be written costs a recompile next time, nothing else.
+fn disk_cache_write(key: &str, words: &[u32]) {
+    let Some(dir) = disk_cache_dir() else { return };
+    if std::fs::create_dir_all(&dir).is_err() {
+        return;
+    }
+    let bytes: Vec<u8> = words.iter().flat_map(|w| w.to_le_bytes()).collect();
+    let tmp = dir.join(format!(".{key}.{}.tmp", std::process::id()));
+    if std::fs::write(&tmp, &bytes).is_ok() && std::fs::rename(&tmp, dir.join(format!("{key}.spv"))).is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+}
+
+/// X of the tangent frame, as the kernels compute it (`file_tangent_frame` in glsl/brdf.glsl): `t` made
+/// orthogonal to the unit normal `n`, or, when `t` is zero or parallel to `n`, the first vector of the
+/// branchless orthonormal basis of Duff et al. 2017 ("Building an Orthonormal Basis, Revisited", JCGT 6(1),
+/// Listing 3). Y = N x X.
+pub fn tangent_frame(n: [f64; 3], t: [f64; 3]) -> [f64; 3] {
+    let d = n[0] * t[0] + n[1] * t[1] + n[2] * t[2];
+    let x = [t[0] - n[0] * d, t[1] - n[1] * d, t[2] - n[2] * d];
+    let len2 = x[0] * x[0] + x[1] * x[1] + x[2] * x[2];
+    let t2 = t[0] * t[0] + t[1] * t[1] + t[2] * t[2];
+    if t2 > 0.0 && len2 > TANGENT_PARALLEL * t2 {
+        let s = 1.0 / len2.sqrt();
+        return [x[0] * s, x[1] * s, x[2] * s];
+    }
+    let sign = if n[2] >= 0.0 { 1.0 } else { -1.0 };
+    let a = -1.0 / (sign + n[2]);
+    let b = n[0] * n[1] * a;
+    [1.0 + sign * n[0] * n[0] * a, sign * b, -sign * n[0]]
+}
+
+/// |t - n (n.t)|^2 / |t|^2 below which a given tangent counts as parallel to N (sin^2 of 1e-3 rad): the
+/// documented basis is used instead. The same constant is in glsl/brdf.glsl (a test reads both).
+pub const TANGENT_PARALLEL: f64 = 1e-6;
