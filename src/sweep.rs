@@ -52,12 +52,7 @@ pub fn default_specs() -> Vec<ModelSpec> {
 
 /// A short label for charts: the preset name where one matches, else d/vis/f.
 pub fn label(model: &Model) -> String {
-    if let Some(f) = model.file() {
-        let name = f.name();
-        let file_name = std::path::Path::new(&f.path).file_name().map_or(f.path.clone(), |n| n.to_string_lossy().into_owned());
-        return file_name + &name[f.path.len()..];
-    }
-    let Some(spec) = model.twin() else { return model.name() };
+    let Some(spec) = model.twin() else { return model.short_name() };
     let name = spec.name();
     if !name.starts_with("d=") {
         return name.replace(",precision=f16", " f16");

@@ -515,3 +515,60 @@ pub fn tangent_frame(n: [f64; 3], t: [f64; 3]) -> [f64; 3] {
 /// |t - n (n.t)|^2 / |t|^2 below which a given tangent counts as parallel to N (sin^2 of 1e-3 rad): the
 /// documented basis is used instead. The same constant is in glsl/brdf.glsl (a test reads both).
 pub const TANGENT_PARALLEL: f64 = 1e-6;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn file(dir: &Path) -> String {
+        let path = dir.join("m.brdf");
+        std::fs::write(&path, "analytic\n::begin parameters\nfloat r 0 1 0.5\ncolor c 0.1 0.2 0.3\nbool b 1\n::end parameters\n::begin shader\nvec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) { return b ? c * r : vec3(0.0); }\n::end shader\n").unwrap();
+        path.display().to_string()
+    }
+
+    #[test]
+    fn model_text_round_trips_with_colours_and_bindings() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = file(dir.path());
+        let m = FileModel::parse(&format!("{path},c=0.9,0.6,0.3,r=@alpha")).unwrap();
+        assert_eq!(m.binding("c"), Some(Binding::Value(Value::Color([0.9, 0.6, 0.3]))));
+        assert_eq!(m.binding("r"), Some(Binding::Input(Input::Alpha)));
+        assert_eq!(m.name(), format!("{path},r=@alpha,c=0.9,0.6,0.3"));
+        assert_eq!(FileModel::parse(&m.canonical()).unwrap(), m);
+        assert_eq!(FileModel::parse(&m.name()).unwrap(), m);
+        assert_eq!(FileModel::parse(&path).unwrap().name(), path, "defaults are not repeated in the name");
+    }
+
+    #[test]
+    fn bad_bindings_are_refused_naming_the_parameter() {
+        let dir = tempfile::tempdir().unwrap();
+        let m = FileModel::parse(&file(dir.path())).unwrap();
+        for (p, needle) in [("b=@roughness", "a bool cannot be bound"), ("b=2", "a bool is 0 or 1"), ("c=1,2", "a colour is r,g,b"), ("r=nan", "is not finite"), ("r=x", "is not a number"), ("q=1", "no parameter `q`"), ("r", "expected NAME=VALUE")] {
+            let e = format!("{:#}", m.with_params(&[p.to_string()]).unwrap_err());
+            assert!(e.contains(needle) && e.contains("m.brdf"), "{p}: {e}");
+        }
+        assert_eq!(m.with_params(&["b=0".into()]).unwrap().binding("b"), Some(Binding::Value(Value::Bool(false))));
+    }
+
+    #[test]
+    fn an_input_converts_to_the_parameter_type() {
+        let float = FileParamKind::Float { min: 0.0, max: 1.0, default: 0.5 };
+        let colour = FileParamKind::Color { default: [0.0; 3] };
+        assert_eq!(Input::F0.glsl_as(&float).unwrap(), "dot(f0, vec3(1.0 / 3.0))");
+        assert_eq!(Input::Roughness.glsl_as(&colour).unwrap(), "vec3(roughness)");
+        assert_eq!(Input::Alpha.glsl_as(&float).unwrap(), "(roughness * roughness)");
+    }
+
+    #[test]
+    fn the_tangent_rule_gives_an_orthonormal_frame() {
+        for n in [[0.0, 0.0, 1.0], [0.0, 0.0, -1.0], [0.6, 0.0, 0.8], [0.0, -0.6, -0.8]] {
+            for t in [[0.0; 3], [1.0, 0.0, 0.0], n] {
+                let x = tangent_frame(n, t);
+                let dot = n[0] * x[0] + n[1] * x[1] + n[2] * x[2];
+                let len = (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
+                assert!(dot.abs() < 1e-12 && (len - 1.0).abs() < 1e-12, "n {n:?} t {t:?}: x {x:?}");
+            }
+        }
+        assert_eq!(tangent_frame([0.0, 0.0, 1.0], [0.0; 3]), [1.0, 0.0, 0.0], "Duff et al.'s basis at the pole");
+    }
+}

@@ -120,6 +120,18 @@ impl Model {
         }
     }
 
+    /// The name without a `.brdf` file's directory, for labels and output file names.
+    pub fn short_name(&self) -> String {
+        match self {
+            Model::Spec(s) => s.name(),
+            Model::File(f) => {
+                let name = f.name();
+                let file_name = std::path::Path::new(&f.path).file_name().map_or(f.path.clone(), |n| n.to_string_lossy().into_owned());
+                file_name + &name[f.path.len()..]
+            }
+        }
+    }
+
     /// The full form, with every parameter (what baselines and reports record).
     pub fn canonical(&self) -> String {
         match self {

@@ -38,7 +38,7 @@ pub fn tone_map(rgb: [f32; 3], exposure: f32) -> [u8; 3] {
 }
 
 fn slug(spec: &BrdfModel) -> String {
-    spec.name().chars().map(|c| if c.is_ascii_alphanumeric() || c == '-' { c } else { '-' }).collect()
+    spec.short_name().chars().map(|c| if c.is_ascii_alphanumeric() || c == '-' { c } else { '-' }).collect()
 }
 
 /// Draws an RGB picture (w x h, row-major) at (x0, y0) of a plotters area.
@@ -91,7 +91,7 @@ fn difference_maps(g: &GBuffer, models: &[BrdfModel], displayed: &[Vec<[u8; 3]>]
         let path = out.join(format!("diff-{}-vs-{}.png", slug(&models[*i]), slug(&models[reference])));
         let px: Vec<[u8; 3]> = d.iter().map(|x| viridis(x / scale)).collect();
         let bar = 60;
-        let title = format!("|{} - {}| in displayed luminance", models[*i].name(), models[reference].name());
+        let title = format!("|{} - {}| in displayed luminance", models[*i].short_name(), models[reference].short_name());
         let mean = d.iter().sum::<f32>() / d.len() as f32;
         chart::render(&path, g.width + bar, g.height, |root| {
             blit(root, 0, 0, g.width, &px)?;
@@ -125,7 +125,7 @@ fn comparison_grid(gpu: &Gpu, scene: &Scene, models: &[BrdfModel], out: &Path) -
     let grid = out.join("grid.png");
     chart::render(&grid, gw, gh, |root| {
         for (j, m) in models.iter().enumerate() {
-            label(root, &m.name(), (label_w + j as u32 * GRID_TILE + 8) as i32, 8, 18, BLACK)?;
+            label(root, &m.short_name(), (label_w + j as u32 * GRID_TILE + 8) as i32, 8, 18, BLACK)?;
         }
         for (i, name) in rows.iter().enumerate() {
             let y0 = (header + i as u32 * GRID_TILE) as i32;
@@ -245,7 +245,7 @@ pub fn lobe_plot(gpu: &Gpu, path: &Path, models: &[BrdfModel], roughness: &[f32]
                 chart
                     .draw_series(LineSeries::new(pts, colour.stroke_width(2)))
                     .map_err(|e| err(&e))?
-                    .label(m.name())
+                    .label(m.short_name())
                     .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], colour.stroke_width(2)));
             }
             chart.configure_series_labels().position(SeriesLabelPosition::UpperLeft).label_font((FONT, 12)).background_style(WHITE.mix(0.8)).border_style(BLACK).draw().map_err(|e| err(&e))?;

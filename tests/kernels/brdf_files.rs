@@ -1,70 +1,30 @@
-//! The thesis models as .brdf files (examples/brdf/) on the GPU: each computes what its built-in preset
-//! computes, within 1e-4 relative on well-conditioned samples (NoV, NoL >= 0.05, roughness in [0.2, 1)).
+//! `.brdf` files as models on the GPU, through the same `Model` and kernels as the built-in specs: the thesis
+//! models written as files (examples/brdf/) compute what their presets compute, the tangent frame follows its
+//! documented rule, and glslang's errors come back at the file's own lines.
 
 use crate::common;
-use brdfprof::brdf::samples;
-use brdfprof::gpu::{Buffer, Gpu, MemoryKind, SpecConstants, WORKGROUP};
-use brdfprof::kernels::{self, RunLimits};
-use brdfprof::model::brdf_file::{self, BrdfFile};
-use brdfprof::model::Model;
-use brdfprof::shaders::{glslang, Spirv};
-use std::path::Path;
+use brdfprof::brdf::{samples, Sample, THESIS_MODELS};
+use brdfprof::kernels::{self, AlbedoCell, EvalExtras, RunLimits};
+use brdfprof::model::file_model::{tangent_frame, TANGENT_PARALLEL};
+use brdfprof::model::{KernelKind, Model};
+use std::path::{Path, PathBuf};
 
-/// An eval kernel around the file, with eval.comp's interface: roughness and f0 are private globals set from
-/// each sample; every other parameter is a constant at its default.
-fn compose(f: &BrdfFile) -> String {
-    let r = f.renamed_shader().unwrap();
-    let mut s = format!(
-        "#version 450\n#extension GL_GOOGLE_cpp_style_line_directive : require\nlayout(local_size_x = {WORKGROUP}) in;\n\
-         layout(std430, set = 0, binding = 0) readonly buffer Inputs {{ vec4 inputs[]; }};\n\
-         layout(std430, set = 0, binding = 1) buffer Outputs {{ vec4 outputs[]; }};\n\
-         layout(push_constant) uniform Push {{ uint count; }} pc;\n"
-    );
-    for p in &f.params {
-        s += &match p.name.as_str() {
-            "roughness" | "f0" => format!("{} {};\n", p.glsl_type(), f.glsl_name(&p.name)),
-            _ => format!("const {} {} = {};\n", p.glsl_type(), f.glsl_name(&p.name), p.default_glsl()),
-        };
-    }
-    s += &format!("{}\n{}#line 1 \"main\"\n", f.line_directive(), r.text());
-    s + &format!(
-        "void main() {{\n    uint i = gl_GlobalInvocationID.x;\n    if (i >= pc.count) return;\n\
-         {r} = inputs[4 * i].w;\n    {f0} = inputs[4 * i + 3].rgb;\n\
-         vec3 N = normalize(inputs[4 * i].xyz), V = normalize(inputs[4 * i + 1].xyz), L = normalize(inputs[4 * i + 2].xyz);\n\
-         outputs[i] = vec4({brdf}(L, V, N, vec3(0.0), vec3(0.0)), 0.0);\n}}\n",
-        r = f.glsl_name("roughness"),
-        f0 = f.glsl_name("f0"),
-        brdf = f.glsl_name("BRDF")
-    )
+fn example(name: &str) -> PathBuf {
+    common::repo_root().join("examples/brdf").join(format!("{name}.brdf"))
 }
 
-fn eval_file(gpu: &Gpu, f: &BrdfFile, samples: &[brdfprof::brdf::Sample]) -> Vec<[f32; 3]> {
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join(format!("{}.comp", f.name));
-    std::fs::write(&path, compose(f)).unwrap();
-    let spirv = Spirv { name: f.name.clone(), words: glslang(&path, &[], &[]).unwrap().into() };
-    let kernel = kernels::kernel(gpu, &spirv, &SpecConstants::default(), 2, 4).unwrap();
-    let floats: Vec<f32> = samples
-        .iter()
-        .flat_map(|s| [s.n[0], s.n[1], s.n[2], s.roughness, s.v[0], s.v[1], s.v[2], 0.0, s.l[0], s.l[1], s.l[2], 0.0, s.f0[0], s.f0[1], s.f0[2], 0.0])
-        .collect();
-    let n = samples.len() as u64;
-    let inputs = Buffer::with_data(gpu, bytemuck::cast_slice(&floats), MemoryKind::Device).unwrap();
-    let outputs = Buffer::new(gpu, n * 16, MemoryKind::Device).unwrap();
-    let set = kernel.bind(&[(&inputs, 0, n * 64), (&outputs, 0, n * 16)]).unwrap();
-    gpu.submit(|cmd| kernel.dispatch(cmd, set, &(n as u32).to_ne_bytes(), n)).unwrap();
-    let out: Vec<f32> = outputs.read_as(0, 4 * n as usize).unwrap();
-    out.chunks_exact(4).map(|c| [c[0], c[1], c[2]]).collect()
+/// The example file of a thesis model with roughness and F0 bound to the inputs, as the presets read them.
+fn bound(name: &str) -> Model {
+    Model::parse(&format!("{},roughness=@roughness,f0=@f0", example(name).display())).unwrap()
 }
 
 #[test]
-fn example_files_match_their_presets() {
+fn example_files_match_their_presets_on_100000_samples() {
     let gpu = common::gpu();
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/brdf");
-    for (i, name) in ["ggx", "blinn", "cook-torrance", "burley"].into_iter().enumerate() {
-        let f = brdf_file::load(&dir.join(format!("{name}.brdf"))).unwrap();
-        let s = samples::well_conditioned(20_000, 40 + i as u64, 0.05, 0.2..1.0);
-        let got = eval_file(&gpu, &f, &s);
+    let per_model = 100_000 / THESIS_MODELS.len();
+    for (i, name) in THESIS_MODELS.iter().enumerate() {
+        let s = samples::well_conditioned(per_model, 40 + i as u64, 0.05, 0.2..1.0);
+        let got = kernels::eval(&gpu, &bound(name), &s, RunLimits::default()).unwrap();
         let builtin = kernels::eval(&gpu, &Model::parse(name).unwrap(), &s, RunLimits::default()).unwrap();
         let mut worst = common::Worst::default();
         for ((g, b), sample) in got.iter().zip(&builtin).zip(&s) {
@@ -72,8 +32,105 @@ fn example_files_match_their_presets() {
                 worst.update(common::rel_err(g[c] as f64, b[c] as f64), || format!("{sample:?} channel {c}: file {} built-in {}", g[c], b[c]));
             }
         }
-        println!("{name:14} max rel diff to the built-in {:.2e}", worst.err);
+        println!("{name:14} max rel diff to the built-in over {per_model} samples: {:.2e}", worst.err);
         assert!(worst.err <= 1e-4, "{name}.brdf: max relative difference {:.3e} at {}", worst.err, worst.what);
     }
     common::assert_no_validation_messages(&gpu);
+}
+
+#[test]
+fn example_files_albedo_matches_their_presets() {
+    let gpu = common::gpu();
+    let cells: Vec<AlbedoCell> = [0.1f32, 0.5, 1.0].iter().flat_map(|&nov| [0.2f32, 0.6, 1.0].map(|roughness| AlbedoCell { nov, roughness, f0: [0.04, 0.5, 1.0] })).collect();
+    for name in THESIS_MODELS {
+        let file = kernels::albedo(&gpu, &bound(name), &cells).unwrap();
+        let builtin = kernels::albedo(&gpu, &Model::parse(name).unwrap(), &cells).unwrap();
+        for ((f, b), cell) in file.iter().zip(&builtin).zip(&cells) {
+            for c in 0..3 {
+                assert!((f.e[c] - b.e[c]).abs() <= 1e-4, "{name}: {cell:?} channel {c}: file E {} built-in E {}", f.e[c], b.e[c]);
+            }
+        }
+    }
+    common::assert_no_validation_messages(&gpu);
+}
+
+/// A file returning its tangent X (or Y) as the colour.
+fn frame_file(dir: &Path) -> Model {
+    let path = dir.join("frame.brdf");
+    std::fs::write(&path, "analytic\n::begin parameters\nbool bitangent 0\n::end parameters\n::begin shader\nvec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) { return bitangent ? Y : X; }\n::end shader\n").unwrap();
+    Model::parse(&path.display().to_string()).unwrap()
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+}
+
+#[test]
+fn tangent_frame_follows_its_documented_rule() {
+    let gpu = common::gpu();
+    let dir = tempfile::tempdir().unwrap();
+    let x_model = frame_file(dir.path());
+    let y_model = x_model.with_params(&["bitangent=1".into()]).unwrap();
+    let mut s: Vec<Sample> = samples::well_conditioned(2_000, 7, 0.05, 0.2..1.0);
+    // Normals everywhere on the sphere, the poles (Duff's basis switches sign at z = 0) included.
+    for (i, n) in [[0.0, 0.0, 1.0], [0.0, 0.0, -1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.3, -0.2, -0.93]].iter().enumerate() {
+        s[i].n = *n;
+    }
+    for (i, x) in s.iter_mut().enumerate().skip(5) {
+        let t = i as f32 * 0.7;
+        x.n = [t.cos() * (t * 0.3).sin(), t.sin() * (t * 0.3).sin(), (t * 0.3).cos()];
+    }
+    // Given tangents: generic, parallel to N (falls back to the basis) and zero (no tangent).
+    let tangents: Vec<[f32; 3]> = s.iter().enumerate().map(|(i, x)| match i % 3 {
+        0 => [0.6, -0.3, 0.2],
+        1 => x.n.map(|c| 2.0 * c),
+        _ => [0.0; 3],
+    }).collect();
+    for (model, bitangent) in [(&x_model, false), (&y_model, true)] {
+        for given in [None, Some(tangents.as_slice())] {
+            let got = kernels::eval_with(&gpu, model, &s, &EvalExtras { tangents: given, ..Default::default() }, RunLimits::default()).unwrap();
+            for (i, (g, x)) in got.iter().zip(&s).enumerate() {
+                let len = x.n.iter().map(|c| (*c as f64).powi(2)).sum::<f64>().sqrt();
+                let n = x.n.map(|c| c as f64 / len);
+                let t = given.map_or([0.0; 3], |t| t[i].map(f64::from));
+                let xf = tangent_frame(n, t);
+                let want = if bitangent { cross(n, xf) } else { xf };
+                for c in 0..3 {
+                    assert!((g[c] as f64 - want[c]).abs() <= 2e-5, "sample {i} (N {n:?}, t {t:?}, Y {bitangent}): GPU {g:?}, rule {want:?}");
+                }
+                let dot: f64 = (0..3).map(|c| xf[c] * n[c]).sum();
+                assert!(dot.abs() < 1e-12 && (xf.iter().map(|c| c * c).sum::<f64>() - 1.0).abs() < 1e-12, "X is a unit vector orthogonal to N");
+            }
+        }
+    }
+    common::assert_no_validation_messages(&gpu);
+}
+
+#[test]
+fn the_parallel_threshold_is_the_same_on_both_sides() {
+    let glsl = std::fs::read_to_string(common::repo_root().join("glsl/brdf.glsl")).unwrap();
+    let line = glsl.lines().find(|l| l.contains("const float FILE_TANGENT_PARALLEL")).expect("brdf.glsl defines FILE_TANGENT_PARALLEL");
+    let value: f64 = line.split('=').nth(1).unwrap().trim().trim_end_matches(';').parse().unwrap();
+    assert_eq!(value, TANGENT_PARALLEL);
+}
+
+#[test]
+fn glslang_errors_name_the_file_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("typo.brdf");
+    std::fs::write(&path, "analytic\n# a comment\n::begin parameters\nfloat k 0 1 0.5\n::end parameters\n::begin shader\nvec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y)\n{\n    return vec3(k * foo);\n}\n::end shader\n").unwrap();
+    let model = Model::parse(&path.display().to_string()).unwrap();
+    let e = format!("{:#}", model.kernel(KernelKind::Eval, kernels::embedded()).unwrap_err());
+    assert!(e.contains(&format!("{}:9: 'foo' : undeclared identifier", path.display())), "{e}");
+    assert!(!e.contains("brdf_f"), "renamed identifiers are shown by their own names: {e}");
+}
+
+#[test]
+fn every_kernel_kind_a_file_can_run_compiles() {
+    let model = bound("burley");
+    for kind in [KernelKind::Eval, KernelKind::Shade, KernelKind::ShadeFloat, KernelKind::Albedo, KernelKind::Scene, KernelKind::SceneAlbedo] {
+        let k = model.kernel(kind, kernels::embedded()).unwrap_or_else(|e| panic!("{kind:?}: {e:#}"));
+        assert!(k.spirv.words.len() > 100, "{kind:?}");
+    }
+    assert!(model.kernel(KernelKind::Terms, kernels::embedded()).is_err(), "a file has no separate terms");
 }

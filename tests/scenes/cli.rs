@@ -119,3 +119,34 @@ fn bad_scenes_exit_2_naming_the_problem() {
     assert_eq!(code, 2);
     assert!(err.contains("nope.json"), "{err}");
 }
+
+#[test]
+fn a_brdf_file_as_a_material_model_renders_as_its_preset() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::copy(common::repo_root().join("examples/brdf/ggx.brdf"), dir.path().join("mine.brdf")).unwrap();
+    // The path is relative to the scene file, not to where brdfprof runs.
+    let scene = SMALL
+        .replace(r#""name": "small""#, r#""name": "file""#)
+        .replace(r#""model": "ggx""#, r#""model": "mine.brdf,roughness=@roughness,f0=@f0""#)
+        .replace(r#""anisotropy": 0.7"#, r#""anisotropy": 0.0"#)
+        .replace("[96, 54]", "[192, 108]")
+        .replace(r#""models": ["ggx", "burley"]"#, r#""models": ["mine.brdf,roughness=@roughness,f0=@f0"]"#);
+    let f = write(dir.path(), "s.json", &scene);
+    let builtin = write(dir.path(), "b.json", &scene.replace("mine.brdf,roughness=@roughness,f0=@f0", "ggx").replace(r#""name": "file""#, r#""name": "builtin""#));
+    let out = dir.path().join("out");
+    for (scene, sub) in [(&f, "file"), (&builtin, "builtin")] {
+        let (code, _, err) = run(&["render", "--scene", scene, "--out", out.join(sub).to_str().unwrap()]);
+        assert_eq!(code, 0, "{err}");
+        assert!(!err.contains("validation ["), "{err}");
+    }
+    let png = |sub: &str, prefix: &str| {
+        let path = std::fs::read_dir(out.join(sub)).unwrap().map(|e| e.unwrap().path()).find(|p| p.file_name().unwrap().to_string_lossy().starts_with(prefix)).unwrap();
+        image::open(path).unwrap().to_rgb8()
+    };
+    let (a, b) = (png("file", "mine-brdf"), png("builtin", "ggx."));
+    assert_eq!(a.dimensions(), b.dimensions());
+    // Below the title, which names the model.
+    let below = |img: &image::RgbImage| img.enumerate_pixels().filter(|(_, y, _)| *y >= 20).map(|(_, _, p)| *p).collect::<Vec<_>>();
+    let worst = below(&a).iter().zip(below(&b).iter()).flat_map(|(p, q)| (0..3).map(move |c| (p[c] as i32 - q[c] as i32).abs())).max().unwrap();
+    assert!(worst <= 1, "the file's picture differs from the preset's by {worst}/255");
+}

@@ -1,0 +1,236 @@
+//! `.brdf` models through the command line: parameters per CSV row and per flag, non-finite output, the
+//! SPIR-V cache, bad files, and the file's kernel in profile, inspect, check, stability and sweep.
+
+use crate::common::{self, run_in};
+use brdfprof::brdf::samples;
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+
+fn example(name: &str) -> String {
+    common::repo_root().join("examples/brdf").join(format!("{name}.brdf")).display().to_string()
+}
+
+/// An eval CSV of well-conditioned samples, with a `gamma` column cycling through `gammas`.
+fn write_csv(path: &Path, n: usize, gammas: &[f64]) {
+    let mut text = String::from("nx,ny,nz,vx,vy,vz,lx,ly,lz,roughness,f0r,f0g,f0b,gamma\n");
+    for (i, s) in samples::well_conditioned(n, 5, 0.05, 0.2..1.0).iter().enumerate() {
+        let [n, v, l, f] = [s.n, s.v, s.l, s.f0];
+        text += &format!("{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", n[0], n[1], n[2], v[0], v[1], v[2], l[0], l[1], l[2], s.roughness, f[0], f[1], f[2], gammas[i % gammas.len()]);
+    }
+    std::fs::write(path, text).unwrap();
+}
+
+fn rows(path: &Path) -> Vec<String> {
+    std::fs::read_to_string(path).unwrap().lines().skip(1).map(str::to_string).collect()
+}
+
+#[test]
+fn a_parameter_per_csv_row_gives_the_rows_of_separate_param_runs() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in.csv");
+    let gammas = [1.0, 1.5, 2.0, 2.5];
+    write_csv(&input, 400, &gammas);
+    let burley = example("burley");
+    let out = dir.path().join("rows.csv");
+    let r = run_in(dir.path(), &["eval", "--model", &burley, "--input", "in.csv", "--output", "rows.csv"]).ok();
+    assert!(r.stderr.contains("gamma set per row"), "{}", r.stderr);
+    let per_row = rows(&out);
+    for (k, g) in gammas.iter().enumerate() {
+        let param = format!("gamma={g}");
+        run_in(dir.path(), &["eval", "--model", &burley, "--param", &param, "--input", "in.csv", "--output", "one.csv"]).ok();
+        let one = rows(&dir.path().join("one.csv"));
+        for i in (k..per_row.len()).step_by(gammas.len()) {
+            assert_eq!(per_row[i], one[i], "row {i} (gamma {g}): per-row column vs --param {param}");
+        }
+    }
+    // The built-in burley reads gamma the same way (within fp32 rounding), so the column did set it.
+    run_in(dir.path(), &["eval", "--model", "burley,gamma=2.5", "--input", "in.csv", "--output", "builtin.csv"]).ok();
+    let builtin = rows(&dir.path().join("builtin.csv"));
+    for i in (3..per_row.len()).step_by(4) {
+        let a: Vec<f64> = per_row[i].split(',').map(|x| x.parse().unwrap()).collect();
+        let b: Vec<f64> = builtin[i].split(',').map(|x| x.parse().unwrap()).collect();
+        for c in 0..3 {
+            assert!(common::rel_err(a[c], b[c]) <= 1e-4, "row {i}: {a:?} vs built-in {b:?}");
+        }
+    }
+}
+
+#[test]
+fn non_finite_values_are_written_and_counted() {
+    let dir = tempfile::tempdir().unwrap();
+    write_csv(&dir.path().join("in.csv"), 10, &[1.0]);
+    std::fs::write(dir.path().join("nan.brdf"), "analytic\n::begin parameters\nfloat k 0 1 0.5\n::end parameters\n::begin shader\nvec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) { return vec3(sqrt(dot(N, L) - 2.0), k, 1.0); }\n::end shader\n").unwrap();
+    let r = run_in(dir.path(), &["eval", "--model", "nan.brdf", "--input", "in.csv", "--output", "out.csv"]).ok();
+    assert!(r.stderr.contains("10 of 10 rows of nan.brdf are not finite"), "{}", r.stderr);
+    for row in rows(&dir.path().join("out.csv")) {
+        let f: Vec<&str> = row.split(',').collect();
+        assert_eq!(f[0], "NaN", "written as is, not turned into a number: {row}");
+        assert_eq!(&f[1..], ["0.5", "1"], "{row}");
+    }
+}
+
+#[test]
+fn a_rerun_takes_the_cached_spirv_without_compiling() {
+    let dir = tempfile::tempdir().unwrap();
+    write_csv(&dir.path().join("in.csv"), 10, &[1.0]);
+    let cache = dir.path().join("cache");
+    // glslangValidator behind a wrapper that logs every compilation (calls with -o).
+    let bin = dir.path().join("bin");
+    std::fs::create_dir(&bin).unwrap();
+    let log = dir.path().join("compilations.log");
+    let real = String::from_utf8(std::process::Command::new("sh").args(["-c", "command -v glslangValidator"]).output().unwrap().stdout).unwrap();
+    let wrapper = bin.join("glslangValidator");
+    std::fs::write(&wrapper, format!("#!/bin/sh\ncase \"$*\" in *' -o '*) echo compile >> '{}';; esac\nexec '{}' \"$@\"\n", log.display(), real.trim())).unwrap();
+    std::fs::set_permissions(&wrapper, std::os::unix::fs::PermissionsExt::from_mode(0o755)).unwrap();
+    let path = format!("{}:{}", bin.display(), std::env::var("PATH").unwrap());
+    let compilations = || std::fs::read_to_string(&log).map_or(0, |t| t.lines().count());
+    let eval = |model: &str| {
+        let out = common::brdfprof()
+            .args(["eval", "--model", model, "--input", "in.csv", "--output", "out.csv"])
+            .env("BRDFPROF_CACHE_DIR", &cache)
+            .env("PATH", &path)
+            .current_dir(dir.path())
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    };
+    std::fs::copy(example("ggx"), dir.path().join("mine.brdf")).unwrap();
+    eval("mine.brdf");
+    assert_eq!(compilations(), 1, "the first run compiles");
+    assert_eq!(std::fs::read_dir(&cache).unwrap().count(), 1, "and caches the kernel");
+    eval("mine.brdf");
+    assert_eq!(compilations(), 1, "a rerun takes the cached SPIR-V");
+    // The cache is keyed on the content: an edited file compiles again.
+    let text = std::fs::read_to_string(dir.path().join("mine.brdf")).unwrap();
+    std::fs::write(dir.path().join("mine.brdf"), text.replace("const float PI", "const float UNUSED = 1.0;\nconst float PI")).unwrap();
+    eval("mine.brdf");
+    assert_eq!(compilations(), 2, "an edited file compiles again");
+}
+
+#[test]
+fn unknown_and_bad_parameters_name_the_file_and_the_parameter() {
+    let dir = tempfile::tempdir().unwrap();
+    write_csv(&dir.path().join("in.csv"), 4, &[1.0]);
+    let burley = example("burley");
+    let cases: [(&str, &str); 4] = [
+        ("gama=2", "no model takes `gama`"),
+        ("gamma=x", "burley.brdf: parameter `gamma` (float at line"),
+        ("f0=0.1,0.2", "a colour is r,g,b"),
+        ("gamma=@shininess", "unknown input `@shininess`"),
+    ];
+    for (param, needle) in cases {
+        let r = run_in(dir.path(), &["eval", "--model", &burley, "--param", param, "--input", "in.csv", "--output", "out.csv"]).fails(2, needle);
+        assert!(r.stderr.contains("burley.brdf"), "{param}: {}", r.stderr);
+        assert!(!dir.path().join("out.csv").exists(), "{param}: nothing written");
+    }
+    let r = run_in(dir.path(), &["eval", "--model", &burley, "--param", "gamma=9", "--input", "in.csv", "--output", "out.csv"]).ok();
+    assert!(r.stderr.contains("gamma = 9 is outside the file's range [1, 3]"), "{}", r.stderr);
+}
+
+#[test]
+fn bad_files_exit_2_naming_the_line_and_write_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    write_csv(&dir.path().join("in.csv"), 4, &[1.0]);
+    std::fs::write(dir.path().join("out.csv"), "kept\n").unwrap();
+    let shader = "::begin shader\nvec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) { return vec3(1.0); }\n::end shader\n";
+    let cases: Vec<(&str, Vec<u8>, &str)> = vec![
+        ("missing-end", format!("analytic\n{shader}::begin parameters\nfloat k 0 1 0.5\n").into_bytes(), ":5: section `parameters` has no `::end parameters`"),
+        ("nested", format!("analytic\n::begin parameters\nfloat k 0 1 0.5\n{shader}").into_bytes(), ":4: `::begin shader` inside section `parameters`"),
+        ("unknown-type", format!("analytic\n::begin parameters\nvec2 k 0 1\n::end parameters\n{shader}").into_bytes(), ":3: unknown parameter type"),
+        ("bad-number", format!("analytic\n::begin parameters\nfloat k 0 1 zero\n::end parameters\n{shader}").into_bytes(), ":3: DEFAULT of `k`: `zero` is not a finite number"),
+        ("duplicate", format!("analytic\n::begin parameters\nfloat k 0 1 0.5\nfloat k 0 1 0.5\n::end parameters\n{shader}").into_bytes(), ":4: parameter `k` is declared twice"),
+        ("no-brdf", b"analytic\n::begin shader\nvec3 f(vec3 L) { return L; }\n::end shader\n".to_vec(), ":2: the shader defines no function `BRDF`"),
+        ("glsl-error", b"analytic\n::begin shader\nvec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) {\n  return vec3(undefined_thing);\n}\n::end shader\n".to_vec(), ":4: 'undefined_thing' : undeclared identifier"),
+        ("empty", Vec::new(), ":1: empty file"),
+        ("binary", vec![0x7f, b'E', b'L', b'F', 0, 1, 2, 3], ":1: binary content"),
+    ];
+    for (name, bytes, needle) in cases {
+        let file = format!("{name}.brdf");
+        std::fs::write(dir.path().join(&file), bytes).unwrap();
+        let r = run_in(dir.path(), &["eval", "--model", &file, "--input", "in.csv", "--output", "out.csv"]);
+        assert_eq!(r.code, Some(2), "{name}: {}", r.stderr);
+        assert!(r.stderr.contains(&format!("{file}{needle}")), "{name}: expected `{file}{needle}` in:\n{}", r.stderr);
+        assert_eq!(std::fs::read_to_string(dir.path().join("out.csv")).unwrap(), "kept\n", "{name}: the existing output is untouched");
+    }
+}
+
+fn json(path: &Path) -> Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+#[test]
+fn profile_times_a_file_and_a_spec_interleaved() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = format!("{},roughness=@roughness,f0=@f0", example("ggx"));
+    run_in(dir.path(), &["profile", "--model", &model, "--model", "ggx", "--size", "64x64", "--min-rounds", "3", "--budget", "20", "--json", "p.json"]).ok();
+    let p = json(&dir.path().join("p.json"));
+    let names: Vec<&str> = p["rows"].as_array().unwrap().iter().map(|r| r["model"].as_str().unwrap()).collect();
+    assert!(names.contains(&model.as_str()) && names.contains(&"ggx"), "{names:?}");
+    for r in p["rows"].as_array().unwrap() {
+        assert!(r["ns_per_eval"]["median"].as_f64().unwrap() > 0.0, "{r}");
+    }
+}
+
+#[test]
+fn check_gates_a_file_and_catches_an_extra_pow() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::copy(example("ggx"), dir.path().join("mine.brdf")).unwrap();
+    let model = "mine.brdf,roughness=@roughness";
+    let gate = ["check", "--model", model, "--no-callgrind", "--rounds", "0", "--baseline", "base.json"];
+    run_in(dir.path(), &["check", "--model", model, "--no-callgrind", "--rounds", "0", "--save-baseline", "base.json"]).ok();
+    run_in(dir.path(), &gate).ok();
+    let inspect = json(&dir.path().join("base.json"));
+    let text = inspect.to_string();
+    assert!(text.contains("mine.brdf"), "the baseline records the file's model");
+    let src = std::fs::read_to_string(dir.path().join("mine.brdf")).unwrap();
+    let edited = src.replace("return a2 / (PI * d * d);", "return a2 / (PI * pow(d, 2.0) * pow(max(d, 1.0), 0.5));");
+    assert_ne!(src, edited, "the edit applies");
+    std::fs::write(dir.path().join("mine.brdf"), edited).unwrap();
+    let r = run_in(dir.path(), &gate);
+    assert_eq!(r.code, Some(1), "{}", r.stderr);
+    assert!(r.stdout.contains("REGRESSION"), "{}", r.stdout);
+    assert!(r.stdout.contains("mine.brdf") && r.stdout.contains("glsl.Pow"), "{}", r.stdout);
+}
+
+#[test]
+fn inspect_counts_the_file_kernel() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = format!("{},roughness=@roughness", example("blinn"));
+    run_in(dir.path(), &["inspect", "--model", &model, "--no-callgrind", "--json", "i.json", "--markdown", "i.md"]).ok();
+    let md = std::fs::read_to_string(dir.path().join("i.md")).unwrap();
+    assert!(md.contains("blinn.brdf"), "{md}");
+    let i = json(&dir.path().join("i.json"));
+    let row = i["rows"].as_array().unwrap().iter().find(|r| r["model"].as_str().unwrap().contains("blinn.brdf")).expect("a row for the file");
+    assert!(row.to_string().contains("\"spirv/total\""), "{row}");
+}
+
+#[test]
+fn stability_fails_a_file_that_goes_negative_and_passes_the_examples() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("neg.brdf"), "analytic\n::begin shader\nvec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) { return vec3(dot(L, V) - 0.5); }\n::end shader\n").unwrap();
+    let r = run_in(dir.path(), &["stability", "--model", "neg.brdf", "--no-energy", "--out", "st"]);
+    assert_eq!(r.code, Some(1), "{}", r.stderr);
+    let ok = format!("{},roughness=@roughness,f0=@f0", example("ggx"));
+    run_in(dir.path(), &["stability", "--model", &ok, "--out", "st2"]).ok();
+    let s = json(&common::device_file(&dir.path().join("st2"), "stability-", ".json"));
+    let spec = &s["specs"][0];
+    assert_eq!(spec["has_twin"], false);
+    assert_eq!(spec["nan"].as_u64(), Some(0));
+    let max_e = spec["energy"]["max_e"].as_f64().unwrap();
+    assert!(max_e > 0.5 && max_e < 1.01, "GGX's white furnace with F0 = 1 through @f0: {max_e}");
+}
+
+#[test]
+fn sweep_measures_a_file_against_a_reference() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = format!("{},roughness=@roughness,f0=@f0", example("ggx"));
+    run_in(dir.path(), &["sweep", "--model", &model, "--model", "ggx", "--reference", "ggx", "--size", "64x64", "--min-rounds", "3", "--budget", "60", "--out", "sw"]).ok();
+    let s = json(&common::device_file(&dir.path().join("sw"), "sweep-", ".json"));
+    let rows = s["rows"].as_array().unwrap();
+    let file = rows.iter().find(|r| r["spec"].as_str().unwrap().contains("ggx.brdf")).unwrap();
+    let builtin = rows.iter().find(|r| r["spec"] == "ggx").unwrap();
+    assert_eq!(file["accuracy"]["reference"], "ggx");
+    assert!(file["accuracy"]["numerical"].is_null(), "no twin, no numerical error");
+    let (a, b) = (file["accuracy"]["vs_exact"]["rms"].as_f64().unwrap(), builtin["accuracy"]["vs_exact"]["rms"].as_f64().unwrap());
+    assert!((a - b).abs() <= 1e-3 * b, "the file's error against exact GGX is the preset's: {a} vs {b}");
+}
