@@ -69,3 +69,12 @@ pub fn cpu_features() -> Vec<String> {
 pub fn cpu_features() -> Vec<String> {
     vec![std::env::consts::ARCH.to_string()]
 }
+
+/// The memory the kernel says can be allocated without swapping (`MemAvailable` of /proc/meminfo), in bytes;
+/// None where it cannot be read.
+pub fn available_memory() -> Option<u64> {
+    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024)
+}

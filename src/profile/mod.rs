@@ -174,6 +174,7 @@ pub fn run(gpu: &Gpu, options: &ProfileOptions, progress: &ProgressBar) -> Resul
     if !models.contains(&reference_model) {
         models.insert(0, reference_model.clone());
     }
+    workload::check_size(&gpu.info, options.width, options.height, options.format, options.lights.len())?;
     progress.set_message("building the G-buffer");
     let gbuffer = gbuffer::synthetic(options.width, options.height, options.format);
     let works = options.lights.iter().map(|&l| Workload::upload(gpu, &gbuffer, &gbuffer::lights(l), options.max_chunk)).collect::<Result<Vec<_>>>()?;

@@ -47,6 +47,40 @@ pub struct Workload<'g> {
     plan: ChunkPlan,
 }
 
+/// Host bytes per pixel while a profile builds and uploads its G-buffer: the picture, the padded copy that is
+/// uploaded, and (on a CPU driver such as lavapipe, whose device memory is host memory) the device's copy and
+/// its output, per light count.
+fn host_bytes_per_pixel(format: GBufferFormat, light_counts: u64) -> u64 {
+    2 * format.bytes_in() + light_counts * (format.bytes_in() + format.bytes_out())
+}
+
+/// Refuses, before anything is allocated, a G-buffer that cannot be one device allocation or would not fit in
+/// the memory this machine has available, naming the size and the limit.
+pub fn check_size(info: &crate::gpu::DeviceInfo, width: u32, height: u32, format: GBufferFormat, light_counts: usize) -> Result<()> {
+    let pixels = width as u64 * height as u64;
+    let padded = pixels.div_ceil(crate::gpu::WORKGROUP as u64) * crate::gpu::WORKGROUP as u64;
+    let side = |max_pixels: u64| {
+        let h = ((max_pixels as f64 * 9.0 / 16.0).sqrt() as u64).max(1);
+        format!("{}x{h}", max_pixels / h)
+    };
+    let bytes = padded * format.bytes_in();
+    if bytes > info.max_memory_allocation_size {
+        let most = info.max_memory_allocation_size / format.bytes_in();
+        anyhow::bail!(
+            "--size {width}x{height}: the {} G-buffer is {bytes} bytes, more than one allocation on `{}` may be ({} bytes, maxMemoryAllocationSize); at most {most} pixels (about {})",
+            format.name(), info.name, info.max_memory_allocation_size, side(most)
+        );
+    }
+    if let Some(available) = crate::host::available_memory() {
+        let need = pixels * host_bytes_per_pixel(format, light_counts as u64);
+        if need > available {
+            let most = available / host_bytes_per_pixel(format, light_counts as u64);
+            anyhow::bail!("--size {width}x{height}: building and uploading the G-buffer needs about {need} bytes of memory and {available} are available (MemAvailable); at most about {most} pixels here (about {})", side(most));
+        }
+    }
+    Ok(())
+}
+
 impl<'g> Workload<'g> {
     pub fn upload(gpu: &'g Gpu, gbuffer: &GBuffer, lights: &[f32], max_chunk: Option<u64>) -> Result<Self> {
         let count = lights.len() / LIGHT_FLOATS;

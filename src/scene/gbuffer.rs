@@ -300,6 +300,23 @@ pub fn closeup(scene: &Scene, material: u32, size: u32) -> GBuffer {
     GBuffer { width: size, height: size, camera: layout.camera, pixels }
 }
 
+/// Host bytes per pixel of a scene run: the G-buffer, the pixels and extras uploaded (3 + 2 vec4) and the
+/// radiance read back (1 vec4); on a CPU driver the device's copies are host memory too.
+const HOST_BYTES_PER_PIXEL: u64 = std::mem::size_of::<Pixel>() as u64 + 2 * (5 * 16) + 2 * 16;
+
+/// Refuses a G-buffer that would not fit in the memory available (MemAvailable), before building it.
+fn check_memory(file: &str, width: u32, height: u32) -> Result<()> {
+    let Some(available) = crate::host::available_memory() else { return Ok(()) };
+    let need = width as u64 * height as u64 * HOST_BYTES_PER_PIXEL;
+    if need > available {
+        bail!(
+            "{file}: gbuffer.procedural.size [{width}, {height}]: a scene run needs about {need} bytes ({HOST_BYTES_PER_PIXEL} per pixel) and {available} are available (MemAvailable); at most about {} pixels here",
+            available / HOST_BYTES_PER_PIXEL
+        );
+    }
+    Ok(())
+}
+
 /// The scene's G-buffer.
 pub fn build(scene: &Scene) -> Result<GBuffer> {
     match &scene.file.gbuffer {
@@ -311,6 +328,7 @@ pub fn build(scene: &Scene) -> Result<GBuffer> {
                 Procedural::Statues { size, statues: s, floor } => (size.0, statues(scene, s, floor)),
                 Procedural::OldWest { size, ground, walls, roofs } => (size.0, old_west(scene, ground, walls, roofs)),
             };
+            check_memory(&scene.path.display().to_string(), size[0], size[1])?;
             let camera = scene.file.camera.unwrap_or(layout.camera);
             let pixels = ray_cast(scene, &layout, &camera, size[0], size[1]);
             Ok(GBuffer { width: size[0], height: size[1], camera, pixels })

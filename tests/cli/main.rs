@@ -9,6 +9,7 @@ mod devices;
 mod eval;
 mod eval_csv;
 mod fuzz;
+mod limits;
 mod outputs;
 mod scenes;
 mod signals;
