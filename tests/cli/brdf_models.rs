@@ -4,7 +4,7 @@
 use crate::common::{self, run_in};
 use brdfprof::brdf::samples;
 use serde_json::Value;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 fn example(name: &str) -> String {
     common::repo_root().join("examples/brdf").join(format!("{name}.brdf")).display().to_string()

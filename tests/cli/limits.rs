@@ -29,3 +29,14 @@ fn a_scene_larger_than_memory_is_refused_before_it_is_built() {
     common::run(&["render", "--scene", path.to_str().unwrap(), "--out", out.to_str().unwrap()]).fails(2, "big.json: gbuffer.procedural.size [16384, 16384]: a scene run needs about");
     assert!(!out.exists(), "nothing written");
 }
+
+#[test]
+fn a_scene_with_more_lights_than_compile_in_seconds_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut scene: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(common::repo_root().join("scenes/sphere-grid.json")).unwrap()).unwrap();
+    let n = brdfprof::scene::format::MAX_LIGHTS + 1;
+    scene["lights"] = serde_json::Value::Array((0..n).map(|i| serde_json::json!({"type": "point", "position": [i as f64 * 0.01, 3.0, 1.0]})).collect());
+    let path = dir.path().join("many.json");
+    std::fs::write(&path, scene.to_string()).unwrap();
+    common::run(&["scene", path.to_str().unwrap()]).fails(2, &format!("many.json: lights: at most {} lights ({n} given)", n - 1));
+}
