@@ -7,6 +7,7 @@ pub mod accuracy;
 pub mod brdf;
 pub mod chart;
 pub mod cleanup;
+pub mod compare;
 pub mod gpu;
 pub mod host;
 pub mod inspect;

@@ -45,6 +45,8 @@ enum Command {
     Render(cli::scene::RenderArgs),
     #[command(name = "__callgrind-child", hide = true)]
     CallgrindChild { request: String },
+    #[command(name = "__radv-child", hide = true)]
+    RadvChild { request: String },
     /// Writes glsl/generated/ from the Rust term tables (`make spv` runs it).
     #[command(name = "__generate-glsl", hide = true)]
     GenerateGlsl {
@@ -58,7 +60,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     // The callgrind child runs under valgrind and dies with its parent; every other command cleans up on
     // SIGINT/SIGTERM (children killed, temporary files removed, exit 130).
-    if !matches!(cli.command, Command::CallgrindChild { .. }) {
+    if !matches!(cli.command, Command::CallgrindChild { .. } | Command::RadvChild { .. }) {
         if let Err(e) = brdfprof::cleanup::install_signal_handler() {
             eprintln!("brdfprof: error: {e:#}");
             return ExitCode::from(2);
@@ -76,6 +78,7 @@ fn main() -> ExitCode {
         Command::Scene(args) => cli::scene::scene(&args),
         Command::Render(args) => cli::scene::render(&args),
         Command::CallgrindChild { request } => brdfprof::inspect::callgrind::child_main(&request).map(|_| ExitCode::SUCCESS),
+        Command::RadvChild { request } => brdfprof::inspect::radv::child_main(&request).map(|_| ExitCode::SUCCESS),
         Command::GenerateGlsl { dir } => cli::info::generate_glsl(&dir),
     };
     // An interrupted command ends with the signal handler's exit status, not its own.

@@ -9,5 +9,6 @@ mod eval;
 mod eval_csv;
 mod fuzz;
 mod outputs;
+mod radv;
 mod scenes;
 mod signals;

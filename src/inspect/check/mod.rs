@@ -148,6 +148,7 @@ mod tests {
             callgrind: None,
             callgrind_setup: BTreeMap::new(),
             vs_profile: None,
+            aco: None,
         };
         let mut environment = BTreeMap::new();
         for g in ["callgrind", "timing"] {
