@@ -290,7 +290,12 @@ pub fn check(args: &CheckArgs) -> Result<ExitCode> {
         callgrind: args.counts.callgrind(args.device.validation())?,
         timing: TimingOptions { width, height, lights: 0, rounds: args.rounds, reps: args.reps, seed: 1 },
     };
-    let outcome = check::run(&options, &args.counts.shaders()?, || args.device.open())?;
+    let shaders = args.counts.shaders()?;
+    let outcome = match args.device.device.as_deref().map(targets::parse).transpose()?.flatten() {
+        Some(ts) if ts.len() == 1 => check::run_radv(&options, &shaders, ts[0], args.device.validation())?,
+        Some(_) => bail!("--device {}: check compares one family with its baseline; give one radv:FAMILY", args.device.device.as_deref().unwrap_or_default()),
+        None => check::run(&options, &shaders, || args.device.open_with(true))?,
+    };
     print!("{}", outcome.text);
     Ok(ExitCode::from(outcome.exit))
 }

@@ -55,6 +55,7 @@ impl DeviceArgs {
     }
 
     /// Opens the device for a command that executes kernels: a compile-only device is refused.
+    #[allow(dead_code)]
     pub fn open(&self) -> Result<Gpu> {
         self.open_with(false)
     }

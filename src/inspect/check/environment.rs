@@ -7,6 +7,8 @@ use std::collections::BTreeMap;
 
 /// The fingerprint key only a successful callgrind run can fill in (the CPU features valgrind shows the JIT).
 pub(super) const JIT_FEATURES: &str = "jit-cpu-features";
+/// The Mesa version a compile-only device's statistics depend on.
+pub(super) const MESA: &str = "mesa";
 
 /// "vendor family F model M stepping S (model name)" from /proc/cpuinfo: the host CPU as the JIT sees it.
 pub fn host_cpu() -> String {
@@ -29,7 +31,14 @@ pub fn environment(inspect: &InspectReport, timing: Option<&TimingRun>) -> BTree
     out.insert("spirv".into(), BTreeMap::new());
     out.insert("naga".into(), BTreeMap::new());
     out.insert("spirv-O".into(), [("spirv-opt".to_string(), inspect.tools.get("spirv-opt").cloned().unwrap_or_default())].into());
-    out.insert("driver".into(), machine(vec![]));
+    if crate::gpu::targets::family_of_device(&device).is_some() {
+        // RADV's compile-only device: ACO's output depends on the family (the device) and the Mesa version
+        // alone, not on the host.
+        let mesa = p["mesa_version"].as_str().map_or_else(|| text(&p["device"]["driver_info"]), str::to_string);
+        out.insert("driver".into(), [("device".to_string(), device.clone()), (MESA.to_string(), mesa)].into());
+    } else {
+        out.insert("driver".into(), machine(vec![]));
+    }
     if !inspect.callgrind_setup.is_empty() {
         // Callgrind counts the instructions lavapipe's JIT emits, which depend on the Mesa and LLVM versions
         // (device, driver), the environment, the workload, valgrind and the CPU features valgrind shows the
