@@ -162,16 +162,22 @@ pub fn check_kernels(columns: &[CostColumn]) -> Result<()> {
     }
     let mut seen: BTreeMap<&str, (&str, &CostColumn)> = BTreeMap::new();
     for c in columns {
+        // Every model whose kernel differs from the first column that has it, against that column.
+        let mut differ: BTreeMap<&str, Vec<String>> = BTreeMap::new();
         for (model, h) in &c.hashes {
             match seen.get(model.as_str()) {
                 Some((h0, c0)) if *h0 != h.as_str() => {
-                    bail!("the kernels differ: `{model}` is SPIR-V {} in {} ({}) but {} in {} ({}); compare reports of the same kernels", &h0[..12.min(h0.len())], c0.name, c0.source, &h[..12.min(h.len())], c.name, c.source)
+                    differ.entry(c0.name.as_str()).or_default().push(format!("`{model}` ({} vs {})", &h0[..12.min(h0.len())], &h[..12.min(h.len())]));
                 }
                 Some(_) => {}
                 None => {
                     seen.insert(model, (h, c));
                 }
             }
+        }
+        if let Some((other, models)) = differ.into_iter().next() {
+            let c0 = columns.iter().find(|x| x.name == other).expect("a column seen before");
+            bail!("the kernels differ: {} SPIR-V hashes in {} ({}) and {} ({}); compare reports of the same kernels", models.join(", "), c0.name, c0.source, c.name, c.source);
         }
     }
     Ok(())
@@ -273,12 +279,10 @@ impl CostTable {
                 .y_label_area_size(60)
                 .build_cartesian_2d(0f64..models.len() as f64, 0f64..max)
                 .map_err(e)?;
-            let names: Vec<String> = models.iter().map(|m| m.to_string()).collect();
             chart
                 .configure_mesh()
                 .disable_x_mesh()
-                .x_labels(models.len().max(1))
-                .x_label_formatter(&|x| names.get(x.floor() as usize).filter(|_| (x.fract() - 0.5).abs() < 0.01).cloned().unwrap_or_default())
+                .x_labels(0)
                 .y_desc("net cost / ggx's net cost")
                 .label_style((crate::chart::FONT, 13))
                 .draw()
@@ -298,6 +302,14 @@ impl CostTable {
                 chart.draw_series(bars).map_err(e)?.label(c.name.clone()).legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 10, y + 5)], colour.filled()));
             }
             chart.draw_series(std::iter::once(PathElement::new(vec![(0.0, 1.0), (models.len() as f64, 1.0)], BLACK.mix(0.5)))).map_err(e)?;
+            // Model names under their groups (long specs wrapped at commas).
+            for (i, m) in models.iter().enumerate() {
+                let (px, py) = chart.backend_coord(&(i as f64 + 0.5, 0.0));
+                for (k, part) in m.split_inclusive(',').enumerate() {
+                    let w = 7 * part.len() as i32;
+                    root.draw(&Text::new(part.to_string(), (px - w / 2, py + 8 + 16 * k as i32), (crate::chart::FONT, 13))).map_err(e)?;
+                }
+            }
             chart.configure_series_labels().background_style(WHITE.mix(0.9)).border_style(BLACK).label_font((crate::chart::FONT, 13)).position(SeriesLabelPosition::UpperLeft).draw().map_err(e)?;
             Ok(())
         })
@@ -314,6 +326,9 @@ pub fn load_columns(path: &Path) -> Result<Vec<CostColumn>> {
         serde_json::from_value(v.clone()).map_err(|e| anyhow!("{}: not a brdfprof inspect report ({e})", path.display()))
     };
     let columns = if value.get("raw").is_some() && value.get("workload").is_some() {
+        if value.get("kernel_sha256").is_none() {
+            bail!("{}: a profile report that records no kernel hashes (written by an older brdfprof); its kernels cannot be matched with the others'. Measure it again", path.display());
+        }
         profile_columns(&value, &source).with_context(|| format!("{}: not a brdfprof profile report", path.display()))?
     } else if let Some(reports) = value.get("reports").and_then(|r| r.as_array()) {
         let mut out = Vec::new();

@@ -38,6 +38,10 @@ enum Command {
     /// Measures the counts and a short timing run and compares them with a saved baseline: exit 0 no
     /// regression, 1 regression, 2 could not measure.
     Check(cli::counts::CheckArgs),
+    /// Merge saved profile and inspect JSON reports (other machines, GPUs, compile-only AMD targets) into one
+    /// cost table across devices with rank correlations, its JSON and a PNG chart; refuses reports whose
+    /// kernels differ.
+    Compare(cli::compare::CompareArgs),
     /// Check a scene file and say what it compiles in; --explain prints the scene format with an example.
     Scene(cli::scene::SceneArgs),
     /// Render a scene: a tone-mapped sRGB PNG per model, the comparison grid, difference heat maps against ggx
@@ -75,6 +79,7 @@ fn main() -> ExitCode {
         Command::Stability(args) => cli::measure::stability(&args),
         Command::Inspect(args) => cli::counts::inspect(&args),
         Command::Check(args) => cli::counts::check(&args),
+        Command::Compare(args) => cli::compare::compare(&args),
         Command::Scene(args) => cli::scene::scene(&args),
         Command::Render(args) => cli::scene::render(&args),
         Command::CallgrindChild { request } => brdfprof::inspect::callgrind::child_main(&request).map(|_| ExitCode::SUCCESS),

@@ -1,6 +1,7 @@
 //! What every command shares: the device, model and timing arguments, and the one sequence that opens the
 //! device, shows progress, runs the work and checks the validation layer.
 
+pub mod compare;
 pub mod counts;
 pub mod eval;
 pub mod info;

@@ -4,6 +4,7 @@
 #[path = "../common/mod.rs"]
 mod common;
 
+mod compare;
 mod devices;
 mod eval;
 mod eval_csv;
