@@ -20,5 +20,6 @@ pub mod shaders;
 pub mod stability;
 pub mod stats;
 pub mod sweep;
+pub mod sweep_aco;
 pub mod scene;
 pub mod util;

@@ -173,3 +173,27 @@ fn a_child_that_crashes_after_its_report_still_gives_the_report_and_exit_0() {
     assert!(report["section_notes"]["driver/"].as_str().unwrap().contains("crashed after writing its complete report"));
     assert!(report["aco"]["rows"][0]["inverse_throughput"].as_f64().unwrap() > 0.0);
 }
+
+#[test]
+fn sweep_cost_device_draws_the_frontier_again_with_acos_cycles() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let base = ["sweep", "--model", "ggx", "--model", "blinn", "--model", "ggx,vis=smith-ggx-correlated,f=dielectric", "--size", "16x16", "--min-rounds", "2", "--max-rounds", "2", "--out", "out"];
+    run_in(d, &[&base[..], &["--cost-device", "0"]].concat()).fails(2, "--cost-device 0: give a compile-only AMD target");
+    run_in(d, &[&base[..], &["--cost-device", "radv:navi31"]].concat()).fails(2, "unknown AMD family `navi31`");
+    assert!(!d.join("out").exists());
+    let out = run_in(d, &[&base[..], &["--cost-device", "radv:navi21", "--cost-device", "radv:vega10"]].concat()).ok();
+    assert!(out.stdout.contains("# brdfprof sweep: cost on navi21 (RDNA 2)"), "{}", out.stdout);
+    for family in ["navi21", "vega10"] {
+        let stem = std::fs::read_dir(d.join("out")).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).find(|n| n.ends_with(&format!("-aco-{family}.json"))).unwrap();
+        let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(d.join("out").join(&stem)).unwrap()).unwrap();
+        let rows = report["rows"].as_array().unwrap();
+        assert_eq!(rows.len(), 3);
+        assert_eq!(rows[0]["cost_vs_fastest"].as_f64(), Some(1.0), "sorted by cost, relative to the cheapest");
+        assert!(rows.iter().all(|r| r["cycles_per_eval"].as_f64().unwrap() > 0.0 && r["accuracy"]["vs_exact"]["rms"].is_number()));
+        assert!(rows.iter().any(|r| r["pareto"] == true));
+        // The exact model (most accurate) is on every frontier.
+        assert!(rows.iter().any(|r| r["spec"].as_str().unwrap().contains("dielectric") && r["pareto"] == true), "{rows:?}");
+        assert!(d.join("out").join(stem.replace(".json", ".png")).exists());
+    }
+}
