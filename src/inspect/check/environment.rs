@@ -67,3 +67,51 @@ pub fn environment(inspect: &InspectReport, timing: Option<&TimingRun>) -> BTree
     out
 }
 
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::inspect::callgrind::CallgrindRun;
+
+    fn report(host_model: &str, jit: &[&str], device: &str) -> InspectReport {
+        InspectReport {
+            provenance: serde_json::json!({
+                "device": {"name": device, "driver_name": "radv", "driver_info": "Mesa 22.3.6", "driver_version": "22.3.6"},
+                "mesa_version": "22.3.6",
+                "env": {"MESA_SHADER_CACHE_DISABLE": "true"},
+                "host_cpu": host_model,
+                "cpu": {"model": host_model},
+            }),
+            kernels: String::new(),
+            lights: 8,
+            tools: BTreeMap::new(),
+            columns: vec![],
+            rows: vec![],
+            section_notes: BTreeMap::new(),
+            callgrind: Some(CallgrindRun { kernels: vec![], evaluations: 1, jit_cpu_features: jit.iter().map(|s| s.to_string()).collect(), valgrind: "valgrind-3.19.0".into() }),
+            callgrind_setup: [("workload".to_string(), "64x64 pixels x 8 lights".to_string()), ("valgrind".to_string(), "valgrind-3.19.0".to_string())].into(),
+            vs_profile: None,
+            aco: None,
+        }
+    }
+
+    #[test]
+    fn callgrind_is_keyed_on_what_the_jit_sees_not_the_host_model() {
+        let lvp = "llvmpipe (LLVM 15.0.6, 256 bits)";
+        let amd = environment(&report("AMD EPYC family 26 model 2", &["avx", "avx2"], lvp), None);
+        let intel = environment(&report("Intel Xeon family 6 model 207", &["avx", "avx2"], lvp), None);
+        assert_eq!(amd["callgrind"], intel["callgrind"], "the same JIT features and tools on another CPU model gate alike");
+        assert!(!amd["callgrind"].contains_key("host-cpu"));
+        for key in ["device", "driver", "driver-env", JIT_FEATURES, "valgrind", "workload"] {
+            assert!(amd["callgrind"].contains_key(key), "{key}");
+        }
+        let wider = environment(&report("AMD EPYC family 26 model 2", &["avx", "avx2", "avx512f"], lvp), None);
+        assert_ne!(amd["callgrind"], wider["callgrind"], "other JIT features: not comparable");
+    }
+
+    #[test]
+    fn a_compile_only_device_is_keyed_on_its_family_and_mesa_only() {
+        let navi = environment(&report("any", &[], "Null hardware (RADV NAVI21)"), None);
+        assert_eq!(navi["driver"], [("device".to_string(), "Null hardware (RADV NAVI21)".to_string()), (MESA.to_string(), "22.3.6".to_string())].into());
+    }
+}
