@@ -8,7 +8,7 @@ use crate::gpu::targets::Target;
 use crate::inspect::aco::AcoTable;
 use crate::report::{self, Table};
 use crate::sweep::{pareto_front, SweepReport};
-use anyhow::{anyhow, Result};
+use anyhow::Result;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 
@@ -45,13 +45,19 @@ pub struct AcoSweep {
     pub fastest: String,
     /// Sorted by cost.
     pub rows: Vec<AcoSweepRow>,
+    /// Specs the family cannot compile (fp16 without shaderFloat16), with the reason.
+    pub skipped: Option<String>,
 }
 
 /// ACO's cost of every spec of `sweep` for one family, with the sweep's accuracy.
-pub fn build(sweep: &SweepReport, target: &Target, aco: &AcoTable, driver: &str) -> Result<AcoSweep> {
+pub fn build(sweep: &SweepReport, target: &Target, aco: &AcoTable, driver: &str, note: Option<&str>) -> Result<AcoSweep> {
     let mut rows: Vec<AcoSweepRow> = Vec::new();
+    let mut skipped = Vec::new();
     for r in &sweep.rows {
-        let a = aco.row(&r.spec).ok_or_else(|| anyhow!("radv:{}: no ACO statistics for {}", target.family, r.spec))?;
+        let Some(a) = aco.row(&r.spec) else {
+            skipped.push(r.spec.clone());
+            continue;
+        };
         rows.push(AcoSweepRow {
             spec: r.spec.clone(),
             canonical: r.canonical.clone(),
@@ -86,6 +92,8 @@ pub fn build(sweep: &SweepReport, target: &Target, aco: &AcoTable, driver: &str)
         measured_on: sweep.profile.provenance.device.name.clone(),
         fastest: rows.first().map(|r| r.spec.clone()).unwrap_or_default(),
         rows,
+        // The child's note names each spec with the reason; without one, the specs alone.
+        skipped: (!skipped.is_empty()).then(|| note.map_or_else(|| format!("not compiled for {}: {}", target.family, skipped.join(", ")), str::to_string)),
     })
 }
 
@@ -125,7 +133,7 @@ impl AcoSweep {
             self.fastest,
             self.measured_on,
             self.table().markdown()
-        )
+        ) + &self.skipped.as_ref().map_or(String::new(), |s| format!("\n{s}\n"))
     }
 
     /// Writes `<stem>.md`, `.json` and `.png`; returns their paths.

@@ -76,6 +76,9 @@ pub struct InspectArgs {
     /// Run under the Khronos validation layer and fail on any message (also BRDFPROF_VALIDATION=1).
     #[arg(long)]
     pub validate: bool,
+    /// Inspect the default sweep's specs (`brdfprof sweep`'s 61) instead of the thesis models.
+    #[arg(long, conflicts_with = "models")]
+    pub sweep_specs: bool,
 }
 
 /// What one `--device` stands for.
@@ -163,7 +166,8 @@ pub fn inspect(args: &InspectArgs) -> Result<ExitCode> {
         }
         io::check_output_dir("--isa", dir)?;
     }
-    let options = InspectOptions { models: args.model.models(&THESIS_MODELS)?, lights, callgrind: args.counts.callgrind(validate)? };
+    let models = if args.sweep_specs { brdfprof::sweep::default_specs().into_iter().map(brdfprof::model::Model::spec).collect() } else { args.model.models(&THESIS_MODELS)? };
+    let options = InspectOptions { models, lights, callgrind: args.counts.callgrind(validate)? };
     let profile = args.profile.as_deref().map(inspect::correlate::load_profile).transpose()?;
     let shaders = args.counts.shaders()?;
     let mut reports = inspect_reports(args, &plan, &options, &shaders, validate)?;

@@ -149,7 +149,8 @@ pub fn sweep(args: &SweepArgs) -> Result<ExitCode> {
     for run in &aco {
         let table = run.report.aco.clone().ok_or_else(|| anyhow::anyhow!("radv:{}: the driver reported no ACO statistics", run.target.family))?;
         let driver = run.report.provenance["device"]["driver_info"].as_str().unwrap_or("?").to_string();
-        let sweep_aco = brdfprof::sweep_aco::build(&result, run.target, &table, &driver)?;
+        let note = run.report.section_notes.get("driver/").map(String::as_str);
+        let sweep_aco = brdfprof::sweep_aco::build(&result, run.target, &table, &driver, note)?;
         files.extend(sweep_aco.write(&args.out.join(format!("sweep-{slug}-aco-{}", run.target.family)))?);
         print!("\n{}", sweep_aco.markdown());
     }

@@ -85,7 +85,14 @@ pub fn child_main(request_json: &str) -> Result<()> {
     if !gpu.info.compile_only() {
         bail!("{} is not RADV's compile-only device", gpu.info.name);
     }
-    let report = super::run(&gpu, &shaders, &InspectOptions { models: models.clone(), lights: req.lights, callgrind: None })?;
+    // A model this family cannot compile (fp16 arithmetic where the device has no shaderFloat16) is left out
+    // and named in the driver section's notes, so that one family does not stop a report of many.
+    let (models, skipped): (Vec<Model>, Vec<Model>) = models.into_iter().partition(|m| m.check_support(&gpu.info).is_ok());
+    let mut report = super::run(&gpu, &shaders, &InspectOptions { models: models.clone(), lights: req.lights, callgrind: None })?;
+    if !skipped.is_empty() {
+        let why = skipped.iter().map(|m| format!("{} ({:#})", m.name(), m.check_support(&gpu.info).unwrap_err())).collect::<Vec<_>>().join("; ");
+        report.section_notes.insert("driver/".into(), format!("not compiled for {}: {why}", target.family));
+    }
     let mut isa_files = Vec::new();
     if let Some(dir) = &req.isa_dir {
         let dir = dir.join(target.family);
@@ -159,8 +166,11 @@ pub fn run(target: &'static Target, models: &[Model], lights: u32, shaders: &Sha
     let output = cleanup::output(&mut cmd).context("cannot run brdfprof's radv child")?;
     let stdout = String::from_utf8_lossy(&output.stdout);
     let stderr = String::from_utf8_lossy(&output.stderr);
-    // Validation messages and warnings of the child reach the user as they are.
-    eprint!("{stderr}");
+    // Validation messages and warnings of the child reach the user as they are, but for the banner RADV prints
+    // for every device it does not know to be conformant (its null device among them).
+    for line in stderr.lines().filter(|l| !l.starts_with("WARNING: radv is not a conformant Vulkan implementation")) {
+        eprintln!("{line}");
+    }
     let reply: Option<RadvReply> = stdout.lines().rev().find_map(|l| serde_json::from_str(l).ok());
     let teardown_note = match (&reply, output.status.success()) {
         (Some(_), true) => None,

@@ -197,3 +197,13 @@ fn sweep_cost_device_draws_the_frontier_again_with_acos_cycles() {
         assert!(d.join("out").join(stem.replace(".json", ".png")).exists());
     }
 }
+
+#[test]
+fn a_family_without_fp16_leaves_out_the_fp16_models_and_says_why() {
+    let dir = tempfile::tempdir().unwrap();
+    let report = inspect_json(dir.path(), "gcn", &["radv:tahiti"], &["--model", "ggx", "--model", "ggx,precision=f16"]);
+    let models: Vec<&str> = report["rows"].as_array().unwrap().iter().map(|r| r["model"].as_str().unwrap()).collect();
+    assert_eq!(models, ["ggx", "baseline"]);
+    let note = report["section_notes"]["driver/"].as_str().unwrap();
+    assert!(note.contains("not compiled for tahiti: ggx,precision=f16") && note.contains("shaderFloat16"), "{note}");
+}
