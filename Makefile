@@ -26,5 +26,11 @@ spv:
 # Re-measure the committed `check` baseline after a deliberate change to the kernels (or to spv/ after a
 # merge): prints the comparison with the old baseline, then replaces it; commit the result.
 BASELINE := results/baseline-llvmpipe.json
+# The ACO baselines (Mesa RADV's compiler for navi21 and vangogh, no AMD GPU needed) likewise.
+ACO_FAMILIES := navi21 vangogh
 baseline: build
 	$(BIN) check --baseline $(BASELINE) --save-baseline $(BASELINE); test $$? -le 1
+	for f in $(ACO_FAMILIES); do \
+		$(BIN) check --device radv:$$f --baseline results/baseline-radv-$$f.json --save-baseline results/baseline-radv-$$f.json; \
+		test $$? -le 1 || exit 1; \
+	done

@@ -38,6 +38,10 @@ enum Command {
     /// Measures the counts and a short timing run and compares them with a saved baseline: exit 0 no
     /// regression, 1 regression, 2 could not measure.
     Check(cli::counts::CheckArgs),
+    /// Merge saved profile and inspect JSON reports (other machines, GPUs, compile-only AMD targets) into one
+    /// cost table across devices with rank correlations, its JSON and a PNG chart; refuses reports whose
+    /// kernels differ.
+    Compare(cli::compare::CompareArgs),
     /// Check a scene file and say what it compiles in; --explain prints the scene format with an example.
     Scene(cli::scene::SceneArgs),
     /// Render a scene: a tone-mapped sRGB PNG per model, the comparison grid, difference heat maps against ggx
@@ -45,6 +49,8 @@ enum Command {
     Render(cli::scene::RenderArgs),
     #[command(name = "__callgrind-child", hide = true)]
     CallgrindChild { request: String },
+    #[command(name = "__radv-child", hide = true)]
+    RadvChild { request: String },
     /// Writes glsl/generated/ from the Rust term tables (`make spv` runs it).
     #[command(name = "__generate-glsl", hide = true)]
     GenerateGlsl {
@@ -58,7 +64,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     // The callgrind child runs under valgrind and dies with its parent; every other command cleans up on
     // SIGINT/SIGTERM (children killed, temporary files removed, exit 130).
-    if !matches!(cli.command, Command::CallgrindChild { .. }) {
+    if !matches!(cli.command, Command::CallgrindChild { .. } | Command::RadvChild { .. }) {
         if let Err(e) = brdfprof::cleanup::install_signal_handler() {
             eprintln!("brdfprof: error: {e:#}");
             return ExitCode::from(2);
@@ -73,9 +79,11 @@ fn main() -> ExitCode {
         Command::Stability(args) => cli::measure::stability(&args),
         Command::Inspect(args) => cli::counts::inspect(&args),
         Command::Check(args) => cli::counts::check(&args),
+        Command::Compare(args) => cli::compare::compare(&args),
         Command::Scene(args) => cli::scene::scene(&args),
         Command::Render(args) => cli::scene::render(&args),
         Command::CallgrindChild { request } => brdfprof::inspect::callgrind::child_main(&request).map(|_| ExitCode::SUCCESS),
+        Command::RadvChild { request } => brdfprof::inspect::radv::child_main(&request).map(|_| ExitCode::SUCCESS),
         Command::GenerateGlsl { dir } => cli::info::generate_glsl(&dir),
     };
     // An interrupted command ends with the signal handler's exit status, not its own.

@@ -100,6 +100,10 @@ impl Provenance {
 
 /// A lower-case file-name-safe form of a device name ("llvmpipe (LLVM 15.0.6, 256 bits)" -> "llvmpipe").
 pub fn device_slug(device: &DeviceInfo) -> String {
+    // RADV's compile-only devices are all "Null hardware (RADV <FAMILY>)": the family tells them apart.
+    if let Some(t) = crate::gpu::targets::family_of_device(&device.name) {
+        return format!("radv-{}", t.family);
+    }
     let first = device.name.split(['(', ',']).next().unwrap_or("device").trim().to_lowercase();
     let slug: String = first.chars().map(|c| if c.is_ascii_alphanumeric() { c } else { '-' }).collect();
     let slug = slug.trim_matches('-').to_string();

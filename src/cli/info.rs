@@ -9,9 +9,32 @@ use std::path::Path;
 use std::process::ExitCode;
 
 #[derive(Args)]
-pub struct DevicesArgs {}
+pub struct DevicesArgs {
+    /// List the compile-only AMD targets (`--device radv:FAMILY`) instead: Mesa RADV's compiler for GPU
+    /// families this machine does not have.
+    #[arg(long)]
+    pub targets: bool,
+}
 
-pub fn devices(_args: &DevicesArgs) -> Result<ExitCode> {
+/// `devices --targets`: the family table (`gpu::targets::TARGETS`).
+fn targets_table() -> String {
+    let mut t = report::Table::new(["--device", "GFX", "architecture", "products", "compute wave size", "in radv:all"]);
+    for x in &gpu::targets::TARGETS {
+        t.row([format!("radv:{}", x.family), x.gfx.into(), x.architecture.into(), x.products.into(), x.wave_size.to_string(), if x.default { "yes".into() } else { String::new() }]);
+    }
+    format!(
+        "Compile-only AMD targets: brdfprof runs Mesa RADV's ACO compiler for these families in a child process with \
+         RADV_FORCE_FAMILY set (no AMD GPU needed; nothing executes). Commands that compile take them: inspect, check, \
+         sweep --cost-device.\n\n{}",
+        t.markdown()
+    )
+}
+
+pub fn devices(args: &DevicesArgs) -> Result<ExitCode> {
+    if args.targets {
+        print!("{}", targets_table());
+        return Ok(ExitCode::SUCCESS);
+    }
     let infos = gpu::list_devices()?;
     let default = gpu::select_device(&infos, None).ok();
     let mut t = report::Table::new([

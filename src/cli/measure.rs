@@ -109,12 +109,36 @@ pub struct SweepArgs {
     /// (its GPU values). Built-in specs are always measured against their own exact model.
     #[arg(long, default_value = "ggx")]
     pub reference: String,
+    /// Also draw the table, JSON and Pareto chart with ACO's cycles per evaluation for this AMD family as the
+    /// cost (radv:FAMILY or radv:all, repeatable; see `devices --targets`): sweep-<device>-aco-<family>.*.
+    #[arg(long = "cost-device", value_name = "DEVICE", value_parser = super::device_name)]
+    pub cost_devices: Vec<String>,
     #[command(flatten)]
     pub device: DeviceArgs,
 }
 
+/// The compile-only targets of `--cost-device`, in order, each once.
+fn cost_targets(devices: &[String]) -> Result<Vec<&'static brdfprof::gpu::targets::Target>> {
+    let mut out: Vec<&'static brdfprof::gpu::targets::Target> = Vec::new();
+    for d in devices {
+        let Some(ts) = brdfprof::gpu::targets::parse(d)? else {
+            anyhow::bail!("--cost-device {d}: give a compile-only AMD target, radv:FAMILY or radv:all (see `brdfprof devices --targets`); the sweep's own --device times the specs");
+        };
+        for t in ts {
+            if !out.contains(&t) {
+                out.push(t);
+            }
+        }
+    }
+    Ok(out)
+}
+
 pub fn sweep(args: &SweepArgs) -> Result<ExitCode> {
     io::check_output_dir("--out", &args.out)?;
+    let cost_targets = cost_targets(&args.cost_devices)?;
+    if let Some(d) = args.device.device.as_deref().filter(|d| brdfprof::gpu::targets::is_compile_only(d)) {
+        return Err(super::compiles_only_error(d));
+    }
     fresh_compilation(args.timing.shader_cache);
     let models = if args.model.models.is_empty() { sweep::default_specs().into_iter().map(Model::spec).collect() } else { args.model.models(&[])? };
     let reference = Model::parse(&args.reference).map_err(|e| anyhow::anyhow!("--reference {}: {e:#}", args.reference))?;
@@ -122,9 +146,22 @@ pub fn sweep(args: &SweepArgs) -> Result<ExitCode> {
         eprintln!("brdfprof: note: --reference applies to .brdf models; built-in specs are measured against their own exact model");
     }
     let options = sweep::SweepOptions { profile: args.timing.options(models, &args.size, args.reps, args.budget, args.target_ci)?, reference };
+    let shaders = options.profile.glsl.as_deref().map(brdfprof::shaders::Shaders::from_glsl).transpose()?.unwrap_or_else(brdfprof::shaders::Shaders::embedded);
+    // ACO's figures first (seconds): a missing RADV fails before the long measurement.
+    let validate = args.device.validation();
+    let aco = brdfprof::inspect::radv::run_all(&cost_targets, &options.profile.models, options.profile.lights[0], &shaders, validate, None)?;
     let (gpu, result) = on_device(&args.device, |gpu, progress| sweep::run(gpu, &options, progress))?;
-    let files = result.write(&args.out, &report::device_slug(&gpu.info))?;
+    let slug = report::device_slug(&gpu.info);
+    let mut files = result.write(&args.out, &slug)?;
     print!("{}", result.markdown());
+    for run in &aco {
+        let table = run.report.aco.clone().ok_or_else(|| anyhow::anyhow!("radv:{}: the driver reported no ACO statistics", run.target.family))?;
+        let driver = run.report.provenance["device"]["driver_info"].as_str().unwrap_or("?").to_string();
+        let note = run.report.section_notes.get("driver/").map(String::as_str);
+        let sweep_aco = brdfprof::sweep_aco::build(&result, run.target, &table, &driver, note)?;
+        files.extend(sweep_aco.write(&args.out.join(format!("sweep-{slug}-aco-{}", run.target.family)))?);
+        print!("\n{}", sweep_aco.markdown());
+    }
     println!("\n{}", written(&files));
     Ok(ExitCode::SUCCESS)
 }

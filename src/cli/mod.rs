@@ -1,6 +1,7 @@
 //! What every command shares: the device, model and timing arguments, and the one sequence that opens the
 //! device, shows progress, runs the work and checks the validation layer.
 
+pub mod compare;
 pub mod counts;
 pub mod eval;
 pub mod info;
@@ -8,7 +9,7 @@ pub mod measure;
 pub mod scene;
 
 use anyhow::{anyhow, bail, Result};
-use brdfprof::gpu::{Gpu, GpuOptions};
+use brdfprof::gpu::{targets, Gpu, GpuOptions};
 use brdfprof::io;
 use brdfprof::model::{self, Model};
 use brdfprof::profile::protocol::ProtocolOptions;
@@ -29,12 +30,23 @@ pub struct DeviceArgs {
     pub validate: bool,
 }
 
-/// `--device`: an empty or blank name would match every device (a substring of each), so it is refused.
-fn device_name(text: &str) -> Result<String, String> {
+/// `--device`: an empty or blank name would match every device (a substring of each), so it is refused; a
+/// `radv:FAMILY` must name known families (`gpu::targets`).
+pub fn device_name(text: &str) -> Result<String, String> {
     if text.trim().is_empty() {
         return Err("empty; give an index or a name substring (see `brdfprof devices`)".into());
     }
+    targets::parse(text).map_err(|e| format!("{e:#}"))?;
     Ok(text.to_string())
+}
+
+/// The error of a command that must execute kernels given a compile-only device.
+pub fn compiles_only_error(device: &str) -> anyhow::Error {
+    anyhow!(
+        "--device {device}: a compile-only device (RADV's null device: Mesa's AMD compiler without an AMD GPU) compiles only \
+         and cannot run kernels; this command must execute them. Use `inspect`, `check` or `sweep --cost-device` with it, \
+         and a device from `brdfprof devices` here"
+    )
 }
 
 impl DeviceArgs {
@@ -43,17 +55,38 @@ impl DeviceArgs {
         self.validate || std::env::var("BRDFPROF_VALIDATION").is_ok_and(|v| !v.is_empty() && v != "0")
     }
 
+    /// Opens the device for a command that executes kernels: a compile-only device is refused.
+    #[allow(dead_code)]
     pub fn open(&self) -> Result<Gpu> {
+        self.open_with(false)
+    }
+
+    /// Opens the device; `compile_only_ok`: the command only compiles (inspect, check), so RADV's null device
+    /// (the user's own RADV_FORCE_FAMILY and an explicit `--device`) will do. `radv:` is never opened here: the
+    /// commands that take it run it in a child (`inspect::radv`).
+    pub fn open_with(&self, compile_only_ok: bool) -> Result<Gpu> {
         if self.device.as_deref().is_some_and(|d| d.trim().is_empty()) {
             bail!("--device: empty; give an index or a name substring (see `brdfprof devices`)");
         }
-        Gpu::new(&GpuOptions { device: self.device.clone(), validation: self.validation() })
+        if let Some(d) = self.device.as_deref().filter(|d| targets::is_compile_only(d)) {
+            return Err(compiles_only_error(d));
+        }
+        let gpu = Gpu::new(&GpuOptions { device: self.device.clone(), validation: self.validation() })?;
+        if gpu.info.compile_only() && !compile_only_ok {
+            return Err(compiles_only_error(&format!("{} ({})", self.device.as_deref().unwrap_or("?"), gpu.info.name)));
+        }
+        Ok(gpu)
     }
 }
 
 /// Opens the device, runs `work` with a progress bar, and fails if the validation layer said anything.
 pub fn on_device<T>(device: &DeviceArgs, work: impl FnOnce(&Gpu, &ProgressBar) -> Result<T>) -> Result<(Gpu, T)> {
-    let gpu = device.open()?;
+    on_device_with(device, false, work)
+}
+
+/// `on_device`; `compile_only_ok`: the work only compiles, so a compile-only device will do.
+pub fn on_device_with<T>(device: &DeviceArgs, compile_only_ok: bool, work: impl FnOnce(&Gpu, &ProgressBar) -> Result<T>) -> Result<(Gpu, T)> {
+    let gpu = device.open_with(compile_only_ok)?;
     let progress = ProgressBar::new(0).with_style(ProgressStyle::with_template("{spinner} {elapsed} {pos} {msg}").expect("valid progress template"));
     progress.enable_steady_tick(Duration::from_millis(200));
     let result = work(&gpu, &progress);

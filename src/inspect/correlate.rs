@@ -54,8 +54,8 @@ fn rho(pairs: &[(f64, f64)]) -> Option<f64> {
 
 /// A `brdfprof profile` report, read (before anything is measured, so that a bad file fails at once).
 pub struct ProfileReport {
-    file: String,
-    json: serde_json::Value,
+    pub file: String,
+    pub json: serde_json::Value,
 }
 
 /// Reads the profile report at `path`: JSON with a `rows` array.

@@ -4,6 +4,9 @@
 
 pub use crate::gpu::DriverStat;
 
+/// The executable's subgroup (wave) size as the driver reports it with its properties (not a statistic).
+pub const SUBGROUP_SIZE: &str = "driver/subgroup-size";
+
 /// Common key <- the vendor names that mean it (Mesa RADV/ACO, AMDVLK, Intel ANV, NVIDIA's driver). Values of
 /// every matching statistic in every executable are summed (RADV's spilled SGPRs and VGPRs make `spills`).
 pub const ALIASES: &[(&str, &[&str])] = &[
@@ -15,6 +18,9 @@ pub const ALIASES: &[(&str, &[&str])] = &[
     ("fills", &["Fill Count"]),
     ("scratch-bytes", &["Scratch size", "Scratch Memory Size"]),
     ("branches", &["Branches"]),
+    // ACO's (RADV) cycle estimates of one wave: issue plus stall cycles, and busy cycles per wave64.
+    ("latency", &["Latency"]),
+    ("inverse-throughput", &["Inverse Throughput"]),
 ];
 
 /// Statistic keys: `driver/<executable>/<name>` for each statistic, `driver/<alias>` for each alias that some

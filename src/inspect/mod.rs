@@ -4,11 +4,13 @@
 //! CPU instructions its JIT code executes per BRDF evaluation (callgrind). `check` turns these counts (and
 //! a short timing run) into a regression gate against a saved baseline.
 
+pub mod aco;
 pub mod callgrind;
 pub mod check;
 pub mod correlate;
 pub mod driver;
 pub mod naga_info;
+pub mod radv;
 pub mod spirv;
 pub mod timing;
 
@@ -77,6 +79,9 @@ pub struct InspectReport {
     /// Callgrind figures next to a profile's timings (`inspect --profile FILE`).
     #[serde(default)]
     pub vs_profile: Option<correlate::Correlation>,
+    /// ACO's statistics and cycles per evaluation, where the driver is RADV (`aco::table`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub aco: Option<aco::AcoTable>,
 }
 
 /// SPIR-V statistics of one specialised kernel, and naga's of `naga_kernel` (the same BRDF over the float
@@ -98,6 +103,10 @@ fn driver_stats(gpu: &Gpu, kernel: &ModelKernel, row: &mut Row) -> Result<()> {
     }
     let pipeline = crate::gpu::Kernel::new(gpu, &kernel.spirv.name, &kernel.spirv.words, &kernel.constants, &workload::bindings(GBufferFormat::Packed), workload::PUSH_BYTES)?;
     if let Some(executables) = pipeline.executables()? {
+        // The wave size the driver compiled for (VkPipelineExecutablePropertiesKHR::subgroupSize).
+        if let Some(size) = executables.iter().map(|e| e.subgroup_size).max().filter(|s| *s > 0) {
+            row.stats.insert(driver::SUBGROUP_SIZE.into(), f64::from(size));
+        }
         let stats: Vec<_> = executables.into_iter().flat_map(|e| e.stats).collect();
         row.stats.extend(driver::stats(&stats));
     }
@@ -131,6 +140,7 @@ fn kernel_row(gpu: &Gpu, shaders: &Shaders, model: Option<&Model>, lights: u32) 
     let (per_dispatch, accumulate) = steady_block(lights);
     let kernel = shade_kernel(model, GBufferFormat::Packed, per_dispatch, accumulate, shaders)?;
     let float_kernel = shade_kernel(model, GBufferFormat::Float, per_dispatch, accumulate, shaders)?;
+    row.notes.insert(crate::compare::HASH_NOTE.into(), crate::compare::kernel_hash(model, GBufferFormat::Packed, shaders)?);
     static_stats(&kernel, &float_kernel, &mut row)?;
     driver_stats(gpu, &kernel, &mut row)?;
     Ok(row)
@@ -179,7 +189,7 @@ pub fn run(gpu: &Gpu, shaders: &Shaders, options: &InspectOptions) -> Result<Ins
             emitted.push(key.to_string());
         }
     }
-    Ok(InspectReport {
+    let mut report = InspectReport {
         provenance: serde_json::to_value(Provenance::new(&gpu.info))?,
         kernels: shaders.describe(),
         lights: options.lights,
@@ -190,7 +200,10 @@ pub fn run(gpu: &Gpu, shaders: &Shaders, options: &InspectOptions) -> Result<Ins
         callgrind,
         callgrind_setup,
         vs_profile: None,
-    })
+        aco: None,
+    };
+    report.aco = aco::table(&report);
+    Ok(report)
 }
 
 /// The SPIR-V keys of a row in the order `Counts::stats` gives them.
@@ -287,6 +300,10 @@ impl InspectReport {
                 t.row(cells);
             }
             out += &t.markdown();
+            out += "\n";
+        }
+        if let Some(a) = &self.aco {
+            out += &a.markdown();
             out += "\n";
         }
         if let Some(c) = &self.vs_profile {

@@ -234,3 +234,18 @@ fn sweep_measures_a_file_against_a_reference() {
     let (a, b) = (file["accuracy"]["vs_exact"]["rms"].as_f64().unwrap(), builtin["accuracy"]["vs_exact"]["rms"].as_f64().unwrap());
     assert!((a - b).abs() <= 1e-3 * b, "the file's error against exact GGX is the preset's: {a} vs {b}");
 }
+
+#[test]
+fn a_file_gates_on_a_compile_only_amd_target() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::copy(example("ggx"), dir.path().join("mine.brdf")).unwrap();
+    let model = "mine.brdf,roughness=@roughness,f0=@f0";
+    run_in(dir.path(), &["check", "--device", "radv:navi21", "--model", model, "--save-baseline", "aco.json"]).ok();
+    let base = json(&dir.path().join("aco.json")).to_string();
+    assert!(base.contains("mine.brdf"), "the baseline records the file's model");
+    let src = std::fs::read_to_string(dir.path().join("mine.brdf")).unwrap();
+    std::fs::write(dir.path().join("mine.brdf"), src.replace("return a2 / (PI * d * d);", "return a2 / (PI * pow(d, 2.0) * pow(max(d, 1.0), 0.5));")).unwrap();
+    let r = run_in(dir.path(), &["check", "--device", "radv:navi21", "--model", model, "--baseline", "aco.json"]);
+    assert_eq!(r.code, Some(1), "{}\n{}", r.stdout, r.stderr);
+    assert!(r.stdout.contains("driver/inverse-throughput") && r.stdout.contains("mine.brdf"), "{}", r.stdout);
+}

@@ -5,11 +5,13 @@
 mod common;
 
 mod brdf_models;
+mod compare;
 mod devices;
 mod eval;
 mod eval_csv;
 mod fuzz;
 mod limits;
 mod outputs;
+mod radv;
 mod scenes;
 mod signals;

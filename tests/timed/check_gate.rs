@@ -67,7 +67,7 @@ fn this_build_passes_the_committed_baseline() {
 }
 
 /// A copy of glsl/ whose D_Ggx multiplies its result by pow(NoH, 0.01): one more pow, same shape.
-fn glsl_with_extra_pow(dir: &Path) -> PathBuf {
+pub(crate) fn glsl_with_extra_pow(dir: &Path) -> PathBuf {
     let copy = dir.join("glsl");
     brdfprof::shaders::write_glsl_tree(&copy).unwrap();
     let brdf = copy.join("brdf.glsl");

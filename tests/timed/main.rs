@@ -4,6 +4,7 @@
 #[path = "../common/mod.rs"]
 mod common;
 
+mod aco_gate;
 mod check_gate;
 mod inspect;
 mod profile;

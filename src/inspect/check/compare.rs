@@ -1,7 +1,7 @@
 //! Two runs compared statistic by statistic and group by group.
 
 use super::baseline::Baseline;
-use super::environment::JIT_FEATURES;
+use super::environment::{JIT_FEATURES, MESA};
 use super::thresholds::{group_of, is_gated, Thresholds, ALPHA, GROUPS, MIN_TIMING_ROUNDS, TIMING_KEY};
 use crate::inspect::timing::TimingRun;
 use crate::stats;
@@ -98,7 +98,10 @@ fn differences(old: Option<&BTreeMap<String, String>>, new: Option<&BTreeMap<Str
         .collect::<std::collections::BTreeSet<_>>()
         .into_iter()
         .filter(|k| old.get(*k) != new.get(*k))
-        .map(|k| format!("{k}: baseline `{}`, now `{}`", old.get(k).unwrap_or(&none), new.get(k).unwrap_or(&none)))
+        .map(|k| match k.as_str() {
+            MESA => format!("Mesa {} vs {}", old.get(k).unwrap_or(&none), new.get(k).unwrap_or(&none)),
+            _ => format!("{k}: baseline `{}`, now `{}`", old.get(k).unwrap_or(&none), new.get(k).unwrap_or(&none)),
+        })
         .collect();
     (!diffs.is_empty()).then(|| diffs.join("; "))
 }
@@ -145,6 +148,7 @@ fn new_note(new: &Baseline, group: &str) -> String {
 
 fn absent_reason(new: &Baseline, group: &str) -> String {
     match group {
+        "timing" if new.timing.is_none() && !new_note(new, group).is_empty() => new_note(new, group),
         "timing" if new.timing.is_none() => "not measured now (--rounds 0)".into(),
         _ => {
             let note = new_note(new, group);

@@ -7,6 +7,8 @@ use std::collections::BTreeMap;
 
 /// The fingerprint key only a successful callgrind run can fill in (the CPU features valgrind shows the JIT).
 pub(super) const JIT_FEATURES: &str = "jit-cpu-features";
+/// The Mesa version a compile-only device's statistics depend on.
+pub(super) const MESA: &str = "mesa";
 
 /// "vendor family F model M stepping S (model name)" from /proc/cpuinfo: the host CPU as the JIT sees it.
 pub fn host_cpu() -> String {
@@ -29,7 +31,14 @@ pub fn environment(inspect: &InspectReport, timing: Option<&TimingRun>) -> BTree
     out.insert("spirv".into(), BTreeMap::new());
     out.insert("naga".into(), BTreeMap::new());
     out.insert("spirv-O".into(), [("spirv-opt".to_string(), inspect.tools.get("spirv-opt").cloned().unwrap_or_default())].into());
-    out.insert("driver".into(), machine(vec![]));
+    if crate::gpu::targets::family_of_device(&device).is_some() {
+        // RADV's compile-only device: ACO's output depends on the family (the device) and the Mesa version
+        // alone, not on the host.
+        let mesa = p["mesa_version"].as_str().map_or_else(|| text(&p["device"]["driver_info"]), str::to_string);
+        out.insert("driver".into(), [("device".to_string(), device.clone()), (MESA.to_string(), mesa)].into());
+    } else {
+        out.insert("driver".into(), machine(vec![]));
+    }
     if !inspect.callgrind_setup.is_empty() {
         // Callgrind counts the instructions lavapipe's JIT emits, which depend on the Mesa and LLVM versions
         // (device, driver), the environment, the workload, valgrind and the CPU features valgrind shows the
@@ -58,3 +67,51 @@ pub fn environment(inspect: &InspectReport, timing: Option<&TimingRun>) -> BTree
     out
 }
 
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::inspect::callgrind::CallgrindRun;
+
+    fn report(host_model: &str, jit: &[&str], device: &str) -> InspectReport {
+        InspectReport {
+            provenance: serde_json::json!({
+                "device": {"name": device, "driver_name": "radv", "driver_info": "Mesa 22.3.6", "driver_version": "22.3.6"},
+                "mesa_version": "22.3.6",
+                "env": {"MESA_SHADER_CACHE_DISABLE": "true"},
+                "host_cpu": host_model,
+                "cpu": {"model": host_model},
+            }),
+            kernels: String::new(),
+            lights: 8,
+            tools: BTreeMap::new(),
+            columns: vec![],
+            rows: vec![],
+            section_notes: BTreeMap::new(),
+            callgrind: Some(CallgrindRun { kernels: vec![], evaluations: 1, jit_cpu_features: jit.iter().map(|s| s.to_string()).collect(), valgrind: "valgrind-3.19.0".into() }),
+            callgrind_setup: [("workload".to_string(), "64x64 pixels x 8 lights".to_string()), ("valgrind".to_string(), "valgrind-3.19.0".to_string())].into(),
+            vs_profile: None,
+            aco: None,
+        }
+    }
+
+    #[test]
+    fn callgrind_is_keyed_on_what_the_jit_sees_not_the_host_model() {
+        let lvp = "llvmpipe (LLVM 15.0.6, 256 bits)";
+        let amd = environment(&report("AMD EPYC family 26 model 2", &["avx", "avx2"], lvp), None);
+        let intel = environment(&report("Intel Xeon family 6 model 207", &["avx", "avx2"], lvp), None);
+        assert_eq!(amd["callgrind"], intel["callgrind"], "the same JIT features and tools on another CPU model gate alike");
+        assert!(!amd["callgrind"].contains_key("host-cpu"));
+        for key in ["device", "driver", "driver-env", JIT_FEATURES, "valgrind", "workload"] {
+            assert!(amd["callgrind"].contains_key(key), "{key}");
+        }
+        let wider = environment(&report("AMD EPYC family 26 model 2", &["avx", "avx2", "avx512f"], lvp), None);
+        assert_ne!(amd["callgrind"], wider["callgrind"], "other JIT features: not comparable");
+    }
+
+    #[test]
+    fn a_compile_only_device_is_keyed_on_its_family_and_mesa_only() {
+        let navi = environment(&report("any", &[], "Null hardware (RADV NAVI21)"), None);
+        assert_eq!(navi["driver"], [("device".to_string(), "Null hardware (RADV NAVI21)".to_string()), (MESA.to_string(), "22.3.6".to_string())].into());
+    }
+}

@@ -95,14 +95,40 @@ pub fn measure(gpu: &Gpu, shaders: &Shaders, models: Vec<Model>, lights: u32, op
 /// Runs `check`: loads the baseline (before opening the device, so a bad file fails at once), measures,
 /// compares, saves.
 pub fn run(options: &CheckOptions, shaders: &Shaders, open: impl FnOnce() -> Result<Gpu>) -> Result<Outcome> {
+    run_measured(options, |specs, lights| {
+        let gpu = open()?;
+        let new = measure(&gpu, shaders, specs, lights, options)?;
+        gpu.check_validation()?;
+        Ok(new)
+    })
+}
+
+/// `run` on a compile-only AMD target (`--device radv:FAMILY`): ACO's statistics from the child process
+/// (`inspect::radv`), no timing and no callgrind (nothing executes).
+pub fn run_radv(options: &CheckOptions, shaders: &Shaders, target: &'static crate::gpu::targets::Target, validate: bool) -> Result<Outcome> {
+    run_measured(options, |specs, lights| {
+        eprintln!("brdfprof check: compiling for radv:{} ({} models + baseline kernel)", target.family, specs.len());
+        let run = super::radv::run(target, &specs, lights, shaders, validate, None)?;
+        let mut inspect = run.report;
+        if let Some(note) = run.teardown_note {
+            eprintln!("brdfprof check: note: {note}");
+        }
+        for group in ["callgrind/", "timing/"] {
+            inspect.section_notes.insert(group.into(), format!("not applicable: radv:{} compiles only, nothing executes", target.family));
+        }
+        let environment = environment(&inspect, None);
+        Ok(Baseline { format: FORMAT.into(), inspect, timing: None, environment })
+    })
+}
+
+/// Loads the baseline, measures with `measure(models, lights)`, compares, saves.
+fn run_measured(options: &CheckOptions, measure: impl FnOnce(Vec<Model>, u32) -> Result<Baseline>) -> Result<Outcome> {
     if options.baseline.is_none() && options.save.is_none() {
         bail!("check needs --baseline FILE (and/or --save-baseline FILE to write one)");
     }
     let old = options.baseline.as_deref().map(load).transpose()?;
     let (specs, lights) = plan(options, old.as_ref())?;
-    let gpu = open()?;
-    let new = measure(&gpu, shaders, specs, lights, options)?;
-    gpu.check_validation()?;
+    let new = measure(specs, lights)?;
     let outcome = match (&old, &options.baseline) {
         (Some(old), Some(path)) => {
             let cmp = compare(old, &new, &options.thresholds, options.force);
@@ -148,6 +174,7 @@ mod tests {
             callgrind: None,
             callgrind_setup: BTreeMap::new(),
             vs_profile: None,
+            aco: None,
         };
         let mut environment = BTreeMap::new();
         for g in ["callgrind", "timing"] {

@@ -13,8 +13,18 @@ pub const GROUPS: [&str; 6] = ["spirv", "spirv-O", "naga", "driver", "callgrind"
 /// The timing statistic of each model.
 pub const TIMING_KEY: &str = "timing/cost-ratio";
 /// Driver statistics that cost more when they grow (the aliases); other driver statistics are reported only.
-const GATED_DRIVER_KEYS: [&str; 8] =
-    ["driver/registers", "driver/scalar-registers", "driver/instructions", "driver/code-bytes", "driver/spills", "driver/fills", "driver/scratch-bytes", "driver/branches"];
+const GATED_DRIVER_KEYS: [&str; 10] = [
+    "driver/registers",
+    "driver/scalar-registers",
+    "driver/instructions",
+    "driver/code-bytes",
+    "driver/spills",
+    "driver/fills",
+    "driver/scratch-bytes",
+    "driver/branches",
+    "driver/latency",
+    "driver/inverse-throughput",
+];
 
 
 /// The group of a statistic key.

@@ -1,0 +1,367 @@
+//! One cost table across devices: each device's cost per BRDF evaluation of every model (lavapipe's measured
+//! ns/eval from a `profile` report, callgrind's Ir/eval and ACO's cycles/eval from `inspect` reports), net of
+//! the memory-only kernel, relative to ggx, with Spearman's rank correlation between every pair of devices.
+//! `inspect` builds it from the devices it ran; `brdfprof compare` from saved JSON reports, refusing files
+//! whose kernels differ (each report records a SHA-256 of every model's kernel: SPIR-V and the
+//! specialisation constants that select the model).
+
+use crate::inspect::{self, InspectReport};
+use crate::model::Model;
+use crate::profile::gbuffer::GBufferFormat;
+use crate::profile::workload::{shade_kernel, BASELINE_LABEL};
+use crate::report::{sig, Table};
+use crate::shaders::Shaders;
+use anyhow::{anyhow, bail, Context, Result};
+use serde::{Deserialize, Serialize};
+use sha2::{Digest, Sha256};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// Key of a row's kernel hash in `inspect::Row::notes`.
+pub const HASH_NOTE: &str = "kernel-sha256";
+
+/// SHA-256 of a model's shading kernel (None: the memory-only kernel) over `format`: the SPIR-V words and the
+/// constants that select the model, with the light count fixed at one block of one light, so that the hash
+/// names the code and the model, not the workload.
+pub fn kernel_hash(model: Option<&Model>, format: GBufferFormat, shaders: &Shaders) -> Result<String> {
+    let k = shade_kernel(model, format, 1, false, shaders)?;
+    let mut h = Sha256::new();
+    for w in k.spirv.words.iter() {
+        h.update(w.to_le_bytes());
+    }
+    h.update(format!("{:?}", k.constants).as_bytes());
+    Ok(h.finalize().iter().map(|b| format!("{b:02x}")).collect())
+}
+
+/// One device's (or one measure's) cost per evaluation of each kernel.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct CostColumn {
+    /// Column name: "llvmpipe ns/eval", "callgrind Ir/eval", "navi21 cycles/eval".
+    pub name: String,
+    pub unit: String,
+    /// Where the figures come from (device, driver, file).
+    pub source: String,
+    /// Model -> cost per evaluation.
+    pub gross: BTreeMap<String, f64>,
+    /// Model -> cost minus the memory-only kernel's.
+    pub net: BTreeMap<String, f64>,
+    /// Model -> 95% CI of the net cost, where measured.
+    #[serde(default)]
+    pub net_ci: BTreeMap<String, (f64, f64)>,
+    /// Model -> kernel hash.
+    #[serde(default)]
+    pub hashes: BTreeMap<String, String>,
+    /// Lights per pixel of the workload.
+    pub lights: u32,
+}
+
+/// Rank correlation of two columns over the models both have.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct PairCorrelation {
+    pub a: String,
+    pub b: String,
+    pub models: usize,
+    /// Spearman's rho of the net costs (None with fewer than 3 models in common).
+    pub spearman_net: Option<f64>,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct CostTable {
+    /// Models in row order (the memory-only kernel last).
+    pub models: Vec<String>,
+    pub columns: Vec<CostColumn>,
+    pub correlations: Vec<PairCorrelation>,
+}
+
+fn hashes(report: &InspectReport) -> BTreeMap<String, String> {
+    report.rows.iter().filter_map(|r| r.notes.get(HASH_NOTE).map(|h| (r.model.clone(), h.clone()))).collect()
+}
+
+fn device_name(report: &InspectReport) -> String {
+    report.provenance["device"]["name"].as_str().unwrap_or("?").to_string()
+}
+
+/// The cost columns an inspect report gives: ACO's cycles/eval (RADV), callgrind's Ir/eval (lavapipe).
+pub fn inspect_columns(report: &InspectReport, source: &str) -> Vec<CostColumn> {
+    let mut out = Vec::new();
+    let device = device_name(report);
+    if let Some(aco) = report.aco.clone().or_else(|| inspect::aco::table(report)) {
+        out.push(CostColumn {
+            name: format!("{} cycles/eval", aco.family.clone().unwrap_or_else(|| device.clone())),
+            unit: "ACO SIMD cycles per evaluation".into(),
+            source: format!("{source}{device}, {}", report.provenance["device"]["driver_info"].as_str().unwrap_or("?")),
+            gross: aco.rows.iter().map(|r| (r.model.clone(), r.cycles_per_eval)).collect(),
+            net: aco.rows.iter().filter_map(|r| r.net_cycles_per_eval.map(|n| (r.model.clone(), n))).collect(),
+            net_ci: BTreeMap::new(),
+            hashes: hashes(report),
+            lights: report.lights,
+        });
+    }
+    let gross: BTreeMap<String, f64> = report.rows.iter().filter_map(|r| r.stats.get("callgrind/ir-per-eval").map(|v| (r.model.clone(), *v))).collect();
+    if !gross.is_empty() {
+        out.push(CostColumn {
+            name: "callgrind Ir/eval".into(),
+            unit: "x86 instructions of lavapipe's JIT code per evaluation".into(),
+            source: format!("{source}{device}"),
+            gross,
+            net: report.rows.iter().filter_map(|r| r.stats.get("callgrind/net-ir-per-eval").map(|v| (r.model.clone(), *v))).collect(),
+            net_ci: BTreeMap::new(),
+            hashes: hashes(report),
+            lights: report.lights,
+        });
+    }
+    out
+}
+
+/// The cost columns of a `profile` report (JSON): ns/eval per light count.
+pub fn profile_columns(value: &serde_json::Value, source: &str) -> Result<Vec<CostColumn>> {
+    let rows = value["rows"].as_array().ok_or_else(|| anyhow!("no `rows`"))?;
+    let device = value["provenance"]["device"]["name"].as_str().unwrap_or("?").to_string();
+    let short = device.split([' ', '(']).next().unwrap_or("?").to_string();
+    let hashes: BTreeMap<String, String> =
+        value["kernel_sha256"].as_object().map(|m| m.iter().filter_map(|(k, v)| v.as_str().map(|s| (k.clone(), s.to_string()))).collect()).unwrap_or_default();
+    let mut lights: Vec<u32> = rows.iter().filter_map(|r| r["lights"].as_u64()).map(|l| l as u32).collect();
+    lights.sort();
+    lights.dedup();
+    let several = lights.len() > 1;
+    let mut out = Vec::new();
+    for l in lights {
+        let mut col = CostColumn {
+            name: if several { format!("{short} ns/eval ({l} lights)") } else { format!("{short} ns/eval") },
+            unit: "measured ns per evaluation (median over rounds)".into(),
+            source: format!("{source}{device}"),
+            gross: BTreeMap::new(),
+            net: BTreeMap::new(),
+            net_ci: BTreeMap::new(),
+            hashes: hashes.clone(),
+            lights: l,
+        };
+        for r in rows.iter().filter(|r| r["lights"].as_u64() == Some(u64::from(l))) {
+            let model = r["model"].as_str().ok_or_else(|| anyhow!("a row without `model`"))?.to_string();
+            let ns = r["ns_per_eval"]["median"].as_f64().ok_or_else(|| anyhow!("row `{model}`: no ns_per_eval.median"))?;
+            col.gross.insert(model.clone(), ns);
+            if let Some(n) = r["net_ns_per_eval"]["median"].as_f64() {
+                col.net.insert(model.clone(), n);
+                if let (Some(lo), Some(hi)) = (r["net_ns_per_eval"]["lo"].as_f64(), r["net_ns_per_eval"]["hi"].as_f64()) {
+                    col.net_ci.insert(model, (lo, hi));
+                }
+            }
+        }
+        out.push(col);
+    }
+    Ok(out)
+}
+
+/// Refuses columns whose kernels differ: a model whose hash is not the same in every column that has it, or
+/// a column without hashes.
+pub fn check_kernels(columns: &[CostColumn]) -> Result<()> {
+    for c in columns {
+        if c.hashes.is_empty() {
+            bail!("{} ({}): records no kernel hashes (written by an older brdfprof); its kernels cannot be matched with the others'. Measure it again", c.name, c.source);
+        }
+    }
+    let mut seen: BTreeMap<&str, (&str, &CostColumn)> = BTreeMap::new();
+    for c in columns {
+        // Every model whose kernel differs from the first column that has it, against that column.
+        let mut differ: BTreeMap<&str, Vec<String>> = BTreeMap::new();
+        for (model, h) in &c.hashes {
+            match seen.get(model.as_str()) {
+                Some((h0, c0)) if *h0 != h.as_str() => {
+                    differ.entry(c0.name.as_str()).or_default().push(format!("`{model}` ({} vs {})", &h0[..12.min(h0.len())], &h[..12.min(h.len())]));
+                }
+                Some(_) => {}
+                None => {
+                    seen.insert(model, (h, c));
+                }
+            }
+        }
+        if let Some((other, models)) = differ.into_iter().next() {
+            let c0 = columns.iter().find(|x| x.name == other).expect("a column seen before");
+            bail!("the kernels differ: {} SPIR-V hashes in {} ({}) and {} ({}); compare reports of the same kernels", models.join(", "), c0.name, c0.source, c.name, c.source);
+        }
+    }
+    Ok(())
+}
+
+/// The table of `columns`, with every pair's rank correlation.
+pub fn build(columns: Vec<CostColumn>) -> CostTable {
+    let mut models: Vec<String> = Vec::new();
+    for c in &columns {
+        for m in c.gross.keys() {
+            if !models.contains(m) && m != BASELINE_LABEL {
+                models.push(m.clone());
+            }
+        }
+    }
+    // Row order: the reference first, then by name as the first column orders them (cheapest net first).
+    let first = columns.first().cloned();
+    models.sort_by(|a, b| {
+        let key = |m: &String| (m != crate::brdf::spec::REFERENCE_MODEL, first.as_ref().and_then(|c| c.net.get(m).copied()).unwrap_or(f64::INFINITY));
+        let (ka, kb) = (key(a), key(b));
+        ka.0.cmp(&kb.0).then(ka.1.total_cmp(&kb.1)).then(a.cmp(b))
+    });
+    if columns.iter().any(|c| c.gross.contains_key(BASELINE_LABEL)) {
+        models.push(BASELINE_LABEL.into());
+    }
+    let mut correlations = Vec::new();
+    for i in 0..columns.len() {
+        for j in i + 1..columns.len() {
+            let (a, b) = (&columns[i], &columns[j]);
+            let common: Vec<&String> = models.iter().filter(|m| a.net.contains_key(*m) && b.net.contains_key(*m)).collect();
+            let xs: Vec<f64> = common.iter().map(|m| a.net[*m]).collect();
+            let ys: Vec<f64> = common.iter().map(|m| b.net[*m]).collect();
+            correlations.push(PairCorrelation {
+                a: a.name.clone(),
+                b: b.name.clone(),
+                models: common.len(),
+                spearman_net: (common.len() >= 3).then(|| crate::stats::spearman(&xs, &ys)),
+            });
+        }
+    }
+    CostTable { models, columns, correlations }
+}
+
+impl CostTable {
+    /// Net cost relative to ggx's net cost in the same column.
+    pub fn relative(&self, column: &CostColumn, model: &str) -> Option<f64> {
+        let g = column.net.get(crate::brdf::spec::REFERENCE_MODEL)?;
+        column.net.get(model).map(|n| n / g).filter(|r| r.is_finite() && *g > 0.0)
+    }
+
+    pub fn markdown(&self) -> String {
+        let mut headers = vec!["model".to_string()];
+        for c in &self.columns {
+            headers.push(c.name.clone());
+            headers.push("net".into());
+            headers.push("net vs ggx".into());
+        }
+        let mut t = Table::new(headers);
+        for m in &self.models {
+            let mut cells = vec![m.clone()];
+            for c in &self.columns {
+                cells.push(c.gross.get(m).map_or("-".into(), |v| sig(*v, 4)));
+                cells.push(match (c.net.get(m), c.net_ci.get(m)) {
+                    (Some(v), Some((lo, hi))) => format!("{} [{}, {}]", sig(*v, 3), sig(*lo, 3), sig(*hi, 3)),
+                    (Some(v), None) => sig(*v, 4),
+                    _ => "-".into(),
+                });
+                cells.push(self.relative(c, m).map_or("-".into(), |r| format!("{r:.2}")));
+            }
+            t.row(cells);
+        }
+        let mut out = format!("### Cost per BRDF evaluation across devices\n\n{}\n", t.markdown());
+        out += "Sources: ";
+        out += &self.columns.iter().map(|c| format!("{}: {} ({} lights)", c.name, c.source, c.lights)).collect::<Vec<_>>().join("; ");
+        out += "\n\n";
+        if !self.correlations.is_empty() {
+            let mut t = Table::new(["device A", "device B", "models", "Spearman rho (net cost)"]);
+            for p in &self.correlations {
+                t.row([p.a.clone(), p.b.clone(), p.models.to_string(), p.spearman_net.map_or("- (fewer than 3 models)".into(), |r| format!("{r:.2}"))]);
+            }
+            out += &format!("### Rank correlation between devices\n\n{}\n", t.markdown());
+        }
+        out
+    }
+
+    /// A grouped bar chart: net cost relative to ggx, per model (groups) and device (colours).
+    pub fn chart(&self, path: &Path) -> Result<()> {
+        use plotters::prelude::*;
+        let models: Vec<&String> = self.models.iter().filter(|m| *m != BASELINE_LABEL).collect();
+        let values: Vec<Vec<Option<f64>>> = models.iter().map(|m| self.columns.iter().map(|c| self.relative(c, m)).collect()).collect();
+        let max = values.iter().flatten().flatten().fold(1.0f64, |a, &b| a.max(b)) * 1.1;
+        let width = (300 + 60 * models.len() as u32 * self.columns.len().max(1) as u32 / 2).clamp(800, 2400);
+        crate::chart::render(path, width, 600, |root| {
+            let e = |e: DrawingAreaErrorKind<_>| anyhow!("{e}");
+            let mut chart = ChartBuilder::on(root)
+                .caption("BRDF cost net of the memory-only kernel, relative to ggx, per device", (crate::chart::FONT, 20))
+                .margin(15)
+                .x_label_area_size(90)
+                .y_label_area_size(60)
+                .build_cartesian_2d(0f64..models.len() as f64, 0f64..max)
+                .map_err(e)?;
+            chart
+                .configure_mesh()
+                .disable_x_mesh()
+                .x_labels(0)
+                .y_desc("net cost / ggx's net cost")
+                .label_style((crate::chart::FONT, 13))
+                .draw()
+                .map_err(e)?;
+            let n = self.columns.len().max(1) as f64;
+            for (j, c) in self.columns.iter().enumerate() {
+                let colour = crate::chart::palette(j);
+                let bars: Vec<_> = values
+                    .iter()
+                    .enumerate()
+                    .filter_map(|(i, v)| v[j].map(|y| (i, y)))
+                    .map(|(i, y)| {
+                        let x0 = i as f64 + 0.1 + 0.8 * j as f64 / n;
+                        Rectangle::new([(x0, 0.0), (x0 + 0.8 / n, y.max(0.0))], colour.filled())
+                    })
+                    .collect();
+                chart.draw_series(bars).map_err(e)?.label(c.name.clone()).legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 10, y + 5)], colour.filled()));
+            }
+            chart.draw_series(std::iter::once(PathElement::new(vec![(0.0, 1.0), (models.len() as f64, 1.0)], BLACK.mix(0.5)))).map_err(e)?;
+            // Model names under their groups (long specs wrapped at commas).
+            for (i, m) in models.iter().enumerate() {
+                let (px, py) = chart.backend_coord(&(i as f64 + 0.5, 0.0));
+                for (k, part) in m.split_inclusive(',').enumerate() {
+                    let w = 7 * part.len() as i32;
+                    root.draw(&Text::new(part.to_string(), (px - w / 2, py + 8 + 16 * k as i32), (crate::chart::FONT, 13))).map_err(e)?;
+                }
+            }
+            chart.configure_series_labels().background_style(WHITE.mix(0.9)).border_style(BLACK).label_font((crate::chart::FONT, 13)).position(SeriesLabelPosition::UpperLeft).draw().map_err(e)?;
+            Ok(())
+        })
+    }
+}
+
+/// The columns of one saved JSON report: a `profile` report, an `inspect` report, an `inspect` report of
+/// several devices, or a `check` baseline (its inspect part).
+pub fn load_columns(path: &Path) -> Result<Vec<CostColumn>> {
+    let text = std::fs::read_to_string(path).with_context(|| format!("{}: cannot read it", path.display()))?;
+    let value: serde_json::Value = serde_json::from_str(&text).map_err(|e| anyhow!("{}: not valid JSON ({e})", path.display()))?;
+    let source = format!("{}: ", path.display());
+    let inspect_of = |v: &serde_json::Value| -> Result<InspectReport> {
+        serde_json::from_value(v.clone()).map_err(|e| anyhow!("{}: not a brdfprof inspect report ({e})", path.display()))
+    };
+    let columns = if value.get("raw").is_some() && value.get("workload").is_some() {
+        if value.get("kernel_sha256").is_none() {
+            bail!("{}: a profile report that records no kernel hashes (written by an older brdfprof); its kernels cannot be matched with the others'. Measure it again", path.display());
+        }
+        profile_columns(&value, &source).with_context(|| format!("{}: not a brdfprof profile report", path.display()))?
+    } else if let Some(reports) = value.get("reports").and_then(|r| r.as_array()) {
+        let mut out = Vec::new();
+        for r in reports {
+            out.extend(inspect_columns(&inspect_of(r)?, &source));
+        }
+        out
+    } else if value.get("inspect").is_some() && value.get("environment").is_some() {
+        inspect_columns(&inspect_of(&value["inspect"])?, &source)
+    } else {
+        inspect_columns(&inspect_of(&value)?, &source)
+    };
+    if columns.is_empty() {
+        bail!("{}: no cost per evaluation in it (a profile report, or an inspect report with ACO statistics or callgrind counts)", path.display());
+    }
+    Ok(columns)
+}
+
+/// `brdfprof compare FILE ...`: every file's columns, checked for the same kernels, in one table.
+pub fn from_files(files: &[PathBuf]) -> Result<CostTable> {
+    if files.is_empty() {
+        bail!("compare needs at least one FILE.json (profile or inspect reports)");
+    }
+    let mut columns: Vec<CostColumn> = Vec::new();
+    for f in files {
+        for mut c in load_columns(f)? {
+            // Two files of the same device: keep both, told apart by their file.
+            if columns.iter().any(|o| o.name == c.name) {
+                c.name = format!("{} [{}]", c.name, f.file_name().map_or_else(|| f.display().to_string(), |n| n.to_string_lossy().into_owned()));
+            }
+            columns.push(c);
+        }
+    }
+    check_kernels(&columns)?;
+    Ok(build(columns))
+}
