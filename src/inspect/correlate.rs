@@ -109,7 +109,9 @@ pub fn correlate_with(report: &InspectReport, profile: &ProfileReport) -> Result
     let gross: Vec<(f64, f64)> = out.iter().map(|r| (r.ir_per_eval, r.ns_per_eval)).collect();
     Ok(Correlation {
         profile: file,
-        profile_lights: profile["workload"]["lights"].as_u64().unwrap_or(0),
+        // The profile's light counts (a list since `--lights 1,8,64`; a number in older reports); the rows used are
+        // those at the inspected count.
+        profile_lights: u64::from(report.lights),
         reference,
         spearman_net: rho(&net),
         spearman_gross: rho(&gross),
