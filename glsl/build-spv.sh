@@ -3,7 +3,10 @@
 set -eu
 cd "$(dirname "$0")/.."
 mkdir -p spv
-grep -v -e '^#' -e '^[[:space:]]*$' glsl/kernels.txt > "${TMPDIR:-/tmp}/brdfprof-kernels.$$"
+list="${TMPDIR:-/tmp}/brdfprof-kernels.$$"
+trap 'rm -f "$list"' EXIT
+trap 'exit 130' INT TERM
+grep -v -e '^#' -e '^[[:space:]]*$' glsl/kernels.txt > "$list"
 while read -r name source defines; do
     flags=""
     for d in $defines; do flags="$flags -D$d"; done
@@ -14,5 +17,4 @@ while read -r name source defines; do
     fi
     spirv-val --target-env vulkan1.1 "spv/$name.spv"
     echo "spv/$name.spv"
-done < "${TMPDIR:-/tmp}/brdfprof-kernels.$$"
-rm -f "${TMPDIR:-/tmp}/brdfprof-kernels.$$"
+done < "$list"
