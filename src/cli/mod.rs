@@ -99,11 +99,13 @@ pub fn on_device_with<T>(device: &DeviceArgs, compile_only_ok: bool, work: impl 
 #[derive(Args, Clone)]
 pub struct ModelArgs {
     /// Model spec: a preset (ggx, blinn, cook-torrance, burley, ue-default-lit, filament-high, filament-low)
-    /// or d=..,vis=..,f=..,precision=..; see `brdfprof models`.
+    /// or d=..,vis=..,f=..,precision=..; see `brdfprof models`. Or a BRDF Explorer file,
+    /// PATH.brdf[,NAME=VALUE|@roughness|@alpha|@f0|@basecolor|@metallic...].
     #[arg(long = "model")]
     pub models: Vec<String>,
     /// Parameter override applied to every model that takes it, e.g. gamma=1.5 (GTR exponent), metal=copper,
-    /// precision=f16.
+    /// precision=f16; for a .brdf file one of its parameters (a colour as r,g,b) or a binding such as
+    /// roughness=@roughness.
     #[arg(long = "param")]
     pub params: Vec<String>,
 }
