@@ -117,6 +117,16 @@ pub fn write_json_compact(path: &Path, value: &impl Serialize) -> Result<()> {
     crate::io::write_output(path, text.as_bytes())
 }
 
+/// Writes `<stem>.md` (`markdown`), `<stem>.json` (`value`, compact) and `<stem>.png` (`chart`); returns their
+/// paths.
+pub fn write_md_json_png(stem: &Path, value: &impl Serialize, markdown: &str, chart: impl FnOnce(&Path) -> Result<()>) -> Result<Vec<std::path::PathBuf>> {
+    let (md, json, png) = (stem.with_extension("md"), stem.with_extension("json"), stem.with_extension("png"));
+    write_json_compact(&json, value)?;
+    crate::io::write_output(&md, markdown.as_bytes())?;
+    chart(&png)?;
+    Ok(vec![md, json, png])
+}
+
 pub fn write_json(path: &Path, value: &impl Serialize) -> Result<()> {
     let mut text = serde_json::to_string_pretty(value)?;
     text.push('\n');

@@ -208,12 +208,7 @@ impl SweepReport {
 
     /// Writes sweep-<device>.md, .json and .png under `out`; returns their paths.
     pub fn write(&self, out: &Path, device: &str) -> Result<Vec<std::path::PathBuf>> {
-        let stem = out.join(format!("sweep-{device}"));
-        let (md, json, png) = (stem.with_extension("md"), stem.with_extension("json"), stem.with_extension("png"));
-        report::write_json_compact(&json, self)?;
-        crate::io::write_output(&md, self.markdown().as_bytes())?;
-        self.chart(&png)?;
-        Ok(vec![md, json, png])
+        report::write_md_json_png(&out.join(format!("sweep-{device}")), self, &self.markdown(), |png| self.chart(png))
     }
 
     /// Approximation error (RMS vs exact, log) against cost, every point labelled, the frontier drawn.

@@ -138,11 +138,7 @@ impl AcoSweep {
 
     /// Writes `<stem>.md`, `.json` and `.png`; returns their paths.
     pub fn write(&self, stem: &Path) -> Result<Vec<PathBuf>> {
-        let (md, json, png) = (stem.with_extension("md"), stem.with_extension("json"), stem.with_extension("png"));
-        report::write_json_compact(&json, self)?;
-        crate::io::write_output(&md, self.markdown().as_bytes())?;
-        self.chart(&png)?;
-        Ok(vec![md, json, png])
+        report::write_md_json_png(stem, self, &self.markdown(), |png| self.chart(png))
     }
 
     pub fn chart(&self, path: &Path) -> Result<()> {

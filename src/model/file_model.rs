@@ -13,6 +13,7 @@ use super::brdf_file::{self, glsl_float, BrdfFile, FileParam, FileParamKind};
 use super::KernelKind;
 use crate::shaders::{self, Shaders, Spirv};
 use anyhow::{anyhow, bail, Context, Result};
+use glam::DVec3;
 use sha2::{Digest, Sha256};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -71,17 +72,6 @@ impl Input {
             (FileParamKind::Float { .. }, true) => Some(format!("dot({e}, vec3(1.0 / 3.0))")),
             (FileParamKind::Color { .. }, false) => Some(format!("vec3({e})")),
             (FileParamKind::Bool { .. }, _) => None,
-        }
-    }
-
-    /// The value of the input for a sample with perceptual roughness `r` and reflectance `f0` (the eval and
-    /// sample-set convention: base colour F0, metallic 1), as the GPU computes it.
-    pub fn value(self, r: f64, f0: [f64; 3]) -> [f64; 3] {
-        match self {
-            Input::Roughness => [r; 3],
-            Input::Alpha => [r * r; 3],
-            Input::F0 | Input::BaseColor => f0,
-            Input::Metallic => [1.0; 3],
         }
     }
 }
@@ -497,19 +487,15 @@ fn disk_cache_write(key: &str, words: &[u32]) {
 /// orthogonal to the unit normal `n`, or, when `t` is zero or parallel to `n`, the first vector of the
 /// branchless orthonormal basis of Duff et al. 2017 ("Building an Orthonormal Basis, Revisited", JCGT 6(1),
 /// Listing 3). Y = N x X.
-pub fn tangent_frame(n: [f64; 3], t: [f64; 3]) -> [f64; 3] {
-    let d = n[0] * t[0] + n[1] * t[1] + n[2] * t[2];
-    let x = [t[0] - n[0] * d, t[1] - n[1] * d, t[2] - n[2] * d];
-    let len2 = x[0] * x[0] + x[1] * x[1] + x[2] * x[2];
-    let t2 = t[0] * t[0] + t[1] * t[1] + t[2] * t[2];
-    if t2 > 0.0 && len2 > TANGENT_PARALLEL * t2 {
-        let s = 1.0 / len2.sqrt();
-        return [x[0] * s, x[1] * s, x[2] * s];
+pub fn tangent_frame(n: DVec3, t: DVec3) -> DVec3 {
+    let x = t - n * n.dot(t);
+    if t.length_squared() > 0.0 && x.length_squared() > TANGENT_PARALLEL * t.length_squared() {
+        return x.normalize();
     }
-    let sign = if n[2] >= 0.0 { 1.0 } else { -1.0 };
-    let a = -1.0 / (sign + n[2]);
-    let b = n[0] * n[1] * a;
-    [1.0 + sign * n[0] * n[0] * a, sign * b, -sign * n[0]]
+    let sign = if n.z >= 0.0 { 1.0 } else { -1.0 };
+    let a = -1.0 / (sign + n.z);
+    let b = n.x * n.y * a;
+    DVec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x)
 }
 
 /// |t - n (n.t)|^2 / |t|^2 below which a given tangent counts as parallel to N (sin^2 of 1e-3 rad): the
@@ -561,14 +547,12 @@ mod tests {
 
     #[test]
     fn the_tangent_rule_gives_an_orthonormal_frame() {
-        for n in [[0.0, 0.0, 1.0], [0.0, 0.0, -1.0], [0.6, 0.0, 0.8], [0.0, -0.6, -0.8]] {
-            for t in [[0.0; 3], [1.0, 0.0, 0.0], n] {
+        for n in [DVec3::Z, -DVec3::Z, DVec3::new(0.6, 0.0, 0.8), DVec3::new(0.0, -0.6, -0.8)] {
+            for t in [DVec3::ZERO, DVec3::X, n] {
                 let x = tangent_frame(n, t);
-                let dot = n[0] * x[0] + n[1] * x[1] + n[2] * x[2];
-                let len = (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
-                assert!(dot.abs() < 1e-12 && (len - 1.0).abs() < 1e-12, "n {n:?} t {t:?}: x {x:?}");
+                assert!(n.dot(x).abs() < 1e-12 && (x.length() - 1.0).abs() < 1e-12, "n {n:?} t {t:?}: x {x:?}");
             }
         }
-        assert_eq!(tangent_frame([0.0, 0.0, 1.0], [0.0; 3]), [1.0, 0.0, 0.0], "Duff et al.'s basis at the pole");
+        assert_eq!(tangent_frame(DVec3::Z, DVec3::ZERO), DVec3::X, "Duff et al.'s basis at the pole");
     }
 }

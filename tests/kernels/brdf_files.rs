@@ -7,6 +7,7 @@ use brdfprof::brdf::{samples, Sample, THESIS_MODELS};
 use brdfprof::kernels::{self, AlbedoCell, EvalExtras, RunLimits};
 use brdfprof::model::file_model::{tangent_frame, TANGENT_PARALLEL};
 use brdfprof::model::{KernelKind, Model};
+use glam::DVec3;
 use std::path::{Path, PathBuf};
 
 fn example(name: &str) -> PathBuf {
@@ -61,10 +62,6 @@ fn frame_file(dir: &Path) -> Model {
     Model::parse(&path.display().to_string()).unwrap()
 }
 
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
-}
-
 #[test]
 fn tangent_frame_follows_its_documented_rule() {
     let gpu = common::gpu();
@@ -90,16 +87,14 @@ fn tangent_frame_follows_its_documented_rule() {
         for given in [None, Some(tangents.as_slice())] {
             let got = kernels::eval_with(&gpu, model, &s, &EvalExtras { tangents: given, ..Default::default() }, RunLimits::default()).unwrap();
             for (i, (g, x)) in got.iter().zip(&s).enumerate() {
-                let len = x.n.iter().map(|c| (*c as f64).powi(2)).sum::<f64>().sqrt();
-                let n = x.n.map(|c| c as f64 / len);
-                let t = given.map_or([0.0; 3], |t| t[i].map(f64::from));
+                let n = DVec3::from(x.n.map(f64::from)).normalize();
+                let t = given.map_or(DVec3::ZERO, |t| DVec3::from(t[i].map(f64::from)));
                 let xf = tangent_frame(n, t);
-                let want = if bitangent { cross(n, xf) } else { xf };
+                let want = if bitangent { n.cross(xf) } else { xf };
                 for c in 0..3 {
                     assert!((g[c] as f64 - want[c]).abs() <= 2e-5, "sample {i} (N {n:?}, t {t:?}, Y {bitangent}): GPU {g:?}, rule {want:?}");
                 }
-                let dot: f64 = (0..3).map(|c| xf[c] * n[c]).sum();
-                assert!(dot.abs() < 1e-12 && (xf.iter().map(|c| c * c).sum::<f64>() - 1.0).abs() < 1e-12, "X is a unit vector orthogonal to N");
+                assert!(xf.dot(n).abs() < 1e-12 && (xf.length() - 1.0).abs() < 1e-12, "X is a unit vector orthogonal to N");
             }
         }
     }
