@@ -1,6 +1,8 @@
 #!/bin/sh
-# Installs the system packages brdfprof needs (Debian 12 names): the Vulkan loader, lavapipe (Mesa's CPU
-# Vulkan driver), the Khronos validation layer, glslang, SPIRV-Tools, vulkaninfo and valgrind.
+# Installs what brdfprof needs (Debian 12 names): the Vulkan loader, lavapipe (Mesa's CPU Vulkan driver), the
+# Khronos validation layer, glslang, SPIRV-Tools, vulkaninfo and valgrind; g++ (runs the kernels' C translation
+# on the CPU); Intel's OpenCL compiler (ocloc/IGC) and PoCL (OpenCL on the CPU) for the intel: targets; and,
+# from PyPI, NVIDIA's NVRTC and nvdisasm for the nvidia: targets, into .tools/nvidia (about 150 MB).
 # As root with apt-get it installs what is missing; otherwise it says exactly what to install and fails.
 set -eu
 
@@ -15,6 +17,10 @@ command -v glslangValidator >/dev/null 2>&1 || missing="$missing glslang-tools"
 { command -v spirv-opt && command -v spirv-val; } >/dev/null 2>&1 || missing="$missing spirv-tools"
 command -v vulkaninfo >/dev/null 2>&1 || missing="$missing vulkan-tools"
 command -v valgrind >/dev/null 2>&1 || missing="$missing valgrind"
+command -v g++ >/dev/null 2>&1 || missing="$missing g++"
+command -v ocloc >/dev/null 2>&1 || missing="$missing intel-opencl-icd"
+have_file /etc/OpenCL/vendors/pocl.icd || missing="$missing pocl-opencl-icd"
+have_lib 'libOpenCL.so.1' || missing="$missing ocl-icd-libopencl1"
 
 if [ -n "$missing" ]; then
     if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
@@ -27,9 +33,29 @@ if [ -n "$missing" ]; then
         echo "brdfprof setup: missing system packages:$missing" >&2
         echo "  install them as root on Debian/Ubuntu:  apt-get install$missing" >&2
         echo "  (other systems: the Vulkan loader, Mesa's lavapipe driver, the Khronos validation layer," >&2
-        echo "   glslang, SPIRV-Tools, vulkan-tools and valgrind from your package manager)" >&2
+        echo "   glslang, SPIRV-Tools, vulkan-tools, valgrind, g++, Intel's compute runtime (ocloc), PoCL and the" >&2
+        echo "   OpenCL ICD loader from your package manager)" >&2
         exit 1
     fi
 fi
 command -v cargo >/dev/null 2>&1 || { echo "brdfprof setup: cargo not found; install Rust (https://rustup.rs)" >&2; exit 1; }
+
+# NVIDIA's compiler (no GPU or driver needed): the pinned wheels of scripts/nvidia-wheels.txt, project-local.
+root=$(cd "$(dirname "$0")/.." && pwd)
+nv="$root/.tools/nvidia"
+wheels=$(cat "$root/scripts/nvidia-wheels.txt")
+if [ ! -f "$nv/nvidia/cu13/lib/libnvrtc.so.13" ] || [ ! -x "$nv/nvidia/cu13/bin/nvdisasm" ] || [ "$(cat "$nv/.wheels" 2>/dev/null)" != "$wheels" ]; then
+    python3 -m pip --version >/dev/null 2>&1 || { echo "brdfprof setup: python3 -m pip not found; install python3-pip (needed for NVIDIA's NVRTC wheels)" >&2; exit 1; }
+    echo "brdfprof setup: installing $wheels into $nv" >&2
+    rm -rf "$nv"
+    # shellcheck disable=SC2086
+    python3 -m pip install --quiet --disable-pip-version-check --root-user-action=ignore --no-deps --target "$nv" $wheels
+    echo "$wheels" > "$nv/.wheels"
+fi
+# ocloc disassembles only where it can dlopen libiga64.so; Debian ships libiga64.so.1 alone: a private link.
+iga=$(ls /usr/lib/x86_64-linux-gnu/libiga64.so.1 /usr/lib/*/libiga64.so.1 2>/dev/null | head -n 1)
+if [ -n "$iga" ]; then
+    mkdir -p "$root/.tools/intel"
+    ln -sf "$iga" "$root/.tools/intel/libiga64.so"
+fi
 echo "brdfprof setup: system packages present" >&2

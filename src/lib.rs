@@ -21,5 +21,7 @@ pub mod stability;
 pub mod stats;
 pub mod sweep;
 pub mod sweep_aco;
+pub mod targets;
+pub mod translate;
 pub mod scene;
 pub mod util;

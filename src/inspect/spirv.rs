@@ -155,7 +155,9 @@ pub fn spirv_opt(words: &[u32], args: &[String]) -> Result<Vec<u32>> {
 
 /// The module with its specialisation constants set and frozen, and only the code they select kept.
 pub fn specialise(words: &[u32], constants: &SpecConstants) -> Result<Vec<u32>> {
-    let mut args = vec!["--set-spec-const-default-value".to_string(), spec_default_values(words, constants)?];
+    let values = spec_default_values(words, constants)?;
+    // A module none of whose constants is set (a .brdf model's eval kernel) keeps its defaults.
+    let mut args = if values.is_empty() { Vec::new() } else { vec!["--set-spec-const-default-value".to_string(), values] };
     args.extend(SPECIALISE_PASSES.iter().map(|s| s.to_string()));
     spirv_opt(words, &args)
 }

@@ -100,7 +100,7 @@ impl EvalExtras<'_> {
     }
 }
 
-fn pack_samples(samples: &[Sample], extras: &EvalExtras) -> Vec<u8> {
+pub fn pack_samples(samples: &[Sample], extras: &EvalExtras) -> Vec<u8> {
     let stride = extras.stride();
     let mut floats: Vec<f32> = Vec::with_capacity(samples.len() * stride * 4);
     for (i, s) in samples.iter().enumerate() {

@@ -88,18 +88,10 @@ impl<'g> Workload<'g> {
             anyhow::bail!("{count} lights: a profile takes 1 to {MAX_LIGHTS} whole lights");
         }
         let n = gbuffer.pixel_count();
-        let wg = crate::gpu::WORKGROUP as u64;
-        let padded = n.div_ceil(wg) * wg;
-        let per = gbuffer.words_per_pixel();
-        let mut words = gbuffer.words.clone();
-        let last = words[words.len() - per..].to_vec();
-        for _ in n..padded {
-            words.extend_from_slice(&last);
-        }
+        let words = padded_words(gbuffer);
+        let padded = words.len() as u64 / gbuffer.words_per_pixel() as u64;
         let (f, c) = (gbuffer.format, gbuffer.camera);
-        // Whole blocks, so that every dispatch's window of BLOCK_BYTES lies inside the buffer.
-        let mut light_data = lights.to_vec();
-        light_data.resize(light_blocks((lights.len() / LIGHT_FLOATS) as u32).len().max(1) * BLOCK_BYTES as usize / 4, 0.0);
+        let light_data = light_buffer(lights);
         Ok(Workload {
             gbuffer: Buffer::with_data(gpu, bytemuck::cast_slice(&words), MemoryKind::Device)?,
             radiance: Buffer::new(gpu, padded * f.bytes_out(), MemoryKind::Device)?,
@@ -136,11 +128,37 @@ impl<'g> Workload<'g> {
         }
     }
 
-    /// The push constants of a dispatch over the chunk starting at pixel `first_pixel` (glsl/shade.glsl `Push`).
     fn push(&self, first_pixel: u64) -> Vec<u8> {
-        let words: [u32; 8] = [first_pixel as u32, self.width, 0, 0, self.camera[0].to_bits(), self.camera[1].to_bits(), self.camera[2].to_bits(), self.camera[3].to_bits()];
-        bytemuck::cast_slice(&words).to_vec()
+        push_constants(first_pixel, self.width, self.camera)
     }
+}
+
+/// The G-buffer's words padded to whole workgroups with copies of its last pixel (the kernel has no bounds
+/// check).
+pub fn padded_words(gbuffer: &GBuffer) -> Vec<u32> {
+    let n = gbuffer.pixel_count();
+    let wg = crate::gpu::WORKGROUP as u64;
+    let per = gbuffer.words_per_pixel();
+    let mut words = gbuffer.words.clone();
+    let last = words[words.len() - per..].to_vec();
+    for _ in n..n.div_ceil(wg) * wg {
+        words.extend_from_slice(&last);
+    }
+    words
+}
+
+/// The light buffer: the lights in whole blocks, so that every dispatch's window of BLOCK_BYTES lies inside it.
+pub fn light_buffer(lights: &[f32]) -> Vec<f32> {
+    let mut light_data = lights.to_vec();
+    light_data.resize(light_blocks((lights.len() / LIGHT_FLOATS) as u32).len().max(1) * BLOCK_BYTES as usize / 4, 0.0);
+    light_data
+}
+
+/// The push constants of a dispatch over the chunk starting at pixel `first_pixel` of a picture `width`
+/// wide, with the camera's (scale x, offset x, scale y, offset y) (glsl/shade.glsl `Push`).
+pub fn push_constants(first_pixel: u64, width: u32, camera: [f32; 4]) -> Vec<u8> {
+    let words: [u32; 8] = [first_pixel as u32, width, 0, 0, camera[0].to_bits(), camera[1].to_bits(), camera[2].to_bits(), camera[3].to_bits()];
+    bytemuck::cast_slice(&words).to_vec()
 }
 
 /// The packed layout's views hold at most maxTexelBufferElements pixels each: chunks no larger.

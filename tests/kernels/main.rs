@@ -15,3 +15,4 @@ mod sources;
 mod stability;
 mod sweep;
 mod terms;
+mod translation;

@@ -1,0 +1,78 @@
+//! The translation run on the CPU: its CUDA C++ text compiled by g++ (with the host prelude) into a shared
+//! library, loaded, and every invocation of a dispatch run in order, over the same bytes the Vulkan kernel
+//! reads and writes.
+
+use super::{BindingKind, Dialect, Translation};
+use crate::brdf::Sample;
+use crate::kernels::EvalExtras;
+use anyhow::{anyhow, bail, Context, Result};
+
+/// The host compiler and its flags: precise maths (no -ffast-math), no FMA contraction beyond what the
+/// source writes.
+pub const HOST_COMPILER: &str = "g++";
+pub const HOST_FLAGS: [&str; 6] = ["-std=c++17", "-O2", "-fPIC", "-shared", "-ffp-contract=off", "-fno-strict-aliasing"];
+
+/// A translation compiled for the host.
+pub struct HostKernel {
+    // The library must be dropped before its directory.
+    lib: libloading::Library,
+    _dir: crate::cleanup::TempDir,
+    bindings: Vec<BindingKind>,
+    local_size: [u32; 3],
+}
+
+type RunFn = unsafe extern "C" fn(*const *mut u8, u32, u32, u32) -> u32;
+
+impl HostKernel {
+    pub fn compile(t: &Translation) -> Result<Self> {
+        let dir = crate::cleanup::TempDir::new().context("cannot create a temporary directory for the host build")?;
+        let src = dir.path().join("kernel.cpp");
+        let lib = dir.path().join("kernel.so");
+        std::fs::write(&src, t.source(Dialect::Host)).with_context(|| format!("cannot write {}", src.display()))?;
+        let mut cmd = crate::cleanup::command(HOST_COMPILER);
+        cmd.args(HOST_FLAGS).arg("-o").arg(&lib).arg(&src);
+        let out = crate::cleanup::output(&mut cmd).map_err(|e| anyhow!("cannot run {HOST_COMPILER} ({e}): install g++ (Debian: apt-get install g++), or run `make setup`"))?;
+        if !out.status.success() {
+            let log = String::from_utf8_lossy(&out.stderr);
+            let head: Vec<&str> = log.lines().take(20).collect();
+            bail!("{HOST_COMPILER} cannot compile the host translation (a translator defect):\n{}", head.join("\n"));
+        }
+        // SAFETY: the library is the one just built from the translation; loading runs no constructors of
+        // ours (the prelude defines none).
+        let lib = unsafe { libloading::Library::new(&lib) }.with_context(|| format!("cannot load {}", lib.display()))?;
+        Ok(HostKernel { lib, _dir: dir, bindings: t.bindings.iter().map(|b| b.kind.clone()).collect(), local_size: t.local_size })
+    }
+
+    /// Runs `groups` workgroups over `buffers` (one per binding, in the translation's binding order, push
+    /// constants last); returns the invocations' flags (1: one stopped at the host's loop limit).
+    pub fn run(&self, buffers: &mut [&mut [u8]], groups: [u32; 3]) -> Result<u32> {
+        if buffers.len() != self.bindings.len() {
+            bail!("the host kernel takes {} bindings, {} given", self.bindings.len(), buffers.len());
+        }
+        let pointers: Vec<*mut u8> = buffers.iter_mut().map(|b| b.as_mut_ptr()).collect();
+        // SAFETY: `brdfprof_host_run` is the wrapper `entry::host_wrapper` writes, with this signature; every
+        // pointer is a live buffer of the size the kernel's own bounds (its push-constant count) allow.
+        unsafe {
+            let run: libloading::Symbol<RunFn> = self.lib.get(b"brdfprof_host_run\0").context("the host build has no brdfprof_host_run")?;
+            Ok(run(pointers.as_ptr(), groups[0], groups[1], groups[2]))
+        }
+    }
+
+    pub fn local_size(&self) -> [u32; 3] {
+        self.local_size
+    }
+}
+
+/// f_s of the translated eval kernel on the host for every sample (as `kernels::eval_with` on a device).
+pub fn eval(kernel: &HostKernel, samples: &[Sample], extras: &EvalExtras) -> Result<Vec<[f32; 3]>> {
+    let mut input = crate::kernels::pack_samples(samples, extras);
+    let mut output = vec![0u8; samples.len() * 16];
+    let mut push = (samples.len() as u32).to_ne_bytes().to_vec();
+    let groups = (samples.len() as u32).div_ceil(kernel.local_size[0].max(1));
+    let flags = kernel.run(&mut [&mut input, &mut output, &mut push], [groups, 1, 1])?;
+    if flags & 1 != 0 {
+        bail!("the host run stopped an evaluation at its loop limit (2^20 iterations)");
+    }
+    let floats: Vec<f32> = bytemuck::pod_collect_to_vec(&output);
+    Ok(floats.chunks_exact(4).map(|c| [c[0], c[1], c[2]]).collect())
+}

@@ -1,0 +1,231 @@
+//! SPIR-V compute kernels translated mechanically into C dialects, so that compilers that take no Vulkan
+//! SPIR-V (NVIDIA's NVRTC/ptxas: CUDA C++; Intel's IGC: OpenCL C) compile the very kernel a Vulkan driver
+//! compiles, and so that the translation can be run on the CPU (the CUDA C++ text under g++; the OpenCL C text
+//! under PoCL) and checked against the Vulkan kernel before its cost is believed.
+//!
+//! Why from SPIR-V (and not naga's IR or the GLSL): the SPIR-V glslang emits is what every Vulkan driver
+//! compiles, specialised by spirv-opt exactly as `inspect` counts it; every result carries its type; texel
+//! buffers and the specialisation-constant operations of the fp16 kernels are representable (naga 30's
+//! SPIR-V reader refuses both); and a user's `.brdf` file reaches it through the same glslang composition as
+//! the Vulkan kernel. The control flow is kept as the SPIR-V's own block graph (labels and gotos), which C and
+//! both dialects express exactly without restructuring. What the translation cannot express is an error naming
+//! the construct, the function and, where the module has line information, the source line.
+//!
+//! One translator, three preludes (`prelude/`): the body (types, `Env`, functions) is the same text in every
+//! dialect; a dialect is its prelude (scalar types, math and buffer access) and its entry wrapper.
+
+mod body;
+mod constants;
+mod ctypes;
+mod entry;
+mod ext;
+mod module;
+mod ops;
+pub mod prepare;
+pub mod host;
+pub mod verify;
+
+pub use entry::{BindingKind, EnvBinding};
+
+use module::ModuleInfo;
+use rspirv::spirv::ImageFormat;
+use std::collections::BTreeMap;
+use std::fmt;
+
+/// The C dialects the translation is printed in.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Dialect {
+    /// CUDA C++ for NVRTC.
+    Cuda,
+    /// OpenCL C 1.2 for IGC (ocloc) and PoCL.
+    OpenCl,
+    /// The CUDA C++ text compiled for the CPU by g++, with a prelude that defines CUDA's names on the host.
+    Host,
+}
+
+impl Dialect {
+    pub fn name(self) -> &'static str {
+        match self {
+            Dialect::Cuda => "CUDA C++",
+            Dialect::OpenCl => "OpenCL C",
+            Dialect::Host => "C++ (host)",
+        }
+    }
+
+    fn prelude(self) -> &'static str {
+        match self {
+            Dialect::Cuda => include_str!("prelude/cuda.h"),
+            Dialect::OpenCl => include_str!("prelude/opencl.h"),
+            Dialect::Host => include_str!("prelude/host.h"),
+        }
+    }
+}
+
+/// The C text shared by every dialect's prelude (after the dialect's own part).
+const COMMON_PRELUDE: &str = include_str!("prelude/common.h");
+
+/// Texel formats of the texel buffers the translation reads and writes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TexelFormat {
+    Rgba32ui,
+    Rgba32f,
+    R32ui,
+    R32f,
+    R11g11b10f,
+    Rgba8,
+}
+
+impl TexelFormat {
+    pub fn from_spirv(f: ImageFormat) -> Option<Self> {
+        Some(match f {
+            ImageFormat::Rgba32ui => TexelFormat::Rgba32ui,
+            ImageFormat::Rgba32f => TexelFormat::Rgba32f,
+            ImageFormat::R32ui => TexelFormat::R32ui,
+            ImageFormat::R32f => TexelFormat::R32f,
+            ImageFormat::R11fG11fB10f => TexelFormat::R11g11b10f,
+            ImageFormat::Rgba8 => TexelFormat::Rgba8,
+            _ => return None,
+        })
+    }
+
+    /// The prelude's `tex_ld_`/`tex_st_` suffix.
+    fn suffix(self) -> &'static str {
+        match self {
+            TexelFormat::Rgba32ui => "rgba32ui",
+            TexelFormat::Rgba32f => "rgba32f",
+            TexelFormat::R32ui => "r32ui",
+            TexelFormat::R32f => "r32f",
+            TexelFormat::R11g11b10f => "r11g11b10f",
+            TexelFormat::Rgba8 => "rgba8",
+        }
+    }
+
+    /// The scalar a texel holds in the shader and how many of them.
+    fn texel(self) -> (ctypes::Scalar, u32) {
+        match self {
+            TexelFormat::Rgba32ui => (ctypes::Scalar::U32, 4),
+            TexelFormat::R32ui => (ctypes::Scalar::U32, 1),
+            TexelFormat::Rgba32f | TexelFormat::Rgba8 => (ctypes::Scalar::F32, 4),
+            TexelFormat::R32f => (ctypes::Scalar::F32, 1),
+            TexelFormat::R11g11b10f => (ctypes::Scalar::F32, 3),
+        }
+    }
+
+    /// Bytes per texel in the buffer.
+    pub fn bytes(self) -> u32 {
+        match self {
+            TexelFormat::Rgba32ui | TexelFormat::Rgba32f => 16,
+            _ => 4,
+        }
+    }
+}
+
+#[derive(Clone, Debug, Default)]
+pub struct TranslateOptions {
+    /// The view format of each sampled texel buffer, by (descriptor set, binding).
+    pub texel_formats: BTreeMap<(u32, u32), TexelFormat>,
+}
+
+/// Where in the source a construct is, from the module's OpLine.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Location {
+    pub file: String,
+    pub line: u32,
+}
+
+/// A construct the translation cannot express.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TranslateError {
+    pub construct: String,
+    /// The GLSL function it is in.
+    pub function: Option<String>,
+    pub location: Option<Location>,
+}
+
+impl TranslateError {
+    pub fn new(construct: String) -> Self {
+        TranslateError { construct, function: None, location: None }
+    }
+}
+
+impl fmt::Display for TranslateError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "the C translation cannot express {}", self.construct)?;
+        if let Some(func) = &self.function {
+            write!(f, " (in function `{func}`)")?;
+        }
+        if let Some(l) = &self.location {
+            write!(f, " at {}:{}", l.file, l.line)?;
+        }
+        Ok(())
+    }
+}
+
+impl std::error::Error for TranslateError {}
+
+/// What the kernel needs from a dialect: which optional scalar types it computes with.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Features {
+    pub f16: bool,
+    pub f64: bool,
+}
+
+/// A translated kernel: the dialect-independent body and what the wrappers need.
+#[derive(Clone, Debug)]
+pub struct Translation {
+    body: String,
+    wrappers: [String; 3],
+    pub bindings: Vec<EnvBinding>,
+    pub local_size: [u32; 3],
+    pub features: Features,
+}
+
+/// Translates a compute kernel (specialised SPIR-V words, see `prepare`).
+pub fn translate(words: &[u32], options: &TranslateOptions) -> Result<Translation, TranslateError> {
+    let m = ModuleInfo::read(words)?;
+    let layout = entry::EnvLayout::of(&m, options)?;
+    let mut body = m.type_declarations()?;
+    body += &layout.declaration(&m)?;
+    let mut prototypes = String::new();
+    let mut functions = String::new();
+    for f in &m.functions {
+        let w = body::FunctionWriter::new(&m, &layout, f);
+        let text = w.write(f)?;
+        prototypes += text.lines().next().unwrap_or_default().trim_end_matches(" {");
+        prototypes += ";\n";
+        functions += &text;
+    }
+    body += &prototypes;
+    body += &functions;
+    let wrappers = [Dialect::Cuda, Dialect::OpenCl, Dialect::Host].map(|d| layout.wrapper(&m, d, m.local_size));
+    let [cuda, opencl, host] = wrappers;
+    let features = Features {
+        f16: m.types.values().any(|t| *t == module::Type::Float { width: 16 }),
+        f64: m.types.values().any(|t| *t == module::Type::Float { width: 64 }),
+    };
+    Ok(Translation { body, wrappers: [cuda?, opencl?, host?], bindings: layout.bindings, local_size: m.local_size, features })
+}
+
+impl Translation {
+    /// The whole source in `dialect`: prelude, body, entry wrapper.
+    pub fn source(&self, dialect: Dialect) -> String {
+        let wrapper = match dialect {
+            Dialect::Cuda => &self.wrappers[0],
+            Dialect::OpenCl => &self.wrappers[1],
+            Dialect::Host => &self.wrappers[2],
+        };
+        let mut s = String::new();
+        if self.features.f64 && dialect == Dialect::OpenCl {
+            s += "#pragma OPENCL EXTENSION cl_khr_fp64 : enable\n#define BRDFPROF_F64 1\n";
+        }
+        if self.features.f16 && dialect == Dialect::OpenCl {
+            s += "#pragma OPENCL EXTENSION cl_khr_fp16 : enable\n";
+        }
+        format!("// Generated by brdfprof from SPIR-V: {}.\n{s}{}{COMMON_PRELUDE}\n// ---- the kernel ----\n{}\n{wrapper}", dialect.name(), dialect.prelude(), self.body)
+    }
+
+    /// The body alone (types, Env, functions): the same text in every dialect.
+    pub fn body(&self) -> &str {
+        &self.body
+    }
+}

@@ -1,0 +1,58 @@
+// ---- brdfprof prelude, every dialect: GLSL functions without a C library equivalent and texel formats,
+// in the C that C++, CUDA C++ and OpenCL C share. ----
+// GLSL 4.50 8.3: mod(x, y) = x - y floor(x / y).
+BRDFPROF_FN float m_glsl_mod(float x, float y) { return x - y * m_floor(m_fdiv(x, y)); }
+// GLSL 4.50 8.3: t = clamp((x - e0) / (e1 - e0), 0, 1); t t (3 - 2 t).
+BRDFPROF_FN float m_smoothstep(float e0, float e1, float x) { float t = m_fmin(m_fmax(m_fdiv(x - e0, e1 - e0), 0.0f), 1.0f); return t * t * (3.0f - 2.0f * t); }
+BRDFPROF_FN i32 m_smod(i32 a, i32 b) { i32 r = m_srem(a, b); return (r != 0 && ((r < 0) != (b < 0))) ? r + b : r; }
+BRDFPROF_FN i32 m_sabs(i32 a) { return a < 0 ? (i32)(0u - (u32)a) : a; }
+BRDFPROF_FN u32 m_umin(u32 a, u32 b) { return a < b ? a : b; }
+BRDFPROF_FN u32 m_umax(u32 a, u32 b) { return a > b ? a : b; }
+BRDFPROF_FN i32 m_smin(i32 a, i32 b) { return a < b ? a : b; }
+BRDFPROF_FN i32 m_smax(i32 a, i32 b) { return a > b ? a : b; }
+BRDFPROF_FN i32 m_findlsb(u32 x) { if (x == 0u) return -1; i32 n = 0; while ((x & 1u) == 0u) { x >>= 1; ++n; } return n; }
+BRDFPROF_FN i32 m_findumsb(u32 x) { i32 n = -1; while (x != 0u) { x >>= 1; ++n; } return n; }
+BRDFPROF_FN i32 m_findsmsb(i32 x) { return m_findumsb(x < 0 ? ~(u32)x : (u32)x); }
+
+// Unsigned 11- and 10-bit floats (Vulkan 1.3, "Unsigned 11-Bit Floating-Point Numbers"): 5-bit exponent
+// (bias 15), 6- or 5-bit mantissa; negative values and NaN's sign give 0, values past the largest finite one
+// the largest, the mantissa truncated.
+BRDFPROF_FN u32 uf_encode(float v, u32 mbits) {
+  u32 b = f32_bits(v);
+  u32 e = (b >> 23) & 255u, m = b & 0x7fffffu;
+  if (e == 255u) return m != 0u ? ((31u << mbits) | 1u) : ((b >> 31) != 0u ? 0u : (31u << mbits));
+  if ((b >> 31) != 0u || v == 0.0f) return 0u;
+  if (e > 142u) return (30u << mbits) | ((1u << mbits) - 1u);
+  if (e < 113u) return (u32)(v * f32_from_bits((u32)(127 + 14 + (i32)mbits) << 23));
+  return ((e - 112u) << mbits) | (m >> (23u - mbits));
+}
+BRDFPROF_FN float uf_decode(u32 x, u32 mbits) {
+  u32 e = x >> mbits, m = x & ((1u << mbits) - 1u);
+  if (e == 0u) return (float)m * f32_from_bits((u32)(127 - 14 - (i32)mbits) << 23);
+  if (e == 31u) return m != 0u ? f32_from_bits(0x7fc00000u) : f32_from_bits(0x7f800000u);
+  return f32_from_bits(((e + 112u) << 23) | (m << (23u - mbits)));
+}
+BRDFPROF_FN void tex_ld_r11g11b10f(GLOBAL const u8* p, u32 i, float* o) {
+  u32 t = ldro_u32(p, 4u * i);
+  o[0] = uf_decode(t & 2047u, 6u); o[1] = uf_decode((t >> 11) & 2047u, 6u); o[2] = uf_decode(t >> 22, 5u);
+}
+BRDFPROF_FN void tex_st_r11g11b10f(GLOBAL u8* p, u32 i, float r, float g, float b) {
+  st_u32(p, 4u * i, uf_encode(r, 6u) | (uf_encode(g, 6u) << 11) | (uf_encode(b, 5u) << 22));
+}
+BRDFPROF_FN void tex_ld_rgba32ui(GLOBAL const u8* p, u32 i, u32* o) { ldro4_u32(p, 16u * i, o); }
+BRDFPROF_FN void tex_st_rgba32ui(GLOBAL u8* p, u32 i, u32 a, u32 b, u32 c, u32 d) { st4_u32(p, 16u * i, a, b, c, d); }
+BRDFPROF_FN void tex_ld_rgba32f(GLOBAL const u8* p, u32 i, float* o) { ldro4_f32(p, 16u * i, o); }
+BRDFPROF_FN void tex_st_rgba32f(GLOBAL u8* p, u32 i, float a, float b, float c, float d) { st4_f32(p, 16u * i, a, b, c, d); }
+BRDFPROF_FN void tex_ld_r32ui(GLOBAL const u8* p, u32 i, u32* o) { o[0] = ldro_u32(p, 4u * i); }
+BRDFPROF_FN void tex_st_r32ui(GLOBAL u8* p, u32 i, u32 a) { st_u32(p, 4u * i, a); }
+BRDFPROF_FN void tex_ld_r32f(GLOBAL const u8* p, u32 i, float* o) { o[0] = ldro_f32(p, 4u * i); }
+BRDFPROF_FN void tex_st_r32f(GLOBAL u8* p, u32 i, float a) { st_f32(p, 4u * i, a); }
+BRDFPROF_FN void tex_ld_rgba8(GLOBAL const u8* p, u32 i, float* o) {
+  u32 t = ldro_u32(p, 4u * i);
+  for (u32 k = 0u; k < 4u; ++k) o[k] = (float)((t >> (8u * k)) & 255u) / 255.0f;
+}
+BRDFPROF_FN void tex_st_rgba8(GLOBAL u8* p, u32 i, float a, float b, float c, float d) {
+  float v[4] = {a, b, c, d}; u32 t = 0u;
+  for (u32 k = 0u; k < 4u; ++k) t |= (u32)m_rint(m_fmin(m_fmax(v[k], 0.0f), 1.0f) * 255.0f) << (8u * k);
+  st_u32(p, 4u * i, t);
+}

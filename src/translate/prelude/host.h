@@ -1,0 +1,117 @@
+// ---- brdfprof prelude: the CUDA C++ text compiled for the CPU by g++ (brdfprof runs it to check the
+// translation against the Vulkan kernel). Precise C library maths; halves as _Float16, rounded after every
+// operation as PTX's f16 instructions round. ----
+#include <cmath>
+#include <cstring>
+typedef unsigned char u8;
+typedef unsigned short u16;
+typedef unsigned int u32;
+typedef int i32;
+typedef unsigned long long u64;
+#define GLOBAL
+#define BRDFPROF_FN static inline
+// An invocation stops after 2^20 loop iterations and flags itself (lavapipe stops every loop at 65535).
+#define BRDFPROF_LOOP_LIMIT(env) (++(env)->loop_iterations > (1u << 20) && ((env)->flags |= 1u))
+
+typedef _Float16 half_t;
+BRDFPROF_FN half_t h_from_bits(u32 b) { u16 x = (u16)b; half_t h; memcpy(&h, &x, 2); return h; }
+BRDFPROF_FN u32 h_bits(half_t h) { u16 x; memcpy(&x, &h, 2); return x; }
+BRDFPROF_FN float h_to_f32(half_t h) { return (float)h; }
+BRDFPROF_FN half_t h_from_f32(float f) { return (half_t)f; }
+BRDFPROF_FN half_t h_add(half_t a, half_t b) { return (half_t)((float)a + (float)b); }
+BRDFPROF_FN half_t h_sub(half_t a, half_t b) { return (half_t)((float)a - (float)b); }
+BRDFPROF_FN half_t h_mul(half_t a, half_t b) { return (half_t)((float)a * (float)b); }
+BRDFPROF_FN half_t h_fma(half_t a, half_t b, half_t c) { return (half_t)std::fma((float)a, (float)b, (float)c); }
+BRDFPROF_FN half_t h_neg(half_t a) { return (half_t)(-(float)a); }
+BRDFPROF_FN half_t h_div(half_t a, half_t b) { return (half_t)((float)a / (float)b); }
+
+BRDFPROF_FN u32 f32_bits(float x) { u32 b; memcpy(&b, &x, 4); return b; }
+BRDFPROF_FN float f32_from_bits(u32 b) { float x; memcpy(&x, &b, 4); return x; }
+BRDFPROF_FN double f64_from_bits(u64 b) { double x; memcpy(&x, &b, 8); return x; }
+
+BRDFPROF_FN float m_fdiv(float a, float b) { return a / b; }
+BRDFPROF_FN float m_sqrt(float x) { return std::sqrt(x); }
+BRDFPROF_FN float m_rsqrt(float x) { return 1.0f / std::sqrt(x); }
+BRDFPROF_FN float m_exp(float x) { return std::exp2(x * 1.44269504f); }
+BRDFPROF_FN float m_exp2(float x) { return std::exp2(x); }
+BRDFPROF_FN float m_log(float x) { return std::log2(x) * 0.693147181f; }
+BRDFPROF_FN float m_log2(float x) { return std::log2(x); }
+BRDFPROF_FN float m_pow(float x, float y) { return std::exp2(y * std::log2(x)); }
+BRDFPROF_FN float m_sin(float x) { return std::sin(x); }
+BRDFPROF_FN float m_cos(float x) { return std::cos(x); }
+BRDFPROF_FN float m_tan(float x) { return std::tan(x); }
+BRDFPROF_FN float m_asin(float x) { return std::asin(x); }
+BRDFPROF_FN float m_acos(float x) { return std::acos(x); }
+BRDFPROF_FN float m_atan(float x) { return std::atan(x); }
+BRDFPROF_FN float m_atan2(float y, float x) { return std::atan2(y, x); }
+BRDFPROF_FN float m_sinh(float x) { return std::sinh(x); }
+BRDFPROF_FN float m_cosh(float x) { return std::cosh(x); }
+BRDFPROF_FN float m_tanh(float x) { return std::tanh(x); }
+BRDFPROF_FN float m_asinh(float x) { return std::asinh(x); }
+BRDFPROF_FN float m_acosh(float x) { return std::acosh(x); }
+BRDFPROF_FN float m_atanh(float x) { return std::atanh(x); }
+BRDFPROF_FN float m_floor(float x) { return std::floor(x); }
+BRDFPROF_FN float m_ceil(float x) { return std::ceil(x); }
+BRDFPROF_FN float m_trunc(float x) { return std::trunc(x); }
+BRDFPROF_FN float m_round(float x) { return std::round(x); }
+BRDFPROF_FN float m_rint(float x) { return std::rint(x); }
+BRDFPROF_FN float m_fabs(float x) { return std::fabs(x); }
+BRDFPROF_FN float m_fmin(float a, float b) { return std::fmin(a, b); }
+BRDFPROF_FN float m_fmax(float a, float b) { return std::fmax(a, b); }
+BRDFPROF_FN float m_fma(float a, float b, float c) { return std::fma(a, b, c); }
+BRDFPROF_FN float m_ldexp(float x, i32 e) { return std::ldexp(x, e); }
+BRDFPROF_FN float m_fmod(float a, float b) { return std::fmod(a, b); }
+BRDFPROF_FN bool m_isnan(float x) { return std::isnan(x); }
+BRDFPROF_FN bool m_isinf(float x) { return std::isinf(x); }
+BRDFPROF_FN double m_sqrt_d(double x) { return std::sqrt(x); }
+BRDFPROF_FN double m_rsqrt_d(double x) { return 1.0 / std::sqrt(x); }
+BRDFPROF_FN double m_exp_d(double x) { return std::exp(x); }
+BRDFPROF_FN double m_exp2_d(double x) { return std::exp2(x); }
+BRDFPROF_FN double m_log_d(double x) { return std::log(x); }
+BRDFPROF_FN double m_log2_d(double x) { return std::log2(x); }
+BRDFPROF_FN double m_pow_d(double x, double y) { return std::pow(x, y); }
+BRDFPROF_FN double m_sin_d(double x) { return std::sin(x); }
+BRDFPROF_FN double m_cos_d(double x) { return std::cos(x); }
+BRDFPROF_FN double m_tan_d(double x) { return std::tan(x); }
+BRDFPROF_FN double m_asin_d(double x) { return std::asin(x); }
+BRDFPROF_FN double m_acos_d(double x) { return std::acos(x); }
+BRDFPROF_FN double m_atan_d(double x) { return std::atan(x); }
+BRDFPROF_FN double m_atan2_d(double y, double x) { return std::atan2(y, x); }
+BRDFPROF_FN double m_floor_d(double x) { return std::floor(x); }
+BRDFPROF_FN double m_ceil_d(double x) { return std::ceil(x); }
+BRDFPROF_FN double m_trunc_d(double x) { return std::trunc(x); }
+BRDFPROF_FN double m_round_d(double x) { return std::round(x); }
+BRDFPROF_FN double m_rint_d(double x) { return std::rint(x); }
+BRDFPROF_FN double m_fabs_d(double x) { return std::fabs(x); }
+BRDFPROF_FN double m_fmin_d(double a, double b) { return std::fmin(a, b); }
+BRDFPROF_FN double m_fmax_d(double a, double b) { return std::fmax(a, b); }
+BRDFPROF_FN double m_fma_d(double a, double b, double c) { return std::fma(a, b, c); }
+
+// Integer division without the CPU's trap: a zero divisor gives what NVIDIA's hardware gives (all ones for
+// unsigned, -1 or 1 for signed), INT_MIN / -1 wraps.
+BRDFPROF_FN u32 m_udiv(u32 a, u32 b) { return b == 0u ? 0xffffffffu : a / b; }
+BRDFPROF_FN u32 m_umod(u32 a, u32 b) { return b == 0u ? a : a % b; }
+BRDFPROF_FN i32 m_sdiv(i32 a, i32 b) { return b == 0 ? (a < 0 ? 1 : -1) : (b == -1 ? (i32)(0u - (u32)a) : a / b); }
+BRDFPROF_FN i32 m_srem(i32 a, i32 b) { return (b == 0 || b == -1) ? (b == 0 ? a : 0) : a % b; }
+
+BRDFPROF_FN u32 ld_u32(const u8* p, u32 off) { u32 v; memcpy(&v, p + off, 4); return v; }
+BRDFPROF_FN i32 ld_i32(const u8* p, u32 off) { i32 v; memcpy(&v, p + off, 4); return v; }
+BRDFPROF_FN float ld_f32(const u8* p, u32 off) { float v; memcpy(&v, p + off, 4); return v; }
+BRDFPROF_FN half_t ld_f16(const u8* p, u32 off) { half_t v; memcpy(&v, p + off, 2); return v; }
+BRDFPROF_FN double ld_f64(const u8* p, u32 off) { double v; memcpy(&v, p + off, 8); return v; }
+#define ldro_u32 ld_u32
+#define ldro_i32 ld_i32
+#define ldro_f32 ld_f32
+#define ldro_f16 ld_f16
+#define ldro_f64 ld_f64
+BRDFPROF_FN void ld4_f32(const u8* p, u32 off, float* o) { memcpy(o, p + off, 16); }
+BRDFPROF_FN void ld4_u32(const u8* p, u32 off, u32* o) { memcpy(o, p + off, 16); }
+#define ldro4_f32 ld4_f32
+#define ldro4_u32 ld4_u32
+BRDFPROF_FN void st_u32(u8* p, u32 off, u32 v) { memcpy(p + off, &v, 4); }
+BRDFPROF_FN void st_i32(u8* p, u32 off, i32 v) { memcpy(p + off, &v, 4); }
+BRDFPROF_FN void st_f32(u8* p, u32 off, float v) { memcpy(p + off, &v, 4); }
+BRDFPROF_FN void st_f16(u8* p, u32 off, half_t v) { memcpy(p + off, &v, 2); }
+BRDFPROF_FN void st_f64(u8* p, u32 off, double v) { memcpy(p + off, &v, 8); }
+BRDFPROF_FN void st4_f32(u8* p, u32 off, float a, float b, float c, float d) { float v[4] = {a, b, c, d}; memcpy(p + off, v, 16); }
+BRDFPROF_FN void st4_u32(u8* p, u32 off, u32 a, u32 b, u32 c, u32 d) { u32 v[4] = {a, b, c, d}; memcpy(p + off, v, 16); }

@@ -1,0 +1,43 @@
+//! The SPIR-V a translation starts from: a model's kernel specialised exactly as `inspect` counts it
+//! (`inspect::spirv::specialise`: constants set and frozen, the code they do not select removed), then in SSA
+//! form with the loops its `[[unroll]]` marks unrolled (`spirv-opt --ssa-rewrite --loop-unroll`), as a Vulkan
+//! driver unrolls the light loop the hint marks. Nothing else is optimised: the target's compiler does that.
+
+use super::{translate, TexelFormat, TranslateOptions, Translation};
+use crate::gpu::SpecConstants;
+use crate::inspect::spirv;
+use crate::model::{KernelKind, Model};
+use crate::profile::gbuffer::GBufferFormat;
+use crate::profile::workload;
+use crate::shaders::Shaders;
+use anyhow::{anyhow, Result};
+
+/// spirv-opt passes after specialisation.
+pub const UNROLL_PASSES: [&str; 2] = ["--ssa-rewrite", "--loop-unroll"];
+
+/// `words` specialised with `constants` and unrolled.
+pub fn prepared(words: &[u32], constants: &SpecConstants) -> Result<Vec<u32>> {
+    let frozen = spirv::specialise(words, constants)?;
+    spirv::spirv_opt(&frozen, &UNROLL_PASSES.map(str::to_string))
+}
+
+fn translated(label: &str, words: &[u32], constants: &SpecConstants, options: &TranslateOptions) -> Result<Translation> {
+    translate(&prepared(words, constants)?, options).map_err(|e| anyhow!("{label}: {e}"))
+}
+
+/// `model`'s eval kernel (f_s per sample, glsl/eval.comp), translated.
+pub fn eval_kernel(model: &Model, shaders: &Shaders) -> Result<Translation> {
+    let k = model.kernel(KernelKind::Eval, shaders)?;
+    translated(&model.name(), &k.spirv.words, &k.constants, &TranslateOptions::default())
+}
+
+/// The profiling kernel over the packed G-buffer (glsl/shade.comp) for `model` (None: the memory-only
+/// kernel) with `lights` lights per dispatch, as `inspect` compiles it, translated.
+pub fn shade_kernel(model: Option<&Model>, lights: u32, shaders: &Shaders) -> Result<Translation> {
+    let (per_dispatch, accumulate) = workload::steady_block(lights);
+    let k = workload::shade_kernel(model, GBufferFormat::Packed, per_dispatch, accumulate, shaders)?;
+    // The G-buffer's texel view (`workload::bindings`): four 32-bit words per pixel.
+    let options = TranslateOptions { texel_formats: [((0, 0), TexelFormat::Rgba32ui)].into() };
+    let label = model.map_or_else(|| workload::BASELINE_LABEL.to_string(), Model::name);
+    translated(&label, &k.spirv.words, &k.constants, &options)
+}
