@@ -43,9 +43,41 @@ pub struct Rate {
     pub per_clock: [u32; 5],
 }
 
-/// The rows the cost model uses, as published in the CUDA C++ Programming Guide (see README, "NVIDIA
-/// targets", for the version and section); tests tie every figure to the cited table.
-pub const THROUGHPUT: &[Rate] = &[];
+/// The rows the cost model uses, with the guide's labels and figures (CUDA C++ Programming Guide v12.x,
+/// 5.4.1, for 7.5 to 9.0; CUDA C++ Best Practices Guide v13.x, 12.1.1, for 12.0; sources and their copies in
+/// docs/targets.md). `tests/fixtures/nvidia-throughput.tsv` transcribes the same table with its citation, and
+/// a test ties every entry here to it.
+pub const THROUGHPUT: &[Rate] = &[
+    Rate { row: FP16, per_clock: [128, 256, 128, 256, 128] },
+    Rate { row: FP32, per_clock: [64, 128, 128, 128, 128] },
+    Rate { row: FP64, per_clock: [2, 2, 2, 64, 2] },
+    Rate { row: MUFU, per_clock: [16, 16, 16, 16, 16] },
+    Rate { row: IADD, per_clock: [64, 64, 64, 64, 128] },
+    Rate { row: IMAD, per_clock: [64, 64, 64, 64, 64] },
+    Rate { row: SHIFT, per_clock: [64, 64, 64, 64, 64] },
+    Rate { row: CMP, per_clock: [64, 64, 64, 64, 64] },
+    Rate { row: LOGIC, per_clock: [64, 64, 64, 64, 64] },
+    Rate { row: SHUFFLE, per_clock: [32, 32, 32, 32, 32] },
+    Rate { row: CVT, per_clock: [16, 16, 16, 16, 16] },
+];
+
+const FP16: &str = "16-bit floating-point add, multiply, multiply-add";
+const FP32: &str = "32-bit floating-point add, multiply, multiply-add";
+const FP64: &str = "64-bit floating-point add, multiply, multiply-add";
+const MUFU: &str = "32-bit floating-point reciprocal, reciprocal square root, base-2 logarithm (__log2f), base 2 exponential (exp2f), sine (__sinf), cosine (__cosf)";
+const IADD: &str = "32-bit integer add, extended-precision add, subtract, extended-precision subtract";
+const IMAD: &str = "32-bit integer multiply, multiply-add, extended-precision multiply-add";
+const SHIFT: &str = "32-bit integer shift";
+const CMP: &str = "compare, minimum, maximum";
+const LOGIC: &str = "32-bit bitwise AND, OR, XOR";
+const SHUFFLE: &str = "warp shuffle";
+const CVT: &str = "all other type conversions";
+
+/// Results one instruction of a row computes per thread: the 16-bit row counts both halves of an
+/// HFMA2/HADD2/HMUL2, which the translation's scalar halves issue one instruction each for.
+fn results_per_instruction(row: &str) -> u32 {
+    if row == FP16 { 2 } else { 1 }
+}
 
 /// Instructions one SM issues per clock: four warp schedulers, one warp instruction each (Programming Guide,
 /// the compute-capability sections: "4 warp schedulers"), i.e. 128 results per clock: the rate of every
@@ -87,31 +119,26 @@ impl Class {
 /// The report class of a SASS opcode (its mnemonic before the first `.`) and the `THROUGHPUT` row it issues
 /// at (None: the issue rate).
 pub fn classify(opcode: &str) -> (Class, Option<&'static str>) {
-    const FP32: &str = "32-bit floating-point add, multiply, multiply-add";
-    const CMP: &str = "compare, minimum, maximum";
-    const CVT: &str = "all other type conversions";
     match opcode {
         "FADD" | "FMUL" | "FFMA" | "FADD32I" | "FMUL32I" | "FFMA32I" | "FSWZADD" => (Class::Fp32, Some(FP32)),
         "FMNMX" | "FSETP" | "FSET" | "FSEL" | "FCHK" => (Class::Fp32, Some(CMP)),
-        "HADD2" | "HMUL2" | "HFMA2" | "HADD2_32I" | "HMUL2_32I" | "HFMA2_32I" => (Class::Fp16, Some("16-bit floating-point add, multiply, multiply-add")),
+        "HADD2" | "HMUL2" | "HFMA2" | "HADD2_32I" | "HMUL2_32I" | "HFMA2_32I" => (Class::Fp16, Some(FP16)),
         "HSETP2" | "HSET2" | "HMNMX2" => (Class::Fp16, Some(CMP)),
-        "DADD" | "DMUL" | "DFMA" => (Class::Fp64, Some("64-bit floating-point add, multiply, multiply-add")),
+        "DADD" | "DMUL" | "DFMA" => (Class::Fp64, Some(FP64)),
         "DSETP" | "DMNMX" => (Class::Fp64, Some(CMP)),
-        "MUFU" => (Class::Mufu, Some("32-bit floating-point reciprocal, reciprocal square root, base-2 logarithm (__log2f), base 2 exponential (exp2f), sine (__sinf), cosine (__cosf)")),
-        "IADD3" | "IADD" | "IADD32I" | "VIADD" | "LEA" | "IABS" => (Class::Integer, Some("32-bit integer add, extended-precision add, subtract, extended-precision subtract")),
-        "IMAD" | "IMUL" | "IMAD32I" | "IMUL32I" | "IMADSP" | "XMAD" | "IDP" | "IDP4A" => (Class::Integer, Some("32-bit integer multiply, multiply-add, extended-precision multiply-add")),
-        "SHF" | "SHL" | "SHR" => (Class::Integer, Some("32-bit integer shift")),
+        "MUFU" => (Class::Mufu, Some(MUFU)),
+        "IADD3" | "IADD" | "IADD32I" | "VIADD" | "LEA" | "IABS" => (Class::Integer, Some(IADD)),
+        "IMAD" | "IMUL" | "IMAD32I" | "IMUL32I" | "IMADSP" | "XMAD" => (Class::Integer, Some(IMAD)),
+        "SHF" | "SHL" | "SHR" => (Class::Integer, Some(SHIFT)),
         "ISETP" | "IMNMX" | "VIMNMX" | "ISET" | "ICMP" => (Class::Integer, Some(CMP)),
-        "LOP3" | "LOP" | "LOP32I" => (Class::Integer, Some("32-bit bitwise AND, OR, XOR")),
-        "BREV" => (Class::Integer, Some("32-bit integer bit reverse")),
-        "BFE" | "BFI" | "SGXT" | "BMSK" => (Class::Integer, Some("Bit field extract/insert")),
-        "FLO" => (Class::Integer, Some("count of leading zeros, most significant non-sign bit")),
-        "POPC" => (Class::Integer, Some("population count")),
-        "SHFL" => (Class::Move, Some("warp shuffle")),
+        "LOP3" | "LOP" | "LOP32I" => (Class::Integer, Some(LOGIC)),
+        "SHFL" => (Class::Move, Some(SHUFFLE)),
         "F2F" | "F2I" | "I2F" | "I2FP" | "F2FP" | "F2IP" | "FRND" | "I2I" | "I2IP" => (Class::Conversion, Some(CVT)),
-        op if op.starts_with("LD") || op.starts_with("ST") || op.starts_with("ATOM") || op.starts_with("RED") || op.starts_with("TEX") || op.starts_with("TLD") || op.starts_with("SU") || op.starts_with("ULDC") => (Class::Memory, None),
+        op if ["LD", "ST", "ATOM", "RED", "TEX", "TLD", "SULD", "SUST", "ULDC"].iter().any(|p| op.starts_with(p)) => (Class::Memory, None),
         "BRA" | "BRX" | "JMP" | "JMX" | "EXIT" | "RET" | "CALL" | "BSSY" | "BSYNC" | "BREAK" | "BMOV" | "BPT" | "WARPSYNC" | "BAR" | "YIELD" | "KILL" | "NANOSLEEP" => (Class::Control, None),
-        op if op.starts_with('U') => (Class::Integer, None),
+        // The uniform datapath's own instructions (UIADD3, ULOP3, UMOV, ...) and bit operations the table
+        // has no row for: the issue rate.
+        op if op.starts_with('U') || ["BREV", "BMSK", "SGXT", "FLO", "POPC", "IDP", "IDP4A"].contains(&op) => (Class::Integer, None),
         _ => (Class::Move, None),
     }
 }
@@ -191,7 +218,8 @@ impl SassStats {
             if per_clock == 0 {
                 bail!("`{}` has no native throughput on {}", row.unwrap_or("?"), family.name);
             }
-            cycles += f64::from(*n) * 32.0 / f64::from(per_clock.min(ISSUE_PER_CLOCK));
+            let results = row.map_or(1, results_per_instruction);
+            cycles += f64::from(*n) * 32.0 * f64::from(results) / f64::from(per_clock.min(ISSUE_PER_CLOCK * results));
         }
         Ok(cycles)
     }
@@ -253,4 +281,102 @@ pub fn compile(source: &str, family: &Family, precise: bool) -> Result<Sass> {
     let compiled = tools.compile(source, "brdfprof_kernel.cu", &options(family, precise))?;
     let listing = tools.disassemble(&compiled.cubin)?;
     Ok(Sass { listing, log: compiled.log, cubin_bytes: compiled.cubin.len() })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The transcription of NVIDIA's table with its citation (tests/fixtures/nvidia-throughput.tsv).
+    fn fixture() -> Vec<(String, Vec<u32>)> {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/nvidia-throughput.tsv");
+        std::fs::read_to_string(path)
+            .unwrap()
+            .lines()
+            .filter(|l| !l.starts_with('#') && !l.trim().is_empty())
+            .map(|l| {
+                let mut f = l.split('\t');
+                let row = f.next().unwrap().to_string();
+                (row, f.map(|x| x.trim().parse().unwrap()).collect())
+            })
+            .collect()
+    }
+
+    #[test]
+    fn every_throughput_entry_is_the_cited_tables() {
+        let cited = fixture();
+        let rows: Vec<&(String, Vec<u32>)> = cited.iter().filter(|(r, _)| r != "ratio").collect();
+        assert_eq!(rows.len(), THROUGHPUT.len(), "one entry per transcribed row");
+        for r in THROUGHPUT {
+            let (_, figures) = rows.iter().find(|(label, _)| label == r.row).unwrap_or_else(|| panic!("`{}` is not a row of the cited table", r.row));
+            assert_eq!(&r.per_clock[..], &figures[..], "{}", r.row);
+        }
+        // 64-bit floating point is the 32-bit rate over the guide's FP32:FP64 ratio (its Table 30).
+        let ratio = &cited.iter().find(|(r, _)| r == "ratio").unwrap().1;
+        for k in 0..COLUMNS.len() {
+            assert_eq!(rate(FP64, &FAMILIES[k]).unwrap() * ratio[k], rate(FP32, &FAMILIES[k]).unwrap(), "column {}", COLUMNS[k]);
+        }
+        for (k, f) in FAMILIES.iter().enumerate() {
+            assert_eq!(format!("{}.{}", f.compute_capability.0, f.compute_capability.1), COLUMNS[f.column], "{}", f.name);
+            assert_eq!(f.column, k);
+        }
+    }
+
+    #[test]
+    fn every_row_an_opcode_issues_at_is_in_the_table() {
+        for op in ["FFMA", "FMNMX", "HFMA2", "HSETP2", "DFMA", "MUFU", "IADD3", "IMAD", "SHF", "ISETP", "LOP3", "SHFL", "F2F", "I2FP"] {
+            let (_, row) = classify(op);
+            let row = row.unwrap_or_else(|| panic!("{op} has no row"));
+            assert!(THROUGHPUT.iter().any(|r| r.row == row), "{op}: `{row}`");
+        }
+        assert_eq!(classify("LDG"), (Class::Memory, None));
+        assert_eq!(classify("BSSY"), (Class::Control, None));
+        assert_eq!(classify("UIADD3"), (Class::Integer, None));
+        assert_eq!(classify("MOV"), (Class::Move, None));
+    }
+
+    const LISTING: &str = "
+        .text.brdfprof_kernel:
+        /*0000*/                   MOV R1, c[0x0][0x28] ;
+        /*0010*/                   S2R R0, SR_TID.X ;
+        /*0020*/                   FFMA R2, R3, R4, R5 ;
+        /*0030*/                   FMUL.FTZ R2, R2, R2 ;
+        /*0040*/               @P0 MUFU.RSQ R6, R2 ;
+        /*0050*/                   HFMA2 R7, R7.H0_H0, R7.H0_H0, R7.H0_H0 ;
+        /*0060*/                   IMAD.MOV.U32 R8, RZ, RZ, R9 ;
+        /*0070*/                   F2F.F16.F32 R10, R2 ;
+        /*0080*/                   LDG.E.CONSTANT R4, [R2.64] ;
+        /*0090*/                   STG.E [R2.64], R5 ;
+        /*00a0*/                   EXIT ;
+        /*00b0*/                   BRA `(.L_x_0);
+        /*00c0*/                   NOP;
+    ";
+    const LOG: &str = "ptxas info    : Compiling entry function 'brdfprof_kernel' for 'sm_89'\nptxas info    : Function properties for brdfprof_kernel\nptxas         .     16 bytes stack frame, 8 bytes spill stores, 4 bytes spill loads\nptxas info    : Used 40 registers, used 0 barriers, 384 bytes cmem[0]\n";
+
+    #[test]
+    fn sass_is_counted_to_the_last_exit_and_costed_by_hand() {
+        let s = SassStats::of(LISTING, LOG, 3000);
+        assert_eq!(s.instructions, 11, "the padding branch and NOP after EXIT are not counted");
+        assert_eq!((s.registers, s.stack_bytes, s.spill_bytes, s.cubin_bytes), (40, 16, 12, 3000));
+        let class = |c: Class| s.by_class.get(&c).copied().unwrap_or(0);
+        assert_eq!((class(Class::Fp32), class(Class::Mufu), class(Class::Fp16), class(Class::Integer), class(Class::Conversion), class(Class::Memory), class(Class::Control), class(Class::Move)), (2, 1, 1, 1, 1, 2, 1, 2));
+        // sm_89 (8.9): per warp, 32 lanes x results / rate: FFMA, FMUL 2 x 32/128; MUFU 32/16; HFMA2 32 x 2/128;
+        // IMAD 32/64; F2F 32/16; MOV, S2R, LDG, STG, EXIT at the issue rate, 5 x 32/128.
+        let by_hand = 2.0 * 0.25 + 2.0 + 0.5 + 0.5 + 2.0 + 5.0 * 0.25;
+        assert_eq!(s.issue_cycles(&FAMILIES[2]).unwrap(), by_hand);
+        // sm_75: FP32 at 64, FP16 at 128 results.
+        assert_eq!(s.issue_cycles(&FAMILIES[0]).unwrap(), 2.0 * 0.5 + 2.0 + 0.5 + 0.5 + 2.0 + 5.0 * 0.25);
+    }
+
+    #[test]
+    fn occupancy_follows_the_register_file() {
+        let at = |registers: u32, family: usize| SassStats { registers, ..Default::default() }.warps_per_sm(&FAMILIES[family]);
+        // 40 registers: 1280 per warp, 51 warps of registers, 50 in whole 64-thread workgroups; 48 at most on 8.9.
+        assert_eq!(at(40, 2), 48);
+        assert_eq!(at(40, 3), 50);
+        assert_eq!(at(40, 0), 32);
+        // 128 registers: 4096 per warp, 16 warps.
+        assert_eq!(at(128, 3), 16);
+        assert_eq!(at(255, 3), 8, "255 registers round up to 8192 per warp");
+    }
 }

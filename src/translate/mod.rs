@@ -23,6 +23,7 @@ mod module;
 mod ops;
 pub mod prepare;
 pub mod host;
+pub mod opencl;
 pub mod verify;
 
 pub use entry::{BindingKind, EnvBinding};

@@ -150,3 +150,30 @@ fn the_translated_profiling_kernel_shades_as_the_vulkan_one_and_the_check_catche
     assert!(worst > 1e3 * 1e-4, "ggx's translation against blinn's kernel differs by only {worst:.2e}");
     common::assert_no_validation_messages(&gpu);
 }
+
+#[test]
+fn the_opencl_translation_on_pocl_agrees_with_vulkan_on_every_preset_and_example_file() {
+    use brdfprof::translate::opencl;
+    let gpu = common::gpu();
+    let samples = well_conditioned(100_000, 13, 0.05, 0.2..1.0);
+    let mut report = Vec::new();
+    let mut unexplained = Vec::new();
+    let models: Vec<Model> = PRESETS.iter().map(|p| Model::parse(p.name).unwrap()).chain(examples()).collect();
+    for model in &models {
+        let t = prepare::eval_kernel(model, kernels::embedded()).unwrap();
+        let k = opencl::ClKernel::build(&t, true).unwrap_or_else(|e| panic!("{model}: {e:#}"));
+        let on_cl = opencl::eval(&k, &samples, &EvalExtras::default()).unwrap();
+        let on_device = kernels::eval(&gpu, model, &samples, RunLimits::default()).unwrap();
+        // The native_ forms the Intel figures are compiled with are PoCL's own approximations: within the
+        // runtime check's tolerance.
+        let fast = opencl::eval(&opencl::ClKernel::build(&t, false).unwrap(), &samples, &EvalExtras::default()).unwrap();
+        let fast_worst = verify::worst_relative(&fast, &on_device, |i, c| f64::from(on_device[i][c]).abs().max(1e-3));
+        assert!(fast_worst <= 1e-4, "{model}: the native_ build differs by {fast_worst:.2e}");
+        let judge = if model.twin().is_some() { model.clone() } else { twin_of_example(model).unwrap_or_else(|| model.clone()) };
+        let o = compare(&judge, &samples, &on_cl, &on_device);
+        report.push(format!("{:60} worst {:.2e} ({} of {} beyond {AGREEMENT:.0e}; native_ build {fast_worst:.2e}) on {}", model.short_name(), o.worst, o.over, 3 * samples.len(), k.device));
+        unexplained.extend(o.unexplained);
+    }
+    println!("{}", report.join("\n"));
+    assert!(unexplained.is_empty(), "{} values beyond {AGREEMENT:.0e}:\n{}", unexplained.len(), unexplained.iter().take(10).cloned().collect::<Vec<_>>().join("\n"));
+}

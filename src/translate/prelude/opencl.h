@@ -44,6 +44,9 @@ BRDFPROF_FN double f64_from_bits(u64 b) { return as_double(b); }
 #endif
 
 #ifdef BRDFPROF_PRECISE
+// The precise build (PoCL's check of the translation): no contraction into FMA either (OpenCL C contracts by
+// default, as a Vulkan driver may).
+#pragma OPENCL FP_CONTRACT OFF
 BRDFPROF_FN float m_fdiv(float a, float b) { return a / b; }
 BRDFPROF_FN float m_sqrt(float x) { return sqrt(x); }
 BRDFPROF_FN float m_rsqrt(float x) { return rsqrt(x); }
