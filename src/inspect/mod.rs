@@ -126,11 +126,9 @@ fn ordered_columns(rows: &[Row], emitted: &[String]) -> Vec<String> {
     columns
 }
 
-/// One kernel's SPIR-V, naga and driver statistics (None: the baseline kernel).
-fn kernel_row(gpu: &Gpu, shaders: &Shaders, model: Option<&Model>, lights: u32) -> Result<Row> {
-    if let Some(m) = model {
-        m.check_support(&gpu.info)?;
-    }
+/// One kernel's device-independent statistics (None: the baseline kernel): SPIR-V and naga counts, and the
+/// kernel's hash.
+pub fn static_row(shaders: &Shaders, model: Option<&Model>, lights: u32) -> Result<Row> {
     let mut row = Row {
         model: model.map_or_else(|| BASELINE_LABEL.to_string(), Model::name),
         spec: model.map(Model::canonical),
@@ -142,31 +140,81 @@ fn kernel_row(gpu: &Gpu, shaders: &Shaders, model: Option<&Model>, lights: u32) 
     let float_kernel = shade_kernel(model, GBufferFormat::Float, per_dispatch, accumulate, shaders)?;
     row.notes.insert(crate::compare::HASH_NOTE.into(), crate::compare::kernel_hash(model, GBufferFormat::Packed, shaders)?);
     static_stats(&kernel, &float_kernel, &mut row)?;
+    Ok(row)
+}
+
+/// One kernel's SPIR-V, naga and driver statistics (None: the baseline kernel).
+fn kernel_row(gpu: &Gpu, shaders: &Shaders, model: Option<&Model>, lights: u32) -> Result<Row> {
+    if let Some(m) = model {
+        m.check_support(&gpu.info)?;
+    }
+    let mut row = static_row(shaders, model, lights)?;
+    let (per_dispatch, accumulate) = steady_block(lights);
+    let kernel = shade_kernel(model, GBufferFormat::Packed, per_dispatch, accumulate, shaders)?;
     driver_stats(gpu, &kernel, &mut row)?;
     Ok(row)
 }
 
-/// Runs every analysis for every model and the baseline kernel.
-pub fn run(gpu: &Gpu, shaders: &Shaders, options: &InspectOptions) -> Result<InspectReport> {
-    let mut all: Vec<Option<&Model>> = options.models.iter().map(Some).collect();
+/// The models' kernels and then the memory-only one (None).
+pub fn kernels_of(models: &[Model]) -> Vec<Option<&Model>> {
+    let mut all: Vec<Option<&Model>> = models.iter().map(Some).collect();
     all.push(None);
-    let mut rows = all.into_iter().map(|model| kernel_row(gpu, shaders, model, options.lights)).collect::<Result<Vec<_>>>()?;
-    // Column order: the SPIR-V counts in their own order (total, functions, classes, instructions by name),
-    // then the other keys (a row's map is sorted by key).
+    all
+}
+
+/// Statistic keys in the order rows give them (the SPIR-V counts first, in their own order), after filling
+/// in the SPIR-V classes and extended instructions a kernel lacks as 0.
+fn emitted_keys(rows: &mut [Row]) -> Vec<String> {
     let mut emitted: Vec<String> = Vec::new();
-    for row in &rows {
+    for row in rows.iter() {
         for key in spirv_key_order(row).into_iter().chain(row.stats.keys().cloned()) {
             if !emitted.contains(&key) {
                 emitted.push(key);
             }
         }
     }
-    // A class or an extended instruction that a kernel lacks counts 0 there.
     for key in emitted.iter().filter(|k| k.starts_with("spirv")) {
-        for row in &mut rows {
+        for row in rows.iter_mut() {
             row.stats.entry(key.clone()).or_insert(0.0);
         }
     }
+    emitted
+}
+
+/// The tools every report names: spirv-opt, and glslang when the kernels were compiled at run time.
+fn tool_versions(shaders: &Shaders) -> BTreeMap<String, String> {
+    let mut tools = BTreeMap::new();
+    tools.insert("spirv-opt".into(), spirv::spirv_opt_version().unwrap_or_else(|| "not found".into()));
+    if shaders.glsl_dir().is_some() {
+        tools.insert("glslang".into(), crate::shaders::glslang_version().unwrap_or_else(|| "not found".into()));
+    }
+    tools
+}
+
+/// The report of a compile-only target that compiles in this process (no Vulkan device of its own): the
+/// static rows with the target compiler's statistics added under `driver/`, nothing executed.
+pub fn compiled_report(mut rows: Vec<Row>, provenance: serde_json::Value, lights: u32, shaders: &Shaders, mut tools: BTreeMap<String, String>, section_notes: BTreeMap<String, String>) -> InspectReport {
+    let emitted = emitted_keys(&mut rows);
+    tools.extend(tool_versions(shaders));
+    InspectReport {
+        provenance,
+        kernels: shaders.describe(),
+        lights,
+        tools,
+        columns: ordered_columns(&rows, &emitted),
+        rows,
+        section_notes,
+        callgrind: None,
+        callgrind_setup: BTreeMap::new(),
+        vs_profile: None,
+        aco: None,
+    }
+}
+
+/// Runs every analysis for every model and the baseline kernel.
+pub fn run(gpu: &Gpu, shaders: &Shaders, options: &InspectOptions) -> Result<InspectReport> {
+    let mut rows = kernels_of(&options.models).into_iter().map(|model| kernel_row(gpu, shaders, model, options.lights)).collect::<Result<Vec<_>>>()?;
+    let mut emitted = emitted_keys(&mut rows);
     let mut section_notes = BTreeMap::new();
     if !gpu.info.pipeline_executable_properties {
         section_notes.insert(
@@ -174,11 +222,7 @@ pub fn run(gpu: &Gpu, shaders: &Shaders, options: &InspectOptions) -> Result<Ins
             format!("not available on this device ({} has no VK_KHR_pipeline_executable_properties)", gpu.info.name),
         );
     }
-    let mut tools = BTreeMap::new();
-    tools.insert("spirv-opt".into(), spirv::spirv_opt_version().unwrap_or_else(|| "not found".into()));
-    if shaders.glsl_dir().is_some() {
-        tools.insert("glslang".into(), crate::shaders::glslang_version().unwrap_or_else(|| "not found".into()));
-    }
+    let mut tools = tool_versions(shaders);
     let mut callgrind_setup = BTreeMap::new();
     let callgrind = measure_callgrind(gpu, shaders, options, &mut rows, &mut section_notes, &mut callgrind_setup);
     if let Some(v) = callgrind_setup.get("valgrind") {

@@ -380,3 +380,92 @@ mod tests {
         assert_eq!(at(255, 3), 8, "255 registers round up to 8192 per warp");
     }
 }
+
+/// The device name of a family's reports.
+pub fn device_name(family: &Family) -> String {
+    format!("NVIDIA {} ({}), compile-only", family.name, family.architecture)
+}
+
+/// What a compile-only run compiles.
+pub struct Request<'a> {
+    pub models: &'a [crate::model::Model],
+    pub lights: u32,
+    pub shaders: &'a crate::shaders::Shaders,
+    /// Writes each kernel's CUDA C++ and SASS under DIR/nvidia-<family>/.
+    pub isa_dir: Option<&'a std::path::Path>,
+    /// Compiles with NVRTC's IEEE defaults instead of -use_fast_math.
+    pub precise: bool,
+    /// The Vulkan device the translations are checked against before any cost is reported.
+    pub verify_on: &'a crate::gpu::Gpu,
+}
+
+/// One kernel's translation, checked, ready for every family.
+struct Checked {
+    source: String,
+    agreement: String,
+}
+
+fn check_translations(req: &Request) -> Result<Vec<Checked>> {
+    crate::inspect::kernels_of(req.models)
+        .into_iter()
+        .map(|m| {
+            let agreements = crate::translate::verify::check(req.verify_on, m, req.lights, req.shaders)?;
+            let source = crate::translate::prepare::shade_kernel(m, req.lights, req.shaders)?.source(crate::translate::Dialect::Cuda);
+            let agreement = agreements.iter().map(|a| format!("{} {:.1e} (tolerance {:.0e})", a.kernel, a.worst, a.tolerance)).collect::<Vec<_>>().join(", ");
+            Ok(Checked { source, agreement: format!("translation checked on the host against {}: worst relative difference {agreement}", req.verify_on.info.name) })
+        })
+        .collect()
+}
+
+/// Every kernel (the models' and the memory-only one) compiled by NVIDIA's compiler for each family, as
+/// `inspect` reports (one per family, in order), after each translation agreed with its Vulkan kernel.
+pub fn inspect(families: &[&Family], req: &Request) -> Result<Vec<crate::inspect::InspectReport>> {
+    let tools = nvrtc::tools()?;
+    let checked = check_translations(req)?;
+    let statics = crate::inspect::kernels_of(req.models).into_iter().map(|m| crate::inspect::static_row(req.shaders, m, req.lights)).collect::<Result<Vec<_>>>()?;
+    let jobs: Vec<(usize, usize)> = (0..families.len()).flat_map(|f| (0..checked.len()).map(move |k| (f, k))).collect();
+    // NVRTC compiles distinct programs concurrently (its API is thread-safe); one job per core.
+    use rayon::prelude::*;
+    let (sources, precise): (Vec<&str>, bool) = (checked.iter().map(|c| c.source.as_str()).collect(), req.precise);
+    let compiled = jobs.par_iter().map(|&(f, k)| compile(sources[k], families[f], precise)).collect::<Result<Vec<_>>>()?;
+    let mut reports = Vec::new();
+    for (f, family) in families.iter().enumerate() {
+        let mut rows = statics.clone();
+        for (k, row) in rows.iter_mut().enumerate() {
+            let sass = &compiled[f * checked.len() + k];
+            let stats = SassStats::of(&sass.listing, &sass.log, sass.cubin_bytes);
+            row.stats.extend(crate::inspect::driver::stats(&stats.driver_stats(family)?));
+            row.notes.insert("translation".into(), checked[k].agreement.clone());
+            if let Some(dir) = req.isa_dir {
+                write_isa(dir, family, &row.model, &checked[k].source, sass)?;
+            }
+        }
+        reports.push(report(family, rows, tools, req));
+    }
+    Ok(reports)
+}
+
+/// Writes the kernel's CUDA C++ translation and its SASS to DIR/nvidia-<family>/<kernel>.{cu,sass}.
+fn write_isa(dir: &std::path::Path, family: &Family, label: &str, source: &str, sass: &Sass) -> Result<()> {
+    let dir = dir.join(format!("nvidia-{}", family.name));
+    std::fs::create_dir_all(&dir).map_err(|e| anyhow::anyhow!("--isa: cannot create {}: {e}", dir.display()))?;
+    let stem = crate::inspect::radv::file_slug(label);
+    crate::io::write_output(&dir.join(format!("{stem}.cu")), source.as_bytes())?;
+    crate::io::write_output(&dir.join(format!("{stem}.sass")), format!("// {label}: SASS for {} by {}\n{}\n{}", family.name, nvrtc::tools()?.version, sass.log.trim(), sass.listing).as_bytes())
+}
+
+fn report(family: &Family, rows: Vec<crate::inspect::Row>, tools: &nvrtc::Tools, req: &Request) -> crate::inspect::InspectReport {
+    let options = options(family, req.precise).join(" ");
+    let provenance = serde_json::json!({
+        "tool": format!("brdfprof {}", env!("CARGO_PKG_VERSION")),
+        "device": {"name": device_name(family), "driver_name": "NVRTC", "driver_info": format!("{} ({options})", tools.version), "driver_version": tools.version},
+        "target": format!("nvidia:{}", family.name),
+        "compiler": {"name": tools.version, "options": options, "translation": "brdfprof's SPIR-V to CUDA C++ translation"},
+        "host_cpu": crate::host::HostCpu::detect().describe(),
+    });
+    let mut notes = std::collections::BTreeMap::new();
+    notes.insert("driver/".into(), format!("NVIDIA's CUDA compiler ({}, ptxas) on the kernels' CUDA C++ translation, same maths; options: {options}", tools.version));
+    notes.insert("callgrind/".into(), format!("not applicable: nvidia:{} compiles only, nothing executes", family.name));
+    let tool_list = [("nvrtc".to_string(), tools.version.clone())].into();
+    crate::inspect::compiled_report(rows, provenance, req.lights, req.shaders, tool_list, notes)
+}
