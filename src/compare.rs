@@ -5,7 +5,7 @@
 //! whose kernels differ (each report records a SHA-256 of every model's kernel: SPIR-V and the
 //! specialisation constants that select the model).
 
-use crate::inspect::{self, InspectReport};
+use crate::inspect::InspectReport;
 use crate::model::Model;
 use crate::profile::gbuffer::GBufferFormat;
 use crate::profile::workload::{shade_kernel, BASELINE_LABEL};
@@ -85,13 +85,13 @@ fn device_name(report: &InspectReport) -> String {
 pub fn inspect_columns(report: &InspectReport, source: &str) -> Vec<CostColumn> {
     let mut out = Vec::new();
     let device = device_name(report);
-    if let Some(aco) = report.aco.clone().or_else(|| inspect::aco::table(report)) {
+    if let Some(cost) = report.cost.clone().or_else(|| crate::targets::cost_of(report)) {
         out.push(CostColumn {
-            name: format!("{} cycles/eval", aco.family.clone().unwrap_or_else(|| device.clone())),
-            unit: "ACO SIMD cycles per evaluation".into(),
+            name: cost.column_name(),
+            unit: format!("{} {} per evaluation ({})", cost.compiler, cost.unit, cost.model),
             source: format!("{source}{device}, {}", report.provenance["device"]["driver_info"].as_str().unwrap_or("?")),
-            gross: aco.rows.iter().map(|r| (r.model.clone(), r.cycles_per_eval)).collect(),
-            net: aco.rows.iter().filter_map(|r| r.net_cycles_per_eval.map(|n| (r.model.clone(), n))).collect(),
+            gross: cost.rows.iter().map(|r| (r.model.clone(), r.cycles_per_eval)).collect(),
+            net: cost.rows.iter().filter_map(|r| r.net_cycles_per_eval.map(|n| (r.model.clone(), n))).collect(),
             net_ci: BTreeMap::new(),
             hashes: hashes(report),
             lights: report.lights,

@@ -20,7 +20,7 @@ pub mod shaders;
 pub mod stability;
 pub mod stats;
 pub mod sweep;
-pub mod sweep_aco;
+pub mod sweep_cost;
 pub mod targets;
 pub mod translate;
 pub mod scene;

@@ -83,7 +83,7 @@ fn main() -> ExitCode {
         Command::Scene(args) => cli::scene::scene(&args),
         Command::Render(args) => cli::scene::render(&args),
         Command::CallgrindChild { request } => brdfprof::inspect::callgrind::child_main(&request).map(|_| ExitCode::SUCCESS),
-        Command::RadvChild { request } => brdfprof::inspect::radv::child_main(&request).map(|_| ExitCode::SUCCESS),
+        Command::RadvChild { request } => brdfprof::targets::radv_child::child_main(&request).map(|_| ExitCode::SUCCESS),
         Command::GenerateGlsl { dir } => cli::info::generate_glsl(&dir),
     };
     // An interrupted command ends with the signal handler's exit status, not its own.

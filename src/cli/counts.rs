@@ -1,9 +1,8 @@
 //! `brdfprof inspect` and `check`: instruction counts of the kernels, and the regression gate on them.
 
 use super::{check_output, fresh_compilation, on_device_with, parse_size, DeviceArgs, ModelArgs};
-use brdfprof::compare;
-use brdfprof::gpu::targets;
-use brdfprof::inspect::InspectReport;
+use brdfprof::gpu::Gpu;
+use brdfprof::inspect::devices;
 use anyhow::{anyhow, bail, Result};
 use brdfprof::brdf::THESIS_MODELS;
 use brdfprof::inspect::callgrind::CallgrindOptions;
@@ -64,13 +63,15 @@ pub struct InspectArgs {
     /// evaluation, with their rank correlation, and its ns/eval to the cost table across devices.
     #[arg(long)]
     pub profile: Option<PathBuf>,
-    /// Write each kernel's ACO disassembly (and RADV's other internal representations: NIR, ACO IR) to
-    /// DIR/<family>/<kernel>.<representation>.txt, for every `--device radv:FAMILY`.
+    /// Write each kernel's compiler output for every compile-only target: RADV's internal representations
+    /// (NIR, ACO IR, disassembly) to DIR/<family>/<kernel>.<representation>.txt; NVIDIA's CUDA C++
+    /// translation and SASS to DIR/nvidia-<family>/<kernel>.{cu,sass}.
     #[arg(long)]
     pub isa: Option<PathBuf>,
-    /// Device, repeatable: an index or name substring (see `brdfprof devices`), or `radv:FAMILY` (Mesa RADV's
-    /// compiler for an AMD family, no AMD GPU needed; `radv:all` for the default set; see `devices
-    /// --targets`). Default: the first discrete or integrated GPU, else lavapipe.
+    /// Device, repeatable: an index or name substring (see `brdfprof devices`), or a compile-only target
+    /// (`radv:FAMILY`: Mesa RADV's compiler for an AMD family; `nvidia:FAMILY`: NVIDIA's compiler for a compute
+    /// capability; `PREFIX:all` for the default set; see `devices --targets`). Default: the first discrete or
+    /// integrated GPU, else lavapipe.
     #[arg(long = "device", value_name = "DEVICE", value_parser = super::device_name)]
     pub devices: Vec<String>,
     /// Run under the Khronos validation layer and fail on any message (also BRDFPROF_VALIDATION=1).
@@ -79,74 +80,10 @@ pub struct InspectArgs {
     /// Inspect the default sweep's specs (`brdfprof sweep`'s 61) instead of the thesis models.
     #[arg(long, conflicts_with = "models")]
     pub sweep_specs: bool,
-}
-
-/// What one `--device` stands for.
-enum Planned {
-    Local(Option<String>),
-    Radv(&'static targets::Target),
-}
-
-/// The devices in the order given (a target named twice is measured once).
-fn plan_devices(devices: &[String]) -> Result<Vec<Planned>> {
-    if devices.is_empty() {
-        return Ok(vec![Planned::Local(None)]);
-    }
-    let mut out: Vec<Planned> = Vec::new();
-    for d in devices {
-        match targets::parse(d).map_err(|e| anyhow!("--device {d}: {e:#}"))? {
-            Some(ts) => {
-                for t in ts {
-                    if !out.iter().any(|p| matches!(p, Planned::Radv(x) if *x == t)) {
-                        out.push(Planned::Radv(t));
-                    }
-                }
-            }
-            None => out.push(Planned::Local(Some(d.clone()))),
-        }
-    }
-    Ok(out)
-}
-
-/// The devices' reports for `inspect`, in order: local devices in this process, compile-only targets in
-/// children (several at once).
-fn inspect_reports(args: &InspectArgs, plan: &[Planned], options: &InspectOptions, shaders: &Shaders, validate: bool) -> Result<Vec<InspectReport>> {
-    let radv: Vec<&'static targets::Target> = plan.iter().filter_map(|p| if let Planned::Radv(t) = p { Some(*t) } else { None }).collect();
-    let mut radv_runs = inspect::radv::run_all(&radv, &options.models, options.lights, shaders, validate, args.isa.as_deref())?.into_iter();
-    let mut reports = Vec::new();
-    for p in plan {
-        match p {
-            Planned::Local(device) => {
-                let device = DeviceArgs { device: device.clone(), validate };
-                let (_, result) = on_device_with(&device, true, |gpu, _| inspect::run(gpu, shaders, options))?;
-                reports.push(result);
-            }
-            Planned::Radv(_) => {
-                let run = radv_runs.next().expect("one run per target");
-                let mut report = run.report;
-                if let Some(note) = run.teardown_note {
-                    eprintln!("brdfprof inspect: note: {note}");
-                    report.section_notes.insert("driver/".into(), note);
-                }
-                if !run.isa_files.is_empty() {
-                    eprintln!("brdfprof inspect: radv:{}: {} ISA files under {}", run.target.family, run.isa_files.len(), args.isa.as_deref().map_or(String::new(), |d| d.join(run.target.family).display().to_string()));
-                }
-                reports.push(report);
-            }
-        }
-    }
-    Ok(reports)
-}
-
-/// The JSON of `inspect` over several devices.
-#[derive(serde::Serialize)]
-struct MultiReport<'a> {
-    format: &'static str,
-    reports: &'a [InspectReport],
-    costs: &'a compare::CostTable,
-    /// Why a `--profile` report is not in the cost table, if it is not.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    profile_note: Option<String>,
+    /// Compile-only targets that translate the kernels compile them with their IEEE-exact defaults instead of
+    /// the precision freedom a Vulkan driver has (NVIDIA: without -use_fast_math).
+    #[arg(long)]
+    pub precise_math: bool,
 }
 
 pub fn inspect(args: &InspectArgs) -> Result<ExitCode> {
@@ -154,15 +91,14 @@ pub fn inspect(args: &InspectArgs) -> Result<ExitCode> {
     if lights == 0 {
         bail!("--lights must be at least 1");
     }
-    let validate = args.validate || std::env::var("BRDFPROF_VALIDATION").is_ok_and(|v| !v.is_empty() && v != "0");
-    let plan = plan_devices(&args.devices)?;
-    let several = plan.len() > 1;
-    let default_name = if several { "inspect-devices" } else { "inspect-<device>" };
+    let validate = DeviceArgs { device: None, validate: args.validate }.validation();
+    let plan = devices::plan(&args.devices)?;
+    let default_name = if plan.len() > 1 { "inspect-devices" } else { "inspect-<device>" };
     check_output("--json", args.json.as_deref(), "results", &format!("{default_name}.json"))?;
     check_output("--markdown", args.markdown.as_deref(), "results", &format!("{default_name}.md"))?;
     if let Some(dir) = &args.isa {
-        if !plan.iter().any(|p| matches!(p, Planned::Radv(_))) {
-            bail!("--isa {}: the disassembly is ACO's; give a compile-only device, e.g. --device radv:navi21 (see `brdfprof devices --targets`)", dir.display());
+        if !plan.iter().any(|p| matches!(p, devices::Planned::Target(_))) {
+            bail!("--isa {}: the listings are a compile-only target's; give one, e.g. --device radv:navi21 or nvidia:sm_89 (see `brdfprof devices --targets`)", dir.display());
         }
         io::check_output_dir("--isa", dir)?;
     }
@@ -170,76 +106,28 @@ pub fn inspect(args: &InspectArgs) -> Result<ExitCode> {
     let options = InspectOptions { models, lights, callgrind: args.counts.callgrind(validate)? };
     let profile = args.profile.as_deref().map(inspect::correlate::load_profile).transpose()?;
     let shaders = args.counts.shaders()?;
-    let mut reports = inspect_reports(args, &plan, &options, &shaders, validate)?;
-    if let Some(p) = &profile {
-        for r in reports.iter_mut().filter(|r| r.callgrind.is_some()) {
-            r.vs_profile = Some(inspect::correlate::correlate_with(r, p)?);
-        }
-    }
-    let (json, markdown, text) = if !several {
-        let result = &reports[0];
-        let slug = result.provenance["device"]["name"].as_str().map(device_slug_of).unwrap_or_else(|| "device".into());
-        let json = args.json.clone().unwrap_or_else(|| PathBuf::from(format!("results/inspect-{slug}.json")));
-        let markdown = args.markdown.clone().unwrap_or_else(|| PathBuf::from(format!("results/inspect-{slug}.md")));
-        let text = format!("# brdfprof inspect\n\n{}\n\n{}", result.summary(), result.markdown());
-        report::write_json(&json, result)?;
-        (json, markdown, text)
-    } else {
-        let mut columns: Vec<compare::CostColumn> = Vec::new();
-        let mut profile_note = None;
-        if let Some(p) = &profile {
-            let cols = compare::profile_columns(&p.json, &format!("{}: ", p.file))?;
-            let mut all = cols.clone();
-            all.extend(reports.iter().flat_map(|r| compare::inspect_columns(r, "")));
-            match compare::check_kernels(&all) {
-                Ok(()) => columns.extend(cols),
-                Err(e) => profile_note = Some(format!("--profile {} is not in the cost table: {e:#}", p.file)),
-            }
-        }
-        for r in &reports {
-            columns.extend(compare::inspect_columns(r, ""));
-        }
-        let costs = compare::build(columns);
-        let mut text = String::from("# brdfprof inspect\n\n");
-        for r in &reports {
-            text += &format!("## {}\n\n{}\n\n", r.provenance["device"]["name"].as_str().unwrap_or("?"), r.summary());
-            match &r.aco {
-                // A compile-only device's SPIR-V and naga counts are the other devices' (same kernels): its
-                // ACO table is what it adds; the JSON has everything.
-                Some(a) if targets::family_of_device(&a.device).is_some() => {
-                    text += &a.markdown();
-                    text += "\n";
-                    if let Some(n) = r.section_notes.get("driver/") {
-                        text += &format!("{n}\n\n");
-                    }
-                }
-                _ => text += &r.markdown(),
-            }
-        }
-        text += &costs.markdown();
-        if let Some(n) = &profile_note {
-            text += &format!("{n}\n");
-        }
-        let json = args.json.clone().unwrap_or_else(|| PathBuf::from("results/inspect-devices.json"));
-        let markdown = args.markdown.clone().unwrap_or_else(|| PathBuf::from("results/inspect-devices.md"));
-        report::write_json(&json, &MultiReport { format: "brdfprof-inspect-devices/1", reports: &reports, costs: &costs, profile_note })?;
-        (json, markdown, text)
+    // A named device may be a compile-only one (RADV's null device); the default device verifies translations.
+    let local = |device: Option<&str>, work: &mut dyn FnMut(&Gpu) -> Result<()>| -> Result<()> {
+        let d = DeviceArgs { device: device.map(str::to_string), validate };
+        on_device_with(&d, device.is_some(), |gpu, _| work(gpu)).map(|_| ())
     };
-    io::write_output(&markdown, text.as_bytes())?;
-    print!("{text}");
+    let run = devices::Run { options: &options, shaders: &shaders, validate, isa_dir: args.isa.as_deref(), precise: args.precise_math };
+    let result = devices::inspect(&plan, &run, &local, profile.as_ref())?;
+    let (json, markdown) = match &result.multi {
+        None => {
+            let slug = devices::slug(&result.reports[0]);
+            (args.json.clone().unwrap_or_else(|| PathBuf::from(format!("results/inspect-{slug}.json"))), args.markdown.clone().unwrap_or_else(|| PathBuf::from(format!("results/inspect-{slug}.md"))))
+        }
+        Some(_) => (args.json.clone().unwrap_or_else(|| PathBuf::from("results/inspect-devices.json")), args.markdown.clone().unwrap_or_else(|| PathBuf::from("results/inspect-devices.md"))),
+    };
+    match &result.multi {
+        None => report::write_json(&json, &result.reports[0])?,
+        Some(m) => report::write_json(&json, m)?,
+    }
+    io::write_output(&markdown, result.markdown.as_bytes())?;
+    print!("{}", result.markdown);
     println!("JSON: {}\nMarkdown: {}", json.display(), markdown.display());
     Ok(ExitCode::SUCCESS)
-}
-
-/// `report::device_slug` of a device name.
-fn device_slug_of(name: &str) -> String {
-    if let Some(t) = targets::family_of_device(name) {
-        return format!("radv-{}", t.family);
-    }
-    let first = name.split(['(', ',']).next().unwrap_or("device").trim().to_lowercase();
-    let slug: String = first.chars().map(|c| if c.is_ascii_alphanumeric() { c } else { '-' }).collect();
-    let slug = slug.trim_matches('-').to_string();
-    if slug.is_empty() { "device".into() } else { slug }
 }
 
 #[derive(Args)]
@@ -295,9 +183,13 @@ pub fn check(args: &CheckArgs) -> Result<ExitCode> {
         timing: TimingOptions { width, height, lights: 0, rounds: args.rounds, reps: args.reps, seed: 1 },
     };
     let shaders = args.counts.shaders()?;
-    let outcome = match args.device.device.as_deref().map(targets::parse).transpose()?.flatten() {
-        Some(ts) if ts.len() == 1 => check::run_radv(&options, &shaders, ts[0], args.device.validation())?,
-        Some(_) => bail!("--device {}: check compares one family with its baseline; give one radv:FAMILY", args.device.device.as_deref().unwrap_or_default()),
+    let outcome = match args.device.device.as_deref().map(brdfprof::targets::parse).transpose()?.flatten() {
+        Some(ts) if ts.len() == 1 => {
+            // A target that compiles a translation checks it against the default device first.
+            let verify = if ts[0].vendor.needs_verification() { Some(DeviceArgs { device: None, validate: args.device.validate }.open()?) } else { None };
+            check::run_target(&options, &shaders, ts[0], args.device.validation(), verify.as_ref())?
+        }
+        Some(_) => bail!("--device {}: check compares one family with its baseline; give one target, e.g. radv:navi21", args.device.device.as_deref().unwrap_or_default()),
         None => check::run(&options, &shaders, || args.device.open_with(true))?,
     };
     print!("{}", outcome.text);

@@ -10,24 +10,25 @@ use std::process::ExitCode;
 
 #[derive(Args)]
 pub struct DevicesArgs {
-    /// List the compile-only AMD targets (`--device radv:FAMILY`) instead: Mesa RADV's compiler for GPU
-    /// families this machine does not have.
+    /// List the compile-only targets (`--device radv:FAMILY`, `nvidia:FAMILY`) instead: each vendor's compiler
+    /// for GPU families this machine does not have.
     #[arg(long)]
     pub targets: bool,
 }
 
-/// `devices --targets`: the family table (`gpu::targets::TARGETS`).
+/// `devices --targets`: every vendor's families (`targets::VENDORS`) and whether its compiler is installed.
 fn targets_table() -> String {
-    let mut t = report::Table::new(["--device", "GFX", "architecture", "products", "compute wave size", "in radv:all"]);
-    for x in &gpu::targets::TARGETS {
-        t.row([format!("radv:{}", x.family), x.gfx.into(), x.architecture.into(), x.products.into(), x.wave_size.to_string(), if x.default { "yes".into() } else { String::new() }]);
+    let mut out = String::from("Compile-only targets: each vendor's production compiler for GPU families this machine does not have (no GPU \
+         needed; nothing executes). Commands that compile take them: inspect, check, sweep --cost-device.\n\n");
+    for v in brdfprof::targets::VENDORS {
+        let status = v.status().unwrap_or_else(|e| format!("{e:#}"));
+        let mut t = report::Table::new(["--device", "architecture", "products", "compiler", &format!("in {}:all", v.prefix())]);
+        for f in v.families() {
+            t.row([format!("{}:{}", v.prefix(), f.name), f.architecture.into(), f.products.into(), f.detail, if f.default { "yes".into() } else { String::new() }]);
+        }
+        out += &format!("## {}\n\n{}\n\nCompiler: {status}\n\n{}\n", v.prefix(), v.title(), t.markdown());
     }
-    format!(
-        "Compile-only AMD targets: brdfprof runs Mesa RADV's ACO compiler for these families in a child process with \
-         RADV_FORCE_FAMILY set (no AMD GPU needed; nothing executes). Commands that compile take them: inspect, check, \
-         sweep --cost-device.\n\n{}",
-        t.markdown()
-    )
+    out
 }
 
 pub fn devices(args: &DevicesArgs) -> Result<ExitCode> {

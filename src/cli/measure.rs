@@ -109,8 +109,9 @@ pub struct SweepArgs {
     /// (its GPU values). Built-in specs are always measured against their own exact model.
     #[arg(long, default_value = "ggx")]
     pub reference: String,
-    /// Also draw the table, JSON and Pareto chart with ACO's cycles per evaluation for this AMD family as the
-    /// cost (radv:FAMILY or radv:all, repeatable; see `devices --targets`): sweep-<device>-aco-<family>.*.
+    /// Also draw the table, JSON and Pareto chart with a compile-only target's modelled cycles per evaluation
+    /// as the cost (radv:FAMILY, nvidia:FAMILY, PREFIX:all; repeatable; see `devices --targets`):
+    /// sweep-<device>-<compiler>-<family>.* (aco, ptxas).
     #[arg(long = "cost-device", value_name = "DEVICE", value_parser = super::device_name)]
     pub cost_devices: Vec<String>,
     #[command(flatten)]
@@ -118,11 +119,11 @@ pub struct SweepArgs {
 }
 
 /// The compile-only targets of `--cost-device`, in order, each once.
-fn cost_targets(devices: &[String]) -> Result<Vec<&'static brdfprof::gpu::targets::Target>> {
-    let mut out: Vec<&'static brdfprof::gpu::targets::Target> = Vec::new();
+fn cost_targets(devices: &[String]) -> Result<Vec<brdfprof::targets::Target>> {
+    let mut out: Vec<brdfprof::targets::Target> = Vec::new();
     for d in devices {
-        let Some(ts) = brdfprof::gpu::targets::parse(d)? else {
-            anyhow::bail!("--cost-device {d}: give a compile-only AMD target, radv:FAMILY or radv:all (see `brdfprof devices --targets`); the sweep's own --device times the specs");
+        let Some(ts) = brdfprof::targets::parse(d)? else {
+            anyhow::bail!("--cost-device {d}: give a compile-only target ({}FAMILY or PREFIX:all; see `brdfprof devices --targets`); the sweep's own --device times the specs", brdfprof::targets::prefixes());
         };
         for t in ts {
             if !out.contains(&t) {
@@ -136,7 +137,7 @@ fn cost_targets(devices: &[String]) -> Result<Vec<&'static brdfprof::gpu::target
 pub fn sweep(args: &SweepArgs) -> Result<ExitCode> {
     io::check_output_dir("--out", &args.out)?;
     let cost_targets = cost_targets(&args.cost_devices)?;
-    if let Some(d) = args.device.device.as_deref().filter(|d| brdfprof::gpu::targets::is_compile_only(d)) {
+    if let Some(d) = args.device.device.as_deref().filter(|d| brdfprof::targets::is_compile_only(d)) {
         return Err(super::compiles_only_error(d));
     }
     fresh_compilation(args.timing.shader_cache);
@@ -147,20 +148,24 @@ pub fn sweep(args: &SweepArgs) -> Result<ExitCode> {
     }
     let options = sweep::SweepOptions { profile: args.timing.options(models, &args.size, args.reps, args.budget, args.target_ci)?, reference };
     let shaders = options.profile.glsl.as_deref().map(brdfprof::shaders::Shaders::from_glsl).transpose()?.unwrap_or_else(brdfprof::shaders::Shaders::embedded);
-    // ACO's figures first (seconds): a missing RADV fails before the long measurement.
     let validate = args.device.validation();
-    let aco = brdfprof::inspect::radv::run_all(&cost_targets, &options.profile.models, options.profile.lights[0], &shaders, validate, None)?;
-    let (gpu, result) = on_device(&args.device, |gpu, progress| sweep::run(gpu, &options, progress))?;
+    let (gpu, (result, costs)) = on_device(&args.device, |gpu, progress| {
+        // The targets' figures first (seconds): a missing compiler fails before the long measurement.
+        let request = brdfprof::targets::Request { models: &options.profile.models, lights: options.profile.lights[0], shaders: &shaders, validate, isa_dir: None, precise: false, verify_on: Some(gpu) };
+        let costs = brdfprof::targets::compile_all(&cost_targets, &request)?;
+        Ok((sweep::run(gpu, &options, progress)?, costs))
+    })?;
     let slug = report::device_slug(&gpu.info);
     let mut files = result.write(&args.out, &slug)?;
     print!("{}", result.markdown());
-    for run in &aco {
-        let table = run.report.aco.clone().ok_or_else(|| anyhow::anyhow!("radv:{}: the driver reported no ACO statistics", run.target.family))?;
-        let driver = run.report.provenance["device"]["driver_info"].as_str().unwrap_or("?").to_string();
-        let note = run.report.section_notes.get("driver/").map(String::as_str);
-        let sweep_aco = brdfprof::sweep_aco::build(&result, run.target, &table, &driver, note)?;
-        files.extend(sweep_aco.write(&args.out.join(format!("sweep-{slug}-aco-{}", run.target.family)))?);
-        print!("\n{}", sweep_aco.markdown());
+    for run in &costs {
+        let name = run.target.name();
+        let table = run.report.cost.clone().ok_or_else(|| anyhow::anyhow!("{name}: the compiler reported no statistics the cost model reads"))?;
+        let note = run.report.section_notes.get("driver/").map(String::as_str).filter(|n| n.starts_with("not compiled"));
+        let swept = brdfprof::sweep_cost::build(&result, &name, &table, note)?;
+        let family = table.family.clone().unwrap_or_else(|| name.replace(':', "-"));
+        files.extend(swept.write(&args.out.join(format!("sweep-{slug}-{}-{family}", table.compiler.to_ascii_lowercase())))?);
+        print!("\n{}", swept.markdown());
     }
     println!("\n{}", written(&files));
     Ok(ExitCode::SUCCESS)

@@ -9,7 +9,8 @@ pub mod measure;
 pub mod scene;
 
 use anyhow::{anyhow, bail, Result};
-use brdfprof::gpu::{targets, Gpu, GpuOptions};
+use brdfprof::gpu::{Gpu, GpuOptions};
+use brdfprof::targets;
 use brdfprof::io;
 use brdfprof::model::{self, Model};
 use brdfprof::profile::protocol::ProtocolOptions;
@@ -31,7 +32,7 @@ pub struct DeviceArgs {
 }
 
 /// `--device`: an empty or blank name would match every device (a substring of each), so it is refused; a
-/// `radv:FAMILY` must name known families (`gpu::targets`).
+/// compile-only target must name known families (`targets`).
 pub fn device_name(text: &str) -> Result<String, String> {
     if text.trim().is_empty() {
         return Err("empty; give an index or a name substring (see `brdfprof devices`)".into());
@@ -43,9 +44,10 @@ pub fn device_name(text: &str) -> Result<String, String> {
 /// The error of a command that must execute kernels given a compile-only device.
 pub fn compiles_only_error(device: &str) -> anyhow::Error {
     anyhow!(
-        "--device {device}: a compile-only device (RADV's null device: Mesa's AMD compiler without an AMD GPU) compiles only \
-         and cannot run kernels; this command must execute them. Use `inspect`, `check` or `sweep --cost-device` with it, \
-         and a device from `brdfprof devices` here"
+        "--device {device}: a compile-only device ({}: a vendor's compiler without its GPU) compiles only and cannot run \
+         kernels; this command must execute them. Use `inspect`, `check` or `sweep --cost-device` with it, and a device \
+         from `brdfprof devices` here",
+        targets::prefixes()
     )
 }
 
@@ -56,14 +58,13 @@ impl DeviceArgs {
     }
 
     /// Opens the device for a command that executes kernels: a compile-only device is refused.
-    #[allow(dead_code)]
     pub fn open(&self) -> Result<Gpu> {
         self.open_with(false)
     }
 
     /// Opens the device; `compile_only_ok`: the command only compiles (inspect, check), so RADV's null device
-    /// (the user's own RADV_FORCE_FAMILY and an explicit `--device`) will do. `radv:` is never opened here: the
-    /// commands that take it run it in a child (`inspect::radv`).
+    /// (the user's own RADV_FORCE_FAMILY and an explicit `--device`) will do. A compile-only target is never
+    /// opened here: the commands that take it compile through `targets`.
     pub fn open_with(&self, compile_only_ok: bool) -> Result<Gpu> {
         if self.device.as_deref().is_some_and(|d| d.trim().is_empty()) {
             bail!("--device: empty; give an index or a name substring (see `brdfprof devices`)");

@@ -4,7 +4,6 @@
 mod driver_stats;
 mod kernel;
 mod memory;
-pub mod targets;
 mod timing;
 
 pub use driver_stats::{DriverStat, PipelineExecutable};

@@ -4,13 +4,12 @@
 //! CPU instructions its JIT code executes per BRDF evaluation (callgrind). `check` turns these counts (and
 //! a short timing run) into a regression gate against a saved baseline.
 
-pub mod aco;
 pub mod callgrind;
 pub mod check;
 pub mod correlate;
+pub mod devices;
 pub mod driver;
 pub mod naga_info;
-pub mod radv;
 pub mod spirv;
 pub mod timing;
 
@@ -79,9 +78,10 @@ pub struct InspectReport {
     /// Callgrind figures next to a profile's timings (`inspect --profile FILE`).
     #[serde(default)]
     pub vs_profile: Option<correlate::Correlation>,
-    /// ACO's statistics and cycles per evaluation, where the driver is RADV (`aco::table`).
+    /// The compiler's cost model applied to the kernels (`targets::cost_of`: ACO's on RADV, NVIDIA's issue
+    /// model on `nvidia:` targets), where the device's statistics have one.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub aco: Option<aco::AcoTable>,
+    pub cost: Option<crate::targets::cost::TargetCost>,
 }
 
 /// SPIR-V statistics of one specialised kernel, and naga's of `naga_kernel` (the same BRDF over the float
@@ -207,7 +207,7 @@ pub fn compiled_report(mut rows: Vec<Row>, provenance: serde_json::Value, lights
         callgrind: None,
         callgrind_setup: BTreeMap::new(),
         vs_profile: None,
-        aco: None,
+        cost: None,
     }
 }
 
@@ -244,9 +244,9 @@ pub fn run(gpu: &Gpu, shaders: &Shaders, options: &InspectOptions) -> Result<Ins
         callgrind,
         callgrind_setup,
         vs_profile: None,
-        aco: None,
+        cost: None,
     };
-    report.aco = aco::table(&report);
+    report.cost = crate::targets::cost_of(&report);
     Ok(report)
 }
 
@@ -346,7 +346,7 @@ impl InspectReport {
             out += &t.markdown();
             out += "\n";
         }
-        if let Some(a) = &self.aco {
+        if let Some(a) = &self.cost {
             out += &a.markdown();
             out += "\n";
         }
@@ -360,5 +360,27 @@ impl InspectReport {
     pub fn summary(&self) -> String {
         let device = self.provenance["device"]["name"].as_str().unwrap_or("?");
         format!("{device}; shade kernel, {} lights; SPIR-V {}; tools: {}", self.lights, self.kernels, self.tools.iter().map(|(k, v)| format!("{k} = {v}")).collect::<Vec<_>>().join(", "))
+    }
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+
+    /// A report of `device` with no rows, for tests of what reads reports.
+    pub fn empty_report(device: &str) -> InspectReport {
+        InspectReport {
+            provenance: serde_json::json!({"device": {"name": device}}),
+            kernels: String::new(),
+            lights: 8,
+            tools: BTreeMap::new(),
+            columns: vec![],
+            rows: vec![],
+            section_notes: BTreeMap::new(),
+            callgrind: None,
+            callgrind_setup: BTreeMap::new(),
+            vs_profile: None,
+            cost: None,
+        }
     }
 }

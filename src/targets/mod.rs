@@ -1,4 +1,195 @@
-//! Compile-only targets: GPU families whose production compiler brdfprof runs without the GPU.
+//! Compile-only targets: GPU families whose production compiler brdfprof runs without the GPU, one `Vendor`
+//! each (`radv`: Mesa RADV's ACO in a child process; `nvidia`: NVRTC and ptxas on the kernels' CUDA C++
+//! translation), listed once in `VENDORS`. A target is `--device PREFIX:FAMILY` (or `PREFIX:all`, or
+//! `PREFIX:a,b`); `devices --targets`, `inspect`, `check`, `sweep --cost-device` and `compare` reach the vendors
+//! only through this module: a vendor is its families, how it compiles every kernel for them (an `inspect`
+//! report per family, with its compiler's statistics under `driver/`), its cost model (`cost`), and what its
+//! statistics depend on (the gate's fingerprint).
 
+pub mod cost;
 pub mod nvidia;
 pub mod nvrtc;
+pub mod radv;
+pub mod radv_child;
+
+use crate::gpu::Gpu;
+use crate::inspect::InspectReport;
+use crate::model::Model;
+use crate::shaders::Shaders;
+use anyhow::{anyhow, bail, Result};
+use cost::TargetCost;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// One family of a vendor, as the tables and `devices --targets` show it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Family {
+    /// The name after the prefix (`navi21`, `sm_89`).
+    pub name: &'static str,
+    pub architecture: &'static str,
+    pub products: &'static str,
+    /// What else identifies it (`GFX10.3, wave64`; `compute capability 8.9`).
+    pub detail: String,
+    /// In `PREFIX:all`.
+    pub default: bool,
+}
+
+/// What a compile-only run compiles.
+pub struct Request<'a> {
+    pub models: &'a [Model],
+    pub lights: u32,
+    pub shaders: &'a Shaders,
+    pub validate: bool,
+    /// Writes each kernel's compiler output under DIR/<vendor>-<family>/ (RADV: DIR/<family>/).
+    pub isa_dir: Option<&'a Path>,
+    /// The target's IEEE-exact maths instead of the precision freedom a Vulkan driver has (where the vendor
+    /// distinguishes them).
+    pub precise: bool,
+    /// The Vulkan device translations are checked against before their cost is reported (vendors that
+    /// compile a translation need one).
+    pub verify_on: Option<&'a Gpu>,
+}
+
+/// One family's result.
+pub struct Run {
+    pub target: Target,
+    pub report: InspectReport,
+    pub isa_files: Vec<PathBuf>,
+    /// Something the user should know about how the run went (a child that crashed after its report).
+    pub note: Option<String>,
+}
+
+/// A vendor's compile-only targets.
+pub trait Vendor: Sync {
+    /// The `--device` prefix, without the colon.
+    fn prefix(&self) -> &'static str;
+    /// The GPU vendor ("AMD").
+    fn name(&self) -> &'static str;
+    /// One line: the vendor and its compiler, how brdfprof runs it.
+    fn title(&self) -> &'static str;
+    fn families(&self) -> Vec<Family>;
+    /// The compiler's name and version, or an error saying how to install it.
+    fn status(&self) -> Result<String>;
+    /// Whether `compile` needs `Request::verify_on` (it compiles a translation that must run first).
+    fn needs_verification(&self) -> bool;
+    /// Every kernel (the models' and the memory-only one) compiled for each of `families` (indices into
+    /// `families()`), in order.
+    fn compile(&self, families: &[usize], request: &Request) -> Result<Vec<Run>>;
+    /// The cost table of a report whose statistics are this vendor's, None for any other report.
+    fn cost(&self, report: &InspectReport) -> Option<TargetCost>;
+    /// The family a report of this vendor's compile-only targets was made for.
+    fn family_of(&self, report: &InspectReport) -> Option<usize>;
+    /// What the report's compiler statistics depend on: the gate compares them only where this is the same.
+    fn fingerprint(&self, report: &InspectReport) -> BTreeMap<String, String>;
+}
+
+/// Every vendor: the one list (a new compiler lands here and in its own file).
+pub static VENDORS: [&dyn Vendor; 2] = [&radv::RADV, &nvidia::NVIDIA];
+
+/// One family of one vendor.
+#[derive(Clone, Copy)]
+pub struct Target {
+    pub vendor: &'static dyn Vendor,
+    pub family: usize,
+}
+
+impl PartialEq for Target {
+    fn eq(&self, other: &Self) -> bool {
+        self.vendor.prefix() == other.vendor.prefix() && self.family == other.family
+    }
+}
+
+impl std::fmt::Debug for Target {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.name())
+    }
+}
+
+impl Target {
+    pub fn info(&self) -> Family {
+        self.vendor.families().swap_remove(self.family)
+    }
+
+    /// `radv:navi21`.
+    pub fn name(&self) -> String {
+        format!("{}:{}", self.vendor.prefix(), self.info().name)
+    }
+}
+
+/// `all`, after a prefix: the vendor's default set.
+pub const ALL: &str = "all";
+
+fn vendor_of(device: &str) -> Option<(&'static dyn Vendor, &str)> {
+    let (prefix, rest) = device.trim().split_once(':')?;
+    VENDORS.iter().copied().find(|v| v.prefix().eq_ignore_ascii_case(prefix.trim())).map(|v| (v, rest))
+}
+
+/// Whether a `--device` value names compile-only targets.
+pub fn is_compile_only(device: &str) -> bool {
+    vendor_of(device).is_some()
+}
+
+/// Every prefix, for messages: "radv:, nvidia:".
+pub fn prefixes() -> String {
+    VENDORS.iter().map(|v| format!("{}:", v.prefix())).collect::<Vec<_>>().join(", ")
+}
+
+/// The targets a `--device PREFIX:FAMILY[,FAMILY...]` (or `PREFIX:all`) names; None for any other device.
+pub fn parse(device: &str) -> Result<Option<Vec<Target>>> {
+    let Some((vendor, rest)) = vendor_of(device) else { return Ok(None) };
+    let families = vendor.families();
+    let known = || format!("{} (or `{}:{ALL}` for {})", families.iter().map(|f| f.name).collect::<Vec<_>>().join(", "), vendor.prefix(), families.iter().filter(|f| f.default).map(|f| f.name).collect::<Vec<_>>().join(", "));
+    if rest.trim().is_empty() {
+        bail!("`{device}`: give a family after `{}:`; known: {}", vendor.prefix(), known());
+    }
+    let mut out: Vec<Target> = Vec::new();
+    for name in rest.split(',').map(str::trim) {
+        let found: Vec<usize> = if name.eq_ignore_ascii_case(ALL) {
+            (0..families.len()).filter(|&k| families[k].default).collect()
+        } else {
+            vec![families.iter().position(|f| f.name.eq_ignore_ascii_case(name)).ok_or_else(|| anyhow!("unknown {} family `{name}`; known: {}", vendor.name(), known()))?]
+        };
+        for family in found {
+            let t = Target { vendor, family };
+            if !out.contains(&t) {
+                out.push(t);
+            }
+        }
+    }
+    Ok(Some(out))
+}
+
+/// Compiles for every target, vendor by vendor, each vendor's families at once; results in `targets` order.
+pub fn compile_all(targets: &[Target], request: &Request) -> Result<Vec<Run>> {
+    let mut runs: Vec<Option<Run>> = targets.iter().map(|_| None).collect();
+    for vendor in VENDORS {
+        let mine: Vec<usize> = (0..targets.len()).filter(|&k| targets[k].vendor.prefix() == vendor.prefix()).collect();
+        if mine.is_empty() {
+            continue;
+        }
+        if vendor.needs_verification() && request.verify_on.is_none() {
+            bail!("{}: its costs are of a translation that must first run against a Vulkan device, and none was opened", vendor.prefix());
+        }
+        let families: Vec<usize> = mine.iter().map(|&k| targets[k].family).collect();
+        for (k, run) in mine.into_iter().zip(vendor.compile(&families, request)?) {
+            runs[k] = Some(run);
+        }
+    }
+    Ok(runs.into_iter().map(|r| r.expect("every target compiled")).collect())
+}
+
+/// The compile-only target a report was made for, if any.
+pub fn of_report(report: &InspectReport) -> Option<Target> {
+    VENDORS.iter().find_map(|v| v.family_of(report).map(|family| Target { vendor: *v, family }))
+}
+
+/// The cost table of a report: its vendor's model applied to its statistics (a real RADV GPU's too).
+pub fn cost_of(report: &InspectReport) -> Option<TargetCost> {
+    VENDORS.iter().find_map(|v| v.cost(report))
+}
+
+/// File-name form of a kernel label.
+pub fn file_slug(label: &str) -> String {
+    let s: String = label.chars().map(|c| if c.is_ascii_alphanumeric() || c == '.' { c.to_ascii_lowercase() } else { '-' }).collect();
+    s.trim_matches('-').to_string()
+}

@@ -6,7 +6,9 @@
 //! maths" figures: NVIDIA's Vulkan driver compiles SPIR-V with its own front end, and no public comparison of
 //! the two exists.
 
-use super::nvrtc;
+use super::cost::{self, TargetCost};
+use super::{nvrtc, Request, Run, Target};
+use crate::inspect::InspectReport;
 use crate::gpu::DriverStat;
 use anyhow::{bail, Result};
 use std::collections::BTreeMap;
@@ -386,42 +388,30 @@ pub fn device_name(family: &Family) -> String {
     format!("NVIDIA {} ({}), compile-only", family.name, family.architecture)
 }
 
-/// What a compile-only run compiles.
-pub struct Request<'a> {
-    pub models: &'a [crate::model::Model],
-    pub lights: u32,
-    pub shaders: &'a crate::shaders::Shaders,
-    /// Writes each kernel's CUDA C++ and SASS under DIR/nvidia-<family>/.
-    pub isa_dir: Option<&'a std::path::Path>,
-    /// Compiles with NVRTC's IEEE defaults instead of -use_fast_math.
-    pub precise: bool,
-    /// The Vulkan device the translations are checked against before any cost is reported.
-    pub verify_on: &'a crate::gpu::Gpu,
-}
-
 /// One kernel's translation, checked, ready for every family.
 struct Checked {
     source: String,
     agreement: String,
 }
 
-fn check_translations(req: &Request) -> Result<Vec<Checked>> {
+fn check_translations(req: &Request, gpu: &crate::gpu::Gpu) -> Result<Vec<Checked>> {
     crate::inspect::kernels_of(req.models)
         .into_iter()
         .map(|m| {
-            let agreements = crate::translate::verify::check(req.verify_on, m, req.lights, req.shaders)?;
+            let agreements = crate::translate::verify::check(gpu, m, req.lights, req.shaders)?;
             let source = crate::translate::prepare::shade_kernel(m, req.lights, req.shaders)?.source(crate::translate::Dialect::Cuda);
             let agreement = agreements.iter().map(|a| format!("{} {:.1e} (tolerance {:.0e})", a.kernel, a.worst, a.tolerance)).collect::<Vec<_>>().join(", ");
-            Ok(Checked { source, agreement: format!("translation checked on the host against {}: worst relative difference {agreement}", req.verify_on.info.name) })
+            Ok(Checked { source, agreement: format!("translation checked on the host against {}: worst relative difference {agreement}", gpu.info.name) })
         })
         .collect()
 }
 
 /// Every kernel (the models' and the memory-only one) compiled by NVIDIA's compiler for each family, as
 /// `inspect` reports (one per family, in order), after each translation agreed with its Vulkan kernel.
-pub fn inspect(families: &[&Family], req: &Request) -> Result<Vec<crate::inspect::InspectReport>> {
+pub fn inspect(families: &[&Family], req: &Request) -> Result<Vec<InspectReport>> {
     let tools = nvrtc::tools()?;
-    let checked = check_translations(req)?;
+    let gpu = req.verify_on.ok_or_else(|| anyhow::anyhow!("nvidia: no Vulkan device to check the translation against"))?;
+    let checked = check_translations(req, gpu)?;
     let statics = crate::inspect::kernels_of(req.models).into_iter().map(|m| crate::inspect::static_row(req.shaders, m, req.lights)).collect::<Result<Vec<_>>>()?;
     let jobs: Vec<(usize, usize)> = (0..families.len()).flat_map(|f| (0..checked.len()).map(move |k| (f, k))).collect();
     // NVRTC compiles distinct programs concurrently (its API is thread-safe); one job per core.
@@ -449,12 +439,12 @@ pub fn inspect(families: &[&Family], req: &Request) -> Result<Vec<crate::inspect
 fn write_isa(dir: &std::path::Path, family: &Family, label: &str, source: &str, sass: &Sass) -> Result<()> {
     let dir = dir.join(format!("nvidia-{}", family.name));
     std::fs::create_dir_all(&dir).map_err(|e| anyhow::anyhow!("--isa: cannot create {}: {e}", dir.display()))?;
-    let stem = crate::inspect::radv::file_slug(label);
+    let stem = super::file_slug(label);
     crate::io::write_output(&dir.join(format!("{stem}.cu")), source.as_bytes())?;
     crate::io::write_output(&dir.join(format!("{stem}.sass")), format!("// {label}: SASS for {} by {}\n{}\n{}", family.name, nvrtc::tools()?.version, sass.log.trim(), sass.listing).as_bytes())
 }
 
-fn report(family: &Family, rows: Vec<crate::inspect::Row>, tools: &nvrtc::Tools, req: &Request) -> crate::inspect::InspectReport {
+fn report(family: &Family, rows: Vec<crate::inspect::Row>, tools: &nvrtc::Tools, req: &Request) -> InspectReport {
     let options = options(family, req.precise).join(" ");
     let provenance = serde_json::json!({
         "tool": format!("brdfprof {}", env!("CARGO_PKG_VERSION")),
@@ -467,5 +457,81 @@ fn report(family: &Family, rows: Vec<crate::inspect::Row>, tools: &nvrtc::Tools,
     notes.insert("driver/".into(), format!("NVIDIA's CUDA compiler ({}, ptxas) on the kernels' CUDA C++ translation, same maths; options: {options}", tools.version));
     notes.insert("callgrind/".into(), format!("not applicable: nvidia:{} compiles only, nothing executes", family.name));
     let tool_list = [("nvrtc".to_string(), tools.version.clone())].into();
-    crate::inspect::compiled_report(rows, provenance, req.lights, req.shaders, tool_list, notes)
+    let mut report = crate::inspect::compiled_report(rows, provenance, req.lights, req.shaders, tool_list, notes);
+    report.cost = super::Vendor::cost(&NVIDIA, &report);
+    report
+}
+
+/// The statistics the cost table shows beside cycles/eval.
+pub const SHOWN: [&str; 7] = ["Instruction Count", "Register Count", "Spill Count", "FP32 (FMA, MUL, ADD, compare)", "MUFU (special functions)", "Warps per SM", "Issue Cycles"];
+
+pub struct Nvidia;
+pub static NVIDIA: Nvidia = Nvidia;
+
+impl super::Vendor for Nvidia {
+    fn prefix(&self) -> &'static str {
+        "nvidia"
+    }
+
+    fn name(&self) -> &'static str {
+        "NVIDIA"
+    }
+
+    fn title(&self) -> &'static str {
+        "NVIDIA: NVRTC and ptxas (NVIDIA's PyPI wheels) on the kernels' CUDA C++ translation, checked on the host first (no NVIDIA GPU or driver needed)"
+    }
+
+    fn families(&self) -> Vec<super::Family> {
+        FAMILIES
+            .iter()
+            .map(|f| super::Family { name: f.name, architecture: f.architecture, products: f.products, detail: format!("compute capability {}.{}", f.compute_capability.0, f.compute_capability.1), default: true })
+            .collect()
+    }
+
+    fn status(&self) -> Result<String> {
+        Ok(format!("{} and nvdisasm under {}", nvrtc::tools()?.version, nvrtc::install_dir().display()))
+    }
+
+    fn needs_verification(&self) -> bool {
+        true
+    }
+
+    fn compile(&self, families: &[usize], request: &Request) -> Result<Vec<Run>> {
+        let chosen: Vec<&Family> = families.iter().map(|&k| &FAMILIES[k]).collect();
+        let reports = inspect(&chosen, request)?;
+        Ok(reports.into_iter().zip(families).map(|(report, &family)| Run { target: Target { vendor: &NVIDIA, family }, report, isa_files: Vec::new(), note: None }).collect())
+    }
+
+    fn cost(&self, report: &InspectReport) -> Option<TargetCost> {
+        let family = &FAMILIES[self.family_of(report)?];
+        let header = TargetCost {
+            device: device_name(family),
+            target: Some(format!("nvidia:{}", family.name)),
+            family: Some(family.name.to_string()),
+            architecture: Some(family.architecture.to_string()),
+            compiler: "ptxas".into(),
+            model: "cycles/eval = issue-limited SM cycles of a warp at the guide's throughputs / (32 x lights per kernel)".into(),
+            unit: "SM cycles".into(),
+            lights_per_kernel: 0,
+            columns: SHOWN.iter().map(|s| s.to_string()).collect(),
+            rows: Vec::new(),
+        };
+        cost::table(report, header, |stats, lights| cost::driver_stat(stats, "Issue Cycles").map(|c| c / (32.0 * f64::from(lights))))
+    }
+
+    fn family_of(&self, report: &InspectReport) -> Option<usize> {
+        let target = report.provenance["target"].as_str()?.strip_prefix("nvidia:")?;
+        FAMILIES.iter().position(|f| f.name == target)
+    }
+
+    fn fingerprint(&self, report: &InspectReport) -> BTreeMap<String, String> {
+        // ptxas' output depends on the architecture, NVRTC's version and options, and the translation.
+        let p = &report.provenance;
+        [
+            ("device".to_string(), p["device"]["name"].as_str().unwrap_or("?").to_string()),
+            ("compiler".to_string(), p["compiler"]["name"].as_str().unwrap_or("?").to_string()),
+            ("options".to_string(), p["compiler"]["options"].as_str().unwrap_or("?").to_string()),
+        ]
+        .into()
+    }
 }

@@ -3,7 +3,7 @@
 //! family, deterministic, and every command that must execute refuses the device.
 
 use crate::common::{self, run, run_in};
-use brdfprof::gpu::targets::TARGETS;
+use brdfprof::targets::radv::FAMILIES as TARGETS;
 use std::path::Path;
 
 const KERNELS: [&str; 5] = ["ggx", "blinn", "cook-torrance", "burley", "baseline"];
@@ -52,17 +52,17 @@ fn inspect_reports_aco_statistics_for_rdna2_gfx9_and_rdna3_identical_across_runs
             assert_eq!(row["stats"]["driver/subgroup-size"].as_f64(), Some(f64::from(target.wave_size)), "{family}");
         }
         // ACO's derived figures: a BRDF costs more than the memory-only kernel, which costs something.
-        let aco = report["aco"]["rows"].as_array().unwrap();
+        let aco = report["cost"]["rows"].as_array().unwrap();
         let base = aco.iter().find(|r| r["model"] == "baseline").unwrap();
         assert!(base["cycles_per_eval"].as_f64().unwrap() > 0.0);
         for r in aco.iter().filter(|r| r["model"] != "baseline") {
-            let it = r["inverse_throughput"].as_f64().unwrap();
+            let it = r["stats"]["Inverse Throughput"].as_f64().unwrap();
             assert_eq!(r["cycles_per_eval"].as_f64().unwrap(), it / (64.0 * 8.0));
             assert!(r["net_cycles_per_eval"].as_f64().unwrap() > 0.0, "{family} {}", r["model"]);
         }
     }
     // GCN-class vega10 (8 waves per SIMD at most, wave64 over 16 lanes) is slower per evaluation than RDNA 2.
-    let ggx = |i: usize| reports[i]["aco"]["rows"][0]["cycles_per_eval"].as_f64().unwrap();
+    let ggx = |i: usize| reports[i]["cost"]["rows"][0]["cycles_per_eval"].as_f64().unwrap();
     assert!(ggx(1) > 1.5 * ggx(0), "vega10 {} vs navi21 {}", ggx(1), ggx(0));
     // The cost table across devices has every pair's rank correlation.
     assert_eq!(first["costs"]["correlations"].as_array().unwrap().len(), 3);
@@ -73,7 +73,7 @@ fn isa_writes_acos_disassembly_per_kernel_and_family() {
     let dir = tempfile::tempdir().unwrap();
     let isa = dir.path().join("isa");
     let report = inspect_json(dir.path(), "one", &["radv:vangogh"], &["--model", "ggx", "--isa", isa.to_str().unwrap()]);
-    assert!(report["aco"].is_object(), "a single device's JSON is that device's report");
+    assert!(report["cost"].is_object(), "a single device's JSON is that device's report");
     for kernel in ["ggx", "baseline"] {
         let text = std::fs::read_to_string(isa.join("vangogh").join(format!("{kernel}.assembly.txt"))).unwrap();
         assert!(text.contains("s_endpgm") && text.contains("v_"), "{kernel}: {}", &text[..text.len().min(400)]);
@@ -163,7 +163,7 @@ fn a_child_that_crashes_after_its_report_still_gives_the_report_and_exit_0() {
     let json = dir.path().join("r.json");
     let out = common::brdfprof()
         .args(["inspect", "--no-callgrind", "--model", "ggx", "--device", "radv:navi21", "--json", json.to_str().unwrap(), "--markdown", dir.path().join("r.md").to_str().unwrap()])
-        .env(brdfprof::inspect::radv::CRASH_AFTER_REPLY, "1")
+        .env(brdfprof::targets::radv_child::CRASH_AFTER_REPLY, "1")
         .output()
         .unwrap();
     let stderr = String::from_utf8_lossy(&out.stderr);
@@ -171,7 +171,7 @@ fn a_child_that_crashes_after_its_report_still_gives_the_report_and_exit_0() {
     assert!(stderr.contains("crashed after writing its complete report") && stderr.contains("SIGSEGV"), "{stderr}");
     let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(json).unwrap()).unwrap();
     assert!(report["section_notes"]["driver/"].as_str().unwrap().contains("crashed after writing its complete report"));
-    assert!(report["aco"]["rows"][0]["inverse_throughput"].as_f64().unwrap() > 0.0);
+    assert!(report["cost"]["rows"][0]["stats"]["Inverse Throughput"].as_f64().unwrap() > 0.0);
 }
 
 #[test]
@@ -179,7 +179,7 @@ fn sweep_cost_device_draws_the_frontier_again_with_acos_cycles() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let base = ["sweep", "--model", "ggx", "--model", "blinn", "--model", "ggx,vis=smith-ggx-correlated,f=dielectric", "--size", "16x16", "--min-rounds", "2", "--max-rounds", "2", "--out", "out"];
-    run_in(d, &[&base[..], &["--cost-device", "0"]].concat()).fails(2, "--cost-device 0: give a compile-only AMD target");
+    run_in(d, &[&base[..], &["--cost-device", "0"]].concat()).fails(2, "--cost-device 0: give a compile-only target");
     run_in(d, &[&base[..], &["--cost-device", "radv:navi31"]].concat()).fails(2, "unknown AMD family `navi31`");
     assert!(!d.join("out").exists());
     let out = run_in(d, &[&base[..], &["--cost-device", "radv:navi21", "--cost-device", "radv:vega10"]].concat()).ok();

@@ -178,20 +178,3 @@ fn the_opencl_translation_on_pocl_agrees_with_vulkan_on_every_preset_and_example
     assert!(unexplained.is_empty(), "{} values beyond {AGREEMENT:.0e}:\n{}", unexplained.len(), unexplained.iter().take(10).cloned().collect::<Vec<_>>().join("\n"));
 }
 
-#[test]
-fn probe_nvidia() {
-    use brdfprof::targets::nvidia;
-    let gpu = common::gpu();
-    let models: Vec<Model> = brdfprof::brdf::THESIS_MODELS.iter().map(|m| Model::parse(m).unwrap()).collect();
-    let fams: Vec<&nvidia::Family> = nvidia::FAMILIES.iter().collect();
-    let t = std::time::Instant::now();
-    let req = nvidia::Request { models: &models, lights: 8, shaders: kernels::embedded(), isa_dir: Some(std::path::Path::new("/tmp/isa")), precise: false, verify_on: &gpu };
-    let reports = nvidia::inspect(&fams, &req).unwrap();
-    eprintln!("{:?}", t.elapsed());
-    for r in &reports {
-        for row in &r.rows {
-            let g = |k: &str| row.stats.get(k).copied().unwrap_or(-1.0);
-            eprintln!("{} {}: instr {} regs {} issue {} fp32 {} mufu {} warps {}", r.provenance["device"]["name"], row.model, g("driver/instructions"), g("driver/registers"), g("driver/SASS/Issue Cycles"), g("driver/SASS/FP32 (FMA, MUL, ADD, compare)"), g("driver/SASS/MUFU (special functions)"), g("driver/SASS/Warps per SM"));
-        }
-    }
-}

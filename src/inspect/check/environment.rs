@@ -31,11 +31,10 @@ pub fn environment(inspect: &InspectReport, timing: Option<&TimingRun>) -> BTree
     out.insert("spirv".into(), BTreeMap::new());
     out.insert("naga".into(), BTreeMap::new());
     out.insert("spirv-O".into(), [("spirv-opt".to_string(), inspect.tools.get("spirv-opt").cloned().unwrap_or_default())].into());
-    if crate::gpu::targets::family_of_device(&device).is_some() {
-        // RADV's compile-only device: ACO's output depends on the family (the device) and the Mesa version
-        // alone, not on the host.
-        let mesa = p["mesa_version"].as_str().map_or_else(|| text(&p["device"]["driver_info"]), str::to_string);
-        out.insert("driver".into(), [("device".to_string(), device.clone()), (MESA.to_string(), mesa)].into());
+    if let Some(target) = crate::targets::of_report(inspect) {
+        // A compile-only target: its compiler's output depends on what the vendor says (the family and the
+        // compiler's version), not on the host.
+        out.insert("driver".into(), target.vendor.fingerprint(inspect));
     } else {
         out.insert("driver".into(), machine(vec![]));
     }
@@ -91,7 +90,7 @@ mod tests {
             callgrind: Some(CallgrindRun { kernels: vec![], evaluations: 1, jit_cpu_features: jit.iter().map(|s| s.to_string()).collect(), valgrind: "valgrind-3.19.0".into() }),
             callgrind_setup: [("workload".to_string(), "64x64 pixels x 8 lights".to_string()), ("valgrind".to_string(), "valgrind-3.19.0".to_string())].into(),
             vs_profile: None,
-            aco: None,
+            cost: None,
         }
     }
 

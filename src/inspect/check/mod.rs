@@ -103,18 +103,20 @@ pub fn run(options: &CheckOptions, shaders: &Shaders, open: impl FnOnce() -> Res
     })
 }
 
-/// `run` on a compile-only AMD target (`--device radv:FAMILY`): ACO's statistics from the child process
-/// (`inspect::radv`), no timing and no callgrind (nothing executes).
-pub fn run_radv(options: &CheckOptions, shaders: &Shaders, target: &'static crate::gpu::targets::Target, validate: bool) -> Result<Outcome> {
+/// `run` on a compile-only target (`--device radv:FAMILY`, `nvidia:FAMILY`): its compiler's statistics
+/// (`targets`), no timing and no callgrind (nothing executes). `verify_on`: the Vulkan device a target's
+/// translation is checked against first.
+pub fn run_target(options: &CheckOptions, shaders: &Shaders, target: crate::targets::Target, validate: bool, verify_on: Option<&Gpu>) -> Result<Outcome> {
     run_measured(options, |specs, lights| {
-        eprintln!("brdfprof check: compiling for radv:{} ({} models + baseline kernel)", target.family, specs.len());
-        let run = super::radv::run(target, &specs, lights, shaders, validate, None)?;
+        eprintln!("brdfprof check: compiling for {} ({} models + baseline kernel)", target.name(), specs.len());
+        let request = crate::targets::Request { models: &specs, lights, shaders, validate, isa_dir: None, precise: false, verify_on };
+        let run = crate::targets::compile_all(&[target], &request)?.pop().expect("one run per target");
         let mut inspect = run.report;
-        if let Some(note) = run.teardown_note {
+        if let Some(note) = run.note {
             eprintln!("brdfprof check: note: {note}");
         }
         for group in ["callgrind/", "timing/"] {
-            inspect.section_notes.insert(group.into(), format!("not applicable: radv:{} compiles only, nothing executes", target.family));
+            inspect.section_notes.insert(group.into(), format!("not applicable: {} compiles only, nothing executes", target.name()));
         }
         let environment = environment(&inspect, None);
         Ok(Baseline { format: FORMAT.into(), inspect, timing: None, environment })
@@ -174,7 +176,7 @@ mod tests {
             callgrind: None,
             callgrind_setup: BTreeMap::new(),
             vs_profile: None,
-            aco: None,
+            cost: None,
         };
         let mut environment = BTreeMap::new();
         for g in ["callgrind", "timing"] {

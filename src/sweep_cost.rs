@@ -1,11 +1,10 @@
-//! `sweep --cost-device radv:FAMILY`: the sweep's accuracy-against-cost table, JSON and Pareto chart drawn
-//! again with ACO's estimate of an AMD GPU's cost (SIMD cycles per evaluation, `inspect::aco`) in place of
-//! the measured time. ACO's figures are deterministic: no CI, no noise, the same on every machine with the
-//! same Mesa. The accuracy is the sweep's own (measured on the device that executed it).
+//! `sweep --cost-device TARGET`: the sweep's accuracy-against-cost table, JSON and Pareto chart drawn again
+//! with a compile-only target's modelled cost (cycles per evaluation, `targets::cost`) in place of the measured
+//! time. Those figures are deterministic: no CI, no noise, the same on every machine with the same compiler.
+//! The accuracy is the sweep's own (measured on the device that executed it).
 
 use crate::chart::{self, Point};
-use crate::gpu::targets::Target;
-use crate::inspect::aco::AcoTable;
+use crate::targets::cost::TargetCost;
 use crate::report::{self, Table};
 use crate::sweep::{pareto_front, SweepReport};
 use anyhow::Result;
@@ -13,13 +12,12 @@ use serde::Serialize;
 use std::path::{Path, PathBuf};
 
 #[derive(Clone, Debug, Serialize)]
-pub struct AcoSweepRow {
+pub struct CostSweepRow {
     pub spec: String,
     pub canonical: String,
     pub label: String,
-    pub instructions: f64,
-    pub vgprs: f64,
-    pub subgroups_per_simd: f64,
+    /// The target's statistics the table shows (`TargetCost::columns` chosen by the vendor).
+    pub stats: std::collections::BTreeMap<String, f64>,
     pub cycles_per_eval: f64,
     pub net_cycles_per_eval: Option<f64>,
     /// cycles/eval over the cheapest spec's.
@@ -27,44 +25,47 @@ pub struct AcoSweepRow {
     /// The measured cost ratio of the sweep (median), for reading the two side by side.
     pub measured_cost_vs_fastest: f64,
     pub accuracy: crate::accuracy::Accuracy,
-    /// On ACO's frontier: no spec both cheaper (cycles) and more accurate (RMS vs exact).
+    /// On the target's frontier: no spec both cheaper (cycles) and more accurate (RMS vs exact).
     pub pareto: bool,
     /// On the measured sweep's frontier.
     pub measured_pareto: bool,
 }
 
 #[derive(Clone, Debug, Serialize)]
-pub struct AcoSweep {
-    pub family: String,
+pub struct CostSweep {
+    /// `radv:navi21`, `nvidia:sm_89`.
+    pub target: String,
     pub architecture: String,
     pub device: String,
-    pub driver: String,
+    pub compiler: String,
+    pub model: String,
+    pub unit: String,
+    /// The statistics each row shows, in order.
+    pub columns: Vec<String>,
     pub lights_per_kernel: u32,
     /// The measured sweep's device.
     pub measured_on: String,
     pub fastest: String,
     /// Sorted by cost.
-    pub rows: Vec<AcoSweepRow>,
+    pub rows: Vec<CostSweepRow>,
     /// Specs the family cannot compile (fp16 without shaderFloat16), with the reason.
     pub skipped: Option<String>,
 }
 
-/// ACO's cost of every spec of `sweep` for one family, with the sweep's accuracy.
-pub fn build(sweep: &SweepReport, target: &Target, aco: &AcoTable, driver: &str, note: Option<&str>) -> Result<AcoSweep> {
-    let mut rows: Vec<AcoSweepRow> = Vec::new();
+/// The target's cost of every spec of `sweep`, with the sweep's accuracy.
+pub fn build(sweep: &SweepReport, target: &str, cost: &TargetCost, note: Option<&str>) -> Result<CostSweep> {
+    let mut rows: Vec<CostSweepRow> = Vec::new();
     let mut skipped = Vec::new();
     for r in &sweep.rows {
-        let Some(a) = aco.row(&r.spec) else {
+        let Some(a) = cost.row(&r.spec) else {
             skipped.push(r.spec.clone());
             continue;
         };
-        rows.push(AcoSweepRow {
+        rows.push(CostSweepRow {
             spec: r.spec.clone(),
             canonical: r.canonical.clone(),
             label: r.label.clone(),
-            instructions: a.instructions,
-            vgprs: a.vgprs,
-            subgroups_per_simd: a.subgroups_per_simd,
+            stats: a.stats.clone(),
             cycles_per_eval: a.cycles_per_eval,
             net_cycles_per_eval: a.net_cycles_per_eval,
             cost_vs_fastest: 0.0,
@@ -83,31 +84,33 @@ pub fn build(sweep: &SweepReport, target: &Target, aco: &AcoTable, driver: &str,
         r.pareto = f;
     }
     rows.sort_by(|a, b| a.cycles_per_eval.total_cmp(&b.cycles_per_eval).then(a.spec.cmp(&b.spec)));
-    Ok(AcoSweep {
-        family: target.family.into(),
-        architecture: target.architecture.into(),
-        device: aco.device.clone(),
-        driver: driver.into(),
-        lights_per_kernel: aco.lights_per_kernel,
+    Ok(CostSweep {
+        target: target.into(),
+        architecture: cost.architecture.clone().unwrap_or_default(),
+        device: cost.device.clone(),
+        compiler: cost.compiler.clone(),
+        model: cost.model.clone(),
+        unit: cost.unit.clone(),
+        columns: cost.columns.clone(),
+        lights_per_kernel: cost.lights_per_kernel,
         measured_on: sweep.profile.provenance.device.name.clone(),
         fastest: rows.first().map(|r| r.spec.clone()).unwrap_or_default(),
         rows,
         // The child's note names each spec with the reason; without one, the specs alone.
-        skipped: (!skipped.is_empty()).then(|| note.map_or_else(|| format!("not compiled for {}: {}", target.family, skipped.join(", ")), str::to_string)),
+        skipped: (!skipped.is_empty()).then(|| note.map_or_else(|| format!("not compiled for {target}: {}", skipped.join(", ")), str::to_string)),
     })
 }
 
-impl AcoSweep {
+impl CostSweep {
     pub fn table(&self) -> Table {
-        let mut t = Table::new([
-            "spec", "Instructions", "VGPRs", "Subgroups per SIMD", "cycles/eval", "net cycles/eval", "cost vs fastest", "measured cost vs fastest", "vs exact: max / RMS err", "Pareto (ACO)", "Pareto (measured)",
-        ]);
+        let mut headers: Vec<String> = vec!["spec".into()];
+        headers.extend(self.columns.iter().cloned());
+        headers.extend(["cycles/eval", "net cycles/eval", "cost vs fastest", "measured cost vs fastest", "vs exact: max / RMS err", "Pareto (target)", "Pareto (measured)"].map(String::from));
+        let mut t = Table::new(headers);
         for r in &self.rows {
-            t.row([
-                r.spec.clone(),
-                crate::inspect::format_value(r.instructions),
-                crate::inspect::format_value(r.vgprs),
-                crate::inspect::format_value(r.subgroups_per_simd),
+            let mut cells = vec![r.spec.clone()];
+            cells.extend(self.columns.iter().map(|c| r.stats.get(c).map_or("-".into(), |v| crate::inspect::format_value(*v))));
+            cells.extend([
                 report::sig(r.cycles_per_eval, 4),
                 r.net_cycles_per_eval.map_or("-".into(), |v| report::sig(v, 4)),
                 format!("{:.3}", r.cost_vs_fastest),
@@ -116,19 +119,22 @@ impl AcoSweep {
                 if r.pareto { "yes".into() } else { String::new() },
                 if r.measured_pareto { "yes".into() } else { String::new() },
             ]);
+            t.row(cells);
         }
         t
     }
 
     pub fn markdown(&self) -> String {
         format!(
-            "# brdfprof sweep: cost on {} ({})\n\n{} ({}); cost = ACO's estimate, SIMD cycles per evaluation = Inverse Throughput / \
-             (64 x {} lights per kernel), deterministic (no CI); relative to the cheapest spec ({}). Accuracy and the measured cost \
-             ratio: the sweep on {}. Pareto (ACO): no spec both fewer cycles and more accurate (RMS vs exact).\n\n{}",
-            self.family,
+            "# brdfprof sweep: cost on {} ({})\n\n{}; cost = {}'s estimate, {} per evaluation ({}; {} lights per kernel), \
+             deterministic (no CI); relative to the cheapest spec ({}). Accuracy and the measured cost ratio: the sweep on {}. \
+             Pareto (target): no spec both fewer cycles and more accurate (RMS vs exact).\n\n{}",
+            self.target,
             self.architecture,
             self.device,
-            self.driver,
+            self.compiler,
+            self.unit,
+            self.model,
             self.lights_per_kernel,
             self.fastest,
             self.measured_on,
@@ -143,7 +149,7 @@ impl AcoSweep {
 
     pub fn chart(&self, path: &Path) -> Result<()> {
         let thesis: Vec<String> = crate::brdf::THESIS_MODELS.iter().map(|m| m.to_string()).collect();
-        let group = |r: &AcoSweepRow| if r.canonical.contains("precision=f16") { 1 } else { 0 };
+        let group = |r: &CostSweepRow| if r.canonical.contains("precision=f16") { 1 } else { 0 };
         let points: Vec<Point> = self
             .rows
             .iter()
@@ -160,10 +166,11 @@ impl AcoSweep {
         let front: Vec<(f64, f64)> = self.rows.iter().filter(|r| r.pareto).map(|r| (r.cost_vs_fastest, r.accuracy.vs_exact.rms)).collect();
         let legend = vec![(0, "fp32".to_string()), (1, "fp16".to_string())];
         let split = self.rows.iter().filter(|r| group(r) == 0).map(|r| r.cost_vs_fastest).fold(f64::NEG_INFINITY, f64::max);
-        let title = format!("Accuracy against ACO's cost on {} ({}), {}", self.family, self.architecture, self.driver);
+        let title = format!("Accuracy against {}'s cost on {} ({})", self.compiler, self.target, self.architecture);
+        let x_desc = format!("{} cycles per evaluation relative to the cheapest spec (deterministic)", self.compiler);
         let spec = chart::Scatter {
             title: &title,
-            x_desc: "ACO cycles per evaluation relative to the cheapest spec (deterministic)",
+            x_desc: &x_desc,
             y_desc: "RMS relative error against the exact physical model",
             line: &front,
             legend: &legend,

@@ -9,9 +9,9 @@
 //! (Mesa 22.3's vkDeviceWaitIdle calls through a null pointer there), and a child that still crashes after
 //! printing its complete report is accepted with a note, so the user gets the report and exit 0.
 
-use super::{InspectOptions, InspectReport};
+use crate::inspect::{InspectOptions, InspectReport};
 use crate::cleanup;
-use crate::gpu::targets::{self, Target};
+use super::radv::{self as targets, Family};
 use crate::gpu::{Gpu, GpuOptions, Kernel};
 use crate::model::Model;
 use crate::profile::gbuffer::GBufferFormat;
@@ -50,17 +50,11 @@ pub struct RadvReply {
 /// One target's result in the parent.
 #[derive(Clone, Debug)]
 pub struct RadvRun {
-    pub target: &'static Target,
+    pub target: &'static Family,
     pub report: InspectReport,
     pub isa_files: Vec<PathBuf>,
     /// Set when the child crashed after it had printed its complete report.
     pub teardown_note: Option<String>,
-}
-
-/// File-name form of a kernel label.
-pub fn file_slug(label: &str) -> String {
-    let s: String = label.chars().map(|c| if c.is_ascii_alphanumeric() || c == '.' { c.to_ascii_lowercase() } else { '-' }).collect();
-    s.trim_matches('-').to_string()
 }
 
 /// The child: compiles every kernel on the null device of `RADV_FORCE_FAMILY` and reports.
@@ -88,7 +82,7 @@ pub fn child_main(request_json: &str) -> Result<()> {
     // A model this family cannot compile (fp16 arithmetic where the device has no shaderFloat16) is left out
     // and named in the driver section's notes, so that one family does not stop a report of many.
     let (models, skipped): (Vec<Model>, Vec<Model>) = models.into_iter().partition(|m| m.check_support(&gpu.info).is_ok());
-    let mut report = super::run(&gpu, &shaders, &InspectOptions { models: models.clone(), lights: req.lights, callgrind: None })?;
+    let mut report = crate::inspect::run(&gpu, &shaders, &InspectOptions { models: models.clone(), lights: req.lights, callgrind: None })?;
     if !skipped.is_empty() {
         let why = skipped.iter().map(|m| format!("{} ({:#})", m.name(), m.check_support(&gpu.info).unwrap_err())).collect::<Vec<_>>().join("; ");
         report.section_notes.insert("driver/".into(), format!("not compiled for {}: {why}", target.family));
@@ -134,7 +128,7 @@ fn write_isa(gpu: &Gpu, shaders: &Shaders, model: Option<&Model>, lights: u32, d
     let mut files = Vec::new();
     for exe in kernel.executables()?.unwrap_or_default() {
         for (name, text) in &exe.representations {
-            let path = dir.join(format!("{}.{}.txt", file_slug(&label), file_slug(name)));
+            let path = dir.join(format!("{}.{}.txt", super::file_slug(&label), super::file_slug(name)));
             crate::io::write_output(&path, format!("; {label}: {} of {}, {}\n{text}", name, exe.name, gpu.info.name).as_bytes())?;
             files.push(path);
         }
@@ -146,7 +140,7 @@ fn write_isa(gpu: &Gpu, shaders: &Shaders, model: Option<&Model>, lights: u32, d
 }
 
 /// Runs the child for one target and reads its report.
-pub fn run(target: &'static Target, models: &[Model], lights: u32, shaders: &Shaders, validate: bool, isa_dir: Option<&Path>) -> Result<RadvRun> {
+pub fn run(target: &'static Family, models: &[Model], lights: u32, shaders: &Shaders, validate: bool, isa_dir: Option<&Path>) -> Result<RadvRun> {
     let req = RadvRequest {
         family: target.family.to_string(),
         models: models.iter().map(Model::canonical).collect(),
@@ -191,7 +185,7 @@ pub fn run(target: &'static Target, models: &[Model], lights: u32, shaders: &Sha
 }
 
 /// `run` for every target, at most as many children at once as the host has cores; results in order.
-pub fn run_all(targets: &[&'static Target], models: &[Model], lights: u32, shaders: &Shaders, validate: bool, isa_dir: Option<&Path>) -> Result<Vec<RadvRun>> {
+pub fn run_all(targets: &[&'static Family], models: &[Model], lights: u32, shaders: &Shaders, validate: bool, isa_dir: Option<&Path>) -> Result<Vec<RadvRun>> {
     let workers = std::thread::available_parallelism().map_or(1, |n| n.get()).min(targets.len()).max(1);
     let next = std::sync::atomic::AtomicUsize::new(0);
     let results: std::sync::Mutex<Vec<Option<Result<RadvRun>>>> = std::sync::Mutex::new((0..targets.len()).map(|_| None).collect());

@@ -1,0 +1,114 @@
+//! A compile-only target's cost model applied to a report's kernels: for every kernel a few of its compiler's
+//! statistics, its modelled cycles per BRDF evaluation, and the same net of the memory-only kernel. Each
+//! vendor fills it from its own statistics and model (ACO's inverse throughput, NVIDIA's issue-limited SM
+//! cycles, ...); `inspect`, `compare` and `sweep --cost-device` read only this.
+
+use crate::inspect::InspectReport;
+use crate::profile::workload::{steady_block, BASELINE_LABEL};
+use crate::report::{sig, Table};
+use serde::{Deserialize, Serialize};
+
+/// One kernel's figures.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct CostRow {
+    pub model: String,
+    /// The statistics of `TargetCost::columns` by name.
+    pub stats: std::collections::BTreeMap<String, f64>,
+    /// Modelled cycles per evaluation (one invocation x one light).
+    pub cycles_per_eval: f64,
+    /// The same minus the memory-only kernel's (None for that kernel).
+    pub net_cycles_per_eval: Option<f64>,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct TargetCost {
+    /// The report's device name.
+    pub device: String,
+    /// `radv:navi21`, `nvidia:sm_89`, ... (None: a real device that reports such statistics).
+    pub target: Option<String>,
+    /// The family's short name (navi21, sm_89) and architecture.
+    pub family: Option<String>,
+    pub architecture: Option<String>,
+    /// What the compiler is, with the options that matter to the figures.
+    pub compiler: String,
+    /// How cycles/eval is computed, one line.
+    pub model: String,
+    /// What a cycle is ("SIMD cycles", "SM cycles").
+    pub unit: String,
+    pub lights_per_kernel: u32,
+    /// Statistic names of `CostRow::stats` (as the compiler names them).
+    pub columns: Vec<String>,
+    pub rows: Vec<CostRow>,
+}
+
+/// The value of driver statistic `name` of any executable, summed (a compute pipeline has one).
+pub fn driver_stat(stats: &std::collections::BTreeMap<String, f64>, name: &str) -> Option<f64> {
+    let suffix = format!("/{name}");
+    let v: Vec<f64> = stats.iter().filter(|(k, _)| k.starts_with("driver/") && k.ends_with(&suffix) && k.matches('/').count() == 2).map(|(_, v)| *v).collect();
+    (!v.is_empty()).then(|| v.iter().sum())
+}
+
+/// A cost table of `report` from a per-kernel rule: `cycles(stats, lights per kernel)` (None: the kernel has no
+/// figure, e.g. the driver reported none) and the statistics `columns` shown beside it.
+pub fn table(report: &InspectReport, header: TargetCost, cycles: impl Fn(&std::collections::BTreeMap<String, f64>, u32) -> Option<f64>) -> Option<TargetCost> {
+    let lights = steady_block(report.lights).0;
+    let mut t = TargetCost { lights_per_kernel: lights, rows: Vec::new(), ..header };
+    for r in &report.rows {
+        let Some(c) = cycles(&r.stats, lights) else { continue };
+        let stats = t.columns.iter().map(|name| (name.clone(), driver_stat(&r.stats, name).unwrap_or(0.0))).collect();
+        t.rows.push(CostRow { model: r.model.clone(), stats, cycles_per_eval: c, net_cycles_per_eval: None });
+    }
+    if t.rows.is_empty() {
+        return None;
+    }
+    if let Some(base) = t.rows.iter().find(|r| r.model == BASELINE_LABEL).map(|r| r.cycles_per_eval) {
+        for r in t.rows.iter_mut().filter(|r| r.model != BASELINE_LABEL) {
+            r.net_cycles_per_eval = Some(r.cycles_per_eval - base);
+        }
+    }
+    Some(t)
+}
+
+impl TargetCost {
+    /// "navi21 (RDNA 2)" or the device name.
+    pub fn label(&self) -> String {
+        match (&self.family, &self.architecture) {
+            (Some(f), Some(a)) => format!("{f} ({a})"),
+            _ => self.device.clone(),
+        }
+    }
+
+    /// The column name in cross-device tables: "navi21 cycles/eval".
+    pub fn column_name(&self) -> String {
+        format!("{} cycles/eval", self.family.clone().unwrap_or_else(|| self.device.clone()))
+    }
+
+    pub fn row(&self, model: &str) -> Option<&CostRow> {
+        self.rows.iter().find(|r| r.model == model)
+    }
+
+    /// A statistic of a row by its column name.
+    pub fn stat(&self, row: &CostRow, name: &str) -> Option<f64> {
+        row.stats.get(name).copied()
+    }
+
+    pub fn markdown(&self) -> String {
+        let mut headers: Vec<String> = vec!["model".into()];
+        headers.extend(self.columns.iter().cloned());
+        headers.extend(["cycles/eval".into(), "net cycles/eval".into(), "net vs ggx".into()]);
+        let mut t = Table::new(headers);
+        let reference = self.row(crate::brdf::spec::REFERENCE_MODEL).and_then(|r| r.net_cycles_per_eval);
+        for r in &self.rows {
+            let mut cells = vec![r.model.clone()];
+            cells.extend(self.columns.iter().map(|c| r.stats.get(c).map_or("-".into(), |v| crate::inspect::format_value(*v))));
+            cells.push(sig(r.cycles_per_eval, 4));
+            cells.push(r.net_cycles_per_eval.map_or("-".into(), |v| sig(v, 4)));
+            cells.push(match (r.net_cycles_per_eval, reference) {
+                (Some(v), Some(g)) if g > 0.0 => format!("{:.2}", v / g),
+                _ => "-".into(),
+            });
+            t.row(cells);
+        }
+        format!("### {} statistics, {} ({} lights per kernel; {}; {})\n\n{}", self.compiler, self.label(), self.lights_per_kernel, self.model, self.unit, t.markdown())
+    }
+}

@@ -1,0 +1,211 @@
+//! `--device radv:FAMILY`: the GPU families whose real compiler (Mesa RADV's ACO) brdfprof runs on a machine
+//! without an AMD GPU. With `RADV_FORCE_FAMILY=<family>` in the environment before the Vulkan loader starts,
+//! RADV offers a "Null hardware (RADV <FAMILY>)" device: it has no queue that executes anything, but pipeline
+//! creation runs ACO for that family and VK_KHR_pipeline_executable_properties returns ACO's statistics.
+//! brdfprof runs itself as a child with the variable set (`radv_child`), so neither the user's environment
+//! nor the parent's devices change.
+//!
+//! ACO's cost model (`aco_statistics.cpp`): Latency, "issue cycles plus stall cycles" of one wave, and Inverse
+//! Throughput, "estimated busy cycles to execute one wave": cycles per wave64 per SIMD, with as many waves in
+//! flight as the register budget allows (Subgroups per SIMD) hiding latency. ACO normalises the throughput to
+//! 64 invocations whatever the wave size, so one evaluation (one invocation x one light) costs
+//! `Inverse Throughput / (64 x lights per kernel)` SIMD cycles.
+
+use super::cost::{self, TargetCost};
+use super::{Request, Run, Target};
+use crate::inspect::InspectReport;
+use anyhow::Result;
+use std::collections::BTreeMap;
+
+/// One family RADV can compile for without the hardware.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Family {
+    /// RADV_FORCE_FAMILY's name for it (Mesa's `ac_get_family_name`, lower case).
+    pub family: &'static str,
+    /// The graphics IP level ACO compiles for.
+    pub gfx: &'static str,
+    /// The architecture, as AMD names it.
+    pub architecture: &'static str,
+    /// Products built on it.
+    pub products: &'static str,
+    /// The subgroup (wave) size RADV compiles compute shaders for on this family by default (Mesa 22.3:
+    /// wave64 everywhere; RDNA runs wave32 natively too, with RADV_PERFTEST=cswave32). A test checks it
+    /// against the subgroupSize the driver reports for every family.
+    pub wave_size: u32,
+    /// In `radv:all`.
+    pub default: bool,
+}
+
+const fn t(family: &'static str, gfx: &'static str, architecture: &'static str, products: &'static str, default: bool) -> Family {
+    Family { family, gfx, architecture, products, wave_size: 64, default }
+}
+
+/// Every family Mesa 22.3.6 accepted in RADV_FORCE_FAMILY (navi31, gfx1030 and gfx900 it did not), oldest
+/// first.
+pub const FAMILIES: [Family; 12] = [
+    t("tahiti", "GFX6", "GCN 1", "Radeon HD 7970", true),
+    t("bonaire", "GFX7", "GCN 2", "Radeon R7 260X, HD 7790", false),
+    t("polaris10", "GFX8", "GCN 4", "Radeon RX 470/480/570/580", true),
+    t("vega10", "GFX9", "GFX9 Vega", "Radeon RX Vega 56/64", true),
+    t("raven", "GFX9", "GFX9 Vega APU", "Ryzen 2000/3000 APUs (Vega graphics)", false),
+    t("navi10", "GFX10", "RDNA 1", "Radeon RX 5700 (XT)", true),
+    t("navi14", "GFX10", "RDNA 1", "Radeon RX 5500 (XT)", false),
+    t("navi21", "GFX10.3", "RDNA 2", "Radeon RX 6800/6900 (XT)", true),
+    t("navi22", "GFX10.3", "RDNA 2", "Radeon RX 6700 (XT)", false),
+    t("vangogh", "GFX10.3", "RDNA 2 Steam Deck APU", "Steam Deck (Van Gogh)", true),
+    t("rembrandt", "GFX10.3", "RDNA 2 APU", "Ryzen 6000 APUs (Radeon 680M)", false),
+    t("gfx1100", "GFX11", "RDNA 3", "Radeon RX 7900 (XT/XTX, Navi 31)", true),
+];
+
+/// A family by its name (case-insensitive).
+pub fn lookup(family: &str) -> Result<&'static Family> {
+    FAMILIES.iter().find(|t| t.family.eq_ignore_ascii_case(family.trim())).ok_or_else(|| anyhow::anyhow!("unknown AMD family `{family}`"))
+}
+
+/// The compile-only devices' name as RADV gives it: "Null hardware (RADV NAVI21)".
+pub fn null_device_name(t: &Family) -> String {
+    format!("Null hardware (RADV {})", t.family.to_ascii_uppercase())
+}
+
+/// The family of a RADV null device's name, if it is one.
+pub fn family_of_device(name: &str) -> Option<&'static Family> {
+    let inner = name.strip_prefix("Null hardware (RADV ")?.strip_suffix(')')?;
+    FAMILIES.iter().find(|t| t.family.eq_ignore_ascii_case(inner))
+}
+
+/// The environment variable RADV reads.
+pub const FORCE_FAMILY_VAR: &str = "RADV_FORCE_FAMILY";
+
+/// Invocations ACO's Inverse Throughput is normalised to.
+pub const THROUGHPUT_INVOCATIONS: f64 = 64.0;
+
+/// The ACO statistics the cost table shows beside cycles/eval.
+pub const SHOWN: [&str; 7] = ["Instructions", "VGPRs", "SGPRs", "Spilled VGPRs", "Latency", "Inverse Throughput", "Subgroups per SIMD"];
+
+pub struct Radv;
+pub static RADV: Radv = Radv;
+
+fn device_name(report: &InspectReport) -> &str {
+    report.provenance["device"]["name"].as_str().unwrap_or("?")
+}
+
+impl super::Vendor for Radv {
+    fn prefix(&self) -> &'static str {
+        "radv"
+    }
+
+    fn name(&self) -> &'static str {
+        "AMD"
+    }
+
+    fn title(&self) -> &'static str {
+        "AMD: Mesa RADV's ACO compiler, run in a child process with RADV_FORCE_FAMILY set (its null device compiles, nothing executes)"
+    }
+
+    fn families(&self) -> Vec<super::Family> {
+        FAMILIES.iter().map(|f| super::Family { name: f.family, architecture: f.architecture, products: f.products, detail: format!("{}, wave{}", f.gfx, f.wave_size), default: f.default }).collect()
+    }
+
+    fn status(&self) -> Result<String> {
+        Ok("Mesa RADV (ACO), the system's Vulkan driver".into())
+    }
+
+    fn needs_verification(&self) -> bool {
+        false
+    }
+
+    fn compile(&self, families: &[usize], request: &Request) -> Result<Vec<Run>> {
+        let targets: Vec<&'static Family> = families.iter().map(|&k| &FAMILIES[k]).collect();
+        let runs = super::radv_child::run_all(&targets, request.models, request.lights, request.shaders, request.validate, request.isa_dir)?;
+        Ok(runs
+            .into_iter()
+            .zip(families)
+            .map(|(run, &family)| {
+                let mut report = run.report;
+                if let Some(note) = &run.teardown_note {
+                    report.section_notes.insert("driver/".into(), note.clone());
+                }
+                report.cost = super::Vendor::cost(self, &report);
+                Run { target: Target { vendor: &RADV, family }, report, isa_files: run.isa_files, note: run.teardown_note }
+            })
+            .collect())
+    }
+
+    fn cost(&self, report: &InspectReport) -> Option<TargetCost> {
+        let family = family_of_device(device_name(report));
+        let header = TargetCost {
+            device: device_name(report).to_string(),
+            target: family.map(|f| format!("radv:{}", f.family)),
+            family: family.map(|f| f.family.to_string()),
+            architecture: family.map(|f| f.architecture.to_string()),
+            compiler: "ACO".into(),
+            model: "cycles/eval = Inverse Throughput / (64 x lights per kernel)".into(),
+            unit: "SIMD cycles".into(),
+            lights_per_kernel: 0,
+            columns: SHOWN.iter().map(|s| s.to_string()).collect(),
+            rows: Vec::new(),
+        };
+        cost::table(report, header, |stats, lights| cost::driver_stat(stats, "Inverse Throughput").map(|it| it / (THROUGHPUT_INVOCATIONS * f64::from(lights))))
+    }
+
+    fn family_of(&self, report: &InspectReport) -> Option<usize> {
+        let f = family_of_device(device_name(report))?;
+        FAMILIES.iter().position(|x| x == f)
+    }
+
+    fn fingerprint(&self, report: &InspectReport) -> BTreeMap<String, String> {
+        // ACO's output depends on the family (the device) and the Mesa version alone, not on the host.
+        let p = &report.provenance;
+        let mesa = p["mesa_version"].as_str().or_else(|| p["device"]["driver_info"].as_str()).unwrap_or("?");
+        [("device".to_string(), device_name(report).to_string()), ("mesa".to_string(), mesa.to_string())].into()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::{parse, Vendor};
+    use super::*;
+    use crate::inspect::Row;
+
+    #[test]
+    fn parses_families_all_and_lists() {
+        assert!(parse("0").unwrap().is_none());
+        assert!(parse("llvmpipe").unwrap().is_none());
+        assert_eq!(parse("radv:navi21").unwrap().unwrap()[0].info().name, "navi21");
+        assert_eq!(parse("RADV:Vangogh").unwrap().unwrap()[0].info().architecture, "RDNA 2 Steam Deck APU");
+        let all = parse("radv:all").unwrap().unwrap();
+        assert!(all.len() >= 6 && all.iter().any(|t| t.info().name == "vega10") && all.iter().any(|t| t.info().name == "gfx1100"));
+        assert_eq!(parse("radv:navi21,navi21,vega10").unwrap().unwrap().len(), 2);
+        let e = parse("radv:navi31").unwrap_err().to_string();
+        assert!(e.contains("unknown AMD family `navi31`") && e.contains("tahiti") && e.contains("gfx1100"), "{e}");
+        assert!(parse("radv:").unwrap_err().to_string().contains("give a family"));
+    }
+
+    #[test]
+    fn null_device_names_round_trip() {
+        for t in &FAMILIES {
+            assert_eq!(family_of_device(&null_device_name(t)), Some(t));
+        }
+        assert_eq!(family_of_device("llvmpipe (LLVM 15.0.6, 256 bits)"), None);
+    }
+
+    #[test]
+    fn cycles_per_eval_is_inverse_throughput_per_64_lanes_and_light() {
+        let row = |model: &str, it: f64| Row {
+            model: model.into(),
+            spec: None,
+            stats: [("driver/Compute Shader/Inverse Throughput".to_string(), it), ("driver/Compute Shader/VGPRs".to_string(), 40.0)].into(),
+            notes: BTreeMap::new(),
+        };
+        let mut report = crate::inspect::tests::empty_report("Null hardware (RADV NAVI21)");
+        report.rows = vec![row("ggx", 1536.0), row(crate::inspect::BASELINE_LABEL, 512.0)];
+        let t = RADV.cost(&report).unwrap();
+        assert_eq!(t.family.as_deref(), Some("navi21"));
+        assert_eq!(t.rows[0].cycles_per_eval, 3.0);
+        assert_eq!(t.rows[0].net_cycles_per_eval, Some(2.0));
+        assert_eq!(t.rows[1].net_cycles_per_eval, None);
+        assert_eq!(t.stat(&t.rows[0], "VGPRs"), Some(40.0));
+        assert!(t.markdown().contains("| ggx "));
+        assert_eq!(RADV.fingerprint(&report)["device"], "Null hardware (RADV NAVI21)");
+    }
+}
