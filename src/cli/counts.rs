@@ -125,11 +125,11 @@ fn inspect_reports(args: &InspectArgs, plan: &[Planned], options: &InspectOption
                 let run = radv_runs.next().expect("one run per target");
                 let mut report = run.report;
                 if let Some(note) = run.teardown_note {
-                    eprintln!("brdfprof inspect: note: {note}");
+                    brdfprof::messages::note(&note);
                     report.section_notes.insert("driver/".into(), note);
                 }
                 if !run.isa_files.is_empty() {
-                    eprintln!("brdfprof inspect: radv:{}: {} ISA files under {}", run.target.family, run.isa_files.len(), args.isa.as_deref().map_or(String::new(), |d| d.join(run.target.family).display().to_string()));
+                    brdfprof::messages::progress(format!("inspect: radv:{}: {} ISA files under {}", run.target.family, run.isa_files.len(), args.isa.as_deref().map_or(String::new(), |d| d.join(run.target.family).display().to_string())));
                 }
                 reports.push(report);
             }

@@ -80,10 +80,10 @@ fn plan(options: &CheckOptions, old: Option<&Baseline>) -> Result<(Vec<Model>, u
 
 /// Measures this build: every count, then the timing run.
 pub fn measure(gpu: &Gpu, shaders: &Shaders, models: Vec<Model>, lights: u32, options: &CheckOptions) -> Result<Baseline> {
-    eprintln!("brdfprof check: counting instructions ({} models + baseline kernel{})", models.len(), if options.callgrind.is_some() { ", callgrind" } else { "" });
+    crate::messages::progress(format!("check: counting instructions ({} models + baseline kernel{})", models.len(), if options.callgrind.is_some() { ", callgrind" } else { "" }));
     let inspect = super::run(gpu, shaders, &InspectOptions { models: models.clone(), lights, callgrind: options.callgrind.clone() })?;
     let timing = if options.timing.rounds > 0 {
-        eprintln!("brdfprof check: timing {} rounds", options.timing.rounds);
+        crate::messages::progress(format!("check: timing {} rounds", options.timing.rounds));
         Some(timing::run(gpu, shaders, &models, &TimingOptions { lights, ..options.timing.clone() })?)
     } else {
         None
@@ -107,11 +107,11 @@ pub fn run(options: &CheckOptions, shaders: &Shaders, open: impl FnOnce() -> Res
 /// (`inspect::radv`), no timing and no callgrind (nothing executes).
 pub fn run_radv(options: &CheckOptions, shaders: &Shaders, target: &'static crate::gpu::targets::Target, validate: bool) -> Result<Outcome> {
     run_measured(options, |specs, lights| {
-        eprintln!("brdfprof check: compiling for radv:{} ({} models + baseline kernel)", target.family, specs.len());
+        crate::messages::progress(format!("check: compiling for radv:{} ({} models + baseline kernel)", target.family, specs.len()));
         let run = super::radv::run(target, &specs, lights, shaders, validate, None)?;
         let mut inspect = run.report;
         if let Some(note) = run.teardown_note {
-            eprintln!("brdfprof check: note: {note}");
+            crate::messages::note(note);
         }
         for group in ["callgrind/", "timing/"] {
             inspect.section_notes.insert(group.into(), format!("not applicable: radv:{} compiles only, nothing executes", target.family));
@@ -138,7 +138,7 @@ fn run_measured(options: &CheckOptions, measure: impl FnOnce(Vec<Model>, u32) ->
     };
     if let Some(path) = &options.save {
         reports::write_json(path, &new)?;
-        eprintln!("brdfprof check: baseline saved to {}", path.display());
+        crate::messages::progress(format!("check: baseline saved to {}", path.display()));
     }
     Ok(outcome)
 }
