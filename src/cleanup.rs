@@ -18,9 +18,11 @@ pub const INTERRUPTED_EXIT: i32 = 130;
 struct Registry {
     children: Vec<u32>,
     paths: Vec<PathBuf>,
+    /// Directories created for staged outputs, outermost first: removed when empty.
+    created_dirs: Vec<PathBuf>,
 }
 
-static REGISTRY: Mutex<Registry> = Mutex::new(Registry { children: Vec::new(), paths: Vec::new() });
+static REGISTRY: Mutex<Registry> = Mutex::new(Registry { children: Vec::new(), paths: Vec::new(), created_dirs: Vec::new() });
 static INTERRUPTED: AtomicBool = AtomicBool::new(false);
 
 /// The registry, even if a panicking thread poisoned it (it holds plain lists; nothing is half-updated).
@@ -47,12 +49,33 @@ pub fn park_if_interrupted() {
 }
 
 fn on_signal() {
+    stop(INTERRUPTED_EXIT, "brdfprof: interrupted");
+}
+
+/// Held while staged outputs are renamed into place (`committing`): `stop` waits for it, so a command that
+/// stops leaves all of its outputs or none.
+static COMMIT: Mutex<()> = Mutex::new(());
+
+/// Runs `f` (the renames that publish a command's outputs) so that no `stop` cuts it short.
+pub fn committing<T>(f: impl FnOnce() -> T) -> T {
+    let _lock = COMMIT.lock().unwrap_or_else(|e| e.into_inner());
+    f()
+}
+
+/// Ends the process now with `code`: kills the registered children, removes the registered paths (staged
+/// outputs and temporaries, then the directories created for outputs, where empty) and prints `message`
+/// with what was cleaned up. For a signal, and for work that cannot be stopped otherwise (a driver call past
+/// the compile limit, a fence that never signals). A second caller waits for the first to end the process.
+pub fn stop(code: i32, message: &str) -> ! {
     if INTERRUPTED.swap(true, Ordering::SeqCst) {
-        return;
+        loop {
+            std::thread::park();
+        }
     }
-    let (children, paths) = {
+    let _commit = COMMIT.lock().unwrap_or_else(|e| e.into_inner());
+    let (children, paths, dirs) = {
         let r = registry();
-        (r.children.clone(), r.paths.clone())
+        (r.children.clone(), r.paths.clone(), r.created_dirs.clone())
     };
     for pid in &children {
         kill_and_reap(*pid);
@@ -61,11 +84,14 @@ fn on_signal() {
     for p in &paths {
         remove(p);
     }
-    eprintln!("brdfprof: interrupted; stopped {} child process(es) and removed {} temporary path(s)", children.len(), paths.len());
+    for d in dirs.iter().rev() {
+        let _ = std::fs::remove_dir(d);
+    }
+    crate::messages::line(&format!("{message}; stopped {} child process(es) and removed {} temporary path(s)", children.len(), paths.len()));
     // _exit, not exit: other threads may be inside the Vulkan driver, whose exit-time teardown must not run
-    // under them. Nothing buffered is lost that matters for an interrupted run.
+    // under them. Nothing buffered is lost that matters for a stopped run.
     // SAFETY: _exit ends the process at once; it has no preconditions.
-    unsafe { libc::_exit(INTERRUPTED_EXIT) }
+    unsafe { libc::_exit(code) }
 }
 
 /// SIGKILL, then wait up to 2 s for it to be gone (so it writes nothing after the cleanup).
@@ -110,6 +136,17 @@ impl Drop for PathGuard {
             r.paths.swap_remove(i);
         }
     }
+}
+
+/// Directories created for a command's outputs (outermost first), removed by `stop` where they are empty,
+/// until `forget_created_dirs`.
+pub fn register_created_dirs(dirs: &[PathBuf]) {
+    registry().created_dirs.extend(dirs.iter().cloned());
+}
+
+/// The directories registered by `register_created_dirs`, no longer registered.
+pub fn forget_created_dirs() -> Vec<PathBuf> {
+    std::mem::take(&mut registry().created_dirs)
 }
 
 /// A temporary directory (under TMPDIR), removed when dropped and by the signal handler.
@@ -180,6 +217,15 @@ fn die_with_parent(cmd: &mut Command) {
 
 #[cfg(not(target_os = "linux"))]
 fn die_with_parent(_cmd: &mut Command) {}
+
+/// Gives `cmd` a TMPDIR of its own, inside a directory of this process that is removed when the guard is
+/// dropped (after the child is reaped) and by the signal handler: what a child leaves there when it is
+/// killed (it cannot clean up after SIGKILL) goes with it.
+pub fn child_tmpdir(cmd: &mut Command) -> Result<TempDir> {
+    let dir = TempDir::new().context("cannot create a temporary directory for a child process")?;
+    cmd.env("TMPDIR", dir.path());
+    Ok(dir)
+}
 
 /// `cmd.output()`, with the child registered for the signal handler while it runs.
 pub fn output(cmd: &mut Command) -> std::io::Result<Output> {

@@ -347,14 +347,54 @@ pub fn load_columns(path: &Path) -> Result<Vec<CostColumn>> {
     Ok(columns)
 }
 
+/// Refuses a report given twice (the same file by any path, or two files with the same content): a column
+/// against itself correlates perfectly and says nothing.
+fn refuse_repeats(files: &[PathBuf]) -> Result<()> {
+    let mut seen: Vec<(&PathBuf, Vec<u8>)> = Vec::new();
+    for f in files {
+        let digest = Sha256::digest(std::fs::read(f).with_context(|| format!("{}: cannot read it", f.display()))?).to_vec();
+        if let Some((first, _)) = seen.iter().find(|(_, d)| *d == digest) {
+            bail!("{} is the same report as {}: give each report once (a report compared with itself correlates perfectly and says nothing)", f.display(), first.display());
+        }
+        seen.push((f, digest));
+    }
+    Ok(())
+}
+
+impl CostColumn {
+    /// Refuses figures no measurement gives: a cost that is not finite or not above 0, a net cost that is not
+    /// finite or above the gross one (the memory-only kernel cannot cost less than nothing), a CI that does
+    /// not hold its median.
+    pub fn check_figures(&self) -> Result<()> {
+        let fail = |model: &str, why: String| anyhow!("{} ({}): `{model}`: {why}; not a figure a measurement gives (an edited or damaged report?)", self.name, self.source);
+        for (model, &g) in &self.gross {
+            if !(g.is_finite() && g > 0.0) {
+                return Err(fail(model, format!("cost {g}")));
+            }
+        }
+        for (model, &n) in &self.net {
+            let gross = self.gross.get(model).copied().unwrap_or(f64::INFINITY);
+            if !n.is_finite() || n > gross {
+                return Err(fail(model, format!("net cost {n} (gross {gross})")));
+            }
+            if let Some(&(lo, hi)) = self.net_ci.get(model).filter(|(lo, hi)| !(lo.is_finite() && hi.is_finite() && *lo <= n && n <= *hi)) {
+                return Err(fail(model, format!("net cost {n} outside its confidence interval [{lo}, {hi}]")));
+            }
+        }
+        Ok(())
+    }
+}
+
 /// `brdfprof compare FILE ...`: every file's columns, checked for the same kernels, in one table.
 pub fn from_files(files: &[PathBuf]) -> Result<CostTable> {
     if files.is_empty() {
         bail!("compare needs at least one FILE.json (profile or inspect reports)");
     }
+    refuse_repeats(files)?;
     let mut columns: Vec<CostColumn> = Vec::new();
     for f in files {
         for mut c in load_columns(f)? {
+            c.check_figures()?;
             // Two files of the same device: keep both, told apart by their file.
             if columns.iter().any(|o| o.name == c.name) {
                 c.name = format!("{} [{}]", c.name, f.file_name().map_or_else(|| f.display().to_string(), |n| n.to_string_lossy().into_owned()));

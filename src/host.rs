@@ -78,3 +78,27 @@ pub fn available_memory() -> Option<u64> {
     let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
     Some(kib * 1024)
 }
+
+/// Bytes that lower the memory brdfprof plans with below `MemAvailable` (`available_memory`), so that the
+/// refusals of sizes that do not fit can be tested without filling a machine's memory (README "Limits").
+pub const MEMORY_LIMIT_ENV: &str = "BRDFPROF_MEMORY_LIMIT";
+
+/// `MEMORY_LIMIT_ENV` when set: a whole number of bytes (an error names the variable otherwise).
+pub fn memory_limit() -> anyhow::Result<Option<u64>> {
+    match std::env::var(MEMORY_LIMIT_ENV) {
+        Ok(v) if !v.trim().is_empty() => v.trim().parse::<u64>().map(Some).map_err(|_| anyhow::anyhow!("{MEMORY_LIMIT_ENV}={v}: give a whole number of bytes")),
+        _ => Ok(None),
+    }
+}
+
+/// The memory a run may plan to use: `MemAvailable`, lowered by `MEMORY_LIMIT_ENV`; None where neither is
+/// known. `where_from` says which applies, for messages.
+pub fn memory_budget() -> Option<(u64, &'static str)> {
+    let limit = memory_limit().ok().flatten();
+    match (available_memory(), limit) {
+        (Some(a), Some(l)) if l < a => Some((l, MEMORY_LIMIT_ENV)),
+        (Some(a), _) => Some((a, "MemAvailable")),
+        (None, Some(l)) => Some((l, MEMORY_LIMIT_ENV)),
+        (None, None) => None,
+    }
+}

@@ -5,14 +5,17 @@
 
 pub mod accuracy;
 pub mod brdf;
+pub mod cache;
 pub mod chart;
 pub mod cleanup;
 pub mod compare;
+pub mod compile_limit;
 pub mod gpu;
 pub mod host;
 pub mod inspect;
 pub mod io;
 pub mod kernels;
+pub mod messages;
 pub mod model;
 pub mod profile;
 pub mod report;

@@ -12,6 +12,10 @@ use std::process::ExitCode;
 struct Cli {
     #[command(subcommand)]
     command: Command,
+    /// Seconds any one compilation may take (glslang, the driver's pipeline creation, a compile-only child)
+    /// before the command stops with exit status 2, naming it (default 60; also BRDFPROF_COMPILE_TIMEOUT).
+    #[arg(long, global = true, value_name = "SECONDS", value_parser = cli::compile_timeout)]
+    compile_timeout: Option<std::time::Duration>,
 }
 
 #[derive(Subcommand)]
@@ -47,10 +51,14 @@ enum Command {
     /// Render a scene: a tone-mapped sRGB PNG per model, the comparison grid, difference heat maps against ggx
     /// and polar lobe plots, under --out (default results/scenes/<scene name>/).
     Render(cli::scene::RenderArgs),
+    /// The disk cache of compiled kernels: `show` (directory, entries, size) or `clear`.
+    Cache(cli::cache::CacheArgs),
     #[command(name = "__callgrind-child", hide = true)]
     CallgrindChild { request: String },
     #[command(name = "__radv-child", hide = true)]
     RadvChild { request: String },
+    #[command(name = "__probe-vulkan", hide = true)]
+    ProbeVulkan,
     /// Writes glsl/generated/ from the Rust term tables (`make spv` runs it).
     #[command(name = "__generate-glsl", hide = true)]
     GenerateGlsl {
@@ -62,13 +70,9 @@ enum Command {
 fn main() -> ExitCode {
     cli::command_started();
     let cli = Cli::parse();
-    // The callgrind child runs under valgrind and dies with its parent; every other command cleans up on
-    // SIGINT/SIGTERM (children killed, temporary files removed, exit 130).
-    if !matches!(cli.command, Command::CallgrindChild { .. } | Command::RadvChild { .. }) {
-        if let Err(e) = brdfprof::cleanup::install_signal_handler() {
-            eprintln!("brdfprof: error: {e:#}");
-            return ExitCode::from(2);
-        }
+    let child = matches!(cli.command, Command::CallgrindChild { .. } | Command::RadvChild { .. } | Command::ProbeVulkan);
+    if let Err(e) = cli::prepare(child, cli.compile_timeout) {
+        return cli::finish(Err(e));
     }
     let result = match cli.command {
         Command::Devices(args) => cli::info::devices(&args),
@@ -82,17 +86,11 @@ fn main() -> ExitCode {
         Command::Compare(args) => cli::compare::compare(&args),
         Command::Scene(args) => cli::scene::scene(&args),
         Command::Render(args) => cli::scene::render(&args),
+        Command::Cache(args) => cli::cache::cache(&args),
         Command::CallgrindChild { request } => brdfprof::inspect::callgrind::child_main(&request).map(|_| ExitCode::SUCCESS),
         Command::RadvChild { request } => brdfprof::targets::radv_child::child_main(&request).map(|_| ExitCode::SUCCESS),
+        Command::ProbeVulkan => brdfprof::targets::radv_env::probe_main().map(|_| ExitCode::SUCCESS),
         Command::GenerateGlsl { dir } => cli::info::generate_glsl(&dir),
     };
-    // An interrupted command ends with the signal handler's exit status, not its own.
-    brdfprof::cleanup::park_if_interrupted();
-    match result {
-        Ok(code) => code,
-        Err(e) => {
-            eprintln!("brdfprof: error: {e:#}");
-            ExitCode::from(2)
-        }
-    }
+    cli::finish(result)
 }

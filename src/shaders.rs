@@ -106,7 +106,7 @@ impl Shaders {
             return Ok(k.clone());
         }
         let (source, defines) = kernel_entry(dir, name)?;
-        let words = glslang(&dir.join(&source), &defines, &[])?;
+        let words = glslang(&dir.join(&source), &defines, &[], &format!("{name} from {} (glslang)", dir.display()))?;
         let spirv = Spirv { name: name.to_string(), words: words.into() };
         compiled.insert(name.to_string(), spirv.clone());
         Ok(spirv)
@@ -128,8 +128,9 @@ pub fn kernel_entry(dir: &Path, name: &str) -> Result<(String, Vec<String>)> {
 }
 
 /// Compiles `source` with glslang (`GLSLANG_FLAGS`, `-D` for each define, `-I` for each include directory)
-/// and returns the SPIR-V words; a failure carries glslang's own messages.
-pub fn glslang(source: &Path, defines: &[String], includes: &[&Path]) -> Result<Vec<u32>> {
+/// under the compile limit (`compile_limit`; `what` names the compilation in its messages) and returns the
+/// SPIR-V words; a failure carries glslang's own messages.
+pub fn glslang(source: &Path, defines: &[String], includes: &[&Path], what: &str) -> Result<Vec<u32>> {
     let out_dir = crate::cleanup::TempDir::new().context("cannot create a temporary directory for glslang's output")?;
     let out = out_dir.path().join("out.spv");
     let mut cmd = crate::cleanup::command("glslangValidator");
@@ -141,7 +142,11 @@ pub fn glslang(source: &Path, defines: &[String], includes: &[&Path]) -> Result<
         cmd.arg(format!("-I{}", i.display()));
     }
     cmd.arg("-o").arg(&out).arg(source);
-    let result = crate::cleanup::output(&mut cmd).map_err(|e| anyhow!("cannot run glslangValidator ({e}): install glslang-tools, or run `make setup`"))?;
+    let result = match crate::compile_limit::output(&mut cmd, what) {
+        Ok(r) => r,
+        Err(e) if e.downcast_ref::<std::io::Error>().is_some() => bail!("cannot run glslangValidator ({e}): install glslang-tools, or run `make setup`"),
+        Err(e) => return Err(e),
+    };
     if !result.status.success() {
         bail!(GlslangError { source: source.to_path_buf(), log: format!("{}{}", String::from_utf8_lossy(&result.stdout), String::from_utf8_lossy(&result.stderr)) });
     }

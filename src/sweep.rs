@@ -112,6 +112,9 @@ pub fn run(gpu: &Gpu, options: &SweepOptions, progress: &ProgressBar) -> Result<
     }
     // Accuracy first, so that the profile's budget (the whole command's) accounts for it.
     let set = SampleSet::standard();
+    if options.profile.models.iter().any(|m| m.twin().is_none()) {
+        accuracy::check_reference(gpu, &options.reference, &set, &format!("--reference {}", options.reference.name()))?;
+    }
     let mut cache = ExactCache::default();
     let n = options.profile.models.len();
     let mut accuracies = Vec::with_capacity(n);
@@ -180,8 +183,8 @@ impl SweepReport {
                 report::estimate(&r.ns_per_eval, 3),
                 r.net_ns_per_eval.as_ref().map_or("-".into(), |e| report::sig(e.median, 3)),
                 report::estimate(&r.cost_vs_fastest, 3),
-                a.numerical.as_ref().map_or_else(|| format!("- (vs {})", a.reference.as_deref().unwrap_or("?")), |n| format!("{:.1e}", n.max)),
-                format!("{:.1e} / {:.1e}", a.vs_exact.max, a.vs_exact.rms),
+                a.numerical.as_ref().map_or_else(|| format!("- (vs {})", a.reference.as_deref().unwrap_or("?")), |n| if n.nonfinite > 0 { format!("{} NaN/Inf", n.nonfinite) } else { format!("{:.1e}", n.max) }),
+                a.vs_exact.cell(),
                 format!("{:.1e}", a.albedo_vs_exact),
                 if r.pareto { "yes".into() } else { String::new() },
             ]);

@@ -115,7 +115,7 @@ impl CostSweep {
                 r.net_cycles_per_eval.map_or("-".into(), |v| report::sig(v, 4)),
                 format!("{:.3}", r.cost_vs_fastest),
                 format!("{:.3}", r.measured_cost_vs_fastest),
-                format!("{:.1e} / {:.1e}", r.accuracy.vs_exact.max, r.accuracy.vs_exact.rms),
+                r.accuracy.vs_exact.cell(),
                 if r.pareto { "yes".into() } else { String::new() },
                 if r.measured_pareto { "yes".into() } else { String::new() },
             ]);

@@ -24,10 +24,15 @@ pub fn rel_err(x: f64, reference: f64) -> f64 {
 
 #[derive(Clone, Debug, Default, Serialize)]
 pub struct ErrorStats {
+    /// Over every value; a NaN or Inf value counts as an infinite error (`nonfinite` says how many there are).
     pub max: f64,
     pub rms: f64,
     /// The sample with the largest error.
     pub worst: String,
+    /// Values (samples x channels) that are NaN or Inf.
+    pub nonfinite: usize,
+    /// Values compared.
+    pub values: usize,
 }
 
 impl ErrorStats {
@@ -37,6 +42,8 @@ impl ErrorStats {
         let mut sum_sq = 0.0;
         for (i, (g, r)) in got.iter().zip(reference).enumerate() {
             for c in 0..3 {
+                stats.values += 1;
+                stats.nonfinite += !g[c].is_finite() as usize;
                 let e = rel_err(g[c], r[c]);
                 sum_sq += e * e;
                 if e > stats.max || stats.worst.is_empty() {
@@ -48,6 +55,35 @@ impl ErrorStats {
         stats.rms = (sum_sq / (3 * got.len()).max(1) as f64).sqrt();
         stats
     }
+
+    /// "max / RMS" as a table cell, or how many values are NaN or Inf (which make both infinite).
+    pub fn cell(&self) -> String {
+        if self.nonfinite > 0 {
+            format!("{} of {} values NaN/Inf", self.nonfinite, self.values)
+        } else {
+            format!("{:.1e} / {:.1e}", self.max, self.rms)
+        }
+    }
+}
+
+/// Refuses a reference that is not finite on the sample set or the albedo cells: every error against it
+/// would be NaN or infinite. `what` names it (`--reference FILE`).
+pub fn check_reference(gpu: &Gpu, reference: &Model, set: &SampleSet, what: &str) -> Result<()> {
+    if reference.twin().is_some() {
+        return Ok(()); // a spec's exact f64 model
+    }
+    let values = kernels::eval(gpu, reference, &set.samples, RunLimits::default())?;
+    let bad = values.iter().flatten().filter(|x| !x.is_finite()).count();
+    let albedo = kernels::albedo(gpu, reference, &set.cells)?;
+    let bad_albedo = albedo.iter().flat_map(|a| a.e).filter(|x| !x.is_finite()).count();
+    if bad + bad_albedo > 0 {
+        anyhow::bail!(
+            "{what}: the reference is not finite: {bad} of {} values on the sample set and {bad_albedo} of {} albedo values are NaN or Inf, so every error against it would be too. Give a reference that is finite everywhere",
+            3 * values.len(),
+            3 * albedo.len()
+        );
+    }
+    Ok(())
 }
 
 /// The fixed sample set: 10 strata each in roughness [0.1, 1], NoV and NoL [0.05, 1] and azimuth [0, pi]
@@ -128,7 +164,8 @@ pub struct Accuracy {
 pub fn measure(gpu: &Gpu, model: &Model, set: &SampleSet, cache: &mut ExactCache, reference: &Model) -> Result<Accuracy> {
     let got: Vec<[f64; 3]> = kernels::eval(gpu, model, &set.samples, RunLimits::default())?.iter().map(|g| g.map(f64::from)).collect();
     let gpu_albedo = kernels::albedo(gpu, model, &set.cells)?;
-    let albedo_diff = |exact: &[[f64; 3]]| gpu_albedo.iter().zip(exact).flat_map(|(g, x)| (0..3).map(move |c| (g.e[c] - x[c]).abs())).fold(0.0, f64::max);
+    // A NaN difference is an infinite one, not none (f64::max would drop it).
+    let albedo_diff = |exact: &[[f64; 3]]| gpu_albedo.iter().zip(exact).flat_map(|(g, x)| (0..3).map(move |c| (g.e[c] - x[c]).abs())).map(|d| if d.is_nan() { f64::INFINITY } else { d }).fold(0.0, f64::max);
     let albedo_error_bound = gpu_albedo.iter().map(|a| a.error).fold(0.0, f64::max);
     let Some(spec) = model.twin() else {
         let (values, albedo): (Vec<[f64; 3]>, Vec<[f64; 3]>) = match reference.twin() {

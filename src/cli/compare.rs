@@ -29,6 +29,11 @@ pub fn compare(args: &CompareArgs) -> Result<ExitCode> {
     check_output("--json", args.json.as_deref(), "results", "compare.json")?;
     check_output("--markdown", args.markdown.as_deref(), "results", "compare.md")?;
     check_output("--chart", args.chart.as_deref(), "results", "compare.png")?;
+    for (flag, out) in [("--json", &args.json), ("--markdown", &args.markdown), ("--chart", &args.chart)] {
+        if let Some(out) = out {
+            io::check_not_input(flag, out, &args.files.iter().map(|f| ("FILE", f.as_path())).collect::<Vec<_>>())?;
+        }
+    }
     let table = compare::from_files(&args.files)?;
     let json = args.json.clone().unwrap_or_else(|| PathBuf::from("results/compare.json"));
     let markdown = args.markdown.clone().unwrap_or_else(|| PathBuf::from("results/compare.md"));

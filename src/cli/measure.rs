@@ -56,7 +56,10 @@ pub fn profile(args: &ProfileArgs) -> Result<ExitCode> {
     if let Some(t) = result.light_table() {
         println!("\nns/eval by light count (net of the baseline; the baseline gross):\n\n{}", t.markdown());
     }
-    eprint!("{}", result.harness_warning());
+    let harness = result.harness_warning();
+    if let Some(text) = harness.trim_end().strip_prefix("warning: ") {
+        brdfprof::messages::warning(text);
+    }
     println!("\nJSON: {}", path.display());
     Ok(ExitCode::SUCCESS)
 }
@@ -144,7 +147,7 @@ pub fn sweep(args: &SweepArgs) -> Result<ExitCode> {
     let models = if args.model.models.is_empty() { sweep::default_specs().into_iter().map(Model::spec).collect() } else { args.model.models(&[])? };
     let reference = Model::parse(&args.reference).map_err(|e| anyhow::anyhow!("--reference {}: {e:#}", args.reference))?;
     if models.iter().all(|m| m.twin().is_some()) && args.reference != "ggx" {
-        eprintln!("brdfprof: note: --reference applies to .brdf models; built-in specs are measured against their own exact model");
+        brdfprof::messages::note("--reference applies to .brdf models; built-in specs are measured against their own exact model");
     }
     let options = sweep::SweepOptions { profile: args.timing.options(models, &args.size, args.reps, args.budget, args.target_ci)?, reference };
     let shaders = options.profile.glsl.as_deref().map(brdfprof::shaders::Shaders::from_glsl).transpose()?.unwrap_or_else(brdfprof::shaders::Shaders::embedded);
@@ -155,6 +158,9 @@ pub fn sweep(args: &SweepArgs) -> Result<ExitCode> {
         let costs = brdfprof::targets::compile_all(&cost_targets, &request)?;
         Ok((sweep::run(gpu, &options, progress)?, costs))
     })?;
+    for r in result.rows.iter().filter(|r| r.accuracy.vs_exact.nonfinite > 0) {
+        brdfprof::messages::warning(format!("{}: {} of {} values on the sample set are NaN or Inf", r.spec, r.accuracy.vs_exact.nonfinite, r.accuracy.vs_exact.values));
+    }
     let slug = report::device_slug(&gpu.info);
     let mut files = result.write(&args.out, &slug)?;
     print!("{}", result.markdown());
@@ -197,6 +203,6 @@ pub fn stability(args: &StabilityArgs) -> Result<ExitCode> {
     if failing.is_empty() {
         return Ok(ExitCode::SUCCESS);
     }
-    eprintln!("brdfprof: {} spec(s) give NaN, Inf or negative values on valid inputs", failing.len());
+    brdfprof::messages::progress(format!("{} spec(s) give NaN, Inf or negative values on valid inputs", failing.len()));
     Ok(ExitCode::from(1))
 }

@@ -1,6 +1,7 @@
 //! What every command shares: the device, model and timing arguments, and the one sequence that opens the
 //! device, shows progress, runs the work and checks the validation layer.
 
+pub mod cache;
 pub mod compare;
 pub mod counts;
 pub mod eval;
@@ -90,7 +91,10 @@ pub fn on_device_with<T>(device: &DeviceArgs, compile_only_ok: bool, work: impl 
     let gpu = device.open_with(compile_only_ok)?;
     let progress = ProgressBar::new(0).with_style(ProgressStyle::with_template("{spinner} {elapsed} {pos} {msg}").expect("valid progress template"));
     progress.enable_steady_tick(Duration::from_millis(200));
+    let bar = progress.clone();
+    let messages = brdfprof::messages::ProgressGuard::new(move |print| bar.suspend(print));
     let result = work(&gpu, &progress);
+    drop(messages);
     progress.finish_and_clear();
     let result = result?;
     gpu.check_validation()?;
@@ -181,6 +185,52 @@ impl TimingArgs {
             instances: self.instances.max(1),
             glsl: self.glsl.clone(),
         })
+    }
+}
+
+/// `--compile-timeout`: seconds, more than 0 and at most a day.
+pub fn compile_timeout(text: &str) -> Result<Duration, String> {
+    brdfprof::compile_limit::parse(text)
+}
+
+/// Everything before a command runs: the signal handler (children have none: they die with brdfprof), the
+/// compile limit, the environment knobs checked, a `RADV_FORCE_FAMILY` that would abort the process
+/// removed, and outputs staged until the command succeeds (`finish`).
+pub fn prepare(child: bool, compile_timeout: Option<Duration>) -> Result<()> {
+    if child {
+        brdfprof::messages::set_child_process();
+    } else {
+        brdfprof::cleanup::install_signal_handler()?;
+    }
+    brdfprof::compile_limit::init(compile_timeout)?;
+    check_env_seconds(brdfprof::gpu::FENCE_TIMEOUT_ENV)?;
+    brdfprof::host::memory_limit()?;
+    if !child {
+        brdfprof::targets::radv_env::sanitise()?;
+    }
+    brdfprof::io::stage_outputs();
+    Ok(())
+}
+
+/// An environment variable that holds seconds, when set: more than 0, at most a day.
+fn check_env_seconds(var: &str) -> Result<()> {
+    match std::env::var(var) {
+        Ok(v) if !v.trim().is_empty() => brdfprof::compile_limit::parse(&v).map(|_| ()).map_err(|e| anyhow!("{var}={e}")),
+        _ => Ok(()),
+    }
+}
+
+/// The end of every command: its staged outputs published if it succeeded (exit 0 or 1), removed if it
+/// failed; an error printed with exit status 2. An interrupted command ends in the signal handler instead.
+pub fn finish(result: Result<std::process::ExitCode>) -> std::process::ExitCode {
+    brdfprof::cleanup::park_if_interrupted();
+    match result.and_then(|code| brdfprof::io::commit_outputs().map(|_| code)) {
+        Ok(code) => code,
+        Err(e) => {
+            brdfprof::io::discard_outputs();
+            brdfprof::messages::error(format!("{e:#}"));
+            std::process::ExitCode::from(2)
+        }
     }
 }
 

@@ -40,7 +40,10 @@ pub fn render(args: &RenderArgs) -> Result<ExitCode> {
     io::check_output_dir(if args.out.is_some() { "--out" } else { "--out (default results/scenes/<scene name>)" }, &out)?;
     let (_, result) = on_device(&args.device, |gpu, progress| scene::render::render(gpu, &scene, &out, progress))?;
     for n in &result.notes {
-        eprintln!("brdfprof: note: {n}");
+        brdfprof::messages::note(n);
+    }
+    for w in &result.warnings {
+        brdfprof::messages::warning(w);
     }
     println!("{}", written(&result.files));
     Ok(ExitCode::SUCCESS)

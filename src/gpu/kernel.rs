@@ -89,6 +89,8 @@ pub struct Kernel<'g> {
     pub workgroup: u32,
     /// Created with CAPTURE_INTERNAL_REPRESENTATIONS (`executables` returns them).
     pub(super) captures_ir: bool,
+    /// Whether a dispatch of it was ever recorded (`Commands::first_dispatches`).
+    dispatched: std::cell::Cell<bool>,
 }
 
 /// Descriptor sets one kernel can hold at a time (one per chunk of a dispatch).
@@ -132,7 +134,6 @@ impl<'g> Kernel<'g> {
             .map(|(i, (id, _))| vk::SpecializationMapEntry { constant_id: *id, offset: 4 * i as u32, size: 4 })
             .collect();
         let data: Vec<u8> = spec.entries.iter().flat_map(|(_, v)| *v).collect();
-        let spec_info = vk::SpecializationInfo::default().map_entries(&map).data(&data);
         // SAFETY: every create info and what it points to outlives its call; handles are destroyed in Drop.
         unsafe {
             let module = device.create_shader_module(&vk::ShaderModuleCreateInfo::default().code(words), None)?;
@@ -145,11 +146,6 @@ impl<'g> Kernel<'g> {
                 layout_info = layout_info.push_constant_ranges(&ranges);
             }
             let layout = device.create_pipeline_layout(&layout_info, None)?;
-            let stage = vk::PipelineShaderStageCreateInfo::default()
-                .stage(vk::ShaderStageFlags::COMPUTE)
-                .module(module)
-                .name(c"main")
-                .specialization_info(&spec_info);
             let mut flags = vk::PipelineCreateFlags::empty();
             if gpu.executable_properties.is_some() {
                 flags |= vk::PipelineCreateFlags::CAPTURE_STATISTICS_KHR;
@@ -157,10 +153,7 @@ impl<'g> Kernel<'g> {
                     flags |= vk::PipelineCreateFlags::CAPTURE_INTERNAL_REPRESENTATIONS_KHR;
                 }
             }
-            let info = vk::ComputePipelineCreateInfo::default().stage(stage).layout(layout).flags(flags);
-            let pipeline = device
-                .create_compute_pipelines(vk::PipelineCache::null(), &[info], None)
-                .map_err(|(_, e)| anyhow!("creating the {name} pipeline: {e}"))?[0];
+            let pipeline = create_pipeline(gpu, name, module, layout, &map, &data, flags)?;
             device.destroy_shader_module(module, None);
             let mut sizes: Vec<vk::DescriptorPoolSize> = Vec::new();
             for b in bindings {
@@ -174,7 +167,7 @@ impl<'g> Kernel<'g> {
                 None,
             )?;
             let captures_ir = capture_ir && gpu.executable_properties.is_some();
-            Ok(Kernel { gpu, name: name.into(), pipeline, layout, set_layout, pool, bindings: bindings.to_vec(), views: Default::default(), push_bytes, workgroup: WORKGROUP, captures_ir })
+            Ok(Kernel { gpu, name: name.into(), pipeline, layout, set_layout, pool, bindings: bindings.to_vec(), views: Default::default(), push_bytes, workgroup: WORKGROUP, captures_ir, dispatched: Default::default() })
         }
     }
 
@@ -248,6 +241,9 @@ impl<'g> Kernel<'g> {
         assert_eq!(offsets.len(), self.bindings.iter().filter(|b| **b == Binding::UniformDynamic).count(), "{}: wrong number of dynamic offsets", self.name);
         let groups = invocations.div_ceil(self.workgroup as u64) as u32;
         assert!(groups <= self.gpu.info.max_compute_work_group_count[0], "dispatch past maxComputeWorkGroupCount: chunk it");
+        if !self.dispatched.replace(true) {
+            cmd.first_dispatches.borrow_mut().push(self.name.clone());
+        }
         let device = &self.gpu.device;
         let raw = cmd.raw;
         // SAFETY: cmd is recording; set and layout match this pipeline.
@@ -260,6 +256,23 @@ impl<'g> Kernel<'g> {
             device.cmd_dispatch(raw, groups, 1, 1);
         }
     }
+}
+
+/// The compute pipeline of `module` specialised with `map`/`data`. The driver compiles here (RADV: ACO; lavapipe
+/// only prepares, and compiles at the first dispatch: `Gpu::submit`), in a call that cannot be interrupted: it
+/// runs under the compile limit on a worker thread (`compile_limit::bounded`).
+fn create_pipeline(gpu: &Gpu, name: &str, module: vk::ShaderModule, layout: vk::PipelineLayout, map: &[vk::SpecializationMapEntry], data: &[u8], flags: vk::PipelineCreateFlags) -> Result<vk::Pipeline> {
+    let device = &gpu.device;
+    let what = format!("{name} (pipeline creation on {})", gpu.info.name);
+    let created = crate::compile_limit::bounded(&what, || {
+        let spec_info = vk::SpecializationInfo::default().map_entries(map).data(data);
+        let stage = vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::COMPUTE).module(module).name(c"main").specialization_info(&spec_info);
+        let info = vk::ComputePipelineCreateInfo::default().stage(stage).layout(layout).flags(flags);
+        // SAFETY: the module and layout belong to this device; the create info and what it points to live
+        // through the call.
+        unsafe { device.create_compute_pipelines(vk::PipelineCache::null(), &[info], None) }.map(|p| p[0]).map_err(|(_, e)| e)
+    });
+    created.map_err(|e| anyhow!("creating the {name} pipeline: {e}"))
 }
 
 impl Drop for Kernel<'_> {

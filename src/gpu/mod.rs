@@ -20,6 +20,17 @@ use std::sync::{Arc, Mutex};
 const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
 const EXECUTABLE_PROPERTIES_EXT: &CStr = ash::khr::pipeline_executable_properties::NAME;
 
+/// How long a submission may take before the device counts as hung: far above any one submission brdfprof
+/// makes (a host batch is at most 1 GiB of input), far below forever.
+pub const DEFAULT_FENCE_TIMEOUT: std::time::Duration = std::time::Duration::from_secs(600);
+/// Seconds that replace `DEFAULT_FENCE_TIMEOUT` (tests use a tiny one).
+pub const FENCE_TIMEOUT_ENV: &str = "BRDFPROF_FENCE_TIMEOUT";
+
+/// The fence timeout in force: `FENCE_TIMEOUT_ENV` when it holds seconds (more than 0), else the default.
+pub fn fence_timeout() -> std::time::Duration {
+    std::env::var(FENCE_TIMEOUT_ENV).ok().and_then(|t| t.trim().parse::<f64>().ok()).filter(|s| s.is_finite() && *s > 0.0 && *s <= 86_400.0).map_or(DEFAULT_FENCE_TIMEOUT, std::time::Duration::from_secs_f64)
+}
+
 /// How to open a device.
 #[derive(Clone, Debug, Default)]
 pub struct GpuOptions {
@@ -100,6 +111,9 @@ pub struct Gpu {
 /// A command buffer being recorded (`Gpu::submit`); kernels, barriers and timestamps record into it.
 pub struct Commands {
     raw: vk::CommandBuffer,
+    /// Kernels dispatched for the first time in this command buffer: lavapipe compiles a pipeline (LLVM) at
+    /// its first dispatch, inside the submission, so that submission's wait is a compilation's.
+    first_dispatches: std::cell::RefCell<Vec<String>>,
 }
 
 fn load_entry() -> Result<ash::Entry> {
@@ -202,7 +216,7 @@ unsafe extern "system" fn on_validation_message(
         .and_then(|d| unsafe { d.message_as_c_str() })
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default();
-    eprintln!("vulkan validation [{severity:?}]: {text}");
+    crate::messages::line(&format!("vulkan validation [{severity:?}]: {text}"));
     if let Some(messages) = unsafe { (user as *const Messages).as_ref() } {
         messages.lock().unwrap().push(text);
     }
@@ -407,19 +421,57 @@ impl Gpu {
             let cmd = self.device.allocate_command_buffers(&alloc)?[0];
             let begin = vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
             self.device.begin_command_buffer(cmd, &begin)?;
-            let out = record(&Commands { raw: cmd });
+            let commands = Commands { raw: cmd, first_dispatches: Default::default() };
+            let out = record(&commands);
+            let compiling = if self.info.is_cpu() { commands.first_dispatches.take() } else { Vec::new() };
             self.device.end_command_buffer(cmd)?;
             let fence = self.device.create_fence(&vk::FenceCreateInfo::default(), None)?;
             let cmds = [cmd];
             let submit = vk::SubmitInfo::default().command_buffers(&cmds);
-            let result = self
-                .device
-                .queue_submit(self.queue, &[submit], fence)
-                .and_then(|_| self.device.wait_for_fences(&[fence], true, u64::MAX));
+            let result = self.device.queue_submit(self.queue, &[submit], fence).and_then(|_| if compiling.is_empty() { self.wait(fence) } else { self.wait_compiling(fence, &compiling) });
             self.device.destroy_fence(fence, None);
             self.device.free_command_buffers(self.command_pool, &cmds);
             result.context("queue submission failed")?;
             Ok(out)
+        }
+    }
+
+    /// Waits for `fence` at most `fence_timeout()`. Past it the submission is still pending on a device that
+    /// may be hung: nothing it uses can be freed, so the command stops (`cleanup::stop`, exit status 2).
+    fn wait(&self, fence: vk::Fence) -> ash::prelude::VkResult<()> {
+        let limit = fence_timeout();
+        // SAFETY: the fence belongs to this device and was just submitted with work.
+        match unsafe { self.device.wait_for_fences(&[fence], true, limit.as_nanos().min(u64::MAX as u128) as u64) } {
+            Err(vk::Result::TIMEOUT) => crate::cleanup::stop(
+                2,
+                &format!(
+                    "brdfprof: error: {} did not finish a submission within {} s ({FENCE_TIMEOUT_ENV}; default {} s): the device may be hung; stopped",
+                    self.info.name,
+                    limit.as_secs_f64(),
+                    DEFAULT_FENCE_TIMEOUT.as_secs()
+                ),
+            ),
+            other => other,
+        }
+    }
+
+    /// Waits for a submission in which lavapipe compiles `kernels` (their first dispatch): under the compile
+    /// limit, saying what compiles once it takes a while (`compile_limit::Watch`); past the limit the command
+    /// stops (`cleanup::stop`, exit status 2), as a pipeline creation past it does.
+    fn wait_compiling(&self, fence: vk::Fence, kernels: &[String]) -> ash::prelude::VkResult<()> {
+        let limit = crate::compile_limit::limit();
+        let what = format!("{} (lavapipe compiles a pipeline at its first dispatch)", kernels.join(", "));
+        let mut watch = crate::compile_limit::Watch::new(&what);
+        loop {
+            // SAFETY: the fence belongs to this device and was just submitted with work.
+            match unsafe { self.device.wait_for_fences(&[fence], true, 100_000_000) } {
+                Err(vk::Result::TIMEOUT) => {}
+                other => return other,
+            }
+            if watch.elapsed() >= limit {
+                crate::cleanup::stop(2, &format!("brdfprof: error: {}", crate::compile_limit::over_limit(&what, limit)));
+            }
+            watch.tick(limit);
         }
     }
 

@@ -26,6 +26,9 @@ use std::path::{Path, PathBuf};
 
 /// The hidden subcommand the child runs.
 pub const CHILD_COMMAND: &str = "__callgrind-child";
+/// How many times the compile limit a compilation in the callgrind child may take (valgrind slows the JIT's
+/// LLVM about this much; README "Limits").
+pub const VALGRIND_SLOWDOWN: u32 = 20;
 /// The object callgrind files code without symbols under (the JIT-compiled kernel).
 const ANONYMOUS_OBJECT: &str = "???";
 /// Prefix of each dump's label; the kernel's index follows.
@@ -106,7 +109,9 @@ pub fn child_main(request_json: &str) -> Result<()> {
     if !running_on_valgrind() {
         bail!("`brdfprof {CHILD_COMMAND}` only measures under valgrind; `brdfprof inspect` runs it there");
     }
-    let models = req.models.iter().map(|s| Model::parse(s).map_err(|e| anyhow!("{s}: {e}"))).collect::<Result<Vec<_>>>()?;
+    // LLVM runs many times slower under valgrind: each compilation gets that much more time.
+    crate::compile_limit::scale(VALGRIND_SLOWDOWN);
+    let models = req.models.iter().map(|s| Model::parse(s).map_err(|e| anyhow!("{s}: {e:#}"))).collect::<Result<Vec<_>>>()?;
     let shaders = match &req.glsl {
         Some(dir) => Shaders::from_glsl(dir)?,
         None => Shaders::embedded(),
@@ -217,6 +222,8 @@ pub fn run(models: &[Model], lights: u32, shaders: &Shaders, options: &Callgrind
         .arg(serde_json::to_string(&req)?)
         .env("LP_NUM_THREADS", "0")
         .env("MESA_SHADER_CACHE_DISABLE", "true");
+    crate::compile_limit::export(&mut cmd);
+    let _tmp = cleanup::child_tmpdir(&mut cmd)?;
     let output = cleanup::output(&mut cmd).context("cannot run valgrind")?;
     let stdout = String::from_utf8_lossy(&output.stdout);
     let stderr = String::from_utf8_lossy(&output.stderr);

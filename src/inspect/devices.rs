@@ -84,10 +84,10 @@ fn target_reports(plan: &[Planned], run: &Run, open: &OpenLocal) -> Result<Vec<I
         let runs = targets::compile_all(&targets, &request)?;
         for r in &runs {
             if let Some(n) = &r.note {
-                eprintln!("brdfprof inspect: note: {n}");
+                crate::messages::note(n);
             }
             if !r.isa_files.is_empty() {
-                eprintln!("brdfprof inspect: {}: {} ISA files", r.target.name(), r.isa_files.len());
+                crate::messages::progress(format!("inspect: {}: {} ISA files", r.target.name(), r.isa_files.len()));
             }
         }
         Ok(runs.into_iter().map(|r| r.report).collect())

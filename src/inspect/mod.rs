@@ -19,7 +19,7 @@ use crate::profile::gbuffer::GBufferFormat;
 use crate::profile::workload::{self, shade_kernel, steady_block};
 use crate::report::{self, Provenance, Table};
 use crate::shaders::Shaders;
-use anyhow::Result;
+use anyhow::{Context, Result};
 use callgrind::{CallgrindOptions, CallgrindRun};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -87,10 +87,11 @@ pub struct InspectReport {
 /// SPIR-V statistics of one specialised kernel, and naga's of `naga_kernel` (the same BRDF over the float
 /// G-buffer: naga's SPIR-V front end has no texel buffers, which the packed kernel reads).
 fn static_stats(kernel: &ModelKernel, naga_kernel: &ModelKernel, row: &mut Row) -> Result<()> {
-    let frozen = spirv::specialise(&kernel.spirv.words, &kernel.constants)?;
+    let model = row.model.clone();
+    let frozen = spirv::specialise(&kernel.spirv.words, &kernel.constants).with_context(|| model.clone())?;
     row.stats.extend(spirv::count(&frozen)?.stats("spirv"));
-    row.stats.extend(spirv::count(&spirv::optimise(&frozen)?)?.stats("spirv-O"));
-    let naga = naga_info::analyse(&spirv::specialise(&naga_kernel.spirv.words, &naga_kernel.constants)?);
+    row.stats.extend(spirv::count(&spirv::optimise(&frozen).with_context(|| model.clone())?)?.stats("spirv-O"));
+    let naga = naga_info::analyse(&spirv::specialise(&naga_kernel.spirv.words, &naga_kernel.constants).with_context(|| model.clone())?);
     row.stats.extend(naga.stats());
     row.notes.insert("naga".into(), naga.verdict());
     Ok(())

@@ -4,12 +4,10 @@
 //! every instruction inside a function body is counted by class.
 
 use crate::gpu::SpecConstants;
-use anyhow::{anyhow, bail, Context, Result};
+use anyhow::{anyhow, bail, Result};
 use rspirv::dr::{Module, Operand};
 use rspirv::spirv::{Decoration, GlslStd450Op, Op};
 use std::collections::BTreeMap;
-use std::io::Write;
-use std::process::Stdio;
 
 /// spirv-opt passes that keep only the code a frozen specialisation runs, without optimising it further.
 pub const SPECIALISE_PASSES: [&str; 5] = ["--freeze-spec-const", "--fold-spec-const-op-composite", "--eliminate-dead-branches", "--eliminate-dead-code-aggressive", "--eliminate-dead-functions"];
@@ -127,23 +125,17 @@ pub fn spec_default_values(words: &[u32], constants: &SpecConstants) -> Result<S
     Ok(items.join(" "))
 }
 
-/// Runs spirv-opt with `args` on `words` (through stdin and stdout).
+/// Runs spirv-opt with `args` on `words` (through stdin and stdout), under the compile limit.
 pub fn spirv_opt(words: &[u32], args: &[String]) -> Result<Vec<u32>> {
-    let mut child = crate::cleanup::command("spirv-opt")
-        .args(args)
-        .args(["-", "-o", "-"])
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .map_err(|e| anyhow!("cannot run spirv-opt ({e}): install spirv-tools, or run `make setup`"))?;
-    let _guard = crate::cleanup::ChildGuard::new(&child);
+    let mut cmd = crate::cleanup::command("spirv-opt");
+    cmd.args(args).args(["-", "-o", "-"]);
     let bytes: Vec<u8> = words.iter().flat_map(|w| w.to_le_bytes()).collect();
-    let mut stdin = child.stdin.take().expect("piped stdin");
-    // Written on a thread so that a large output cannot deadlock against the input.
-    let writer = std::thread::spawn(move || stdin.write_all(&bytes));
-    let out = child.wait_with_output().context("spirv-opt did not finish")?;
-    writer.join().expect("stdin writer").context("cannot write to spirv-opt")?;
+    let shown = if args.len() > 3 { format!("{} ...", args[..3].join(" ")) } else { args.join(" ") };
+    let out = match crate::compile_limit::output_with_input(&mut cmd, bytes, &format!("spirv-opt {shown}")) {
+        Ok(out) => out,
+        Err(e) if e.downcast_ref::<std::io::Error>().is_some() => bail!("cannot run spirv-opt ({e}): install spirv-tools, or run `make setup`"),
+        Err(e) => return Err(e),
+    };
     if !out.status.success() {
         bail!("spirv-opt {} failed: {}", args.join(" "), String::from_utf8_lossy(&out.stderr).trim());
     }

@@ -5,7 +5,7 @@
 
 use crate::brdf::guards::MIN_VECTOR;
 use crate::brdf::Sample;
-use anyhow::{anyhow, bail, Context, Result};
+use anyhow::{anyhow, bail, Result};
 use std::borrow::Cow;
 use std::path::Path;
 
@@ -22,6 +22,10 @@ pub struct EvalInput {
     pub samples: Vec<Sample>,
     pub tangents: Option<Vec<[f32; 3]>>,
     pub columns: Vec<(String, Vec<f32>)>,
+    /// The 1-based column number of each of `columns`.
+    pub column_numbers: Vec<usize>,
+    /// The file line of each row.
+    pub lines: Vec<usize>,
 }
 
 /// Reads `eval` input: every value a finite number, vectors non-zero, roughness and F0 in [0, 1].
@@ -31,8 +35,14 @@ pub fn read_samples_csv(path: &Path) -> Result<Vec<Sample>> {
 
 /// Reads an eval CSV with the tangents and the `optional` columns it has (values finite).
 pub fn read_eval_csv(path: &Path, optional: &[&str]) -> Result<EvalInput> {
-    let bytes = std::fs::read(path).with_context(|| format!("cannot read {}", path.display()))?;
-    parse_eval_csv(&bytes, &path.display().to_string(), optional)
+    read_eval_csv_with(path, optional, &[])
+}
+
+/// `read_eval_csv`, with `relaxed` sample columns (`roughness`, `f0r`, ...) only required to be finite: a
+/// `.brdf` model that reads no input from them takes them as its own parameter's column.
+pub fn read_eval_csv_with(path: &Path, optional: &[&str], relaxed: &[&str]) -> Result<EvalInput> {
+    let bytes = super::read_input(path)?;
+    parse_eval_csv_with(&bytes, &path.display().to_string(), optional, relaxed)
 }
 
 /// `read_samples_csv` of bytes already read; `name` prefixes errors.
@@ -44,16 +54,48 @@ const BOM: &[u8] = b"\xEF\xBB\xBF";
 
 /// `read_eval_csv` of bytes already read; `name` prefixes errors.
 pub fn parse_eval_csv(bytes: &[u8], name: &str, optional: &[&str]) -> Result<EvalInput> {
+    parse_eval_csv_with(bytes, name, optional, &[])
+}
+
+/// The lines of `bytes`, numbered from 1, ended by `\n`, `\r\n` or a lone `\r` (an old Mac's line ends).
+fn split_lines(bytes: &[u8]) -> impl Iterator<Item = (usize, &[u8])> {
+    let mut rest = Some(bytes);
+    std::iter::from_fn(move || {
+        let b = rest?;
+        match b.iter().position(|&c| c == b'\n' || c == b'\r') {
+            Some(i) => {
+                let next = if b[i..].starts_with(b"\r\n") { i + 2 } else { i + 1 };
+                rest = Some(&b[next..]);
+                Some(&b[..i])
+            }
+            None => {
+                rest = None;
+                Some(b)
+            }
+        }
+    })
+    .enumerate()
+    .map(|(i, l)| (i + 1, l))
+}
+
+/// `parse_eval_csv` with `relaxed` sample columns (`read_eval_csv_with`).
+pub fn parse_eval_csv_with(bytes: &[u8], name: &str, optional: &[&str], relaxed: &[&str]) -> Result<EvalInput> {
     let bom = if bytes.starts_with(BOM) { BOM.len() } else { 0 };
-    let mut lines = bytes[bom..].split(|&b| b == b'\n').enumerate().map(|(i, l)| (i + 1, l.strip_suffix(b"\r").unwrap_or(l)));
+    let mut lines = split_lines(&bytes[bom..]);
     let mut decoded = std::iter::from_fn(move || {
         lines.find(|(_, l)| !l.trim_ascii().is_empty()).map(|(line, bytes)| decode(name, line, bytes, if line == 1 { bom } else { 0 }))
     });
     let (header_line, header) = decoded
         .next()
         .ok_or_else(|| anyhow!("{name}: empty file; expected a header with columns {}", SAMPLE_COLUMNS.join(",")))??;
-    let layout = Layout::new(name, header_line, header, optional)?;
-    let mut input = EvalInput { tangents: layout.tangents.map(|_| Vec::new()), columns: layout.optional.iter().map(|(n, _)| (n.clone(), Vec::new())).collect(), ..Default::default() };
+    let mut layout = Layout::new(name, header_line, header, optional)?;
+    layout.relaxed = SAMPLE_COLUMNS.map(|c| relaxed.contains(&c));
+    let mut input = EvalInput {
+        tangents: layout.tangents.map(|_| Vec::new()),
+        columns: layout.optional.iter().map(|(n, _)| (n.clone(), Vec::new())).collect(),
+        column_numbers: layout.optional.iter().map(|(_, i)| i + 1).collect(),
+        ..Default::default()
+    };
     for item in decoded {
         let (line, text) = item?;
         layout.read_row(name, line, text, &mut input)?;
@@ -126,6 +168,8 @@ struct Layout {
     tangents: Option<[usize; 3]>,
     /// Optional columns present: name and field index.
     optional: Vec<(String, usize)>,
+    /// Which of SAMPLE_COLUMNS need only be finite (no [0, 1] range).
+    relaxed: [bool; 13],
 }
 
 impl Layout {
@@ -160,7 +204,7 @@ impl Layout {
                 wanted.push((c.to_string(), i));
             }
         }
-        Ok(Layout { width: names.len(), names, samples, tangents, optional: wanted })
+        Ok(Layout { width: names.len(), names, samples, tangents, optional: wanted, relaxed: [false; 13] })
     }
 
     /// Reads one data row into `input`.
@@ -178,11 +222,12 @@ impl Layout {
             nonzero(name, line, &format!("{label}x,{label}y,{label}z"), &v[first..first + 3])?;
         }
         for k in 9..13 {
-            if !(0.0..=1.0).contains(&v[k]) {
+            if !self.relaxed[k] && !(0.0..=1.0).contains(&v[k]) {
                 bail!("{name}:{line}: column {} `{}`: {} is outside [0, 1]", self.samples[k] + 1, SAMPLE_COLUMNS[k], v[k]);
             }
         }
         input.samples.push(Sample { n: [v[0], v[1], v[2]], v: [v[3], v[4], v[5]], l: [v[6], v[7], v[8]], roughness: v[9], f0: [v[10], v[11], v[12]] });
+        input.lines.push(line);
         if let (Some(cols), Some(out)) = (self.tangents, input.tangents.as_mut()) {
             let t = [value(cols[0])?, value(cols[1])?, value(cols[2])?];
             nonzero(name, line, &TANGENT_COLUMNS.join(","), &t)?;
@@ -205,11 +250,16 @@ fn number(name: &str, line: usize, col: usize, column: &str, raw: &str) -> Resul
     Ok(x)
 }
 
-/// A vector whose largest component reaches MIN_VECTOR (what the kernels can normalise).
+/// A vector whose largest component reaches MIN_VECTOR (what the kernels can normalise: GPUs may flush
+/// smaller values to zero).
 fn nonzero(name: &str, line: usize, columns: &str, v: &[f32]) -> Result<()> {
     let largest = v.iter().fold(0f32, |m, x| m.max(x.abs()));
+    let shown = v.iter().map(|&x| if x != 0.0 && x.abs() < 1e-4 { format!("{x:e}") } else { x.to_string() }).collect::<Vec<_>>().join(", ");
+    if largest == 0.0 {
+        bail!("{name}:{line}: columns {columns}: zero-length vector ({shown})");
+    }
     if f64::from(largest) < MIN_VECTOR {
-        bail!("{name}:{line}: columns {columns}: zero-length vector ({})", v.iter().map(|x| x.to_string()).collect::<Vec<_>>().join(", "));
+        bail!("{name}:{line}: columns {columns}: vector too short to normalise ({shown}): its largest component is below {MIN_VECTOR:e} (FLT_MIN), where GPUs may flush values to zero; scale it up");
     }
     Ok(())
 }
@@ -293,5 +343,28 @@ mod tests {
         assert!(e.contains("in.csv:2: column 16 `ty`: `inf` is not finite"), "{e}");
         let e = parse_eval_csv(format!("{HEADER},aniso\n{ROW},nan\n").as_bytes(), "in.csv", &["aniso"]).unwrap_err().to_string();
         assert!(e.contains("in.csv:2: column 15 `aniso`: `nan` is not finite"), "{e}");
+    }
+
+    #[test]
+    fn a_tiny_vector_is_named_for_what_it_is() {
+        let e = err(format!("{HEADER}\n0.5,0,0,1e-40,0,0.6,0.8,0.6,0,0.8,0.04,0.05,0.06,x\n"));
+        assert!(e.contains("in.csv:2: columns nx,ny,nz: vector too short to normalise (0, 0, 1e-40)") && e.contains("FLT_MIN"), "{e}");
+        assert!(!e.contains("zero-length"), "{e}");
+    }
+
+    #[test]
+    fn cr_only_line_ends_and_row_lines() {
+        let input = parse_eval_csv(format!("{HEADER}\r{ROW}\r\r{ROW}\r").as_bytes(), "in.csv", &[]).unwrap();
+        assert_eq!((input.samples.len(), input.lines.clone()), (2, vec![2, 4]));
+        let e = err(format!("{HEADER}\r{ROW}\r0.5,0,0,1,0,x,0.8,0.6,0,0.8,0.04,0.05,0.06,x\r"));
+        assert!(e.contains("in.csv:3: column 6 `vy`"), "{e}");
+    }
+
+    #[test]
+    fn relaxed_sample_columns_need_only_be_finite() {
+        let row = "5,0,0,1,0,0.6,0.8,0.6,0,0.8,0.04,0.05,0.06,x";
+        assert!(err(format!("{HEADER}\n{row}\n")).contains("column 1 `roughness`: 5 is outside [0, 1]"));
+        let input = parse_eval_csv_with(format!("{HEADER}\n{row}\n").as_bytes(), "in.csv", &["roughness"], &["roughness"]).unwrap();
+        assert_eq!((input.columns.clone(), input.column_numbers.clone()), (vec![("roughness".to_string(), vec![5.0])], vec![1]));
     }
 }

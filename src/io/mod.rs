@@ -4,7 +4,7 @@
 
 pub mod csv;
 
-pub use csv::{parse_eval_csv, parse_samples_csv, read_eval_csv, read_samples_csv, EvalInput, SAMPLE_COLUMNS, TANGENT_COLUMNS};
+pub use csv::{parse_eval_csv, parse_samples_csv, read_eval_csv, read_eval_csv_with, read_samples_csv, EvalInput, SAMPLE_COLUMNS, TANGENT_COLUMNS};
 
 use anyhow::{anyhow, bail, Context, Result};
 use std::io::Write;
@@ -19,6 +19,18 @@ pub fn format_rgb_csv(rows: &[[f32; 3]]) -> String {
         out.push_str(&format!("{r},{g},{b}\n"));
     }
     out
+}
+
+/// Reads an input file; the error names the file and the reason the system gives (a directory, a loop of
+/// symbolic links), and for a dangling symbolic link the missing file it points to.
+pub fn read_input(path: &Path) -> Result<Vec<u8>> {
+    std::fs::read(path).map_err(|e| {
+        let dangling = std::fs::symlink_metadata(path).is_ok_and(|m| m.file_type().is_symlink()) && e.kind() == std::io::ErrorKind::NotFound;
+        match std::fs::read_link(path).ok().filter(|_| dangling) {
+            Some(to) => anyhow!("cannot read {}: it is a symbolic link to {}, which does not exist ({e})", path.display(), to.display()),
+            None => anyhow!("cannot read {}: {e}", path.display()),
+        }
+    })
 }
 
 /// Symbolic links followed at most this many times (Linux's own limit, MAXSYMLINKS).
@@ -44,7 +56,8 @@ fn link_target(path: &Path) -> Result<PathBuf> {
 /// a temporary file in the same directory (with the old file's permissions), synced, then renamed over it, so
 /// a failure leaves any existing file untouched and no temporary behind. A symbolic link is followed, and its
 /// target written the same way, so the link stays a link. Any other existing file (a device such as
-/// /dev/null, a FIFO) is opened and written in place, never replaced.
+/// /dev/null, a FIFO) is opened and written in place, never replaced. While outputs are staged
+/// (`stage_outputs`), the rename waits for `commit_outputs`.
 pub fn write_output(path: &Path, bytes: &[u8]) -> Result<()> {
     crate::cleanup::park_if_interrupted();
     let target = link_target(path)?;
@@ -59,14 +72,89 @@ pub fn write_output(path: &Path, bytes: &[u8]) -> Result<()> {
     }
 }
 
-/// Temp-then-rename in `path`'s directory (regular files only; `write_output` decides).
+/// A written temporary waiting for `commit_outputs` to be renamed over its target.
+struct Staged {
+    tmp: PathBuf,
+    target: PathBuf,
+    _guard: crate::cleanup::PathGuard,
+}
+
+static STAGING: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+static STAGED: std::sync::Mutex<Vec<Staged>> = std::sync::Mutex::new(Vec::new());
+
+fn staged() -> std::sync::MutexGuard<'static, Vec<Staged>> {
+    STAGED.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// From now on, `write_output` stages: every output of the command is written beside its target and renamed
+/// into place only by `commit_outputs`, so that a command that fails or is stopped leaves none of them
+/// (`discard_outputs`, or the signal handler, removes the temporaries and the directories created for them).
+/// `main` turns it on for every command.
+pub fn stage_outputs() {
+    STAGING.store(true, std::sync::atomic::Ordering::SeqCst);
+}
+
+/// Renames every staged output into place (all of them, even if a signal arrives meanwhile: `stop` waits).
+pub fn commit_outputs() -> Result<()> {
+    crate::cleanup::committing(|| {
+        let all = std::mem::take(&mut *staged());
+        let mut result = Ok(());
+        for s in &all {
+            if result.is_ok() {
+                result = std::fs::rename(&s.tmp, &s.target).with_context(|| format!("cannot write {}", s.target.display()));
+            }
+            if result.is_err() {
+                let _ = std::fs::remove_file(&s.tmp);
+            }
+        }
+        crate::cleanup::forget_created_dirs();
+        result
+    })
+}
+
+/// Removes every staged output, and the directories created for them where empty: a failed command leaves
+/// none of its outputs.
+pub fn discard_outputs() {
+    for s in std::mem::take(&mut *staged()) {
+        let _ = std::fs::remove_file(&s.tmp);
+    }
+    for d in crate::cleanup::forget_created_dirs().iter().rev() {
+        let _ = std::fs::remove_dir(d);
+    }
+}
+
+/// Creates `dir` and its missing ancestors; while staging, the created ones are registered so that a failed
+/// command removes them again.
+fn create_dirs(dir: &Path) -> Result<()> {
+    let mut missing = Vec::new();
+    let mut d = dir.to_path_buf();
+    while std::fs::symlink_metadata(&d).is_err() {
+        missing.push(d.clone());
+        match d.parent() {
+            Some(p) if !p.as_os_str().is_empty() => d = p.to_path_buf(),
+            _ => break,
+        }
+    }
+    std::fs::create_dir_all(dir).with_context(|| format!("cannot create directory {}", dir.display()))?;
+    if STAGING.load(std::sync::atomic::Ordering::SeqCst) {
+        missing.reverse();
+        crate::cleanup::register_created_dirs(&missing);
+    }
+    Ok(())
+}
+
+/// Temp-then-rename in `path`'s directory (regular files only; `write_output` decides); the rename waits for
+/// `commit_outputs` while staging.
 fn write_atomic(path: &Path, bytes: &[u8], permissions: Option<std::fs::Permissions>) -> Result<()> {
     let dir = parent_dir(path);
-    std::fs::create_dir_all(&dir).with_context(|| format!("cannot create directory {}", dir.display()))?;
+    create_dirs(&dir)?;
     let file_name = path.file_name().ok_or_else(|| anyhow!("{} is not a file path", path.display()))?;
-    let tmp = dir.join(format!(".{}.{}.tmp", file_name.to_string_lossy(), std::process::id()));
+    static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+    let n = NEXT.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
+    let tmp = dir.join(format!(".{}.{}.{n}.tmp", file_name.to_string_lossy(), std::process::id()));
     // Registered, so that an interrupted write leaves no temporary behind either.
-    let _guard = crate::cleanup::PathGuard::new(&tmp);
+    let guard = crate::cleanup::PathGuard::new(&tmp);
+    let staging = STAGING.load(std::sync::atomic::Ordering::SeqCst);
     let result = (|| -> Result<()> {
         let mut f = std::fs::File::create(&tmp)?;
         f.write_all(bytes)?;
@@ -74,11 +162,20 @@ fn write_atomic(path: &Path, bytes: &[u8], permissions: Option<std::fs::Permissi
             f.set_permissions(p)?;
         }
         f.sync_all()?;
-        std::fs::rename(&tmp, path)?;
+        if !staging {
+            std::fs::rename(&tmp, path)?;
+        }
         Ok(())
     })();
     if result.is_err() {
         let _ = std::fs::remove_file(&tmp);
+    } else if staging {
+        let mut all = staged();
+        // The same output written twice: the later content wins.
+        if let Some(i) = all.iter().position(|s| s.target == path) {
+            let _ = std::fs::remove_file(&all.remove(i).tmp);
+        }
+        all.push(Staged { tmp, target: path.to_path_buf(), _guard: guard });
     }
     result.with_context(|| format!("cannot write {}", path.display()))
 }
@@ -123,6 +220,19 @@ pub fn check_output_dir(flag: &str, dir: &Path) -> Result<()> {
         Err(e) if missing(&e) => creatable(flag, dir, dir),
         Err(e) => bail!("{flag} {}: {e}", dir.display()),
     }
+}
+
+/// Refuses an output that is one of the command's inputs (the same file, by whatever path or link): writing
+/// it would replace what the command reads. `inputs` are (flag, path) pairs; errors name both flags.
+pub fn check_not_input(flag: &str, output: &Path, inputs: &[(&str, &Path)]) -> Result<()> {
+    use std::os::unix::fs::MetadataExt;
+    let Ok(out) = std::fs::metadata(output) else { return Ok(()) };
+    for (input_flag, input) in inputs {
+        if std::fs::metadata(input).is_ok_and(|m| (m.dev(), m.ino()) == (out.dev(), out.ino())) {
+            bail!("{flag} {}: is the same file as {input_flag} {}; writing it would replace the input. Give another output path", output.display(), input.display());
+        }
+    }
+    Ok(())
 }
 
 /// No such path (ENOENT), or a file where a directory should be on the way (ENOTDIR: found by `creatable`).

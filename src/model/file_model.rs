@@ -7,14 +7,15 @@
 //! parameters from its inputs and returns the file's `BRDF(L, V, N, X, Y)` as is; the kernels set the tangent
 //! and the material the binding reads. A parameter bound to a value is a `const`, which the compiler folds as
 //! it folds a built-in model's specialisation constants, so the timed loop holds the file's code and nothing
-//! else. The SPIR-V is cached per composed source (so per file content) in memory and on disk.
+//! else. The SPIR-V is cached in memory and on disk (`crate::cache`), keyed by everything that reaches glslang:
+//! the composed source (so the file's content), every file of the GLSL tree it includes, defines, flags,
+//! glslang's and brdfprof's versions.
 
 use super::brdf_file::{self, glsl_float, BrdfFile, FileParam, FileParamKind};
 use super::KernelKind;
 use crate::shaders::{self, Shaders, Spirv};
 use anyhow::{anyhow, bail, Context, Result};
 use glam::DVec3;
-use sha2::{Digest, Sha256};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex, OnceLock};
@@ -153,6 +154,9 @@ impl FileParam {
             if !x.is_finite() {
                 return Err(fail(format!("`{t}` is not finite")));
             }
+            if x.abs() > f64::from(f32::MAX) {
+                return Err(fail(format!("`{t}` is beyond fp32's range (at most {:e} in magnitude), in which the kernels compute", f32::MAX)));
+            }
             Ok(x)
         };
         let value = match self.kind {
@@ -172,7 +176,7 @@ impl FileParam {
         };
         if let (FileParamKind::Float { min, max, .. }, Value::Float(x)) = (self.kind, value) {
             if !(min..=max).contains(&x) {
-                eprintln!("brdfprof: warning: {file}: {} = {x} is outside the file's range [{min}, {max}] (BRDF Explorer's slider bounds); used as given", self.name);
+                crate::messages::input_warning(format!("{file}: {} = {x} is outside the file's range [{min}, {max}] (BRDF Explorer's slider bounds); used as given", self.name));
             }
         }
         Ok(Binding::Value(value))
@@ -203,9 +207,32 @@ impl FileParam {
     }
 }
 
-/// Whether a model text names a `.brdf` file (its first comma-separated field ends in `.brdf`).
+/// A model text's `.brdf` path and the `NAME=VALUE` fields after it. The path ends at a `.brdf` followed by a
+/// comma or the end (so a path may hold commas: `a,b/m.brdf,k=1`): the first such whose file exists
+/// (relative to `base`), else the first such. None when the text names no `.brdf` file (a spec never does).
+pub fn split_path<'a>(text: &'a str, base: &Path) -> Option<(&'a str, Vec<&'a str>)> {
+    let lower = text.to_ascii_lowercase();
+    let ends: Vec<usize> = lower.match_indices(".brdf").map(|(i, _)| i + ".brdf".len()).filter(|&e| e == text.len() || text.as_bytes()[e] == b',').collect();
+    let end = ends.iter().copied().find(|&e| base.join(text[..e].trim()).is_file()).or_else(|| ends.first().copied())?;
+    let fields = text[end..].strip_prefix(',').map(|r| r.split(',').collect()).unwrap_or_default();
+    Some((text[..end].trim(), fields))
+}
+
+/// Whether a model text names a `.brdf` file (`split_path`).
 pub fn names_a_file(text: &str) -> bool {
-    text.split(',').next().is_some_and(|p| p.trim().to_ascii_lowercase().ends_with(".brdf"))
+    split_path(text, Path::new("")).is_some()
+}
+
+/// What a loop of a file means on lavapipe, which ends every loop after `LAVAPIPE_LOOP_LIMIT` iterations
+/// without a word: within it, beyond it, or not known from the source.
+fn loop_warning(path: &str, l: &brdf_file::Loop) -> String {
+    let limit = brdf_file::LAVAPIPE_LOOP_LIMIT;
+    let head = format!("{path}:{}: a `{}` loop", l.line, l.keyword);
+    match l.trip_count {
+        Some(n) if n <= limit => format!("{head} of {n} iterations: within the {limit} iterations after which lavapipe ends every loop"),
+        Some(n) => format!("{head} of {n} iterations: lavapipe ends every loop after {limit} iterations, so its results there are wrong (other drivers run it to the end)"),
+        None => format!("{head} whose iterations brdfprof cannot bound from the source: lavapipe ends every loop after {limit} iterations without a word, so a longer loop gives wrong results there"),
+    }
 }
 
 /// `k=v` items of a model text after its path; a field without `=` continues the previous value (a colour's
@@ -225,18 +252,20 @@ fn split_params(rest: &[&str]) -> Result<Vec<String>> {
 impl FileModel {
     /// `PATH.brdf[,NAME=VALUE...]`: the file with its defaults, then the overrides.
     pub fn parse(text: &str) -> Result<Self> {
-        let fields: Vec<&str> = text.split(',').collect();
-        let path = fields[0].trim();
+        let (path, fields) = split_path(text, Path::new("")).ok_or_else(|| anyhow!("`{text}` names no .brdf file"))?;
         let file = brdf_file::load(Path::new(path))?;
         for w in &file.warnings {
-            eprintln!("brdfprof: warning: {w}");
+            crate::messages::input_warning(w);
         }
         if file.has_is_func {
-            warn_once(&format!("{path}: its isFunc section (importance sampling) is ignored: brdfprof integrates with its own estimator"));
+            crate::messages::input_note(format!("{path}: its isFunc section (importance sampling) is ignored: brdfprof integrates with its own estimator"));
+        }
+        for l in &file.loops {
+            crate::messages::input_warning(loop_warning(path, l));
         }
         let bindings = file.params.iter().map(|p| Binding::Value(p.default_value())).collect();
         let model = FileModel { file, path: path.to_string(), bindings };
-        model.with_params(&split_params(&fields[1..])?)
+        model.with_params(&split_params(&fields)?)
     }
 
     pub fn takes_param(&self, name: &str) -> bool {
@@ -246,9 +275,14 @@ impl FileModel {
     /// Applies `NAME=VALUE` overrides; an unknown name is an error naming the file and its parameters.
     pub fn with_params(&self, params: &[String]) -> Result<Self> {
         let mut m = self.clone();
+        let mut given: Vec<&str> = Vec::new();
         for p in params {
             let (name, value) = p.split_once('=').ok_or_else(|| anyhow!("{}: `{p}`: expected NAME=VALUE", self.path))?;
             let name = name.trim();
+            if given.contains(&name) {
+                bail!("{}: `{name}` is given twice ({}); give each parameter once", self.path, params.join(", "));
+            }
+            given.push(name);
             let k = self.file.params.iter().position(|q| q.name == name).ok_or_else(|| {
                 let known = self.file.params.iter().map(|q| q.name.as_str()).collect::<Vec<_>>();
                 anyhow!("{}: no parameter `{name}` (the file's parameters: {})", self.path, if known.is_empty() { "none".to_string() } else { known.join(", ") })
@@ -344,45 +378,54 @@ impl FileModel {
     }
 
     /// The file's kernel of `kind`, composed with `shaders`' GLSL (the embedded tree or `--glsl DIR`) and
-    /// compiled, or taken from the cache.
+    /// compiled, or taken from the cache (in memory, then on disk: `crate::cache`), keyed by everything that
+    /// reaches glslang (`cache_key`).
     pub fn kernel(&self, kind: KernelKind, shaders: &Shaders) -> Result<Spirv> {
         if matches!(kind, KernelKind::Terms | KernelKind::SceneTerms) {
             bail!("{}: a .brdf model is one function; it has no separate D, Vis and F terms", self.path);
         }
         let kernel_name = format!("{}_f32", kind.base());
-        let tree = GlslTree::of(shaders)?;
+        let tree = GlslTree::of(shaders);
         let (source_file, defines) = tree.entry(&kernel_name)?;
-        let kernel_source = std::fs::read_to_string(tree.root.join(&source_file)).with_context(|| format!("cannot read {source_file}"))?;
+        let kernel_source = tree.read(Path::new(&source_file)).with_context(|| format!("cannot read {source_file}"))?;
         let composed = self.compose(kind, &kernel_source)?;
-        let key = cache_key(&composed, &defines, &tree.fingerprint);
-        let name = format!("{}:{}", self.file.name, kernel_name);
+        let key = cache_key(&composed, &defines, &tree);
+        let name = format!("{}:{}", self.path, kernel_name);
         if let Some(words) = memory_cache().lock().unwrap().get(&key) {
             return Ok(Spirv { name, words: words.clone() });
         }
-        let words: Arc<[u32]> = match disk_cache_read(&key) {
-            Some(words) => words.into(),
-            None => {
-                let words = self.compile(&tree.root, kind, &composed, &defines)?;
-                disk_cache_write(&key, &words);
-                words.into()
-            }
-        };
+        let store = crate::cache::Store::open_default();
+        let valid = |bytes: &[u8]| Spirv::from_bytes(&name, bytes).map(|_| ());
+        let compile = || Ok(words_to_bytes(&self.compile(&tree, kind, &composed, &defines)?));
+        let bytes = crate::cache::get_or_build(store.as_ref(), SPIRV_KIND, &key, &name, valid, compile)?;
+        let words: Arc<[u32]> = Spirv::from_bytes(&name, &bytes)?.words;
         memory_cache().lock().unwrap().insert(key, words.clone());
         Ok(Spirv { name, words })
     }
 
-    fn compile(&self, root: &Path, kind: KernelKind, composed: &str, defines: &[String]) -> Result<Vec<u32>> {
+    /// glslang on the composed source: written beside a copy of the embedded tree (or with `--glsl DIR` on the
+    /// include path), so that the kernel's `#include "brdf.glsl"` resolves as in glsl/. Errors name the file's
+    /// lines and its own identifiers.
+    fn compile(&self, tree: &GlslTree, kind: KernelKind, composed: &str, defines: &[String]) -> Result<Vec<u32>> {
         let dir = crate::cleanup::TempDir::new().context("cannot create a temporary directory for the composed kernel")?;
-        // Beside a copy of the tree, so that the kernel's `#include "brdf.glsl"` resolves as in glsl/.
-        let path = dir.path().join(format!("{}.comp", kind.base()));
+        let root = tree.materialise(&dir.path().join("glsl"))?;
+        let src = dir.path().join("composed");
+        std::fs::create_dir_all(&src).with_context(|| format!("cannot create {}", src.display()))?;
+        let path = src.join(format!("{}.comp", kind.base()));
         std::fs::write(&path, composed).with_context(|| format!("cannot write {}", path.display()))?;
-        match shaders::glslang(&path, defines, &[root]) {
+        let what = format!("{} ({} kernel, glslang)", self.path, kind.base());
+        match shaders::glslang(&path, defines, &[&root], &what) {
             Ok(words) => Ok(words),
             Err(e) => match e.downcast_ref::<shaders::GlslangError>() {
                 Some(g) => {
                     let renamed = self.file.renamed_shader()?;
                     let log = self.file.remap_log(&renamed, &g.log, |_| None);
-                    let log = if log.trim().is_empty() { g.log.clone() } else { log };
+                    let log = if log.trim().is_empty() { self.file.unlocated_log(&renamed, &g.log) } else { log };
+                    // The temporary directory means nothing to the user: the kernel's file and glsl/'s names do.
+                    let mut log = log.replace(&format!("{}/", src.display()), "");
+                    if root.starts_with(dir.path()) {
+                        log = log.replace(&format!("{}/", root.display()), "glsl/");
+                    }
                     bail!("{}: glslang cannot compile the file's shader into the {} kernel:\n{}", self.path, kind.base(), log.trim_end())
                 }
                 None => Err(e),
@@ -391,48 +434,126 @@ impl FileModel {
     }
 }
 
-/// Prints `message` on stderr once per process.
-fn warn_once(message: &str) {
-    static SEEN: OnceLock<Mutex<Vec<String>>> = OnceLock::new();
-    let mut seen = SEEN.get_or_init(Mutex::default).lock().unwrap();
-    if !seen.iter().any(|m| m == message) {
-        eprintln!("brdfprof: note: {message}");
-        seen.push(message.to_string());
-    }
+/// The cache's kind for SPIR-V entries (`<key>.spv`).
+const SPIRV_KIND: &str = "spv";
+
+fn words_to_bytes(words: &[u32]) -> Vec<u8> {
+    words.iter().flat_map(|w| w.to_le_bytes()).collect()
 }
 
-/// The GLSL the kernels are composed with: a directory holding glsl/'s tree (the embedded one, written once
-/// per process, or `--glsl DIR`), and what identifies its compiler.
-struct GlslTree {
-    root: PathBuf,
-    embedded: bool,
-    fingerprint: String,
+/// The GLSL the kernels are composed with: the embedded tree (glsl/ as brdfprof was built) or `--glsl DIR`.
+enum GlslTree {
+    Embedded,
+    Dir(PathBuf),
 }
 
 impl GlslTree {
-    fn of(shaders: &Shaders) -> Result<Self> {
-        let fingerprint = format!("{} {}", env!("CARGO_PKG_VERSION"), glslang_version());
-        if let Some(dir) = shaders.glsl_dir() {
-            return Ok(GlslTree { root: dir.to_path_buf(), embedded: false, fingerprint });
+    fn of(shaders: &Shaders) -> Self {
+        match shaders.glsl_dir() {
+            Some(dir) => GlslTree::Dir(dir.to_path_buf()),
+            None => GlslTree::Embedded,
         }
-        static TREE: OnceLock<std::result::Result<crate::cleanup::TempDir, String>> = OnceLock::new();
-        let tree = TREE.get_or_init(|| {
-            let dir = crate::cleanup::TempDir::new().map_err(|e| format!("cannot create a temporary directory for glsl/: {e}"))?;
-            shaders::write_glsl_tree(dir.path()).map_err(|e| format!("{e:#}"))?;
-            Ok(dir)
-        });
-        let dir = tree.as_ref().map_err(|e| anyhow!("{e}"))?;
-        Ok(GlslTree { root: dir.path().to_path_buf(), embedded: true, fingerprint })
     }
 
     /// The kernel's source file and defines, as kernels.txt lists them.
     fn entry(&self, name: &str) -> Result<(String, Vec<String>)> {
-        if self.embedded {
-            let k = shaders::embedded(name)?;
-            return Ok((k.source.to_string(), k.defines.iter().map(|d| d.to_string()).collect()));
+        match self {
+            GlslTree::Embedded => {
+                let k = shaders::embedded(name)?;
+                Ok((k.source.to_string(), k.defines.iter().map(|d| d.to_string()).collect()))
+            }
+            GlslTree::Dir(root) => shaders::kernel_entry(root, name),
         }
-        shaders::kernel_entry(&self.root, name)
     }
+
+    /// The text of `rel` (a path relative to the tree's root, `..` resolved).
+    fn read(&self, rel: &Path) -> Result<String> {
+        match self {
+            GlslTree::Embedded => {
+                let rel = rel.to_string_lossy();
+                shaders::GLSL_FILES.iter().find(|(p, _)| *p == rel).map(|(_, t)| t.to_string()).ok_or_else(|| anyhow!("the embedded glsl/ has no {rel}"))
+            }
+            GlslTree::Dir(root) => std::fs::read_to_string(root.join(rel)).with_context(|| format!("cannot read {}", root.join(rel).display())),
+        }
+    }
+
+    fn exists(&self, rel: &Path) -> bool {
+        match self {
+            GlslTree::Embedded => shaders::GLSL_FILES.iter().any(|(p, _)| Path::new(p) == rel),
+            GlslTree::Dir(root) => root.join(rel).is_file(),
+        }
+    }
+
+    /// A directory glslang can include from: the embedded tree written into `dir`, or `--glsl DIR` itself.
+    fn materialise(&self, dir: &Path) -> Result<PathBuf> {
+        match self {
+            GlslTree::Embedded => {
+                shaders::write_glsl_tree(dir)?;
+                Ok(dir.to_path_buf())
+            }
+            GlslTree::Dir(root) => Ok(root.clone()),
+        }
+    }
+
+    /// Every file the composed source includes, directly or not, with its content, as glslang resolves them
+    /// (`#include "x"`: beside the including file, then the tree's root; `<x>`: the root), found by following
+    /// every `#include` line whatever the conditionals around it (a superset of what one compilation reads).
+    /// A name that resolves nowhere is recorded as missing.
+    fn included(&self, composed: &str) -> Vec<(String, Option<String>)> {
+        let mut out: Vec<(String, Option<String>)> = Vec::new();
+        // The composed source sits outside the tree: its includes resolve from the root.
+        let mut pending: Vec<(Option<PathBuf>, String)> = include_names(composed).into_iter().map(|n| (None, n)).collect();
+        while let Some((from, name)) = pending.pop() {
+            let beside = from.as_ref().and_then(|f| f.parent()).map(|d| normalise(&d.join(&name)));
+            let found = beside.filter(|p| self.exists(p)).or_else(|| Some(normalise(Path::new(&name))).filter(|p| self.exists(p)));
+            let shown = found.as_ref().map_or(format!("missing: {name}"), |p| p.display().to_string());
+            if out.iter().any(|(s, _)| *s == shown) {
+                continue;
+            }
+            let text = found.as_ref().and_then(|p| self.read(p).ok());
+            if let (Some(p), Some(t)) = (&found, &text) {
+                pending.extend(include_names(t).into_iter().map(|n| (Some(p.clone()), n)));
+            }
+            out.push((shown, text));
+        }
+        out.sort();
+        out
+    }
+}
+
+/// The names of a source's `#include "x"` and `#include <x>` lines.
+fn include_names(source: &str) -> Vec<String> {
+    source
+        .lines()
+        .filter_map(|l| l.trim_start().strip_prefix('#'))
+        .filter_map(|l| l.trim_start().strip_prefix("include"))
+        .filter_map(|l| {
+            let l = l.trim();
+            let (open, close) = match l.chars().next()? {
+                '"' => ('"', '"'),
+                '<' => ('<', '>'),
+                _ => return None,
+            };
+            l.strip_prefix(open)?.split(close).next().map(str::to_string)
+        })
+        .collect()
+}
+
+/// `a/./b/../c` as `a/c` (lexically; the tree has no links that matter to its includes).
+fn normalise(p: &Path) -> PathBuf {
+    let mut out = PathBuf::new();
+    for c in p.components() {
+        match c {
+            std::path::Component::CurDir => {}
+            std::path::Component::ParentDir => {
+                if !out.pop() {
+                    out.push("..");
+                }
+            }
+            other => out.push(other),
+        }
+    }
+    out
 }
 
 fn glslang_version() -> String {
@@ -440,47 +561,25 @@ fn glslang_version() -> String {
     V.get_or_init(|| shaders::glslang_version().unwrap_or_default()).clone()
 }
 
-fn cache_key(composed: &str, defines: &[String], fingerprint: &str) -> String {
-    let mut h = Sha256::new();
-    for part in [fingerprint, &defines.join(" "), composed] {
-        h.update(part.as_bytes());
-        h.update([0]);
+/// Everything that reaches glslang for one kernel: brdfprof's version, glslang's version and flags, the
+/// defines, the composed source (the file's renamed shader, its parameters and the kernel's own text) and
+/// the content of every file it includes from the tree.
+fn cache_key(composed: &str, defines: &[String], tree: &GlslTree) -> crate::cache::Key {
+    let mut key = crate::cache::KeyBuilder::new(SPIRV_KIND)
+        .part("brdfprof", env!("CARGO_PKG_VERSION"))
+        .part("glslang", glslang_version())
+        .part("flags", shaders::GLSLANG_FLAGS.join(" "))
+        .part("defines", defines.join(" "))
+        .part("composed", composed);
+    for (file, text) in tree.included(composed) {
+        key = key.part("include", file).part("content", text.as_deref().unwrap_or("\0missing"));
     }
-    h.finalize().iter().map(|b| format!("{b:02x}")).collect()
+    key.finish()
 }
 
-fn memory_cache() -> &'static Mutex<HashMap<String, Arc<[u32]>>> {
-    static CACHE: OnceLock<Mutex<HashMap<String, Arc<[u32]>>>> = OnceLock::new();
+fn memory_cache() -> &'static Mutex<HashMap<crate::cache::Key, Arc<[u32]>>> {
+    static CACHE: OnceLock<Mutex<HashMap<crate::cache::Key, Arc<[u32]>>>> = OnceLock::new();
     CACHE.get_or_init(Mutex::default)
-}
-
-/// Where compiled `.brdf` kernels are kept between runs: `$BRDFPROF_CACHE_DIR`, else
-/// `$XDG_CACHE_HOME/brdfprof/kernels`, else `~/.cache/brdfprof/kernels`; none when `BRDFPROF_CACHE_DIR` is
-/// empty (caching off) or no home is known.
-pub fn disk_cache_dir() -> Option<PathBuf> {
-    if let Some(d) = std::env::var_os("BRDFPROF_CACHE_DIR") {
-        return (!d.is_empty()).then(|| PathBuf::from(d));
-    }
-    let base = std::env::var_os("XDG_CACHE_HOME").filter(|d| !d.is_empty()).map(PathBuf::from).or_else(|| std::env::var_os("HOME").filter(|d| !d.is_empty()).map(|h| PathBuf::from(h).join(".cache")))?;
-    Some(base.join("brdfprof").join("kernels"))
-}
-
-fn disk_cache_read(key: &str) -> Option<Vec<u32>> {
-    let bytes = std::fs::read(disk_cache_dir()?.join(format!("{key}.spv"))).ok()?;
-    Spirv::from_bytes(key, &bytes).ok().map(|s| s.words.to_vec())
-}
-
-/// Best effort: a cache that cannot be written costs a recompile next time, nothing else.
-fn disk_cache_write(key: &str, words: &[u32]) {
-    let Some(dir) = disk_cache_dir() else { return };
-    if std::fs::create_dir_all(&dir).is_err() {
-        return;
-    }
-    let bytes: Vec<u8> = words.iter().flat_map(|w| w.to_le_bytes()).collect();
-    let tmp = dir.join(format!(".{key}.{}.tmp", std::process::id()));
-    if std::fs::write(&tmp, &bytes).is_ok() && std::fs::rename(&tmp, dir.join(format!("{key}.spv"))).is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
 }
 
 /// X of the tangent frame, as the kernels compute it (`file_tangent_frame` in glsl/brdf.glsl): `t` made
@@ -554,5 +653,69 @@ mod tests {
             }
         }
         assert_eq!(tangent_frame(DVec3::Z, DVec3::ZERO), DVec3::X, "Duff et al.'s basis at the pole");
+    }
+
+    #[test]
+    fn a_key_given_twice_and_values_beyond_fp32_are_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = file(dir.path());
+        let e = format!("{:#}", FileModel::parse(&format!("{path},r=0.1,r=0.2")).unwrap_err());
+        assert!(e.contains("`r` is given twice (r=0.1, r=0.2)"), "{e}");
+        let m = FileModel::parse(&format!("{path},r=0.1")).unwrap();
+        assert_eq!(m.with_params(&["r=0.3".into()]).unwrap().binding("r"), Some(Binding::Value(Value::Float(0.3))), "--param overrides the text");
+        for bad in ["r=1e39", "r=-3.5e38", "c=0,1e39,0"] {
+            let e = format!("{:#}", m.with_params(&[bad.into()]).unwrap_err());
+            assert!(e.contains("is beyond fp32's range"), "{bad}: {e}");
+        }
+    }
+
+    #[test]
+    fn a_path_may_hold_commas() {
+        let dir = tempfile::tempdir().unwrap();
+        let sub = dir.path().join("a,b.brdf,c");
+        std::fs::create_dir(&sub).unwrap();
+        let path = file(&sub);
+        assert!(names_a_file(&path) && names_a_file(&format!("{path},r=0.25")) && !names_a_file("ggx,gamma=2"));
+        let m = FileModel::parse(&format!("{path},r=0.25,c=1,0,0")).unwrap();
+        assert_eq!((m.path.as_str(), m.binding("r")), (path.as_str(), Some(Binding::Value(Value::Float(0.25)))));
+        assert_eq!(FileModel::parse(&m.name()).unwrap(), m, "its name reads back");
+    }
+
+    /// The key covers every file of the tree the kernel includes, and only those: an edit of brdf.glsl or of
+    /// generated/ changes it, an edit of a file no kernel includes does not.
+    #[test]
+    fn the_cache_key_covers_every_included_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let glsl = dir.path().join("glsl");
+        shaders::write_glsl_tree(&glsl).unwrap();
+        let m = FileModel::parse(&file(dir.path())).unwrap();
+        let tree = GlslTree::Dir(glsl.clone());
+        let key = || {
+            let (source, defines) = tree.entry("eval_f32").unwrap();
+            let composed = m.compose(KernelKind::Eval, &tree.read(Path::new(&source)).unwrap()).unwrap();
+            cache_key(&composed, &defines, &tree)
+        };
+        let embedded = {
+            let (source, defines) = GlslTree::Embedded.entry("eval_f32").unwrap();
+            let composed = m.compose(KernelKind::Eval, &GlslTree::Embedded.read(Path::new(&source)).unwrap()).unwrap();
+            cache_key(&composed, &defines, &GlslTree::Embedded)
+        };
+        let original = key();
+        assert_eq!(original, embedded, "a copy of the tree keys as the embedded tree does");
+        let included: Vec<String> = tree.included(&m.compose(KernelKind::Eval, &tree.read(Path::new("eval.comp")).unwrap()).unwrap()).into_iter().map(|(f, _)| f).collect();
+        assert!(included.iter().any(|f| f == "brdf.glsl") && included.iter().any(|f| f.starts_with("generated/")), "{included:?}");
+        let edit = |rel: &str| {
+            let p = glsl.join(rel);
+            let text = std::fs::read_to_string(&p).unwrap();
+            std::fs::write(&p, format!("{text}\n// edited\n")).unwrap();
+            let k = key();
+            std::fs::write(&p, text).unwrap();
+            k
+        };
+        assert_ne!(edit("brdf.glsl"), original);
+        let generated = included.iter().find(|f| f.starts_with("generated/")).unwrap().clone();
+        assert_ne!(edit(&generated), original, "{generated}");
+        assert_eq!(edit("shade.comp"), original, "the eval kernel does not include shade.comp");
+        assert_eq!(key(), original);
     }
 }

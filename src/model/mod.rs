@@ -159,7 +159,7 @@ impl Model {
     /// Applies `key=value` overrides (`--param`).
     pub fn with_params(&self, params: &[String]) -> Result<Self> {
         match self {
-            Model::Spec(s) => s.with_params(params).map(Model::Spec).map_err(|e| anyhow!("{}: {e}", s.name())),
+            Model::Spec(s) => s.with_params(params).map(Model::Spec).map_err(|e| anyhow!("{}: {e:#}", s.name())),
             Model::File(f) => f.with_params(params).map(|f| Model::File(Arc::new(f))),
         }
     }
@@ -205,7 +205,7 @@ impl fmt::Display for Model {
 /// that takes them; an override no model takes is an error.
 pub fn models_from_args(models: &[String], params: &[String], default: &[&str]) -> Result<Vec<Model>> {
     let names: Vec<String> = if models.is_empty() { default.iter().map(|s| s.to_string()).collect() } else { models.to_vec() };
-    let parsed = names.iter().map(|m| Model::parse(m).map_err(|e| anyhow!("--model {m}: {e}"))).collect::<Result<Vec<_>>>()?;
+    let parsed = names.iter().map(|m| Model::parse(m).map_err(|e| anyhow!("--model {m}: {e:#}"))).collect::<Result<Vec<_>>>()?;
     for p in params {
         let key = p.split_once('=').map(|(k, _)| k.trim()).ok_or_else(|| anyhow!("--param `{p}`: expected KEY=VALUE"))?;
         if !parsed.iter().any(|m| m.takes_param(key)) {
@@ -220,7 +220,7 @@ pub fn models_from_args(models: &[String], params: &[String], default: &[&str]) 
         .iter()
         .map(|m| {
             let mine: Vec<String> = params.iter().filter(|p| p.split_once('=').is_some_and(|(k, _)| m.takes_param(k.trim()))).cloned().collect();
-            m.with_params(&mine).map_err(|e| anyhow!("--param: {e}"))
+            m.with_params(&mine).map_err(|e| anyhow!("--param: {e:#}"))
         })
         .collect()
 }

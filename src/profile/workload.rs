@@ -71,11 +71,11 @@ pub fn check_size(info: &crate::gpu::DeviceInfo, width: u32, height: u32, format
             format.name(), info.name, info.max_memory_allocation_size, side(most)
         );
     }
-    if let Some(available) = crate::host::available_memory() {
+    if let Some((available, source)) = crate::host::memory_budget() {
         let need = pixels * host_bytes_per_pixel(format, light_counts as u64);
         if need > available {
             let most = available / host_bytes_per_pixel(format, light_counts as u64);
-            anyhow::bail!("--size {width}x{height}: building and uploading the G-buffer needs about {need} bytes of memory and {available} are available (MemAvailable); at most about {most} pixels here (about {})", side(most));
+            anyhow::bail!("--size {width}x{height}: building and uploading the G-buffer needs about {need} bytes of memory and {available} are available ({source}); at most about {most} pixels here (about {})", side(most));
         }
     }
     Ok(())

@@ -310,16 +310,14 @@ thread_local! {
 
 /// A `.brdf` model text with a relative path made relative to the scene file's directory.
 fn relative_to_scene(text: &str) -> String {
-    let (path, rest) = text.split_once(',').map_or((text, None), |(p, r)| (p, Some(r)));
-    let path = Path::new(path.trim());
+    let dir = SCENE_DIR.with(|d| d.borrow().clone());
+    let Some((path, fields)) = model::file_model::split_path(text, &dir) else { return text.to_string() };
+    let path = Path::new(path);
     if path.is_absolute() {
         return text.to_string();
     }
-    let joined = SCENE_DIR.with(|d| d.borrow().join(path)).display().to_string();
-    match rest {
-        Some(r) => format!("{joined},{r}"),
-        None => joined,
-    }
+    let joined = dir.join(path).display().to_string();
+    std::iter::once(joined.as_str()).chain(fields).collect::<Vec<_>>().join(",")
 }
 
 impl Serialize for Model {

@@ -304,14 +304,76 @@ pub fn closeup(scene: &Scene, material: u32, size: u32) -> GBuffer {
 /// radiance read back (1 vec4); on a CPU driver the device's copies are host memory too.
 const HOST_BYTES_PER_PIXEL: u64 = std::mem::size_of::<Pixel>() as u64 + 2 * (5 * 16) + 2 * 16;
 
-/// Refuses a G-buffer that would not fit in the memory available (MemAvailable), before building it.
+/// Refuses a G-buffer that would not fit in the memory available (`host::memory_budget`), before building it.
 fn check_memory(file: &str, width: u32, height: u32) -> Result<()> {
-    let Some(available) = crate::host::available_memory() else { return Ok(()) };
+    let Some((available, source)) = crate::host::memory_budget() else { return Ok(()) };
     let need = width as u64 * height as u64 * HOST_BYTES_PER_PIXEL;
     if need > available {
         bail!(
-            "{file}: gbuffer.procedural.size [{width}, {height}]: a scene run needs about {need} bytes ({HOST_BYTES_PER_PIXEL} per pixel) and {available} are available (MemAvailable); at most about {} pixels here",
+            "{file}: gbuffer.procedural.size [{width}, {height}]: a scene run needs about {need} bytes ({HOST_BYTES_PER_PIXEL} per pixel) and {available} are available ({source}); at most about {} pixels here",
             available / HOST_BYTES_PER_PIXEL
+        );
+    }
+    Ok(())
+}
+
+/// Host bytes per pixel of decoding image planes: each plane's decoded pixels are kept as RGBA f32 (16 bytes)
+/// until the G-buffer is built; while one decodes, its native pixels and two RGBA f32 copies exist at once.
+fn decode_bytes_per_pixel(planes: &[PlaneHeader]) -> u64 {
+    let peak = planes.iter().map(|p| p.native_bytes + 32).max().unwrap_or(0);
+    16 * planes.len() as u64 + peak
+}
+
+/// Refuses image planes whose decoding and scene run would not fit in the memory available, from their
+/// headers, before any pixel is decoded.
+fn check_image_memory(file: &str, planes: &[PlaneHeader]) -> Result<()> {
+    let Some((available, source)) = crate::host::memory_budget() else { return Ok(()) };
+    let (w, h) = (planes[0].width as u64, planes[0].height as u64);
+    let per_pixel = decode_bytes_per_pixel(planes) + HOST_BYTES_PER_PIXEL;
+    let need = w * h * per_pixel;
+    if need > available {
+        bail!(
+            "{file}: gbuffer.images: decoding its {} images of {w}x{h} and running the scene needs about {need} bytes ({per_pixel} per pixel) and {available} are available ({source}); at most about {} pixels here",
+            planes.len(),
+            available / per_pixel
+        );
+    }
+    Ok(())
+}
+
+/// Refuses, before anything is built or decoded, a G-buffer that would not fit in the memory available: a
+/// procedural one from its size, an image one from its images' headers.
+pub fn check_host(scene: &Scene) -> Result<()> {
+    match &scene.file.gbuffer {
+        GBufferSource::Images(files) => check_headers(scene, files),
+        GBufferSource::Procedural(_) => {
+            let (w, h) = size(scene)?;
+            check_memory(&scene.path.display().to_string(), w, h)
+        }
+    }
+}
+
+/// The G-buffer's size, from the scene file or its normal image's header.
+pub fn size(scene: &Scene) -> Result<(u32, u32)> {
+    match &scene.file.gbuffer {
+        GBufferSource::Procedural(Procedural::SphereGrid { size, .. } | Procedural::Statues { size, .. } | Procedural::OldWest { size, .. }) => Ok((size.0[0], size.0[1])),
+        GBufferSource::Images(files) => plane_header(&scene.dir.join(&files.normal), "normal", PlaneKind::Vector).map(|h| (h.width, h.height)),
+    }
+}
+
+/// Refuses, before the G-buffer is built, a scene whose per-pixel buffer cannot be one allocation on the
+/// device: `render` shades every pixel with one model, so one kernel's buffer holds all of them.
+pub fn check_device(scene: &Scene, info: &crate::gpu::DeviceInfo) -> Result<()> {
+    let (w, h) = size(scene)?;
+    let padded = (w as u64 * h as u64).div_ceil(crate::gpu::WORKGROUP as u64) * crate::gpu::WORKGROUP as u64;
+    let bytes = padded * super::run::PIXEL_BYTES;
+    if info.max_memory_allocation_size > 0 && bytes > info.max_memory_allocation_size {
+        bail!(
+            "{}: a {w}x{h} G-buffer needs a {bytes}-byte buffer of pixels on `{}`, more than one allocation may be ({} bytes, maxMemoryAllocationSize); at most {} pixels there",
+            scene.path.display(),
+            info.name,
+            info.max_memory_allocation_size,
+            info.max_memory_allocation_size / super::run::PIXEL_BYTES
         );
     }
     Ok(())
@@ -333,8 +395,19 @@ pub fn build(scene: &Scene) -> Result<GBuffer> {
             let pixels = ray_cast(scene, &layout, &camera, size[0], size[1]);
             Ok(GBuffer { width: size[0], height: size[1], camera, pixels })
         }
-        GBufferSource::Images(files) => load_images(scene, files),
+        GBufferSource::Images(files) => {
+            check_headers(scene, files)?;
+            load_images(scene, files)
+        }
     }
+}
+
+/// `build`, after checking that the G-buffer fits the host's memory and one allocation on the device
+/// (`check_host`, `check_device`), before building anything.
+pub fn build_for(scene: &Scene, info: &crate::gpu::DeviceInfo) -> Result<GBuffer> {
+    check_host(scene)?;
+    check_device(scene, info)?;
+    build(scene)
 }
 
 // ---- Image G-buffers ----------------------------------------------------------------------------------
@@ -411,10 +484,16 @@ fn describe(format: Option<ImageFormat>, colour: ColorType) -> String {
     format!("{article} {depth} {channels} {}", format.to_uppercase())
 }
 
-/// Reads a plane of kind `kind` (`what` names it: "normal", "depth", ...) from a PNG or EXR file. The header
-/// is checked first, against the size limit and what the plane needs, so that a file that does not fit is
-/// refused without being decoded. Errors name the file.
-pub fn read_plane(path: &Path, what: &str, kind: PlaneKind) -> Result<Plane> {
+/// What a plane's header says: its size and the bytes per pixel of its decoded native pixels.
+pub struct PlaneHeader {
+    pub width: u32,
+    pub height: u32,
+    pub native_bytes: u64,
+}
+
+/// Opens an image and checks its header against the size limit and what the plane needs, so that a file that
+/// does not fit is refused without being decoded. Errors name the file.
+fn open_plane(path: &Path, what: &str, kind: PlaneKind) -> Result<(impl ImageDecoder, PlaneHeader, bool)> {
     let shown = path.display();
     let reader = image::ImageReader::open(path).map_err(|e| anyhow!("cannot read image {shown}: {e}"))?;
     let mut reader = reader.with_guessed_format().map_err(|e| anyhow!("cannot read image {shown}: {e}"))?;
@@ -431,9 +510,21 @@ pub fn read_plane(path: &Path, what: &str, kind: PlaneKind) -> Result<Plane> {
     if !kind.accepts(float, colour) {
         bail!("{shown}: the {what} image must be {}; this file is {}", kind.needs(), describe(format, colour));
     }
-    let img = DynamicImage::from_decoder(decoder).map_err(|e| anyhow!("cannot decode image {shown}: {e}"))?;
+    Ok((decoder, PlaneHeader { width, height, native_bytes: u64::from(colour.bytes_per_pixel()) }, float))
+}
+
+/// A plane's header, checked as `read_plane` checks it, without decoding a pixel.
+pub fn plane_header(path: &Path, what: &str, kind: PlaneKind) -> Result<PlaneHeader> {
+    open_plane(path, what, kind).map(|(_, header, _)| header)
+}
+
+/// Reads a plane of kind `kind` (`what` names it: "normal", "depth", ...) from a PNG or EXR file, its header
+/// checked first (`open_plane`). Errors name the file.
+pub fn read_plane(path: &Path, what: &str, kind: PlaneKind) -> Result<Plane> {
+    let (decoder, header, float) = open_plane(path, what, kind)?;
+    let img = DynamicImage::from_decoder(decoder).map_err(|e| anyhow!("cannot decode image {}: {e}", path.display()))?;
     let rgba: Vec<[f32; 4]> = img.into_rgba32f().pixels().map(|p| p.0).collect();
-    Ok(Plane { width, height, float, rgba, path: path.to_path_buf() })
+    Ok(Plane { width: header.width, height: header.height, float, rgba, path: path.to_path_buf() })
 }
 
 /// The sRGB EOTF (IEC 61966-2-1): display-encoded c in [0, 1] to linear.
@@ -451,6 +542,33 @@ fn check_material_ids(m: &Plane, w: u32, materials: usize) -> Result<()> {
         bail!("{}: pixel ({}, {}) names material {} but the scene has {materials} materials", m.path.display(), i as u32 % w, i as u32 / w, (c[0] * 255.0).round());
     }
     Ok(())
+}
+
+/// Every plane of the scene's images: (file, what it is, its kind).
+fn planes(files: &ImageFiles) -> Vec<(&PathBuf, &'static str, PlaneKind)> {
+    let optional = [
+        (&files.roughness, "roughness", PlaneKind::Grey),
+        (&files.base_colour, "base_colour", PlaneKind::Colour),
+        (&files.metallic, "metallic", PlaneKind::Grey),
+        (&files.depth, "depth", PlaneKind::Depth),
+        (&files.position, "position", PlaneKind::Position),
+        (&files.material, "material", PlaneKind::MaterialId),
+        (&files.tangent, "tangent", PlaneKind::Vector),
+    ];
+    std::iter::once((&files.normal, "normal", PlaneKind::Vector)).chain(optional.into_iter().filter_map(|(p, what, kind)| p.as_ref().map(|p| (p, what, kind)))).collect()
+}
+
+/// Every plane's header: the same size as the normal image's, and the memory to decode them available.
+fn check_headers(scene: &Scene, files: &ImageFiles) -> Result<()> {
+    let planes = planes(files);
+    let headers = planes.iter().map(|(p, what, kind)| plane_header(&scene.dir.join(p), what, *kind)).collect::<Result<Vec<_>>>()?;
+    let (w, h) = (headers[0].width, headers[0].height);
+    for ((p, _, _), header) in planes.iter().zip(&headers).skip(1) {
+        if (header.width, header.height) != (w, h) {
+            bail!("{} is {}x{}, but the normal image {} is {w}x{h}", scene.dir.join(p).display(), header.width, header.height, scene.dir.join(&files.normal).display());
+        }
+    }
+    check_image_memory(&scene.path.display().to_string(), &headers)
 }
 
 fn load_images(scene: &Scene, files: &ImageFiles) -> Result<GBuffer> {

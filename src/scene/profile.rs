@@ -159,7 +159,7 @@ fn slot_of(slots: &[Slot], k: usize, without: Option<Effect>) -> usize {
 /// Loads the G-buffer, plans, compiles and times the scene.
 pub fn run(gpu: &Gpu, scene: &Scene, options: &SceneProfileOptions, progress: &ProgressBar) -> Result<SceneProfileReport> {
     progress.set_message("building the G-buffer");
-    let g: GBuffer = gbuffer::build(scene)?;
+    let g: GBuffer = gbuffer::build_for(scene, &gpu.info)?;
     let p: ScenePlan = plan::plan(scene, &g, None);
     p.check_device(&gpu.info)?;
     progress.set_message("E tables");

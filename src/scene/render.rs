@@ -74,6 +74,17 @@ fn studio_lights() -> Vec<Light> {
 pub struct Rendered {
     pub files: Vec<PathBuf>,
     pub notes: Vec<String>,
+    /// Pictures with NaN or Inf pixels, each with their count.
+    pub warnings: Vec<String>,
+}
+
+/// Shown for a pixel whose radiance is NaN or Inf (never black, which a BRDF can be).
+pub const NON_FINITE_COLOUR: [u8; 3] = [255, 0, 255];
+
+/// Tone-mapped pixels, non-finite ones in `NON_FINITE_COLOUR`, and how many those are.
+fn display(hdr: &[[f32; 3]], exposure: f32) -> (Vec<[u8; 3]>, usize) {
+    let bad = |c: &[f32; 3]| c.iter().any(|x| !x.is_finite());
+    (hdr.iter().map(|c| if bad(c) { NON_FINITE_COLOUR } else { tone_map(*c, exposure) }).collect(), hdr.iter().filter(|c| bad(c)).count())
 }
 
 /// Difference heat maps against the reference model, in displayed luminance (what a viewer sees), one shared
@@ -105,7 +116,7 @@ fn difference_maps(g: &GBuffer, models: &[BrdfModel], displayed: &[Vec<[u8; 3]>]
 }
 
 /// The comparison grid: one sphere per material (rows) and model (columns), under a studio rig.
-fn comparison_grid(gpu: &Gpu, scene: &Scene, models: &[BrdfModel], out: &Path) -> Result<PathBuf> {
+fn comparison_grid(gpu: &Gpu, scene: &Scene, models: &[BrdfModel], out: &Path, warnings: &mut Vec<String>) -> Result<PathBuf> {
     let settings = &scene.file.render;
     let rows: Vec<String> = if settings.grid.is_empty() { scene.file.materials.iter().map(|m| m.name.clone()).collect() } else { settings.grid.clone() };
     let mut studio = scene.clone();
@@ -119,7 +130,11 @@ fn comparison_grid(gpu: &Gpu, scene: &Scene, models: &[BrdfModel], out: &Path) -
         let closeup = gbuffer::closeup(&studio, index as u32, GRID_TILE);
         for m in models {
             let (hdr, _) = radiance(gpu, &studio, &closeup, Some(m))?;
-            tiles.push(hdr.iter().map(|c| tone_map(*c, settings.exposure)).collect::<Vec<_>>());
+            let (px, bad) = display(&hdr, settings.exposure);
+            if bad > 0 {
+                warnings.push(format!("grid.png: {} on {name}: {bad} of {} pixels are NaN or Inf (drawn magenta)", m.name(), hdr.len()));
+            }
+            tiles.push(px);
         }
     }
     let grid = out.join("grid.png");
@@ -144,17 +159,21 @@ pub fn render(gpu: &Gpu, scene: &Scene, out: &Path, progress: &ProgressBar) -> R
     let settings = &scene.file.render;
     let exposure = settings.exposure;
     progress.set_message("building the G-buffer");
-    let g = gbuffer::build(scene)?;
+    let g = gbuffer::build_for(scene, &gpu.info)?;
     let models: Vec<BrdfModel> = settings.models.iter().map(|m: &Model| m.0.clone()).collect();
     let mut files = Vec::new();
     let mut notes = Vec::new();
+    let mut warnings = Vec::new();
     let mut displayed: Vec<Vec<[u8; 3]>> = Vec::new();
     for m in &models {
         progress.set_message(format!("rendering {}", m.name()));
         let (hdr, n) = radiance(gpu, scene, &g, Some(m))?;
         notes.extend(n);
-        let px: Vec<[u8; 3]> = hdr.iter().map(|c| tone_map(*c, exposure)).collect();
+        let (px, bad) = display(&hdr, exposure);
         let path = out.join(format!("{}.png", slug(m)));
+        if bad > 0 {
+            warnings.push(format!("{}: {} of {} pixels are NaN or Inf (drawn magenta in {})", m.name(), bad, hdr.len(), path.display()));
+        }
         let title = format!("{}: {} ({})", scene.name(), m.name(), m.canonical());
         chart::render(&path, g.width, g.height, |root| {
             blit(root, 0, 0, g.width, &px)?;
@@ -165,14 +184,14 @@ pub fn render(gpu: &Gpu, scene: &Scene, out: &Path, progress: &ProgressBar) -> R
     }
     files.extend(difference_maps(&g, &models, &displayed, out)?);
     progress.set_message("comparison grid");
-    files.push(comparison_grid(gpu, scene, &models, out)?);
+    files.push(comparison_grid(gpu, scene, &models, out, &mut warnings)?);
     progress.set_message("lobes");
     let lobes = out.join("lobes.png");
     lobe_plot(gpu, &lobes, &models, &settings.lobe_roughness.iter().map(|u| u.0).collect::<Vec<_>>())?;
     files.push(lobes);
     notes.sort();
     notes.dedup();
-    Ok(Rendered { files, notes })
+    Ok(Rendered { files, notes, warnings })
 }
 
 /// Viridis colour map (matplotlib's, 9 control points, linear in between) for t in [0, 1].

@@ -15,7 +15,7 @@ use crate::profile::protocol::{Dispatch, Pipelines, Timed};
 use anyhow::Result;
 
 /// Bytes per pixel of each per-pixel binding: pixels (3 vec4), output (1 vec4), extras (2 vec4).
-const PIXEL_BYTES: u64 = 48;
+pub(crate) const PIXEL_BYTES: u64 = 48;
 const OUT_BYTES: u64 = 16;
 const EXTRA_BYTES: u64 = 32;
 

@@ -188,13 +188,21 @@ fn scan_steps(grid: &[Sample], out: &[[f32; 3]], twin: Option<&[[f64; 3]]>, devi
     steps
 }
 
-/// max |f(v, l) - f(l, v)| / max(|f|, FLOOR).
-fn reciprocity_error(forward: &[[f32; 3]], backward: &[[f32; 3]]) -> f64 {
-    forward
-        .iter()
-        .zip(backward)
-        .flat_map(|(a, b)| (0..3).map(move |c| (a[c] as f64 - b[c] as f64).abs() / (a[c].abs().max(b[c].abs()) as f64).max(FLOOR)))
-        .fold(0.0, f64::max)
+/// max |f(v, l) - f(l, v)| / max(|f|, FLOOR) over the pairs whose values are both finite (None when none
+/// is), and how many pairs are not: a NaN says nothing about reciprocity, least of all that it holds.
+fn reciprocity_error(forward: &[[f32; 3]], backward: &[[f32; 3]]) -> (Option<f64>, usize) {
+    let (mut worst, mut nonfinite) = (None, 0);
+    for (a, b) in forward.iter().zip(backward) {
+        for c in 0..3 {
+            if !(a[c].is_finite() && b[c].is_finite()) {
+                nonfinite += 1;
+                continue;
+            }
+            let e = (a[c] as f64 - b[c] as f64).abs() / (a[c].abs().max(b[c].abs()) as f64).max(FLOOR);
+            worst = Some(worst.map_or(e, |w: f64| w.max(e)));
+        }
+    }
+    (worst, nonfinite)
 }
 
 /// Checks one model: catalogue, grid, discontinuities and reciprocity (energy is added by `run`).
@@ -223,6 +231,7 @@ pub fn check_model(gpu: &Gpu, model: &Model, cases: &[HardCase], grid: &[Sample]
     }
     let steps = scan_steps(grid, grid_out, twin.as_deref(), &deviations);
     let any_bad = cells.iter().flatten().any(|&n| n > 0);
+    let (reciprocity, reciprocity_nonfinite) = reciprocity_error(forward, backward);
     Ok(SpecStability {
         spec: model.name(),
         precision: model.precision().name().into(),
@@ -239,7 +248,8 @@ pub fn check_model(gpu: &Gpu, model: &Model, cases: &[HardCase], grid: &[Sample]
         discontinuities: steps.discontinuities,
         discontinuity_examples: steps.examples,
         model_jumps: steps.model_jumps,
-        reciprocity: reciprocity_error(forward, backward),
+        reciprocity,
+        reciprocity_nonfinite,
         bad_cells: any_bad.then_some(cells),
         energy: None,
     })

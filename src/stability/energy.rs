@@ -25,9 +25,12 @@ pub struct Energy {
     pub e: Vec<Vec<f32>>,
     /// The largest integration-error estimate of the cells.
     pub error_bound: f64,
-    pub max_e: f64,
+    /// The largest E of the finite cells (None when no cell is finite).
+    pub max_e: Option<f64>,
     /// (NoV, roughness) of max_e.
     pub max_at: (f32, f32),
+    /// Cells whose E is NaN or Inf (left out of max_e; never a gain or a loss).
+    pub nonfinite: usize,
     /// max_e > 1 + error_bound.
     pub gains_energy: bool,
     /// Hemispherical albedo 2 * integral of E(mu) mu dmu at r = 1 (1 - this is the energy lost to single scattering).
@@ -37,6 +40,13 @@ pub struct Energy {
     /// model without an f64 twin (a `.brdf` file).
     pub cpu_check: Option<f64>,
     pub cpu_check_nonfinite: usize,
+}
+
+impl Energy {
+    /// The number of (roughness, NoV) cells.
+    pub fn cells(&self) -> usize {
+        self.e.iter().map(Vec::len).sum()
+    }
 }
 
 /// The spec with F = 1 (F = none with F0 = 1): only D and Vis (and the precision) decide energy.
@@ -62,12 +72,14 @@ pub fn energy_of(gpu: &Gpu, model: &Model) -> Result<Energy> {
     let albedo = kernels::albedo(gpu, &white, &cells())?;
     let e: Vec<Vec<f32>> = albedo.chunks(NOV.len()).map(|row| row.iter().map(|a| a.e[0] as f32).collect()).collect();
     let error_bound = albedo.iter().map(|a| a.error).fold(0.0, f64::max);
-    let (mut max_e, mut max_at) = (f64::NEG_INFINITY, (0.0, 0.0));
+    let (mut max_e, mut max_at, mut nonfinite) = (None, (0.0, 0.0), 0);
     for (ri, row) in e.iter().enumerate() {
         for (vi, &x) in row.iter().enumerate() {
             let x = x as f64;
-            if x > max_e || x.is_nan() {
-                max_e = if x.is_nan() { f64::INFINITY } else { x };
+            if !x.is_finite() {
+                nonfinite += 1;
+            } else if max_e.is_none_or(|m| x > m) {
+                max_e = Some(x);
                 max_at = (NOV[vi], ROUGHNESS[ri]);
             }
         }
@@ -91,7 +103,8 @@ pub fn energy_of(gpu: &Gpu, model: &Model) -> Result<Energy> {
         }
         cpu_check = Some(worst);
     }
-    Ok(Energy { e, error_bound, max_e, max_at, gains_energy: max_e > 1.0 + error_bound, hemispherical_at_r1: hemi, cpu_check, cpu_check_nonfinite })
+    let gains_energy = max_e.is_some_and(|m| m > 1.0 + error_bound);
+    Ok(Energy { e, error_bound, max_e, max_at, nonfinite, gains_energy, hemispherical_at_r1: hemi, cpu_check, cpu_check_nonfinite })
 }
 
 /// Computes energy once per distinct white model and attaches it to every result.

@@ -138,8 +138,11 @@ pub struct SpecStability {
     pub discontinuity_examples: Vec<String>,
     /// Steps the f64 model takes too, between lit points (the formula's and its guards' own).
     pub model_jumps: usize,
-    /// max |f(v, l) - f(l, v)| / max(|f|, 1e-3) over the reciprocity samples.
-    pub reciprocity: f64,
+    /// max |f(v, l) - f(l, v)| / max(|f|, 1e-3) over the reciprocity samples whose values are finite (None
+    /// when none is).
+    pub reciprocity: Option<f64>,
+    /// Reciprocity values (sample pairs x channels) left out because either side is NaN or Inf.
+    pub reciprocity_nonfinite: usize,
     /// Bad values (NaN, Inf, negative) per (NoV, roughness) grid cell, [roughness][NoV], where any.
     #[serde(serialize_with = "sparse_cells")]
     pub bad_cells: Option<Vec<Vec<u32>>>,
@@ -221,17 +224,51 @@ pub fn run(gpu: &Gpu, options: &StabilityOptions, progress: &ProgressBar) -> Res
     Ok(StabilityReport { provenance: crate::report::Provenance::new(&gpu.info), specs, grid_points: grid.len(), cases })
 }
 
+/// The worst deviation as a table cell: in tolerances, or what the value was when it is not a number.
+fn worst_cell(w: &Worst) -> String {
+    if w.got.is_nan() {
+        "NaN result".into()
+    } else if w.got.is_infinite() {
+        "Inf result".into()
+    } else {
+        format!("{:.2e}", w.deviation)
+    }
+}
+
+/// The max E, hemispherical albedo and E-vs-CPU cells, NaN/Inf cells counted (never a gain, never "inf").
+fn energy_cells(e: &energy::Energy) -> (String, String, String) {
+    use crate::report::sig;
+    let nonfinite = if e.nonfinite > 0 { format!(" ({} of {} cells NaN/Inf)", e.nonfinite, e.cells()) } else { String::new() };
+    let max_e = match e.max_e {
+        Some(m) => format!("{}{} (±{:.0e}){nonfinite}", sig(m, 3), if e.gains_energy { " gain" } else { "" }, e.error_bound),
+        None => format!("-{nonfinite}"),
+    };
+    let hemi = if e.hemispherical_at_r1.is_finite() { sig(e.hemispherical_at_r1, 3) } else { "- (NaN/Inf)".into() };
+    let cpu_nonfinite = if e.cpu_check_nonfinite > 0 { format!(" ({} NaN/Inf)", e.cpu_check_nonfinite) } else { String::new() };
+    (max_e, hemi, format!("{}{cpu_nonfinite}", e.cpu_check.map_or("- (no twin)".into(), |c| format!("{c:.1e}"))))
+}
+
+/// Reciprocity as a table cell, with the values it had to leave out.
+fn reciprocity_cell(s: &SpecStability) -> String {
+    let left_out = if s.reciprocity_nonfinite > 0 { format!(" ({} NaN/Inf)", s.reciprocity_nonfinite) } else { String::new() };
+    match s.reciprocity {
+        Some(r) => format!("{r:.1e}{left_out}"),
+        None => format!("-{left_out}"),
+    }
+}
+
 impl StabilityReport {
     pub fn markdown(&self) -> String {
-        use crate::report::{sig, Table};
+        use crate::report::Table;
         let mut out = format!(
             "# brdfprof stability\n\n{} ({}), {} specs; {} hard cases and {} grid points each.\n\n\
              NaN/Inf/neg: results on valid inputs (a spec with any fails, and the command exits 1). Out of tolerance: cases and \
              grid points whose result is further from the expected value (the f64 twin, which applies the same guards) than \
              max(base, 4 x what rounding the inputs at the kernel's precision alone moves the f64 result), base = 1e-3 (fp32) \
              or 2e-2 (fp16) relative; worst: that distance in tolerances. Jumps: steps in f_s NoL along NoV, NoL or roughness \
-             that the f64 model does not take. Reciprocity: max |f(v,l) - f(l,v)| / max(|f|, 1e-3). E: directional albedo with \
-             F = 1 (max over NoV in [0.02, 1], r in [0.1, 1]; error bound of the integration); hemi r=1: the hemispherical albedo \
+             that the f64 model does not take. Reciprocity: max |f(v,l) - f(l,v)| / max(|f|, 1e-3) over finite pairs (NaN/Inf \
+             values are counted, never taken for agreement). E: directional albedo with F = 1 (max over the finite cells of \
+             NoV in [0.02, 1], r in [0.1, 1]; error bound of the integration; NaN/Inf cells counted); hemi r=1: the hemispherical albedo \
              at r = 1, so 1 - hemi is the energy single scattering loses; E vs CPU: max |E_gpu - E_cpu| / max(1, E_cpu) against \
              the CPU's f64 integration of the same formula at r = 0.1, 0.5, 1. A `.brdf` model has no f64 twin: its NaN, Inf \
              and negative counts, invalid-input cases, reciprocity and E (its own Fresnel, given F0 = 1) are measured; \
@@ -244,13 +281,7 @@ impl StabilityReport {
         );
         let mut t = Table::new(["spec", "NaN", "Inf", "neg", "cases out of tol.", "grid out of tol.", "worst (x tol.)", "jumps", "reciprocity", "max E", "hemi r=1", "E vs CPU", "verdict"]);
         for s in &self.specs {
-            let (max_e, hemi, cpu) = s.energy.as_ref().map_or(("-".into(), "-".into(), "-".into()), |e| {
-                (
-                    format!("{}{} (±{:.0e})", sig(e.max_e, 3), if e.gains_energy { " gain" } else { "" }, e.error_bound),
-                    sig(e.hemispherical_at_r1, 3),
-                    format!("{}{}", e.cpu_check.map_or("- (no twin)".into(), |c| format!("{c:.1e}")), if e.cpu_check_nonfinite > 0 { format!(" ({} inf)", e.cpu_check_nonfinite) } else { String::new() }),
-                )
-            });
+            let (max_e, hemi, cpu) = s.energy.as_ref().map_or(("-".into(), "-".into(), "-".into()), energy_cells);
             t.row([
                 s.spec.clone(),
                 s.nan.to_string(),
@@ -258,9 +289,9 @@ impl StabilityReport {
                 s.negative.to_string(),
                 if s.has_twin { format!("{}/{}", s.cases_out_of_tolerance.len(), s.cases_run) } else { "- (no twin)".into() },
                 if s.has_twin { s.grid_out_of_tolerance.to_string() } else { "-".into() },
-                if s.has_twin { format!("{:.2e}", s.worst.deviation) } else { "-".into() },
+                if s.has_twin { worst_cell(&s.worst) } else { "-".into() },
                 s.discontinuities.to_string(),
-                format!("{:.1e}", s.reciprocity),
+                reciprocity_cell(s),
                 max_e,
                 hemi,
                 cpu,

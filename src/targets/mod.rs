@@ -11,6 +11,7 @@ pub mod nvidia;
 pub mod nvrtc;
 pub mod radv;
 pub mod radv_child;
+pub mod radv_env;
 
 use crate::gpu::Gpu;
 use crate::inspect::InspectReport;

@@ -277,110 +277,32 @@ pub struct Sass {
     pub cubin_bytes: usize,
 }
 
-/// Compiles the CUDA C++ `source` for `family` and disassembles it.
+/// Compiles the CUDA C++ `source` for `family` and disassembles it, under the compile limit, or takes both from
+/// the cache: the key covers the source, the options, NVRTC's and nvdisasm's versions and brdfprof's.
 pub fn compile(source: &str, family: &Family, precise: bool) -> Result<Sass> {
     let tools = nvrtc::tools()?;
-    let compiled = tools.compile(source, "brdfprof_kernel.cu", &options(family, precise))?;
-    let listing = tools.disassemble(&compiled.cubin)?;
-    Ok(Sass { listing, log: compiled.log, cubin_bytes: compiled.cubin.len() })
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The transcription of NVIDIA's table with its citation (tests/fixtures/nvidia-throughput.tsv).
-    fn fixture() -> Vec<(String, Vec<u32>)> {
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/nvidia-throughput.tsv");
-        std::fs::read_to_string(path)
-            .unwrap()
-            .lines()
-            .filter(|l| !l.starts_with('#') && !l.trim().is_empty())
-            .map(|l| {
-                let mut f = l.split('\t');
-                let row = f.next().unwrap().to_string();
-                (row, f.map(|x| x.trim().parse().unwrap()).collect())
-            })
-            .collect()
-    }
-
-    #[test]
-    fn every_throughput_entry_is_the_cited_tables() {
-        let cited = fixture();
-        let rows: Vec<&(String, Vec<u32>)> = cited.iter().filter(|(r, _)| r != "ratio").collect();
-        assert_eq!(rows.len(), THROUGHPUT.len(), "one entry per transcribed row");
-        for r in THROUGHPUT {
-            let (_, figures) = rows.iter().find(|(label, _)| label == r.row).unwrap_or_else(|| panic!("`{}` is not a row of the cited table", r.row));
-            assert_eq!(&r.per_clock[..], &figures[..], "{}", r.row);
+    let options = options(family, precise);
+    let key = crate::cache::KeyBuilder::new("sass")
+        .part("brdfprof", env!("CARGO_PKG_VERSION"))
+        .part("nvrtc", &tools.version)
+        .part("nvdisasm", &tools.nvdisasm_version)
+        .part("options", options.join(" "))
+        .part("source", source)
+        .finish();
+    let what = format!("the CUDA C++ translation for nvidia:{} (NVRTC)", family.name);
+    let valid = |bytes: &[u8]| -> Result<()> {
+        let sass: Sass = serde_json::from_slice(bytes)?;
+        if !sass.listing.contains("EXIT") {
+            bail!("a SASS listing without EXIT");
         }
-        // 64-bit floating point is the 32-bit rate over the guide's FP32:FP64 ratio (its Table 30).
-        let ratio = &cited.iter().find(|(r, _)| r == "ratio").unwrap().1;
-        for k in 0..COLUMNS.len() {
-            assert_eq!(rate(FP64, &FAMILIES[k]).unwrap() * ratio[k], rate(FP32, &FAMILIES[k]).unwrap(), "column {}", COLUMNS[k]);
-        }
-        for (k, f) in FAMILIES.iter().enumerate() {
-            assert_eq!(format!("{}.{}", f.compute_capability.0, f.compute_capability.1), COLUMNS[f.column], "{}", f.name);
-            assert_eq!(f.column, k);
-        }
-    }
-
-    #[test]
-    fn every_row_an_opcode_issues_at_is_in_the_table() {
-        for op in ["FFMA", "FMNMX", "HFMA2", "HSETP2", "DFMA", "MUFU", "IADD3", "IMAD", "SHF", "ISETP", "LOP3", "SHFL", "F2F", "I2FP"] {
-            let (_, row) = classify(op);
-            let row = row.unwrap_or_else(|| panic!("{op} has no row"));
-            assert!(THROUGHPUT.iter().any(|r| r.row == row), "{op}: `{row}`");
-        }
-        assert_eq!(classify("LDG"), (Class::Memory, None));
-        assert_eq!(classify("BSSY"), (Class::Control, None));
-        assert_eq!(classify("UIADD3"), (Class::Integer, None));
-        assert_eq!(classify("MOV"), (Class::Move, None));
-    }
-
-    const LISTING: &str = "
-        .text.brdfprof_kernel:
-        /*0000*/                   MOV R1, c[0x0][0x28] ;
-        /*0010*/                   S2R R0, SR_TID.X ;
-        /*0020*/                   FFMA R2, R3, R4, R5 ;
-        /*0030*/                   FMUL.FTZ R2, R2, R2 ;
-        /*0040*/               @P0 MUFU.RSQ R6, R2 ;
-        /*0050*/                   HFMA2 R7, R7.H0_H0, R7.H0_H0, R7.H0_H0 ;
-        /*0060*/                   IMAD.MOV.U32 R8, RZ, RZ, R9 ;
-        /*0070*/                   F2F.F16.F32 R10, R2 ;
-        /*0080*/                   LDG.E.CONSTANT R4, [R2.64] ;
-        /*0090*/                   STG.E [R2.64], R5 ;
-        /*00a0*/                   EXIT ;
-        /*00b0*/                   BRA `(.L_x_0);
-        /*00c0*/                   NOP;
-    ";
-    const LOG: &str = "ptxas info    : Compiling entry function 'brdfprof_kernel' for 'sm_89'\nptxas info    : Function properties for brdfprof_kernel\nptxas         .     16 bytes stack frame, 8 bytes spill stores, 4 bytes spill loads\nptxas info    : Used 40 registers, used 0 barriers, 384 bytes cmem[0]\n";
-
-    #[test]
-    fn sass_is_counted_to_the_last_exit_and_costed_by_hand() {
-        let s = SassStats::of(LISTING, LOG, 3000);
-        assert_eq!(s.instructions, 11, "the padding branch and NOP after EXIT are not counted");
-        assert_eq!((s.registers, s.stack_bytes, s.spill_bytes, s.cubin_bytes), (40, 16, 12, 3000));
-        let class = |c: Class| s.by_class.get(&c).copied().unwrap_or(0);
-        assert_eq!((class(Class::Fp32), class(Class::Mufu), class(Class::Fp16), class(Class::Integer), class(Class::Conversion), class(Class::Memory), class(Class::Control), class(Class::Move)), (2, 1, 1, 1, 1, 2, 1, 2));
-        // sm_89 (8.9): per warp, 32 lanes x results / rate: FFMA, FMUL 2 x 32/128; MUFU 32/16; HFMA2 32 x 2/128;
-        // IMAD 32/64; F2F 32/16; MOV, S2R, LDG, STG, EXIT at the issue rate, 5 x 32/128.
-        let by_hand = 2.0 * 0.25 + 2.0 + 0.5 + 0.5 + 2.0 + 5.0 * 0.25;
-        assert_eq!(s.issue_cycles(&FAMILIES[2]).unwrap(), by_hand);
-        // sm_75: FP32 at 64, FP16 at 128 results.
-        assert_eq!(s.issue_cycles(&FAMILIES[0]).unwrap(), 2.0 * 0.5 + 2.0 + 0.5 + 0.5 + 2.0 + 5.0 * 0.25);
-    }
-
-    #[test]
-    fn occupancy_follows_the_register_file() {
-        let at = |registers: u32, family: usize| SassStats { registers, ..Default::default() }.warps_per_sm(&FAMILIES[family]);
-        // 40 registers: 1280 per warp, 51 warps of registers, 50 in whole 64-thread workgroups; 48 at most on 8.9.
-        assert_eq!(at(40, 2), 48);
-        assert_eq!(at(40, 3), 50);
-        assert_eq!(at(40, 0), 32);
-        // 128 registers: 4096 per warp, 16 warps.
-        assert_eq!(at(128, 3), 16);
-        assert_eq!(at(255, 3), 8, "255 registers round up to 8192 per warp");
-    }
+        Ok(())
+    };
+    let bytes = crate::cache::get_or_build(crate::cache::Store::open_default().as_ref(), "sass", &key, &what, valid, || {
+        let compiled = crate::compile_limit::bounded(&what, || tools.compile(source, "brdfprof_kernel.cu", &options))?;
+        let listing = tools.disassemble(&compiled.cubin)?;
+        Ok(serde_json::to_vec(&Sass { listing, log: compiled.log, cubin_bytes: compiled.cubin.len() })?)
+    })?;
+    Ok(serde_json::from_slice(&bytes)?)
 }
 
 /// The device name of a family's reports.
@@ -398,7 +320,7 @@ fn check_translations(req: &Request, gpu: &crate::gpu::Gpu) -> Result<Vec<Checke
     crate::inspect::kernels_of(req.models)
         .into_iter()
         .map(|m| {
-            let agreements = crate::translate::verify::check(gpu, m, req.lights, req.shaders)?;
+            let agreements = crate::translate::verify::check_cached(gpu, m, req.lights, req.shaders)?;
             let source = crate::translate::prepare::shade_kernel(m, req.lights, req.shaders)?.source(crate::translate::Dialect::Cuda);
             let agreement = agreements.iter().map(|a| format!("{} {:.1e} (tolerance {:.0e})", a.kernel, a.worst, a.tolerance)).collect::<Vec<_>>().join(", ");
             Ok(Checked { source, agreement: format!("translation checked on the host against {}: worst relative difference {agreement}", gpu.info.name) })

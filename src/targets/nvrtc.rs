@@ -29,6 +29,8 @@ pub struct Tools {
     pub nvdisasm: PathBuf,
     /// "NVRTC 13.5".
     pub version: String,
+    /// nvdisasm's `--version` line with its build.
+    pub nvdisasm_version: String,
 }
 
 /// The pinned wheel versions `make setup` installs (scripts/setup.sh reads the same line of the Makefile).
@@ -82,7 +84,9 @@ fn load() -> std::result::Result<Tools, String> {
         f(&mut major, &mut minor);
         format!("NVRTC {major}.{minor}")
     };
-    Ok(Tools { _lib: lib, api, nvdisasm, version })
+    // Its last line names the build ("Build cuda_13.5.r13.5/compiler.37..."): the cache keys on it.
+    let nvdisasm_version = std::process::Command::new(&nvdisasm).arg("--version").output().ok().and_then(|o| String::from_utf8_lossy(&o.stdout).lines().last().map(str::to_string)).unwrap_or_default();
+    Ok(Tools { _lib: lib, api, nvdisasm, version, nvdisasm_version })
 }
 
 /// The tools, loaded once per process; an error naming the fix when they are not installed.
@@ -145,7 +149,7 @@ impl Tools {
         std::fs::write(&path, cubin).with_context(|| format!("cannot write {}", path.display()))?;
         let mut cmd = crate::cleanup::command(self.nvdisasm.to_str().unwrap_or("nvdisasm"));
         cmd.arg("-c").arg(&path);
-        let out = crate::cleanup::output(&mut cmd).with_context(|| format!("cannot run {}", self.nvdisasm.display()))?;
+        let out = crate::compile_limit::output(&mut cmd, "a cubin's SASS (nvdisasm)").with_context(|| format!("cannot run {}", self.nvdisasm.display()))?;
         if !out.status.success() {
             bail!("nvdisasm failed: {}", String::from_utf8_lossy(&out.stderr).trim());
         }

@@ -141,31 +141,40 @@ fn write_isa(gpu: &Gpu, shaders: &Shaders, model: Option<&Model>, lights: u32, d
 
 /// Runs the child for one target and reads its report.
 pub fn run(target: &'static Family, models: &[Model], lights: u32, shaders: &Shaders, validate: bool, isa_dir: Option<&Path>) -> Result<RadvRun> {
+    // The child writes its ISA files into its own TMPDIR; they become outputs of this process (staged with
+    // its others) only once the child has succeeded.
+    let mut cmd = cleanup::command(&std::env::current_exe().context("cannot find brdfprof's own executable")?.to_string_lossy());
+    let tmp = cleanup::child_tmpdir(&mut cmd)?;
+    let child_isa = isa_dir.map(|_| tmp.path().join("isa"));
     let req = RadvRequest {
         family: target.family.to_string(),
         models: models.iter().map(Model::canonical).collect(),
         lights,
         validate,
         glsl: shaders.glsl_dir().map(Path::to_path_buf),
-        isa_dir: isa_dir.map(Path::to_path_buf),
+        isa_dir: child_isa.clone(),
     };
-    let exe = std::env::current_exe().context("cannot find brdfprof's own executable")?;
-    let exe = exe.to_str().ok_or_else(|| anyhow!("brdfprof's path is not UTF-8"))?;
-    let mut cmd = cleanup::command(exe);
     cmd.arg(CHILD_COMMAND)
         .arg(serde_json::to_string(&req)?)
         .env(targets::FORCE_FAMILY_VAR, target.family)
         // ACO's output, not a binary an earlier process cached, and no stale statistics.
         .env("MESA_SHADER_CACHE_DISABLE", "true");
-    let output = cleanup::output(&mut cmd).context("cannot run brdfprof's radv child")?;
+    // The child compiles each kernel under the compile limit itself; the whole child gets one limit per
+    // kernel (models, the memory-only kernel, their ISA captures) and a few seconds to start.
+    crate::compile_limit::export(&mut cmd);
+    let kernels = (models.len() as u32 + 1) * if isa_dir.is_some() { 2 } else { 1 };
+    let limit = crate::compile_limit::limit() * kernels + std::time::Duration::from_secs(10);
+    let what = format!("the kernels for radv:{} (ACO, in a child process)", target.family);
+    let output = crate::compile_limit::output_within(&mut cmd, &what, limit).context("cannot run brdfprof's radv child")?;
     let stdout = String::from_utf8_lossy(&output.stdout);
     let stderr = String::from_utf8_lossy(&output.stderr);
     // Validation messages and warnings of the child reach the user as they are, but for the banner RADV prints
     // for every device it does not know to be conformant (its null device among them).
-    for line in stderr.lines().filter(|l| !l.starts_with("WARNING: radv is not a conformant Vulkan implementation")) {
-        eprintln!("{line}");
-    }
     let reply: Option<RadvReply> = stdout.lines().rev().find_map(|l| serde_json::from_str(l).ok());
+    // (A failed child's last lines are in the error below.)
+    for line in stderr.lines().filter(|l| reply.is_some() && !l.starts_with("WARNING: radv is not a conformant Vulkan implementation")) {
+        crate::messages::line(line);
+    }
     let teardown_note = match (&reply, output.status.success()) {
         (Some(_), true) => None,
         (Some(_), false) if output.status.code().is_none() => Some(format!(
@@ -181,7 +190,20 @@ pub fn run(target: &'static Family, models: &[Model], lights: u32, shaders: &Sha
     if reply.family != target.family {
         bail!("radv child answered for {} instead of {}", reply.family, target.family);
     }
-    Ok(RadvRun { target, report: reply.report, isa_files: reply.isa_files, teardown_note })
+    let isa_files = match (&child_isa, isa_dir) {
+        (Some(from), Some(to)) => reply.isa_files.iter().map(|f| publish(f, from, to)).collect::<Result<Vec<_>>>()?,
+        _ => Vec::new(),
+    };
+    Ok(RadvRun { target, report: reply.report, isa_files, teardown_note })
+}
+
+/// Writes a file the child wrote under `from` as this process' output under `to`.
+fn publish(file: &Path, from: &Path, to: &Path) -> Result<PathBuf> {
+    let rel = file.strip_prefix(from).map_err(|_| anyhow!("the radv child wrote {} outside its ISA directory", file.display()))?;
+    let bytes = std::fs::read(file).with_context(|| format!("cannot read the radv child's {}", file.display()))?;
+    let path = to.join(rel);
+    crate::io::write_output(&path, &bytes)?;
+    Ok(path)
 }
 
 /// `run` for every target, at most as many children at once as the host has cores; results in order.

@@ -116,3 +116,30 @@ pub fn check(gpu: &Gpu, model: Option<&Model>, lights: u32, shaders: &Shaders) -
     }
     Ok(out)
 }
+
+/// `check`, or its result from the cache: the key covers the host translations (their whole source), the
+/// Vulkan kernels' SPIR-V and constants, the device and its driver, and the comparison's set-up.
+pub fn check_cached(gpu: &Gpu, model: Option<&Model>, lights: u32, shaders: &Shaders) -> Result<Vec<Agreement>> {
+    let (per_dispatch, accumulate) = workload::steady_block(lights);
+    let shade = workload::shade_kernel(model, GBufferFormat::Packed, per_dispatch, accumulate, shaders)?;
+    let mut key = crate::cache::KeyBuilder::new("agreement")
+        .part("brdfprof", env!("CARGO_PKG_VERSION"))
+        .part("device", format!("{} {} {} {}", gpu.info.name, gpu.info.driver_name, gpu.info.driver_info, gpu.info.driver_version))
+        .part("setup", format!("{EVAL_SAMPLES} {SHADE_SIZE:?} {lights} {}", host::HOST_FLAGS.join(" ")))
+        .part("shade-spirv", bytemuck::cast_slice::<u32, u8>(&shade.spirv.words))
+        .part("shade-constants", format!("{:?}", shade.constants))
+        .part("shade-host", prepare::shade_kernel(model, lights, shaders)?.source(super::Dialect::Host));
+    if let Some(m) = model {
+        let eval = m.kernel(crate::model::KernelKind::Eval, shaders)?;
+        key = key
+            .part("eval-spirv", bytemuck::cast_slice::<u32, u8>(&eval.spirv.words))
+            .part("eval-constants", format!("{:?}", eval.constants))
+            .part("eval-host", prepare::eval_kernel(m, shaders)?.source(super::Dialect::Host));
+    }
+    let key = key.finish();
+    let label = model.map_or_else(|| workload::BASELINE_LABEL.to_string(), Model::name);
+    let what = format!("the check of {label}'s translation");
+    let valid = |bytes: &[u8]| serde_json::from_slice::<Vec<Agreement>>(bytes).map(|_| ()).map_err(anyhow::Error::from);
+    let bytes = crate::cache::get_or_build(crate::cache::Store::open_default().as_ref(), "agreement", &key, &what, valid, || Ok(serde_json::to_vec(&check(gpu, model, lights, shaders)?)?))?;
+    Ok(serde_json::from_slice(&bytes)?)
+}

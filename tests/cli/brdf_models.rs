@@ -249,3 +249,118 @@ fn a_file_gates_on_a_compile_only_amd_target() {
     assert_eq!(r.code, Some(1), "{}\n{}", r.stdout, r.stderr);
     assert!(r.stdout.contains("driver/inverse-throughput") && r.stdout.contains("mine.brdf"), "{}", r.stdout);
 }
+
+const NAN_FILE: &str = "analytic\n::begin shader\nvec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) { return vec3(sqrt(dot(N, L) - 2.0)); }\n::end shader\n";
+
+/// Issue 21: stability of an all-NaN file reported reciprocity 0.0 (perfect), max E "inf gain" (JSON null)
+/// and NaN results as "(inf)". NaN is now counted and named wherever it is.
+#[test]
+fn stability_counts_and_names_nan_instead_of_calling_it_perfect() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("nan.brdf"), NAN_FILE).unwrap();
+    let r = run_in(dir.path(), &["stability", "--model", "nan.brdf", "--out", "st"]);
+    assert_eq!(r.code, Some(1), "{}", r.stderr);
+    let s = json(&common::device_file(&dir.path().join("st"), "stability-", ".json"));
+    let spec = &s["specs"][0];
+    assert!(spec["nan"].as_u64().unwrap() > 0);
+    assert!(spec["reciprocity"].is_null() && spec["reciprocity_nonfinite"].as_u64().unwrap() > 0, "{spec}");
+    let energy = &spec["energy"];
+    assert!(energy["max_e"].is_null() && !energy["gains_energy"].as_bool().unwrap(), "{energy}");
+    assert_eq!(energy["nonfinite"].as_u64().unwrap(), (energy["e"].as_array().unwrap().len() * energy["e"][0].as_array().unwrap().len()) as u64);
+    let md = std::fs::read_to_string(common::device_file(&dir.path().join("st"), "stability-", ".md")).unwrap();
+    let row = md.lines().find(|l| l.starts_with("| nan.brdf")).unwrap();
+    assert!(row.contains("NaN/Inf") && !row.contains("gain") && !row.contains("(inf)") && !row.contains("0.0e0"), "{row}");
+    assert!(row.contains("FAIL"), "{row}");
+}
+
+/// A reference that is not finite is refused before anything is measured or written (the sweep wrote its
+/// .md and .json, then exited 2 without saying why).
+#[test]
+fn sweep_refuses_a_non_finite_reference_before_writing() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("nan.brdf"), NAN_FILE).unwrap();
+    let model = format!("{},roughness=@roughness,f0=@f0", example("ggx"));
+    run_in(dir.path(), &["sweep", "--model", &model, "--reference", "nan.brdf", "--size", "16x16", "--out", "sw"]).fails(2, "--reference nan.brdf: the reference is not finite");
+    assert!(!dir.path().join("sw").exists(), "nothing written");
+}
+
+/// `render` of a model whose values are NaN counts its bad pixels, names the picture and draws them in
+/// magenta, not black.
+#[test]
+fn render_counts_nan_pixels() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("nan.brdf"), NAN_FILE).unwrap();
+    let mut scene: Value = serde_json::from_str(&std::fs::read_to_string(common::repo_root().join("scenes/sphere-grid.json")).unwrap()).unwrap();
+    scene["gbuffer"]["procedural"]["size"] = serde_json::json!([96, 48]);
+    scene["render"]["models"] = serde_json::json!(["ggx", "nan.brdf"]);
+    std::fs::write(d.join("s.json"), scene.to_string()).unwrap();
+    let r = run_in(d, &["render", "--scene", "s.json", "--out", "pictures"]).ok();
+    let warned = r.stderr.lines().find(|l| l.contains("warning: nan.brdf:")).unwrap_or_else(|| panic!("{}", r.stderr));
+    assert!(warned.contains(" of 4608 pixels are NaN or Inf (drawn magenta in pictures/"), "{warned}");
+    let picture = std::fs::read_dir(d.join("pictures")).unwrap().map(|e| e.unwrap().path()).find(|p| p.file_name().unwrap().to_string_lossy().starts_with("nan")).unwrap();
+    let img = image::open(&picture).unwrap().to_rgb8();
+    assert!(img.pixels().filter(|p| p.0 == [255, 0, 255]).count() > 1000, "{}: magenta pixels", picture.display());
+}
+
+/// lavapipe ends every loop after 65535 iterations without a word; a file's loops are said out loud, with
+/// the bound where the source gives one.
+#[test]
+fn loops_are_warned_about_with_their_bounds() {
+    let dir = tempfile::tempdir().unwrap();
+    write_csv(&dir.path().join("in.csv"), 4, &[1.0]);
+    let shader = "::begin shader\nvec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y)\n{\n    float s = 0.0;\n    for (int i = 0; i < 100000; i++) s += 1e-6;\n    for (int i = 0; i < 8; i++) s += 1.0;\n    while (s > 1e9) s -= 1.0;\n    return vec3(s);\n}\n::end shader\n";
+    std::fs::write(dir.path().join("loops.brdf"), format!("analytic\n{shader}")).unwrap();
+    let r = run_in(dir.path(), &["eval", "--model", "loops.brdf", "--input", "in.csv", "--output", "out.csv"]).ok();
+    assert!(r.stderr.contains("warning: loops.brdf:6: a `for` loop of 100000 iterations: lavapipe ends every loop after 65535 iterations"), "{}", r.stderr);
+    assert!(r.stderr.contains("loops.brdf:7: a `for` loop of 8 iterations: within the 65535"), "{}", r.stderr);
+    assert!(r.stderr.contains("loops.brdf:8: a `while` loop whose iterations brdfprof cannot bound from the source"), "{}", r.stderr);
+}
+
+/// The smaller items of issue 21 (11), each as the user meets it.
+#[test]
+fn csv_columns_follow_the_parameters_declarations() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let header = "nx,ny,nz,vx,vy,vz,lx,ly,lz,roughness,f0r,f0g,f0b";
+    let row = "0,0,1,0,0.6,0.8,0.6,0,0.8";
+    let file = "analytic\n::begin parameters\nfloat roughness 0 10 1\nbool on 1\nfloat nx 0 1 0.5\nfloat k 0 1 0.5\n::end parameters\n::begin shader\nvec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) { return on ? vec3(roughness, nx, k) : vec3(0.0); }\n::end shader\n";
+    std::fs::write(d.join("p.brdf"), file).unwrap();
+    // A bool column takes 0 or 1 only.
+    std::fs::write(d.join("bool.csv"), format!("{header},on\n{row},0.5,0.04,0.04,0.04,1\n{row},0.5,0.04,0.04,0.04,0.5\n")).unwrap();
+    run_in(d, &["eval", "--model", "p.brdf", "--input", "bool.csv", "--output", "out.csv"]).fails(2, "bool.csv:3: column 14 `on`: 0.5 is not a bool (0 or 1)");
+    // The file's 0..10 roughness comes from the CSV; outside the slider range is a warning; a parameter
+    // named like a normal's column is not read per row, and says so.
+    std::fs::write(d.join("range.csv"), format!("{header},k\n{row},5,0.04,0.04,0.04,0.25\n{row},0.5,0.04,0.04,0.04,2\n")).unwrap();
+    let r = run_in(d, &["eval", "--model", "p.brdf", "--input", "range.csv", "--output", "out.csv"]).ok();
+    assert!(r.stderr.contains("range.csv: column 14 `k`: 1 of 2 rows are outside the file's range [0, 1] (BRDF Explorer's slider bounds), the first at line 3 (2)"), "{}", r.stderr);
+    assert!(r.stderr.contains("parameter `nx` is not read per row: column(s) nx hold the geometry's vectors"), "{}", r.stderr);
+    assert_eq!(rows(&d.join("out.csv")), ["5,0.5,0.25", "0.5,0.5,2"]);
+    // With roughness bound to the input, the column is the input's and must be in [0, 1].
+    run_in(d, &["eval", "--model", "p.brdf,roughness=@roughness", "--input", "range.csv", "--output", "out.csv"]).fails(2, "range.csv:2: column 10 `roughness`: 5 is outside [0, 1]");
+}
+
+#[test]
+fn model_files_errors_say_why() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write_csv(&d.join("in.csv"), 4, &[1.0]);
+    std::fs::create_dir(d.join("dir.brdf")).unwrap();
+    std::os::unix::fs::symlink("loop.brdf", d.join("loop.brdf")).unwrap();
+    std::os::unix::fs::symlink("gone.brdf", d.join("dangling.brdf")).unwrap();
+    let eval = |model: &str| run_in(d, &["eval", "--model", model, "--input", "in.csv", "--output", "out.csv"]);
+    eval("dir.brdf").fails(2, "cannot read dir.brdf: Is a directory");
+    eval("loop.brdf").fails(2, "cannot read loop.brdf: Too many levels of symbolic links");
+    eval("dangling.brdf").fails(2, "cannot read dangling.brdf: it is a symbolic link to gone.brdf, which does not exist");
+    // A key given twice is an error, as for a built-in spec.
+    eval(&format!("{},gamma=1.5,gamma=2", example("burley"))).fails(2, "`gamma` is given twice");
+    // A path may hold commas.
+    std::fs::create_dir(d.join("a,b")).unwrap();
+    std::fs::copy(example("ggx"), d.join("a,b/m.brdf")).unwrap();
+    eval("a,b/m.brdf,roughness=0.3").ok();
+    // A recursion error names the file's own functions, not renamed ones, and no temporary path.
+    std::fs::write(d.join("rec.brdf"), "analytic\n::begin shader\nfloat f(float x) { return x < 1.0 ? x : f(x - 1.0); }\nvec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) { return vec3(f(dot(N, L))); }\n::end shader\n").unwrap();
+    let r = eval("rec.brdf").fails(2, "rec.brdf: glslang cannot compile");
+    assert!(r.stderr.contains("Recursion detected") && r.stderr.contains("f(f1; calling f(f1;") && r.stderr.contains("GLSL forbids recursion"), "{}", r.stderr);
+    assert!(!r.stderr.contains("brdf_f") && !r.stderr.contains("/tmp") && !r.stderr.contains("brdfprof-"), "{}", r.stderr);
+}

@@ -49,4 +49,21 @@ fn compare_merges_profile_and_inspect_reports_and_refuses_other_kernels() {
     std::fs::write(d.join("junk.json"), "{\"rows\": 3}").unwrap();
     run_in(d, &["compare", "junk.json", "--json", "x.json", "--markdown", "x.md", "--chart", "x.png"]).fails(2, "junk.json: not a brdfprof inspect report");
     assert!(!d.join("x.json").exists() && !d.join("x.png").exists());
+    // The same report twice (by name, or a copy) correlates perfectly with itself: refused.
+    run_in(d, &["compare", "navi21.json", "./navi21.json", "--json", "x.json", "--markdown", "x.md", "--chart", "x.png"]).fails(2, "./navi21.json is the same report as navi21.json");
+    std::fs::copy(d.join("profile.json"), d.join("copy.json")).unwrap();
+    run_in(d, &["compare", "profile.json", "copy.json", "--json", "x.json", "--markdown", "x.md", "--chart", "x.png"]).fails(2, "copy.json is the same report as profile.json");
+    // Figures no measurement gives: a negative cost, a net cost above the gross one.
+    let mut edited = json(&d.join("profile.json"));
+    edited["rows"][0]["ns_per_eval"]["median"] = serde_json::json!(-1.0);
+    std::fs::write(d.join("negative.json"), edited.to_string()).unwrap();
+    run_in(d, &["compare", "negative.json", "navi21.json", "--json", "x.json", "--markdown", "x.md", "--chart", "x.png"]).fails(2, "cost -1; not a figure a measurement gives");
+    let mut edited = json(&d.join("navi21.json"));
+    let gross = edited["aco"]["rows"][0]["cycles_per_eval"].as_f64().unwrap();
+    edited["aco"]["rows"][0]["net_cycles_per_eval"] = serde_json::json!(gross * 2.0);
+    std::fs::write(d.join("net.json"), edited.to_string()).unwrap();
+    run_in(d, &["compare", "profile.json", "net.json", "--json", "x.json", "--markdown", "x.md", "--chart", "x.png"]).fails(2, "not a figure a measurement gives");
+    // An output that is one of the reports is refused.
+    run_in(d, &["compare", "profile.json", "navi21.json", "--json", "profile.json", "--markdown", "x.md", "--chart", "x.png"]).fails(2, "--json profile.json: is the same file as FILE profile.json");
+    assert!(!d.join("x.json").exists() && !d.join("x.png").exists());
 }

@@ -40,3 +40,199 @@ fn a_scene_with_more_lights_than_compile_in_seconds_is_refused() {
     std::fs::write(&path, scene.to_string()).unwrap();
     common::run(&["scene", path.to_str().unwrap()]).fails(2, &format!("many.json: lights: at most {} lights ({n} given)", n - 1));
 }
+
+const CSV: &str = "nx,ny,nz,vx,vy,vz,lx,ly,lz,roughness,f0r,f0g,f0b\n0,0,1,0,0.6,0.8,0.6,0,0.8,0.5,0.04,0.04,0.04\n";
+
+/// A `.brdf` whose kernel LLVM compiles for minutes (a million-element array).
+const HUGE_ARRAY: &str = "analytic\n::begin shader\nvec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y)\n{\n    float a[1000000];\n    for (int i = 0; i < 1000000; i++) a[i] = float(i) * dot(N, L);\n    float s = 0.0;\n    for (int i = 0; i < 1000000; i += 7) s += a[i];\n    return vec3(s);\n}\n::end shader\n";
+
+/// Issue 21: `float a[1000000]` compiled for minutes. Under --compile-timeout it says what it compiles once
+/// that takes seconds, then stops with exit 2 naming the model and the limit, writing nothing and leaving no
+/// temporary file.
+#[test]
+fn a_compile_past_the_limit_stops_naming_the_model_and_the_limit() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("in.csv"), CSV).unwrap();
+    std::fs::write(d.join("huge.brdf"), HUGE_ARRAY).unwrap();
+    let tmp = d.join("tmp");
+    std::fs::create_dir(&tmp).unwrap();
+    let started = std::time::Instant::now();
+    let out = common::brdfprof()
+        .args(["eval", "--model", "huge.brdf", "--input", "in.csv", "--output", "out.csv", "--compile-timeout", "6"])
+        .env("BRDFPROF_CACHE_DIR", "")
+        .env("TMPDIR", &tmp)
+        .current_dir(d)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(started.elapsed().as_secs() < 30, "stopped at the limit: {:?}", started.elapsed());
+    assert!(stderr.contains("brdfprof: still compiling huge.brdf:eval_f32") && stderr.contains("(the limit is 6 s)"), "progress after 5 s:\n{stderr}");
+    assert!(stderr.contains("brdfprof: error: huge.brdf:eval_f32") && stderr.contains("longer than the compile limit of 6 s"), "{stderr}");
+    assert!(!d.join("out.csv").exists(), "nothing written");
+    assert_eq!(std::fs::read_dir(&tmp).unwrap().count(), 0, "no temporary left");
+}
+
+#[test]
+fn bad_limits_are_refused_naming_the_flag_or_variable() {
+    common::run(&["devices", "--compile-timeout", "0"]).fails(2, "--compile-timeout <SECONDS>");
+    let out = common::brdfprof().args(["devices"]).env("BRDFPROF_COMPILE_TIMEOUT", "soon").output().unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("BRDFPROF_COMPILE_TIMEOUT=`soon`: give seconds"));
+    for (var, value, needle) in [("BRDFPROF_FENCE_TIMEOUT", "-1", "BRDFPROF_FENCE_TIMEOUT=`-1`: give seconds"), ("BRDFPROF_MEMORY_LIMIT", "lots", "BRDFPROF_MEMORY_LIMIT=lots: give a whole number of bytes")] {
+        let out = common::brdfprof().args(["devices"]).env(var, value).output().unwrap();
+        assert_eq!(out.status.code(), Some(2), "{var}");
+        assert!(String::from_utf8_lossy(&out.stderr).contains(needle), "{}", String::from_utf8_lossy(&out.stderr));
+    }
+}
+
+/// A submission that does not finish within BRDFPROF_FENCE_TIMEOUT stops the command (fence waits were
+/// unbounded). A tiny timeout stands in for a hung device; the profile's timed rounds reuse pipelines whose
+/// first dispatch (lavapipe's compilation, under the compile limit instead) is past.
+#[test]
+fn a_fence_that_does_not_signal_in_time_stops_the_command() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = common::brdfprof()
+        .args(["profile", "--model", "ggx", "--size", "64x64", "--min-rounds", "2", "--max-rounds", "2", "--json", "st/p.json"])
+        .env("BRDFPROF_FENCE_TIMEOUT", "0.000001")
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("did not finish a submission within 0.000001 s (BRDFPROF_FENCE_TIMEOUT") && stderr.contains("may be hung"), "{stderr}");
+    assert!(!dir.path().join("st").exists(), "nothing written");
+}
+
+/// A PNG of zeros (`width` x `height`, 8-bit RGB or 16-bit grey), written as zlib's fixed-Huffman deflate
+/// of one literal and 258-byte back-references: a valid image of any size in a few MB.
+fn zero_png(width: u32, height: u32, grey16: bool) -> Vec<u8> {
+    fn crc32(bytes: &[u8]) -> u32 {
+        let table: Vec<u32> = (0..256u32).map(|n| (0..8).fold(n, |c, _| if c & 1 != 0 { 0xEDB8_8320 ^ (c >> 1) } else { c >> 1 })).collect();
+        !bytes.iter().fold(!0u32, |c, &b| table[((c ^ u32::from(b)) & 0xff) as usize] ^ (c >> 8))
+    }
+    struct Bits {
+        out: Vec<u8>,
+        acc: u64,
+        n: u32,
+    }
+    impl Bits {
+        // Deflate packs fields from the least significant bit; Huffman codes go most significant bit first.
+        fn put(&mut self, value: u64, bits: u32) {
+            self.acc |= value << self.n;
+            self.n += bits;
+            while self.n >= 8 {
+                self.out.push(self.acc as u8);
+                self.acc >>= 8;
+                self.n -= 8;
+            }
+        }
+        fn code(&mut self, code: u64, bits: u32) {
+            let reversed = (0..bits).fold(0, |r, i| r | (((code >> i) & 1) << (bits - 1 - i)));
+            self.put(reversed, bits);
+        }
+    }
+    let row = 1 + width as u64 * if grey16 { 2 } else { 3 };
+    let total = row * height as u64;
+    let mut z = Bits { out: vec![0x78, 0x01], acc: 0, n: 0 };
+    z.put(1, 1); // final block
+    z.put(1, 2); // fixed Huffman codes
+    z.code(0x30, 8); // literal 0
+    let mut left = total - 1;
+    while left >= 258 {
+        z.code(0b1100_0101, 8); // length 258 (code 285)
+        z.code(0, 5); // distance 1
+        left -= 258;
+    }
+    for _ in 0..left {
+        z.code(0x30, 8);
+    }
+    z.code(0, 7); // end of block
+    if z.n > 0 {
+        z.out.push(z.acc as u8);
+    }
+    let adler = (((total % 65521) as u32) << 16) | 1;
+    z.out.extend_from_slice(&adler.to_be_bytes());
+    let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
+    let mut chunk = |kind: &[u8], data: &[u8]| {
+        png.extend_from_slice(&(data.len() as u32).to_be_bytes());
+        let body = [kind, data].concat();
+        png.extend_from_slice(&body);
+        png.extend_from_slice(&crc32(&body).to_be_bytes());
+    };
+    let (depth, colour) = if grey16 { (16, 0) } else { (8, 2) };
+    chunk(b"IHDR", &[&width.to_be_bytes()[..], &height.to_be_bytes(), &[depth, colour, 0, 0, 0]].concat());
+    chunk(b"IDAT", &z.out);
+    chunk(b"IEND", &[]);
+    png
+}
+
+/// Issue 21: a real 16384x16384 normal + depth PNG scene was OOM-killed at 24.4 GB in `render`. Its images'
+/// decoding is checked against the memory available from their headers, before a pixel is decoded;
+/// BRDFPROF_MEMORY_LIMIT makes the memory short here without filling the machine.
+#[test]
+fn a_16384_square_image_scene_is_refused_before_it_is_decoded() {
+    let small = zero_png(37, 5, false);
+    let decoded = image::load_from_memory(&small).expect("the writer makes real PNGs").to_rgb8();
+    assert!(decoded.dimensions() == (37, 5) && decoded.pixels().all(|p| p.0 == [0, 0, 0]));
+    assert_eq!(image::load_from_memory(&zero_png(9, 300, true)).unwrap().to_luma16().dimensions(), (9, 300));
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("normal.png"), zero_png(16384, 16384, false)).unwrap();
+    std::fs::write(d.join("depth.png"), zero_png(16384, 16384, true)).unwrap();
+    let scene = serde_json::json!({
+        "name": "big",
+        "gbuffer": {"images": {"normal": "normal.png", "depth": "depth.png", "depth_range": [1.0, 10.0]}},
+        "camera": {"position": [0.0, 0.0, 5.0], "look_at": [0.0, 0.0, 0.0]},
+        "lights": [{"type": "directional", "direction": [0.0, -1.0, -1.0]}],
+        "materials": [{"name": "m", "model": "ggx"}]
+    });
+    std::fs::write(d.join("big.json"), scene.to_string()).unwrap();
+    let limited = |args: &[&str]| {
+        let started = std::time::Instant::now();
+        let out = common::brdfprof().args(args).env("BRDFPROF_MEMORY_LIMIT", "2000000000").current_dir(d).output().unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
+        assert!(started.elapsed().as_secs() < 30, "{args:?} refused up front: {:?}", started.elapsed());
+        stderr
+    };
+    let e = limited(&["scene", "big.json"]);
+    assert!(e.contains("big.json: gbuffer.images: decoding its 2 images of 16384x16384") && e.contains("2000000000 are available (BRDFPROF_MEMORY_LIMIT)"), "{e}");
+    let e = limited(&["render", "--scene", "big.json", "--out", "pictures"]);
+    assert!(e.contains("gbuffer.images: decoding its 2 images"), "{e}");
+    assert!(!d.join("pictures").exists(), "nothing written");
+}
+
+/// A scene whose pixels cannot be one device allocation is refused before its G-buffer is built (it failed
+/// at the allocation, after building it), or, where memory is shorter, by the memory check.
+#[test]
+fn a_scene_beyond_one_device_allocation_is_refused_before_it_is_built() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut scene: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(common::repo_root().join("scenes/sphere-grid.json")).unwrap()).unwrap();
+    scene["gbuffer"]["procedural"]["size"] = serde_json::json!([7000, 7000]);
+    std::fs::write(dir.path().join("wide.json"), scene.to_string()).unwrap();
+    let started = std::time::Instant::now();
+    let r = common::run_in(dir.path(), &["render", "--scene", "wide.json", "--out", "pictures"]);
+    assert_eq!(r.code, Some(2), "{}", r.stderr);
+    assert!(r.stderr.contains("maxMemoryAllocationSize") || r.stderr.contains("are available"), "{}", r.stderr);
+    assert!(started.elapsed().as_secs() < 30 && !dir.path().join("pictures").exists());
+}
+
+/// The compile-only child compiles under the limit too: a file whose calls branch exponentially (2^18 inlined
+/// calls) stops the child's spirv-opt and ACO at the limit, and the command with exit 2 naming the model.
+#[test]
+fn a_compile_only_child_past_the_limit_stops_naming_the_model() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut text = String::from("analytic\n::begin shader\nfloat f18(float x) { return sin(x); }\n");
+    for i in (0..18).rev() {
+        text += &format!("float f{i}(float x) {{ return f{}(x) + f{}(x * 1.5); }}\n", i + 1, i + 1);
+    }
+    text += "vec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) { return vec3(f0(dot(N, L))); }\n::end shader\n";
+    std::fs::write(dir.path().join("tree.brdf"), text).unwrap();
+    let started = std::time::Instant::now();
+    let r = common::run_in(dir.path(), &["inspect", "--no-callgrind", "--device", "radv:navi21", "--model", "tree.brdf", "--compile-timeout", "3", "--json", "i.json", "--markdown", "i.md"]);
+    assert_eq!(r.code, Some(2), "{}", r.stderr);
+    assert!(r.stderr.contains("tree.brdf") && r.stderr.contains("longer than the compile limit of 3 s"), "{}", r.stderr);
+    assert!(started.elapsed().as_secs() < 30 && !dir.path().join("i.json").exists());
+}

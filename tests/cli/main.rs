@@ -5,6 +5,7 @@
 mod common;
 
 mod brdf_models;
+mod cache;
 mod compare;
 mod devices;
 mod eval;

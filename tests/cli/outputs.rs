@@ -70,3 +70,35 @@ fn every_output_flag_is_checked_first() {
     std::fs::write(d.join("results"), "x").unwrap();
     run_in(d, &inspect).fails(2, "--json (default results/inspect-<device>.json) results: exists and is not a directory");
 }
+
+/// An output that is the input (by any path) is refused before anything runs: `eval --input X --output X`
+/// silently replaced its input.
+#[test]
+fn an_output_that_is_an_input_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("in.csv"), CSV).unwrap();
+    std::os::unix::fs::symlink("in.csv", d.join("link.csv")).unwrap();
+    for out in ["in.csv", "./in.csv", "link.csv"] {
+        run_in(d, &["eval", "--model", "ggx", "--input", "in.csv", "--output", out]).fails(2, &format!("--output {out}: is the same file as --input in.csv"));
+        assert_eq!(std::fs::read_to_string(d.join("in.csv")).unwrap(), CSV, "the input is untouched");
+    }
+    let ggx = common::repo_root().join("examples/brdf/ggx.brdf");
+    std::fs::copy(&ggx, d.join("m.brdf")).unwrap();
+    run_in(d, &["eval", "--model", "m.brdf", "--input", "in.csv", "--output", "m.brdf"]).fails(2, "--output m.brdf: is the same file as --model m.brdf");
+    assert_eq!(std::fs::read(d.join("m.brdf")).unwrap(), std::fs::read(&ggx).unwrap());
+}
+
+/// A command that fails after writing some of its outputs leaves none of them: every output is staged and
+/// published only when the command succeeds. Here `compare` writes its JSON and Markdown, then cannot write its
+/// chart (/dev/full).
+#[test]
+fn a_command_that_fails_midway_leaves_none_of_its_outputs() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let report = common::repo_root().join("results/radv/profile-llvmpipe.json");
+    run_in(d, &["compare", report.to_str().unwrap(), "--json", "out/c.json", "--markdown", "out/c.md", "--chart", "/dev/full"]).fails(2, "/dev/full");
+    assert!(!d.join("out").exists(), "left: {:?}", files(d));
+    run_in(d, &["compare", report.to_str().unwrap(), "--json", "out/c.json", "--markdown", "out/c.md", "--chart", "out/c.png"]).ok();
+    assert_eq!(files(d), ["out/c.json", "out/c.md", "out/c.png"]);
+}

@@ -1,6 +1,8 @@
 //! Nothing outlives an interrupted brdfprof: SIGINT or SIGTERM during the callgrind run of `inspect` or
-//! `check` kills the valgrind child, removes the callgrind files and exits with status 130, writing no report;
-//! SIGKILL, which no handler sees, still takes the child with it (PR_SET_PDEATHSIG).
+//! `check` kills the valgrind child, removes the callgrind files (and what the child left in its temporary
+//! directory) and exits with status 130, writing no report; SIGINT during `render` leaves none of its
+//! pictures; SIGKILL, which no handler sees, still takes the child with it (PR_SET_PDEATHSIG). Runs that end
+//! normally leave no temporary directory either.
 
 use crate::common::{self, brdfprof};
 use std::path::{Path, PathBuf};
@@ -23,6 +25,7 @@ fn start(args: &[&str]) -> Run {
         .args(args)
         .current_dir(cwd.path())
         .env("TMPDIR", tmp.path())
+        .env("BRDFPROF_CACHE_DIR", "")
         .stdout(Stdio::null())
         .stderr(std::fs::File::create(&stderr).unwrap())
         .spawn()
@@ -30,15 +33,33 @@ fn start(args: &[&str]) -> Run {
     Run { child, tmp, cwd, stderr }
 }
 
-/// Processes whose command line contains `__callgrind-child` and whose TMPDIR is `tmp` (a zombie has neither).
+/// Sends `signal` to the run and waits (at most 15 s) for its exit status.
+fn stop(run: &mut Run, signal: libc::c_int) -> Option<i32> {
+    // SAFETY: a signal to the process this test spawned, which it has not yet reaped.
+    assert_eq!(unsafe { libc::kill(run.child.id() as libc::pid_t, signal) }, 0);
+    let start = Instant::now();
+    loop {
+        if let Some(s) = run.child.try_wait().unwrap() {
+            return s.code();
+        }
+        if start.elapsed() > Duration::from_secs(15) {
+            let _ = run.child.kill();
+            panic!("brdfprof still running 15 s after signal {signal}");
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+}
+
+/// Processes whose command line contains `__callgrind-child` and whose TMPDIR is in `tmp` (brdfprof gives each
+/// child a directory of its own there; a zombie has neither).
 fn callgrind_children(tmp: &Path) -> Vec<u32> {
-    let marker = format!("TMPDIR={}", tmp.display());
+    let marker = format!("TMPDIR={}/", tmp.display());
     let mut pids = Vec::new();
     for entry in std::fs::read_dir("/proc").unwrap().flatten() {
         let Ok(pid) = entry.file_name().to_string_lossy().parse::<u32>() else { continue };
         let read = |f: &str| std::fs::read(entry.path().join(f)).unwrap_or_default();
         let has = |bytes: Vec<u8>, needle: &str| bytes.split(|&b| b == 0).any(|s| String::from_utf8_lossy(s).contains(needle));
-        if has(read("cmdline"), "__callgrind-child") && read("environ").split(|&b| b == 0).any(|s| s == marker.as_bytes()) {
+        if has(read("cmdline"), "__callgrind-child") && read("environ").split(|&b| b == 0).any(|s| s.starts_with(marker.as_bytes())) {
             pids.push(pid);
         }
     }
@@ -77,21 +98,9 @@ fn interrupt(args: &[&str], signal: libc::c_int) -> (Run, Option<i32>) {
     // Mid-measurement: callgrind writes callgrind.out at its start, and a dump callgrind.out.N per kernel.
     let dumped = |p: &PathBuf| p.file_name().is_some_and(|n| n.to_string_lossy().starts_with("callgrind.out."));
     wait_for("first callgrind dump", Duration::from_secs(240), || files_under(&tmp).iter().any(dumped));
-    // SAFETY: a signal to the process this test spawned, which it has not yet reaped.
-    assert_eq!(unsafe { libc::kill(run.child.id() as libc::pid_t, signal) }, 0);
-    let start = Instant::now();
-    let status = loop {
-        if let Some(s) = run.child.try_wait().unwrap() {
-            break s;
-        }
-        if start.elapsed() > Duration::from_secs(15) {
-            let _ = run.child.kill();
-            panic!("brdfprof still running 15 s after signal {signal}");
-        }
-        std::thread::sleep(Duration::from_millis(20));
-    };
+    let code = stop(&mut run, signal);
     wait_for("end of the valgrind child", Duration::from_secs(10), || callgrind_children(&tmp).is_empty());
-    (run, status.code())
+    (run, code)
 }
 
 fn assert_cleaned_up(run: &Run, code: Option<i32>) {
@@ -103,9 +112,39 @@ fn assert_cleaned_up(run: &Run, code: Option<i32>) {
     assert!(!run.cwd.path().join("results").exists(), "an interrupted run wrote reports");
 }
 
+/// Issue 21: every `.brdf` run left a `$TMPDIR/brdfprof-XXXXXX` (the GLSL tree, in a static never dropped), a
+/// killed child left its own, and SIGINT during `render` left the pictures written so far. Here 20 evals, an
+/// interrupted render and an interrupted callgrind run of a `.brdf` model (whose child composes its kernel in
+/// its own temporary directory) leave nothing in TMPDIR and no picture.
 #[test]
-fn sigint_during_inspect_kills_valgrind_and_removes_its_files() {
-    let (run, code) = interrupt(&["inspect", "--model", "ggx"], libc::SIGINT);
+fn evals_and_interrupted_runs_leave_no_temporary_and_no_picture() {
+    let dir = tempfile::tempdir().unwrap();
+    let (d, tmp) = (dir.path(), dir.path().join("tmp"));
+    std::fs::create_dir(&tmp).unwrap();
+    std::fs::write(d.join("in.csv"), "nx,ny,nz,vx,vy,vz,lx,ly,lz,roughness,f0r,f0g,f0b\n0,0,1,0,0.6,0.8,0.6,0,0.8,0.5,0.04,0.04,0.04\n").unwrap();
+    let ggx = common::repo_root().join("examples/brdf/ggx.brdf");
+    let model = format!("{},roughness=@roughness,f0=@f0", ggx.display());
+    for i in 0..20 {
+        // Every other run compiles (the disk cache off), the others take the cached kernel.
+        let cache = if i % 2 == 0 { String::new() } else { d.join("cache").display().to_string() };
+        let out = brdfprof().args(["eval", "--model", &model, "--input", "in.csv", "--output", "out.csv"]).env("TMPDIR", &tmp).env("BRDFPROF_CACHE_DIR", cache).current_dir(d).output().unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    }
+    assert!(files_under(&tmp).is_empty(), "left in TMPDIR after 20 evals: {:?}", files_under(&tmp));
+
+    let scene = common::repo_root().join("scenes/statues.json");
+    let mut render = start(&["render", "--scene", scene.to_str().unwrap(), "--out", "pictures"]);
+    let pictures = render.cwd.path().join("pictures");
+    // The first picture is being written (staged beside its name) when the signal comes.
+    let staged = |p: &PathBuf| p.file_name().is_some_and(|n| n.to_string_lossy().ends_with(".tmp"));
+    wait_for("a picture being written", Duration::from_secs(240), || files_under(&pictures).iter().any(staged));
+    let code = stop(&mut render, libc::SIGINT);
+    assert_eq!(code, Some(130), "{}", std::fs::read_to_string(&render.stderr).unwrap());
+    let left: Vec<PathBuf> = files_under(&pictures);
+    assert!(left.is_empty(), "an interrupted render left {left:?}");
+    assert!(files_under(render.tmp.path()).is_empty(), "left in TMPDIR: {:?}", files_under(render.tmp.path()));
+
+    let (run, code) = interrupt(&["inspect", "--model", &model], libc::SIGINT);
     assert_cleaned_up(&run, code);
 }
 

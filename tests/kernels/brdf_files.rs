@@ -129,3 +129,24 @@ fn every_kernel_kind_a_file_can_run_compiles() {
     }
     assert!(model.kernel(KernelKind::Terms, kernels::embedded()).is_err(), "a file has no separate terms");
 }
+
+/// The limit the loop warnings state: lavapipe ends a loop of 100,000 iterations after
+/// `LAVAPIPE_LOOP_LIMIT` (65535), and runs one of 1,000 to its end. Other drivers are not lavapipe.
+#[test]
+fn lavapipe_ends_every_loop_at_the_stated_limit() {
+    let gpu = common::gpu();
+    if !gpu.info.name.starts_with("llvmpipe") {
+        eprintln!("skipped: {} is not lavapipe", gpu.info.name);
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("count.brdf");
+    std::fs::write(&path, "analytic\n::begin parameters\nfloat n 0 1000000 10\n::end parameters\n::begin shader\nvec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y)\n{\n    float c = 0.0;\n    for (int i = 0; i < int(n); i++) c += 1.0;\n    return vec3(c);\n}\n::end shader\n").unwrap();
+    let s = samples::well_conditioned(4, 3, 0.05, 0.2..1.0);
+    for (n, expected) in [(1000u64, 1000u64), (100_000, brdfprof::model::brdf_file::LAVAPIPE_LOOP_LIMIT)] {
+        let model = Model::parse(&format!("{},n={n}", path.display())).unwrap();
+        let got = kernels::eval(&gpu, &model, &s, RunLimits::default()).unwrap();
+        assert!(got.iter().all(|v| v[0] as u64 == expected), "a loop of {n} iterations counted {:?} on lavapipe", got[0]);
+    }
+    common::assert_no_validation_messages(&gpu);
+}

@@ -80,10 +80,10 @@ fn plan(options: &CheckOptions, old: Option<&Baseline>) -> Result<(Vec<Model>, u
 
 /// Measures this build: every count, then the timing run.
 pub fn measure(gpu: &Gpu, shaders: &Shaders, models: Vec<Model>, lights: u32, options: &CheckOptions) -> Result<Baseline> {
-    eprintln!("brdfprof check: counting instructions ({} models + baseline kernel{})", models.len(), if options.callgrind.is_some() { ", callgrind" } else { "" });
+    crate::messages::progress(format!("check: counting instructions ({} models + baseline kernel{})", models.len(), if options.callgrind.is_some() { ", callgrind" } else { "" }));
     let inspect = super::run(gpu, shaders, &InspectOptions { models: models.clone(), lights, callgrind: options.callgrind.clone() })?;
     let timing = if options.timing.rounds > 0 {
-        eprintln!("brdfprof check: timing {} rounds", options.timing.rounds);
+        crate::messages::progress(format!("check: timing {} rounds", options.timing.rounds));
         Some(timing::run(gpu, shaders, &models, &TimingOptions { lights, ..options.timing.clone() })?)
     } else {
         None
@@ -108,12 +108,12 @@ pub fn run(options: &CheckOptions, shaders: &Shaders, open: impl FnOnce() -> Res
 /// translation is checked against first.
 pub fn run_target(options: &CheckOptions, shaders: &Shaders, target: crate::targets::Target, validate: bool, verify_on: Option<&Gpu>) -> Result<Outcome> {
     run_measured(options, |specs, lights| {
-        eprintln!("brdfprof check: compiling for {} ({} models + baseline kernel)", target.name(), specs.len());
+        crate::messages::progress(format!("check: compiling for {} ({} models + baseline kernel)", target.name(), specs.len()));
         let request = crate::targets::Request { models: &specs, lights, shaders, validate, isa_dir: None, precise: false, verify_on };
         let run = crate::targets::compile_all(&[target], &request)?.pop().expect("one run per target");
         let mut inspect = run.report;
         if let Some(note) = run.note {
-            eprintln!("brdfprof check: note: {note}");
+            crate::messages::note(note);
         }
         for group in ["callgrind/", "timing/"] {
             inspect.section_notes.insert(group.into(), format!("not applicable: {} compiles only, nothing executes", target.name()));
@@ -140,7 +140,7 @@ fn run_measured(options: &CheckOptions, measure: impl FnOnce(Vec<Model>, u32) ->
     };
     if let Some(path) = &options.save {
         reports::write_json(path, &new)?;
-        eprintln!("brdfprof check: baseline saved to {}", path.display());
+        crate::messages::progress(format!("check: baseline saved to {}", path.display()));
     }
     Ok(outcome)
 }

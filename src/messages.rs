@@ -1,0 +1,132 @@
+//! The one place brdfprof talks to the user on stderr about a run (its results go to stdout and files):
+//! `brdfprof: warning: ...`, `brdfprof: note: ...`, `brdfprof: error: ...` and progress lines
+//! `brdfprof: ...`, each printed whole (one `eprintln!` per message, so that lines of several threads do not
+//! interleave) and, while a progress bar is drawn, around it (`ProgressGuard`), so that neither garbles the
+//! other.
+//!
+//! Child processes (`__radv-child`, `__callgrind-child`) parse the same models as their parent, which has
+//! already said what there is to say about them: in a child, `input_warning`/`input_note` print nothing.
+
+use std::fmt::Display;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex, OnceLock};
+
+/// Prints a line, suspending the progress bar while it does.
+type Printer = Arc<dyn Fn(&str) + Send + Sync>;
+
+static PRINTER: Mutex<Option<Printer>> = Mutex::new(None);
+static CHILD: AtomicBool = AtomicBool::new(false);
+
+/// Prints `line` on stderr as it is (every other function here adds the prefix first).
+pub fn line(line: &str) {
+    let printer = PRINTER.lock().unwrap_or_else(|e| e.into_inner()).clone();
+    match printer {
+        Some(p) => p(line),
+        None => eprintln!("{line}"),
+    }
+}
+
+/// `brdfprof: warning: TEXT`: something is likely wrong but the command goes on.
+pub fn warning(text: impl Display) {
+    line(&format!("brdfprof: warning: {text}"));
+}
+
+/// `brdfprof: note: TEXT`: what the user may want to know about how the command ran.
+pub fn note(text: impl Display) {
+    line(&format!("brdfprof: note: {text}"));
+}
+
+/// `brdfprof: error: TEXT`: why the command stops (the caller exits with status 2).
+pub fn error(text: impl Display) {
+    line(&format!("brdfprof: error: {text}"));
+}
+
+/// `brdfprof: TEXT`: what the command is doing or did (rows written, compilations under way).
+pub fn progress(text: impl Display) {
+    line(&format!("brdfprof: {text}"));
+}
+
+/// Whether `text` is new in this process (the first call with it answers true).
+fn first_time(text: &str) -> bool {
+    static SEEN: OnceLock<Mutex<std::collections::HashSet<String>>> = OnceLock::new();
+    SEEN.get_or_init(Mutex::default).lock().unwrap_or_else(|e| e.into_inner()).insert(text.to_string())
+}
+
+/// `warning`, once per process for the same text.
+pub fn warning_once(text: impl Display) {
+    let text = text.to_string();
+    if first_time(&format!("warning: {text}")) {
+        warning(text);
+    }
+}
+
+/// `note`, once per process for the same text.
+pub fn note_once(text: impl Display) {
+    let text = text.to_string();
+    if first_time(&format!("note: {text}")) {
+        note(text);
+    }
+}
+
+/// Marks this process as a child of brdfprof: input warnings and notes were the parent's to print.
+pub fn set_child_process() {
+    CHILD.store(true, Ordering::SeqCst);
+}
+
+/// A warning about the user's input (a model file, a parameter): once per process, never in a child.
+pub fn input_warning(text: impl Display) {
+    if !CHILD.load(Ordering::SeqCst) {
+        warning_once(text);
+    }
+}
+
+/// A note about the user's input: once per process, never in a child.
+pub fn input_note(text: impl Display) {
+    if !CHILD.load(Ordering::SeqCst) {
+        note_once(text);
+    }
+}
+
+/// While it lives, messages are printed through `suspend` (a progress bar's `suspend`, which hides the bar,
+/// runs the print and draws the bar again).
+pub struct ProgressGuard(());
+
+impl ProgressGuard {
+    pub fn new(suspend: impl Fn(&mut dyn FnMut()) + Send + Sync + 'static) -> ProgressGuard {
+        let printer: Printer = Arc::new(move |text: &str| suspend(&mut || eprintln!("{text}")));
+        *PRINTER.lock().unwrap_or_else(|e| e.into_inner()) = Some(printer);
+        ProgressGuard(())
+    }
+}
+
+impl Drop for ProgressGuard {
+    fn drop(&mut self) {
+        *PRINTER.lock().unwrap_or_else(|e| e.into_inner()) = None;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn once_means_once_per_text() {
+        assert!(first_time("messages test: a"));
+        assert!(!first_time("messages test: a"));
+        assert!(first_time("messages test: b"));
+    }
+
+    #[test]
+    fn a_progress_guard_routes_messages_while_it_lives() {
+        let seen = Arc::new(Mutex::new(0));
+        let counter = seen.clone();
+        let guard = ProgressGuard::new(move |print| {
+            *counter.lock().unwrap() += 1;
+            print();
+        });
+        note("messages test: through the guard");
+        assert!(*seen.lock().unwrap() >= 1, "printed through the guard");
+        drop(guard);
+        assert!(PRINTER.lock().unwrap().is_none(), "and straight to stderr after it");
+    }
+}
