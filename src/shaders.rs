@@ -131,10 +131,15 @@ pub fn kernel_entry(dir: &Path, name: &str) -> Result<(String, Vec<String>)> {
 /// under the compile limit (`compile_limit`; `what` names the compilation in its messages) and returns the
 /// SPIR-V words; a failure carries glslang's own messages.
 pub fn glslang(source: &Path, defines: &[String], includes: &[&Path], what: &str) -> Result<Vec<u32>> {
+    glslang_with(source, defines, includes, what, &[])
+}
+
+/// `glslang` with `extra` flags after brdfprof's own (`-g`: line information for the translation's messages).
+pub fn glslang_with(source: &Path, defines: &[String], includes: &[&Path], what: &str, extra: &[&str]) -> Result<Vec<u32>> {
     let out_dir = crate::cleanup::TempDir::new().context("cannot create a temporary directory for glslang's output")?;
     let out = out_dir.path().join("out.spv");
     let mut cmd = crate::cleanup::command("glslangValidator");
-    cmd.args(GLSLANG_FLAGS);
+    cmd.args(GLSLANG_FLAGS).args(extra);
     for d in defines {
         cmd.arg(format!("-D{d}"));
     }

@@ -33,8 +33,9 @@ pub struct CostSweepRow {
 
 #[derive(Clone, Debug, Serialize)]
 pub struct CostSweep {
-    /// `radv:navi21`, `nvidia:sm_89`.
+    /// `radv:navi21`, `nvidia:sm_89`, and the family alone.
     pub target: String,
+    pub family: String,
     pub architecture: String,
     pub device: String,
     pub compiler: String,
@@ -86,6 +87,7 @@ pub fn build(sweep: &SweepReport, target: &str, cost: &TargetCost, note: Option<
     rows.sort_by(|a, b| a.cycles_per_eval.total_cmp(&b.cycles_per_eval).then(a.spec.cmp(&b.spec)));
     Ok(CostSweep {
         target: target.into(),
+        family: cost.family.clone().unwrap_or_else(|| target.into()),
         architecture: cost.architecture.clone().unwrap_or_default(),
         device: cost.device.clone(),
         compiler: cost.compiler.clone(),
@@ -126,12 +128,13 @@ impl CostSweep {
 
     pub fn markdown(&self) -> String {
         format!(
-            "# brdfprof sweep: cost on {} ({})\n\n{}; cost = {}'s estimate, {} per evaluation ({}; {} lights per kernel), \
+            "# brdfprof sweep: cost on {} ({})\n\n{} ({}); cost = {}'s estimate, {} per evaluation ({}; {} lights per kernel), \
              deterministic (no CI); relative to the cheapest spec ({}). Accuracy and the measured cost ratio: the sweep on {}. \
              Pareto (target): no spec both fewer cycles and more accurate (RMS vs exact).\n\n{}",
-            self.target,
+            self.family,
             self.architecture,
             self.device,
+            self.target,
             self.compiler,
             self.unit,
             self.model,

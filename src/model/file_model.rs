@@ -396,17 +396,42 @@ impl FileModel {
         }
         let store = crate::cache::Store::open_default();
         let valid = |bytes: &[u8]| Spirv::from_bytes(&name, bytes).map(|_| ());
-        let compile = || Ok(words_to_bytes(&self.compile(&tree, kind, &composed, &defines)?));
+        let compile = || Ok(words_to_bytes(&self.compile(&tree, kind, &composed, &defines, &[])?));
         let bytes = crate::cache::get_or_build(store.as_ref(), SPIRV_KIND, &key, &name, valid, compile)?;
         let words: Arc<[u32]> = Spirv::from_bytes(&name, &bytes)?.words;
         memory_cache().lock().unwrap().insert(key, words.clone());
         Ok(Spirv { name, words })
     }
 
+    /// The file's kernel of `kind` compiled again with glslang's line information (`-g`), never cached: what
+    /// the C translation reads to name the file's line of a construct it cannot express.
+    pub fn kernel_with_lines(&self, kind: KernelKind, shaders: &Shaders) -> Result<Spirv> {
+        let kernel_name = format!("{}_f32", kind.base());
+        let tree = GlslTree::of(shaders);
+        let (source_file, defines) = tree.entry(&kernel_name)?;
+        let kernel_source = tree.read(Path::new(&source_file)).with_context(|| format!("cannot read {source_file}"))?;
+        let composed = self.compose(kind, &kernel_source)?;
+        let words = self.compile(&tree, kind, &composed, &defines, &["-g"])?;
+        Ok(Spirv { name: format!("{}:{kernel_name}", self.path), words: words.into() })
+    }
+
+    /// The file's line and own name of a translation error located in its composed kernel: `file.brdf:LINE`
+    /// for the file's lines, its identifiers without brdfprof's prefix.
+    pub fn locate(&self, e: &crate::translate::TranslateError) -> String {
+        let prefix = self.file.renamed_shader().map(|r| r.prefix).unwrap_or_default();
+        let function = e.function.as_deref().map(|f| f.strip_prefix(prefix.as_str()).unwrap_or(f).to_string());
+        let construct = format!("the C translation cannot express {}{}", e.construct, function.map_or(String::new(), |f| format!(" (in function `{f}`)")));
+        match &e.location {
+            Some(l) if l.file == self.file.path.display().to_string() || l.file.ends_with(".brdf") => format!("{}:{}: {construct}", self.path, l.line),
+            Some(l) => format!("{}: {construct} (at {}:{} of brdfprof's kernel)", self.path, l.file, l.line),
+            None => format!("{}: {construct}", self.path),
+        }
+    }
+
     /// glslang on the composed source: written beside a copy of the embedded tree (or with `--glsl DIR` on the
     /// include path), so that the kernel's `#include "brdf.glsl"` resolves as in glsl/. Errors name the file's
     /// lines and its own identifiers.
-    fn compile(&self, tree: &GlslTree, kind: KernelKind, composed: &str, defines: &[String]) -> Result<Vec<u32>> {
+    fn compile(&self, tree: &GlslTree, kind: KernelKind, composed: &str, defines: &[String], extra: &[&str]) -> Result<Vec<u32>> {
         let dir = crate::cleanup::TempDir::new().context("cannot create a temporary directory for the composed kernel")?;
         let root = tree.materialise(&dir.path().join("glsl"))?;
         let src = dir.path().join("composed");
@@ -414,7 +439,7 @@ impl FileModel {
         let path = src.join(format!("{}.comp", kind.base()));
         std::fs::write(&path, composed).with_context(|| format!("cannot write {}", path.display()))?;
         let what = format!("{} ({} kernel, glslang)", self.path, kind.base());
-        match shaders::glslang(&path, defines, &[&root], &what) {
+        match shaders::glslang_with(&path, defines, &[&root], &what, extra) {
             Ok(words) => Ok(words),
             Err(e) => match e.downcast_ref::<shaders::GlslangError>() {
                 Some(g) => {

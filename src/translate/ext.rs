@@ -76,6 +76,10 @@ impl FunctionWriter<'_> {
             return Err(self.err("an extended instruction outside GLSL.std.450"));
         }
         let op = G::from_u32(Self::lit(inst, 1)).ok_or_else(|| self.err(format!("the GLSL.std.450 instruction {}", Self::lit(inst, 1))))?;
+        if matches!(op, G::Determinant | G::MatrixInverse | G::Modf | G::ModfStruct | G::Frexp | G::FrexpStruct | G::InterpolateAtCentroid | G::InterpolateAtSample | G::InterpolateAtOffset | G::PackDouble2x32 | G::UnpackDouble2x32) {
+            let name = format!("{op:?}");
+            return Err(self.err(format!("the GLSL.std.450 function {name} (GLSL's {})", name.to_ascii_lowercase())));
+        }
         let ty = inst.result_type.unwrap_or(0);
         let args: Vec<Word> = (2..inst.operands.len()).map(|k| Self::id(inst, k)).collect();
         let arg_ty = args.first().and_then(|a| self.m.type_of(*a)).unwrap_or(ty);
@@ -176,9 +180,6 @@ impl FunctionWriter<'_> {
                 let r = self.build(ty, (0..n).map(|c| fbin(s, "-", &fbin(s, "*", eta, &comp(&a[0], n, c)), &fbin(s, "*", &f, &comp(&a[1], n, c)))).collect())?;
                 format!("({} < 0.0f ? {} : {r})", as_f32(s, &k), self.m.zero(ty)?)
             }
-            G::Determinant | G::MatrixInverse | G::Modf | G::ModfStruct | G::Frexp | G::FrexpStruct | G::InterpolateAtCentroid | G::InterpolateAtSample | G::InterpolateAtOffset => {
-                return Err(self.err(format!("the GLSL.std.450 function {op:?}")));
-            }
             _ => return Ok(None),
         };
         Ok(Some(e))
@@ -199,7 +200,6 @@ impl FunctionWriter<'_> {
             G::PackUnorm2x16 => (0..2).map(|k| format!("((u32)m_rint({} * 65535.0f) << {}u)", clamp(comp(&p, n, k), "0.0f", "1.0f"), 16 * k)).collect::<Vec<_>>().join(" | "),
             G::PackSnorm2x16 => (0..2).map(|k| format!("(((u32)(i32)m_rint({} * 32767.0f) & 65535u) << {}u)", clamp(comp(&p, n, k), "-1.0f", "1.0f"), 16 * k)).collect::<Vec<_>>().join(" | "),
             G::PackHalf2x16 => (0..2).map(|k| format!("((u32)h_bits(h_from_f32({})) << {}u)", comp(&p, n, k), 16 * k)).collect::<Vec<_>>().join(" | "),
-            G::PackDouble2x32 | G::UnpackDouble2x32 => return Err(self.err(format!("the GLSL.std.450 function {op:?}"))),
             _ => return Ok(None),
         };
         Ok(Some(if matches!(op, G::PackUnorm4x8 | G::PackSnorm4x8 | G::PackUnorm2x16 | G::PackSnorm2x16 | G::PackHalf2x16) { format!("({e})") } else { e }))

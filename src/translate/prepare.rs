@@ -21,14 +21,27 @@ pub fn prepared(words: &[u32], constants: &SpecConstants) -> Result<Vec<u32>> {
     spirv::spirv_opt(&frozen, &UNROLL_PASSES.map(str::to_string))
 }
 
-fn translated(label: &str, words: &[u32], constants: &SpecConstants, options: &TranslateOptions) -> Result<Translation> {
-    translate(&prepared(words, constants)?, options).map_err(|e| anyhow!("{label}: {e}"))
+/// The translation of a model's kernel; for a `.brdf` model a construct the translation cannot express is
+/// located again in a line-annotated compile of the file, and named at the file's own line.
+fn translated(model: Option<&Model>, kind: KernelKind, words: &[u32], constants: &SpecConstants, options: &TranslateOptions, shaders: &Shaders) -> Result<Translation> {
+    let label = model.map_or_else(|| workload::BASELINE_LABEL.to_string(), Model::name);
+    match translate(&prepared(words, constants)?, options) {
+        Ok(t) => Ok(t),
+        Err(e) => match model.and_then(Model::file) {
+            Some(f) => {
+                let lines = f.kernel_with_lines(kind, shaders)?;
+                let located = translate(&prepared(&lines.words, constants)?, options).err().unwrap_or(e);
+                Err(anyhow!("{}", f.locate(&located)))
+            }
+            None => Err(anyhow!("{label}: {e}")),
+        },
+    }
 }
 
 /// `model`'s eval kernel (f_s per sample, glsl/eval.comp), translated.
 pub fn eval_kernel(model: &Model, shaders: &Shaders) -> Result<Translation> {
     let k = model.kernel(KernelKind::Eval, shaders)?;
-    translated(&model.name(), &k.spirv.words, &k.constants, &TranslateOptions::default())
+    translated(Some(model), KernelKind::Eval, &k.spirv.words, &k.constants, &TranslateOptions::default(), shaders)
 }
 
 /// The profiling kernel over the packed G-buffer (glsl/shade.comp) for `model` (None: the memory-only
@@ -38,6 +51,5 @@ pub fn shade_kernel(model: Option<&Model>, lights: u32, shaders: &Shaders) -> Re
     let k = workload::shade_kernel(model, GBufferFormat::Packed, per_dispatch, accumulate, shaders)?;
     // The G-buffer's texel view (`workload::bindings`): four 32-bit words per pixel.
     let options = TranslateOptions { texel_formats: [((0, 0), TexelFormat::Rgba32ui)].into() };
-    let label = model.map_or_else(|| workload::BASELINE_LABEL.to_string(), Model::name);
-    translated(&label, &k.spirv.words, &k.constants, &options)
+    translated(model, KernelKind::Shade, &k.spirv.words, &k.constants, &options, shaders)
 }

@@ -59,8 +59,8 @@ fn compare_merges_profile_and_inspect_reports_and_refuses_other_kernels() {
     std::fs::write(d.join("negative.json"), edited.to_string()).unwrap();
     run_in(d, &["compare", "negative.json", "navi21.json", "--json", "x.json", "--markdown", "x.md", "--chart", "x.png"]).fails(2, "cost -1; not a figure a measurement gives");
     let mut edited = json(&d.join("navi21.json"));
-    let gross = edited["aco"]["rows"][0]["cycles_per_eval"].as_f64().unwrap();
-    edited["aco"]["rows"][0]["net_cycles_per_eval"] = serde_json::json!(gross * 2.0);
+    let gross = edited["cost"]["rows"][0]["cycles_per_eval"].as_f64().unwrap();
+    edited["cost"]["rows"][0]["net_cycles_per_eval"] = serde_json::json!(gross * 2.0);
     std::fs::write(d.join("net.json"), edited.to_string()).unwrap();
     run_in(d, &["compare", "profile.json", "net.json", "--json", "x.json", "--markdown", "x.md", "--chart", "x.png"]).fails(2, "not a figure a measurement gives");
     // An output that is one of the reports is refused.
