@@ -26,11 +26,12 @@ spv:
 # Re-measure the committed `check` baseline after a deliberate change to the kernels (or to spv/ after a
 # merge): prints the comparison with the old baseline, then replaces it; commit the result.
 BASELINE := results/baseline-llvmpipe.json
-# The ACO baselines (Mesa RADV's compiler for navi21 and vangogh, no AMD GPU needed) likewise.
-ACO_FAMILIES := navi21 vangogh
+# The compile-only targets' baselines (ACO for navi21 and vangogh, ptxas for sm_89; no GPU needed) likewise.
+TARGET_BASELINES := radv:navi21 radv:vangogh nvidia:sm_89
 baseline: build
 	$(BIN) check --baseline $(BASELINE) --save-baseline $(BASELINE); test $$? -le 1
-	for f in $(ACO_FAMILIES); do \
-		$(BIN) check --device radv:$$f --baseline results/baseline-radv-$$f.json --save-baseline results/baseline-radv-$$f.json; \
+	for t in $(TARGET_BASELINES); do \
+		f=results/baseline-$$(echo $$t | tr : -).json; \
+		$(BIN) check --device $$t --baseline $$f --save-baseline $$f; \
 		test $$? -le 1 || exit 1; \
 	done

@@ -21,6 +21,8 @@ pub const ALIASES: &[(&str, &[&str])] = &[
     // ACO's (RADV) cycle estimates of one wave: issue plus stall cycles, and busy cycles per wave64.
     ("latency", &["Latency"]),
     ("inverse-throughput", &["Inverse Throughput"]),
+    // NVIDIA's compile-only targets: SM cycles of one warp at the guide's issue rates (`targets::nvidia`).
+    ("issue-cycles", &["Issue Cycles"]),
 ];
 
 /// Statistic keys: `driver/<executable>/<name>` for each statistic, `driver/<alias>` for each alias that some

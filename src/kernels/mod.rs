@@ -124,8 +124,15 @@ pub fn eval(gpu: &Gpu, model: &Model, samples: &[Sample], limits: RunLimits) -> 
 
 /// `eval` with a `.brdf` model's tangents and per-row parameters.
 pub fn eval_with(gpu: &Gpu, model: &Model, samples: &[Sample], extras: &EvalExtras, limits: RunLimits) -> Result<Vec<[f32; 3]>> {
+    eval_from(gpu, model, embedded(), samples, extras, limits)
+}
+
+/// `eval_with` on the kernels of `shaders` (the embedded ones, or a `--glsl DIR`).
+pub fn eval_from(gpu: &Gpu, model: &Model, shaders: &Shaders, samples: &[Sample], extras: &EvalExtras, limits: RunLimits) -> Result<Vec<[f32; 3]>> {
     assert_eq!(extras.rows.len(), samples.len() * extras.row_floats, "one row of parameters per sample");
-    let kernel = model_kernel(gpu, model, KernelKind::Eval, |c| c, 2, 4)?;
+    model.check_support(&gpu.info)?;
+    let k = model.kernel(KernelKind::Eval, shaders)?;
+    let kernel = self::kernel(gpu, &k.spirv, &k.constants, 2, 4)?;
     let in_stride = 16 * extras.stride() as u64;
     let out = run_elementwise(gpu, &kernel, &pack_samples(samples, extras), in_stride, 16, samples.len() as u64, limits)?;
     let floats: Vec<f32> = bytemuck::pod_collect_to_vec(&out);

@@ -64,7 +64,7 @@ pub fn eval_agreement(gpu: &Gpu, model: &Model, shaders: &Shaders) -> Result<Agr
     let samples = well_conditioned(EVAL_SAMPLES, 0x7e57, 0.05, 0.2..1.0);
     let kernel = host::HostKernel::compile(&prepare::eval_kernel(model, shaders)?)?;
     let on_host = host::eval(&kernel, &samples, &EvalExtras::default())?;
-    let on_device = kernels::eval(gpu, model, &samples, RunLimits::default())?;
+    let on_device = kernels::eval_from(gpu, model, shaders, &samples, &EvalExtras::default(), RunLimits::default())?;
     let worst = worst_relative(&on_host, &on_device, |i, c| f64::from(on_device[i][c]).abs().max(1e-3));
     Ok(Agreement { kernel: "eval".into(), values: 3 * samples.len(), worst, tolerance: eval_tolerance(model), device: gpu.info.name.clone() })
 }

@@ -12,6 +12,7 @@ mod eval;
 mod eval_csv;
 mod fuzz;
 mod limits;
+mod nvidia;
 mod outputs;
 mod radv;
 mod scenes;

@@ -7,6 +7,7 @@ mod common;
 mod aco_gate;
 mod check_gate;
 mod inspect;
+mod nvidia_gate;
 mod profile;
 
 /// Held by every test of this binary while it runs.

@@ -13,7 +13,7 @@ pub const GROUPS: [&str; 6] = ["spirv", "spirv-O", "naga", "driver", "callgrind"
 /// The timing statistic of each model.
 pub const TIMING_KEY: &str = "timing/cost-ratio";
 /// Driver statistics that cost more when they grow (the aliases); other driver statistics are reported only.
-const GATED_DRIVER_KEYS: [&str; 10] = [
+const GATED_DRIVER_KEYS: [&str; 11] = [
     "driver/registers",
     "driver/scalar-registers",
     "driver/instructions",
@@ -24,6 +24,7 @@ const GATED_DRIVER_KEYS: [&str; 10] = [
     "driver/branches",
     "driver/latency",
     "driver/inverse-throughput",
+    "driver/issue-cycles",
 ];
 
 

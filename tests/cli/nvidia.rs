@@ -1,0 +1,157 @@
+//! Compile-only NVIDIA targets (`--device nvidia:FAMILY`): NVIDIA's real compiler (NVRTC and ptxas, from its
+//! PyPI wheels, `make setup`) on the kernels' CUDA C++ translation, run without an NVIDIA GPU or driver, after
+//! the translation agreed with the Vulkan kernels on the test device. Every command that executes refuses the
+//! targets; a missing compiler and a construct the translation lacks are errors naming the fix and the line.
+
+use crate::common::{self, run};
+use brdfprof::targets::nvidia::FAMILIES;
+use std::path::Path;
+
+fn inspect_json(dir: &Path, name: &str, devices: &[&str], extra: &[&str]) -> serde_json::Value {
+    let json = dir.join(format!("{name}.json"));
+    let md = dir.join(format!("{name}.md"));
+    let mut args = vec!["inspect", "--no-callgrind", "--json", json.to_str().unwrap(), "--markdown", md.to_str().unwrap()];
+    for d in devices {
+        args.extend(["--device", d]);
+    }
+    args.extend(extra);
+    // A cache of its own: every call compiles (and checks) afresh.
+    let out = common::brdfprof().args(&args).env("BRDFPROF_CACHE_DIR", dir.join(format!("cache-{name}"))).output().unwrap();
+    let out = common::Run { code: out.status.code(), stdout: String::from_utf8_lossy(&out.stdout).into_owned(), stderr: String::from_utf8_lossy(&out.stderr).into_owned() }.ok();
+    assert!(out.stdout.contains("ptxas statistics"), "{}", out.stdout);
+    serde_json::from_str(&std::fs::read_to_string(json).unwrap()).unwrap()
+}
+
+fn sass(row: &serde_json::Value, name: &str) -> f64 {
+    row["stats"][format!("driver/SASS/{name}")].as_f64().unwrap_or_else(|| panic!("{} has no {name}: {row}", row["model"]))
+}
+
+/// Every preset and each example `.brdf` file (parameters bound to the kernel inputs).
+fn every_preset_and_example() -> Vec<String> {
+    let mut models: Vec<String> = brdfprof::brdf::spec::PRESETS.iter().map(|p| p.name.to_string()).collect();
+    let dir = common::repo_root().join("examples/brdf");
+    let mut files: Vec<_> = std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().path()).filter(|p| p.extension().is_some_and(|x| x == "brdf")).collect();
+    files.sort();
+    models.extend(files.iter().map(|p| format!("{},roughness=@roughness,f0=@f0", p.display())));
+    models
+}
+
+#[test]
+fn every_preset_and_example_file_gets_sass_statistics_on_all_five_families() {
+    let dir = tempfile::tempdir().unwrap();
+    let models = every_preset_and_example();
+    let mut extra: Vec<&str> = Vec::new();
+    for m in &models {
+        extra.extend(["--model", m.as_str()]);
+    }
+    let report = inspect_json(dir.path(), "all", &["nvidia:all"], &extra);
+    let reports = report["reports"].as_array().unwrap();
+    assert_eq!(reports.len(), FAMILIES.len());
+    for (r, family) in reports.iter().zip(&FAMILIES) {
+        assert_eq!(r["provenance"]["target"], format!("nvidia:{}", family.name));
+        assert!(r["provenance"]["compiler"]["options"].as_str().unwrap().contains("-use_fast_math"));
+        let rows = r["rows"].as_array().unwrap();
+        assert_eq!(rows.len(), models.len() + 1, "every model and the memory-only kernel");
+        for row in rows {
+            for stat in ["Instruction Count", "Register Count", "Binary Size", "Issue Cycles", "Warps per SM", "FP32 (FMA, MUL, ADD, compare)"] {
+                assert!(sass(row, stat) > 0.0, "{} {}: {stat} is 0", family.name, row["model"]);
+            }
+            let note = row["notes"]["translation"].as_str().unwrap_or_else(|| panic!("{} {}: no translation check", family.name, row["model"]));
+            assert!(note.contains("translation checked on the host against"), "{note}");
+        }
+        // A BRDF costs more than the memory-only kernel; cycles/eval = issue cycles / (32 x 8 lights).
+        for c in r["cost"]["rows"].as_array().unwrap() {
+            let issue = c["stats"]["Issue Cycles"].as_f64().unwrap();
+            assert_eq!(c["cycles_per_eval"].as_f64().unwrap(), issue / (32.0 * 8.0));
+            if c["model"] != "baseline" {
+                assert!(c["net_cycles_per_eval"].as_f64().unwrap() > 0.0, "{} {}", family.name, c["model"]);
+            }
+        }
+    }
+    // The cost table across the five families has every pair's rank correlation.
+    assert_eq!(report["costs"]["correlations"].as_array().unwrap().len(), 10);
+}
+
+#[test]
+fn the_statistics_are_deterministic_and_the_exact_defaults_cost_more() {
+    let dir = tempfile::tempdir().unwrap();
+    let fast = inspect_json(dir.path(), "fast", &["nvidia:sm_89"], &["--model", "blinn"]);
+    let again = inspect_json(dir.path(), "again", &["nvidia:sm_89"], &["--model", "blinn"]);
+    for (a, b) in fast["rows"].as_array().unwrap().iter().zip(again["rows"].as_array().unwrap()) {
+        for (key, value) in a["stats"].as_object().unwrap().iter().filter(|(k, _)| k.starts_with("driver/")) {
+            assert_eq!(&b["stats"][key], value, "{} {key} changed between runs", a["model"]);
+        }
+    }
+    let precise = inspect_json(dir.path(), "precise", &["nvidia:sm_89"], &["--model", "blinn", "--precise-math"]);
+    assert!(!precise["provenance"]["compiler"]["options"].as_str().unwrap().contains("-use_fast_math"));
+    let net = |r: &serde_json::Value| r["cost"]["rows"][0]["net_cycles_per_eval"].as_f64().unwrap();
+    assert!(net(&precise) > 1.2 * net(&fast), "IEEE division, square root and pow cost more: {} vs {}", net(&precise), net(&fast));
+}
+
+#[test]
+fn isa_writes_the_translation_and_its_sass_per_kernel_and_family() {
+    let dir = tempfile::tempdir().unwrap();
+    let isa = dir.path().join("isa");
+    inspect_json(dir.path(), "one", &["nvidia:sm_90"], &["--model", "ggx", "--isa", isa.to_str().unwrap()]);
+    for kernel in ["ggx", "baseline"] {
+        let cu = std::fs::read_to_string(isa.join("nvidia-sm_90").join(format!("{kernel}.cu"))).unwrap();
+        assert!(cu.contains("extern \"C\" __global__") && cu.contains("fn_main"), "{}", &cu[..cu.len().min(400)]);
+        let sass = std::fs::read_to_string(isa.join("nvidia-sm_90").join(format!("{kernel}.sass"))).unwrap();
+        assert!(sass.contains("EXIT") && sass.contains("registers"), "{}", &sass[..sass.len().min(400)]);
+    }
+}
+
+#[test]
+fn commands_that_execute_refuse_an_nvidia_target_and_unknown_families_are_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("o");
+    let out = out.to_str().unwrap();
+    for args in [
+        vec!["profile", "--device", "nvidia:sm_89", "--json", out],
+        vec!["stability", "--device", "nvidia:sm_89", "--out", out],
+        vec!["render", "--scene", "scenes/sphere-grid.json", "--device", "nvidia:sm_89", "--out", out],
+    ] {
+        let mut cmd = common::brdfprof();
+        let r = cmd.args(&args).current_dir(common::repo_root()).output().unwrap();
+        assert_eq!(r.status.code(), Some(2), "{args:?}");
+        assert!(String::from_utf8_lossy(&r.stderr).contains("compiles only"), "{args:?}: {}", String::from_utf8_lossy(&r.stderr));
+    }
+    run(&["inspect", "--device", "nvidia:sm_87"]).fails(2, "unknown NVIDIA family `sm_87`");
+    let listed = run(&["devices", "--targets"]).ok();
+    for f in &FAMILIES {
+        assert!(listed.stdout.lines().any(|l| l.starts_with(&format!("| nvidia:{} ", f.name)) && l.contains(f.architecture)), "{}", listed.stdout);
+    }
+}
+
+#[test]
+fn a_missing_compiler_says_make_setup() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = common::brdfprof()
+        .args(["inspect", "--no-callgrind", "--device", "nvidia:sm_89", "--model", "ggx", "--json"])
+        .arg(dir.path().join("x.json"))
+        .env("BRDFPROF_NVIDIA_DIR", dir.path().join("nowhere"))
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("NVIDIA compiler not installed: run `make setup`"), "{stderr}");
+    assert!(!dir.path().join("x.json").exists());
+}
+
+#[test]
+fn a_construct_the_translation_lacks_is_refused_at_the_files_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("volume.brdf");
+    std::fs::write(
+        &file,
+        "analytic\n::begin parameters\nfloat roughness 0 1 0.5\n::end parameters\n::begin shader\nfloat frame_volume(vec3 a, vec3 b, vec3 c)\n{\n    return determinant(mat3(a, b, c));\n}\n\nvec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y)\n{\n    return vec3(abs(frame_volume(X, Y, N)) * roughness);\n}\n::end shader\n",
+    )
+    .unwrap();
+    let json = dir.path().join("x.json");
+    let r = run(&["inspect", "--no-callgrind", "--device", "nvidia:sm_89", "--model", file.to_str().unwrap(), "--json", json.to_str().unwrap()]);
+    r.fails(2, &format!("{}:8: the C translation cannot express the GLSL.std.450 function Determinant (GLSL's determinant) (in function `frame_volume`)", file.display()));
+    // The same file runs on Vulkan: the refusal is the translation's, not the file's.
+    let csv = dir.path().join("in.csv");
+    std::fs::write(&csv, "nx,ny,nz,vx,vy,vz,lx,ly,lz,roughness,f0r,f0g,f0b\n0,0,1,0,0.6,0.8,0,-0.6,0.8,0.5,0.04,0.04,0.04\n").unwrap();
+    run(&["eval", "--model", file.to_str().unwrap(), "--input", csv.to_str().unwrap(), "--output", dir.path().join("out.csv").to_str().unwrap()]).ok();
+}
