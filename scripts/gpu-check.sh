@@ -1,79 +1,157 @@
 #!/bin/sh
-# brdfprof on a machine with a real GPU (NVIDIA's driver, RADV, ANV, any Vulkan driver), in under 8 minutes:
-#   devices, a profile of the thesis models at 1920x1080 with 8 and 64 lights, a short sweep (with ACO's cost
-#   for RDNA 2 beside it), inspect with the driver's own statistics (VK_KHR_pipeline_executable_properties),
-#   the cost table across this GPU and the compile-only AMD targets, every JSON under OUTDIR.
+# brdfprof on a lent GPU machine, in two halves, so that the machine with the GPU only measures:
 #
-# Usage: scripts/gpu-check.sh OUTDIR [DEVICE]
-#   DEVICE: index or name substring from `brdfprof devices` (default: the first discrete or integrated GPU).
-#   BRDFPROF=path/to/brdfprof uses that binary (default: target/release/brdfprof, built if missing).
-#   GPU_CHECK_SIZE=WxH overrides the profile's 1920x1080 (only to try the script on lavapipe: a CPU device at
-#   1080p with 64 lights takes minutes per round).
-# The time limits add up to 480 s (8 minutes); the budgets make it about 5.
-# Exit status: that of the first command that failed (2: could not measure; 124: over its time limit), else
-# 0. Never part of CI.
-set -eu
+#   scripts/gpu-check.sh prepare DIR          here (network, compilers): builds brdfprof, copies it stripped to
+#                                             DIR/brdfprof, runs the compile-only targets (NVIDIA sm_90, which
+#                                             an H200 is, and the default AMD families) into DIR/targets.json,
+#                                             and downloads the Vulkan loader's package into DIR/debs
+#   scripts/gpu-check.sh measure DIR [DEVICE] on the GPU machine (no registry, nothing built): devices, a profile
+#                                             of the thesis models at 1920x1080 with 8 and 64 lights, a short
+#                                             sweep (accuracy against the f64 reference on this device, and
+#                                             time), the hard-case stability catalogue, the driver's own
+#                                             statistics, and the cost table joining the measured ns/eval with
+#                                             the modelled cycles/eval of DIR/targets.json, with their rank
+#                                             correlation (DIR/compare.md); DIR/summary.md lists every step
+#   scripts/gpu-check.sh all DIR [DEVICE]     both, on one machine (how it is tried on lavapipe)
+#
+# DEVICE: index or name substring from `brdfprof devices` (default: the first discrete or integrated GPU).
+# GPU_CHECK_SIZE=WxH overrides the profile's 1920x1080 (on lavapipe: a CPU device at 1080p with 64 lights takes
+# minutes per round). BRDFPROF=path uses that binary for `prepare` (default target/release/brdfprof, built if
+# missing). DIR must travel to the GPU machine (the device tool's `carry`): `prepare` checks it stays under
+# 64 MiB. Every step runs under its own time limit and the next one runs whatever it returned; measure's
+# limits add up to 460 s, inside one 10-minute command. Exit status: that of the first step that failed (2:
+# could not measure; 124: over its time limit), else 0. Never part of CI.
+set -u
 
-if [ $# -lt 1 ] || [ $# -gt 2 ]; then
-    echo "usage: $0 OUTDIR [DEVICE]" >&2
+usage() {
+    echo "usage: $0 prepare DIR | measure DIR [DEVICE] | all DIR [DEVICE]" >&2
     exit 2
-fi
-OUT=$1
-DEVICE=${2:-}
-SIZE=${GPU_CHECK_SIZE:-1920x1080}
+}
+[ $# -ge 2 ] || usage
+MODE=$1
+OUT=$2
+DEVICE=${3:-}
+case $MODE in prepare | measure | all) ;; *) usage ;; esac
+[ "$MODE" != prepare ] || [ $# -eq 2 ] || usage
+[ $# -le 3 ] || usage
 cd "$(dirname "$0")/.."
-BIN=${BRDFPROF:-target/release/brdfprof}
-if [ ! -x "$BIN" ]; then
-    cargo build --release --locked
-fi
 mkdir -p "$OUT"
+OUT=$(cd "$OUT" && pwd)
 LOG="$OUT/gpu-check.log"
-: > "$LOG"
+FIRST_FAILURE=0
 
-# run NAME SECONDS ARGS...: one brdfprof command with a time limit, its output in OUT/NAME.txt, its wall time
-# in the log.
-run() {
+# step NAME SECONDS COMMAND...: one command under a time limit, its output in OUT/NAME.txt and OUT/NAME.err,
+# its exit status and wall time in the log and OUT/summary.md; a failure is reported and the next step runs.
+step() {
     name=$1
     limit=$2
     shift 2
-    echo "== $name: $BIN $*" | tee -a "$LOG"
+    echo "== $name: $*" | tee -a "$LOG"
     start=$(date +%s)
     status=0
-    timeout "$limit" "$BIN" "$@" > "$OUT/$name.txt" 2> "$OUT/$name.err" || status=$?
-    echo "   exit $status after $(( $(date +%s) - start )) s" | tee -a "$LOG"
+    timeout "$limit" "$@" > "$OUT/$name.txt" 2> "$OUT/$name.err" || status=$?
+    took=$(( $(date +%s) - start ))
+    echo "   exit $status after $took s" | tee -a "$LOG"
+    echo "| $name | $status | $took | \`$*\` |" >> "$OUT/summary.md"
     if [ "$status" -ne 0 ]; then
         tail -20 "$OUT/$name.err" >&2
-        exit "$status"
+        [ "$FIRST_FAILURE" -ne 0 ] || FIRST_FAILURE=$status
+    fi
+    return 0
+}
+
+summary_header() {
+    {
+        echo "# brdfprof gpu-check ($1), $(date -u '+%Y-%m-%d %H:%M UTC') on $(uname -n)"
+        echo
+        echo "| step | exit | seconds | command |"
+        echo "|---|---|---|---|"
+    } >> "$OUT/summary.md"
+}
+
+prepare() {
+    : > "$LOG"
+    : > "$OUT/summary.md"
+    summary_header prepare
+    bin=${BRDFPROF:-target/release/brdfprof}
+    [ -x "$bin" ] || step build 1800 cargo build --release --locked
+    step strip 60 objcopy --strip-debug "$bin" "$OUT/brdfprof"
+    # What no GPU is needed for: NVIDIA's compiler for the H200's sm_90 and ACO for the AMD families, from the
+    # same binary (so the same kernels: `compare` checks their hashes).
+    step targets 300 "$OUT/brdfprof" inspect --device nvidia:sm_90 --device radv:all --no-callgrind \
+        --json "$OUT/targets.json" --markdown "$OUT/targets.md"
+    # The lent machine may have no Vulkan loader; it cannot reach a registry to fetch one.
+    rm -rf "$OUT/debs"
+    mkdir -p "$OUT/debs"
+    step loader 120 sh -c "cd '$OUT/debs' && apt-get download libvulkan1"
+    size=$(du -sm "$OUT" | cut -f1)
+    echo "prepared $OUT: ${size} MiB" | tee -a "$LOG"
+    if [ "$size" -ge 64 ]; then
+        echo "error: $OUT is ${size} MiB, over the 64 MiB a lent machine takes" | tee -a "$LOG" >&2
+        [ "$FIRST_FAILURE" -ne 0 ] || FIRST_FAILURE=2
     fi
 }
 
-set --
-if [ -n "$DEVICE" ]; then
-    set -- --device "$DEVICE"
-fi
+# Vulkan on a machine that has the NVIDIA driver but perhaps no loader: the carried package, unpacked under
+# DIR (never over /), and NVIDIA's ICD file where the driver's installer left it outside the loader's paths.
+bring_loader() {
+    if ! ldconfig -p 2>/dev/null | grep -q 'libvulkan\.so\.1'; then
+        for deb in "$OUT"/debs/*.deb; do
+            [ -f "$deb" ] && dpkg -x "$deb" "$OUT/root"
+        done
+        if [ -d "$OUT/root" ]; then
+            lib=$(dirname "$(find "$OUT/root" -name 'libvulkan.so.1' | head -1)")
+            export LD_LIBRARY_PATH="$lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
+            echo "Vulkan loader: carried, $lib" | tee -a "$LOG"
+        else
+            echo "Vulkan loader: none installed and none carried (run prepare where apt-get works)" | tee -a "$LOG"
+        fi
+    fi
+    nvidia_icd=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json
+    if [ -z "${VK_DRIVER_FILES:-}" ] && [ -f "$nvidia_icd" ] \
+        && ! ls /usr/share/vulkan/icd.d/nvidia* /etc/vulkan/icd.d/nvidia* > /dev/null 2>&1; then
+        export VK_DRIVER_FILES="$nvidia_icd"
+        echo "Vulkan driver: $nvidia_icd" | tee -a "$LOG"
+    fi
+}
 
-run devices 10 devices
-cat "$OUT/devices.txt"
-run targets 10 devices --targets
-if grep -q '(default)' "$OUT/devices.txt" && grep '(default)' "$OUT/devices.txt" | grep -q '| cpu '; then
-    [ -n "$DEVICE" ] || echo "note: the default device is a CPU device (no GPU driver found); pass DEVICE to choose one" | tee -a "$LOG"
-fi
-# The thesis models, 8 and 64 lights interleaved in the same rounds: 150 s at most.
-run profile 170 profile "$@" --size "$SIZE" --lights 8,64 --budget 150 --json "$OUT/profile.json"
-# A short sweep: the default 61 specs at 256x256 (the accuracy part runs on this device too), and ACO's
-# RDNA 2 cost of the same specs beside it (seconds, no GPU needed).
-run sweep 140 sweep "$@" --budget 120 --out "$OUT" --cost-device radv:navi21
-# The driver's own statistics of this device (registers, instructions, spills where the driver reports them).
-run inspect 90 inspect "$@" --profile "$OUT/profile.json" --json "$OUT/inspect.json" --markdown "$OUT/inspect.md"
-# ACO's estimate for the default AMD families (compile-only, no AMD GPU needed), and the cost table of this
-# device (measured ns/eval, driver statistics) beside them.
-run inspect-radv 40 inspect --device radv:all --no-callgrind --json "$OUT/inspect-radv.json" --markdown "$OUT/inspect-radv.md"
-# inspect.json joins the table where it has a cost per evaluation (callgrind on lavapipe, ACO on RADV).
-own=""
-if grep -q -e '"callgrind/ir-per-eval"' -e 'Inverse Throughput' "$OUT/inspect.json"; then
-    own="$OUT/inspect.json"
-fi
-# shellcheck disable=SC2086 # $own is one path or nothing
-run compare 20 compare "$OUT/profile.json" $own "$OUT/inspect-radv.json" \
-    --json "$OUT/compare.json" --markdown "$OUT/compare.md" --chart "$OUT/compare.png"
-echo "done: $(ls "$OUT" | tr '\n' ' ')" | tee -a "$LOG"
+measure() {
+    [ "$MODE" = all ] || : > "$LOG"
+    summary_header measure
+    bin="$OUT/brdfprof"
+    if [ ! -x "$bin" ]; then
+        echo "error: $bin is missing: run \`$0 prepare $OUT\` first" >&2
+        exit 2
+    fi
+    bring_loader
+    size=${GPU_CHECK_SIZE:-1920x1080}
+    set --
+    [ -z "$DEVICE" ] || set -- --device "$DEVICE"
+    step devices 20 "$bin" devices
+    cat "$OUT/devices.txt"
+    # The thesis models, 8 and 64 lights interleaved in the same rounds: 150 s at most.
+    step profile 170 "$bin" profile "$@" --size "$size" --lights 8,64 --budget 150 --json "$OUT/profile.json"
+    # The default 61 specs at 256x256: error against the exact f64 reference on this device, and time.
+    step sweep 140 "$bin" sweep "$@" --budget 120 --out "$OUT/sweep"
+    # NaN, Inf and negative values on the hard cases, on this device's driver.
+    step stability 60 "$bin" stability "$@" --out "$OUT/stability"
+    # The driver's own statistics (VK_KHR_pipeline_executable_properties, where the driver reports them).
+    step inspect 50 "$bin" inspect "$@" --no-callgrind --profile "$OUT/profile.json" \
+        --json "$OUT/inspect.json" --markdown "$OUT/inspect.md"
+    # Measured ns/eval beside the compile-only targets' modelled cycles/eval, and their rank correlation.
+    set -- "$OUT/profile.json"
+    [ -f "$OUT/targets.json" ] && set -- "$@" "$OUT/targets.json"
+    step compare 20 "$bin" compare "$@" --json "$OUT/compare.json" --markdown "$OUT/compare.md" --chart "$OUT/compare.png"
+}
+
+case $MODE in
+    prepare) prepare ;;
+    measure) measure ;;
+    all)
+        prepare
+        measure
+        ;;
+esac
+echo "done ($FIRST_FAILURE): $(ls "$OUT" | tr '\n' ' ')" | tee -a "$LOG"
+cat "$OUT/summary.md"
+exit "$FIRST_FAILURE"

@@ -53,6 +53,17 @@ fn float_call(s: Scalar, name: &str, args: &[String]) -> String {
     }
 }
 
+/// `a < b` in scalar kind `s` (halves with the prelude's native comparison).
+fn less(s: Scalar, a: &str, b: &str) -> String {
+    if s == Scalar::F16 { format!("h_lt({a}, {b})") } else { format!("({a} < {b})") }
+}
+
+/// `min` or `max` (`what`) of `a` and `b` in scalar kind `s`: GLSL.std.450's FMin/FMax, the other operand where
+/// one is NaN; halves with the prelude's native `h_min`/`h_max`.
+fn min_max(s: Scalar, what: &str, a: &str, b: &str) -> String {
+    if s == Scalar::F16 { format!("h_{what}({a}, {b})") } else { float_call(s, &format!("m_f{what}"), &[a.to_string(), b.to_string()]) }
+}
+
 /// A float literal in scalar kind `s`.
 fn lit(s: Scalar, x: f32) -> String {
     match s {
@@ -109,16 +120,16 @@ impl FunctionWriter<'_> {
         let int = |x: &str| format!("(i32)({x})");
         let uint = |x: &str| format!("(u32)({x})");
         Ok(match op {
-            G::FSign => format!("({0} > {1} ? {2} : ({0} < {1} ? {3} : {1}))", a[0], lit(s, 0.0), lit(s, 1.0), lit(s, -1.0)),
+            G::FSign => format!("({} ? {} : ({} ? {} : {}))", less(s, &lit(s, 0.0), &a[0]), lit(s, 1.0), less(s, &a[0], &lit(s, 0.0)), lit(s, -1.0), lit(s, 0.0)),
             G::Fract => fbin(s, "-", &a[0], &float_call(s, "m_floor", &a[..1])),
             G::Radians => fbin(s, "*", &a[0], &lit(s, std::f32::consts::PI / 180.0)),
             G::Degrees => fbin(s, "*", &a[0], &lit(s, 180.0 / std::f32::consts::PI)),
             G::Pow => float_call(s, "m_pow", &a[..2]),
             G::Atan2 => float_call(s, "m_atan2", &a[..2]),
-            G::FMin | G::NMin => float_call(s, "m_fmin", &a[..2]),
-            G::FMax | G::NMax => float_call(s, "m_fmax", &a[..2]),
-            G::FClamp | G::NClamp => float_call(s, "m_fmin", &[float_call(s, "m_fmax", &a[..2]), a[2].clone()]),
-            G::Step => format!("({} < {} ? {} : {})", a[1], a[0], lit(s, 0.0), lit(s, 1.0)),
+            G::FMin | G::NMin => min_max(s, "min", &a[0], &a[1]),
+            G::FMax | G::NMax => min_max(s, "max", &a[0], &a[1]),
+            G::FClamp | G::NClamp => min_max(s, "min", &min_max(s, "max", &a[0], &a[1]), &a[2]),
+            G::Step => format!("({} ? {} : {})", less(s, &a[1], &a[0]), lit(s, 0.0), lit(s, 1.0)),
             G::SmoothStep => float_call(s, "m_smoothstep", &a[..3]),
             // GLSL 4.50 8.3: mix(x, y, a) = x (1 - a) + y a.
             G::FMix => fbin(s, "+", &fbin(s, "*", &a[0], &fbin(s, "-", &lit(s, 1.0), &a[2])), &fbin(s, "*", &a[1], &a[2])),

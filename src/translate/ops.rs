@@ -29,6 +29,25 @@ pub fn fbin(s: Scalar, op: &str, a: &str, b: &str) -> String {
     }
 }
 
+/// A comparison of two halves with the prelude's ordered `h_lt`, `h_le`, `h_gt`, `h_ge` and `h_eq` (the unordered
+/// forms are the negated ordered ones).
+pub fn half_compare(op: Op, a: &str, b: &str) -> String {
+    match op {
+        Op::FOrdEqual => format!("h_eq({a}, {b})"),
+        Op::FUnordEqual => format!("(!(h_lt({a}, {b}) || h_gt({a}, {b})))"),
+        Op::FOrdNotEqual => format!("(h_lt({a}, {b}) || h_gt({a}, {b}))"),
+        Op::FUnordNotEqual => format!("(!h_eq({a}, {b}))"),
+        Op::FOrdLessThan => format!("h_lt({a}, {b})"),
+        Op::FUnordLessThan => format!("(!h_ge({a}, {b}))"),
+        Op::FOrdGreaterThan => format!("h_gt({a}, {b})"),
+        Op::FUnordGreaterThan => format!("(!h_le({a}, {b}))"),
+        Op::FOrdLessThanEqual => format!("h_le({a}, {b})"),
+        Op::FUnordLessThanEqual => format!("(!h_gt({a}, {b}))"),
+        Op::FOrdGreaterThanEqual => format!("h_ge({a}, {b})"),
+        _ => format!("(!h_lt({a}, {b}))"),
+    }
+}
+
 /// A scalar float as f32 (exact from f16) for the operations the translation does in f32.
 pub fn as_f32(s: Scalar, e: &str) -> String {
     if s == Scalar::F16 { format!("h_to_f32({e})") } else { e.to_string() }
@@ -209,7 +228,10 @@ impl FunctionWriter<'_> {
         let s = self.scalar_kind(self.ty_of(Self::id(inst, 0)))?;
         let op = inst.class.opcode;
         self.each(inst, |o| {
-            let (a, b) = (as_f32(s, &o[0]), as_f32(s, &o[1]));
+            if s == Scalar::F16 {
+                return half_compare(op, &o[0], &o[1]);
+            }
+            let (a, b) = (&o[0], &o[1]);
             match op {
                 Op::FOrdEqual => format!("({a} == {b})"),
                 Op::FUnordEqual => format!("(!({a} < {b} || {a} > {b}))"),

@@ -102,6 +102,18 @@ fn isa_writes_the_translation_and_its_sass_per_kernel_and_family() {
 }
 
 #[test]
+fn fp16_kernels_compare_and_clamp_in_half_precision_where_the_family_has_the_instructions() {
+    let dir = tempfile::tempdir().unwrap();
+    let isa = dir.path().join("isa");
+    // sm_75 has no f16 min/max (the f32 fallback), sm_89 has (PTX min.f16, SASS HMNMX2); both compare in f16.
+    inspect_json(dir.path(), "f16", &["nvidia:sm_75,sm_89"], &["--model", "ggx,precision=f16", "--isa", isa.to_str().unwrap()]);
+    let sass = |family: &str| std::fs::read_to_string(isa.join(format!("nvidia-{family}")).join("ggx-precision-f16.sass")).unwrap();
+    let (turing, ada) = (sass("sm_75"), sass("sm_89"));
+    assert!(turing.contains("HFMA2") && turing.contains("HSETP2") && !turing.contains("HMNMX2"), "sm_75 SASS:\n{}", &turing[..turing.len().min(2000)]);
+    assert!(ada.contains("HMNMX2") && ada.contains("HSETP2"), "sm_89 SASS:\n{}", &ada[..ada.len().min(2000)]);
+}
+
+#[test]
 fn commands_that_execute_refuse_an_nvidia_target_and_unknown_families_are_named() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("o");

@@ -23,6 +23,17 @@ BRDFPROF_FN half_t h_mul(half_t a, half_t b) { half_t r; asm("mul.f16 %0, %1, %2
 BRDFPROF_FN half_t h_fma(half_t a, half_t b, half_t c) { half_t r; asm("fma.rn.f16 %0, %1, %2, %3;" : "=h"(r.b) : "h"(a.b), "h"(b.b), "h"(c.b)); return r; }
 BRDFPROF_FN half_t h_neg(half_t a) { half_t r; asm("neg.f16 %0, %1;" : "=h"(r.b) : "h"(a.b)); return r; }
 BRDFPROF_FN half_t h_div(half_t a, half_t b) { return h_from_f32(h_to_f32(a) / h_to_f32(b)); }
+// Comparisons (ordered, as PTX's setp.f16) and min/max (PTX's min.f16 and max.f16 from sm_80; before that in
+// f32, exact) in half precision, so that no conversion stands where a native fp16 compiler would put none.
+#define BRDFPROF_H_CMP(name, rel) BRDFPROF_FN bool name(half_t a, half_t b) { u32 r; asm("{ .reg .pred p; setp." rel ".f16 p, %1, %2; selp.u32 %0, 1, 0, p; }" : "=r"(r) : "h"(a.b), "h"(b.b)); return r != 0u; }
+BRDFPROF_H_CMP(h_lt, "lt") BRDFPROF_H_CMP(h_le, "le") BRDFPROF_H_CMP(h_gt, "gt") BRDFPROF_H_CMP(h_ge, "ge") BRDFPROF_H_CMP(h_eq, "eq")
+#if __CUDA_ARCH__ >= 800
+BRDFPROF_FN half_t h_min(half_t a, half_t b) { half_t r; asm("min.f16 %0, %1, %2;" : "=h"(r.b) : "h"(a.b), "h"(b.b)); return r; }
+BRDFPROF_FN half_t h_max(half_t a, half_t b) { half_t r; asm("max.f16 %0, %1, %2;" : "=h"(r.b) : "h"(a.b), "h"(b.b)); return r; }
+#else
+BRDFPROF_FN half_t h_min(half_t a, half_t b) { return h_from_f32(fminf(h_to_f32(a), h_to_f32(b))); }
+BRDFPROF_FN half_t h_max(half_t a, half_t b) { return h_from_f32(fmaxf(h_to_f32(a), h_to_f32(b))); }
+#endif
 
 BRDFPROF_FN u32 f32_bits(float x) { return __float_as_uint(x); }
 BRDFPROF_FN float f32_from_bits(u32 b) { return __uint_as_float(b); }

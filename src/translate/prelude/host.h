@@ -24,6 +24,14 @@ BRDFPROF_FN half_t h_mul(half_t a, half_t b) { return (half_t)((float)a * (float
 BRDFPROF_FN half_t h_fma(half_t a, half_t b, half_t c) { return (half_t)std::fma((float)a, (float)b, (float)c); }
 BRDFPROF_FN half_t h_neg(half_t a) { return (half_t)(-(float)a); }
 BRDFPROF_FN half_t h_div(half_t a, half_t b) { return (half_t)((float)a / (float)b); }
+// Comparisons and min/max in f32 (exact for halves).
+BRDFPROF_FN bool h_lt(half_t a, half_t b) { return h_to_f32(a) < h_to_f32(b); }
+BRDFPROF_FN bool h_le(half_t a, half_t b) { return h_to_f32(a) <= h_to_f32(b); }
+BRDFPROF_FN bool h_gt(half_t a, half_t b) { return h_to_f32(a) > h_to_f32(b); }
+BRDFPROF_FN bool h_ge(half_t a, half_t b) { return h_to_f32(a) >= h_to_f32(b); }
+BRDFPROF_FN bool h_eq(half_t a, half_t b) { return h_to_f32(a) == h_to_f32(b); }
+BRDFPROF_FN half_t h_min(half_t a, half_t b) { return h_from_f32(std::fmin(h_to_f32(a), h_to_f32(b))); }
+BRDFPROF_FN half_t h_max(half_t a, half_t b) { return h_from_f32(std::fmax(h_to_f32(a), h_to_f32(b))); }
 
 BRDFPROF_FN u32 f32_bits(float x) { u32 b; memcpy(&b, &x, 4); return b; }
 BRDFPROF_FN float f32_from_bits(u32 b) { float x; memcpy(&x, &b, 4); return x; }

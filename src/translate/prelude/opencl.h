@@ -36,6 +36,14 @@ BRDFPROF_FN half_t h_fma(half_t a, half_t b, half_t c) { return h_from_f32(fma(h
 BRDFPROF_FN half_t h_neg(half_t a) { return h_from_bits(a.b ^ 0x8000u); }
 BRDFPROF_FN half_t h_div(half_t a, half_t b) { return h_from_f32(h_to_f32(a) / h_to_f32(b)); }
 #endif
+// Comparisons and min/max in f32 (exact for halves).
+BRDFPROF_FN bool h_lt(half_t a, half_t b) { return h_to_f32(a) < h_to_f32(b); }
+BRDFPROF_FN bool h_le(half_t a, half_t b) { return h_to_f32(a) <= h_to_f32(b); }
+BRDFPROF_FN bool h_gt(half_t a, half_t b) { return h_to_f32(a) > h_to_f32(b); }
+BRDFPROF_FN bool h_ge(half_t a, half_t b) { return h_to_f32(a) >= h_to_f32(b); }
+BRDFPROF_FN bool h_eq(half_t a, half_t b) { return h_to_f32(a) == h_to_f32(b); }
+BRDFPROF_FN half_t h_min(half_t a, half_t b) { return h_from_f32(fmin(h_to_f32(a), h_to_f32(b))); }
+BRDFPROF_FN half_t h_max(half_t a, half_t b) { return h_from_f32(fmax(h_to_f32(a), h_to_f32(b))); }
 
 BRDFPROF_FN u32 f32_bits(float x) { return as_uint(x); }
 BRDFPROF_FN float f32_from_bits(u32 b) { return as_float(b); }
