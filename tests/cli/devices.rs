@@ -60,3 +60,18 @@ fn mesa_variables_in_the_environment_cannot_crash_it() {
         }
     }
 }
+
+/// `scripts/gpu-check.sh` (run by hand on a lent GPU machine; its whole run on lavapipe takes minutes, so the
+/// test checks only what it refuses): a wrong mode and a `measure` with nothing prepared exit 2, saying why.
+#[test]
+fn gpu_check_refuses_a_wrong_mode_and_a_measure_before_prepare() {
+    let script = common::repo_root().join("scripts/gpu-check.sh");
+    let dir = tempfile::tempdir().unwrap();
+    let run_script = |args: &[&str]| std::process::Command::new("sh").arg(&script).args(args).output().unwrap();
+    let wrong = run_script(&["measur", dir.path().to_str().unwrap()]);
+    assert_eq!(wrong.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&wrong.stderr).contains("usage: "), "{wrong:?}");
+    let early = run_script(&["measure", dir.path().to_str().unwrap()]);
+    assert_eq!(early.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&early.stderr).contains("gpu-check.sh prepare"), "{early:?}");
+}
