@@ -19,6 +19,7 @@ mod eval;
 mod eval_csv;
 mod fuzz;
 mod limits;
+mod intel;
 mod nvidia;
 mod outputs;
 mod radv;
