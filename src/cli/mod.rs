@@ -4,6 +4,7 @@
 pub mod cache;
 pub mod compare;
 pub mod counts;
+pub mod diff;
 pub mod eval;
 pub mod info;
 pub mod measure;

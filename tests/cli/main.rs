@@ -8,6 +8,7 @@ mod brdf_models;
 mod cache;
 mod compare;
 mod devices;
+mod diff;
 mod eval;
 mod eval_csv;
 mod fuzz;
