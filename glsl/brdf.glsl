@@ -309,7 +309,8 @@ real perceptual_to_alpha(float roughness) {
     return real(r * r);
 }
 
-real guard_cosine(real x) { return clamp(x, real(MIN_COSINE), real(1)); }
+// A visible cosine into [MIN_COSINE, 1]; without the cosine-floor guard into [0, 1], as engines saturate.
+real guard_cosine(real x) { return clamp(x, guarded(GUARD_COSINE_FLOOR) ? real(MIN_COSINE) : real(0), real(1)); }
 
 // f_s = D Vis F from cosines already guarded and sin2h = 1 - NoH^2 (the kernels' shared core).
 real3 specular_from_cosines(real NoV, real NoL, real NoH, real VoH, real sin2h, real a, real3 f0) {
@@ -347,16 +348,19 @@ vec3 specular_brdf_unit(vec3 N, vec3 V, vec3 L, float roughness, vec3 f0) {
 #else
 // f_s for unit (or zero) N, V, L; 0 unless NoL > 0 and NoV > 0 (not multiplied by NoL).
 vec3 specular_brdf_unit(vec3 N, vec3 V, vec3 L, float roughness, vec3 f0) {
-    vec3 H = safe_normalize(V + L);
+    // The switchable guards (GUARDS, a specialisation constant: the driver folds every `guarded` test).
+    vec3 H = guarded(GUARD_SAFE_H) ? safe_normalize(V + L) : normalize(V + L);
     real3 Nr = real3(N), Hr = real3(H);
     real NoV = dot(Nr, real3(V));
     real NoL = dot(Nr, real3(L));
+    real NoH = guard_cosine(dot(Nr, Hr));
     real3 NxH = cross(Nr, Hr);
+    real sin2h = guarded(GUARD_SIN2H) ? min(dot(NxH, NxH), real(1)) : real(1) - NoH * NoH;
+    real3 F0 = real3(guarded(GUARD_F0_CLAMP) ? clamp(f0, vec3(0), vec3(1)) : f0);
     bool lit = NoV > real(0) && NoL > real(0);
-    real3 fs = specular_from_cosines(guard_cosine(NoV), guard_cosine(NoL), guard_cosine(dot(Nr, Hr)),
-                                     guard_cosine(dot(real3(V), Hr)), min(dot(NxH, NxH), real(1)),
-                                     perceptual_to_alpha(roughness), real3(clamp(f0, vec3(0), vec3(1))));
-    return mix(vec3(0), vec3(fs), bvec3(lit));
+    real3 fs = specular_from_cosines(guard_cosine(NoV), guard_cosine(NoL), NoH, guard_cosine(dot(real3(V), Hr)), sin2h,
+                                     perceptual_to_alpha(roughness), F0);
+    return guarded(GUARD_LIT_MASK) ? mix(vec3(0), vec3(fs), bvec3(lit)) : vec3(fs);
 }
 #endif
 

@@ -10,6 +10,7 @@ pub mod chart;
 pub mod cleanup;
 pub mod compare;
 pub mod compile_limit;
+pub mod diff;
 pub mod gpu;
 pub mod host;
 pub mod inspect;

@@ -26,6 +26,10 @@ enum Command {
     Models,
     /// Evaluate f_s of one model on the GPU for every row of a CSV file.
     Eval(cli::eval::EvalArgs),
+    /// Evaluate two models on the same inputs (a CSV or seeded samples) and report how far B is from A: per
+    /// channel max and RMS relative and absolute difference, the worst rows, a histogram; optional CSV of both
+    /// outputs, JSON report and a picture (lit spheres, difference maps, lobes). Exit 1 above --tolerance.
+    Diff(cli::diff::DiffArgs),
     /// Measure the cost per BRDF evaluation of models over a synthetic G-buffer lit by several lights.
     Profile(cli::measure::ProfileArgs),
     /// Time and measure the accuracy of many model specs in one interleaved run: table, JSON and a chart of
@@ -78,6 +82,7 @@ fn main() -> ExitCode {
         Command::Devices(args) => cli::info::devices(&args),
         Command::Models => cli::info::models(),
         Command::Eval(args) => cli::eval::eval(&args),
+        Command::Diff(args) => cli::diff::diff(&args),
         Command::Profile(args) => cli::measure::profile(&args),
         Command::Sweep(args) => cli::measure::sweep(&args),
         Command::Stability(args) => cli::measure::stability(&args),

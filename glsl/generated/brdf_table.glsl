@@ -58,6 +58,15 @@ const float MIN_VECTOR = 1.1754944e-38; // FLT_MIN: a vector whose largest compo
 const float GTR_SERIES_BAND = 0.05; // |a2-1| below which the GTR normaliser uses its series (0/0 at a2 = 1)
 const float F0_MAX = 0.9999; // dielectric F0 cap: the IOR (1+sqrt F0)/(1-sqrt F0) is infinite at 1
 
+// Switchable guards (guards= in a spec; docs/guards.md): the bits of GUARDS, all on by default.
+layout(constant_id = 15) const int GUARDS = 31;
+#define GUARD_SAFE_H 1 // H = safe_normalize(V + L): scaled first, 0 for V = -L; off: H = normalize(V + L)
+#define GUARD_SIN2H 2 // 1 - NoH^2 as |N x H|^2, no cancellation at the peak; off: 1 - NoH * NoH
+#define GUARD_COSINE_FLOOR 4 // NoV, NoL, NoH, VoH clamped into [MIN_COSINE, 1]; off: clamped into [0, 1] (saturate)
+#define GUARD_F0_CLAMP 8 // F0 clamped into [0, 1]; off: F0 as given
+#define GUARD_LIT_MASK 16 // f_s = 0 unless NoV > 0 and NoL > 0; off: f_s of the saturated cosines, whatever it is
+bool guarded(int bit) { return (GUARDS & bit) != 0; }
+
 // An id outside the tables: unreachable, and NaN rather than another term if it ever happened.
 float not_a_term() { return uintBitsToFloat(0x7fc00000u); }
 

@@ -5,7 +5,7 @@
 //! this module generates. A term missing its GLSL function is a glslang error, and no `switch` has a term as
 //! its `default`: an id outside the table gives NaN.
 
-use super::guards::{GLSL_GUARDS, MIN_ROUGHNESS_F16, MIN_ROUGHNESS_F32};
+use super::guards::{GuardSet, GLSL_GUARDS, GUARDS_CONSTANT_ID, MIN_ROUGHNESS_F16, MIN_ROUGHNESS_F32, SWITCHES};
 use super::terms::{Metal, ParamKind, PARAMS, D, F, Vis};
 use crate::kernels::constants::{ConstantKind, ALL as KERNEL_CONSTANTS, LIGHT_BLOCK};
 
@@ -56,6 +56,11 @@ fn table() -> String {
     for g in &GLSL_GUARDS {
         out += &format!("const float {} = {}; // {}\n", g.name, float(g.value), g.why);
     }
+    out += &format!("\n// Switchable guards (guards= in a spec; docs/guards.md): the bits of GUARDS, all on by default.\nlayout(constant_id = {GUARDS_CONSTANT_ID}) const int GUARDS = {};\n", GuardSet::ALL.0);
+    for g in &SWITCHES {
+        out += &format!("#define {} {} // {}; off: {}\n", g.glsl, g.bit, g.guarded, g.unguarded);
+    }
+    out += "bool guarded(int bit) { return (GUARDS & bit) != 0; }\n";
     out += "\n// An id outside the tables: unreachable, and NaN rather than another term if it ever happened.\nfloat not_a_term() { return uintBitsToFloat(0x7fc00000u); }\n";
     out += "\n// ---- Metals: complex IOR n + ik at 650/550/450 nm (src/brdf/terms.rs) ----\n";
     out += "// (A switch, not a const array: glslang 12 emits invalid SPIR-V when a spec constant indexes one.)\n";

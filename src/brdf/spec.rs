@@ -3,7 +3,7 @@
 //! overrides (`burley,gamma=2`, `ggx,precision=f16`). Every key is checked once: a parameter no term of the
 //! spec reads, or a key given twice, is an error.
 
-use super::guards::{self, MIN_ROUGHNESS_F16, MIN_ROUGHNESS_F32};
+use super::guards::{self, GuardSet, MIN_ROUGHNESS_F16, MIN_ROUGHNESS_F32};
 use super::terms::{Cosines, Exact, Metal, Param, ParamKind, ParamValue, Params, D, F, Vis};
 use super::Sample;
 use glam::DVec3;
@@ -43,6 +43,8 @@ pub struct ModelSpec {
     pub precision: Precision,
     /// Every parameter's value; only those the terms read matter (`reads`).
     pub params: Params,
+    /// The switchable guards it keeps (`guards=`; all by default).
+    pub guards: GuardSet,
 }
 
 /// A named combination, as an engine or the thesis ships it.
@@ -71,11 +73,11 @@ pub const THESIS_MODELS: [&str; 4] = ["ggx", "blinn", "cook-torrance", "burley"]
 pub const REFERENCE_MODEL: &str = "ggx";
 
 /// Keys of a spec besides the parameters.
-const TERM_KEYS: [&str; 4] = ["d", "vis", "f", "precision"];
+const TERM_KEYS: [&str; 5] = ["d", "vis", "f", "precision", "guards"];
 
 impl ModelSpec {
     pub fn new(d: D, vis: Vis, f: F) -> Self {
-        ModelSpec { d, vis, f, precision: Precision::F32, params: Params::default() }
+        ModelSpec { d, vis, f, precision: Precision::F32, params: Params::default(), guards: GuardSet::ALL }
     }
 
     pub fn preset(name: &str) -> Option<Self> {
@@ -134,6 +136,7 @@ impl ModelSpec {
                 "vis" => spec.vis = Vis::from_name(value).ok_or_else(|| unknown("vis", value, &Vis::names()))?,
                 "f" => spec.f = parse_f(value, &mut given)?,
                 "precision" => spec.precision = Precision::from_name(value).ok_or_else(|| unknown("precision", value, &["f32", "f16"]))?,
+                "guards" => spec.guards = GuardSet::parse(value)?,
                 _ => {
                     let p = Param::from_name(key).ok_or_else(|| {
                         let keys: Vec<&str> = TERM_KEYS.into_iter().chain(Param::ALL.map(Param::name)).collect();
@@ -176,6 +179,9 @@ impl ModelSpec {
         if self.precision != Precision::F32 {
             s += &format!(",precision={}", self.precision.name());
         }
+        if self.guards != GuardSet::ALL {
+            s += &format!(",guards={}", self.guards.text());
+        }
         s
     }
 
@@ -192,6 +198,9 @@ impl ModelSpec {
         }
         if self.precision != Precision::F32 {
             s += &format!(",precision={}", self.precision.name());
+        }
+        if self.guards != GuardSet::ALL {
+            s += &format!(",guards={}", self.guards.text());
         }
         s
     }
@@ -239,7 +248,7 @@ impl ModelSpec {
 
     /// The twin of `specular_brdf_unit`: N, V, L taken as given (the kernel's unit vectors, rounding and all).
     pub fn eval_unit(&self, n: DVec3, v: DVec3, l: DVec3, roughness: f64, f0: [f64; 3]) -> [f64; 3] {
-        match guarded_cosines_unit(n, v, l, f0) {
+        match cosines_with(n, v, l, f0, self.guards) {
             Some((c, f0)) => self.from_cosines(&c, self.alpha(roughness), f0),
             None => [0.0; 3],
         }
@@ -268,19 +277,26 @@ pub fn guarded_cosines(s: &Sample) -> Option<(Cosines, [f64; 3])> {
 
 /// As `guarded_cosines` for vectors already normalised (only H is formed and normalised here).
 pub fn guarded_cosines_unit(n: DVec3, v: DVec3, l: DVec3, f0: [f64; 3]) -> Option<(Cosines, [f64; 3])> {
-    let h = guards::safe_normalize(v + l);
+    cosines_with(n, v, l, f0, GuardSet::ALL)
+}
+
+/// The twin of `specular_brdf_unit`'s geometry with the guards of `g` (`guards::SWITCHES`); None when the lit
+/// mask is on and NoV <= 0 or NoL <= 0.
+pub fn cosines_with(n: DVec3, v: DVec3, l: DVec3, f0: [f64; 3], g: GuardSet) -> Option<(Cosines, [f64; 3])> {
+    let h = if g.on("safe-h") { guards::safe_normalize(v + l) } else { (v + l) / (v + l).length() };
     let (nov, nol) = (n.dot(v), n.dot(l));
-    if !(nov > 0.0 && nol > 0.0) {
+    if g.on("lit-mask") && !(nov > 0.0 && nol > 0.0) {
         return None;
     }
+    let noh = g.cosine(n.dot(h));
     let c = Cosines {
-        nov: guards::guard_cosine(nov),
-        nol: guards::guard_cosine(nol),
-        noh: guards::guard_cosine(n.dot(h)),
-        voh: guards::guard_cosine(v.dot(h)),
-        sin2h: n.cross(h).length_squared().min(1.0),
+        nov: g.cosine(nov),
+        nol: g.cosine(nol),
+        noh,
+        voh: g.cosine(v.dot(h)),
+        sin2h: if g.on("sin2h") { n.cross(h).length_squared().min(1.0) } else { 1.0 - noh * noh },
     };
-    Some((c, f0.map(|x| x.clamp(0.0, 1.0))))
+    Some((c, if g.on("f0-clamp") { f0.map(|x| x.clamp(0.0, 1.0)) } else { f0 }))
 }
 
 impl fmt::Display for ModelSpec {
@@ -346,6 +362,13 @@ mod tests {
         let c = ModelSpec::parse("d=beckmann,vis=smith-beckmann-walter,f=conductor-copper").unwrap();
         assert_eq!((c.f, c.params.metal()), (F::Conductor, Metal::Copper));
         assert_eq!(ModelSpec::parse(&c.name()).unwrap(), c);
+        for text in ["ggx,guards=off", "burley,guards=off:sin2h+f0-clamp", "ggx,guards=on"] {
+            let g = ModelSpec::parse(text).unwrap();
+            assert_eq!(ModelSpec::parse(&g.name()).unwrap(), g, "{text}");
+            assert_eq!(ModelSpec::parse(&g.canonical()).unwrap(), g, "{text}");
+        }
+        assert_eq!(ModelSpec::parse("ggx,guards=on").unwrap(), ModelSpec::parse("ggx").unwrap());
+        assert_eq!(ModelSpec::parse("ggx,guards=off:safe-h+sin2h+cosine-floor+f0-clamp+lit-mask").unwrap().guards, GuardSet::NONE);
         assert_eq!(ModelSpec::parse("d=beckmann,vis=smith-beckmann-walter,f=conductor,metal=copper").unwrap(), c);
         assert_eq!(ModelSpec::parse("burley").unwrap().with_params(&["gamma=2.5".into()]).unwrap().params.number(Param::Gamma), 2.5);
         assert_eq!(ModelSpec::parse("burley,gamma=2").unwrap().with_params(&["gamma=2.5".into()]).unwrap().params.number(Param::Gamma), 2.5);
@@ -362,6 +385,8 @@ mod tests {
         assert!(ModelSpec::parse("ggx,gamma=2").unwrap_err().contains("read by no term"));
         assert!(ModelSpec::parse("ggx,metal=gold").unwrap_err().contains("read by no term"));
         assert!(ModelSpec::parse("ggx,f=conductor-tin").unwrap_err().contains("unknown metal `tin`"));
+        assert!(ModelSpec::parse("ggx,guards=of").unwrap_err().contains("guards `of`"));
+        assert!(ModelSpec::parse("ggx,guards=off:sin2h+nope").unwrap_err().contains("cosine-floor"));
     }
 
     #[test]

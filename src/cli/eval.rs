@@ -51,14 +51,14 @@ pub fn eval(args: &EvalArgs) -> Result<ExitCode> {
 
 /// Parameters read per CSV row: `floats` values per row, rows one after another.
 #[derive(Default)]
-struct RowValues {
-    values: Vec<f32>,
-    floats: usize,
+pub(super) struct RowValues {
+    pub(super) values: Vec<f32>,
+    pub(super) floats: usize,
 }
 
 /// The CSV's samples and tangents, and, for a `.brdf` model, the model with each parameter that has a column
 /// named like it (NAME, or NAMEr,NAMEg,NAMEb for a colour) read per row, unless `--param` sets it.
-fn read_input(model: &Model, path: &Path, params: &[String]) -> Result<(Model, io::csv::EvalInput, RowValues)> {
+pub(super) fn read_input(model: &Model, path: &Path, params: &[String]) -> Result<(Model, io::csv::EvalInput, RowValues)> {
     let Some(file) = model.file() else {
         let input = io::csv::read_eval_csv(path, &[])?;
         if input.tangents.is_some() {

@@ -184,6 +184,10 @@ pub struct StabilityArgs {
     /// Skip the directional-albedo (energy) part.
     #[arg(long)]
     pub no_energy: bool,
+    /// Also check each spec without brdfprof's guards (`guards=off`, docs/guards.md), listed next to it: the
+    /// hard cases it then fails are the ones its guards save.
+    #[arg(long)]
+    pub unguarded: bool,
     /// Directory for stability-<device>.md/.json and the furnace, albedo and failure PNGs.
     #[arg(long, default_value = "results")]
     pub out: PathBuf,
@@ -194,7 +198,7 @@ pub struct StabilityArgs {
 pub fn stability(args: &StabilityArgs) -> Result<ExitCode> {
     io::check_output_dir("--out", &args.out)?;
     let models = if args.model.models.is_empty() { stability::default_specs().into_iter().map(Model::spec).collect() } else { args.model.models(&[])? };
-    let options = stability::StabilityOptions { models, energy: !args.no_energy };
+    let options = stability::StabilityOptions { models: super::with_unguarded(models, args.unguarded), energy: !args.no_energy };
     let (gpu, result) = on_device(&args.device, |gpu, progress| stability::run(gpu, &options, progress))?;
     let files = result.write(&args.out, &report::device_slug(&gpu.info))?;
     print!("{}", result.markdown());

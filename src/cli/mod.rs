@@ -4,6 +4,7 @@
 pub mod cache;
 pub mod compare;
 pub mod counts;
+pub mod diff;
 pub mod eval;
 pub mod info;
 pub mod measure;
@@ -152,6 +153,27 @@ pub struct TimingArgs {
     /// glslang instead of using the embedded SPIR-V: time an edited kernel against the built-in one.
     #[arg(long)]
     pub glsl: Option<std::path::PathBuf>,
+    /// Also time each spec without brdfprof's guards (`guards=off`, docs/guards.md), listed next to it and
+    /// timed in the same interleaved rounds.
+    #[arg(long)]
+    pub unguarded: bool,
+}
+
+/// `models` with, after each built-in spec that keeps a guard, the same spec with `guards=off` (a `.brdf`
+/// file has no brdfprof guards to remove), when `unguarded`.
+pub fn with_unguarded(models: Vec<Model>, unguarded: bool) -> Vec<Model> {
+    if !unguarded {
+        return models;
+    }
+    let mut out = Vec::with_capacity(2 * models.len());
+    for m in models {
+        let off = m.twin().filter(|s| s.guards != brdfprof::brdf::guards::GuardSet::NONE).map(|s| Model::spec(brdfprof::brdf::ModelSpec { guards: brdfprof::brdf::guards::GuardSet::NONE, ..*s }));
+        out.push(m);
+        out.extend(off);
+    }
+    let mut seen = Vec::new();
+    out.retain(|m| if seen.contains(m) { false } else { seen.push(m.clone()); true });
+    out
 }
 
 impl TimingArgs {
@@ -167,7 +189,7 @@ impl TimingArgs {
         }
         let min_rounds = self.min_rounds.max(1);
         Ok(ProfileOptions {
-            models,
+            models: with_unguarded(models, self.unguarded),
             width,
             height,
             lights: self.lights.clone(),

@@ -50,7 +50,7 @@ mod tests {
 
     #[test]
     fn ids_are_unique_and_above_the_term_constants() {
-        let mut ids: Vec<u32> = ALL.iter().map(|c| c.id).chain(PARAMS.iter().map(|p| p.constant_id)).chain([0, 1, 2]).collect();
+        let mut ids: Vec<u32> = ALL.iter().map(|c| c.id).chain(PARAMS.iter().map(|p| p.constant_id)).chain([0, 1, 2, crate::brdf::guards::GUARDS_CONSTANT_ID]).collect();
         let n = ids.len();
         ids.sort();
         ids.dedup();

@@ -77,6 +77,7 @@ impl From<ModelSpec> for Model {
 /// The specialisation constants that select `spec`'s terms and set the parameters they read.
 pub fn spec_constants(spec: &ModelSpec) -> SpecConstants {
     let mut c = SpecConstants::default().int(0, spec.d.id() as i32).int(1, spec.vis.id() as i32).int(2, spec.f.id() as i32);
+    c = c.int(crate::brdf::guards::GUARDS_CONSTANT_ID, spec.guards.0 as i32);
     for p in &PARAMS {
         c = match spec.params.get(p.param) {
             ParamValue::Number(x) => c.float(p.constant_id, x as f32),
@@ -167,7 +168,7 @@ impl Model {
     /// Whether an override key is a parameter of this model (so that `--param` skips models it does not fit).
     pub fn takes_param(&self, key: &str) -> bool {
         match self {
-            Model::Spec(s) => ["d", "vis", "f", "precision"].contains(&key) || s.reads().iter().any(|p| p.name() == key),
+            Model::Spec(s) => ["d", "vis", "f", "precision", "guards"].contains(&key) || s.reads().iter().any(|p| p.name() == key),
             Model::File(f) => f.takes_param(key),
         }
     }

@@ -42,7 +42,7 @@ fn slug(spec: &BrdfModel) -> String {
 }
 
 /// Draws an RGB picture (w x h, row-major) at (x0, y0) of a plotters area.
-fn blit(root: &DrawingArea<BitMapBackend, plotters::coord::Shift>, x0: i32, y0: i32, w: u32, px: &[[u8; 3]]) -> Result<()> {
+pub fn blit(root: &DrawingArea<BitMapBackend, plotters::coord::Shift>, x0: i32, y0: i32, w: u32, px: &[[u8; 3]]) -> Result<()> {
     for (i, c) in px.iter().enumerate() {
         let (x, y) = ((i as u32 % w) as i32, (i as u32 / w) as i32);
         root.draw_pixel((x0 + x, y0 + y), &RGBColor(c[0], c[1], c[2])).map_err(|e| anyhow!("{e}"))?;
@@ -50,7 +50,7 @@ fn blit(root: &DrawingArea<BitMapBackend, plotters::coord::Shift>, x0: i32, y0: 
     Ok(())
 }
 
-fn label(root: &DrawingArea<BitMapBackend, plotters::coord::Shift>, text: &str, x: i32, y: i32, size: i32, colour: RGBColor) -> Result<()> {
+pub fn label(root: &DrawingArea<BitMapBackend, plotters::coord::Shift>, text: &str, x: i32, y: i32, size: i32, colour: RGBColor) -> Result<()> {
     root.draw(&Text::new(text.to_string(), (x, y), (FONT, size).into_font().color(&colour))).map_err(|e| anyhow!("{e}"))
 }
 
@@ -206,19 +206,38 @@ pub fn viridis(t: f32) -> [u8; 3] {
     [0, 1, 2].map(|c| (P[i][c] * (1.0 - f) + P[i + 1][c] * f).round() as u8)
 }
 
-fn colour_bar(root: &DrawingArea<BitMapBackend, plotters::coord::Shift>, x0: i32, y0: i32, h: i32, scale: f32) -> Result<()> {
+/// A vertical viridis bar from 0 (bottom) to `scale` (top), the top labelled with `report::sig` (three
+/// significant figures: a scale of 0.003 reads 0.003, not 0.00).
+pub fn colour_bar(root: &DrawingArea<BitMapBackend, plotters::coord::Shift>, x0: i32, y0: i32, h: i32, scale: f32) -> Result<()> {
     for y in 0..h {
         let c = viridis(1.0 - y as f32 / (h - 1) as f32);
         root.draw(&Rectangle::new([(x0, y0 + y), (x0 + 14, y0 + y + 1)], RGBColor(c[0], c[1], c[2]).filled())).map_err(|e| anyhow!("{e}"))?;
     }
-    label(root, &format!("{scale:.2}"), x0 + 16, y0, 12, BLACK)?;
+    label(root, &crate::report::sig(f64::from(scale), 3), x0 + 16, y0, 12, BLACK)?;
     label(root, "0", x0 + 16, y0 + h - 12, 12, BLACK)
 }
 
 /// f_s NoL in the plane of incidence, view at 45 degrees, F0 = 1 (Schlick F = 1), one panel per roughness and a
 /// curve per model, each panel normalised to its largest value; evaluated on the device.
 pub fn lobe_plot(gpu: &Gpu, path: &Path, models: &[BrdfModel], roughness: &[f32]) -> Result<()> {
-    let theta_v = 45f64.to_radians();
+    let panels = lobe_curves(gpu, models, roughness)?;
+    let labels: Vec<String> = models.iter().map(BrdfModel::short_name).collect();
+    chart::render(path, LOBE_PANEL.0 * panels.len() as u32, LOBE_PANEL.1 + 40, |root| draw_lobes(root, &labels, &panels))
+}
+
+/// One lobe panel's size in pixels (`draw_lobes` adds a 40-pixel title).
+pub const LOBE_PANEL: (u32, u32) = (420, 300);
+
+/// View angle of the lobe plots, from the normal.
+const LOBE_VIEW_DEG: f64 = 45.0;
+
+/// One panel of the lobe plot: its roughness and, per model, (theta_l, f_s NoL) in the plane of incidence.
+pub type LobePanel = (f32, Vec<Vec<(f64, f64)>>);
+
+/// The lobe plot's curves, evaluated on the device: per roughness, per model, f_s NoL (red channel) at every
+/// half degree of the plane of incidence, view at 45 degrees, F0 = 1.
+pub fn lobe_curves(gpu: &Gpu, models: &[BrdfModel], roughness: &[f32]) -> Result<Vec<LobePanel>> {
+    let theta_v = LOBE_VIEW_DEG.to_radians();
     let v = [-(theta_v.sin()) as f32, 0.0, theta_v.cos() as f32];
     let angles: Vec<f64> = (0..=358).map(|i| (-89.5 + i as f64 * 0.5).to_radians()).collect();
     let mut panels = Vec::new();
@@ -234,41 +253,44 @@ pub fn lobe_plot(gpu: &Gpu, path: &Path, models: &[BrdfModel], roughness: &[f32]
         }
         panels.push((r, curves));
     }
-    let (pw, ph) = (420u32, 300u32);
-    chart::render(path, pw * panels.len() as u32, ph + 40, |root| {
-        let err = |e: &dyn std::fmt::Display| anyhow!("lobes: {e}");
-        let root = root.titled("f_s NoL in the plane of incidence (view at 45 deg, F0 = 1); each panel scaled to its peak", (FONT, 18)).map_err(|e| err(&e))?;
-        for (area, (r, curves)) in root.split_evenly((1, panels.len())).iter().zip(&panels) {
-            let peak = curves.iter().flatten().map(|p| p.1).fold(0.0f64, f64::max).max(1e-30);
-            let mut chart = ChartBuilder::on(area)
-                .caption(format!("r = {r} (peak {peak:.3})"), (FONT, 16))
-                .margin(10)
-                .build_cartesian_2d(-1.15f64..1.15, -0.05f64..1.15)
-                .map_err(|e| err(&e))?;
-            for rr in [0.25, 0.5, 0.75, 1.0] {
-                let arc = (0..=180).map(|i| {
-                    let t = (i as f64 - 90.0).to_radians();
-                    (rr * t.sin(), rr * t.cos())
-                });
-                chart.draw_series(LineSeries::new(arc, RGBColor(215, 215, 215).stroke_width(1))).map_err(|e| err(&e))?;
-            }
-            let view = [(0.0, 0.0), (-theta_v.sin() * 1.1, theta_v.cos() * 1.1)];
-            chart.draw_series(LineSeries::new(view, BLACK.stroke_width(2))).map_err(|e| err(&e))?;
-            chart.draw_series(std::iter::once(Text::new("V", (-theta_v.sin() * 1.12, theta_v.cos() * 1.12 + 0.05), (FONT, 14)))).map_err(|e| err(&e))?;
-            for (i, (m, c)) in models.iter().zip(curves).enumerate() {
-                let colour = chart::palette(i);
-                let pts = c.iter().map(|(t, y)| {
-                    let rr = y / peak;
-                    (rr * t.sin(), rr * t.cos())
-                });
-                chart
-                    .draw_series(LineSeries::new(pts, colour.stroke_width(2)))
-                    .map_err(|e| err(&e))?
-                    .label(m.short_name())
-                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], colour.stroke_width(2)));
-            }
-            chart.configure_series_labels().position(SeriesLabelPosition::UpperLeft).label_font((FONT, 12)).background_style(WHITE.mix(0.8)).border_style(BLACK).draw().map_err(|e| err(&e))?;
+    Ok(panels)
+}
+
+/// Draws `lobe_curves` (one curve per label) into `root`: a title, then the panels side by side.
+pub fn draw_lobes(root: &DrawingArea<BitMapBackend, plotters::coord::Shift>, labels: &[String], panels: &[LobePanel]) -> Result<()> {
+    let theta_v = LOBE_VIEW_DEG.to_radians();
+    let err = |e: &dyn std::fmt::Display| anyhow!("lobes: {e}");
+    let root = root.titled("f_s NoL in the plane of incidence (view at 45 deg, F0 = 1); each panel scaled to its peak", (FONT, 18)).map_err(|e| err(&e))?;
+    for (area, (r, curves)) in root.split_evenly((1, panels.len())).iter().zip(panels) {
+        let peak = curves.iter().flatten().map(|p| p.1).fold(0.0f64, f64::max).max(1e-30);
+        let mut chart = ChartBuilder::on(area)
+            .caption(format!("r = {r} (peak {})", crate::report::sig(peak, 3)), (FONT, 16))
+            .margin(10)
+            .build_cartesian_2d(-1.15f64..1.15, -0.05f64..1.15)
+            .map_err(|e| err(&e))?;
+        for rr in [0.25, 0.5, 0.75, 1.0] {
+            let arc = (0..=180).map(|i| {
+                let t = (i as f64 - 90.0).to_radians();
+                (rr * t.sin(), rr * t.cos())
+            });
+            chart.draw_series(LineSeries::new(arc, RGBColor(215, 215, 215).stroke_width(1))).map_err(|e| err(&e))?;
         }
-        Ok(())
-    })
+        let view = [(0.0, 0.0), (-theta_v.sin() * 1.1, theta_v.cos() * 1.1)];
+        chart.draw_series(LineSeries::new(view, BLACK.stroke_width(2))).map_err(|e| err(&e))?;
+        chart.draw_series(std::iter::once(Text::new("V", (-theta_v.sin() * 1.12, theta_v.cos() * 1.12 + 0.05), (FONT, 14)))).map_err(|e| err(&e))?;
+        for (i, (label, c)) in labels.iter().zip(curves).enumerate() {
+            let colour = chart::palette(i);
+            let pts = c.iter().map(|(t, y)| {
+                let rr = y / peak;
+                (rr * t.sin(), rr * t.cos())
+            });
+            chart
+                .draw_series(LineSeries::new(pts, colour.stroke_width(2)))
+                .map_err(|e| err(&e))?
+                .label(label.clone())
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], colour.stroke_width(2)));
+        }
+        chart.configure_series_labels().position(SeriesLabelPosition::UpperLeft).label_font((FONT, 12)).background_style(WHITE.mix(0.8)).border_style(BLACK).draw().map_err(|e| err(&e))?;
+    }
+    Ok(())
 }

@@ -14,6 +14,7 @@ mod brdf_models;
 mod cache;
 mod compare;
 mod devices;
+mod diff;
 mod docs;
 mod eval;
 mod eval_csv;

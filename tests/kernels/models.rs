@@ -52,3 +52,30 @@ fn every_preset_parameter_value_and_a_limit() {
     }
     common::assert_no_validation_messages(&gpu);
 }
+
+#[test]
+fn every_preset_without_its_guards_matches_its_unguarded_twin() {
+    use brdfprof::brdf::guards::{GuardSet, SWITCHES};
+    let gpu = common::gpu();
+    // All guards off, and each one off alone: the twin follows the same switches (`spec::cosines_with`).
+    let sets: Vec<GuardSet> = std::iter::once(GuardSet::NONE).chain(SWITCHES.iter().map(|s| GuardSet(GuardSet::ALL.0 & !s.bit))).collect();
+    for preset in PRESETS {
+        for &guards in &sets {
+            let spec = ModelSpec { guards, ..ModelSpec::preset(preset.name).unwrap() };
+            let worst = check(&gpu, &spec, 20_000, 31);
+            assert!(worst.err <= 1e-3, "{}: max relative error {:.3e} at {}", spec.name(), worst.err, worst.what);
+        }
+    }
+    // Off the well-conditioned set the switches change the result, on the GPU as in the twin: a back-facing
+    // light gives 0 with the lit mask and not without it; F0 = 2 is clamped to 1 only with the F0 clamp.
+    let back = brdfprof::brdf::Sample { n: [0.0, 0.0, 1.0], v: [0.0, 0.6, 0.8], l: [0.6, 0.0, -0.8], roughness: 0.5, f0: [0.04; 3] };
+    let bright = brdfprof::brdf::Sample { l: [0.6, 0.0, 0.8], f0: [2.0; 3], ..back };
+    for (text, sample) in [("ggx,guards=off:lit-mask", back), ("ggx,guards=off:f0-clamp", bright)] {
+        let spec = ModelSpec::parse(text).unwrap();
+        let [on, off] = [ModelSpec::preset("ggx").unwrap(), spec].map(|s| kernels::eval(&gpu, &common::model(s), &[sample], RunLimits::default()).unwrap()[0][0] as f64);
+        assert!(on != off, "{text}: guarded {on}, unguarded {off}");
+        let twin = spec.eval(&sample)[0];
+        assert!(common::rel_err(off, twin) <= 1e-3 || (off.is_nan() && twin.is_nan()), "{text}: gpu {off} twin {twin}");
+    }
+    common::assert_no_validation_messages(&gpu);
+}

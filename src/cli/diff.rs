@@ -1,0 +1,139 @@
+//! `brdfprof diff --model A --model B`: both models on the same inputs, B measured against A.
+
+use super::eval::read_input;
+use super::{on_device, DeviceArgs, ModelArgs};
+use anyhow::{bail, Result};
+use brdfprof::brdf::Sample;
+use brdfprof::diff::{self, DiffReport, Evaluated};
+use brdfprof::model::Model;
+use brdfprof::{io, kernels, report};
+use clap::Args;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+#[derive(Args)]
+pub struct DiffArgs {
+    /// The two models, A then B (B is measured against A); specs or .brdf files, as for `eval`.
+    #[command(flatten)]
+    pub model: ModelArgs,
+    /// CSV of inputs, as for `eval` (columns nx,ny,nz,vx,vy,vz,lx,ly,lz,roughness,f0r,f0g,f0b). Default: seeded
+    /// well-conditioned samples (--samples, --seed).
+    #[arg(long)]
+    pub input: Option<PathBuf>,
+    /// Number of default samples (NoV, NoL in [0.05, 1], roughness in [0, 1], F0 in [0, 1]^3).
+    #[arg(long, default_value_t = 10_000, conflicts_with = "input")]
+    pub samples: usize,
+    #[arg(long, default_value_t = 19, conflicts_with = "input")]
+    pub seed: u64,
+    /// Rows listed where the models differ most.
+    #[arg(long, default_value_t = 10)]
+    pub worst: usize,
+    /// Exit 1 when the largest relative difference |B - A| / max(|A|, 1e-3) over every channel exceeds this,
+    /// or a value is finite on one side only.
+    #[arg(long, value_parser = tolerance)]
+    pub tolerance: Option<f64>,
+    /// CSV of the inputs with both outputs: nx..f0b, a_r,a_g,a_b, b_r,b_g,b_b.
+    #[arg(long)]
+    pub csv: Option<PathBuf>,
+    /// JSON report (`"kind": "diff"`, docs/diff.md).
+    #[arg(long)]
+    pub json: Option<PathBuf>,
+    /// PNG: lit spheres of A and B, the relative difference of B against A, and both models' lobes.
+    #[arg(long)]
+    pub png: Option<PathBuf>,
+    #[command(flatten)]
+    pub device: DeviceArgs,
+}
+
+/// `--tolerance`: a finite number, 0 or more.
+fn tolerance(text: &str) -> Result<f64, String> {
+    match text.trim().parse::<f64>() {
+        Ok(t) if t.is_finite() && t >= 0.0 => Ok(t),
+        _ => Err(format!("`{text}`: give a relative difference, a finite number 0 or more (e.g. 1e-3)")),
+    }
+}
+
+/// The outputs asked for, each checked writable, none an input, no two the same path.
+fn outputs(args: &DiffArgs, models: &[Model]) -> Result<Vec<(&'static str, PathBuf)>> {
+    let asked = [("--csv", &args.csv), ("--json", &args.json), ("--png", &args.png)];
+    let outs: Vec<(&'static str, PathBuf)> = asked.into_iter().filter_map(|(f, p)| p.clone().map(|p| (f, p))).collect();
+    let mut inputs: Vec<(&str, &Path)> = args.input.iter().map(|p| ("--input", p.as_path())).collect();
+    inputs.extend(models.iter().filter_map(Model::file).map(|f| ("--model", Path::new(&f.path))));
+    for (i, (flag, path)) in outs.iter().enumerate() {
+        io::check_output_path(flag, path)?;
+        io::check_not_input(flag, path, &inputs)?;
+        if let Some((other, _)) = outs[..i].iter().find(|(_, p)| p == path) {
+            bail!("{flag} {}: is also given to {other}; give each output its own path", path.display());
+        }
+    }
+    Ok(outs)
+}
+
+pub fn diff(args: &DiffArgs) -> Result<ExitCode> {
+    let models = args.model.models(&[])?;
+    let [a, b] = models.as_slice() else {
+        bail!("diff takes exactly two --model (A, then B measured against A); got {}", models.len());
+    };
+    if args.input.is_none() && !(1..=diff::MAX_SAMPLES).contains(&args.samples) {
+        bail!("--samples {}: give 1 to {}", args.samples, diff::MAX_SAMPLES);
+    }
+    let outs = outputs(args, &models)?;
+    let inputs = Inputs::read(args, a, b)?;
+    let (gpu, (va, vb)) = on_device(&args.device, |gpu, progress| {
+        progress.set_message(format!("{} and {} on {} rows", a.short_name(), b.short_name(), inputs.samples.len()));
+        let eval = |(m, rows): &(Model, super::eval::RowValues)| {
+            let extras = kernels::EvalExtras { tangents: inputs.tangents.as_deref(), rows: &rows.values, row_floats: rows.floats };
+            kernels::eval_with(gpu, m, &inputs.samples, &extras, kernels::RunLimits::default())
+        };
+        let values = (eval(&inputs.a)?, eval(&inputs.b)?);
+        if let Some((_, path)) = outs.iter().find(|(f, _)| *f == "--png") {
+            progress.set_message("picture");
+            diff::picture::write(gpu, path, &inputs.a.0, &inputs.b.0)?;
+        }
+        Ok(values)
+    })?;
+    let evaluated = Evaluated { a, b, samples: &inputs.samples, lines: inputs.lines.as_deref(), a_values: &va, b_values: &vb };
+    let result = DiffReport::build(&evaluated, &gpu.info.name, &inputs.label, args.worst, args.tolerance);
+    for (flag, path) in &outs {
+        match *flag {
+            "--csv" => io::write_output(path, diff::csv(&inputs.samples, &va, &vb).as_bytes())?,
+            "--json" => report::write_json(path, &result)?,
+            _ => {}
+        }
+    }
+    print!("{}", result.markdown());
+    if !outs.is_empty() {
+        println!("\n{}", super::written(&outs.iter().map(|(_, p)| p.clone()).collect::<Vec<_>>()));
+    }
+    Ok(if result.within_tolerance { ExitCode::SUCCESS } else { ExitCode::from(1) })
+}
+
+/// The rows both models are evaluated on, and each model with its per-row parameters (a `.brdf` file's
+/// columns, as `eval` reads them).
+struct Inputs {
+    samples: Vec<Sample>,
+    tangents: Option<Vec<[f32; 3]>>,
+    lines: Option<Vec<usize>>,
+    label: String,
+    a: (Model, super::eval::RowValues),
+    b: (Model, super::eval::RowValues),
+}
+
+impl Inputs {
+    fn read(args: &DiffArgs, a: &Model, b: &Model) -> Result<Self> {
+        let Some(path) = &args.input else {
+            let none = || super::eval::RowValues::default();
+            return Ok(Inputs {
+                samples: diff::default_samples(args.samples, args.seed),
+                tangents: None,
+                lines: None,
+                label: diff::default_samples_label(args.samples, args.seed),
+                a: (a.clone(), none()),
+                b: (b.clone(), none()),
+            });
+        };
+        let (ma, input, ra) = read_input(a, path, &args.model.params)?;
+        let (mb, _, rb) = read_input(b, path, &args.model.params)?;
+        Ok(Inputs { samples: input.samples, tangents: input.tangents, lines: Some(input.lines), label: path.display().to_string(), a: (ma, ra), b: (mb, rb) })
+    }
+}
