@@ -1396,7 +1396,8 @@ vec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) { return vec3(f(1.0)); }
 
     /// Renaming is linear in the file's size: four times the functions take about four times as long (the
     /// quadratic list lookup it replaced took sixteen times, 12.5 s for 100,000 functions). The best of three
-    /// runs each, so a loaded machine does not decide it.
+    /// runs each, and a bound (11x) between the two, so a loaded machine (8.2x seen with four builds running)
+    /// does not decide it.
     #[test]
     fn renaming_is_linear_in_the_number_of_functions() {
         let of = |n: usize| {
@@ -1415,6 +1416,6 @@ vec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) { return vec3(f(1.0)); }
         let (small, _) = of(10_000);
         let (large, f) = of(40_000);
         assert!(f.renamed_shader().unwrap().text().contains("float brdf_f_f39999(float x)"));
-        assert!(large / small < 8.0, "10,000 functions: {small:.3} s, 40,000: {large:.3} s (linear: about 4x; quadratic: 16x)");
+        assert!(large / small < 11.0, "10,000 functions: {small:.3} s, 40,000: {large:.3} s (linear: about 4x; quadratic: 16x)");
     }
 }
