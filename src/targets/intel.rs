@@ -461,3 +461,38 @@ mod tests {
         assert_eq!(t[&18][1], 0x8000);
     }
 }
+
+#[cfg(test)]
+mod throughput_fixture {
+    use super::*;
+
+    /// The fixture's rows: (row, family, lanes, basis, source).
+    fn fixture() -> Vec<(String, String, u32, String, String)> {
+        include_str!("../../tests/fixtures/intel-throughput.tsv")
+            .lines()
+            .filter(|l| !l.starts_with('#') && !l.trim().is_empty())
+            .map(|l| {
+                let f: Vec<&str> = l.split('\t').collect();
+                assert!(f.len() == 6 && !f[5].trim().is_empty(), "a fixture line needs row, family, lanes, basis, source and note: {l}");
+                (f[0].to_string(), f[1].to_string(), f[2].parse().unwrap(), f[3].to_string(), f[4].to_string())
+            })
+            .collect()
+    }
+
+    #[test]
+    fn every_rate_is_the_fixtures_and_every_fixture_entry_is_a_rate() {
+        let rows = fixture();
+        let header = include_str!("../../tests/fixtures/intel-throughput.tsv");
+        for (row, family, lanes, basis, source) in &rows {
+            assert!(["stated", "derived", "assumed"].contains(&basis.as_str()), "{row} {family}: basis `{basis}`");
+            assert!(header.contains(&format!("# [{source}]")), "{row} {family}: source `{source}` is not cited in the header");
+            let column = COLUMNS.iter().position(|c| c == family).unwrap_or_else(|| panic!("unknown family {family}"));
+            let rate = THROUGHPUT.iter().find(|r| r.row == row).unwrap_or_else(|| panic!("the code has no row `{row}`"));
+            assert_eq!(rate.lanes_per_clock[column], *lanes, "{row} on {family}");
+        }
+        assert_eq!(rows.len(), THROUGHPUT.len() * COLUMNS.len(), "every rate of every family is in the fixture once");
+        for (k, f) in FAMILIES.iter().enumerate() {
+            assert_eq!((COLUMNS[f.column], f.column), (f.name, k));
+        }
+    }
+}
