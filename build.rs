@@ -1,6 +1,6 @@
 // Embeds every SPIR-V module listed in glsl/kernels.txt, so the binary runs without glslang, and the GLSL
 // sources themselves, from which `.brdf` models' kernels are composed at run time.
-// (Rebuilding spv/ from glsl/ is `make spv`; tests/spv_fresh.rs fails when spv/ is stale.)
+// (Rebuilding spv/ from glsl/ is `make spv`; tests/kernels/sources.rs fails when spv/ is stale.)
 use std::{env, fs, path::Path};
 
 fn main() {

@@ -1,7 +1,7 @@
 #version 450
 // The scene kernel: one G-buffer pixel per invocation, every light of the scene in one dispatch, for one model
 // (the materials of the scene that use it). Light counts per type are specialisation constants and each
-// type's loop is [[unroll]]ed (lavapipe turns rolled light loops into per-lane gathers; README "Kernel design");
+// type's loop is [[unroll]]ed (lavapipe turns rolled light loops into per-lane gathers; docs/measurement.md);
 // effects are switched by constants (scene.glsl). No early return and no bounds check: buffers are padded
 // to whole workgroups.
 // Pixel: vec4 (n.xyz, roughness), vec4 (world position.xyz, metallic), vec4 (base colour.rgb, -).

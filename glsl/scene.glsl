@@ -11,7 +11,7 @@
 // The effect switches (ANISOTROPY, ENERGY_COMPENSATION, DIFFUSE, CLEAR_COAT) and the E table's size are
 // specialisation constants declared in generated/kernel_constants.glsl.
 
-// Guards of the scene path (README "Scenes"): a light closer than MIN_LIGHT_DISTANCE (world units) is taken at
+// Guards of the scene path (docs/scenes.md): a light closer than MIN_LIGHT_DISTANCE (world units) is taken at
 // that distance, so inverse-square falloff stays finite [Karis 2013 uses a 1 cm floor likewise]; anisotropic
 // alphas are floored at MIN_ROUGHNESS^2 as Filament floors them [Filament, getAnisotropicRoughness].
 const float MIN_LIGHT_DISTANCE = 1e-2;

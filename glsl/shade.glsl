@@ -1,8 +1,8 @@
 // The profiling kernel's body: one G-buffer pixel per invocation, lit by NUM_LIGHTS directional lights per
 // dispatch, out (+)= sum_j f_s(n, v, l_j) NoL_j colour_j. A profile of L lights runs ceil(L / LIGHT_BLOCK)
 // dispatches of at most LIGHT_BLOCK lights each, each adding to what the earlier ones wrote (ACCUMULATE), as a
-// lighting pass adds light volumes into its target. Shaped by what costs on lavapipe (README "How the
-// measurement works"): the block's lights are a uniform buffer at a dynamic offset, read with constant
+// lighting pass adds light volumes into its target. Shaped by what costs on lavapipe (docs/measurement.md):
+// the block's lights are a uniform buffer at a dynamic offset, read with constant
 // indices in a loop [[unroll]]ed over the block (a rolled loop turns light loads into per-lane gathers), so the
 // unrolled code stays one block long at any light count. Light directions are unit vectors (normalised on the
 // host, as engines pass them). No early return and no bounds check (buffers are padded to whole workgroups).

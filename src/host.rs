@@ -80,7 +80,7 @@ pub fn available_memory() -> Option<u64> {
 }
 
 /// Bytes that lower the memory brdfprof plans with below `MemAvailable` (`available_memory`), so that the
-/// refusals of sizes that do not fit can be tested without filling a machine's memory (README "Limits").
+/// refusals of sizes that do not fit can be tested without filling a machine's memory (docs/limits.md).
 pub const MEMORY_LIMIT_ENV: &str = "BRDFPROF_MEMORY_LIMIT";
 
 /// `MEMORY_LIMIT_ENV` when set: a whole number of bytes (an error names the variable otherwise).

@@ -47,7 +47,7 @@ layout(constant_id = 4) const int METAL = 0; // metal of the conductor Fresnel t
 #define METAL_ALUMINIUM 3
 #define METAL_IRON 4
 
-// ---- Guards (src/brdf/guards.rs; README "Guards") ----
+// ---- Guards (src/brdf/guards.rs; docs/limits.md "Guards") ----
 #ifdef BRDF_F16
 const float MIN_ROUGHNESS = 0.089; // Filament MIN_PERCEPTUAL_ROUGHNESS for mediump: a2 stays a normal fp16
 #else

@@ -50,7 +50,7 @@ fn table() -> String {
     ids(&mut out, "Vis", "VIS", Vis::ALL, Vis::name, Vis::id);
     ids(&mut out, "F", "F", F::ALL, F::name, F::id);
     ids(&mut out, "Metal", "METAL", Metal::ALL, Metal::name, Metal::id);
-    out += "\n// ---- Guards (src/brdf/guards.rs; README \"Guards\") ----\n#ifdef BRDF_F16\n";
+    out += "\n// ---- Guards (src/brdf/guards.rs; docs/limits.md \"Guards\") ----\n#ifdef BRDF_F16\n";
     out += &format!("const float MIN_ROUGHNESS = {}; // Filament MIN_PERCEPTUAL_ROUGHNESS for mediump: a2 stays a normal fp16\n#else\n", float(MIN_ROUGHNESS_F16));
     out += &format!("const float MIN_ROUGHNESS = {}; // Filament MIN_PERCEPTUAL_ROUGHNESS (highp)\n#endif\n", float(MIN_ROUGHNESS_F32));
     for g in &GLSL_GUARDS {

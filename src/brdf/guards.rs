@@ -1,5 +1,6 @@
 //! The guards every kernel applies, named once. `brdf::glsl_gen` writes the same constants into the GLSL
-//! (glsl/generated.glsl); README "Guards" says why each exists and where it comes from.
+//! (glsl/generated/brdf_table.glsl); docs/limits.md ("Guards and evaluation forms") says why each exists and
+//! where it comes from.
 
 use glam::DVec3;
 

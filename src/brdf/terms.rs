@@ -86,7 +86,7 @@ pub const PARAMS: [ParamDef; 2] = [
             default: 1.5,
             min: 1.0,
             max: 3.0,
-            why: "GTR's peak a2^-gamma at the fp32 roughness floor leaves fp32's range for large gamma (measured by `brdfprof stability`: README \"Limits\")",
+            why: "GTR's peak a2^-gamma at the fp32 roughness floor leaves fp32's range for large gamma (measured by `brdfprof stability`: docs/limits.md)",
         },
         about: "GTR exponent [Burley 2012]: 1 Berry, 2 GGX; the thesis used 1.5",
         // g = 1 is the normaliser's limit form (a2-1)/ln(a2); 1 +- 1e-6 straddle it; 2 is GGX; 3 the range end.

@@ -16,7 +16,7 @@ pub struct ProfileArgs {
     #[command(flatten)]
     pub timing: TimingArgs,
     /// G-buffer size, WIDTHxHEIGHT (default 960x540: a quarter of 1080p gives the same ratios on lavapipe as
-    /// 1080p and four times the rounds per second, README "How the measurement works").
+    /// 1080p and four times the rounds per second, docs/measurement.md).
     #[arg(long)]
     pub size: Option<String>,
     /// Timed dispatches of each kernel per round.

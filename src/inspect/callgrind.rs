@@ -27,7 +27,7 @@ use std::path::{Path, PathBuf};
 /// The hidden subcommand the child runs.
 pub const CHILD_COMMAND: &str = "__callgrind-child";
 /// How many times the compile limit a compilation in the callgrind child may take (valgrind slows the JIT's
-/// LLVM about this much; README "Limits").
+/// LLVM about this much; docs/limits.md).
 pub const VALGRIND_SLOWDOWN: u32 = 20;
 /// The object callgrind files code without symbols under (the JIT-compiled kernel).
 const ANONYMOUS_OBJECT: &str = "???";

@@ -1,6 +1,6 @@
 //! naga's view of a specialised module: whether its SPIR-V front end parses it, how many functions and IR
 //! expressions it makes of it, and whether naga's validator accepts it. naga's SPIR-V front end has limits
-//! (it rejects some constructs drivers accept, see the notes in README), so a failure here is reported
+//! (it rejects some constructs drivers accept, see the notes in docs/gate.md), so a failure here is reported
 //! plainly, never treated as a problem with the kernel.
 
 use std::error::Error;

@@ -1,7 +1,7 @@
 //! The scene file: JSON read with serde through `serde_path_to_error`, so that every error names the JSON path
 //! of the problem (`materials[2].roughness: invalid type: string "x", expected f32`). Values are range-checked
 //! while they are read (the same path errors), names and combinations after (errors name the path too).
-//! `brdfprof scene --explain` prints `EXPLAIN`, the format with an example.
+//! `brdfprof scene --explain` prints `explain_text()` (docs/scenes.md's format block) with an example.
 
 use crate::model;
 use anyhow::{anyhow, bail, Result};
@@ -619,7 +619,7 @@ fn check(f: &SceneFile) -> Result<()> {
     check_render(f)
 }
 
-/// Lights a scene may have (README "Limits").
+/// Lights a scene may have (docs/limits.md).
 pub const MAX_LIGHTS: usize = 128;
 
 /// `path: no material named ...` unless `name` is one of the scene's materials.
@@ -765,70 +765,18 @@ fn names(f: &SceneFile) -> String {
     f.materials.iter().map(|m| format!("`{}`", m.name)).collect::<Vec<_>>().join(", ")
 }
 
-/// `brdfprof scene --explain`.
-pub const EXPLAIN: &str = r#"brdfprof scene files (JSON)
+/// docs/scenes.md, whose block between the `scene --explain` markers is the scene format: one text for the
+/// reader of the docs and for `brdfprof scene --explain`.
+const SCENES_DOC: &str = include_str!("../../docs/scenes.md");
 
-A scene is a G-buffer (procedural, or image files), a camera, lights and materials. `brdfprof profile --scene
-FILE` times it (one kernel per model present, every light in one dispatch, per-effect costs); `brdfprof render
---scene FILE` draws it. Errors name the JSON path of the problem (e.g. `materials[2].roughness: invalid type:
-string "x", expected f32`); image paths are relative to the scene file. Unknown keys are errors.
-
-{
-  "name": "...",                      optional, a plain file name (it names outputs); default: the file's stem
-  "description": "...",               optional
-  "gbuffer":                          one of:
-    {"procedural": {"kind": "sphere-grid", "size": [W, H], "rows": [MATERIAL...], "columns": 8, "floor": MATERIAL}}
-        thesis Fig. 5.2: a row of spheres per material, roughness (c + 0.5)/columns along each row
-    {"procedural": {"kind": "statues", "size": [W, H], "statues": [MATERIAL...], "floor": MATERIAL}}
-        thesis "metal statues": pedestal, body and head per statue, in a row on a floor
-    {"procedural": {"kind": "old-west", "size": [W, H], "ground": MATERIAL, "walls": [MATERIAL...], "roofs": MATERIAL}}
-        thesis "Old West": a street of buildings, low specular, rough
-    {"images": {
-        "normal": "n.png",            PNG 8/16-bit RGB, n = 2c - 1 (c = value/max); EXR float RGB as stored
-        "roughness": "r.png",         optional; PNG grey c = value/max, EXR R; default: the material's
-        "base_colour": "c.png",       optional; PNG sRGB-encoded, EXR linear; default: the material's
-        "metallic": "m.png",          optional; like roughness
-        "depth": "d.exr",             view-space depth along the camera axis: EXR R, or 16-bit PNG with
-        "depth_range": [near, far],     depth = near + c (far - near)
-        "position": "p.exr",          or world position, EXR RGB (exactly one of depth and position)
-        "material": "id.png",         optional; 8-bit grey material index, 255 = background; default: 0
-        "tangent": "t.png"            optional; encoded like normal; default: a frame built from the normal
-    }}                                sizes up to 16384 x 16384; the GPU work is chunked to the device's limits
-  "camera": {"position": [x,y,z], "look_at": [x,y,z], "up": [0,1,0], "fov_y_deg": 40}
-                                      optional for procedural G-buffers (each kind has a default), required for images
-  "lights": [                         up to 128, any mix; colour is linear RGB times intensity
-    {"type": "directional", "direction": [x,y,z], "colour": [1,1,1], "intensity": 1}   direction of travel
-    {"type": "point", "position": [x,y,z], "colour": [..], "intensity": I}             I / d^2
-    {"type": "spot", "position": [..], "direction": [..], "inner_angle_deg": 20, "outer_angle_deg": 30, ...}
-                                      I / d^2 times saturate((cos - cos_outer)/(cos_inner - cos_outer))^2
-    {"type": "sphere", "position": [..], "radius": R, "colour": [..], "intensity": I}
-                                      Karis 2013 representative point, normalised by (a / saturate(a + R/(2d)))^2
-  ],
-  "materials": [
-    {"name": "metal",
-     "model": "ggx",                  any model spec: a preset or d=..,vis=..,f=..[,precision=f16][,gamma=G]
-     "base_colour": [0.5,0.5,0.5], "metallic": 0, "roughness": 0.5,   F0 = mix(0.04, base_colour, metallic)
-     "params": {"gamma": 1.5},        optional parameter overrides of the model ("gamma": G is short for this)
-     "effects": {
-       "anisotropy": 0,               [-1, 1]; anisotropic GGX (needs d=ggx): at = a(1+s), ab = a(1-s)
-       "energy_compensation": false,  multiple scattering: f_s (1 + F0 (1/E - 1)), E(mu, r) integrated on the GPU
-       "diffuse": "none",             none | lambert | burley; diffuse colour = base_colour (1 - metallic)
-       "clear_coat": {"strength": 1, "roughness": 0.1}   Filament's: GGX, Kelemen, Schlick F0 = 0.04, base x (1 - Fc)
-     }}
-  ],
-  "render": {                         optional
-    "exposure": 1,                    radiance multiplier before tone mapping (ACES fit, sRGB)
-    "models": ["ggx", "blinn", "cook-torrance", "burley"],   one picture per model (every material switched to it)
-    "grid": ["metal", "rubber", "black"],                    rows of the comparison grid; default: every material
-    "lobe_roughness": [0.2, 0.4, 0.6, 0.8],                  panels of the polar lobe plot
-    "background": [0, 0, 0]
-  }
+/// `brdfprof scene --explain`: the scene format, as docs/scenes.md gives it between its markers.
+pub fn explain_text() -> &'static str {
+    const BEGIN: &str = "<!-- scene --explain: begin -->\n```text\n";
+    const END: &str = "```\n<!-- scene --explain: end -->";
+    let start = SCENES_DOC.find(BEGIN).expect("docs/scenes.md has the `scene --explain: begin` marker") + BEGIN.len();
+    let len = SCENES_DOC[start..].find(END).expect("docs/scenes.md has the `scene --explain: end` marker");
+    &SCENES_DOC[start..start + len]
 }
-
-What is compiled in: one kernel per model that covers at least one pixel; in it, each light type's loop with
-its count (specialisation constants, unrolled), and an effect only when a material of that model uses it.
-Example (scenes/sphere-grid.json):
-"#;
 
 #[cfg(test)]
 mod tests {
@@ -841,6 +789,14 @@ mod tests {
     const GOOD: &str = r#"{"gbuffer": {"procedural": {"kind": "sphere-grid", "size": [64, 32], "rows": ["a"], "floor": "a"}},
         "lights": [{"type": "directional", "direction": [0, -1, -1]}],
         "materials": [{"name": "a", "model": "ggx"}, {"name": "b", "model": "blinn", "roughness": 0.3}]}"#;
+
+    #[test]
+    fn the_explain_text_is_the_docs_format_block() {
+        let t = explain_text();
+        assert!(t.starts_with("brdfprof scene files (JSON)\n"), "{t}");
+        assert!(t.ends_with("Example (scenes/sphere-grid.json):\n"), "{t}");
+        assert!(!t.contains("```") && !t.contains("<!--"), "{t}");
+    }
 
     #[test]
     fn a_good_scene_parses_with_defaults() {

@@ -422,7 +422,7 @@ pub struct Plane {
     pub path: PathBuf,
 }
 
-/// What each G-buffer plane may be stored as (README "Scenes"; `scene --explain`).
+/// What each G-buffer plane may be stored as (docs/scenes.md; `scene --explain`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum PlaneKind {
     /// Normals and tangents: PNG 8/16-bit RGB (or RGBA, alpha ignored), n = 2c - 1; EXR float RGB.

@@ -13,7 +13,7 @@ pub mod run;
 pub mod spirv;
 pub mod terms;
 
-pub use format::{Scene, EXPLAIN};
+pub use format::{explain_text, Scene};
 
 /// `brdfprof scene FILE`: checks the scene, builds its G-buffer and says what would be compiled in (no device).
 pub fn check(path: &std::path::Path) -> anyhow::Result<String> {
@@ -30,5 +30,5 @@ pub fn check(path: &std::path::Path) -> anyhow::Result<String> {
 
 /// `brdfprof scene --explain`: the format, then the built-in sphere grid as an example.
 pub fn explain() -> String {
-    format!("{EXPLAIN}{}", include_str!("../../scenes/sphere-grid.json"))
+    format!("{}{}", explain_text(), include_str!("../../scenes/sphere-grid.json"))
 }

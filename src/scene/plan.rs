@@ -1,6 +1,7 @@
 //! Specialisation: what a scene compiles in. One kernel per model that covers at least one pixel; in it every
-//! light type's count (constants 5..8; a type with count 0 has no loop) and each effect only when a material of
-//! that model uses it (constants 9..12). The plan also packs the lights and each kernel's pixels.
+//! light type's count (the constants `NUM_DIRECTIONAL`..`NUM_SPHERE` of `kernels::constants`, ids there only; a
+//! type with count 0 has no loop) and each effect only when a material of that model uses it (`ANISOTROPY`,
+//! `ENERGY_COMPENSATION`, `DIFFUSE`, `CLEAR_COAT`). The plan also packs the lights and each kernel's pixels.
 
 use super::format::{Light, Scene};
 use super::gbuffer::{GBuffer, BACKGROUND};

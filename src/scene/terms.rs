@@ -156,7 +156,7 @@ impl ETable {
     }
 }
 
-/// The kernel's effect switches (scene.glsl constants 9..12).
+/// The kernel's effect switches (`kernels::constants` `ANISOTROPY`, `ENERGY_COMPENSATION`, `DIFFUSE`, `CLEAR_COAT`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize)]
 pub struct Switches {
     pub anisotropy: bool,

@@ -1,14 +1,16 @@
 //! Compile-only targets: GPU families whose production compiler brdfprof runs without the GPU, one `Vendor`
 //! each (`radv`: Mesa RADV's ACO in a child process; `nvidia`: NVRTC and ptxas on the kernels' CUDA C++
-//! translation), listed once in `VENDORS`. A target is `--device PREFIX:FAMILY` (or `PREFIX:all`, or
+//! translation; `intel`: IGC through ocloc on their OpenCL C translation), listed once in `VENDORS`. A target is `--device PREFIX:FAMILY` (or `PREFIX:all`, or
 //! `PREFIX:a,b`); `devices --targets`, `inspect`, `check`, `sweep --cost-device` and `compare` reach the vendors
 //! only through this module: a vendor is its families, how it compiles every kernel for them (an `inspect`
 //! report per family, with its compiler's statistics under `driver/`), its cost model (`cost`), and what its
 //! statistics depend on (the gate's fingerprint).
 
 pub mod cost;
+pub mod intel;
 pub mod nvidia;
 pub mod nvrtc;
+pub mod ocloc;
 pub mod radv;
 pub mod radv_child;
 pub mod radv_env;
@@ -85,7 +87,7 @@ pub trait Vendor: Sync {
 }
 
 /// Every vendor: the one list (a new compiler lands here and in its own file).
-pub static VENDORS: [&dyn Vendor; 2] = [&radv::RADV, &nvidia::NVIDIA];
+pub static VENDORS: [&dyn Vendor; 3] = [&radv::RADV, &nvidia::NVIDIA, &intel::INTEL];
 
 /// One family of one vendor.
 #[derive(Clone, Copy)]
@@ -193,4 +195,25 @@ pub fn cost_of(report: &InspectReport) -> Option<TargetCost> {
 pub fn file_slug(label: &str) -> String {
     let s: String = label.chars().map(|c| if c.is_ascii_alphanumeric() || c == '.' { c.to_ascii_lowercase() } else { '-' }).collect();
     s.trim_matches('-').to_string()
+}
+
+/// One kernel's translation in a dialect, checked against its Vulkan kernel, ready for every family.
+pub struct Checked {
+    pub source: String,
+    /// The row note: the device checked on and the worst difference.
+    pub agreement: String,
+}
+
+/// Every kernel of `req` (the models' and the memory-only one) translated into `dialect`, after the
+/// translation (its body is the same text in every dialect) agreed with the Vulkan kernel on `gpu`.
+pub fn checked_translations(req: &Request, gpu: &Gpu, dialect: crate::translate::Dialect) -> Result<Vec<Checked>> {
+    crate::inspect::kernels_of(req.models)
+        .into_iter()
+        .map(|m| {
+            let agreements = crate::translate::verify::check_cached(gpu, m, req.lights, req.shaders)?;
+            let source = crate::translate::prepare::shade_kernel(m, req.lights, req.shaders)?.source(dialect);
+            let agreement = agreements.iter().map(|a| format!("{} {:.1e} (tolerance {:.0e})", a.kernel, a.worst, a.tolerance)).collect::<Vec<_>>().join(", ");
+            Ok(Checked { source, agreement: format!("translation checked on the host against {}: worst relative difference {agreement}", gpu.info.name) })
+        })
+        .collect()
 }

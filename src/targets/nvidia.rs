@@ -310,30 +310,12 @@ pub fn device_name(family: &Family) -> String {
     format!("NVIDIA {} ({}), compile-only", family.name, family.architecture)
 }
 
-/// One kernel's translation, checked, ready for every family.
-struct Checked {
-    source: String,
-    agreement: String,
-}
-
-fn check_translations(req: &Request, gpu: &crate::gpu::Gpu) -> Result<Vec<Checked>> {
-    crate::inspect::kernels_of(req.models)
-        .into_iter()
-        .map(|m| {
-            let agreements = crate::translate::verify::check_cached(gpu, m, req.lights, req.shaders)?;
-            let source = crate::translate::prepare::shade_kernel(m, req.lights, req.shaders)?.source(crate::translate::Dialect::Cuda);
-            let agreement = agreements.iter().map(|a| format!("{} {:.1e} (tolerance {:.0e})", a.kernel, a.worst, a.tolerance)).collect::<Vec<_>>().join(", ");
-            Ok(Checked { source, agreement: format!("translation checked on the host against {}: worst relative difference {agreement}", gpu.info.name) })
-        })
-        .collect()
-}
-
 /// Every kernel (the models' and the memory-only one) compiled by NVIDIA's compiler for each family, as
 /// `inspect` reports (one per family, in order), after each translation agreed with its Vulkan kernel.
 pub fn inspect(families: &[&Family], req: &Request) -> Result<Vec<InspectReport>> {
     let tools = nvrtc::tools()?;
     let gpu = req.verify_on.ok_or_else(|| anyhow::anyhow!("nvidia: no Vulkan device to check the translation against"))?;
-    let checked = check_translations(req, gpu)?;
+    let checked = super::checked_translations(req, gpu, crate::translate::Dialect::Cuda)?;
     let statics = crate::inspect::kernels_of(req.models).into_iter().map(|m| crate::inspect::static_row(req.shaders, m, req.lights)).collect::<Result<Vec<_>>>()?;
     let jobs: Vec<(usize, usize)> = (0..families.len()).flat_map(|f| (0..checked.len()).map(move |k| (f, k))).collect();
     // NVRTC compiles distinct programs concurrently (its API is thread-safe); one job per core.

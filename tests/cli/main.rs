@@ -1,5 +1,11 @@
-//! The command line end to end: eval's CSV round trip and its errors, device and output checks made before
-//! anything is measured, scene names, cleanup on signals, and fuzzed inputs.
+//! The command line end to end, the binary run as a user runs it: eval's CSV round trip and its errors, `.brdf`
+//! models through every command, the kernel cache, device and output checks made before anything is measured,
+//! limits, cleanup on signals, compile-only targets' reports and `compare`, fuzzed inputs; and README and docs/
+//! against the tree (`docs`).
+//!
+//! What goes here: a test that runs `brdfprof` (or a script) and checks its exit status, output and files, and
+//! that does not time kernels. Not here: library calls against f64 twins (tests/kernels), anything about scenes
+//! (tests/scenes), timing or callgrind gates (tests/timed, which runs one test at a time).
 
 #[path = "../common/mod.rs"]
 mod common;
@@ -9,12 +15,13 @@ mod cache;
 mod compare;
 mod devices;
 mod diff;
+mod docs;
 mod eval;
 mod eval_csv;
 mod fuzz;
 mod limits;
+mod intel;
 mod nvidia;
 mod outputs;
 mod radv;
-mod scenes;
 mod signals;

@@ -1,5 +1,10 @@
 //! The commands that time kernels or count their instructions under callgrind: profile, inspect and the check
-//! gate. They run one at a time (`serial`), so that no timing shares the two cores with another measurement.
+//! gates (lavapipe's, ACO's, NVIDIA's). They run one at a time (`serial`), so that no timing shares the two
+//! cores with another measurement.
+//!
+//! What goes here: a test whose figure is a time, a callgrind count or a gate verdict on them, or that would
+//! disturb such a figure by running beside it; each takes `serial()` first. Everything else goes to tests/cli,
+//! tests/kernels or tests/scenes, which run their tests in parallel.
 
 #[path = "../common/mod.rs"]
 mod common;

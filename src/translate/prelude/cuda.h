@@ -1,6 +1,6 @@
 // ---- brdfprof prelude: CUDA C++ for NVRTC (no headers: NVRTC's built-in device functions only) ----
 // Precision is the compiler options' to decide (brdfprof passes -use_fast_math: approximate division,
-// square root, exp2/log2-based pow, denormals flushed, as a Vulkan driver may; see README).
+// square root, exp2/log2-based pow, denormals flushed, as a Vulkan driver may; see docs/targets.md).
 typedef unsigned char u8;
 typedef unsigned short u16;
 typedef unsigned int u32;

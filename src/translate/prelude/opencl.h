@@ -1,6 +1,6 @@
 // ---- brdfprof prelude: OpenCL C 1.2, for Intel's IGC (ocloc) and PoCL. The transcendental functions and
 // division are the native_ forms (the precision freedom Vulkan gives a driver) unless BRDFPROF_PRECISE is
-// defined; see README for the build options beside every figure. ----
+// defined; see docs/targets.md for the build options beside every figure. ----
 typedef uchar u8;
 typedef ushort u16;
 typedef uint u32;

@@ -1,0 +1,463 @@
+//! `--device intel:FAMILY`: Intel's production GPU compiler (IGC, through `ocloc`, see `ocloc`) on the kernels'
+//! OpenCL C translation (`translate`), Gen9 to Xe-HPC, with no Intel GPU or driver. Per kernel: the SIMD width
+//! IGC chose, its GRF count and mode, scratch space (spills and private memory), IGA's ISA listing counted by
+//! class, the binary's size, and a documented cost model: EU (vector engine) cycles from the instruction mix
+//! at the issue rates of Intel's public architecture documents (`THROUGHPUT`, the one place those figures
+//! live). These are "Intel's OpenCL compiler (IGC), same maths" figures: Mesa's ANV, Intel's Vulkan driver on
+//! Linux, compiles SPIR-V with its own compiler (brw); Intel's Windows Vulkan driver uses IGC.
+
+use super::cost::{self, TargetCost};
+use super::{ocloc, Request, Run, Target};
+use crate::gpu::DriverStat;
+use crate::inspect::InspectReport;
+use anyhow::{anyhow, bail, Result};
+use std::collections::BTreeMap;
+
+/// One Intel GPU generation, as ocloc names a device of it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Family {
+    /// The `--device intel:` name.
+    pub name: &'static str,
+    /// ocloc's `-device` (one product of the family).
+    pub device: &'static str,
+    pub architecture: &'static str,
+    pub products: &'static str,
+    /// Column of `THROUGHPUT`.
+    column: usize,
+}
+
+pub const FAMILIES: [Family; 5] = [
+    Family { name: "gen9", device: "skl", architecture: "Gen9", products: "HD/UHD Graphics 5xx-6xx (Skylake to Comet Lake)", column: 0 },
+    Family { name: "gen11", device: "icllp", architecture: "Gen11", products: "Iris Plus / UHD (Ice Lake)", column: 1 },
+    Family { name: "gen12lp", device: "tgllp", architecture: "Xe-LP (Gen12LP)", products: "Iris Xe / UHD (Tiger Lake to Raptor Lake), Iris Xe MAX", column: 2 },
+    Family { name: "xe-hpg", device: "dg2", architecture: "Xe-HPG", products: "Arc A-series (Alchemist, ACM-G10)", column: 3 },
+    Family { name: "xe-hpc", device: "pvc", architecture: "Xe-HPC", products: "Data Center GPU Max (Ponte Vecchio)", column: 4 },
+];
+
+/// The families of `THROUGHPUT`'s columns.
+pub const COLUMNS: [&str; 5] = ["gen9", "gen11", "gen12lp", "xe-hpg", "xe-hpc"];
+
+/// A rate of the cost model: lanes one EU (Xe-HPG/HPC: one vector engine) completes per clock for a kind of
+/// instruction, per family, with the document it is taken from.
+pub struct Rate {
+    pub row: &'static str,
+    pub lanes_per_clock: [u32; 5],
+}
+
+/// Lanes per clock per EU/vector engine (sources per row and column in `tests/fixtures/intel-throughput.tsv`,
+/// which transcribes the documents with their sections; a test ties every entry here to it; docs/targets.md
+/// names which figures the documents state and which are assumed).
+pub const THROUGHPUT: &[Rate] = &[
+    Rate { row: FP32, lanes_per_clock: [8, 8, 8, 8, 16] },
+    Rate { row: FP16, lanes_per_clock: [16, 16, 16, 16, 32] },
+    Rate { row: INT32, lanes_per_clock: [8, 8, 8, 8, 16] },
+    Rate { row: EM, lanes_per_clock: [2, 2, 2, 2, 4] },
+];
+
+const FP32: &str = "FP32 add, multiply, multiply-add";
+const FP16: &str = "FP16 add, multiply, multiply-add";
+const INT32: &str = "INT32 operations";
+const EM: &str = "extended math (math.*: inv, sqrt, rsqt, exp, log, sin, cos, pow, fdiv)";
+
+/// What an instruction is counted as in the report.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Class {
+    Fma,
+    Alu,
+    ExtendedMath,
+    Send,
+    Control,
+    Move,
+}
+
+impl Class {
+    pub const ALL: [Class; 6] = [Class::Fma, Class::Alu, Class::ExtendedMath, Class::Send, Class::Control, Class::Move];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Class::Fma => "FMA and arithmetic (add, mul, mad)",
+            Class::Alu => "Compare, select, logic",
+            Class::ExtendedMath => "Extended math",
+            Class::Send => "Send",
+            Class::Control => "Control",
+            Class::Move => "Move",
+        }
+    }
+}
+
+/// The report class of a Gen ISA mnemonic (before its first `.`).
+pub fn classify(mnemonic: &str) -> Class {
+    match mnemonic {
+        "add" | "add3" | "mul" | "mad" | "mac" | "mach" | "macl" | "madm" | "lrp" | "dp2" | "dp3" | "dp4" | "dph" | "dp4a" | "line" | "pln" | "avg" | "frc" | "rndd" | "rnde" | "rndu" | "rndz" | "sad2" | "sada2" | "addc" | "subb" => Class::Fma,
+        "math" => Class::ExtendedMath,
+        "send" | "sendc" | "sends" | "sendsc" => Class::Send,
+        "if" | "else" | "endif" | "while" | "break" | "cont" | "goto" | "join" | "jmpi" | "call" | "calla" | "ret" | "halt" | "brd" | "brc" | "wait" | "sync" | "nop" | "illegal" => Class::Control,
+        "mov" | "movi" | "smov" => Class::Move,
+        _ => Class::Alu,
+    }
+}
+
+/// The `THROUGHPUT` row an instruction issues at (None: one issue cycle, whatever its width: sends, whose
+/// latency the model leaves out, and control), from its class and destination type.
+fn row_of(class: Class, dst_type: &str) -> Option<&'static str> {
+    match class {
+        Class::Send | Class::Control => None,
+        Class::ExtendedMath => Some(EM),
+        _ if dst_type == "hf" => Some(FP16),
+        _ if dst_type == "f" || dst_type == "df" => Some(FP32),
+        _ => Some(INT32),
+    }
+}
+
+/// The rate of row `row` on `family` (lanes per clock per EU).
+pub fn rate(row: &str, family: &Family) -> Option<u32> {
+    THROUGHPUT.iter().find(|r| r.row == row).map(|r| r.lanes_per_clock[family.column])
+}
+
+/// One instruction of IGA's listing: its mnemonic, execution size and destination type.
+#[derive(Debug, PartialEq)]
+pub struct Instruction<'a> {
+    pub mnemonic: &'a str,
+    pub exec_size: u32,
+    pub dst_type: &'a str,
+}
+
+/// Parses one line of IGA's listing (`(W&f0.0) sel (16|M0) (lt)f1.0 r39.0<1>:f ...`); None for labels,
+/// comments and blank lines.
+pub fn instruction(line: &str) -> Option<Instruction<'_>> {
+    let code = line.split("//").next()?.trim();
+    if code.is_empty() || code.ends_with(':') {
+        return None;
+    }
+    let mut words = code.split_whitespace().peekable();
+    if words.peek()?.starts_with('(') {
+        words.next();
+    }
+    let op = words.next()?;
+    let mnemonic = op.split('.').next().unwrap_or(op);
+    if !mnemonic.chars().all(|c| c.is_ascii_alphanumeric()) || mnemonic.is_empty() {
+        return None;
+    }
+    let rest: Vec<&str> = words.collect();
+    let exec_size = rest.iter().find_map(|w| w.strip_prefix('(')?.split('|').next()?.parse().ok()).unwrap_or(1);
+    let dst_type = rest.iter().find(|w| w.contains(':') && !w.starts_with('{')).and_then(|w| w.rsplit(':').next()).unwrap_or("");
+    Some(Instruction { mnemonic, exec_size, dst_type })
+}
+
+/// The u32 words of every patch token in ocloc's PTM.txt dump, by token number (a token present twice keeps
+/// its first).
+fn patch_tokens(ptm: &str) -> BTreeMap<u32, Vec<u32>> {
+    let mut tokens: BTreeMap<u32, Vec<u32>> = BTreeMap::new();
+    let mut current: Option<u32> = None;
+    let mut bytes: Vec<u8> = Vec::new();
+    let mut flush = |current: Option<u32>, bytes: &mut Vec<u8>| {
+        if let Some(t) = current {
+            let words = bytes.chunks_exact(4).map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect();
+            tokens.entry(t).or_insert(words);
+        }
+        bytes.clear();
+    };
+    for line in ptm.lines().map(str::trim) {
+        if let Some(t) = line.strip_prefix("4 Token ") {
+            flush(current, &mut bytes);
+            current = t.trim().parse().ok();
+        } else if let Some(hex) = line.strip_prefix("Hex ") {
+            bytes.extend(hex.split_whitespace().filter_map(|b| u8::from_str_radix(b, 16).ok()));
+        } else if !line.starts_with("4 Size") {
+            flush(current, &mut bytes);
+            current = None;
+        }
+    }
+    flush(current, &mut bytes);
+    tokens
+}
+
+/// The kernel's ISA size in bytes (`KernelUnpaddedSize` of the kernel's binary header): the device binary
+/// ocloc writes also carries the program's SPIR-V and its state heaps.
+fn kernel_bytes(ptm: &str) -> Option<usize> {
+    ptm.lines().find_map(|l| l.trim().strip_prefix("4 KernelUnpaddedSize ")?.trim().parse().ok())
+}
+
+/// IGC's patch tokens brdfprof reads (IGC's `patch_list.h`): the execution environment and the scratch space
+/// of the two scratch slots.
+const EXECUTION_ENVIRONMENT: u32 = 23;
+const MEDIA_VFE_STATE: u32 = 18;
+const MEDIA_VFE_STATE_SLOT1: u32 = 55;
+/// Words of `SPatchExecutionEnvironment` after its header: LargestCompiledSIMDSize and NumGRFRequired.
+const SIMD_WORD: usize = 3;
+const GRF_WORD: usize = 20;
+
+/// One kernel's binary, counted.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct IsaStats {
+    pub simd: u32,
+    pub grf: u32,
+    /// Per-thread scratch bytes (register spills and private memory; IGC allocates them together).
+    pub scratch_bytes: u32,
+    pub instructions: u32,
+    pub by_class: BTreeMap<Class, u32>,
+    /// Lanes per `THROUGHPUT` row (None: instructions issued in one cycle each).
+    pub by_row: BTreeMap<Option<&'static str>, Vec<u32>>,
+    pub binary_bytes: u32,
+}
+
+impl IsaStats {
+    pub fn of(binary: &ocloc::Binary) -> Result<Self> {
+        let tokens = patch_tokens(&binary.tokens);
+        let env = tokens.get(&EXECUTION_ENVIRONMENT).filter(|w| w.len() > GRF_WORD).ok_or_else(|| anyhow!("ocloc's patch tokens carry no execution environment (SIMD width, GRF count)"))?;
+        let scratch = |t: u32| tokens.get(&t).and_then(|w| w.get(1).copied()).unwrap_or(0);
+        let mut s = IsaStats { simd: env[SIMD_WORD], grf: env[GRF_WORD], scratch_bytes: scratch(MEDIA_VFE_STATE) + scratch(MEDIA_VFE_STATE_SLOT1), binary_bytes: kernel_bytes(&binary.tokens).unwrap_or(binary.bytes) as u32, ..Default::default() };
+        for i in binary.listing.lines().filter_map(instruction) {
+            let class = classify(i.mnemonic);
+            s.instructions += 1;
+            *s.by_class.entry(class).or_default() += 1;
+            // sync waits on a scoreboard (a latency the model leaves out) and issues no work.
+            if i.mnemonic != "sync" {
+                s.by_row.entry(row_of(class, i.dst_type)).or_default().push(i.exec_size);
+            }
+        }
+        if s.instructions == 0 || ![8, 16, 32].contains(&s.simd) {
+            bail!("IGA's listing has {} instructions and the binary says SIMD{}: not a kernel brdfprof can count", s.instructions, s.simd);
+        }
+        Ok(s)
+    }
+
+    /// EU cycles of one hardware thread (SIMD lanes): each instruction its execution size over its row's
+    /// lanes per clock, at least one cycle; sends and control one issue cycle each.
+    pub fn issue_cycles(&self, family: &Family) -> Result<f64> {
+        let mut cycles = 0.0;
+        for (row, sizes) in &self.by_row {
+            let lanes = match row {
+                Some(r) => rate(r, family).ok_or_else(|| anyhow!("the throughput table has no row `{r}`"))?,
+                None => {
+                    cycles += sizes.len() as f64;
+                    continue;
+                }
+            };
+            cycles += sizes.iter().map(|&n| (f64::from(n) / f64::from(lanes)).max(1.0)).sum::<f64>();
+        }
+        Ok(cycles)
+    }
+
+    /// The statistics as driver statistics of the executable "IGC" (names lined up with `inspect::driver`'s
+    /// aliases, so that the gate reads registers, instructions, spills and code size as for any driver).
+    pub fn driver_stats(&self, family: &Family) -> Result<Vec<DriverStat>> {
+        let stat = |name: &str, value: f64| DriverStat { executable: "IGC".into(), name: name.into(), description: String::new(), value };
+        let mut out = vec![
+            stat("SIMD Width", f64::from(self.simd)),
+            stat("Register Count", f64::from(self.grf)),
+            stat("Large GRF Mode", if self.grf > 128 { 1.0 } else { 0.0 }),
+            stat("Instruction Count", f64::from(self.instructions)),
+            stat("Spill Count", f64::from(self.scratch_bytes)),
+            stat("Scratch Memory Size", f64::from(self.scratch_bytes)),
+            stat("Binary Size", f64::from(self.binary_bytes)),
+            stat("Issue Cycles", self.issue_cycles(family)?),
+        ];
+        for c in Class::ALL {
+            out.push(stat(c.name(), f64::from(self.by_class.get(&c).copied().unwrap_or(0))));
+        }
+        Ok(out)
+    }
+}
+
+/// ocloc's `-options`: OpenCL C 1.2 and the freedom a Vulkan driver has over SPIR-V without NoContraction or
+/// float controls: contraction into mad and denormals flushed. The translation's prelude writes GLSL's
+/// transcendentals, division and square root as OpenCL's native_ forms (Vulkan's precision for them) unless
+/// `precise`, which builds the IEEE library forms with no contraction (`-DBRDFPROF_PRECISE`).
+pub fn options(precise: bool) -> String {
+    if precise {
+        crate::translate::opencl::build_options(true)
+    } else {
+        format!("{} -cl-mad-enable -cl-denorms-are-zero", crate::translate::opencl::build_options(false))
+    }
+}
+
+/// Compiles the OpenCL C `source` for `family` and lists its ISA, under the compile limit, or takes both
+/// from the cache: the key covers the source, the options, ocloc's and IGC's versions and brdfprof's.
+pub fn compile(source: &str, family: &Family, precise: bool) -> Result<ocloc::Binary> {
+    let tools = ocloc::tools()?;
+    let options = options(precise);
+    let key = crate::cache::KeyBuilder::new("igc")
+        .part("brdfprof", env!("CARGO_PKG_VERSION"))
+        .part("ocloc", &tools.version)
+        .part("device", family.device)
+        .part("options", &options)
+        .part("source", source)
+        .finish();
+    let what = format!("the OpenCL C translation for intel:{} (ocloc -device {})", family.name, family.device);
+    let valid = |bytes: &[u8]| -> Result<()> {
+        let binary: ocloc::Binary = serde_json::from_slice(bytes)?;
+        IsaStats::of(&binary).map(|_| ())
+    };
+    let bytes = crate::cache::get_or_build(crate::cache::Store::open_default().as_ref(), "igc", &key, &what, valid, || {
+        let binary = tools.compile(source, family.device, &options, &what)?;
+        Ok(serde_json::to_vec(&binary)?)
+    })?;
+    Ok(serde_json::from_slice(&bytes)?)
+}
+
+/// The device name of a family's reports.
+pub fn device_name(family: &Family) -> String {
+    format!("Intel {} ({}), compile-only", family.name, family.architecture)
+}
+
+/// Every kernel (the models' and the memory-only one) compiled by IGC for each family, as `inspect` reports
+/// (one per family, in order), after each translation agreed with its Vulkan kernel.
+pub fn inspect(families: &[&Family], req: &Request) -> Result<Vec<InspectReport>> {
+    let tools = ocloc::tools()?;
+    let gpu = req.verify_on.ok_or_else(|| anyhow!("intel: no Vulkan device to check the translation against"))?;
+    let checked = super::checked_translations(req, gpu, crate::translate::Dialect::OpenCl)?;
+    let statics = crate::inspect::kernels_of(req.models).into_iter().map(|m| crate::inspect::static_row(req.shaders, m, req.lights)).collect::<Result<Vec<_>>>()?;
+    let jobs: Vec<(usize, usize)> = (0..families.len()).flat_map(|f| (0..checked.len()).map(move |k| (f, k))).collect();
+    // Each job is an ocloc process: one per core.
+    use rayon::prelude::*;
+    let (sources, precise): (Vec<&str>, bool) = (checked.iter().map(|c| c.source.as_str()).collect(), req.precise);
+    let compiled = jobs.par_iter().map(|&(f, k)| compile(sources[k], families[f], precise)).collect::<Result<Vec<_>>>()?;
+    let mut reports = Vec::new();
+    for (f, family) in families.iter().enumerate() {
+        let mut rows = statics.clone();
+        for (k, row) in rows.iter_mut().enumerate() {
+            let binary = &compiled[f * checked.len() + k];
+            let stats = IsaStats::of(binary)?;
+            row.stats.extend(crate::inspect::driver::stats(&stats.driver_stats(family)?));
+            row.notes.insert("translation".into(), checked[k].agreement.clone());
+            if let Some(dir) = req.isa_dir {
+                write_isa(dir, family, &row.model, &checked[k].source, binary, &tools.version)?;
+            }
+        }
+        reports.push(report(family, rows, tools, req));
+    }
+    Ok(reports)
+}
+
+/// Writes the kernel's OpenCL C translation and IGA's listing to DIR/intel-<family>/<kernel>.{cl,asm}.
+fn write_isa(dir: &std::path::Path, family: &Family, label: &str, source: &str, binary: &ocloc::Binary, version: &str) -> Result<()> {
+    let dir = dir.join(format!("intel-{}", family.name));
+    std::fs::create_dir_all(&dir).map_err(|e| anyhow!("--isa: cannot create {}: {e}", dir.display()))?;
+    let stem = super::file_slug(label);
+    crate::io::write_output(&dir.join(format!("{stem}.cl")), source.as_bytes())?;
+    let stats = IsaStats::of(binary)?;
+    let header = format!("// {label}: Gen ISA for {} (ocloc -device {}) by {version}, listed by IGA\n// SIMD{}, {} GRF, {} bytes scratch per thread\n", family.name, family.device, stats.simd, stats.grf, stats.scratch_bytes);
+    crate::io::write_output(&dir.join(format!("{stem}.asm")), format!("{header}{}", binary.listing).as_bytes())
+}
+
+fn report(family: &Family, rows: Vec<crate::inspect::Row>, tools: &ocloc::Tools, req: &Request) -> InspectReport {
+    let options = options(req.precise);
+    let provenance = serde_json::json!({
+        "tool": format!("brdfprof {}", env!("CARGO_PKG_VERSION")),
+        "device": {"name": device_name(family), "driver_name": "IGC (ocloc)", "driver_info": format!("{} (-device {}; {options})", tools.version, family.device), "driver_version": tools.version},
+        "target": format!("intel:{}", family.name),
+        "compiler": {"name": tools.version, "options": options, "device": family.device, "translation": "brdfprof's SPIR-V to OpenCL C translation"},
+        "host_cpu": crate::host::HostCpu::detect().describe(),
+    });
+    let mut notes = BTreeMap::new();
+    notes.insert("driver/".into(), format!("Intel's OpenCL compiler (IGC, {}) on the kernels' OpenCL C translation, same maths; -device {}; options: {options}", tools.version, family.device));
+    notes.insert("callgrind/".into(), format!("not applicable: intel:{} compiles only, nothing executes", family.name));
+    let tool_list = [("ocloc".to_string(), tools.version.clone())].into();
+    let mut report = crate::inspect::compiled_report(rows, provenance, req.lights, req.shaders, tool_list, notes);
+    report.cost = super::Vendor::cost(&INTEL, &report);
+    report
+}
+
+/// The statistics the cost table shows beside cycles/eval.
+pub const SHOWN: [&str; 7] = ["SIMD Width", "Register Count", "Spill Count", "Instruction Count", "FMA and arithmetic (add, mul, mad)", "Extended math", "Issue Cycles"];
+
+pub struct Intel;
+pub static INTEL: Intel = Intel;
+
+impl super::Vendor for Intel {
+    fn prefix(&self) -> &'static str {
+        "intel"
+    }
+
+    fn name(&self) -> &'static str {
+        "Intel"
+    }
+
+    fn title(&self) -> &'static str {
+        "Intel: IGC through ocloc (Debian's intel-opencl-icd) on the kernels' OpenCL C translation, checked on the host first (no Intel GPU or driver needed)"
+    }
+
+    fn families(&self) -> Vec<super::Family> {
+        FAMILIES.iter().map(|f| super::Family { name: f.name, architecture: f.architecture, products: f.products, detail: format!("ocloc -device {}", f.device), default: true }).collect()
+    }
+
+    fn status(&self) -> Result<String> {
+        let t = ocloc::tools()?;
+        Ok(format!("{} at {}, IGA from {}", t.version, t.ocloc.display(), t.iga_dir.display()))
+    }
+
+    fn needs_verification(&self) -> bool {
+        true
+    }
+
+    fn compile(&self, families: &[usize], request: &Request) -> Result<Vec<Run>> {
+        let chosen: Vec<&Family> = families.iter().map(|&k| &FAMILIES[k]).collect();
+        let reports = inspect(&chosen, request)?;
+        Ok(reports.into_iter().zip(families).map(|(report, &family)| Run { target: Target { vendor: &INTEL, family }, report, isa_files: Vec::new(), note: None }).collect())
+    }
+
+    fn cost(&self, report: &InspectReport) -> Option<TargetCost> {
+        let family = &FAMILIES[self.family_of(report)?];
+        let header = TargetCost {
+            device: device_name(family),
+            target: Some(format!("intel:{}", family.name)),
+            family: Some(family.name.to_string()),
+            architecture: Some(family.architecture.to_string()),
+            compiler: "IGC".into(),
+            model: "cycles/eval = EU cycles of one hardware thread at the documented lanes per clock / (SIMD width x lights per kernel)".into(),
+            unit: "EU cycles".into(),
+            lights_per_kernel: 0,
+            columns: SHOWN.iter().map(|s| s.to_string()).collect(),
+            rows: Vec::new(),
+        };
+        cost::table(report, header, |stats, lights| {
+            let simd = cost::driver_stat(stats, "SIMD Width")?;
+            cost::driver_stat(stats, "Issue Cycles").map(|c| c / (simd * f64::from(lights)))
+        })
+    }
+
+    fn family_of(&self, report: &InspectReport) -> Option<usize> {
+        let target = report.provenance["target"].as_str()?.strip_prefix("intel:")?;
+        FAMILIES.iter().position(|f| f.name == target)
+    }
+
+    fn fingerprint(&self, report: &InspectReport) -> BTreeMap<String, String> {
+        // IGC's output depends on the device, ocloc's (IGC's) version and options, and the translation.
+        let p = &report.provenance;
+        [
+            ("device".to_string(), p["device"]["name"].as_str().unwrap_or("?").to_string()),
+            ("compiler".to_string(), p["compiler"]["name"].as_str().unwrap_or("?").to_string()),
+            ("options".to_string(), p["compiler"]["options"].as_str().unwrap_or("?").to_string()),
+        ]
+        .into()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn iga_lines_give_mnemonic_width_and_type() {
+        let i = instruction("(W&f0.0)  sel (16|M0)   (lt)f1.0   r39.0<1>:f    r4.1<0;1,0>:f     1.0:f   {Compacted}").unwrap();
+        assert_eq!(i, Instruction { mnemonic: "sel", exec_size: 16, dst_type: "f" });
+        let m = instruction("        math.inv (32|M0)         r6.0<1>:f     r2.0<1;1,0>:f                    {F@1}").unwrap();
+        assert_eq!((m.mnemonic, m.exec_size, classify(m.mnemonic)), ("math", 32, Class::ExtendedMath));
+        let h = instruction("        mad (16|M0)              r5.0<1>:hf    r1.0<1;0>:hf   r2.0<1;0>:hf   r3.0<1;0>:hf").unwrap();
+        assert_eq!(row_of(classify(h.mnemonic), h.dst_type), Some(FP16));
+        assert!(instruction("L640:").is_none());
+        assert!(instruction("// a comment").is_none());
+        let s = instruction("        sync.nop                             null                             {Compacted,$6.dst}").unwrap();
+        assert_eq!((s.mnemonic, s.exec_size), ("sync", 1));
+    }
+
+    #[test]
+    fn patch_tokens_read_simd_grf_and_scratch() {
+        let ptm = "Kernel #0\nUnidentified PatchToken:\n\t4 Token 18\n\t4 Size 16\n\tHex 0 0 0 0 0 80 0 0\nUnidentified PatchToken:\n\t4 Token 23\n\t4 Size 96\n\tHex 40 0 0 0 1 0 0 0 1 0 0 0 10 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 1 0 0 0 0 0 0 0 80 0 0 0\n";
+        let t = patch_tokens(ptm);
+        assert_eq!(t[&23][SIMD_WORD], 16);
+        assert_eq!(t[&23][GRF_WORD], 128);
+        assert_eq!(t[&18][1], 0x8000);
+    }
+}

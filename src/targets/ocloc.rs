@@ -1,0 +1,128 @@
+//! Intel's offline compiler (`ocloc`, Debian's intel-opencl-icd: IGC, Intel's production OpenCL/Level Zero
+//! compiler) run as a process on OpenCL C, with no Intel GPU or driver, and its disassembler (`ocloc disasm`,
+//! which lists the ISA through IGA, `libiga64.so`, and the binary's patch tokens). Every run is under the
+//! compile limit (`compile_limit::output`).
+
+use anyhow::{anyhow, bail, Context, Result};
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+/// ocloc and what its output depends on.
+pub struct Tools {
+    pub ocloc: PathBuf,
+    /// "ocloc 22.43.24595 (libigc 1.0.12504 ...)": the driver version and IGC's library, for the cache key.
+    pub version: String,
+    /// The directory with `libiga64.so` (ocloc dlopens it to disassemble).
+    pub iga_dir: PathBuf,
+}
+
+/// `$BRDFPROF_OCLOC`, else ocloc on PATH (Debian: /usr/bin/ocloc).
+fn ocloc_path() -> PathBuf {
+    match std::env::var_os("BRDFPROF_OCLOC").filter(|d| !d.is_empty()) {
+        Some(p) => PathBuf::from(p),
+        None => std::env::var_os("PATH")
+            .and_then(|paths| std::env::split_paths(&paths).map(|d| d.join("ocloc")).find(|p| p.is_file()))
+            .unwrap_or_else(|| PathBuf::from("/usr/bin/ocloc")),
+    }
+}
+
+/// Where `make setup` links `libiga64.so`: `$BRDFPROF_INTEL_DIR`, else `.tools/intel` in the checkout brdfprof
+/// was built from.
+pub fn iga_dir() -> PathBuf {
+    match std::env::var_os("BRDFPROF_INTEL_DIR").filter(|d| !d.is_empty()) {
+        Some(d) => PathBuf::from(d),
+        None => Path::new(env!("CARGO_MANIFEST_DIR")).join(".tools/intel"),
+    }
+}
+
+fn not_installed(why: &str) -> String {
+    format!("Intel compiler not installed: run `make setup` (it installs Debian's intel-opencl-icd, whose ocloc runs IGC with no Intel GPU, and links IGA's libiga64.so into {}); {why}", iga_dir().display())
+}
+
+/// IGC's library as ocloc loads it: its resolved name and size stand for its version (Debian ships no
+/// version query for it).
+fn igc_identity() -> String {
+    ["/usr/lib/x86_64-linux-gnu/libigc.so.1", "/usr/lib/libigc.so.1"]
+        .iter()
+        .find_map(|p| {
+            let real = std::fs::canonicalize(p).ok()?;
+            let len = std::fs::metadata(&real).ok()?.len();
+            Some(format!("{} ({len} bytes)", real.display()))
+        })
+        .unwrap_or_else(|| "libigc not found".into())
+}
+
+fn load() -> std::result::Result<Tools, String> {
+    let ocloc = ocloc_path();
+    if !ocloc.is_file() {
+        return Err(not_installed(&format!("{} is missing", ocloc.display())));
+    }
+    let iga_dir = iga_dir();
+    if !iga_dir.join("libiga64.so").exists() {
+        return Err(not_installed(&format!("{} is missing (ocloc cannot disassemble without it)", iga_dir.join("libiga64.so").display())));
+    }
+    // `ocloc query OCL_DRIVER_VERSION` writes the version to a file of that name in its working directory.
+    let dir = crate::cleanup::TempDir::new().map_err(|e| not_installed(&format!("no temporary directory: {e}")))?;
+    let mut cmd = crate::cleanup::command(ocloc.to_str().unwrap_or("ocloc"));
+    cmd.args(["query", "OCL_DRIVER_VERSION"]).current_dir(dir.path());
+    let out = crate::compile_limit::output(&mut cmd, "ocloc's version query").map_err(|e| not_installed(&format!("cannot run {}: {e:#}", ocloc.display())))?;
+    let driver = std::fs::read_to_string(dir.path().join("OCL_DRIVER_VERSION")).unwrap_or_default();
+    let driver = driver.trim_matches(|c: char| c.is_whitespace() || c == '\0');
+    if !out.status.success() || driver.is_empty() {
+        return Err(not_installed(&format!("{} does not answer `query OCL_DRIVER_VERSION`", ocloc.display())));
+    }
+    Ok(Tools { ocloc, version: format!("ocloc {driver} ({})", igc_identity()), iga_dir })
+}
+
+/// The tools, checked once per process; an error naming the fix when they are not installed.
+pub fn tools() -> Result<&'static Tools> {
+    static TOOLS: OnceLock<std::result::Result<Tools, String>> = OnceLock::new();
+    TOOLS.get_or_init(load).as_ref().map_err(|e| anyhow!("{e}"))
+}
+
+/// What one compilation produced.
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize, PartialEq)]
+pub struct Binary {
+    /// IGA's listing of the kernel heap (`ocloc disasm`).
+    pub listing: String,
+    /// The patch-token dump (`PTM.txt`): SIMD width, GRF count, scratch space.
+    pub tokens: String,
+    /// The device binary's size in bytes.
+    pub bytes: usize,
+    /// ocloc's build log (warnings).
+    pub log: String,
+}
+
+impl Tools {
+    fn run(&self, args: &[&std::ffi::OsStr], cwd: &Path, what: &str) -> Result<std::process::Output> {
+        let mut cmd = crate::cleanup::command(self.ocloc.to_str().unwrap_or("ocloc"));
+        cmd.args(args).current_dir(cwd).env("LD_LIBRARY_PATH", &self.iga_dir);
+        let out = crate::compile_limit::output(&mut cmd, what).with_context(|| format!("cannot run {}", self.ocloc.display()))?;
+        Ok(out)
+    }
+
+    /// Compiles the OpenCL C `source` for ocloc device `device` (`tgllp`) with `options` and disassembles it.
+    pub fn compile(&self, source: &str, device: &str, options: &str, what: &str) -> Result<Binary> {
+        let dir = crate::cleanup::TempDir::new().context("cannot create a temporary directory for ocloc")?;
+        let src = dir.path().join("brdfprof_kernel.cl");
+        std::fs::write(&src, source).with_context(|| format!("cannot write {}", src.display()))?;
+        let out_dir = dir.path().join("out");
+        let os = |s: &str| std::ffi::OsString::from(s);
+        let args = [os("compile"), os("-file"), src.clone().into_os_string(), os("-device"), os(device), os("-options"), os(options), os("-q"), os("-out_dir"), out_dir.clone().into_os_string()];
+        let out = self.run(&args.iter().map(|a| a.as_os_str()).collect::<Vec<_>>(), dir.path(), what)?;
+        let log = format!("{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
+        if !out.status.success() {
+            bail!("ocloc cannot compile the OpenCL C translation for {device} (a translator defect):\n{}", log.lines().take(20).collect::<Vec<_>>().join("\n"));
+        }
+        let bin = std::fs::read_dir(&out_dir)?.filter_map(|e| e.ok().map(|e| e.path())).find(|p| p.extension().is_some_and(|x| x == "bin")).ok_or_else(|| anyhow!("ocloc wrote no binary for {device}: {log}"))?;
+        let bytes = std::fs::metadata(&bin)?.len() as usize;
+        let dump = dir.path().join("disasm");
+        let args = [os("disasm"), os("-file"), bin.into_os_string(), os("-device"), os(device), os("-dump"), dump.clone().into_os_string()];
+        let out = self.run(&args.iter().map(|a| a.as_os_str()).collect::<Vec<_>>(), dir.path(), &format!("{what}: its ISA (ocloc disasm)"))?;
+        let listing = std::fs::read_to_string(dump.join("brdfprof_kernel_KernelHeap.asm")).map_err(|e| {
+            anyhow!("ocloc disasm wrote no ISA listing ({e}; it needs {} to load IGA): {}", self.iga_dir.join("libiga64.so").display(), String::from_utf8_lossy(&out.stderr).trim())
+        })?;
+        let tokens = std::fs::read_to_string(dump.join("PTM.txt")).context("ocloc disasm wrote no PTM.txt")?;
+        Ok(Binary { listing, tokens, bytes, log: log.trim().to_string() })
+    }
+}

@@ -1,0 +1,139 @@
+//! Compile-only Intel targets (`--device intel:FAMILY`): Intel's real compiler (IGC through ocloc, Debian's
+//! intel-opencl-icd, `make setup`) on the kernels' OpenCL C translation, with IGA's listing, run without an
+//! Intel GPU or driver, after the translation agreed with the Vulkan kernels on the test device. Every command
+//! that executes refuses the targets; a missing compiler is an error naming the fix.
+
+use crate::common::{self, run};
+use brdfprof::targets::intel::{Class, FAMILIES};
+use std::path::Path;
+
+fn inspect_json(dir: &Path, name: &str, devices: &[&str], extra: &[&str]) -> serde_json::Value {
+    let json = dir.join(format!("{name}.json"));
+    let md = dir.join(format!("{name}.md"));
+    let mut args = vec!["inspect", "--no-callgrind", "--json", json.to_str().unwrap(), "--markdown", md.to_str().unwrap()];
+    for d in devices {
+        args.extend(["--device", d]);
+    }
+    args.extend(extra);
+    // A cache of its own: every call compiles (and checks) afresh.
+    let out = common::brdfprof().args(&args).env("BRDFPROF_CACHE_DIR", dir.join(format!("cache-{name}"))).output().unwrap();
+    let out = common::Run { code: out.status.code(), stdout: String::from_utf8_lossy(&out.stdout).into_owned(), stderr: String::from_utf8_lossy(&out.stderr).into_owned() }.ok();
+    assert!(out.stdout.contains("IGC statistics"), "{}", out.stdout);
+    serde_json::from_str(&std::fs::read_to_string(json).unwrap()).unwrap()
+}
+
+fn igc(row: &serde_json::Value, name: &str) -> f64 {
+    row["stats"][format!("driver/IGC/{name}")].as_f64().unwrap_or_else(|| panic!("{} has no {name}: {row}", row["model"]))
+}
+
+/// Every preset and each example `.brdf` file (parameters bound to the kernel inputs).
+fn every_preset_and_example() -> Vec<String> {
+    let mut models: Vec<String> = brdfprof::brdf::spec::PRESETS.iter().map(|p| p.name.to_string()).collect();
+    let dir = common::repo_root().join("examples/brdf");
+    let mut files: Vec<_> = std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().path()).filter(|p| p.extension().is_some_and(|x| x == "brdf")).collect();
+    files.sort();
+    models.extend(files.iter().map(|p| format!("{},roughness=@roughness,f0=@f0", p.display())));
+    models
+}
+
+#[test]
+fn every_preset_and_example_file_gets_igc_statistics_on_all_five_families() {
+    let dir = tempfile::tempdir().unwrap();
+    let models = every_preset_and_example();
+    let mut extra: Vec<&str> = Vec::new();
+    for m in &models {
+        extra.extend(["--model", m.as_str()]);
+    }
+    let report = inspect_json(dir.path(), "all", &["intel:all"], &extra);
+    let reports = report["reports"].as_array().unwrap();
+    assert_eq!(reports.len(), FAMILIES.len());
+    for (r, family) in reports.iter().zip(&FAMILIES) {
+        assert_eq!(r["provenance"]["target"], format!("intel:{}", family.name));
+        assert_eq!(r["provenance"]["compiler"]["device"], family.device);
+        assert!(r["provenance"]["compiler"]["options"].as_str().unwrap().contains("-cl-mad-enable"));
+        let rows = r["rows"].as_array().unwrap();
+        assert_eq!(rows.len(), models.len() + 1, "every model and the memory-only kernel");
+        for row in rows {
+            assert!([8.0, 16.0, 32.0].contains(&igc(row, "SIMD Width")), "{} {}", family.name, row["model"]);
+            assert!([128.0, 256.0].contains(&igc(row, "Register Count")), "{} {}", family.name, row["model"]);
+            for stat in ["Instruction Count", "Binary Size", "Issue Cycles", Class::Fma.name(), Class::Send.name(), Class::Control.name()] {
+                assert!(igc(row, stat) > 0.0, "{} {}: {stat} is 0", family.name, row["model"]);
+            }
+            let classes: f64 = Class::ALL.iter().map(|c| igc(row, c.name())).sum();
+            assert_eq!(classes, igc(row, "Instruction Count"), "{} {}: the classes partition the listing", family.name, row["model"]);
+            let note = row["notes"]["translation"].as_str().unwrap_or_else(|| panic!("{} {}: no translation check", family.name, row["model"]));
+            assert!(note.contains("translation checked on the host against"), "{note}");
+        }
+        // A BRDF costs more than the memory-only kernel; cycles/eval = issue cycles / (SIMD x 8 lights).
+        for c in r["cost"]["rows"].as_array().unwrap() {
+            let issue = c["stats"]["Issue Cycles"].as_f64().unwrap();
+            let simd = c["stats"]["SIMD Width"].as_f64().unwrap();
+            assert_eq!(c["cycles_per_eval"].as_f64().unwrap(), issue / (simd * 8.0));
+            if c["model"] != "baseline" {
+                assert!(c["net_cycles_per_eval"].as_f64().unwrap() > 0.0, "{} {}", family.name, c["model"]);
+            }
+        }
+    }
+    assert_eq!(report["costs"]["correlations"].as_array().unwrap().len(), 10);
+}
+
+#[test]
+fn the_statistics_are_deterministic_and_the_precise_forms_cost_more() {
+    let dir = tempfile::tempdir().unwrap();
+    let fast = inspect_json(dir.path(), "fast", &["intel:gen12lp"], &["--model", "blinn"]);
+    let again = inspect_json(dir.path(), "again", &["intel:gen12lp"], &["--model", "blinn"]);
+    for (a, b) in fast["rows"].as_array().unwrap().iter().zip(again["rows"].as_array().unwrap()) {
+        for (key, value) in a["stats"].as_object().unwrap().iter().filter(|(k, _)| k.starts_with("driver/")) {
+            assert_eq!(&b["stats"][key], value, "{} {key} changed between runs", a["model"]);
+        }
+    }
+    let precise = inspect_json(dir.path(), "precise", &["intel:gen12lp"], &["--model", "blinn", "--precise-math"]);
+    assert!(!precise["provenance"]["compiler"]["options"].as_str().unwrap().contains("-cl-mad-enable"));
+    let net = |r: &serde_json::Value| r["cost"]["rows"][0]["net_cycles_per_eval"].as_f64().unwrap();
+    assert!(net(&precise) > 1.2 * net(&fast), "IEEE pow, division and square root cost more: {} vs {}", net(&precise), net(&fast));
+}
+
+#[test]
+fn isa_writes_the_translation_and_igas_listing_per_kernel_and_family() {
+    let dir = tempfile::tempdir().unwrap();
+    let isa = dir.path().join("isa");
+    inspect_json(dir.path(), "one", &["intel:xe-hpg"], &["--model", "ggx", "--isa", isa.to_str().unwrap()]);
+    for kernel in ["ggx", "baseline"] {
+        let cl = std::fs::read_to_string(isa.join("intel-xe-hpg").join(format!("{kernel}.cl"))).unwrap();
+        assert!(cl.contains("__kernel") && cl.contains("fn_main"), "{}", &cl[..cl.len().min(400)]);
+        let asm = std::fs::read_to_string(isa.join("intel-xe-hpg").join(format!("{kernel}.asm"))).unwrap();
+        assert!(asm.contains("send") && asm.contains("EOT") && asm.contains("GRF"), "{}", &asm[..asm.len().min(400)]);
+    }
+}
+
+#[test]
+fn commands_that_execute_refuse_an_intel_target_and_unknown_families_are_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("o");
+    let out = out.to_str().unwrap();
+    for args in [vec!["profile", "--device", "intel:gen12lp", "--json", out], vec!["stability", "--device", "intel:gen9", "--out", out]] {
+        let r = common::brdfprof().args(&args).current_dir(common::repo_root()).output().unwrap();
+        assert_eq!(r.status.code(), Some(2), "{args:?}");
+        assert!(String::from_utf8_lossy(&r.stderr).contains("compiles only"), "{args:?}: {}", String::from_utf8_lossy(&r.stderr));
+    }
+    run(&["inspect", "--device", "intel:gen8"]).fails(2, "unknown Intel family `gen8`");
+    let listed = run(&["devices", "--targets"]).ok();
+    for f in &FAMILIES {
+        assert!(listed.stdout.lines().any(|l| l.starts_with(&format!("| intel:{} ", f.name)) && l.contains(f.architecture)), "{}", listed.stdout);
+    }
+}
+
+#[test]
+fn a_missing_compiler_says_make_setup() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = common::brdfprof()
+        .args(["inspect", "--no-callgrind", "--device", "intel:gen12lp", "--model", "ggx", "--json"])
+        .arg(dir.path().join("x.json"))
+        .env("BRDFPROF_OCLOC", dir.path().join("nowhere/ocloc"))
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("Intel compiler not installed: run `make setup`"), "{stderr}");
+    assert!(!dir.path().join("x.json").exists());
+}
