@@ -170,6 +170,17 @@ pub fn run(gpu: &Gpu, options: &SweepOptions, progress: &ProgressBar) -> Result<
     })
 }
 
+/// The numerical error's cell: max error against the spec's own f64 formula; for a `.brdf` file, against the
+/// `--reference` spec's f64 formula, saying so (`- (vs FILE)` against another file, which has no formula).
+fn numerical_cell(a: &accuracy::Accuracy) -> String {
+    let against = a.reference.as_deref().map_or(String::new(), |r| format!(" (vs {r} f64)"));
+    match &a.numerical {
+        None => format!("- (vs {})", a.reference.as_deref().unwrap_or("?")),
+        Some(n) if n.nonfinite > 0 => format!("{} NaN/Inf{against}", n.nonfinite),
+        Some(n) => format!("{:.1e}{against}", n.max),
+    }
+}
+
 impl SweepReport {
     pub fn table(&self) -> Table {
         let mut t = Table::new([
@@ -183,7 +194,7 @@ impl SweepReport {
                 report::estimate(&r.ns_per_eval, 3),
                 r.net_ns_per_eval.as_ref().map_or("-".into(), |e| report::sig(e.median, 3)),
                 report::estimate(&r.cost_vs_fastest, 3),
-                a.numerical.as_ref().map_or_else(|| format!("- (vs {})", a.reference.as_deref().unwrap_or("?")), |n| if n.nonfinite > 0 { format!("{} NaN/Inf", n.nonfinite) } else { format!("{:.1e}", n.max) }),
+                numerical_cell(a),
                 a.vs_exact.cell(),
                 format!("{:.1e}", a.albedo_vs_exact),
                 if r.pareto { "yes".into() } else { String::new() },
@@ -197,8 +208,9 @@ impl SweepReport {
             "# brdfprof sweep\n\n{}\n\nCost: per-round ratio to the fastest spec ({}), median and distribution-free 95% CI over {} rounds; \
              rank = 1 + the number of specs whose CI lies wholly below; `=` marks specs whose CI overlaps another's, so they \
              cannot be told apart. Errors are relative errors |x - ref| / max(|ref|, 1e-3) over the sample set ({}); numerical: \
-             GPU against the same formula in f64; vs exact: GPU against the exact physical model (same D, exact height-correlated \
-             Smith G2, exact Fresnel); albedo: max |E_gpu - E_exact| over the albedo cells. Pareto: no spec is both cheaper and \
+             GPU against the same formula in f64 (a .brdf file: against the --reference spec's formula in f64, `vs SPEC f64`); \
+             vs exact: GPU against the exact physical model (same D, exact height-correlated Smith G2, exact Fresnel; a .brdf \
+             file: the --reference spec's exact model, or another file's GPU values); albedo: max |E_gpu - E_exact| over the albedo cells. Pareto: no spec is both cheaper and \
              more accurate (RMS vs exact).\n\n{}{}",
             self.profile.summary(),
             self.fastest,

@@ -143,7 +143,8 @@ impl ExactCache {
 
 #[derive(Clone, Debug, Serialize)]
 pub struct Accuracy {
-    /// GPU result against the same formula in f64 (None for a model without an f64 twin, a `.brdf` file).
+    /// GPU result against the same formula in f64; for a model without a twin (a `.brdf` file) measured
+    /// against a spec (`reference`), against that spec's own f64 formula; None against another `.brdf` file.
     pub numerical: Option<ErrorStats>,
     /// GPU result against the exact physical reference: what a user of the spec gets. For a model without a
     /// twin: against `reference`.
@@ -175,8 +176,11 @@ pub fn measure(gpu: &Gpu, model: &Model, set: &SampleSet, cache: &mut ExactCache
                 kernels::albedo(gpu, reference, &set.cells)?.iter().map(|a| a.e).collect(),
             ),
         };
+        // Against a spec, the numerical error is against that spec's own f64 formula (its twin): what a file that
+        // transcribes the spec's formula should match to fp32 rounding.
+        let numerical = reference.twin().map(|r| ErrorStats::of(&set.samples, &got, &set.samples.par_iter().map(|s| r.eval(s)).collect::<Vec<_>>()));
         return Ok(Accuracy {
-            numerical: None,
+            numerical,
             vs_exact: ErrorStats::of(&set.samples, &got, &values),
             formula_vs_exact: None,
             albedo_vs_exact: albedo_diff(&albedo),
