@@ -12,6 +12,8 @@ pub mod compare;
 pub mod compile_limit;
 pub mod gpu;
 pub mod host;
+pub mod html;
+pub mod htmlreport;
 pub mod inspect;
 pub mod io;
 pub mod kernels;

@@ -7,6 +7,7 @@ pub mod counts;
 pub mod eval;
 pub mod info;
 pub mod measure;
+pub mod report;
 pub mod scene;
 
 use anyhow::{anyhow, bail, Result};
