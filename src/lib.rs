@@ -13,6 +13,8 @@ pub mod compile_limit;
 pub mod diff;
 pub mod gpu;
 pub mod host;
+pub mod html;
+pub mod htmlreport;
 pub mod inspect;
 pub mod io;
 pub mod kernels;

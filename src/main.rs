@@ -50,6 +50,10 @@ enum Command {
     /// cost table across devices with rank correlations, its JSON and a PNG chart; refuses reports whose
     /// kernels differ.
     Compare(cli::compare::CompareArgs),
+    /// One self-contained HTML page (opens from file://) of saved profile, sweep, stability, inspect and
+    /// compare reports: provenance, cost tables with CIs, the table across devices, the accuracy-against-cost
+    /// chart, lobes, lit spheres and albedo per model (evaluated on the device now), stability heat maps.
+    Report(cli::report::ReportArgs),
     /// Check a scene file and say what it compiles in; --explain prints the scene format with an example.
     Scene(cli::scene::SceneArgs),
     /// Render a scene: a tone-mapped sRGB PNG per model, the comparison grid, difference heat maps against ggx
@@ -89,6 +93,7 @@ fn main() -> ExitCode {
         Command::Inspect(args) => cli::counts::inspect(&args),
         Command::Check(args) => cli::counts::check(&args),
         Command::Compare(args) => cli::compare::compare(&args),
+        Command::Report(args) => cli::report::report(&args),
         Command::Scene(args) => cli::scene::scene(&args),
         Command::Render(args) => cli::scene::render(&args),
         Command::Cache(args) => cli::cache::cache(&args),

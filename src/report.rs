@@ -8,6 +8,8 @@ use serde::Serialize;
 use std::collections::BTreeMap;
 use std::path::Path;
 
+pub mod view;
+
 /// A Markdown table.
 #[derive(Clone, Debug, Default)]
 pub struct Table {
@@ -76,6 +78,8 @@ pub struct Provenance {
     /// Family, model, stepping and vector features: lavapipe's costs are this CPU's.
     pub cpu: crate::host::HostCpu,
     pub host_threads: usize,
+    /// The command line that wrote the report.
+    pub command: Vec<String>,
 }
 
 impl Provenance {
@@ -94,6 +98,7 @@ impl Provenance {
             host_cpu,
             cpu: crate::host::HostCpu::detect(),
             host_threads: std::thread::available_parallelism().map_or(1, |n| n.get()),
+            command: std::env::args().collect(),
         }
     }
 }

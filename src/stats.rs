@@ -4,7 +4,7 @@
 use serde::Serialize;
 
 /// A median with its confidence interval.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, serde::Deserialize)]
 pub struct Estimate {
     pub median: f64,
     pub lo: f64,

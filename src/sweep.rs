@@ -2,6 +2,8 @@
 //! profile protocol) and measured for accuracy (`accuracy`), and the result is a table, a JSON file and a chart
 //! of error against cost with the Pareto frontier.
 
+pub mod view;
+
 use crate::accuracy::{self, Accuracy, ExactCache, SampleSet};
 use crate::brdf::spec::with_each_param_sample;
 use crate::brdf::{ModelSpec, Precision, Vis, D, F, THESIS_MODELS};

@@ -84,6 +84,8 @@ pub struct InspectArgs {
     /// the precision freedom a Vulkan driver has (NVIDIA: without -use_fast_math).
     #[arg(long)]
     pub precise_math: bool,
+    #[command(flatten)]
+    pub html: super::report::HtmlArg,
 }
 
 pub fn inspect(args: &InspectArgs) -> Result<ExitCode> {
@@ -96,6 +98,7 @@ pub fn inspect(args: &InspectArgs) -> Result<ExitCode> {
     let default_name = if plan.len() > 1 { "inspect-devices" } else { "inspect-<device>" };
     check_output("--json", args.json.as_deref(), "results", &format!("{default_name}.json"))?;
     check_output("--markdown", args.markdown.as_deref(), "results", &format!("{default_name}.md"))?;
+    args.html.check()?;
     if let Some(dir) = &args.isa {
         if !plan.iter().any(|p| matches!(p, devices::Planned::Target(_))) {
             bail!("--isa {}: the listings are a compile-only target's; give one, e.g. --device radv:navi21 or nvidia:sm_89 (see `brdfprof devices --targets`)", dir.display());
@@ -120,9 +123,21 @@ pub fn inspect(args: &InspectArgs) -> Result<ExitCode> {
         }
         Some(_) => (args.json.clone().unwrap_or_else(|| PathBuf::from("results/inspect-devices.json")), args.markdown.clone().unwrap_or_else(|| PathBuf::from("results/inspect-devices.md"))),
     };
-    match &result.multi {
-        None => report::write_json(&json, &result.reports[0])?,
-        Some(m) => report::write_json(&json, m)?,
+    let input = match &result.multi {
+        None => {
+            report::write_json(&json, &result.reports[0])?;
+            super::report::just_measured(&json, &result.reports[0])?
+        }
+        Some(m) => {
+            report::write_json(&json, m)?;
+            super::report::just_measured(&json, m)?
+        }
+    };
+    if args.html.html.is_some() {
+        // The lobes and spheres are drawn on the default local device (the inspected ones may only compile).
+        let gpu = DeviceArgs { device: None, validate }.open()?;
+        args.html.write(&[input], Some(&gpu))?;
+        gpu.check_validation()?;
     }
     io::write_output(&markdown, result.markdown.as_bytes())?;
     print!("{}", result.markdown);

@@ -37,6 +37,8 @@ pub struct ProfileArgs {
     #[arg(long)]
     pub scene: Option<PathBuf>,
     #[command(flatten)]
+    pub html: super::report::HtmlArg,
+    #[command(flatten)]
     pub device: DeviceArgs,
 }
 
@@ -45,12 +47,14 @@ pub fn profile(args: &ProfileArgs) -> Result<ExitCode> {
         return profile_scene(args, path);
     }
     check_output("--json", args.json.as_deref(), "results", "profile-<device>.json")?;
+    args.html.check()?;
     fresh_compilation(args.timing.shader_cache);
     let size = args.size.as_deref().unwrap_or("960x540");
     let options = args.timing.options(args.model.models(&THESIS_MODELS)?, size, args.reps, args.budget, args.target_ci)?;
     let (gpu, result) = on_device(&args.device, |gpu, progress| profile::run(gpu, &options, progress))?;
     let path = args.json.clone().unwrap_or_else(|| PathBuf::from(format!("results/profile-{}.json", report::device_slug(&gpu.info))));
     report::write_json(&path, &result)?;
+    args.html.write(&[super::report::just_measured(&path, &result)?], Some(&gpu))?;
     println!("{}\n", result.summary());
     print!("{}{}", result.table().markdown(), result.placement_notes());
     if let Some(t) = result.light_table() {
@@ -118,6 +122,8 @@ pub struct SweepArgs {
     #[arg(long = "cost-device", value_name = "DEVICE", value_parser = super::device_name)]
     pub cost_devices: Vec<String>,
     #[command(flatten)]
+    pub html: super::report::HtmlArg,
+    #[command(flatten)]
     pub device: DeviceArgs,
 }
 
@@ -139,6 +145,7 @@ fn cost_targets(devices: &[String]) -> Result<Vec<brdfprof::targets::Target>> {
 
 pub fn sweep(args: &SweepArgs) -> Result<ExitCode> {
     io::check_output_dir("--out", &args.out)?;
+    args.html.check()?;
     let cost_targets = cost_targets(&args.cost_devices)?;
     if let Some(d) = args.device.device.as_deref().filter(|d| brdfprof::targets::is_compile_only(d)) {
         return Err(super::compiles_only_error(d));
@@ -163,6 +170,7 @@ pub fn sweep(args: &SweepArgs) -> Result<ExitCode> {
     }
     let slug = report::device_slug(&gpu.info);
     let mut files = result.write(&args.out, &slug)?;
+    files.extend(args.html.write(&[super::report::just_measured(&args.out.join(format!("sweep-{slug}.json")), &result)?], Some(&gpu))?);
     print!("{}", result.markdown());
     for run in &costs {
         let name = run.target.name();
@@ -192,15 +200,20 @@ pub struct StabilityArgs {
     #[arg(long, default_value = "results")]
     pub out: PathBuf,
     #[command(flatten)]
+    pub html: super::report::HtmlArg,
+    #[command(flatten)]
     pub device: DeviceArgs,
 }
 
 pub fn stability(args: &StabilityArgs) -> Result<ExitCode> {
     io::check_output_dir("--out", &args.out)?;
+    args.html.check()?;
     let models = if args.model.models.is_empty() { stability::default_specs().into_iter().map(Model::spec).collect() } else { args.model.models(&[])? };
     let options = stability::StabilityOptions { models: super::with_unguarded(models, args.unguarded), energy: !args.no_energy };
     let (gpu, result) = on_device(&args.device, |gpu, progress| stability::run(gpu, &options, progress))?;
-    let files = result.write(&args.out, &report::device_slug(&gpu.info))?;
+    let slug = report::device_slug(&gpu.info);
+    let mut files = result.write(&args.out, &slug)?;
+    files.extend(args.html.write(&[super::report::just_measured(&args.out.join(format!("stability-{slug}.json")), &result)?], Some(&gpu))?);
     print!("{}", result.markdown());
     println!("\n{}", written(&files));
     let failing = result.failing();

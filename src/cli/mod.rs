@@ -8,6 +8,7 @@ pub mod diff;
 pub mod eval;
 pub mod info;
 pub mod measure;
+pub mod report;
 pub mod scene;
 
 use anyhow::{anyhow, bail, Result};

@@ -64,6 +64,15 @@ pub struct MultiReport {
     pub profile_note: Option<String>,
 }
 
+/// `MultiReport` as read back (`brdfprof report`, `--html`).
+#[derive(Clone, Debug, serde::Deserialize)]
+pub struct MultiView {
+    pub reports: Vec<InspectReport>,
+    pub costs: CostTable,
+    #[serde(default)]
+    pub profile_note: Option<String>,
+}
+
 /// What `inspect` produced: one report per device, the markdown of them all, and with several devices the
 /// combined JSON.
 pub struct Inspected {

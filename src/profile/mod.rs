@@ -4,6 +4,7 @@
 
 pub mod gbuffer;
 pub mod protocol;
+pub mod view;
 pub mod workload;
 
 use crate::gpu::Gpu;

@@ -7,6 +7,7 @@ pub mod catalogue;
 mod check;
 pub mod energy;
 pub mod grid;
+pub mod view;
 
 pub use check::check_model;
 

@@ -1,0 +1,377 @@
+//! A self-contained HTML page: sections, sortable tables, SVG charts (scatter, polar, lines) and PNG images as
+//! data: URIs, with its CSS and script inline, so that it opens from file:// with no network. Knows nothing of
+//! BRDFs: `htmlreport` decides what goes in.
+
+use anyhow::Result;
+use std::fmt::Write;
+
+/// `text` with the five characters HTML gives meaning escaped (safe in text and in quoted attributes).
+pub fn esc(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    for c in text.chars() {
+        match c {
+            '&' => out.push_str("&amp;"),
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '"' => out.push_str("&quot;"),
+            '\'' => out.push_str("&#39;"),
+            c => out.push(c),
+        }
+    }
+    out
+}
+
+/// Standard base64 (RFC 4648, padded), for data: URIs.
+pub fn base64(bytes: &[u8]) -> String {
+    const A: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    let mut out = String::with_capacity(bytes.len().div_ceil(3) * 4);
+    for chunk in bytes.chunks(3) {
+        let b = [chunk[0], *chunk.get(1).unwrap_or(&0), *chunk.get(2).unwrap_or(&0)];
+        let n = (u32::from(b[0]) << 16) | (u32::from(b[1]) << 8) | u32::from(b[2]);
+        for k in 0..4 {
+            if k <= chunk.len() {
+                out.push(A[(n >> (18 - 6 * k) & 63) as usize] as char);
+            } else {
+                out.push('=');
+            }
+        }
+    }
+    out
+}
+
+/// An 8-bit RGB image as a PNG data: URI.
+pub fn png_data_uri(width: u32, height: u32, rgb: &[u8]) -> Result<String> {
+    use image::ImageEncoder;
+    anyhow::ensure!(rgb.len() == width as usize * height as usize * 3, "image of {width}x{height} needs {} bytes, got {}", width * height * 3, rgb.len());
+    let mut png = Vec::new();
+    image::codecs::png::PngEncoder::new(&mut png).write_image(rgb, width, height, image::ExtendedColorType::Rgb8)?;
+    Ok(format!("data:image/png;base64,{}", base64(&png)))
+}
+
+/// `<img>` of a data: URI, drawn `scale` times its size with square pixels.
+pub fn img(uri: &str, width: u32, height: u32, scale: u32, alt: &str) -> String {
+    format!("<img class=\"px\" src=\"{uri}\" width=\"{}\" height=\"{}\" alt=\"{}\" title=\"{}\">", width * scale, height * scale, esc(alt), esc(alt))
+}
+
+/// Ten distinguishable colours (the same order as `chart::palette`).
+pub fn colour(i: usize) -> &'static str {
+    const P: [&str; 10] = ["#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#17becf"];
+    P[i % P.len()]
+}
+
+/// A table cell: its text, and for a number the value a sort uses (and a test reads back).
+#[derive(Clone, Debug)]
+pub struct Cell {
+    pub text: String,
+    pub value: Option<f64>,
+}
+
+impl Cell {
+    pub fn text(text: impl Into<String>) -> Self {
+        Cell { text: text.into(), value: None }
+    }
+
+    pub fn num(value: f64, text: impl Into<String>) -> Self {
+        Cell { text: text.into(), value: Some(value) }
+    }
+}
+
+/// A sortable table: click a header to sort by it. Each row has a key (`data-row`) and each cell its column's
+/// key (`data-col`), so that a reader of the DOM finds a figure without counting columns.
+#[derive(Clone, Debug, Default)]
+pub struct HtmlTable {
+    pub columns: Vec<(String, String)>,
+    pub rows: Vec<(String, Vec<Cell>)>,
+}
+
+impl HtmlTable {
+    /// `columns`: (key, header) pairs.
+    pub fn new(columns: &[(&str, &str)]) -> Self {
+        HtmlTable { columns: columns.iter().map(|(k, h)| (k.to_string(), h.to_string())).collect(), rows: Vec::new() }
+    }
+
+    pub fn row(&mut self, key: impl Into<String>, cells: Vec<Cell>) {
+        assert_eq!(cells.len(), self.columns.len(), "one cell per column");
+        self.rows.push((key.into(), cells));
+    }
+
+    pub fn html(&self) -> String {
+        let mut s = String::from("<table class=\"sortable\"><thead><tr>");
+        for (key, header) in &self.columns {
+            let _ = write!(s, "<th data-col=\"{}\" title=\"sort\">{}</th>", esc(key), esc(header));
+        }
+        s += "</tr></thead><tbody>\n";
+        for (key, cells) in &self.rows {
+            let _ = write!(s, "<tr data-row=\"{}\">", esc(key));
+            for ((col, _), c) in self.columns.iter().zip(cells) {
+                match c.value {
+                    Some(v) => {
+                        let _ = write!(s, "<td data-col=\"{}\" data-v=\"{v:e}\" class=\"n\">{}</td>", esc(col), esc(&c.text));
+                    }
+                    None => {
+                        let _ = write!(s, "<td data-col=\"{}\">{}</td>", esc(col), esc(&c.text));
+                    }
+                }
+            }
+            s += "</tr>\n";
+        }
+        s + "</tbody></table>\n"
+    }
+}
+
+/// A chart axis: the value range and whether it is logarithmic.
+#[derive(Clone, Copy, Debug)]
+pub struct Axis {
+    pub lo: f64,
+    pub hi: f64,
+    pub log: bool,
+}
+
+impl Axis {
+    /// The range of `values` (finite, and positive on a log axis), padded a little; None when none fits.
+    pub fn fit(values: impl Iterator<Item = f64>, log: bool) -> Option<Axis> {
+        let v: Vec<f64> = values.filter(|v| v.is_finite() && (!log || *v > 0.0)).collect();
+        let (lo, hi) = v.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| (a.min(x), b.max(x)));
+        if v.is_empty() {
+            return None;
+        }
+        Some(if log {
+            let (l, h) = (lo.log10(), hi.log10().max(lo.log10() + 0.5));
+            let pad = 0.05 * (h - l);
+            Axis { lo: 10f64.powf(l - pad), hi: 10f64.powf(h + pad), log }
+        } else {
+            let pad = 0.05 * (hi - lo).max(hi.abs() * 0.1).max(1e-12);
+            Axis { lo: lo - pad, hi: hi + pad, log }
+        })
+    }
+
+    /// Where `v` falls from 0 (lo) to 1 (hi).
+    pub fn frac(&self, v: f64) -> f64 {
+        if self.log { (v.log10() - self.lo.log10()) / (self.hi.log10() - self.lo.log10()) } else { (v - self.lo) / (self.hi - self.lo) }
+    }
+
+    /// Tick values: decades (and 2x, 5x when there are few) on a log axis, 1/2/5 steps on a linear one.
+    pub fn ticks(&self) -> Vec<f64> {
+        let within = |t: &f64| *t >= self.lo * (1.0 - 1e-9) && *t <= self.hi * (1.0 + 1e-9);
+        if self.log {
+            let (a, b) = (self.lo.log10().floor() as i32, self.hi.log10().ceil() as i32);
+            let steps: &[f64] = if b - a <= 2 { &[1.0, 2.0, 5.0] } else { &[1.0] };
+            return (a..=b).flat_map(|e| steps.iter().map(move |m| m * 10f64.powi(e))).filter(within).collect();
+        }
+        let raw = (self.hi - self.lo) / 6.0;
+        let mag = 10f64.powf(raw.log10().floor());
+        let step = [1.0, 2.0, 5.0, 10.0].iter().map(|m| m * mag).find(|s| *s >= raw).unwrap_or(10.0 * mag);
+        let first = (self.lo / step).ceil() as i64;
+        (first..).map(|k| k as f64 * step).take_while(|t| *t <= self.hi).collect()
+    }
+}
+
+/// A tick label: short, in engineering-friendly form.
+pub fn tick_label(v: f64) -> String {
+    if v == 0.0 {
+        return "0".into();
+    }
+    let a = v.abs();
+    if !(1e-3..1e4).contains(&a) { format!("{v:.0e}") } else { format!("{}", (v * 1e6).round() / 1e6) }
+}
+
+/// One point of a scatter chart: its position, its label, the text shown on hover, and whether it is drawn
+/// emphasised (e.g. on the Pareto frontier).
+#[derive(Clone, Debug)]
+pub struct Point {
+    pub x: f64,
+    pub y: f64,
+    pub label: String,
+    pub tip: String,
+    pub emphasis: bool,
+}
+
+const M: (f64, f64, f64, f64) = (62.0, 14.0, 14.0, 44.0); // left, right, top, bottom
+
+/// A chart's size in pixels.
+#[derive(Clone, Copy, Debug)]
+pub struct Size {
+    pub w: f64,
+    pub h: f64,
+}
+
+/// The full-width chart size.
+pub const WIDE: Size = Size { w: 760.0, h: 440.0 };
+/// A chart that fits beside others in a card.
+pub const SMALL: Size = Size { w: 320.0, h: 200.0 };
+
+#[allow(non_snake_case)] // W, H: the chart's width and height, as in the SVG
+fn frame(s: &mut String, x: &Axis, y: &Axis, x_label: &str, y_label: &str, size: Size) {
+    let (l, r, t, b) = M;
+    let Size { w: W, h: H } = size;
+    let _ = write!(s, "<rect x=\"{l}\" y=\"{t}\" width=\"{}\" height=\"{}\" class=\"frame\"/>", W - l - r, H - t - b);
+    for v in x.ticks() {
+        let px = l + x.frac(v) * (W - l - r);
+        let _ = write!(s, "<line x1=\"{px:.1}\" y1=\"{t}\" x2=\"{px:.1}\" y2=\"{}\" class=\"grid\"/><text x=\"{px:.1}\" y=\"{}\" class=\"tick\" text-anchor=\"middle\">{}</text>", H - b, H - b + 16.0, tick_label(v));
+    }
+    for v in y.ticks() {
+        let py = H - b - y.frac(v) * (H - t - b);
+        let _ = write!(s, "<line x1=\"{l}\" y1=\"{py:.1}\" x2=\"{}\" y2=\"{py:.1}\" class=\"grid\"/><text x=\"{}\" y=\"{:.1}\" class=\"tick\" text-anchor=\"end\">{}</text>", W - r, l - 6.0, py + 4.0, tick_label(v));
+    }
+    let _ = write!(s, "<text x=\"{}\" y=\"{}\" text-anchor=\"middle\" class=\"axis\">{}</text>", (l + W - r) / 2.0, H - 10.0, esc(x_label));
+    let _ = write!(s, "<text transform=\"translate(16 {}) rotate(-90)\" text-anchor=\"middle\" class=\"axis\">{}</text>", (t + H - b) / 2.0, esc(y_label));
+}
+
+/// A scatter chart; each point shows its tip on hover (an SVG `<title>`, and the page's tooltip line).
+#[allow(non_snake_case)] // W, H: the chart's width and height, as in the SVG
+pub fn scatter_svg(points: &[Point], x: Axis, y: Axis, x_label: &str, y_label: &str, size: Size) -> String {
+    let (l, r, t, b) = M;
+    let Size { w: W, h: H } = size;
+    let mut s = format!("<svg class=\"chart\" viewBox=\"0 0 {W} {H}\" width=\"{W}\" height=\"{H}\" role=\"img\">");
+    frame(&mut s, &x, &y, x_label, y_label, size);
+    for p in points.iter().filter(|p| p.x.is_finite() && p.y.is_finite() && (!x.log || p.x > 0.0) && (!y.log || p.y > 0.0)) {
+        let px = l + x.frac(p.x) * (W - l - r);
+        let py = H - b - y.frac(p.y) * (H - t - b);
+        let class = if p.emphasis { "pt em" } else { "pt" };
+        let _ = write!(s, "<circle cx=\"{px:.1}\" cy=\"{py:.1}\" r=\"5\" class=\"{class}\" data-tip=\"{}\"><title>{}</title></circle>", esc(&p.tip), esc(&p.tip));
+        if p.emphasis {
+            let _ = write!(s, "<text x=\"{:.1}\" y=\"{:.1}\" class=\"lbl\">{}</text>", px + 7.0, py - 5.0, esc(&p.label));
+        }
+    }
+    s + "</svg>"
+}
+
+/// A named curve of (x, y) points.
+#[derive(Clone, Debug)]
+pub struct Curve {
+    pub label: String,
+    pub points: Vec<(f64, f64)>,
+}
+
+fn legend(s: &mut String, labels: &[&str], x0: f64, y0: f64) {
+    for (i, label) in labels.iter().enumerate() {
+        let y = y0 + 16.0 * i as f64;
+        let _ = write!(s, "<line x1=\"{x0}\" y1=\"{y}\" x2=\"{}\" y2=\"{y}\" stroke=\"{}\" stroke-width=\"2.5\"/><text x=\"{}\" y=\"{}\" class=\"tick\">{}</text>", x0 + 18.0, colour(i), x0 + 22.0, y + 4.0, esc(label));
+    }
+}
+
+/// Lines of `curves` on shared axes, with a legend.
+#[allow(non_snake_case)] // W, H: the chart's width and height, as in the SVG
+pub fn lines_svg(curves: &[Curve], x: Axis, y: Axis, x_label: &str, y_label: &str, size: Size) -> String {
+    let (l, r, t, b) = M;
+    let Size { w: W, h: H } = size;
+    let mut s = format!("<svg class=\"chart\" viewBox=\"0 0 {W} {H}\" width=\"{W}\" height=\"{H}\" role=\"img\">");
+    frame(&mut s, &x, &y, x_label, y_label, size);
+    for (i, c) in curves.iter().enumerate() {
+        let pts: Vec<String> = c
+            .points
+            .iter()
+            .filter(|(a, v)| a.is_finite() && v.is_finite() && (!y.log || *v > 0.0))
+            .map(|(a, v)| format!("{:.1},{:.1}", l + x.frac(*a) * (W - l - r), H - b - y.frac(*v).clamp(-0.02, 1.02) * (H - t - b)))
+            .collect();
+        let _ = write!(s, "<polyline fill=\"none\" stroke=\"{}\" stroke-width=\"2\" points=\"{}\" data-tip=\"{}\"><title>{}</title></polyline>", colour(i), pts.join(" "), esc(&c.label), esc(&c.label));
+    }
+    legend(&mut s, &curves.iter().map(|c| c.label.as_str()).collect::<Vec<_>>(), l + 10.0, t + 14.0);
+    s + "</svg>"
+}
+
+/// A polar plot of the upper half plane: each curve's points are (angle from the normal in radians, positive
+/// toward +x; radius), scaled so that the largest radius of all curves reaches the rim; with `log_decades`, the
+/// radius is log10(r / peak) + decades over decades (values below the range at the centre). `marks` draws a
+/// labelled direction (e.g. the light).
+pub fn polar_svg(title: &str, curves: &[Curve], marks: &[(f64, &str)], log_decades: Option<f64>) -> String {
+    let (w, h, cx, cy, rim) = (300.0, 180.0, 150.0, 160.0, 135.0);
+    let mut s = format!("<svg class=\"polar\" viewBox=\"0 0 {w} {h}\" width=\"{w}\" height=\"{h}\" role=\"img\"><text x=\"6\" y=\"14\" class=\"tick\">{}</text>", esc(title));
+    for k in 1..=4 {
+        let rr = rim * k as f64 / 4.0;
+        let _ = write!(s, "<path d=\"M {:.1} {cy} A {rr:.1} {rr:.1} 0 0 1 {:.1} {cy}\" class=\"grid\" fill=\"none\"/>", cx - rr, cx + rr);
+    }
+    let _ = write!(s, "<line x1=\"{}\" y1=\"{cy}\" x2=\"{}\" y2=\"{cy}\" class=\"grid\"/>", cx - rim, cx + rim);
+    let peak = curves.iter().flat_map(|c| c.points.iter().map(|p| p.1)).filter(|r| r.is_finite()).fold(0.0f64, f64::max);
+    let scale = |r: f64| -> f64 {
+        if !(peak > 0.0 && r.is_finite() && r > 0.0) {
+            return 0.0;
+        }
+        match log_decades {
+            Some(d) => ((r / peak).log10() + d).max(0.0) / d,
+            None => r / peak,
+        }
+    };
+    for (i, c) in curves.iter().enumerate() {
+        let pts: Vec<String> = c.points.iter().map(|&(a, r)| format!("{:.1},{:.1}", cx + rim * scale(r) * a.sin(), cy - rim * scale(r) * a.cos())).collect();
+        let _ = write!(s, "<polyline fill=\"none\" stroke=\"{}\" stroke-width=\"1.8\" points=\"{}\" data-tip=\"{}\"><title>{}</title></polyline>", colour(i), pts.join(" "), esc(&c.label), esc(&c.label));
+    }
+    for (a, label) in marks {
+        let (x, y) = (cx + rim * 1.05 * a.sin(), cy - rim * 1.05 * a.cos());
+        let _ = write!(s, "<line x1=\"{cx}\" y1=\"{cy}\" x2=\"{x:.1}\" y2=\"{y:.1}\" stroke=\"#000\" stroke-dasharray=\"3 2\"/><text x=\"{x:.1}\" y=\"{:.1}\" class=\"tick\">{}</text>", y - 2.0, esc(label));
+    }
+    s + "</svg>"
+}
+
+/// A page section: its anchor, heading and HTML body.
+struct Section {
+    id: String,
+    title: String,
+    body: String,
+}
+
+/// The page: a title, a navigation bar and sections, with the page's CSS and script inline.
+pub struct Page {
+    title: String,
+    sections: Vec<Section>,
+}
+
+const CSS: &str = include_str!("html/page.css");
+const SCRIPT: &str = include_str!("html/page.js");
+
+impl Page {
+    pub fn new(title: impl Into<String>) -> Self {
+        Page { title: title.into(), sections: Vec::new() }
+    }
+
+    pub fn section(&mut self, id: &str, title: &str, body: String) {
+        self.sections.push(Section { id: id.into(), title: title.into(), body });
+    }
+
+    pub fn render(&self) -> String {
+        let mut s = format!("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><meta name=\"viewport\" content=\"width=device-width, initial-scale=1\"><title>{}</title><style>{CSS}</style></head><body>\n", esc(&self.title));
+        let _ = write!(s, "<header><h1>{}</h1><nav>", esc(&self.title));
+        for sec in &self.sections {
+            let _ = write!(s, "<a href=\"#{}\">{}</a> ", esc(&sec.id), esc(&sec.title));
+        }
+        s += "</nav></header><div id=\"tip\"></div><main>\n";
+        for sec in &self.sections {
+            let _ = write!(s, "<section id=\"{}\"><h2>{}</h2>\n{}\n</section>\n", esc(&sec.id), esc(&sec.title), sec.body);
+        }
+        s + "</main><script>" + SCRIPT + "</script></body></html>\n"
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn base64_matches_rfc4648_vectors() {
+        for (input, want) in [("", ""), ("f", "Zg=="), ("fo", "Zm8="), ("foo", "Zm9v"), ("foob", "Zm9vYg=="), ("fooba", "Zm9vYmE="), ("foobar", "Zm9vYmFy")] {
+            assert_eq!(base64(input.as_bytes()), want, "{input}");
+        }
+    }
+
+    #[test]
+    fn escaping_covers_markup_and_quotes() {
+        assert_eq!(esc("<a href=\"x\">&'</a>"), "&lt;a href=&quot;x&quot;&gt;&amp;&#39;&lt;/a&gt;");
+    }
+
+    #[test]
+    fn log_axis_ticks_are_decades_within_range() {
+        let a = Axis::fit([0.003, 40.0].into_iter(), true).unwrap();
+        let t = a.ticks();
+        assert!(t.contains(&0.01) && t.contains(&10.0), "{t:?}");
+        assert!(t.iter().all(|v| *v >= a.lo && *v <= a.hi));
+        assert!((a.frac(a.lo)).abs() < 1e-12 && (a.frac(a.hi) - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn table_rows_carry_keys_and_values() {
+        let mut t = HtmlTable::new(&[("m", "model"), ("ns", "ns/eval")]);
+        t.row("ggx", vec![Cell::text("ggx"), Cell::num(1.25, "1.25")]);
+        let h = t.html();
+        assert!(h.contains("<tr data-row=\"ggx\">") && h.contains("data-col=\"ns\" data-v=\"1.25e0\""), "{h}");
+    }
+}

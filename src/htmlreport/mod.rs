@@ -1,0 +1,181 @@
+//! One HTML report from saved results (`brdfprof report`, and `--html` on the measuring commands): provenance,
+//! cost tables with their confidence intervals, the cost table across devices with rank correlations, the
+//! sweep's accuracy-against-cost chart, per-model lobes, lit spheres and directional albedo, and stability
+//! heat maps. Reports are read back through the typed views their writers own (`profile::view`,
+//! `sweep::view`, `stability::view`, `inspect`). Lobes, spheres and albedo are evaluated at report time by the
+//! GPU kernels on the device given (docs/report.md says why).
+
+pub mod sections;
+pub mod shapes;
+
+use crate::compare::CostTable;
+use crate::gpu::Gpu;
+use crate::html::{self, Page};
+use crate::inspect::InspectReport;
+use crate::profile::view::ProfileView;
+use crate::stability::view::StabilityView;
+use crate::sweep::view::SweepView;
+use anyhow::{anyhow, bail, Context, Result};
+use serde::de::{DeserializeOwned, IgnoredAny};
+use serde::Deserialize;
+use std::path::{Path, PathBuf};
+
+
+/// What a results file holds.
+pub enum Loaded {
+    Profile(Box<ProfileView>),
+    Sweep(Box<SweepView>),
+    Stability(Box<StabilityView>),
+    /// One inspect report per device, and with several devices the inspect's own cost table.
+    Inspect(Vec<InspectReport>, Option<CostTable>),
+    /// A `brdfprof compare` table.
+    Costs(CostTable),
+}
+
+impl Loaded {
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Loaded::Profile(_) => "profile",
+            Loaded::Sweep(_) => "sweep",
+            Loaded::Stability(_) => "stability",
+            Loaded::Inspect(..) => "inspect",
+            Loaded::Costs(_) => "compare",
+        }
+    }
+}
+
+/// One results file, read.
+pub struct Input {
+    pub path: PathBuf,
+    pub loaded: Loaded,
+}
+
+/// The keys that tell the report kinds apart (each kind's writer puts them there).
+#[derive(Deserialize)]
+struct Probe {
+    fastest: Option<IgnoredAny>,
+    workload: Option<IgnoredAny>,
+    grid_points: Option<IgnoredAny>,
+    kernels: Option<IgnoredAny>,
+    reports: Option<IgnoredAny>,
+    correlations: Option<IgnoredAny>,
+}
+
+/// The largest results file read (the biggest default report, a sweep's, is under 1 MB).
+pub const MAX_INPUT_BYTES: u64 = 256 << 20;
+
+fn parse<T: DeserializeOwned>(path: &Path, text: &str, kind: &str) -> Result<T> {
+    let de = &mut serde_json::Deserializer::from_str(text);
+    serde_path_to_error::deserialize(de).map_err(|e| anyhow!("{}: not a brdfprof {kind} report: at JSON path `{}`: {}", path.display(), e.path(), e.inner()))
+}
+
+/// Reads a profile, sweep, stability, inspect (one device or several) or compare JSON report.
+pub fn load(path: &Path) -> Result<Input> {
+    let size = std::fs::metadata(path).with_context(|| format!("{}: cannot read it", path.display()))?.len();
+    if size > MAX_INPUT_BYTES {
+        bail!("{}: {size} bytes; a brdfprof report is far smaller (at most {MAX_INPUT_BYTES} bytes read)", path.display());
+    }
+    let text = std::fs::read_to_string(path).with_context(|| format!("{}: cannot read it", path.display()))?;
+    from_json(path, &text)
+}
+
+/// A report just measured, read back through its view as a saved one would be (`--html`): what the page
+/// shows is what the JSON says.
+pub fn from_report(label: &Path, report: &impl serde::Serialize) -> Result<Input> {
+    from_json(label, &serde_json::to_string(report)?)
+}
+
+/// Reads a report's JSON text; `path` names it in errors.
+pub fn from_json(path: &Path, text: &str) -> Result<Input> {
+    let text = text.to_string();
+    let probe: Probe = serde_json::from_str(&text).map_err(|e| anyhow!("{}: not a JSON object: line {}, column {}: {e}", path.display(), e.line(), e.column()))?;
+    let loaded = if probe.fastest.is_some() {
+        Loaded::Sweep(parse(path, &text, "sweep")?)
+    } else if probe.workload.is_some() {
+        Loaded::Profile(parse(path, &text, "profile")?)
+    } else if probe.grid_points.is_some() {
+        Loaded::Stability(parse(path, &text, "stability")?)
+    } else if probe.reports.is_some() {
+        let m: crate::inspect::devices::MultiView = parse(path, &text, "inspect (several devices)")?;
+        Loaded::Inspect(m.reports, Some(m.costs))
+    } else if probe.kernels.is_some() {
+        Loaded::Inspect(vec![parse(path, &text, "inspect")?], None)
+    } else if probe.correlations.is_some() {
+        Loaded::Costs(parse(path, &text, "compare")?)
+    } else {
+        bail!("{}: not a brdfprof profile, sweep, stability, inspect or compare JSON report (none of the keys `fastest`, `workload`, `grid_points`, `reports`, `kernels`, `correlations` at its top level)", path.display());
+    };
+    Ok(Input { path: path.to_path_buf(), loaded })
+}
+
+/// The report page of `inputs`; with `gpu`, each model's lobes, spheres and albedo evaluated on it.
+pub fn build(inputs: &[Input], gpu: Option<&Gpu>) -> Result<String> {
+    let mut page = Page::new("brdfprof report");
+    page.section("provenance", "Provenance", sections::provenance(inputs));
+    let costs = sections::profiles(inputs);
+    if !costs.is_empty() {
+        page.section("costs", "Cost per evaluation", costs);
+    }
+    if let Some(body) = sections::across_devices(inputs) {
+        page.section("devices", "Across devices", body);
+    }
+    let sweeps = sections::sweeps(inputs);
+    if !sweeps.is_empty() {
+        page.section("sweep", "Accuracy against cost", sweeps);
+    }
+    let models = shapes::models_of(inputs);
+    if !models.is_empty() {
+        let body = match gpu {
+            Some(gpu) => shapes::section(gpu, &models)?,
+            None => "<p class=\"note\">Not drawn: the report was built without a device (--no-gpu).</p>".to_string(),
+        };
+        page.section("models", "Lobes, lit spheres and directional albedo", body);
+    }
+    let stability = sections::stability(inputs)?;
+    if !stability.is_empty() {
+        page.section("stability", "Stability", stability);
+    }
+    Ok(page.render())
+}
+
+/// Builds the page of `inputs` and writes it to `out` (atomically); returns its size in bytes.
+pub fn write(inputs: &[Input], out: &Path, gpu: Option<&Gpu>) -> Result<usize> {
+    if inputs.is_empty() {
+        bail!("report needs at least one RESULTS.json (a profile, sweep, stability, inspect or compare report)");
+    }
+    let page = build(inputs, gpu)?;
+    crate::io::write_output(out, page.as_bytes())?;
+    Ok(page.len())
+}
+
+/// "YYYY-MM-DD HH:MM UTC" of a Unix time (days to a civil date: the proleptic Gregorian calendar).
+pub fn utc(unix: u64) -> String {
+    let (days, secs) = ((unix / 86_400) as i64, unix % 86_400);
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z - era * 146_097;
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let day = doy - (153 * mp + 2) / 5 + 1;
+    let month = if mp < 10 { mp + 3 } else { mp - 9 };
+    let year = yoe + era * 400 + i64::from(month <= 2);
+    format!("{year:04}-{month:02}-{day:02} {:02}:{:02} UTC", secs / 3600, secs % 3600 / 60)
+}
+
+/// A file's name for headings.
+pub fn file_label(path: &Path) -> String {
+    html::esc(&path.display().to_string())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::utc;
+
+    #[test]
+    fn utc_dates_match_known_instants() {
+        assert_eq!(utc(0), "1970-01-01 00:00 UTC");
+        assert_eq!(utc(951_782_400), "2000-02-29 00:00 UTC");
+        assert_eq!(utc(1_796_163_856), "2026-12-01 22:24 UTC");
+    }
+}

@@ -1,0 +1,351 @@
+//! The report's tables and charts drawn from the saved figures: provenance, profile cost tables, the cost
+//! table across devices, the sweep's accuracy-against-cost chart and table, stability's summary and heat maps.
+//! Every figure shown in a table carries its value (`data-v`) and the row and column it belongs to, so that
+//! the browser test reads it back and checks it against the JSON.
+
+use super::{file_label, utc, Input, Loaded};
+use crate::compare::CostTable;
+use crate::html::{self, esc, Axis, Cell, HtmlTable, Point};
+use crate::profile::view::{ProfileView, RowView};
+use crate::report::sig;
+use crate::report::view::ProvenanceView;
+use crate::stability::view::{SpecView, StabilityView};
+use crate::stats::Estimate;
+use crate::sweep::view::{ErrorView, SweepView};
+use anyhow::Result;
+use std::fmt::Write;
+
+/// Significant digits of the figures shown.
+pub const DIGITS: usize = 3;
+
+/// "median [lo, hi]" as a cell whose value is the median.
+pub fn estimate_cell(e: Option<&Estimate>) -> Cell {
+    match e {
+        Some(e) => Cell::num(e.median, format!("{} [{}, {}]", sig(e.median, DIGITS), sig(e.lo, DIGITS), sig(e.hi, DIGITS))),
+        None => Cell::text("-"),
+    }
+}
+
+/// A number as a cell ("-" where absent; "NaN/Inf" where the report wrote null for a figure that exists).
+pub fn num_cell(x: Option<f64>) -> Cell {
+    match x {
+        Some(x) => Cell::num(x, sig(x, DIGITS)),
+        None => Cell::text("-"),
+    }
+}
+
+fn count_cell(n: usize) -> Cell {
+    Cell::num(n as f64, n.to_string())
+}
+
+fn kv(items: &[(&str, String)]) -> String {
+    let mut s = String::from("<dl class=\"kv\">");
+    for (k, v) in items.iter().filter(|(_, v)| !v.is_empty()) {
+        let _ = write!(s, "<dt>{}</dt><dd>{}</dd>", esc(k), esc(v));
+    }
+    s + "</dl>"
+}
+
+fn provenance_items(p: &ProvenanceView) -> Vec<(&'static str, String)> {
+    let d = &p.device;
+    let cpu = p.cpu.as_ref().map_or_else(|| p.host_cpu.clone().unwrap_or_default(), |c| format!("{} (family {}, model {}, stepping {}; {})", c.model_name, c.family, c.model, c.stepping, c.features.join(" ")));
+    vec![
+        ("device", format!("{} ({})", d.name, d.device_type)),
+        ("driver", format!("{} {} ({})", d.driver_name, d.driver_version, d.driver_info)),
+        ("Vulkan", d.api_version.clone()),
+        ("Mesa / LLVM", format!("{} / {}", p.mesa_version.as_deref().unwrap_or("-"), p.llvm_version.as_deref().unwrap_or("-"))),
+        ("CPU", cpu),
+        ("host threads", if p.host_threads > 0 { p.host_threads.to_string() } else { String::new() }),
+        ("driver environment", p.env.iter().map(|(k, v)| format!("{k}={v}")).collect::<Vec<_>>().join(" ")),
+        ("tool", p.tool.clone()),
+        ("written", if p.unix_time > 0 { utc(p.unix_time) } else { String::new() }),
+        ("command", p.command.as_ref().map_or_else(|| "(not recorded by the brdfprof that wrote it)".to_string(), |c| c.join(" "))),
+    ]
+}
+
+/// Where and how each input was measured.
+pub fn provenance(inputs: &[Input]) -> String {
+    let mut s = String::new();
+    for (i, input) in inputs.iter().enumerate() {
+        let _ = write!(s, "<h3 data-input=\"{i}\">{} <code>{}</code></h3>", input.loaded.kind(), file_label(&input.path));
+        match &input.loaded {
+            Loaded::Profile(p) => s += &kv(&provenance_items(&p.provenance)),
+            Loaded::Sweep(w) => s += &kv(&provenance_items(&w.profile.provenance)),
+            Loaded::Stability(st) => s += &kv(&provenance_items(&st.provenance)),
+            Loaded::Inspect(reports, _) => {
+                for r in reports {
+                    let p: ProvenanceView = serde_json::from_value(r.provenance.clone()).unwrap_or_default();
+                    let mut items = provenance_items(&p);
+                    items.push(("compilers", r.tools.iter().map(|(k, v)| format!("{k}: {v}")).collect::<Vec<_>>().join("; ")));
+                    items.push(("kernels", r.kernels.clone()));
+                    s += &kv(&items);
+                }
+            }
+            Loaded::Costs(t) => s += &kv(&[("columns", t.columns.iter().map(|c| format!("{} ({})", c.name, c.source)).collect::<Vec<_>>().join("; "))]),
+        }
+    }
+    s
+}
+
+/// The profile columns: (key, header).
+const PROFILE_COLUMNS: [(&str, &str); 7] = [
+    ("model", "model"),
+    ("spec", "spec"),
+    ("ns", "ns/eval [95% CI]"),
+    ("net", "net ns/eval [CI]"),
+    ("ratio", "x reference [CI]"),
+    ("net-ratio", "net x reference [CI]"),
+    ("harness", "harness share [CI]"),
+];
+
+fn profile_row(r: &RowView) -> Vec<Cell> {
+    vec![
+        Cell::text(r.model.clone()),
+        Cell::text(r.spec.clone().unwrap_or_else(|| "memory-only kernel".into())),
+        estimate_cell(Some(&r.ns_per_eval)),
+        estimate_cell(r.net_ns_per_eval.as_ref()),
+        estimate_cell(r.vs_reference.as_ref()),
+        estimate_cell(r.net_vs_reference.as_ref()),
+        estimate_cell(r.harness_share.as_ref()),
+    ]
+}
+
+/// One profile report's tables, a table per light count; rows keyed `profile<i>/<lights>/<model>`.
+pub fn profile_tables(i: usize, p: &ProfileView, path: &str) -> String {
+    let w = &p.workload;
+    let mut s = format!(
+        "<h3>{path}</h3><p class=\"note\">{}x{} G-buffer, {} rounds, {:.0}% confidence intervals of the median over rounds; reference {}; net = minus the memory-only kernel (loads, light loop, stores).</p>",
+        w.width,
+        w.height,
+        p.rounds,
+        100.0 * p.confidence_level,
+        esc(&p.reference)
+    );
+    for &lights in &w.lights {
+        let mut t = HtmlTable::new(&PROFILE_COLUMNS);
+        for r in p.rows.iter().filter(|r| r.lights == lights) {
+            t.row(format!("profile{i}/{lights}/{}", r.model), profile_row(r));
+        }
+        let _ = write!(s, "<p class=\"note\">{lights} light(s) per pixel</p>{}", t.html());
+    }
+    s
+}
+
+/// The cost tables of every profile input.
+pub fn profiles(inputs: &[Input]) -> String {
+    let mut s = String::new();
+    for (i, input) in inputs.iter().enumerate() {
+        if let Loaded::Profile(p) = &input.loaded {
+            s += &profile_tables(i, p, &file_label(&input.path));
+        }
+    }
+    s
+}
+
+/// A cost table across devices: net cost and net relative to ggx per column; rows keyed `devices/<model>`,
+/// columns `c<j>` (net) and `c<j>r` (relative); the rank correlations after it.
+pub fn cost_table_html(table: &CostTable) -> String {
+    let mut columns: Vec<(String, String)> = vec![("model".into(), "model".into())];
+    for (j, c) in table.columns.iter().enumerate() {
+        columns.push((format!("c{j}"), format!("{} net", c.name)));
+        columns.push((format!("c{j}r"), "x ggx".into()));
+    }
+    let refs: Vec<(&str, &str)> = columns.iter().map(|(k, h)| (k.as_str(), h.as_str())).collect();
+    let mut t = HtmlTable::new(&refs);
+    for m in &table.models {
+        let mut cells = vec![Cell::text(m.clone())];
+        for c in &table.columns {
+            cells.push(num_cell(c.net.get(m).copied()));
+            cells.push(num_cell(table.relative(c, m)));
+        }
+        t.row(format!("devices/{m}"), cells);
+    }
+    let mut corr = HtmlTable::new(&[("a", "device A"), ("b", "device B"), ("models", "models"), ("rho", "Spearman rho (net)")]);
+    for (k, p) in table.correlations.iter().enumerate() {
+        corr.row(format!("rho/{k}"), vec![Cell::text(p.a.clone()), Cell::text(p.b.clone()), count_cell(p.models), num_cell(p.spearman_net)]);
+    }
+    let units: Vec<String> = table.columns.iter().map(|c| format!("<b>{}</b>: {} ({})", esc(&c.name), esc(&c.unit), esc(&c.source))).collect();
+    format!("{}<p class=\"note\">{}</p><h3>Rank correlations</h3>{}", t.html(), units.join("<br>"), corr.html())
+}
+
+/// The cost table across devices: `compare` over the profile and inspect inputs (refusing kernels that
+/// differ, as `brdfprof compare` does), else the inspect's own table or a compare input.
+pub fn across_devices(inputs: &[Input]) -> Option<String> {
+    let joinable: Vec<std::path::PathBuf> = inputs.iter().filter(|i| matches!(i.loaded, Loaded::Profile(_) | Loaded::Inspect(..))).map(|i| i.path.clone()).collect();
+    let has_devices = inputs.iter().any(|i| matches!(i.loaded, Loaded::Inspect(..) | Loaded::Costs(_))) || joinable.len() > 1;
+    if !has_devices {
+        return None;
+    }
+    let own = inputs.iter().find_map(|i| match &i.loaded {
+        Loaded::Inspect(_, Some(t)) | Loaded::Costs(t) => Some(t.clone()),
+        _ => None,
+    });
+    match crate::compare::from_files(&joinable) {
+        Ok(t) => Some(cost_table_html(&t)),
+        Err(e) => {
+            let why = format!("<p class=\"err\">The profile and inspect reports given were not joined: {}</p>", esc(&format!("{e:#}")));
+            Some(why + &own.map_or_else(String::new, |t| cost_table_html(&t)))
+        }
+    }
+}
+
+fn err_text(e: &ErrorView) -> String {
+    match (e.rms, e.max) {
+        (Some(r), Some(m)) => format!("RMS {}, max {}", sig(r, DIGITS), sig(m, DIGITS)),
+        _ => format!("infinite ({} NaN/Inf values)", e.nonfinite),
+    }
+}
+
+/// The sweep's error-against-cost chart: net ns/eval (gross where there is no net) against the RMS relative
+/// error against the exact reference, both log; the Pareto frontier emphasised.
+pub fn sweep_chart(w: &SweepView) -> String {
+    let points: Vec<Point> = w
+        .rows
+        .iter()
+        .map(|r| {
+            let cost = r.net_ns_per_eval.as_ref().unwrap_or(&r.ns_per_eval);
+            let err = r.accuracy.vs_exact.rms.unwrap_or(f64::INFINITY);
+            let tip = format!("{}\nspec: {}\ncost: {} [{}, {}] ns/eval{}\nerror vs exact: {}", r.label, r.canonical, sig(cost.median, DIGITS), sig(cost.lo, DIGITS), sig(cost.hi, DIGITS), if r.net_ns_per_eval.is_some() { " net" } else { "" }, err_text(&r.accuracy.vs_exact));
+            Point { x: cost.median, y: err, label: r.label.clone(), tip, emphasis: r.pareto }
+        })
+        .collect();
+    let drawable = |p: &&Point| p.x.is_finite() && p.x > 0.0 && p.y.is_finite() && p.y > 0.0;
+    let left_out = points.len() - points.iter().filter(drawable).count();
+    let (Some(x), Some(y)) = (Axis::fit(points.iter().filter(drawable).map(|p| p.x), true), Axis::fit(points.iter().filter(drawable).map(|p| p.y), true)) else {
+        return "<p class=\"note\">No spec has a finite, positive cost and error to draw.</p>".into();
+    };
+    let mut s = html::scatter_svg(&points, x, y, "net ns per evaluation (log)", "RMS relative error vs exact (log)", html::WIDE);
+    let _ = write!(s, "<p class=\"note\">Red: the Pareto frontier (no spec both cheaper and more accurate). Hover a point for its spec, cost and error.{}</p>", if left_out > 0 { format!(" {left_out} spec(s) with an infinite, zero or NaN figure are not drawn.") } else { String::new() });
+    s
+}
+
+const SWEEP_COLUMNS: [(&str, &str); 10] = [
+    ("rank", "rank"),
+    ("label", "spec"),
+    ("ns", "ns/eval [CI]"),
+    ("net", "net ns/eval [CI]"),
+    ("fastest", "x fastest [CI]"),
+    ("rms", "RMS err vs exact"),
+    ("max", "max err vs exact"),
+    ("numerical", "RMS err vs f64 formula"),
+    ("albedo", "albedo err"),
+    ("pareto", "Pareto"),
+];
+
+/// One sweep: the chart and the table; rows keyed `sweep<i>/<label>`.
+pub fn sweep_html(i: usize, w: &SweepView, path: &str) -> String {
+    let mut t = HtmlTable::new(&SWEEP_COLUMNS);
+    for r in &w.rows {
+        let a = &r.accuracy;
+        t.row(
+            format!("sweep{i}/{}", r.label),
+            vec![
+                Cell::num(r.rank as f64, format!("{}{}", r.rank, if r.tied { " (tied)" } else { "" })),
+                Cell::text(r.label.clone()),
+                estimate_cell(Some(&r.ns_per_eval)),
+                estimate_cell(r.net_ns_per_eval.as_ref()),
+                estimate_cell(Some(&r.cost_vs_fastest)),
+                num_cell(a.vs_exact.rms),
+                num_cell(a.vs_exact.max),
+                num_cell(a.numerical.as_ref().and_then(|n| n.rms)),
+                num_cell(a.albedo_vs_exact),
+                Cell::text(if r.pareto { "yes" } else { "" }),
+            ],
+        );
+    }
+    format!("<h3>{path}</h3><p class=\"note\">{} specs on {}; fastest {}.</p>{}{}", w.rows.len(), esc(&w.sample_set), esc(&w.fastest), sweep_chart(w), t.html())
+}
+
+pub fn sweeps(inputs: &[Input]) -> String {
+    let mut s = String::new();
+    for (i, input) in inputs.iter().enumerate() {
+        if let Loaded::Sweep(w) = &input.loaded {
+            s += &sweep_html(i, w, &file_label(&input.path));
+        }
+    }
+    s
+}
+
+const STABILITY_COLUMNS: [(&str, &str); 12] = [
+    ("spec", "spec"),
+    ("nan", "NaN"),
+    ("inf", "Inf"),
+    ("negative", "negative"),
+    ("cases", "cases out of tolerance"),
+    ("grid", "grid points out of tolerance"),
+    ("worst", "worst deviation (tolerances)"),
+    ("jumps", "discontinuities"),
+    ("model-jumps", "the formula's own steps"),
+    ("reciprocity", "reciprocity"),
+    ("max-e", "max albedo (F = 1)"),
+    ("verdict", "verdict"),
+];
+
+fn stability_row(s: &SpecView) -> Vec<Cell> {
+    vec![
+        Cell::text(s.spec.clone()),
+        count_cell(s.nan),
+        count_cell(s.inf),
+        count_cell(s.negative),
+        Cell::num(s.cases_out_of_tolerance.len() as f64, format!("{} of {}", s.cases_out_of_tolerance.len(), s.cases_run)),
+        count_cell(s.grid_out_of_tolerance),
+        num_cell(s.worst.deviation),
+        count_cell(s.discontinuities),
+        count_cell(s.model_jumps),
+        num_cell(s.reciprocity),
+        num_cell(s.energy.as_ref().and_then(|e| e.max_e)),
+        Cell::text(if s.fails() { "FAIL" } else if s.energy.as_ref().is_some_and(|e| e.gains_energy) { "gains energy" } else { "ok" }),
+    ]
+}
+
+/// The bad values of a spec over (roughness, NoV) as a heat map image: white none, viridis by log count.
+fn heat_map(s: &SpecView, triples: &[[u32; 3]]) -> Result<String> {
+    use crate::stability::grid::{COSINES, ROUGHNESS};
+    let (w, h) = (COSINES.len() as u32, ROUGHNESS.len() as u32);
+    let max = triples.iter().map(|t| t[2]).max().unwrap_or(1).max(1) as f32;
+    let mut rgb = vec![255u8; (w * h * 3) as usize];
+    for &[r, v, n] in triples.iter().filter(|t| (t[0] as usize) < ROUGHNESS.len() && (t[1] as usize) < COSINES.len()) {
+        // Roughness up the image (row 0 at the bottom), NoV to the right.
+        let k = (((h - 1 - r) * w + v) * 3) as usize;
+        let c = crate::scene::render::viridis((1.0 + n as f32).ln() / (1.0 + max).ln());
+        rgb[k..k + 3].copy_from_slice(&c);
+    }
+    let total: u32 = triples.iter().map(|t| t[2]).sum();
+    let uri = html::png_data_uri(w, h, &rgb)?;
+    let caption = format!("{}: {total} bad values (NaN, Inf, negative) in {} cells; NoV {}..{} right, roughness {}..{} up; most in a cell {max}", s.spec, triples.len(), COSINES[0], COSINES[COSINES.len() - 1], ROUGHNESS[0], ROUGHNESS[ROUGHNESS.len() - 1]);
+    Ok(format!("<figure>{}<figcaption>{}</figcaption></figure>", html::img(&uri, w, h, 6, &caption), esc(&s.spec)))
+}
+
+/// One stability report: the summary table (rows keyed `stability<i>/<spec>`) and a heat map per spec with
+/// bad values.
+pub fn stability_html(i: usize, st: &StabilityView, path: &str) -> Result<String> {
+    let mut t = HtmlTable::new(&STABILITY_COLUMNS);
+    for s in &st.specs {
+        t.row(format!("stability{i}/{}", s.spec), stability_row(s));
+    }
+    let failing = st.specs.iter().filter(|s| s.fails()).count();
+    let mut maps = String::new();
+    for s in &st.specs {
+        if let Some(cells) = s.bad_cells.as_ref().filter(|c| !c.is_empty()) {
+            maps += &heat_map(s, cells)?;
+        }
+    }
+    let maps = if maps.is_empty() { "<p class=\"note\">No spec gives a bad value on the grid.</p>".to_string() } else { format!("<h3>Where the bad values are (grid of NoV x roughness, all azimuths and NoL)</h3><div class=\"heat\">{maps}</div>") };
+    Ok(format!(
+        "<h3>{path}</h3><p class=\"note\">{} specs, {failing} failing (NaN, Inf or negative on valid inputs); {} hard cases; {} grid points. Deviation in units of the tolerance.</p>{}{maps}",
+        st.specs.len(),
+        st.cases.len(),
+        st.grid_points,
+        t.html()
+    ))
+}
+
+pub fn stability(inputs: &[Input]) -> Result<String> {
+    let mut s = String::new();
+    for (i, input) in inputs.iter().enumerate() {
+        if let Loaded::Stability(st) = &input.loaded {
+            s += &stability_html(i, st, &file_label(&input.path))?;
+        }
+    }
+    Ok(s)
+}

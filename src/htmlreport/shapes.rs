@@ -1,0 +1,189 @@
+//! What each model looks like, evaluated at report time by the GPU kernels (`kernels::eval`,
+//! `stability::energy::energy_of`) on the report's device: BRDF Explorer-style polar plots of f_s in the plane
+//! of incidence at several incidence angles (linear and log), lit spheres at three roughnesses, and the
+//! directional albedo E(NoV) per roughness. Built-in specs and `.brdf` files go through the same kernels.
+
+use super::{Input, Loaded};
+use crate::brdf::Sample;
+use crate::gpu::Gpu;
+use crate::html::{self, esc, Axis, Curve};
+use crate::kernels::{self, RunLimits};
+use crate::model::Model;
+use crate::stability::energy;
+use anyhow::Result;
+use std::fmt::Write;
+
+/// The most models drawn (each costs a few kernel compilations and ~5M albedo evaluations).
+pub const MAX_MODELS: usize = 16;
+/// Incidence angles of the lobe slices, degrees.
+pub const INCIDENCE: [f64; 4] = [0.0, 30.0, 60.0, 80.0];
+/// Roughness and F0 of the lobes.
+pub const LOBE_ROUGHNESS: f32 = 0.3;
+pub const LOBE_F0: [f32; 3] = [0.04; 3];
+/// Outgoing angles of a slice: -89..89 degrees in 1 degree steps.
+const SLICE: std::ops::RangeInclusive<i32> = -89..=89;
+/// Roughnesses of the lit spheres, their size in pixels, their F0 (copper-like, so that Fresnel shows).
+pub const SPHERE_ROUGHNESS: [f32; 3] = [0.15, 0.4, 0.75];
+pub const SPHERE_PX: u32 = 64;
+pub const SPHERE_F0: [f32; 3] = [0.95, 0.64, 0.54];
+/// The spheres' light (toward it), before normalisation.
+const LIGHT: [f32; 3] = [-0.5, 0.6, 0.62];
+/// The log plots' range below the peak, in decades.
+pub const LOG_DECADES: f64 = 3.0;
+
+/// The models to draw, each once by canonical spec, in input order: the profile's models, the sweep's
+/// Pareto frontier, the inspected models, the stability specs that fail; at most MAX_MODELS. Returns
+/// (canonical spec, label).
+pub fn models_of(inputs: &[Input]) -> Vec<(String, String)> {
+    let mut out: Vec<(String, String)> = Vec::new();
+    let mut add = |spec: &str, label: &str| {
+        if !out.iter().any(|(s, _)| s == spec) {
+            out.push((spec.to_string(), label.to_string()));
+        }
+    };
+    for input in inputs {
+        match &input.loaded {
+            Loaded::Profile(p) => p.rows.iter().filter_map(|r| r.spec.as_deref().map(|s| (s, &r.model))).for_each(|(s, m)| add(s, m)),
+            Loaded::Sweep(w) => w.rows.iter().filter(|r| r.pareto).for_each(|r| add(&r.canonical, &r.label)),
+            Loaded::Inspect(reports, _) => reports.iter().flat_map(|r| &r.rows).filter_map(|r| r.spec.as_deref().map(|s| (s, &r.model))).for_each(|(s, m)| add(s, m)),
+            Loaded::Stability(st) => st.specs.iter().filter(|s| s.fails()).for_each(|s| add(&s.spec, &s.spec)),
+            Loaded::Costs(_) => {}
+        }
+    }
+    out
+}
+
+fn unit(v: [f32; 3]) -> [f32; 3] {
+    let n = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    v.map(|c| c / n)
+}
+
+/// The lobe samples: per incidence angle, light at -theta_i in the x-z plane, view over the slice.
+fn lobe_samples() -> Vec<Sample> {
+    let mut out = Vec::new();
+    for ti in INCIDENCE {
+        let ti = ti.to_radians();
+        let l = [-(ti.sin()) as f32, 0.0, ti.cos() as f32];
+        for a in SLICE {
+            let a = (a as f64).to_radians();
+            out.push(Sample { n: [0.0, 0.0, 1.0], v: [a.sin() as f32, 0.0, a.cos() as f32], l, roughness: LOBE_ROUGHNESS, f0: LOBE_F0 });
+        }
+    }
+    out
+}
+
+/// The sphere samples: for each roughness, each pixel inside the disc (orthographic view along +z); returns
+/// the samples and, per sample, (sphere, pixel index, NoL).
+fn sphere_samples() -> (Vec<Sample>, Vec<(usize, usize, f32)>) {
+    let l = unit(LIGHT);
+    let (mut samples, mut at) = (Vec::new(), Vec::new());
+    for (k, &r) in SPHERE_ROUGHNESS.iter().enumerate() {
+        for p in 0..(SPHERE_PX * SPHERE_PX) as usize {
+            let (px, py) = (p as u32 % SPHERE_PX, p as u32 / SPHERE_PX);
+            let x = (px as f32 + 0.5) / SPHERE_PX as f32 * 2.0 - 1.0;
+            let y = 1.0 - (py as f32 + 0.5) / SPHERE_PX as f32 * 2.0;
+            let rr = x * x + y * y;
+            if rr >= 1.0 {
+                continue;
+            }
+            let n = [x, y, (1.0 - rr).sqrt()];
+            let nol = n[0] * l[0] + n[1] * l[1] + n[2] * l[2];
+            samples.push(Sample { n, v: [0.0, 0.0, 1.0], l, roughness: r, f0: SPHERE_F0 });
+            at.push((k, p, nol));
+        }
+    }
+    (samples, at)
+}
+
+/// The lobe plots of one model (linear and log), from f_s over `lobe_samples` (channel 0).
+fn lobes_svg(values: &[[f32; 3]]) -> String {
+    let n = SLICE.count();
+    let curves: Vec<Curve> = INCIDENCE
+        .iter()
+        .enumerate()
+        .map(|(i, ti)| Curve { label: format!("light at {ti} deg"), points: SLICE.zip(&values[i * n..(i + 1) * n]).map(|(a, f)| ((a as f64).to_radians(), f64::from(f[0]))).collect() })
+        .collect();
+    let peak = curves.iter().flat_map(|c| c.points.iter().map(|p| p.1)).filter(|v| v.is_finite()).fold(0.0f64, f64::max);
+    let marks: Vec<(f64, String)> = INCIDENCE.iter().map(|t| (-t.to_radians(), format!("L{t}"))).collect();
+    let marks: Vec<(f64, &str)> = marks.iter().map(|(a, l)| (*a, l.as_str())).collect();
+    let linear = html::polar_svg(&format!("f_s, linear (peak {})", crate::report::sig(peak, 3)), &curves, &marks, None);
+    let log = html::polar_svg(&format!("f_s, log ({LOG_DECADES} decades below the peak)"), &curves, &marks, Some(LOG_DECADES));
+    let legend: Vec<String> = INCIDENCE.iter().enumerate().map(|(i, t)| format!("<span style=\"color:{}\">&#9632; light at {t}&deg;</span>", html::colour(i))).collect();
+    format!("<figure><div class=\"row\">{linear}{log}</div><figcaption>{}</figcaption></figure>", legend.join(" "))
+}
+
+/// The lit spheres of one model: f_s NoL times pi (a white Lambertian would read 1), tone-mapped.
+fn spheres_html(values: &[[f32; 3]], at: &[(usize, usize, f32)]) -> Result<String> {
+    let px = (SPHERE_PX * SPHERE_PX) as usize;
+    let mut images = vec![vec![40u8; px * 3]; SPHERE_ROUGHNESS.len()];
+    for (f, &(k, p, nol)) in values.iter().zip(at) {
+        let radiance = f.map(|c| if c.is_finite() { c * nol.max(0.0) * std::f32::consts::PI } else { f32::NAN });
+        // NaN or Inf shows magenta: a sphere must say where the model breaks.
+        let rgb = if radiance.iter().all(|c| c.is_finite()) { crate::scene::render::tone_map(radiance, 1.0) } else { [255, 0, 255] };
+        images[k][p * 3..p * 3 + 3].copy_from_slice(&rgb);
+    }
+    let mut s = String::from("<div class=\"row\">");
+    for (img, r) in images.iter().zip(SPHERE_ROUGHNESS) {
+        let uri = html::png_data_uri(SPHERE_PX, SPHERE_PX, img)?;
+        let _ = write!(s, "<figure>{}<figcaption>r = {r}</figcaption></figure>", html::img(&uri, SPHERE_PX, SPHERE_PX, 2, &format!("lit sphere, roughness {r}")));
+    }
+    Ok(s + "</div>")
+}
+
+/// E(NoV) per roughness (F = 1), from the albedo kernel.
+fn albedo_svg(e: &energy::Energy) -> String {
+    let curves: Vec<Curve> = e
+        .e
+        .iter()
+        .zip(energy::ROUGHNESS)
+        .map(|(row, r)| Curve { label: format!("r = {r}"), points: energy::NOV.iter().zip(row).map(|(v, x)| (f64::from(*v), f64::from(*x))).collect() })
+        .collect();
+    let top = e.max_e.unwrap_or(1.0).max(1.0) * 1.05;
+    html::lines_svg(&curves, Axis { lo: 0.0, hi: 1.0, log: false }, Axis { lo: 0.0, hi: top, log: false }, "NoV", "directional albedo E (F = 1)", html::SMALL)
+}
+
+/// One model's card.
+fn model_card(gpu: &Gpu, spec: &str, label: &str) -> Result<String> {
+    let model = Model::parse(spec)?;
+    let lobes = lobe_samples();
+    let (spheres, at) = sphere_samples();
+    let all: Vec<Sample> = lobes.iter().chain(&spheres).copied().collect();
+    let values = kernels::eval(gpu, &model, &all, RunLimits::default())?;
+    let (lobe_values, sphere_values) = values.split_at(lobes.len());
+    let e = energy::energy_of(gpu, &model)?;
+    Ok(format!(
+        "<div class=\"model\" data-model=\"{}\"><h3>{}</h3><p class=\"note\"><code>{}</code></p>{}<div class=\"row\">{}{}</div></div>",
+        esc(spec),
+        esc(label),
+        esc(spec),
+        lobes_svg(lobe_values),
+        spheres_html(sphere_values, &at)?,
+        albedo_svg(&e)
+    ))
+}
+
+/// The section: a card per model (a model that cannot be evaluated, e.g. a `.brdf` file no longer there,
+/// says why in its place).
+pub fn section(gpu: &Gpu, models: &[(String, String)]) -> Result<String> {
+    let mut s = format!(
+        "<p class=\"note\">Evaluated now on {} by the same kernels that were measured. Lobes: f_s in the plane of incidence, roughness {LOBE_ROUGHNESS}, F0 {}, light at each incidence angle on the left (dashed), view over the plane; each plot scaled to its peak. Spheres: f_s NoL pi, F0 ({}, {}, {}), one directional light, tone-mapped (ACES, sRGB); magenta where a value is NaN or Inf. Albedo: E(NoV) with F = 1.</p><div class=\"models\">",
+        esc(&gpu.info.name),
+        LOBE_F0[0],
+        SPHERE_F0[0],
+        SPHERE_F0[1],
+        SPHERE_F0[2]
+    );
+    for (spec, label) in models.iter().take(MAX_MODELS) {
+        match model_card(gpu, spec, label) {
+            Ok(card) => s += &card,
+            Err(e) => {
+                crate::messages::warning(format!("report: {label}: not drawn: {e:#}"));
+                let _ = write!(s, "<div class=\"model\"><h3>{}</h3><p class=\"err\">Not drawn: {}</p></div>", esc(label), esc(&format!("{e:#}")));
+            }
+        }
+    }
+    if models.len() > MAX_MODELS {
+        let _ = write!(s, "<p class=\"note\">{} more model(s) not drawn (at most {MAX_MODELS}).</p>", models.len() - MAX_MODELS);
+    }
+    Ok(s + "</div>")
+}
