@@ -49,7 +49,7 @@ pub fn profile(args: &ProfileArgs) -> Result<ExitCode> {
     let size = args.size.as_deref().unwrap_or("960x540");
     let options = args.timing.options(args.model.models(&THESIS_MODELS)?, size, args.reps, args.budget, args.target_ci)?;
     let (gpu, result) = on_device(&args.device, |gpu, progress| profile::run(gpu, &options, progress))?;
-    let path = args.json.clone().unwrap_or_else(|| PathBuf::from(format!("results/profile-{}.json", report::device_slug(&gpu.info))));
+    let path = args.json.clone().unwrap_or_else(|| PathBuf::from(format!("results/profile-{}.json", brdfprof::targets::device_slug(&gpu.info))));
     report::write_json(&path, &result)?;
     println!("{}\n", result.summary());
     print!("{}{}", result.table().markdown(), result.placement_notes());
@@ -77,7 +77,7 @@ fn profile_scene(args: &ProfileArgs, path: &std::path::Path) -> Result<ExitCode>
     let base = args.timing.options(Vec::new(), "1x1", args.reps, args.budget, args.target_ci)?;
     let options = scene::profile::SceneProfileOptions { protocol: base.protocol, target_rel_ci: args.target_ci, max_chunk: None, instances: base.instances };
     let (gpu, result) = on_device(&args.device, |gpu, progress| scene::profile::run(gpu, &scene, &options, progress))?;
-    let path = args.json.clone().unwrap_or_else(|| PathBuf::from(format!("results/scene-{}-{}.json", scene.name(), report::device_slug(&gpu.info))));
+    let path = args.json.clone().unwrap_or_else(|| PathBuf::from(format!("results/scene-{}-{}.json", scene.name(), brdfprof::targets::device_slug(&gpu.info))));
     report::write_json(&path, &result)?;
     println!("{}\n", result.summary());
     print!("{}", result.markdown());
@@ -161,7 +161,7 @@ pub fn sweep(args: &SweepArgs) -> Result<ExitCode> {
     for r in result.rows.iter().filter(|r| r.accuracy.vs_exact.nonfinite > 0) {
         brdfprof::messages::warning(format!("{}: {} of {} values on the sample set are NaN or Inf", r.spec, r.accuracy.vs_exact.nonfinite, r.accuracy.vs_exact.values));
     }
-    let slug = report::device_slug(&gpu.info);
+    let slug = brdfprof::targets::device_slug(&gpu.info);
     let mut files = result.write(&args.out, &slug)?;
     print!("{}", result.markdown());
     for run in &costs {
@@ -196,7 +196,7 @@ pub fn stability(args: &StabilityArgs) -> Result<ExitCode> {
     let models = if args.model.models.is_empty() { stability::default_specs().into_iter().map(Model::spec).collect() } else { args.model.models(&[])? };
     let options = stability::StabilityOptions { models, energy: !args.no_energy };
     let (gpu, result) = on_device(&args.device, |gpu, progress| stability::run(gpu, &options, progress))?;
-    let files = result.write(&args.out, &report::device_slug(&gpu.info))?;
+    let files = result.write(&args.out, &brdfprof::targets::device_slug(&gpu.info))?;
     print!("{}", result.markdown());
     println!("\n{}", written(&files));
     let failing = result.failing();
