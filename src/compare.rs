@@ -6,32 +6,14 @@
 //! specialisation constants that select the model).
 
 use crate::inspect::InspectReport;
-use crate::model::Model;
-use crate::profile::gbuffer::GBufferFormat;
-use crate::profile::workload::{shade_kernel, BASELINE_LABEL};
+use crate::inspect::HASH_NOTE;
+use crate::profile::workload::BASELINE_LABEL;
 use crate::report::{sig, Table};
-use crate::shaders::Shaders;
 use anyhow::{anyhow, bail, Context, Result};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-
-/// Key of a row's kernel hash in `inspect::Row::notes`.
-pub const HASH_NOTE: &str = "kernel-sha256";
-
-/// SHA-256 of a model's shading kernel (None: the memory-only kernel) over `format`: the SPIR-V words and the
-/// constants that select the model, with the light count fixed at one block of one light, so that the hash
-/// names the code and the model, not the workload.
-pub fn kernel_hash(model: Option<&Model>, format: GBufferFormat, shaders: &Shaders) -> Result<String> {
-    let k = shade_kernel(model, format, 1, false, shaders)?;
-    let mut h = Sha256::new();
-    for w in k.spirv.words.iter() {
-        h.update(w.to_le_bytes());
-    }
-    h.update(format!("{:?}", k.constants).as_bytes());
-    Ok(h.finalize().iter().map(|b| format!("{b:02x}")).collect())
-}
 
 /// One device's (or one measure's) cost per evaluation of each kernel.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]

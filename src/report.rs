@@ -103,15 +103,6 @@ impl Provenance {
     }
 }
 
-/// A lower-case file-name-safe form of a device name ("llvmpipe (LLVM 15.0.6, 256 bits)" -> "llvmpipe").
-pub fn device_slug(device: &DeviceInfo) -> String {
-    // RADV's compile-only devices are all "Null hardware (RADV <FAMILY>)": the family tells them apart.
-    if let Some(t) = crate::targets::radv::family_of_device(&device.name) {
-        return format!("radv-{}", t.family);
-    }
-    name_slug(&device.name)
-}
-
 /// The file-name form of a device name: its first words, lower case ("llvmpipe (LLVM 15.0.6, 256 bits)" ->
 /// "llvmpipe").
 pub fn name_slug(name: &str) -> String {

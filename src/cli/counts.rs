@@ -2,11 +2,11 @@
 
 use super::{check_output, fresh_compilation, on_device_with, parse_size, DeviceArgs, ModelArgs};
 use brdfprof::gpu::Gpu;
-use brdfprof::inspect::devices;
+use brdfprof::devices;
 use anyhow::{anyhow, bail, Result};
 use brdfprof::brdf::THESIS_MODELS;
 use brdfprof::inspect::callgrind::CallgrindOptions;
-use brdfprof::inspect::check::{self, CheckOptions, Thresholds};
+use brdfprof::check::{self, CheckOptions, Thresholds};
 use brdfprof::inspect::timing::TimingOptions;
 use brdfprof::inspect::{self, InspectOptions};
 use brdfprof::shaders::Shaders;

@@ -103,7 +103,7 @@ pub fn models() -> Result<ExitCode> {
 /// Writes glsl/generated/ (`make spv`).
 pub fn generate_glsl(dir: &Path) -> Result<ExitCode> {
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
-    for (name, text) in brdfprof::brdf::glsl_gen::files() {
+    for (name, text) in brdfprof::kernels::generated_glsl() {
         let path = dir.join(name);
         brdfprof::io::write_output(&path, text.as_bytes())?;
         println!("{}", path.display());

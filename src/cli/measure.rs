@@ -52,7 +52,7 @@ pub fn profile(args: &ProfileArgs) -> Result<ExitCode> {
     let size = args.size.as_deref().unwrap_or("960x540");
     let options = args.timing.options(args.model.models(&THESIS_MODELS)?, size, args.reps, args.budget, args.target_ci)?;
     let (gpu, result) = on_device(&args.device, |gpu, progress| profile::run(gpu, &options, progress))?;
-    let path = args.json.clone().unwrap_or_else(|| PathBuf::from(format!("results/profile-{}.json", report::device_slug(&gpu.info))));
+    let path = args.json.clone().unwrap_or_else(|| PathBuf::from(format!("results/profile-{}.json", brdfprof::targets::device_slug(&gpu.info))));
     report::write_json(&path, &result)?;
     args.html.write(&[super::report::just_measured(&path, &result)?], Some(&gpu))?;
     println!("{}\n", result.summary());
@@ -81,7 +81,7 @@ fn profile_scene(args: &ProfileArgs, path: &std::path::Path) -> Result<ExitCode>
     let base = args.timing.options(Vec::new(), "1x1", args.reps, args.budget, args.target_ci)?;
     let options = scene::profile::SceneProfileOptions { protocol: base.protocol, target_rel_ci: args.target_ci, max_chunk: None, instances: base.instances };
     let (gpu, result) = on_device(&args.device, |gpu, progress| scene::profile::run(gpu, &scene, &options, progress))?;
-    let path = args.json.clone().unwrap_or_else(|| PathBuf::from(format!("results/scene-{}-{}.json", scene.name(), report::device_slug(&gpu.info))));
+    let path = args.json.clone().unwrap_or_else(|| PathBuf::from(format!("results/scene-{}-{}.json", scene.name(), brdfprof::targets::device_slug(&gpu.info))));
     report::write_json(&path, &result)?;
     println!("{}\n", result.summary());
     print!("{}", result.markdown());
@@ -168,7 +168,7 @@ pub fn sweep(args: &SweepArgs) -> Result<ExitCode> {
     for r in result.rows.iter().filter(|r| r.accuracy.vs_exact.nonfinite > 0) {
         brdfprof::messages::warning(format!("{}: {} of {} values on the sample set are NaN or Inf", r.spec, r.accuracy.vs_exact.nonfinite, r.accuracy.vs_exact.values));
     }
-    let slug = report::device_slug(&gpu.info);
+    let slug = brdfprof::targets::device_slug(&gpu.info);
     let mut files = result.write(&args.out, &slug)?;
     files.extend(args.html.write(&[super::report::just_measured(&args.out.join(format!("sweep-{slug}.json")), &result)?], Some(&gpu))?);
     print!("{}", result.markdown());
@@ -211,7 +211,7 @@ pub fn stability(args: &StabilityArgs) -> Result<ExitCode> {
     let models = if args.model.models.is_empty() { stability::default_specs().into_iter().map(Model::spec).collect() } else { args.model.models(&[])? };
     let options = stability::StabilityOptions { models: super::with_unguarded(models, args.unguarded), energy: !args.no_energy };
     let (gpu, result) = on_device(&args.device, |gpu, progress| stability::run(gpu, &options, progress))?;
-    let slug = report::device_slug(&gpu.info);
+    let slug = brdfprof::targets::device_slug(&gpu.info);
     let mut files = result.write(&args.out, &slug)?;
     files.extend(args.html.write(&[super::report::just_measured(&args.out.join(format!("stability-{slug}.json")), &result)?], Some(&gpu))?);
     print!("{}", result.markdown());

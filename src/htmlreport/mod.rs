@@ -96,7 +96,7 @@ pub fn from_json(path: &Path, text: &str) -> Result<Input> {
     } else if probe.grid_points.is_some() {
         Loaded::Stability(parse(path, &text, "stability")?)
     } else if probe.reports.is_some() {
-        let m: crate::inspect::devices::MultiView = parse(path, &text, "inspect (several devices)")?;
+        let m: crate::devices::MultiView = parse(path, &text, "inspect (several devices)")?;
         Loaded::Inspect(m.reports, Some(m.costs))
     } else if probe.kernels.is_some() {
         Loaded::Inspect(vec![parse(path, &text, "inspect")?], None)

@@ -5,9 +5,8 @@
 //! a short timing run) into a regression gate against a saved baseline.
 
 pub mod callgrind;
-pub mod check;
+pub mod cost;
 pub mod correlate;
-pub mod devices;
 pub mod driver;
 pub mod naga_info;
 pub mod spirv;
@@ -25,6 +24,10 @@ use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
 pub use crate::profile::workload::BASELINE_LABEL;
+
+
+/// Key of a row's kernel hash in `inspect::Row::notes`.
+pub const HASH_NOTE: &str = "kernel-sha256";
 
 /// Statistic sections, in report order: key prefix and title.
 pub const SECTIONS: [(&str, &str); 5] = [
@@ -78,10 +81,10 @@ pub struct InspectReport {
     /// Callgrind figures next to a profile's timings (`inspect --profile FILE`).
     #[serde(default)]
     pub vs_profile: Option<correlate::Correlation>,
-    /// The compiler's cost model applied to the kernels (`targets::cost_of`: ACO's on RADV, NVIDIA's issue
+    /// The compiler's cost model applied to the kernels (set by `targets::cost_of`: ACO's on RADV, NVIDIA's issue
     /// model on `nvidia:` targets), where the device's statistics have one.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub cost: Option<crate::targets::cost::TargetCost>,
+    pub cost: Option<cost::TargetCost>,
 }
 
 /// SPIR-V statistics of one specialised kernel, and naga's of `naga_kernel` (the same BRDF over the float
@@ -139,7 +142,7 @@ pub fn static_row(shaders: &Shaders, model: Option<&Model>, lights: u32) -> Resu
     let (per_dispatch, accumulate) = steady_block(lights);
     let kernel = shade_kernel(model, GBufferFormat::Packed, per_dispatch, accumulate, shaders)?;
     let float_kernel = shade_kernel(model, GBufferFormat::Float, per_dispatch, accumulate, shaders)?;
-    row.notes.insert(crate::compare::HASH_NOTE.into(), crate::compare::kernel_hash(model, GBufferFormat::Packed, shaders)?);
+    row.notes.insert(HASH_NOTE.into(), workload::kernel_hash(model, GBufferFormat::Packed, shaders)?);
     static_stats(&kernel, &float_kernel, &mut row)?;
     Ok(row)
 }
@@ -234,7 +237,7 @@ pub fn run(gpu: &Gpu, shaders: &Shaders, options: &InspectOptions) -> Result<Ins
             emitted.push(key.to_string());
         }
     }
-    let mut report = InspectReport {
+    let report = InspectReport {
         provenance: serde_json::to_value(Provenance::new(&gpu.info))?,
         kernels: shaders.describe(),
         lights: options.lights,
@@ -247,7 +250,6 @@ pub fn run(gpu: &Gpu, shaders: &Shaders, options: &InspectOptions) -> Result<Ins
         vs_profile: None,
         cost: None,
     };
-    report.cost = crate::targets::cost_of(&report);
     Ok(report)
 }
 

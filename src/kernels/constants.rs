@@ -1,6 +1,8 @@
-//! Every kernel-level specialisation constant, named once: `brdf::glsl_gen` declares them in
+//! Every kernel-level specialisation constant, named once: `glsl()` declares them in
 //! glsl/generated/kernel_constants.glsl (included by every kernel) and the host sets them by these names.
 //! Ids 0..2 select the terms and 3..15 are the term parameters (`brdf::terms::PARAMS`); these start at 16.
+
+use crate::brdf::glsl_gen;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ConstantKind {
@@ -43,6 +45,20 @@ pub const LIGHT_BLOCK: u32 = 8;
 pub const ALL: &[Constant] =
     &[NUM_LIGHTS, BASELINE, ALBEDO_N, NUM_DIRECTIONAL, NUM_POINT, NUM_SPOT, NUM_SPHERE, ANISOTROPY, ENERGY_COMPENSATION, DIFFUSE, CLEAR_COAT, E_TABLE_MU, E_TABLE_R, ACCUMULATE];
 
+/// glsl/generated/kernel_constants.glsl: every constant of `ALL` and `LIGHT_BLOCK`.
+pub fn glsl() -> String {
+    let mut out = format!("{}// Kernel-level specialisation constants (src/kernels/constants.rs), declared for every kernel.\n#ifndef KERNEL_CONSTANTS_GLSL\n#define KERNEL_CONSTANTS_GLSL\n", glsl_gen::HEADER);
+    for c in ALL {
+        let (ty, value) = match c.kind {
+            ConstantKind::Int => ("int", format!("{}", c.default as i64)),
+            ConstantKind::Float => ("float", glsl_gen::float(c.default)),
+        };
+        out += &format!("layout(constant_id = {}) const {ty} {} = {value}; // {}\n", c.id, c.name, c.about);
+    }
+    out += &format!("#define LIGHT_BLOCK {LIGHT_BLOCK} // shade.glsl: lights per dispatch at most\n#endif\n");
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -58,3 +74,4 @@ mod tests {
         assert!(ALL.iter().all(|c| c.id >= 16) && PARAMS.iter().all(|p| (3..16).contains(&p.constant_id)));
     }
 }
+

@@ -11,6 +11,14 @@ use anyhow::Result;
 use constants::{Constant, ConstantKind};
 use std::sync::OnceLock;
 
+/// Every file under glsl/generated/ and its contents: the term table's (`brdf::glsl_gen`) and the kernel
+/// constants'. `brdfprof __generate-glsl` writes them (`make spv`); tests/kernels/sources.rs compares.
+pub fn generated_glsl() -> Vec<(&'static str, String)> {
+    let mut files = crate::brdf::glsl_gen::files();
+    files.push(("kernel_constants.glsl", constants::glsl()));
+    files
+}
+
 /// The embedded kernels (`spv/`), shared by every command that does not compile its own.
 pub fn embedded() -> &'static Shaders {
     static EMBEDDED: OnceLock<Shaders> = OnceLock::new();

@@ -415,19 +415,6 @@ impl FileModel {
         Ok(Spirv { name: format!("{}:{kernel_name}", self.path), words: words.into() })
     }
 
-    /// The file's line and own name of a translation error located in its composed kernel: `file.brdf:LINE`
-    /// for the file's lines, its identifiers without brdfprof's prefix.
-    pub fn locate(&self, e: &crate::translate::TranslateError) -> String {
-        let prefix = self.file.renamed_shader().map(|r| r.prefix).unwrap_or_default();
-        let function = e.function.as_deref().map(|f| f.strip_prefix(prefix.as_str()).unwrap_or(f).to_string());
-        let construct = format!("the C translation cannot express {}{}", e.construct, function.map_or(String::new(), |f| format!(" (in function `{f}`)")));
-        match &e.location {
-            Some(l) if l.file == self.file.path.display().to_string() || l.file.ends_with(".brdf") => format!("{}:{}: {construct}", self.path, l.line),
-            Some(l) => format!("{}: {construct} (at {}:{} of brdfprof's kernel)", self.path, l.file, l.line),
-            None => format!("{}: {construct}", self.path),
-        }
-    }
-
     /// glslang on the composed source: written beside a copy of the embedded tree (or with `--glsl DIR` on the
     /// include path), so that the kernel's `#include "brdf.glsl"` resolves as in glsl/. Errors name the file's
     /// lines and its own identifiers.

@@ -157,6 +157,12 @@ impl Model {
         }
     }
 
+    /// Whether its D has an anisotropic form (a term spec whose D row says so): the scene kernel's anisotropic
+    /// lobe extends that D, so it can stand in for the model's.
+    pub fn takes_anisotropy(&self) -> bool {
+        self.twin().is_some_and(|s| s.d.row().anisotropic)
+    }
+
     /// Applies `key=value` overrides (`--param`).
     pub fn with_params(&self, params: &[String]) -> Result<Self> {
         match self {

@@ -98,7 +98,7 @@ pub struct ProfileReport {
     pub rows: Vec<Row>,
     /// Labels of the variants, indexing `raw.ns`.
     pub labels: Vec<String>,
-    /// Model (and "baseline") -> SHA-256 of its kernel (`compare::kernel_hash`): `brdfprof compare` joins
+    /// Model (and "baseline") -> SHA-256 of its kernel (`workload::kernel_hash`): `brdfprof compare` joins
     /// reports of the same kernels only.
     pub kernel_sha256: std::collections::BTreeMap<String, String>,
     pub raw: RawTimes,
@@ -214,7 +214,7 @@ pub fn run(gpu: &Gpu, options: &ProfileOptions, progress: &ProgressBar) -> Resul
     let mut kernel_sha256 = std::collections::BTreeMap::new();
     for spec in models.iter().map(Some).chain([None]) {
         let label = spec.map_or_else(|| workload::BASELINE_LABEL.to_string(), Model::name);
-        kernel_sha256.insert(label, crate::compare::kernel_hash(spec, options.format, shaders)?);
+        kernel_sha256.insert(label, workload::kernel_hash(spec, options.format, shaders)?);
     }
     Ok(ProfileReport {
         provenance: Provenance::new(&gpu.info),

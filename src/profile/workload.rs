@@ -202,6 +202,20 @@ pub fn shade_kernel(model: Option<&Model>, format: GBufferFormat, lights: u32, a
     Ok(k)
 }
 
+/// SHA-256 of a model's shading kernel (None: the memory-only kernel) over `format`: the SPIR-V words and the
+/// constants that select the model, with the light count fixed at one block of one light, so that the hash
+/// names the code and the model, not the workload.
+pub fn kernel_hash(model: Option<&Model>, format: GBufferFormat, shaders: &Shaders) -> Result<String> {
+    let k = shade_kernel(model, format, 1, false, shaders)?;
+    use sha2::Digest;
+    let mut h = sha2::Sha256::new();
+    for w in k.spirv.words.iter() {
+        h.update(w.to_le_bytes());
+    }
+    h.update(format!("{:?}", k.constants).as_bytes());
+    Ok(h.finalize().iter().map(|b| format!("{b:02x}")).collect())
+}
+
 /// A model's shading kernel (or the memory-only baseline) bound to the workload, every light block, ready to
 /// dispatch.
 pub struct Variant<'g> {

@@ -647,7 +647,7 @@ fn check_materials(materials: &[Material]) -> Result<()> {
             bail!("materials[{i}].name: `{}` is used by an earlier material", m.name);
         }
         let model = m.try_model().map_err(|e| anyhow!("materials[{i}].{}: {e:#}", if m.gamma.is_some() { "gamma" } else { "params" }))?;
-        if m.effects.anisotropy.0 != 0.0 && !super::plan::takes_anisotropy(&model) {
+        if m.effects.anisotropy.0 != 0.0 && !model.takes_anisotropy() {
             bail!("materials[{i}].effects.anisotropy: anisotropic GGX replaces the model's D and Vis, so it needs d=ggx (model `{}`)", model.name());
         }
     }

@@ -13,6 +13,9 @@ use std::path::{Path, PathBuf};
 /// Material index of pixels no surface covers (not shaded).
 pub const BACKGROUND: u32 = u32::MAX;
 
+/// Bytes per pixel of the pixel binding on the device (3 vec4: the scene kernel's `Pixel`).
+pub(crate) const PIXEL_BYTES: u64 = 48;
+
 /// One G-buffer pixel.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Pixel {
@@ -366,14 +369,14 @@ pub fn size(scene: &Scene) -> Result<(u32, u32)> {
 pub fn check_device(scene: &Scene, info: &crate::gpu::DeviceInfo) -> Result<()> {
     let (w, h) = size(scene)?;
     let padded = (w as u64 * h as u64).div_ceil(crate::gpu::WORKGROUP as u64) * crate::gpu::WORKGROUP as u64;
-    let bytes = padded * super::run::PIXEL_BYTES;
+    let bytes = padded * PIXEL_BYTES;
     if info.max_memory_allocation_size > 0 && bytes > info.max_memory_allocation_size {
         bail!(
             "{}: a {w}x{h} G-buffer needs a {bytes}-byte buffer of pixels on `{}`, more than one allocation may be ({} bytes, maxMemoryAllocationSize); at most {} pixels there",
             scene.path.display(),
             info.name,
             info.max_memory_allocation_size,
-            info.max_memory_allocation_size / super::run::PIXEL_BYTES
+            info.max_memory_allocation_size / PIXEL_BYTES
         );
     }
     Ok(())

@@ -155,7 +155,7 @@ pub fn plan(scene: &Scene, gbuffer: &GBuffer, model: Option<&Model>) -> ScenePla
         .zip(&specs)
         .map(|(m, s)| {
             let a = m.effects.anisotropy.0;
-            if a != 0.0 && !takes_anisotropy(s) {
+            if a != 0.0 && !s.takes_anisotropy() {
                 notes.push(format!("material `{}`: anisotropy needs d=ggx, so it is off under {}", m.name, s.name()));
                 0.0
             } else {
@@ -202,11 +202,6 @@ pub fn plan(scene: &Scene, gbuffer: &GBuffer, model: Option<&Model>) -> ScenePla
     }
     let (counts, light_data, lights) = pack_lights(&scene.file.lights);
     ScenePlan { kernels, counts, light_data, lights, anisotropy, notes }
-}
-
-/// Whether the scene kernel's anisotropic lobe can stand in for `model`'s (it extends its D).
-pub fn takes_anisotropy(model: &Model) -> bool {
-    model.twin().is_some_and(|s| s.d.row().anisotropic)
 }
 
 /// The effect switches as specialisation constants (scene.glsl), with the E table's size.

@@ -4,7 +4,7 @@
 //! maxComputeWorkGroupCount), so a 4K or larger G-buffer runs as several dispatches of one pipeline.
 
 use super::format::Scene;
-use super::gbuffer::GBuffer;
+use super::gbuffer::{GBuffer, PIXEL_BYTES};
 use super::plan::ScenePlan;
 use super::terms::{ETable, Switches};
 use super::effects;
@@ -14,8 +14,7 @@ use crate::model::KernelKind;
 use crate::profile::protocol::{Dispatch, Pipelines, Timed};
 use anyhow::Result;
 
-/// Bytes per pixel of each per-pixel binding: pixels (3 vec4), output (1 vec4), extras (2 vec4).
-pub(crate) const PIXEL_BYTES: u64 = 48;
+/// Bytes per pixel of the other per-pixel bindings: output (1 vec4), extras (2 vec4); pixels: `PIXEL_BYTES`.
 const OUT_BYTES: u64 = 16;
 const EXTRA_BYTES: u64 = 32;
 

@@ -6,7 +6,7 @@
 //! report per family, with its compiler's statistics under `driver/`), its cost model (`cost`), and what its
 //! statistics depend on (the gate's fingerprint).
 
-pub mod cost;
+pub use crate::inspect::cost;
 pub mod intel;
 pub mod nvidia;
 pub mod nvrtc;
@@ -189,6 +189,23 @@ pub fn of_report(report: &InspectReport) -> Option<Target> {
 /// The cost table of a report: its vendor's model applied to its statistics (a real RADV GPU's too).
 pub fn cost_of(report: &InspectReport) -> Option<TargetCost> {
     VENDORS.iter().find_map(|v| v.cost(report))
+}
+
+/// `inspect` on a Vulkan device of this machine, with the cost table its vendor's model gives, if any (a real
+/// RADV GPU reports ACO's statistics).
+pub fn inspect_device(gpu: &Gpu, shaders: &Shaders, options: &crate::inspect::InspectOptions) -> Result<InspectReport> {
+    let mut report = crate::inspect::run(gpu, shaders, options)?;
+    report.cost = cost_of(&report);
+    Ok(report)
+}
+
+/// A lower-case file-name-safe form of a device name ("llvmpipe (LLVM 15.0.6, 256 bits)" -> "llvmpipe").
+pub fn device_slug(device: &crate::gpu::DeviceInfo) -> String {
+    // RADV's compile-only devices are all "Null hardware (RADV <FAMILY>)": the family tells them apart.
+    if let Some(t) = radv::family_of_device(&device.name) {
+        return format!("radv-{}", t.family);
+    }
+    crate::report::name_slug(&device.name)
 }
 
 /// File-name form of a kernel label.

@@ -82,7 +82,7 @@ pub fn child_main(request_json: &str) -> Result<()> {
     // A model this family cannot compile (fp16 arithmetic where the device has no shaderFloat16) is left out
     // and named in the driver section's notes, so that one family does not stop a report of many.
     let (models, skipped): (Vec<Model>, Vec<Model>) = models.into_iter().partition(|m| m.check_support(&gpu.info).is_ok());
-    let mut report = crate::inspect::run(&gpu, &shaders, &InspectOptions { models: models.clone(), lights: req.lights, callgrind: None })?;
+    let mut report = super::inspect_device(&gpu, &shaders, &InspectOptions { models: models.clone(), lights: req.lights, callgrind: None })?;
     if !skipped.is_empty() {
         let why = skipped.iter().map(|m| format!("{} ({:#})", m.name(), m.check_support(&gpu.info).unwrap_err())).collect::<Vec<_>>().join("; ");
         report.section_notes.insert("driver/".into(), format!("not compiled for {}: {why}", target.family));

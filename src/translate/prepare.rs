@@ -3,9 +3,10 @@
 //! form with the loops its `[[unroll]]` marks unrolled (`spirv-opt --ssa-rewrite --loop-unroll`), as a Vulkan
 //! driver unrolls the light loop the hint marks. Nothing else is optimised: the target's compiler does that.
 
-use super::{translate, TexelFormat, TranslateOptions, Translation};
+use super::{translate, TexelFormat, TranslateError, TranslateOptions, Translation};
 use crate::gpu::SpecConstants;
 use crate::inspect::spirv;
+use crate::model::file_model::FileModel;
 use crate::model::{KernelKind, Model};
 use crate::profile::gbuffer::GBufferFormat;
 use crate::profile::workload;
@@ -31,7 +32,7 @@ fn translated(model: Option<&Model>, kind: KernelKind, words: &[u32], constants:
             Some(f) => {
                 let lines = f.kernel_with_lines(kind, shaders)?;
                 let located = translate(&prepared(&lines.words, constants)?, options).err().unwrap_or(e);
-                Err(anyhow!("{}", f.locate(&located)))
+                Err(anyhow!("{}", locate(f, &located)))
             }
             None => Err(anyhow!("{label}: {e}")),
         },
@@ -52,4 +53,17 @@ pub fn shade_kernel(model: Option<&Model>, lights: u32, shaders: &Shaders) -> Re
     // The G-buffer's texel view (`workload::bindings`): four 32-bit words per pixel.
     let options = TranslateOptions { texel_formats: [((0, 0), TexelFormat::Rgba32ui)].into() };
     translated(model, KernelKind::Shade, &k.spirv.words, &k.constants, &options, shaders)
+}
+
+/// The file's line and own name of a translation error located in its composed kernel: `file.brdf:LINE`
+/// for the file's lines, its identifiers without brdfprof's prefix.
+fn locate(f: &FileModel, e: &TranslateError) -> String {
+    let prefix = f.file.renamed_shader().map(|r| r.prefix).unwrap_or_default();
+    let function = e.function.as_deref().map(|f| f.strip_prefix(prefix.as_str()).unwrap_or(f).to_string());
+    let construct = format!("the C translation cannot express {}{}", e.construct, function.map_or(String::new(), |f| format!(" (in function `{f}`)")));
+    match &e.location {
+        Some(l) if l.file == f.file.path.display().to_string() || l.file.ends_with(".brdf") => format!("{}:{}: {construct}", f.path, l.line),
+        Some(l) => format!("{}: {construct} (at {}:{} of brdfprof's kernel)", f.path, l.file, l.line),
+        None => format!("{}: {construct}", f.path),
+    }
 }

@@ -143,7 +143,7 @@ fn parsers_survive_random_and_mutated_input() {
     assert!(brdfprof::io::parse_samples_csv(&csv, "good.csv").is_ok());
     assert!(brdfprof::scene::Scene::parse(std::str::from_utf8(&scene).unwrap(), "good.json", PathBuf::new(), PathBuf::from("good.json")).is_ok());
     std::fs::write(&baseline_path, &baseline).unwrap();
-    assert!(brdfprof::inspect::check::load(&baseline_path).is_ok());
+    assert!(brdfprof::check::load(&baseline_path).is_ok());
     let (mut accepted, mut total) = ([0usize; 3], 0);
     for i in 0..2 * MUTANTS {
         let pick = |rng: &mut Pcg64, good: &[u8]| if i % 2 == 0 { mutate(rng, good) } else { random_bytes(rng) };
@@ -158,7 +158,7 @@ fn parsers_survive_random_and_mutated_input() {
         });
         let input = pick(&mut rng, &baseline);
         std::fs::write(&baseline_path, &input).unwrap();
-        survives("baseline", &input, &baseline_name, || brdfprof::inspect::check::load(&baseline_path).map(|_| accepted[2] += 1));
+        survives("baseline", &input, &baseline_name, || brdfprof::check::load(&baseline_path).map(|_| accepted[2] += 1));
         total += 1;
     }
     println!("accepted of {total} each: eval CSV {}, scene {}, baseline {}", accepted[0], accepted[1], accepted[2]);

@@ -39,7 +39,7 @@ fn kernel_list_covers_every_spv_file() {
 #[test]
 fn generated_glsl_is_what_the_rust_tables_generate() {
     let dir = common::repo_root().join("glsl/generated");
-    for (name, text) in brdfprof::brdf::glsl_gen::files() {
+    for (name, text) in brdfprof::kernels::generated_glsl() {
         let committed = std::fs::read_to_string(dir.join(name)).unwrap_or_default();
         assert!(committed == text, "glsl/generated/{name} is stale against the Rust tables: run `make spv` and commit glsl/ and spv/");
     }

@@ -2,8 +2,8 @@
 //! targets (`targets`), one report each, then one cost table across them with every pair's rank correlation
 //! and, with `--profile`, a profile's measured costs beside them.
 
-use super::correlate::{self, ProfileReport};
-use super::{InspectOptions, InspectReport};
+use crate::inspect::correlate::{self, ProfileReport};
+use crate::inspect::{InspectOptions, InspectReport};
 use crate::compare::{self, CostTable};
 use crate::gpu::Gpu;
 use crate::shaders::Shaders;
@@ -121,7 +121,7 @@ pub fn inspect(plan: &[Planned], run: &Run, open: &OpenLocal, profile: Option<&P
             Planned::Local(device) => {
                 let mut report = None;
                 open(device.as_deref(), &mut |gpu| {
-                    report = Some(super::run(gpu, run.shaders, run.options)?);
+                    report = Some(targets::inspect_device(gpu, run.shaders, run.options)?);
                     Ok(())
                 })?;
                 reports.push(report.expect("the device ran"));

@@ -22,9 +22,9 @@ pub use compare::{compare, Change, Comparison, GroupStatus, TimingChange};
 pub use environment::{environment, host_cpu};
 pub use thresholds::{group_of, is_gated, Thresholds, ALPHA, DEFAULT_COUNT_THRESHOLD, DEFAULT_TIMING_THRESHOLD, GROUPS, MIN_TIMING_ROUNDS, TIMING_KEY};
 
-use super::callgrind::CallgrindOptions;
-use super::timing::{self, TimingOptions};
-use super::InspectOptions;
+use crate::inspect::callgrind::CallgrindOptions;
+use crate::inspect::timing::{self, TimingOptions};
+use crate::inspect::InspectOptions;
 use crate::brdf::spec::THESIS_MODELS;
 use crate::gpu::Gpu;
 use crate::model::Model;
@@ -81,7 +81,7 @@ fn plan(options: &CheckOptions, old: Option<&Baseline>) -> Result<(Vec<Model>, u
 /// Measures this build: every count, then the timing run.
 pub fn measure(gpu: &Gpu, shaders: &Shaders, models: Vec<Model>, lights: u32, options: &CheckOptions) -> Result<Baseline> {
     crate::messages::progress(format!("check: counting instructions ({} models + baseline kernel{})", models.len(), if options.callgrind.is_some() { ", callgrind" } else { "" }));
-    let inspect = super::run(gpu, shaders, &InspectOptions { models: models.clone(), lights, callgrind: options.callgrind.clone() })?;
+    let inspect = crate::targets::inspect_device(gpu, shaders, &InspectOptions { models: models.clone(), lights, callgrind: options.callgrind.clone() })?;
     let timing = if options.timing.rounds > 0 {
         crate::messages::progress(format!("check: timing {} rounds", options.timing.rounds));
         Some(timing::run(gpu, shaders, &models, &TimingOptions { lights, ..options.timing.clone() })?)
