@@ -26,8 +26,8 @@ spv:
 # Re-measure the committed `check` baseline after a deliberate change to the kernels (or to spv/ after a
 # merge): prints the comparison with the old baseline, then replaces it; commit the result.
 BASELINE := results/baseline-llvmpipe.json
-# The compile-only targets' baselines (ACO for navi21 and vangogh, ptxas for sm_89; no GPU needed) likewise.
-TARGET_BASELINES := radv:navi21 radv:vangogh nvidia:sm_89
+# The compile-only targets' baselines (ACO for navi21 and vangogh, ptxas for sm_89, IGC for gen12lp; no GPU needed) likewise.
+TARGET_BASELINES := radv:navi21 radv:vangogh nvidia:sm_89 intel:gen12lp
 baseline: build
 	$(BIN) check --baseline $(BASELINE) --save-baseline $(BASELINE); test $$? -le 1
 	for t in $(TARGET_BASELINES); do \

@@ -12,6 +12,7 @@ mod common;
 mod aco_gate;
 mod check_gate;
 mod inspect;
+mod intel_gate;
 mod nvidia_gate;
 mod profile;
 
