@@ -39,17 +39,21 @@ pub struct EnergyView {
 pub struct SpecView {
     pub spec: String,
     pub precision: String,
+    #[serde(default)]
     pub has_twin: bool,
     pub nan: usize,
     pub inf: usize,
     pub negative: usize,
+    #[serde(default)]
     pub invalid_input_poisoned: usize,
     pub cases_run: usize,
     pub cases_out_of_tolerance: Vec<CaseResultView>,
     pub grid_out_of_tolerance: usize,
     #[serde(default)]
     pub worst: WorstView,
+    #[serde(default)]
     pub discontinuities: usize,
+    #[serde(default)]
     pub model_jumps: usize,
     pub reciprocity: Option<f64>,
     pub bad_cells: Option<Vec<[u32; 3]>>,
