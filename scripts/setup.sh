@@ -1,7 +1,8 @@
 #!/bin/sh
 # Installs what brdfprof needs (Debian 12 names): the Vulkan loader, lavapipe (Mesa's CPU Vulkan driver), the
 # Khronos validation layer, glslang, SPIRV-Tools, vulkaninfo and valgrind; g++ (runs the kernels' C translation
-# on the CPU); Intel's OpenCL compiler (ocloc/IGC) and PoCL (OpenCL on the CPU) for the intel: targets; and,
+# on the CPU); Intel's OpenCL compiler (ocloc/IGC) and PoCL (OpenCL on the CPU) for the intel: targets; Chromium
+# (the HTML report is tested in it, headless); and,
 # from PyPI, NVIDIA's NVRTC and nvdisasm for the nvidia: targets, into .tools/nvidia (about 150 MB).
 # As root with apt-get it installs what is missing; otherwise it says exactly what to install and fails.
 set -eu
@@ -21,6 +22,7 @@ command -v g++ >/dev/null 2>&1 || missing="$missing g++"
 command -v ocloc >/dev/null 2>&1 || missing="$missing intel-opencl-icd"
 have_file /etc/OpenCL/vendors/pocl.icd || missing="$missing pocl-opencl-icd"
 have_lib 'libOpenCL.so.1' || missing="$missing ocl-icd-libopencl1"
+have_file /usr/bin/chromium || missing="$missing chromium"
 
 if [ -n "$missing" ]; then
     if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
@@ -33,8 +35,8 @@ if [ -n "$missing" ]; then
         echo "brdfprof setup: missing system packages:$missing" >&2
         echo "  install them as root on Debian/Ubuntu:  apt-get install$missing" >&2
         echo "  (other systems: the Vulkan loader, Mesa's lavapipe driver, the Khronos validation layer," >&2
-        echo "   glslang, SPIRV-Tools, vulkan-tools, valgrind, g++, Intel's compute runtime (ocloc), PoCL and the" >&2
-        echo "   OpenCL ICD loader from your package manager)" >&2
+        echo "   glslang, SPIRV-Tools, vulkan-tools, valgrind, g++, Intel's compute runtime (ocloc), PoCL, the" >&2
+        echo "   OpenCL ICD loader and Chromium from your package manager)" >&2
         exit 1
     fi
 fi

@@ -189,6 +189,18 @@ struct Open {
     line: usize,
 }
 
+/// A `#` line of the shader section is a comment to BRDF Explorer, so brdfprof drops it too; never silently:
+/// a dropped `#define` leaves its name undeclared, and the code of every `#if` branch is compiled (issue 19).
+fn dropped_hash_line(path: &Path, n: usize, line: &str) -> String {
+    let directive = line[1..].trim_start().split(|c: char| !c.is_ascii_alphanumeric() && c != '_').next().unwrap_or("");
+    let what = match directive {
+        "if" | "ifdef" | "ifndef" | "elif" | "else" | "endif" => "the code of every #if branch is compiled, whichever the condition selects",
+        "define" | "undef" => "the macro is not defined",
+        _ => "it has no effect",
+    };
+    at(path, n, format!("`{line}` is dropped: `#` lines are BRDF Explorer comments and brdfprof runs no preprocessor on a .brdf shader; {what}"))
+}
+
 /// Reads every line after the first into `file`; returns the line of `::begin shader`, if any.
 fn read_sections<'a>(file: &mut BrdfFile, lines: impl Iterator<Item = &'a str>) -> Result<Option<usize>> {
     let path = file.path.clone();
@@ -204,6 +216,9 @@ fn read_sections<'a>(file: &mut BrdfFile, lines: impl Iterator<Item = &'a str>) 
         if trimmed.is_empty() || trimmed.starts_with('#') {
             if in_shader {
                 file.shader.push((n, String::new()));
+                if trimmed.starts_with('#') {
+                    file.warnings.push(dropped_hash_line(&path, n, trimmed));
+                }
             }
             continue;
         }
@@ -1135,6 +1150,22 @@ mod tests {
         assert_eq!(r.lines.iter().map(|l| l.0).collect::<Vec<_>>(), numbers);
         assert_eq!(r.lines[7].1, "vec3 brdf_f_BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) { return vec3(1.0); }");
         assert_eq!(f.line_directive(), "#line 3 \"dir/t.brdf\"");
+        let dropped: Vec<&String> = f.warnings.iter().filter(|w| w.contains("is dropped")).collect();
+        assert_eq!(dropped.len(), 3, "every dropped `#` line is named: {dropped:?}");
+        assert!(dropped[0].contains(":4") && dropped[0].contains("`#define FOO 1`") && dropped[0].contains("the macro is not defined"), "{}", dropped[0]);
+        assert!(dropped[1].contains(":5") && dropped[1].contains("`# indented`"), "{}", dropped[1]);
+    }
+
+    /// An engine-style quality switch: both branches' code stays (no preprocessor runs), so each of its
+    /// directives is a warning saying so.
+    #[test]
+    fn a_quality_switch_is_never_dropped_silently() {
+        let shader = "#define QUALITY_HIGH 1\n#if QUALITY == QUALITY_HIGH\nfloat f5(float u) { return pow(1.0 - u, 5.0); }\n#else\nfloat f5(float u) { return 1.0 - u; }\n#endif\n";
+        let f = ok(&file("", &format!("{shader}{BRDF}")));
+        let w: Vec<&String> = f.warnings.iter().filter(|w| w.contains("is dropped")).collect();
+        assert_eq!(w.len(), 4, "{w:?}");
+        assert!(w[1].contains("`#if QUALITY == QUALITY_HIGH`") && w[1].contains("every #if branch is compiled"), "{}", w[1]);
+        assert!(w[3].contains("`#endif`"), "{}", w[3]);
     }
 
     /// A file in BRDF Explorer's dialect: a global PI, helpers, its own `reflect`, a function whose parameter is

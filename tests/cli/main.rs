@@ -24,4 +24,5 @@ mod intel;
 mod nvidia;
 mod outputs;
 mod radv;
+mod report;
 mod signals;

@@ -7,8 +7,8 @@ use std::path::{Path, PathBuf};
 
 /// Top-level modules of src/, lowest first: a module may use only those before it. Written once, here.
 const LAYERS: &[&str] = &[
-    "util", "messages", "cleanup", "compile_limit", "host", "stats", "gpu", "brdf", "io", "chart", "cache", "shaders", "model", "kernels", "accuracy",
-    "report", "profile", "inspect", "translate", "targets", "compare", "devices", "check", "sweep", "sweep_cost", "stability", "scene",
+    "util", "messages", "cleanup", "compile_limit", "host", "stats", "gpu", "brdf", "io", "chart", "html", "cache", "shaders", "model", "kernels", "accuracy",
+    "report", "profile", "inspect", "translate", "targets", "compare", "devices", "check", "sweep", "sweep_cost", "stability", "scene", "diff", "htmlreport",
 ];
 
 fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {

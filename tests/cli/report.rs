@@ -1,0 +1,92 @@
+//! `brdfprof report` opened in a real browser: Debian's headless Chromium (installed by `make setup`) loads the
+//! page from file://, and the test fails on any console message, reads the DOM back after the page's script
+//! ran and checks the figures shown are the JSON's, and checks a screenshot is not blank.
+
+use crate::common;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// The reports of a default profile, sweep, stability and `inspect --device radv:all`, as committed.
+const INPUTS: [&str; 4] = ["results/profile-llvmpipe.json", "results/sweep-llvmpipe.json", "results/stability-llvmpipe.json", "results/radv/inspect-radv-all.json"];
+
+fn chromium() -> PathBuf {
+    let found = ["/usr/bin/chromium", "/usr/bin/chromium-browser"].into_iter().map(PathBuf::from).find(|p| p.exists());
+    found.expect("Chromium is not installed: run `make setup` (Debian package chromium); the report is tested in a real browser")
+}
+
+/// Runs headless Chromium on `page` with `extra` arguments; returns (stdout, the console lines of stderr).
+fn headless(page: &Path, profile: &Path, extra: &[&str]) -> (String, Vec<String>) {
+    let out = Command::new(chromium())
+        .args(["--headless", "--no-sandbox", "--disable-gpu", "--no-first-run", "--enable-logging=stderr", "--v=0", "--virtual-time-budget=3000"])
+        .arg(format!("--user-data-dir={}", profile.display()))
+        .args(extra)
+        .arg(format!("file://{}", page.display()))
+        .output()
+        .expect("chromium runs");
+    assert!(out.status.success(), "chromium failed: {}", String::from_utf8_lossy(&out.stderr));
+    let console = String::from_utf8_lossy(&out.stderr).lines().filter(|l| l.contains("CONSOLE")).map(str::to_owned).collect();
+    (String::from_utf8_lossy(&out.stdout).into_owned(), console)
+}
+
+/// The `data-v` of column `col` in the table row keyed `row`, as the browser's DOM holds it.
+fn shown(dom: &str, row: &str, col: &str) -> f64 {
+    let start = dom.find(&format!("<tr data-row=\"{row}\">")).unwrap_or_else(|| panic!("no row {row} in the DOM"));
+    let tr = &dom[start..start + dom[start..].find("</tr>").unwrap()];
+    let at = tr.find(&format!("data-col=\"{col}\" data-v=\"")).unwrap_or_else(|| panic!("no {col} figure in row {row}: {tr}"));
+    let v = &tr[at + col.len() + 20..];
+    v[..v.find('"').unwrap()].parse().unwrap()
+}
+
+fn json(path: &str) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(common::repo_root().join(path)).unwrap()).unwrap()
+}
+
+#[test]
+fn a_report_of_profile_sweep_inspect_and_stability_opens_in_chromium_with_the_jsons_numbers() {
+    let dir = tempfile::tempdir().unwrap();
+    let page = dir.path().join("report.html");
+    let mut args = vec!["report".to_string()];
+    args.extend(INPUTS.iter().map(|p| common::repo_root().join(p).display().to_string()));
+    args.extend(["--out".into(), page.display().to_string()]);
+    common::run(&args.iter().map(String::as_str).collect::<Vec<_>>()).ok();
+    let size = std::fs::metadata(&page).unwrap().len();
+    assert!(size < 5 << 20, "the report is {size} bytes, over 5 MB");
+
+    let (dom, console) = headless(&page, &dir.path().join("profile"), &["--dump-dom"]);
+    assert!(console.is_empty(), "console messages:\n{}", console.join("\n"));
+    assert!(dom.contains("data-ready=\"1\""), "the page's script did not finish");
+    assert!(!dom.contains("src=\"http") && !dom.contains("href=\"http"), "the page loads nothing from the network");
+
+    let profile = json(INPUTS[0]);
+    let rows = profile["rows"].as_array().unwrap();
+    assert!(!rows.is_empty());
+    for r in rows {
+        let key = format!("profile0/{}/{}", r["lights"], r["model"].as_str().unwrap());
+        assert_eq!(shown(&dom, &key, "ns"), r["ns_per_eval"]["median"].as_f64().unwrap(), "{key}");
+    }
+    let sweep = json(INPUTS[1]);
+    for r in sweep["rows"].as_array().unwrap() {
+        // Rows are keyed by the input's position among the report's inputs (the sweep is the second).
+        let key = format!("sweep1/{}", r["label"].as_str().unwrap());
+        assert_eq!(shown(&dom, &key, "ns"), r["ns_per_eval"]["median"].as_f64().unwrap(), "{key}");
+        if let Some(rms) = r["accuracy"]["vs_exact"]["rms"].as_f64() {
+            assert_eq!(shown(&dom, &key, "rms"), rms, "{key}");
+        }
+    }
+
+    let shot = dir.path().join("shot.png");
+    headless(&page, &dir.path().join("profile"), &[&format!("--screenshot={}", shot.display()), "--window-size=1280,900"]);
+    let img = image::open(&shot).unwrap().to_rgb8();
+    let colours: std::collections::HashSet<[u8; 3]> = img.pixels().map(|p| p.0).collect();
+    assert!(colours.len() > 64, "the screenshot has {} colours: blank", colours.len());
+}
+
+/// The console check can fail: a page that logs an error is caught.
+#[test]
+fn a_console_error_is_seen() {
+    let dir = tempfile::tempdir().unwrap();
+    let page = dir.path().join("bad.html");
+    std::fs::write(&page, "<!doctype html><html><body><script>console.error('brdfprof-test-error');</script></body></html>").unwrap();
+    let (_, console) = headless(&page, &dir.path().join("profile"), &["--dump-dom"]);
+    assert!(console.iter().any(|l| l.contains("brdfprof-test-error")), "console lines: {console:?}");
+}
