@@ -39,14 +39,32 @@ pub fn eval(args: &EvalArgs) -> Result<ExitCode> {
     let shown = model.name();
     let (model, input, rows) = read_input(model, &args.input, &args.model.params)?;
     let extras = kernels::EvalExtras { tangents: input.tangents.as_deref(), rows: &rows.values, row_floats: rows.floats };
-    let (gpu, values) = on_device(&args.device, |gpu, _| kernels::eval_with(gpu, &model, &input.samples, &extras, kernels::RunLimits::default()))?;
+    let (device, values) = if args.device.device.as_deref() == Some(OPENCL_DEVICE) {
+        on_opencl(&model, &input.samples, &extras)?
+    } else {
+        let (gpu, values) = on_device(&args.device, |gpu, _| kernels::eval_with(gpu, &model, &input.samples, &extras, kernels::RunLimits::default()))?;
+        (gpu.info.name.clone(), values)
+    };
     io::write_output(&args.output, io::format_rgb_csv(&values).as_bytes())?;
     let bad = values.iter().filter(|v| v.iter().any(|x| !x.is_finite())).count();
     if bad > 0 {
         messages::warning(format!("{bad} of {} rows of {shown} are not finite (written as NaN or inf)", values.len()));
     }
-    messages::progress(format!("{} rows of {shown} on {} -> {}", values.len(), gpu.info.name, args.output.display()));
+    messages::progress(format!("{} rows of {shown} on {device} -> {}", values.len(), args.output.display()));
     Ok(ExitCode::SUCCESS)
+}
+
+/// `eval --device opencl`: the eval kernel's OpenCL C translation (the one Intel's compiler gets) run through
+/// OpenCL, PoCL on this CPU unless BRDFPROF_OPENCL_DEVICE names another: a second execution of the same BRDF
+/// source, independent of Vulkan, with the same CSV in and out.
+pub const OPENCL_DEVICE: &str = "opencl";
+
+fn on_opencl(model: &Model, samples: &[brdfprof::brdf::Sample], extras: &kernels::EvalExtras) -> Result<(String, Vec<[f32; 3]>)> {
+    use brdfprof::translate::{opencl, prepare};
+    let translation = prepare::eval_kernel(model, kernels::embedded())?;
+    let kernel = opencl::ClKernel::build(&translation, false)?;
+    let values = opencl::eval(&kernel, samples, extras)?;
+    Ok((format!("{} (OpenCL)", kernel.device), values))
 }
 
 /// Parameters read per CSV row: `floats` values per row, rows one after another.

@@ -98,3 +98,31 @@ fn bad_input_fails_clearly_with_exit_2_and_no_output() {
     assert_eq!(missing.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&missing.stderr).contains("cannot read /nonexistent/in.csv"));
 }
+
+/// `eval --device opencl` runs the OpenCL C translation on PoCL: the same CSV out as on Vulkan, within 1e-5
+/// relative (1e-3 floor) for every thesis model and each example `.brdf`, so a user can diff two independent
+/// executions of one BRDF source.
+#[test]
+fn eval_on_opencl_agrees_with_vulkan_for_the_thesis_models_and_the_example_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in.csv");
+    write_csv(&input, &samples::well_conditioned(5_000, 13, 0.05, 0.2..1.0));
+    let mut models: Vec<String> = THESIS_MODELS.iter().map(|m| m.to_string()).collect();
+    let examples = common::repo_root().join("examples/brdf");
+    let mut files: Vec<String> = std::fs::read_dir(&examples).unwrap().map(|e| e.unwrap().path().display().to_string()).filter(|p| p.ends_with(".brdf")).collect();
+    files.sort();
+    assert!(!files.is_empty());
+    models.extend(files);
+    let read = |p: &Path| -> Vec<f64> { std::fs::read_to_string(p).unwrap().lines().skip(1).flat_map(|l| l.split(',').map(|x| x.parse::<f64>().unwrap()).collect::<Vec<_>>()).collect() };
+    for model in &models {
+        let (vk, cl) = (dir.path().join("vk.csv"), dir.path().join("cl.csv"));
+        common::run(&["eval", "--model", model, "--input", input.to_str().unwrap(), "--output", vk.to_str().unwrap()]).ok();
+        let run = common::run(&["eval", "--device", "opencl", "--model", model, "--input", input.to_str().unwrap(), "--output", cl.to_str().unwrap()]).ok();
+        assert!(run.stderr.contains("(OpenCL)"), "{}", run.stderr);
+        let (a, b) = (read(&vk), read(&cl));
+        assert_eq!(a.len(), 15_000, "{model}");
+        assert_eq!(a.len(), b.len(), "{model}");
+        let worst = a.iter().zip(&b).map(|(x, y)| (x - y).abs() / x.abs().max(1e-3)).fold(0.0, f64::max);
+        assert!(worst <= 1e-5, "{model}: OpenCL against Vulkan {worst:.2e}");
+    }
+}
