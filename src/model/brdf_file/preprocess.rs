@@ -74,7 +74,7 @@ pub(super) fn number_preprocessed(path: &Path, source: &[(usize, String)], out: 
     let mut next: usize = 0;
     for line in out.lines().skip_while(|l| l.trim().is_empty()).skip(1) {
         if let Some(n) = line.trim().strip_prefix("#line ") {
-            next = n.trim().split_whitespace().next().and_then(|d| d.parse().ok()).ok_or_else(|| anyhow!("{}: glslang's preprocessor wrote `{line}`", path.display()))?;
+            next = n.split_whitespace().next().and_then(|d| d.parse().ok()).ok_or_else(|| anyhow!("{}: glslang's preprocessor wrote `{line}`", path.display()))?;
             continue;
         }
         let slot = next.checked_sub(first).and_then(|k| shader.get_mut(k));
