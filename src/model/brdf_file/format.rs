@@ -86,6 +86,19 @@ pub(super) fn dropped_hash_line(path: &Path, n: usize, line: &str) -> String {
     at(path, n, format!("`{line}` is dropped: {why}"))
 }
 
+/// A blank or `#` line of the shader section: a kept directive as written, anything else empty (with a
+/// warning for a dropped `#` line).
+fn push_blank_or_hash_line(file: &mut BrdfFile, n: usize, raw: &str) -> Result<()> {
+    let trimmed = raw.trim();
+    let kept = trimmed.starts_with('#') && keeps_directive(&file.path, n, trimmed)?;
+    file.source.push((n, if kept { raw.to_string() } else { String::new() }));
+    if trimmed.starts_with('#') && !kept {
+        let warning = dropped_hash_line(&file.path, n, trimmed);
+        file.warnings.push(warning);
+    }
+    Ok(())
+}
+
 /// Reads every line after the first into `file`; returns the line of `::begin shader`, if any.
 pub(super) fn read_sections<'a>(file: &mut BrdfFile, lines: impl Iterator<Item = &'a str>) -> Result<Option<usize>> {
     let path = file.path.clone();
@@ -101,11 +114,7 @@ pub(super) fn read_sections<'a>(file: &mut BrdfFile, lines: impl Iterator<Item =
         // preprocessor and any other stays as an empty line, to keep the numbering.
         if trimmed.is_empty() || trimmed.starts_with('#') {
             if in_shader {
-                let kept = trimmed.starts_with('#') && keeps_directive(&path, n, trimmed)?;
-                file.source.push((n, if kept { raw.to_string() } else { String::new() }));
-                if trimmed.starts_with('#') && !kept {
-                    file.warnings.push(dropped_hash_line(&path, n, trimmed));
-                }
+                push_blank_or_hash_line(file, n, raw)?;
             }
             continue;
         }
