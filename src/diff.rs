@@ -43,7 +43,7 @@ pub struct Side {
 
 impl Side {
     pub fn of(model: &Model) -> Self {
-        Side { name: model.short_name(), canonical: model.canonical() }
+        Side { name: model.label(), canonical: model.canonical() }
     }
 }
 

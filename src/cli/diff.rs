@@ -80,7 +80,7 @@ pub fn diff(args: &DiffArgs) -> Result<ExitCode> {
     let outs = outputs(args, &models)?;
     let inputs = Inputs::read(args, a, b)?;
     let (gpu, (va, vb)) = on_device(&args.device, |gpu, progress| {
-        progress.set_message(format!("{} and {} on {} rows", a.short_name(), b.short_name(), inputs.samples.len()));
+        progress.set_message(format!("{} and {} on {} rows", a.label(), b.label(), inputs.samples.len()));
         let eval = |(m, rows): &(Model, super::eval::RowValues)| {
             let extras = kernels::EvalExtras { tangents: inputs.tangents.as_deref(), rows: &rows.values, row_floats: rows.floats };
             kernels::eval_with(gpu, m, &inputs.samples, &extras, kernels::RunLimits::default())

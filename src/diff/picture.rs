@@ -71,7 +71,7 @@ pub fn write(gpu: &Gpu, path: &Path, a: &Model, b: &Model) -> Result<()> {
     }
     let scale = diffs.iter().flatten().flatten().copied().fold(0.0f32, |m, x| if x.is_finite() { m.max(x) } else { m });
     let panels = lobe_curves(gpu, &[a.clone(), b.clone()], &ROUGHNESS)?;
-    let names = [a.short_name(), b.short_name()];
+    let names = [a.label(), b.label()];
     let width = LOBE_PANEL.0 * ROUGHNESS.len() as u32;
     chart::render(path, width + 70, TOP + LOBE_PANEL.1 + 40, |root| {
         let title = format!("B = {} against A = {}: lit spheres and |B - A| / max(|A|, 1e-3) (largest channel)", names[1], names[0]);

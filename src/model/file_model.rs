@@ -133,6 +133,8 @@ pub struct FileModel {
     pub path: String,
     /// One per `file.params`, in order.
     pub bindings: Vec<Binding>,
+    /// Its `name=` label (`Model::label`), when one was given.
+    pub label: Option<String>,
 }
 
 impl FileParam {
@@ -264,7 +266,7 @@ impl FileModel {
             crate::messages::input_warning(loop_warning(path, l));
         }
         let bindings = file.params.iter().map(|p| Binding::Value(p.default_value())).collect();
-        let model = FileModel { file, path: path.to_string(), bindings };
+        let model = FileModel { file, path: path.to_string(), bindings, label: None };
         model.with_params(&split_params(&fields)?)
     }
 

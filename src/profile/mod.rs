@@ -142,7 +142,7 @@ fn analyse(raw: &RawTimes, specs: &[Option<Model>], group: &Group) -> Vec<Row> {
                 _ => (None, None, None),
             };
             Row {
-                model: specs[i].as_ref().map_or_else(|| workload::BASELINE_LABEL.to_string(), Model::name),
+                model: specs[i].as_ref().map_or_else(|| workload::BASELINE_LABEL.to_string(), Model::label),
                 spec: specs[i].as_ref().map(Model::canonical),
                 lights: group.lights,
                 evaluations_per_dispatch: group.evaluations,
@@ -213,7 +213,7 @@ pub fn run(gpu: &Gpu, options: &ProfileOptions, progress: &ProgressBar) -> Resul
     let rows = analyse_all(&raw, &specs, &groups);
     let mut kernel_sha256 = std::collections::BTreeMap::new();
     for spec in models.iter().map(Some).chain([None]) {
-        let label = spec.map_or_else(|| workload::BASELINE_LABEL.to_string(), Model::name);
+        let label = spec.map_or_else(|| workload::BASELINE_LABEL.to_string(), Model::label);
         kernel_sha256.insert(label, workload::kernel_hash(spec, options.format, shaders)?);
     }
     Ok(ProfileReport {
