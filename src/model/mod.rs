@@ -161,7 +161,8 @@ impl Model {
     }
 
     /// What every table, chart and output file name calls the model: its `name=` label; else a spec's shortest
-    /// name, or a `.brdf` file's stem with the parameters that differ from the file's defaults.
+    /// name, or a `.brdf` file's stem (its file name where the stem is a preset's name) with the parameters that
+    /// differ from the file's defaults.
     pub fn label(&self) -> String {
         if let Some(l) = self.given_label() {
             return l.to_string();
@@ -170,7 +171,10 @@ impl Model {
             Model::Spec(s, _) => s.name(),
             Model::File(f) => {
                 let name = f.name();
-                let stem = std::path::Path::new(&f.path).file_stem().map_or(f.path.clone(), |n| n.to_string_lossy().into_owned());
+                let path = std::path::Path::new(&f.path);
+                let part = |p: Option<&std::ffi::OsStr>| p.map_or(f.path.clone(), |n| n.to_string_lossy().into_owned());
+                // `ggx.brdf` keeps its extension: a stem that reads as a built-in model would take that one's rows.
+                let stem = Some(part(path.file_stem())).filter(|s| ModelSpec::parse(s).is_err()).unwrap_or_else(|| part(path.file_name()));
                 stem + &name[f.path.len()..]
             }
         }
@@ -276,6 +280,16 @@ pub fn models_from_args(models: &[String], params: &[String], default: &[&str]) 
         .and_then(|models| check_labels(&models, "--model").map(|_| models))
 }
 
+/// The models with the reference (plain ggx) first when they lack it: what every cost is compared with.
+pub fn with_reference(models: &[Model]) -> Vec<Model> {
+    let reference = Model::reference();
+    let mut all = models.to_vec();
+    if !all.contains(&reference) {
+        all.insert(0, reference);
+    }
+    all
+}
+
 /// Splits a `name=LABEL` item off a model text; a label is a file-name-safe word.
 fn split_label(text: &str) -> Result<(String, Option<String>)> {
     let (mut rest, mut label) = (Vec::new(), None);
@@ -333,13 +347,13 @@ mod tests {
     #[test]
     fn a_brdf_file_is_called_by_its_stem_or_its_label() {
         let m = Model::parse(FILE).unwrap();
-        assert_eq!(m.label(), "ggx");
+        assert_eq!(m.label(), "ggx.brdf", "a stem that is a preset's name keeps its extension");
         let named = Model::parse(&format!("{FILE},name=engine")).unwrap();
         assert_eq!(named.label(), "engine");
         assert_eq!(named.canonical(), m.canonical());
         assert_eq!(Model::parse(&named.name()).unwrap(), named);
         let bound = m.with_params(&["roughness=0.25".into()]).unwrap();
-        assert_eq!(bound.label(), "ggx,roughness=0.25", "the stem with the parameters that differ from the file's");
+        assert_eq!(bound.label(), "ggx.brdf,roughness=0.25", "the stem with the parameters that differ from the file's");
     }
 
     #[test]

@@ -174,10 +174,7 @@ fn analyse_all(raw: &RawTimes, specs: &[Option<Model>], groups: &[Group]) -> Vec
 /// all interleaved in the same rounds.
 pub fn run(gpu: &Gpu, options: &ProfileOptions, progress: &ProgressBar) -> Result<ProfileReport> {
     let reference_model = Model::reference();
-    let mut models = options.models.clone();
-    if !models.contains(&reference_model) {
-        models.insert(0, reference_model.clone());
-    }
+    let models = crate::model::with_reference(&options.models);
     workload::check_size(&gpu.info, options.width, options.height, options.format, options.lights.len())?;
     progress.set_message("building the G-buffer");
     let gbuffer = gbuffer::synthetic(options.width, options.height, options.format);

@@ -165,7 +165,7 @@ fn profile_times_a_file_and_a_spec_interleaved() {
     run_in(dir.path(), &["profile", "--model", &model, "--model", "ggx", "--size", "64x64", "--min-rounds", "3", "--budget", "20", "--json", "p.json"]).ok();
     let p = json(&dir.path().join("p.json"));
     let names: Vec<&str> = p["rows"].as_array().unwrap().iter().map(|r| r["model"].as_str().unwrap()).collect();
-    assert!(names.contains(&model.as_str()) && names.contains(&"ggx"), "{names:?}");
+    assert!(names.contains(&"ggx.brdf,roughness=@roughness,f0=@f0") && names.contains(&"ggx"), "the file by its name, not its path: {names:?}");
     for r in p["rows"].as_array().unwrap() {
         assert!(r["ns_per_eval"]["median"].as_f64().unwrap() > 0.0, "{r}");
     }
@@ -200,8 +200,11 @@ fn inspect_counts_the_file_kernel() {
     let md = std::fs::read_to_string(dir.path().join("i.md")).unwrap();
     assert!(md.contains("blinn.brdf"), "{md}");
     let i = json(&dir.path().join("i.json"));
-    let row = i["rows"].as_array().unwrap().iter().find(|r| r["model"].as_str().unwrap().contains("blinn.brdf")).expect("a row for the file");
+    let rows = i["rows"].as_array().unwrap();
+    let row = rows.iter().find(|r| r["model"] == "blinn.brdf,roughness=@roughness").expect("a row for the file, by its name");
     assert!(row.to_string().contains("\"spirv/total\""), "{row}");
+    // The reference is added as profile adds it, so the file's cost has a ggx to be compared with.
+    assert_eq!(rows.iter().map(|r| r["model"].as_str().unwrap()).collect::<Vec<_>>(), ["ggx", "blinn.brdf,roughness=@roughness", "baseline"]);
 }
 
 #[test]
