@@ -5,6 +5,7 @@
 //! rounding. docs/diff.md documents the JSON report (`"kind": "diff"`).
 
 pub mod picture;
+pub mod view;
 
 use crate::accuracy::rel_err;
 use crate::brdf::{samples, Sample};

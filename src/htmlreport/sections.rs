@@ -81,6 +81,7 @@ pub fn provenance(inputs: &[Input]) -> String {
                     s += &kv(&items);
                 }
             }
+            Loaded::Diff(d) => s += &kv(&[("device", d.device.clone()), ("models", format!("A = {}, B = {}", d.a.canonical, d.b.canonical)), ("input", d.input.clone())]),
             Loaded::Costs(t) => s += &kv(&[("columns", t.columns.iter().map(|c| format!("{} ({})", c.name, c.source)).collect::<Vec<_>>().join("; "))]),
         }
     }

@@ -47,7 +47,7 @@ pub fn models_of(inputs: &[Input]) -> Vec<(String, String)> {
             Loaded::Sweep(w) => w.rows.iter().filter(|r| r.pareto).for_each(|r| add(&r.canonical, &r.label)),
             Loaded::Inspect(reports, _) => reports.iter().flat_map(|r| &r.rows).filter_map(|r| r.spec.as_deref().map(|s| (s, &r.model))).for_each(|(s, m)| add(s, m)),
             Loaded::Stability(st) => st.specs.iter().filter(|s| s.fails()).for_each(|s| add(&s.spec, &s.spec)),
-            Loaded::Costs(_) => {}
+            Loaded::Costs(_) | Loaded::Diff(_) => {}
         }
     }
     out
