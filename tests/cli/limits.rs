@@ -258,6 +258,6 @@ fn a_compile_only_child_past_the_limit_stops_naming_the_model() {
     let started = std::time::Instant::now();
     let r = common::run_in(dir.path(), &["inspect", "--no-callgrind", "--device", "radv:navi21", "--model", "tree.brdf", "--compile-timeout", "3", "--json", "i.json", "--markdown", "i.md"]);
     assert_eq!(r.code, Some(2), "{}", r.stderr);
-    assert!(r.stderr.contains("tree.brdf") && r.stderr.contains("longer than the compile limit of 3 s"), "{}", r.stderr);
+    assert!(r.stderr.contains("tree") && r.stderr.contains("longer than the compile limit of 3 s"), "{}", r.stderr);
     assert!(started.elapsed().as_secs() < 30 && !dir.path().join("i.json").exists());
 }
