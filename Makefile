@@ -11,9 +11,11 @@ setup:
 build: setup
 	$(CARGO) build --release --locked
 
+# A default output never overwrites a file git tracks (docs/commands.md), so the run names its own, outside results/.
+RUN_JSON ?= brdfprof-results/profile.json
 run: build
 	$(BIN) devices
-	$(BIN) profile
+	$(BIN) profile --json $(RUN_JSON)
 
 test: setup
 	$(CARGO) test --release --locked

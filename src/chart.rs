@@ -27,6 +27,12 @@ pub fn write_png(path: &Path, width: u32, height: u32, rgb: Vec<u8>) -> Result<(
 
 /// Draws with plotters into a fresh white `width` x `height` canvas and writes it as PNG.
 pub fn render(path: &Path, width: u32, height: u32, draw: impl FnOnce(&DrawingArea<BitMapBackend, plotters::coord::Shift>) -> Result<()>) -> Result<()> {
+    let buffer = pixels(width, height, draw)?;
+    write_png(path, width, height, buffer)
+}
+
+/// What `render` draws, as 8-bit RGB pixels (for a page that embeds the picture instead of writing a file).
+pub fn pixels(width: u32, height: u32, draw: impl FnOnce(&DrawingArea<BitMapBackend, plotters::coord::Shift>) -> Result<()>) -> Result<Vec<u8>> {
     register_font();
     let mut buffer = vec![255u8; (width * height * 3) as usize];
     {
@@ -35,7 +41,7 @@ pub fn render(path: &Path, width: u32, height: u32, draw: impl FnOnce(&DrawingAr
         draw(&root)?;
         root.present().map_err(|e| anyhow!("{e}"))?;
     }
-    write_png(path, width, height, buffer)
+    Ok(buffer)
 }
 
 /// A distinct colour per group (Tableau 10).

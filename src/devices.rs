@@ -113,7 +113,11 @@ fn target_reports(plan: &[Planned], run: &Run, open: &OpenLocal) -> Result<Vec<I
 }
 
 /// Runs every planned device, in order.
+/// The reference (ggx) is added first when the models lack it, as `profile` adds it, so that every device's
+/// "net vs ggx" column has its denominator.
 pub fn inspect(plan: &[Planned], run: &Run, open: &OpenLocal, profile: Option<&ProfileReport>) -> Result<Inspected> {
+    let options = InspectOptions { models: crate::model::with_reference(&run.options.models), ..run.options.clone() };
+    let run = &Run { options: &options, ..*run };
     let mut compiled = target_reports(plan, run, open)?.into_iter();
     let mut reports = Vec::new();
     for p in plan {

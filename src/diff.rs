@@ -5,6 +5,7 @@
 //! rounding. docs/diff.md documents the JSON report (`"kind": "diff"`).
 
 pub mod picture;
+pub mod view;
 
 use crate::accuracy::rel_err;
 use crate::brdf::{samples, Sample};
@@ -43,7 +44,7 @@ pub struct Side {
 
 impl Side {
     pub fn of(model: &Model) -> Self {
-        Side { name: model.short_name(), canonical: model.canonical() }
+        Side { name: model.label(), canonical: model.canonical() }
     }
 }
 

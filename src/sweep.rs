@@ -52,9 +52,10 @@ pub fn default_specs() -> Vec<ModelSpec> {
     specs
 }
 
-/// A short label for charts: the preset name where one matches, else d/vis/f.
+/// A short label for charts: the model's `name=` label or a file's stem; else the preset name where one
+/// matches, else d/vis/f.
 pub fn label(model: &Model) -> String {
-    let Some(spec) = model.twin() else { return model.short_name() };
+    let Some(spec) = model.twin().filter(|_| model.label() == model.name()) else { return model.label() };
     let name = spec.name();
     if !name.starts_with("d=") {
         return name.replace(",precision=f16", " f16");
@@ -130,7 +131,7 @@ pub fn run(gpu: &Gpu, options: &SweepOptions, progress: &ProgressBar) -> Result<
         .profile
         .models
         .iter()
-        .map(|m| (profile.labels.iter().position(|l| *l == m.name()).expect("every spec was timed"), m.clone()))
+        .map(|m| (profile.labels.iter().position(|l| *l == m.label()).expect("every spec was timed"), m.clone()))
         .collect();
     let evals = profile.rows[0].evaluations_per_dispatch as f64;
     let costs: Vec<Vec<f64>> = specs.iter().map(|(i, _)| profile::per_round(&profile.raw, *i, evals)).collect();

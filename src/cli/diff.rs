@@ -42,6 +42,8 @@ pub struct DiffArgs {
     #[arg(long)]
     pub png: Option<PathBuf>,
     #[command(flatten)]
+    pub html: super::report::HtmlArg,
+    #[command(flatten)]
     pub device: DeviceArgs,
 }
 
@@ -55,7 +57,7 @@ fn tolerance(text: &str) -> Result<f64, String> {
 
 /// The outputs asked for, each checked writable, none an input, no two the same path.
 fn outputs(args: &DiffArgs, models: &[Model]) -> Result<Vec<(&'static str, PathBuf)>> {
-    let asked = [("--csv", &args.csv), ("--json", &args.json), ("--png", &args.png)];
+    let asked = [("--csv", &args.csv), ("--json", &args.json), ("--png", &args.png), ("--html", &args.html.html)];
     let outs: Vec<(&'static str, PathBuf)> = asked.into_iter().filter_map(|(f, p)| p.clone().map(|p| (f, p))).collect();
     let mut inputs: Vec<(&str, &Path)> = args.input.iter().map(|p| ("--input", p.as_path())).collect();
     inputs.extend(models.iter().filter_map(Model::file).map(|f| ("--model", Path::new(&f.path))));
@@ -80,7 +82,7 @@ pub fn diff(args: &DiffArgs) -> Result<ExitCode> {
     let outs = outputs(args, &models)?;
     let inputs = Inputs::read(args, a, b)?;
     let (gpu, (va, vb)) = on_device(&args.device, |gpu, progress| {
-        progress.set_message(format!("{} and {} on {} rows", a.short_name(), b.short_name(), inputs.samples.len()));
+        progress.set_message(format!("{} and {} on {} rows", a.label(), b.label(), inputs.samples.len()));
         let eval = |(m, rows): &(Model, RowValues)| {
             let extras = kernels::EvalExtras { tangents: inputs.tangents.as_deref(), rows: &rows.values, row_floats: rows.floats };
             kernels::eval_with(gpu, m, &inputs.samples, &extras, kernels::RunLimits::default())
@@ -101,6 +103,9 @@ pub fn diff(args: &DiffArgs) -> Result<ExitCode> {
             _ => {}
         }
     }
+    // The page reads the result back through its JSON view, as `brdfprof report` reads a saved one.
+    let label = args.json.clone().unwrap_or_else(|| PathBuf::from("diff.json"));
+    args.html.write(&[super::report::just_measured(&label, &result)?], Some(&gpu))?;
     print!("{}", result.markdown());
     if !outs.is_empty() {
         println!("\n{}", super::written(&outs.iter().map(|(_, p)| p.clone()).collect::<Vec<_>>()));

@@ -52,7 +52,7 @@ pub fn profile(args: &ProfileArgs) -> Result<ExitCode> {
     let size = args.size.as_deref().unwrap_or("960x540");
     let options = args.timing.options(args.model.models(&THESIS_MODELS)?, size, args.reps, args.budget, args.target_ci)?;
     let (gpu, result) = on_device(&args.device, |gpu, progress| profile::run(gpu, &options, progress))?;
-    let path = args.json.clone().unwrap_or_else(|| PathBuf::from(format!("results/profile-{}.json", brdfprof::targets::device_slug(&gpu.info))));
+    let path = args.json.clone().unwrap_or_else(|| PathBuf::from(format!("{}/profile-{}.json", super::DEFAULT_OUT, brdfprof::targets::device_slug(&gpu.info))));
     report::write_json(&path, &result)?;
     args.html.write(&[super::report::just_measured(&path, &result)?], Some(&gpu))?;
     println!("{}\n", result.summary());
@@ -68,6 +68,19 @@ pub fn profile(args: &ProfileArgs) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
+/// `--out`, checked writable; else the default results/, refused where the command's `files` there (patterns,
+/// `*` for the device) match a file git tracks.
+fn out_dir(given: Option<&std::path::Path>, files: &[&str]) -> Result<PathBuf> {
+    if let Some(out) = given {
+        io::check_output_dir("--out", out)?;
+        return Ok(out.to_path_buf());
+    }
+    let out = PathBuf::from(super::DEFAULT_OUT);
+    io::check_output_dir("--out (default results)", &out)?;
+    io::refuse_tracked_default("--out", &out, &files.iter().map(|f| f.to_string()).collect::<Vec<_>>())?;
+    Ok(out)
+}
+
 fn profile_scene(args: &ProfileArgs, path: &std::path::Path) -> Result<ExitCode> {
     if !args.model.models.is_empty() || !args.model.params.is_empty() {
         bail!("--scene: the scene's materials choose the models; --model and --param do not apply (edit the scene file)");
@@ -81,7 +94,7 @@ fn profile_scene(args: &ProfileArgs, path: &std::path::Path) -> Result<ExitCode>
     let base = args.timing.options(Vec::new(), "1x1", args.reps, args.budget, args.target_ci)?;
     let options = scene::profile::SceneProfileOptions { protocol: base.protocol, target_rel_ci: args.target_ci, max_chunk: None, instances: base.instances };
     let (gpu, result) = on_device(&args.device, |gpu, progress| scene::profile::run(gpu, &scene, &options, progress))?;
-    let path = args.json.clone().unwrap_or_else(|| PathBuf::from(format!("results/scene-{}-{}.json", scene.name(), brdfprof::targets::device_slug(&gpu.info))));
+    let path = args.json.clone().unwrap_or_else(|| PathBuf::from(format!("{}/scene-{}-{}.json", super::DEFAULT_OUT, scene.name(), brdfprof::targets::device_slug(&gpu.info))));
     report::write_json(&path, &result)?;
     println!("{}\n", result.summary());
     print!("{}", result.markdown());
@@ -109,9 +122,10 @@ pub struct SweepArgs {
     /// CI half-width target: 1.5% resolves neighbours 3% apart.
     #[arg(long, default_value_t = 0.015)]
     pub target_ci: f64,
-    /// Directory for sweep-<device>.md, .json and .png.
-    #[arg(long, default_value = "results")]
-    pub out: PathBuf,
+    /// Directory for sweep-<device>.md, .json and .png (default results/, refused where that would overwrite a
+    /// file git tracks).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
     /// What a .brdf model's accuracy is measured against: a spec (its exact f64 model) or another .brdf file
     /// (its GPU values). Built-in specs are always measured against their own exact model.
     #[arg(long, default_value = "ggx")]
@@ -144,7 +158,7 @@ fn cost_targets(devices: &[String]) -> Result<Vec<brdfprof::targets::Target>> {
 }
 
 pub fn sweep(args: &SweepArgs) -> Result<ExitCode> {
-    io::check_output_dir("--out", &args.out)?;
+    let out = out_dir(args.out.as_deref(), &["sweep-*"])?;
     args.html.check()?;
     let cost_targets = cost_targets(&args.cost_devices)?;
     if let Some(d) = args.device.device.as_deref().filter(|d| brdfprof::targets::is_compile_only(d)) {
@@ -169,8 +183,8 @@ pub fn sweep(args: &SweepArgs) -> Result<ExitCode> {
         brdfprof::messages::warning(format!("{}: {} of {} values on the sample set are NaN or Inf", r.spec, r.accuracy.vs_exact.nonfinite, r.accuracy.vs_exact.values));
     }
     let slug = brdfprof::targets::device_slug(&gpu.info);
-    let mut files = result.write(&args.out, &slug)?;
-    files.extend(args.html.write(&[super::report::just_measured(&args.out.join(format!("sweep-{slug}.json")), &result)?], Some(&gpu))?);
+    let mut files = result.write(&out, &slug)?;
+    files.extend(args.html.write(&[super::report::just_measured(&out.join(format!("sweep-{slug}.json")), &result)?], Some(&gpu))?);
     print!("{}", result.markdown());
     for run in &costs {
         let name = run.target.name();
@@ -178,7 +192,7 @@ pub fn sweep(args: &SweepArgs) -> Result<ExitCode> {
         let note = run.report.section_notes.get("driver/").map(String::as_str).filter(|n| n.starts_with("not compiled"));
         let swept = brdfprof::sweep_cost::build(&result, &name, &table, note)?;
         let family = table.family.clone().unwrap_or_else(|| name.replace(':', "-"));
-        files.extend(swept.write(&args.out.join(format!("sweep-{slug}-{}-{family}", table.compiler.to_ascii_lowercase())))?);
+        files.extend(swept.write(&out.join(format!("sweep-{slug}-{}-{family}", table.compiler.to_ascii_lowercase())))?);
         print!("\n{}", swept.markdown());
     }
     println!("\n{}", written(&files));
@@ -197,9 +211,10 @@ pub struct StabilityArgs {
     /// (the report's "What each guard saves").
     #[arg(long)]
     pub unguarded: bool,
-    /// Directory for stability-<device>.md/.json and the furnace, albedo and failure PNGs.
-    #[arg(long, default_value = "results")]
-    pub out: PathBuf,
+    /// Directory for stability-<device>.md/.json and the furnace, albedo and failure PNGs (default results/,
+    /// refused where that would overwrite a file git tracks).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
     #[command(flatten)]
     pub html: super::report::HtmlArg,
     #[command(flatten)]
@@ -207,14 +222,14 @@ pub struct StabilityArgs {
 }
 
 pub fn stability(args: &StabilityArgs) -> Result<ExitCode> {
-    io::check_output_dir("--out", &args.out)?;
+    let out = out_dir(args.out.as_deref(), &["stability-*", "furnace-*.png", "albedo-*.png"])?;
     args.html.check()?;
     let models = if args.model.models.is_empty() { stability::default_specs().into_iter().map(Model::spec).collect() } else { args.model.models(&[])? };
     let options = stability::StabilityOptions { models: if args.unguarded { stability::with_guard_variants(models) } else { models }, energy: !args.no_energy };
     let (gpu, result) = on_device(&args.device, |gpu, progress| stability::run(gpu, &options, progress))?;
     let slug = brdfprof::targets::device_slug(&gpu.info);
-    let mut files = result.write(&args.out, &slug)?;
-    files.extend(args.html.write(&[super::report::just_measured(&args.out.join(format!("stability-{slug}.json")), &result)?], Some(&gpu))?);
+    let mut files = result.write(&out, &slug)?;
+    files.extend(args.html.write(&[super::report::just_measured(&out.join(format!("stability-{slug}.json")), &result)?], Some(&gpu))?);
     print!("{}", result.markdown());
     println!("\n{}", written(&files));
     let failing = result.failing();

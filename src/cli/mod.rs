@@ -308,12 +308,21 @@ pub fn fresh_compilation(keep_cache: bool) {
     }
 }
 
+/// The directory of every default output (relative to the working directory; a default path git tracks there is
+/// refused, `io::refuse_tracked_default`).
+pub const DEFAULT_OUT: &str = "results";
+
 /// Checks a file output given by `flag` (see `io::check_output_path`), or, when it defaults to a file in
-/// `default_dir` that is named only once the device is open, that directory.
+/// `default_dir` that is named only once the device is open, that directory, and that no file git tracks there
+/// has the default's name.
 pub fn check_output(flag: &str, path: Option<&Path>, default_dir: &str, default_name: &str) -> Result<()> {
     match path {
         Some(p) => io::check_output_path(flag, p),
-        None => io::check_output_dir(&format!("{flag} (default {default_dir}/{default_name})"), Path::new(default_dir)),
+        None => {
+            io::check_output_dir(&format!("{flag} (default {default_dir}/{default_name})"), Path::new(default_dir))?;
+            // The device is not known yet: a `<device>` name is refused where git tracks it for any device.
+            io::refuse_tracked_default(flag, Path::new(default_dir), &[default_name.replace("<device>", "*")])
+        }
     }
 }
 

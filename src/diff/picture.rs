@@ -59,6 +59,12 @@ fn radiance(gpu: &Gpu, model: &Model, pixels: &[Option<Sample>]) -> Result<Vec<[
 
 /// Writes the picture of B against A to `path`.
 pub fn write(gpu: &Gpu, path: &Path, a: &Model, b: &Model) -> Result<()> {
+    let (w, h, px) = pixels(gpu, a, b)?;
+    chart::write_png(path, w, h, px)
+}
+
+/// The picture of B against A: (width, height, 8-bit RGB pixels).
+pub fn pixels(gpu: &Gpu, a: &Model, b: &Model) -> Result<(u32, u32, Vec<u8>)> {
     let mut shown: Vec<[Vec<[u8; 3]>; 2]> = Vec::new();
     let mut diffs: Vec<Vec<Option<f32>>> = Vec::new();
     for r in ROUGHNESS {
@@ -71,9 +77,10 @@ pub fn write(gpu: &Gpu, path: &Path, a: &Model, b: &Model) -> Result<()> {
     }
     let scale = diffs.iter().flatten().flatten().copied().fold(0.0f32, |m, x| if x.is_finite() { m.max(x) } else { m });
     let panels = lobe_curves(gpu, &[a.clone(), b.clone()], &ROUGHNESS)?;
-    let names = [a.short_name(), b.short_name()];
+    let names = [a.label(), b.label()];
     let width = LOBE_PANEL.0 * ROUGHNESS.len() as u32;
-    chart::render(path, width + 70, TOP + LOBE_PANEL.1 + 40, |root| {
+    let size = (width + 70, TOP + LOBE_PANEL.1 + 40);
+    let px = chart::pixels(size.0, size.1, |root| {
         let title = format!("B = {} against A = {}: lit spheres and |B - A| / max(|A|, 1e-3) (largest channel)", names[1], names[0]);
         label(root, &title, 10, 8, 18, BLACK)?;
         for (g, r) in ROUGHNESS.iter().enumerate() {
@@ -89,5 +96,6 @@ pub fn write(gpu: &Gpu, path: &Path, a: &Model, b: &Model) -> Result<()> {
         let (_, below) = root.split_vertically(TOP);
         let (lobes, _) = below.split_horizontally(width);
         draw_lobes(&lobes, &names, &panels)
-    })
+    })?;
+    Ok((size.0, size.1, px))
 }

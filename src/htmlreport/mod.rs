@@ -5,6 +5,7 @@
 //! `sweep::view`, `stability::view`, `inspect`). Lobes, spheres and albedo are evaluated at report time by the
 //! GPU kernels on the device given (docs/report.md says why).
 
+pub mod diff;
 pub mod sections;
 pub mod shapes;
 
@@ -30,6 +31,8 @@ pub enum Loaded {
     Inspect(Vec<InspectReport>, Option<CostTable>),
     /// A `brdfprof compare` table.
     Costs(CostTable),
+    /// A `brdfprof diff` result.
+    Diff(Box<crate::diff::view::DiffView>),
 }
 
 impl Loaded {
@@ -40,6 +43,7 @@ impl Loaded {
             Loaded::Stability(_) => "stability",
             Loaded::Inspect(..) => "inspect",
             Loaded::Costs(_) => "compare",
+            Loaded::Diff(_) => "diff",
         }
     }
 }
@@ -59,6 +63,7 @@ struct Probe {
     kernels: Option<IgnoredAny>,
     reports: Option<IgnoredAny>,
     correlations: Option<IgnoredAny>,
+    kind: Option<String>,
 }
 
 /// The largest results file read (the biggest default report, a sweep's, is under 1 MB).
@@ -102,8 +107,10 @@ pub fn from_json(path: &Path, text: &str) -> Result<Input> {
         Loaded::Inspect(vec![parse(path, &text, "inspect")?], None)
     } else if probe.correlations.is_some() {
         Loaded::Costs(parse(path, &text, "compare")?)
+    } else if probe.kind.as_deref() == Some("diff") {
+        Loaded::Diff(parse(path, &text, "diff")?)
     } else {
-        bail!("{}: not a brdfprof profile, sweep, stability, inspect or compare JSON report (none of the keys `fastest`, `workload`, `grid_points`, `reports`, `kernels`, `correlations` at its top level)", path.display());
+        bail!("{}: not a brdfprof profile, sweep, stability, inspect, compare or diff JSON report (none of the keys `fastest`, `workload`, `grid_points`, `reports`, `kernels`, `correlations`, nor `\"kind\": \"diff\"` at its top level)", path.display());
     };
     Ok(Input { path: path.to_path_buf(), loaded })
 }
@@ -135,13 +142,17 @@ pub fn build(inputs: &[Input], gpu: Option<&Gpu>) -> Result<String> {
     if !stability.is_empty() {
         page.section("stability", "Stability", stability);
     }
+    let diffs = diff::diffs(inputs, gpu)?;
+    if !diffs.is_empty() {
+        page.section("diff", "Two models side by side (brdfprof diff)", diffs);
+    }
     Ok(page.render())
 }
 
 /// Builds the page of `inputs` and writes it to `out` (atomically); returns its size in bytes.
 pub fn write(inputs: &[Input], out: &Path, gpu: Option<&Gpu>) -> Result<usize> {
     if inputs.is_empty() {
-        bail!("report needs at least one RESULTS.json (a profile, sweep, stability, inspect or compare report)");
+        bail!("report needs at least one RESULTS.json (a profile, sweep, stability, inspect, compare or diff report)");
     }
     let page = build(inputs, gpu)?;
     crate::io::write_output(out, page.as_bytes())?;

@@ -81,6 +81,7 @@ pub fn provenance(inputs: &[Input]) -> String {
                     s += &kv(&items);
                 }
             }
+            Loaded::Diff(d) => s += &kv(&[("device", d.device.clone()), ("models", format!("A = {}, B = {}", d.a.canonical, d.b.canonical)), ("input", d.input.clone())]),
             Loaded::Costs(t) => s += &kv(&[("columns", t.columns.iter().map(|c| format!("{} ({})", c.name, c.source)).collect::<Vec<_>>().join("; "))]),
         }
     }
@@ -283,7 +284,7 @@ const STABILITY_COLUMNS: [(&str, &str); 12] = [
 
 fn stability_row(s: &SpecView) -> Vec<Cell> {
     vec![
-        Cell::text(s.spec.clone()),
+        Cell::text(s.label().to_string()),
         count_cell(s.nan),
         count_cell(s.inf),
         count_cell(s.negative),
@@ -312,8 +313,8 @@ fn heat_map(s: &SpecView, triples: &[[u32; 3]]) -> Result<String> {
     }
     let total: u32 = triples.iter().map(|t| t[2]).sum();
     let uri = html::png_data_uri(w, h, &rgb)?;
-    let caption = format!("{}: {total} bad values (NaN, Inf, negative) in {} cells; NoV {}..{} right, roughness {}..{} up; most in a cell {max}", s.spec, triples.len(), COSINES[0], COSINES[COSINES.len() - 1], ROUGHNESS[0], ROUGHNESS[ROUGHNESS.len() - 1]);
-    Ok(format!("<figure>{}<figcaption>{}</figcaption></figure>", html::img(&uri, w, h, 6, &caption), esc(&s.spec)))
+    let caption = format!("{}: {total} bad values (NaN, Inf, negative) in {} cells; NoV {}..{} right, roughness {}..{} up; most in a cell {max}", s.label(), triples.len(), COSINES[0], COSINES[COSINES.len() - 1], ROUGHNESS[0], ROUGHNESS[ROUGHNESS.len() - 1]);
+    Ok(format!("<figure>{}<figcaption>{}</figcaption></figure>", html::img(&uri, w, h, 6, &caption), esc(s.label())))
 }
 
 /// One stability report: the summary table (rows keyed `stability<i>/<spec>`) and a heat map per spec with

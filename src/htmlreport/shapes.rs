@@ -46,7 +46,8 @@ pub fn models_of(inputs: &[Input]) -> Vec<(String, String)> {
             Loaded::Profile(p) => p.rows.iter().filter_map(|r| r.spec.as_deref().map(|s| (s, &r.model))).for_each(|(s, m)| add(s, m)),
             Loaded::Sweep(w) => w.rows.iter().filter(|r| r.pareto).for_each(|r| add(&r.canonical, &r.label)),
             Loaded::Inspect(reports, _) => reports.iter().flat_map(|r| &r.rows).filter_map(|r| r.spec.as_deref().map(|s| (s, &r.model))).for_each(|(s, m)| add(s, m)),
-            Loaded::Stability(st) => st.specs.iter().filter(|s| s.fails()).for_each(|s| add(&s.spec, &s.spec)),
+            Loaded::Stability(st) => st.specs.iter().filter(|s| s.fails()).for_each(|s| add(&s.spec, s.label())),
+            Loaded::Diff(d) => [&d.a, &d.b].into_iter().for_each(|m| add(&m.canonical, &m.name)),
             Loaded::Costs(_) => {}
         }
     }

@@ -81,7 +81,7 @@ fn running_on_valgrind() -> bool {
 /// What the parent asks the child to measure (passed as one JSON argument).
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct ChildRequest {
-    /// Canonical models; the memory-only baseline kernel is measured after them.
+    /// Models by `Model::name` (label included, so the child labels them alike); the memory-only baseline kernel is measured after them.
     pub models: Vec<String>,
     pub lights: u32,
     pub width: u32,
@@ -204,7 +204,7 @@ pub fn run(models: &[Model], lights: u32, shaders: &Shaders, options: &Callgrind
     let dir = cleanup::TempDir::new().context("cannot create a directory for callgrind's output")?;
     let out_file = dir.path().join("callgrind.out");
     let req = ChildRequest {
-        models: models.iter().map(Model::canonical).collect(),
+        models: models.iter().map(Model::name).collect(),
         lights,
         width: options.width,
         height: options.height,
@@ -237,7 +237,7 @@ pub fn run(models: &[Model], lights: u32, shaders: &Shaders, options: &Callgrind
         .find_map(|l| serde_json::from_str(l).ok())
         .ok_or_else(|| anyhow!("the callgrind child printed no reply; its output:\n{stdout}"))?;
     let dumps = read_dumps(dir.path())?;
-    let names: Vec<String> = models.iter().map(Model::name).chain([super::BASELINE_LABEL.to_string()]).collect();
+    let names: Vec<String> = models.iter().map(Model::label).chain([super::BASELINE_LABEL.to_string()]).collect();
     let kernels = reply
         .labels
         .iter()

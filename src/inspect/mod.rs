@@ -134,7 +134,7 @@ fn ordered_columns(rows: &[Row], emitted: &[String]) -> Vec<String> {
 /// kernel's hash.
 pub fn static_row(shaders: &Shaders, model: Option<&Model>, lights: u32) -> Result<Row> {
     let mut row = Row {
-        model: model.map_or_else(|| BASELINE_LABEL.to_string(), Model::name),
+        model: model.map_or_else(|| BASELINE_LABEL.to_string(), Model::label),
         spec: model.map(Model::canonical),
         stats: BTreeMap::new(),
         notes: BTreeMap::new(),

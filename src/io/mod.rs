@@ -188,6 +188,32 @@ fn parent_dir(path: &Path) -> PathBuf {
     }
 }
 
+/// The files git tracks in `dir` whose names match `pattern` (a git pathspec: `*` matches any text), as paths
+/// under `dir`; none where `dir` does not exist, is in no repository, or git is not installed (then nothing a
+/// checkout committed can be there to overwrite).
+pub fn tracked_by_git(dir: &Path, pattern: &str) -> Vec<PathBuf> {
+    if !dir.is_dir() {
+        return Vec::new();
+    }
+    let out = std::process::Command::new("git").arg("-C").arg(dir).args(["ls-files", "-z", "--"]).arg(pattern).stderr(std::process::Stdio::null()).output();
+    match out {
+        Ok(o) if o.status.success() => o.stdout.split(|&b| b == 0).filter(|n| !n.is_empty()).map(|n| dir.join(std::ffi::OsStr::from_bytes(n))).collect(),
+        _ => Vec::new(),
+    }
+}
+
+/// Refuses a default output (one the user did not name) that would overwrite a file git tracks: run inside a
+/// checkout, a default path must not replace the committed results. `files` are the names the command writes in
+/// `dir` (patterns, as `tracked_by_git`); `flag` is the option that names the output instead.
+pub fn refuse_tracked_default(flag: &str, dir: &Path, files: &[String]) -> Result<()> {
+    for f in files {
+        if let Some(t) = tracked_by_git(dir, f).first() {
+            bail!("{flag} not given: the default output {} would overwrite {}, a file git tracks; name the output with {flag} PATH", dir.join(f).display(), t.display());
+        }
+    }
+    Ok(())
+}
+
 /// Checks, before a command measures anything, that it will be able to write the file output `path` given
 /// by `flag`: not a directory, and in a directory that exists or can be created. Errors name the flag and
 /// the path.

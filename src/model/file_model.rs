@@ -133,6 +133,8 @@ pub struct FileModel {
     pub path: String,
     /// One per `file.params`, in order.
     pub bindings: Vec<Binding>,
+    /// Its `name=` label (`Model::label`), when one was given.
+    pub label: Option<String>,
 }
 
 impl FileParam {
@@ -297,7 +299,7 @@ impl FileModel {
             crate::messages::input_note(format!("{path}: its isFunc section (importance sampling) is ignored: brdfprof integrates with its own estimator"));
         }
         let bindings = file.params.iter().map(|p| Binding::Value(p.default_value())).collect();
-        let model = FileModel { file, path: path.to_string(), bindings };
+        let model = FileModel { file, path: path.to_string(), bindings, label: None };
         model.warn_new(None);
         model.with_params(&params)
     }

@@ -1,7 +1,9 @@
 //! The one model type every command takes. A model has a name, a precision, the kernels that evaluate it
 //! (SPIR-V plus specialisation constants, for each kind of kernel) and, where one exists, an f64 twin and an
 //! exact physical reference. A D x Vis x F spec is one constructor (`Model::spec`), a user's `.brdf` file the
-//! other (`Model::parse` of `PATH.brdf[,NAME=VALUE...]`).
+//! other (`Model::parse` of `PATH.brdf[,NAME=VALUE...]`). Either may carry a `name=LABEL`: what tables, charts
+//! and output file names call it. A label is not part of the maths: `canonical` (baselines, kernel hashes)
+//! never shows it.
 
 pub mod brdf_file;
 pub mod csv_rows;
@@ -61,17 +63,23 @@ pub struct ModelKernel {
     pub constants: SpecConstants,
 }
 
+/// The label of the memory-only baseline kernel in every report (so no model may take it).
+pub const BASELINE_LABEL: &str = "baseline";
+
+/// The spec key that names a model.
+pub const LABEL_KEY: &str = "name";
+
 #[derive(Clone, Debug, PartialEq)]
 pub enum Model {
-    /// A D x Vis x F spec of the built-in term library.
-    Spec(ModelSpec),
+    /// A D x Vis x F spec of the built-in term library, with its `name=` label if it was given one.
+    Spec(ModelSpec, Option<Arc<str>>),
     /// A BRDF Explorer `.brdf` file with its parameter bindings.
     File(Arc<file_model::FileModel>),
 }
 
 impl From<ModelSpec> for Model {
     fn from(s: ModelSpec) -> Self {
-        Model::Spec(s)
+        Model::Spec(s, None)
     }
 }
 
@@ -89,47 +97,86 @@ pub fn spec_constants(spec: &ModelSpec) -> SpecConstants {
 }
 
 impl Model {
-    /// A model from its spec text (see `ModelSpec::parse`).
+    /// A model from its spec text (see `ModelSpec::parse`), less a `name=LABEL` item, which labels it.
     pub fn parse(text: &str) -> Result<Self> {
-        if file_model::names_a_file(text) {
-            return file_model::FileModel::parse(text).map(|f| Model::File(Arc::new(f)));
+        let (rest, label) = split_label(text)?;
+        let model = if file_model::names_a_file(&rest) {
+            Model::File(Arc::new(file_model::FileModel::parse(&rest)?))
+        } else {
+            ModelSpec::parse(&rest).map(Model::spec).map_err(|e| anyhow!(e))?
+        };
+        let Some(label) = label else { return Ok(model) };
+        let model = model.with_label(None);
+        if label == model.label() {
+            return Ok(model);
         }
-        ModelSpec::parse(text).map(Model::Spec).map_err(|e| anyhow!(e))
+        if let Ok(other) = ModelSpec::parse(&label) {
+            bail!("`{text}`: {LABEL_KEY}={label} would read as the model `{}`; give another name", other.name());
+        }
+        Ok(model.with_label(Some(label)))
+    }
+
+    /// The same model under `label` (None: its own name).
+    pub fn with_label(self, label: Option<String>) -> Self {
+        match self {
+            Model::Spec(s, _) => Model::Spec(s, label.map(Arc::from)),
+            Model::File(f) => Model::File(Arc::new(file_model::FileModel { label, ..(*f).clone() })),
+        }
     }
 
     /// The `.brdf` file, for a file model.
     pub fn file(&self) -> Option<&file_model::FileModel> {
         match self {
             Model::File(f) => Some(f),
-            Model::Spec(_) => None,
+            Model::Spec(..) => None,
         }
     }
 
     pub fn spec(spec: ModelSpec) -> Self {
-        Model::Spec(spec)
+        Model::Spec(spec, None)
     }
 
     /// The reference every cost is compared with (ggx).
     pub fn reference() -> Self {
-        Model::Spec(ModelSpec::reference())
+        Model::spec(ModelSpec::reference())
     }
 
-    /// The shortest name that parses back to this model.
+    /// The shortest text that parses back to this model, its label included.
     pub fn name(&self) -> String {
-        match self {
-            Model::Spec(s) => s.name(),
+        let spec = match self {
+            Model::Spec(s, _) => s.name(),
             Model::File(f) => f.name(),
+        };
+        match self.given_label() {
+            Some(l) => format!("{spec},{LABEL_KEY}={l}"),
+            None => spec,
         }
     }
 
-    /// The name without a `.brdf` file's directory, for labels and output file names.
-    pub fn short_name(&self) -> String {
+    /// The `name=` label, when one was given.
+    fn given_label(&self) -> Option<&str> {
         match self {
-            Model::Spec(s) => s.name(),
+            Model::Spec(_, l) => l.as_deref(),
+            Model::File(f) => f.label.as_deref(),
+        }
+    }
+
+    /// What every table, chart and output file name calls the model: its `name=` label; else a spec's shortest
+    /// name, or a `.brdf` file's stem (its file name where the stem is a preset's name) with the parameters that
+    /// differ from the file's defaults.
+    pub fn label(&self) -> String {
+        if let Some(l) = self.given_label() {
+            return l.to_string();
+        }
+        match self {
+            Model::Spec(s, _) => s.name(),
             Model::File(f) => {
                 let name = f.name();
-                let file_name = std::path::Path::new(&f.path).file_name().map_or(f.path.clone(), |n| n.to_string_lossy().into_owned());
-                file_name + &name[f.path.len()..]
+                let path = std::path::Path::new(&f.path);
+                let part = |p: Option<&std::ffi::OsStr>| p.map_or(f.path.clone(), |n| n.to_string_lossy().into_owned());
+                // `ggx.brdf` keeps its extension: a stem that reads as a built-in model would take that one's rows.
+                let stem = Some(part(path.file_stem())).filter(|s| ModelSpec::parse(s).is_err()).unwrap_or_else(|| part(path.file_name()));
+                stem + &name[f.path.len()..]
             }
         }
     }
@@ -140,7 +187,7 @@ impl Model {
     /// `@f0`/`@basecolor`).
     pub fn unread_columns(&self) -> Vec<&'static str> {
         let (roughness, f0) = match self {
-            Model::Spec(s) => (true, s.reads_f0()),
+            Model::Spec(s, _) => (true, s.reads_f0()),
             Model::File(f) => {
                 let reads = |inputs: &[file_model::Input]| f.bindings.iter().any(|b| matches!(b, file_model::Binding::Input(i) if inputs.contains(i)));
                 (reads(&[file_model::Input::Roughness, file_model::Input::Alpha]), reads(&[file_model::Input::F0, file_model::Input::BaseColor]))
@@ -159,14 +206,14 @@ impl Model {
     /// The full form, with every parameter (what baselines and reports record).
     pub fn canonical(&self) -> String {
         match self {
-            Model::Spec(s) => s.canonical(),
+            Model::Spec(s, _) => s.canonical(),
             Model::File(f) => f.canonical(),
         }
     }
 
     pub fn precision(&self) -> Precision {
         match self {
-            Model::Spec(s) => s.precision,
+            Model::Spec(s, _) => s.precision,
             // The file's GLSL is fp32, as BRDF Explorer compiled it.
             Model::File(_) => Precision::F32,
         }
@@ -175,7 +222,7 @@ impl Model {
     /// The f64 twin (and, through `brdf::exact`, the exact reference), where the model has one.
     pub fn twin(&self) -> Option<&ModelSpec> {
         match self {
-            Model::Spec(s) => Some(s),
+            Model::Spec(s, _) => Some(s),
             Model::File(_) => None,
         }
     }
@@ -189,7 +236,7 @@ impl Model {
     /// Applies `key=value` overrides (`--param`).
     pub fn with_params(&self, params: &[String]) -> Result<Self> {
         match self {
-            Model::Spec(s) => s.with_params(params).map(Model::Spec).map_err(|e| anyhow!("{}: {e:#}", s.name())),
+            Model::Spec(s, l) => s.with_params(params).map(|s| Model::Spec(s, l.clone())).map_err(|e| anyhow!("{}: {e:#}", s.name())),
             Model::File(f) => f.with_params(params).map(|f| Model::File(Arc::new(f))),
         }
     }
@@ -197,7 +244,7 @@ impl Model {
     /// Whether an override key is a parameter of this model (so that `--param` skips models it does not fit).
     pub fn takes_param(&self, key: &str) -> bool {
         match self {
-            Model::Spec(s) => ["d", "vis", "f", "precision", "guards"].contains(&key) || s.reads().iter().any(|p| p.name() == key),
+            Model::Spec(s, _) => ["d", "vis", "f", "precision", "guards"].contains(&key) || s.reads().iter().any(|p| p.name() == key),
             Model::File(f) => f.takes_param(key),
         }
     }
@@ -205,7 +252,7 @@ impl Model {
     /// The kernel of `kind` that evaluates this model.
     pub fn kernel(&self, kind: KernelKind, shaders: &Shaders) -> Result<ModelKernel> {
         match self {
-            Model::Spec(s) => {
+            Model::Spec(s, _) => {
                 if kind == KernelKind::SceneTerms && s.precision != Precision::F32 {
                     bail!("the scene terms kernel is compiled in fp32 only");
                 }
@@ -252,5 +299,96 @@ pub fn models_from_args(models: &[String], params: &[String], default: &[&str]) 
             let mine: Vec<String> = params.iter().filter(|p| p.split_once('=').is_some_and(|(k, _)| m.takes_param(k.trim()))).cloned().collect();
             m.with_params(&mine).map_err(|e| anyhow!("--param: {e:#}"))
         })
-        .collect()
+        .collect::<Result<Vec<_>>>()
+        .and_then(|models| check_labels(&models, "--model").map(|_| models))
+}
+
+/// The models with the reference (plain ggx) first when they lack it: what every cost is compared with.
+pub fn with_reference(models: &[Model]) -> Vec<Model> {
+    let reference = Model::reference();
+    let mut all = models.to_vec();
+    if !all.contains(&reference) {
+        all.insert(0, reference);
+    }
+    all
+}
+
+/// Splits a `name=LABEL` item off a model text; a label is a file-name-safe word.
+fn split_label(text: &str) -> Result<(String, Option<String>)> {
+    let (mut rest, mut label) = (Vec::new(), None);
+    for item in text.split(',') {
+        match item.trim().strip_prefix(LABEL_KEY).and_then(|r| r.trim_start().strip_prefix('=')) {
+            Some(_) if label.is_some() => bail!("`{text}`: {LABEL_KEY}= is given twice"),
+            Some(l) => label = Some(l.trim().to_string()),
+            None => rest.push(item),
+        }
+    }
+    if let Some(l) = &label {
+        let safe = |c: char| c.is_ascii_alphanumeric() || "-_.+".contains(c);
+        if l.is_empty() || l.len() > 64 || !l.chars().all(safe) || l.starts_with(['-', '.']) {
+            bail!("`{text}`: {LABEL_KEY}={l}: a label is 1 to 64 of A-Z a-z 0-9 - _ . + (not starting with - or .), as it names output files");
+        }
+        if l == BASELINE_LABEL {
+            bail!("`{text}`: {LABEL_KEY}={l} is the memory-only baseline kernel's label; give another name");
+        }
+    }
+    Ok((rest.join(","), label))
+}
+
+/// Fails when two different models of one run share a label (each names a row, a chart point and an output
+/// file); the same model given twice (`diff` of a preset with itself) is not ambiguous.
+pub fn check_labels(models: &[Model], flag: &str) -> Result<()> {
+    for (i, m) in models.iter().enumerate() {
+        if let Some(o) = models[..i].iter().find(|o| o.label() == m.label() && *o != m) {
+            bail!("{flag} {} and {flag} {}: both are labelled `{}`; give one of them its own {LABEL_KEY}=", o.name(), m.name(), m.label());
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const FILE: &str = "examples/brdf/ggx.brdf";
+
+    #[test]
+    fn a_label_names_the_model_but_not_its_maths() {
+        for (text, plain) in [("ggx,name=mine", "ggx"), ("d=beckmann,vis=vcavity,name=ct_2", "cook-torrance"), ("blinn, name = b+1", "blinn")] {
+            let m = Model::parse(text).unwrap();
+            let p = Model::parse(plain).unwrap();
+            assert_eq!(m.label(), text.rsplit('=').next().unwrap().trim(), "{text}");
+            assert_eq!(m.canonical(), p.canonical(), "{text}: the label is not part of the canonical spec");
+            assert_eq!(format!("{:?}", spec_constants(m.twin().unwrap())), format!("{:?}", spec_constants(p.twin().unwrap())), "{text}: the same kernel constants");
+            assert_eq!(Model::parse(&m.name()).unwrap(), m, "{text}: its name reads back, label included");
+            assert_ne!(m, p, "{text}");
+        }
+        assert_eq!(Model::parse("ggx").unwrap().label(), "ggx");
+        assert_eq!(Model::parse("ggx,name=ggx").unwrap(), Model::reference(), "a label that is the model's own name is no label");
+    }
+
+    #[test]
+    fn a_brdf_file_is_called_by_its_stem_or_its_label() {
+        let m = Model::parse(FILE).unwrap();
+        assert_eq!(m.label(), "ggx.brdf", "a stem that is a preset's name keeps its extension");
+        let named = Model::parse(&format!("{FILE},name=engine")).unwrap();
+        assert_eq!(named.label(), "engine");
+        assert_eq!(named.canonical(), m.canonical());
+        assert_eq!(Model::parse(&named.name()).unwrap(), named);
+        let bound = m.with_params(&["roughness=0.25".into()]).unwrap();
+        assert_eq!(bound.label(), "ggx.brdf,roughness=0.25", "the stem with the parameters that differ from the file's");
+    }
+
+    #[test]
+    fn bad_and_clashing_labels_are_errors_naming_the_flag() {
+        for (text, why) in [("ggx,name=", "a label is"), ("ggx,name=a/b", "a label is"), ("ggx,name=x,name=y", "given twice"), ("ggx,name=baseline", "baseline"), ("ggx,name=blinn", "would read as the model `blinn`")] {
+            let e = format!("{:#}", Model::parse(text).unwrap_err());
+            assert!(e.contains(why), "{text}: {e}");
+        }
+        let e = format!("{:#}", models_from_args(&["ggx,name=a".into(), "blinn,name=a".into()], &[], &[]).unwrap_err());
+        assert!(e.contains("--model ggx,name=a and --model blinn,name=a") && e.contains("labelled `a`"), "{e}");
+        assert_eq!(models_from_args(&["ggx".into(), "ggx".into()], &[], &[]).unwrap().len(), 2, "the same model twice is not a clash");
+        let e = format!("{:#}", models_from_args(&[format!("{FILE},name=x"), "blinn,name=x".into()], &[], &[]).unwrap_err());
+        assert!(e.contains("labelled `x`"), "{e}");
+    }
 }

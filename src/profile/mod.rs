@@ -142,7 +142,7 @@ fn analyse(raw: &RawTimes, specs: &[Option<Model>], group: &Group) -> Vec<Row> {
                 _ => (None, None, None),
             };
             Row {
-                model: specs[i].as_ref().map_or_else(|| workload::BASELINE_LABEL.to_string(), Model::name),
+                model: specs[i].as_ref().map_or_else(|| workload::BASELINE_LABEL.to_string(), Model::label),
                 spec: specs[i].as_ref().map(Model::canonical),
                 lights: group.lights,
                 evaluations_per_dispatch: group.evaluations,
@@ -174,10 +174,7 @@ fn analyse_all(raw: &RawTimes, specs: &[Option<Model>], groups: &[Group]) -> Vec
 /// all interleaved in the same rounds.
 pub fn run(gpu: &Gpu, options: &ProfileOptions, progress: &ProgressBar) -> Result<ProfileReport> {
     let reference_model = Model::reference();
-    let mut models = options.models.clone();
-    if !models.contains(&reference_model) {
-        models.insert(0, reference_model.clone());
-    }
+    let models = crate::model::with_reference(&options.models);
     workload::check_size(&gpu.info, options.width, options.height, options.format, options.lights.len())?;
     progress.set_message("building the G-buffer");
     let gbuffer = gbuffer::synthetic(options.width, options.height, options.format);
@@ -213,7 +210,7 @@ pub fn run(gpu: &Gpu, options: &ProfileOptions, progress: &ProgressBar) -> Resul
     let rows = analyse_all(&raw, &specs, &groups);
     let mut kernel_sha256 = std::collections::BTreeMap::new();
     for spec in models.iter().map(Some).chain([None]) {
-        let label = spec.map_or_else(|| workload::BASELINE_LABEL.to_string(), Model::name);
+        let label = spec.map_or_else(|| workload::BASELINE_LABEL.to_string(), Model::label);
         kernel_sha256.insert(label, workload::kernel_hash(spec, options.format, shaders)?);
     }
     Ok(ProfileReport {

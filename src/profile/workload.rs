@@ -225,8 +225,7 @@ pub struct Variant<'g> {
     pipelines: Pipelines<'g>,
 }
 
-/// The label of the memory-only baseline kernel in every report.
-pub const BASELINE_LABEL: &str = "baseline";
+pub use crate::model::BASELINE_LABEL;
 
 impl<'g> Variant<'g> {
     /// The shading kernels for `model` (None: the memory-only baseline) from `shaders`, as `instances`
@@ -276,7 +275,7 @@ impl<'g> Variant<'g> {
                 })
                 .collect())
         })?;
-        Ok(Variant { label: model.map_or_else(|| BASELINE_LABEL.to_string(), Model::name), model: model.cloned(), pipelines })
+        Ok(Variant { label: model.map_or_else(|| BASELINE_LABEL.to_string(), Model::label), model: model.cloned(), pipelines })
     }
 }
 

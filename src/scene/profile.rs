@@ -126,7 +126,7 @@ fn resolved(a: &Analysis, target: f64) -> bool {
 fn variants<'g>(gpu: &'g Gpu, work: &SceneWork<'g>, p: &ScenePlan, instances: usize) -> Result<(Vec<Slot>, Vec<SceneVariant<'g>>)> {
     let (mut slots, mut variants) = (Vec::new(), Vec::new());
     for (k, kp) in p.kernels.iter().enumerate() {
-        let name = kp.model.name();
+        let name = kp.model.label();
         slots.push(Slot { kernel: k, without: None });
         variants.push(SceneVariant::new(gpu, work, p, k, kp.switches, name.clone(), instances)?);
         for e in Effect::ALL.into_iter().filter(|e| e.is_on(&kp.switches)) {
@@ -187,7 +187,7 @@ pub fn run(gpu: &Gpu, scene: &Scene, options: &SceneProfileOptions, progress: &P
         .iter()
         .enumerate()
         .map(|(k, kp)| KernelRow {
-            model: kp.model.name(),
+            model: kp.model.label(),
             spec: kp.model.canonical(),
             materials: kp.materials.iter().map(|&i| scene.file.materials[i].name.clone()).collect(),
             pixels: pixels[k],
@@ -202,7 +202,7 @@ pub fn run(gpu: &Gpu, scene: &Scene, options: &SceneProfileOptions, progress: &P
         .effects
         .iter()
         .map(|&(k, e, extra, frac)| EffectRow {
-            model: p.kernels[k].model.name(),
+            model: p.kernels[k].model.label(),
             effect: e.name().into(),
             extra_ns_per_pixel: extra,
             extra_fraction: frac,

@@ -38,7 +38,7 @@ pub fn tone_map(rgb: [f32; 3], exposure: f32) -> [u8; 3] {
 }
 
 fn slug(spec: &BrdfModel) -> String {
-    spec.short_name().chars().map(|c| if c.is_ascii_alphanumeric() || c == '-' { c } else { '-' }).collect()
+    spec.label().chars().map(|c| if c.is_ascii_alphanumeric() || c == '-' { c } else { '-' }).collect()
 }
 
 /// Draws an RGB picture (w x h, row-major) at (x0, y0) of a plotters area.
@@ -102,7 +102,7 @@ fn difference_maps(g: &GBuffer, models: &[BrdfModel], displayed: &[Vec<[u8; 3]>]
         let path = out.join(format!("diff-{}-vs-{}.png", slug(&models[*i]), slug(&models[reference])));
         let px: Vec<[u8; 3]> = d.iter().map(|x| viridis(x / scale)).collect();
         let bar = 60;
-        let title = format!("|{} - {}| in displayed luminance", models[*i].short_name(), models[reference].short_name());
+        let title = format!("|{} - {}| in displayed luminance", models[*i].label(), models[reference].label());
         let mean = d.iter().sum::<f32>() / d.len() as f32;
         chart::render(&path, g.width + bar, g.height, |root| {
             blit(root, 0, 0, g.width, &px)?;
@@ -140,7 +140,7 @@ fn comparison_grid(gpu: &Gpu, scene: &Scene, models: &[BrdfModel], out: &Path, w
     let grid = out.join("grid.png");
     chart::render(&grid, gw, gh, |root| {
         for (j, m) in models.iter().enumerate() {
-            label(root, &m.short_name(), (label_w + j as u32 * GRID_TILE + 8) as i32, 8, 18, BLACK)?;
+            label(root, &m.label(), (label_w + j as u32 * GRID_TILE + 8) as i32, 8, 18, BLACK)?;
         }
         for (i, name) in rows.iter().enumerate() {
             let y0 = (header + i as u32 * GRID_TILE) as i32;
@@ -174,7 +174,7 @@ pub fn render(gpu: &Gpu, scene: &Scene, out: &Path, progress: &ProgressBar) -> R
         if bad > 0 {
             warnings.push(format!("{}: {} of {} pixels are NaN or Inf (drawn magenta in {})", m.name(), bad, hdr.len(), path.display()));
         }
-        let title = format!("{}: {} ({})", scene.name(), m.name(), m.canonical());
+        let title = format!("{}: {} ({})", scene.name(), m.label(), m.canonical());
         chart::render(&path, g.width, g.height, |root| {
             blit(root, 0, 0, g.width, &px)?;
             label(root, &title, 8, 6, 16.max(g.height as i32 / 28), WHITE)
@@ -221,7 +221,7 @@ pub fn colour_bar(root: &DrawingArea<BitMapBackend, plotters::coord::Shift>, x0:
 /// curve per model, each panel normalised to its largest value; evaluated on the device.
 pub fn lobe_plot(gpu: &Gpu, path: &Path, models: &[BrdfModel], roughness: &[f32]) -> Result<()> {
     let panels = lobe_curves(gpu, models, roughness)?;
-    let labels: Vec<String> = models.iter().map(BrdfModel::short_name).collect();
+    let labels: Vec<String> = models.iter().map(BrdfModel::label).collect();
     chart::render(path, LOBE_PANEL.0 * panels.len() as u32, LOBE_PANEL.1 + 40, |root| draw_lobes(root, &labels, &panels))
 }
 

@@ -233,6 +233,7 @@ pub fn check_model(gpu: &Gpu, model: &Model, cases: &[HardCase], grid: &[Sample]
     let any_bad = cells.iter().flatten().any(|&n| n > 0);
     let (reciprocity, reciprocity_nonfinite) = reciprocity_error(forward, backward);
     Ok(SpecStability {
+        label: model.label(),
         spec: model.name(),
         precision: model.precision().name().into(),
         has_twin: spec.is_some(),

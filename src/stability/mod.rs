@@ -114,6 +114,9 @@ pub struct Worst {
 
 #[derive(Clone, Debug, Serialize)]
 pub struct SpecStability {
+    /// What tables and charts call it (`Model::label`).
+    pub label: String,
+    /// The text that parses back to the model (`Model::name`).
     pub spec: String,
     pub precision: String,
     /// Whether the model has an f64 twin: without one, nothing is out of tolerance (there is nothing to be
@@ -361,7 +364,7 @@ impl StabilityReport {
         for s in &self.specs {
             let (max_e, hemi, cpu) = s.energy.as_ref().map_or(("-".into(), "-".into(), "-".into()), energy_cells);
             t.row([
-                s.spec.clone(),
+                s.label.clone(),
                 s.nan.to_string(),
                 s.inf.to_string(),
                 s.negative.to_string(),
@@ -390,7 +393,7 @@ impl StabilityReport {
                 },
                 count("f32").to_string(),
                 count("f16").to_string(),
-                worst.map_or("-".into(), |s| format!("{} ({:.1e})", s.spec, s.case_deviation[i])),
+                worst.map_or("-".into(), |s| format!("{} ({:.1e})", s.label, s.case_deviation[i])),
             ]);
         }
         out += &c.markdown();
@@ -399,7 +402,7 @@ impl StabilityReport {
         if !failing.is_empty() {
             out += "\n## Failing specs: first failing inputs\n\n";
             for s in failing {
-                out += &format!("- `{}`: {} NaN, {} Inf, {} negative; worst deviation {:.2e} x tolerance at {}\n", s.spec, s.nan, s.inf, s.negative, s.worst.deviation, s.worst.input);
+                out += &format!("- `{}`: {} NaN, {} Inf, {} negative; worst deviation {:.2e} x tolerance at {}\n", s.label, s.nan, s.inf, s.negative, s.worst.deviation, s.worst.input);
             }
         }
         out
@@ -438,7 +441,7 @@ impl StabilityReport {
                 let cells = s.bad_cells.as_ref().expect("filtered above");
                 let max = cells.iter().flatten().copied().max().unwrap_or(1).max(1) as f64;
                 let mut chart = ChartBuilder::on(area)
-                    .caption(&s.spec, (crate::chart::FONT, 12))
+                    .caption(&s.label, (crate::chart::FONT, 12))
                     .margin(6)
                     .x_label_area_size(28)
                     .y_label_area_size(36)
@@ -476,7 +479,7 @@ impl StabilityReport {
         for s in self.specs.iter().filter(|s| s.energy.is_some()) {
             let Ok(spec) = ModelSpec::parse(&s.spec) else {
                 // A .brdf model: always drawn, under its own name.
-                files.push((s.spec.clone(), s.energy.as_ref().unwrap()));
+                files.push((s.label.clone(), s.energy.as_ref().unwrap()));
                 continue;
             };
             let white = energy::white(&spec);

@@ -37,6 +37,9 @@ pub struct EnergyView {
 /// over `grid::ROUGHNESS` x `grid::COSINES`.
 #[derive(Clone, Debug, Deserialize)]
 pub struct SpecView {
+    /// `Model::label` (reports written before labels: empty, read as `spec`).
+    #[serde(default)]
+    pub label: String,
     pub spec: String,
     pub precision: String,
     #[serde(default)]
@@ -61,6 +64,11 @@ pub struct SpecView {
 }
 
 impl SpecView {
+    /// What to call it: its label, or its spec in a report written before labels.
+    pub fn label(&self) -> &str {
+        if self.label.is_empty() { &self.spec } else { &self.label }
+    }
+
     /// NaN, Inf or a negative value on a valid input (as `SpecStability::fails`).
     pub fn fails(&self) -> bool {
         self.nan + self.inf + self.negative > 0

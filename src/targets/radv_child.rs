@@ -28,7 +28,7 @@ pub const CHILD_COMMAND: &str = "__radv-child";
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct RadvRequest {
     pub family: String,
-    /// Models by their spec text (`Model::canonical`, which `Model::parse` reads back); the memory-only
+    /// Models by their spec text (`Model::name`, label included, which `Model::parse` reads back); the memory-only
     /// kernel is analysed after them.
     pub models: Vec<String>,
     pub lights: u32,
@@ -121,7 +121,7 @@ pub const CRASH_AFTER_REPLY: &str = "BRDFPROF_TEST_RADV_CHILD_CRASH";
 /// Compiles one kernel with CAPTURE_INTERNAL_REPRESENTATIONS and writes each text representation
 /// (RADV: NIR, ACO IR, disassembly) to DIR/<kernel>.<representation>.txt.
 fn write_isa(gpu: &Gpu, shaders: &Shaders, model: Option<&Model>, lights: u32, dir: &Path) -> Result<Vec<PathBuf>> {
-    let label = model.map_or_else(|| BASELINE_LABEL.to_string(), Model::name);
+    let label = model.map_or_else(|| BASELINE_LABEL.to_string(), Model::label);
     let (per_dispatch, accumulate) = steady_block(lights);
     let k = shade_kernel(model, GBufferFormat::Packed, per_dispatch, accumulate, shaders)?;
     let kernel = Kernel::with_capture(gpu, &k.spirv.name, &k.spirv.words, &k.constants, &workload::bindings(GBufferFormat::Packed), workload::PUSH_BYTES, true)?;
@@ -148,7 +148,7 @@ pub fn run(target: &'static Family, models: &[Model], lights: u32, shaders: &Sha
     let child_isa = isa_dir.map(|_| tmp.path().join("isa"));
     let req = RadvRequest {
         family: target.family.to_string(),
-        models: models.iter().map(Model::canonical).collect(),
+        models: models.iter().map(Model::name).collect(),
         lights,
         validate,
         glsl: shaders.glsl_dir().map(Path::to_path_buf),

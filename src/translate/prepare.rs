@@ -25,7 +25,7 @@ pub fn prepared(words: &[u32], constants: &SpecConstants) -> Result<Vec<u32>> {
 /// The translation of a model's kernel; for a `.brdf` model a construct the translation cannot express is
 /// located again in a line-annotated compile of the file, and named at the file's own line.
 fn translated(model: Option<&Model>, kind: KernelKind, words: &[u32], constants: &SpecConstants, options: &TranslateOptions, shaders: &Shaders) -> Result<Translation> {
-    let label = model.map_or_else(|| workload::BASELINE_LABEL.to_string(), Model::name);
+    let label = model.map_or_else(|| workload::BASELINE_LABEL.to_string(), Model::label);
     match translate(&prepared(words, constants)?, options) {
         Ok(t) => Ok(t),
         Err(e) => match model.and_then(Model::file) {

@@ -107,7 +107,7 @@ pub fn check(gpu: &Gpu, model: Option<&Model>, lights: u32, shaders: &Shaders) -
         out.push(eval_agreement(gpu, m, shaders)?);
     }
     out.push(shade_agreement(gpu, model, lights, shaders)?);
-    let label = model.map_or_else(|| workload::BASELINE_LABEL.to_string(), Model::name);
+    let label = model.map_or_else(|| workload::BASELINE_LABEL.to_string(), Model::label);
     for a in &out {
         if !(a.worst <= a.tolerance) {
             bail!(
@@ -139,7 +139,7 @@ pub fn check_cached(gpu: &Gpu, model: Option<&Model>, lights: u32, shaders: &Sha
             .part("eval-host", prepare::eval_kernel(m, shaders)?.source(super::Dialect::Host));
     }
     let key = key.finish();
-    let label = model.map_or_else(|| workload::BASELINE_LABEL.to_string(), Model::name);
+    let label = model.map_or_else(|| workload::BASELINE_LABEL.to_string(), Model::label);
     let what = format!("the check of {label}'s translation");
     let valid = |bytes: &[u8]| serde_json::from_slice::<Vec<Agreement>>(bytes).map(|_| ()).map_err(anyhow::Error::from);
     let bytes = crate::cache::get_or_build(crate::cache::Store::open_default().as_ref(), "agreement", &key, &what, valid, || Ok(serde_json::to_vec(&check(gpu, model, lights, shaders)?)?))?;

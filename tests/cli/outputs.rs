@@ -102,3 +102,48 @@ fn a_command_that_fails_midway_leaves_none_of_its_outputs() {
     run_in(d, &["compare", report.to_str().unwrap(), "--json", "out/c.json", "--markdown", "out/c.md", "--chart", "out/c.png"]).ok();
     assert_eq!(files(d), ["out/c.json", "out/c.md", "out/c.png"]);
 }
+
+/// `git` in `dir`, which must succeed.
+fn git(dir: &Path, args: &[&str]) {
+    let s = std::process::Command::new("git").args(["-c", "user.name=t", "-c", "user.email=t@t"]).args(args).current_dir(dir).output().expect("git runs");
+    assert!(s.status.success(), "git {args:?}: {}", String::from_utf8_lossy(&s.stderr));
+}
+
+#[test]
+fn a_default_output_never_overwrites_a_file_git_tracks() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    git(d, &["init", "-q"]);
+    std::fs::create_dir(d.join("results")).unwrap();
+    for f in ["profile-somegpu.json", "sweep-somegpu.md", "stability-somegpu.json", "compare.json", "inspect-somegpu.md"] {
+        std::fs::write(d.join("results").join(f), "committed\n").unwrap();
+    }
+    git(d, &["add", "results"]);
+    git(d, &["commit", "-q", "-m", "results"]);
+    for (args, flag, file) in [
+        (&["profile", "--budget", "5"][..], "--json", "profile-somegpu.json"),
+        (&["sweep", "--budget", "5"][..], "--out", "sweep-somegpu.md"),
+        (&["stability"][..], "--out", "stability-somegpu.json"),
+        (&["inspect", "--no-callgrind", "--json", "i.json"][..], "--markdown", "inspect-somegpu.md"),
+        (&["compare", "a.json"][..], "--json", "compare.json"),
+    ] {
+        let r = run_in(d, args).fails(2, "a file git tracks");
+        assert!(r.stderr.contains(flag) && r.stderr.contains(&format!("results/{file}")) && r.stderr.contains(&format!("{flag} PATH")), "{args:?}: {}", r.stderr);
+    }
+    for f in std::fs::read_dir(d.join("results")).unwrap() {
+        assert_eq!(std::fs::read_to_string(f.unwrap().path()).unwrap(), "committed\n", "nothing overwritten");
+    }
+    assert!(!d.join("i.json").exists());
+    // Not tracked (outside any repository, or untracked in one): the defaults stand.
+    assert!(brdfprof::io::tracked_by_git(&d.join("results"), "*").len() == 5);
+    std::fs::write(d.join("results").join("profile-other.json"), "").unwrap();
+    assert!(brdfprof::io::tracked_by_git(&d.join("results"), "profile-other.json").is_empty(), "an untracked file");
+    let plain = tempfile::tempdir().unwrap();
+    std::fs::write(plain.path().join("compare.json"), "").unwrap();
+    assert!(brdfprof::io::tracked_by_git(plain.path(), "*").is_empty() || git_above(plain.path()), "outside a repository");
+}
+
+/// Whether `dir` is inside some git repository (a temp dir under a checkout would be).
+fn git_above(dir: &Path) -> bool {
+    std::process::Command::new("git").args(["rev-parse", "--git-dir"]).current_dir(dir).output().is_ok_and(|o| o.status.success())
+}

@@ -81,6 +81,42 @@ fn a_report_of_profile_sweep_inspect_and_stability_opens_in_chromium_with_the_js
     assert!(colours.len() > 64, "the screenshot has {} colours: blank", colours.len());
 }
 
+/// A `brdfprof diff` result in the report (from `report d.json` and from `diff --html`): in Chromium, every
+/// channel's max/RMS, every worst row's difference and every histogram count is the JSON's, and the picture is
+/// there.
+#[test]
+fn a_diff_report_shows_the_jsons_numbers_in_chromium() {
+    let dir = tempfile::tempdir().unwrap();
+    let (d, from_diff, from_report) = (dir.path().join("d.json"), dir.path().join("diff.html"), dir.path().join("report.html"));
+    let path = |p: &Path| p.display().to_string();
+    let r = common::run(&["diff", "--model", "ggx,name=base", "--model", "filament-high", "--samples", "2000", "--worst", "5", "--json", &path(&d), "--html", &path(&from_diff)]);
+    assert!(r.code == Some(0), "{}", r.stderr);
+    common::run(&["report", &path(&d), "--out", &path(&from_report)]).ok();
+    let j: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&d).unwrap()).unwrap();
+    for (k, page) in [from_diff, from_report].iter().enumerate() {
+        let (dom, console) = headless(page, &dir.path().join(format!("profile{k}")), &["--dump-dom"]);
+        assert!(console.is_empty(), "console messages:\n{}", console.join("\n"));
+        assert!(dom.contains("data-ready=\"1\""), "the page's script did not finish");
+        assert!(dom.contains("B = <code>filament-high</code> against A = <code>base</code>"), "the models by their labels");
+        for c in j["difference"]["channels"].as_array().unwrap() {
+            let key = format!("diff0/{}", c["channel"].as_str().unwrap());
+            for col in ["max_rel", "rms_rel", "max_abs", "rms_abs"] {
+                assert_eq!(shown(&dom, &key, col), c[col].as_f64().unwrap(), "{key} {col}");
+            }
+        }
+        let worst = j["worst"].as_array().unwrap();
+        assert_eq!(worst.len(), 5);
+        for (w, row) in worst.iter().enumerate() {
+            assert_eq!(shown(&dom, &format!("diff0/worst{w}"), "rel"), row["rel"].as_f64().unwrap(), "worst row {w}");
+            assert_eq!(shown(&dom, &format!("diff0/worst{w}"), "index"), row["index"].as_f64().unwrap(), "worst row {w}");
+        }
+        for (b, count) in j["histogram"]["counts"].as_array().unwrap().iter().enumerate() {
+            assert_eq!(shown(&dom, &format!("diff0/bin{b}"), "rows"), count.as_f64().unwrap(), "bin {b}");
+        }
+        assert!(dom.contains("src=\"data:image/png;base64,") && dom.contains("alt=\"B = filament-high against A = base: lit spheres"), "the picture of B against A");
+    }
+}
+
 /// The console check can fail: a page that logs an error is caught.
 #[test]
 fn a_console_error_is_seen() {

@@ -97,7 +97,7 @@ fn the_host_translation_agrees_with_vulkan_on_every_preset_and_example_file() {
                 o.unexplained = compare(&preset, &samples, &on_host, &on_device).unexplained;
             }
         }
-        report.push(format!("{:60} worst {:.2e} ({} of {} values beyond {AGREEMENT:.0e}) at {}", model.short_name(), o.worst, o.over, 3 * samples.len(), o.at));
+        report.push(format!("{:60} worst {:.2e} ({} of {} values beyond {AGREEMENT:.0e}) at {}", model.label(), o.worst, o.over, 3 * samples.len(), o.at));
         unexplained.extend(o.unexplained);
     }
     println!("{}", report.join("\n"));
@@ -137,7 +137,7 @@ fn the_translated_profiling_kernel_shades_as_the_vulkan_one_and_the_check_catche
     for m in &models {
         let agreements = verify::check(&gpu, m.as_ref(), lights, kernels::embedded()).unwrap_or_else(|e| panic!("{e:#}"));
         for a in &agreements {
-            println!("{:40} {}: worst {:.2e} over {} values (tolerance {:.1e})", m.as_ref().map_or("baseline".into(), Model::short_name), a.kernel, a.worst, a.values, a.tolerance);
+            println!("{:40} {}: worst {:.2e} over {} values (tolerance {:.1e})", m.as_ref().map_or("baseline".into(), Model::label), a.kernel, a.worst, a.values, a.tolerance);
         }
         assert_eq!(agreements.len(), if m.is_some() { 2 } else { 1 });
     }
@@ -171,7 +171,7 @@ fn the_opencl_translation_on_pocl_agrees_with_vulkan_on_every_preset_and_example
         assert!(fast_worst <= 1e-4, "{model}: the native_ build differs by {fast_worst:.2e}");
         let judge = if model.twin().is_some() { model.clone() } else { twin_of_example(model).unwrap_or_else(|| model.clone()) };
         let o = compare(&judge, &samples, &on_cl, &on_device);
-        report.push(format!("{:60} worst {:.2e} ({} of {} beyond {AGREEMENT:.0e}; native_ build {fast_worst:.2e}) on {}", model.short_name(), o.worst, o.over, 3 * samples.len(), k.device));
+        report.push(format!("{:60} worst {:.2e} ({} of {} beyond {AGREEMENT:.0e}; native_ build {fast_worst:.2e}) on {}", model.label(), o.worst, o.over, 3 * samples.len(), k.device));
         unexplained.extend(o.unexplained);
     }
     println!("{}", report.join("\n"));

@@ -1,0 +1,96 @@
+//! The report's section for `brdfprof diff` results: per channel max/RMS (rows keyed `diff<i>/<channel>`), the
+//! worst rows with their inputs (`diff<i>/worst<k>`), the histogram (`diff<i>/bin<k>`) and, with a device, the
+//! lit-sphere and lobe picture of B against A (`diff::picture`).
+
+use super::sections::num_cell;
+use super::{file_label, Input, Loaded};
+use crate::diff::view::{DiffView, WorstView};
+use crate::gpu::Gpu;
+use crate::html::{esc, img, png_data_uri, Cell, HtmlTable};
+use crate::model::Model;
+use crate::report::sig;
+use anyhow::Result;
+use std::fmt::Write;
+
+const CHANNEL_COLUMNS: [(&str, &str); 6] =
+    [("channel", "channel"), ("max_rel", "max rel"), ("rms_rel", "RMS rel"), ("max_abs", "max |B - A|"), ("rms_abs", "RMS |B - A|"), ("mismatched", "finite on one side")];
+
+const WORST_COLUMNS: [(&str, &str); 9] =
+    [("index", "row"), ("line", "CSV line"), ("nov", "NoV"), ("nol", "NoL"), ("roughness", "roughness"), ("f0", "F0"), ("channel", "channel"), ("a_b", "A / B"), ("rel", "rel")];
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn worst_row(w: &WorstView) -> Vec<Cell> {
+    let value = |x: Option<f64>| x.map_or("NaN/Inf".into(), |x| sig(x, 4));
+    let c = ["r", "g", "b"].iter().position(|c| *c == w.channel).unwrap_or(0);
+    let s = &w.sample;
+    vec![
+        Cell::num(w.index as f64, w.index.to_string()),
+        w.line.map_or(Cell::text("-"), |l| Cell::num(l as f64, l.to_string())),
+        num_cell(Some(dot(s.n, s.v))),
+        num_cell(Some(dot(s.n, s.l))),
+        num_cell(Some(s.roughness)),
+        Cell::text(s.f0.map(|x| sig(x, 3)).join(", ")),
+        Cell::text(w.channel.clone()),
+        Cell::text(format!("{} / {}", value(w.a[c]), value(w.b[c]))),
+        num_cell(w.rel),
+    ]
+}
+
+/// The histogram as a table: one row per bin, its lower edge and count.
+fn histogram(i: usize, d: &DiffView) -> String {
+    let mut t = HtmlTable::new(&[("from", "rel from"), ("to", "to"), ("rows", "rows")]);
+    let h = &d.histogram;
+    for (k, (&edge, &count)) in h.edges.iter().zip(&h.counts).enumerate() {
+        let to = h.edges.get(k + 1).map_or(Cell::text("inf"), |&e| Cell::num(e, sig(e, 3)));
+        t.row(format!("diff{i}/bin{k}"), vec![Cell::num(edge, sig(edge, 3)), to, Cell::num(count as f64, count.to_string())]);
+    }
+    format!("<p>{} rows identical in value; {} finite on one side only.</p>{}", h.identical, h.nonfinite, t.html())
+}
+
+/// The picture of B against A drawn on `gpu` (a PNG data: URI), or why not.
+fn picture(d: &DiffView, gpu: Option<&Gpu>) -> Result<String> {
+    let Some(gpu) = gpu else { return Ok("<p class=\"note\">Picture not drawn: the report was built without a device (--no-gpu).</p>".into()) };
+    let (a, b) = (Model::parse(&d.a.canonical)?, Model::parse(&d.b.canonical)?);
+    let (w, h, px) = crate::diff::picture::pixels(gpu, &a, &b)?;
+    let alt = format!("B = {} against A = {}: lit spheres, relative difference and lobes", d.b.name, d.a.name);
+    Ok(format!("<figure>{}<figcaption>{}</figcaption></figure>", img(&png_data_uri(w, h, &px)?, w, h, 1, &alt), esc(&alt)))
+}
+
+fn diff_html(i: usize, d: &DiffView, path: &str, gpu: Option<&Gpu>) -> Result<String> {
+    let mut s = String::new();
+    let verdict = match (d.tolerance, d.within_tolerance) {
+        (Some(t), true) => format!("within --tolerance {t}"),
+        (Some(t), false) => format!("beyond --tolerance {t}"),
+        (None, _) => "no tolerance given".into(),
+    };
+    let _ = write!(
+        s,
+        "<h3>B = <code>{}</code> against A = <code>{}</code> ({path})</h3><p>{} rows: {}; on {}; {}; {verdict}. A: <code>{}</code>; B: <code>{}</code>.</p>",
+        esc(&d.b.name), esc(&d.a.name), d.rows, esc(&d.input), esc(&d.device), esc(&d.relative_to), esc(&d.a.canonical), esc(&d.b.canonical)
+    );
+    let mut t = HtmlTable::new(&CHANNEL_COLUMNS);
+    for c in &d.difference.channels {
+        t.row(format!("diff{i}/{}", c.channel), vec![Cell::text(c.channel.clone()), num_cell(c.max_rel), num_cell(c.rms_rel), num_cell(c.max_abs), num_cell(c.rms_abs), Cell::num(c.mismatched_nonfinite as f64, c.mismatched_nonfinite.to_string())]);
+    }
+    s += &t.html();
+    let mut w = HtmlTable::new(&WORST_COLUMNS);
+    for (k, row) in d.worst.iter().enumerate() {
+        w.row(format!("diff{i}/worst{k}"), worst_row(row));
+    }
+    let _ = write!(s, "<h4>Rows where they differ most</h4>{}<h4>Rows by their largest relative difference</h4>{}", w.html(), histogram(i, d));
+    Ok(s + &picture(d, gpu)?)
+}
+
+/// Every diff input's section.
+pub fn diffs(inputs: &[Input], gpu: Option<&Gpu>) -> Result<String> {
+    let mut s = String::new();
+    for (i, input) in inputs.iter().enumerate() {
+        if let Loaded::Diff(d) = &input.loaded {
+            s += &diff_html(i, d, &file_label(&input.path), gpu)?;
+        }
+    }
+    Ok(s)
+}
