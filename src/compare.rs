@@ -7,6 +7,7 @@
 
 use crate::inspect::InspectReport;
 use crate::inspect::HASH_NOTE;
+use crate::profile::view::ProfileView;
 use crate::profile::workload::BASELINE_LABEL;
 use crate::report::{sig, Table};
 use anyhow::{anyhow, bail, Context, Result};
@@ -95,14 +96,11 @@ pub fn inspect_columns(report: &InspectReport, source: &str) -> Vec<CostColumn> 
     out
 }
 
-/// The cost columns of a `profile` report (JSON): ns/eval per light count.
-pub fn profile_columns(value: &serde_json::Value, source: &str) -> Result<Vec<CostColumn>> {
-    let rows = value["rows"].as_array().ok_or_else(|| anyhow!("no `rows`"))?;
-    let device = value["provenance"]["device"]["name"].as_str().unwrap_or("?").to_string();
+/// The cost columns of a `profile` report, read back typed: ns/eval per light count.
+pub fn profile_columns(view: &ProfileView, source: &str) -> Vec<CostColumn> {
+    let device = Some(view.provenance.device.name.as_str()).filter(|n| !n.is_empty()).unwrap_or("?").to_string();
     let short = device.split([' ', '(']).next().unwrap_or("?").to_string();
-    let hashes: BTreeMap<String, String> =
-        value["kernel_sha256"].as_object().map(|m| m.iter().filter_map(|(k, v)| v.as_str().map(|s| (k.clone(), s.to_string()))).collect()).unwrap_or_default();
-    let mut lights: Vec<u32> = rows.iter().filter_map(|r| r["lights"].as_u64()).map(|l| l as u32).collect();
+    let mut lights: Vec<u32> = view.rows.iter().map(|r| r.lights).collect();
     lights.sort();
     lights.dedup();
     let several = lights.len() > 1;
@@ -115,23 +113,19 @@ pub fn profile_columns(value: &serde_json::Value, source: &str) -> Result<Vec<Co
             gross: BTreeMap::new(),
             net: BTreeMap::new(),
             net_ci: BTreeMap::new(),
-            hashes: hashes.clone(),
+            hashes: view.kernel_sha256.clone(),
             lights: l,
         };
-        for r in rows.iter().filter(|r| r["lights"].as_u64() == Some(u64::from(l))) {
-            let model = r["model"].as_str().ok_or_else(|| anyhow!("a row without `model`"))?.to_string();
-            let ns = r["ns_per_eval"]["median"].as_f64().ok_or_else(|| anyhow!("row `{model}`: no ns_per_eval.median"))?;
-            col.gross.insert(model.clone(), ns);
-            if let Some(n) = r["net_ns_per_eval"]["median"].as_f64() {
-                col.net.insert(model.clone(), n);
-                if let (Some(lo), Some(hi)) = (r["net_ns_per_eval"]["lo"].as_f64(), r["net_ns_per_eval"]["hi"].as_f64()) {
-                    col.net_ci.insert(model, (lo, hi));
-                }
+        for r in view.rows.iter().filter(|r| r.lights == l) {
+            col.gross.insert(r.model.clone(), r.ns_per_eval.median);
+            if let Some(n) = &r.net_ns_per_eval {
+                col.net.insert(r.model.clone(), n.median);
+                col.net_ci.insert(r.model.clone(), (n.lo, n.hi));
             }
         }
         out.push(col);
     }
-    Ok(out)
+    out
 }
 
 /// Refuses columns whose kernels differ: a model whose hash is not the same in every column that has it, or
@@ -311,7 +305,8 @@ pub fn load_columns(path: &Path) -> Result<Vec<CostColumn>> {
         if value.get("kernel_sha256").is_none() {
             bail!("{}: a profile report that records no kernel hashes (written by an older brdfprof); its kernels cannot be matched with the others'. Measure it again", path.display());
         }
-        profile_columns(&value, &source).with_context(|| format!("{}: not a brdfprof profile report", path.display()))?
+        let view: ProfileView = serde_json::from_value(value).map_err(|e| anyhow!("{}: not a brdfprof profile report ({e})", path.display()))?;
+        profile_columns(&view, &source)
     } else if let Some(reports) = value.get("reports").and_then(|r| r.as_array()) {
         let mut out = Vec::new();
         for r in reports {

@@ -154,7 +154,7 @@ fn cost_table(reports: &[InspectReport], profile: Option<&ProfileReport>) -> Res
     let mut columns: Vec<compare::CostColumn> = Vec::new();
     let mut profile_note = None;
     if let Some(p) = profile {
-        let cols = compare::profile_columns(&p.json, &format!("{}: ", p.file))?;
+        let cols = compare::profile_columns(&p.view, &format!("{}: ", p.file));
         let mut all = cols.clone();
         all.extend(reports.iter().flat_map(|r| compare::inspect_columns(r, "")));
         match compare::check_kernels(&all) {

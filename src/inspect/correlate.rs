@@ -3,6 +3,7 @@
 //! between them, gross and net of the memory-only kernel.
 
 use super::InspectReport;
+use crate::profile::view::ProfileView;
 use crate::stats;
 use anyhow::{anyhow, bail, Context, Result};
 use serde::{Deserialize, Serialize};
@@ -35,18 +36,6 @@ pub struct Correlation {
     pub spearman_gross: Option<f64>,
 }
 
-/// A number at `path` in a profile row, or a clear error.
-fn number(row: &serde_json::Value, path: &[&str], file: &str, model: &str) -> Result<Option<f64>> {
-    let mut v = row;
-    for key in path {
-        v = &v[*key];
-    }
-    match v {
-        serde_json::Value::Null => Ok(None),
-        v => v.as_f64().map(Some).ok_or_else(|| anyhow!("{file}: row `{model}`: {} is not a number", path.join("."))),
-    }
-}
-
 /// Spearman's rho, where there are at least three pairs to rank.
 fn rho(pairs: &[(f64, f64)]) -> Option<f64> {
     (pairs.len() >= 3).then(|| stats::spearman(&pairs.iter().map(|p| p.0).collect::<Vec<_>>(), &pairs.iter().map(|p| p.1).collect::<Vec<_>>()))
@@ -55,7 +44,7 @@ fn rho(pairs: &[(f64, f64)]) -> Option<f64> {
 /// A `brdfprof profile` report, read (before anything is measured, so that a bad file fails at once).
 pub struct ProfileReport {
     pub file: String,
-    pub json: serde_json::Value,
+    pub view: ProfileView,
 }
 
 /// Reads the profile report at `path`: JSON with a `rows` array.
@@ -66,7 +55,8 @@ pub fn load_profile(path: &Path) -> Result<ProfileReport> {
     if !json["rows"].is_array() {
         bail!("--profile {file}: no `rows` array (is it a `brdfprof profile` report?)");
     }
-    Ok(ProfileReport { file, json })
+    let view = serde_json::from_value(json).map_err(|e| anyhow!("--profile {file}: not a brdfprof profile report ({e})"))?;
+    Ok(ProfileReport { file, view })
 }
 
 /// Joins `report`'s callgrind figures with the profile report at `path`.
@@ -76,27 +66,24 @@ pub fn correlate(report: &InspectReport, path: &Path) -> Result<Correlation> {
 
 /// Joins `report`'s callgrind figures with a profile report already read.
 pub fn correlate_with(report: &InspectReport, profile: &ProfileReport) -> Result<Correlation> {
-    let (file, profile) = (profile.file.clone(), &profile.json);
-    let rows = profile["rows"].as_array().expect("checked by load_profile");
+    let (file, profile) = (profile.file.clone(), &profile.view);
     let mut out = Vec::new();
     for row in &report.rows {
         let Some(ir) = row.stats.get("callgrind/ir-per-eval") else { continue };
         let model = row.model.as_str();
-        // A profile of several light counts: the rows at the count inspect measured (older reports have one).
-        let at_lights = |r: &&serde_json::Value| r["lights"].as_u64().is_none_or(|l| l == u64::from(report.lights));
-        let Some(p) = rows.iter().filter(at_lights).find(|r| r["model"].as_str() == Some(model)) else { continue };
-        let ns = number(p, &["ns_per_eval", "median"], &file, model)?.ok_or_else(|| anyhow!("--profile {file}: row `{model}` has no ns_per_eval"))?;
+        // A profile of several light counts: the rows at the count inspect measured.
+        let Some(p) = profile.rows.iter().find(|r| r.lights == report.lights && r.model == model) else { continue };
         out.push(CostRow {
             model: row.model.clone(),
             ir_per_eval: *ir,
             net_ir_per_eval: row.stats.get("callgrind/net-ir-per-eval").copied(),
-            ns_per_eval: ns,
-            net_ns_per_eval: number(p, &["net_ns_per_eval", "median"], &file, model)?,
+            ns_per_eval: p.ns_per_eval.median,
+            net_ns_per_eval: p.net_ns_per_eval.as_ref().map(|e| e.median),
             net_ir_vs_reference: None,
-            net_vs_reference: number(p, &["net_vs_reference", "median"], &file, model)?,
+            net_vs_reference: p.net_vs_reference.as_ref().map(|e| e.median),
         });
     }
-    let reference = profile["reference"].as_str().unwrap_or("ggx").to_string();
+    let reference = profile.reference.clone();
     if let Some(reference_ir) = out.iter().find(|r| r.model == reference).and_then(|r| r.net_ir_per_eval) {
         for r in &mut out {
             r.net_ir_vs_reference = r.net_ir_per_eval.map(|n| n / reference_ir);

@@ -3,24 +3,16 @@
 //! so a `{` inside them does not count.
 
 use crate::common;
-use std::path::{Path, PathBuf};
+use crate::layering::rust_files;
 
 const MAX_LINES: usize = 70;
 
 /// Files not held to the limit yet, with why. The lead owns these (issue 20 item 3 splits them); remove an
 /// entry when its file is split.
-const NOT_YET: &[(&str, &str)] = &[];
-
-fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
-    for e in std::fs::read_dir(dir).unwrap() {
-        let p = e.unwrap().path();
-        if p.is_dir() {
-            rust_files(&p, out);
-        } else if p.extension().is_some_and(|x| x == "rs") {
-            out.push(p);
-        }
-    }
-}
+const NOT_YET: &[(&str, &str)] = &[
+    // read_sections is 71 lines; the file is the lead's (issue 20 item 3), shortened there.
+    ("src/model/brdf_file/format.rs", "the lead's, being split (issue 20 item 3)"),
+];
 
 fn is_ident(c: char) -> bool {
     c.is_alphanumeric() || c == '_'

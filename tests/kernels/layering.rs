@@ -11,7 +11,7 @@ const LAYERS: &[&str] = &[
     "report", "profile", "inspect", "translate", "targets", "compare", "devices", "check", "sweep", "sweep_cost", "stability", "scene", "diff", "htmlreport",
 ];
 
-fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
+pub fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
     for e in std::fs::read_dir(dir).unwrap() {
         let p = e.unwrap().path();
         if p.is_dir() {
