@@ -159,6 +159,33 @@ pub fn glslang_with(source: &Path, defines: &[String], includes: &[&Path], what:
     Ok(Spirv::from_bytes(&source.display().to_string(), &bytes)?.words.to_vec())
 }
 
+/// glslang's preprocessor alone (`-E`) on `text` (a whole source, `#version` first) as a compute shader, with
+/// `-D` for each define, under the compile limit: Ok(the preprocessed text) or Err(glslang's log).
+/// `-E` cannot be combined with `-V`, so `VULKAN=100`, which glslang defines when it compiles for Vulkan, is
+/// given here as a define: a `#ifdef VULKAN` selects what the kernel compilation will see.
+pub fn glslang_preprocess(text: &str, defines: &[String], what: &str) -> Result<std::result::Result<String, String>> {
+    let dir = crate::cleanup::TempDir::new().context("cannot create a temporary directory for glslang's preprocessor")?;
+    let source = dir.path().join("shader.comp");
+    std::fs::write(&source, text).with_context(|| format!("cannot write {}", source.display()))?;
+    let mut cmd = crate::cleanup::command("glslangValidator");
+    cmd.arg("-E").arg("-DVULKAN=100");
+    for d in defines {
+        cmd.arg(format!("-D{d}"));
+    }
+    cmd.arg(&source);
+    let result = match crate::compile_limit::output(&mut cmd, what) {
+        Ok(r) => r,
+        Err(e) if e.downcast_ref::<std::io::Error>().is_some() => bail!("cannot run glslangValidator ({e}): install glslang-tools, or run `make setup`"),
+        Err(e) => return Err(e),
+    };
+    let stdout = String::from_utf8_lossy(&result.stdout).into_owned();
+    if result.status.success() {
+        return Ok(Ok(stdout));
+    }
+    let log = stdout + &String::from_utf8_lossy(&result.stderr);
+    Ok(Err(log.replace(&source.display().to_string(), "shader")))
+}
+
 /// glslang refused a source: its log, as it printed it.
 #[derive(Debug)]
 pub struct GlslangError {

@@ -97,6 +97,13 @@ impl ModelSpec {
         reads
     }
 
+    /// Whether it reads the sample's F0: a Fresnel term for a dielectric does (its IOR comes from F0), one for a
+    /// conductor reads the metal's complex IOR instead (`Exact`, tied to the f64 terms by a test in terms.rs).
+    /// Every D term is a function of a = roughness^2, so every spec reads roughness.
+    pub fn reads_f0(&self) -> bool {
+        self.f.row().exact == Exact::Dielectric
+    }
+
     /// This spec with `p` set to `value` if one of its terms reads `p` (else unchanged).
     pub fn with_param(mut self, p: Param, value: ParamValue) -> Self {
         if self.reads().contains(&p) {
@@ -396,6 +403,21 @@ mod tests {
             let all = with_each_param_sample(spec);
             let expected: usize = spec.reads().iter().map(|&q| param_samples(q).len()).product();
             assert_eq!(all.len(), expected, "{}", p.name);
+        }
+    }
+
+    /// What a spec says it reads (`reads_f0`, and roughness always) is what its f64 terms depend on: every F
+    /// for a dielectric changes with F0 and every other F does not; every D changes with a.
+    #[test]
+    fn the_inputs_a_spec_reads_are_those_its_terms_depend_on() {
+        let p = Params::default();
+        for &f in F::ALL {
+            let spec = ModelSpec::new(D::Ggx, Vis::Implicit, f);
+            let varies = (f.row().eval)([0.04; 3], 0.7, &p) != (f.row().eval)([0.9; 3], 0.7, &p);
+            assert_eq!(spec.reads_f0(), varies, "{f:?}: reads_f0 {} but F varies with F0: {varies}", spec.reads_f0());
+        }
+        for &d in D::ALL {
+            assert_ne!(d.at(0.9, 0.1, &p), d.at(0.9, 0.5, &p), "{d:?} does not vary with a");
         }
     }
 }

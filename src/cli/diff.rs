@@ -1,6 +1,6 @@
 //! `brdfprof diff --model A --model B`: both models on the same inputs, B measured against A.
 
-use super::eval::read_input;
+use brdfprof::model::csv_rows::{read_rows, RowValues};
 use super::{on_device, DeviceArgs, ModelArgs};
 use anyhow::{bail, Result};
 use brdfprof::brdf::Sample;
@@ -81,7 +81,7 @@ pub fn diff(args: &DiffArgs) -> Result<ExitCode> {
     let inputs = Inputs::read(args, a, b)?;
     let (gpu, (va, vb)) = on_device(&args.device, |gpu, progress| {
         progress.set_message(format!("{} and {} on {} rows", a.short_name(), b.short_name(), inputs.samples.len()));
-        let eval = |(m, rows): &(Model, super::eval::RowValues)| {
+        let eval = |(m, rows): &(Model, RowValues)| {
             let extras = kernels::EvalExtras { tangents: inputs.tangents.as_deref(), rows: &rows.values, row_floats: rows.floats };
             kernels::eval_with(gpu, m, &inputs.samples, &extras, kernels::RunLimits::default())
         };
@@ -115,14 +115,14 @@ struct Inputs {
     tangents: Option<Vec<[f32; 3]>>,
     lines: Option<Vec<usize>>,
     label: String,
-    a: (Model, super::eval::RowValues),
-    b: (Model, super::eval::RowValues),
+    a: (Model, RowValues),
+    b: (Model, RowValues),
 }
 
 impl Inputs {
     fn read(args: &DiffArgs, a: &Model, b: &Model) -> Result<Self> {
         let Some(path) = &args.input else {
-            let none = || super::eval::RowValues::default();
+            let none = || RowValues::default();
             return Ok(Inputs {
                 samples: diff::default_samples(args.samples, args.seed),
                 tangents: None,
@@ -132,8 +132,8 @@ impl Inputs {
                 b: (b.clone(), none()),
             });
         };
-        let (ma, input, ra) = read_input(a, path, &args.model.params)?;
-        let (mb, _, rb) = read_input(b, path, &args.model.params)?;
+        let (ma, input, ra) = read_rows(a, path, &args.model.params)?;
+        let (mb, _, rb) = read_rows(b, path, &args.model.params)?;
         Ok(Inputs { samples: input.samples, tangents: input.tangents, lines: Some(input.lines), label: path.display().to_string(), a: (ma, ra), b: (mb, rb) })
     }
 }

@@ -192,8 +192,9 @@ pub struct StabilityArgs {
     /// Skip the directional-albedo (energy) part.
     #[arg(long)]
     pub no_energy: bool,
-    /// Also check each spec without brdfprof's guards (`guards=off`, docs/guards.md), listed next to it: the
-    /// hard cases it then fails are the ones its guards save.
+    /// Also check each spec without brdfprof's guards (`guards=off`, docs/guards.md) and with each guard off
+    /// alone (`guards=off:NAME`), listed next to it: the hard cases it then fails are the ones its guards save
+    /// (the report's "What each guard saves").
     #[arg(long)]
     pub unguarded: bool,
     /// Directory for stability-<device>.md/.json and the furnace, albedo and failure PNGs.
@@ -209,7 +210,7 @@ pub fn stability(args: &StabilityArgs) -> Result<ExitCode> {
     io::check_output_dir("--out", &args.out)?;
     args.html.check()?;
     let models = if args.model.models.is_empty() { stability::default_specs().into_iter().map(Model::spec).collect() } else { args.model.models(&[])? };
-    let options = stability::StabilityOptions { models: super::with_unguarded(models, args.unguarded), energy: !args.no_energy };
+    let options = stability::StabilityOptions { models: if args.unguarded { stability::with_guard_variants(models) } else { models }, energy: !args.no_energy };
     let (gpu, result) = on_device(&args.device, |gpu, progress| stability::run(gpu, &options, progress))?;
     let slug = brdfprof::targets::device_slug(&gpu.info);
     let mut files = result.write(&args.out, &slug)?;

@@ -115,12 +115,24 @@ pub struct ModelArgs {
     /// roughness=@roughness.
     #[arg(long = "param")]
     pub params: Vec<String>,
+    /// A macro for every .brdf file's shader, NAME or NAME=VALUE, as glslang's -D: the shader's `#if`
+    /// branches and `#define`s see it (the same as `define=NAME=VALUE` in the file's spec; docs/brdf-files.md).
+    #[arg(long = "define", value_name = "NAME[=VALUE]")]
+    pub defines: Vec<String>,
 }
 
 impl ModelArgs {
     /// The models asked for, or `default` when none.
     pub fn models(&self, default: &[&str]) -> Result<Vec<Model>> {
-        model::models_from_args(&self.models, &self.params, default)
+        let models = model::models_from_args(&self.models, &self.params, default)?;
+        if self.defines.is_empty() {
+            return Ok(models);
+        }
+        if !models.iter().any(|m| m.file().is_some()) {
+            bail!("--define {}: a define is for a .brdf file's shader, and no --model is a .brdf file", self.defines[0]);
+        }
+        let items: Vec<String> = self.defines.iter().map(|d| format!("{}={d}", model::file_model::DEFINE)).collect();
+        models.iter().map(|m| if m.file().is_some() { m.with_params(&items).map_err(|e| anyhow!("--define: {e:#}")) } else { Ok(m.clone()) }).collect()
     }
 }
 

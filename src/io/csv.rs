@@ -35,14 +35,29 @@ pub fn read_samples_csv(path: &Path) -> Result<Vec<Sample>> {
 
 /// Reads an eval CSV with the tangents and the `optional` columns it has (values finite).
 pub fn read_eval_csv(path: &Path, optional: &[&str]) -> Result<EvalInput> {
-    read_eval_csv_with(path, optional, &[])
+    read_eval_csv_with(path, &Columns { optional, ..Columns::default() })
 }
 
-/// `read_eval_csv`, with `relaxed` sample columns (`roughness`, `f0r`, ...) only required to be finite: a
-/// `.brdf` model that reads no input from them takes them as its own parameter's column.
-pub fn read_eval_csv_with(path: &Path, optional: &[&str], relaxed: &[&str]) -> Result<EvalInput> {
+/// What an eval CSV must and may hold besides the geometry (nx..lz), for one model.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Columns<'a> {
+    /// Further columns read where the file has them (a `.brdf` parameter's), in this order.
+    pub optional: &'a [&'a str],
+    /// Sample columns (`roughness`, `f0r`, ...) only required to be finite: a `.brdf` model that reads no input
+    /// from them takes them as its own parameter's column.
+    pub relaxed: &'a [&'a str],
+    /// Sample columns the model does not read, which may then be absent (their value is `UNREAD_VALUES`').
+    pub unread: &'a [&'a str],
+}
+
+/// The value of an absent sample column that the model does not read (`Columns::unread`): roughness 0.5, F0
+/// 0.04, for the record only, as nothing reads them.
+pub const UNREAD_VALUES: [f32; 4] = [0.5, 0.04, 0.04, 0.04];
+
+/// `read_eval_csv` for a model's `Columns`.
+pub fn read_eval_csv_with(path: &Path, columns: &Columns) -> Result<EvalInput> {
     let bytes = super::read_input(path)?;
-    parse_eval_csv_with(&bytes, &path.display().to_string(), optional, relaxed)
+    parse_eval_csv_with(&bytes, &path.display().to_string(), columns)
 }
 
 /// `read_samples_csv` of bytes already read; `name` prefixes errors.
@@ -54,7 +69,7 @@ const BOM: &[u8] = b"\xEF\xBB\xBF";
 
 /// `read_eval_csv` of bytes already read; `name` prefixes errors.
 pub fn parse_eval_csv(bytes: &[u8], name: &str, optional: &[&str]) -> Result<EvalInput> {
-    parse_eval_csv_with(bytes, name, optional, &[])
+    parse_eval_csv_with(bytes, name, &Columns { optional, ..Columns::default() })
 }
 
 /// The lines of `bytes`, numbered from 1, ended by `\n`, `\r\n` or a lone `\r` (an old Mac's line ends).
@@ -78,8 +93,8 @@ fn split_lines(bytes: &[u8]) -> impl Iterator<Item = (usize, &[u8])> {
     .map(|(i, l)| (i + 1, l))
 }
 
-/// `parse_eval_csv` with `relaxed` sample columns (`read_eval_csv_with`).
-pub fn parse_eval_csv_with(bytes: &[u8], name: &str, optional: &[&str], relaxed: &[&str]) -> Result<EvalInput> {
+/// `parse_eval_csv` for a model's `Columns` (`read_eval_csv_with`).
+pub fn parse_eval_csv_with(bytes: &[u8], name: &str, columns: &Columns) -> Result<EvalInput> {
     let bom = if bytes.starts_with(BOM) { BOM.len() } else { 0 };
     let mut lines = split_lines(&bytes[bom..]);
     let mut decoded = std::iter::from_fn(move || {
@@ -88,8 +103,8 @@ pub fn parse_eval_csv_with(bytes: &[u8], name: &str, optional: &[&str], relaxed:
     let (header_line, header) = decoded
         .next()
         .ok_or_else(|| anyhow!("{name}: empty file; expected a header with columns {}", SAMPLE_COLUMNS.join(",")))??;
-    let mut layout = Layout::new(name, header_line, header, optional)?;
-    layout.relaxed = SAMPLE_COLUMNS.map(|c| relaxed.contains(&c));
+    let mut layout = Layout::new(name, header_line, header, columns)?;
+    layout.relaxed = SAMPLE_COLUMNS.map(|c| columns.relaxed.contains(&c));
     let mut input = EvalInput {
         tangents: layout.tangents.map(|_| Vec::new()),
         columns: layout.optional.iter().map(|(n, _)| (n.clone(), Vec::new())).collect(),
@@ -163,8 +178,8 @@ fn unquote(s: &str) -> Option<(Cow<'_, str>, &str)> {
 struct Layout {
     width: usize,
     names: Vec<String>,
-    /// Field index of each of SAMPLE_COLUMNS.
-    samples: [usize; 13],
+    /// Field index of each of SAMPLE_COLUMNS; None for an absent column the model does not read.
+    samples: [Option<usize>; 13],
     tangents: Option<[usize; 3]>,
     /// Optional columns present: name and field index.
     optional: Vec<(String, usize)>,
@@ -173,7 +188,7 @@ struct Layout {
 }
 
 impl Layout {
-    fn new(name: &str, line: usize, header: &str, optional: &[&str]) -> Result<Layout> {
+    fn new(name: &str, line: usize, header: &str, columns: &Columns) -> Result<Layout> {
         let names: Vec<String> = split_fields(header)
             .map_err(|(col, why)| anyhow!("{name}:{line}: header column {col}: {why}"))?
             .into_iter()
@@ -185,11 +200,12 @@ impl Layout {
             }
         }
         let find = |c: &str| names.iter().position(|n| n == c);
-        let missing: Vec<&str> = SAMPLE_COLUMNS.iter().copied().filter(|c| find(c).is_none()).collect();
+        let needed: Vec<&str> = SAMPLE_COLUMNS.iter().enumerate().filter(|(k, c)| *k < 9 || !columns.unread.contains(c)).map(|(_, c)| *c).collect();
+        let missing: Vec<&str> = needed.iter().copied().filter(|c| find(c).is_none()).collect();
         if !missing.is_empty() {
-            bail!("{name}:{line}: header lacks column(s) {} (needs {})", missing.join(", "), SAMPLE_COLUMNS.join(","));
+            bail!("{name}:{line}: header lacks column(s) {} (the model reads {})", missing.join(", "), needed.join(","));
         }
-        let samples = SAMPLE_COLUMNS.map(|c| find(c).expect("checked above"));
+        let samples = SAMPLE_COLUMNS.map(find); // absent ones are unread material columns (checked above)
         let tangents = match TANGENT_COLUMNS.map(find) {
             [Some(x), Some(y), Some(z)] => Some([x, y, z]),
             [None, None, None] => None,
@@ -199,7 +215,7 @@ impl Layout {
             }
         };
         let mut wanted: Vec<(String, usize)> = Vec::new();
-        for c in optional {
+        for c in columns.optional {
             if let Some(i) = find(c).filter(|_| !wanted.iter().any(|(n, _)| n == c)) {
                 wanted.push((c.to_string(), i));
             }
@@ -215,15 +231,18 @@ impl Layout {
         }
         let value = |col: usize| -> Result<f32> { number(name, line, col, &self.names[col], &fields[col]) };
         let mut v = [0f32; 13];
-        for (k, &col) in self.samples.iter().enumerate() {
-            v[k] = value(col)?;
+        for (k, col) in self.samples.iter().enumerate() {
+            v[k] = match col {
+                Some(col) => value(*col)?,
+                None => UNREAD_VALUES[k - 9],
+            };
         }
         for (first, label) in [(0, "n"), (3, "v"), (6, "l")] {
             nonzero(name, line, &format!("{label}x,{label}y,{label}z"), &v[first..first + 3])?;
         }
         for k in 9..13 {
-            if !self.relaxed[k] && !(0.0..=1.0).contains(&v[k]) {
-                bail!("{name}:{line}: column {} `{}`: {} is outside [0, 1]", self.samples[k] + 1, SAMPLE_COLUMNS[k], v[k]);
+            if let Some(col) = self.samples[k].filter(|_| !self.relaxed[k] && !(0.0..=1.0).contains(&v[k])) {
+                bail!("{name}:{line}: column {} `{}`: {} is outside [0, 1]", col + 1, SAMPLE_COLUMNS[k], v[k]);
             }
         }
         input.samples.push(Sample { n: [v[0], v[1], v[2]], v: [v[3], v[4], v[5]], l: [v[6], v[7], v[8]], roughness: v[9], f0: [v[10], v[11], v[12]] });
@@ -364,7 +383,7 @@ mod tests {
     fn relaxed_sample_columns_need_only_be_finite() {
         let row = "5,0,0,1,0,0.6,0.8,0.6,0,0.8,0.04,0.05,0.06,x";
         assert!(err(format!("{HEADER}\n{row}\n")).contains("column 1 `roughness`: 5 is outside [0, 1]"));
-        let input = parse_eval_csv_with(format!("{HEADER}\n{row}\n").as_bytes(), "in.csv", &["roughness"], &["roughness"]).unwrap();
+        let input = parse_eval_csv_with(format!("{HEADER}\n{row}\n").as_bytes(), "in.csv", &Columns { optional: &["roughness"], relaxed: &["roughness"], unread: &[] }).unwrap();
         assert_eq!((input.columns.clone(), input.column_numbers.clone()), (vec![("roughness".to_string(), vec![5.0])], vec![1]));
     }
 }

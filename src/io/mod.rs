@@ -4,7 +4,7 @@
 
 pub mod csv;
 
-pub use csv::{parse_eval_csv, parse_samples_csv, read_eval_csv, read_eval_csv_with, read_samples_csv, EvalInput, SAMPLE_COLUMNS, TANGENT_COLUMNS};
+pub use csv::{parse_eval_csv, parse_samples_csv, read_eval_csv, read_eval_csv_with, read_samples_csv, Columns, EvalInput, SAMPLE_COLUMNS, TANGENT_COLUMNS};
 
 use anyhow::{anyhow, bail, Context, Result};
 use std::io::Write;

@@ -235,6 +235,40 @@ fn loop_warning(path: &str, l: &brdf_file::Loop) -> String {
     }
 }
 
+/// The key of a macro for the file's shader in a model text (`my.brdf,define=QUALITY=1`), as `--define`
+/// gives one to every file and a scene material's `define` does.
+pub const DEFINE: &str = "define";
+
+fn is_define(item: &str) -> bool {
+    item.split_once('=').is_some_and(|(k, _)| k.trim() == DEFINE)
+}
+
+/// `defines` (`define=NAME[=VALUE]` items) over `old`: a name given again replaces its value; a name given
+/// twice in `defines` is an error, as a parameter is.
+fn merge_defines(path: &str, old: &[(String, String)], defines: &[String]) -> Result<Vec<(String, String)>> {
+    let mut out = old.to_vec();
+    let mut given: Vec<String> = Vec::new();
+    for item in defines {
+        let macro_text = item.split_once('=').map_or("", |(_, v)| v.trim());
+        let (name, value) = macro_text.split_once('=').map_or((macro_text, ""), |(n, v)| (n.trim(), v.trim()));
+        if !brdf_file::is_identifier(name) || name.starts_with("GL_") || name.contains("__") {
+            bail!("{path}: `{item}`: expected define=NAME or define=NAME=VALUE with NAME an identifier (not GL_... and without `__`, which GLSL reserves)");
+        }
+        if value.contains(['\n', '\r']) {
+            bail!("{path}: `{item}`: a define's value is one line");
+        }
+        if given.iter().any(|g| g == name) {
+            bail!("{path}: `define={name}` is given twice; give each macro once");
+        }
+        given.push(name.to_string());
+        match out.iter_mut().find(|(n, _)| n == name) {
+            Some(slot) => slot.1 = value.to_string(),
+            None => out.push((name.to_string(), value.to_string())),
+        }
+    }
+    Ok(out)
+}
+
 /// `k=v` items of a model text after its path; a field without `=` continues the previous value (a colour's
 /// `r,g,b`).
 fn split_params(rest: &[&str]) -> Result<Vec<String>> {
@@ -253,34 +287,52 @@ impl FileModel {
     /// `PATH.brdf[,NAME=VALUE...]`: the file with its defaults, then the overrides.
     pub fn parse(text: &str) -> Result<Self> {
         let (path, fields) = split_path(text, Path::new("")).ok_or_else(|| anyhow!("`{text}` names no .brdf file"))?;
-        let file = brdf_file::load(Path::new(path))?;
-        for w in &file.warnings {
-            crate::messages::input_warning(w);
+        let items = split_params(&fields)?;
+        let (defines, params): (Vec<String>, Vec<String>) = items.into_iter().partition(|i| is_define(i));
+        let mut file = brdf_file::load(Path::new(path))?;
+        if !defines.is_empty() {
+            file = file.with_defines(&merge_defines(path, &[], &defines)?)?;
         }
         if file.has_is_func {
             crate::messages::input_note(format!("{path}: its isFunc section (importance sampling) is ignored: brdfprof integrates with its own estimator"));
         }
-        for l in &file.loops {
-            crate::messages::input_warning(loop_warning(path, l));
-        }
         let bindings = file.params.iter().map(|p| Binding::Value(p.default_value())).collect();
         let model = FileModel { file, path: path.to_string(), bindings };
-        model.with_params(&split_params(&fields)?)
+        model.warn_new(None);
+        model.with_params(&params)
+    }
+
+    /// Prints the file's warnings and loop warnings that `before` (the model it was made from) did not have.
+    fn warn_new(&self, before: Option<&FileModel>) {
+        let loops = |m: &FileModel| m.file.loops.iter().map(|l| loop_warning(&m.path, l)).collect::<Vec<_>>();
+        let old: Vec<String> = before.map(|b| b.file.warnings.iter().cloned().chain(loops(b)).collect()).unwrap_or_default();
+        for w in self.file.warnings.iter().cloned().chain(loops(self)) {
+            if !old.contains(&w) {
+                crate::messages::input_warning(w);
+            }
+        }
     }
 
     pub fn takes_param(&self, name: &str) -> bool {
-        self.file.params.iter().any(|p| p.name == name)
+        name == DEFINE || self.file.params.iter().any(|p| p.name == name)
     }
 
-    /// Applies `NAME=VALUE` overrides; an unknown name is an error naming the file and its parameters.
+    /// Applies `NAME=VALUE` overrides and `define=NAME[=VALUE]` macros (the shader then preprocessed again); an
+    /// unknown name is an error naming the file and its parameters.
     pub fn with_params(&self, params: &[String]) -> Result<Self> {
         let mut m = self.clone();
+        let (defines, params): (Vec<&String>, Vec<&String>) = params.iter().partition(|i| is_define(i));
+        if !defines.is_empty() {
+            let defines: Vec<String> = defines.into_iter().cloned().collect();
+            m.file = self.file.with_defines(&merge_defines(&self.path, &self.file.defines, &defines)?)?;
+            m.warn_new(Some(self));
+        }
         let mut given: Vec<&str> = Vec::new();
-        for p in params {
+        for p in &params {
             let (name, value) = p.split_once('=').ok_or_else(|| anyhow!("{}: `{p}`: expected NAME=VALUE", self.path))?;
             let name = name.trim();
             if given.contains(&name) {
-                bail!("{}: `{name}` is given twice ({}); give each parameter once", self.path, params.join(", "));
+                bail!("{}: `{name}` is given twice ({}); give each parameter once", self.path, params.iter().map(|p| p.as_str()).collect::<Vec<_>>().join(", "));
             }
             given.push(name);
             let k = self.file.params.iter().position(|q| q.name == name).ok_or_else(|| {
@@ -308,6 +360,9 @@ impl FileModel {
 
     fn text_with(&self, all: bool) -> String {
         let mut s = self.path.clone();
+        for (name, value) in &self.file.defines {
+            s += &if value.is_empty() { format!(",{DEFINE}={name}") } else { format!(",{DEFINE}={name}={value}") };
+        }
         for (p, b) in self.file.params.iter().zip(&self.bindings) {
             let text = match b {
                 Binding::Value(v) if all || *v != p.default_value() => v.text(),
@@ -336,7 +391,7 @@ impl FileModel {
 
     /// The source composed for `kind`: the preamble, the file, then the kernel's own source (from `glsl/`).
     fn compose(&self, kind: KernelKind, kernel_source: &str) -> Result<String> {
-        let renamed = self.file.renamed_shader()?;
+        let renamed = self.file.renamed_shader();
         let mut s = String::from("#version 450\n#extension GL_GOOGLE_include_directive : require\n#define BRDF_FILE 1\n");
         let mut bind = Vec::new();
         let mut rows = Vec::new();
@@ -430,9 +485,9 @@ impl FileModel {
             Ok(words) => Ok(words),
             Err(e) => match e.downcast_ref::<shaders::GlslangError>() {
                 Some(g) => {
-                    let renamed = self.file.renamed_shader()?;
-                    let log = self.file.remap_log(&renamed, &g.log, |_| None);
-                    let log = if log.trim().is_empty() { self.file.unlocated_log(&renamed, &g.log) } else { log };
+                    let renamed = self.file.renamed_shader();
+                    let log = self.file.remap_log(renamed, &g.log, |_| None);
+                    let log = if log.trim().is_empty() { self.file.unlocated_log(renamed, &g.log) } else { log };
                     // The temporary directory means nothing to the user: the kernel's file and glsl/'s names do.
                     let mut log = log.replace(&format!("{}/", src.display()), "");
                     if root.starts_with(dir.path()) {

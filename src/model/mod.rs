@@ -4,6 +4,7 @@
 //! other (`Model::parse` of `PATH.brdf[,NAME=VALUE...]`).
 
 pub mod brdf_file;
+pub mod csv_rows;
 pub mod file_model;
 
 use crate::brdf::terms::{ParamValue, PARAMS};
@@ -131,6 +132,28 @@ impl Model {
                 file_name + &name[f.path.len()..]
             }
         }
+    }
+
+    /// The eval CSV's material columns (`io::SAMPLE_COLUMNS[9..]`) this model does not read, which a CSV may
+    /// then leave out: a built-in spec reads roughness always (every D is a function of a = r^2) and F0 where
+    /// `ModelSpec::reads_f0`; a `.brdf` file reads those its bindings take (`@roughness`/`@alpha`,
+    /// `@f0`/`@basecolor`).
+    pub fn unread_columns(&self) -> Vec<&'static str> {
+        let (roughness, f0) = match self {
+            Model::Spec(s) => (true, s.reads_f0()),
+            Model::File(f) => {
+                let reads = |inputs: &[file_model::Input]| f.bindings.iter().any(|b| matches!(b, file_model::Binding::Input(i) if inputs.contains(i)));
+                (reads(&[file_model::Input::Roughness, file_model::Input::Alpha]), reads(&[file_model::Input::F0, file_model::Input::BaseColor]))
+            }
+        };
+        let mut unread = Vec::new();
+        if !roughness {
+            unread.push("roughness");
+        }
+        if !f0 {
+            unread.extend(["f0r", "f0g", "f0b"]);
+        }
+        unread
     }
 
     /// The full form, with every parameter (what baselines and reports record).

@@ -171,40 +171,7 @@ pub fn measure<V: Timed>(
     let mut slowest_round = Duration::ZERO;
     for round in 0..options.max_rounds {
         let round_start = Instant::now();
-        let orders: Vec<Vec<(usize, usize)>> = (0..options.reps)
-            .map(|_| {
-                let mut o = slots.clone();
-                o.shuffle(&mut rng);
-                o
-            })
-            .collect();
-        let mut pairs = Vec::new();
-        gpu.submit(|cmd| {
-            timestamps.reset(cmd);
-            for order in &orders {
-                for &(i, k) in order {
-                    let q = pairs.len() as u32 * 2;
-                    gpu.barrier(cmd);
-                    timestamps.write(cmd, q);
-                    variants[i].record(cmd, k);
-                    timestamps.write(cmd, q + 1);
-                    pairs.push((q, q + 1));
-                }
-            }
-        })?;
-        let times = timestamps.intervals_ns(&pairs)?;
-        // Per variant: each instance's repetitions; keep the faster instance's (by median) for the round.
-        let mut by_slot: Vec<Vec<Vec<f64>>> = variants.iter().map(|var| vec![Vec::new(); var.instances()]).collect();
-        for (t, &(i, k)) in times.iter().zip(orders.iter().flatten()) {
-            by_slot[i][k].push(*t);
-        }
-        for (i, instances) in by_slot.into_iter().enumerate() {
-            let medians: Vec<f64> = instances.iter().map(|reps| crate::stats::median(reps)).collect();
-            let fastest = (0..medians.len()).min_by(|&a, &b| medians[a].total_cmp(&medians[b])).unwrap();
-            raw.ns[i].push(instances[fastest].clone());
-            raw.instance_ns[i].push(medians);
-        }
-        raw.orders.push(orders);
+        time_round(gpu, variants, &timestamps, &slots, options.reps, &mut rng, &mut raw)?;
         raw.elapsed_s = start.elapsed().as_secs_f64();
         on_round(&raw);
         if round + 1 >= options.min_rounds && converged(&raw) {
@@ -219,6 +186,54 @@ pub fn measure<V: Timed>(
         }
     }
     Ok(raw)
+}
+
+/// One round: `reps` shuffled orders of every (variant, instance) slot in one submission; per variant the
+/// faster instance's repetitions (by median) join `raw`, with every instance's median and the orders.
+fn time_round<V: Timed>(
+    gpu: &Gpu,
+    variants: &[V],
+    timestamps: &Timestamps,
+    slots: &[(usize, usize)],
+    reps: usize,
+    rng: &mut rand_pcg::Pcg64,
+    raw: &mut RawTimes,
+) -> Result<()> {
+    let orders: Vec<Vec<(usize, usize)>> = (0..reps)
+        .map(|_| {
+            let mut o = slots.to_vec();
+            o.shuffle(rng);
+            o
+        })
+        .collect();
+    let mut pairs = Vec::new();
+    gpu.submit(|cmd| {
+        timestamps.reset(cmd);
+        for order in &orders {
+            for &(i, k) in order {
+                let q = pairs.len() as u32 * 2;
+                gpu.barrier(cmd);
+                timestamps.write(cmd, q);
+                variants[i].record(cmd, k);
+                timestamps.write(cmd, q + 1);
+                pairs.push((q, q + 1));
+            }
+        }
+    })?;
+    let times = timestamps.intervals_ns(&pairs)?;
+    // Per variant: each instance's repetitions; keep the faster instance's (by median) for the round.
+    let mut by_slot: Vec<Vec<Vec<f64>>> = variants.iter().map(|var| vec![Vec::new(); var.instances()]).collect();
+    for (t, &(i, k)) in times.iter().zip(orders.iter().flatten()) {
+        by_slot[i][k].push(*t);
+    }
+    for (i, instances) in by_slot.into_iter().enumerate() {
+        let medians: Vec<f64> = instances.iter().map(|reps| crate::stats::median(reps)).collect();
+        let fastest = (0..medians.len()).min_by(|&a, &b| medians[a].total_cmp(&medians[b])).unwrap();
+        raw.ns[i].push(instances[fastest].clone());
+        raw.instance_ns[i].push(medians);
+    }
+    raw.orders.push(orders);
+    Ok(())
 }
 
 /// What the protocol can time: a variant that records its dispatches into a command buffer (the profile's

@@ -391,6 +391,9 @@ pub struct Material {
     /// Shorthand for `params: {"gamma": G}` (the GTR exponent).
     #[serde(default)]
     pub gamma: Option<f64>,
+    /// Macros for a `.brdf` model's shader (`{"QUALITY": 1}`), as `--define` gives them.
+    #[serde(default)]
+    pub define: std::collections::BTreeMap<String, ParamValue>,
     #[serde(default)]
     pub effects: Effects,
 }
@@ -410,6 +413,7 @@ impl Material {
     fn param_items(&self) -> Vec<String> {
         let mut items: Vec<String> = self.params.iter().map(|(k, v)| format!("{k}={}", v.text())).collect();
         items.extend(self.gamma.map(|g| format!("gamma={g}")));
+        items.extend(self.define.iter().map(|(k, v)| format!("{}={k}={}", model::file_model::DEFINE, v.text())));
         items
     }
 
@@ -646,7 +650,16 @@ fn check_materials(materials: &[Material]) -> Result<()> {
         if materials[..i].iter().any(|o| o.name == m.name) {
             bail!("materials[{i}].name: `{}` is used by an earlier material", m.name);
         }
-        let model = m.try_model().map_err(|e| anyhow!("materials[{i}].{}: {e:#}", if m.gamma.is_some() { "gamma" } else { "params" }))?;
+        let field = if !m.define.is_empty() && m.model.0.file().is_none() {
+            bail!("materials[{i}].define: a define is for a .brdf model's shader, and `{}` is a built-in spec", m.model.0.name());
+        } else if m.gamma.is_some() {
+            "gamma"
+        } else if m.define.is_empty() {
+            "params"
+        } else {
+            "params/define"
+        };
+        let model = m.try_model().map_err(|e| anyhow!("materials[{i}].{field}: {e:#}"))?;
         if m.effects.anisotropy.0 != 0.0 && !model.takes_anisotropy() {
             bail!("materials[{i}].effects.anisotropy: anisotropic GGX replaces the model's D and Vis, so it needs d=ggx (model `{}`)", model.name());
         }
@@ -804,6 +817,20 @@ mod tests {
         assert_eq!(s.file.materials[1].roughness, Unit(0.3));
         assert_eq!(s.file.materials[0].effects, Effects::default());
         assert_eq!(s.file.render.models.len(), 4);
+    }
+
+    /// A material's `define` reaches a `.brdf` model's shader as `--define` does; a built-in spec refuses it.
+    #[test]
+    fn a_material_define_preprocesses_its_file() {
+        let file = GOOD.replace(r#""model": "ggx"}"#, r#""model": "tests/fixtures/brdf/quality-switch.brdf", "define": {"QUALITY_LEVEL": 1}}"#);
+        let s = parse(&file).unwrap();
+        let m = s.file.materials[0].model();
+        assert!(m.canonical().contains(",define=QUALITY_LEVEL=1"), "{}", m.canonical());
+        let shader = m.file().unwrap().file.shader.iter().map(|l| l.1.clone()).collect::<Vec<_>>().join("\n");
+        assert!(shader.contains("pow5(1.0 - VoH)") || shader.replace(' ', "").contains("pow5(1.0-VoH)"), "the high branch: {shader}");
+        let spec = GOOD.replace(r#""model": "ggx"}"#, r#""model": "ggx", "define": {"Q": 1}}"#);
+        let e = parse(&spec).unwrap_err().to_string();
+        assert!(e.contains("materials[0].define") && e.contains("built-in spec"), "{e}");
     }
 
     #[test]

@@ -574,6 +574,12 @@ fn check_headers(scene: &Scene, files: &ImageFiles) -> Result<()> {
     check_image_memory(&scene.path.display().to_string(), &headers)
 }
 
+/// Pixel `i` of a normal or tangent image as a unit vector (an 8-bit image stores `0.5 * (v + 1)`).
+fn decode_vector(plane: &Plane, i: usize) -> V3 {
+    let c = Vec3::from_slice(&plane.rgba[i][..3]);
+    if plane.float { c.normalize_or_zero() } else { (2.0 * c - Vec3::ONE).normalize_or_zero() }
+}
+
 fn load_images(scene: &Scene, files: &ImageFiles) -> Result<GBuffer> {
     let camera = scene.file.camera.expect("checked: image G-buffers have a camera");
     let open = |p: &PathBuf, what: &str, kind: PlaneKind| read_plane(&scene.dir.join(p), what, kind);
@@ -603,10 +609,6 @@ fn load_images(scene: &Scene, files: &ImageFiles) -> Result<GBuffer> {
     }
     let mats = &scene.file.materials;
     let rays = Rays::new(&camera, w, h);
-    let decode_vector = |plane: &Plane, i: usize| -> V3 {
-        let c = Vec3::from_slice(&plane.rgba[i][..3]);
-        if plane.float { c.normalize_or_zero() } else { (2.0 * c - Vec3::ONE).normalize_or_zero() }
-    };
     let pixels = (0..(w as usize * h as usize))
         .into_par_iter()
         .map(|i| {

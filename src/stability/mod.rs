@@ -12,7 +12,7 @@ pub mod view;
 pub use check::check_model;
 
 use crate::accuracy::FLOOR;
-use crate::brdf::guards::unit;
+use crate::brdf::guards::{unit, GuardSet, SWITCHES};
 use crate::brdf::spec::with_each_param_sample;
 use crate::brdf::{samples, ModelSpec, Precision, Sample, D, F, Vis};
 use crate::gpu::Gpu;
@@ -177,6 +177,82 @@ pub struct StabilityReport {
     pub specs: Vec<SpecStability>,
     pub grid_points: usize,
     pub cases: Vec<HardCase>,
+    /// What each guard saves, where a spec ran with and without some of its guards (`with_guard_variants`).
+    pub guard_savings: Vec<GuardSaving>,
+}
+
+/// A spec run without some of its guards against the same spec with all of them: what they save.
+#[derive(Clone, Debug, Serialize)]
+pub struct GuardSaving {
+    /// The guarded spec's name.
+    pub spec: String,
+    /// The guards taken off, as the spec key writes them (`off`, `off:sin2h`).
+    pub off: String,
+    /// NaN, Inf and negative results on valid inputs without them (the guarded spec has none where it passes).
+    pub nan: usize,
+    pub inf: usize,
+    pub negative: usize,
+    /// Grid points out of tolerance without them, beyond the guarded spec's.
+    pub grid_out_of_tolerance: usize,
+    /// The hard cases out of tolerance without them and within it with them.
+    pub cases: Vec<String>,
+}
+
+/// `models`, each built-in spec that keeps all its guards followed by the same spec with all of them off, with
+/// each one off alone (`guards=off:NAME`: what that guard saves that the others do not) and with each one on
+/// alone (what it saves by itself): the runs `guard_savings` reads.
+pub fn with_guard_variants(models: Vec<Model>) -> Vec<Model> {
+    let mut out = Vec::new();
+    for m in models {
+        let variants: Vec<Model> = match m.twin().filter(|s| s.guards == GuardSet::ALL) {
+            Some(s) => std::iter::once(GuardSet::NONE)
+                .chain(SWITCHES.iter().map(|g| GuardSet(GuardSet::ALL.0 & !g.bit)))
+                .chain(SWITCHES.iter().map(|g| GuardSet(g.bit)))
+                .map(|guards| Model::spec(ModelSpec { guards, ..*s }))
+                .collect(),
+            None => Vec::new(),
+        };
+        out.push(m);
+        out.extend(variants);
+    }
+    let mut seen = Vec::new();
+    out.retain(|m| if seen.contains(m) { false } else { seen.push(m.clone()); true });
+    out
+}
+
+/// A guard set as a reader says it: `none`, `all but NAME`, `only NAME`, or the spec key's form.
+fn describe_guards(text: &str) -> String {
+    let Ok(set) = GuardSet::parse(text) else { return text.to_string() };
+    let on: Vec<&str> = SWITCHES.iter().filter(|g| set.0 & g.bit != 0).map(|g| g.name).collect();
+    let off: Vec<&str> = SWITCHES.iter().filter(|g| set.0 & g.bit == 0).map(|g| g.name).collect();
+    match (on.as_slice(), off.as_slice()) {
+        ([], _) => "none (`off`)".into(),
+        ([only], _) => format!("only {only}"),
+        (_, [one]) => format!("all but {one}"),
+        _ => format!("`{text}`"),
+    }
+}
+
+/// For each spec run with all its guards and also with some off, what those guards save (`GuardSaving`).
+fn guard_savings(models: &[Model], specs: &[SpecStability], cases: &[HardCase]) -> Vec<GuardSaving> {
+    let mut out = Vec::new();
+    for (i, guarded) in models.iter().enumerate() {
+        let Some(g) = guarded.twin().filter(|s| s.guards == GuardSet::ALL) else { continue };
+        for (j, without) in models.iter().enumerate() {
+            let Some(w) = without.twin().filter(|w| w.guards != GuardSet::ALL && ModelSpec { guards: GuardSet::ALL, ..**w } == *g) else { continue };
+            let saved = (0..cases.len()).filter(|&k| specs[j].case_deviation[k] > 1.0 && specs[i].case_deviation[k] <= 1.0);
+            out.push(GuardSaving {
+                spec: specs[i].spec.clone(),
+                off: w.guards.text(),
+                nan: specs[j].nan,
+                inf: specs[j].inf,
+                negative: specs[j].negative,
+                grid_out_of_tolerance: specs[j].grid_out_of_tolerance.saturating_sub(specs[i].grid_out_of_tolerance),
+                cases: saved.map(|k| cases[k].name.clone()).collect(),
+            });
+        }
+    }
+    out
 }
 
 impl StabilityReport {
@@ -222,7 +298,8 @@ pub fn run(gpu: &Gpu, options: &StabilityOptions, progress: &ProgressBar) -> Res
     if options.energy {
         energy::attach(gpu, &options.models, &mut specs, progress)?;
     }
-    Ok(StabilityReport { provenance: crate::report::Provenance::new(&gpu.info), specs, grid_points: grid.len(), cases })
+    let guard_savings = guard_savings(&options.models, &specs, &cases);
+    Ok(StabilityReport { provenance: crate::report::Provenance::new(&gpu.info), specs, grid_points: grid.len(), cases, guard_savings })
 }
 
 /// The worst deviation as a table cell: in tolerances, or what the value was when it is not a number.
@@ -317,6 +394,7 @@ impl StabilityReport {
             ]);
         }
         out += &c.markdown();
+        out += &self.guard_savings_markdown();
         let failing = self.failing();
         if !failing.is_empty() {
             out += "\n## Failing specs: first failing inputs\n\n";
@@ -325,6 +403,19 @@ impl StabilityReport {
             }
         }
         out
+    }
+
+    /// The "what each guard saves" section, where specs ran without some of their guards.
+    fn guard_savings_markdown(&self) -> String {
+        if self.guard_savings.is_empty() {
+            return String::new();
+        }
+        let mut t = crate::report::Table::new(["spec", "guards", "NaN", "Inf", "neg", "grid out of tol. (more)", "hard cases out of tolerance only without them"]);
+        for g in &self.guard_savings {
+            let cases = if g.cases.is_empty() { "-".to_string() } else { g.cases.join("; ") };
+            t.row([g.spec.clone(), describe_guards(&g.off), g.nan.to_string(), g.inf.to_string(), g.negative.to_string(), g.grid_out_of_tolerance.to_string(), cases]);
+        }
+        format!("\n## What each guard saves\n\nEach spec with all its guards against the same spec with all of them off (`off`), with each one off alone (`off:NAME`: what only that guard saves) and with each one on alone (`off:` all the others: what it saves by itself) (docs/guards.md): the results on valid inputs without them, and the hard cases they keep within tolerance.\n\n{}", t.markdown())
     }
 
     /// A heat map per failing spec over (NoV, roughness): bad values per grid cell, one panel each.

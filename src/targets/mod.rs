@@ -14,6 +14,7 @@ pub mod ocloc;
 pub mod radv;
 pub mod radv_child;
 pub mod radv_env;
+pub mod radv_families;
 
 use crate::gpu::Gpu;
 use crate::inspect::InspectReport;
@@ -202,7 +203,7 @@ pub fn inspect_device(gpu: &Gpu, shaders: &Shaders, options: &crate::inspect::In
 /// A lower-case file-name-safe form of a device name ("llvmpipe (LLVM 15.0.6, 256 bits)" -> "llvmpipe").
 pub fn device_slug(device: &crate::gpu::DeviceInfo) -> String {
     // RADV's compile-only devices are all "Null hardware (RADV <FAMILY>)": the family tells them apart.
-    if let Some(t) = radv::family_of_device(&device.name) {
+    if let Some(t) = radv_families::family_of_device(&device.name) {
         return format!("radv-{}", t.family);
     }
     crate::report::name_slug(&device.name)

@@ -11,7 +11,7 @@
 
 use crate::inspect::{InspectOptions, InspectReport};
 use crate::cleanup;
-use super::radv::{self as targets, Family};
+use super::radv_families::{self as targets, Family};
 use crate::gpu::{Gpu, GpuOptions, Kernel};
 use crate::model::Model;
 use crate::profile::gbuffer::GBufferFormat;

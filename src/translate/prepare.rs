@@ -58,7 +58,7 @@ pub fn shade_kernel(model: Option<&Model>, lights: u32, shaders: &Shaders) -> Re
 /// The file's line and own name of a translation error located in its composed kernel: `file.brdf:LINE`
 /// for the file's lines, its identifiers without brdfprof's prefix.
 fn locate(f: &FileModel, e: &TranslateError) -> String {
-    let prefix = f.file.renamed_shader().map(|r| r.prefix).unwrap_or_default();
+    let prefix = f.file.renamed_shader().prefix.clone();
     let function = e.function.as_deref().map(|f| f.strip_prefix(prefix.as_str()).unwrap_or(f).to_string());
     let construct = format!("the C translation cannot express {}{}", e.construct, function.map_or(String::new(), |f| format!(" (in function `{f}`)")));
     match &e.location {

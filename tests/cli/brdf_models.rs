@@ -367,3 +367,50 @@ fn model_files_errors_say_why() {
     assert!(r.stderr.contains("Recursion detected") && r.stderr.contains("f(f1; calling f(f1;") && r.stderr.contains("GLSL forbids recursion"), "{}", r.stderr);
     assert!(!r.stderr.contains("brdf_f") && !r.stderr.contains("/tmp") && !r.stderr.contains("brdfprof-"), "{}", r.stderr);
 }
+
+/// Engine-style code with a quality switch (tests/fixtures/brdf/quality-switch.brdf, written for this test):
+/// glslang's preprocessor selects the branch the defines select, from `--define`, from the spec's `define=`,
+/// or the file's own default, and each branch's value is the f64 formula's.
+#[test]
+fn the_preprocessor_selects_the_branch_the_defines_select() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let file = common::repo_root().join("tests/fixtures/brdf/quality-switch.brdf").display().to_string();
+    let samples = samples::well_conditioned(500, 7, 0.05, 0.2..1.0);
+    let mut text = String::from("nx,ny,nz,vx,vy,vz,lx,ly,lz,roughness,f0r,f0g,f0b\n");
+    for s in &samples {
+        let [n, v, l, f] = [s.n, s.v, s.l, s.f0];
+        text += &format!("{},{},{},{},{},{},{},{},{},{},{},{},{}\n", n[0], n[1], n[2], v[0], v[1], v[2], l[0], l[1], l[2], s.roughness, f[0], f[1], f[2]);
+    }
+    std::fs::write(d.join("in.csv"), text).unwrap();
+    let values = |args: &[&str]| -> Vec<f64> {
+        let r = run_in(d, &[&["eval", "--input", "in.csv", "--output", "out.csv"], args].concat()).ok();
+        assert!(!r.stderr.contains("dropped"), "no directive is dropped: {}", r.stderr);
+        rows(&d.join("out.csv")).iter().map(|row| row.split(',').next().unwrap().parse().unwrap()).collect()
+    };
+    let schlick = |s: &brdfprof::brdf::Sample| {
+        let (v, l) = (glam::Vec3::from(s.v).as_dvec3(), glam::Vec3::from(s.l).as_dvec3());
+        let voh = v.dot((v + l).normalize()).clamp(0.0, 1.0);
+        0.04 + 0.96 * (1.0 - voh).powi(5)
+    };
+    let pi = std::f64::consts::PI;
+    let check = |got: &[f64], expected: &dyn Fn(&brdfprof::brdf::Sample) -> f64, what: &str| {
+        assert_eq!(got.len(), samples.len());
+        for (g, s) in got.iter().zip(&samples) {
+            assert!(common::rel_err(*g, expected(s)) <= 1e-5, "{what}: {g} vs {}", expected(s));
+        }
+    };
+    check(&values(&["--model", &file]), &|_| 0.04 / pi, "default (QUALITY_LOW)");
+    let high = values(&["--model", &file, "--define", "QUALITY_LEVEL=1"]);
+    check(&high, &|s| schlick(s) / pi, "--define QUALITY_LEVEL=1");
+    assert_eq!(values(&["--model", &format!("{file},define=QUALITY_LEVEL=QUALITY_HIGH,scale=1")]), high, "the spec's define= selects the same branch");
+    check(&values(&["--model", &file, "--define", "QUALITY_LEVEL=1", "--param", "scale=2"]), &|s| 2.0 * schlick(s) / pi, "a define and a parameter together");
+    // A define is for a file; a bad one names what is wrong.
+    run_in(d, &["eval", "--model", "ggx", "--define", "Q=1", "--input", "in.csv", "--output", "x.csv"]).fails(2, "no --model is a .brdf file");
+    run_in(d, &["eval", "--model", &file, "--define", "scale=1", "--input", "in.csv", "--output", "x.csv"]).fails(2, "is the file's parameter");
+    run_in(d, &["eval", "--model", &file, "--define", "1Q=1", "--input", "in.csv", "--output", "x.csv"]).fails(2, "NAME an identifier");
+    // A define names the model: the two kernels are two models.
+    let r = run_in(d, &["inspect", "--no-callgrind", "--model", &file, "--model", &format!("{file},define=QUALITY_LEVEL=1"), "--json", "i.json", "--markdown", "i.md"]).ok();
+    let report = std::fs::read_to_string(d.join("i.md")).unwrap();
+    assert!(report.contains("define=QUALITY_LEVEL=1"), "{report}\n{}", r.stderr);
+}

@@ -3,7 +3,7 @@
 //! family, deterministic, and every command that must execute refuses the device.
 
 use crate::common::{self, run, run_in};
-use brdfprof::targets::radv::FAMILIES as TARGETS;
+use brdfprof::targets::radv_families::FAMILIES as TARGETS;
 use std::path::Path;
 
 const KERNELS: [&str; 5] = ["ggx", "blinn", "cook-torrance", "burley", "baseline"];

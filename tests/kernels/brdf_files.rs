@@ -150,3 +150,73 @@ fn lavapipe_ends_every_loop_at_the_stated_limit() {
     }
     common::assert_no_validation_messages(&gpu);
 }
+
+/// What brdfprof says about `path`: each warning of the file (`warning: ...`), then either the error (`error:
+/// ...`, glslang's messages remapped to the file included) or `compiles` once the file's eval kernel compiled.
+fn messages_about(path: &Path) -> String {
+    let mut out = String::new();
+    let model = brdfprof::model::brdf_file::load(path).and_then(|f| {
+        for w in &f.warnings {
+            out += &format!("warning: {w}\n");
+        }
+        Model::parse(&path.display().to_string())
+    });
+    match model.and_then(|m| m.kernel(KernelKind::Eval, &brdfprof::shaders::Shaders::embedded())) {
+        Ok(_) => out += "compiles\n",
+        Err(e) => out += &format!("error: {e:#}\n"),
+    }
+    out
+}
+
+/// Bad and odd `.brdf` files with what brdfprof must say about them (tests/fixtures/brdf/messages/NAME.brdf
+/// -> NAME.out, as naga's tests/in -> tests/out): format errors, the preprocessor's, glslang's remapped to the
+/// file's lines and names, and the warnings. `BLESS=1` writes the .out files from what brdfprof says now
+/// (read the diff before committing it).
+#[test]
+fn bad_files_give_the_expected_messages() {
+    let dir = Path::new("tests/fixtures/brdf/messages");
+    let mut files: Vec<PathBuf> = std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().path()).filter(|p| p.extension().is_some_and(|e| e == "brdf")).collect();
+    files.sort();
+    assert!(files.len() >= 20, "{} fixtures", files.len());
+    let bless = std::env::var_os("BLESS").is_some();
+    let mut wrong = Vec::new();
+    for f in &files {
+        let got = messages_about(f);
+        let expected_path = f.with_extension("out");
+        if bless {
+            std::fs::write(&expected_path, &got).unwrap();
+            continue;
+        }
+        let expected = std::fs::read_to_string(&expected_path).unwrap_or_else(|_| panic!("{} has no {}", f.display(), expected_path.display()));
+        if got != expected {
+            wrong.push(format!("{}:\n--- expected\n{expected}--- got\n{got}", f.display()));
+        }
+    }
+    assert!(wrong.is_empty(), "{}", wrong.join("\n"));
+}
+
+/// The renaming's promise (src/model/brdf_file/rename.rs): no identifier of glsl/ starts with the prefix a
+/// file's names are given, so a renamed name can never meet one of the kernels'.
+#[test]
+fn glsl_declares_no_identifier_with_the_file_prefix() {
+    let mut found = Vec::new();
+    let mut stack = vec![common::repo_root().join("glsl")];
+    while let Some(dir) = stack.pop() {
+        for entry in std::fs::read_dir(&dir).unwrap() {
+            let path = entry.unwrap().path();
+            if path.is_dir() {
+                stack.push(path);
+            } else if path.extension().is_some_and(|e| e == "glsl" || e == "comp") {
+                let text = std::fs::read_to_string(&path).unwrap();
+                for (n, line) in text.lines().enumerate() {
+                    for word in line.split(|c: char| !(c == '_' || c.is_ascii_alphanumeric())) {
+                        if word.starts_with("brdf_f") {
+                            found.push(format!("{}:{}: {word}", path.display(), n + 1));
+                        }
+                    }
+                }
+            }
+        }
+    }
+    assert!(found.is_empty(), "glsl/ uses the .brdf file prefix `brdf_f`: {found:?}");
+}

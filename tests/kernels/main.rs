@@ -14,6 +14,7 @@ mod brdf_files;
 mod chunking;
 mod d_normalisation;
 mod exact_reference;
+mod fn_length;
 mod layering;
 mod models;
 mod shading;

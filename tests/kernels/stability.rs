@@ -125,3 +125,39 @@ fn guards_are_the_same_constants_in_glsl_and_rust() {
     assert_eq!(constant("GTR_SERIES_BAND", 0), guards::GTR_SERIES_BAND);
     assert_eq!(constant("F0_MAX", 0), guards::F0_MAX);
 }
+
+/// Issue 19: which hard cases each guard saves. Presets run with all their guards, all off, each off alone
+/// and each on alone (`with_guard_variants`): the guarded spec passes; without its guards `L = -V` is out of
+/// tolerance, and the reference (GGX) gives NaN or Inf, as measured (docs/guards.md); no guard set that keeps
+/// the safe half vector lets `L = -V` out of tolerance.
+#[test]
+fn stability_says_what_each_guard_saves() {
+    let gpu = common::gpu();
+    let presets: Vec<brdfprof::model::Model> = PRESETS.iter().take(2).map(|p| common::model(ModelSpec::preset(p.name).unwrap())).collect();
+    let models = stability::with_guard_variants(presets.clone());
+    assert_eq!(models.len(), presets.len() * (2 + 2 * guards::SWITCHES.len()), "each preset, off, each off alone, each on alone");
+    let options = stability::StabilityOptions { models, energy: false };
+    let report = stability::run(&gpu, &options, &indicatif::ProgressBar::hidden()).unwrap();
+    common::assert_no_validation_messages(&gpu);
+    assert_eq!(report.guard_savings.len(), presets.len() * (1 + 2 * guards::SWITCHES.len()));
+    let safe_h = guards::SWITCHES.iter().find(|g| g.name == "safe-h").unwrap();
+    let no_half_vector = catalogue::hard_cases().into_iter().find(|c| c.name.starts_with("L = -V")).unwrap().name;
+    for p in &presets {
+        let guarded = report.specs.iter().find(|s| s.spec == p.name()).unwrap();
+        assert!(!guarded.fails(), "{}: fails with its guards", guarded.spec);
+        let mine: Vec<&stability::GuardSaving> = report.guard_savings.iter().filter(|g| g.spec == p.name()).collect();
+        let all_off = mine.iter().find(|g| g.off == "off").unwrap();
+        assert!(all_off.cases.contains(&no_half_vector), "{}: without its guards: {all_off:?}", p.name());
+        if p.name() == ModelSpec::reference().name() {
+            assert!(all_off.nan + all_off.inf > 0, "the reference without its guards: {all_off:?}");
+        }
+        for g in &mine {
+            let set = guards::GuardSet::parse(&g.off).unwrap();
+            if set.0 & safe_h.bit != 0 {
+                assert!(!g.cases.contains(&no_half_vector), "{} {}: L = -V out of tolerance with the safe half vector on", p.name(), g.off);
+            }
+        }
+    }
+    let md = report.markdown();
+    assert!(md.contains("## What each guard saves") && md.contains("only safe-h") && md.contains("all but lit-mask"), "{md}");
+}

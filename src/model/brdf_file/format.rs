@@ -1,0 +1,235 @@
+//! The `.brdf` format as BRDF Explorer reads it: line ends, the kind line, sections, parameters, and which
+//! `#` lines of the shader stay for the preprocessor.
+
+use super::*;
+use anyhow::{anyhow, bail, Result};
+use std::path::Path;
+
+/// The lines of `text`, ended by `\n`, `\r\n` or a lone `\r` (classic Mac OS line ends, which some editors
+/// still write): each counts as one line, as editors number them.
+pub(super) fn split_lines(text: &str) -> impl Iterator<Item = &str> {
+    let mut rest = Some(text);
+    std::iter::from_fn(move || {
+        let t = rest?;
+        match t.find(['\n', '\r']) {
+            Some(i) => {
+                let next = if t[i..].starts_with("\r\n") { i + 2 } else { i + 1 };
+                rest = Some(&t[next..]).filter(|r| !r.is_empty());
+                Some(&t[..i])
+            }
+            None => {
+                rest = None;
+                Some(t)
+            }
+        }
+    })
+}
+
+/// The file as text: not empty, no NUL byte, UTF-8 (a UTF-8 byte order mark is skipped).
+pub(super) fn text_of<'a>(path: &Path, bytes: &'a [u8]) -> Result<&'a str> {
+    let line_of = |offset: usize| bytes[..offset].iter().filter(|&&b| b == b'\n').count() + 1;
+    if let Some(p) = bytes.iter().position(|&b| b == 0) {
+        bail!(at(path, line_of(p), format!("binary content: NUL byte at byte {p} of the file, not a .brdf text file")));
+    }
+    let text = std::str::from_utf8(bytes).map_err(|e| {
+        let p = e.valid_up_to();
+        anyhow!(at(path, line_of(p), format!("not UTF-8 text: byte {p} of the file is {:#04x}", bytes[p])))
+    })?;
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    if text.trim().is_empty() {
+        bail!(at(path, 1, "empty file: a .brdf file starts with `analytic`"));
+    }
+    Ok(text)
+}
+
+/// Line 1 names the kind of BRDF, up to its first space.
+pub(super) fn check_kind(path: &Path, first: &str) -> Result<()> {
+    match first.split_whitespace().next().unwrap_or("") {
+        "analytic" => Ok(()),
+        "bparam" => bail!(at(path, 1, "`bparam` files are not supported: brdfprof reads only `analytic` .brdf files")),
+        other => bail!(at(path, 1, format!("expected `analytic` as the first line, found `{other}`"))),
+    }
+}
+
+/// An open section and the line of its `::begin`.
+pub(super) struct Open {
+    pub(super) name: String,
+    pub(super) line: usize,
+}
+
+/// The directives of a `.brdf` shader that glslang's preprocessor runs, as in any GLSL (issue 19: engine code
+/// selects its branches with `#if` and names its constants with `#define`).
+pub(super) const PREPROCESSOR_DIRECTIVES: [&str; 11] = ["define", "undef", "if", "ifdef", "ifndef", "elif", "else", "endif", "error", "pragma", "extension"];
+
+/// The directive name of a `#` line (`#  if X` -> `if`).
+pub(super) fn directive_of(line: &str) -> &str {
+    line[1..].trim_start().split(|c: char| !c.is_ascii_alphanumeric() && c != '_').next().unwrap_or("")
+}
+
+/// Whether a `#` line of the shader section stays for the preprocessor; `#include` is refused (the file is
+/// composed alone, so nothing could be found), any other line is dropped (`dropped_hash_line`).
+pub(super) fn keeps_directive(path: &Path, n: usize, line: &str) -> Result<bool> {
+    match directive_of(line) {
+        "include" => bail!(at(path, n, format!("`{line}`: a .brdf shader is composed alone, so it cannot include files; paste the included code into the file"))),
+        d => Ok(PREPROCESSOR_DIRECTIVES.contains(&d)),
+    }
+}
+
+/// A `#` line of the shader that is no directive brdfprof keeps is dropped, as BRDF Explorer drops every `#`
+/// line; never silently.
+pub(super) fn dropped_hash_line(path: &Path, n: usize, line: &str) -> String {
+    let why = match directive_of(line) {
+        "version" => "the kernel the file is composed into sets `#version 450`",
+        "line" => "brdfprof numbers the file's lines itself, so messages name the file's own lines",
+        _ => "a `#` line that is no preprocessor directive is a BRDF Explorer comment",
+    };
+    at(path, n, format!("`{line}` is dropped: {why}"))
+}
+
+/// Reads every line after the first into `file`; returns the line of `::begin shader`, if any.
+pub(super) fn read_sections<'a>(file: &mut BrdfFile, lines: impl Iterator<Item = &'a str>) -> Result<Option<usize>> {
+    let path = file.path.clone();
+    let mut open: Option<Open> = None;
+    let mut shader_begin = None;
+    let mut declared: std::collections::HashMap<String, usize> = std::collections::HashMap::new();
+    for (i, raw) in lines.enumerate() {
+        let n = i + 2;
+        let raw = raw.strip_suffix('\r').unwrap_or(raw);
+        let trimmed = raw.trim();
+        let in_shader = open.as_ref().is_some_and(|o| o.name == "shader");
+        // BRDF Explorer skips these everywhere; in the shader a preprocessor directive stays for glslang's
+        // preprocessor and any other stays as an empty line, to keep the numbering.
+        if trimmed.is_empty() || trimmed.starts_with('#') {
+            if in_shader {
+                let kept = trimmed.starts_with('#') && keeps_directive(&path, n, trimmed)?;
+                file.source.push((n, if kept { raw.to_string() } else { String::new() }));
+                if trimmed.starts_with('#') && !kept {
+                    file.warnings.push(dropped_hash_line(&path, n, trimmed));
+                }
+            }
+            continue;
+        }
+        let mut tokens = trimmed.split_whitespace();
+        match tokens.next().unwrap_or("") {
+            "::begin" => {
+                let name = tokens.next().ok_or_else(|| anyhow!(at(&path, n, "`::begin` names no section")))?;
+                if let Some(o) = &open {
+                    bail!(at(&path, n, format!("`::begin {name}` inside section `{}` (begun at line {}): sections do not nest", o.name, o.line)));
+                }
+                match name {
+                    "shader" => {
+                        if let Some(first) = shader_begin {
+                            bail!(at(&path, n, format!("a second shader section (the first begins at line {first})")));
+                        }
+                        shader_begin = Some(n);
+                    }
+                    "parameters" | "isFunc" => {}
+                    other => file.warnings.push(at(&path, n, format!("don't know what to do with section `{other}`: its content is ignored"))),
+                }
+                open = Some(Open { name: name.to_string(), line: n });
+            }
+            "::end" => {
+                let name = tokens.next().unwrap_or("");
+                match &open {
+                    None => bail!(at(&path, n, format!("`::end {name}` outside any section"))),
+                    Some(o) if o.name != name => {
+                        bail!(at(&path, n, format!("`::end {name}` does not close section `{}` (begun at line {})", o.name, o.line)))
+                    }
+                    Some(_) => open = None,
+                }
+            }
+            _ => match open.as_ref().map(|o| o.name.as_str()) {
+                None => file.warnings.push(at(&path, n, "text outside any section is ignored")),
+                Some("parameters") => {
+                    let param = parse_param(&path, n, trimmed, &mut file.warnings)?;
+                    if let Some(first) = declared.insert(param.name.clone(), param.line) {
+                        bail!(at(&path, n, format!("parameter `{}` is declared twice (first at line {first})", param.name)));
+                    }
+                    file.params.push(param);
+                }
+                Some("shader") => file.source.push((n, raw.to_string())),
+                Some("isFunc") => file.has_is_func = true,
+                Some(_) => {}
+            },
+        }
+    }
+    if let Some(o) = open {
+        bail!(at(&path, o.line, format!("section `{}` has no `::end {}`", o.name, o.name)));
+    }
+    Ok(shader_begin)
+}
+
+/// One line of the parameters section.
+pub(super) fn parse_param(path: &Path, n: usize, line: &str, warnings: &mut Vec<String>) -> Result<FileParam> {
+    let tokens: Vec<&str> = line.split_whitespace().collect();
+    let (form, needed) = match tokens[0] {
+        "float" => ("float NAME MIN MAX DEFAULT", 4),
+        "bool" => ("bool NAME DEFAULT", 2),
+        "color" => ("color NAME R G B", 4),
+        other => bail!(at(path, n, format!("unknown parameter type `{other}`: BRDF Explorer knows float, bool and color"))),
+    };
+    if tokens.len() < needed + 1 {
+        bail!(at(path, n, format!("`{line}`: too few values, expected `{form}`")));
+    }
+    let name = tokens[1];
+    check_identifier(path, n, name, warnings)?;
+    let number = |what: &str, s: &str| -> Result<f64> {
+        let x = s.parse::<f64>().ok().filter(|x| x.is_finite()).ok_or_else(|| anyhow!(at(path, n, format!("{what} of `{name}`: `{s}` is not a finite number"))))?;
+        if x.abs() > f64::from(f32::MAX) && what != "MIN" && what != "MAX" {
+            bail!(at(path, n, format!("{what} of `{name}`: `{s}` is beyond fp32's range (at most {:e} in magnitude), in which the kernels compute", f32::MAX)));
+        }
+        Ok(x)
+    };
+    let kind = match tokens[0] {
+        "float" => {
+            let (min, max, default) = (number("MIN", tokens[2])?, number("MAX", tokens[3])?, number("DEFAULT", tokens[4])?);
+            if !(min <= default && default <= max) {
+                warnings.push(at(path, n, format!("`{name}`'s default {default} is outside its slider range [{min}, {max}]")));
+            }
+            FileParamKind::Float { min, max, default }
+        }
+        // BRDF Explorer reads a bool with `>> bool`: a number, 0 or 1.
+        "bool" => match tokens[2] {
+            "0" => FileParamKind::Bool { default: false },
+            "1" => FileParamKind::Bool { default: true },
+            other => bail!(at(path, n, format!("DEFAULT of bool `{name}`: `{other}` is not 0 or 1"))),
+        },
+        _ => FileParamKind::Color { default: [number("R", tokens[2])?, number("G", tokens[3])?, number("B", tokens[4])?] },
+    };
+    let rest = &tokens[needed + 1..];
+    if rest.first().is_some_and(|t| !t.starts_with('#')) {
+        warnings.push(at(path, n, format!("`{}` after `{name}` is ignored (BRDF Explorer ignores it too)", rest.join(" "))));
+    }
+    Ok(FileParam { name: name.to_string(), kind, line: n })
+}
+
+/// GLSL keywords and reserved words (GLSL 4.60, with Vulkan's), which cannot name a parameter.
+pub(super) const GLSL_KEYWORDS: &[&str] = &[
+    "active", "asm", "atomic_uint", "attribute", "bool", "break", "buffer", "bvec2", "bvec3", "bvec4", "case", "cast", "centroid", "class",
+    "coherent", "common", "const", "continue", "default", "discard", "dmat2", "dmat2x2", "dmat2x3", "dmat2x4", "dmat3", "dmat3x2",
+    "dmat3x3", "dmat3x4", "dmat4", "dmat4x2", "dmat4x3", "dmat4x4", "do", "double", "dvec2", "dvec3", "dvec4", "else", "enum", "extern",
+    "external", "false", "filter", "fixed", "flat", "float", "for", "fvec2", "fvec3", "fvec4", "goto", "half", "highp", "hvec2", "hvec3",
+    "hvec4", "if", "in", "inline", "inout", "input", "int", "interface", "invariant", "isampler2D", "isampler3D", "ivec2", "ivec3", "ivec4",
+    "layout", "long", "lowp", "mat2", "mat2x2", "mat2x3", "mat2x4", "mat3", "mat3x2", "mat3x3", "mat3x4", "mat4", "mat4x2", "mat4x3",
+    "mat4x4", "mediump", "namespace", "noinline", "noperspective", "out", "output", "partition", "patch", "precise", "precision", "public",
+    "readonly", "resource", "restrict", "return", "sample", "sampler", "sampler1D", "sampler2D", "sampler3D", "samplerCube",
+    "sampler2DShadow", "shared", "short", "sizeof", "smooth", "static", "struct", "subpassInput", "subroutine", "superp", "switch",
+    "template", "texture2D", "texture3D", "textureCube", "this", "true", "typedef", "uint", "uniform", "union", "unsigned", "usampler2D",
+    "using", "uvec2", "uvec3", "uvec4", "varying", "vec2", "vec3", "vec4", "void", "volatile", "while", "writeonly",
+];
+
+pub fn is_identifier(s: &str) -> bool {
+    let mut chars = s.chars();
+    chars.next().is_some_and(|c| c == '_' || c.is_ascii_alphabetic()) && chars.all(|c| c == '_' || c.is_ascii_alphanumeric())
+}
+
+/// A parameter name must be a GLSL identifier that GLSL does not reserve.
+pub(super) fn check_identifier(path: &Path, n: usize, name: &str, warnings: &mut Vec<String>) -> Result<()> {
+    if !is_identifier(name) || GLSL_KEYWORDS.contains(&name) || name.starts_with("gl_") {
+        bail!(at(path, n, format!("parameter name `{name}` is not a valid GLSL identifier")));
+    }
+    if name.contains("__") {
+        warnings.push(at(path, n, format!("`{name}`: GLSL reserves identifiers containing `__`")));
+    }
+    Ok(())
+}

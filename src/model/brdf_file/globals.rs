@@ -1,0 +1,242 @@
+//! What the shader declares at global scope, and the checks on it (`BRDF`'s signature, no `layout`, no
+//! global named like a parameter).
+
+use super::*;
+use anyhow::{bail, Result};
+use std::collections::HashSet;
+use std::path::Path;
+
+/// The shader section must exist and define `BRDF`; its globals must not take a parameter's name; a `uniform`
+/// qualifier on a global is dropped (renamed_shader) with a warning.
+pub(super) fn check_shader(file: &mut BrdfFile, begin: usize, tokens: &[Token], scan: &Scan) -> Result<()> {
+    if let Some(t) = tokens.iter().find(|t| t.kind == Kind::Ident && t.text == "layout") {
+        bail!(at(&file.path, file.shader[t.line].0, "`layout(...)` is not supported in a .brdf shader: the kernel the file is composed into sets its own layout (work-group size, bindings); declare values in the parameters section"));
+    }
+    file.loops = loops(&file.shader, tokens);
+    let params: std::collections::HashMap<&str, usize> = file.params.iter().map(|p| (p.name.as_str(), p.line)).collect();
+    for g in &scan.globals {
+        if let Some(line) = params.get(g.name.as_str()) {
+            bail!(at(&file.path, g.line, format!("`{}` is both a parameter (line {line}) and a global of the shader", g.name)));
+        }
+    }
+    for &(line, ref name) in &scan.uniforms {
+        file.warnings.push(at(&file.path, line, format!("`uniform` dropped from `{name}`: Vulkan GLSL has no uniforms outside blocks, so it is a private global nothing sets (declare it as a parameter instead)")));
+    }
+    check_brdf(&file.path, begin, &scan.globals)
+}
+
+pub(super) const BRDF_SIGNATURE: &str = "vec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y)";
+
+/// `BRDF` must be defined at global scope with BRDF Explorer's signature.
+pub(super) fn check_brdf(path: &Path, begin: usize, globals: &[Global]) -> Result<()> {
+    let brdfs: Vec<&Global> = globals.iter().filter(|g| g.name == "BRDF").collect();
+    let fits = |g: &Global| match &g.kind {
+        GlobalKind::Function { defined, returns, params } => *defined && returns == "vec3" && params.len() == 5 && params.iter().all(|p| p.iter().any(|t| t == "vec3")),
+        _ => false,
+    };
+    if brdfs.iter().any(|g| fits(g)) {
+        return Ok(());
+    }
+    let defined = |g: &&&Global| matches!(g.kind, GlobalKind::Function { defined: true, .. });
+    match (brdfs.iter().find(defined), brdfs.first()) {
+        (Some(g), _) => bail!(at(path, g.line, format!("`BRDF` must be defined as `{BRDF_SIGNATURE}`"))),
+        (None, Some(g)) => bail!(at(path, g.line, format!("`BRDF` is declared but not defined (BRDF Explorer calls `{BRDF_SIGNATURE}`)"))),
+        (None, None) => bail!(at(path, begin, format!("the shader defines no function `BRDF` at global scope (BRDF Explorer calls `{BRDF_SIGNATURE}`)"))),
+    }
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub(super) enum GlobalKind {
+    /// A function definition (`defined`) or prototype: the token before its name, and each parameter's tokens.
+    Function { defined: bool, returns: String, params: Vec<Vec<String>> },
+    Variable,
+    Struct,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub(super) struct Global {
+    pub(super) name: String,
+    /// File line.
+    pub(super) line: usize,
+    pub(super) kind: GlobalKind,
+}
+
+/// What the shader declares at global scope, and the `uniform` qualifiers to drop (token index).
+pub(super) struct Scan {
+    pub(super) globals: Vec<Global>,
+    /// (file line, variable) of each dropped `uniform`.
+    pub(super) uniforms: Vec<(usize, String)>,
+    pub(super) uniform_tokens: Vec<usize>,
+}
+
+/// Qualifiers that may precede a global's type.
+pub(super) const QUALIFIERS: &[&str] = &[
+    "const", "uniform", "in", "out", "inout", "buffer", "shared", "highp", "mediump", "lowp", "precise", "invariant", "flat", "smooth",
+    "noperspective", "centroid", "sample", "patch", "coherent", "volatile", "restrict", "readonly", "writeonly",
+];
+
+pub(super) fn scan_globals(path: &Path, lines: &[(usize, String)], tokens: &[Token]) -> Result<Scan> {
+    let mut scan = Scan { globals: Vec::new(), uniforms: Vec::new(), uniform_tokens: Vec::new() };
+    let mut i = 0;
+    while i < tokens.len() {
+        let (end, body) = item_end(path, lines, tokens, i)?;
+        let item = &tokens[i..end];
+        declare(&mut scan, lines, item, i, body.map(|(o, c)| (o - i, c - i)));
+        i = end;
+    }
+    Ok(scan)
+}
+
+/// The end (exclusive) of the global-scope item starting at `start` (a declaration up to its `;`, or a
+/// function definition up to its body's `}`), and the body's braces (function or struct), if any.
+pub(super) fn item_end(path: &Path, lines: &[(usize, String)], tokens: &[Token], start: usize) -> Result<(usize, Option<(usize, usize)>)> {
+    let mut nest = 0;
+    let mut body = None;
+    let mut j = start;
+    while j < tokens.len() {
+        let t = &tokens[j];
+        if t.is("(") || t.is("[") {
+            nest += 1;
+        } else if t.is(")") || t.is("]") {
+            nest -= 1;
+        } else if t.is("{") && nest == 0 {
+            let close = matching(tokens, j);
+            let header = &tokens[start..j];
+            if j > start && tokens[j - 1].is(")") {
+                return Ok(((close + 1).min(tokens.len()), Some((j, close))));
+            } else if header.iter().any(|t| t.text == "struct") {
+                body = Some((j, close));
+                j = close;
+            } else if header.last().is_some_and(|t| t.kind == Kind::Ident) && header.iter().any(|t| ["uniform", "buffer", "in", "out"].contains(&t.text.as_str())) {
+                bail!(at(path, lines[t.line].0, "interface blocks are not supported in a .brdf shader: declare values in the parameters section"));
+            } else {
+                nest += 1; // an initializer list
+            }
+        } else if t.is("{") {
+            nest += 1;
+        } else if t.is("}") {
+            if nest == 0 {
+                return Ok((j + 1, body)); // a stray `}`: glslang will say so
+            }
+            nest -= 1;
+        } else if t.is(";") && nest == 0 {
+            return Ok((j + 1, body));
+        }
+        j += 1;
+    }
+    Ok((tokens.len(), body))
+}
+
+/// Records what one global-scope item declares. `first` is its first token's index; `body` its braces,
+/// relative to the item.
+pub(super) fn declare(scan: &mut Scan, lines: &[(usize, String)], item: &[Token], first: usize, body: Option<(usize, usize)>) {
+    let line_of = |t: &Token| lines[t.line].0;
+    let mut push = |t: &Token, kind: GlobalKind| scan.globals.push(Global { name: t.text.clone(), line: line_of(t), kind });
+    if item.first().is_some_and(|t| t.text == "precision") {
+        return;
+    }
+    if let Some(s) = item.iter().position(|t| t.text == "struct") {
+        if let (Some(name), Some((_, close))) = (item.get(s + 1).filter(|t| t.kind == Kind::Ident), body) {
+            push(name, GlobalKind::Struct);
+            for (k, t) in item.iter().enumerate().skip(close + 1) {
+                if t.kind == Kind::Ident && (item[k - 1].is("}") || item[k - 1].is(",")) {
+                    push(t, GlobalKind::Variable);
+                }
+            }
+        }
+        return;
+    }
+    let header_end = body.map_or(item.len(), |(open, _)| open);
+    let header = &item[..header_end];
+    if let Some(k) = header.iter().position(|t| t.is("(")) {
+        let typed = k >= 2 && (header[k - 2].kind == Kind::Ident || header[k - 2].is("]"));
+        if typed && header[k - 1].kind == Kind::Ident && !header[..k].iter().any(|t| t.is("=")) {
+            let close = matching(header, k).min(header.len());
+            let params = split_params(&header[k + 1..close]);
+            push(&header[k - 1], GlobalKind::Function { defined: body.is_some(), returns: header[k - 2].text.clone(), params });
+            return;
+        }
+    }
+    // A variable: [qualifiers] TYPE [[..]] NAME [[..]] [= ...] {, NAME [[..]] [= ...]} ;
+    let mut p = 0;
+    let mut uniform = None;
+    while p < header.len() && (QUALIFIERS.contains(&header[p].text.as_str()) || header[p].text == "layout") {
+        if header[p].text == "uniform" {
+            uniform = Some(p);
+        }
+        p = if header[p].text == "layout" && header.get(p + 1).is_some_and(|t| t.is("(")) { matching(header, p + 1) + 1 } else { p + 1 };
+    }
+    if p >= header.len() || header[p].kind != Kind::Ident {
+        return;
+    }
+    p += 1;
+    while p < header.len() && header[p].is("[") {
+        p = matching(header, p) + 1;
+    }
+    let Some(name) = header.get(p).filter(|t| t.kind == Kind::Ident) else {
+        return;
+    };
+    if let Some(u) = uniform {
+        scan.uniforms.push((line_of(name), name.text.clone()));
+        scan.uniform_tokens.push(first + u);
+    }
+    let mut push = |t: &Token| scan.globals.push(Global { name: t.text.clone(), line: line_of(t), kind: GlobalKind::Variable });
+    push(name);
+    let mut nest = 0;
+    for k in p + 1..header.len() {
+        let t = &header[k];
+        if t.is("(") || t.is("[") || t.is("{") {
+            nest += 1;
+        } else if t.is(")") || t.is("]") || t.is("}") {
+            nest -= 1;
+        } else if nest == 0 && t.kind == Kind::Ident && header[k - 1].is(",") {
+            push(t);
+        }
+    }
+}
+
+/// The parameter list between a function's parentheses, split at its top-level commas (`()` and `(void)`: none).
+pub(super) fn split_params(tokens: &[Token]) -> Vec<Vec<String>> {
+    if tokens.is_empty() || (tokens.len() == 1 && tokens[0].text == "void") {
+        return Vec::new();
+    }
+    let mut params = vec![Vec::new()];
+    let mut nest = 0;
+    for t in tokens {
+        if t.is("(") || t.is("[") {
+            nest += 1;
+        } else if t.is(")") || t.is("]") {
+            nest -= 1;
+        }
+        if nest == 0 && t.is(",") {
+            params.push(Vec::new());
+        } else {
+            params.last_mut().unwrap().push(t.text.clone());
+        }
+    }
+    params
+}
+
+/// Token indices of struct members' names (`struct S { float a, b[2]; }`: `a`, `b`), which are reached after a
+/// `.` and so are never renamed: an identifier in a struct body preceded by a type (or `,` or `]`) and followed
+/// by `;`, `,` or `[`.
+pub(super) fn struct_members(tokens: &[Token]) -> HashSet<usize> {
+    let mut members = HashSet::new();
+    for (s, t) in tokens.iter().enumerate() {
+        if t.text != "struct" {
+            continue;
+        }
+        let Some(open) = (s + 1..tokens.len().min(s + 3)).find(|&j| tokens[j].is("{")) else {
+            continue;
+        };
+        let close = matching(tokens, open);
+        for k in open + 1..close {
+            let (prev, next) = (&tokens[k - 1], tokens.get(k + 1));
+            let declarator = prev.kind == Kind::Ident || prev.is(",") || prev.is("]");
+            if tokens[k].kind == Kind::Ident && declarator && next.is_some_and(|n| n.is(";") || n.is(",") || n.is("[")) {
+                members.insert(k);
+            }
+        }
+    }
+    members
+}

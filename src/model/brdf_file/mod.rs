@@ -1,0 +1,232 @@
+//! BRDF Explorer `.brdf` files (wdas/brdf, `BRDFBase::loadBRDF`), read as BRDF Explorer reads them, and their
+//! GLSL prepared for composition into brdfprof's Vulkan kernels.
+//!
+//! The format: line 1 names the kind (`analytic`; brdfprof reads no other). After it, blank lines and lines
+//! whose trimmed text starts with `#` are skipped, as BRDF Explorer skips them; but in the shader a
+//! preprocessor directive (`#define`, `#if`, ...) is kept and the shader goes through glslang's preprocessor
+//! (`preprocess`, under the model's defines), because engine code relies on it (issue 19); any other `#` line
+//! there is dropped with a warning. `::begin NAME` / `::end NAME` enclose sections: `parameters` (`float NAME MIN
+//! MAX DEFAULT`, `bool NAME 0|1`, `color NAME R G B`), `shader` (GLSL defining
+//! `vec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y)`; BRDF Explorer declares each parameter before it as
+//! `uniform float/bool/vec3 NAME;`) and `isFunc` (importance sampling, ignored here).
+//!
+//! Composition (`renamed_shader`): every global name the shader declares and every parameter name is renamed,
+//! at each of its occurrences, with a prefix (`brdf_f_`, or a variant when the file already uses identifiers
+//! starting with `brdf_f`), so that the file's functions win over GLSL built-ins of the same name (a file's own
+//! `reflect`, which glslang refuses to redefine in Vulkan mode) and cannot collide with the host kernels'
+//! identifiers (`PI`, `pow5`, `D_Ggx`, ...). Renaming every occurrence is alpha-equivalent: a function parameter
+//! or local named like a global is renamed with it. The host must declare no identifier that starts with
+//! `brdf_f`. Lines keep their number and order, so errors map back to the file:
+//!
+//! ```text
+//! #version 450
+//! #extension GL_GOOGLE_cpp_style_line_directive : require   // implied by GL_GOOGLE_include_directive
+//! const float brdf_f_roughness = 0.5;                       // default_constants(); or `float brdf_f_f0;`,
+//!                                                           // a private global main sets per sample
+//! #line 12 "my.brdf"                                        // line_directive()
+//! ...the renamed shader lines...
+//! #line 40 "kernel.comp"                                     // back to the composed source's own numbering
+//! #include "brdf.glsl"                                       // host code after the file: its macros
+//! void main() { ... brdf_f_BRDF(L, V, N, X, Y) ... }         // (`real`, ...) cannot touch the file's text
+//! ```
+//!
+//! glslang then names the file and its own line in every message about it; `remap_log` turns those messages
+//! (or, without the directive, messages located through a line map) into `my.brdf:57: ...` with the original
+//! identifiers.
+
+mod format;
+mod globals;
+mod loops;
+mod preprocess;
+mod rename;
+mod tokens;
+#[cfg(test)]
+mod tests;
+
+use format::*;
+use globals::*;
+use loops::*;
+use preprocess::*;
+use rename::*;
+use tokens::*;
+
+pub use format::is_identifier;
+pub use loops::LAVAPIPE_LOOP_LIMIT;
+
+use anyhow::{anyhow, bail, Result};
+use sha2::{Digest, Sha256};
+use std::collections::HashSet;
+use std::fmt::Display;
+use std::path::{Path, PathBuf};
+
+/// A parsed `.brdf` file.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BrdfFile {
+    /// The path as the user gave it (every message names it so).
+    pub path: PathBuf,
+    /// The file stem.
+    pub name: String,
+    pub params: Vec<FileParam>,
+    /// Every line of the shader section as written, with its 1-based file line: preprocessor directives kept,
+    /// blank lines and dropped `#` lines (`dropped_hash_line`) empty, so that the lines are consecutive.
+    pub source: Vec<(usize, String)>,
+    /// The defines the shader is preprocessed with (`define=NAME=VALUE` in the model spec, `--define`).
+    pub defines: Vec<(String, String)>,
+    /// `source` after glslang's preprocessor (`preprocess`), line for line: what every later step reads. The
+    /// same as `source` when it has no directive and no define is given.
+    pub shader: Vec<(usize, String)>,
+    /// The line of `::begin shader`.
+    shader_begin: usize,
+    /// The file has an `isFunc` section with code in it (brdfprof ignores it; BRDF Explorer samples with it).
+    pub has_is_func: bool,
+    /// `FILE:LINE: ...` for what the file does that BRDF Explorer tolerates but is likely a mistake: those of
+    /// its format, then those of its preprocessed shader.
+    pub warnings: Vec<String>,
+    /// The warnings of the format alone (the shader's depend on the defines).
+    format_warnings: Vec<String>,
+    /// SHA-256 of the file's bytes, lowercase hex.
+    pub hash: String,
+    /// What every renamed name starts with (`BrdfFile::prefix`), computed once.
+    pub prefix: String,
+    /// The shader's loops (`for`, `while`, `do`), with the trip count where the source bounds it.
+    pub loops: Vec<Loop>,
+    /// The preprocessed shader with its globals and parameters renamed, computed once.
+    renamed: RenamedShader,
+}
+
+/// A loop of the shader: lavapipe stops every loop at `LAVAPIPE_LOOP_LIMIT` iterations.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Loop {
+    /// The 1-based file line of its keyword.
+    pub line: usize,
+    pub keyword: &'static str,
+    /// Iterations, where the loop is `for (T i = A; i OP B; i STEP)` with literal A, B and step.
+    pub trip_count: Option<u64>,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct FileParam {
+    pub name: String,
+    pub kind: FileParamKind,
+    /// The 1-based file line that declares it.
+    pub line: usize,
+}
+
+/// A parameter's type and default. MIN and MAX are BRDF Explorer's slider bounds, not physical limits.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum FileParamKind {
+    Float { min: f64, max: f64, default: f64 },
+    Bool { default: bool },
+    Color { default: [f64; 3] },
+}
+
+/// The shader section with the file's global names and parameters renamed (`BrdfFile::renamed_shader`).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct RenamedShader {
+    /// The shader's lines, one for one with `BrdfFile::shader` (same file line numbers).
+    pub lines: Vec<(usize, String)>,
+    /// What every renamed name starts with.
+    pub prefix: String,
+    /// The original names that were renamed: the parameters, then the shader's globals, in declaration order.
+    pub renamed: Vec<String>,
+    /// `renamed` as a set, for `original_names`.
+    lookup: HashSet<String>,
+}
+
+/// Reads and parses `path`.
+pub fn load(path: &Path) -> Result<BrdfFile> {
+    let bytes = crate::io::read_input(path)?;
+    parse(path, &bytes)
+}
+
+/// Parses a `.brdf` file's bytes; `path` is how messages name it.
+pub fn parse(path: &Path, bytes: &[u8]) -> Result<BrdfFile> {
+    let text = text_of(path, bytes)?;
+    let mut lines = split_lines(text);
+    check_kind(path, lines.next().unwrap_or(""))?;
+    let mut file = BrdfFile {
+        path: path.to_path_buf(),
+        name: path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default(),
+        params: Vec::new(),
+        source: Vec::new(),
+        defines: Vec::new(),
+        shader: Vec::new(),
+        shader_begin: 0,
+        has_is_func: false,
+        warnings: Vec::new(),
+        format_warnings: Vec::new(),
+        hash: hex(&Sha256::digest(bytes)),
+        prefix: String::new(),
+        loops: Vec::new(),
+        renamed: RenamedShader::default(),
+    };
+    let shader_begin = read_sections(&mut file, lines)?;
+    file.shader_begin = shader_begin.ok_or_else(|| anyhow!(at(path, 1, "no shader section (`::begin shader` ... `::end shader`)")))?;
+    file.format_warnings = std::mem::take(&mut file.warnings);
+    file.prepare_shader()?;
+    Ok(file)
+}
+
+impl BrdfFile {
+    /// The same file with its shader preprocessed under `defines` (`NAME`, `VALUE`; an empty value defines
+    /// NAME as glslang's `-DNAME` does).
+    pub fn with_defines(&self, defines: &[(String, String)]) -> Result<BrdfFile> {
+        for (name, _) in defines {
+            if let Some(p) = self.params.iter().find(|p| &p.name == name) {
+                bail!("{}: `define={name}`: `{name}` is the file's parameter (line {}); a macro of that name would replace it in the shader", self.path.display(), p.line);
+            }
+        }
+        let mut file = self.clone();
+        file.defines = defines.to_vec();
+        file.prepare_shader()?;
+        Ok(file)
+    }
+
+    /// Preprocesses `source` into `shader` and reads what the shader declares; the warnings are the format's,
+    /// then the shader's.
+    fn prepare_shader(&mut self) -> Result<()> {
+        self.shader = preprocess(&self.path, &self.source, &self.defines)?;
+        self.warnings = self.format_warnings.clone();
+        // Tokens and globals once: the checks, the loops and the renaming all read them.
+        let tokens = tokenize(&self.path, &self.shader)?;
+        let scan = scan_globals(&self.path, &self.shader, &tokens)?;
+        check_shader(self, self.shader_begin, &tokens, &scan)?;
+        self.prefix = self.choose_prefix();
+        self.renamed = self.rename(&tokens, &scan);
+        Ok(())
+    }
+}
+
+/// `FILE:LINE: message`, the form of every error and warning.
+fn at(path: &Path, line: usize, message: impl Display) -> String {
+    format!("{}:{line}: {message}", path.display())
+}
+
+fn hex(bytes: &[u8]) -> String {
+    bytes.iter().map(|b| format!("{b:02x}")).collect()
+}
+
+impl FileParam {
+    /// The GLSL type BRDF Explorer declares it with.
+    pub fn glsl_type(&self) -> &'static str {
+        match self.kind {
+            FileParamKind::Float { .. } => "float",
+            FileParamKind::Bool { .. } => "bool",
+            FileParamKind::Color { .. } => "vec3",
+        }
+    }
+
+    /// Its default as a GLSL constant expression (`0.5`, `true`, `vec3(0.04, 0.04, 0.04)`).
+    pub fn default_glsl(&self) -> String {
+        match self.kind {
+            FileParamKind::Float { default, .. } => glsl_float(default),
+            FileParamKind::Bool { default } => default.to_string(),
+            FileParamKind::Color { default: [r, g, b] } => format!("vec3({}, {}, {})", glsl_float(r), glsl_float(g), glsl_float(b)),
+        }
+    }
+}
+
+/// A finite f64 as a GLSL float literal (Rust's shortest round-trip form has a `.` or an exponent).
+pub fn glsl_float(x: f64) -> String {
+    format!("{x:?}")
+}
