@@ -81,6 +81,24 @@ pub struct Inspected {
     pub markdown: String,
 }
 
+impl Inspected {
+    /// The outputs' default file stem: `inspect-<device>` for one device, `inspect-devices` for several.
+    pub fn stem(&self) -> String {
+        match &self.multi {
+            None => format!("inspect-{}", slug(&self.reports[0])),
+            Some(_) => "inspect-devices".to_string(),
+        }
+    }
+
+    /// The JSON written: the one device's report, or the combined report of several.
+    pub fn json_value(&self) -> Result<serde_json::Value> {
+        Ok(match &self.multi {
+            None => serde_json::to_value(&self.reports[0])?,
+            Some(m) => serde_json::to_value(m)?,
+        })
+    }
+}
+
 /// The compile-only targets' runs: the default Vulkan device opened first for the targets whose costs are of
 /// a translation that must run before it is believed.
 fn target_reports(plan: &[Planned], run: &Run, open: &OpenLocal) -> Result<Vec<InspectReport>> {

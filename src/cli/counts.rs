@@ -116,23 +116,12 @@ pub fn inspect(args: &InspectArgs) -> Result<ExitCode> {
     };
     let run = devices::Run { options: &options, shaders: &shaders, validate, isa_dir: args.isa.as_deref(), precise: args.precise_math };
     let result = devices::inspect(&plan, &run, &local, profile.as_ref())?;
-    let (json, markdown) = match &result.multi {
-        None => {
-            let slug = devices::slug(&result.reports[0]);
-            (args.json.clone().unwrap_or_else(|| PathBuf::from(format!("results/inspect-{slug}.json"))), args.markdown.clone().unwrap_or_else(|| PathBuf::from(format!("results/inspect-{slug}.md"))))
-        }
-        Some(_) => (args.json.clone().unwrap_or_else(|| PathBuf::from("results/inspect-devices.json")), args.markdown.clone().unwrap_or_else(|| PathBuf::from("results/inspect-devices.md"))),
-    };
-    let input = match &result.multi {
-        None => {
-            report::write_json(&json, &result.reports[0])?;
-            super::report::just_measured(&json, &result.reports[0])?
-        }
-        Some(m) => {
-            report::write_json(&json, m)?;
-            super::report::just_measured(&json, m)?
-        }
-    };
+    let stem = result.stem();
+    let json = args.json.clone().unwrap_or_else(|| PathBuf::from(format!("results/{stem}.json")));
+    let markdown = args.markdown.clone().unwrap_or_else(|| PathBuf::from(format!("results/{stem}.md")));
+    let value = result.json_value()?;
+    report::write_json(&json, &value)?;
+    let input = super::report::just_measured(&json, &value)?;
     if args.html.html.is_some() {
         // The lobes and spheres are drawn on the default local device (the inspected ones may only compile).
         let gpu = DeviceArgs { device: None, validate }.open()?;
