@@ -63,6 +63,10 @@ pub struct InspectArgs {
     /// evaluation, with their rank correlation, and its ns/eval to the cost table across devices.
     #[arg(long)]
     pub profile: Option<PathBuf>,
+    /// PNG chart of each model's net cost relative to ggx per device, as `compare --chart` draws it (needs
+    /// several --device).
+    #[arg(long)]
+    pub chart: Option<PathBuf>,
     /// Write each kernel's compiler output for every compile-only target: RADV's internal representations
     /// (NIR, ACO IR, disassembly) to DIR/<family>/<kernel>.<representation>.txt; NVIDIA's CUDA C++
     /// translation and SASS to DIR/nvidia-<family>/<kernel>.{cu,sass}.
@@ -99,6 +103,12 @@ pub fn inspect(args: &InspectArgs) -> Result<ExitCode> {
     check_output("--json", args.json.as_deref(), "results", &format!("{default_name}.json"))?;
     check_output("--markdown", args.markdown.as_deref(), "results", &format!("{default_name}.md"))?;
     args.html.check()?;
+    if let Some(chart) = &args.chart {
+        if plan.len() < 2 {
+            bail!("--chart {}: the chart compares devices; give several --device (e.g. --device radv:all --device nvidia:all)", chart.display());
+        }
+        io::check_output_path("--chart", chart)?;
+    }
     if let Some(dir) = &args.isa {
         if !plan.iter().any(|p| matches!(p, devices::Planned::Target(_))) {
             bail!("--isa {}: the listings are a compile-only target's; give one, e.g. --device radv:navi21 or nvidia:sm_89 (see `brdfprof devices --targets`)", dir.display());
@@ -129,8 +139,11 @@ pub fn inspect(args: &InspectArgs) -> Result<ExitCode> {
         gpu.check_validation()?;
     }
     io::write_output(&markdown, result.markdown.as_bytes())?;
+    if let (Some(chart), Some(multi)) = (&args.chart, &result.multi) {
+        multi.costs.chart(chart)?;
+    }
     print!("{}", result.markdown);
-    println!("JSON: {}\nMarkdown: {}", json.display(), markdown.display());
+    println!("JSON: {}\nMarkdown: {}{}", json.display(), markdown.display(), args.chart.as_ref().map_or(String::new(), |c| format!("\nChart: {}", c.display())));
     Ok(ExitCode::SUCCESS)
 }
 

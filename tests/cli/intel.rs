@@ -139,3 +139,24 @@ fn a_missing_compiler_says_make_setup() {
     assert!(stderr.contains("Intel compiler not installed: run `make setup`"), "{stderr}");
     assert!(!dir.path().join("x.json").exists());
 }
+
+/// Issue 18 item 6: `inspect --chart` draws the cost table across devices as compare does: one colour per
+/// device (the chart's palette), its bars drawn; one device is refused with exit 2.
+#[test]
+fn inspect_charts_the_cost_across_devices() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let out = |n: &str| d.join(n).display().to_string();
+    let r = run(&["inspect", "--no-callgrind", "--device", "nvidia:sm_89", "--device", "intel:gen12lp", "--json", &out("i.json"), "--markdown", &out("i.md"), "--chart", &out("c.png")]).ok();
+    assert!(r.stdout.contains("Chart: "), "{}", r.stdout);
+    let img = image::open(d.join("c.png")).unwrap().to_rgb8();
+    assert!(img.width() >= 800 && img.height() >= 600, "{}x{}", img.width(), img.height());
+    for device in 0..2 {
+        let c = brdfprof::chart::palette(device);
+        let n = img.pixels().filter(|p| p.0 == [c.0, c.1, c.2]).count();
+        assert!(n > 2_000, "device {device}'s colour covers {n} pixels: its bars are missing");
+    }
+    assert!(!d.join("x.png").exists());
+    run(&["inspect", "--no-callgrind", "--device", "intel:gen12lp", "--json", &out("j.json"), "--markdown", &out("j.md"), "--chart", &out("x.png")]).fails(2, "give several --device");
+    assert!(!d.join("x.png").exists());
+}
