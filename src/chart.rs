@@ -50,8 +50,14 @@ pub fn palette(i: usize) -> RGBColor {
         (31, 119, 180), (255, 127, 14), (44, 160, 44), (214, 39, 40), (148, 103, 189),
         (140, 86, 75), (227, 119, 194), (127, 127, 127), (188, 189, 34), (23, 190, 207),
     ];
+    // Past the ten base colours, the same hues lighter (then darker), so that up to 30 series differ.
     let (r, g, b) = P[i % P.len()];
-    RGBColor(r, g, b)
+    let shade = |c: u8| match (i / P.len()) % 3 {
+        0 => c,
+        1 => c + (255 - c) / 2,
+        _ => c / 2,
+    };
+    RGBColor(shade(r), shade(g), shade(b))
 }
 
 /// One point of the accuracy-against-cost scatter: x with its confidence interval (drawn as a horizontal

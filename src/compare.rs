@@ -242,15 +242,18 @@ impl CostTable {
     /// A grouped bar chart: net cost relative to ggx, per model (groups) and device (colours).
     pub fn chart(&self, path: &Path) -> Result<()> {
         use plotters::prelude::*;
+        const LEGEND_WIDTH: i32 = 230;
         let models: Vec<&String> = self.models.iter().filter(|m| *m != BASELINE_LABEL).collect();
         let values: Vec<Vec<Option<f64>>> = models.iter().map(|m| self.columns.iter().map(|c| self.relative(c, m)).collect()).collect();
         let max = values.iter().flatten().flatten().fold(1.0f64, |a, &b| a.max(b)) * 1.1;
-        let width = (300 + 60 * models.len() as u32 * self.columns.len().max(1) as u32 / 2).clamp(800, 2400);
+        let width = (300 + 60 * models.len() as u32 * self.columns.len().max(1) as u32 / 2).clamp(800, 2400) + LEGEND_WIDTH as u32;
         crate::chart::render(path, width, 600, |root| {
             let e = |e: DrawingAreaErrorKind<_>| anyhow!("{e}");
+            // The legend goes in a right margin of its own, so that it never hides a bar.
             let mut chart = ChartBuilder::on(root)
                 .caption("BRDF cost net of the memory-only kernel, relative to ggx, per device", (crate::chart::FONT, 20))
                 .margin(15)
+                .margin_right(LEGEND_WIDTH)
                 .x_label_area_size(90)
                 .y_label_area_size(60)
                 .build_cartesian_2d(0f64..models.len() as f64, 0f64..max)
@@ -275,7 +278,10 @@ impl CostTable {
                         Rectangle::new([(x0, 0.0), (x0 + 0.8 / n, y.max(0.0))], colour.filled())
                     })
                     .collect();
-                chart.draw_series(bars).map_err(e)?.label(c.name.clone()).legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 10, y + 5)], colour.filled()));
+                chart.draw_series(bars).map_err(e)?;
+                let (lx, ly) = (width as i32 - LEGEND_WIDTH + 10, 50 + 18 * j as i32);
+                root.draw(&Rectangle::new([(lx, ly - 5), (lx + 12, ly + 7)], colour.filled())).map_err(e)?;
+                root.draw(&Text::new(c.name.clone(), (lx + 18, ly - 5), (crate::chart::FONT, 13))).map_err(e)?;
             }
             chart.draw_series(std::iter::once(PathElement::new(vec![(0.0, 1.0), (models.len() as f64, 1.0)], BLACK.mix(0.5)))).map_err(e)?;
             // Model names under their groups (long specs wrapped at commas).
@@ -286,7 +292,6 @@ impl CostTable {
                     root.draw(&Text::new(part.to_string(), (px - w / 2, py + 8 + 16 * k as i32), (crate::chart::FONT, 13))).map_err(e)?;
                 }
             }
-            chart.configure_series_labels().background_style(WHITE.mix(0.9)).border_style(BLACK).label_font((crate::chart::FONT, 13)).position(SeriesLabelPosition::UpperLeft).draw().map_err(e)?;
             Ok(())
         })
     }
