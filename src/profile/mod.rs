@@ -196,17 +196,7 @@ pub fn run(gpu: &Gpu, options: &ProfileOptions, progress: &ProgressBar) -> Resul
         let reference = first + models.iter().position(|m| *m == reference_model).unwrap();
         groups.push(Group { lights: work.light_count, evaluations: work.evaluations(), variants: first..variants.len(), reference, baseline: variants.len() - 1 });
     }
-    progress.set_length(options.protocol.max_rounds as u64);
-    let raw = protocol::measure(
-        gpu,
-        &variants,
-        &options.protocol,
-        |raw| resolved(&analyse_all(raw, &specs, &groups), options.target_rel_ci),
-        |raw| {
-            progress.set_position(raw.rounds() as u64);
-            progress.set_message(format!("{:.0} s of rounds", raw.elapsed_s));
-        },
-    )?;
+    let raw = protocol::measure_with_progress(gpu, &variants, &options.protocol, |raw| resolved(&analyse_all(raw, &specs, &groups), options.target_rel_ci), progress)?;
     let rows = analyse_all(&raw, &specs, &groups);
     let mut kernel_sha256 = std::collections::BTreeMap::new();
     for spec in models.iter().map(Some).chain([None]) {

@@ -147,6 +147,16 @@ impl RawTimes {
 
 /// Runs the protocol. After each round (from `min_rounds` on) `converged` sees the times so far; the run
 /// stops when it returns true, at `max_rounds`, or when the budget is spent (even before `min_rounds`).
+/// `measure`, showing its rounds on `progress` (position, seconds of rounds so far): what profile and scene
+/// profile both show.
+pub fn measure_with_progress<V: Timed>(gpu: &Gpu, variants: &[V], options: &ProtocolOptions, converged: impl FnMut(&RawTimes) -> bool, progress: &indicatif::ProgressBar) -> Result<RawTimes> {
+    progress.set_length(options.max_rounds as u64);
+    measure(gpu, variants, options, converged, |raw| {
+        progress.set_position(raw.rounds() as u64);
+        progress.set_message(format!("{:.0} s of rounds", raw.elapsed_s));
+    })
+}
+
 pub fn measure<V: Timed>(
     gpu: &Gpu,
     variants: &[V],

@@ -168,17 +168,7 @@ pub fn run(gpu: &Gpu, scene: &Scene, options: &SceneProfileOptions, progress: &P
     progress.set_message("compiling kernels");
     let (slots, variants) = variants(gpu, &work, &p, options.instances)?;
     let pixels: Vec<u64> = work.kernels.iter().map(|k| k.count).collect();
-    progress.set_length(options.protocol.max_rounds as u64);
-    let raw = protocol::measure(
-        gpu,
-        &variants,
-        &options.protocol,
-        |raw| resolved(&analyse(raw, &slots, &pixels), options.target_rel_ci),
-        |raw| {
-            progress.set_position(raw.rounds() as u64);
-            progress.set_message(format!("{:.0} s", raw.elapsed_s));
-        },
-    )?;
+    let raw = protocol::measure_with_progress(gpu, &variants, &options.protocol, |raw| resolved(&analyse(raw, &slots, &pixels), options.target_rel_ci), progress)?;
     let a = analyse(&raw, &slots, &pixels);
     let instructions = instructions(&p, &variants);
     let compiled = p.describe(scene);

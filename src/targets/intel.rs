@@ -343,20 +343,14 @@ fn write_isa(dir: &std::path::Path, family: &Family, label: &str, source: &str, 
 
 fn report(family: &Family, rows: Vec<crate::inspect::Row>, tools: &ocloc::Tools, req: &Request) -> InspectReport {
     let options = options(req.precise);
-    let provenance = serde_json::json!({
-        "tool": format!("brdfprof {}", env!("CARGO_PKG_VERSION")),
-        "device": {"name": device_name(family), "driver_name": "IGC (ocloc)", "driver_info": format!("{} (-device {}; {options})", tools.version, family.device), "driver_version": tools.version},
-        "target": format!("intel:{}", family.name),
-        "compiler": {"name": tools.version, "options": options, "device": family.device, "translation": "brdfprof's SPIR-V to OpenCL C translation"},
-        "host_cpu": crate::host::HostCpu::detect().describe(),
-    });
-    let mut notes = BTreeMap::new();
-    notes.insert("driver/".into(), format!("Intel's OpenCL compiler (IGC, {}) on the kernels' OpenCL C translation, same maths; -device {}; options: {options}", tools.version, family.device));
-    notes.insert("callgrind/".into(), format!("not applicable: intel:{} compiles only, nothing executes", family.name));
-    let tool_list = [("ocloc".to_string(), tools.version.clone())].into();
-    let mut report = crate::inspect::compiled_report(rows, provenance, req.lights, req.shaders, tool_list, notes);
-    report.cost = super::Vendor::cost(&INTEL, &report);
-    report
+    let compilation = super::Compilation {
+        target: format!("intel:{}", family.name),
+        device: serde_json::json!({"name": device_name(family), "driver_name": "IGC (ocloc)", "driver_info": format!("{} (-device {}; {options})", tools.version, family.device), "driver_version": tools.version}),
+        compiler: serde_json::json!({"name": tools.version, "options": options, "device": family.device, "translation": "brdfprof's SPIR-V to OpenCL C translation"}),
+        driver_note: format!("Intel's OpenCL compiler (IGC, {}) on the kernels' OpenCL C translation, same maths; -device {}; options: {options}", tools.version, family.device),
+        tool: ("ocloc".to_string(), tools.version.clone()),
+    };
+    super::translated_report(&INTEL, compilation, rows, req)
 }
 
 /// The statistics the cost table shows beside cycles/eval.

@@ -235,3 +235,34 @@ pub fn checked_translations(req: &Request, gpu: &Gpu, dialect: crate::translate:
         })
         .collect()
 }
+
+/// What a translating target (NVIDIA, Intel) says about its compilation, for `translated_report`.
+pub(crate) struct Compilation {
+    /// `nvidia:sm_89`, `intel:gen12lp`.
+    pub target: String,
+    /// The report's `provenance.device` and `provenance.compiler`.
+    pub device: serde_json::Value,
+    pub compiler: serde_json::Value,
+    /// The `driver/` section's note: which compiler, on what, with which options.
+    pub driver_note: String,
+    /// The compiler in the report's tool list: (name, version).
+    pub tool: (String, String),
+}
+
+/// The inspect report of a target that compiles the kernels' C translation: provenance, notes (callgrind does
+/// not apply: nothing executes), the rows and the vendor's cost table.
+pub(crate) fn translated_report(vendor: &dyn Vendor, c: Compilation, rows: Vec<crate::inspect::Row>, req: &Request) -> InspectReport {
+    let provenance = serde_json::json!({
+        "tool": format!("brdfprof {}", env!("CARGO_PKG_VERSION")),
+        "device": c.device,
+        "target": c.target,
+        "compiler": c.compiler,
+        "host_cpu": crate::host::HostCpu::detect().describe(),
+    });
+    let mut notes = std::collections::BTreeMap::new();
+    notes.insert("driver/".into(), c.driver_note);
+    notes.insert("callgrind/".into(), format!("not applicable: {} compiles only, nothing executes", c.target));
+    let mut report = crate::inspect::compiled_report(rows, provenance, req.lights, req.shaders, [c.tool].into(), notes);
+    report.cost = vendor.cost(&report);
+    report
+}

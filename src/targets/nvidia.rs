@@ -350,20 +350,14 @@ fn write_isa(dir: &std::path::Path, family: &Family, label: &str, source: &str, 
 
 fn report(family: &Family, rows: Vec<crate::inspect::Row>, tools: &nvrtc::Tools, req: &Request) -> InspectReport {
     let options = options(family, req.precise).join(" ");
-    let provenance = serde_json::json!({
-        "tool": format!("brdfprof {}", env!("CARGO_PKG_VERSION")),
-        "device": {"name": device_name(family), "driver_name": "NVRTC", "driver_info": format!("{} ({options})", tools.version), "driver_version": tools.version},
-        "target": format!("nvidia:{}", family.name),
-        "compiler": {"name": tools.version, "options": options, "translation": "brdfprof's SPIR-V to CUDA C++ translation"},
-        "host_cpu": crate::host::HostCpu::detect().describe(),
-    });
-    let mut notes = std::collections::BTreeMap::new();
-    notes.insert("driver/".into(), format!("NVIDIA's CUDA compiler ({}, ptxas) on the kernels' CUDA C++ translation, same maths; options: {options}", tools.version));
-    notes.insert("callgrind/".into(), format!("not applicable: nvidia:{} compiles only, nothing executes", family.name));
-    let tool_list = [("nvrtc".to_string(), tools.version.clone())].into();
-    let mut report = crate::inspect::compiled_report(rows, provenance, req.lights, req.shaders, tool_list, notes);
-    report.cost = super::Vendor::cost(&NVIDIA, &report);
-    report
+    let compilation = super::Compilation {
+        target: format!("nvidia:{}", family.name),
+        device: serde_json::json!({"name": device_name(family), "driver_name": "NVRTC", "driver_info": format!("{} ({options})", tools.version), "driver_version": tools.version}),
+        compiler: serde_json::json!({"name": tools.version, "options": options, "translation": "brdfprof's SPIR-V to CUDA C++ translation"}),
+        driver_note: format!("NVIDIA's CUDA compiler ({}, ptxas) on the kernels' CUDA C++ translation, same maths; options: {options}", tools.version),
+        tool: ("nvrtc".to_string(), tools.version.clone()),
+    };
+    super::translated_report(&NVIDIA, compilation, rows, req)
 }
 
 /// The statistics the cost table shows beside cycles/eval.

@@ -4,42 +4,22 @@
 //! that executes refuses the targets; a missing compiler is an error naming the fix.
 
 use crate::common::{self, run};
+use crate::translated;
 use brdfprof::targets::intel::{Class, FAMILIES};
 use std::path::Path;
 
 fn inspect_json(dir: &Path, name: &str, devices: &[&str], extra: &[&str]) -> serde_json::Value {
-    let json = dir.join(format!("{name}.json"));
-    let md = dir.join(format!("{name}.md"));
-    let mut args = vec!["inspect", "--no-callgrind", "--json", json.to_str().unwrap(), "--markdown", md.to_str().unwrap()];
-    for d in devices {
-        args.extend(["--device", d]);
-    }
-    args.extend(extra);
-    // A cache of its own: every call compiles (and checks) afresh.
-    let out = common::brdfprof().args(&args).env("BRDFPROF_CACHE_DIR", dir.join(format!("cache-{name}"))).output().unwrap();
-    let out = common::Run { code: out.status.code(), stdout: String::from_utf8_lossy(&out.stdout).into_owned(), stderr: String::from_utf8_lossy(&out.stderr).into_owned() }.ok();
-    assert!(out.stdout.contains("IGC statistics"), "{}", out.stdout);
-    serde_json::from_str(&std::fs::read_to_string(json).unwrap()).unwrap()
+    translated::inspect_json(dir, name, devices, extra, "IGC statistics")
 }
 
 fn igc(row: &serde_json::Value, name: &str) -> f64 {
-    row["stats"][format!("driver/IGC/{name}")].as_f64().unwrap_or_else(|| panic!("{} has no {name}: {row}", row["model"]))
-}
-
-/// Every preset and each example `.brdf` file (parameters bound to the kernel inputs).
-fn every_preset_and_example() -> Vec<String> {
-    let mut models: Vec<String> = brdfprof::brdf::spec::PRESETS.iter().map(|p| p.name.to_string()).collect();
-    let dir = common::repo_root().join("examples/brdf");
-    let mut files: Vec<_> = std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().path()).filter(|p| p.extension().is_some_and(|x| x == "brdf")).collect();
-    files.sort();
-    models.extend(files.iter().map(|p| format!("{},roughness=@roughness,f0=@f0", p.display())));
-    models
+    translated::stat(row, "IGC", name)
 }
 
 #[test]
 fn every_preset_and_example_file_gets_igc_statistics_on_all_five_families() {
     let dir = tempfile::tempdir().unwrap();
-    let models = every_preset_and_example();
+    let models = translated::every_preset_and_example();
     let mut extra: Vec<&str> = Vec::new();
     for m in &models {
         extra.extend(["--model", m.as_str()]);

@@ -1,0 +1,38 @@
+//! What the tests of the translating compile-only targets (tests/cli/nvidia.rs, tests/cli/intel.rs) share:
+//! an inspect run with a cache of its own, a compiler statistic of a row, and the models every target must
+//! take (every preset and each example `.brdf` file).
+
+use crate::common;
+use std::path::Path;
+
+/// `inspect --no-callgrind` on `devices` with `extra` arguments, writing NAME.json and NAME.md in `dir` with a
+/// cache of its own (every call compiles and checks afresh); its output must have `section` (the compiler's
+/// statistics heading). Returns the JSON.
+pub fn inspect_json(dir: &Path, name: &str, devices: &[&str], extra: &[&str], section: &str) -> serde_json::Value {
+    let json = dir.join(format!("{name}.json"));
+    let md = dir.join(format!("{name}.md"));
+    let mut args = vec!["inspect", "--no-callgrind", "--json", json.to_str().unwrap(), "--markdown", md.to_str().unwrap()];
+    for d in devices {
+        args.extend(["--device", d]);
+    }
+    args.extend(extra);
+    let out = common::brdfprof().args(&args).env("BRDFPROF_CACHE_DIR", dir.join(format!("cache-{name}"))).output().unwrap();
+    let out = common::Run { code: out.status.code(), stdout: String::from_utf8_lossy(&out.stdout).into_owned(), stderr: String::from_utf8_lossy(&out.stderr).into_owned() }.ok();
+    assert!(out.stdout.contains(section), "{}", out.stdout);
+    serde_json::from_str(&std::fs::read_to_string(json).unwrap()).unwrap()
+}
+
+/// The row's `driver/COMPILER/NAME` statistic.
+pub fn stat(row: &serde_json::Value, compiler: &str, name: &str) -> f64 {
+    row["stats"][format!("driver/{compiler}/{name}")].as_f64().unwrap_or_else(|| panic!("{} has no {name}: {row}", row["model"]))
+}
+
+/// Every preset and each example `.brdf` file (parameters bound to the kernel inputs).
+pub fn every_preset_and_example() -> Vec<String> {
+    let mut models: Vec<String> = brdfprof::brdf::spec::PRESETS.iter().map(|p| p.name.to_string()).collect();
+    let dir = common::repo_root().join("examples/brdf");
+    let mut files: Vec<_> = std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().path()).filter(|p| p.extension().is_some_and(|x| x == "brdf")).collect();
+    files.sort();
+    models.extend(files.iter().map(|p| format!("{},roughness=@roughness,f0=@f0", p.display())));
+    models
+}
