@@ -73,7 +73,10 @@ fn default_profile_is_fast_resolved_and_repeatable() {
             let (bx, by) = (other(&x.0), other(&y.0));
             let separated_a = x.3 < y.2 || y.3 < x.2;
             let separated_b = bx.3 < by.2 || by.3 < bx.2;
-            if separated_a || separated_b {
+            // Only a ranking both runs resolve must agree: two models within a few percent (blinn and burley
+            // on lavapipe, 1.49-1.56x) resolve in one run and overlap in the next, and their point estimates
+            // may then cross without either run being wrong.
+            if separated_a && separated_b {
                 assert_eq!(x.1 < y.1, bx.1 < by.1, "{} and {} swapped order between runs: {x:?} {y:?} vs {bx:?} {by:?}", x.0, y.0);
             }
         }
