@@ -124,15 +124,18 @@ pub struct ModelArgs {
 impl ModelArgs {
     /// The models asked for, or `default` when none.
     pub fn models(&self, default: &[&str]) -> Result<Vec<Model>> {
-        let models = model::models_from_args(&self.models, &self.params, default)?;
         if self.defines.is_empty() {
-            return Ok(models);
+            return model::models_from_args(&self.models, &self.params, default);
         }
-        if !models.iter().any(|m| m.file().is_some()) {
+        // The defines join each .brdf model's text, so that its shader is preprocessed once, with them (a file
+        // may `#error` without them).
+        let texts: Vec<String> = self.models.iter().filter(|m| model::file_model::names_a_file(m)).cloned().collect();
+        if texts.is_empty() {
             bail!("--define {}: a define is for a .brdf file's shader, and no --model is a .brdf file", self.defines[0]);
         }
-        let items: Vec<String> = self.defines.iter().map(|d| format!("{}={d}", model::file_model::DEFINE)).collect();
-        models.iter().map(|m| if m.file().is_some() { m.with_params(&items).map_err(|e| anyhow!("--define: {e:#}")) } else { Ok(m.clone()) }).collect()
+        let items: String = self.defines.iter().map(|d| format!(",{}={d}", model::file_model::DEFINE)).collect();
+        let with: Vec<String> = self.models.iter().map(|m| if model::file_model::names_a_file(m) { format!("{m}{items}") } else { m.clone() }).collect();
+        model::models_from_args(&with, &self.params, default)
     }
 }
 

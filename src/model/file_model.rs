@@ -291,10 +291,7 @@ impl FileModel {
         let (path, fields) = split_path(text, Path::new("")).ok_or_else(|| anyhow!("`{text}` names no .brdf file"))?;
         let items = split_params(&fields)?;
         let (defines, params): (Vec<String>, Vec<String>) = items.into_iter().partition(|i| is_define(i));
-        let mut file = brdf_file::load(Path::new(path))?;
-        if !defines.is_empty() {
-            file = file.with_defines(&merge_defines(path, &[], &defines)?)?;
-        }
+        let file = brdf_file::load_with(Path::new(path), &merge_defines(path, &[], &defines)?)?;
         if file.has_is_func {
             crate::messages::input_note(format!("{path}: its isFunc section (importance sampling) is ignored: brdfprof integrates with its own estimator"));
         }

@@ -412,6 +412,11 @@ fn the_preprocessor_selects_the_branch_the_defines_select() {
     run_in(d, &["eval", "--model", "ggx", "--define", "Q=1", "--input", "in.csv", "--output", "x.csv"]).fails(2, "no --model is a .brdf file");
     run_in(d, &["eval", "--model", &file, "--define", "scale=1", "--input", "in.csv", "--output", "x.csv"]).fails(2, "is the file's parameter");
     run_in(d, &["eval", "--model", &file, "--define", "1Q=1", "--input", "in.csv", "--output", "x.csv"]).fails(2, "NAME an identifier");
+    // A file that refuses to preprocess without its macro is read with it, from --define or define=.
+    std::fs::write(d.join("needs.brdf"), "analytic\n::begin shader\n#ifndef GAIN\n#error GAIN must be defined\n#endif\nvec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) { return vec3(GAIN); }\n::end shader\n").unwrap();
+    run_in(d, &["eval", "--model", "needs.brdf", "--input", "in.csv", "--output", "x.csv"]).fails(2, "GAIN must be defined");
+    check(&values(&["--model", "needs.brdf", "--define", "GAIN=0.25"]), &|_| 0.25, "--define on a file that needs it");
+    check(&values(&["--model", "needs.brdf,define=GAIN=0.5"]), &|_| 0.5, "define= on a file that needs it");
     // A define names the model: the two kernels are two models.
     let r = run_in(d, &["inspect", "--no-callgrind", "--model", &file, "--model", &format!("{file},define=QUALITY_LEVEL=1"), "--json", "i.json", "--markdown", "i.md"]).ok();
     let report = std::fs::read_to_string(d.join("i.md")).unwrap();

@@ -135,12 +135,23 @@ pub struct RenamedShader {
 
 /// Reads and parses `path`.
 pub fn load(path: &Path) -> Result<BrdfFile> {
+    load_with(path, &[])
+}
+
+/// Reads and parses `path`, its shader preprocessed under `defines` (as `BrdfFile::with_defines`), in one pass:
+/// a file whose own defaults do not preprocess (an `#error` unless a macro is given) is read with its macros.
+pub fn load_with(path: &Path, defines: &[(String, String)]) -> Result<BrdfFile> {
     let bytes = crate::io::read_input(path)?;
-    parse(path, &bytes)
+    parse_with(path, &bytes, defines)
 }
 
 /// Parses a `.brdf` file's bytes; `path` is how messages name it.
 pub fn parse(path: &Path, bytes: &[u8]) -> Result<BrdfFile> {
+    parse_with(path, bytes, &[])
+}
+
+/// `parse`, the shader preprocessed under `defines`.
+pub fn parse_with(path: &Path, bytes: &[u8], defines: &[(String, String)]) -> Result<BrdfFile> {
     let text = text_of(path, bytes)?;
     let mut lines = split_lines(text);
     check_kind(path, lines.next().unwrap_or(""))?;
@@ -163,6 +174,7 @@ pub fn parse(path: &Path, bytes: &[u8]) -> Result<BrdfFile> {
     let shader_begin = read_sections(&mut file, lines)?;
     file.shader_begin = shader_begin.ok_or_else(|| anyhow!(at(path, 1, "no shader section (`::begin shader` ... `::end shader`)")))?;
     file.format_warnings = std::mem::take(&mut file.warnings);
+    file.set_defines(defines)?;
     file.prepare_shader()?;
     Ok(file)
 }
@@ -171,15 +183,21 @@ impl BrdfFile {
     /// The same file with its shader preprocessed under `defines` (`NAME`, `VALUE`; an empty value defines
     /// NAME as glslang's `-DNAME` does).
     pub fn with_defines(&self, defines: &[(String, String)]) -> Result<BrdfFile> {
+        let mut file = self.clone();
+        file.set_defines(defines)?;
+        file.prepare_shader()?;
+        Ok(file)
+    }
+
+    /// `defines`, refused where one is named like a parameter.
+    fn set_defines(&mut self, defines: &[(String, String)]) -> Result<()> {
         for (name, _) in defines {
             if let Some(p) = self.params.iter().find(|p| &p.name == name) {
                 bail!("{}: `define={name}`: `{name}` is the file's parameter (line {}); a macro of that name would replace it in the shader", self.path.display(), p.line);
             }
         }
-        let mut file = self.clone();
-        file.defines = defines.to_vec();
-        file.prepare_shader()?;
-        Ok(file)
+        self.defines = defines.to_vec();
+        Ok(())
     }
 
     /// Preprocesses `source` into `shader` and reads what the shader declares; the warnings are the format's,
