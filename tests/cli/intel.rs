@@ -4,22 +4,22 @@
 //! that executes refuses the targets; a missing compiler is an error naming the fix.
 
 use crate::common::{self, run};
-use crate::translated;
+use crate::compile_only;
 use brdfprof::targets::intel::{Class, FAMILIES};
 use std::path::Path;
 
 fn inspect_json(dir: &Path, name: &str, devices: &[&str], extra: &[&str]) -> serde_json::Value {
-    translated::inspect_json(dir, name, devices, extra, "IGC statistics")
+    compile_only::inspect_json(dir, name, devices, extra, "IGC statistics")
 }
 
 fn igc(row: &serde_json::Value, name: &str) -> f64 {
-    translated::stat(row, "IGC", name)
+    compile_only::stat(row, "IGC", name)
 }
 
 #[test]
 fn every_preset_and_example_file_gets_igc_statistics_on_all_five_families() {
     let dir = tempfile::tempdir().unwrap();
-    let models = translated::every_preset_and_example();
+    let models = compile_only::every_preset_and_example();
     let mut extra: Vec<&str> = Vec::new();
     for m in &models {
         extra.extend(["--model", m.as_str()]);

@@ -26,4 +26,4 @@ mod outputs;
 mod radv;
 mod report;
 mod signals;
-mod translated;
+mod compile_only;

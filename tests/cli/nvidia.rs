@@ -4,22 +4,22 @@
 //! targets; a missing compiler and a construct the translation lacks are errors naming the fix and the line.
 
 use crate::common::{self, run};
-use crate::translated;
+use crate::compile_only;
 use brdfprof::targets::nvidia::FAMILIES;
 use std::path::Path;
 
 fn inspect_json(dir: &Path, name: &str, devices: &[&str], extra: &[&str]) -> serde_json::Value {
-    translated::inspect_json(dir, name, devices, extra, "ptxas statistics")
+    compile_only::inspect_json(dir, name, devices, extra, "ptxas statistics")
 }
 
 fn sass(row: &serde_json::Value, name: &str) -> f64 {
-    translated::stat(row, "SASS", name)
+    compile_only::stat(row, "SASS", name)
 }
 
 #[test]
 fn every_preset_and_example_file_gets_sass_statistics_on_all_five_families() {
     let dir = tempfile::tempdir().unwrap();
-    let models = translated::every_preset_and_example();
+    let models = compile_only::every_preset_and_example();
     let mut extra: Vec<&str> = Vec::new();
     for m in &models {
         extra.extend(["--model", m.as_str()]);

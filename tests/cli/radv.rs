@@ -9,20 +9,11 @@ use std::path::Path;
 const KERNELS: [&str; 5] = ["ggx", "blinn", "cook-torrance", "burley", "baseline"];
 
 fn inspect_json(dir: &Path, name: &str, devices: &[&str], extra: &[&str]) -> serde_json::Value {
-    let json = dir.join(format!("{name}.json"));
-    let md = dir.join(format!("{name}.md"));
-    let mut args = vec!["inspect", "--no-callgrind", "--json", json.to_str().unwrap(), "--markdown", md.to_str().unwrap()];
-    for d in devices {
-        args.extend(["--device", d]);
-    }
-    args.extend(extra);
-    let out = run(&args).ok();
-    assert!(out.stdout.contains("ACO statistics"), "{}", out.stdout);
-    serde_json::from_str(&std::fs::read_to_string(json).unwrap()).unwrap()
+    crate::compile_only::inspect_json(dir, name, devices, extra, "ACO statistics")
 }
 
 fn stat(row: &serde_json::Value, name: &str) -> f64 {
-    row["stats"][format!("driver/Compute Shader/{name}")].as_f64().unwrap_or_else(|| panic!("{} has no {name}: {row}", row["model"]))
+    crate::compile_only::stat(row, "Compute Shader", name)
 }
 
 #[test]

@@ -1,6 +1,6 @@
-//! What the tests of the translating compile-only targets (tests/cli/nvidia.rs, tests/cli/intel.rs) share:
-//! an inspect run with a cache of its own, a compiler statistic of a row, and the models every target must
-//! take (every preset and each example `.brdf` file).
+//! What the tests of the compile-only targets (tests/cli/radv.rs, nvidia.rs, intel.rs) share: an inspect run
+//! with a cache of its own, a compiler statistic of a row, and the models every target must take (every
+//! preset and each example `.brdf` file).
 
 use crate::common;
 use std::path::Path;
