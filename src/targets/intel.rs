@@ -2,8 +2,8 @@
 //! OpenCL C translation (`translate`), Gen9 to Xe-HPC, with no Intel GPU or driver. Per kernel: the SIMD width
 //! IGC chose, its GRF count and mode, scratch space (spills and private memory), IGA's ISA listing counted by
 //! class, the binary's size, and a documented cost model: EU (vector engine) cycles from the instruction mix
-//! at the issue rates of Intel's public architecture documents (`THROUGHPUT`, the one place those figures
-//! live). These are "Intel's OpenCL compiler (IGC), same maths" figures: Mesa's ANV, Intel's Vulkan driver on
+//! at the issue rates of Intel's public architecture documents and of IGC's own scheduling model
+//! (`THROUGHPUT`, the one place those figures live). These are "Intel's OpenCL compiler (IGC), same maths" figures: Mesa's ANV, Intel's Vulkan driver on
 //! Linux, compiles SPIR-V with its own compiler (brw); Intel's Windows Vulkan driver uses IGC.
 
 use super::cost::{self, TargetCost};
@@ -45,19 +45,24 @@ pub struct Rate {
 }
 
 /// Lanes per clock per EU/vector engine (sources per row and column in `tests/fixtures/intel-throughput.tsv`,
-/// which transcribes the documents with their sections; a test ties every entry here to it; docs/targets.md
-/// names which figures the documents state and which are assumed).
+/// which transcribes the documents with their sections and the figures each rate is computed from; a test
+/// ties every entry here to it and recomputes it; docs/targets.md says which figures are stated and which
+/// derived).
 pub const THROUGHPUT: &[Rate] = &[
     Rate { row: FP32, lanes_per_clock: [8, 8, 8, 8, 16] },
     Rate { row: FP16, lanes_per_clock: [16, 16, 16, 16, 32] },
     Rate { row: INT32, lanes_per_clock: [8, 8, 8, 8, 16] },
     Rate { row: EM, lanes_per_clock: [2, 2, 2, 2, 4] },
+    Rate { row: EM_TWO_SOURCE, lanes_per_clock: [1, 1, 2, 2, 4] },
 ];
 
 const FP32: &str = "FP32 add, multiply, multiply-add";
 const FP16: &str = "FP16 add, multiply, multiply-add";
 const INT32: &str = "INT32 operations";
-const EM: &str = "extended math (math.*: inv, sqrt, rsqt, exp, log, sin, cos, pow, fdiv)";
+const EM: &str = "extended math (math.inv, sqt, rsqt, exp, log, sin, cos, iqot, irem)";
+const EM_TWO_SOURCE: &str = "extended math, pow and fdiv (math.pow, math.fdiv)";
+/// The math functions IGC's Gen8-11 scheduling model issues at half the other functions' rate.
+const TWO_SOURCE_FUNCTIONS: [&str; 2] = ["pow", "fdiv"];
 
 /// What an instruction is counted as in the report.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
@@ -98,10 +103,11 @@ pub fn classify(mnemonic: &str) -> Class {
 }
 
 /// The `THROUGHPUT` row an instruction issues at (None: one issue cycle, whatever its width: sends, whose
-/// latency the model leaves out, and control), from its class and destination type.
-fn row_of(class: Class, dst_type: &str) -> Option<&'static str> {
+/// latency the model leaves out, and control), from its class, destination type and math function.
+fn row_of(class: Class, dst_type: &str, function: &str) -> Option<&'static str> {
     match class {
         Class::Send | Class::Control => None,
+        Class::ExtendedMath if TWO_SOURCE_FUNCTIONS.contains(&function) => Some(EM_TWO_SOURCE),
         Class::ExtendedMath => Some(EM),
         _ if dst_type == "hf" => Some(FP16),
         _ if dst_type == "f" || dst_type == "df" => Some(FP32),
@@ -118,6 +124,8 @@ pub fn rate(row: &str, family: &Family) -> Option<u32> {
 #[derive(Debug, PartialEq)]
 pub struct Instruction<'a> {
     pub mnemonic: &'a str,
+    /// What follows the mnemonic's first `.` (`math.pow`: `pow`; `sync.nop`: `nop`), empty if nothing.
+    pub function: &'a str,
     pub exec_size: u32,
     pub dst_type: &'a str,
 }
@@ -134,14 +142,14 @@ pub fn instruction(line: &str) -> Option<Instruction<'_>> {
         words.next();
     }
     let op = words.next()?;
-    let mnemonic = op.split('.').next().unwrap_or(op);
+    let (mnemonic, function) = op.split_once('.').map_or((op, ""), |(m, f)| (m, f.split('.').next().unwrap_or(f)));
     if !mnemonic.chars().all(|c| c.is_ascii_alphanumeric()) || mnemonic.is_empty() {
         return None;
     }
     let rest: Vec<&str> = words.collect();
     let exec_size = rest.iter().find_map(|w| w.strip_prefix('(')?.split('|').next()?.parse().ok()).unwrap_or(1);
     let dst_type = rest.iter().find(|w| w.contains(':') && !w.starts_with('{')).and_then(|w| w.rsplit(':').next()).unwrap_or("");
-    Some(Instruction { mnemonic, exec_size, dst_type })
+    Some(Instruction { mnemonic, function, exec_size, dst_type })
 }
 
 /// The u32 words of every patch token in ocloc's PTM.txt dump, by token number (a token present twice keeps
@@ -213,7 +221,7 @@ impl IsaStats {
             *s.by_class.entry(class).or_default() += 1;
             // sync waits on a scoreboard (a latency the model leaves out) and issues no work.
             if i.mnemonic != "sync" {
-                s.by_row.entry(row_of(class, i.dst_type)).or_default().push(i.exec_size);
+                s.by_row.entry(row_of(class, i.dst_type, i.function)).or_default().push(i.exec_size);
             }
         }
         if s.instructions == 0 || ![8, 16, 32].contains(&s.simd) {
@@ -435,11 +443,15 @@ mod tests {
     #[test]
     fn iga_lines_give_mnemonic_width_and_type() {
         let i = instruction("(W&f0.0)  sel (16|M0)   (lt)f1.0   r39.0<1>:f    r4.1<0;1,0>:f     1.0:f   {Compacted}").unwrap();
-        assert_eq!(i, Instruction { mnemonic: "sel", exec_size: 16, dst_type: "f" });
+        assert_eq!(i, Instruction { mnemonic: "sel", function: "", exec_size: 16, dst_type: "f" });
         let m = instruction("        math.inv (32|M0)         r6.0<1>:f     r2.0<1;1,0>:f                    {F@1}").unwrap();
         assert_eq!((m.mnemonic, m.exec_size, classify(m.mnemonic)), ("math", 32, Class::ExtendedMath));
         let h = instruction("        mad (16|M0)              r5.0<1>:hf    r1.0<1;0>:hf   r2.0<1;0>:hf   r3.0<1;0>:hf").unwrap();
-        assert_eq!(row_of(classify(h.mnemonic), h.dst_type), Some(FP16));
+        assert_eq!(row_of(classify(h.mnemonic), h.dst_type, h.function), Some(FP16));
+        let p = instruction("        math.pow (16|M0)         r8.0<1>:f     r2.0<1;1,0>:f     r4.0<1;1,0>:f  {F@1}").unwrap();
+        assert_eq!((p.mnemonic, p.function), ("math", "pow"));
+        assert_eq!(row_of(classify(p.mnemonic), p.dst_type, p.function), Some(EM_TWO_SOURCE));
+        assert_eq!(row_of(classify(m.mnemonic), m.dst_type, m.function), Some(EM));
         assert!(instruction("L640:").is_none());
         assert!(instruction("// a comment").is_none());
         let s = instruction("        sync.nop                             null                             {Compacted,$6.dst}").unwrap();
@@ -460,33 +472,98 @@ mod tests {
 mod throughput_fixture {
     use super::*;
 
-    /// The fixture's rows: (row, family, lanes, basis, source).
-    fn fixture() -> Vec<(String, String, u32, String, String)> {
+    /// One fixture line: the rate, where it comes from and the source's figures it is computed from.
+    struct Entry {
+        row: String,
+        family: String,
+        lanes: u32,
+        basis: String,
+        source: String,
+        figures: String,
+    }
+
+    fn fixture() -> Vec<Entry> {
         include_str!("../../tests/fixtures/intel-throughput.tsv")
             .lines()
             .filter(|l| !l.starts_with('#') && !l.trim().is_empty())
             .map(|l| {
                 let f: Vec<&str> = l.split('\t').collect();
-                assert!(f.len() == 6 && !f[5].trim().is_empty(), "a fixture line needs row, family, lanes, basis, source and note: {l}");
-                (f[0].to_string(), f[1].to_string(), f[2].parse().unwrap(), f[3].to_string(), f[4].to_string())
+                assert!(f.len() == 7 && !f[6].trim().is_empty(), "a fixture line needs row, family, lanes, basis, source, figures and note: {l}");
+                Entry { row: f[0].into(), family: f[1].into(), lanes: f[2].parse().unwrap(), basis: f[3].into(), source: f[4].into(), figures: f[5].into() }
             })
             .collect()
     }
 
+    /// `a/b*c...` over integers, left to right, exact (a division that leaves a remainder is refused).
+    fn evaluate(figures: &str) -> u32 {
+        let mut value: Option<u32> = None;
+        let mut op = '*';
+        let mut number = String::new();
+        for c in figures.chars().chain(std::iter::once('\0')) {
+            if c.is_ascii_digit() {
+                number.push(c);
+                continue;
+            }
+            let n: u32 = number.parse().unwrap_or_else(|_| panic!("`{figures}`: a number expected before `{c}`"));
+            number.clear();
+            value = Some(match (value, op) {
+                (None, _) => n,
+                (Some(v), '*') => v * n,
+                (Some(v), _) => {
+                    assert_eq!(v % n, 0, "`{figures}` does not divide exactly");
+                    v / n
+                }
+            });
+            assert!(matches!(c, '*' | '/' | '\0'), "`{figures}`: only integers, * and /");
+            op = c;
+        }
+        value.unwrap()
+    }
+
     #[test]
-    fn every_rate_is_the_fixtures_and_every_fixture_entry_is_a_rate() {
+    fn every_rate_is_the_fixtures_computed_from_its_cited_figures() {
         let rows = fixture();
         let header = include_str!("../../tests/fixtures/intel-throughput.tsv");
-        for (row, family, lanes, basis, source) in &rows {
-            assert!(["stated", "derived", "assumed"].contains(&basis.as_str()), "{row} {family}: basis `{basis}`");
-            assert!(header.contains(&format!("# [{source}]")), "{row} {family}: source `{source}` is not cited in the header");
-            let column = COLUMNS.iter().position(|c| c == family).unwrap_or_else(|| panic!("unknown family {family}"));
-            let rate = THROUGHPUT.iter().find(|r| r.row == row).unwrap_or_else(|| panic!("the code has no row `{row}`"));
-            assert_eq!(rate.lanes_per_clock[column], *lanes, "{row} on {family}");
+        for e in &rows {
+            let what = format!("{} on {}", e.row, e.family);
+            assert!(["stated", "derived"].contains(&e.basis.as_str()), "{what}: basis `{}` (a rate is the source's figure or computed from it)", e.basis);
+            assert!(header.contains(&format!("# [{}]", e.source)), "{what}: source `{}` is not cited in the header", e.source);
+            assert_eq!(evaluate(&e.figures), e.lanes, "{what}: the figures `{}` do not give the rate", e.figures);
+            if e.basis == "stated" {
+                assert!(e.figures.chars().all(|c| c.is_ascii_digit()), "{what}: a stated rate is the figure itself, not `{}`", e.figures);
+            }
+            let column = COLUMNS.iter().position(|c| *c == e.family).unwrap_or_else(|| panic!("unknown family {}", e.family));
+            let rate = THROUGHPUT.iter().find(|r| r.row == e.row).unwrap_or_else(|| panic!("the code has no row `{}`", e.row));
+            assert_eq!(rate.lanes_per_clock[column], e.lanes, "{what}");
         }
         assert_eq!(rows.len(), THROUGHPUT.len() * COLUMNS.len(), "every rate of every family is in the fixture once");
         for (k, f) in FAMILIES.iter().enumerate() {
             assert_eq!((COLUMNS[f.column], f.column), (f.name, k));
         }
+        assert_eq!(evaluate("256/8/2"), 16);
+    }
+
+    /// The cost model by hand: a SIMD16 thread of two mads, a math.inv, a math.pow, a send and a sync.
+    #[test]
+    fn issue_cycles_by_hand() {
+        let listing = "        mad (16|M0)   r5.0<1>:f  r1.0<1;0>:f  r2.0<1;0>:f  r3.0<1;0>:f\n\
+                       (W)     mad (16|M0)   r6.0<1>:f  r1.0<1;0>:f  r2.0<1;0>:f  r3.0<1;0>:f\n\
+                               math.inv (16|M0)  r7.0<1>:f  r5.0<1;1,0>:f\n\
+                               math.pow (16|M0)  r8.0<1>:f  r5.0<1;1,0>:f  r6.0<1;1,0>:f\n\
+                               send.ugm (16|M0)  r9  r10  null:0  0x0  0x08200580  {$1}\n\
+                               sync.nop  null  {$1.dst}\n";
+        let mut s = IsaStats::default();
+        for i in listing.lines().filter_map(instruction) {
+            if i.mnemonic != "sync" {
+                s.by_row.entry(row_of(classify(i.mnemonic), i.dst_type, i.function)).or_default().push(i.exec_size);
+            }
+        }
+        let family = |n: &str| FAMILIES.iter().find(|f| f.name == n).unwrap();
+        // gen9: mads 16/8 = 2 each, inv 16/2 = 8, pow 16/1 = 16, send 1.
+        assert_eq!(s.issue_cycles(family("gen9")).unwrap(), 2.0 + 2.0 + 8.0 + 16.0 + 1.0);
+        // gen12lp: pow at the other functions' rate, 16/2 = 8.
+        assert_eq!(s.issue_cycles(family("gen12lp")).unwrap(), 2.0 + 2.0 + 8.0 + 8.0 + 1.0);
+        // xe-hpc: mads 16/16 = 1, math 16/4 = 4.
+        assert_eq!(s.issue_cycles(family("xe-hpc")).unwrap(), 1.0 + 1.0 + 4.0 + 4.0 + 1.0);
     }
 }
