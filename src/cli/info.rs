@@ -19,7 +19,7 @@ pub struct DevicesArgs {
 /// `devices --targets`: every vendor's families (`targets::VENDORS`) and whether its compiler is installed.
 fn targets_table() -> String {
     let mut out = String::from("Compile-only targets: each vendor's production compiler for GPU families this machine does not have (no GPU \
-         needed; nothing executes). Commands that compile take them: inspect, check, sweep --cost-device.\n\n");
+         needed; nothing executes). Commands that compile take them: inspect, check, sweep --cost-device, profile --scene --cost-device.\n\n");
     for v in brdfprof::targets::VENDORS {
         let status = v.status().unwrap_or_else(|e| format!("{e:#}"));
         let mut t = report::Table::new(["--device", "architecture", "products", "compiler", &format!("in {}:all", v.prefix())]);

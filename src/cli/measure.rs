@@ -36,6 +36,11 @@ pub struct ProfileArgs {
     /// ns/pixel and each effect's cost, measured by toggling it. The G-buffer size and models are the scene's.
     #[arg(long)]
     pub scene: Option<PathBuf>,
+    /// With --scene: also compile every kernel the scene profile times (each kernel as compiled and without
+    /// each effect) for a compile-only target (radv:FAMILY, nvidia:FAMILY, intel:FAMILY, PREFIX:all;
+    /// repeatable; see `devices --targets`): modelled cycles per pixel and per effect beside the measured ns.
+    #[arg(long = "cost-device", value_name = "DEVICE", value_parser = super::device_name)]
+    pub cost_devices: Vec<String>,
     #[command(flatten)]
     pub html: super::report::HtmlArg,
     #[command(flatten)]
@@ -45,6 +50,9 @@ pub struct ProfileArgs {
 pub fn profile(args: &ProfileArgs) -> Result<ExitCode> {
     if let Some(path) = &args.scene {
         return profile_scene(args, path);
+    }
+    if !args.cost_devices.is_empty() {
+        bail!("--cost-device applies to --scene; for models, `brdfprof inspect --device {}` gives the compile-only targets' figures", args.cost_devices[0]);
     }
     check_output("--json", args.json.as_deref(), "results", "profile-<device>.json")?;
     args.html.check()?;
@@ -88,11 +96,12 @@ fn profile_scene(args: &ProfileArgs, path: &std::path::Path) -> Result<ExitCode>
     if args.size.is_some() {
         bail!("--scene: the G-buffer size is the scene's; --size does not apply");
     }
+    let cost_targets = cost_targets(&args.cost_devices)?;
     let scene = scene::Scene::load(path)?;
     check_output("--json", args.json.as_deref(), "results", &format!("scene-{}-<device>.json", scene.name()))?;
     fresh_compilation(args.timing.shader_cache);
     let base = args.timing.options(Vec::new(), "1x1", args.reps, args.budget, args.target_ci)?;
-    let options = scene::profile::SceneProfileOptions { protocol: base.protocol, target_rel_ci: args.target_ci, max_chunk: None, instances: base.instances };
+    let options = scene::profile::SceneProfileOptions { protocol: base.protocol, target_rel_ci: args.target_ci, max_chunk: None, instances: base.instances, cost_targets, validate: args.device.validation() };
     let (gpu, result) = on_device(&args.device, |gpu, progress| scene::profile::run(gpu, &scene, &options, progress))?;
     let path = args.json.clone().unwrap_or_else(|| PathBuf::from(format!("{}/scene-{}-{}.json", super::DEFAULT_OUT, scene.name(), brdfprof::targets::device_slug(&gpu.info))));
     report::write_json(&path, &result)?;
@@ -146,7 +155,7 @@ fn cost_targets(devices: &[String]) -> Result<Vec<brdfprof::targets::Target>> {
     let mut out: Vec<brdfprof::targets::Target> = Vec::new();
     for d in devices {
         let Some(ts) = brdfprof::targets::parse(d)? else {
-            anyhow::bail!("--cost-device {d}: give a compile-only target ({}FAMILY or PREFIX:all; see `brdfprof devices --targets`); the sweep's own --device times the specs", brdfprof::targets::prefixes());
+            anyhow::bail!("--cost-device {d}: give a compile-only target ({}FAMILY or PREFIX:all; see `brdfprof devices --targets`); the command's own --device is the one that measures", brdfprof::targets::prefixes());
         };
         for t in ts {
             if !out.contains(&t) {

@@ -48,7 +48,7 @@ pub fn device_name(text: &str) -> Result<String, String> {
 pub fn compiles_only_error(device: &str) -> anyhow::Error {
     anyhow!(
         "--device {device}: a compile-only device ({}: a vendor's compiler without its GPU) compiles only and cannot run \
-         kernels; this command must execute them. Use `inspect`, `check` or `sweep --cost-device` with it, and a device \
+         kernels; this command must execute them. Use `inspect`, `check`, `sweep --cost-device` or `profile --scene --cost-device` with it, and a device \
          from `brdfprof devices` here",
         targets::prefixes()
     )

@@ -3,6 +3,7 @@
 //! only the light types and effects the scene uses (`plan`), run on the device (`run`), timed effect by effect
 //! (`profile`) and drawn (`render`).
 
+pub mod compile;
 pub mod effects;
 pub mod format;
 pub mod gbuffer;

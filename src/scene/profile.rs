@@ -6,6 +6,7 @@
 
 use super::format::Scene;
 use super::gbuffer::{self, GBuffer};
+use super::compile;
 use super::plan::{self, Effect, ScenePlan};
 use super::run::{self, SceneVariant, SceneWork};
 use super::spirv;
@@ -29,6 +30,9 @@ pub struct SceneProfileOptions {
     pub max_chunk: Option<u64>,
     /// Independently compiled pipelines per variant, all timed every round; the faster one counts.
     pub instances: usize,
+    /// Compile-only targets that also compile every variant (`compile`), with validation as the device has it.
+    pub cost_targets: Vec<crate::targets::Target>,
+    pub validate: bool,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -75,6 +79,9 @@ pub struct SceneProfileReport {
     pub confidence_level: f64,
     pub labels: Vec<String>,
     pub raw: RawTimes,
+    /// The same kernels on compile-only targets (`--cost-device`).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub targets: Vec<compile::SceneTargetReport>,
 }
 
 /// One timed variant: kernel index, the effect compiled out (None: as planned).
@@ -125,14 +132,9 @@ fn resolved(a: &Analysis, target: f64) -> bool {
 /// Every kernel of the plan as compiled and, for each effect it compiles in, without that effect.
 fn variants<'g>(gpu: &'g Gpu, work: &SceneWork<'g>, p: &ScenePlan, instances: usize) -> Result<(Vec<Slot>, Vec<SceneVariant<'g>>)> {
     let (mut slots, mut variants) = (Vec::new(), Vec::new());
-    for (k, kp) in p.kernels.iter().enumerate() {
-        let name = kp.model.label();
-        slots.push(Slot { kernel: k, without: None });
-        variants.push(SceneVariant::new(gpu, work, p, k, kp.switches, name.clone(), instances)?);
-        for e in Effect::ALL.into_iter().filter(|e| e.is_on(&kp.switches)) {
-            slots.push(Slot { kernel: k, without: Some(e) });
-            variants.push(SceneVariant::new(gpu, work, p, k, e.off(kp.switches), format!("{name} without {}", e.name()), instances)?);
-        }
+    for v in compile::variant_specs(p) {
+        slots.push(Slot { kernel: v.kernel, without: v.without });
+        variants.push(SceneVariant::new(gpu, work, p, v.kernel, v.switches, v.label, instances)?);
     }
     Ok((slots, variants))
 }
@@ -165,6 +167,9 @@ pub fn run(gpu: &Gpu, scene: &Scene, options: &SceneProfileOptions, progress: &P
     progress.set_message("E tables");
     let tables = run::e_tables(gpu, &p)?;
     let work = SceneWork::upload(gpu, scene, &g, &p, &tables, RunLimits { max_chunk: options.max_chunk })?;
+    // The targets' figures first (seconds): a missing compiler fails before the long measurement.
+    progress.set_message("compile-only targets");
+    let targets = compile::reports(gpu, &work, &p, &options.cost_targets, options.validate)?;
     progress.set_message("compiling kernels");
     let (slots, variants) = variants(gpu, &work, &p, options.instances)?;
     let pixels: Vec<u64> = work.kernels.iter().map(|k| k.count).collect();
@@ -215,6 +220,7 @@ pub fn run(gpu: &Gpu, scene: &Scene, options: &SceneProfileOptions, progress: &P
         confidence_level: LEVEL,
         labels: variants.iter().map(|v| v.label.clone()).collect(),
         raw,
+        targets,
     })
 }
 
@@ -274,6 +280,8 @@ impl SceneProfileReport {
             }
             out += &format!("\nCost of each effect (kernel as compiled minus the kernel without it, per round):\n\n{}", e.markdown());
         }
-        out
+        let measured = |model: &str| self.kernels.iter().find(|k| k.model == model).map_or("-".into(), |k| report::estimate(&k.ns_per_pixel, 3));
+        let measured_effect = |model: &str, effect: &str| self.effects.iter().find(|e| e.model == model && e.effect == effect).map_or("-".into(), |e| report::estimate(&e.extra_ns_per_pixel, 3));
+        out + &compile::markdown(&self.targets, measured, measured_effect, &self.provenance.device.name)
     }
 }

@@ -86,6 +86,16 @@ impl<'g> SceneWork<'g> {
         self.kernels[k].chunks.chunks.len()
     }
 
+    /// Kernel `k`'s bindings as bytes by (set, binding), as its last run read them (the radiance zeroed), its
+    /// push constants (the camera), and the invocations of one run (its pixels padded to whole workgroups):
+    /// what the kernel's translation runs on, on the host.
+    pub fn host_inputs(&self, k: usize) -> Result<(std::collections::BTreeMap<(u32, u32), Vec<u8>>, Vec<u8>, u64)> {
+        let kb = &self.kernels[k];
+        let bytes = |b: &Buffer| b.read_as::<u8>(0, b.size as usize);
+        let buffers = [((0, 0), bytes(&kb.pixels)?), ((0, 1), vec![0u8; kb.radiance.size as usize]), ((0, 2), bytes(&self.lights)?), ((0, 3), bytes(&kb.extras)?), ((0, 4), bytes(&kb.table)?)];
+        Ok((buffers.into(), bytemuck::cast::<[f32; 4], [u8; 16]>(self.camera).to_vec(), kb.radiance.size / OUT_BYTES))
+    }
+
     /// Radiance written by kernel `k`'s last run, one rgb per pixel of the kernel.
     pub fn radiance(&self, k: usize) -> Result<Vec<[f32; 3]>> {
         let kb = &self.kernels[k];

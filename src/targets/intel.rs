@@ -316,6 +316,12 @@ pub fn inspect(families: &[&Family], req: &Request) -> Result<Vec<InspectReport>
     let gpu = req.verify_on.ok_or_else(|| anyhow!("intel: no Vulkan device to check the translation against"))?;
     let checked = super::checked_translations(req, gpu, crate::translate::Dialect::OpenCl)?;
     let statics = crate::inspect::kernels_of(req.models).into_iter().map(|m| crate::inspect::static_row(req.shaders, m, req.lights)).collect::<Result<Vec<_>>>()?;
+    compile_checked(families, statics, &checked, tools, req)
+}
+
+/// Every checked translation compiled for each family, its statistics added to its row (`statics`, in the
+/// same order), as one report per family.
+fn compile_checked(families: &[&Family], statics: Vec<crate::inspect::Row>, checked: &[super::Checked], tools: &ocloc::Tools, req: &Request) -> Result<Vec<InspectReport>> {
     let jobs: Vec<(usize, usize)> = (0..families.len()).flat_map(|f| (0..checked.len()).map(move |k| (f, k))).collect();
     // Each job is an ocloc process: one per core.
     use rayon::prelude::*;
@@ -396,6 +402,13 @@ impl super::Vendor for Intel {
     fn compile(&self, families: &[usize], request: &Request) -> Result<Vec<Run>> {
         let chosen: Vec<&Family> = families.iter().map(|&k| &FAMILIES[k]).collect();
         let reports = inspect(&chosen, request)?;
+        Ok(reports.into_iter().zip(families).map(|(report, &family)| Run { target: Target { vendor: &INTEL, family }, report, isa_files: Vec::new(), note: None }).collect())
+    }
+
+    fn compile_raw(&self, families: &[usize], kernels: &[super::RawKernel], request: &Request) -> Result<Vec<Run>> {
+        let chosen: Vec<&Family> = families.iter().map(|&k| &FAMILIES[k]).collect();
+        let checked: Vec<super::Checked> = kernels.iter().map(|k| super::Checked { source: k.translation.source(crate::translate::Dialect::OpenCl), agreement: k.agreement.clone() }).collect();
+        let reports = compile_checked(&chosen, kernels.iter().map(super::raw_row).collect(), &checked, ocloc::tools()?, request)?;
         Ok(reports.into_iter().zip(families).map(|(report, &family)| Run { target: Target { vendor: &INTEL, family }, report, isa_files: Vec::new(), note: None }).collect())
     }
 

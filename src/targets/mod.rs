@@ -1,10 +1,11 @@
 //! Compile-only targets: GPU families whose production compiler brdfprof runs without the GPU, one `Vendor`
 //! each (`radv`: Mesa RADV's ACO in a child process; `nvidia`: NVRTC and ptxas on the kernels' CUDA C++
 //! translation; `intel`: IGC through ocloc on their OpenCL C translation), listed once in `VENDORS`. A target is `--device PREFIX:FAMILY` (or `PREFIX:all`, or
-//! `PREFIX:a,b`); `devices --targets`, `inspect`, `check`, `sweep --cost-device` and `compare` reach the vendors
+//! `PREFIX:a,b`); `devices --targets`, `inspect`, `check`, `sweep --cost-device`, `profile --scene --cost-device` and `compare` reach the vendors
 //! only through this module: a vendor is its families, how it compiles every kernel for them (an `inspect`
 //! report per family, with its compiler's statistics under `driver/`), its cost model (`cost`), and what its
-//! statistics depend on (the gate's fingerprint).
+//! statistics depend on (the gate's fingerprint). Kernels from outside the model set (a scene's kernels) reach
+//! the same compilers as `RawKernel`s (`compile_raw_all`).
 
 pub use crate::inspect::cost;
 pub mod intel;
@@ -54,6 +55,21 @@ pub struct Request<'a> {
     pub verify_on: Option<&'a Gpu>,
 }
 
+/// A kernel from outside the model set (a scene's kernels, `scene::compile`), ready for every vendor: its
+/// SPIR-V specialised and frozen (what RADV compiles), its translation checked against the Vulkan kernel
+/// before (what NVIDIA's and Intel's compilers compile), and its interface: storage buffers 0..n of set 0
+/// and the push-constant bytes.
+pub struct RawKernel {
+    /// The row name in the reports ("ggx", "ggx without clear-coat").
+    pub label: String,
+    pub spirv: Vec<u32>,
+    pub storage_buffers: u32,
+    pub push_bytes: u32,
+    pub translation: crate::translate::Translation,
+    /// The row note: the device the translation was checked on and the worst difference.
+    pub agreement: String,
+}
+
 /// One family's result.
 pub struct Run {
     pub target: Target,
@@ -79,6 +95,10 @@ pub trait Vendor: Sync {
     /// Every kernel (the models' and the memory-only one) compiled for each of `families` (indices into
     /// `families()`), in order.
     fn compile(&self, families: &[usize], request: &Request) -> Result<Vec<Run>>;
+    /// `kernels` compiled for each of `families`: one report per family whose rows are the kernels, in order,
+    /// with the vendor's cost table (`request` gives the lights per kernel the cost divides by, and the
+    /// options; its models are not compiled).
+    fn compile_raw(&self, families: &[usize], kernels: &[RawKernel], request: &Request) -> Result<Vec<Run>>;
     /// The cost table of a report whose statistics are this vendor's, None for any other report.
     fn cost(&self, report: &InspectReport) -> Option<TargetCost>;
     /// The family a report of this vendor's compile-only targets was made for.
@@ -180,6 +200,27 @@ pub fn compile_all(targets: &[Target], request: &Request) -> Result<Vec<Run>> {
         }
     }
     Ok(runs.into_iter().map(|r| r.expect("every target compiled")).collect())
+}
+
+/// `compile_all` for kernels outside the model set.
+pub fn compile_raw_all(targets: &[Target], kernels: &[RawKernel], request: &Request) -> Result<Vec<Run>> {
+    let mut runs: Vec<Option<Run>> = targets.iter().map(|_| None).collect();
+    for vendor in VENDORS {
+        let mine: Vec<usize> = (0..targets.len()).filter(|&k| targets[k].vendor.prefix() == vendor.prefix()).collect();
+        if mine.is_empty() {
+            continue;
+        }
+        let families: Vec<usize> = mine.iter().map(|&k| targets[k].family).collect();
+        for (k, run) in mine.into_iter().zip(vendor.compile_raw(&families, kernels, request)?) {
+            runs[k] = Some(run);
+        }
+    }
+    Ok(runs.into_iter().map(|r| r.expect("every target compiled")).collect())
+}
+
+/// A report row for a raw kernel: its label, no spec, the translation's agreement as its note.
+pub(crate) fn raw_row(k: &RawKernel) -> crate::inspect::Row {
+    crate::inspect::Row { model: k.label.clone(), spec: None, stats: BTreeMap::new(), notes: [("translation".to_string(), k.agreement.clone())].into() }
 }
 
 /// The compile-only target a report was made for, if any.

@@ -27,6 +27,27 @@ pub const SHOWN: [&str; 7] = ["Instructions", "VGPRs", "SGPRs", "Spilled VGPRs",
 pub struct Radv;
 pub static RADV: Radv = Radv;
 
+impl Radv {
+    /// One child per family compiling the models (or, when given, the raw kernels instead).
+    fn children(&self, families: &[usize], raw: &[super::RawKernel], request: &Request) -> Result<Vec<Run>> {
+        let targets: Vec<&'static Family> = families.iter().map(|&k| &FAMILIES[k]).collect();
+        let lights = if raw.is_empty() { request.lights } else { 1 };
+        let runs = super::radv_child::run_all(&targets, request.models, raw, lights, request.shaders, request.validate, request.isa_dir)?;
+        Ok(runs
+            .into_iter()
+            .zip(families)
+            .map(|(run, &family)| {
+                let mut report = run.report;
+                if let Some(note) = &run.teardown_note {
+                    report.section_notes.insert("driver/".into(), note.clone());
+                }
+                report.cost = super::Vendor::cost(self, &report);
+                Run { target: Target { vendor: &RADV, family }, report, isa_files: run.isa_files, note: run.teardown_note }
+            })
+            .collect())
+    }
+}
+
 fn device_name(report: &InspectReport) -> &str {
     report.provenance["device"]["name"].as_str().unwrap_or("?")
 }
@@ -57,20 +78,14 @@ impl super::Vendor for Radv {
     }
 
     fn compile(&self, families: &[usize], request: &Request) -> Result<Vec<Run>> {
-        let targets: Vec<&'static Family> = families.iter().map(|&k| &FAMILIES[k]).collect();
-        let runs = super::radv_child::run_all(&targets, request.models, request.lights, request.shaders, request.validate, request.isa_dir)?;
-        Ok(runs
-            .into_iter()
-            .zip(families)
-            .map(|(run, &family)| {
-                let mut report = run.report;
-                if let Some(note) = &run.teardown_note {
-                    report.section_notes.insert("driver/".into(), note.clone());
-                }
-                report.cost = super::Vendor::cost(self, &report);
-                Run { target: Target { vendor: &RADV, family }, report, isa_files: run.isa_files, note: run.teardown_note }
-            })
-            .collect())
+        self.children(families, &[], request)
+    }
+
+    fn compile_raw(&self, families: &[usize], kernels: &[super::RawKernel], request: &Request) -> Result<Vec<Run>> {
+        if kernels.is_empty() {
+            anyhow::bail!("radv: no raw kernel to compile");
+        }
+        self.children(families, kernels, request)
     }
 
     fn cost(&self, report: &InspectReport) -> Option<TargetCost> {

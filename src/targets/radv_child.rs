@@ -36,6 +36,19 @@ pub struct RadvRequest {
     pub glsl: Option<PathBuf>,
     /// Write each kernel's internal representations under DIR/<family>/.
     pub isa_dir: Option<PathBuf>,
+    /// Kernels from outside the model set (`RawKernel`), compiled instead of the models when given.
+    #[serde(default)]
+    pub raw: Vec<RawSpirv>,
+}
+
+/// A raw kernel for the child: its frozen SPIR-V in a file (a scene kernel's words are more than one
+/// command-line argument may carry) and its interface.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct RawSpirv {
+    pub label: String,
+    pub path: PathBuf,
+    pub storage_buffers: u32,
+    pub push_bytes: u32,
 }
 
 /// What the child prints on its last stdout line.
@@ -79,6 +92,13 @@ pub fn child_main(request_json: &str) -> Result<()> {
     if !gpu.info.compile_only() {
         bail!("{} is not RADV's compile-only device", gpu.info.name);
     }
+    if !req.raw.is_empty() {
+        let report = raw_report(&gpu, &shaders, &req.raw)?;
+        gpu.check_validation()?;
+        drop(gpu);
+        println!("{}", serde_json::to_string(&RadvReply { family: target.family.to_string(), report, isa_files: Vec::new() })?);
+        return Ok(());
+    }
     // A model this family cannot compile (fp16 arithmetic where the device has no shaderFloat16) is left out
     // and named in the driver section's notes, so that one family does not stop a report of many.
     let (models, skipped): (Vec<Model>, Vec<Model>) = models.into_iter().partition(|m| m.check_support(&gpu.info).is_ok());
@@ -114,6 +134,23 @@ pub fn child_main(request_json: &str) -> Result<()> {
     Ok(())
 }
 
+/// The raw kernels compiled on the null device, one row each with ACO's statistics, as one report (one light
+/// per kernel: a raw kernel's own loops are its cost).
+fn raw_report(gpu: &Gpu, shaders: &Shaders, raw: &[RawSpirv]) -> Result<InspectReport> {
+    let mut rows = Vec::new();
+    for r in raw {
+        let bytes = std::fs::read(&r.path).with_context(|| format!("the radv child cannot read {}", r.path.display()))?;
+        let words: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes);
+        let kernel = Kernel::new(gpu, &r.label, &words, &Default::default(), &crate::gpu::Binding::storage(r.storage_buffers), r.push_bytes)?;
+        let mut row = crate::inspect::Row { model: r.label.clone(), spec: None, stats: Default::default(), notes: Default::default() };
+        let executables = kernel.executables()?.ok_or_else(|| anyhow!("{} reports no pipeline statistics", gpu.info.name))?;
+        row.stats.extend(crate::inspect::driver::stats(&executables.into_iter().flat_map(|e| e.stats).collect::<Vec<_>>()));
+        rows.push(row);
+    }
+    let provenance = serde_json::to_value(crate::report::Provenance::new(&gpu.info))?;
+    Ok(crate::inspect::compiled_report(rows, provenance, 1, shaders, Default::default(), Default::default()))
+}
+
 /// Set in a child's environment, it dies of SIGSEGV after printing its report, as Mesa 22.3's teardown of the
 /// null device did (vkDeviceWaitIdle through a null pointer): the test that the parent contains such a crash.
 pub const CRASH_AFTER_REPLY: &str = "BRDFPROF_TEST_RADV_CHILD_CRASH";
@@ -140,12 +177,18 @@ fn write_isa(gpu: &Gpu, shaders: &Shaders, model: Option<&Model>, lights: u32, d
 }
 
 /// Runs the child for one target and reads its report.
-pub fn run(target: &'static Family, models: &[Model], lights: u32, shaders: &Shaders, validate: bool, isa_dir: Option<&Path>) -> Result<RadvRun> {
+pub fn run(target: &'static Family, models: &[Model], raw: &[super::RawKernel], lights: u32, shaders: &Shaders, validate: bool, isa_dir: Option<&Path>) -> Result<RadvRun> {
     // The child writes its ISA files into its own TMPDIR; they become outputs of this process (staged with
     // its others) only once the child has succeeded.
     let mut cmd = cleanup::command(&std::env::current_exe().context("cannot find brdfprof's own executable")?.to_string_lossy());
     let tmp = cleanup::child_tmpdir(&mut cmd)?;
     let child_isa = isa_dir.map(|_| tmp.path().join("isa"));
+    let mut raw_files = Vec::new();
+    for (k, r) in raw.iter().enumerate() {
+        let path = tmp.path().join(format!("raw-{k}.spv"));
+        std::fs::write(&path, bytemuck::cast_slice::<u32, u8>(&r.spirv)).with_context(|| format!("cannot write {}", path.display()))?;
+        raw_files.push(RawSpirv { label: r.label.clone(), path, storage_buffers: r.storage_buffers, push_bytes: r.push_bytes });
+    }
     let req = RadvRequest {
         family: target.family.to_string(),
         models: models.iter().map(Model::name).collect(),
@@ -153,6 +196,7 @@ pub fn run(target: &'static Family, models: &[Model], lights: u32, shaders: &Sha
         validate,
         glsl: shaders.glsl_dir().map(Path::to_path_buf),
         isa_dir: child_isa.clone(),
+        raw: raw_files,
     };
     cmd.arg(CHILD_COMMAND)
         .arg(serde_json::to_string(&req)?)
@@ -162,7 +206,7 @@ pub fn run(target: &'static Family, models: &[Model], lights: u32, shaders: &Sha
     // The child compiles each kernel under the compile limit itself; the whole child gets one limit per
     // kernel (models, the memory-only kernel, their ISA captures) and a few seconds to start.
     crate::compile_limit::export(&mut cmd);
-    let kernels = (models.len() as u32 + 1) * if isa_dir.is_some() { 2 } else { 1 };
+    let kernels = (models.len() as u32 + 1 + raw.len() as u32) * if isa_dir.is_some() { 2 } else { 1 };
     let limit = crate::compile_limit::limit() * kernels + std::time::Duration::from_secs(10);
     let what = format!("the kernels for radv:{} (ACO, in a child process)", target.family);
     let output = crate::compile_limit::output_within(&mut cmd, &what, limit).context("cannot run brdfprof's radv child")?;
@@ -207,7 +251,7 @@ fn publish(file: &Path, from: &Path, to: &Path) -> Result<PathBuf> {
 }
 
 /// `run` for every target, at most as many children at once as the host has cores; results in order.
-pub fn run_all(targets: &[&'static Family], models: &[Model], lights: u32, shaders: &Shaders, validate: bool, isa_dir: Option<&Path>) -> Result<Vec<RadvRun>> {
+pub fn run_all(targets: &[&'static Family], models: &[Model], raw: &[super::RawKernel], lights: u32, shaders: &Shaders, validate: bool, isa_dir: Option<&Path>) -> Result<Vec<RadvRun>> {
     let workers = std::thread::available_parallelism().map_or(1, |n| n.get()).min(targets.len()).max(1);
     let next = std::sync::atomic::AtomicUsize::new(0);
     let results: std::sync::Mutex<Vec<Option<Result<RadvRun>>>> = std::sync::Mutex::new((0..targets.len()).map(|_| None).collect());
@@ -219,7 +263,7 @@ pub fn run_all(targets: &[&'static Family], models: &[Model], lights: u32, shade
                 if i >= targets.len() {
                     break;
                 }
-                let r = run(targets[i], models, lights, shaders, validate, isa_dir);
+                let r = run(targets[i], models, raw, lights, shaders, validate, isa_dir);
                 results.lock().unwrap_or_else(|e| e.into_inner())[i] = Some(r);
             });
         }

@@ -91,6 +91,62 @@ fn profile_scene_prints_what_is_compiled_in_and_effect_costs() {
     assert_eq!(report["kernels"].as_array().unwrap().len(), 2);
 }
 
+/// `--cost-device`: every kernel the profile times, compiled by each vendor's compiler (ACO on the frozen
+/// SPIR-V; NVRTC and IGC on the translation, which first shades the scene's pixels on the host and agrees
+/// with the Vulkan kernel), with modelled cycles per pixel and what each effect adds.
+#[test]
+fn profile_scene_cost_devices_compile_every_variant_on_each_vendor() {
+    let dir = tempfile::tempdir().unwrap();
+    let f = write(dir.path(), "s.json", SMALL);
+    let json = dir.path().join("p.json");
+    let targets = ["radv:navi21", "nvidia:sm_89", "intel:gen12lp"];
+    let mut args = vec!["profile", "--validate", "--scene", &f, "--budget", "3", "--min-rounds", "2", "--json", json.to_str().unwrap()];
+    for t in targets {
+        args.extend(["--cost-device", t]);
+    }
+    let (code, out, err) = run(&args);
+    assert_eq!(code, 0, "{err}");
+    assert!(!err.contains("validation ["), "{err}");
+    let report: Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let reports = report["targets"].as_array().unwrap();
+    assert_eq!(reports.iter().map(|r| r["target"].as_str().unwrap()).collect::<Vec<_>>(), targets);
+    for r in reports {
+        let name = r["target"].as_str().unwrap();
+        assert!(out.contains(&format!("{name} cycles/pixel")), "{out}");
+        let kernels = r["kernels"].as_array().unwrap();
+        assert_eq!(kernels.iter().map(|k| k["model"].as_str().unwrap()).collect::<Vec<_>>(), ["ggx", "blinn"], "{name}");
+        for k in kernels {
+            assert!(k["cycles_per_pixel"].as_f64().unwrap() > 0.0, "{name} {}", k["model"]);
+            assert!(k["stats"].as_object().unwrap().len() >= 5, "{name}: the cost table's statistics are carried");
+        }
+        let effects = r["effects"].as_array().unwrap();
+        assert_eq!(effects.len(), 4, "{name}");
+        // Anisotropy (a second lobe per light) and the clear coat (a second specular lobe) add instructions on
+        // every compiler: compiling them out must save modelled cycles.
+        for e in effects.iter().filter(|e| e["effect"] == "anisotropy" || e["effect"] == "clear-coat") {
+            assert!(e["extra_cycles_per_pixel"].as_f64().unwrap() > 0.0, "{name} {}: {e}", e["effect"]);
+        }
+        if name.starts_with("radv:") {
+            assert!(r["translation"].as_object().unwrap().is_empty(), "ACO compiles the SPIR-V itself");
+            continue;
+        }
+        let notes = r["translation"].as_object().unwrap();
+        assert_eq!(notes.len(), 6, "{name}: every variant's translation was checked: {notes:?}");
+        for (label, note) in notes {
+            let worst: f64 = note.as_str().unwrap().split("worst relative difference ").nth(1).unwrap().split_whitespace().next().unwrap().parse().unwrap();
+            assert!(worst <= 1e-3, "{name} {label}: {note}");
+            assert!(note.as_str().unwrap().contains("pixels (") && !note.as_str().unwrap().contains("(0 lit)"), "{label}: {note}");
+        }
+    }
+    // The cost devices are compile-only targets, and only a scene profile takes them.
+    let (code, _, err) = run(&["profile", "--scene", &f, "--cost-device", "llvmpipe"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("--cost-device llvmpipe") && err.contains("compile-only target"), "{err}");
+    let (code, _, err) = run(&["profile", "--cost-device", "radv:navi21"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("--cost-device applies to --scene") && err.contains("inspect --device radv:navi21"), "{err}");
+}
+
 #[test]
 fn bad_scenes_exit_2_naming_the_problem() {
     let dir = tempfile::tempdir().unwrap();

@@ -1,0 +1,241 @@
+//! `profile --scene FILE --cost-device TARGET`: the scene's kernels as its profile times them (each kernel of
+//! the plan as compiled, and without each effect it compiles in) compiled by compile-only targets' compilers
+//! (`targets::compile_raw_all`): modelled cycles per shaded pixel, every light of the plan included, and what
+//! each effect adds, beside the measured ns/pixel. RADV compiles the frozen SPIR-V; NVIDIA and Intel compile
+//! its C translation, which first shades the scene's own pixels on the host (g++) and must agree with the Vulkan
+//! kernel on the measuring device before its cost is reported.
+
+use super::plan::{Effect, ScenePlan};
+use super::run::{SceneVariant, SceneWork};
+use super::terms::Switches;
+use crate::gpu::Gpu;
+use crate::kernels;
+use crate::model::KernelKind;
+use crate::profile::protocol::Timed;
+use crate::report::Table;
+use crate::targets::{self, RawKernel, Target};
+use crate::translate::{self, host::HostKernel, verify};
+use anyhow::{anyhow, bail, Result};
+use serde::{Deserialize, Serialize};
+
+/// Storage buffers of glsl/scene.comp (pixels, radiance, lights, extras, E table) and its push constants (the
+/// camera).
+const STORAGE_BUFFERS: u32 = 5;
+const PUSH_BYTES: u32 = 16;
+/// The radiance output's binding.
+const RADIANCE: (u32, u32) = (0, 1);
+
+/// Relative tolerance of the host run against the Vulkan kernel, over each pixel's brightest channel: the float
+/// output has no quantisation, so this is the two maths libraries' difference (a few ulps, amplified by the
+/// pow and exp forms and summed over the lights) with a wide margin, and far below a wrong translation's.
+pub const TOLERANCE: f64 = 1e-3;
+
+/// How a scene kernel's translation agreed with the Vulkan kernel over the kernel's pixels.
+#[derive(Clone, Copy, Debug, Serialize, Deserialize)]
+struct Agreement {
+    worst: f64,
+    pixels: usize,
+    /// Pixels the device's kernel lit (any channel not 0): the comparison says nothing about the others.
+    lit: usize,
+}
+
+/// One kernel the profile times: kernel `kernel` of the plan with `switches` (as planned, or without `without`).
+#[derive(Clone, Debug)]
+pub struct VariantSpec {
+    pub kernel: usize,
+    pub without: Option<Effect>,
+    pub switches: Switches,
+    pub label: String,
+}
+
+/// Every kernel of the plan as compiled and, for each effect it compiles in, without that effect.
+pub fn variant_specs(p: &ScenePlan) -> Vec<VariantSpec> {
+    let mut out = Vec::new();
+    for (k, kp) in p.kernels.iter().enumerate() {
+        let name = kp.model.label();
+        out.push(VariantSpec { kernel: k, without: None, switches: kp.switches, label: name.clone() });
+        for e in Effect::ALL.into_iter().filter(|e| e.is_on(&kp.switches)) {
+            out.push(VariantSpec { kernel: k, without: Some(e), switches: e.off(kp.switches), label: format!("{name} without {}", e.name()) });
+        }
+    }
+    out
+}
+
+/// A kernel's modelled cost on one target.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct TargetKernelRow {
+    pub model: String,
+    pub cycles_per_pixel: f64,
+    /// The statistics the target's cost table shows (registers, instructions, ...), by name.
+    pub stats: std::collections::BTreeMap<String, f64>,
+}
+
+/// What an effect adds on one target.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct TargetEffectRow {
+    pub model: String,
+    pub effect: String,
+    pub extra_cycles_per_pixel: f64,
+    /// The same difference over the cycles without the effect.
+    pub extra_fraction: f64,
+}
+
+/// One compile-only target's report on the scene's kernels.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct SceneTargetReport {
+    /// `radv:navi21`.
+    pub target: String,
+    pub device: String,
+    pub compiler: String,
+    /// The cost rule and its unit, as the target's cost table states them (one light per kernel: a scene
+    /// kernel's own light loops are in its cost, so cycles/eval is cycles per shaded pixel).
+    pub model: String,
+    pub unit: String,
+    pub kernels: Vec<TargetKernelRow>,
+    pub effects: Vec<TargetEffectRow>,
+    /// Per variant label: how its translation agreed with the Vulkan kernel (translating targets only).
+    pub translation: std::collections::BTreeMap<String, String>,
+    pub notes: Vec<String>,
+}
+
+/// The variants compiled for every target: RADV from the frozen SPIR-V, the others from the translation,
+/// checked on the host against `gpu` first.
+pub fn reports(gpu: &Gpu, work: &SceneWork, p: &ScenePlan, targets: &[Target], validate: bool) -> Result<Vec<SceneTargetReport>> {
+    if targets.is_empty() {
+        return Ok(Vec::new());
+    }
+    let specs = variant_specs(p);
+    let raw = specs.iter().map(|v| raw_kernel(gpu, work, p, v)).collect::<Result<Vec<_>>>()?;
+    let shaders = crate::shaders::Shaders::embedded();
+    let request = targets::Request { models: &[], lights: 1, shaders: &shaders, validate, isa_dir: None, precise: false, verify_on: Some(gpu) };
+    let runs = targets::compile_raw_all(targets, &raw, &request)?;
+    runs.into_iter().map(|run| target_report(run, &specs, p)).collect()
+}
+
+/// One variant as a raw kernel: its frozen SPIR-V and its checked translation.
+fn raw_kernel(gpu: &Gpu, work: &SceneWork, p: &ScenePlan, v: &VariantSpec) -> Result<RawKernel> {
+    let mk = p.kernels[v.kernel].model.kernel(KernelKind::Scene, kernels::embedded())?;
+    let constants = p.constants(mk.constants, v.switches);
+    let spirv = crate::inspect::spirv::specialise(&mk.spirv.words, &constants)?;
+    let translation = translate::translate(&translate::prepare::prepared(&mk.spirv.words, &constants)?, &Default::default()).map_err(|e| anyhow!("{}: {e}", v.label))?;
+    let a = agreement_cached(gpu, work, p, v, &translation, &mk.spirv.words, &format!("{constants:?}"))?;
+    let worst = a.worst;
+    if !(worst <= TOLERANCE) {
+        bail!(
+            "{}: the C translation of the scene kernel disagrees with the Vulkan kernel on {} (worst relative difference {worst:.3e}, tolerance {TOLERANCE:.0e}): its cost is not reported. This is a translator defect; please report it with the scene",
+            v.label, gpu.info.name
+        );
+    }
+    let agreement = format!("translation checked on the host against {} over the kernel's {} pixels ({} lit): worst relative difference {worst:.1e} (tolerance {TOLERANCE:.0e})", gpu.info.name, a.pixels, a.lit);
+    Ok(RawKernel { label: v.label.clone(), spirv, storage_buffers: STORAGE_BUFFERS, push_bytes: PUSH_BYTES, translation, agreement })
+}
+
+/// `agreement`, or its result from the cache: the key covers the host translation, the Vulkan kernel's SPIR-V
+/// and constants, the device and its driver, and the kernel's inputs.
+fn agreement_cached(gpu: &Gpu, work: &SceneWork, p: &ScenePlan, v: &VariantSpec, t: &translate::Translation, words: &[u32], constants: &str) -> Result<Agreement> {
+    let (inputs, push, invocations) = work.host_inputs(v.kernel)?;
+    let mut key = crate::cache::KeyBuilder::new("scene-agreement")
+        .part("brdfprof", env!("CARGO_PKG_VERSION"))
+        .part("device", format!("{} {} {} {}", gpu.info.name, gpu.info.driver_name, gpu.info.driver_info, gpu.info.driver_version))
+        .part("host", format!("{} {}", t.source(translate::Dialect::Host), translate::host::HOST_FLAGS.join(" ")))
+        .part("spirv", bytemuck::cast_slice::<u32, u8>(words))
+        .part("constants", constants)
+        .part("push", &push)
+        .part("invocations", invocations.to_string());
+    for (slot, bytes) in &inputs {
+        key = key.part(&format!("binding {slot:?}"), bytes);
+    }
+    let what = format!("the check of {}'s translation", v.label);
+    let valid = |bytes: &[u8]| serde_json::from_slice::<Agreement>(bytes).map(|_| ()).map_err(anyhow::Error::from);
+    let bytes = crate::cache::get_or_build(crate::cache::Store::open_default().as_ref(), "scene-agreement", &key.finish(), &what, valid, || Ok(serde_json::to_vec(&agreement(gpu, work, p, v, t)?)?))?;
+    Ok(serde_json::from_slice(&bytes)?)
+}
+
+/// The worst relative difference between the translation run on the host and the Vulkan kernel on `gpu`, over
+/// every pixel of the kernel and each pixel's brightest channel.
+fn agreement(gpu: &Gpu, work: &SceneWork, p: &ScenePlan, v: &VariantSpec, t: &translate::Translation) -> Result<Agreement> {
+    SceneVariant::new(gpu, work, p, v.kernel, v.switches, v.label.clone(), 1)?.run_once(gpu, 0)?;
+    let on_device = work.radiance(v.kernel)?;
+    let (mut inputs, mut push, invocations) = work.host_inputs(v.kernel)?;
+    let host = HostKernel::compile(t)?;
+    // The translation's bindings in its order (those the specialised kernel still uses), push constants last.
+    let mut owned: Vec<Vec<u8>> = Vec::new();
+    for b in t.bindings.iter().filter(|b| b.slot.0 != u32::MAX) {
+        owned.push(inputs.remove(&b.slot).ok_or_else(|| anyhow!("{}: the translation binds {:?}, which the scene kernel has not", v.label, b.slot))?);
+    }
+    let radiance_at = t.bindings.iter().position(|b| b.slot == RADIANCE).ok_or_else(|| anyhow!("{}: the translation writes no radiance", v.label))?;
+    let groups = (invocations as u32).div_ceil(host.local_size()[0].max(1));
+    let mut buffers: Vec<&mut [u8]> = owned.iter_mut().map(Vec::as_mut_slice).collect();
+    buffers.push(push.as_mut_slice());
+    if host.run(&mut buffers, [groups, 1, 1])? & 1 != 0 {
+        bail!("{}: the host run stopped a pixel at its loop limit", v.label);
+    }
+    let floats: Vec<f32> = bytemuck::pod_collect_to_vec(&owned[radiance_at]);
+    let on_host: Vec<[f32; 3]> = floats.chunks_exact(4).take(on_device.len()).map(|c| [c[0], c[1], c[2]]).collect();
+    let brightest: Vec<f64> = on_device.iter().map(|p| p.iter().fold(1e-3f64, |a, &b| a.max(f64::from(b).abs()))).collect();
+    let lit = on_device.iter().filter(|p| p.iter().any(|&c| c != 0.0)).count();
+    Ok(Agreement { worst: verify::worst_relative(&on_host, &on_device, |i, _| brightest[i]), pixels: on_device.len(), lit })
+}
+
+/// A target's run as the scene's kernel and effect rows.
+fn target_report(run: targets::Run, specs: &[VariantSpec], p: &ScenePlan) -> Result<SceneTargetReport> {
+    let name = run.target.name();
+    let cost = run.report.cost.clone().ok_or_else(|| anyhow!("{name}: the compiler reported no statistics the cost model reads"))?;
+    let cycles = |label: &str| cost.row(label).map(|r| r.cycles_per_eval).ok_or_else(|| anyhow!("{name}: no figure for {label}"));
+    let mut kernels = Vec::new();
+    let mut effects = Vec::new();
+    for v in specs {
+        let c = cycles(&v.label)?;
+        match v.without {
+            None => kernels.push(TargetKernelRow { model: v.label.clone(), cycles_per_pixel: c, stats: cost.row(&v.label).map(|r| r.stats.clone()).unwrap_or_default() }),
+            Some(e) => {
+                let with = cycles(&p.kernels[v.kernel].model.label())?;
+                effects.push(TargetEffectRow { model: p.kernels[v.kernel].model.label(), effect: e.name().into(), extra_cycles_per_pixel: with - c, extra_fraction: (with - c) / c });
+            }
+        }
+    }
+    let translation = run.report.rows.iter().filter_map(|r| Some((r.model.clone(), r.notes.get("translation")?.clone()))).collect();
+    Ok(SceneTargetReport {
+        target: name,
+        device: cost.device.clone(),
+        compiler: run.report.provenance["compiler"]["name"].as_str().map_or_else(|| cost.compiler.clone(), |c| format!("{} ({c})", cost.compiler)),
+        model: cost.model.clone(),
+        unit: cost.unit.clone(),
+        kernels,
+        effects,
+        translation,
+        notes: run.note.into_iter().collect(),
+    })
+}
+
+/// The kernels' and the effects' tables across targets, beside the measured figures (`measured(kernel)`:
+/// ns/pixel; `measured_effect(kernel, effect)`: extra ns/pixel), as Markdown.
+pub fn markdown(reports: &[SceneTargetReport], measured: impl Fn(&str) -> String, measured_effect: impl Fn(&str, &str) -> String, device: &str) -> String {
+    let Some(first) = reports.first() else { return String::new() };
+    let mut head = vec!["kernel".to_string(), format!("{device} ns/pixel")];
+    head.extend(reports.iter().map(|r| format!("{} cycles/pixel", r.target)));
+    let mut t = Table::new(head);
+    for (i, k) in first.kernels.iter().enumerate() {
+        let mut row = vec![k.model.clone(), measured(&k.model)];
+        row.extend(reports.iter().map(|r| format!("{:.2}", r.kernels[i].cycles_per_pixel)));
+        t.row(row);
+    }
+    let mut out = format!("\nOn compile-only targets (modelled cycles per shaded pixel, every light included; each target's cost rule and options in the JSON):\n\n{}", t.markdown());
+    if !first.effects.is_empty() {
+        let mut head = vec!["kernel".to_string(), "effect".to_string(), format!("{device} +ns/pixel")];
+        head.extend(reports.iter().map(|r| format!("{} +cycles/pixel (+fraction)", r.target)));
+        let mut e = Table::new(head);
+        for (i, x) in first.effects.iter().enumerate() {
+            let mut row = vec![x.model.clone(), x.effect.clone(), measured_effect(&x.model, &x.effect)];
+            row.extend(reports.iter().map(|r| format!("{:+.2} ({:+.2})", r.effects[i].extra_cycles_per_pixel, r.effects[i].extra_fraction)));
+            e.row(row);
+        }
+        out += &format!("\nWhat each effect adds on each target (kernel as compiled minus the kernel without it):\n\n{}", e.markdown());
+    }
+    for r in reports {
+        for n in &r.notes {
+            out += &format!("\nnote ({}): {n}\n", r.target);
+        }
+    }
+    out
+}
