@@ -138,6 +138,14 @@ fn profile_scene_cost_devices_compile_every_variant_on_each_vendor() {
             assert!(note.as_str().unwrap().contains("pixels (") && !note.as_str().unwrap().contains("(0 lit)"), "{label}: {note}");
         }
     }
+    // An fp16 model's translation agrees within fp16's tolerance (the maths libraries differ by its ulps).
+    let f16 = write(dir.path(), "f16.json", &SMALL.replace(r#""model": "blinn""#, r#""model": "burley,precision=f16""#));
+    let (code, _, err) = run(&["profile", "--scene", &f16, "--budget", "2", "--min-rounds", "2", "--json", json.to_str().unwrap(), "--cost-device", "nvidia:sm_89"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(!err.contains("note: cache"), "the agreements are cached: {err}");
+    let report: Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let notes = report["targets"][0]["translation"].as_object().unwrap();
+    assert!(notes.iter().any(|(label, note)| label.starts_with("burley,precision=f16") && note.as_str().unwrap().contains("(tolerance 5e-2)")), "{notes:?}");
     // The cost devices are compile-only targets, and only a scene profile takes them.
     let (code, _, err) = run(&["profile", "--scene", &f, "--cost-device", "llvmpipe"]);
     assert_eq!(code, 2, "{err}");
