@@ -74,7 +74,7 @@ pub struct InspectArgs {
     pub isa: Option<PathBuf>,
     /// Device, repeatable: an index or name substring (see `brdfprof devices`), or a compile-only target
     /// (`radv:FAMILY`: Mesa RADV's compiler for an AMD family; `nvidia:FAMILY`: NVIDIA's compiler for a compute
-    /// capability; `PREFIX:all` for the default set; see `devices --targets`). Default: the first discrete or
+    /// capability; `intel:FAMILY`: Intel's IGC for a GPU generation; `PREFIX:all` for the default set; see `devices --targets`). Default: the first discrete or
     /// integrated GPU, else lavapipe.
     #[arg(long = "device", value_name = "DEVICE", value_parser = super::device_name)]
     pub devices: Vec<String>,

@@ -10,7 +10,7 @@ use std::process::ExitCode;
 
 #[derive(Args)]
 pub struct DevicesArgs {
-    /// List the compile-only targets (`--device radv:FAMILY`, `nvidia:FAMILY`) instead: each vendor's compiler
+    /// List the compile-only targets (`--device radv:FAMILY`, `nvidia:FAMILY`, `intel:FAMILY`) instead: each vendor's compiler
     /// for GPU families this machine does not have.
     #[arg(long)]
     pub targets: bool,

@@ -140,8 +140,8 @@ pub struct SweepArgs {
     #[arg(long, default_value = "ggx")]
     pub reference: String,
     /// Also draw the table, JSON and Pareto chart with a compile-only target's modelled cycles per evaluation
-    /// as the cost (radv:FAMILY, nvidia:FAMILY, PREFIX:all; repeatable; see `devices --targets`):
-    /// sweep-<device>-<compiler>-<family>.* (aco, ptxas).
+    /// as the cost (radv:FAMILY, nvidia:FAMILY, intel:FAMILY, PREFIX:all; repeatable; see `devices --targets`):
+    /// sweep-<device>-<compiler>-<family>.* (aco, ptxas, igc).
     #[arg(long = "cost-device", value_name = "DEVICE", value_parser = super::device_name)]
     pub cost_devices: Vec<String>,
     #[command(flatten)]

@@ -3,27 +3,20 @@
 //! (`targets::compile_raw_all`): modelled cycles per shaded pixel, every light of the plan included, and what
 //! each effect adds, beside the measured ns/pixel. RADV compiles the frozen SPIR-V; NVIDIA and Intel compile
 //! its C translation, which first shades the scene's own pixels on the host (g++) and must agree with the Vulkan
-//! kernel on the measuring device before its cost is reported.
+//! kernel on the measuring device before its cost is reported (only when such a target is asked for).
 
 use super::plan::{Effect, ScenePlan};
-use super::run::{SceneVariant, SceneWork};
+use super::run::{SceneVariant, SceneWork, PUSH_BYTES, RADIANCE, STORAGE_BUFFERS};
 use super::terms::Switches;
 use crate::gpu::Gpu;
 use crate::kernels;
 use crate::model::KernelKind;
 use crate::profile::protocol::Timed;
 use crate::report::Table;
-use crate::targets::{self, RawKernel, Target};
+use crate::targets::{self, CheckedTranslation, RawKernel, Target};
 use crate::translate::{self, host::HostKernel, verify};
 use anyhow::{anyhow, bail, Result};
 use serde::{Deserialize, Serialize};
-
-/// Storage buffers of glsl/scene.comp (pixels, radiance, lights, extras, E table) and its push constants (the
-/// camera).
-const STORAGE_BUFFERS: u32 = 5;
-const PUSH_BYTES: u32 = 16;
-/// The radiance output's binding.
-const RADIANCE: (u32, u32) = (0, 1);
 
 /// Relative tolerance of the host run against the Vulkan kernel, over each pixel's brightest channel: the float
 /// output has no quantisation, so this is the two maths libraries' difference (a few ulps, amplified by the
@@ -93,6 +86,8 @@ pub struct SceneTargetReport {
     pub target: String,
     pub device: String,
     pub compiler: String,
+    /// The compiler's options (empty for ACO, which a Vulkan pipeline drives with none).
+    pub options: String,
     /// The cost rule and its unit, as the target's cost table states them (one light per kernel: a scene
     /// kernel's own light loops are in its cost, so cycles/eval is cycles per shaded pixel).
     pub model: String,
@@ -111,20 +106,28 @@ pub fn reports(gpu: &Gpu, work: &SceneWork, p: &ScenePlan, targets: &[Target], v
         return Ok(Vec::new());
     }
     let specs = variant_specs(p);
-    let raw = specs.iter().map(|v| raw_kernel(gpu, work, p, v)).collect::<Result<Vec<_>>>()?;
+    let translate = targets.iter().any(|t| t.vendor.needs_verification());
+    let raw = specs.iter().map(|v| raw_kernel(gpu, work, p, v, translate)).collect::<Result<Vec<_>>>()?;
     let shaders = crate::shaders::Shaders::embedded();
     let request = targets::Request { models: &[], lights: 1, shaders: &shaders, validate, isa_dir: None, precise: false, verify_on: Some(gpu) };
     let runs = targets::compile_raw_all(targets, &raw, &request)?;
     runs.into_iter().map(|run| target_report(run, &specs, p)).collect()
 }
 
-/// One variant as a raw kernel: its frozen SPIR-V and its checked translation.
-fn raw_kernel(gpu: &Gpu, work: &SceneWork, p: &ScenePlan, v: &VariantSpec) -> Result<RawKernel> {
-    let mk = p.kernels[v.kernel].model.kernel(KernelKind::Scene, kernels::embedded())?;
+/// One variant as a raw kernel: its frozen SPIR-V and, when `translate`, its checked translation.
+fn raw_kernel(gpu: &Gpu, work: &SceneWork, p: &ScenePlan, v: &VariantSpec, translate: bool) -> Result<RawKernel> {
+    let model = p.kernels[v.kernel].model.clone();
+    let mk = model.kernel(KernelKind::Scene, kernels::embedded())?;
     let constants = p.constants(mk.constants, v.switches);
     let spirv = crate::inspect::spirv::specialise(&mk.spirv.words, &constants)?;
-    let translation = translate::translate(&translate::prepare::prepared(&mk.spirv.words, &constants)?, &Default::default()).map_err(|e| anyhow!("{}: {e}", v.label))?;
-    let a = agreement_cached(gpu, work, p, v, &translation, &mk.spirv.words, &format!("{constants:?}"))?;
+    let translation = if translate { Some(checked_translation(gpu, work, p, v, &mk.spirv.words, &constants)?) } else { None };
+    Ok(RawKernel { label: v.label.clone(), model, spirv, storage_buffers: STORAGE_BUFFERS, push_bytes: PUSH_BYTES, translation })
+}
+
+/// The variant's translation, after it agreed with the Vulkan kernel over the kernel's pixels.
+fn checked_translation(gpu: &Gpu, work: &SceneWork, p: &ScenePlan, v: &VariantSpec, words: &[u32], constants: &crate::gpu::SpecConstants) -> Result<CheckedTranslation> {
+    let translation = translate::translate(&translate::prepare::prepared(words, constants)?, &Default::default()).map_err(|e| anyhow!("{}: {e}", v.label))?;
+    let a = agreement_cached(gpu, work, p, v, &translation, words, &format!("{constants:?}"))?;
     let (worst, tolerance) = (a.worst, tolerance(p.kernels[v.kernel].model.precision()));
     if !(worst <= tolerance) {
         bail!(
@@ -133,7 +136,7 @@ fn raw_kernel(gpu: &Gpu, work: &SceneWork, p: &ScenePlan, v: &VariantSpec) -> Re
         );
     }
     let agreement = format!("translation checked on the host against {} over the kernel's {} pixels ({} lit): worst relative difference {worst:.1e} (tolerance {tolerance:.0e})", gpu.info.name, a.pixels, a.lit);
-    Ok(RawKernel { label: v.label.clone(), spirv, storage_buffers: STORAGE_BUFFERS, push_bytes: PUSH_BYTES, translation, agreement })
+    Ok(CheckedTranslation { translation, agreement })
 }
 
 /// `agreement`, or its result from the cache: the key covers the host translation, the Vulkan kernel's SPIR-V
@@ -183,57 +186,72 @@ fn agreement(gpu: &Gpu, work: &SceneWork, p: &ScenePlan, v: &VariantSpec, t: &tr
     Ok(Agreement { worst: verify::worst_relative(&on_host, &on_device, |i, _| brightest[i]), pixels: on_device.len(), lit })
 }
 
-/// A target's run as the scene's kernel and effect rows.
+/// A target's run as the scene's kernel and effect rows (a kernel the family left out has neither, and the
+/// reason is in the notes).
 fn target_report(run: targets::Run, specs: &[VariantSpec], p: &ScenePlan) -> Result<SceneTargetReport> {
     let name = run.target.name();
     let cost = run.report.cost.clone().ok_or_else(|| anyhow!("{name}: the compiler reported no statistics the cost model reads"))?;
-    let cycles = |label: &str| cost.row(label).map(|r| r.cycles_per_eval).ok_or_else(|| anyhow!("{name}: no figure for {label}"));
+    let cycles = |label: &str| cost.row(label).map(|r| r.cycles_per_eval);
     let mut kernels = Vec::new();
     let mut effects = Vec::new();
     for v in specs {
-        let c = cycles(&v.label)?;
-        match v.without {
-            None => kernels.push(TargetKernelRow { model: v.label.clone(), cycles_per_pixel: c, stats: cost.row(&v.label).map(|r| r.stats.clone()).unwrap_or_default() }),
-            Some(e) => {
-                let with = cycles(&p.kernels[v.kernel].model.label())?;
-                effects.push(TargetEffectRow { model: p.kernels[v.kernel].model.label(), effect: e.name().into(), extra_cycles_per_pixel: with - c, extra_fraction: (with - c) / c });
-            }
+        let kernel = p.kernels[v.kernel].model.label();
+        match (v.without, cycles(&v.label), cycles(&kernel)) {
+            (None, Some(c), _) => kernels.push(TargetKernelRow { model: v.label.clone(), cycles_per_pixel: c, stats: cost.row(&v.label).map(|r| r.stats.clone()).unwrap_or_default() }),
+            (Some(e), Some(without), Some(with)) => effects.push(TargetEffectRow { model: kernel, effect: e.name().into(), extra_cycles_per_pixel: with - without, extra_fraction: (with - without) / without }),
+            _ => {}
         }
     }
     let translation = run.report.rows.iter().filter_map(|r| Some((r.model.clone(), r.notes.get("translation")?.clone()))).collect();
+    let p = &run.report.provenance;
+    // RADV's reports carry Mesa's version where the translating targets name their compiler and options.
+    let version = p["compiler"]["name"].as_str().or_else(|| p["mesa_version"].as_str().map(|m| m.trim_start_matches("Mesa ")));
+    let mut notes: Vec<String> = run.report.section_notes.get("driver/").filter(|n| n.starts_with("not compiled")).cloned().into_iter().collect();
+    notes.extend(run.note);
     Ok(SceneTargetReport {
         target: name,
         device: cost.device.clone(),
-        compiler: run.report.provenance["compiler"]["name"].as_str().map_or_else(|| cost.compiler.clone(), |c| format!("{} ({c})", cost.compiler)),
+        compiler: version.map_or_else(|| cost.compiler.clone(), |v| format!("{} ({v})", cost.compiler)),
+        options: p["compiler"]["options"].as_str().unwrap_or_default().to_string(),
         model: cost.model.clone(),
         unit: cost.unit.clone(),
         kernels,
         effects,
         translation,
-        notes: run.note.into_iter().collect(),
+        notes,
     })
 }
 
 /// The kernels' and the effects' tables across targets, beside the measured figures (`measured(kernel)`:
-/// ns/pixel; `measured_effect(kernel, effect)`: extra ns/pixel), as Markdown.
+/// ns/pixel; `measured_effect(kernel, effect)`: extra ns/pixel), as Markdown; "-" where a target left a kernel
+/// out.
 pub fn markdown(reports: &[SceneTargetReport], measured: impl Fn(&str) -> String, measured_effect: impl Fn(&str, &str) -> String, device: &str) -> String {
-    let Some(first) = reports.first() else { return String::new() };
+    if reports.is_empty() {
+        return String::new();
+    }
+    let mut kernels: Vec<&str> = Vec::new();
+    let mut effects: Vec<(&str, &str)> = Vec::new();
+    for r in reports {
+        kernels.extend(r.kernels.iter().map(|k| k.model.as_str()).filter(|m| !kernels.contains(m)).collect::<Vec<_>>());
+        effects.extend(r.effects.iter().map(|e| (e.model.as_str(), e.effect.as_str())).filter(|x| !effects.contains(x)).collect::<Vec<_>>());
+    }
     let mut head = vec!["kernel".to_string(), format!("{device} ns/pixel")];
     head.extend(reports.iter().map(|r| format!("{} cycles/pixel", r.target)));
     let mut t = Table::new(head);
-    for (i, k) in first.kernels.iter().enumerate() {
-        let mut row = vec![k.model.clone(), measured(&k.model)];
-        row.extend(reports.iter().map(|r| format!("{:.2}", r.kernels[i].cycles_per_pixel)));
+    for k in &kernels {
+        let mut row = vec![k.to_string(), measured(k)];
+        row.extend(reports.iter().map(|r| r.kernels.iter().find(|x| x.model == *k).map_or("-".into(), |x| format!("{:.2}", x.cycles_per_pixel))));
         t.row(row);
     }
-    let mut out = format!("\nOn compile-only targets (modelled cycles per shaded pixel, every light included; each target's cost rule and options in the JSON):\n\n{}", t.markdown());
-    if !first.effects.is_empty() {
+    let mut out = format!("\nOn compile-only targets (modelled cycles per shaded pixel, every light included; each target's cost rule, compiler and options in the JSON):\n\n{}", t.markdown());
+    if !effects.is_empty() {
         let mut head = vec!["kernel".to_string(), "effect".to_string(), format!("{device} +ns/pixel")];
         head.extend(reports.iter().map(|r| format!("{} +cycles/pixel (+fraction)", r.target)));
         let mut e = Table::new(head);
-        for (i, x) in first.effects.iter().enumerate() {
-            let mut row = vec![x.model.clone(), x.effect.clone(), measured_effect(&x.model, &x.effect)];
-            row.extend(reports.iter().map(|r| format!("{:+.2} ({:+.2})", r.effects[i].extra_cycles_per_pixel, r.effects[i].extra_fraction)));
+        for (model, effect) in &effects {
+            let mut row = vec![model.to_string(), effect.to_string(), measured_effect(model, effect)];
+            let cell = |r: &SceneTargetReport| r.effects.iter().find(|x| x.model == *model && x.effect == *effect).map_or("-".into(), |x| format!("{:+.2} ({:+.2})", x.extra_cycles_per_pixel, x.extra_fraction));
+            row.extend(reports.iter().map(cell));
             e.row(row);
         }
         out += &format!("\nWhat each effect adds on each target (kernel as compiled minus the kernel without it):\n\n{}", e.markdown());

@@ -14,6 +14,12 @@ use crate::model::KernelKind;
 use crate::profile::protocol::{Dispatch, Pipelines, Timed};
 use anyhow::Result;
 
+/// glsl/scene.comp's interface: storage buffers 0..5 of set 0 (pixels, radiance, lights, extras, E table) and
+/// the push constants (the camera); the radiance output's slot.
+pub const STORAGE_BUFFERS: u32 = 5;
+pub const PUSH_BYTES: u32 = 16;
+pub const RADIANCE: (u32, u32) = (0, 1);
+
 /// Bytes per pixel of the other per-pixel bindings: output (1 vec4), extras (2 vec4); pixels: `PIXEL_BYTES`.
 const OUT_BYTES: u64 = 16;
 const EXTRA_BYTES: u64 = 32;
@@ -92,7 +98,7 @@ impl<'g> SceneWork<'g> {
     pub fn host_inputs(&self, k: usize) -> Result<(std::collections::BTreeMap<(u32, u32), Vec<u8>>, Vec<u8>, u64)> {
         let kb = &self.kernels[k];
         let bytes = |b: &Buffer| b.read_as::<u8>(0, b.size as usize);
-        let buffers = [((0, 0), bytes(&kb.pixels)?), ((0, 1), vec![0u8; kb.radiance.size as usize]), ((0, 2), bytes(&self.lights)?), ((0, 3), bytes(&kb.extras)?), ((0, 4), bytes(&kb.table)?)];
+        let buffers = [((0, 0), bytes(&kb.pixels)?), (RADIANCE, vec![0u8; kb.radiance.size as usize]), ((0, 2), bytes(&self.lights)?), ((0, 3), bytes(&kb.extras)?), ((0, 4), bytes(&kb.table)?)];
         Ok((buffers.into(), bytemuck::cast::<[f32; 4], [u8; 16]>(self.camera).to_vec(), kb.radiance.size / OUT_BYTES))
     }
 
@@ -122,7 +128,7 @@ impl<'g> SceneVariant<'g> {
         let push: [u8; 16] = bytemuck::cast(work.camera);
         let mk = model.kernel(KernelKind::Scene, kernels::embedded())?;
         let kernel = [(mk.spirv, plan.constants(mk.constants, switches))];
-        let pipelines = Pipelines::compile(gpu, &kernel, &Binding::storage(5), push.len() as u32, instances, |k| {
+        let pipelines = Pipelines::compile(gpu, &kernel, &Binding::storage(STORAGE_BUFFERS), PUSH_BYTES, instances, |k| {
             let chunk = |&(first, len): &(u64, u64)| -> Result<Dispatch> {
                 let set = k[0].bind(&[
                     (&kb.pixels, first * PIXEL_BYTES, len * PIXEL_BYTES),

@@ -215,19 +215,24 @@ impl IsaStats {
         let env = tokens.get(&EXECUTION_ENVIRONMENT).filter(|w| w.len() > GRF_WORD).ok_or_else(|| anyhow!("ocloc's patch tokens carry no execution environment (SIMD width, GRF count)"))?;
         let scratch = |t: u32| tokens.get(&t).and_then(|w| w.get(1).copied()).unwrap_or(0);
         let mut s = IsaStats { simd: env[SIMD_WORD], grf: env[GRF_WORD], scratch_bytes: scratch(MEDIA_VFE_STATE) + scratch(MEDIA_VFE_STATE_SLOT1), binary_bytes: kernel_bytes(&binary.tokens).unwrap_or(binary.bytes) as u32, ..Default::default() };
-        for i in binary.listing.lines().filter_map(instruction) {
-            let class = classify(i.mnemonic);
-            s.instructions += 1;
-            *s.by_class.entry(class).or_default() += 1;
-            // sync waits on a scoreboard (a latency the model leaves out) and issues no work.
-            if i.mnemonic != "sync" {
-                s.by_row.entry(row_of(class, i.dst_type, i.function)).or_default().push(i.exec_size);
-            }
-        }
+        s.count(&binary.listing);
         if s.instructions == 0 || ![8, 16, 32].contains(&s.simd) {
             bail!("IGA's listing has {} instructions and the binary says SIMD{}: not a kernel brdfprof can count", s.instructions, s.simd);
         }
         Ok(s)
+    }
+
+    /// Counts IGA's listing: instructions by class, and their execution sizes by `THROUGHPUT` row.
+    fn count(&mut self, listing: &str) {
+        for i in listing.lines().filter_map(instruction) {
+            let class = classify(i.mnemonic);
+            self.instructions += 1;
+            *self.by_class.entry(class).or_default() += 1;
+            // sync waits on a scoreboard (a latency the model leaves out) and issues no work.
+            if i.mnemonic != "sync" {
+                self.by_row.entry(row_of(class, i.dst_type, i.function)).or_default().push(i.exec_size);
+            }
+        }
     }
 
     /// EU cycles of one hardware thread (SIMD lanes): each instruction its execution size over its row's
@@ -407,8 +412,8 @@ impl super::Vendor for Intel {
 
     fn compile_raw(&self, families: &[usize], kernels: &[super::RawKernel], request: &Request) -> Result<Vec<Run>> {
         let chosen: Vec<&Family> = families.iter().map(|&k| &FAMILIES[k]).collect();
-        let checked: Vec<super::Checked> = kernels.iter().map(|k| super::Checked { source: k.translation.source(crate::translate::Dialect::OpenCl), agreement: k.agreement.clone() }).collect();
-        let reports = compile_checked(&chosen, kernels.iter().map(super::raw_row).collect(), &checked, ocloc::tools()?, request)?;
+        let (rows, checked) = super::raw_translations(self, kernels, crate::translate::Dialect::OpenCl)?;
+        let reports = compile_checked(&chosen, rows, &checked, ocloc::tools()?, request)?;
         Ok(reports.into_iter().zip(families).map(|(report, &family)| Run { target: Target { vendor: &INTEL, family }, report, isa_files: Vec::new(), note: None }).collect())
     }
 
@@ -420,7 +425,7 @@ impl super::Vendor for Intel {
             family: Some(family.name.to_string()),
             architecture: Some(family.architecture.to_string()),
             compiler: "IGC".into(),
-            model: "cycles/eval = EU cycles of one hardware thread at the documented lanes per clock / (SIMD width x lights per kernel)".into(),
+            model: "cycles/eval = EU cycles of one hardware thread at THROUGHPUT's lanes per clock (Intel's documents; extended math: IGC's scheduling model) / (SIMD width x lights per kernel)".into(),
             unit: "EU cycles".into(),
             lights_per_kernel: 0,
             columns: SHOWN.iter().map(|s| s.to_string()).collect(),
@@ -566,11 +571,8 @@ mod throughput_fixture {
                                send.ugm (16|M0)  r9  r10  null:0  0x0  0x08200580  {$1}\n\
                                sync.nop  null  {$1.dst}\n";
         let mut s = IsaStats::default();
-        for i in listing.lines().filter_map(instruction) {
-            if i.mnemonic != "sync" {
-                s.by_row.entry(row_of(classify(i.mnemonic), i.dst_type, i.function)).or_default().push(i.exec_size);
-            }
-        }
+        s.count(listing);
+        assert_eq!((s.instructions, s.by_class[&Class::ExtendedMath], s.by_class[&Class::Control]), (6, 2, 1));
         let family = |n: &str| FAMILIES.iter().find(|f| f.name == n).unwrap();
         // gen9: mads 16/8 = 2 each, inv 16/2 = 8, pow 16/1 = 16, send 1.
         assert_eq!(s.issue_cycles(family("gen9")).unwrap(), 2.0 + 2.0 + 8.0 + 16.0 + 1.0);

@@ -62,9 +62,18 @@ pub struct Request<'a> {
 pub struct RawKernel {
     /// The row name in the reports ("ggx", "ggx without clear-coat").
     pub label: String,
+    /// The model whose kernel it is: a family that cannot compile it (fp16 arithmetic without shaderFloat16)
+    /// leaves it out with a note, as it leaves out such a model.
+    pub model: Model,
     pub spirv: Vec<u32>,
     pub storage_buffers: u32,
     pub push_bytes: u32,
+    /// None when no target compiles a translation (the check would cost a host build for nothing).
+    pub translation: Option<CheckedTranslation>,
+}
+
+/// A translation that agreed with its Vulkan kernel.
+pub struct CheckedTranslation {
     pub translation: crate::translate::Translation,
     /// The row note: the device the translation was checked on and the worst difference.
     pub agreement: String,
@@ -183,44 +192,49 @@ pub fn parse(device: &str) -> Result<Option<Vec<Target>>> {
     Ok(Some(out))
 }
 
-/// Compiles for every target, vendor by vendor, each vendor's families at once; results in `targets` order.
-pub fn compile_all(targets: &[Target], request: &Request) -> Result<Vec<Run>> {
+/// `compile(vendor, its families)` for every vendor among `targets`, each vendor's families at once; results in
+/// `targets` order.
+fn vendor_by_vendor(targets: &[Target], mut compile: impl FnMut(&dyn Vendor, &[usize]) -> Result<Vec<Run>>) -> Result<Vec<Run>> {
     let mut runs: Vec<Option<Run>> = targets.iter().map(|_| None).collect();
     for vendor in VENDORS {
         let mine: Vec<usize> = (0..targets.len()).filter(|&k| targets[k].vendor.prefix() == vendor.prefix()).collect();
         if mine.is_empty() {
             continue;
         }
-        if vendor.needs_verification() && request.verify_on.is_none() {
-            bail!("{}: its costs are of a translation that must first run against a Vulkan device, and none was opened", vendor.prefix());
-        }
         let families: Vec<usize> = mine.iter().map(|&k| targets[k].family).collect();
-        for (k, run) in mine.into_iter().zip(vendor.compile(&families, request)?) {
+        for (k, run) in mine.into_iter().zip(compile(vendor, &families)?) {
             runs[k] = Some(run);
         }
     }
     Ok(runs.into_iter().map(|r| r.expect("every target compiled")).collect())
+}
+
+/// Compiles the models' kernels for every target; results in `targets` order.
+pub fn compile_all(targets: &[Target], request: &Request) -> Result<Vec<Run>> {
+    vendor_by_vendor(targets, |vendor, families| {
+        if vendor.needs_verification() && request.verify_on.is_none() {
+            bail!("{}: its costs are of a translation that must first run against a Vulkan device, and none was opened", vendor.prefix());
+        }
+        vendor.compile(families, request)
+    })
 }
 
 /// `compile_all` for kernels outside the model set.
 pub fn compile_raw_all(targets: &[Target], kernels: &[RawKernel], request: &Request) -> Result<Vec<Run>> {
-    let mut runs: Vec<Option<Run>> = targets.iter().map(|_| None).collect();
-    for vendor in VENDORS {
-        let mine: Vec<usize> = (0..targets.len()).filter(|&k| targets[k].vendor.prefix() == vendor.prefix()).collect();
-        if mine.is_empty() {
-            continue;
-        }
-        let families: Vec<usize> = mine.iter().map(|&k| targets[k].family).collect();
-        for (k, run) in mine.into_iter().zip(vendor.compile_raw(&families, kernels, request)?) {
-            runs[k] = Some(run);
-        }
-    }
-    Ok(runs.into_iter().map(|r| r.expect("every target compiled")).collect())
+    vendor_by_vendor(targets, |vendor, families| vendor.compile_raw(families, kernels, request))
 }
 
-/// A report row for a raw kernel: its label, no spec, the translation's agreement as its note.
-pub(crate) fn raw_row(k: &RawKernel) -> crate::inspect::Row {
-    crate::inspect::Row { model: k.label.clone(), spec: None, stats: BTreeMap::new(), notes: [("translation".to_string(), k.agreement.clone())].into() }
+/// The rows (label, the agreement as the note) and the `dialect` sources of raw kernels, for a vendor that
+/// compiles their translations.
+pub(crate) fn raw_translations(vendor: &dyn Vendor, kernels: &[RawKernel], dialect: crate::translate::Dialect) -> Result<(Vec<crate::inspect::Row>, Vec<Checked>)> {
+    let mut rows = Vec::new();
+    let mut checked = Vec::new();
+    for k in kernels {
+        let t = k.translation.as_ref().ok_or_else(|| anyhow!("{}: {} compiles the kernel's translation, and none was checked", k.label, vendor.prefix()))?;
+        rows.push(crate::inspect::Row { model: k.label.clone(), spec: Some(k.model.canonical()), stats: BTreeMap::new(), notes: [("translation".to_string(), t.agreement.clone())].into() });
+        checked.push(Checked { source: t.translation.source(dialect), agreement: t.agreement.clone() });
+    }
+    Ok((rows, checked))
 }
 
 /// The compile-only target a report was made for, if any.

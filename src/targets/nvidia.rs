@@ -408,8 +408,8 @@ impl super::Vendor for Nvidia {
 
     fn compile_raw(&self, families: &[usize], kernels: &[super::RawKernel], request: &Request) -> Result<Vec<Run>> {
         let chosen: Vec<&Family> = families.iter().map(|&k| &FAMILIES[k]).collect();
-        let checked: Vec<super::Checked> = kernels.iter().map(|k| super::Checked { source: k.translation.source(crate::translate::Dialect::Cuda), agreement: k.agreement.clone() }).collect();
-        let reports = compile_checked(&chosen, kernels.iter().map(super::raw_row).collect(), &checked, nvrtc::tools()?, request)?;
+        let (rows, checked) = super::raw_translations(self, kernels, crate::translate::Dialect::Cuda)?;
+        let reports = compile_checked(&chosen, rows, &checked, nvrtc::tools()?, request)?;
         Ok(reports.into_iter().zip(families).map(|(report, &family)| Run { target: Target { vendor: &NVIDIA, family }, report, isa_files: Vec::new(), note: None }).collect())
     }
 

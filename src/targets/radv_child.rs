@@ -46,6 +46,8 @@ pub struct RadvRequest {
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct RawSpirv {
     pub label: String,
+    /// The model's spec text (`Model::name`), to check the family can compile it.
+    pub model: String,
     pub path: PathBuf,
     pub storage_buffers: u32,
     pub push_bytes: u32,
@@ -93,11 +95,10 @@ pub fn child_main(request_json: &str) -> Result<()> {
         bail!("{} is not RADV's compile-only device", gpu.info.name);
     }
     if !req.raw.is_empty() {
-        let report = raw_report(&gpu, &shaders, &req.raw)?;
+        let report = raw_report(&gpu, &shaders, &req.raw, target.family)?;
         gpu.check_validation()?;
         drop(gpu);
-        println!("{}", serde_json::to_string(&RadvReply { family: target.family.to_string(), report, isa_files: Vec::new() })?);
-        return Ok(());
+        return reply(RadvReply { family: target.family.to_string(), report, isa_files: Vec::new() });
     }
     // A model this family cannot compile (fp16 arithmetic where the device has no shaderFloat16) is left out
     // and named in the driver section's notes, so that one family does not stop a report of many.
@@ -119,7 +120,11 @@ pub fn child_main(request_json: &str) -> Result<()> {
     }
     gpu.check_validation()?;
     drop(gpu);
-    let reply = RadvReply { family: target.family.to_string(), report, isa_files };
+    reply(RadvReply { family: target.family.to_string(), report, isa_files })
+}
+
+/// Prints the reply as the child's last stdout line.
+fn reply(reply: RadvReply) -> Result<()> {
     println!("{}", serde_json::to_string(&reply)?);
     if std::env::var_os(CRASH_AFTER_REPLY).is_some() {
         use std::io::Write;
@@ -135,10 +140,17 @@ pub fn child_main(request_json: &str) -> Result<()> {
 }
 
 /// The raw kernels compiled on the null device, one row each with ACO's statistics, as one report (one light
-/// per kernel: a raw kernel's own loops are its cost).
-fn raw_report(gpu: &Gpu, shaders: &Shaders, raw: &[RawSpirv]) -> Result<InspectReport> {
+/// per kernel: a raw kernel's own loops are its cost); a kernel the family cannot compile is left out and named
+/// in the driver section's notes.
+fn raw_report(gpu: &Gpu, shaders: &Shaders, raw: &[RawSpirv], family: &str) -> Result<InspectReport> {
     let mut rows = Vec::new();
+    let mut skipped = Vec::new();
     for r in raw {
+        let model = Model::parse(&r.model).map_err(|e| anyhow!("{}: {e:#}", r.model))?;
+        if let Err(e) = model.check_support(&gpu.info) {
+            skipped.push(format!("{} ({e:#})", r.label));
+            continue;
+        }
         let bytes = std::fs::read(&r.path).with_context(|| format!("the radv child cannot read {}", r.path.display()))?;
         let words: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes);
         let kernel = Kernel::new(gpu, &r.label, &words, &Default::default(), &crate::gpu::Binding::storage(r.storage_buffers), r.push_bytes)?;
@@ -148,7 +160,8 @@ fn raw_report(gpu: &Gpu, shaders: &Shaders, raw: &[RawSpirv]) -> Result<InspectR
         rows.push(row);
     }
     let provenance = serde_json::to_value(crate::report::Provenance::new(&gpu.info))?;
-    Ok(crate::inspect::compiled_report(rows, provenance, 1, shaders, Default::default(), Default::default()))
+    let notes = if skipped.is_empty() { Default::default() } else { [("driver/".to_string(), format!("not compiled for {family}: {}", skipped.join("; ")))].into() };
+    Ok(crate::inspect::compiled_report(rows, provenance, 1, shaders, Default::default(), notes))
 }
 
 /// Set in a child's environment, it dies of SIGSEGV after printing its report, as Mesa 22.3's teardown of the
@@ -187,7 +200,7 @@ pub fn run(target: &'static Family, models: &[Model], raw: &[super::RawKernel], 
     for (k, r) in raw.iter().enumerate() {
         let path = tmp.path().join(format!("raw-{k}.spv"));
         std::fs::write(&path, bytemuck::cast_slice::<u32, u8>(&r.spirv)).with_context(|| format!("cannot write {}", path.display()))?;
-        raw_files.push(RawSpirv { label: r.label.clone(), path, storage_buffers: r.storage_buffers, push_bytes: r.push_bytes });
+        raw_files.push(RawSpirv { label: r.label.clone(), model: r.model.name(), path, storage_buffers: r.storage_buffers, push_bytes: r.push_bytes });
     }
     let req = RadvRequest {
         family: target.family.to_string(),
