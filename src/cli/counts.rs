@@ -69,7 +69,8 @@ pub struct InspectArgs {
     pub chart: Option<PathBuf>,
     /// Write each kernel's compiler output for every compile-only target: RADV's internal representations
     /// (NIR, ACO IR, disassembly) to DIR/<family>/<kernel>.<representation>.txt; NVIDIA's CUDA C++
-    /// translation and SASS to DIR/nvidia-<family>/<kernel>.{cu,sass}.
+    /// translation and SASS to DIR/nvidia-<family>/<kernel>.{cu,sass}; Intel's OpenCL C translation and IGA
+    /// listing to DIR/intel-<family>/<kernel>.{cl,asm}.
     #[arg(long)]
     pub isa: Option<PathBuf>,
     /// Device, repeatable: an index or name substring (see `brdfprof devices`), or a compile-only target

@@ -41,6 +41,10 @@ pub struct ProfileArgs {
     /// repeatable; see `devices --targets`): modelled cycles per pixel and per effect beside the measured ns.
     #[arg(long = "cost-device", value_name = "DEVICE", value_parser = super::device_name)]
     pub cost_devices: Vec<String>,
+    /// With --cost-device: write each kernel's compiler output per target as `inspect --isa` does
+    /// (DIR/<family>/, DIR/nvidia-<family>/, DIR/intel-<family>/; a kernel per variant, "ggx-without-diffuse").
+    #[arg(long)]
+    pub isa: Option<PathBuf>,
     #[command(flatten)]
     pub html: super::report::HtmlArg,
     #[command(flatten)]
@@ -51,8 +55,9 @@ pub fn profile(args: &ProfileArgs) -> Result<ExitCode> {
     if let Some(path) = &args.scene {
         return profile_scene(args, path);
     }
-    if !args.cost_devices.is_empty() {
-        bail!("--cost-device applies to --scene; for models, `brdfprof inspect --device {}` gives the compile-only targets' figures", args.cost_devices[0]);
+    if !args.cost_devices.is_empty() || args.isa.is_some() {
+        let device = args.cost_devices.first().map_or("radv:navi21", String::as_str);
+        bail!("--cost-device and --isa apply to --scene; for models, `brdfprof inspect --device {device} [--isa DIR]` gives the compile-only targets' figures and listings");
     }
     check_output("--json", args.json.as_deref(), "results", "profile-<device>.json")?;
     args.html.check()?;
@@ -97,11 +102,17 @@ fn profile_scene(args: &ProfileArgs, path: &std::path::Path) -> Result<ExitCode>
         bail!("--scene: the G-buffer size is the scene's; --size does not apply");
     }
     let cost_targets = cost_targets(&args.cost_devices)?;
+    if let Some(dir) = &args.isa {
+        if cost_targets.is_empty() {
+            bail!("--isa {}: the listings are a compile-only target's; give --cost-device too (e.g. --cost-device radv:navi21)", dir.display());
+        }
+        io::check_output_dir("--isa", dir)?;
+    }
     let scene = scene::Scene::load(path)?;
     check_output("--json", args.json.as_deref(), "results", &format!("scene-{}-<device>.json", scene.name()))?;
     fresh_compilation(args.timing.shader_cache);
     let base = args.timing.options(Vec::new(), "1x1", args.reps, args.budget, args.target_ci)?;
-    let options = scene::profile::SceneProfileOptions { protocol: base.protocol, target_rel_ci: args.target_ci, max_chunk: None, instances: base.instances, cost_targets, validate: args.device.validation() };
+    let options = scene::profile::SceneProfileOptions { protocol: base.protocol, target_rel_ci: args.target_ci, max_chunk: None, instances: base.instances, cost_targets, validate: args.device.validation(), isa_dir: args.isa.clone() };
     let (gpu, result) = on_device(&args.device, |gpu, progress| scene::profile::run(gpu, &scene, &options, progress))?;
     let path = args.json.clone().unwrap_or_else(|| PathBuf::from(format!("{}/scene-{}-{}.json", super::DEFAULT_OUT, scene.name(), brdfprof::targets::device_slug(&gpu.info))));
     report::write_json(&path, &result)?;

@@ -96,12 +96,15 @@ pub struct SceneTargetReport {
     pub effects: Vec<TargetEffectRow>,
     /// Per variant label: how its translation agreed with the Vulkan kernel (translating targets only).
     pub translation: std::collections::BTreeMap<String, String>,
+    /// Compiler output written under `--isa` (RADV's; NVIDIA's and Intel's are under DIR/<vendor>-<family>/).
+    #[serde(skip_serializing_if = "Vec::is_empty", default)]
+    pub isa_files: Vec<std::path::PathBuf>,
     pub notes: Vec<String>,
 }
 
 /// The variants compiled for every target: RADV from the frozen SPIR-V, the others from the translation,
 /// checked on the host against `gpu` first.
-pub fn reports(gpu: &Gpu, work: &SceneWork, p: &ScenePlan, targets: &[Target], validate: bool) -> Result<Vec<SceneTargetReport>> {
+pub fn reports(gpu: &Gpu, work: &SceneWork, p: &ScenePlan, targets: &[Target], validate: bool, isa_dir: Option<&std::path::Path>) -> Result<Vec<SceneTargetReport>> {
     if targets.is_empty() {
         return Ok(Vec::new());
     }
@@ -109,7 +112,7 @@ pub fn reports(gpu: &Gpu, work: &SceneWork, p: &ScenePlan, targets: &[Target], v
     let translate = targets.iter().any(|t| t.vendor.needs_verification());
     let raw = specs.iter().map(|v| raw_kernel(gpu, work, p, v, translate)).collect::<Result<Vec<_>>>()?;
     let shaders = crate::shaders::Shaders::embedded();
-    let request = targets::Request { models: &[], lights: 1, shaders: &shaders, validate, isa_dir: None, precise: false, verify_on: Some(gpu) };
+    let request = targets::Request { models: &[], lights: 1, shaders: &shaders, validate, isa_dir, precise: false, verify_on: Some(gpu) };
     let runs = targets::compile_raw_all(targets, &raw, &request)?;
     runs.into_iter().map(|run| target_report(run, &specs, p)).collect()
 }
@@ -218,6 +221,7 @@ fn target_report(run: targets::Run, specs: &[VariantSpec], p: &ScenePlan) -> Res
         kernels,
         effects,
         translation,
+        isa_files: run.isa_files,
         notes,
     })
 }

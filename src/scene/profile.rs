@@ -33,6 +33,8 @@ pub struct SceneProfileOptions {
     /// Compile-only targets that also compile every variant (`compile`), with validation as the device has it.
     pub cost_targets: Vec<crate::targets::Target>,
     pub validate: bool,
+    /// Where the targets write each kernel's compiler output (`--isa`).
+    pub isa_dir: Option<std::path::PathBuf>,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -169,7 +171,7 @@ pub fn run(gpu: &Gpu, scene: &Scene, options: &SceneProfileOptions, progress: &P
     let work = SceneWork::upload(gpu, scene, &g, &p, &tables, RunLimits { max_chunk: options.max_chunk })?;
     // The targets' figures first (seconds): a missing compiler fails before the long measurement.
     progress.set_message("compile-only targets");
-    let targets = compile::reports(gpu, &work, &p, &options.cost_targets, options.validate)?;
+    let targets = compile::reports(gpu, &work, &p, &options.cost_targets, options.validate, options.isa_dir.as_deref())?;
     progress.set_message("compiling kernels");
     let (slots, variants) = variants(gpu, &work, &p, options.instances)?;
     let pixels: Vec<u64> = work.kernels.iter().map(|k| k.count).collect();

@@ -95,10 +95,11 @@ pub fn child_main(request_json: &str) -> Result<()> {
         bail!("{} is not RADV's compile-only device", gpu.info.name);
     }
     if !req.raw.is_empty() {
-        let report = raw_report(&gpu, &shaders, &req.raw, target.family)?;
+        let isa_dir = req.isa_dir.as_ref().map(|d| d.join(target.family));
+        let (report, isa_files) = raw_report(&gpu, &shaders, &req.raw, target.family, isa_dir.as_deref())?;
         gpu.check_validation()?;
         drop(gpu);
-        return reply(RadvReply { family: target.family.to_string(), report, isa_files: Vec::new() });
+        return reply(RadvReply { family: target.family.to_string(), report, isa_files });
     }
     // A model this family cannot compile (fp16 arithmetic where the device has no shaderFloat16) is left out
     // and named in the driver section's notes, so that one family does not stop a report of many.
@@ -142,9 +143,10 @@ fn reply(reply: RadvReply) -> Result<()> {
 /// The raw kernels compiled on the null device, one row each with ACO's statistics, as one report (one light
 /// per kernel: a raw kernel's own loops are its cost); a kernel the family cannot compile is left out and named
 /// in the driver section's notes.
-fn raw_report(gpu: &Gpu, shaders: &Shaders, raw: &[RawSpirv], family: &str) -> Result<InspectReport> {
+fn raw_report(gpu: &Gpu, shaders: &Shaders, raw: &[RawSpirv], family: &str, isa_dir: Option<&Path>) -> Result<(InspectReport, Vec<PathBuf>)> {
     let mut rows = Vec::new();
     let mut skipped = Vec::new();
+    let mut isa_files = Vec::new();
     for r in raw {
         let model = Model::parse(&r.model).map_err(|e| anyhow!("{}: {e:#}", r.model))?;
         if let Err(e) = model.check_support(&gpu.info) {
@@ -153,15 +155,18 @@ fn raw_report(gpu: &Gpu, shaders: &Shaders, raw: &[RawSpirv], family: &str) -> R
         }
         let bytes = std::fs::read(&r.path).with_context(|| format!("the radv child cannot read {}", r.path.display()))?;
         let words: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes);
-        let kernel = Kernel::new(gpu, &r.label, &words, &Default::default(), &crate::gpu::Binding::storage(r.storage_buffers), r.push_bytes)?;
+        let kernel = Kernel::with_capture(gpu, &r.label, &words, &Default::default(), &crate::gpu::Binding::storage(r.storage_buffers), r.push_bytes, isa_dir.is_some())?;
         let mut row = crate::inspect::Row { model: r.label.clone(), spec: None, stats: Default::default(), notes: Default::default() };
         let executables = kernel.executables()?.ok_or_else(|| anyhow!("{} reports no pipeline statistics", gpu.info.name))?;
+        if let Some(dir) = isa_dir {
+            isa_files.extend(write_representations(gpu, &executables, &r.label, dir)?);
+        }
         row.stats.extend(crate::inspect::driver::stats(&executables.into_iter().flat_map(|e| e.stats).collect::<Vec<_>>()));
         rows.push(row);
     }
     let provenance = serde_json::to_value(crate::report::Provenance::new(&gpu.info))?;
     let notes = if skipped.is_empty() { Default::default() } else { [("driver/".to_string(), format!("not compiled for {family}: {}", skipped.join("; ")))].into() };
-    Ok(crate::inspect::compiled_report(rows, provenance, 1, shaders, Default::default(), notes))
+    Ok((crate::inspect::compiled_report(rows, provenance, 1, shaders, Default::default(), notes), isa_files))
 }
 
 /// Set in a child's environment, it dies of SIGSEGV after printing its report, as Mesa 22.3's teardown of the
@@ -175,10 +180,16 @@ fn write_isa(gpu: &Gpu, shaders: &Shaders, model: Option<&Model>, lights: u32, d
     let (per_dispatch, accumulate) = steady_block(lights);
     let k = shade_kernel(model, GBufferFormat::Packed, per_dispatch, accumulate, shaders)?;
     let kernel = Kernel::with_capture(gpu, &k.spirv.name, &k.spirv.words, &k.constants, &workload::bindings(GBufferFormat::Packed), workload::PUSH_BYTES, true)?;
+    write_representations(gpu, &kernel.executables()?.unwrap_or_default(), &label, dir)
+}
+
+/// Each text representation of each executable (RADV: NIR, ACO IR, disassembly) to DIR/<kernel>.<representation>.txt.
+fn write_representations(gpu: &Gpu, executables: &[crate::gpu::PipelineExecutable], label: &str, dir: &Path) -> Result<Vec<PathBuf>> {
+    std::fs::create_dir_all(dir).with_context(|| format!("--isa: cannot create {}", dir.display()))?;
     let mut files = Vec::new();
-    for exe in kernel.executables()?.unwrap_or_default() {
+    for exe in executables {
         for (name, text) in &exe.representations {
-            let path = dir.join(format!("{}.{}.txt", super::file_slug(&label), super::file_slug(name)));
+            let path = dir.join(format!("{}.{}.txt", super::file_slug(label), super::file_slug(name)));
             crate::io::write_output(&path, format!("; {label}: {} of {}, {}\n{text}", name, exe.name, gpu.info.name).as_bytes())?;
             files.push(path);
         }

@@ -100,7 +100,8 @@ fn profile_scene_cost_devices_compile_every_variant_on_each_vendor() {
     let f = write(dir.path(), "s.json", SMALL);
     let json = dir.path().join("p.json");
     let targets = ["radv:navi21", "nvidia:sm_89", "intel:gen12lp"];
-    let mut args = vec!["profile", "--validate", "--scene", &f, "--budget", "3", "--min-rounds", "2", "--json", json.to_str().unwrap()];
+    let isa = dir.path().join("isa");
+    let mut args = vec!["profile", "--validate", "--scene", &f, "--budget", "3", "--min-rounds", "2", "--json", json.to_str().unwrap(), "--isa", isa.to_str().unwrap()];
     for t in targets {
         args.extend(["--cost-device", t]);
     }
@@ -148,6 +149,11 @@ fn profile_scene_cost_devices_compile_every_variant_on_each_vendor() {
             assert!(note.as_str().unwrap().contains("pixels (") && !note.as_str().unwrap().contains("(0 lit)"), "{label}: {note}");
         }
     }
+    // --isa: each variant's compiler output per target, as `inspect --isa` writes it.
+    for (file, marker) in [("navi21/ggx-without-clear-coat.assembly.txt", "s_endpgm"), ("nvidia-sm_89/ggx-without-clear-coat.sass", "EXIT"), ("intel-gen12lp/blinn-without-diffuse.asm", "EOT"), ("intel-gen12lp/blinn.cl", "__kernel")] {
+        let text = std::fs::read_to_string(isa.join(file)).unwrap_or_else(|e| panic!("{file}: {e}"));
+        assert!(text.contains(marker), "{file} has no {marker}");
+    }
     // An fp16 model's translation agrees within fp16's tolerance (the maths libraries differ by its ulps); a
     // family without fp16 (tahiti) leaves that kernel out with a note, and the others are still reported.
     let f16 = write(dir.path(), "f16.json", &SMALL.replace(r#""model": "blinn""#, r#""model": "burley,precision=f16""#));
@@ -167,7 +173,10 @@ fn profile_scene_cost_devices_compile_every_variant_on_each_vendor() {
     assert!(err.contains("--cost-device llvmpipe") && err.contains("compile-only target"), "{err}");
     let (code, _, err) = run(&["profile", "--cost-device", "radv:navi21"]);
     assert_eq!(code, 2, "{err}");
-    assert!(err.contains("--cost-device applies to --scene") && err.contains("inspect --device radv:navi21"), "{err}");
+    assert!(err.contains("--cost-device and --isa apply to --scene") && err.contains("inspect --device radv:navi21"), "{err}");
+    let (code, _, err) = run(&["profile", "--scene", &f, "--isa", isa.to_str().unwrap()]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("--isa") && err.contains("give --cost-device too"), "{err}");
 }
 
 #[test]
