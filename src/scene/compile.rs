@@ -6,7 +6,7 @@
 //! kernel on the measuring device before its cost is reported (only when such a target is asked for).
 
 use super::plan::{Effect, ScenePlan};
-use super::run::{SceneVariant, SceneWork, PUSH_BYTES, RADIANCE, STORAGE_BUFFERS};
+use super::run::{HostInputs, SceneVariant, SceneWork, PUSH_BYTES, RADIANCE, STORAGE_BUFFERS};
 use super::terms::Switches;
 use crate::gpu::Gpu;
 use crate::kernels;
@@ -145,30 +145,32 @@ fn checked_translation(gpu: &Gpu, work: &SceneWork, p: &ScenePlan, v: &VariantSp
 /// `agreement`, or its result from the cache: the key covers the host translation, the Vulkan kernel's SPIR-V
 /// and constants, the device and its driver, and the kernel's inputs.
 fn agreement_cached(gpu: &Gpu, work: &SceneWork, p: &ScenePlan, v: &VariantSpec, t: &translate::Translation, words: &[u32], constants: &str) -> Result<Agreement> {
-    let (inputs, push, invocations) = work.host_inputs(v.kernel)?;
+    let inputs = work.host_inputs(v.kernel)?;
+    let (buffers, push, invocations) = &inputs;
     let mut key = crate::cache::KeyBuilder::new("scene_agreement")
         .part("brdfprof", env!("CARGO_PKG_VERSION"))
         .part("device", format!("{} {} {} {}", gpu.info.name, gpu.info.driver_name, gpu.info.driver_info, gpu.info.driver_version))
-        .part("host", format!("{} {}", t.source(translate::Dialect::Host), translate::host::HOST_FLAGS.join(" ")))
+        .part("host", format!("{} {}", t.source(translate::Dialect::Host), translate::host::build_identity()))
         .part("spirv", bytemuck::cast_slice::<u32, u8>(words))
         .part("constants", constants)
         .part("push", &push)
         .part("invocations", invocations.to_string());
-    for (slot, bytes) in &inputs {
+    for (slot, bytes) in buffers {
         key = key.part(&format!("binding {slot:?}"), bytes);
     }
     let what = format!("the check of {}'s translation", v.label);
     let valid = |bytes: &[u8]| serde_json::from_slice::<Agreement>(bytes).map(|_| ()).map_err(anyhow::Error::from);
-    let bytes = crate::cache::get_or_build(crate::cache::Store::open_default().as_ref(), "scene_agreement", &key.finish(), &what, valid, || Ok(serde_json::to_vec(&agreement(gpu, work, p, v, t)?)?))?;
+    let bytes = crate::cache::get_or_build(crate::cache::Store::open_default().as_ref(), "scene_agreement", &key.finish(), &what, valid, || Ok(serde_json::to_vec(&agreement(gpu, work, p, v, t, inputs.clone())?)?))?;
     Ok(serde_json::from_slice(&bytes)?)
 }
 
-/// The worst relative difference between the translation run on the host and the Vulkan kernel on `gpu`, over
-/// every pixel of the kernel and each pixel's brightest channel.
-fn agreement(gpu: &Gpu, work: &SceneWork, p: &ScenePlan, v: &VariantSpec, t: &translate::Translation) -> Result<Agreement> {
+/// The worst relative difference between the translation run on the host over `inputs` (the kernel's buffers,
+/// `SceneWork::host_inputs`) and the Vulkan kernel on `gpu`, over every pixel of the kernel and each pixel's
+/// brightest channel.
+fn agreement(gpu: &Gpu, work: &SceneWork, p: &ScenePlan, v: &VariantSpec, t: &translate::Translation, inputs: HostInputs) -> Result<Agreement> {
     SceneVariant::new(gpu, work, p, v.kernel, v.switches, v.label.clone(), 1)?.run_once(gpu, 0)?;
     let on_device = work.radiance(v.kernel)?;
-    let (mut inputs, mut push, invocations) = work.host_inputs(v.kernel)?;
+    let (mut inputs, mut push, invocations) = inputs;
     let host = HostKernel::compile(t)?;
     // The translation's bindings in its order (those the specialised kernel still uses), push constants last.
     let mut owned: Vec<Vec<u8>> = Vec::new();
@@ -184,9 +186,8 @@ fn agreement(gpu: &Gpu, work: &SceneWork, p: &ScenePlan, v: &VariantSpec, t: &tr
     }
     let floats: Vec<f32> = bytemuck::pod_collect_to_vec(&owned[radiance_at]);
     let on_host: Vec<[f32; 3]> = floats.chunks_exact(4).take(on_device.len()).map(|c| [c[0], c[1], c[2]]).collect();
-    let brightest: Vec<f64> = on_device.iter().map(|p| p.iter().fold(1e-3f64, |a, &b| a.max(f64::from(b).abs()))).collect();
     let lit = on_device.iter().filter(|p| p.iter().any(|&c| c != 0.0)).count();
-    Ok(Agreement { worst: verify::worst_relative(&on_host, &on_device, |i, _| brightest[i]), pixels: on_device.len(), lit })
+    Ok(Agreement { worst: verify::worst_relative_to_brightest(&on_host, &on_device), pixels: on_device.len(), lit })
 }
 
 /// A target's run as the scene's kernel and effect rows (a kernel the family left out has neither, and the

@@ -20,6 +20,9 @@ pub const STORAGE_BUFFERS: u32 = 5;
 pub const PUSH_BYTES: u32 = 16;
 pub const RADIANCE: (u32, u32) = (0, 1);
 
+/// A kernel's buffers by (set, binding), its push constants and the invocations of one run.
+pub type HostInputs = (std::collections::BTreeMap<(u32, u32), Vec<u8>>, Vec<u8>, u64);
+
 /// Bytes per pixel of the other per-pixel bindings: output (1 vec4), extras (2 vec4); pixels: `PIXEL_BYTES`.
 const OUT_BYTES: u64 = 16;
 const EXTRA_BYTES: u64 = 32;
@@ -95,7 +98,7 @@ impl<'g> SceneWork<'g> {
     /// Kernel `k`'s bindings as bytes by (set, binding), as its last run read them (the radiance zeroed), its
     /// push constants (the camera), and the invocations of one run (its pixels padded to whole workgroups):
     /// what the kernel's translation runs on, on the host.
-    pub fn host_inputs(&self, k: usize) -> Result<(std::collections::BTreeMap<(u32, u32), Vec<u8>>, Vec<u8>, u64)> {
+    pub fn host_inputs(&self, k: usize) -> Result<HostInputs> {
         let kb = &self.kernels[k];
         let bytes = |b: &Buffer| b.read_as::<u8>(0, b.size as usize);
         let buffers = [((0, 0), bytes(&kb.pixels)?), (RADIANCE, vec![0u8; kb.radiance.size as usize]), ((0, 2), bytes(&self.lights)?), ((0, 3), bytes(&kb.extras)?), ((0, 4), bytes(&kb.table)?)];

@@ -31,8 +31,7 @@ impl Radv {
     /// One child per family compiling the models (or, when given, the raw kernels instead).
     fn children(&self, families: &[usize], raw: &[super::RawKernel], request: &Request) -> Result<Vec<Run>> {
         let targets: Vec<&'static Family> = families.iter().map(|&k| &FAMILIES[k]).collect();
-        let lights = if raw.is_empty() { request.lights } else { 1 };
-        let runs = super::radv_child::run_all(&targets, request.models, raw, lights, request.shaders, request.validate, request.isa_dir)?;
+        let runs = super::radv_child::run_all(&targets, request.models, raw, request.lights, request.shaders, request.validate, request.isa_dir)?;
         Ok(runs
             .into_iter()
             .zip(families)

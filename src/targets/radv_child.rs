@@ -96,7 +96,7 @@ pub fn child_main(request_json: &str) -> Result<()> {
     }
     if !req.raw.is_empty() {
         let isa_dir = req.isa_dir.as_ref().map(|d| d.join(target.family));
-        let (report, isa_files) = raw_report(&gpu, &shaders, &req.raw, target.family, isa_dir.as_deref())?;
+        let (report, isa_files) = raw_report(&gpu, &shaders, &req, target.family, isa_dir.as_deref())?;
         gpu.check_validation()?;
         drop(gpu);
         return reply(RadvReply { family: target.family.to_string(), report, isa_files });
@@ -140,14 +140,14 @@ fn reply(reply: RadvReply) -> Result<()> {
     Ok(())
 }
 
-/// The raw kernels compiled on the null device, one row each with ACO's statistics, as one report (one light
-/// per kernel: a raw kernel's own loops are its cost); a kernel the family cannot compile is left out and named
-/// in the driver section's notes.
-fn raw_report(gpu: &Gpu, shaders: &Shaders, raw: &[RawSpirv], family: &str, isa_dir: Option<&Path>) -> Result<(InspectReport, Vec<PathBuf>)> {
+/// The request's raw kernels compiled on the null device, one row each with ACO's statistics, as one report
+/// (with the request's lights per kernel, which the cost divides by); a kernel the family cannot compile is left
+/// out and named in the driver section's notes.
+fn raw_report(gpu: &Gpu, shaders: &Shaders, req: &RadvRequest, family: &str, isa_dir: Option<&Path>) -> Result<(InspectReport, Vec<PathBuf>)> {
     let mut rows = Vec::new();
     let mut skipped = Vec::new();
     let mut isa_files = Vec::new();
-    for r in raw {
+    for r in &req.raw {
         let model = Model::parse(&r.model).map_err(|e| anyhow!("{}: {e:#}", r.model))?;
         if let Err(e) = model.check_support(&gpu.info) {
             skipped.push(format!("{} ({e:#})", r.label));
@@ -166,7 +166,7 @@ fn raw_report(gpu: &Gpu, shaders: &Shaders, raw: &[RawSpirv], family: &str, isa_
     }
     let provenance = serde_json::to_value(crate::report::Provenance::new(&gpu.info))?;
     let notes = if skipped.is_empty() { Default::default() } else { [("driver/".to_string(), format!("not compiled for {family}: {}", skipped.join("; ")))].into() };
-    Ok((crate::inspect::compiled_report(rows, provenance, 1, shaders, Default::default(), notes), isa_files))
+    Ok((crate::inspect::compiled_report(rows, provenance, req.lights, shaders, Default::default(), notes), isa_files))
 }
 
 /// Set in a child's environment, it dies of SIGSEGV after printing its report, as Mesa 22.3's teardown of the

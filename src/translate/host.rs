@@ -12,6 +12,19 @@ use anyhow::{anyhow, bail, Context, Result};
 pub const HOST_COMPILER: &str = "g++";
 pub const HOST_FLAGS: [&str; 6] = ["-std=c++17", "-O2", "-fPIC", "-shared", "-ffp-contract=off", "-fno-strict-aliasing"];
 
+/// What a host build depends on besides the source, for cache keys: the compiler's version line and the flags
+/// (another g++ may round the maths libraries differently).
+pub fn build_identity() -> String {
+    static IDENTITY: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+    IDENTITY
+        .get_or_init(|| {
+            let out = crate::cleanup::output(crate::cleanup::command(HOST_COMPILER).arg("--version"));
+            let version = out.ok().and_then(|o| String::from_utf8_lossy(&o.stdout).lines().next().map(str::to_string)).unwrap_or_else(|| format!("{HOST_COMPILER} (version unknown)"));
+            format!("{version} {}", HOST_FLAGS.join(" "))
+        })
+        .clone()
+}
+
 /// A translation compiled for the host.
 pub struct HostKernel {
     // The library must be dropped before its directory.

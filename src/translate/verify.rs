@@ -61,6 +61,13 @@ pub fn worst_relative(host: &[[f32; 3]], device: &[[f32; 3]], scale: impl Fn(usi
     worst
 }
 
+/// `worst_relative` over each device value's brightest channel (at least 1e-3): the measure for kernels that
+/// write radiance, whose dim channels carry no precision of their own.
+pub fn worst_relative_to_brightest(host: &[[f32; 3]], device: &[[f32; 3]]) -> f64 {
+    let brightest: Vec<f64> = device.iter().map(|p| p.iter().fold(1e-3f64, |a, &b| a.max(f64::from(b).abs()))).collect();
+    worst_relative(host, device, |i, _| brightest[i])
+}
+
 /// The eval kernel of `model`, translated and run on the host, against `gpu`.
 pub fn eval_agreement(gpu: &Gpu, model: &Model, shaders: &Shaders) -> Result<Agreement> {
     let samples = well_conditioned(EVAL_SAMPLES, 0x7e57, 0.05, 0.2..1.0);
@@ -94,8 +101,7 @@ pub fn shade_agreement(gpu: &Gpu, model: Option<&Model>, lights: u32, shaders: &
     kernel.run(&mut [&mut words, &mut radiance, &mut light_bytes, &mut push], [groups, 1, 1])?;
     let words: Vec<u32> = bytemuck::pod_collect_to_vec(&radiance);
     let on_host: Vec<[f32; 3]> = words.into_iter().take(on_device.len()).map(gbuffer::unpack_r11g11b10).collect();
-    let brightest: Vec<f64> = on_device.iter().map(|p| p.iter().fold(1e-3f64, |a, &b| a.max(f64::from(b).abs()))).collect();
-    let worst = worst_relative(&on_host, &on_device, |i, _| brightest[i]);
+    let worst = worst_relative_to_brightest(&on_host, &on_device);
     Ok(Agreement { kernel: "shade".into(), values: 3 * on_device.len(), worst, tolerance: 2.0 / 32.0, device: gpu.info.name.clone() })
 }
 
@@ -127,7 +133,7 @@ pub fn check_cached(gpu: &Gpu, model: Option<&Model>, lights: u32, shaders: &Sha
     let mut key = crate::cache::KeyBuilder::new("agreement")
         .part("brdfprof", env!("CARGO_PKG_VERSION"))
         .part("device", format!("{} {} {} {}", gpu.info.name, gpu.info.driver_name, gpu.info.driver_info, gpu.info.driver_version))
-        .part("setup", format!("{EVAL_SAMPLES} {SHADE_SIZE:?} {lights} {}", host::HOST_FLAGS.join(" ")))
+        .part("setup", format!("{EVAL_SAMPLES} {SHADE_SIZE:?} {lights} {}", host::build_identity()))
         .part("shade-spirv", bytemuck::cast_slice::<u32, u8>(&shade.spirv.words))
         .part("shade-constants", format!("{:?}", shade.constants))
         .part("shade-host", prepare::shade_kernel(model, lights, shaders)?.source(super::Dialect::Host));
