@@ -123,6 +123,34 @@ fn encode(kind: &str, key: &Key, payload: &[u8]) -> Vec<u8> {
     [header.as_bytes(), payload].concat()
 }
 
+/// The most header bytes read before the blank line that ends it.
+const MAX_HEADER: u64 = 4096;
+
+/// An entry's bytes, read no further than its header says it holds (plus one byte, to tell a longer file):
+/// None when there is none; an error, as for a damaged entry, when it is not a regular file (a symbolic link
+/// to an endless file, a FIFO) or cannot be read.
+fn read_entry(path: &Path) -> std::result::Result<Option<Vec<u8>>, String> {
+    use std::io::Read;
+    match std::fs::symlink_metadata(path) {
+        Err(_) => return Ok(None),
+        Ok(m) if !m.file_type().is_file() => return Err("not a regular file (a symbolic link, directory or device)".into()),
+        Ok(_) => {}
+    }
+    let mut file = std::fs::File::open(path).map_err(|e| format!("cannot be read ({e})"))?;
+    let mut bytes = Vec::new();
+    (&mut file).take(MAX_HEADER).read_to_end(&mut bytes).map_err(|e| format!("cannot be read ({e})"))?;
+    let Some(end) = bytes.windows(2).position(|w| w == b"\n\n") else { return Ok(Some(bytes)) };
+    let length = std::str::from_utf8(&bytes[..end]).ok().and_then(|h| h.lines().find_map(|l| l.strip_prefix("length: ")?.parse::<u64>().ok()));
+    let Some(length) = length else { return Ok(Some(bytes)) };
+    let total = (end as u64).saturating_add(3).saturating_add(length);
+    if (bytes.len() as u64) > total {
+        bytes.truncate(total as usize);
+    } else {
+        file.take(total - bytes.len() as u64).read_to_end(&mut bytes).map_err(|e| format!("cannot be read ({e})"))?;
+    }
+    Ok(Some(bytes))
+}
+
 /// The payload of an entry for `kind` and (when given) `key`, or why it cannot be trusted.
 fn decode<'a>(bytes: &'a [u8], kind: &str, key: Option<&str>) -> std::result::Result<&'a [u8], String> {
     let end = bytes.windows(2).position(|w| w == b"\n\n").ok_or("no header (not a brdfprof cache entry, or cut short)")?;
@@ -172,12 +200,13 @@ impl Store {
     /// that does not verify.
     pub fn get(&self, kind: &str, key: &Key) -> Lookup {
         let path = self.path(kind, key);
-        match std::fs::read(&path) {
-            Ok(bytes) => match decode(&bytes, kind, Some(key.hex())) {
+        match read_entry(&path) {
+            Ok(None) => Lookup::Miss,
+            Ok(Some(bytes)) => match decode(&bytes, kind, Some(key.hex())) {
                 Ok(payload) => Lookup::Hit(payload.to_vec()),
                 Err(why) => Lookup::Bad { path, why },
             },
-            Err(_) => Lookup::Miss,
+            Err(why) => Lookup::Bad { path, why },
         }
     }
 
@@ -319,6 +348,22 @@ mod tests {
         store.put("spv", &key("x"), b"payload").unwrap();
         std::fs::copy(store.path("spv", &key("x")), store.path("spv", &key("y"))).unwrap();
         assert!(matches!(store.get("spv", &key("y")), Lookup::Bad { why, .. } if why.contains("under another key's name")));
+    }
+
+    /// Issue 31 item 6: an entry that is a symbolic link (here to an endless file) is damaged, not read; an
+    /// entry longer than its header says is read no further than that.
+    #[test]
+    fn a_linked_or_overlong_entry_is_bad_and_read_within_its_length() {
+        let dir = tempfile::tempdir().unwrap();
+        let store = Store::at(dir.path());
+        std::os::unix::fs::symlink("/dev/zero", store.path("spv", &key("z"))).unwrap();
+        assert!(matches!(store.get("spv", &key("z")), Lookup::Bad { why, .. } if why.contains("not a regular file")));
+        store.put("spv", &key("x"), b"payload").unwrap();
+        let mut long = std::fs::read(store.path("spv", &key("x"))).unwrap();
+        long.extend(std::iter::repeat_n(b'!', 1 << 20));
+        std::fs::write(store.path("spv", &key("x")), &long).unwrap();
+        assert_eq!(read_entry(&store.path("spv", &key("x"))).unwrap().unwrap().len(), long.len() - (1 << 20) + 1);
+        assert!(matches!(store.get("spv", &key("x")), Lookup::Bad { why, .. } if why.contains("bytes of payload where the header says 7")));
     }
 
     /// The property the cache exists for: whatever happens to an entry's bytes, `get` returns the payload

@@ -7,7 +7,7 @@
 
 use anyhow::{Context, Result};
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Output, Stdio};
+use std::process::{Child, Command};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Mutex, MutexGuard};
 use std::time::{Duration, Instant};
@@ -227,13 +227,6 @@ pub fn child_tmpdir(cmd: &mut Command) -> Result<TempDir> {
     Ok(dir)
 }
 
-/// `cmd.output()`, with the child registered for the signal handler while it runs.
-pub fn output(cmd: &mut Command) -> std::io::Result<Output> {
-    let child = cmd.stdin(Stdio::null()).stdout(Stdio::piped()).stderr(Stdio::piped()).spawn()?;
-    let _guard = ChildGuard::new(&child);
-    child.wait_with_output()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -245,7 +238,7 @@ mod tests {
         assert!(registry().paths.contains(&path));
         drop(dir);
         assert!(!registry().paths.contains(&path) && !path.exists());
-        let out = output(command("sh").args(["-c", "echo $PPID"])).unwrap();
+        let out = command("sh").args(["-c", "echo $PPID"]).output().unwrap();
         assert_eq!(String::from_utf8_lossy(&out.stdout).trim(), std::process::id().to_string());
     }
 }

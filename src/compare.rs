@@ -10,7 +10,7 @@ use crate::inspect::HASH_NOTE;
 use crate::profile::view::ProfileView;
 use crate::profile::workload::BASELINE_LABEL;
 use crate::report::{sig, Table};
-use anyhow::{anyhow, bail, Context, Result};
+use anyhow::{anyhow, bail, Result};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 use std::collections::BTreeMap;
@@ -300,7 +300,7 @@ impl CostTable {
 /// The columns of one saved JSON report: a `profile` report, an `inspect` report, an `inspect` report of
 /// several devices, or a `check` baseline (its inspect part).
 pub fn load_columns(path: &Path) -> Result<Vec<CostColumn>> {
-    let text = std::fs::read_to_string(path).with_context(|| format!("{}: cannot read it", path.display()))?;
+    let text = String::from_utf8(crate::io::read_bounded(path, crate::io::MAX_REPORT_BYTES)?).map_err(|_| anyhow!("{}: not UTF-8 text: not a brdfprof JSON report", path.display()))?;
     let value: serde_json::Value = serde_json::from_str(&text).map_err(|e| anyhow!("{}: not valid JSON ({e})", path.display()))?;
     let source = format!("{}: ", path.display());
     let inspect_of = |v: &serde_json::Value| -> Result<InspectReport> {
@@ -332,11 +332,18 @@ pub fn load_columns(path: &Path) -> Result<Vec<CostColumn>> {
 /// Refuses a report given twice (the same file by any path, or two files with the same content): a column
 /// against itself correlates perfectly and says nothing.
 fn refuse_repeats(files: &[PathBuf]) -> Result<()> {
+    refuse_repeated_reports(files, "a report compared with itself correlates perfectly and says nothing")
+}
+
+/// Refuses a report given twice (by any path, or two files with the same content), `why` saying what the
+/// repeat would do.
+pub fn refuse_repeated_reports(files: &[PathBuf], why: &str) -> Result<()> {
     let mut seen: Vec<(&PathBuf, Vec<u8>)> = Vec::new();
     for f in files {
-        let digest = Sha256::digest(std::fs::read(f).with_context(|| format!("{}: cannot read it", f.display()))?).to_vec();
+        let bytes = crate::io::read_bounded(f, crate::io::MAX_REPORT_BYTES)?;
+        let digest = Sha256::digest(bytes).to_vec();
         if let Some((first, _)) = seen.iter().find(|(_, d)| *d == digest) {
-            bail!("{} is the same report as {}: give each report once (a report compared with itself correlates perfectly and says nothing)", f.display(), first.display());
+            bail!("{} is the same report as {}: give each report once ({why})", f.display(), first.display());
         }
         seen.push((f, digest));
     }

@@ -133,19 +133,36 @@ pub fn output_with_input(cmd: &mut Command, input: Vec<u8>, what: &str) -> Resul
     run(cmd, Some(input), what, limit())
 }
 
+/// The most bytes read from a child's stdout or stderr: brdfprof's largest listing (a 128-light scene
+/// kernel's SASS) is a few MB. A tool that prints more is not printing what it promises (`yes` as nvdisasm),
+/// and is killed rather than read into memory.
+pub const MAX_OUTPUT_BYTES: usize = 256 << 20;
+
+/// `output` with an explicit limit on top of the compile limit: a tool's version query, a probe.
+pub fn output_quick(cmd: &mut Command, what: &str) -> Result<Output> {
+    run(cmd, None, what, limit().min(Duration::from_secs(30)))
+}
+
 fn run(cmd: &mut Command, input: Option<Vec<u8>>, what: &str, limit: Duration) -> Result<Output> {
     use std::io::{Read, Write};
+    use std::sync::atomic::{AtomicBool, Ordering};
+    use std::sync::Arc;
     let stdin = if input.is_some() { Stdio::piped() } else { Stdio::null() };
     let mut child = cmd.stdin(stdin).stdout(Stdio::piped()).stderr(Stdio::piped()).spawn()?;
     let _guard = crate::cleanup::ChildGuard::new(&child);
     // Written on a thread so that a large output cannot deadlock against the input.
     let writer = child.stdin.take().zip(input).map(|(mut pipe, bytes)| std::thread::spawn(move || pipe.write_all(&bytes)));
     // Readers drain the pipes while this thread watches the clock (a full pipe would stall the child).
+    let overflow = Arc::new(AtomicBool::new(false));
     let read_all = |pipe: Option<Box<dyn Read + Send>>| {
+        let overflow = Arc::clone(&overflow);
         std::thread::spawn(move || {
             let mut bytes = Vec::new();
-            if let Some(mut p) = pipe {
-                let _ = p.read_to_end(&mut bytes);
+            if let Some(p) = pipe {
+                let _ = p.take(MAX_OUTPUT_BYTES as u64 + 1).read_to_end(&mut bytes);
+            }
+            if bytes.len() > MAX_OUTPUT_BYTES {
+                overflow.store(true, Ordering::SeqCst);
             }
             bytes
         })
@@ -162,10 +179,19 @@ fn run(cmd: &mut Command, input: Option<Vec<u8>>, what: &str, limit: Duration) -
             let _ = child.wait();
             bail!(over_limit(what, limit));
         }
+        if overflow.load(Ordering::SeqCst) {
+            let _ = child.kill();
+            let _ = child.wait();
+            bail!("{what}: the tool printed more than {} MiB, far more than it prints for any kernel: not its promised output", MAX_OUTPUT_BYTES >> 20);
+        }
         progress.tick(limit);
         std::thread::sleep(Duration::from_millis(10));
     };
     let (stdout, stderr) = (stdout.join().unwrap_or_default(), stderr.join().unwrap_or_default());
+    // A tool cut off at the bound may end (SIGPIPE) before the loop above saw the bound reached.
+    if overflow.load(Ordering::SeqCst) {
+        bail!("{what}: the tool printed more than {} MiB, far more than it prints for any kernel: not its promised output", MAX_OUTPUT_BYTES >> 20);
+    }
     if let Some(w) = writer {
         // A compiler that exits without reading all of its input has said why on stderr.
         let _ = w.join();
@@ -219,6 +245,14 @@ mod tests {
         assert!(started.elapsed() < Duration::from_secs(5), "killed at the limit");
         let out = output_within(Command::new("sh").args(["-c", "echo out; echo err >&2"]), "sh", Duration::from_secs(30)).unwrap();
         assert_eq!((out.stdout.as_slice(), out.stderr.as_slice(), out.status.success()), (&b"out\n"[..], &b"err\n"[..], true));
+    }
+
+    #[test]
+    fn a_tool_that_prints_without_end_is_killed() {
+        let started = Instant::now();
+        let e = output_within(&mut Command::new("yes"), "yes as a disassembler", Duration::from_secs(60)).unwrap_err().to_string();
+        assert!(e.starts_with("yes as a disassembler: the tool printed more than 256 MiB"), "{e}");
+        assert!(started.elapsed() < Duration::from_secs(50), "stopped at the byte bound, not the time limit");
     }
 
     #[test]

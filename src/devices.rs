@@ -92,10 +92,14 @@ impl Inspected {
 
     /// The JSON written: the one device's report, or the combined report of several.
     pub fn json_value(&self) -> Result<serde_json::Value> {
-        Ok(match &self.multi {
-            None => serde_json::to_value(&self.reports[0])?,
-            Some(m) => serde_json::to_value(m)?,
-        })
+        let (kind, mut value) = match &self.multi {
+            None => (crate::report::Kind::Inspect, serde_json::to_value(&self.reports[0])?),
+            Some(m) => (crate::report::Kind::InspectDevices, serde_json::to_value(m)?),
+        };
+        if let Some(map) = value.as_object_mut() {
+            map.insert("kind".into(), kind.name().into());
+        }
+        Ok(value)
     }
 }
 

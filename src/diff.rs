@@ -61,6 +61,9 @@ pub struct ChannelStats {
     pub a_nonfinite: usize,
     pub b_nonfinite: usize,
     pub mismatched_nonfinite: usize,
+    /// Rows where both are non-finite and not the same infinity (NaN on both sides): no difference measures
+    /// them, so no tolerance can be claimed for them.
+    pub unmeasured: usize,
 }
 
 /// A row where the models differ most (largest relative difference over its channels).
@@ -139,6 +142,13 @@ fn pair_rel(a: f64, b: f64) -> Option<f64> {
     }
 }
 
+impl Difference {
+    /// Values (rows times channels) no difference measures: NaN on both sides.
+    pub fn unmeasured(&self) -> usize {
+        self.channels.iter().map(|c| c.unmeasured).sum()
+    }
+}
+
 /// B against A over every row and channel.
 pub fn difference(a: &[[f64; 3]], b: &[[f64; 3]]) -> Difference {
     assert_eq!(a.len(), b.len(), "one value of each model per row");
@@ -159,6 +169,7 @@ fn channel_stats(c: usize, a: &[[f64; 3]], b: &[[f64; 3]]) -> ChannelStats {
             continue;
         }
         if !x.is_finite() {
+            s.unmeasured += (x != y) as usize;
             continue;
         }
         let (abs, rel) = ((y - x).abs(), rel_err(y, x));
@@ -236,7 +247,7 @@ impl DiffReport {
         let wide = |v: &[[f32; 3]]| v.iter().map(|x| x.map(f64::from)).collect::<Vec<_>>();
         let (a, b) = (wide(e.a_values), wide(e.b_values));
         let difference = difference(&a, &b);
-        let within_tolerance = tolerance.is_none_or(|t| difference.max_rel <= t);
+        let within_tolerance = tolerance.is_none_or(|t| difference.max_rel <= t && difference.unmeasured() == 0);
         DiffReport {
             kind: KIND,
             schema: SCHEMA,
@@ -270,7 +281,12 @@ impl DiffReport {
         out += &self.histogram_markdown();
         out += &self.worst_markdown();
         if let Some(tol) = self.tolerance {
-            out += &format!("\n{} --tolerance {tol} (max rel {}).\n", if self.within_tolerance { "Within" } else { "ABOVE" }, sig(self.difference.max_rel, 3));
+            let unmeasured = self.difference.unmeasured();
+            out += &match (self.within_tolerance, unmeasured) {
+                (true, _) => format!("\nWithin --tolerance {tol} (max rel {}).\n", sig(self.difference.max_rel, 3)),
+                (false, 0) => format!("\nABOVE --tolerance {tol} (max rel {}).\n", sig(self.difference.max_rel, 3)),
+                (false, n) => format!("\nNOT within --tolerance {tol}: {n} values are NaN on both sides, which no difference measures (max rel {} over the rest).\n", sig(self.difference.max_rel, 3)),
+            };
         }
         out
     }

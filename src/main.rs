@@ -65,6 +65,8 @@ enum Command {
     CallgrindChild { request: String },
     #[command(name = "__radv-child", hide = true)]
     RadvChild { request: String },
+    #[command(name = "__run-translation", hide = true)]
+    RunTranslation { dir: String },
     #[command(name = "__probe-vulkan", hide = true)]
     ProbeVulkan,
     /// Writes glsl/generated/ from the Rust term tables (`make spv` runs it).
@@ -78,7 +80,7 @@ enum Command {
 fn main() -> ExitCode {
     cli::command_started();
     let cli = Cli::parse();
-    let child = matches!(cli.command, Command::CallgrindChild { .. } | Command::RadvChild { .. } | Command::ProbeVulkan);
+    let child = matches!(cli.command, Command::CallgrindChild { .. } | Command::RadvChild { .. } | Command::RunTranslation { .. } | Command::ProbeVulkan);
     if let Err(e) = cli::prepare(child, cli.compile_timeout) {
         return cli::finish(Err(e));
     }
@@ -99,6 +101,7 @@ fn main() -> ExitCode {
         Command::Cache(args) => cli::cache::cache(&args),
         Command::CallgrindChild { request } => brdfprof::inspect::callgrind::child_main(&request).map(|_| ExitCode::SUCCESS),
         Command::RadvChild { request } => brdfprof::targets::radv_child::child_main(&request).map(|_| ExitCode::SUCCESS),
+        Command::RunTranslation { dir } => brdfprof::translate::runner::child_main(&dir).map(|_| ExitCode::SUCCESS),
         Command::ProbeVulkan => brdfprof::targets::radv_env::probe_main().map(|_| ExitCode::SUCCESS),
         Command::GenerateGlsl { dir } => cli::info::generate_glsl(&dir),
     };

@@ -121,9 +121,9 @@ pub fn write_json_compact(path: &Path, value: &impl Serialize) -> Result<()> {
 
 /// Writes `<stem>.md` (`markdown`), `<stem>.json` (`value`, compact) and `<stem>.png` (`chart`); returns their
 /// paths.
-pub fn write_md_json_png(stem: &Path, value: &impl Serialize, markdown: &str, chart: impl FnOnce(&Path) -> Result<()>) -> Result<Vec<std::path::PathBuf>> {
+pub fn write_md_json_png(stem: &Path, kind: Kind, value: &impl Serialize, markdown: &str, chart: impl FnOnce(&Path) -> Result<()>) -> Result<Vec<std::path::PathBuf>> {
     let (md, json, png) = (stem.with_extension("md"), stem.with_extension("json"), stem.with_extension("png"));
-    write_json_compact(&json, value)?;
+    write_report_compact(&json, kind, value)?;
     crate::io::write_output(&md, markdown.as_bytes())?;
     chart(&png)?;
     Ok(vec![md, json, png])
@@ -135,9 +135,84 @@ pub fn write_json(path: &Path, value: &impl Serialize) -> Result<()> {
     crate::io::write_output(path, text.as_bytes())
 }
 
+/// What a saved JSON report is: its top-level `"kind"`, which `report` and `compare` read instead of
+/// guessing from its keys (docs/commands.md lists them; `diff` writes its own).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Kind {
+    Profile,
+    SceneProfile,
+    Sweep,
+    SweepCost,
+    Stability,
+    Inspect,
+    InspectDevices,
+    Compare,
+    Baseline,
+}
+
+impl Kind {
+    pub const ALL: [Kind; 9] = [Kind::Profile, Kind::SceneProfile, Kind::Sweep, Kind::SweepCost, Kind::Stability, Kind::Inspect, Kind::InspectDevices, Kind::Compare, Kind::Baseline];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Kind::Profile => "profile",
+            Kind::SceneProfile => "scene-profile",
+            Kind::Sweep => "sweep",
+            Kind::SweepCost => "sweep-cost",
+            Kind::Stability => "stability",
+            Kind::Inspect => "inspect",
+            Kind::InspectDevices => "inspect-devices",
+            Kind::Compare => "compare",
+            Kind::Baseline => "baseline",
+        }
+    }
+
+    pub fn parse(name: &str) -> Option<Kind> {
+        Kind::ALL.into_iter().find(|k| k.name() == name)
+    }
+}
+
+/// `value`'s JSON text with `"kind"` as its first key (`value` must serialize as an object without one).
+fn with_kind(kind: Kind, value: &impl Serialize, pretty: bool) -> Result<String> {
+    let text = if pretty { serde_json::to_string_pretty(value)? } else { serde_json::to_string(value)? };
+    let rest = text.strip_prefix('{').ok_or_else(|| anyhow::anyhow!("a {} report that is not a JSON object", kind.name()))?;
+    let empty = rest.trim_start().starts_with('}');
+    let sep = if empty { "" } else { "," };
+    Ok(if pretty { format!("{{\n  \"kind\": \"{}\"{sep}{rest}\n", kind.name()) } else { format!("{{\"kind\":\"{}\"{sep}{rest}\n", kind.name()) })
+}
+
+/// `write_json` of a saved report, its `kind` first.
+pub fn write_report(path: &Path, kind: Kind, value: &impl Serialize) -> Result<()> {
+    crate::io::write_output(path, with_kind(kind, value, true)?.as_bytes())
+}
+
+/// `write_json_compact` of a saved report, its `kind` first.
+pub fn write_report_compact(path: &Path, kind: Kind, value: &impl Serialize) -> Result<()> {
+    crate::io::write_output(path, with_kind(kind, value, false)?.as_bytes())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_saved_report_names_its_kind_first() {
+        #[derive(Serialize)]
+        struct R {
+            a: u32,
+        }
+        for pretty in [false, true] {
+            let text = with_kind(Kind::Sweep, &R { a: 1 }, pretty).unwrap();
+            let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+            assert_eq!((v["kind"].as_str(), v["a"].as_u64()), (Some("sweep"), Some(1)), "{text}");
+            assert!(text.trim_start_matches(['{', ' ', '\n']).starts_with("\"kind\""), "{text}");
+        }
+        let empty = with_kind(Kind::Compare, &serde_json::json!({}), true).unwrap();
+        assert_eq!(serde_json::from_str::<serde_json::Value>(&empty).unwrap()["kind"], "compare");
+        for k in Kind::ALL {
+            assert_eq!(Kind::parse(k.name()), Some(k));
+        }
+    }
 
     #[test]
     fn significant_digits() {

@@ -220,7 +220,8 @@ pub fn glslang_version() -> Option<String> {
 
 /// The first non-empty line a tool prints, or None when it cannot run.
 pub fn first_line_of(cmd: &mut Command) -> Option<String> {
-    let out = crate::cleanup::output(cmd).ok()?;
+    let what = format!("{:?} --version", cmd.get_program());
+    let out = crate::compile_limit::output_quick(cmd, &what).ok()?;
     let text = String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr);
     text.lines().map(str::trim).find(|l| !l.is_empty()).map(str::to_string)
 }

@@ -226,7 +226,7 @@ impl SweepReport {
 
     /// Writes sweep-<device>.md, .json and .png under `out`; returns their paths.
     pub fn write(&self, out: &Path, device: &str) -> Result<Vec<std::path::PathBuf>> {
-        report::write_md_json_png(&out.join(format!("sweep-{device}")), self, &self.markdown(), |png| self.chart(png))
+        report::write_md_json_png(&out.join(format!("sweep-{device}")), report::Kind::Sweep, self, &self.markdown(), |png| self.chart(png))
     }
 
     /// Approximation error (RMS vs exact, log) against cost, every point labelled, the frontier drawn.

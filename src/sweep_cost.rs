@@ -58,7 +58,8 @@ pub fn build(sweep: &SweepReport, target: &str, cost: &TargetCost, note: Option<
     let mut rows: Vec<CostSweepRow> = Vec::new();
     let mut skipped = Vec::new();
     for r in &sweep.rows {
-        let Some(a) = cost.row(&r.spec) else {
+        // The target's rows are named by the model's label (a file's `name=`, or its stem), as every table is.
+        let Some(a) = cost.row(&r.label).or_else(|| cost.row(&r.spec)) else {
             skipped.push(r.spec.clone());
             continue;
         };
@@ -110,7 +111,8 @@ impl CostSweep {
         headers.extend(["cycles/eval", "net cycles/eval", "cost vs fastest", "measured cost vs fastest", "vs exact: max / RMS err", "Pareto (target)", "Pareto (measured)"].map(String::from));
         let mut t = Table::new(headers);
         for r in &self.rows {
-            let mut cells = vec![r.spec.clone()];
+            // The model's label (`name=`, a file's stem) as every table names it; the spec is in the JSON.
+            let mut cells = vec![r.label.clone()];
             cells.extend(self.columns.iter().map(|c| r.stats.get(c).map_or("-".into(), |v| crate::inspect::format_value(*v))));
             cells.extend([
                 report::sig(r.cycles_per_eval, 4),
@@ -147,7 +149,7 @@ impl CostSweep {
 
     /// Writes `<stem>.md`, `.json` and `.png`; returns their paths.
     pub fn write(&self, stem: &Path) -> Result<Vec<PathBuf>> {
-        report::write_md_json_png(stem, self, &self.markdown(), |png| self.chart(png))
+        report::write_md_json_png(stem, report::Kind::SweepCost, self, &self.markdown(), |png| self.chart(png))
     }
 
     pub fn chart(&self, path: &Path) -> Result<()> {

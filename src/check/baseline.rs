@@ -25,7 +25,7 @@ pub struct Baseline {
 /// Reads and checks a baseline file; every error names the file and what is wrong with it.
 pub fn load(path: &Path) -> Result<Baseline> {
     let name = path.display();
-    let text = std::fs::read_to_string(path).with_context(|| format!("baseline {name}: cannot read it"))?;
+    let text = String::from_utf8(crate::io::read_bounded(path, crate::io::MAX_REPORT_BYTES).with_context(|| format!("baseline {name}: cannot read it"))?).map_err(|_| anyhow::anyhow!("baseline {name}: not UTF-8 text: not a brdfprof baseline"))?;
     let value: serde_json::Value = serde_json::from_str(&text).map_err(|e| anyhow!("baseline {name}: corrupt, not valid JSON ({e})"))?;
     match value.get("format").and_then(|f| f.as_str()) {
         Some(FORMAT) => {}

@@ -139,7 +139,7 @@ fn run_measured(options: &CheckOptions, measure: impl FnOnce(Vec<Model>, u32) ->
         _ => Outcome { text: format!("{}\n\n{}", new.inspect.summary(), new.inspect.markdown()), exit: 0 },
     };
     if let Some(path) = &options.save {
-        reports::write_json(path, &new)?;
+        reports::write_report(path, reports::Kind::Baseline, &new)?;
         crate::messages::progress(format!("check: baseline saved to {}", path.display()));
     }
     Ok(outcome)

@@ -40,7 +40,7 @@ pub fn compare(args: &CompareArgs) -> Result<ExitCode> {
     let chart = args.chart.clone().unwrap_or_else(|| PathBuf::from("results/compare.png"));
     let files: Vec<String> = args.files.iter().map(|f| f.display().to_string()).collect();
     let text = format!("# brdfprof compare\n\n{}\n\n{}", files.join(", "), table.markdown());
-    report::write_json(&json, &table)?;
+    report::write_report(&json, report::Kind::Compare, &table)?;
     io::write_output(&markdown, text.as_bytes())?;
     table.chart(&chart)?;
     print!("{text}");

@@ -100,7 +100,12 @@ pub fn inspect(args: &InspectArgs) -> Result<ExitCode> {
     }
     let validate = DeviceArgs { device: None, validate: args.validate }.validation();
     let plan = devices::plan(&args.devices)?;
-    let default_name = if plan.len() > 1 { "inspect-devices" } else { "inspect-<device>" };
+    // A compile-only target's default name is known now (`devices::slug`); a local device's only once it is open.
+    let default_name = match plan.as_slice() {
+        [devices::Planned::Target(t)] => format!("inspect-{}", t.name().replace(':', "-")),
+        [_] => "inspect-<device>".to_string(),
+        _ => "inspect-devices".to_string(),
+    };
     check_output("--json", args.json.as_deref(), "results", &format!("{default_name}.json"))?;
     check_output("--markdown", args.markdown.as_deref(), "results", &format!("{default_name}.md"))?;
     args.html.check()?;

@@ -138,6 +138,9 @@ impl Inputs {
             });
         };
         let (ma, input, ra) = read_rows(a, path, &args.model.params)?;
+        if input.samples.is_empty() {
+            bail!("--input {}: the file has a header but no rows: there is nothing to compare (as --samples 0 is refused)", path.display());
+        }
         let (mb, _, rb) = read_rows(b, path, &args.model.params)?;
         Ok(Inputs { samples: input.samples, tangents: input.tangents, lines: Some(input.lines), label: path.display().to_string(), a: (ma, ra), b: (mb, rb) })
     }

@@ -66,7 +66,7 @@ pub fn profile(args: &ProfileArgs) -> Result<ExitCode> {
     let options = args.timing.options(args.model.models(&THESIS_MODELS)?, size, args.reps, args.budget, args.target_ci)?;
     let (gpu, result) = on_device(&args.device, |gpu, progress| profile::run(gpu, &options, progress))?;
     let path = args.json.clone().unwrap_or_else(|| PathBuf::from(format!("{}/profile-{}.json", super::DEFAULT_OUT, brdfprof::targets::device_slug(&gpu.info))));
-    report::write_json(&path, &result)?;
+    report::write_report(&path, report::Kind::Profile, &result)?;
     args.html.write(&[super::report::just_measured(&path, &result)?], Some(&gpu))?;
     println!("{}\n", result.summary());
     print!("{}{}", result.table().markdown(), result.placement_notes());
@@ -101,6 +101,9 @@ fn profile_scene(args: &ProfileArgs, path: &std::path::Path) -> Result<ExitCode>
     if args.size.is_some() {
         bail!("--scene: the G-buffer size is the scene's; --size does not apply");
     }
+    if let Some(html) = &args.html.html {
+        bail!("--html {}: the HTML report does not draw scene profiles; the scene's tables are in the JSON and printed Markdown (`brdfprof render --scene` draws its pictures)", html.display());
+    }
     let cost_targets = cost_targets(&args.cost_devices)?;
     if let Some(dir) = &args.isa {
         if cost_targets.is_empty() {
@@ -115,7 +118,7 @@ fn profile_scene(args: &ProfileArgs, path: &std::path::Path) -> Result<ExitCode>
     let options = scene::profile::SceneProfileOptions { protocol: base.protocol, target_rel_ci: args.target_ci, max_chunk: None, instances: base.instances, cost_targets, validate: args.device.validation(), isa_dir: args.isa.clone() };
     let (gpu, result) = on_device(&args.device, |gpu, progress| scene::profile::run(gpu, &scene, &options, progress))?;
     let path = args.json.clone().unwrap_or_else(|| PathBuf::from(format!("{}/scene-{}-{}.json", super::DEFAULT_OUT, scene.name(), brdfprof::targets::device_slug(&gpu.info))));
-    report::write_json(&path, &result)?;
+    report::write_report(&path, report::Kind::SceneProfile, &result)?;
     println!("{}\n", result.summary());
     print!("{}", result.markdown());
     println!("\nJSON: {}", path.display());
@@ -206,17 +209,23 @@ pub fn sweep(args: &SweepArgs) -> Result<ExitCode> {
     let mut files = result.write(&out, &slug)?;
     files.extend(args.html.write(&[super::report::just_measured(&out.join(format!("sweep-{slug}.json")), &result)?], Some(&gpu))?);
     print!("{}", result.markdown());
+    let mut missing = false;
     for run in &costs {
         let name = run.target.name();
         let table = run.report.cost.clone().ok_or_else(|| anyhow::anyhow!("{name}: the compiler reported no statistics the cost model reads"))?;
         let note = run.report.section_notes.get("driver/").map(String::as_str).filter(|n| n.starts_with("not compiled"));
         let swept = brdfprof::sweep_cost::build(&result, &name, &table, note)?;
+        if let Some(skipped) = &swept.skipped {
+            // Every model asked for is in every table, or the command says which is not, and exits 1.
+            brdfprof::messages::warning(format!("{skipped}: those specs have no {name} figure"));
+            missing = true;
+        }
         let family = table.family.clone().unwrap_or_else(|| name.replace(':', "-"));
         files.extend(swept.write(&out.join(format!("sweep-{slug}-{}-{family}", table.compiler.to_ascii_lowercase())))?);
         print!("\n{}", swept.markdown());
     }
     println!("\n{}", written(&files));
-    Ok(ExitCode::SUCCESS)
+    Ok(if missing { ExitCode::from(1) } else { ExitCode::SUCCESS })
 }
 
 #[derive(Args)]

@@ -56,6 +56,7 @@ pub fn just_measured(json: &Path, report: &impl serde::Serialize) -> Result<Inpu
 pub fn report(args: &ReportArgs) -> Result<ExitCode> {
     io::check_output_path("--out", &args.out)?;
     io::check_not_input("--out", &args.out, &args.files.iter().map(|f| ("RESULTS", f.as_path())).collect::<Vec<_>>())?;
+    brdfprof::compare::refuse_repeated_reports(&args.files, "a report given twice would draw its sections twice")?;
     let inputs = args.files.iter().map(|f| htmlreport::load(f)).collect::<Result<Vec<_>>>()?;
     let gpu = if args.no_gpu { None } else { Some(args.device.open()?) };
     let bytes = htmlreport::write(&inputs, &args.out, gpu.as_ref())?;

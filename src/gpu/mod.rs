@@ -309,7 +309,10 @@ fn create_device(instance: &ash::Instance, physical: vk::PhysicalDevice, family:
     ) >= 2;
     let mut f16 = vk::PhysicalDeviceShaderFloat16Int8Features::default().shader_float16(info.shader_float16);
     let mut exec = vk::PhysicalDevicePipelineExecutablePropertiesFeaturesKHR::default().pipeline_executable_info(info.pipeline_executable_properties);
-    let mut create = vk::DeviceCreateInfo::default().queue_create_infos(&queues).enabled_extension_names(&extensions);
+    // fp64 where the device has it: a .brdf shader may compute in double (validation refuses the Float64
+    // capability on a device that did not enable it).
+    let features = vk::PhysicalDeviceFeatures::default().shader_float64(info.shader_float64);
+    let mut create = vk::DeviceCreateInfo::default().queue_create_infos(&queues).enabled_extension_names(&extensions).enabled_features(&features);
     if api_1_2 && info.shader_float16 {
         create = create.push_next(&mut f16);
     }

@@ -16,7 +16,7 @@ use crate::inspect::InspectReport;
 use crate::profile::view::ProfileView;
 use crate::stability::view::StabilityView;
 use crate::sweep::view::SweepView;
-use anyhow::{anyhow, bail, Context, Result};
+use anyhow::{anyhow, bail, Result};
 use serde::de::{DeserializeOwned, IgnoredAny};
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
@@ -66,8 +66,8 @@ struct Probe {
     kind: Option<String>,
 }
 
-/// The largest results file read (the biggest default report, a sweep's, is under 1 MB).
-pub const MAX_INPUT_BYTES: u64 = 256 << 20;
+/// The largest results file read (`io::MAX_REPORT_BYTES`).
+pub const MAX_INPUT_BYTES: u64 = crate::io::MAX_REPORT_BYTES;
 
 fn parse<T: DeserializeOwned>(path: &Path, text: &str, kind: &str) -> Result<T> {
     let de = &mut serde_json::Deserializer::from_str(text);
@@ -76,11 +76,9 @@ fn parse<T: DeserializeOwned>(path: &Path, text: &str, kind: &str) -> Result<T> 
 
 /// Reads a profile, sweep, stability, inspect (one device or several) or compare JSON report.
 pub fn load(path: &Path) -> Result<Input> {
-    let size = std::fs::metadata(path).with_context(|| format!("{}: cannot read it", path.display()))?.len();
-    if size > MAX_INPUT_BYTES {
-        bail!("{}: {size} bytes; a brdfprof report is far smaller (at most {MAX_INPUT_BYTES} bytes read)", path.display());
-    }
-    let text = std::fs::read_to_string(path).with_context(|| format!("{}: cannot read it", path.display()))?;
+    // A regular file within the bound (`report /dev/zero` read without end before).
+    let bytes = crate::io::read_bounded(path, MAX_INPUT_BYTES)?;
+    let text = String::from_utf8(bytes).map_err(|e| anyhow!("{}: not UTF-8 text at byte {}: not a brdfprof JSON report", path.display(), e.utf8_error().valid_up_to()))?;
     from_json(path, &text)
 }
 
@@ -94,7 +92,30 @@ pub fn from_report(label: &Path, report: &impl serde::Serialize) -> Result<Input
 pub fn from_json(path: &Path, text: &str) -> Result<Input> {
     let text = text.to_string();
     let probe: Probe = serde_json::from_str(&text).map_err(|e| anyhow!("{}: not a JSON object: line {}, column {}: {e}", path.display(), e.line(), e.column()))?;
-    let loaded = if probe.fastest.is_some() {
+    use crate::report::Kind;
+    // A report that names its kind is read as that kind; older ones, without `kind`, by their keys.
+    let named = match probe.kind.as_deref() {
+        None | Some("diff") => None,
+        Some(k) => Some(Kind::parse(k).ok_or_else(|| anyhow!("{}: at JSON path `kind`: `{k}` is not a kind of brdfprof report ({})", path.display(), Kind::ALL.map(Kind::name).join(", ")))?),
+    };
+    let loaded = if let Some(kind) = named {
+        match kind {
+            Kind::Profile => Loaded::Profile(parse(path, &text, "profile")?),
+            Kind::Sweep => Loaded::Sweep(parse(path, &text, "sweep")?),
+            Kind::Stability => Loaded::Stability(parse(path, &text, "stability")?),
+            Kind::Inspect => Loaded::Inspect(vec![parse(path, &text, "inspect")?], None),
+            Kind::InspectDevices => {
+                let m: crate::devices::MultiView = parse(path, &text, "inspect (several devices)")?;
+                Loaded::Inspect(m.reports, Some(m.costs))
+            }
+            Kind::Compare => Loaded::Costs(parse(path, &text, "compare")?),
+            Kind::SceneProfile | Kind::SweepCost | Kind::Baseline => bail!(
+                "{}: a `{}` report, which the HTML report does not draw (its tables are in the Markdown written beside it); give profile, sweep, stability, inspect, compare or diff reports",
+                path.display(),
+                kind.name()
+            ),
+        }
+    } else if probe.fastest.is_some() {
         Loaded::Sweep(parse(path, &text, "sweep")?)
     } else if probe.workload.is_some() {
         Loaded::Profile(parse(path, &text, "profile")?)

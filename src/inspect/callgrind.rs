@@ -224,7 +224,9 @@ pub fn run(models: &[Model], lights: u32, shaders: &Shaders, options: &Callgrind
         .env("MESA_SHADER_CACHE_DISABLE", "true");
     crate::compile_limit::export(&mut cmd);
     let _tmp = cleanup::child_tmpdir(&mut cmd)?;
-    let output = cleanup::output(&mut cmd).context("cannot run valgrind")?;
+    // The child compiles and runs every kernel under valgrind, each compilation under the scaled limit.
+    let limit = crate::compile_limit::limit() * VALGRIND_SLOWDOWN * (models.len() as u32 + 2);
+    let output = crate::compile_limit::output_within(&mut cmd, "the callgrind run (valgrind)", limit).context("cannot run valgrind")?;
     let stdout = String::from_utf8_lossy(&output.stdout);
     let stderr = String::from_utf8_lossy(&output.stderr);
     if !output.status.success() {

@@ -50,7 +50,7 @@ pub struct ProfileReport {
 /// Reads the profile report at `path`: JSON with a `rows` array.
 pub fn load_profile(path: &Path) -> Result<ProfileReport> {
     let file = path.display().to_string();
-    let text = std::fs::read_to_string(path).with_context(|| format!("--profile {file}: cannot read it"))?;
+    let text = String::from_utf8(crate::io::read_bounded(path, crate::io::MAX_REPORT_BYTES).with_context(|| format!("--profile {file}"))?).map_err(|_| anyhow::anyhow!("--profile {file}: not UTF-8 text: not a brdfprof profile report"))?;
     let json: serde_json::Value = serde_json::from_str(&text).map_err(|e| anyhow!("--profile {file}: not valid JSON ({e})"))?;
     if !json["rows"].is_array() {
         bail!("--profile {file}: no `rows` array (is it a `brdfprof profile` report?)");

@@ -69,6 +69,9 @@ pub fn table(report: &InspectReport, header: TargetCost, cycles: impl Fn(&std::c
     Some(t)
 }
 
+/// The note beside a net cost below zero.
+pub const NEGATIVE_NET: &str = "net cost below zero: the kernel compiled to less than the memory-only kernel (a constant BRDF, or one whose inputs the compiler found unused, lets it drop loads and work the memory-only kernel keeps); its net figures measure that, not a cost of the BRDF";
+
 impl TargetCost {
     /// "navi21 (RDNA 2)" or the device name.
     pub fn label(&self) -> String {
@@ -109,6 +112,10 @@ impl TargetCost {
             });
             t.row(cells);
         }
-        format!("### {} statistics, {} ({} lights per kernel; {}; {})\n\n{}", self.compiler, self.label(), self.lights_per_kernel, self.model, self.unit, t.markdown())
+        let mut out = format!("### {} statistics, {} ({} lights per kernel; {}; {})\n\n{}", self.compiler, self.label(), self.lights_per_kernel, self.model, self.unit, t.markdown());
+        for r in self.rows.iter().filter(|r| r.net_cycles_per_eval.is_some_and(|v| v < 0.0)) {
+            out += &format!("\n{}: {}\n", r.model, NEGATIVE_NET);
+        }
+        out
     }
 }

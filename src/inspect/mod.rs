@@ -132,6 +132,9 @@ fn ordered_columns(rows: &[Row], emitted: &[String]) -> Vec<String> {
 
 /// One kernel's device-independent statistics (None: the baseline kernel): SPIR-V and naga counts, and the
 /// kernel's hash.
+/// The row note that names a file's parameters compiled in as constants (`FileModel::folded`).
+pub const FOLDED_NOTE: &str = "folded";
+
 pub fn static_row(shaders: &Shaders, model: Option<&Model>, lights: u32) -> Result<Row> {
     let mut row = Row {
         model: model.map_or_else(|| BASELINE_LABEL.to_string(), Model::label),
@@ -143,6 +146,11 @@ pub fn static_row(shaders: &Shaders, model: Option<&Model>, lights: u32) -> Resu
     let kernel = shade_kernel(model, GBufferFormat::Packed, per_dispatch, accumulate, shaders)?;
     let float_kernel = shade_kernel(model, GBufferFormat::Float, per_dispatch, accumulate, shaders)?;
     row.notes.insert(HASH_NOTE.into(), workload::kernel_hash(model, GBufferFormat::Packed, shaders)?);
+    if let Some(folded) = model.and_then(Model::file).map(|f| f.folded()).filter(|f| !f.is_empty()) {
+        let note = format!("parameters compiled in as constants, so the figures are for these values (the compiler may fold them): {}; bind one to an input (NAME=@roughness, ...) to cost it as one", folded.join(", "));
+        crate::messages::note_once(format!("{}: {note}", row.model));
+        row.notes.insert(FOLDED_NOTE.into(), note);
+    }
     static_stats(&kernel, &float_kernel, &mut row)?;
     Ok(row)
 }
@@ -352,6 +360,11 @@ impl InspectReport {
         if let Some(a) = &self.cost {
             out += &a.markdown();
             out += "\n";
+        }
+        for row in &self.rows {
+            if let Some(note) = row.notes.get(FOLDED_NOTE) {
+                out += &format!("{}: {note}.\n\n", row.model);
+            }
         }
         if let Some(c) = &self.vs_profile {
             out += &format!("### Instructions vs time per evaluation\n\n{}\n", c.markdown());

@@ -24,13 +24,46 @@ pub fn format_rgb_csv(rows: &[[f32; 3]]) -> String {
 /// Reads an input file; the error names the file and the reason the system gives (a directory, a loop of
 /// symbolic links), and for a dangling symbolic link the missing file it points to.
 pub fn read_input(path: &Path) -> Result<Vec<u8>> {
-    std::fs::read(path).map_err(|e| {
+    if let Err(e) = std::fs::metadata(path) {
         let dangling = std::fs::symlink_metadata(path).is_ok_and(|m| m.file_type().is_symlink()) && e.kind() == std::io::ErrorKind::NotFound;
-        match std::fs::read_link(path).ok().filter(|_| dangling) {
+        return Err(match std::fs::read_link(path).ok().filter(|_| dangling) {
             Some(to) => anyhow!("cannot read {}: it is a symbolic link to {}, which does not exist ({e})", path.display(), to.display()),
             None => anyhow!("cannot read {}: {e}", path.display()),
-        }
-    })
+        });
+    }
+    read_bounded(path, MAX_INPUT_BYTES)
+}
+
+/// The largest input file (a CSV, a `.brdf` file, a scene) read: 1 GiB, some 15 million CSV rows
+/// (docs/limits.md).
+pub const MAX_INPUT_BYTES: u64 = 1 << 30;
+
+/// The largest saved report read (`report`, `compare`, `check --baseline`, `inspect --profile`): the biggest
+/// default report, a sweep's, is under 1 MB.
+pub const MAX_REPORT_BYTES: u64 = 256 << 20;
+
+/// Reads a file that must be a regular one (after symbolic links) of at most `max` bytes: a device, FIFO or
+/// directory is refused before anything is read, and the read itself stops past `max`, so a file that grows
+/// while it is read (or lies about its size) cannot exhaust memory.
+pub fn read_bounded(path: &Path, max: u64) -> Result<Vec<u8>> {
+    use std::io::Read;
+    let file = std::fs::File::open(path).map_err(|e| anyhow!("cannot read {}: {e}", path.display()))?;
+    let meta = file.metadata().map_err(|e| anyhow!("cannot read {}: {e}", path.display()))?;
+    if meta.is_dir() {
+        bail!("cannot read {}: Is a directory", path.display());
+    }
+    if !meta.is_file() {
+        bail!("cannot read {}: not a regular file (a device, FIFO or socket)", path.display());
+    }
+    if meta.len() > max {
+        bail!("cannot read {}: {} bytes, more than the {max} bytes brdfprof reads from such a file", path.display(), meta.len());
+    }
+    let mut bytes = Vec::with_capacity(meta.len() as usize);
+    file.take(max + 1).read_to_end(&mut bytes).map_err(|e| anyhow!("cannot read {}: {e}", path.display()))?;
+    if bytes.len() as u64 > max {
+        bail!("cannot read {}: it grew past the {max} bytes brdfprof reads from such a file", path.display());
+    }
+    Ok(bytes)
 }
 
 /// Symbolic links followed at most this many times (Linux's own limit, MAXSYMLINKS).
@@ -195,7 +228,7 @@ pub fn tracked_by_git(dir: &Path, pattern: &str) -> Vec<PathBuf> {
     if !dir.is_dir() {
         return Vec::new();
     }
-    let out = std::process::Command::new("git").arg("-C").arg(dir).args(["ls-files", "-z", "--"]).arg(pattern).stderr(std::process::Stdio::null()).output();
+    let out = crate::compile_limit::output_quick(crate::cleanup::command("git").arg("-C").arg(dir).args(["ls-files", "-z", "--"]).arg(pattern), "git ls-files");
     match out {
         Ok(o) if o.status.success() => o.stdout.split(|&b| b == 0).filter(|n| !n.is_empty()).map(|n| dir.join(std::ffi::OsStr::from_bytes(n))).collect(),
         _ => Vec::new(),

@@ -241,6 +241,9 @@ fn loop_warning(path: &str, l: &brdf_file::Loop) -> String {
 /// gives one to every file and a scene material's `define` does.
 pub const DEFINE: &str = "define";
 
+/// The entry and its parameters as BRDF Explorer's files name them: no macro may take these names.
+const ENTRY_NAMES: [&str; 6] = ["BRDF", "L", "V", "N", "X", "Y"];
+
 fn is_define(item: &str) -> bool {
     item.split_once('=').is_some_and(|(k, _)| k.trim() == DEFINE)
 }
@@ -258,6 +261,12 @@ fn merge_defines(path: &str, old: &[(String, String)], defines: &[String]) -> Re
         }
         if value.contains(['\n', '\r']) {
             bail!("{path}: `{item}`: a define's value is one line");
+        }
+        if value.ends_with('\\') {
+            bail!("{path}: `{item}`: the value ends with a backslash, which would continue the macro onto the shader's next line; drop it");
+        }
+        if ENTRY_NAMES.contains(&name) {
+            bail!("{path}: `{item}`: `{name}` is a name of the entry `vec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y)`, which a macro of that name would rewrite; choose another macro name");
         }
         if given.iter().any(|g| g == name) {
             bail!("{path}: `define={name}` is given twice; give each macro once");
@@ -381,6 +390,12 @@ impl FileModel {
     /// The path with every parameter.
     pub fn canonical(&self) -> String {
         self.text_with(true)
+    }
+
+    /// The parameters compiled in as constants (bound to a value, not to an input), as `NAME=VALUE`: a kernel
+    /// costed with them is costed for those values, which its compiler may fold away.
+    pub fn folded(&self) -> Vec<String> {
+        self.file.params.iter().zip(&self.bindings).filter_map(|(p, b)| if let Binding::Value(v) = b { Some(format!("{}={}", p.name, v.text())) } else { None }).collect()
     }
 
     /// The binding of parameter `name`.

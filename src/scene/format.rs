@@ -545,7 +545,8 @@ pub struct Scene {
 impl Scene {
     /// Reads and checks a scene file; errors name the file and the JSON path.
     pub fn load(path: &Path) -> Result<Scene> {
-        let text = std::fs::read_to_string(path).map_err(|e| anyhow!("cannot read scene file {}: {e}", path.display()))?;
+        let bytes = crate::io::read_input(path).map_err(|e| anyhow!("scene file: {e}"))?;
+        let text = String::from_utf8(bytes).map_err(|e| anyhow!("cannot read scene file {}: not UTF-8 at byte {}", path.display(), e.utf8_error().valid_up_to()))?;
         let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
         Scene::parse(&text, &path.display().to_string(), dir, path.to_path_buf())
     }

@@ -268,7 +268,7 @@ impl StabilityReport {
     pub fn write(&self, out: &std::path::Path, device: &str) -> Result<Vec<std::path::PathBuf>> {
         let stem = out.join(format!("stability-{device}"));
         let mut written = vec![stem.with_extension("md"), stem.with_extension("json")];
-        crate::report::write_json_compact(&written[1], self)?;
+        crate::report::write_report_compact(&written[1], crate::report::Kind::Stability, self)?;
         crate::io::write_output(&written[0], self.markdown().as_bytes())?;
         let entries = self.energy_entries();
         if !entries.is_empty() {

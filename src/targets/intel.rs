@@ -182,6 +182,25 @@ fn patch_tokens(ptm: &str) -> BTreeMap<u32, Vec<u32>> {
 
 /// The kernel's ISA size in bytes (`KernelUnpaddedSize` of the kernel's binary header): the device binary
 /// ocloc writes also carries the program's SPIR-V and its state heaps.
+/// Bytes of an IGA instruction: 8 compacted, 16 otherwise.
+fn instruction_bytes(line: &str) -> u64 {
+    if line.split("//").next().is_some_and(|c| c.contains("Compacted")) { 8 } else { 16 }
+}
+
+/// Whether IGA's `listing` is the whole kernel: it reaches the thread's end (a send with EOT) and its
+/// instructions fill the kernel's code (`code_bytes`, the binary's unpadded kernel size) exactly.
+pub fn check_listing(listing: &str, code_bytes: Option<usize>) -> std::result::Result<(), String> {
+    let lines: Vec<&str> = listing.lines().filter(|l| instruction(l).is_some()).collect();
+    if !lines.iter().any(|l| l.split("//").next().is_some_and(|c| c.contains("EOT"))) {
+        return Err(format!("{} instructions and no end of thread (EOT)", lines.len()));
+    }
+    let listed: u64 = lines.iter().map(|l| instruction_bytes(l)).sum();
+    match code_bytes {
+        Some(code) if listed != code as u64 => Err(format!("{} instructions of {listed} bytes, where the kernel's code holds {code} bytes", lines.len())),
+        _ => Ok(()),
+    }
+}
+
 fn kernel_bytes(ptm: &str) -> Option<usize> {
     ptm.lines().find_map(|l| l.trim().strip_prefix("4 KernelUnpaddedSize ")?.trim().parse().ok())
 }
@@ -219,6 +238,7 @@ impl IsaStats {
         if s.instructions == 0 || ![8, 16, 32].contains(&s.simd) {
             bail!("IGA's listing has {} instructions and the binary says SIMD{}: not a kernel brdfprof can count", s.instructions, s.simd);
         }
+        check_listing(&binary.listing, kernel_bytes(&binary.tokens)).map_err(|why| anyhow!("ocloc disasm's listing is not the kernel's code ({why}); reinstall Intel's compiler with `make setup`"))?;
         Ok(s)
     }
 
@@ -331,12 +351,22 @@ fn compile_checked(families: &[&Family], statics: Vec<crate::inspect::Row>, chec
     // Each job is an ocloc process: one per core.
     use rayon::prelude::*;
     let (sources, precise): (Vec<&str>, bool) = (checked.iter().map(|c| c.source.as_str()).collect(), req.precise);
-    let compiled = jobs.par_iter().map(|&(f, k)| compile(sources[k], families[f], precise)).collect::<Result<Vec<_>>>()?;
+    let compiled: Vec<Result<ocloc::Binary>> = jobs.par_iter().map(|&(f, k)| compile(sources[k], families[f], precise)).collect();
+    // A family without what a kernel needs (fp64) leaves it out with the reason; any other failure stops.
+    let compiled: Vec<std::result::Result<ocloc::Binary, String>> =
+        compiled.into_iter().map(|r| r.map(Ok).or_else(|e| e.downcast_ref::<ocloc::Unsupported>().map(|u| Err(u.reason.clone())).ok_or(e))).collect::<Result<_>>()?;
     let mut reports = Vec::new();
     for (f, family) in families.iter().enumerate() {
         let mut rows = statics.clone();
+        let mut left_out = Vec::new();
         for (k, row) in rows.iter_mut().enumerate() {
-            let binary = &compiled[f * checked.len() + k];
+            let binary = match &compiled[f * checked.len() + k] {
+                Ok(b) => b,
+                Err(why) => {
+                    left_out.push((row.model.clone(), why.clone()));
+                    continue;
+                }
+            };
             let stats = IsaStats::of(binary)?;
             row.stats.extend(crate::inspect::driver::stats(&stats.driver_stats(family)?));
             row.notes.insert("translation".into(), checked[k].agreement.clone());
@@ -344,7 +374,14 @@ fn compile_checked(families: &[&Family], statics: Vec<crate::inspect::Row>, chec
                 write_isa(dir, family, &row.model, &checked[k].source, binary, &tools.version)?;
             }
         }
-        reports.push(report(family, rows, tools, req));
+        rows.retain(|r| !left_out.iter().any(|(m, _)| *m == r.model));
+        let mut report = report(family, rows, tools, req);
+        if !left_out.is_empty() {
+            let note = format!("not compiled for intel:{}: {}", family.name, left_out.iter().map(|(m, why)| format!("{m} ({why})")).collect::<Vec<_>>().join("; "));
+            crate::messages::warning(&note);
+            report.section_notes.insert("driver/".into(), note);
+        }
+        reports.push(report);
     }
     Ok(reports)
 }

@@ -285,7 +285,7 @@ pub fn checked_translations(req: &Request, gpu: &Gpu, dialect: crate::translate:
         .map(|m| {
             let agreements = crate::translate::verify::check_cached(gpu, m, req.lights, req.shaders)?;
             let source = crate::translate::prepare::shade_kernel(m, req.lights, req.shaders)?.source(dialect);
-            let agreement = agreements.iter().map(|a| format!("{} {:.1e} (tolerance {:.0e})", a.kernel, a.worst, a.tolerance)).collect::<Vec<_>>().join(", ");
+            let agreement = agreements.iter().map(|a| format!("{} {:.1e} (tolerance {:.0e}){}", a.kernel, a.worst, a.tolerance, a.note().map_or_else(String::new, |n| format!(": {n}")))).collect::<Vec<_>>().join(", ");
             Ok(Checked { source, agreement: format!("translation checked on the host against {}: worst relative difference {agreement}", gpu.info.name) })
         })
         .collect()

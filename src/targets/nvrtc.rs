@@ -85,7 +85,12 @@ fn load() -> std::result::Result<Tools, String> {
         format!("NVRTC {major}.{minor}")
     };
     // Its last line names the build ("Build cuda_13.5.r13.5/compiler.37..."): the cache keys on it.
-    let nvdisasm_version = std::process::Command::new(&nvdisasm).arg("--version").output().ok().and_then(|o| String::from_utf8_lossy(&o.stdout).lines().last().map(str::to_string)).unwrap_or_default();
+    let mut cmd = crate::cleanup::command(&nvdisasm.to_string_lossy());
+    cmd.arg("--version");
+    let out = crate::compile_limit::output_quick(&mut cmd, &format!("{} --version", nvdisasm.display())).map_err(|e| not_installed(&format!("{e:#}")))?;
+    let nvdisasm_version = String::from_utf8_lossy(&out.stdout).lines().last().map(str::to_string).filter(|l| out.status.success() && l.contains("uild")).ok_or_else(|| {
+        not_installed(&format!("{} --version printed no build line ({}): not NVIDIA's nvdisasm", nvdisasm.display(), out.status))
+    })?;
     Ok(Tools { _lib: lib, api, nvdisasm, version, nvdisasm_version })
 }
 
@@ -151,8 +156,57 @@ impl Tools {
         cmd.arg("-c").arg(&path);
         let out = crate::compile_limit::output(&mut cmd, "a cubin's SASS (nvdisasm)").with_context(|| format!("cannot run {}", self.nvdisasm.display()))?;
         if !out.status.success() {
-            bail!("nvdisasm failed: {}", String::from_utf8_lossy(&out.stderr).trim());
+            bail!("{} failed ({}): {}", self.nvdisasm.display(), out.status, String::from_utf8_lossy(&out.stderr).trim());
         }
-        Ok(String::from_utf8_lossy(&out.stdout).into_owned())
+        let listing = String::from_utf8_lossy(&out.stdout).into_owned();
+        check_listing(&listing, cubin).map_err(|why| anyhow!("{}: its listing of the cubin is not the kernel's code ({why}); reinstall it with `make setup`", self.nvdisasm.display()))?;
+        Ok(listing)
     }
+}
+
+/// Bytes of one SASS instruction (Volta and later: 128-bit).
+const SASS_INSTRUCTION_BYTES: u64 = 16;
+
+/// The code section of a cubin (`.text.<kernel>`, an ELF64 section), by its size in bytes.
+pub fn code_bytes(cubin: &[u8]) -> Option<u64> {
+    let u16_at = |o: usize| cubin.get(o..o + 2).map(|b| u16::from_le_bytes([b[0], b[1]]));
+    let u32_at = |o: usize| cubin.get(o..o + 4).map(|b| u32::from_le_bytes(b.try_into().unwrap()));
+    let u64_at = |o: usize| cubin.get(o..o + 8).map(|b| u64::from_le_bytes(b.try_into().unwrap()));
+    if cubin.get(0..5)? != b"\x7fELF\x02" {
+        return None;
+    }
+    let (shoff, shentsize, shnum, shstrndx) = (u64_at(0x28)? as usize, u16_at(0x3a)? as usize, u16_at(0x3c)? as usize, u16_at(0x3e)? as usize);
+    let section = |k: usize| shoff.checked_add(k.checked_mul(shentsize)?);
+    let names = u64_at(section(shstrndx)? + 0x18)? as usize;
+    let mut total = None;
+    for k in 0..shnum {
+        let at = section(k)?;
+        let name_at = names.checked_add(u32_at(at)? as usize)?;
+        let name = cubin.get(name_at..)?.split(|&b| b == 0).next()?;
+        if name.starts_with(b".text.") {
+            total = Some(total.unwrap_or(0) + u64_at(at + 0x20)?);
+        }
+    }
+    total
+}
+
+/// Whether nvdisasm's `listing` is the code of `cubin`: instructions at consecutive addresses, through its
+/// EXIT, one listed for every 16 bytes of the code sections (the padding after EXIT included).
+pub fn check_listing(listing: &str, cubin: &[u8]) -> std::result::Result<(), String> {
+    let addresses: Vec<u64> = listing
+        .lines()
+        .filter_map(|l| l.trim_start().strip_prefix("/*")?.split_once("*/").map(|(a, _)| a))
+        .filter(|a| !a.is_empty() && a.chars().all(|c| c.is_ascii_hexdigit()))
+        .filter_map(|a| u64::from_str_radix(a, 16).ok())
+        .collect();
+    if !listing.lines().any(|l| l.contains("EXIT")) {
+        return Err(format!("no EXIT in {} instruction lines", addresses.len()));
+    }
+    let code = code_bytes(cubin).ok_or("the cubin has no code section")?;
+    let covered = addresses.iter().max().map_or(0, |a| a + SASS_INSTRUCTION_BYTES);
+    // Sections list from address 0 each, so the count, not the last address, must match their sum.
+    if (addresses.len() as u64) * SASS_INSTRUCTION_BYTES != code {
+        return Err(format!("{} instructions listed up to byte {covered}, where the code section holds {code} bytes", addresses.len()));
+    }
+    Ok(())
 }

@@ -54,6 +54,9 @@ fn igc_identity() -> String {
 
 fn load() -> std::result::Result<Tools, String> {
     let ocloc = ocloc_path();
+    if ocloc.is_dir() {
+        return Err(not_installed(&format!("{} is a directory, not the ocloc executable (BRDFPROF_OCLOC names the program itself)", ocloc.display())));
+    }
     if !ocloc.is_file() {
         return Err(not_installed(&format!("{} is missing", ocloc.display())));
     }
@@ -93,6 +96,21 @@ pub struct Binary {
     pub log: String,
 }
 
+/// A kernel the device cannot compile for a reason of the device's own (fp64 where it has none): the family
+/// leaves the kernel out with this note, as RADV leaves out fp16 on a family without shaderFloat16.
+#[derive(Debug)]
+pub struct Unsupported {
+    pub reason: String,
+}
+
+impl std::fmt::Display for Unsupported {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.reason)
+    }
+}
+
+impl std::error::Error for Unsupported {}
+
 impl Tools {
     fn run(&self, args: &[&std::ffi::OsStr], cwd: &Path, what: &str) -> Result<std::process::Output> {
         let mut cmd = crate::cleanup::command(self.ocloc.to_str().unwrap_or("ocloc"));
@@ -112,17 +130,31 @@ impl Tools {
         let out = self.run(&args.iter().map(|a| a.as_os_str()).collect::<Vec<_>>(), dir.path(), what)?;
         let log = format!("{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
         if !out.status.success() {
-            bail!("ocloc cannot compile the OpenCL C translation for {device} (a translator defect):\n{}", log.lines().take(20).collect::<Vec<_>>().join("\n"));
+            // -q hides the compiler's messages: the failure is compiled again without it, for the reason.
+            let loud: Vec<&std::ffi::OsStr> = args.iter().filter(|a| a.as_os_str() != "-q").map(|a| a.as_os_str()).collect();
+            let again = self.run(&loud, dir.path(), what)?;
+            let log = format!("{}{}", String::from_utf8_lossy(&again.stdout), String::from_utf8_lossy(&again.stderr));
+            let errors: Vec<&str> = log.lines().filter(|l| l.contains("error:")).take(5).collect();
+            if let Some(e) = errors.iter().find(|l| l.contains("cl_khr_fp64")) {
+                return Err(Unsupported { reason: format!("{device} has no fp64 (cl_khr_fp64); ocloc: {}", e.trim()) }.into());
+            }
+            bail!("ocloc cannot compile the OpenCL C translation for {device} (a translator defect):\n{}", if errors.is_empty() { log.lines().take(20).collect::<Vec<_>>().join("\n") } else { errors.join("\n") });
         }
-        let bin = std::fs::read_dir(&out_dir)?.filter_map(|e| e.ok().map(|e| e.path())).find(|p| p.extension().is_some_and(|x| x == "bin")).ok_or_else(|| anyhow!("ocloc wrote no binary for {device}: {log}"))?;
-        let bytes = std::fs::metadata(&bin)?.len() as usize;
+        let no_binary = |why: String| anyhow!("{}: `ocloc compile` for {device} exited 0 but wrote no device binary ({why}) in {}: {}", self.ocloc.display(), out_dir.display(), if log.trim().is_empty() { "it printed nothing" } else { log.trim() });
+        let bin = std::fs::read_dir(&out_dir)
+            .map_err(|e| no_binary(e.to_string()))?
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .find(|p| p.extension().is_some_and(|x| x == "bin") && p.is_file())
+            .ok_or_else(|| no_binary("no .bin file".into()))?;
+        let bytes = std::fs::metadata(&bin).map_err(|e| no_binary(e.to_string()))?.len() as usize;
         let dump = dir.path().join("disasm");
         let args = [os("disasm"), os("-file"), bin.into_os_string(), os("-device"), os(device), os("-dump"), dump.clone().into_os_string()];
         let out = self.run(&args.iter().map(|a| a.as_os_str()).collect::<Vec<_>>(), dir.path(), &format!("{what}: its ISA (ocloc disasm)"))?;
-        let listing = std::fs::read_to_string(dump.join("brdfprof_kernel_KernelHeap.asm")).map_err(|e| {
-            anyhow!("ocloc disasm wrote no ISA listing ({e}; it needs {} to load IGA): {}", self.iga_dir.join("libiga64.so").display(), String::from_utf8_lossy(&out.stderr).trim())
+        let read = |name: &str| crate::io::read_bounded(&dump.join(name), crate::compile_limit::MAX_OUTPUT_BYTES as u64).map(|b| String::from_utf8_lossy(&b).into_owned());
+        let listing = read("brdfprof_kernel_KernelHeap.asm").map_err(|e| {
+            anyhow!("{}: `ocloc disasm` for {device} wrote no ISA listing ({e}; it needs {} to load IGA): {}", self.ocloc.display(), self.iga_dir.join("libiga64.so").display(), String::from_utf8_lossy(&out.stderr).trim())
         })?;
-        let tokens = std::fs::read_to_string(dump.join("PTM.txt")).context("ocloc disasm wrote no PTM.txt")?;
+        let tokens = read("PTM.txt").map_err(|e| anyhow!("{}: `ocloc disasm` for {device} wrote no patch tokens ({e})", self.ocloc.display()))?;
         Ok(Binary { listing, tokens, bytes, log: log.trim().to_string() })
     }
 }

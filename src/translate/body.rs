@@ -393,18 +393,28 @@ impl<'m> FunctionWriter<'m> {
                     lvalue = format!("{lvalue}.m{k}");
                     ty = members[k as usize];
                 }
-                Type::Vector { elem, .. } | Type::Array { elem, .. } => {
-                    lvalue = format!("{lvalue}.c[{}]", self.v(i)?);
+                Type::Vector { elem, n: len } | Type::Array { elem, len } => {
+                    lvalue = format!("{lvalue}.c[{}]", self.index(i, len)?);
                     ty = elem;
                 }
-                Type::Matrix { column, .. } => {
-                    lvalue = format!("{lvalue}.c[{}]", self.v(i)?);
+                Type::Matrix { column, columns } => {
+                    lvalue = format!("{lvalue}.c[{}]", self.index(i, columns)?);
                     ty = column;
                 }
                 other => return Err(self.err(format!("an access chain through {other:?}"))),
             }
         }
         Ok((lvalue, ty))
+    }
+
+    /// The C index of element `id` of a composite of `len` elements: a constant as it is (glslang refuses one
+    /// out of range), any other value clamped into the composite, as robust Vulkan drivers treat an
+    /// out-of-bounds index (SPIR-V leaves it undefined; unclamped, the C would read or write outside the value).
+    pub fn index(&mut self, id: Word, len: u32) -> Result<String, TranslateError> {
+        match self.m.constants.get(&id) {
+            Some(Constant::Scalar { bits, .. }) if (*bits as u32) < len => Ok((*bits as u32).to_string()),
+            _ => Ok(format!("m_index((u32)({}), {len}u)", self.v(id)?)),
+        }
     }
 
     fn constant_index(&self, id: Word) -> Result<u32, TranslateError> {

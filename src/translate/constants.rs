@@ -34,6 +34,7 @@ pub fn expr(m: &ModuleInfo, id: Word) -> Result<String, TranslateError> {
     match m.constants.get(&id) {
         Some(Constant::Scalar { ty, bits }) => Ok(literal(m.scalar(*ty)?, *bits)),
         Some(Constant::Bool { value, .. }) => Ok(value.to_string()),
+        Some(Constant::Composite { parts, .. }) if parts.len() as u32 > super::ctypes::MAX_CONSTRUCTOR_MEMBERS => Ok(format!("k_{id}()")),
         Some(Constant::Composite { ty, parts }) => {
             let parts = parts.iter().map(|p| expr(m, *p)).collect::<Result<Vec<_>, _>>()?;
             Ok(format!("mk_{}({})", m.c_type(*ty)?, parts.join(", ")))
@@ -91,4 +92,35 @@ pub fn convert_float(from: Scalar, to: Scalar, e: &str) -> String {
         (_, Scalar::F32) => format!("(float)({e})"),
         _ => format!("(double)({e})"),
     }
+}
+
+/// The functions that build the composite constants too large for a `mk_` constructor (a lookup table of
+/// more than `MAX_CONSTRUCTOR_MEMBERS` elements), each `k_ID()`, member by member; those a constant's
+/// members need come first.
+pub fn large_composites(m: &ModuleInfo) -> Result<String, TranslateError> {
+    let mut ids: Vec<Word> = m.constants.keys().copied().collect();
+    ids.sort_unstable();
+    let mut out = String::new();
+    let mut done = std::collections::HashSet::new();
+    for id in ids {
+        define_large(m, id, &mut done, &mut out)?;
+    }
+    Ok(out)
+}
+
+fn define_large(m: &ModuleInfo, id: Word, done: &mut std::collections::HashSet<Word>, out: &mut String) -> Result<(), TranslateError> {
+    let Some(Constant::Composite { ty, parts }) = m.constants.get(&id) else { return Ok(()) };
+    if !done.insert(id) {
+        return Ok(());
+    }
+    for p in parts {
+        define_large(m, *p, done, out)?;
+    }
+    if parts.len() as u32 <= super::ctypes::MAX_CONSTRUCTOR_MEMBERS {
+        return Ok(());
+    }
+    let c = m.c_type(*ty)?;
+    let sets = m.members(*ty).iter().zip(parts).map(|((_, accessor), p)| Ok(format!(" r.{accessor} = {};", expr(m, *p)?))).collect::<Result<String, TranslateError>>()?;
+    out.push_str(&format!("BRDFPROF_FN {c} k_{id}(void) {{ {c} r;{sets} return r; }}\n"));
+    Ok(())
 }

@@ -58,7 +58,7 @@ impl Scalar {
 }
 
 /// Largest composite that gets a `mk_` constructor (one parameter per member).
-const MAX_CONSTRUCTOR_MEMBERS: u32 = 64;
+pub const MAX_CONSTRUCTOR_MEMBERS: u32 = 64;
 
 impl ModuleInfo {
     /// The scalar kind of a scalar type, or an error naming what the translation lacks.

@@ -18,57 +18,57 @@ pub fn build_identity() -> String {
     static IDENTITY: std::sync::OnceLock<String> = std::sync::OnceLock::new();
     IDENTITY
         .get_or_init(|| {
-            let out = crate::cleanup::output(crate::cleanup::command(HOST_COMPILER).arg("--version"));
+            let out = crate::compile_limit::output_quick(crate::cleanup::command(HOST_COMPILER).arg("--version"), "g++ --version");
             let version = out.ok().and_then(|o| String::from_utf8_lossy(&o.stdout).lines().next().map(str::to_string)).unwrap_or_else(|| format!("{HOST_COMPILER} (version unknown)"));
             format!("{version} {}", HOST_FLAGS.join(" "))
         })
         .clone()
 }
 
-/// A translation compiled for the host.
+/// A translation compiled for the host; it runs in a child process (`runner`).
 pub struct HostKernel {
-    // The library must be dropped before its directory.
-    lib: libloading::Library,
+    library: std::path::PathBuf,
     _dir: crate::cleanup::TempDir,
     bindings: Vec<BindingKind>,
     local_size: [u32; 3],
 }
 
-type RunFn = unsafe extern "C" fn(*const *mut u8, u32, u32, u32) -> u32;
-
 impl HostKernel {
     pub fn compile(t: &Translation) -> Result<Self> {
+        Self::compile_with(t, &[])
+    }
+
+    /// `compile` with preprocessor definitions (`-DNAME`) for the prelude's variants.
+    pub fn compile_with(t: &Translation, defines: &[&str]) -> Result<Self> {
         let dir = crate::cleanup::TempDir::new().context("cannot create a temporary directory for the host build")?;
         let src = dir.path().join("kernel.cpp");
         let lib = dir.path().join("kernel.so");
         std::fs::write(&src, t.source(Dialect::Host)).with_context(|| format!("cannot write {}", src.display()))?;
         let mut cmd = crate::cleanup::command(HOST_COMPILER);
-        cmd.args(HOST_FLAGS).arg("-o").arg(&lib).arg(&src);
-        let out = crate::cleanup::output(&mut cmd).map_err(|e| anyhow!("cannot run {HOST_COMPILER} ({e}): install g++ (Debian: apt-get install g++), or run `make setup`"))?;
+        // g++'s own temporaries (cc*.s) go into the build's directory, removed with it even on a signal.
+        cmd.args(HOST_FLAGS).args(defines.iter().map(|d| format!("-D{d}"))).arg("-o").arg(&lib).arg(&src).env("TMPDIR", dir.path());
+        let out = crate::compile_limit::output(&mut cmd, "the host build of the translation (g++)")
+            .map_err(|e| if e.downcast_ref::<std::io::Error>().is_some() { anyhow!("cannot run {HOST_COMPILER} ({e}): install g++ (Debian: apt-get install g++), or run `make setup`") } else { e })?;
         if !out.status.success() {
             let log = String::from_utf8_lossy(&out.stderr);
             let head: Vec<&str> = log.lines().take(20).collect();
             bail!("{HOST_COMPILER} cannot compile the host translation (a translator defect):\n{}", head.join("\n"));
         }
-        // SAFETY: the library is the one just built from the translation; loading runs no constructors of
-        // ours (the prelude defines none).
-        let lib = unsafe { libloading::Library::new(&lib) }.with_context(|| format!("cannot load {}", lib.display()))?;
-        Ok(HostKernel { lib, _dir: dir, bindings: t.bindings.iter().map(|b| b.kind.clone()).collect(), local_size: t.local_size })
+        if !lib.is_file() {
+            bail!("{HOST_COMPILER} exited 0 but wrote no {}", lib.display());
+        }
+        Ok(HostKernel { library: lib, _dir: dir, bindings: t.bindings.iter().map(|b| b.kind.clone()).collect(), local_size: t.local_size })
     }
 
     /// Runs `groups` workgroups over `buffers` (one per binding, in the translation's binding order, push
-    /// constants last); returns the invocations' flags (1: one stopped at the host's loop limit).
+    /// constants last) in a child process; returns the invocations' flags (1: one stopped at the host's loop
+    /// limit).
     pub fn run(&self, buffers: &mut [&mut [u8]], groups: [u32; 3]) -> Result<u32> {
         if buffers.len() != self.bindings.len() {
             bail!("the host kernel takes {} bindings, {} given", self.bindings.len(), buffers.len());
         }
-        let pointers: Vec<*mut u8> = buffers.iter_mut().map(|b| b.as_mut_ptr()).collect();
-        // SAFETY: `brdfprof_host_run` is the wrapper `entry::host_wrapper` writes, with this signature; every
-        // pointer is a live buffer of the size the kernel's own bounds (its push-constant count) allow.
-        unsafe {
-            let run: libloading::Symbol<RunFn> = self.lib.get(b"brdfprof_host_run\0").context("the host build has no brdfprof_host_run")?;
-            Ok(run(pointers.as_ptr(), groups[0], groups[1], groups[2]))
-        }
+        let engine = super::runner::Engine::Host { library: self.library.clone() };
+        Ok(super::runner::run(engine, self.local_size, buffers, groups, "the translated kernel on the host")?.flags)
     }
 
     pub fn local_size(&self) -> [u32; 3] {

@@ -24,6 +24,7 @@ mod ops;
 pub mod prepare;
 pub mod host;
 pub mod opencl;
+pub mod runner;
 pub mod verify;
 
 pub use entry::{BindingKind, EnvBinding};
@@ -186,6 +187,7 @@ pub fn translate(words: &[u32], options: &TranslateOptions) -> Result<Translatio
     let m = ModuleInfo::read(words)?;
     let layout = entry::EnvLayout::of(&m, options)?;
     let mut body = m.type_declarations()?;
+    body += &constants::large_composites(&m)?;
     body += &layout.declaration(&m)?;
     let mut prototypes = String::new();
     let mut functions = String::new();

@@ -6,15 +6,7 @@
 use super::{Dialect, Translation};
 use crate::brdf::Sample;
 use crate::kernels::EvalExtras;
-use anyhow::{anyhow, bail, Context as _, Result};
-use opencl3::command_queue::CommandQueue;
-use opencl3::context::Context;
-use opencl3::device::{Device, CL_DEVICE_TYPE_ALL};
-use opencl3::kernel::{ExecuteKernel, Kernel};
-use opencl3::memory::{Buffer, ClMem, CL_MEM_COPY_HOST_PTR, CL_MEM_READ_WRITE};
-use opencl3::program::Program;
-use opencl3::types::CL_BLOCKING;
-use std::ffi::c_void;
+use anyhow::{bail, Context as _, Result};
 
 /// The platform `--device opencl` takes unless BRDFPROF_OPENCL_DEVICE names another (a substring of the
 /// platform or device name).
@@ -29,79 +21,39 @@ pub fn build_options(precise: bool) -> String {
     o
 }
 
-fn no_runtime(e: impl std::fmt::Display) -> anyhow::Error {
-    anyhow!("no OpenCL runtime ({e}): install PoCL and the ICD loader (Debian: apt-get install pocl-opencl-icd ocl-icd-libopencl1), or run `make setup`")
-}
-
-/// The OpenCL device: the first one whose platform or name contains `wanted`.
-fn device(wanted: &str) -> Result<(Device, String)> {
-    let platforms = opencl3::platform::get_platforms().map_err(no_runtime)?;
-    let mut seen = Vec::new();
-    for p in &platforms {
-        let pname = p.name().unwrap_or_default();
-        for id in p.get_devices(CL_DEVICE_TYPE_ALL).unwrap_or_default() {
-            let d = Device::new(id);
-            let dname = d.name().unwrap_or_default();
-            if pname.contains(wanted) || dname.contains(wanted) {
-                return Ok((d, format!("{dname} ({pname})")));
-            }
-            seen.push(format!("{dname} ({pname})"));
-        }
-    }
-    bail!("no OpenCL device matches `{wanted}` (devices: {}); install PoCL (apt-get install pocl-opencl-icd) or set BRDFPROF_OPENCL_DEVICE", if seen.is_empty() { "none".into() } else { seen.join(", ") })
-}
-
-/// A translation built for an OpenCL device.
+/// A translation for an OpenCL device: built and run in a child process (`runner`), so that a runtime's
+/// crash, an endless kernel or a build past the compile limit ends that child with a message.
 pub struct ClKernel {
-    // Field order: the kernel and program before the queue and context they belong to.
-    kernel: Kernel,
-    _program: Program,
-    queue: CommandQueue,
-    context: Context,
-    pub device: String,
+    dir: crate::cleanup::TempDir,
+    options: String,
+    wanted: String,
     local_size: [u32; 3],
     bindings: usize,
+    device: std::sync::Mutex<String>,
 }
 
 impl ClKernel {
     pub fn build(t: &Translation, precise: bool) -> Result<Self> {
         let wanted = std::env::var("BRDFPROF_OPENCL_DEVICE").ok().filter(|s| !s.is_empty()).unwrap_or_else(|| DEFAULT_PLATFORM.into());
-        let (dev, name) = device(&wanted)?;
-        let context = Context::from_device(&dev).map_err(|e| anyhow!("{name}: cannot create an OpenCL context ({e})"))?;
-        #[allow(deprecated)]
-        let queue = CommandQueue::create_default(&context, 0).map_err(|e| anyhow!("{name}: cannot create a queue ({e})"))?;
-        let program = Program::create_and_build_from_source(&context, &t.source(Dialect::OpenCl), &build_options(precise))
-            .map_err(|log| anyhow!("{name} cannot build the OpenCL C translation (a translator defect):\n{}", log.lines().take(20).collect::<Vec<_>>().join("\n")))?;
-        let kernel = Kernel::create(&program, "brdfprof_kernel").map_err(|e| anyhow!("{name}: no brdfprof_kernel ({e})"))?;
-        Ok(ClKernel { kernel, _program: program, queue, context, device: name, local_size: t.local_size, bindings: t.bindings.len() })
+        let dir = crate::cleanup::TempDir::new().context("cannot create a temporary directory for the OpenCL kernel")?;
+        std::fs::write(dir.path().join("kernel.cl"), t.source(Dialect::OpenCl)).context("cannot write the OpenCL source")?;
+        Ok(ClKernel { dir, options: format!("{} -DBRDFPROF_EXECUTED", build_options(precise)), wanted: wanted.clone(), local_size: t.local_size, bindings: t.bindings.len(), device: std::sync::Mutex::new(wanted) })
     }
 
-    /// Runs `groups` workgroups over `buffers` (the translation's binding order, push constants last) and
-    /// copies every buffer back.
+    /// The device of the last run (before one: the platform asked for).
+    pub fn device(&self) -> String {
+        self.device.lock().unwrap_or_else(|e| e.into_inner()).clone()
+    }
+
+    /// Builds the program and runs `groups` workgroups over `buffers` (the translation's binding order, push
+    /// constants last), every buffer copied back.
     pub fn run(&self, buffers: &mut [&mut [u8]], groups: [u32; 3]) -> Result<()> {
         if buffers.len() != self.bindings {
             bail!("the OpenCL kernel takes {} bindings, {} given", self.bindings, buffers.len());
         }
-        // SAFETY: each buffer is created from (and read back into) a live host slice of its own size; the
-        // kernel's arguments are these buffers in its parameter order.
-        unsafe {
-            let device_buffers = buffers
-                .iter_mut()
-                .map(|b| Buffer::<u8>::create(&self.context, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, b.len().max(1), b.as_mut_ptr() as *mut c_void))
-                .collect::<Result<Vec<_>, _>>()
-                .map_err(|e| anyhow!("{}: cannot create buffers ({e})", self.device))?;
-            let mut exec = ExecuteKernel::new(&self.kernel);
-            for b in &device_buffers {
-                exec.set_arg(&b.get());
-            }
-            let global: Vec<usize> = (0..3).map(|k| (groups[k] * self.local_size[k]) as usize).collect();
-            let local: Vec<usize> = self.local_size.iter().map(|&l| l as usize).collect();
-            exec.set_global_work_sizes(&global).set_local_work_sizes(&local).enqueue_nd_range(&self.queue).map_err(|e| anyhow!("{}: cannot run the kernel ({e})", self.device))?;
-            for (b, host) in device_buffers.iter().zip(buffers.iter_mut()) {
-                self.queue.enqueue_read_buffer(b, CL_BLOCKING, 0, host, &[]).map_err(|e| anyhow!("{}: cannot read a buffer back ({e})", self.device))?;
-            }
-            self.queue.finish().context("clFinish")?;
-        }
+        let engine = super::runner::Engine::OpenCl { source: self.dir.path().join("kernel.cl"), options: self.options.clone(), wanted: self.wanted.clone() };
+        let ran = super::runner::run(engine, self.local_size, buffers, groups, "the OpenCL C translation (built and run on OpenCL)")?;
+        *self.device.lock().unwrap_or_else(|e| e.into_inner()) = ran.device;
         Ok(())
     }
 }

@@ -58,7 +58,12 @@ impl FunctionWriter<'_> {
         self.m.type_of(id).unwrap_or(0)
     }
 
+    /// The scalar kind of a scalar, vector or matrix type (a matrix's: its columns').
     fn scalar_kind(&self, ty: Word) -> Result<Scalar, TranslateError> {
+        let ty = match self.m.ty(ty) {
+            Type::Matrix { column, .. } => *column,
+            _ => ty,
+        };
         self.m.scalar(self.m.scalar_of(ty)).map_err(|e| self.err(e.construct))
     }
 
@@ -119,7 +124,11 @@ impl FunctionWriter<'_> {
                 let path = self.member_path(self.ty_of(Self::id(inst, 0)), &(1..inst.operands.len()).map(|k| Self::lit(inst, k)).collect::<Vec<_>>())?;
                 Ok(format!("{base}{path}"))
             }
-            VectorExtractDynamic => Ok(format!("{}.c[{}]", self.v(Self::id(inst, 0))?, self.v(Self::id(inst, 1))?)),
+            VectorExtractDynamic => {
+                let v = Self::id(inst, 0);
+                let n = self.m.components(self.ty_of(v));
+                Ok(format!("{}.c[{}]", self.v(v)?, self.index(Self::id(inst, 1), n)?))
+            }
             VectorShuffle => self.shuffle(inst),
             CopyObject | CopyLogical => self.v(Self::id(inst, 0)),
             Undef => self.m.zero(ty),
@@ -323,7 +332,8 @@ impl FunctionWriter<'_> {
             let path: Vec<u32> = (2..inst.operands.len()).map(|k| Self::lit(inst, k)).collect();
             (self.v(Self::id(inst, 1))?, self.member_path(self.ty_of(Self::id(inst, 1)), &path)?, self.v(Self::id(inst, 0))?)
         } else {
-            (self.v(Self::id(inst, 0))?, format!(".c[{}]", self.v(Self::id(inst, 2))?), self.v(Self::id(inst, 1))?)
+            let n = self.m.components(self.ty_of(Self::id(inst, 0)));
+            (self.v(Self::id(inst, 0))?, format!(".c[{}]", self.index(Self::id(inst, 2), n)?), self.v(Self::id(inst, 1))?)
         };
         self.assign(inst, copy)?;
         writeln!(self.body, "  _{id}{member} = {value};").unwrap();

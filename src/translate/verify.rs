@@ -36,11 +36,44 @@ pub struct Agreement {
     pub tolerance: f64,
     /// The device the Vulkan kernel ran on.
     pub device: String,
+    /// The difference is the device's, not the translation's: it vanishes when the host computes OpSMod as
+    /// srem, as lavapipe does (`srem_note`).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub srem: bool,
+}
+
+impl Agreement {
+    /// Why the difference is the device's, when it is.
+    pub fn note(&self) -> Option<String> {
+        self.srem.then(|| srem_note(&self.device, self.worst))
+    }
+}
+
+/// The version of `Agreement`'s cached form (2: `srem`), part of the cache key.
+const AGREEMENT_SCHEMA: &str = "2";
+
+/// The prelude variant that computes OpSMod as lavapipe does (srem).
+const SMOD_AS_SREM: &str = "BRDFPROF_SMOD_AS_SREM";
+
+/// The shading comparison's tolerance: two steps of R11G11B10F's 5-bit blue mantissa.
+const SHADE_TOLERANCE: f64 = 2.0 / 32.0;
+
+/// Whether a disagreement (`worst` over `tolerance`) of a kernel that takes OpSMod vanishes when the host
+/// computes it as srem (`compare` run with `SMOD_AS_SREM`): then it is the device's, not the translation's.
+pub fn srem_explains(t: &super::Translation, worst: f64, tolerance: f64, compare: impl Fn(&[&str]) -> Result<f64>) -> Result<bool> {
+    Ok(!(worst <= tolerance) && t.body().contains("m_smod(") && compare(&[SMOD_AS_SREM])? <= tolerance)
+}
+
+/// What a disagreement that vanishes with `SMOD_AS_SREM` means.
+pub fn srem_note(device: &str, worst: f64) -> String {
+    format!(
+        "the kernel takes integer `%` (SPIR-V OpSMod) of a negative value: {device} computes it with the dividend's sign (srem: -7 % 3 = -1) where SPIR-V's OpSMod and the translation take the divisor's (2); GLSL leaves `%` of negative operands undefined. With srem on the host the two agree; as compiled they differ by up to {worst:.1e} relative, so this model's results differ between drivers"
+    )
 }
 
 /// Relative eval tolerance: fp32 maths libraries differ by a few ulps, amplified in exp(m log x) forms; fp16
 /// transcendentals differ by ulps of fp16.
-fn eval_tolerance(model: &Model) -> f64 {
+pub fn eval_tolerance(model: &Model) -> f64 {
     match model.precision() {
         Precision::F32 => 1e-4,
         Precision::F16 => 5e-2,
@@ -71,11 +104,15 @@ pub fn worst_relative_to_brightest(host: &[[f32; 3]], device: &[[f32; 3]]) -> f6
 /// The eval kernel of `model`, translated and run on the host, against `gpu`.
 pub fn eval_agreement(gpu: &Gpu, model: &Model, shaders: &Shaders) -> Result<Agreement> {
     let samples = well_conditioned(EVAL_SAMPLES, 0x7e57, 0.05, 0.2..1.0);
-    let kernel = host::HostKernel::compile(&prepare::eval_kernel(model, shaders)?)?;
-    let on_host = host::eval(&kernel, &samples, &EvalExtras::default())?;
+    let translation = prepare::eval_kernel(model, shaders)?;
     let on_device = kernels::eval_from(gpu, model, shaders, &samples, &EvalExtras::default(), RunLimits::default())?;
-    let worst = worst_relative(&on_host, &on_device, |i, c| f64::from(on_device[i][c]).abs().max(1e-3));
-    Ok(Agreement { kernel: "eval".into(), values: 3 * samples.len(), worst, tolerance: eval_tolerance(model), device: gpu.info.name.clone() })
+    let compare = |defines: &[&str]| -> Result<f64> {
+        let on_host = host::eval(&host::HostKernel::compile_with(&translation, defines)?, &samples, &EvalExtras::default())?;
+        Ok(worst_relative(&on_host, &on_device, |i, c| f64::from(on_device[i][c]).abs().max(1e-3)))
+    };
+    let (worst, tolerance) = (compare(&[])?, eval_tolerance(model));
+    let srem = srem_explains(&translation, worst, tolerance, compare)?;
+    Ok(Agreement { kernel: "eval".into(), values: 3 * samples.len(), worst, tolerance, device: gpu.info.name.clone(), srem })
 }
 
 /// The packed profiling kernel of `model` (None: the memory-only kernel) with `lights` lights, translated and
@@ -90,31 +127,45 @@ pub fn shade_agreement(gpu: &Gpu, model: Option<&Model>, lights: u32, shaders: &
     let variant = Variant::new(gpu, &work, model, shaders, 1)?;
     gpu.submit(|cmd| variant.record(cmd, 0))?;
     let on_device = work.radiance()?;
-    let kernel = host::HostKernel::compile(&prepare::shade_kernel(model, lights, shaders)?)?;
-    let mut words: Vec<u8> = bytemuck::cast_slice(&workload::padded_words(&g)).to_vec();
-    let pixels = words.len() / 16;
-    let mut radiance = vec![0u8; pixels * 4];
-    let mut light_bytes: Vec<u8> = bytemuck::cast_slice(&workload::light_buffer(&light_data)).to_vec();
-    let c = g.camera;
-    let mut push = workload::push_constants(0, w, [c.scale[0], c.offset[0], c.scale[1], c.offset[1]]);
-    let groups = (pixels as u32).div_ceil(kernel.local_size()[0]);
-    kernel.run(&mut [&mut words, &mut radiance, &mut light_bytes, &mut push], [groups, 1, 1])?;
-    let words: Vec<u32> = bytemuck::pod_collect_to_vec(&radiance);
-    let on_host: Vec<[f32; 3]> = words.into_iter().take(on_device.len()).map(gbuffer::unpack_r11g11b10).collect();
-    let worst = worst_relative_to_brightest(&on_host, &on_device);
-    Ok(Agreement { kernel: "shade".into(), values: 3 * on_device.len(), worst, tolerance: 2.0 / 32.0, device: gpu.info.name.clone() })
+    let translation = prepare::shade_kernel(model, lights, shaders)?;
+    let compare = |defines: &[&str]| -> Result<f64> {
+        let kernel = host::HostKernel::compile_with(&translation, defines)?;
+        let mut words: Vec<u8> = bytemuck::cast_slice(&workload::padded_words(&g)).to_vec();
+        let pixels = words.len() / 16;
+        let mut radiance = vec![0u8; pixels * 4];
+        let mut light_bytes: Vec<u8> = bytemuck::cast_slice(&workload::light_buffer(&light_data)).to_vec();
+        let c = g.camera;
+        let mut push = workload::push_constants(0, w, [c.scale[0], c.offset[0], c.scale[1], c.offset[1]]);
+        let groups = (pixels as u32).div_ceil(kernel.local_size()[0]);
+        kernel.run(&mut [&mut words, &mut radiance, &mut light_bytes, &mut push], [groups, 1, 1])?;
+        let words: Vec<u32> = bytemuck::pod_collect_to_vec(&radiance);
+        let on_host: Vec<[f32; 3]> = words.into_iter().take(on_device.len()).map(gbuffer::unpack_r11g11b10).collect();
+        Ok(worst_relative_to_brightest(&on_host, &on_device))
+    };
+    let (worst, tolerance) = (compare(&[])?, SHADE_TOLERANCE);
+    let srem = srem_explains(&translation, worst, tolerance, compare)?;
+    Ok(Agreement { kernel: "shade".into(), values: 3 * on_device.len(), worst, tolerance, device: gpu.info.name.clone(), srem })
 }
 
-/// Both comparisons for `model` (the shade one alone for the memory-only kernel); an error when either is
-/// beyond its tolerance, naming the kernel and the difference.
-pub fn check(gpu: &Gpu, model: Option<&Model>, lights: u32, shaders: &Shaders) -> Result<Vec<Agreement>> {
+/// Both comparisons for `model` (the shade one alone for the memory-only kernel).
+pub fn measure(gpu: &Gpu, model: Option<&Model>, lights: u32, shaders: &Shaders) -> Result<Vec<Agreement>> {
     let mut out = Vec::new();
     if let Some(m) = model {
         out.push(eval_agreement(gpu, m, shaders)?);
     }
     out.push(shade_agreement(gpu, model, lights, shaders)?);
+    Ok(out)
+}
+
+/// The verdict on `measure`'s comparisons: an error when one is beyond its tolerance, naming the kernel and
+/// the difference; a warning for one the device's srem explains.
+pub fn verdict(model: Option<&Model>, agreements: &[Agreement]) -> Result<()> {
     let label = model.map_or_else(|| workload::BASELINE_LABEL.to_string(), Model::label);
-    for a in &out {
+    for a in agreements {
+        if let Some(n) = a.note() {
+            crate::messages::warning_once(format!("{label} ({} kernel): {n}; its cost is reported for the SPIR-V semantics", a.kernel));
+            continue;
+        }
         if !(a.worst <= a.tolerance) {
             bail!(
                 "{label}: the C translation of the {} kernel disagrees with the Vulkan kernel on {} (worst relative difference {:.3e}, tolerance {:.1e}): its cost is not reported. This is a translator defect; please report it with the model",
@@ -122,16 +173,24 @@ pub fn check(gpu: &Gpu, model: Option<&Model>, lights: u32, shaders: &Shaders) -
             );
         }
     }
+    Ok(())
+}
+
+/// `measure` and its `verdict`.
+pub fn check(gpu: &Gpu, model: Option<&Model>, lights: u32, shaders: &Shaders) -> Result<Vec<Agreement>> {
+    let out = measure(gpu, model, lights, shaders)?;
+    verdict(model, &out)?;
     Ok(out)
 }
 
-/// `check`, or its result from the cache: the key covers the host translations (their whole source), the
+/// `check`, its measurement from the cache: the key covers the host translations (their whole source), the
 /// Vulkan kernels' SPIR-V and constants, the device and its driver, and the comparison's set-up.
 pub fn check_cached(gpu: &Gpu, model: Option<&Model>, lights: u32, shaders: &Shaders) -> Result<Vec<Agreement>> {
     let (per_dispatch, accumulate) = workload::steady_block(lights);
     let shade = workload::shade_kernel(model, GBufferFormat::Packed, per_dispatch, accumulate, shaders)?;
     let mut key = crate::cache::KeyBuilder::new("agreement")
         .part("brdfprof", env!("CARGO_PKG_VERSION"))
+        .part("schema", AGREEMENT_SCHEMA)
         .part("device", format!("{} {} {} {}", gpu.info.name, gpu.info.driver_name, gpu.info.driver_info, gpu.info.driver_version))
         .part("setup", format!("{EVAL_SAMPLES} {SHADE_SIZE:?} {lights} {}", host::build_identity()))
         .part("shade-spirv", bytemuck::cast_slice::<u32, u8>(&shade.spirv.words))
@@ -148,6 +207,9 @@ pub fn check_cached(gpu: &Gpu, model: Option<&Model>, lights: u32, shaders: &Sha
     let label = model.map_or_else(|| workload::BASELINE_LABEL.to_string(), Model::label);
     let what = format!("the check of {label}'s translation");
     let valid = |bytes: &[u8]| serde_json::from_slice::<Vec<Agreement>>(bytes).map(|_| ()).map_err(anyhow::Error::from);
-    let bytes = crate::cache::get_or_build(crate::cache::Store::open_default().as_ref(), "agreement", &key, &what, valid, || Ok(serde_json::to_vec(&check(gpu, model, lights, shaders)?)?))?;
-    Ok(serde_json::from_slice(&bytes)?)
+    let bytes = crate::cache::get_or_build(crate::cache::Store::open_default().as_ref(), "agreement", &key, &what, valid, || Ok(serde_json::to_vec(&measure(gpu, model, lights, shaders)?)?))?;
+    // The verdict on every use, cached or not: the same warning or refusal each time.
+    let out: Vec<Agreement> = serde_json::from_slice(&bytes)?;
+    verdict(model, &out)?;
+    Ok(out)
 }

@@ -26,4 +26,5 @@ mod outputs;
 mod radv;
 mod report;
 mod signals;
+mod translation_faults;
 mod compile_only;

@@ -171,10 +171,27 @@ fn the_opencl_translation_on_pocl_agrees_with_vulkan_on_every_preset_and_example
         assert!(fast_worst <= 1e-4, "{model}: the native_ build differs by {fast_worst:.2e}");
         let judge = if model.twin().is_some() { model.clone() } else { twin_of_example(model).unwrap_or_else(|| model.clone()) };
         let o = compare(&judge, &samples, &on_cl, &on_device);
-        report.push(format!("{:60} worst {:.2e} ({} of {} beyond {AGREEMENT:.0e}; native_ build {fast_worst:.2e}) on {}", model.label(), o.worst, o.over, 3 * samples.len(), k.device));
+        report.push(format!("{:60} worst {:.2e} ({} of {} beyond {AGREEMENT:.0e}; native_ build {fast_worst:.2e}) on {}", model.label(), o.worst, o.over, 3 * samples.len(), k.device()));
         unexplained.extend(o.unexplained);
     }
     println!("{}", report.join("\n"));
     assert!(unexplained.is_empty(), "{} values beyond {AGREEMENT:.0e}:\n{}", unexplained.len(), unexplained.iter().take(10).cloned().collect::<Vec<_>>().join("\n"));
 }
 
+
+/// Issue 33 item 1: a translated kernel runs in a child process, so a fault in it (here a library that
+/// writes through a null pointer, built by the real g++) is an error that names the signal, and this process
+/// lives on.
+#[test]
+fn a_kernel_that_faults_ends_its_child_with_a_message_not_brdfprof() {
+    use brdfprof::translate::runner;
+    let dir = tempfile::tempdir().unwrap();
+    let src = dir.path().join("fault.cpp");
+    std::fs::write(&src, "extern \"C\" unsigned brdfprof_host_run(unsigned char* const* b, unsigned x, unsigned y, unsigned z) { volatile int* p = nullptr; *p = (int)x; return 0; }\n").unwrap();
+    let library = dir.path().join("fault.so");
+    let built = std::process::Command::new("g++").args(["-shared", "-fPIC", "-O0", "-o"]).arg(&library).arg(&src).status().unwrap();
+    assert!(built.success());
+    let mut buffer = vec![0u8; 16];
+    let e = runner::run(runner::Engine::Host { library }, [1, 1, 1], &mut [&mut buffer], [1, 1, 1], "a faulting kernel").unwrap_err().to_string();
+    assert!(e.starts_with("a faulting kernel: the kernel crashed the child process that ran it (signal 11, SIGSEGV)"), "{e}");
+}

@@ -59,7 +59,9 @@ pub(super) struct Open {
 
 /// The directives of a `.brdf` shader that glslang's preprocessor runs, as in any GLSL (issue 19: engine code
 /// selects its branches with `#if` and names its constants with `#define`).
-pub(super) const PREPROCESSOR_DIRECTIVES: [&str; 11] = ["define", "undef", "if", "ifdef", "ifndef", "elif", "else", "endif", "error", "pragma", "extension"];
+/// `#pragma` is not among them: glslang's preprocessor passes pragmas through into the text brdfprof reads for
+/// the file's globals, and none changes the SPIR-V of a compute kernel (`dropped_hash_line`).
+pub(super) const PREPROCESSOR_DIRECTIVES: [&str; 10] = ["define", "undef", "if", "ifdef", "ifndef", "elif", "else", "endif", "error", "extension"];
 
 /// The directive name of a `#` line (`#  if X` -> `if`).
 pub(super) fn directive_of(line: &str) -> &str {
@@ -81,6 +83,7 @@ pub(super) fn dropped_hash_line(path: &Path, n: usize, line: &str) -> String {
     let why = match directive_of(line) {
         "version" => "the kernel the file is composed into sets `#version 450`",
         "line" => "brdfprof numbers the file's lines itself, so messages name the file's own lines",
+        "pragma" => "no pragma changes the compute kernel brdfprof compiles (glslang ignores `optimize` and `debug` for SPIR-V, `STDGL invariant` applies to vertex outputs, and a .brdf shader is one file, so `once` guards nothing)",
         _ => "a `#` line that is no preprocessor directive is a BRDF Explorer comment",
     };
     at(path, n, format!("`{line}` is dropped: {why}"))

@@ -4,7 +4,15 @@
 BRDFPROF_FN float m_glsl_mod(float x, float y) { return x - y * m_floor(m_fdiv(x, y)); }
 // GLSL 4.50 8.3: t = clamp((x - e0) / (e1 - e0), 0, 1); t t (3 - 2 t).
 BRDFPROF_FN float m_smoothstep(float e0, float e1, float x) { float t = m_fmin(m_fmax(m_fdiv(x - e0, e1 - e0), 0.0f), 1.0f); return t * t * (3.0f - 2.0f * t); }
+// A dynamic index clamped into its composite (robust drivers' treatment of an out-of-bounds index).
+BRDFPROF_FN u32 m_index(u32 i, u32 n) { return i < n ? i : n - 1u; }
+#ifdef BRDFPROF_SMOD_AS_SREM
+// Only in the host build that tests whether a disagreement is lavapipe's: it computes OpSMod as srem.
+BRDFPROF_FN i32 m_smod(i32 a, i32 b) { return m_srem(a, b); }
+#else
+// SPIR-V OpSMod: the sign of the result is the divisor's.
 BRDFPROF_FN i32 m_smod(i32 a, i32 b) { i32 r = m_srem(a, b); return (r != 0 && ((r < 0) != (b < 0))) ? r + b : r; }
+#endif
 BRDFPROF_FN i32 m_sabs(i32 a) { return a < 0 ? (i32)(0u - (u32)a) : a; }
 BRDFPROF_FN u32 m_umin(u32 a, u32 b) { return a < b ? a : b; }
 BRDFPROF_FN u32 m_umax(u32 a, u32 b) { return a > b ? a : b; }
