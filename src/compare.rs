@@ -8,8 +8,8 @@
 use crate::inspect::InspectReport;
 use crate::inspect::HASH_NOTE;
 use crate::profile::view::ProfileView;
-use crate::profile::workload::BASELINE_LABEL;
-use crate::report::{sig, Table};
+use crate::model::BASELINE_LABEL;
+use crate::results::{sig, Table};
 use anyhow::{anyhow, bail, Result};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};

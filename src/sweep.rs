@@ -11,7 +11,7 @@ use crate::chart::{self, Point};
 use crate::gpu::Gpu;
 use crate::model::Model;
 use crate::profile::{self, ProfileOptions, ProfileReport};
-use crate::report::{self, Table};
+use crate::results::{self, Table};
 use crate::stats::{self, Estimate};
 use anyhow::Result;
 use indicatif::ProgressBar;
@@ -194,9 +194,9 @@ impl SweepReport {
             t.row([
                 format!("{}{}", r.rank, if r.tied { "=" } else { "" }),
                 r.spec.clone(),
-                report::estimate(&r.ns_per_eval, 3),
-                r.net_ns_per_eval.as_ref().map_or("-".into(), |e| report::sig(e.median, 3)),
-                report::estimate(&r.cost_vs_fastest, 3),
+                results::estimate(&r.ns_per_eval, 3),
+                r.net_ns_per_eval.as_ref().map_or("-".into(), |e| results::sig(e.median, 3)),
+                results::estimate(&r.cost_vs_fastest, 3),
                 numerical_cell(a),
                 a.vs_exact.cell(),
                 format!("{:.1e}", a.albedo_vs_exact),
@@ -226,7 +226,7 @@ impl SweepReport {
 
     /// Writes sweep-<device>.md, .json and .png under `out`; returns their paths.
     pub fn write(&self, out: &Path, device: &str) -> Result<Vec<std::path::PathBuf>> {
-        report::write_md_json_png(&out.join(format!("sweep-{device}")), report::Kind::Sweep, self, &self.markdown(), |png| self.chart(png))
+        results::write_md_json_png(&out.join(format!("sweep-{device}")), results::Kind::Sweep, self, &self.markdown(), |png| self.chart(png))
     }
 
     /// Approximation error (RMS vs exact, log) against cost, every point labelled, the frontier drawn.

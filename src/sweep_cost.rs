@@ -5,7 +5,7 @@
 
 use crate::chart::{self, Point};
 use crate::targets::cost::TargetCost;
-use crate::report::{self, Table};
+use crate::results::{self, Table};
 use crate::sweep::{pareto_front, SweepReport};
 use anyhow::Result;
 use serde::Serialize;
@@ -115,8 +115,8 @@ impl CostSweep {
             let mut cells = vec![r.label.clone()];
             cells.extend(self.columns.iter().map(|c| r.stats.get(c).map_or("-".into(), |v| crate::inspect::format_value(*v))));
             cells.extend([
-                report::sig(r.cycles_per_eval, 4),
-                r.net_cycles_per_eval.map_or("-".into(), |v| report::sig(v, 4)),
+                results::sig(r.cycles_per_eval, 4),
+                r.net_cycles_per_eval.map_or("-".into(), |v| results::sig(v, 4)),
                 format!("{:.3}", r.cost_vs_fastest),
                 format!("{:.3}", r.measured_cost_vs_fastest),
                 r.accuracy.vs_exact.cell(),
@@ -149,7 +149,7 @@ impl CostSweep {
 
     /// Writes `<stem>.md`, `.json` and `.png`; returns their paths.
     pub fn write(&self, stem: &Path) -> Result<Vec<PathBuf>> {
-        report::write_md_json_png(stem, report::Kind::SweepCost, self, &self.markdown(), |png| self.chart(png))
+        results::write_md_json_png(stem, results::Kind::SweepCost, self, &self.markdown(), |png| self.chart(png))
     }
 
     pub fn chart(&self, path: &Path) -> Result<()> {

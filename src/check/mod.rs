@@ -28,7 +28,7 @@ use crate::inspect::InspectOptions;
 use crate::brdf::spec::THESIS_MODELS;
 use crate::gpu::Gpu;
 use crate::model::Model;
-use crate::report as reports;
+use crate::results as reports;
 use crate::shaders::Shaders;
 use anyhow::{anyhow, bail, Result};
 use std::path::PathBuf;
@@ -150,7 +150,7 @@ mod tests {
     use super::*;
     use crate::inspect::timing::TimingRun;
     use crate::inspect::{InspectReport, Row};
-    use crate::report;
+    use crate::results;
     use std::collections::BTreeMap;
     use std::path::Path;
 
@@ -305,7 +305,7 @@ mod tests {
         assert!(e.contains("format `brdfprof-check-baseline/0`"), "{e}");
         let good = baseline(vec![row("ggx", &[("spirv/total", 1.0)])], None, "cpu");
         let p = dir.path().join("good.json");
-        report::write_json(&p, &good).unwrap();
+        results::write_json(&p, &good).unwrap();
         assert_eq!(load(&p).unwrap().inspect.rows, good.inspect.rows);
         let e = load(&write("bad.json", &std::fs::read_to_string(&p).unwrap().replace("\"spirv/total\": 1.0", "\"spirv/total\": \"x\""))).unwrap_err().to_string();
         assert!(e.contains("corrupt") && e.contains("bad.json"), "{e}");

@@ -10,7 +10,7 @@ use brdfprof::check::{self, CheckOptions, Thresholds};
 use brdfprof::inspect::timing::TimingOptions;
 use brdfprof::inspect::{self, InspectOptions};
 use brdfprof::shaders::Shaders;
-use brdfprof::{io, report};
+use brdfprof::{io, results};
 use clap::Args;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -136,7 +136,7 @@ pub fn inspect(args: &InspectArgs) -> Result<ExitCode> {
     let json = args.json.clone().unwrap_or_else(|| PathBuf::from(format!("results/{stem}.json")));
     let markdown = args.markdown.clone().unwrap_or_else(|| PathBuf::from(format!("results/{stem}.md")));
     let value = result.json_value()?;
-    report::write_json(&json, &value)?;
+    results::write_json(&json, &value)?;
     let input = super::report::just_measured(&json, &value)?;
     if args.html.html.is_some() {
         // The lobes and spheres are drawn on the default local device (the inspected ones may only compile).

@@ -6,7 +6,7 @@ use anyhow::{bail, Result};
 use brdfprof::brdf::Sample;
 use brdfprof::diff::{self, DiffReport, Evaluated};
 use brdfprof::model::Model;
-use brdfprof::{io, kernels, report};
+use brdfprof::{io, kernels, results};
 use clap::Args;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -99,7 +99,7 @@ pub fn diff(args: &DiffArgs) -> Result<ExitCode> {
     for (flag, path) in &outs {
         match *flag {
             "--csv" => io::write_output(path, diff::csv(&inputs.samples, &va, &vb).as_bytes())?,
-            "--json" => report::write_json(path, &result)?,
+            "--json" => results::write_json(path, &result)?,
             _ => {}
         }
     }

@@ -3,7 +3,7 @@
 use anyhow::{Context, Result};
 use brdfprof::brdf::terms::{ParamKind, PARAMS};
 use brdfprof::brdf::{spec, Metal, ModelSpec, D, F, Vis};
-use brdfprof::{gpu, report};
+use brdfprof::{gpu, results};
 use clap::Args;
 use std::path::Path;
 use std::process::ExitCode;
@@ -22,7 +22,7 @@ fn targets_table() -> String {
          needed; nothing executes). Commands that compile take them: inspect, check, sweep --cost-device, profile --scene --cost-device.\n\n");
     for v in brdfprof::targets::VENDORS {
         let status = v.status().unwrap_or_else(|e| format!("{e:#}"));
-        let mut t = report::Table::new(["--device", "architecture", "products", "compiler", &format!("in {}:all", v.prefix())]);
+        let mut t = results::Table::new(["--device", "architecture", "products", "compiler", &format!("in {}:all", v.prefix())]);
         for f in v.families() {
             t.row([format!("{}:{}", v.prefix(), f.name), f.architecture.into(), f.products.into(), f.detail, if f.default { "yes".into() } else { String::new() }]);
         }
@@ -38,7 +38,7 @@ pub fn devices(args: &DevicesArgs) -> Result<ExitCode> {
     }
     let infos = gpu::list_devices()?;
     let default = gpu::select_device(&infos, None).ok();
-    let mut t = report::Table::new([
+    let mut t = results::Table::new([
         "index", "name", "type", "driver", "API", "timestampPeriod ns", "ts bits", "maxStorageBufferRange", "maxWorkGroupCount.x", "fp16", "fp64", "exec. stats",
     ]);
     for d in &infos {
@@ -63,7 +63,7 @@ pub fn devices(args: &DevicesArgs) -> Result<ExitCode> {
 }
 
 fn section(out: &mut String, title: &str, headers: &[&str], rows: Vec<Vec<String>>) {
-    let mut t = report::Table::new(headers.iter().copied());
+    let mut t = results::Table::new(headers.iter().copied());
     for r in rows {
         t.row(r);
     }

@@ -4,7 +4,7 @@ use super::{check_output, fresh_compilation, on_device, written, DeviceArgs, Mod
 use anyhow::{bail, Result};
 use brdfprof::brdf::THESIS_MODELS;
 use brdfprof::model::Model;
-use brdfprof::{io, profile, report, scene, stability, sweep};
+use brdfprof::{io, profile, results, scene, stability, sweep};
 use clap::Args;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -66,7 +66,7 @@ pub fn profile(args: &ProfileArgs) -> Result<ExitCode> {
     let options = args.timing.options(args.model.models(&THESIS_MODELS)?, size, args.reps, args.budget, args.target_ci)?;
     let (gpu, result) = on_device(&args.device, |gpu, progress| profile::run(gpu, &options, progress))?;
     let path = args.json.clone().unwrap_or_else(|| PathBuf::from(format!("{}/profile-{}.json", super::DEFAULT_OUT, brdfprof::targets::device_slug(&gpu.info))));
-    report::write_report(&path, report::Kind::Profile, &result)?;
+    results::write_report(&path, results::Kind::Profile, &result)?;
     args.html.write(&[super::report::just_measured(&path, &result)?], Some(&gpu))?;
     println!("{}\n", result.summary());
     print!("{}{}", result.table().markdown(), result.placement_notes());
@@ -118,7 +118,7 @@ fn profile_scene(args: &ProfileArgs, path: &std::path::Path) -> Result<ExitCode>
     let options = scene::profile::SceneProfileOptions { protocol: base.protocol, target_rel_ci: args.target_ci, max_chunk: None, instances: base.instances, cost_targets, validate: args.device.validation(), isa_dir: args.isa.clone() };
     let (gpu, result) = on_device(&args.device, |gpu, progress| scene::profile::run(gpu, &scene, &options, progress))?;
     let path = args.json.clone().unwrap_or_else(|| PathBuf::from(format!("{}/scene-{}-{}.json", super::DEFAULT_OUT, scene.name(), brdfprof::targets::device_slug(&gpu.info))));
-    report::write_report(&path, report::Kind::SceneProfile, &result)?;
+    results::write_report(&path, results::Kind::SceneProfile, &result)?;
     println!("{}\n", result.summary());
     print!("{}", result.markdown());
     println!("\nJSON: {}", path.display());

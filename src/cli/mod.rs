@@ -149,7 +149,7 @@ pub struct TimingArgs {
     /// G-buffer layout: packed as engines store it (octahedral normal, RGBA8 material and base colour, V from
     /// the pixel and the camera, R11G11B10F out: 16 bytes in, 4 out), or float (48 bytes in, 16 out).
     #[arg(long, value_enum, default_value = "packed")]
-    pub gbuffer: brdfprof::profile::gbuffer::GBufferFormat,
+    pub gbuffer: brdfprof::kernels::shade::GBufferFormat,
     /// Minimum and maximum number of interleaved rounds.
     #[arg(long, default_value_t = 12)]
     pub min_rounds: usize,

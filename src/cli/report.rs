@@ -4,7 +4,7 @@
 use super::DeviceArgs;
 use anyhow::Result;
 use brdfprof::gpu::Gpu;
-use brdfprof::htmlreport::{self, Input};
+use brdfprof::report_page::{self, Input};
 use brdfprof::io;
 use clap::Args;
 use std::path::{Path, PathBuf};
@@ -42,7 +42,7 @@ impl HtmlArg {
     /// Writes the page of `inputs` (lobes and spheres on `gpu`) where asked; returns its path.
     pub fn write(&self, inputs: &[Input], gpu: Option<&Gpu>) -> Result<Option<PathBuf>> {
         let Some(path) = &self.html else { return Ok(None) };
-        let bytes = htmlreport::write(inputs, path, gpu)?;
+        let bytes = report_page::write(inputs, path, gpu)?;
         brdfprof::messages::progress(format!("HTML report: {} ({bytes} bytes)", path.display()));
         Ok(Some(path.clone()))
     }
@@ -50,16 +50,16 @@ impl HtmlArg {
 
 /// The report just measured, read back as its saved JSON would be.
 pub fn just_measured(json: &Path, report: &impl serde::Serialize) -> Result<Input> {
-    htmlreport::from_report(json, report)
+    report_page::from_report(json, report)
 }
 
 pub fn report(args: &ReportArgs) -> Result<ExitCode> {
     io::check_output_path("--out", &args.out)?;
     io::check_not_input("--out", &args.out, &args.files.iter().map(|f| ("RESULTS", f.as_path())).collect::<Vec<_>>())?;
     brdfprof::compare::refuse_repeated_reports(&args.files, "a report given twice would draw its sections twice")?;
-    let inputs = args.files.iter().map(|f| htmlreport::load(f)).collect::<Result<Vec<_>>>()?;
+    let inputs = args.files.iter().map(|f| report_page::load(f)).collect::<Result<Vec<_>>>()?;
     let gpu = if args.no_gpu { None } else { Some(args.device.open()?) };
-    let bytes = htmlreport::write(&inputs, &args.out, gpu.as_ref())?;
+    let bytes = report_page::write(&inputs, &args.out, gpu.as_ref())?;
     if let Some(gpu) = &gpu {
         gpu.check_validation()?;
     }

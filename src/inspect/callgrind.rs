@@ -16,7 +16,7 @@ use crate::gpu::{Gpu, GpuOptions};
 use crate::model::Model;
 use crate::shaders::Shaders;
 use crate::profile::gbuffer;
-use crate::profile::gbuffer::GBufferFormat;
+use crate::kernels::shade::GBufferFormat;
 use crate::profile::protocol::Timed;
 use crate::profile::workload::{Variant, Workload};
 use anyhow::{anyhow, bail, Context, Result};

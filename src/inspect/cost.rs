@@ -4,8 +4,9 @@
 //! cycles, ...); `inspect`, `compare` and `sweep --cost-device` read only this.
 
 use crate::inspect::InspectReport;
-use crate::profile::workload::{steady_block, BASELINE_LABEL};
-use crate::report::{sig, Table};
+use crate::kernels::shade::steady_block;
+use crate::model::BASELINE_LABEL;
+use crate::results::{sig, Table};
 use serde::{Deserialize, Serialize};
 
 /// One kernel's figures.

@@ -9,21 +9,20 @@ pub mod cost;
 pub mod correlate;
 pub mod driver;
 pub mod naga_info;
-pub mod spirv;
 pub mod timing;
 
+use crate::spirv;
 use crate::gpu::Gpu;
 use crate::model::{Model, ModelKernel};
-use crate::profile::gbuffer::GBufferFormat;
-use crate::profile::workload::{self, shade_kernel, steady_block};
-use crate::report::{self, Provenance, Table};
+use crate::kernels::shade::{self, shade_kernel, steady_block, GBufferFormat};
+use crate::results::{self, Provenance, Table};
 use crate::shaders::Shaders;
 use anyhow::{Context, Result};
 use callgrind::{CallgrindOptions, CallgrindRun};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
-pub use crate::profile::workload::BASELINE_LABEL;
+pub use crate::model::BASELINE_LABEL;
 
 
 /// Key of a row's kernel hash in `inspect::Row::notes`.
@@ -61,7 +60,7 @@ pub struct Row {
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct InspectReport {
-    /// Where it was measured (report::Provenance, kept as JSON so that baselines read back whatever it holds).
+    /// Where it was measured (results::Provenance, kept as JSON so that baselines read back whatever it holds).
     pub provenance: serde_json::Value,
     /// Where the SPIR-V came from.
     pub kernels: String,
@@ -105,7 +104,7 @@ fn driver_stats(gpu: &Gpu, kernel: &ModelKernel, row: &mut Row) -> Result<()> {
     if !gpu.info.pipeline_executable_properties {
         return Ok(());
     }
-    let pipeline = crate::gpu::Kernel::new(gpu, &kernel.spirv.name, &kernel.spirv.words, &kernel.constants, &workload::bindings(GBufferFormat::Packed), workload::PUSH_BYTES)?;
+    let pipeline = crate::gpu::Kernel::new(gpu, &kernel.spirv.name, &kernel.spirv.words, &kernel.constants, &shade::bindings(GBufferFormat::Packed), shade::PUSH_BYTES)?;
     if let Some(executables) = pipeline.executables()? {
         // The wave size the driver compiled for (VkPipelineExecutablePropertiesKHR::subgroupSize).
         if let Some(size) = executables.iter().map(|e| e.subgroup_size).max().filter(|s| *s > 0) {
@@ -145,7 +144,7 @@ pub fn static_row(shaders: &Shaders, model: Option<&Model>, lights: u32) -> Resu
     let (per_dispatch, accumulate) = steady_block(lights);
     let kernel = shade_kernel(model, GBufferFormat::Packed, per_dispatch, accumulate, shaders)?;
     let float_kernel = shade_kernel(model, GBufferFormat::Float, per_dispatch, accumulate, shaders)?;
-    row.notes.insert(HASH_NOTE.into(), workload::kernel_hash(model, GBufferFormat::Packed, shaders)?);
+    row.notes.insert(HASH_NOTE.into(), shade::kernel_hash(model, GBufferFormat::Packed, shaders)?);
     if let Some(folded) = model.and_then(Model::file).map(|f| f.folded()).filter(|f| !f.is_empty()) {
         let note = format!("parameters compiled in as constants, so the figures are for these values (the compiler may fold them): {}; bind one to an input (NAME=@roughness, ...) to cost it as one", folded.join(", "));
         crate::messages::note_once(format!("{}: {note}", row.model));
@@ -319,7 +318,7 @@ pub fn is_lavapipe(info: &crate::gpu::DeviceInfo) -> bool {
 
 /// Formats a statistic: whole numbers as integers, others with 4 significant digits.
 pub fn format_value(v: f64) -> String {
-    if v.fract() == 0.0 && v.abs() < 1e15 { format!("{}", v as i64) } else { report::sig(v, 4) }
+    if v.fract() == 0.0 && v.abs() < 1e15 { format!("{}", v as i64) } else { results::sig(v, 4) }
 }
 
 impl InspectReport {

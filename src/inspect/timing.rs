@@ -14,7 +14,7 @@ use super::BASELINE_LABEL;
 use crate::gpu::Gpu;
 use crate::model::Model;
 use crate::profile::gbuffer;
-use crate::profile::gbuffer::GBufferFormat;
+use crate::kernels::shade::GBufferFormat;
 use crate::profile::protocol::{self, ProtocolOptions};
 use crate::profile::workload::{Variant, Workload};
 use crate::shaders::Shaders;

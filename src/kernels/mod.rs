@@ -2,6 +2,7 @@
 //! limits): `eval` (f_s per sample), `terms` (each term per sample) and `albedo` (directional albedo).
 
 pub mod constants;
+pub mod shade;
 
 use crate::brdf::Sample;
 use crate::gpu::{Binding, Bindings, Buffer, ChunkPlan, Gpu, Kernel, MemoryKind, SpecConstants};

@@ -16,40 +16,10 @@ use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 use serde::Serialize;
 
-/// Floats per float-layout pixel: (n.xyz, roughness), (v.xyz, metallic), (base colour, 1).
-pub const PIXEL_FLOATS: usize = 12;
+pub use crate::kernels::shade::{GBufferFormat, PIXEL_FLOATS};
+
 /// Floats per light: (l.xyz, 0), (rgb, 0).
 pub const LIGHT_FLOATS: usize = 8;
-
-/// How the G-buffer is stored.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, clap::ValueEnum)]
-#[serde(rename_all = "lowercase")]
-pub enum GBufferFormat {
-    Packed,
-    Float,
-}
-
-impl GBufferFormat {
-    /// Bytes per pixel read and written by the shading kernel.
-    pub fn bytes_in(self) -> u64 {
-        match self {
-            GBufferFormat::Packed => 16,
-            GBufferFormat::Float => (PIXEL_FLOATS * 4) as u64,
-        }
-    }
-    pub fn bytes_out(self) -> u64 {
-        match self {
-            GBufferFormat::Packed => 4,
-            GBufferFormat::Float => 16,
-        }
-    }
-    pub fn name(self) -> &'static str {
-        match self {
-            GBufferFormat::Packed => "packed",
-            GBufferFormat::Float => "float",
-        }
-    }
-}
 
 /// One pixel's surface, as the float layout stores it.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -9,7 +9,7 @@ pub mod workload;
 
 use crate::gpu::Gpu;
 use crate::model::Model;
-use crate::report::{self, Provenance, Table};
+use crate::results::{self, Provenance, Table};
 use crate::shaders::Shaders;
 use crate::stats::{self, Estimate};
 use anyhow::Result;
@@ -248,11 +248,11 @@ impl ProfileReport {
         for row in &self.rows {
             let mut cells = vec![
                 row.model.clone(),
-                report::estimate(&row.ns_per_eval, 3),
-                report::sig(row.evals_per_second / 1e6, 3),
-                report::estimate(&row.vs_reference, 3),
-                row.net_ns_per_eval.as_ref().map_or("-".into(), |e| report::estimate(e, 3)),
-                row.net_vs_reference.as_ref().map_or("-".into(), |e| report::estimate(e, 3)),
+                results::estimate(&row.ns_per_eval, 3),
+                results::sig(row.evals_per_second / 1e6, 3),
+                results::estimate(&row.vs_reference, 3),
+                row.net_ns_per_eval.as_ref().map_or("-".into(), |e| results::estimate(e, 3)),
+                row.net_vs_reference.as_ref().map_or("-".into(), |e| results::estimate(e, 3)),
                 row.harness_share.as_ref().map_or("-".into(), |e| format!("{:.0}%", 100.0 * e.median)),
             ];
             if several {
@@ -283,7 +283,7 @@ impl ProfileReport {
             let mut cells = vec![if name == workload::BASELINE_LABEL { format!("{name} (gross)") } else { format!("{name} (net)") }];
             for &l in counts {
                 let row = self.rows.iter().find(|r| r.model == name && r.lights == l);
-                cells.push(row.map_or("-".into(), |r| report::estimate(r.net_ns_per_eval.as_ref().unwrap_or(&r.ns_per_eval), 3)));
+                cells.push(row.map_or("-".into(), |r| results::estimate(r.net_ns_per_eval.as_ref().unwrap_or(&r.ns_per_eval), 3)));
             }
             t.row(cells);
         }

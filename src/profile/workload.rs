@@ -8,13 +8,12 @@
 
 use super::gbuffer::{GBuffer, GBufferFormat, LIGHT_FLOATS};
 use super::protocol::{Dispatch, Pipelines, Timed};
-use crate::gpu::{Binding, Buffer, ChunkPlan, Commands, Gpu, MemoryKind};
-use crate::kernels::{constants, WithConstant};
-use crate::model::{KernelKind, Model, ModelKernel};
+use crate::gpu::{Buffer, ChunkPlan, Commands, Gpu, MemoryKind};
+use crate::model::Model;
 use crate::shaders::Shaders;
 use anyhow::Result;
 
-pub use crate::kernels::constants::LIGHT_BLOCK;
+pub use crate::kernels::shade::{bindings, kernel_hash, light_blocks, shade_kernel, steady_block, LIGHT_BLOCK, PUSH_BYTES};
 
 /// The most lights a profile takes: 512 dispatches per run, 128 KiB of lights. Compilation does not grow
 /// with the count (one block kernel), the run time does.
@@ -22,16 +21,6 @@ pub const MAX_LIGHTS: u32 = 4096;
 
 /// Bytes of one block of lights in the light buffer (std140: two vec4 per light), the dynamic offset's step.
 const BLOCK_BYTES: u64 = LIGHT_BLOCK as u64 * LIGHT_FLOATS as u64 * 4;
-
-/// The dispatches of a profile with `lights` lights: (first light, lights) per block.
-pub fn light_blocks(lights: u32) -> Vec<(u32, u32)> {
-    (0..lights.div_ceil(LIGHT_BLOCK)).map(|b| (b * LIGHT_BLOCK, LIGHT_BLOCK.min(lights - b * LIGHT_BLOCK))).collect()
-}
-
-/// The block kernel that most of a profile's dispatches run: (lights per dispatch, whether it accumulates).
-pub fn steady_block(lights: u32) -> (u32, bool) {
-    (lights.min(LIGHT_BLOCK), lights > LIGHT_BLOCK)
-}
 
 /// The G-buffer, lights and output on the device.
 pub struct Workload<'g> {
@@ -167,53 +156,6 @@ fn texel_cap(gpu: &Gpu, format: GBufferFormat, cap: Option<u64>) -> Option<u64> 
         GBufferFormat::Packed => Some(cap.unwrap_or(u64::MAX).min(gpu.info.max_texel_buffer_elements as u64)),
         GBufferFormat::Float => cap,
     }
-}
-
-/// Bytes of shade.glsl's push constants.
-pub const PUSH_BYTES: u32 = 32;
-/// shade.glsl's bindings: the G-buffer, the radiance, one block of lights.
-pub fn bindings(format: GBufferFormat) -> [Binding; 3] {
-    use ash::vk::Format;
-    match format {
-        GBufferFormat::Packed => [Binding::TexelRead(Format::R32G32B32A32_UINT), Binding::TexelStorage(Format::B10G11R11_UFLOAT_PACK32), Binding::UniformDynamic],
-        GBufferFormat::Float => [Binding::Storage, Binding::Storage, Binding::UniformDynamic],
-    }
-}
-
-/// The kernel of the G-buffer format.
-fn shade_kind(format: GBufferFormat) -> KernelKind {
-    match format {
-        GBufferFormat::Packed => KernelKind::Shade,
-        GBufferFormat::Float => KernelKind::ShadeFloat,
-    }
-}
-
-/// glsl/shade.glsl for `model` (None: the memory-only baseline, compiled with the reference model's selectors,
-/// which it never runs) over `format`, lighting `lights` lights per dispatch and adding to the radiance of an
-/// earlier block when `accumulate`, with every specialisation constant set.
-pub fn shade_kernel(model: Option<&Model>, format: GBufferFormat, lights: u32, accumulate: bool, shaders: &Shaders) -> Result<ModelKernel> {
-    let reference = Model::reference();
-    let mut k = model.unwrap_or(&reference).kernel(shade_kind(format), shaders)?;
-    k.constants = k
-        .constants
-        .with(constants::NUM_LIGHTS, lights as f64)
-        .with(constants::BASELINE, model.is_none() as i32 as f64)
-        .with(constants::ACCUMULATE, accumulate as i32 as f64);
-    Ok(k)
-}
-
-/// SHA-256 of a model's shading kernel (None: the memory-only kernel) over `format`: the SPIR-V words and the
-/// constants that select the model, with the light count fixed at one block of one light, so that the hash
-/// names the code and the model, not the workload.
-pub fn kernel_hash(model: Option<&Model>, format: GBufferFormat, shaders: &Shaders) -> Result<String> {
-    let k = shade_kernel(model, format, 1, false, shaders)?;
-    use sha2::Digest;
-    let mut h = sha2::Sha256::new();
-    for w in k.spirv.words.iter() {
-        h.update(w.to_le_bytes());
-    }
-    h.update(format!("{:?}", k.constants).as_bytes());
-    Ok(h.finalize().iter().map(|b| format!("{b:02x}")).collect())
 }
 
 /// A model's shading kernel (or the memory-only baseline) bound to the workload, every light block, ready to

@@ -12,7 +12,7 @@ use crate::gpu::Gpu;
 use crate::kernels;
 use crate::model::KernelKind;
 use crate::profile::protocol::Timed;
-use crate::report::Table;
+use crate::results::Table;
 use crate::targets::{self, CheckedTranslation, RawKernel, Target};
 use crate::translate::{self, host::HostKernel, verify};
 use anyhow::{anyhow, bail, Result};
@@ -125,7 +125,7 @@ fn raw_kernel(gpu: &Gpu, work: &SceneWork, p: &ScenePlan, v: &VariantSpec, trans
     let model = p.kernels[v.kernel].model.clone();
     let mk = model.kernel(KernelKind::Scene, kernels::embedded())?;
     let constants = p.constants(mk.constants, v.switches);
-    let spirv = crate::inspect::spirv::specialise(&mk.spirv.words, &constants)?;
+    let spirv = crate::spirv::specialise(&mk.spirv.words, &constants)?;
     let translation = if translate {
         // One verdict for a model whatever the path: the checks `inspect` makes of the model's own kernels
         // (its eval kernel compares values a scene's clamped radiance would hide), then the scene kernel's.

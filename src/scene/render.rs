@@ -213,7 +213,7 @@ pub fn colour_bar(root: &DrawingArea<BitMapBackend, plotters::coord::Shift>, x0:
         let c = viridis(1.0 - y as f32 / (h - 1) as f32);
         root.draw(&Rectangle::new([(x0, y0 + y), (x0 + 14, y0 + y + 1)], RGBColor(c[0], c[1], c[2]).filled())).map_err(|e| anyhow!("{e}"))?;
     }
-    label(root, &crate::report::sig(f64::from(scale), 3), x0 + 16, y0, 12, BLACK)?;
+    label(root, &crate::results::sig(f64::from(scale), 3), x0 + 16, y0, 12, BLACK)?;
     label(root, "0", x0 + 16, y0 + h - 12, 12, BLACK)
 }
 
@@ -264,7 +264,7 @@ pub fn draw_lobes(root: &DrawingArea<BitMapBackend, plotters::coord::Shift>, lab
     for (area, (r, curves)) in root.split_evenly((1, panels.len())).iter().zip(panels) {
         let peak = curves.iter().flatten().map(|p| p.1).fold(0.0f64, f64::max).max(1e-30);
         let mut chart = ChartBuilder::on(area)
-            .caption(format!("r = {r} (peak {})", crate::report::sig(peak, 3)), (FONT, 16))
+            .caption(format!("r = {r} (peak {})", crate::results::sig(peak, 3)), (FONT, 16))
             .margin(10)
             .build_cartesian_2d(-1.15f64..1.15, -0.05f64..1.15)
             .map_err(|e| err(&e))?;

@@ -4,7 +4,7 @@
 //! that check an effect no material uses is absent from the kernel.
 
 use crate::gpu::SpecConstants;
-use crate::inspect::spirv::{spec_default_values, spirv_opt};
+use crate::spirv::{spec_default_values, spirv_opt};
 use crate::shaders::Spirv;
 use anyhow::{anyhow, Result};
 use rspirv::dr::{self, Operand};

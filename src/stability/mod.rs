@@ -176,7 +176,7 @@ pub struct StabilityOptions {
 
 #[derive(Clone, Debug, Serialize)]
 pub struct StabilityReport {
-    pub provenance: crate::report::Provenance,
+    pub provenance: crate::results::Provenance,
     pub specs: Vec<SpecStability>,
     pub grid_points: usize,
     pub cases: Vec<HardCase>,
@@ -268,7 +268,7 @@ impl StabilityReport {
     pub fn write(&self, out: &std::path::Path, device: &str) -> Result<Vec<std::path::PathBuf>> {
         let stem = out.join(format!("stability-{device}"));
         let mut written = vec![stem.with_extension("md"), stem.with_extension("json")];
-        crate::report::write_report_compact(&written[1], crate::report::Kind::Stability, self)?;
+        crate::results::write_report_compact(&written[1], crate::results::Kind::Stability, self)?;
         crate::io::write_output(&written[0], self.markdown().as_bytes())?;
         let entries = self.energy_entries();
         if !entries.is_empty() {
@@ -302,7 +302,7 @@ pub fn run(gpu: &Gpu, options: &StabilityOptions, progress: &ProgressBar) -> Res
         energy::attach(gpu, &options.models, &mut specs, progress)?;
     }
     let guard_savings = guard_savings(&options.models, &specs, &cases);
-    Ok(StabilityReport { provenance: crate::report::Provenance::new(&gpu.info), specs, grid_points: grid.len(), cases, guard_savings })
+    Ok(StabilityReport { provenance: crate::results::Provenance::new(&gpu.info), specs, grid_points: grid.len(), cases, guard_savings })
 }
 
 /// The worst deviation as a table cell: in tolerances, or what the value was when it is not a number.
@@ -318,7 +318,7 @@ fn worst_cell(w: &Worst) -> String {
 
 /// The max E, hemispherical albedo and E-vs-CPU cells, NaN/Inf cells counted (never a gain, never "inf").
 fn energy_cells(e: &energy::Energy) -> (String, String, String) {
-    use crate::report::sig;
+    use crate::results::sig;
     let nonfinite = if e.nonfinite > 0 { format!(" ({} of {} cells NaN/Inf)", e.nonfinite, e.cells()) } else { String::new() };
     let max_e = match e.max_e {
         Some(m) => format!("{}{} (±{:.0e}){nonfinite}", sig(m, 3), if e.gains_energy { " gain" } else { "" }, e.error_bound),
@@ -340,7 +340,7 @@ fn reciprocity_cell(s: &SpecStability) -> String {
 
 impl StabilityReport {
     pub fn markdown(&self) -> String {
-        use crate::report::Table;
+        use crate::results::Table;
         let mut out = format!(
             "# brdfprof stability\n\n{} ({}), {} specs; {} hard cases and {} grid points each.\n\n\
              NaN/Inf/neg: results on valid inputs (a spec with any fails, and the command exits 1). Out of tolerance: cases and \
@@ -413,7 +413,7 @@ impl StabilityReport {
         if self.guard_savings.is_empty() {
             return String::new();
         }
-        let mut t = crate::report::Table::new(["spec", "guards", "NaN", "Inf", "neg", "grid out of tol. (more)", "hard cases out of tolerance only without them"]);
+        let mut t = crate::results::Table::new(["spec", "guards", "NaN", "Inf", "neg", "grid out of tol. (more)", "hard cases out of tolerance only without them"]);
         for g in &self.guard_savings {
             let cases = if g.cases.is_empty() { "-".to_string() } else { g.cases.join("; ") };
             t.row([g.spec.clone(), describe_guards(&g.off), g.nan.to_string(), g.inf.to_string(), g.negative.to_string(), g.grid_out_of_tolerance.to_string(), cases]);

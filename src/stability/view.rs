@@ -1,7 +1,7 @@
 //! The stability report (`StabilityReport`) as read back by `brdfprof report` and `--html`. Values that are
 //! NaN or Inf are written as JSON null and read as None.
 
-use crate::report::view::ProvenanceView;
+use crate::results::view::ProvenanceView;
 use serde::Deserialize;
 
 #[derive(Clone, Debug, Deserialize)]

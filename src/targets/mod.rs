@@ -261,7 +261,7 @@ pub fn device_slug(device: &crate::gpu::DeviceInfo) -> String {
     if let Some(t) = radv_families::family_of_device(&device.name) {
         return format!("radv-{}", t.family);
     }
-    crate::report::name_slug(&device.name)
+    crate::results::name_slug(&device.name)
 }
 
 /// File-name form of a kernel label.

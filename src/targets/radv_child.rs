@@ -14,8 +14,8 @@ use crate::cleanup;
 use super::radv_families::{self as targets, Family};
 use crate::gpu::{Gpu, GpuOptions, Kernel};
 use crate::model::Model;
-use crate::profile::gbuffer::GBufferFormat;
-use crate::profile::workload::{self, shade_kernel, steady_block, BASELINE_LABEL};
+use crate::kernels::shade::{self, shade_kernel, steady_block, GBufferFormat};
+use crate::model::BASELINE_LABEL;
 use crate::shaders::Shaders;
 use anyhow::{anyhow, bail, Context, Result};
 use serde::{Deserialize, Serialize};
@@ -164,7 +164,7 @@ fn raw_report(gpu: &Gpu, shaders: &Shaders, req: &RadvRequest, family: &str, isa
         row.stats.extend(crate::inspect::driver::stats(&executables.into_iter().flat_map(|e| e.stats).collect::<Vec<_>>()));
         rows.push(row);
     }
-    let provenance = serde_json::to_value(crate::report::Provenance::new(&gpu.info))?;
+    let provenance = serde_json::to_value(crate::results::Provenance::new(&gpu.info))?;
     let notes = if skipped.is_empty() { Default::default() } else { [("driver/".to_string(), format!("not compiled for {family}: {}", skipped.join("; ")))].into() };
     Ok((crate::inspect::compiled_report(rows, provenance, req.lights, shaders, Default::default(), notes), isa_files))
 }
@@ -179,7 +179,7 @@ fn write_isa(gpu: &Gpu, shaders: &Shaders, model: Option<&Model>, lights: u32, d
     let label = model.map_or_else(|| BASELINE_LABEL.to_string(), Model::label);
     let (per_dispatch, accumulate) = steady_block(lights);
     let k = shade_kernel(model, GBufferFormat::Packed, per_dispatch, accumulate, shaders)?;
-    let kernel = Kernel::with_capture(gpu, &k.spirv.name, &k.spirv.words, &k.constants, &workload::bindings(GBufferFormat::Packed), workload::PUSH_BYTES, true)?;
+    let kernel = Kernel::with_capture(gpu, &k.spirv.name, &k.spirv.words, &k.constants, &shade::bindings(GBufferFormat::Packed), shade::PUSH_BYTES, true)?;
     write_representations(gpu, &kernel.executables()?.unwrap_or_default(), &label, dir)
 }
 

@@ -1,15 +1,14 @@
 //! The SPIR-V a translation starts from: a model's kernel specialised exactly as `inspect` counts it
-//! (`inspect::spirv::specialise`: constants set and frozen, the code they do not select removed), then in SSA
+//! (`spirv::specialise`: constants set and frozen, the code they do not select removed), then in SSA
 //! form with the loops its `[[unroll]]` marks unrolled (`spirv-opt --ssa-rewrite --loop-unroll`), as a Vulkan
 //! driver unrolls the light loop the hint marks. Nothing else is optimised: the target's compiler does that.
 
 use super::{translate, TexelFormat, TranslateError, TranslateOptions, Translation};
 use crate::gpu::SpecConstants;
-use crate::inspect::spirv;
+use crate::spirv;
 use crate::model::file_model::FileModel;
 use crate::model::{KernelKind, Model};
-use crate::profile::gbuffer::GBufferFormat;
-use crate::profile::workload;
+use crate::kernels::shade::{self, GBufferFormat};
 use crate::shaders::Shaders;
 use anyhow::{anyhow, Result};
 
@@ -25,7 +24,7 @@ pub fn prepared(words: &[u32], constants: &SpecConstants) -> Result<Vec<u32>> {
 /// The translation of a model's kernel; for a `.brdf` model a construct the translation cannot express is
 /// located again in a line-annotated compile of the file, and named at the file's own line.
 fn translated(model: Option<&Model>, kind: KernelKind, words: &[u32], constants: &SpecConstants, options: &TranslateOptions, shaders: &Shaders) -> Result<Translation> {
-    let label = model.map_or_else(|| workload::BASELINE_LABEL.to_string(), Model::label);
+    let label = model.map_or_else(|| crate::model::BASELINE_LABEL.to_string(), Model::label);
     match translate(&prepared(words, constants)?, options) {
         Ok(t) => Ok(t),
         Err(e) => match model.and_then(Model::file) {
@@ -48,9 +47,9 @@ pub fn eval_kernel(model: &Model, shaders: &Shaders) -> Result<Translation> {
 /// The profiling kernel over the packed G-buffer (glsl/shade.comp) for `model` (None: the memory-only
 /// kernel) with `lights` lights per dispatch, as `inspect` compiles it, translated.
 pub fn shade_kernel(model: Option<&Model>, lights: u32, shaders: &Shaders) -> Result<Translation> {
-    let (per_dispatch, accumulate) = workload::steady_block(lights);
-    let k = workload::shade_kernel(model, GBufferFormat::Packed, per_dispatch, accumulate, shaders)?;
-    // The G-buffer's texel view (`workload::bindings`): four 32-bit words per pixel.
+    let (per_dispatch, accumulate) = shade::steady_block(lights);
+    let k = shade::shade_kernel(model, GBufferFormat::Packed, per_dispatch, accumulate, shaders)?;
+    // The G-buffer's texel view (`shade::bindings`): four 32-bit words per pixel.
     let options = TranslateOptions { texel_formats: [((0, 0), TexelFormat::Rgba32ui)].into() };
     translated(model, KernelKind::Shade, &k.spirv.words, &k.constants, &options, shaders)
 }

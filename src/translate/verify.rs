@@ -11,7 +11,8 @@ use crate::brdf::Precision;
 use crate::gpu::Gpu;
 use crate::kernels::{self, EvalExtras, RunLimits};
 use crate::model::Model;
-use crate::profile::gbuffer::{self, GBufferFormat};
+use crate::kernels::shade::GBufferFormat;
+use crate::profile::gbuffer;
 use crate::profile::protocol::Timed;
 use crate::profile::workload::{self, Variant, Workload};
 use crate::shaders::Shaders;
@@ -120,7 +121,7 @@ pub fn eval_agreement(gpu: &Gpu, model: &Model, shaders: &Shaders) -> Result<Agr
 /// 5-bit blue mantissa of its brightest channel.
 pub fn shade_agreement(gpu: &Gpu, model: Option<&Model>, lights: u32, shaders: &Shaders) -> Result<Agreement> {
     let (w, h) = SHADE_SIZE;
-    let (per_dispatch, _) = workload::steady_block(lights);
+    let (per_dispatch, _) = crate::kernels::shade::steady_block(lights);
     let g = gbuffer::synthetic(w, h, GBufferFormat::Packed);
     let light_data = gbuffer::lights(per_dispatch);
     let work = Workload::upload(gpu, &g, &light_data, None)?;
@@ -160,7 +161,7 @@ pub fn measure(gpu: &Gpu, model: Option<&Model>, lights: u32, shaders: &Shaders)
 /// The verdict on `measure`'s comparisons: an error when one is beyond its tolerance, naming the kernel and
 /// the difference; a warning for one the device's srem explains.
 pub fn verdict(model: Option<&Model>, agreements: &[Agreement]) -> Result<()> {
-    let label = model.map_or_else(|| workload::BASELINE_LABEL.to_string(), Model::label);
+    let label = model.map_or_else(|| crate::model::BASELINE_LABEL.to_string(), Model::label);
     for a in agreements {
         if let Some(n) = a.note() {
             crate::messages::warning_once(format!("{label} ({} kernel): {n}; its cost is reported for the SPIR-V semantics", a.kernel));
@@ -186,8 +187,8 @@ pub fn check(gpu: &Gpu, model: Option<&Model>, lights: u32, shaders: &Shaders) -
 /// `check`, its measurement from the cache: the key covers the host translations (their whole source), the
 /// Vulkan kernels' SPIR-V and constants, the device and its driver, and the comparison's set-up.
 pub fn check_cached(gpu: &Gpu, model: Option<&Model>, lights: u32, shaders: &Shaders) -> Result<Vec<Agreement>> {
-    let (per_dispatch, accumulate) = workload::steady_block(lights);
-    let shade = workload::shade_kernel(model, GBufferFormat::Packed, per_dispatch, accumulate, shaders)?;
+    let (per_dispatch, accumulate) = crate::kernels::shade::steady_block(lights);
+    let shade = crate::kernels::shade::shade_kernel(model, GBufferFormat::Packed, per_dispatch, accumulate, shaders)?;
     let mut key = crate::cache::KeyBuilder::new("agreement")
         .part("brdfprof", env!("CARGO_PKG_VERSION"))
         .part("schema", AGREEMENT_SCHEMA)
@@ -204,7 +205,7 @@ pub fn check_cached(gpu: &Gpu, model: Option<&Model>, lights: u32, shaders: &Sha
             .part("eval-host", prepare::eval_kernel(m, shaders)?.source(super::Dialect::Host));
     }
     let key = key.finish();
-    let label = model.map_or_else(|| workload::BASELINE_LABEL.to_string(), Model::label);
+    let label = model.map_or_else(|| crate::model::BASELINE_LABEL.to_string(), Model::label);
     let what = format!("the check of {label}'s translation");
     let valid = |bytes: &[u8]| serde_json::from_slice::<Vec<Agreement>>(bytes).map(|_| ()).map_err(anyhow::Error::from);
     let bytes = crate::cache::get_or_build(crate::cache::Store::open_default().as_ref(), "agreement", &key, &what, valid, || Ok(serde_json::to_vec(&measure(gpu, model, lights, shaders)?)?))?;

@@ -131,3 +131,34 @@ fn every_docs_page_is_linked_from_readme_and_every_relative_link_leads_somewhere
     }
     assert!(broken.is_empty(), "broken relative links:\n{}", broken.join("\n"));
 }
+
+/// Issue 31 item 10: every environment variable brdfprof reads (a `"BRDFPROF_..."` string in src/ that is
+/// not a macro of the translation's C preludes) is in docs/commands.md's table of them.
+#[test]
+fn every_environment_variable_brdfprof_reads_is_documented() {
+    fn walk(dir: &Path, out: &mut Vec<std::path::PathBuf>) {
+        for e in std::fs::read_dir(dir).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                walk(&p, out);
+            } else {
+                out.push(p);
+            }
+        }
+    }
+    let table = read("docs/commands.md");
+    let mut files = Vec::new();
+    walk(&common::repo_root().join("src"), &mut files);
+    let macros: String = files.iter().filter(|f| f.extension().is_some_and(|x| x == "h")).map(|f| std::fs::read_to_string(f).unwrap()).collect();
+    let mut missing = BTreeSet::new();
+    for f in files.iter().filter(|f| f.extension().is_some_and(|x| x == "rs")) {
+        let text = std::fs::read_to_string(f).unwrap();
+        for (i, _) in text.match_indices("\"BRDFPROF_") {
+            let name: String = text[i + 1..].chars().take_while(|c| c.is_ascii_uppercase() || c.is_ascii_digit() || *c == '_').collect();
+            if !macros.contains(&name) && !table.contains(&format!("| `{name}")) {
+                missing.insert(name);
+            }
+        }
+    }
+    assert!(missing.is_empty(), "not in docs/commands.md's table of environment variables: {missing:?}");
+}

@@ -1,6 +1,6 @@
 //! A self-contained HTML page: sections, sortable tables, SVG charts (scatter, polar, lines) and PNG images as
 //! data: URIs, with its CSS and script inline, so that it opens from file:// with no network. Knows nothing of
-//! BRDFs: `htmlreport` decides what goes in.
+//! BRDFs: `report_page` decides what goes in.
 
 use anyhow::Result;
 use std::fmt::Write;
@@ -316,8 +316,8 @@ pub struct Page {
     sections: Vec<Section>,
 }
 
-const CSS: &str = include_str!("html/page.css");
-const SCRIPT: &str = include_str!("html/page.js");
+const CSS: &str = include_str!("page/page.css");
+const SCRIPT: &str = include_str!("page/page.js");
 
 impl Page {
     pub fn new(title: impl Into<String>) -> Self {

@@ -6,7 +6,7 @@
 use super::{Input, Loaded};
 use crate::brdf::Sample;
 use crate::gpu::Gpu;
-use crate::html::{self, esc, Axis, Curve};
+use crate::page::{self, esc, Axis, Curve};
 use crate::kernels::{self, RunLimits};
 use crate::model::Model;
 use crate::stability::energy;
@@ -107,9 +107,9 @@ fn lobes_svg(values: &[[f32; 3]]) -> String {
     let peak = curves.iter().flat_map(|c| c.points.iter().map(|p| p.1)).filter(|v| v.is_finite()).fold(0.0f64, f64::max);
     let marks: Vec<(f64, String)> = INCIDENCE.iter().map(|t| (-t.to_radians(), format!("L{t}"))).collect();
     let marks: Vec<(f64, &str)> = marks.iter().map(|(a, l)| (*a, l.as_str())).collect();
-    let linear = html::polar_svg(&format!("f_s, linear (peak {})", crate::report::sig(peak, 3)), &curves, &marks, None);
-    let log = html::polar_svg(&format!("f_s, log ({LOG_DECADES} decades below the peak)"), &curves, &marks, Some(LOG_DECADES));
-    let legend: Vec<String> = INCIDENCE.iter().enumerate().map(|(i, t)| format!("<span style=\"color:{}\">&#9632; light at {t}&deg;</span>", html::colour(i))).collect();
+    let linear = page::polar_svg(&format!("f_s, linear (peak {})", crate::results::sig(peak, 3)), &curves, &marks, None);
+    let log = page::polar_svg(&format!("f_s, log ({LOG_DECADES} decades below the peak)"), &curves, &marks, Some(LOG_DECADES));
+    let legend: Vec<String> = INCIDENCE.iter().enumerate().map(|(i, t)| format!("<span style=\"color:{}\">&#9632; light at {t}&deg;</span>", page::colour(i))).collect();
     format!("<figure><div class=\"row\">{linear}{log}</div><figcaption>{}</figcaption></figure>", legend.join(" "))
 }
 
@@ -125,8 +125,8 @@ fn spheres_html(values: &[[f32; 3]], at: &[(usize, usize, f32)]) -> Result<Strin
     }
     let mut s = String::from("<div class=\"row\">");
     for (img, r) in images.iter().zip(SPHERE_ROUGHNESS) {
-        let uri = html::png_data_uri(SPHERE_PX, SPHERE_PX, img)?;
-        let _ = write!(s, "<figure>{}<figcaption>r = {r}</figcaption></figure>", html::img(&uri, SPHERE_PX, SPHERE_PX, 2, &format!("lit sphere, roughness {r}")));
+        let uri = page::png_data_uri(SPHERE_PX, SPHERE_PX, img)?;
+        let _ = write!(s, "<figure>{}<figcaption>r = {r}</figcaption></figure>", page::img(&uri, SPHERE_PX, SPHERE_PX, 2, &format!("lit sphere, roughness {r}")));
     }
     Ok(s + "</div>")
 }
@@ -140,7 +140,7 @@ fn albedo_svg(e: &energy::Energy) -> String {
         .map(|(row, r)| Curve { label: format!("r = {r}"), points: energy::NOV.iter().zip(row).map(|(v, x)| (f64::from(*v), f64::from(*x))).collect() })
         .collect();
     let top = e.max_e.unwrap_or(1.0).max(1.0) * 1.05;
-    html::lines_svg(&curves, Axis { lo: 0.0, hi: 1.0, log: false }, Axis { lo: 0.0, hi: top, log: false }, "NoV", "directional albedo E (F = 1)", html::SMALL)
+    page::lines_svg(&curves, Axis { lo: 0.0, hi: 1.0, log: false }, Axis { lo: 0.0, hi: top, log: false }, "NoV", "directional albedo E (F = 1)", page::SMALL)
 }
 
 /// One model's card.

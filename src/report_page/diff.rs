@@ -6,9 +6,9 @@ use super::sections::num_cell;
 use super::{file_label, Input, Loaded};
 use crate::diff::view::{DiffView, WorstView};
 use crate::gpu::Gpu;
-use crate::html::{esc, img, png_data_uri, Cell, HtmlTable};
+use crate::page::{esc, img, png_data_uri, Cell, HtmlTable};
 use crate::model::Model;
-use crate::report::sig;
+use crate::results::sig;
 use anyhow::Result;
 use std::fmt::Write;
 

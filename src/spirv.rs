@@ -1,4 +1,5 @@
-//! SPIR-V instruction counts of a kernel specialised for one model: spirv-opt sets and freezes the
+//! Reading SPIR-V, below every command that does (inspect counts it, translate and the compile-only targets
+//! start from it, scenes specialise it). Instruction counts of a kernel specialised for one model: spirv-opt sets and freezes the
 //! specialisation constants and removes the branches and functions the model does not run (so the counts are
 //! those of that model alone), optionally followed by the full `spirv-opt -O`. rspirv parses the result and
 //! every instruction inside a function body is counted by class.
@@ -169,8 +170,7 @@ mod tests {
     use super::*;
     use crate::kernels::{constants, embedded};
     use crate::model::Model;
-    use crate::profile::gbuffer::GBufferFormat;
-    use crate::profile::workload::shade_kernel;
+    use crate::kernels::shade::{shade_kernel, GBufferFormat};
 
     fn frozen(model: Option<&str>, lights: u32) -> Vec<u32> {
         let m = model.map(|m| Model::parse(m).unwrap());
