@@ -155,7 +155,7 @@ pub fn glslang_with(source: &Path, defines: &[String], includes: &[&Path], what:
     if !result.status.success() {
         bail!(GlslangError { source: source.to_path_buf(), log: format!("{}{}", String::from_utf8_lossy(&result.stdout), String::from_utf8_lossy(&result.stderr)) });
     }
-    let bytes = std::fs::read(&out).with_context(|| format!("cannot read glslang's output {}", out.display()))?;
+    let bytes = crate::io::read_bounded(&out, crate::compile_limit::MAX_OUTPUT_BYTES as u64).with_context(|| format!("glslang's output {}", out.display()))?;
     Ok(Spirv::from_bytes(&source.display().to_string(), &bytes)?.words.to_vec())
 }
 

@@ -260,7 +260,8 @@ fn read_dumps(dir: &Path) -> Result<BTreeMap<String, u64>> {
     let mut dumps = BTreeMap::new();
     for entry in std::fs::read_dir(dir)? {
         let path = entry?.path();
-        let text = std::fs::read_to_string(&path).with_context(|| format!("cannot read {}", path.display()))?;
+        // A tool's file, read as its output is: a regular file within the launcher's bound.
+        let text = String::from_utf8_lossy(&crate::io::read_bounded(&path, crate::compile_limit::MAX_OUTPUT_BYTES as u64).with_context(|| format!("callgrind's dump {}", path.display()))?).into_owned();
         let dump = parse_dump(&text).with_context(|| format!("{}", path.display()))?;
         if let Some(label) = dump.trigger.as_deref().and_then(|l| l.strip_prefix("Client Request: ")) {
             dumps.insert(label.to_string(), dump.jit_ir());

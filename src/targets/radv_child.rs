@@ -153,7 +153,7 @@ fn raw_report(gpu: &Gpu, shaders: &Shaders, req: &RadvRequest, family: &str, isa
             skipped.push(format!("{} ({e:#})", r.label));
             continue;
         }
-        let bytes = std::fs::read(&r.path).with_context(|| format!("the radv child cannot read {}", r.path.display()))?;
+        let bytes = crate::io::read_bounded(&r.path, crate::compile_limit::MAX_OUTPUT_BYTES as u64).with_context(|| format!("the radv child cannot read {}", r.path.display()))?;
         let words: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes);
         let kernel = Kernel::with_capture(gpu, &r.label, &words, &Default::default(), &crate::gpu::Binding::storage(r.storage_buffers), r.push_bytes, isa_dir.is_some())?;
         let mut row = crate::inspect::Row { model: r.label.clone(), spec: None, stats: Default::default(), notes: Default::default() };
@@ -268,7 +268,7 @@ pub fn run(target: &'static Family, models: &[Model], raw: &[super::RawKernel], 
 /// Writes a file the child wrote under `from` as this process' output under `to`.
 fn publish(file: &Path, from: &Path, to: &Path) -> Result<PathBuf> {
     let rel = file.strip_prefix(from).map_err(|_| anyhow!("the radv child wrote {} outside its ISA directory", file.display()))?;
-    let bytes = std::fs::read(file).with_context(|| format!("cannot read the radv child's {}", file.display()))?;
+    let bytes = crate::io::read_bounded(file, crate::compile_limit::MAX_OUTPUT_BYTES as u64).with_context(|| format!("cannot read the radv child's {}", file.display()))?;
     let path = to.join(rel);
     crate::io::write_output(&path, &bytes)?;
     Ok(path)

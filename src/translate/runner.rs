@@ -132,7 +132,7 @@ fn signal_name(signal: i32) -> String {
 /// The child: reads `DIR/request.json` and the buffers, runs the engine, writes `out-K.bin` and its reply.
 pub fn child_main(dir: &str) -> Result<()> {
     let dir = Path::new(dir);
-    let request: Request = serde_json::from_slice(&std::fs::read(dir.join("request.json")).context("cannot read the request")?)?;
+    let request: Request = serde_json::from_slice(&crate::io::read_bounded(&dir.join("request.json"), 1 << 20).context("cannot read the request")?)?;
     let mut owned = Vec::new();
     for (k, &len) in request.buffers.iter().enumerate() {
         let bytes = crate::io::read_bounded(&dir.join(format!("in-{k}.bin")), len as u64)?;
@@ -145,7 +145,7 @@ pub fn child_main(dir: &str) -> Result<()> {
     let reply = match &request.engine {
         Engine::Host { library } => Reply { flags: run_host(library, &mut buffers, request.groups)?, device: "host".into() },
         Engine::OpenCl { source, options, wanted } => {
-            let text = std::fs::read_to_string(source).context("cannot read the OpenCL source")?;
+            let text = String::from_utf8_lossy(&crate::io::read_bounded(source, crate::io::MAX_INPUT_BYTES).context("cannot read the OpenCL source")?).into_owned();
             let device = run_opencl(&text, options, wanted, request.local_size, &mut buffers, request.groups)?;
             Reply { flags: 0, device }
         }
