@@ -138,9 +138,13 @@ pub fn output_with_input(cmd: &mut Command, input: Vec<u8>, what: &str) -> Resul
 /// and is killed rather than read into memory.
 pub const MAX_OUTPUT_BYTES: usize = 256 << 20;
 
-/// `output` with an explicit limit on top of the compile limit: a tool's version query, a probe.
+/// `output` for a query that answers at once (a tool's version, a probe): the compile limit, at most 30 s.
 pub fn output_quick(cmd: &mut Command, what: &str) -> Result<Output> {
     run(cmd, None, what, limit().min(Duration::from_secs(30)))
+}
+
+fn over_output(what: &str) -> String {
+    format!("{what}: the tool printed more than {} MiB, far more than it prints for any kernel: not its promised output", MAX_OUTPUT_BYTES >> 20)
 }
 
 fn run(cmd: &mut Command, input: Option<Vec<u8>>, what: &str, limit: Duration) -> Result<Output> {
@@ -182,7 +186,7 @@ fn run(cmd: &mut Command, input: Option<Vec<u8>>, what: &str, limit: Duration) -
         if overflow.load(Ordering::SeqCst) {
             let _ = child.kill();
             let _ = child.wait();
-            bail!("{what}: the tool printed more than {} MiB, far more than it prints for any kernel: not its promised output", MAX_OUTPUT_BYTES >> 20);
+            bail!(over_output(what));
         }
         progress.tick(limit);
         std::thread::sleep(Duration::from_millis(10));
@@ -190,7 +194,7 @@ fn run(cmd: &mut Command, input: Option<Vec<u8>>, what: &str, limit: Duration) -
     let (stdout, stderr) = (stdout.join().unwrap_or_default(), stderr.join().unwrap_or_default());
     // A tool cut off at the bound may end (SIGPIPE) before the loop above saw the bound reached.
     if overflow.load(Ordering::SeqCst) {
-        bail!("{what}: the tool printed more than {} MiB, far more than it prints for any kernel: not its promised output", MAX_OUTPUT_BYTES >> 20);
+        bail!(over_output(what));
     }
     if let Some(w) = writer {
         // A compiler that exits without reading all of its input has said why on stderr.

@@ -217,7 +217,7 @@ fn multi_markdown(reports: &[InspectReport], costs: &CostTable, profile_note: Op
 /// A file-name form of a report's device: `radv-navi21`, `nvidia-sm_89`, `llvmpipe`.
 pub fn slug(report: &InspectReport) -> String {
     if let Some(t) = targets::of_report(report) {
-        return t.name().replace(':', "-");
+        return t.slug();
     }
     crate::results::name_slug(report.provenance["device"]["name"].as_str().unwrap_or("device"))
 }

@@ -102,7 +102,7 @@ pub fn inspect(args: &InspectArgs) -> Result<ExitCode> {
     let plan = devices::plan(&args.devices)?;
     // A compile-only target's default name is known now (`devices::slug`); a local device's only once it is open.
     let default_name = match plan.as_slice() {
-        [devices::Planned::Target(t)] => format!("inspect-{}", t.name().replace(':', "-")),
+        [devices::Planned::Target(t)] => format!("inspect-{}", t.slug()),
         [_] => "inspect-<device>".to_string(),
         _ => "inspect-devices".to_string(),
     };

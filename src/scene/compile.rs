@@ -110,6 +110,18 @@ pub fn reports(gpu: &Gpu, work: &SceneWork, p: &ScenePlan, targets: &[Target], v
     }
     let specs = variant_specs(p);
     let translate = targets.iter().any(|t| t.vendor.needs_verification());
+    if translate {
+        // One verdict for a model whatever the path: the checks `inspect` makes of the model's own kernels
+        // (its eval kernel compares values a scene's clamped radiance would hide), once per model, before the
+        // scene kernels' own.
+        let mut checked: Vec<String> = Vec::new();
+        for k in &p.kernels {
+            if !checked.contains(&k.model.canonical()) {
+                verify::check_cached(gpu, Some(&k.model), MODEL_CHECK_LIGHTS, kernels::embedded())?;
+                checked.push(k.model.canonical());
+            }
+        }
+    }
     let raw = specs.iter().map(|v| raw_kernel(gpu, work, p, v, translate)).collect::<Result<Vec<_>>>()?;
     let shaders = crate::shaders::Shaders::embedded();
     let request = targets::Request { models: &[], lights: 1, shaders: &shaders, validate, isa_dir, precise: false, verify_on: Some(gpu) };
@@ -126,14 +138,7 @@ fn raw_kernel(gpu: &Gpu, work: &SceneWork, p: &ScenePlan, v: &VariantSpec, trans
     let mk = model.kernel(KernelKind::Scene, kernels::embedded())?;
     let constants = p.constants(mk.constants, v.switches);
     let spirv = crate::spirv::specialise(&mk.spirv.words, &constants)?;
-    let translation = if translate {
-        // One verdict for a model whatever the path: the checks `inspect` makes of the model's own kernels
-        // (its eval kernel compares values a scene's clamped radiance would hide), then the scene kernel's.
-        crate::translate::verify::check_cached(gpu, Some(&model), MODEL_CHECK_LIGHTS, kernels::embedded())?;
-        Some(checked_translation(gpu, work, p, v, &mk.spirv.words, &constants)?)
-    } else {
-        None
-    };
+    let translation = if translate { Some(checked_translation(gpu, work, p, v, &mk.spirv.words, &constants)?) } else { None };
     Ok(RawKernel { label: v.label.clone(), model, spirv, storage_buffers: STORAGE_BUFFERS, push_bytes: PUSH_BYTES, translation })
 }
 
@@ -144,7 +149,7 @@ fn checked_translation(gpu: &Gpu, work: &SceneWork, p: &ScenePlan, v: &VariantSp
     let (worst, tolerance) = (a.worst, tolerance(p.kernels[v.kernel].model.precision()));
     let srem = verify::srem_explains(&translation, worst, tolerance, |defines| Ok(agreement(gpu, work, p, v, &translation, work.host_inputs(v.kernel)?, defines)?.worst))?;
     if srem {
-        crate::messages::warning(format!("{} (scene kernel): {}; its cost is reported for the SPIR-V semantics", v.label, verify::srem_note(&gpu.info.name, worst)));
+        verify::warn_srem(&v.label, "scene", &gpu.info.name, worst);
     } else if !(worst <= tolerance) {
         bail!(
             "{}: the C translation of the scene kernel disagrees with the Vulkan kernel on {} (worst relative difference {worst:.3e}, tolerance {tolerance:.0e}): its cost is not reported. This is a translator defect; please report it with the scene",

@@ -147,6 +147,11 @@ impl Target {
     pub fn name(&self) -> String {
         format!("{}:{}", self.vendor.prefix(), self.info().name)
     }
+
+    /// `radv-navi21`: the name in file names (`inspect`'s default outputs).
+    pub fn slug(&self) -> String {
+        self.name().replace(':', "-")
+    }
 }
 
 /// `all`, after a prefix: the vendor's default set.

@@ -88,7 +88,7 @@ fn load() -> std::result::Result<Tools, String> {
     let mut cmd = crate::cleanup::command(&nvdisasm.to_string_lossy());
     cmd.arg("--version");
     let out = crate::compile_limit::output_quick(&mut cmd, &format!("{} --version", nvdisasm.display())).map_err(|e| not_installed(&format!("{e:#}")))?;
-    let nvdisasm_version = String::from_utf8_lossy(&out.stdout).lines().last().map(str::to_string).filter(|l| out.status.success() && l.contains("uild")).ok_or_else(|| {
+    let nvdisasm_version = String::from_utf8_lossy(&out.stdout).lines().last().map(str::to_string).filter(|l| out.status.success() && l.starts_with("Build ")).ok_or_else(|| {
         not_installed(&format!("{} --version printed no build line ({}): not NVIDIA's nvdisasm", nvdisasm.display(), out.status))
     })?;
     Ok(Tools { _lib: lib, api, nvdisasm, version, nvdisasm_version })

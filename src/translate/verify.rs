@@ -65,6 +65,11 @@ pub fn srem_explains(t: &super::Translation, worst: f64, tolerance: f64, compare
     Ok(!(worst <= tolerance) && t.body().contains("m_smod(") && compare(&[SMOD_AS_SREM])? <= tolerance)
 }
 
+/// The warning for a kernel whose disagreement `srem_explains` (once per kernel and command).
+pub fn warn_srem(label: &str, kernel: &str, device: &str, worst: f64) {
+    crate::messages::warning_once(format!("{label} ({kernel} kernel): {}; its cost is reported for the SPIR-V semantics", srem_note(device, worst)));
+}
+
 /// What a disagreement that vanishes with `SMOD_AS_SREM` means.
 pub fn srem_note(device: &str, worst: f64) -> String {
     format!(
@@ -163,8 +168,8 @@ pub fn measure(gpu: &Gpu, model: Option<&Model>, lights: u32, shaders: &Shaders)
 pub fn verdict(model: Option<&Model>, agreements: &[Agreement]) -> Result<()> {
     let label = model.map_or_else(|| crate::model::BASELINE_LABEL.to_string(), Model::label);
     for a in agreements {
-        if let Some(n) = a.note() {
-            crate::messages::warning_once(format!("{label} ({} kernel): {n}; its cost is reported for the SPIR-V semantics", a.kernel));
+        if a.srem {
+            warn_srem(&label, &a.kernel, &a.device, a.worst);
             continue;
         }
         if !(a.worst <= a.tolerance) {
