@@ -28,8 +28,8 @@ spv:
 # Re-measure the committed `check` baseline after a deliberate change to the kernels (or to spv/ after a
 # merge): prints the comparison with the old baseline, then replaces it; commit the result.
 BASELINE := results/baseline-llvmpipe.json
-# The compile-only targets' baselines (ACO for navi21 and vangogh, ptxas for sm_89, IGC for gen12lp; no GPU needed) likewise.
-TARGET_BASELINES := radv:navi21 radv:vangogh nvidia:sm_89 intel:gen12lp
+# The compile-only targets' baselines (ACO for navi21 and vangogh, ptxas for sm_89, IGC for gen12lp, ir3 for a660, Bifrost for g52, brw for tgl; no GPU needed) likewise.
+TARGET_BASELINES := radv:navi21 radv:vangogh nvidia:sm_89 intel:gen12lp adreno:a660 mali:g52 anv:tgl
 baseline: build
 	$(BIN) check --baseline $(BASELINE) --save-baseline $(BASELINE); test $$? -le 1
 	for t in $(TARGET_BASELINES); do \

@@ -72,7 +72,7 @@ pub fn inspect_columns(report: &InspectReport, source: &str) -> Vec<CostColumn> 
         out.push(CostColumn {
             name: cost.column_name(),
             unit: format!("{} {} per evaluation ({})", cost.compiler, cost.unit, cost.model),
-            source: format!("{source}{device}, {}", report.provenance["device"]["driver_info"].as_str().unwrap_or("?")),
+            source: format!("{source}{device}, {}", crate::targets::mesa_noop::driver_version(report)),
             gross: cost.rows.iter().map(|r| (r.model.clone(), r.cycles_per_eval)).collect(),
             net: cost.rows.iter().filter_map(|r| r.net_cycles_per_eval.map(|n| (r.model.clone(), n))).collect(),
             net_ci: BTreeMap::new(),

@@ -63,8 +63,8 @@ enum Command {
     Cache(cli::cache::CacheArgs),
     #[command(name = "__callgrind-child", hide = true)]
     CallgrindChild { request: String },
-    #[command(name = "__radv-child", hide = true)]
-    RadvChild { request: String },
+    #[command(name = "__noop-child", hide = true)]
+    NoopChild { request: String },
     #[command(name = "__run-translation", hide = true)]
     RunTranslation { dir: String },
     #[command(name = "__probe-vulkan", hide = true)]
@@ -80,7 +80,7 @@ enum Command {
 fn main() -> ExitCode {
     cli::command_started();
     let cli = Cli::parse();
-    let child = matches!(cli.command, Command::CallgrindChild { .. } | Command::RadvChild { .. } | Command::RunTranslation { .. } | Command::ProbeVulkan);
+    let child = matches!(cli.command, Command::CallgrindChild { .. } | Command::NoopChild { .. } | Command::RunTranslation { .. } | Command::ProbeVulkan);
     if let Err(e) = cli::prepare(child, cli.compile_timeout) {
         return cli::finish(Err(e));
     }
@@ -100,7 +100,7 @@ fn main() -> ExitCode {
         Command::Render(args) => cli::scene::render(&args),
         Command::Cache(args) => cli::cache::cache(&args),
         Command::CallgrindChild { request } => brdfprof::inspect::callgrind::child_main(&request).map(|_| ExitCode::SUCCESS),
-        Command::RadvChild { request } => brdfprof::targets::radv_child::child_main(&request).map(|_| ExitCode::SUCCESS),
+        Command::NoopChild { request } => brdfprof::targets::mesa_noop::child_main(&request).map(|_| ExitCode::SUCCESS),
         Command::RunTranslation { dir } => brdfprof::translate::runner::child_main(&dir).map(|_| ExitCode::SUCCESS),
         Command::ProbeVulkan => brdfprof::targets::radv_env::probe_main().map(|_| ExitCode::SUCCESS),
         Command::GenerateGlsl { dir } => cli::info::generate_glsl(&dir),

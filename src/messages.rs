@@ -4,7 +4,7 @@
 //! interleave) and, while a progress bar is drawn, around it (`ProgressGuard`), so that neither garbles the
 //! other.
 //!
-//! Child processes (`__radv-child`, `__callgrind-child`) parse the same models as their parent, which has
+//! Child processes (`__noop-child`, `__callgrind-child`) parse the same models as their parent, which has
 //! already said what there is to say about them: in a child, `input_warning`/`input_note` print nothing.
 
 use std::fmt::Display;

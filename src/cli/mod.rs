@@ -75,7 +75,7 @@ impl DeviceArgs {
         if let Some(d) = self.device.as_deref().filter(|d| targets::is_compile_only(d)) {
             return Err(compiles_only_error(d));
         }
-        let gpu = Gpu::new(&GpuOptions { device: self.device.clone(), validation: self.validation() })?;
+        let gpu = Gpu::new(&GpuOptions { device: self.device.clone(), validation: self.validation(), ..Default::default() })?;
         if gpu.info.compile_only() && !compile_only_ok {
             return Err(compiles_only_error(&format!("{} ({})", self.device.as_deref().unwrap_or("?"), gpu.info.name)));
         }

@@ -27,6 +27,9 @@ pub struct PipelineExecutable {
     pub representations: Vec<(String, String)>,
 }
 
+/// The executable name of statistics a driver printed on stderr (`GpuOptions::compiler_log`).
+pub const LOGGED_EXECUTABLE: &str = "Compute Shader";
+
 fn text(r: std::result::Result<&CStr, std::ffi::FromBytesUntilNulError>) -> String {
     r.map(|s| s.to_string_lossy().into_owned()).unwrap_or_default()
 }
@@ -47,6 +50,9 @@ fn value(s: &vk::PipelineExecutableStatisticKHR) -> f64 {
 impl Kernel<'_> {
     /// The pipeline's executables, or None when the device lacks VK_KHR_pipeline_executable_properties.
     pub fn executables(&self) -> Result<Option<Vec<PipelineExecutable>>> {
+        if let Some(stats) = &self.logged_stats {
+            return Ok(Some(vec![PipelineExecutable { name: LOGGED_EXECUTABLE.into(), subgroup_size: 0, stats: stats.clone(), representations: Vec::new() }]));
+        }
         let Some(ext) = &self.gpu.executable_properties else { return Ok(None) };
         let info = vk::PipelineInfoKHR::default().pipeline(self.pipeline);
         // SAFETY: the pipeline was created on this device with CAPTURE_STATISTICS (Kernel::new sets it whenever

@@ -89,6 +89,8 @@ pub struct Kernel<'g> {
     pub workgroup: u32,
     /// Created with CAPTURE_INTERNAL_REPRESENTATIONS (`executables` returns them).
     pub(super) captures_ir: bool,
+    /// The statistics the driver printed on stderr while compiling it (`GpuOptions::compiler_log`).
+    pub(super) logged_stats: Option<Vec<super::DriverStat>>,
     /// Whether a dispatch of it was ever recorded (`Commands::first_dispatches`).
     dispatched: std::cell::Cell<bool>,
 }
@@ -153,7 +155,7 @@ impl<'g> Kernel<'g> {
                     flags |= vk::PipelineCreateFlags::CAPTURE_INTERNAL_REPRESENTATIONS_KHR;
                 }
             }
-            let pipeline = create_pipeline(gpu, name, module, layout, &map, &data, flags)?;
+            let (pipeline, logged_stats) = create_logged_pipeline(gpu, name, module, layout, &map, &data, flags)?;
             device.destroy_shader_module(module, None);
             let mut sizes: Vec<vk::DescriptorPoolSize> = Vec::new();
             for b in bindings {
@@ -167,7 +169,7 @@ impl<'g> Kernel<'g> {
                 None,
             )?;
             let captures_ir = capture_ir && gpu.executable_properties.is_some();
-            Ok(Kernel { gpu, name: name.into(), pipeline, layout, set_layout, pool, bindings: bindings.to_vec(), views: Default::default(), push_bytes, workgroup: WORKGROUP, captures_ir, dispatched: Default::default() })
+            Ok(Kernel { gpu, name: name.into(), pipeline, layout, set_layout, pool, bindings: bindings.to_vec(), views: Default::default(), push_bytes, workgroup: WORKGROUP, captures_ir, logged_stats, dispatched: Default::default() })
         }
     }
 
@@ -261,6 +263,19 @@ impl<'g> Kernel<'g> {
 /// The compute pipeline of `module` specialised with `map`/`data`. The driver compiles here (RADV: ACO; lavapipe
 /// only prepares, and compiles at the first dispatch: `Gpu::submit`), in a call that cannot be interrupted: it
 /// runs under the compile limit on a worker thread (`compile_limit::bounded`).
+/// `create_pipeline`, with the statistics the driver printed on stderr meanwhile where it reports them there
+/// (`GpuOptions::compiler_log`).
+fn create_logged_pipeline(gpu: &Gpu, name: &str, module: vk::ShaderModule, layout: vk::PipelineLayout, map: &[vk::SpecializationMapEntry], data: &[u8], flags: vk::PipelineCreateFlags) -> Result<(vk::Pipeline, Option<Vec<super::DriverStat>>)> {
+    let Some(read) = gpu.compiler_log else { return Ok((create_pipeline(gpu, name, module, layout, map, data, flags)?, None)) };
+    let (pipeline, log) = super::stderr_capture::capture(|| create_pipeline(gpu, name, module, layout, map, data, flags))?;
+    let pipeline = pipeline?;
+    let read = read(&log).with_context(|| format!("{name}: the statistics {} printed while compiling it", gpu.info.name));
+    // SAFETY: the pipeline was just created on this device and nothing uses it.
+    let (stats, rest) = read.inspect_err(|_| unsafe { gpu.device.destroy_pipeline(pipeline, None) })?;
+    super::stderr_capture::pass_on(&rest);
+    Ok((pipeline, Some(stats)))
+}
+
 fn create_pipeline(gpu: &Gpu, name: &str, module: vk::ShaderModule, layout: vk::PipelineLayout, map: &[vk::SpecializationMapEntry], data: &[u8], flags: vk::PipelineCreateFlags) -> Result<vk::Pipeline> {
     let device = &gpu.device;
     let what = format!("{name} (pipeline creation on {})", gpu.info.name);

@@ -4,9 +4,10 @@
 mod driver_stats;
 mod kernel;
 mod memory;
+mod stderr_capture;
 mod timing;
 
-pub use driver_stats::{DriverStat, PipelineExecutable};
+pub use driver_stats::{DriverStat, PipelineExecutable, LOGGED_EXECUTABLE};
 pub use kernel::{Binding, Bindings, ChunkPlan, Kernel, SpecConstants, WORKGROUP};
 pub use memory::{Buffer, MemoryKind};
 pub use timing::Timestamps;
@@ -38,6 +39,22 @@ pub struct GpuOptions {
     pub device: Option<String>,
     /// Enable the Khronos validation layer and record every message it reports.
     pub validation: bool,
+    /// A driver that prints its compiler's statistics on stderr instead of VK_KHR_pipeline_executable_properties
+    /// (PanVK with BIFROST_MESA_DEBUG=shaderdb): what each pipeline creation writes there is captured and read
+    /// into statistics by this function (`Kernel::executables`).
+    pub compiler_log: Option<CompilerLog>,
+}
+
+/// Reads a driver's stderr output of one pipeline creation into its statistics (executable "Compute Shader")
+/// and the lines that are not its statistics (they go on to the real stderr).
+pub type CompilerLog = fn(&str) -> Result<(Vec<DriverStat>, Vec<String>)>;
+
+/// Set in a process whose Vulkan devices are drivers on Mesa's noop kernel shims (`targets::mesa_noop`'s child).
+static COMPILE_ONLY_PROCESS: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// Every device of this process compiles only: nothing is ever submitted, timed or read back.
+pub fn mark_compile_only_process() {
+    COMPILE_ONLY_PROCESS.store(true, std::sync::atomic::Ordering::Relaxed);
 }
 
 /// What `brdfprof devices` lists, and what every report records about the device it measured.
@@ -82,9 +99,10 @@ impl DeviceInfo {
     }
 
     /// A device that compiles pipelines but cannot execute them: RADV's "Null hardware" device
-    /// (RADV_FORCE_FAMILY), whose timestampPeriod is not even finite.
+    /// (RADV_FORCE_FAMILY), whose timestampPeriod is not even finite, and every device of a process that runs a
+    /// Mesa driver on a noop kernel shim (`mark_compile_only_process`), whose submissions execute nothing.
     pub fn compile_only(&self) -> bool {
-        self.name.starts_with("Null hardware") || !self.timestamp_period.is_finite()
+        self.name.starts_with("Null hardware") || !self.timestamp_period.is_finite() || COMPILE_ONLY_PROCESS.load(std::sync::atomic::Ordering::Relaxed)
     }
 }
 
@@ -100,6 +118,7 @@ pub struct Gpu {
     pub info: DeviceInfo,
     pub device: ash::Device,
     pub(crate) executable_properties: Option<ash::khr::pipeline_executable_properties::Device>,
+    pub(crate) compiler_log: Option<CompilerLog>,
     queue: vk::Queue,
     command_pool: vk::CommandPool,
     memory_properties: vk::PhysicalDeviceMemoryProperties,
@@ -168,13 +187,20 @@ fn describe(instance: &ash::Instance, index: usize, pd: vk::PhysicalDevice) -> D
     unsafe {
         let props = instance.get_physical_device_properties(pd);
         let mut driver = vk::PhysicalDeviceDriverProperties::default();
-        let mut maint3 = vk::PhysicalDeviceMaintenance3Properties::default();
-        let mut props2 = vk::PhysicalDeviceProperties2::default().push_next(&mut driver).push_next(&mut maint3);
-        instance.get_physical_device_properties2(pd, &mut props2);
+        // Vulkan 1.1's guaranteed minimum, for a Vulkan 1.0 device (PanVK 22.3), which cannot state it.
+        let mut maint3 = vk::PhysicalDeviceMaintenance3Properties { max_memory_allocation_size: 1 << 30, ..Default::default() };
         let mut f16 = vk::PhysicalDeviceShaderFloat16Int8Features::default();
-        let mut features2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut f16);
-        instance.get_physical_device_features2(pd, &mut features2);
-        let shader_float64 = features2.features.shader_float64 == vk::TRUE;
+        let features = if vk::api_version_minor(props.api_version) >= 1 || vk::api_version_major(props.api_version) > 1 {
+            let mut props2 = vk::PhysicalDeviceProperties2::default().push_next(&mut driver).push_next(&mut maint3);
+            instance.get_physical_device_properties2(pd, &mut props2);
+            let mut features2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut f16);
+            instance.get_physical_device_features2(pd, &mut features2);
+            features2.features
+        } else {
+            // The *2 queries are Vulkan 1.1's: a 1.0 device has neither driver properties nor fp16 arithmetic here.
+            instance.get_physical_device_features(pd)
+        };
+        let shader_float64 = features.shader_float64 == vk::TRUE;
         let shader_float16 = f16.shader_float16 == vk::TRUE;
         let extensions = instance.enumerate_device_extension_properties(pd).unwrap_or_default();
         let has_ext = |name: &CStr| extensions.iter().any(|e| e.extension_name_as_c_str() == Ok(name));
@@ -378,6 +404,7 @@ impl Gpu {
             info,
             device,
             executable_properties,
+            compiler_log: options.compiler_log,
             queue,
             command_pool,
             memory_properties,
@@ -392,6 +419,12 @@ impl Gpu {
         let props = unsafe { self.instance.get_physical_device_format_properties(self.physical, format) };
         let wanted = if storage { vk::FormatFeatureFlags::STORAGE_TEXEL_BUFFER } else { vk::FormatFeatureFlags::UNIFORM_TEXEL_BUFFER };
         props.buffer_features.contains(wanted)
+    }
+
+    /// Whether its pipelines report compiler statistics (`Kernel::executables`): through
+    /// VK_KHR_pipeline_executable_properties or on stderr (`GpuOptions::compiler_log`).
+    pub fn reports_statistics(&self) -> bool {
+        self.executable_properties.is_some() || self.compiler_log.is_some()
     }
 
     pub fn validation_messages(&self) -> Vec<String> {

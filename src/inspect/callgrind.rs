@@ -116,7 +116,7 @@ pub fn child_main(request_json: &str) -> Result<()> {
         Some(dir) => Shaders::from_glsl(dir)?,
         None => Shaders::embedded(),
     };
-    let gpu = Gpu::new(&GpuOptions { device: req.device.clone(), validation: req.validate })?;
+    let gpu = Gpu::new(&GpuOptions { device: req.device.clone(), validation: req.validate, ..Default::default() })?;
     let work = Workload::upload(&gpu, &gbuffer::synthetic(req.width, req.height, GBufferFormat::Packed), &gbuffer::lights(req.lights), None)?;
     let mut all: Vec<Option<&Model>> = models.iter().map(Some).collect();
     all.push(None);

@@ -19,6 +19,9 @@ pub struct CostRow {
     pub cycles_per_eval: f64,
     /// The same minus the memory-only kernel's (None for that kernel).
     pub net_cycles_per_eval: Option<f64>,
+    /// The pipe that binds the net figure, where the vendor's rule is a bound over pipes (Mali's Bifrost).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bound: Option<String>,
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
@@ -57,7 +60,7 @@ pub fn table(report: &InspectReport, header: TargetCost, cycles: impl Fn(&std::c
     for r in &report.rows {
         let Some(c) = cycles(&r.stats, lights) else { continue };
         let stats = t.columns.iter().map(|name| (name.clone(), driver_stat(&r.stats, name).unwrap_or(0.0))).collect();
-        t.rows.push(CostRow { model: r.model.clone(), stats, cycles_per_eval: c, net_cycles_per_eval: None });
+        t.rows.push(CostRow { model: r.model.clone(), stats, cycles_per_eval: c, net_cycles_per_eval: None, bound: None });
     }
     if t.rows.is_empty() {
         return None;
@@ -100,6 +103,10 @@ impl TargetCost {
         let mut headers: Vec<String> = vec!["model".into()];
         headers.extend(self.columns.iter().cloned());
         headers.extend(["cycles/eval".into(), "net cycles/eval".into(), "net vs ggx".into()]);
+        let bound = self.rows.iter().any(|r| r.bound.is_some());
+        if bound {
+            headers.push("bound by".into());
+        }
         let mut t = Table::new(headers);
         let reference = self.row(crate::brdf::spec::REFERENCE_MODEL).and_then(|r| r.net_cycles_per_eval);
         for r in &self.rows {
@@ -111,6 +118,9 @@ impl TargetCost {
                 (Some(v), Some(g)) if g > 0.0 => format!("{:.2}", v / g),
                 _ => "-".into(),
             });
+            if bound {
+                cells.push(r.bound.clone().unwrap_or_else(|| "-".into()));
+            }
             t.row(cells);
         }
         let mut out = format!("### {} statistics, {} ({} lights per kernel; {}; {})\n\n{}", self.compiler, self.label(), self.lights_per_kernel, self.model, self.unit, t.markdown());

@@ -38,6 +38,17 @@ pub fn stats(all: &[DriverStat]) -> Vec<(String, f64)> {
     out
 }
 
+/// A pipeline's statistics as row keys (`stats`), with the wave size the driver compiled for
+/// (VkPipelineExecutablePropertiesKHR::subgroupSize) where it states one.
+pub fn executable_stats(executables: Vec<crate::gpu::PipelineExecutable>) -> Vec<(String, f64)> {
+    let mut out = Vec::new();
+    if let Some(size) = executables.iter().map(|e| e.subgroup_size).max().filter(|s| *s > 0) {
+        out.push((SUBGROUP_SIZE.to_string(), f64::from(size)));
+    }
+    out.extend(stats(&executables.into_iter().flat_map(|e| e.stats).collect::<Vec<_>>()));
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

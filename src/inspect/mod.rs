@@ -101,17 +101,12 @@ fn static_stats(kernel: &ModelKernel, naga_kernel: &ModelKernel, row: &mut Row) 
 
 /// Driver statistics of the kernel's pipeline, where the device reports them.
 fn driver_stats(gpu: &Gpu, kernel: &ModelKernel, row: &mut Row) -> Result<()> {
-    if !gpu.info.pipeline_executable_properties {
+    if !gpu.reports_statistics() {
         return Ok(());
     }
     let pipeline = crate::gpu::Kernel::new(gpu, &kernel.spirv.name, &kernel.spirv.words, &kernel.constants, &shade::bindings(GBufferFormat::Packed), shade::PUSH_BYTES)?;
     if let Some(executables) = pipeline.executables()? {
-        // The wave size the driver compiled for (VkPipelineExecutablePropertiesKHR::subgroupSize).
-        if let Some(size) = executables.iter().map(|e| e.subgroup_size).max().filter(|s| *s > 0) {
-            row.stats.insert(driver::SUBGROUP_SIZE.into(), f64::from(size));
-        }
-        let stats: Vec<_> = executables.into_iter().flat_map(|e| e.stats).collect();
-        row.stats.extend(driver::stats(&stats));
+        row.stats.extend(driver::executable_stats(executables));
     }
     Ok(())
 }
@@ -227,7 +222,7 @@ pub fn run(gpu: &Gpu, shaders: &Shaders, options: &InspectOptions) -> Result<Ins
     let mut rows = kernels_of(&options.models).into_iter().map(|model| kernel_row(gpu, shaders, model, options.lights)).collect::<Result<Vec<_>>>()?;
     let mut emitted = emitted_keys(&mut rows);
     let mut section_notes = BTreeMap::new();
-    if !gpu.info.pipeline_executable_properties {
+    if !gpu.reports_statistics() {
         section_notes.insert(
             "driver/".into(),
             format!("not available on this device ({} has no VK_KHR_pipeline_executable_properties)", gpu.info.name),

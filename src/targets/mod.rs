@@ -1,6 +1,8 @@
 //! Compile-only targets: GPU families whose production compiler brdfprof runs without the GPU, one `Vendor`
 //! each (`radv`: Mesa RADV's ACO in a child process; `nvidia`: NVRTC and ptxas on the kernels' CUDA C++
-//! translation; `intel`: IGC through ocloc on their OpenCL C translation), listed once in `VENDORS`. A target is `--device PREFIX:FAMILY` (or `PREFIX:all`, or
+//! translation; `intel`: IGC through ocloc on their OpenCL C translation; `adreno`, `mali`, `anv`: Mesa's
+//! Turnip, PanVK and ANV on Mesa's noop drm-shims, in child processes like RADV's, `mesa_noop`), listed once
+//! in `VENDORS`. A target is `--device PREFIX:FAMILY` (or `PREFIX:all`, or
 //! `PREFIX:a,b`); `devices --targets`, `inspect`, `check`, `sweep --cost-device`, `profile --scene --cost-device` and `compare` reach the vendors
 //! only through this module: a vendor is its families, how it compiles every kernel for them (an `inspect`
 //! report per family, with its compiler's statistics under `driver/`), its cost model (`cost`), and what its
@@ -12,10 +14,14 @@ pub mod intel;
 pub mod nvidia;
 pub mod nvrtc;
 pub mod ocloc;
+pub mod adreno;
+pub mod anv;
+pub mod mali;
+pub mod mesa_noop;
 pub mod radv;
-pub mod radv_child;
 pub mod radv_env;
 pub mod radv_families;
+pub mod shim;
 
 use crate::gpu::Gpu;
 use crate::inspect::InspectReport;
@@ -114,10 +120,14 @@ pub trait Vendor: Sync {
     fn family_of(&self, report: &InspectReport) -> Option<usize>;
     /// What the report's compiler statistics depend on: the gate compares them only where this is the same.
     fn fingerprint(&self, report: &InspectReport) -> BTreeMap<String, String>;
+    /// The vendor as a Mesa driver on a compile-only device in a child process (`mesa_noop`), if it is one.
+    fn noop(&self) -> Option<&dyn mesa_noop::NoopDriver> {
+        None
+    }
 }
 
 /// Every vendor: the one list (a new compiler lands here and in its own file).
-pub static VENDORS: [&dyn Vendor; 3] = [&radv::RADV, &nvidia::NVIDIA, &intel::INTEL];
+pub static VENDORS: [&dyn Vendor; 6] = [&radv::RADV, &nvidia::NVIDIA, &intel::INTEL, &adreno::ADRENO, &mali::MALI, &anv::ANV];
 
 /// One family of one vendor.
 #[derive(Clone, Copy)]

@@ -2,7 +2,7 @@
 //! without an AMD GPU. With `RADV_FORCE_FAMILY=<family>` in the environment before the Vulkan loader starts,
 //! RADV offers a "Null hardware (RADV <FAMILY>)" device: it has no queue that executes anything, but pipeline
 //! creation runs ACO for that family and VK_KHR_pipeline_executable_properties returns ACO's statistics.
-//! brdfprof runs itself as a child with the variable set (`radv_child`), so neither the user's environment
+//! brdfprof runs itself as a child with the variable set (`mesa_noop`), so neither the user's environment
 //! nor the parent's devices change.
 //!
 //! ACO's cost model (`aco_statistics.cpp`): Latency, "issue cycles plus stall cycles" of one wave, and Inverse
@@ -12,8 +12,9 @@
 //! `Inverse Throughput / (64 x lights per kernel)` SIMD cycles.
 
 use super::cost::{self, TargetCost};
-use super::{Request, Run, Target};
-use super::radv_families::{family_of_device, Family, FAMILIES};
+use super::mesa_noop::{self, NoopDriver};
+use super::{Request, Run};
+use super::radv_families::{family_of_device, null_device_name, FAMILIES, FORCE_FAMILY_VAR};
 use crate::inspect::InspectReport;
 use anyhow::Result;
 use std::collections::BTreeMap;
@@ -26,26 +27,6 @@ pub const SHOWN: [&str; 7] = ["Instructions", "VGPRs", "SGPRs", "Spilled VGPRs",
 
 pub struct Radv;
 pub static RADV: Radv = Radv;
-
-impl Radv {
-    /// One child per family compiling the models (or, when given, the raw kernels instead).
-    fn children(&self, families: &[usize], raw: &[super::RawKernel], request: &Request) -> Result<Vec<Run>> {
-        let targets: Vec<&'static Family> = families.iter().map(|&k| &FAMILIES[k]).collect();
-        let runs = super::radv_child::run_all(&targets, request.models, raw, request.lights, request.shaders, request.validate, request.isa_dir)?;
-        Ok(runs
-            .into_iter()
-            .zip(families)
-            .map(|(run, &family)| {
-                let mut report = run.report;
-                if let Some(note) = &run.teardown_note {
-                    report.section_notes.insert("driver/".into(), note.clone());
-                }
-                report.cost = super::Vendor::cost(self, &report);
-                Run { target: Target { vendor: &RADV, family }, report, isa_files: run.isa_files, note: run.teardown_note }
-            })
-            .collect())
-    }
-}
 
 fn device_name(report: &InspectReport) -> &str {
     report.provenance["device"]["name"].as_str().unwrap_or("?")
@@ -77,14 +58,14 @@ impl super::Vendor for Radv {
     }
 
     fn compile(&self, families: &[usize], request: &Request) -> Result<Vec<Run>> {
-        self.children(families, &[], request)
+        mesa_noop::compile("radv", families, &[], request)
     }
 
     fn compile_raw(&self, families: &[usize], kernels: &[super::RawKernel], request: &Request) -> Result<Vec<Run>> {
         if kernels.is_empty() {
             anyhow::bail!("radv: no raw kernel to compile");
         }
-        self.children(families, kernels, request)
+        mesa_noop::compile("radv", families, kernels, request)
     }
 
     fn cost(&self, report: &InspectReport) -> Option<TargetCost> {
@@ -111,9 +92,36 @@ impl super::Vendor for Radv {
 
     fn fingerprint(&self, report: &InspectReport) -> BTreeMap<String, String> {
         // ACO's output depends on the family (the device) and the Mesa version alone, not on the host.
-        let p = &report.provenance;
-        let mesa = p["mesa_version"].as_str().or_else(|| p["device"]["driver_info"].as_str()).unwrap_or("?");
-        [("device".to_string(), device_name(report).to_string()), ("mesa".to_string(), mesa.to_string())].into()
+        mesa_noop::fingerprint(report)
+    }
+
+    fn noop(&self) -> Option<&dyn NoopDriver> {
+        Some(self)
+    }
+}
+
+impl NoopDriver for Radv {
+    fn compiler(&self) -> &'static str {
+        "ACO"
+    }
+
+    fn environment(&self, family: usize) -> Result<Vec<(String, String)>> {
+        Ok(vec![(FORCE_FAMILY_VAR.to_string(), FAMILIES[family].family.to_string())])
+    }
+
+    fn isa_folder(&self, family: usize) -> String {
+        // RADV's listings were DIR/<family>/ before other drivers joined it.
+        FAMILIES[family].family.to_string()
+    }
+
+    fn device(&self, family: usize) -> Option<String> {
+        Some(null_device_name(&FAMILIES[family]))
+    }
+
+    fn install_hint(&self) -> String {
+        "Is Mesa's AMD Vulkan driver installed? On Debian/Ubuntu as root: `apt-get install mesa-vulkan-drivers` (it ships \
+         /usr/share/vulkan/icd.d/radeon_icd.*.json), or run `make setup`"
+            .into()
     }
 }
 

@@ -28,3 +28,4 @@ mod report;
 mod signals;
 mod translation_faults;
 mod compile_only;
+mod mesa_shims;

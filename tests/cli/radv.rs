@@ -154,7 +154,7 @@ fn a_child_that_crashes_after_its_report_still_gives_the_report_and_exit_0() {
     let json = dir.path().join("r.json");
     let out = common::brdfprof()
         .args(["inspect", "--no-callgrind", "--model", "ggx", "--device", "radv:navi21", "--json", json.to_str().unwrap(), "--markdown", dir.path().join("r.md").to_str().unwrap()])
-        .env(brdfprof::targets::radv_child::CRASH_AFTER_REPLY, "1")
+        .env(brdfprof::targets::mesa_noop::CRASH_AFTER_REPLY, "1")
         .output()
         .unwrap();
     let stderr = String::from_utf8_lossy(&out.stderr);
@@ -196,5 +196,5 @@ fn a_family_without_fp16_leaves_out_the_fp16_models_and_says_why() {
     let models: Vec<&str> = report["rows"].as_array().unwrap().iter().map(|r| r["model"].as_str().unwrap()).collect();
     assert_eq!(models, ["ggx", "baseline"]);
     let note = report["section_notes"]["driver/"].as_str().unwrap();
-    assert!(note.contains("not compiled for tahiti: ggx,precision=f16") && note.contains("shaderFloat16"), "{note}");
+    assert!(note.contains("not compiled for radv:tahiti: ggx,precision=f16") && note.contains("shaderFloat16"), "{note}");
 }

@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 pub fn gpu() -> Gpu {
-    Gpu::new(&GpuOptions { device: std::env::var("BRDFPROF_TEST_DEVICE").ok(), validation: true })
+    Gpu::new(&GpuOptions { device: std::env::var("BRDFPROF_TEST_DEVICE").ok(), validation: true, ..Default::default() })
         .expect("a Vulkan device with the validation layer (run `make setup`)")
 }
 

@@ -1,5 +1,5 @@
 //! The commands that time kernels or count their instructions under callgrind: profile, inspect and the check
-//! gates (lavapipe's, ACO's, NVIDIA's and Intel's). They run one at a time (`serial`), so that no timing shares the two
+//! gates (lavapipe's, the Mesa drivers' (ACO, ir3, Bifrost, brw), NVIDIA's and Intel's). They run one at a time (`serial`), so that no timing shares the two
 //! cores with another measurement.
 //!
 //! What goes here: a test whose figure is a time, a callgrind count or a gate verdict on them, or that would
@@ -9,7 +9,7 @@
 #[path = "../common/mod.rs"]
 mod common;
 
-mod aco_gate;
+mod mesa_gate;
 mod check_gate;
 mod inspect;
 mod profile;

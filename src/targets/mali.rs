@@ -1,0 +1,155 @@
+//! `--device mali:FAMILY`: Arm Mali Bifrost through Mesa's PanVK driver on the panfrost noop drm-shim
+//! (`PAN_GPU_ID`). PanVK 22.3 is marked non-conformant (it needs PAN_I_WANT_A_BROKEN_VULKAN_DRIVER=1); its
+//! shader compiler is Panfrost's Bifrost backend, the production one Panfrost's OpenGL ES driver uses. PanVK
+//! has no VK_KHR_pipeline_executable_properties: with BIFROST_MESA_DEBUG=shaderdb the compiler prints one
+//! `SHADER-DB:` line per shader on stderr, which the child captures for each pipeline (`gpu::GpuOptions::
+//! compiler_log`) and reads here.
+//!
+//! The cost is the compiler's own (`bi_print_stats` in src/panfrost/bifrost/bifrost_compile.c, Mesa 22.3):
+//! per-pipe cycles per thread, normalised to 24 arithmetic tuples, 2 texture messages, 16 16-bit varying
+//! channels and 1 load/store message per cycle ("seem to match Arm Mobile Studio's heuristic"), with the bound
+//! the busiest pipe, the shape of Arm's Mali Offline Compiler report. They count the program's instructions
+//! once each: a loop's body is counted once, a branch's two sides both. `cycles/eval = bound / lights per
+//! kernel`; the net figure is the pipe-parallel bound of the work the BRDF adds, `max over pipes of (kernel's
+//! pipe - memory-only kernel's pipe) / lights`, with the pipe that binds it named: a max of pipes does not
+//! subtract, so the bound of the memory-only kernel (load/store) is not taken from the BRDF's (arithmetic).
+
+use super::cost::{self, TargetCost};
+use super::shim::{Shim, ShimFamily};
+use crate::gpu::DriverStat;
+use crate::inspect::InspectReport;
+use crate::model::BASELINE_LABEL;
+use anyhow::{anyhow, bail, Result};
+
+/// The prefix of the compiler's statistics lines (`fprintf(stderr, "SHADER-DB: %s\n", ...)`).
+const LINE_PREFIX: &str = "SHADER-DB: ";
+
+/// bi_print_stats' fields (its word after each number) and the statistic names brdfprof gives them.
+const FIELDS: [(&str, &str); 12] = [
+    ("inst", "Instructions"),
+    ("tuples", "Tuples"),
+    ("clauses", "Clauses"),
+    ("cycles", "Bound cycles"),
+    ("arith", "Arithmetic cycles"),
+    ("texture", "Texture cycles"),
+    ("vary", "Varying cycles"),
+    ("ldst", "Load-store cycles"),
+    ("quadwords", "Quadwords"),
+    ("threads", "Threads"),
+    ("preloads", "Preloads"),
+    ("loops", "Loops"),
+];
+
+/// The per-pipe cycles and the pipe each names.
+const PIPES: [(&str, &str); 4] = [("Arithmetic cycles", "arithmetic"), ("Texture cycles", "texture"), ("Varying cycles", "varying"), ("Load-store cycles", "load/store")];
+
+/// The statistics shown beside cycles/eval.
+const SHOWN: [&str; 7] = ["Instructions", "Tuples", "Clauses", "Arithmetic cycles", "Load-store cycles", "Bound cycles", "Threads"];
+
+pub static MALI: Shim = Shim {
+    prefix: "mali",
+    vendor: "Arm",
+    title: "Arm Mali: Mesa's PanVK driver (Panfrost's Bifrost compiler) on the panfrost noop drm-shim, in a child process (it compiles, nothing executes)",
+    driver: "PanVK",
+    compiler: "Bifrost",
+    icd: "src/panfrost/vulkan/panfrost_devenv_icd.x86_64.json",
+    shim: "src/panfrost/drm-shim/libpanfrost_noop_drm_shim.so",
+    gpu_var: "PAN_GPU_ID",
+    extra_env: &[("PAN_I_WANT_A_BROKEN_VULKAN_DRIVER", "1"), ("BIFROST_MESA_DEBUG", "shaderdb")],
+    // G72 (0x6221), G76 (0x7211) and G31 (0x7093) gave the same figures as G52 for every kernel
+    // (docs/targets.md): one Bifrost family is listed.
+    families: &[ShimFamily { name: "g52", gpu_id: "0x7212", architecture: "Bifrost (v7)", products: "Mali-G52 (Rockchip RK3566/RK3568, Amlogic S922X)", detail: "PAN_GPU_ID=0x7212, Bifrost v7", default: true }],
+    cost: cost_table,
+    noise: &[],
+    without_validation: Some("PanVK 22.3 is a Vulkan 1.0 driver, and brdfprof's kernels are SPIR-V 1.3 (Vulkan 1.1), which the layer refuses on a 1.0 device; the driver compiles them (Mesa's SPIR-V front end reads any version), so its figures stand, unvalidated"),
+    compiler_log: Some(read_shaderdb),
+};
+
+/// One pipeline's stderr: its compute shader's `SHADER-DB:` line as statistics, the other lines passed on.
+pub fn read_shaderdb(log: &str) -> Result<(Vec<DriverStat>, Vec<String>)> {
+    let (lines, rest): (Vec<&str>, Vec<&str>) = log.lines().partition(|l| l.starts_with(LINE_PREFIX));
+    let compute: Vec<&str> = lines.iter().filter_map(|l| l[LINE_PREFIX.len()..].strip_prefix("MESA_SHADER_COMPUTE shader: ")).collect();
+    let line = match compute.as_slice() {
+        [one] => *one,
+        [] => bail!("the Bifrost compiler printed no `SHADER-DB: MESA_SHADER_COMPUTE` line (is BIFROST_MESA_DEBUG=shaderdb reaching the driver?)"),
+        many => bail!("the Bifrost compiler printed {} compute-shader statistics lines for one pipeline", many.len()),
+    };
+    let mut stats = Vec::new();
+    let mut stat = |name: &str, value: f64| stats.push(DriverStat { executable: crate::gpu::LOGGED_EXECUTABLE.into(), name: name.into(), description: format!("Bifrost compiler (bi_print_stats): {name}"), value });
+    for field in line.split(", ") {
+        let (number, word) = field.trim().split_once(' ').ok_or_else(|| anyhow!("unreadable field `{field}` in `{line}`"))?;
+        if word == "spills:fills" {
+            let (spills, fills) = number.split_once(':').ok_or_else(|| anyhow!("unreadable spills:fills `{number}` in `{line}`"))?;
+            stat("Spills", spills.parse()?);
+            stat("Fills", fills.parse()?);
+            continue;
+        }
+        let name = FIELDS.iter().find(|(w, _)| *w == word).map(|(_, n)| *n).ok_or_else(|| anyhow!("unknown field `{word}` in `{line}`"))?;
+        stat(name, number.parse().map_err(|e| anyhow!("`{number}` in `{line}`: {e}"))?);
+    }
+    Ok((stats, rest.into_iter().map(str::to_string).collect()))
+}
+
+fn cost_table(shim: &Shim, family: &ShimFamily, report: &InspectReport) -> Option<TargetCost> {
+    let rule = "cycles/eval = Bifrost's bound (max of its arithmetic, texture, varying and load/store cycles per thread, bi_print_stats) / lights per kernel; net = max over pipes of (kernel - memory-only kernel) / lights, the binding pipe named";
+    let mut t = cost::table(report, shim.header(family, report, rule.into(), "Bifrost cycles per thread", &SHOWN), |stats, lights| cost::driver_stat(stats, "Bound cycles").map(|c| c / f64::from(lights)))?;
+    let pipes = |model: &str| -> Option<Vec<f64>> {
+        let row = report.rows.iter().find(|r| r.model == model)?;
+        PIPES.iter().map(|(name, _)| cost::driver_stat(&row.stats, name)).collect()
+    };
+    let base = pipes(BASELINE_LABEL);
+    let lights = f64::from(t.lights_per_kernel);
+    for r in t.rows.iter_mut().filter(|r| r.model != BASELINE_LABEL) {
+        let (Some(base), Some(mine)) = (&base, pipes(&r.model)) else {
+            r.net_cycles_per_eval = None;
+            continue;
+        };
+        let (k, net) = mine.iter().zip(base).map(|(m, b)| m - b).enumerate().fold((0, f64::NEG_INFINITY), |best, (k, v)| if v > best.1 { (k, v) } else { best });
+        r.net_cycles_per_eval = Some(net / lights);
+        r.bound = Some(PIPES[k].1.to_string());
+    }
+    Some(t)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::inspect::Row;
+
+    const GGX: &str = "SHADER-DB: MESA_SHADER_COMPUTE shader: 174 inst, 145 tuples, 23 clauses, 8.000000 cycles, 5.750000 arith, 0.000000 texture, 0.000000 vary, 8.000000 ldst, 121 quadwords, 2 threads, 3 preloads, 0 loops, 1:2 spills:fills";
+
+    #[test]
+    fn reads_the_compute_line_and_passes_the_rest_on() {
+        let (stats, rest) = read_shaderdb(&format!("drm-shim: hello\n{GGX}\n")).unwrap();
+        let get = |n: &str| stats.iter().find(|s| s.name == n).map(|s| s.value);
+        assert_eq!((get("Instructions"), get("Arithmetic cycles"), get("Load-store cycles"), get("Bound cycles")), (Some(174.0), Some(5.75), Some(8.0), Some(8.0)));
+        assert_eq!((get("Spills"), get("Fills"), get("Preloads")), (Some(1.0), Some(2.0), Some(3.0)));
+        assert_eq!(rest, vec!["drm-shim: hello".to_string()]);
+        assert!(read_shaderdb("nothing here").unwrap_err().to_string().contains("no `SHADER-DB"));
+        assert!(read_shaderdb(&format!("{GGX}\n{GGX}")).unwrap_err().to_string().contains("2 compute-shader"));
+        assert!(read_shaderdb(&GGX.replace("tuples", "tupels")).unwrap_err().to_string().contains("unknown field `tupels`"));
+    }
+
+    #[test]
+    fn net_is_the_bound_of_the_added_work_per_pipe() {
+        let row = |model: &str, arith: f64, ldst: f64| Row {
+            model: model.into(),
+            spec: None,
+            stats: [("Arithmetic cycles", arith), ("Texture cycles", 0.0), ("Varying cycles", 0.0), ("Load-store cycles", ldst), ("Bound cycles", arith.max(ldst))]
+                .into_iter()
+                .map(|(k, v)| (format!("driver/Compute Shader/{k}"), v))
+                .collect(),
+            notes: Default::default(),
+        };
+        let mut report = crate::inspect::tests::empty_report("Mali-G52 (Panfrost)");
+        report.provenance["target"] = "mali:g52".into();
+        report.rows = vec![row("ggx", 5.75, 8.0), row(BASELINE_LABEL, 1.5, 8.0)];
+        let t = super::super::Vendor::cost(&MALI, &report).unwrap();
+        let lights = f64::from(t.lights_per_kernel);
+        assert_eq!(t.rows[0].cycles_per_eval, 8.0 / lights);
+        // The bounds (8 and 8) would subtract to nothing; the arithmetic the BRDF adds is 4.25.
+        assert_eq!(t.rows[0].net_cycles_per_eval, Some(4.25 / lights));
+        assert_eq!(t.rows[0].bound.as_deref(), Some("arithmetic"));
+        assert!(t.markdown().contains("bound by"));
+    }
+}

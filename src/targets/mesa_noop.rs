@@ -1,0 +1,457 @@
+//! "A Mesa Vulkan driver on a device that only compiles, in a child process", written once for every driver
+//! that runs so: RADV on its null winsys (`RADV_FORCE_FAMILY`), and Turnip (Adreno), PanVK (Mali) and ANV
+//! (Intel) on Mesa's noop drm-shims (`LD_PRELOAD` of the shim, `VK_ICD_FILENAMES` naming the driver that
+//! `make setup` built, the GPU id in the driver's variable). Each driver is one file (`radv.rs`, `adreno.rs`,
+//! `mali.rs`, `anv.rs`) implementing `NoopDriver`: its families, the environment that selects one, and how its
+//! cost is read; this file runs the child, reads its report and contains its crashes.
+//!
+//! brdfprof runs itself as a child (`brdfprof __noop-child REQUEST`) with the driver's environment, so that the
+//! Vulkan loader of that process, and only of it, sees the compile-only device; neither the user's environment
+//! nor the parent's devices change. The child marks every device it opens compile-only (nothing is submitted,
+//! timed or read back: a noop shim executes nothing), runs `inspect`'s analyses on it (no callgrind), optionally
+//! writes the driver's internal representations of every kernel, and prints its report as one JSON line. The
+//! child dies with brdfprof (cleanup::command).
+//!
+//! A compile-only device has no queue that executes work: `Gpu` never waits on it when nothing was submitted
+//! (Mesa 22.3 RADV's vkDeviceWaitIdle calls through a null pointer there), and a child that still crashes after
+//! printing its complete report is accepted with a note, so the user gets the report and exit 0.
+
+use crate::inspect::{InspectOptions, InspectReport};
+use crate::cleanup;
+use crate::gpu::{CompilerLog, Gpu, GpuOptions, Kernel};
+use crate::model::Model;
+use crate::kernels::shade::{self, shade_kernel, steady_block, GBufferFormat};
+use crate::model::BASELINE_LABEL;
+use crate::shaders::Shaders;
+use super::{Request, Run, Target, Vendor};
+use anyhow::{anyhow, bail, Context, Result};
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// A Mesa driver that compiles for a family of GPUs this machine does not have, in a child process.
+pub trait NoopDriver: Vendor {
+    /// The compiler's name in messages ("ACO", "ir3").
+    fn compiler(&self) -> &'static str;
+    /// The environment that makes the child's Vulkan loader offer `family`'s compile-only device (every value
+    /// set, none removed); an error, naming what to run, where the driver is not built.
+    fn environment(&self, family: usize) -> Result<Vec<(String, String)>>;
+    /// The device the child opens (a name substring), None for the only one its environment offers.
+    fn device(&self, _family: usize) -> Option<String> {
+        None
+    }
+    /// The folder of a family's listings under `--isa DIR` (`Target::slug`, `adreno-a660`).
+    fn isa_folder(&self, family: usize) -> String {
+        format!("{}-{}", self.prefix(), self.families()[family].name)
+    }
+    /// What to do when the child finds no such device.
+    fn install_hint(&self) -> String;
+    /// A stderr line of the child that is the driver's or its shim's chatter, not a message for the user
+    /// (beside the non-conformance banner every Mesa driver may print).
+    fn is_noise(&self, _line: &str) -> bool {
+        false
+    }
+    /// Why the Khronos validation layer cannot judge this driver's compilations, where it cannot (the child
+    /// then runs without it and the report says so).
+    fn without_validation(&self) -> Option<&'static str> {
+        None
+    }
+    /// Statistics the compiler prints on stderr (drivers without VK_KHR_pipeline_executable_properties).
+    fn compiler_log(&self) -> Option<CompilerLog> {
+        None
+    }
+}
+
+/// The hidden subcommand the child runs.
+pub const CHILD_COMMAND: &str = "__noop-child";
+
+/// Set in the child's environment to the target it compiles for (`adreno:a660`): the child refuses to run
+/// without it, so that a stray `__noop-child` never reads a user's devices as a target's.
+pub const TARGET_VAR: &str = "BRDFPROF_NOOP_TARGET";
+
+/// What the parent asks the child (one JSON argument).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct NoopRequest {
+    /// The driver's `--device` prefix and the family's name.
+    pub driver: String,
+    pub family: String,
+    /// Models by their spec text (`Model::name`, label included, which `Model::parse` reads back); the memory-only
+    /// kernel is analysed after them.
+    pub models: Vec<String>,
+    pub lights: u32,
+    pub validate: bool,
+    pub glsl: Option<PathBuf>,
+    /// Write each kernel's internal representations under DIR/<family>/.
+    pub isa_dir: Option<PathBuf>,
+    /// Kernels from outside the model set (`RawKernel`), compiled instead of the models when given.
+    #[serde(default)]
+    pub raw: Vec<RawSpirv>,
+}
+
+/// A raw kernel for the child: its frozen SPIR-V in a file (a scene kernel's words are more than one
+/// command-line argument may carry) and its interface.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct RawSpirv {
+    pub label: String,
+    /// The model's spec text (`Model::name`), to check the family can compile it.
+    pub model: String,
+    pub path: PathBuf,
+    pub storage_buffers: u32,
+    pub push_bytes: u32,
+}
+
+/// What the child prints on its last stdout line.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct NoopReply {
+    /// `adreno:a660`.
+    pub target: String,
+    pub report: InspectReport,
+    /// Files written under the ISA directory.
+    pub isa_files: Vec<PathBuf>,
+}
+
+/// The driver of a `--device` prefix.
+fn driver_of(prefix: &str) -> Result<&'static dyn NoopDriver> {
+    super::VENDORS.iter().find_map(|v| v.noop().filter(|d| d.prefix() == prefix)).ok_or_else(|| anyhow!("`{prefix}` is not a driver brdfprof runs on a compile-only device"))
+}
+
+/// The child: compiles every kernel on the compile-only device its environment offers and reports.
+pub fn child_main(request_json: &str) -> Result<()> {
+    let req: NoopRequest = serde_json::from_str(request_json).context("bad compile-only child request")?;
+    let driver = driver_of(&req.driver)?;
+    let family = driver.families().iter().position(|f| f.name == req.family).ok_or_else(|| anyhow!("unknown {} family `{}`", driver.name(), req.family))?;
+    let target = Target { vendor: driver, family }.name();
+    let environment = driver.environment(family)?;
+    let set = |k: &str, v: &str| std::env::var(k).ok().as_deref() == Some(v);
+    if !set(TARGET_VAR, &target) || !environment.iter().all(|(k, v)| set(k, v)) {
+        let vars = environment.iter().map(|(k, v)| format!("{k}={v}")).collect::<Vec<_>>().join(" ");
+        bail!("`brdfprof {CHILD_COMMAND}` runs with {TARGET_VAR}={target} {vars}; `brdfprof inspect --device {target}` runs it so");
+    }
+    crate::gpu::mark_compile_only_process();
+    let models = req.models.iter().map(|s| Model::parse(s).map_err(|e| anyhow!("{s}: {e:#}"))).collect::<Result<Vec<_>>>()?;
+    let shaders = match &req.glsl {
+        Some(dir) => Shaders::from_glsl(dir)?,
+        None => Shaders::embedded(),
+    };
+    let wanted = driver.device(family);
+    let unvalidated = driver.without_validation().filter(|_| req.validate);
+    let options = GpuOptions { device: Some(wanted.clone().unwrap_or_else(|| "0".into())), validation: req.validate && unvalidated.is_none(), compiler_log: driver.compiler_log() };
+    let gpu = Gpu::new(&options).map_err(|e| anyhow!("{target}: the driver offered no compile-only device{} ({e:#}). {}", wanted.map_or_else(String::new, |w| format!(" `{w}`")), driver.install_hint()))?;
+    if !gpu.reports_statistics() {
+        bail!("{target}: {} reports no compiler statistics (no VK_KHR_pipeline_executable_properties)", gpu.info.name);
+    }
+    // A driver without VK_KHR_pipeline_executable_properties (PanVK) returns no listing: --isa says so.
+    let listings = gpu.executable_properties.is_some();
+    let isa_dir = req.isa_dir.as_ref().filter(|_| listings).map(|d| d.join(driver.isa_folder(family)));
+    let (mut report, isa_files) = if req.raw.is_empty() { models_report(&gpu, &shaders, &req, &target, models, isa_dir.as_deref())? } else { raw_report(&gpu, &shaders, &req, &target, isa_dir.as_deref())? };
+    report.provenance["target"] = serde_json::Value::String(target.clone());
+    if req.isa_dir.is_some() && !listings {
+        add_driver_note(&mut report, format!("--isa: no listing for {target}: {} has no VK_KHR_pipeline_executable_properties to return one", gpu.info.name));
+    }
+    if let Some(why) = unvalidated {
+        add_driver_note(&mut report, format!("the Khronos validation layer was not run for {target}: {why}"));
+    }
+    gpu.check_validation()?;
+    drop(gpu);
+    reply(NoopReply { target, report, isa_files })
+}
+
+/// Adds a sentence to the driver section's notes.
+fn add_driver_note(report: &mut InspectReport, note: String) {
+    let joined = report.section_notes.get("driver/").map_or(note.clone(), |n| format!("{n}; {note}"));
+    report.section_notes.insert("driver/".into(), joined);
+}
+
+/// The models' kernels and the memory-only one, as `inspect` reports them; a model this family cannot compile
+/// (fp16 arithmetic where the device has no shaderFloat16) is left out and named in the driver section's
+/// notes, so that one family does not stop a report of many.
+fn models_report(gpu: &Gpu, shaders: &Shaders, req: &NoopRequest, target: &str, models: Vec<Model>, isa_dir: Option<&Path>) -> Result<(InspectReport, Vec<PathBuf>)> {
+    let (models, skipped): (Vec<Model>, Vec<Model>) = models.into_iter().partition(|m| m.check_support(&gpu.info).is_ok());
+    // The listings first: Turnip keeps each compiled kernel in its in-memory pipeline cache, and a capture
+    // compiled after the same kernel without one would come back from there without its IR3 assembly.
+    let mut isa_files = Vec::new();
+    if let Some(dir) = isa_dir {
+        let mut all: Vec<Option<&Model>> = models.iter().map(Some).collect();
+        all.push(None);
+        for model in all {
+            isa_files.extend(write_isa(gpu, shaders, model, req.lights, dir)?);
+        }
+    }
+    let mut report = super::inspect_device(gpu, shaders, &InspectOptions { models: models.clone(), lights: req.lights, callgrind: None })?;
+    if !skipped.is_empty() {
+        let why = skipped.iter().map(|m| format!("{} ({:#})", m.name(), m.check_support(&gpu.info).unwrap_err())).collect::<Vec<_>>().join("; ");
+        report.section_notes.insert("driver/".into(), format!("not compiled for {target}: {why}"));
+    }
+    Ok((report, isa_files))
+}
+
+/// Prints the reply as the child's last stdout line.
+fn reply(reply: NoopReply) -> Result<()> {
+    println!("{}", serde_json::to_string(&reply)?);
+    if std::env::var_os(CRASH_AFTER_REPLY).is_some() {
+        use std::io::Write;
+        std::io::stdout().flush()?;
+        // SAFETY: raising a signal on this process; the test of crash containment asks for it.
+        // The default action (Rust's own SIGSEGV handler is for stack overflows and would return).
+        unsafe {
+            libc::signal(libc::SIGSEGV, libc::SIG_DFL);
+            libc::raise(libc::SIGSEGV);
+        }
+    }
+    Ok(())
+}
+
+/// The request's raw kernels compiled on the compile-only device, one row each with the compiler's statistics, as one report
+/// (with the request's lights per kernel, which the cost divides by); a kernel the family cannot compile is left
+/// out and named in the driver section's notes.
+fn raw_report(gpu: &Gpu, shaders: &Shaders, req: &NoopRequest, target: &str, isa_dir: Option<&Path>) -> Result<(InspectReport, Vec<PathBuf>)> {
+    let mut rows = Vec::new();
+    let mut skipped = Vec::new();
+    let mut isa_files = Vec::new();
+    for r in &req.raw {
+        let model = Model::parse(&r.model).map_err(|e| anyhow!("{}: {e:#}", r.model))?;
+        if let Err(e) = model.check_support(&gpu.info) {
+            skipped.push(format!("{} ({e:#})", r.label));
+            continue;
+        }
+        let bytes = crate::io::read_bounded(&r.path, crate::compile_limit::MAX_OUTPUT_BYTES as u64).with_context(|| format!("the {target} child cannot read {}", r.path.display()))?;
+        let words: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes);
+        let kernel = Kernel::with_capture(gpu, &r.label, &words, &Default::default(), &crate::gpu::Binding::storage(r.storage_buffers), r.push_bytes, isa_dir.is_some())?;
+        let mut row = crate::inspect::Row { model: r.label.clone(), spec: None, stats: Default::default(), notes: Default::default() };
+        let executables = kernel.executables()?.ok_or_else(|| anyhow!("{} reports no pipeline statistics", gpu.info.name))?;
+        if let Some(dir) = isa_dir {
+            isa_files.extend(write_representations(gpu, &executables, &r.label, dir)?);
+        }
+        row.stats.extend(crate::inspect::driver::executable_stats(executables));
+        rows.push(row);
+    }
+    let provenance = serde_json::to_value(crate::results::Provenance::new(&gpu.info))?;
+    let notes = if skipped.is_empty() { Default::default() } else { [("driver/".to_string(), format!("not compiled for {target}: {}", skipped.join("; ")))].into() };
+    Ok((crate::inspect::compiled_report(rows, provenance, req.lights, shaders, Default::default(), notes), isa_files))
+}
+
+/// Set in a child's environment, it dies of SIGSEGV after printing its report, as Mesa 22.3's teardown of
+/// RADV's null device did (vkDeviceWaitIdle through a null pointer): the test that the parent contains such a crash.
+pub const CRASH_AFTER_REPLY: &str = "BRDFPROF_TEST_NOOP_CHILD_CRASH";
+
+/// Compiles one kernel with CAPTURE_INTERNAL_REPRESENTATIONS and writes each text representation
+/// (RADV: NIR, ACO IR, disassembly; Turnip: NIR, IR3 assembly; ANV: NIR, GEN assembly) to
+/// DIR/<kernel>.<representation>.txt.
+fn write_isa(gpu: &Gpu, shaders: &Shaders, model: Option<&Model>, lights: u32, dir: &Path) -> Result<Vec<PathBuf>> {
+    let label = model.map_or_else(|| BASELINE_LABEL.to_string(), Model::label);
+    let (per_dispatch, accumulate) = steady_block(lights);
+    let k = shade_kernel(model, GBufferFormat::Packed, per_dispatch, accumulate, shaders)?;
+    let kernel = Kernel::with_capture(gpu, &k.spirv.name, &k.spirv.words, &k.constants, &shade::bindings(GBufferFormat::Packed), shade::PUSH_BYTES, true)?;
+    write_representations(gpu, &kernel.executables()?.unwrap_or_default(), &label, dir)
+}
+
+/// Each text representation of each executable to DIR/<kernel>.<representation>.txt.
+fn write_representations(gpu: &Gpu, executables: &[crate::gpu::PipelineExecutable], label: &str, dir: &Path) -> Result<Vec<PathBuf>> {
+    std::fs::create_dir_all(dir).with_context(|| format!("--isa: cannot create {}", dir.display()))?;
+    let mut files = Vec::new();
+    for exe in executables {
+        for (name, text) in &exe.representations {
+            let path = dir.join(format!("{}.{}.txt", super::file_slug(label), super::file_slug(name)));
+            crate::io::write_output(&path, format!("; {label}: {} of {}, {}\n{text}", name, exe.name, gpu.info.name).as_bytes())?;
+            files.push(path);
+        }
+    }
+    if files.is_empty() {
+        bail!("{}: the driver returned no internal representation for {label}{}", gpu.info.name, if gpu.executable_properties.is_none() { " (it has no VK_KHR_pipeline_executable_properties: --isa has nothing to write for it)" } else { "" });
+    }
+    Ok(files)
+}
+
+/// What every child of one `compile` is asked (the parts of a `Request` a child reads).
+struct Job<'a> {
+    lights: u32,
+    shaders: &'a Shaders,
+    validate: bool,
+    isa_dir: Option<&'a Path>,
+}
+
+/// One target's child: run, and its report read back.
+struct ChildRun {
+    report: InspectReport,
+    isa_files: Vec<PathBuf>,
+    /// Set when the child crashed after it had printed its complete report.
+    teardown_note: Option<String>,
+}
+
+/// Runs the child for one target and reads its report.
+fn run(driver: &'static dyn NoopDriver, family: usize, models: &[Model], raw: &[super::RawKernel], request: &Job) -> Result<ChildRun> {
+    let target = Target { vendor: driver, family };
+    let name = target.name();
+    // The driver's environment first: a driver that is not built stops here, naming what to run.
+    let environment = driver.environment(family)?;
+    // The child writes its ISA files into its own TMPDIR; they become outputs of this process (staged with
+    // its others) only once the child has succeeded.
+    let mut cmd = cleanup::command(&std::env::current_exe().context("cannot find brdfprof's own executable")?.to_string_lossy());
+    let tmp = cleanup::child_tmpdir(&mut cmd)?;
+    let child_isa = request.isa_dir.map(|_| tmp.path().join("isa"));
+    let mut raw_files = Vec::new();
+    for (k, r) in raw.iter().enumerate() {
+        let path = tmp.path().join(format!("raw-{k}.spv"));
+        std::fs::write(&path, bytemuck::cast_slice::<u32, u8>(&r.spirv)).with_context(|| format!("cannot write {}", path.display()))?;
+        raw_files.push(RawSpirv { label: r.label.clone(), model: r.model.name(), path, storage_buffers: r.storage_buffers, push_bytes: r.push_bytes });
+    }
+    let req = NoopRequest {
+        driver: driver.prefix().to_string(),
+        family: target.info().name.to_string(),
+        models: models.iter().map(Model::name).collect(),
+        lights: request.lights,
+        validate: request.validate,
+        glsl: request.shaders.glsl_dir().map(Path::to_path_buf),
+        isa_dir: child_isa.clone(),
+        raw: raw_files,
+    };
+    cmd.arg(CHILD_COMMAND).arg(serde_json::to_string(&req)?).env(TARGET_VAR, &name).envs(environment)
+        // The compiler's output, not a binary an earlier process cached, and no stale statistics.
+        .env("MESA_SHADER_CACHE_DISABLE", "true");
+    // The child compiles each kernel under the compile limit itself; the whole child gets one limit per
+    // kernel (models, the memory-only kernel, their ISA captures) and a few seconds to start.
+    crate::compile_limit::export(&mut cmd);
+    let kernels = (models.len() as u32 + 1 + raw.len() as u32) * if request.isa_dir.is_some() { 2 } else { 1 };
+    let limit = crate::compile_limit::limit() * kernels + std::time::Duration::from_secs(10);
+    let what = format!("the kernels for {name} ({}, in a child process)", driver.compiler());
+    let output = crate::compile_limit::output_within(&mut cmd, &what, limit).with_context(|| format!("cannot run brdfprof's {name} child"))?;
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    let reply: Option<NoopReply> = stdout.lines().rev().find_map(|l| serde_json::from_str(l).ok());
+    // Validation messages and warnings of the child reach the user as they are, but for the banner Mesa prints
+    // for every driver it does not consider conformant (RADV's null device, PanVK) and the shims' notices.
+    // (A failed child's last lines are in the error below.)
+    for line in stderr.lines().filter(|l| reply.is_some() && !is_banner(l) && !driver.is_noise(l)) {
+        crate::messages::line(line);
+    }
+    let teardown_note = match (&reply, output.status.success()) {
+        (Some(_), true) => None,
+        (Some(_), false) if output.status.code().is_none() => Some(format!(
+            "the {name} child crashed after writing its complete report ({}); the crash is in Mesa's teardown of the compile-only device, not in the figures",
+            output.status
+        )),
+        _ => {
+            let tail: Vec<&str> = stderr.lines().rev().take(15).collect::<Vec<_>>().into_iter().rev().collect();
+            bail!("{name}: the compile-only child failed ({}):\n{}\n{}", output.status, tail.join("\n"), driver.install_hint());
+        }
+    };
+    let reply = reply.expect("checked above");
+    if reply.target != name {
+        bail!("the compile-only child answered for {} instead of {name}", reply.target);
+    }
+    let isa_files = match (&child_isa, request.isa_dir) {
+        (Some(from), Some(to)) => reply.isa_files.iter().map(|f| publish(f, from, to)).collect::<Result<Vec<_>>>()?,
+        _ => Vec::new(),
+    };
+    Ok(ChildRun { report: reply.report, isa_files, teardown_note })
+}
+
+/// The line Mesa prints on every start of a driver it calls non-conformant (RADV's null device, PanVK).
+fn is_banner(line: &str) -> bool {
+    line.starts_with("WARNING: ") && line.contains("not a conformant")
+}
+
+/// Writes a file the child wrote under `from` as this process' output under `to`.
+fn publish(file: &Path, from: &Path, to: &Path) -> Result<PathBuf> {
+    let rel = file.strip_prefix(from).map_err(|_| anyhow!("the compile-only child wrote {} outside its ISA directory", file.display()))?;
+    let bytes = crate::io::read_bounded(file, crate::compile_limit::MAX_OUTPUT_BYTES as u64).with_context(|| format!("cannot read the compile-only child's {}", file.display()))?;
+    let path = to.join(rel);
+    crate::io::write_output(&path, &bytes)?;
+    Ok(path)
+}
+
+/// Every family of `families` compiled by `driver`'s children (the models, or the raw kernels when given), at
+/// most as many children at once as the host has cores; results in order, with the driver's cost table.
+pub fn compile(prefix: &str, families: &[usize], raw: &[super::RawKernel], request: &Request) -> Result<Vec<Run>> {
+    let driver = driver_of(prefix)?;
+    let models: &[Model] = if raw.is_empty() { request.models } else { &[] };
+    let request = &Job { lights: request.lights, shaders: request.shaders, validate: request.validate, isa_dir: request.isa_dir };
+    let workers = std::thread::available_parallelism().map_or(1, |n| n.get()).min(families.len()).max(1);
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let results: std::sync::Mutex<Vec<Option<Result<ChildRun>>>> = std::sync::Mutex::new((0..families.len()).map(|_| None).collect());
+    // Each worker spawns and waits for its own children (PR_SET_PDEATHSIG follows the spawning thread).
+    std::thread::scope(|s| {
+        for _ in 0..workers {
+            s.spawn(|| loop {
+                let i = next.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
+                if i >= families.len() {
+                    break;
+                }
+                let r = run(driver, families[i], models, raw, request);
+                results.lock().unwrap_or_else(|e| e.into_inner())[i] = Some(r);
+            });
+        }
+    });
+    let runs = results.into_inner().unwrap_or_else(|e| e.into_inner()).into_iter().map(|r| r.expect("every target ran"));
+    runs.zip(families)
+        .map(|(run, &family)| {
+            let run = run?;
+            let mut report = run.report;
+            if let Some(note) = &run.teardown_note {
+                report.section_notes.insert("driver/".into(), note.clone());
+            }
+            report.cost = driver.cost(&report);
+            Ok(Run { target: Target { vendor: driver, family }, report, isa_files: run.isa_files, note: run.teardown_note })
+        })
+        .collect()
+}
+
+/// The family a report of `driver`'s children was made for (its provenance names the target).
+pub fn family_of(driver: &dyn NoopDriver, report: &InspectReport) -> Option<usize> {
+    let (prefix, family) = report.provenance["target"].as_str()?.split_once(':')?;
+    (prefix == driver.prefix()).then(|| driver.families().iter().position(|f| f.name == family)).flatten()
+}
+
+/// What a compile-only device's statistics depend on: the device (the family) and the Mesa that compiled,
+/// not the host.
+pub fn fingerprint(report: &InspectReport) -> std::collections::BTreeMap<String, String> {
+    let device = report.provenance["device"]["name"].as_str().unwrap_or("?");
+    [("device".to_string(), device.to_string()), ("mesa".to_string(), driver_version(report))].into()
+}
+
+/// The Mesa version of a compile-only device's report: the provenance's, else the driver's info or version
+/// (PanVK, a Vulkan 1.0 driver, states only its driverVersion).
+pub fn driver_version(report: &InspectReport) -> String {
+    let p = &report.provenance;
+    let nonempty = |v: &serde_json::Value| v.as_str().filter(|s| !s.is_empty()).map(str::to_string);
+    nonempty(&p["mesa_version"]).or_else(|| nonempty(&p["device"]["driver_info"])).or_else(|| nonempty(&p["device"]["driver_version"])).unwrap_or_else(|| "?".into())
+}
+
+/// The directory of the Mesa build `make setup` made (scripts/mesa-noop.sh): `$BRDFPROF_MESA_DIR`, else
+/// `.tools/mesa` of the checkout brdfprof was built from (a link into the build cache).
+pub fn build_dir() -> PathBuf {
+    match std::env::var_os(BUILD_DIR_VAR).filter(|v| !v.is_empty()) {
+        Some(dir) => PathBuf::from(dir),
+        None => Path::new(env!("CARGO_MANIFEST_DIR")).join(".tools/mesa"),
+    }
+}
+
+/// The variable that names the Mesa build directory.
+pub const BUILD_DIR_VAR: &str = "BRDFPROF_MESA_DIR";
+
+/// A file of the Mesa build, or an error naming what is missing and what to run.
+pub fn built_file(driver: &str, relative: &str) -> Result<PathBuf> {
+    let dir = build_dir();
+    let path = dir.join(relative);
+    if !path.is_file() {
+        bail!(
+            "{driver} is not built: {} is missing. Run `make setup` (as root: it builds Mesa's Turnip, PanVK and ANV drivers and their noop \
+             kernel shims from Debian's source package of the installed Mesa, once per machine, ~8 minutes on 2 cores), or set {BUILD_DIR_VAR} to such a build",
+            path.display()
+        );
+    }
+    Ok(path)
+}
+
+/// The environment of a driver on a noop drm-shim: the loader sees only `icd` (the driver's devenv ICD file,
+/// which names the library in the build), `shim` answers the kernel's ioctls, and `extra` selects the GPU.
+pub fn shim_environment(driver: &str, icd: &str, shim: &str, extra: &[(&str, String)]) -> Result<Vec<(String, String)>> {
+    let icd = built_file(driver, icd)?;
+    let shim = built_file(driver, shim)?;
+    let library = icd.with_file_name(format!("libvulkan_{}.so", icd.file_name().and_then(|n| n.to_str()).and_then(|n| n.split('_').next()).unwrap_or("?")));
+    if !library.is_file() {
+        bail!("{driver} is not built: {} is missing. Run `make setup`", library.display());
+    }
+    let mut env = vec![("VK_ICD_FILENAMES".to_string(), icd.display().to_string()), ("VK_DRIVER_FILES".to_string(), icd.display().to_string()), ("LD_PRELOAD".to_string(), shim.display().to_string())];
+    env.extend(extra.iter().map(|(k, v)| (k.to_string(), v.clone())));
+    Ok(env)
+}

@@ -1,0 +1,153 @@
+//! A Mesa Vulkan driver on Mesa's noop drm-shim, as data: the files of the build `make setup` made, the
+//! variable that picks the GPU, the families, and the driver's cost rule. `adreno.rs`, `mali.rs` and `anv.rs`
+//! are one `Shim` each; the child process, its environment checks and crash handling are `mesa_noop`'s.
+
+use super::cost::TargetCost;
+use super::mesa_noop::{self, NoopDriver};
+use super::{Family, Request, Run, Vendor};
+use crate::gpu::CompilerLog;
+use crate::inspect::InspectReport;
+use anyhow::Result;
+use std::collections::BTreeMap;
+
+/// One GPU a shim impersonates.
+pub struct ShimFamily {
+    /// The name after the prefix (`a660`).
+    pub name: &'static str,
+    /// The value of the driver's GPU variable (`660`, `0x7212`, `tgl`).
+    pub gpu_id: &'static str,
+    pub architecture: &'static str,
+    pub products: &'static str,
+    /// What else identifies it (the GPU id, the compiler generation).
+    pub detail: &'static str,
+    /// In `PREFIX:all`.
+    pub default: bool,
+}
+
+/// A driver on a noop drm-shim.
+pub struct Shim {
+    pub prefix: &'static str,
+    /// The GPU vendor ("Qualcomm").
+    pub vendor: &'static str,
+    pub title: &'static str,
+    /// Mesa's driver ("Turnip").
+    pub driver: &'static str,
+    /// The compiler ("ir3").
+    pub compiler: &'static str,
+    /// Under the build directory (`mesa_noop::build_dir`): the driver's devenv ICD file and the shim.
+    pub icd: &'static str,
+    pub shim: &'static str,
+    /// The shim's variable that picks the GPU, and any other variable the driver needs.
+    pub gpu_var: &'static str,
+    pub extra_env: &'static [(&'static str, &'static str)],
+    pub families: &'static [ShimFamily],
+    /// The cost table of a report of this driver (its family's `ShimFamily`).
+    pub cost: fn(&Shim, &ShimFamily, &InspectReport) -> Option<TargetCost>,
+    /// Statistics the compiler prints on stderr, for a driver without VK_KHR_pipeline_executable_properties.
+    pub compiler_log: Option<CompilerLog>,
+    /// Why the validation layer cannot judge this driver's compilations, where it cannot.
+    pub without_validation: Option<&'static str>,
+    /// Prefixes of the stderr lines the shim prints about ioctls it does not emulate (not the user's concern).
+    pub noise: &'static [&'static str],
+}
+
+impl Shim {
+    /// The cost table's header for a report of `family`: the rule text, unit and columns are the driver's.
+    pub fn header(&self, family: &ShimFamily, report: &InspectReport, model: String, unit: &str, columns: &[&str]) -> TargetCost {
+        TargetCost {
+            device: report.provenance["device"]["name"].as_str().unwrap_or("?").to_string(),
+            target: Some(format!("{}:{}", self.prefix, family.name)),
+            family: Some(family.name.to_string()),
+            architecture: Some(family.architecture.to_string()),
+            compiler: format!("{} (Mesa {}, on the noop drm-shim)", self.compiler, mesa_noop::driver_version(report).trim_start_matches("Mesa ")),
+            model,
+            unit: unit.to_string(),
+            lights_per_kernel: 0,
+            columns: columns.iter().map(|c| c.to_string()).collect(),
+            rows: Vec::new(),
+        }
+    }
+}
+
+impl Vendor for Shim {
+    fn prefix(&self) -> &'static str {
+        self.prefix
+    }
+
+    fn name(&self) -> &'static str {
+        self.vendor
+    }
+
+    fn title(&self) -> &'static str {
+        self.title
+    }
+
+    fn families(&self) -> Vec<Family> {
+        self.families.iter().map(|f| Family { name: f.name, architecture: f.architecture, products: f.products, detail: f.detail.to_string(), default: f.default }).collect()
+    }
+
+    fn status(&self) -> Result<String> {
+        self.environment(0)?;
+        Ok(format!("Mesa's {} ({} compiler) on its noop drm-shim, built by make setup in {}", self.driver, self.compiler, mesa_noop::build_dir().display()))
+    }
+
+    fn needs_verification(&self) -> bool {
+        false
+    }
+
+    fn compile(&self, families: &[usize], request: &Request) -> Result<Vec<Run>> {
+        mesa_noop::compile(self.prefix, families, &[], request)
+    }
+
+    fn compile_raw(&self, families: &[usize], kernels: &[super::RawKernel], request: &Request) -> Result<Vec<Run>> {
+        if kernels.is_empty() {
+            anyhow::bail!("{}: no raw kernel to compile", self.prefix);
+        }
+        mesa_noop::compile(self.prefix, families, kernels, request)
+    }
+
+    fn cost(&self, report: &InspectReport) -> Option<TargetCost> {
+        let family = mesa_noop::family_of(self, report)?;
+        (self.cost)(self, &self.families[family], report)
+    }
+
+    fn family_of(&self, report: &InspectReport) -> Option<usize> {
+        mesa_noop::family_of(self, report)
+    }
+
+    fn fingerprint(&self, report: &InspectReport) -> BTreeMap<String, String> {
+        mesa_noop::fingerprint(report)
+    }
+
+    fn noop(&self) -> Option<&dyn NoopDriver> {
+        Some(self)
+    }
+}
+
+impl NoopDriver for Shim {
+    fn compiler(&self) -> &'static str {
+        self.compiler
+    }
+
+    fn environment(&self, family: usize) -> Result<Vec<(String, String)>> {
+        let mut extra: Vec<(&str, String)> = vec![(self.gpu_var, self.families[family].gpu_id.to_string())];
+        extra.extend(self.extra_env.iter().map(|(k, v)| (*k, v.to_string())));
+        mesa_noop::shim_environment(&format!("{}: (Mesa's {})", self.prefix, self.driver), self.icd, self.shim, &extra)
+    }
+
+    fn install_hint(&self) -> String {
+        format!("`make setup` builds Mesa's drivers and their noop shims (once per machine); `brdfprof devices --targets` says whether {}: is ready", self.prefix)
+    }
+
+    fn compiler_log(&self) -> Option<CompilerLog> {
+        self.compiler_log
+    }
+
+    fn without_validation(&self) -> Option<&'static str> {
+        self.without_validation
+    }
+
+    fn is_noise(&self, line: &str) -> bool {
+        self.noise.iter().any(|p| line.starts_with(p))
+    }
+}

@@ -1,0 +1,180 @@
+//! Mesa's Turnip (adreno:), PanVK (mali:) and ANV (anv:) on Mesa's noop drm-shims, built by `make setup`:
+//! the drivers' real compilers (ir3, Bifrost, brw) compile brdfprof's unchanged SPIR-V in child processes, and
+//! their statistics and cost rules reach every compile-only command. Nothing here mocks a driver: a missing
+//! or broken build is a real directory without (or with a broken) driver.
+
+use crate::common::{self, run, run_in};
+use brdfprof::targets;
+use std::path::Path;
+
+/// The shim targets: every family of each shim driver.
+fn shim_targets() -> Vec<String> {
+    targets::VENDORS.iter().filter(|v| v.noop().is_some() && v.prefix() != "radv").flat_map(|v| v.families().into_iter().map(move |f| format!("{}:{}", v.prefix(), f.name))).collect()
+}
+
+fn inspect(dir: &Path, name: &str, devices: &[String], extra: &[&str]) -> serde_json::Value {
+    let devices: Vec<&str> = devices.iter().map(String::as_str).collect();
+    crate::compile_only::inspect_json(dir, name, &devices, extra, "on the noop drm-shim")
+}
+
+#[test]
+fn every_shim_target_reports_its_compilers_statistics_and_cost_identically_on_a_rerun() {
+    let dir = tempfile::tempdir().unwrap();
+    let devices = shim_targets();
+    assert!(devices.len() >= 9, "{devices:?}");
+    let models = crate::compile_only::every_preset_and_example();
+    let extra: Vec<&str> = models.iter().flat_map(|m| ["--model", m.as_str()]).collect();
+    let first = inspect(dir.path(), "first", &devices, &extra);
+    let second = inspect(dir.path(), "second", &devices, &extra);
+    let reports = first["reports"].as_array().unwrap();
+    assert_eq!(reports.len(), devices.len());
+    for ((report, again), device) in reports.iter().zip(second["reports"].as_array().unwrap()).zip(&devices) {
+        assert_eq!(report["provenance"]["target"], device.as_str());
+        assert_eq!(report["cost"], again["cost"], "{device}: the cost table changed between runs");
+        let cost = &report["cost"];
+        assert_eq!(cost["target"], device.as_str(), "{device}: no cost table");
+        assert!(cost["model"].as_str().unwrap().starts_with("cycles/eval = "), "{device}: the rule text is in the report");
+        let rows = cost["rows"].as_array().unwrap();
+        assert_eq!(rows.len(), models.len() + 1, "{device}: every model and the memory-only kernel");
+        for r in rows {
+            assert!(r["cycles_per_eval"].as_f64().unwrap() > 0.0, "{device} {}", r["model"]);
+        }
+        // The built-in BRDFs add work to the memory-only kernel on every compiler.
+        for r in rows.iter().filter(|r| brdfprof::brdf::spec::PRESETS.iter().any(|p| r["model"] == p.name)) {
+            assert!(r["net_cycles_per_eval"].as_f64().unwrap() > 0.0, "{device} {}", r["model"]);
+        }
+        // Deterministic: every driver statistic is the same in a second process.
+        for (row, row_again) in report["rows"].as_array().unwrap().iter().zip(again["rows"].as_array().unwrap()) {
+            for (key, value) in row["stats"].as_object().unwrap().iter().filter(|(k, _)| k.starts_with("driver/")) {
+                assert_eq!(&row_again["stats"][key], value, "{device} {} {key} changed between runs", row["model"]);
+            }
+            assert!(row["stats"]["driver/instructions"].as_f64().unwrap() > 0.0, "{device} {}: no instruction count", row["model"]);
+        }
+    }
+}
+
+#[test]
+fn the_corpus_of_brdf_files_compiles_on_each_shim_driver() {
+    let corpus = common::repo_root().join("tests/fixtures/brdf/corpus");
+    let mut files: Vec<_> = std::fs::read_dir(&corpus).unwrap().map(|e| e.unwrap().path()).filter(|p| p.extension().is_some_and(|x| x == "brdf")).collect();
+    files.sort();
+    assert_eq!(files.len(), 40, "the corpus has 40 files");
+    let models: Vec<String> = files.iter().map(|p| p.display().to_string()).collect();
+    let extra: Vec<&str> = models.iter().flat_map(|m| ["--model", m.as_str()]).collect();
+    let dir = tempfile::tempdir().unwrap();
+    let devices = ["adreno:a660".to_string(), "mali:g52".to_string(), "anv:tgl".to_string()];
+    let out = inspect(dir.path(), "corpus", &devices, &extra);
+    for (report, device) in out["reports"].as_array().unwrap().iter().zip(&devices) {
+        let rows = report["cost"]["rows"].as_array().unwrap();
+        // Each file by its stem (and ggx, which inspect adds as the reference, and the memory-only kernel).
+        for f in &files {
+            let stem = f.file_stem().unwrap().to_str().unwrap();
+            assert!(rows.iter().any(|r| r["model"] == stem), "{device}: no row for {stem}: {}", report["section_notes"]);
+        }
+        assert!(rows.iter().all(|r| r["cycles_per_eval"].as_f64().unwrap() > 0.0), "{device}");
+    }
+}
+
+#[test]
+fn isa_writes_ir3_and_brw_listings_and_says_panvk_has_none() {
+    let dir = tempfile::tempdir().unwrap();
+    let isa = dir.path().join("isa");
+    let devices = ["adreno:a660".to_string(), "anv:tgl".to_string(), "mali:g52".to_string()];
+    let out = inspect(dir.path(), "isa", &devices, &["--model", "ggx", "--isa", isa.to_str().unwrap()]);
+    let ir3 = std::fs::read_to_string(isa.join("adreno-a660/ggx.ir3-assembly.txt")).unwrap();
+    assert!(ir3.lines().any(|l| l.trim() == "end") && ir3.contains("(ss)"), "{}", &ir3[..ir3.len().min(400)]);
+    let brw = std::fs::read_to_string(isa.join("anv-tgl/ggx.gen-assembly.txt")).unwrap();
+    assert!(brw.contains("send"), "{}", &brw[..brw.len().min(400)]);
+    assert!(!isa.join("mali-g52").exists());
+    let note = out["reports"][2]["section_notes"]["driver/"].as_str().unwrap();
+    assert!(note.contains("--isa: no listing for mali:g52") && note.contains("validation layer was not run"), "{note}");
+}
+
+#[test]
+fn a_missing_or_broken_build_exits_2_naming_make_setup() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let inspect_with = |build: &Path, device: &str| {
+        let out = common::brdfprof().args(["inspect", "--no-callgrind", "--model", "ggx", "--device", device, "--json", "r.json", "--markdown", "r.md"]).current_dir(d).env(targets::mesa_noop::BUILD_DIR_VAR, build).output().unwrap();
+        (out.status.code(), String::from_utf8_lossy(&out.stderr).into_owned())
+    };
+    // No build at all.
+    let (code, stderr) = inspect_with(&d.join("nothing"), "adreno:a660");
+    assert_eq!(code, Some(2), "{stderr}");
+    assert!(stderr.contains("is not built") && stderr.contains("make setup") && stderr.contains("freedreno_devenv_icd"), "{stderr}");
+    // The driver and its ICD file present, the shim absent.
+    let real = targets::mesa_noop::build_dir();
+    let partial = d.join("partial");
+    for f in ["src/intel/vulkan/intel_devenv_icd.x86_64.json", "src/intel/vulkan/libvulkan_intel.so"] {
+        std::fs::create_dir_all(partial.join(f).parent().unwrap()).unwrap();
+        std::fs::copy(real.join(f), partial.join(f)).unwrap();
+    }
+    let (code, stderr) = inspect_with(&partial, "anv:tgl");
+    assert_eq!(code, Some(2), "{stderr}");
+    assert!(stderr.contains("libintel_noop_drm_shim.so is missing") && stderr.contains("make setup"), "{stderr}");
+    // A shim that is not a library: the driver finds no GPU, and the child's failure names what to run.
+    let shim = partial.join("src/intel/tools/libintel_noop_drm_shim.so");
+    std::fs::create_dir_all(shim.parent().unwrap()).unwrap();
+    std::fs::write(&shim, b"not a shared object").unwrap();
+    let (code, stderr) = inspect_with(&partial, "anv:tgl");
+    assert_eq!(code, Some(2), "{stderr}");
+    assert!(stderr.contains("anv:tgl") && stderr.contains("make setup"), "{stderr}");
+    assert!(!d.join("r.json").exists() && !d.join("r.md").exists());
+    // devices --targets says which vendor is not ready and why.
+    let out = common::brdfprof().args(["devices", "--targets"]).env(targets::mesa_noop::BUILD_DIR_VAR, d.join("nothing")).output().unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("is not built"), "{stdout}");
+}
+
+#[test]
+fn a_noop_device_is_never_asked_to_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("in.csv"), "nx,ny,nz,vx,vy,vz,lx,ly,lz,roughness,f0r,f0g,f0b\n0,0,1,0,0.6,0.8,0.6,0,0.8,0.5,0.04,0.04,0.04\n").unwrap();
+    for device in shim_targets() {
+        run_in(d, &["profile", "--model", "ggx", "--size", "8x8", "--device", &device]).fails(2, "compiles only and cannot run kernels");
+        run_in(d, &["eval", "--model", "ggx", "--input", "in.csv", "--output", "out.csv", "--device", &device]).fails(2, "compiles only and cannot run kernels");
+    }
+    assert_eq!(std::fs::read_dir(d).unwrap().count(), 1, "nothing but the input in the directory");
+}
+
+#[test]
+fn a_shim_child_that_crashes_after_its_report_still_gives_the_report() {
+    let dir = tempfile::tempdir().unwrap();
+    let json = dir.path().join("r.json");
+    let out = common::brdfprof()
+        .args(["inspect", "--no-callgrind", "--model", "ggx", "--device", "anv:tgl", "--json", json.to_str().unwrap(), "--markdown", dir.path().join("r.md").to_str().unwrap()])
+        .env(targets::mesa_noop::CRASH_AFTER_REPLY, "1")
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{stderr}");
+    assert!(stderr.contains("the anv:tgl child crashed after writing its complete report"), "{stderr}");
+    let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(json).unwrap()).unwrap();
+    assert!(report["cost"]["rows"][0]["stats"]["Cycle Count"].as_f64().unwrap() > 0.0);
+}
+
+#[test]
+fn scene_kernels_and_the_sweep_reach_the_shim_compilers() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let scene = common::repo_root().join("scenes/sphere-grid.json");
+    let json = d.join("scene.json");
+    let out = run_in(d, &["profile", "--scene", scene.to_str().unwrap(), "--budget", "2", "--cost-device", "adreno:a660", "--cost-device", "mali:g52", "--cost-device", "anv:tgl", "--json", json.to_str().unwrap()]).ok();
+    for t in ["adreno:a660 cycles/pixel", "mali:g52 cycles/pixel", "anv:tgl cycles/pixel"] {
+        assert!(out.stdout.contains(t), "{}", out.stdout);
+    }
+    let sweep = run_in(d, &["sweep", "--model", "ggx", "--model", "blinn", "--model", "burley", "--size", "16x16", "--min-rounds", "2", "--max-rounds", "2", "--out", "out", "--cost-device", "mali:g52"]).ok();
+    assert!(sweep.stdout.contains("cost on g52 (Bifrost (v7))"), "{}", sweep.stdout);
+}
+
+#[test]
+fn devices_targets_lists_every_shim_family_and_its_compiler() {
+    let out = run(&["devices", "--targets"]).ok();
+    for device in shim_targets() {
+        assert!(out.stdout.lines().any(|l| l.starts_with(&format!("| {device} "))), "{device}:\n{}", out.stdout);
+    }
+    for compiler in ["Turnip (ir3 compiler)", "PanVK (Bifrost compiler)", "ANV (brw compiler)"] {
+        assert!(out.stdout.contains(compiler), "{compiler}:\n{}", out.stdout);
+    }
+}
