@@ -40,7 +40,7 @@ if ! built; then
         apt-get update -qq
     fi
     echo "brdfprof setup: installing Mesa's build tools (meson, ninja, mako, bison, flex, libdrm, expat, zlib, zstd)" >&2
-    apt-get install -y -qq meson ninja-build python3-mako bison flex libdrm-dev libexpat1-dev zlib1g-dev libzstd-dev pkg-config >/dev/null
+    apt-get install -y -qq dpkg-dev meson ninja-build python3-mako bison flex libdrm-dev libexpat1-dev zlib1g-dev libzstd-dev pkg-config >/dev/null
     rm -rf "$dir"
     mkdir -p "$dir"
     echo "brdfprof setup: fetching Debian's source package mesa=$version into $dir" >&2
