@@ -11,7 +11,7 @@ cache=${BRDFPROF_MESA_CACHE:-${XDG_CACHE_HOME:-$HOME/.cache}/brdfprof}
 options="-Dbuildtype=release -Dvulkan-drivers=freedreno,panfrost,intel -Dgallium-drivers= -Dtools=drm-shim,intel \
 -Dplatforms= -Dglx=disabled -Degl=disabled -Dgbm=disabled -Dopengl=false -Dgles1=disabled -Dgles2=disabled \
 -Dllvm=disabled -Dshared-glapi=disabled -Dvalgrind=disabled -Dlibunwind=disabled -Dzstd=enabled -Dvideo-codecs="
-# What brdfprof loads (src/targets/mesa_noop.rs names the same files).
+# What brdfprof loads: each `Shim` of src/targets/ (adreno.rs, mali.rs, anv.rs) names these files; a test ties them.
 products="src/freedreno/vulkan/libvulkan_freedreno.so src/freedreno/vulkan/freedreno_devenv_icd.x86_64.json
 src/freedreno/drm-shim/libfreedreno_noop_drm_shim.so src/panfrost/vulkan/libvulkan_panfrost.so
 src/panfrost/vulkan/panfrost_devenv_icd.x86_64.json src/panfrost/drm-shim/libpanfrost_noop_drm_shim.so

@@ -30,6 +30,7 @@ pub static ADRENO: Shim = Shim {
     driver: "Turnip",
     compiler: "ir3",
     icd: "src/freedreno/vulkan/freedreno_devenv_icd.x86_64.json",
+    library: "src/freedreno/vulkan/libvulkan_freedreno.so",
     shim: "src/freedreno/drm-shim/libfreedreno_noop_drm_shim.so",
     gpu_var: "FD_GPU_ID",
     extra_env: &[],

@@ -27,6 +27,7 @@ pub static ANV: Shim = Shim {
     driver: "ANV",
     compiler: "brw",
     icd: "src/intel/vulkan/intel_devenv_icd.x86_64.json",
+    library: "src/intel/vulkan/libvulkan_intel.so",
     shim: "src/intel/tools/libintel_noop_drm_shim.so",
     gpu_var: "INTEL_STUB_GPU_PLATFORM",
     extra_env: &[],

@@ -53,6 +53,7 @@ pub static MALI: Shim = Shim {
     driver: "PanVK",
     compiler: "Bifrost",
     icd: "src/panfrost/vulkan/panfrost_devenv_icd.x86_64.json",
+    library: "src/panfrost/vulkan/libvulkan_panfrost.so",
     shim: "src/panfrost/drm-shim/libpanfrost_noop_drm_shim.so",
     gpu_var: "PAN_GPU_ID",
     extra_env: &[("PAN_I_WANT_A_BROKEN_VULKAN_DRIVER", "1"), ("BIFROST_MESA_DEBUG", "shaderdb")],

@@ -443,14 +443,12 @@ pub fn built_file(driver: &str, relative: &str) -> Result<PathBuf> {
 }
 
 /// The environment of a driver on a noop drm-shim: the loader sees only `icd` (the driver's devenv ICD file,
-/// which names the library in the build), `shim` answers the kernel's ioctls, and `extra` selects the GPU.
-pub fn shim_environment(driver: &str, icd: &str, shim: &str, extra: &[(&str, String)]) -> Result<Vec<(String, String)>> {
+/// which names `library` in the build), `shim` answers the kernel's ioctls, and `extra` selects the GPU. Each
+/// file must be in the build, or the error names it and `make setup`.
+pub fn shim_environment(driver: &str, icd: &str, library: &str, shim: &str, extra: &[(&str, String)]) -> Result<Vec<(String, String)>> {
     let icd = built_file(driver, icd)?;
+    built_file(driver, library)?;
     let shim = built_file(driver, shim)?;
-    let library = icd.with_file_name(format!("libvulkan_{}.so", icd.file_name().and_then(|n| n.to_str()).and_then(|n| n.split('_').next()).unwrap_or("?")));
-    if !library.is_file() {
-        bail!("{driver} is not built: {} is missing. Run `make setup`", library.display());
-    }
     let mut env = vec![("VK_ICD_FILENAMES".to_string(), icd.display().to_string()), ("VK_DRIVER_FILES".to_string(), icd.display().to_string()), ("LD_PRELOAD".to_string(), shim.display().to_string())];
     env.extend(extra.iter().map(|(k, v)| (k.to_string(), v.clone())));
     Ok(env)

@@ -34,8 +34,10 @@ pub struct Shim {
     pub driver: &'static str,
     /// The compiler ("ir3").
     pub compiler: &'static str,
-    /// Under the build directory (`mesa_noop::build_dir`): the driver's devenv ICD file and the shim.
+    /// Under the build directory (`mesa_noop::build_dir`): the driver's devenv ICD file, the driver library it
+    /// names and the shim (scripts/mesa-noop.sh builds exactly these; a test ties the two lists).
     pub icd: &'static str,
+    pub library: &'static str,
     pub shim: &'static str,
     /// The shim's variable that picks the GPU, and any other variable the driver needs.
     pub gpu_var: &'static str,
@@ -132,7 +134,7 @@ impl NoopDriver for Shim {
     fn environment(&self, family: usize) -> Result<Vec<(String, String)>> {
         let mut extra: Vec<(&str, String)> = vec![(self.gpu_var, self.families[family].gpu_id.to_string())];
         extra.extend(self.extra_env.iter().map(|(k, v)| (*k, v.to_string())));
-        mesa_noop::shim_environment(&format!("{}: (Mesa's {})", self.prefix, self.driver), self.icd, self.shim, &extra)
+        mesa_noop::shim_environment(&format!("{}: (Mesa's {})", self.prefix, self.driver), self.icd, self.library, self.shim, &extra)
     }
 
     fn install_hint(&self) -> String {

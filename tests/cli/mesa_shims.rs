@@ -178,3 +178,20 @@ fn devices_targets_lists_every_shim_family_and_its_compiler() {
         assert!(out.stdout.contains(compiler), "{compiler}:\n{}", out.stdout);
     }
 }
+
+#[test]
+fn setup_builds_every_file_each_shim_driver_loads() {
+    let script = std::fs::read_to_string(common::repo_root().join("scripts/mesa-noop.sh")).unwrap();
+    let products: Vec<&str> = script.split("products=\"").nth(1).unwrap().split('"').next().unwrap().split_whitespace().collect();
+    let shims = [&targets::adreno::ADRENO, &targets::mali::MALI, &targets::anv::ANV];
+    let loaded: Vec<&str> = shims.iter().flat_map(|s| [s.icd, s.library, s.shim]).collect();
+    let mut a = products.clone();
+    let mut b = loaded.clone();
+    a.sort();
+    b.sort();
+    assert_eq!(a, b, "scripts/mesa-noop.sh's products and the Shims' files differ");
+    // Every shim driver is in VENDORS.
+    for s in shims {
+        assert!(targets::VENDORS.iter().any(|v| v.prefix() == s.prefix), "{}", s.prefix);
+    }
+}
