@@ -277,12 +277,59 @@ struct ChildRun {
     teardown_note: Option<String>,
 }
 
-/// Runs the child for one target and reads its report.
+/// What the cache keeps of a child's run: its report and the messages it had for the user.
+#[derive(Serialize, Deserialize)]
+struct CachedChild {
+    target: String,
+    report: InspectReport,
+    messages: Vec<String>,
+}
+
+/// Runs the child for one target and reads its report, or takes both from the kernel cache when nothing that
+/// reaches the driver changed (`noop_cache`); the child's messages reach the user either way.
 fn run(driver: &'static dyn NoopDriver, family: usize, models: &[Model], raw: &[super::RawKernel], request: &Job) -> Result<ChildRun> {
-    let target = Target { vendor: driver, family };
-    let name = target.name();
+    let name = Target { vendor: driver, family }.name();
     // The driver's environment first: a driver that is not built stops here, naming what to run.
     let environment = driver.environment(family)?;
+    let inputs = super::noop_cache::ChildInputs { driver, family, models, raw, lights: request.lights, validate: request.validate, shaders: request.shaders, environment: &environment };
+    let key = match request.isa_dir {
+        Some(_) => None,
+        None => super::noop_cache::key(&inputs)?,
+    };
+    let Some(key) = key else {
+        let (run, messages) = spawn(driver, family, models, raw, request, environment)?;
+        messages.iter().for_each(|m| crate::messages::line(m));
+        return Ok(run);
+    };
+    let store = crate::cache::Store::open_default();
+    let what = format!("the report of the {name} child");
+    let valid = |bytes: &[u8]| -> Result<()> {
+        let cached: CachedChild = serde_json::from_slice(bytes)?;
+        if cached.target != name {
+            bail!("a report for {} under {name}'s key", cached.target);
+        }
+        Ok(())
+    };
+    let mut teardown_note = None;
+    let mut built = false;
+    let bytes = crate::cache::get_or_build(store.as_ref(), super::noop_cache::KIND, &key, &what, valid, || {
+        let (run, messages) = spawn(driver, family, models, raw, request, environment)?;
+        teardown_note = run.teardown_note;
+        built = true;
+        Ok(serde_json::to_vec(&CachedChild { target: name.clone(), report: run.report, messages })?)
+    })?;
+    let mut cached: CachedChild = serde_json::from_slice(&bytes)?;
+    cached.messages.iter().for_each(|m| crate::messages::line(m));
+    if let (false, Some(store)) = (built, &store) {
+        cached.report.provenance["cache_entry"] = serde_json::Value::String(store.path(super::noop_cache::KIND, &key).display().to_string());
+    }
+    Ok(ChildRun { report: cached.report, isa_files: Vec::new(), teardown_note })
+}
+
+/// Runs the child for one target: its report, and the lines of its stderr meant for the user.
+fn spawn(driver: &'static dyn NoopDriver, family: usize, models: &[Model], raw: &[super::RawKernel], request: &Job, environment: Vec<(String, String)>) -> Result<(ChildRun, Vec<String>)> {
+    let target = Target { vendor: driver, family };
+    let name = target.name();
     // The child writes its ISA files into its own TMPDIR; they become outputs of this process (staged with
     // its others) only once the child has succeeded.
     let mut cmd = cleanup::command(&std::env::current_exe().context("cannot find brdfprof's own executable")?.to_string_lossy());
@@ -320,9 +367,7 @@ fn run(driver: &'static dyn NoopDriver, family: usize, models: &[Model], raw: &[
     // Validation messages and warnings of the child reach the user as they are, but for the banner Mesa prints
     // for every driver it does not consider conformant (RADV's null device, PanVK) and the shims' notices.
     // (A failed child's last lines are in the error below.)
-    for line in stderr.lines().filter(|l| reply.is_some() && !is_banner(l) && !driver.is_noise(l)) {
-        crate::messages::line(line);
-    }
+    let messages: Vec<String> = stderr.lines().filter(|l| reply.is_some() && !is_banner(l) && !driver.is_noise(l)).map(str::to_string).collect();
     let teardown_note = match (&reply, output.status.success()) {
         (Some(_), true) => None,
         (Some(_), false) if output.status.code().is_none() => Some(format!(
@@ -342,7 +387,7 @@ fn run(driver: &'static dyn NoopDriver, family: usize, models: &[Model], raw: &[
         (Some(from), Some(to)) => reply.isa_files.iter().map(|f| publish(f, from, to)).collect::<Result<Vec<_>>>()?,
         _ => Vec::new(),
     };
-    Ok(ChildRun { report: reply.report, isa_files, teardown_note })
+    Ok((ChildRun { report: reply.report, isa_files, teardown_note }, messages))
 }
 
 /// The line Mesa prints on every start of a driver it calls non-conformant (RADV's null device, PanVK).

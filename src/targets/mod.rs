@@ -18,6 +18,7 @@ pub mod adreno;
 pub mod anv;
 pub mod mali;
 pub mod mesa_noop;
+pub mod noop_cache;
 pub mod radv;
 pub mod radv_env;
 pub mod radv_families;

@@ -127,6 +127,45 @@ fn a_missing_or_broken_build_exits_2_naming_make_setup() {
 }
 
 #[test]
+fn a_childs_report_is_cached_and_a_changed_driver_environment_compiles_afresh() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let cache = d.join("cache");
+    let inspect_with = |name: &str, env: &[(&str, &str)]| -> serde_json::Value {
+        let json = d.join(format!("{name}.json"));
+        let mut cmd = common::brdfprof();
+        cmd.args(["inspect", "--no-callgrind", "--model", "ggx", "--device", "adreno:a660", "--device", "mali:g52", "--json", json.to_str().unwrap(), "--markdown", d.join(format!("{name}.md")).to_str().unwrap()]);
+        let out = cmd.env("BRDFPROF_CACHE_DIR", &cache).envs(env.iter().copied()).output().unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(0), "{stderr}");
+        let mut value: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(json).unwrap()).unwrap();
+        value["stderr"] = stderr.into_owned().into();
+        value
+    };
+    let entry = |run: &serde_json::Value, i: usize| run["reports"][i]["provenance"]["cache_entry"].as_str().map(str::to_string);
+    let first = inspect_with("first", &[]);
+    let second = inspect_with("second", &[]);
+    for i in 0..2 {
+        assert_eq!(entry(&first, i), None, "a first run compiles");
+        let path = entry(&second, i).expect("the second run reads the cache");
+        assert!(Path::new(&path).starts_with(&cache) && path.ends_with(".noop_report"), "{path}");
+        assert_eq!(first["reports"][i]["cost"], second["reports"][i]["cost"]);
+        assert_eq!(first["reports"][i]["rows"], second["reports"][i]["rows"]);
+    }
+    // A variable the drivers read is part of the key.
+    let third = inspect_with("third", &[("MESA_SPIRV_LOG_LEVEL", "error")]);
+    assert!((0..2).all(|i| entry(&third, i).is_none()), "a changed driver variable compiles afresh");
+    // A damaged entry is reported, discarded and replaced.
+    let damaged = entry(&second, 0).unwrap();
+    std::fs::write(&damaged, b"brdfprof-cache 1\nkind: noop_report\n").unwrap();
+    let fourth = inspect_with("fourth", &[]);
+    assert!(fourth["stderr"].as_str().unwrap().contains("is damaged"), "{}", fourth["stderr"]);
+    assert_eq!(entry(&fourth, 0), None);
+    assert_eq!(first["reports"][0]["cost"], fourth["reports"][0]["cost"]);
+    assert!(entry(&inspect_with("fifth", &[]), 0).is_some(), "the replaced entry is read");
+}
+
+#[test]
 fn a_noop_device_is_never_asked_to_run() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();

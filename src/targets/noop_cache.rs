@@ -1,0 +1,150 @@
+//! The key under which a compile-only child's report is cached (`cache.rs`'s rule: everything that reaches
+//! the compiler). A child's figures depend on the kernels it compiles, the driver that compiles them and the
+//! environment the driver reads; the key holds:
+//! - every kernel's SPIR-V and selecting constants (`kernel_hash`, the models' and the memory-only one; a raw
+//!   kernel's words and interface), the models' spec texts, the light count, whether validation ran;
+//! - the driver: the child's environment (family variable, ICD, shim), each Vulkan ICD file the loader of the
+//!   child reads and the library it names, and every `LD_PRELOAD` file, each by path, size and modification
+//!   time (a rebuilt Mesa, or another installed one, is another key);
+//! - the variables of this process that Mesa, the loader or the dynamic linker read (`MESA_*`, `RADV_*`,
+//!   `ACO_*`, `TU_*`, `IR3_*`, `PAN_*`, `BIFROST_*`, `INTEL_*`, `ANV_*`, `NIR_*`, `VK_*`, `LD_*`...), which the
+//!   child inherits;
+//! - brdfprof's executable by size and modification time (the child's analyses are its code).
+//!
+//! A request that writes files (`--isa`) or asks the child to crash (the containment test) is never cached.
+
+use super::mesa_noop::{NoopDriver, CRASH_AFTER_REPLY};
+use super::RawKernel;
+use crate::cache::{Key, KeyBuilder};
+use crate::kernels::shade::{kernel_hash, GBufferFormat};
+use crate::model::Model;
+use crate::shaders::Shaders;
+use anyhow::Result;
+use std::path::{Path, PathBuf};
+
+/// The cache kind of a child's report.
+pub const KIND: &str = "noop_report";
+
+/// Prefixes of the variables a Mesa driver, the Vulkan loader or the dynamic linker may read.
+const DRIVER_PREFIXES: [&str; 18] =
+    ["MESA_", "RADV_", "ACO_", "TU_", "IR3_", "FD_", "PAN_", "BIFROST_", "MIDGARD_", "INTEL_", "ANV_", "BRW_", "NIR_", "GALLIUM_", "LP_", "VK_", "LD_", "XDG_DATA"];
+
+/// The Vulkan loader's system ICD directories (where no variable names the ICDs).
+const ICD_DIRS: [&str; 4] = ["/etc/vulkan/icd.d", "/usr/local/share/vulkan/icd.d", "/usr/share/vulkan/icd.d", "/usr/local/etc/vulkan/icd.d"];
+
+/// What one child is asked, as far as its figures depend on it.
+pub struct ChildInputs<'a> {
+    pub driver: &'a dyn NoopDriver,
+    pub family: usize,
+    pub models: &'a [Model],
+    pub raw: &'a [RawKernel],
+    pub lights: u32,
+    pub validate: bool,
+    pub shaders: &'a Shaders,
+    /// The driver's environment for the child.
+    pub environment: &'a [(String, String)],
+}
+
+/// The key of a child's report, or None when the request must run afresh.
+pub fn key(inputs: &ChildInputs) -> Result<Option<Key>> {
+    if std::env::var_os(CRASH_AFTER_REPLY).is_some() {
+        return Ok(None);
+    }
+    let exe = std::env::current_exe()?;
+    let mut key = KeyBuilder::new(KIND)
+        .part("brdfprof", env!("CARGO_PKG_VERSION"))
+        .part("executable", identity(&exe))
+        .part("target", format!("{}:{}", inputs.driver.prefix(), inputs.driver.families()[inputs.family].name))
+        .part("lights", inputs.lights.to_le_bytes())
+        .part("validate", [inputs.validate as u8]);
+    for model in inputs.models {
+        key = key.part("model", model.name()).part("kernel", kernel_hash(Some(model), GBufferFormat::Packed, inputs.shaders)?);
+    }
+    if inputs.raw.is_empty() {
+        key = key.part("memory-only kernel", kernel_hash(None, GBufferFormat::Packed, inputs.shaders)?);
+    }
+    for r in inputs.raw {
+        let interface = format!("{} {} {} {}", r.label, r.model.name(), r.storage_buffers, r.push_bytes);
+        key = key.part("raw", interface).part("raw words", bytemuck::cast_slice::<u32, u8>(&r.spirv));
+    }
+    let mut environment: std::collections::BTreeMap<String, String> =
+        std::env::vars().filter(|(k, _)| DRIVER_PREFIXES.iter().any(|p| k.starts_with(p))).collect();
+    environment.extend(inputs.environment.iter().cloned());
+    for (k, v) in &environment {
+        key = key.part("env", format!("{k}={v}"));
+    }
+    for file in driver_files(&environment) {
+        key = key.part("driver file", identity(&file));
+    }
+    Ok(Some(key.finish()))
+}
+
+/// A file by its path, size and modification time (nanoseconds), or that it is absent.
+fn identity(path: &Path) -> String {
+    match std::fs::metadata(path) {
+        Ok(m) => {
+            let mtime = m.modified().ok().and_then(|t| t.duration_since(std::time::UNIX_EPOCH).ok()).map_or(0, |d| d.as_nanos());
+            format!("{} {} {mtime}", path.display(), m.len())
+        }
+        Err(_) => format!("{} absent", path.display()),
+    }
+}
+
+/// The ICD files the child's loader reads (the variables' list, else the system directories), the library
+/// each names, and the preloaded files.
+fn driver_files(environment: &std::collections::BTreeMap<String, String>) -> Vec<PathBuf> {
+    let named = ["VK_DRIVER_FILES", "VK_ICD_FILENAMES"].iter().find_map(|v| environment.get(*v).filter(|s| !s.is_empty()));
+    let icds: Vec<PathBuf> = match named {
+        Some(list) => std::env::split_paths(list).collect(),
+        None => {
+            let mut all: Vec<PathBuf> = ICD_DIRS.iter().flat_map(|d| std::fs::read_dir(d).into_iter().flatten().flatten().map(|e| e.path())).collect();
+            all.sort();
+            all
+        }
+    };
+    let mut files = Vec::new();
+    for icd in icds {
+        if let Some(library) = icd_library(&icd) {
+            files.push(library);
+        }
+        files.push(icd);
+    }
+    if let Some(preload) = environment.get("LD_PRELOAD") {
+        files.extend(preload.split([' ', ':']).filter(|s| !s.is_empty()).map(PathBuf::from));
+    }
+    files
+}
+
+/// The library an ICD file names (relative to the file's folder when the name is a relative path).
+fn icd_library(icd: &Path) -> Option<PathBuf> {
+    let text = std::fs::read_to_string(icd).ok()?;
+    let json: serde_json::Value = serde_json::from_str(&text).ok()?;
+    let library = Path::new(json["ICD"]["library_path"].as_str()?);
+    Some(if library.is_relative() && library.components().count() > 1 { icd.parent()?.join(library) } else { library.to_path_buf() })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_file_changes_its_identity_when_rewritten() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("lib.so");
+        assert!(identity(&path).ends_with("absent"));
+        std::fs::write(&path, b"one").unwrap();
+        let first = identity(&path);
+        std::fs::write(&path, b"three").unwrap();
+        assert_ne!(first, identity(&path));
+    }
+
+    #[test]
+    fn an_icd_names_its_library_and_the_preloaded_shim_counts() {
+        let dir = tempfile::tempdir().unwrap();
+        let icd = dir.path().join("x_icd.json");
+        std::fs::write(&icd, r#"{"file_format_version": "1.0.0", "ICD": {"library_path": "./lib/libvulkan_x.so", "api_version": "1.3"}}"#).unwrap();
+        let env = [("VK_ICD_FILENAMES".to_string(), icd.display().to_string()), ("LD_PRELOAD".to_string(), "/s/shim.so".to_string())].into();
+        let files = driver_files(&env);
+        assert_eq!(files, vec![dir.path().join("./lib/libvulkan_x.so"), icd, PathBuf::from("/s/shim.so")]);
+    }
+}
