@@ -14,7 +14,12 @@ float cell_roughness;
 vec3 cell_f0;
 
 vec3 albedo_integrand(vec3 L) {
+#ifdef BRDF_FILE_RETURNS_F_NOL
+    // The file's entry returns f_s NoL itself (returns=f_nol).
+    return specular_brdf_unit(vec3(0.0, 0.0, 1.0), cell_V, L, cell_roughness, cell_f0);
+#else
     return specular_brdf_unit(vec3(0.0, 0.0, 1.0), cell_V, L, cell_roughness, cell_f0) * L.z;
+#endif
 }
 
 #include "albedo_estimator.glsl"

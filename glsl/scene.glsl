@@ -208,7 +208,13 @@ float diffuse_lobe(Surface s, vec3 L) {
 vec3 shade(Surface s, vec3 Ld, vec3 Ls, float spec_scale) {
     float NoLd = max(dot(s.N, Ld), 0.0);
     float NoLs = max(dot(s.N, Ls), 0.0);
+#ifdef BRDF_FILE_RETURNS_F_NOL
+    // The file's entry returns f_s NoL with its own cosine (returns=f_nol); a file takes no anisotropy (the
+    // scene refuses it), so its lobe is the file's alone.
+    vec3 c = specular_brdf_unit(s.N, s.V, Ls, s.roughness, s.f0) * spec_scale;
+#else
     vec3 c = specular_lobe(s, Ls) * (spec_scale * NoLs);
+#endif
     if (ENERGY_COMPENSATION != 0) {
         c *= s.energy;
     }

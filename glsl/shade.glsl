@@ -114,8 +114,13 @@ void main() {
         vec3 L = lights[2 * j].xyz;
         vec3 colour = lights[2 * j + 1].rgb;
         float NoL = max(dot(p.N, L), 0.0);
+#ifdef BRDF_FILE_RETURNS_F_NOL
+        // The file's entry returns f_s NoL with its own cosine (returns=f_nol): taken as it is, no second NoL.
+        acc += specular_brdf_unit(p.N, p.V, L, p.roughness, p.f0) * colour;
+#else
         vec3 fs = (BASELINE != 0) ? vec3(1.0) : specular_brdf_unit(p.N, p.V, L, p.roughness, p.f0);
         acc += fs * (NoL * colour);
+#endif
     }
     // The baseline folds every input it would otherwise skip into the result, so no load is dead code.
     if (BASELINE != 0) acc = acc * p.f0 + vec3(p.roughness) + p.V;

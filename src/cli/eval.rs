@@ -87,6 +87,6 @@ fn on_opencl(model: &Model, samples: &[brdfprof::brdf::Sample], extras: &kernels
     use brdfprof::translate::{opencl, prepare};
     let translation = prepare::eval_kernel(model, kernels::embedded())?;
     let kernel = opencl::ClKernel::build(&translation, false)?;
-    let values = opencl::eval(&kernel, samples, extras)?;
+    let values = kernels::as_f(model, opencl::eval(&kernel, samples, extras)?, samples);
     Ok((format!("{} (OpenCL)", kernel.device()), values, translation.body().contains("m_smod(")))
 }

@@ -145,7 +145,25 @@ pub fn eval_from(gpu: &Gpu, model: &Model, shaders: &Shaders, samples: &[Sample]
     let in_stride = 16 * extras.stride() as u64;
     let out = run_elementwise(gpu, &kernel, &pack_samples(samples, extras), in_stride, 16, samples.len() as u64, limits)?;
     let floats: Vec<f32> = bytemuck::pod_collect_to_vec(&out);
-    Ok(floats.chunks_exact(4).map(|c| [c[0], c[1], c[2]]).collect())
+    Ok(as_f(model, floats.chunks_exact(4).map(|c| [c[0], c[1], c[2]]).collect(), samples))
+}
+
+/// The eval kernel's values (of any device) as f_s: a `.brdf` entry that returns f_s N.L (`returns f_nol`)
+/// divided by N.L (`f_from_f_nol`), any other model's as they are.
+pub fn as_f(model: &Model, values: Vec<[f32; 3]>, samples: &[Sample]) -> Vec<[f32; 3]> {
+    if !model.file().is_some_and(|f| f.returns_f_nol()) {
+        return values;
+    }
+    values.into_iter().zip(samples).map(|(g, s)| f_from_f_nol(g, s)).collect()
+}
+
+/// f_s from an entry's f_s N.L (`returns f_nol`), divided on the host so that no kernel holds the division:
+/// N.L of the unit n and l in f64; where N.L <= 0 a zero stays zero and anything else is divided as it is
+/// (light from below the horizon shows as a negative or infinite f_s, which `stability` counts).
+pub fn f_from_f_nol(g: [f32; 3], s: &Sample) -> [f32; 3] {
+    let unit = |v: [f32; 3]| glam::DVec3::new(v[0].into(), v[1].into(), v[2].into()).normalize_or_zero();
+    let nol = unit(s.n).dot(unit(s.l));
+    g.map(|x| if x == 0.0 { 0.0 } else { (f64::from(x) / nol) as f32 })
 }
 
 /// Inputs of the per-term kernel: cosines as given (the kernel guards them), sin2h = 1 - NoH^2, roughness, F0.

@@ -11,7 +11,7 @@
 //! the composed source (so the file's content), every file of the GLSL tree it includes, defines, flags,
 //! glslang's and brdfprof's versions.
 
-use super::brdf_file::{self, glsl_float, BrdfFile, FileParam, FileParamKind};
+use super::brdf_file::{self, glsl_float, BrdfFile, FileParam, FileParamKind, Returns};
 use super::KernelKind;
 use crate::shaders::{self, Shaders, Spirv};
 use anyhow::{anyhow, bail, Context, Result};
@@ -135,6 +135,18 @@ pub struct FileModel {
     pub bindings: Vec<Binding>,
     /// Its `name=` label (`Model::label`), when one was given.
     pub label: Option<String>,
+    /// `entry=NAME`: a declared entry other than the file's default (`FileModel::entry`).
+    pub entry: Option<String>,
+    /// `returns=f|f_nol`: overrides what the entry's declaration says it returns.
+    pub returns: Option<Returns>,
+}
+
+/// The function the kernels call for f_s: `BRDF`, or a declared entry (`entry NAME(ARG, ...)` in the file).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ChosenEntry<'a> {
+    /// None: BRDF Explorer's `BRDF(L, V, N, X, Y)`.
+    pub declared: Option<&'a brdf_file::Entry>,
+    pub returns: Returns,
 }
 
 impl FileParam {
@@ -209,6 +221,17 @@ impl FileParam {
     }
 }
 
+/// Each parameter's default: its `bind NAME=@INPUT` in the file's `brdfprof` section, else its value.
+fn default_bindings(file: &BrdfFile, path: &str) -> Result<Vec<Binding>> {
+    file.params
+        .iter()
+        .map(|p| match file.binds.iter().find(|(name, _, _)| name == &p.name) {
+            Some((_, input, line)) => p.parse_binding(path, input).map_err(|e| anyhow!("{}:{line}: `bind`: {e:#}", file.path.display())),
+            None => Ok(Binding::Value(p.default_value())),
+        })
+        .collect()
+}
+
 /// A model text's `.brdf` path and the `NAME=VALUE` fields after it. The path ends at a `.brdf` followed by a
 /// comma or the end (so a path may hold commas: `a,b/m.brdf,k=1`): the first such whose file exists
 /// (relative to `base`), else the first such. None when the text names no `.brdf` file (a spec never does).
@@ -240,6 +263,10 @@ fn loop_warning(path: &str, l: &brdf_file::Loop) -> String {
 /// The key of a macro for the file's shader in a model text (`my.brdf,define=QUALITY=1`), as `--define`
 /// gives one to every file and a scene material's `define` does.
 pub const DEFINE: &str = "define";
+
+/// The keys of a model text that choose the entry (`entry=NAME`) and say what it returns (`returns=f|f_nol`).
+pub const ENTRY: &str = "entry";
+pub const RETURNS: &str = "returns";
 
 /// The entry and its parameters as BRDF Explorer's files name them: no macro may take these names.
 const ENTRY_NAMES: [&str; 6] = ["BRDF", "L", "V", "N", "X", "Y"];
@@ -304,10 +331,26 @@ impl FileModel {
         if file.has_is_func {
             crate::messages::input_note(format!("{path}: its isFunc section (importance sampling) is ignored: brdfprof integrates with its own estimator"));
         }
-        let bindings = file.params.iter().map(|p| Binding::Value(p.default_value())).collect();
-        let model = FileModel { file, path: path.to_string(), bindings, label: None };
+        let bindings = default_bindings(&file, path)?;
+        let model = FileModel { file, path: path.to_string(), bindings, label: None, entry: None, returns: None };
         model.warn_new(None);
         model.with_params(&params)
+    }
+
+    /// The entry the kernels call: `entry=NAME`'s, else the first declared, else `BRDF`; what it returns, as
+    /// `returns=` or its declaration says.
+    pub fn entry(&self) -> ChosenEntry<'_> {
+        let declared = match &self.entry {
+            Some(name) => self.file.entries.iter().find(|e| &e.name == name),
+            None => self.file.entries.first(),
+        };
+        ChosenEntry { declared, returns: self.returns.or(declared.map(|e| e.returns)).unwrap_or(Returns::F) }
+    }
+
+    /// Whether the entry returns f_s N.L (`returns f_nol`): the kernels then take its value as f_s N.L, and
+    /// `eval` divides it by N.L on the host.
+    pub fn returns_f_nol(&self) -> bool {
+        self.entry().returns == Returns::FNoL
     }
 
     /// Prints the file's warnings and loop warnings that `before` (the model it was made from) did not have.
@@ -322,7 +365,7 @@ impl FileModel {
     }
 
     pub fn takes_param(&self, name: &str) -> bool {
-        name == DEFINE || self.file.params.iter().any(|p| p.name == name)
+        [DEFINE, ENTRY, RETURNS].contains(&name) || self.file.params.iter().any(|p| p.name == name)
     }
 
     /// Applies `NAME=VALUE` overrides and `define=NAME[=VALUE]` macros (the shader then preprocessed again); an
@@ -343,6 +386,14 @@ impl FileModel {
                 bail!("{}: `{name}` is given twice ({}); give each parameter once", self.path, params.iter().map(|p| p.as_str()).collect::<Vec<_>>().join(", "));
             }
             given.push(name);
+            if name == ENTRY {
+                m.entry = Some(self.parse_entry(value.trim())?);
+                continue;
+            }
+            if name == RETURNS {
+                m.returns = Some(Returns::parse(value.trim()).ok_or_else(|| anyhow!("{}: `returns={}`: expected returns=f or returns=f_nol", self.path, value.trim()))?);
+                continue;
+            }
             let k = self.file.params.iter().position(|q| q.name == name).ok_or_else(|| {
                 let known = self.file.params.iter().map(|q| q.name.as_str()).collect::<Vec<_>>();
                 anyhow!("{}: no parameter `{name}` (the file's parameters: {})", self.path, if known.is_empty() { "none".to_string() } else { known.join(", ") })
@@ -366,15 +417,35 @@ impl FileModel {
         (m, offset)
     }
 
+    /// `entry=NAME`: a declared entry, or `BRDF` where the file defines it; anything else is an error naming
+    /// the declared ones.
+    fn parse_entry(&self, name: &str) -> Result<String> {
+        let declared: Vec<&str> = self.file.entries.iter().map(|e| e.name.as_str()).collect();
+        if declared.contains(&name) || (name == "BRDF" && self.file.defines_brdf) {
+            return Ok(name.to_string());
+        }
+        let known = declared.iter().map(|d| d.to_string()).chain(self.file.defines_brdf.then(|| "BRDF".to_string())).collect::<Vec<_>>();
+        bail!("{}: `entry={name}`: the file declares no such entry (its entries: {}; declare one as `entry NAME(ARG, ...) returns f|f_nol` in a `::begin brdfprof` section)", self.path, known.join(", "))
+    }
+
     fn text_with(&self, all: bool) -> String {
         let mut s = self.path.clone();
         for (name, value) in &self.file.defines {
             s += &if value.is_empty() { format!(",{DEFINE}={name}") } else { format!(",{DEFINE}={name}={value}") };
         }
-        for (p, b) in self.file.params.iter().zip(&self.bindings) {
+        let default_entry = self.file.entries.first().map_or("BRDF", |e| e.name.as_str());
+        if let Some(e) = self.entry.as_ref().filter(|e| all || e.as_str() != default_entry) {
+            s += &format!(",{ENTRY}={e}");
+        }
+        let declared = self.entry().declared.map_or(Returns::F, |e| e.returns);
+        if let Some(r) = self.returns.filter(|r| all || *r != declared) {
+            s += &format!(",{RETURNS}={}", r.text());
+        }
+        let defaults = default_bindings(&self.file, &self.path).unwrap_or_default();
+        for ((p, b), d) in self.file.params.iter().zip(&self.bindings).zip(defaults) {
             let text = match b {
-                Binding::Value(v) if all || *v != p.default_value() => v.text(),
-                Binding::Input(i) => format!("@{}", i.name()),
+                Binding::Value(v) if all || *b != d => v.text(),
+                Binding::Input(i) if all || *b != d => format!("@{}", i.name()),
                 _ => continue,
             };
             s += &format!(",{}={text}", p.name);
@@ -435,8 +506,17 @@ impl FileModel {
         }
         s += &format!("#define BRDF_FILE_BIND {}\n", bind.join(" "));
         s += &format!("#define EVAL_STRIDE {}\n#define BRDF_FILE_ROWS(base) {}\n", 4 + row_floats.div_ceil(4), rows.join(" "));
-        s += &format!("#define BRDF_FILE_FUNCTION {}\n", self.file.glsl_name("BRDF"));
+        let entry = self.entry();
+        let glue = entry.declared.map(|e| self.file.entry_glue(e));
+        let function = glue.as_ref().map_or_else(|| self.file.glsl_name("BRDF"), |(name, _)| name.clone());
+        s += &format!("#define BRDF_FILE_FUNCTION {function}\n");
+        if entry.returns == Returns::FNoL {
+            s += "#define BRDF_FILE_RETURNS_F_NOL 1\n";
+        }
         s += &format!("{}\n{}", self.file.line_directive(), renamed.text());
+        if let Some((_, text)) = &glue {
+            s += text;
+        }
         // The kernel's own text, numbered as in its file (its `#version` line dropped).
         let (first, body) = kernel_source.split_once('\n').unwrap_or(("", kernel_source));
         if !first.starts_with("#version") {

@@ -15,6 +15,7 @@ mod cache;
 mod compare;
 mod devices;
 mod diff;
+mod engine_entries;
 mod docs;
 mod eval;
 mod eval_csv;

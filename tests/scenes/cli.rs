@@ -239,3 +239,33 @@ fn a_brdf_file_as_a_material_model_renders_as_its_preset() {
     let worst = below(&a).iter().zip(below(&b).iter()).flat_map(|(p, q)| (0..3).map(move |c| (p[c] as i32 - q[c] as i32).abs())).max().unwrap();
     assert!(worst <= 1, "the file's picture differs from the preset's by {worst}/255");
 }
+
+#[test]
+fn an_engine_entry_returning_f_nol_renders_as_its_twin_returning_f() {
+    // tests/fixtures/brdf/engine: the same GGX as an engine's light function (f_s N.L, `returns f_nol`) and as
+    // BRDF Explorer's BRDF (f_s); both bind their inputs in the file. The clear coat stays on (a file takes no
+    // anisotropy: that replaces GGX's D and Vis).
+    let dir = tempfile::tempdir().unwrap();
+    let engine = common::repo_root().join("tests/fixtures/brdf/engine");
+    let mut pictures = Vec::new();
+    for file in ["engine-ggx", "engine-ggx-f"] {
+        let model = engine.join(format!("{file}.brdf")).display().to_string();
+        let scene = SMALL
+            .replace(r#""model": "ggx""#, &format!(r#""model": "{model}""#))
+            .replace(r#""anisotropy": 0.7"#, r#""anisotropy": 0.0"#)
+            .replace(r#""models": ["ggx", "burley"]"#, &format!(r#""models": ["{model}"]"#));
+        let f = write(dir.path(), &format!("{file}.json"), &scene);
+        let out = dir.path().join(file);
+        let (code, _, err) = run(&["render", "--scene", &f, "--out", out.to_str().unwrap()]);
+        assert_eq!(code, 0, "{err}");
+        assert!(!err.contains("validation ["), "{err}");
+        let path = std::fs::read_dir(&out).unwrap().map(|e| e.unwrap().path()).find(|p| p.file_name().unwrap().to_string_lossy().starts_with(file) && p.extension().is_some_and(|x| x == "png")).unwrap();
+        pictures.push(image::open(path).unwrap().to_rgb8());
+    }
+    let below = |img: &image::RgbImage| img.enumerate_pixels().filter(|(_, y, _)| *y >= 20).map(|(_, _, p)| *p).collect::<Vec<_>>();
+    let (a, b) = (below(&pictures[0]), below(&pictures[1]));
+    assert_eq!(a.len(), b.len());
+    let worst = a.iter().zip(&b).flat_map(|(p, q)| (0..3).map(move |c| (p[c] as i32 - q[c] as i32).abs())).max().unwrap();
+    assert!(worst <= 1, "the engine form's picture differs from the f form's by {worst}/255");
+    assert!(a.iter().any(|p| p[0] > 10), "a lit picture");
+}

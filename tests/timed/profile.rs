@@ -118,3 +118,31 @@ fn protocol_keeps_the_faster_instance_and_reports_the_spread() {
     }
     common::assert_no_validation_messages(&gpu);
 }
+
+/// An engine's function returning f_s N.L (tests/fixtures/brdf/engine/engine-ggx.brdf, `returns f_nol`) costs
+/// what the same maths written as BRDF Explorer's BRDF returning f_s costs: the net cost ratios' 95% CIs of
+/// the two, interleaved in one run on lavapipe, overlap (no glue is timed: brdfprof divides by N.L on the host).
+#[test]
+fn an_engine_entry_costs_what_its_twin_returning_f_costs() {
+    let _serial = crate::serial();
+    let dir = tempfile::tempdir().unwrap();
+    let json = dir.path().join("p.json");
+    let engine = common::repo_root().join("tests/fixtures/brdf/engine");
+    let out = common::brdfprof()
+        .args(["profile", "--validate", "--size", "512x512", "--json", json.to_str().unwrap(), "--model"])
+        .arg(engine.join("engine-ggx.brdf"))
+        .arg("--model")
+        .arg(engine.join("engine-ggx-f.brdf"))
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success() && !stderr.contains("validation ["), "{stderr}");
+    let report: Value = serde_json::from_str(&std::fs::read_to_string(json).unwrap()).unwrap();
+    let ci = |name: &str| {
+        let row = report["rows"].as_array().unwrap().iter().find(|r| r["model"] == name).unwrap_or_else(|| panic!("no row {name}"));
+        let r = &row["net_vs_reference"];
+        (r["lo"].as_f64().unwrap(), r["median"].as_f64().unwrap(), r["hi"].as_f64().unwrap())
+    };
+    let (a, b) = (ci("engine-ggx"), ci("engine-ggx-f"));
+    assert!(a.0 <= b.2 && b.0 <= a.2, "net cost vs ggx: engine form {a:?}, f form {b:?}: the CIs do not overlap");
+}

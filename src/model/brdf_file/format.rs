@@ -135,7 +135,7 @@ pub(super) fn read_sections<'a>(file: &mut BrdfFile, lines: impl Iterator<Item =
                         }
                         shader_begin = Some(n);
                     }
-                    "parameters" | "isFunc" => {}
+                    "parameters" | "isFunc" | DIRECTIVES_SECTION => {}
                     other => file.warnings.push(at(&path, n, format!("don't know what to do with section `{other}`: its content is ignored"))),
                 }
                 open = Some(Open { name: name.to_string(), line: n });
@@ -161,6 +161,7 @@ pub(super) fn read_sections<'a>(file: &mut BrdfFile, lines: impl Iterator<Item =
                 }
                 Some("shader") => file.source.push((n, raw.to_string())),
                 Some("isFunc") => file.has_is_func = true,
+                Some(DIRECTIVES_SECTION) => parse_directive(file, n, trimmed)?,
                 Some(_) => {}
             },
         }
@@ -244,4 +245,88 @@ pub(super) fn check_identifier(path: &Path, n: usize, name: &str, warnings: &mut
         warnings.push(at(path, n, format!("`{name}`: GLSL reserves identifiers containing `__`")));
     }
     Ok(())
+}
+
+/// The section of brdfprof's own directives (BRDF Explorer warns about it and reads on): `entry`, `bind`.
+pub(super) const DIRECTIVES_SECTION: &str = "brdfprof";
+
+/// One line of the `brdfprof` section:
+/// - `entry NAME(ARG, ...) [returns f|f_nol]`: the shader's function to call instead of `BRDF`, with each
+///   argument a GLSL expression over `L V N X Y` (BRDF Explorer's entry's arguments) and the file's
+///   parameters; `returns f_nol` when it returns f_s times N.L (an engine's light loop body).
+/// - `bind NAME=@INPUT ...`: a parameter's default binding to a kernel input, as `NAME=@INPUT` in the model spec.
+pub(super) fn parse_directive(file: &mut BrdfFile, n: usize, line: &str) -> Result<()> {
+    let path = file.path.clone();
+    let (word, rest) = line.split_once(char::is_whitespace).map_or((line, ""), |(w, r)| (w, r.trim()));
+    match word {
+        "entry" => {
+            let entry = parse_entry(&path, n, rest)?;
+            if let Some(first) = file.entries.iter().find(|e| e.name == entry.name) {
+                bail!(at(&path, n, format!("entry `{}` is declared twice (first at line {})", entry.name, first.line)));
+            }
+            file.entries.push(entry);
+        }
+        "bind" => {
+            for item in rest.split_whitespace() {
+                let (name, value) = item.split_once('=').ok_or_else(|| anyhow!(at(&path, n, format!("`{item}`: expected NAME=@INPUT"))))?;
+                if !value.starts_with('@') {
+                    bail!(at(&path, n, format!("`{item}`: `bind` binds a parameter to an input (NAME=@roughness, ...); a value belongs in the parameters section")));
+                }
+                if let Some((_, _, first)) = file.binds.iter().find(|(b, _, _)| b == name) {
+                    bail!(at(&path, n, format!("`{name}` is bound twice (first at line {first})")));
+                }
+                file.binds.push((name.to_string(), value.to_string(), n));
+            }
+            if rest.is_empty() {
+                bail!(at(&path, n, "`bind` names no parameter: `bind NAME=@INPUT ...`"));
+            }
+        }
+        other => bail!(at(&path, n, format!("unknown directive `{other}` in the `{DIRECTIVES_SECTION}` section (known: entry, bind)"))),
+    }
+    Ok(())
+}
+
+/// `NAME(ARG, ...) [returns f|f_nol]`.
+fn parse_entry(path: &Path, n: usize, text: &str) -> Result<Entry> {
+    let form = "`entry NAME(ARG, ...) [returns f|f_nol]`";
+    let open = text.find('(').ok_or_else(|| anyhow!(at(path, n, format!("`entry {text}`: expected {form}"))))?;
+    let name = text[..open].trim();
+    if !is_identifier(name) || GLSL_KEYWORDS.contains(&name) {
+        bail!(at(path, n, format!("`entry {text}`: `{name}` is not a function name")));
+    }
+    let mut depth = 0usize;
+    let mut args = Vec::new();
+    let mut start = open + 1;
+    let mut close = None;
+    for (i, c) in text.char_indices().skip(open) {
+        match c {
+            '(' => depth += 1,
+            ')' => {
+                depth -= 1;
+                if depth == 0 {
+                    close = Some(i);
+                    break;
+                }
+            }
+            ',' if depth == 1 => {
+                args.push(text[start..i].trim().to_string());
+                start = i + 1;
+            }
+            _ => {}
+        }
+    }
+    let close = close.ok_or_else(|| anyhow!(at(path, n, format!("`entry {text}`: the argument list has no closing `)`"))))?;
+    let last = text[start..close].trim();
+    if !(args.is_empty() && last.is_empty()) {
+        args.push(last.to_string());
+    }
+    if let Some(empty) = args.iter().position(|a| a.is_empty()) {
+        bail!(at(path, n, format!("`entry {text}`: argument {} is empty", empty + 1)));
+    }
+    let returns = match text[close + 1..].split_whitespace().collect::<Vec<_>>().as_slice() {
+        [] => Returns::F,
+        ["returns", r] => Returns::parse(r).ok_or_else(|| anyhow!(at(path, n, format!("`returns {r}`: expected f or f_nol"))))?,
+        _ => bail!(at(path, n, format!("`entry {text}`: expected {form}"))),
+    };
+    Ok(Entry { name: name.to_string(), args, returns, line: n })
 }

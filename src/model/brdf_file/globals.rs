@@ -22,7 +22,33 @@ pub(super) fn check_shader(file: &mut BrdfFile, begin: usize, tokens: &[Token], 
     for &(line, ref name) in &scan.uniforms {
         file.warnings.push(at(&file.path, line, format!("`uniform` dropped from `{name}`: Vulkan GLSL has no uniforms outside blocks, so it is a private global nothing sets (declare it as a parameter instead)")));
     }
-    check_brdf(&file.path, begin, &scan.globals)
+    for (name, _, line) in &file.binds {
+        if !params.contains_key(name.as_str()) {
+            bail!(at(&file.path, *line, format!("`bind {name}=...`: the file has no parameter `{name}`")));
+        }
+    }
+    let brdf = check_brdf(&file.path, begin, &scan.globals);
+    file.defines_brdf = brdf.is_ok();
+    if file.entries.is_empty() {
+        return brdf;
+    }
+    file.entries.iter().try_for_each(|e| check_entry(&file.path, e, &scan.globals))
+}
+
+/// A declared entry must be a function defined at global scope, returning vec3, with one parameter per argument.
+pub(super) fn check_entry(path: &Path, entry: &Entry, globals: &[Global]) -> Result<()> {
+    let defined = globals.iter().find_map(|g| match &g.kind {
+        GlobalKind::Function { defined: true, returns, params } if g.name == entry.name => Some((g.line, returns, params.len())),
+        _ => None,
+    });
+    match defined {
+        None => bail!(at(path, entry.line, format!("entry `{}`: the shader defines no function `{}` at global scope", entry.name, entry.name))),
+        Some((line, returns, _)) if returns != "vec3" => bail!(at(path, entry.line, format!("entry `{}` returns `{returns}` (line {line}); an entry returns vec3 (f_s, or f_s N.L with `returns f_nol`)", entry.name))),
+        Some((line, _, count)) if count != entry.args.len() => {
+            bail!(at(path, entry.line, format!("entry `{}` takes {count} arguments (line {line}) and the declaration gives {}", entry.name, entry.args.len())))
+        }
+        Some(_) => Ok(()),
+    }
 }
 
 pub(super) const BRDF_SIGNATURE: &str = "vec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y)";

@@ -8,7 +8,9 @@
 //! there is dropped with a warning. `::begin NAME` / `::end NAME` enclose sections: `parameters` (`float NAME MIN
 //! MAX DEFAULT`, `bool NAME 0|1`, `color NAME R G B`), `shader` (GLSL defining
 //! `vec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y)`; BRDF Explorer declares each parameter before it as
-//! `uniform float/bool/vec3 NAME;`) and `isFunc` (importance sampling, ignored here).
+//! `uniform float/bool/vec3 NAME;`), `isFunc` (importance sampling, ignored here) and brdfprof's own `brdfprof`
+//! (`entry NAME(ARG, ...) returns f|f_nol`: an engine's function to call instead of `BRDF`; `bind NAME=@INPUT`:
+//! default bindings; docs/engine-brdf.md).
 //!
 //! Composition (`renamed_shader`): every global name the shader declares and every parameter name is renamed,
 //! at each of its occurrences, with a prefix (`brdf_f_`, or a variant when the file already uses identifiers
@@ -77,6 +79,12 @@ pub struct BrdfFile {
     pub shader: Vec<(usize, String)>,
     /// The line of `::begin shader`.
     shader_begin: usize,
+    /// Functions declared in the `brdfprof` section to call instead of `BRDF` (`entry ...`), in order.
+    pub entries: Vec<Entry>,
+    /// The shader defines `BRDF` with BRDF Explorer's signature (it may not when it declares entries).
+    pub defines_brdf: bool,
+    /// Default bindings of parameters to inputs (`bind NAME=@INPUT`): (name, `@INPUT`, line).
+    pub binds: Vec<(String, String, usize)>,
     /// The file has an `isFunc` section with code in it (brdfprof ignores it; BRDF Explorer samples with it).
     pub has_is_func: bool,
     /// `FILE:LINE: ...` for what the file does that BRDF Explorer tolerates but is likely a mistake: those of
@@ -102,6 +110,43 @@ pub struct Loop {
     pub keyword: &'static str,
     /// Iterations, where the loop is `for (T i = A; i OP B; i STEP)` with literal A, B and step.
     pub trip_count: Option<u64>,
+}
+
+/// An engine's function the file names as its entry (`entry NAME(ARG, ...) returns ...`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Entry {
+    pub name: String,
+    /// GLSL expressions over L, V, N, X, Y and the file's parameters, one per argument of the function.
+    pub args: Vec<String>,
+    pub returns: Returns,
+    /// The 1-based file line that declares it.
+    pub line: usize,
+}
+
+/// What an entry returns.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Returns {
+    /// f_s itself, as BRDF Explorer's `BRDF`.
+    F,
+    /// f_s times N.L with the function's own cosine, as an engine's light loop returns it.
+    FNoL,
+}
+
+impl Returns {
+    pub fn parse(text: &str) -> Option<Returns> {
+        match text {
+            "f" => Some(Returns::F),
+            "f_nol" => Some(Returns::FNoL),
+            _ => None,
+        }
+    }
+
+    pub fn text(self) -> &'static str {
+        match self {
+            Returns::F => "f",
+            Returns::FNoL => "f_nol",
+        }
+    }
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -163,6 +208,9 @@ pub fn parse_with(path: &Path, bytes: &[u8], defines: &[(String, String)]) -> Re
         defines: Vec::new(),
         shader: Vec::new(),
         shader_begin: 0,
+        entries: Vec::new(),
+        defines_brdf: false,
+        binds: Vec::new(),
         has_is_func: false,
         warnings: Vec::new(),
         format_warnings: Vec::new(),

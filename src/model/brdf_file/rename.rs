@@ -73,6 +73,23 @@ impl BrdfFile {
         self.path.display().to_string().chars().map(|c| if c == '"' || c.is_control() { '_' } else { c }).collect()
     }
 
+    /// The function that calls a declared entry as BRDF Explorer's `BRDF(L, V, N, X, Y)` is called, and its
+    /// text, to put after the renamed shader: `#line` at the declaration (so glslang's messages about an
+    /// argument name the `entry` line), then one call whose arguments are the declaration's expressions with
+    /// the file's names renamed. The name (the prefix, then a digit) is one no renamed name can take.
+    pub fn entry_glue(&self, entry: &Entry) -> (String, String) {
+        let name = format!("{}0entry", self.prefix);
+        let args: Vec<String> = entry.args.iter().map(|a| self.renamed.rename_expression(a)).collect();
+        let text = format!(
+            "#line {} \"{}\"\nvec3 {name}(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) {{ return {}({}); }}\n",
+            entry.line,
+            self.directive_name(),
+            self.glsl_name(&entry.name),
+            args.join(", ")
+        );
+        (name, text)
+    }
+
     /// `#line N "FILE"`, to put just before the renamed shader lines (it needs
     /// `GL_GOOGLE_cpp_style_line_directive`, or `GL_GOOGLE_include_directive`, which implies it): glslang then
     /// reports the file's own name and lines.
@@ -160,6 +177,26 @@ impl RenamedShader {
                 Some(original) => out += original,
                 None => out += word,
             }
+            rest = &rest[start + len..];
+        }
+        out + rest
+    }
+
+    /// A GLSL expression of an entry's declaration with the file's parameters and globals renamed, except
+    /// the entry's own arguments (`L V N X Y`) and names after a `.` (swizzles, members).
+    pub fn rename_expression(&self, text: &str) -> String {
+        let mut out = String::with_capacity(text.len());
+        let mut rest = text;
+        while let Some(start) = rest.find(|c: char| c == '_' || c.is_ascii_alphanumeric()) {
+            let len = rest[start..].find(|c: char| !(c == '_' || c.is_ascii_alphanumeric())).unwrap_or(rest.len() - start);
+            let word = &rest[start..start + len];
+            let after_dot = rest[..start].trim_end().ends_with('.') || out.trim_end().ends_with('.') && rest[..start].trim().is_empty();
+            out += &rest[..start];
+            let starts_identifier = word.starts_with(|c: char| c == '_' || c.is_ascii_alphabetic());
+            if starts_identifier && !after_dot && !["L", "V", "N", "X", "Y"].contains(&word) && self.lookup.contains(word) {
+                out += &self.prefix;
+            }
+            out += word;
             rest = &rest[start + len..];
         }
         out + rest

@@ -1,0 +1,133 @@
+//! An engine's own function as a `.brdf` model's entry (`entry NAME(ARG, ...) returns f_nol` in the file's
+//! `brdfprof` section, `entry=` / `returns=` in the spec) and per-file default bindings (`bind`): the
+//! engine-shaped test file (tests/fixtures/brdf/engine/engine-ggx.brdf, written for the project) against its
+//! twin written as BRDF Explorer's `BRDF` returning f_s (engine-ggx-f.brdf), with no glue written by the user.
+
+use crate::common::{self, run_in};
+use std::path::{Path, PathBuf};
+
+fn fixture(name: &str) -> PathBuf {
+    common::repo_root().join("tests/fixtures/brdf/engine").join(name)
+}
+
+fn engine() -> String {
+    fixture("engine-ggx.brdf").display().to_string()
+}
+
+fn twin() -> String {
+    fixture("engine-ggx-f.brdf").display().to_string()
+}
+
+/// Seeded rows over the hemisphere with N.L, N.V in (0.05, 1] and roughness at or above the engine's floor.
+fn write_rows(path: &Path, n: usize) {
+    let mut s = String::from("nx,ny,nz,vx,vy,vz,lx,ly,lz,roughness,f0r,f0g,f0b\n");
+    let mut x: u64 = 0x9e37_79b9_7f4a_7c15;
+    let next = |x: &mut u64| {
+        *x ^= *x << 13;
+        *x ^= *x >> 7;
+        *x ^= *x << 17;
+        (*x >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let dir = |x: &mut u64| {
+        let (c, phi) = (0.05 + 0.95 * next(x), std::f64::consts::TAU * next(x));
+        let s = (1.0 - c * c).sqrt();
+        [s * phi.cos(), s * phi.sin(), c]
+    };
+    for _ in 0..n {
+        let (v, l) = (dir(&mut x), dir(&mut x));
+        let (r, f0) = (0.06 + 0.94 * next(&mut x), 0.02 + 0.9 * next(&mut x));
+        s += &format!("0,0,1,{},{},{},{},{},{},{r},{f0},0.5,0.9\n", v[0], v[1], v[2], l[0], l[1], l[2]);
+    }
+    std::fs::write(path, s).unwrap();
+}
+
+fn values(path: &Path) -> Vec<[f64; 3]> {
+    std::fs::read_to_string(path).unwrap().lines().skip(1).map(|l| {
+        let v: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
+        [v[0], v[1], v[2]]
+    }).collect()
+}
+
+#[test]
+fn an_entry_returning_f_nol_evaluates_as_its_twin_returning_f() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write_rows(&d.join("in.csv"), 2000);
+    for (model, out) in [(engine(), "engine.csv"), (twin(), "twin.csv")] {
+        run_in(d, &["eval", "--model", &model, "--input", "in.csv", "--output", out]).ok();
+    }
+    let (a, b) = (values(&d.join("engine.csv")), values(&d.join("twin.csv")));
+    assert_eq!(a.len(), 2000);
+    let worst = a.iter().zip(&b).flat_map(|(x, y)| (0..3).map(move |c| common::rel_err(x[c], y[c]))).fold(0.0, f64::max);
+    // The division by N.L happens on the host in f64; the rest is the same fp32 maths in another order.
+    assert!(worst < 1e-5, "engine form against f form: worst relative difference {worst:e}");
+    assert!(a.iter().any(|v| v[0] > 0.0));
+}
+
+#[test]
+fn the_files_bindings_are_its_defaults_and_entry_and_returns_are_named_where_they_differ() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write_rows(&d.join("in.csv"), 4);
+    // `bind roughness=@roughness f0=@f0` in the file: the bare path is bound, and named by its stem alone.
+    let json = d.join("p.json");
+    run_in(d, &["profile", "--model", &engine(), "--size", "64x64", "--budget", "5", "--json", json.to_str().unwrap()]).ok();
+    let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let names: Vec<String> = report["rows"].as_array().unwrap().iter().map(|r| r["model"].as_str().unwrap().to_string()).collect();
+    assert!(names.contains(&"engine-ggx".to_string()), "{names:?}");
+    // returns=f overrides the declaration (the value is then f_s N.L taken as f_s: smaller by N.L < 1).
+    let forced = format!("{},returns=f", engine());
+    run_in(d, &["eval", "--model", &forced, "--input", "in.csv", "--output", "f.csv"]).ok();
+    run_in(d, &["eval", "--model", &engine(), "--input", "in.csv", "--output", "fnol.csv"]).ok();
+    let (f, g) = (values(&d.join("f.csv")), values(&d.join("fnol.csv")));
+    assert!(f.iter().zip(&g).all(|(x, y)| x[0] < y[0]), "{f:?} {g:?}");
+    // The twin's BRDF can be chosen by name; an unknown entry is refused naming the declared ones.
+    run_in(d, &["eval", "--model", &format!("{},entry=BRDF", twin()), "--input", "in.csv", "--output", "t.csv"]).ok();
+    run_in(d, &["eval", "--model", &format!("{},entry=light", engine()), "--input", "in.csv", "--output", "x.csv"]).fails(2, "its entries: surface_light");
+    run_in(d, &["eval", "--model", &format!("{},returns=fnol", engine()), "--input", "in.csv", "--output", "x.csv"]).fails(2, "expected returns=f or returns=f_nol");
+    assert!(!d.join("x.csv").exists());
+}
+
+#[test]
+fn its_compiler_statistics_on_radv_are_its_twins() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = crate::compile_only::inspect_json(dir.path(), "e", &["radv:navi21"], &["--model", &engine(), "--model", &twin()], "ACO statistics");
+    let rows = out["rows"].as_array().unwrap();
+    let row = |name: &str| rows.iter().find(|r| r["model"] == name).unwrap_or_else(|| panic!("no {name}: {rows:?}"));
+    let (e, t) = (row("engine-ggx"), row("engine-ggx-f"));
+    let stat = |r: &serde_json::Value, k: &str| crate::compile_only::stat(r, "Compute Shader", k);
+    // The engine's f_s N.L times the light against the twin's f_s times (N.L times the light): the same
+    // arithmetic, associated differently, which ACO may settle with one register copy more or less.
+    for k in ["VGPRs", "SGPRs", "Spilled VGPRs", "Spilled SGPRs", "Branches"] {
+        assert_eq!(stat(e, k), stat(t, k), "{k}");
+    }
+    assert_eq!(stat(e, "Instructions") - stat(e, "Copies"), stat(t, "Instructions") - stat(t, "Copies"), "instructions other than copies");
+    assert!((stat(e, "Copies") - stat(t, "Copies")).abs() <= 1.0, "copies {} against {}", stat(e, "Copies"), stat(t, "Copies"));
+}
+
+#[test]
+fn bad_entry_declarations_exit_2_at_their_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write_rows(&d.join("in.csv"), 2);
+    let base = std::fs::read_to_string(fixture("engine-ggx.brdf")).unwrap();
+    let entry_line = base.lines().position(|l| l.starts_with("entry ")).unwrap() + 1;
+    let cases = [
+        ("entry surface_light(N, L, V, f0, roughness) returns f_nol", "entry missing_fn(N, L, V) returns f_nol", format!(":{entry_line}: entry `missing_fn`: the shader defines no function")),
+        ("entry surface_light(N, L, V, f0, roughness) returns f_nol", "entry surface_light(N, L, V) returns f_nol", format!(":{entry_line}: entry `surface_light` takes 5 arguments")),
+        ("entry surface_light(N, L, V, f0, roughness) returns f_nol", "entry surface_light(N, L, V, f0, roughness) returns nol", format!(":{entry_line}: `returns nol`: expected f or f_nol")),
+        ("entry surface_light(N, L, V, f0, roughness) returns f_nol", "entry surface_light(N, L, V, f0, roughness", format!(":{entry_line}: `entry surface_light(N, L, V, f0, roughness`: the argument list has no closing")),
+        ("bind roughness=@roughness f0=@f0", "bind gloss=@roughness", ": `bind gloss=...`: the file has no parameter `gloss`".to_string()),
+        ("bind roughness=@roughness f0=@f0", "bind roughness=0.5", ": `roughness=0.5`: `bind` binds a parameter to an input".to_string()),
+        ("bind roughness=@roughness f0=@f0", "tint 1 2 3", ": unknown directive `tint`".to_string()),
+        // An argument glslang refuses is reported at the entry's own line, with the file's names.
+        ("entry surface_light(N, L, V, f0, roughness) returns f_nol", "entry surface_light(N, L, V, f0, gloss) returns f_nol", format!("engine.brdf:{entry_line}:")),
+    ];
+    for (from, to, needle) in cases {
+        let text = base.replacen(from, to, 1);
+        assert_ne!(text, base, "{from}");
+        std::fs::write(d.join("engine.brdf"), text).unwrap();
+        let r = run_in(d, &["eval", "--model", "engine.brdf", "--input", "in.csv", "--output", "out.csv"]).fails(2, &needle);
+        assert!(!d.join("out.csv").exists(), "{}", r.stderr);
+    }
+}
