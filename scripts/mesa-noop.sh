@@ -1,9 +1,14 @@
 #!/bin/sh
-# Builds Mesa's Turnip (Adreno), PanVK (Mali) and ANV (Intel) Vulkan drivers and their noop drm-shims from
-# Debian's source package of the installed Mesa, once per machine (docs/targets.md, "Mesa's drivers on noop
-# devices"). Nothing in it is patched: the source is Debian's, the options below are the whole recipe.
-# The build lives outside the checkout, in $BRDFPROF_MESA_CACHE (default ~/.cache/brdfprof), keyed on the source
-# version and the options; .tools/mesa in the checkout links to it. A second run finds the key and does nothing.
+# Builds Mesa's Vulkan drivers that brdfprof runs on Mesa's noop drm-shims, once per machine (docs/targets.md,
+# "Mesa's drivers on noop devices"), from Debian's source packages; nothing in them is patched, the options
+# below are the whole recipe:
+# - the installed Mesa's own source package (Debian 12: 22.3.6): Turnip (Adreno 6xx), PanVK (Mali Bifrost)
+#   and ANV (Intel), linked as .tools/mesa;
+# - bookworm-backports' Mesa (25.0.7): Turnip (Adreno 7xx) and PanVK (Mali Valhall), linked as .tools/mesa25.
+#   Its meson (>= 1.1) comes from PyPI into the build's own folder; its ANV is not built: Mesa 25's Intel
+#   driver needs libclc and LLVM's SPIR-V translator (docs/targets.md).
+# Each build lives outside the checkout, in $BRDFPROF_MESA_CACHE (default ~/.cache/brdfprof), keyed on the
+# source version and the options; a second run finds the key and does nothing.
 set -eu
 
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -11,25 +16,61 @@ cache=${BRDFPROF_MESA_CACHE:-${XDG_CACHE_HOME:-$HOME/.cache}/brdfprof}
 options="-Dbuildtype=release -Dvulkan-drivers=freedreno,panfrost,intel -Dgallium-drivers= -Dtools=drm-shim,intel \
 -Dplatforms= -Dglx=disabled -Degl=disabled -Dgbm=disabled -Dopengl=false -Dgles1=disabled -Dgles2=disabled \
 -Dllvm=disabled -Dshared-glapi=disabled -Dvalgrind=disabled -Dlibunwind=disabled -Dzstd=enabled -Dvideo-codecs="
+# Mesa 25 has no shared-glapi option, and its ANV is not built (above).
+options25="-Dbuildtype=release -Dvulkan-drivers=freedreno,panfrost -Dgallium-drivers= -Dtools=drm-shim \
+-Dplatforms= -Dglx=disabled -Degl=disabled -Dgbm=disabled -Dopengl=false -Dgles1=disabled -Dgles2=disabled \
+-Dllvm=disabled -Dvalgrind=disabled -Dlibunwind=disabled -Dzstd=enabled -Dvideo-codecs="
 # What brdfprof loads: each `Shim` of src/targets/ (adreno.rs, mali.rs, anv.rs) names these files; a test ties them.
-products="src/freedreno/vulkan/libvulkan_freedreno.so src/freedreno/vulkan/freedreno_devenv_icd.x86_64.json
+shim_products="src/freedreno/vulkan/libvulkan_freedreno.so src/freedreno/vulkan/freedreno_devenv_icd.x86_64.json
 src/freedreno/drm-shim/libfreedreno_noop_drm_shim.so src/panfrost/vulkan/libvulkan_panfrost.so
-src/panfrost/vulkan/panfrost_devenv_icd.x86_64.json src/panfrost/drm-shim/libpanfrost_noop_drm_shim.so
+src/panfrost/vulkan/panfrost_devenv_icd.x86_64.json src/panfrost/drm-shim/libpanfrost_noop_drm_shim.so"
+products="$shim_products
 src/intel/vulkan/libvulkan_intel.so src/intel/vulkan/intel_devenv_icd.x86_64.json src/intel/tools/libintel_noop_drm_shim.so"
+products25="$shim_products"
+meson_pypi="meson==1.12.1"
+backports_suite="$(. /etc/os-release && echo "$VERSION_CODENAME")-backports"
+
+as_root() {
+    [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1 || {
+        echo "brdfprof setup: the Mesa noop drivers are not built in $1; run make setup as root (it needs apt-get)" >&2; exit 1; }
+}
+
+# The build tools of both builds, from Debian.
+tools() {
+    export DEBIAN_FRONTEND=noninteractive
+    echo "brdfprof setup: installing Mesa's build tools (meson, ninja, mako, yaml, bison, flex, libdrm, expat, zlib, zstd)" >&2
+    apt-get install -y -qq dpkg-dev meson ninja-build python3-mako python3-yaml python3-packaging python3-pip xz-utils bison flex \
+        libdrm-dev libexpat1-dev zlib1g-dev libzstd-dev pkg-config >/dev/null
+}
+
+# build NAME KEY DIR OPTIONS PRODUCTS MESON SRCDIR: meson + ninja of the products, the source tree removed after.
+build() {
+    name=$1 key=$2 dir=$3 opts=$4 prods=$5 meson=$6 srcdir=$7
+    echo "brdfprof setup: building $name (once per machine; ninja's [N/M] is the progress)" >&2
+    # meson must run on Debian's python3, the one with python3-mako.
+    # shellcheck disable=SC2086
+    PATH=/usr/bin:$PATH $meson setup "$dir/build" "$srcdir" $opts >"$dir/meson-setup.log" 2>&1 || {
+        tail -n 30 "$dir/meson-setup.log" >&2; echo "brdfprof setup: meson setup failed (log: $dir/meson-setup.log)" >&2; exit 1; }
+    PATH=/usr/bin:$PATH nice -n 10 ninja -C "$dir/build" $(for p in $prods; do printf '%s ' "$p"; done)
+    for p in $prods; do [ -e "$dir/build/$p" ] || { echo "brdfprof setup: the Mesa build did not produce $p" >&2; exit 1; }; done
+    # The source tree is not needed once built; the build directory holds what brdfprof loads.
+    rm -rf "$srcdir" "$dir"/mesa_*
+    printf '%s\n' "$key" > "$dir/.key"
+}
+
+# built KEY DIR PRODUCTS
+built() {
+    [ "$(cat "$2/.key" 2>/dev/null)" = "$1" ] || return 1
+    for p in $3; do [ -e "$2/build/$p" ] || return 1; done
+}
 
 version=$(dpkg-query -W -f='${Version}' mesa-vulkan-drivers 2>/dev/null) || {
     echo "brdfprof setup: mesa-vulkan-drivers is not installed; run the first part of make setup as root" >&2; exit 1; }
 key="$version $(printf '%s' "$options" | sha256sum | cut -c1-16)"
 dir="$cache/mesa-noop-$(printf '%s' "$key" | tr ' +:~' '----')"
 
-built() {
-    [ "$(cat "$dir/.key" 2>/dev/null)" = "$key" ] || return 1
-    for p in $products; do [ -e "$dir/build/$p" ] || return 1; done
-}
-
-if ! built; then
-    [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1 || {
-        echo "brdfprof setup: the Mesa noop drivers are not built in $dir; run make setup as root (it needs apt-get)" >&2; exit 1; }
+if ! built "$key" "$dir" "$products"; then
+    as_root "$dir"
     export DEBIAN_FRONTEND=noninteractive
     # Debian's deb-src entry beside the deb one: the source package of the installed Mesa.
     src_list=/etc/apt/sources.list.d/brdfprof-deb-src.sources
@@ -39,26 +80,60 @@ if ! built; then
             "$codename" "$codename" "$codename" > "$src_list"
         apt-get update -qq
     fi
-    echo "brdfprof setup: installing Mesa's build tools (meson, ninja, mako, bison, flex, libdrm, expat, zlib, zstd)" >&2
-    apt-get install -y -qq dpkg-dev meson ninja-build python3-mako bison flex libdrm-dev libexpat1-dev zlib1g-dev libzstd-dev pkg-config >/dev/null
+    tools
     rm -rf "$dir"
     mkdir -p "$dir"
     echo "brdfprof setup: fetching Debian's source package mesa=$version into $dir" >&2
     (cd "$dir" && apt-get source -qq "mesa=$version" >/dev/null)
     srcdir=$(find "$dir" -mindepth 1 -maxdepth 1 -type d -name 'mesa-*' | head -n 1)
     [ -n "$srcdir" ] || { echo "brdfprof setup: apt-get source mesa=$version unpacked nothing in $dir" >&2; exit 1; }
-    echo "brdfprof setup: building Turnip, PanVK, ANV and their noop shims (about 1000 steps, ~8 min on 2 cores, once per machine)" >&2
-    # meson must run on Debian's python3, the one with python3-mako.
-    # shellcheck disable=SC2086
-    PATH=/usr/bin:$PATH meson setup "$dir/build" "$srcdir" $options >"$dir/meson-setup.log" 2>&1 || {
-        tail -n 30 "$dir/meson-setup.log" >&2; echo "brdfprof setup: meson setup failed (log: $dir/meson-setup.log)" >&2; exit 1; }
-    # ninja's own progress line ([N/974]) is the terminal's progress.
-    PATH=/usr/bin:$PATH nice -n 10 ninja -C "$dir/build" $(for p in $products; do printf '%s ' "$p"; done)
-    for p in $products; do [ -e "$dir/build/$p" ] || { echo "brdfprof setup: the Mesa build did not produce $p" >&2; exit 1; }; done
-    # The source tree is not needed once built; the build directory holds what brdfprof loads.
-    rm -rf "$srcdir" "$dir"/mesa_*
-    printf '%s\n' "$key" > "$dir/.key"
+    build "Turnip, PanVK, ANV and their noop shims from Mesa $version (about 1000 steps, ~8 min on 2 cores)" "$key" "$dir" "$options" "$products" meson "$srcdir"
 fi
 mkdir -p "$root/.tools"
 ln -sfn "$dir/build" "$root/.tools/mesa"
 echo "brdfprof setup: Mesa noop drivers present ($key) in $dir" >&2
+
+# bookworm-backports' Mesa: its source package's upstream tarball, checked against the SHA-256 of Debian's
+# signed Sources index (apt-get source --print-uris); Debian's packaging of it (the .dsc, its patches) is not
+# needed for a build of these drivers.
+backports_uris() {
+    apt-get source --print-uris "mesa/$backports_suite" 2>&1 || true
+}
+uris=$(backports_uris)
+version25=$(printf '%s\n' "$uris" | sed -n "s/^Selected version '\([^']*\)'.*/\1/p" | head -n 1)
+if [ -z "$version25" ]; then
+    # No deb-src entry for backports yet: add it (source indexes only; nothing installed comes from it).
+    as_root "$cache"
+    printf 'Types: deb-src\nURIs: http://deb.debian.org/debian\nSuites: %s\nComponents: main\nSigned-By: /usr/share/keyrings/debian-archive-keyring.gpg\n' \
+        "$backports_suite" > /etc/apt/sources.list.d/brdfprof-deb-src-backports.sources
+    apt-get update -qq
+    uris=$(backports_uris)
+    version25=$(printf '%s\n' "$uris" | sed -n "s/^Selected version '\([^']*\)'.*/\1/p" | head -n 1)
+    [ -n "$version25" ] || { echo "brdfprof setup: $backports_suite has no mesa source package:" >&2; printf '%s\n' "$uris" >&2; exit 1; }
+fi
+key25="$version25 $(printf '%s %s' "$options25" "$meson_pypi" | sha256sum | cut -c1-16)"
+dir25="$cache/mesa-noop-$(printf '%s' "$key25" | tr ' +:~' '----')"
+if ! built "$key25" "$dir25" "$products25"; then
+    as_root "$dir25"
+    tools
+    rm -rf "$dir25"
+    mkdir -p "$dir25"
+    line=$(printf '%s\n' "$uris" | grep "\.orig\.tar\." | head -n 1)
+    tarball=$(printf '%s' "$line" | cut -d' ' -f2)
+    sum=$(printf '%s' "$line" | sed -n 's/.*SHA256:\([0-9a-f]*\).*/\1/p')
+    [ -n "$tarball" ] && [ -n "$sum" ] || { echo "brdfprof setup: no upstream tarball for mesa/$backports_suite in apt's index" >&2; exit 1; }
+    echo "brdfprof setup: fetching $tarball (Debian's mesa $version25 source package, $backports_suite) into $dir25" >&2
+    # --download-only fetches and checks each file it can; only the tarball is needed (see above).
+    (cd "$dir25" && apt-get source --download-only -qq "mesa/$backports_suite" >/dev/null 2>&1) || true
+    echo "$sum  $dir25/$tarball" | sha256sum -c --quiet - || { echo "brdfprof setup: $tarball is missing or does not match Debian's index" >&2; exit 1; }
+    tar -xf "$dir25/$tarball" -C "$dir25"
+    src25=$(find "$dir25" -mindepth 1 -maxdepth 1 -type d -name 'mesa-*' | head -n 1)
+    # Mesa 25 needs meson >= 1.1 (Debian 12 has 1.0.1): PyPI's, pinned, in the build's own folder.
+    python3 -m pip install --quiet --disable-pip-version-check --root-user-action=ignore --no-deps --target "$dir25/meson" "$meson_pypi"
+    # Exported: ninja runs meson's own script again for generated files.
+    export PYTHONPATH="$dir25/meson"
+    build "Turnip and PanVK and their noop shims from Mesa $version25 (about 900 steps, ~12 min on 2 cores)" "$key25" "$dir25" "$options25" "$products25" \
+        "python3 $dir25/meson/bin/meson" "$src25"
+fi
+ln -sfn "$dir25/build" "$root/.tools/mesa25"
+echo "brdfprof setup: Mesa noop drivers present ($key25) in $dir25" >&2

@@ -1,9 +1,9 @@
-//! `--device adreno:FAMILY`: Qualcomm Adreno 6xx through Mesa's Turnip driver and its ir3 compiler, on the
-//! freedreno noop drm-shim (`FD_GPU_ID`). Turnip's ir3 is what Linux and some Android systems run on Adreno;
+//! `--device adreno:FAMILY`: Qualcomm Adreno 6xx (the installed Mesa 22.3) and 7xx (bookworm-backports' Mesa
+//! 25.0) through Mesa's Turnip driver and its ir3 compiler, on the freedreno noop drm-shim (`FD_GPU_ID`). Turnip's ir3 is what Linux and some Android systems run on Adreno;
 //! stock phone drivers use Qualcomm's own compiler, so these are ir3's figures, not a phone driver's.
 //!
 //! ir3 states no cycle model, so brdfprof's rule is built from the statistics ir3 computes itself
-//! (`collect_info` in src/freedreno/ir3/ir3.c, Mesa 22.3): "Instruction Count" counts every issue slot of one
+//! (`collect_info` in src/freedreno/ir3/ir3.c, Mesa 22.3 and 25.0 alike): "Instruction Count" counts every issue slot of one
 //! wave (each instruction `1 + repeat + nop`, so the NOPs it folds into `(nopN)` and plain `nop`s are already in
 //! it), and "Estimated cycles stalled on SS/SY" are its own estimates of the cycles a wave waits for SFU
 //! (transcendental) and memory results at the `(ss)`/`(sy)` sync bits. One wave's issue cycles are their sum; a
@@ -13,6 +13,7 @@
 //! registers) is beside it to say how much latency other waves could hide.
 
 use super::cost::{self, TargetCost};
+use super::mesa_noop::{MESA_25_UNVALIDATED, MESA_BACKPORTS, MESA_DEBIAN};
 use super::shim::{Shim, ShimFamily};
 use crate::inspect::InspectReport;
 
@@ -20,7 +21,12 @@ use crate::inspect::InspectReport;
 const SHOWN: [&str; 6] = ["Instruction Count", "NOPs Count", "Estimated cycles stalled on SS", "Estimated cycles stalled on SY", "Registers used", "Max Waves Per Core"];
 
 const fn family(name: &'static str, gpu_id: &'static str, products: &'static str, detail: &'static str) -> ShimFamily {
-    ShimFamily { name, gpu_id, architecture: "Adreno 6xx", products, detail, default: true }
+    ShimFamily { name, gpu_id, architecture: "Adreno 6xx", products, detail, default: true, build: &MESA_DEBIAN, without_validation: None }
+}
+
+/// An a7xx GPU: Mesa 22.3's Turnip has none; bookworm-backports' Mesa 25.0 compiles for them.
+const fn family_a7xx(name: &'static str, gpu_id: &'static str, products: &'static str, detail: &'static str) -> ShimFamily {
+    ShimFamily { name, gpu_id, architecture: "Adreno 7xx", products, detail, default: true, build: &MESA_BACKPORTS, without_validation: Some(MESA_25_UNVALIDATED) }
 }
 
 pub static ADRENO: Shim = Shim {
@@ -34,15 +40,17 @@ pub static ADRENO: Shim = Shim {
     shim: "src/freedreno/drm-shim/libfreedreno_noop_drm_shim.so",
     gpu_var: "FD_GPU_ID",
     extra_env: &[],
-    // The a6xx GPUs Mesa 22.3's shim accepts (650 and 690 it refuses).
+    // The a6xx GPUs Mesa 22.3's shim accepts (650 and 690 it refuses), and the a7xx ones Mesa 25.0's does.
     families: &[
         family("a618", "618", "Snapdragon 730/730G/732G", "FD_GPU_ID=618, a6xx gen 1"),
         family("a630", "630", "Snapdragon 845", "FD_GPU_ID=630, a6xx gen 1"),
         family("a660", "660", "Snapdragon 888", "FD_GPU_ID=660, a6xx gen 4"),
+        family_a7xx("a730", "730", "Snapdragon 8 Gen 1", "FD_GPU_ID=730, a7xx gen 1, Mesa 25.0"),
+        family_a7xx("a740", "740", "Snapdragon 8 Gen 2", "FD_GPU_ID=740, a7xx gen 2, Mesa 25.0"),
+        family_a7xx("a750", "750", "Snapdragon 8 Gen 3", "FD_GPU_ID=750, a7xx gen 3, Mesa 25.0"),
     ],
     cost: cost_table,
     noise: &[],
-    without_validation: None,
     compiler_log: None,
 };
 

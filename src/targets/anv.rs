@@ -17,7 +17,7 @@ use crate::inspect::InspectReport;
 const SHOWN: [&str; 5] = ["Instruction Count", "SEND Count", "Cycle Count", "Spill Count", "Fill Count"];
 
 const fn family(name: &'static str, gpu_id: &'static str, architecture: &'static str, products: &'static str, detail: &'static str) -> ShimFamily {
-    ShimFamily { name, gpu_id, architecture, products, detail, default: true }
+    ShimFamily { name, gpu_id, architecture, products, detail, default: true, build: &super::mesa_noop::MESA_DEBIAN, without_validation: None }
 }
 
 pub static ANV: Shim = Shim {
@@ -41,7 +41,6 @@ pub static ANV: Shim = Shim {
     cost: cost_table,
     // The shim's line for each ioctl query it does not emulate (Mesa 22.3's i915 shim: DG2's memory regions).
     noise: &["Unknown drm_i915_query_item id="],
-    without_validation: None,
     compiler_log: None,
 };
 

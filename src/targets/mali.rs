@@ -1,8 +1,9 @@
-//! `--device mali:FAMILY`: Arm Mali Bifrost through Mesa's PanVK driver on the panfrost noop drm-shim
-//! (`PAN_GPU_ID`). PanVK 22.3 is marked non-conformant (it needs PAN_I_WANT_A_BROKEN_VULKAN_DRIVER=1); its
-//! shader compiler is Panfrost's Bifrost backend, the production one Panfrost's OpenGL ES driver uses. PanVK
-//! has no VK_KHR_pipeline_executable_properties: with BIFROST_MESA_DEBUG=shaderdb the compiler prints one
-//! `SHADER-DB:` line per shader on stderr, which the child captures for each pipeline (`gpu::GpuOptions::
+//! `--device mali:FAMILY`: Arm Mali Bifrost (the installed Mesa 22.3) and Valhall (bookworm-backports' Mesa 25.0)
+//! through Mesa's PanVK driver on the panfrost noop drm-shim (`PAN_GPU_ID`). PanVK 22.3 is marked
+//! non-conformant (it needs PAN_I_WANT_A_BROKEN_VULKAN_DRIVER=1); its shader compiler is Panfrost's Bifrost
+//! backend, the production one Panfrost's OpenGL ES driver uses (Mesa 25.0's compiles Valhall too). PanVK 22.3
+//! has no VK_KHR_pipeline_executable_properties (25.0's has, without statistics): with
+//! BIFROST_MESA_DEBUG=shaderdb the compiler prints one `SHADER-DB:` line per shader on stderr, which the child captures for each pipeline (`gpu::GpuOptions::
 //! compiler_log`) and reads here.
 //!
 //! The cost is the compiler's own (`bi_print_stats` in src/panfrost/bifrost/bifrost_compile.c, Mesa 22.3):
@@ -13,8 +14,11 @@
 //! kernel`; the net figure is the pipe-parallel bound of the work the BRDF adds, `max over pipes of (kernel's
 //! pipe - memory-only kernel's pipe) / lights`, with the pipe that binds it named: a max of pipes does not
 //! subtract, so the bound of the memory-only kernel (load/store) is not taken from the BRDF's (arithmetic).
+//! Valhall's statistics are `va_print_stats`' (same file, Mesa 25.0): FMA and CVT at 64 per cycle, SFU 16,
+//! varying 16, texture 4, load/store 1 ("Mali G78 peak performance"), the bound their max, read by the same rule.
 
 use super::cost::{self, TargetCost};
+use super::mesa_noop::{MESA_25_UNVALIDATED, MESA_BACKPORTS, MESA_DEBIAN};
 use super::shim::{Shim, ShimFamily};
 use crate::gpu::DriverStat;
 use crate::inspect::InspectReport;
@@ -24,8 +28,9 @@ use anyhow::{anyhow, bail, Result};
 /// The prefix of the compiler's statistics lines (`fprintf(stderr, "SHADER-DB: %s\n", ...)`).
 const LINE_PREFIX: &str = "SHADER-DB: ";
 
-/// bi_print_stats' fields (its word after each number) and the statistic names brdfprof gives them.
-const FIELDS: [(&str, &str); 12] = [
+/// The fields of the compiler's statistics line (Bifrost's `bi_print_stats`, Valhall's `va_print_stats`: its
+/// word after each number) and the statistic names brdfprof gives them.
+const FIELDS: [(&str, &str); 18] = [
     ("inst", "Instructions"),
     ("tuples", "Tuples"),
     ("clauses", "Clauses"),
@@ -34,17 +39,35 @@ const FIELDS: [(&str, &str); 12] = [
     ("texture", "Texture cycles"),
     ("vary", "Varying cycles"),
     ("ldst", "Load-store cycles"),
+    ("fma", "FMA cycles"),
+    ("cvt", "CVT cycles"),
+    ("sfu", "SFU cycles"),
+    ("v", "Varying cycles"),
+    ("t", "Texture cycles"),
+    ("ls", "Load-store cycles"),
     ("quadwords", "Quadwords"),
     ("threads", "Threads"),
     ("preloads", "Preloads"),
     ("loops", "Loops"),
 ];
 
-/// The per-pipe cycles and the pipe each names.
-const PIPES: [(&str, &str); 4] = [("Arithmetic cycles", "arithmetic"), ("Texture cycles", "texture"), ("Varying cycles", "varying"), ("Load-store cycles", "load/store")];
+/// The per-pipe cycles and the pipe each names (Bifrost's arithmetic pipe is Valhall's FMA, CVT and SFU).
+const PIPES: [(&str, &str); 7] = [
+    ("Arithmetic cycles", "arithmetic"),
+    ("FMA cycles", "FMA"),
+    ("CVT cycles", "CVT"),
+    ("SFU cycles", "SFU"),
+    ("Texture cycles", "texture"),
+    ("Varying cycles", "varying"),
+    ("Load-store cycles", "load/store"),
+];
 
 /// The statistics shown beside cycles/eval.
-const SHOWN: [&str; 7] = ["Instructions", "Tuples", "Clauses", "Arithmetic cycles", "Load-store cycles", "Bound cycles", "Threads"];
+const SHOWN_BIFROST: [&str; 7] = ["Instructions", "Tuples", "Clauses", "Arithmetic cycles", "Load-store cycles", "Bound cycles", "Threads"];
+const SHOWN_VALHALL: [&str; 7] = ["Instructions", "FMA cycles", "CVT cycles", "SFU cycles", "Load-store cycles", "Bound cycles", "Threads"];
+
+/// PanVK 22.3 (Bifrost); Mesa 25.0's PanVK is a Vulkan 1.1 driver for Valhall, which the layer judges.
+const PANVK_22_UNVALIDATED: &str = "PanVK 22.3 is a Vulkan 1.0 driver, and brdfprof's kernels are SPIR-V 1.3 (Vulkan 1.1), which the layer refuses on a 1.0 device; the driver compiles them (Mesa's SPIR-V front end reads any version), so its figures stand, unvalidated";
 
 pub static MALI: Shim = Shim {
     prefix: "mali",
@@ -62,12 +85,12 @@ pub static MALI: Shim = Shim {
     // thread per core where v7 runs two (bi_print_stats: two only on v7 with <= 32 work registers), so it is
     // listed and they are not (docs/targets.md).
     families: &[
-        ShimFamily { name: "g52", gpu_id: "0x7212", architecture: "Bifrost (v7)", products: "Mali-G52 (Rockchip RK3566/RK3568, Amlogic S922X)", detail: "PAN_GPU_ID=0x7212, Bifrost v7", default: true },
-        ShimFamily { name: "g72", gpu_id: "0x6221", architecture: "Bifrost (v6)", products: "Mali-G72 (Exynos 9810, Kirin 970, Helio P60)", detail: "PAN_GPU_ID=0x6221, Bifrost v6", default: true },
+        ShimFamily { name: "g52", gpu_id: "0x7212", architecture: "Bifrost (v7)", products: "Mali-G52 (Rockchip RK3566/RK3568, Amlogic S922X)", detail: "PAN_GPU_ID=0x7212, Bifrost v7", default: true, build: &MESA_DEBIAN, without_validation: Some(PANVK_22_UNVALIDATED) },
+        ShimFamily { name: "g72", gpu_id: "0x6221", architecture: "Bifrost (v6)", products: "Mali-G72 (Exynos 9810, Kirin 970, Helio P60)", detail: "PAN_GPU_ID=0x6221, Bifrost v6", default: true, build: &MESA_DEBIAN, without_validation: Some(PANVK_22_UNVALIDATED) },
+        ShimFamily { name: "g610", gpu_id: "0xa867", architecture: "Valhall (v10)", products: "Mali-G610 (Rockchip RK3588, MediaTek Dimensity 1080)", detail: "PAN_GPU_ID=0xa867, Valhall v10, Mesa 25.0", default: true, build: &MESA_BACKPORTS, without_validation: Some(MESA_25_UNVALIDATED) },
     ],
     cost: cost_table,
     noise: &[],
-    without_validation: Some("PanVK 22.3 is a Vulkan 1.0 driver, and brdfprof's kernels are SPIR-V 1.3 (Vulkan 1.1), which the layer refuses on a 1.0 device; the driver compiles them (Mesa's SPIR-V front end reads any version), so its figures stand, unvalidated"),
     compiler_log: Some(read_shaderdb),
 };
 
@@ -97,11 +120,19 @@ pub fn read_shaderdb(log: &str) -> Result<(Vec<DriverStat>, Vec<String>)> {
 }
 
 fn cost_table(shim: &Shim, family: &ShimFamily, report: &InspectReport) -> Option<TargetCost> {
-    let rule = "cycles/eval = Bifrost's bound (max of its arithmetic, texture, varying and load/store cycles per thread, bi_print_stats) / lights per kernel; net = max over pipes of (kernel - memory-only kernel) / lights, the binding pipe named";
-    let mut t = cost::table(report, shim.header(family, report, rule.into(), "Bifrost cycles per thread", &SHOWN), |stats, lights| cost::driver_stat(stats, "Bound cycles").map(|c| c / f64::from(lights)))?;
-    let pipes = |model: &str| -> Option<Vec<f64>> {
+    let valhall = family.architecture.starts_with("Valhall");
+    let (rule, shown) = if valhall {
+        ("cycles/eval = Valhall's bound (max of its FMA, CVT, SFU, varying, texture and load/store cycles per thread, va_print_stats) / lights per kernel; net = max over pipes of (kernel - memory-only kernel) / lights, the binding pipe named", &SHOWN_VALHALL)
+    } else {
+        ("cycles/eval = Bifrost's bound (max of its arithmetic, texture, varying and load/store cycles per thread, bi_print_stats) / lights per kernel; net = max over pipes of (kernel - memory-only kernel) / lights, the binding pipe named", &SHOWN_BIFROST)
+    };
+    let unit = if valhall { "Valhall cycles per thread" } else { "Bifrost cycles per thread" };
+    let mut t = cost::table(report, shim.header(family, report, rule.into(), unit, shown), |stats, lights| cost::driver_stat(stats, "Bound cycles").map(|c| c / f64::from(lights)))?;
+    // The pipes the compiler reported for a kernel (its architecture's), by PIPES' index.
+    let pipes = |model: &str| -> Option<Vec<(usize, f64)>> {
         let row = report.rows.iter().find(|r| r.model == model)?;
-        PIPES.iter().map(|(name, _)| cost::driver_stat(&row.stats, name)).collect()
+        let found: Vec<(usize, f64)> = PIPES.iter().enumerate().filter_map(|(k, (name, _))| cost::driver_stat(&row.stats, name).map(|v| (k, v))).collect();
+        (!found.is_empty()).then_some(found)
     };
     let base = pipes(BASELINE_LABEL);
     let lights = f64::from(t.lights_per_kernel);
@@ -110,7 +141,11 @@ fn cost_table(shim: &Shim, family: &ShimFamily, report: &InspectReport) -> Optio
             r.net_cycles_per_eval = None;
             continue;
         };
-        let (k, net) = mine.iter().zip(base).map(|(m, b)| m - b).enumerate().fold((0, f64::NEG_INFINITY), |best, (k, v)| if v > best.1 { (k, v) } else { best });
+        let added = mine.iter().filter_map(|&(k, m)| base.iter().find(|(b, _)| *b == k).map(|&(_, b)| (k, m - b)));
+        let Some((k, net)) = added.fold(None, |best: Option<(usize, f64)>, (k, v)| if best.is_none_or(|(_, b)| v > b) { Some((k, v)) } else { best }) else {
+            r.net_cycles_per_eval = None;
+            continue;
+        };
         r.net_cycles_per_eval = Some(net / lights);
         r.bound = Some(PIPES[k].1.to_string());
     }
@@ -134,6 +169,32 @@ mod tests {
         assert!(read_shaderdb("nothing here").unwrap_err().to_string().contains("no `SHADER-DB"));
         assert!(read_shaderdb(&format!("{GGX}\n{GGX}")).unwrap_err().to_string().contains("2 compute-shader"));
         assert!(read_shaderdb(&GGX.replace("tuples", "tupels")).unwrap_err().to_string().contains("unknown field `tupels`"));
+    }
+
+    const VALHALL: &str = "SHADER-DB: MESA_SHADER_COMPUTE shader: 809 inst, 18.000000 cycles, 7.921875 fma, 3.546875 cvt, 3.500000 sfu, 0.000000 v, 0.250000 t, 18.000000 ls, 408 quadwords, 1 threads, 0 loops, 0:0 spills:fills";
+
+    #[test]
+    fn reads_valhalls_line_and_prices_its_fma_pipe() {
+        let (stats, _) = read_shaderdb(VALHALL).unwrap();
+        let get = |n: &str| stats.iter().find(|s| s.name == n).map(|s| s.value);
+        assert_eq!((get("FMA cycles"), get("SFU cycles"), get("Texture cycles"), get("Load-store cycles"), get("Bound cycles")), (Some(7.921875), Some(3.5), Some(0.25), Some(18.0), Some(18.0)));
+        let row = |model: &str, fma: f64, sfu: f64| Row {
+            model: model.into(),
+            spec: None,
+            stats: [("FMA cycles", fma), ("CVT cycles", 1.0), ("SFU cycles", sfu), ("Texture cycles", 0.0), ("Varying cycles", 0.0), ("Load-store cycles", 18.0), ("Bound cycles", 18.0)]
+                .into_iter()
+                .map(|(k, v)| (format!("driver/Compute Shader/{k}"), v))
+                .collect(),
+            notes: Default::default(),
+        };
+        let mut report = crate::inspect::tests::empty_report("Mali-G610 (Panfrost)");
+        report.provenance["target"] = "mali:g610".into();
+        report.rows = vec![row("ggx", 7.9, 3.5), row(BASELINE_LABEL, 1.5, 1.0)];
+        let t = super::super::Vendor::cost(&MALI, &report).unwrap();
+        let lights = f64::from(t.lights_per_kernel);
+        assert_eq!(t.rows[0].net_cycles_per_eval, Some((7.9 - 1.5) / lights));
+        assert_eq!(t.rows[0].bound.as_deref(), Some("FMA"));
+        assert!(t.model.contains("va_print_stats") && t.columns.iter().any(|c| c == "FMA cycles"), "{}", t.model);
     }
 
     #[test]

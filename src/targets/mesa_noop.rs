@@ -52,7 +52,7 @@ pub trait NoopDriver: Vendor {
     }
     /// Why the Khronos validation layer cannot judge this driver's compilations, where it cannot (the child
     /// then runs without it and the report says so).
-    fn without_validation(&self) -> Option<&'static str> {
+    fn without_validation(&self, _family: usize) -> Option<&'static str> {
         None
     }
     /// Statistics the compiler prints on stderr (drivers without VK_KHR_pipeline_executable_properties).
@@ -133,7 +133,7 @@ pub fn child_main(request_json: &str) -> Result<()> {
         None => Shaders::embedded(),
     };
     let wanted = driver.device(family);
-    let unvalidated = driver.without_validation().filter(|_| req.validate);
+    let unvalidated = driver.without_validation(family).filter(|_| req.validate);
     let options = GpuOptions { device: Some(wanted.clone().unwrap_or_else(|| "0".into())), validation: req.validate && unvalidated.is_none(), compiler_log: driver.compiler_log() };
     let gpu = Gpu::new(&options).map_err(|e| anyhow!("{target}: the driver offered no compile-only device{} ({e:#}). {}", wanted.map_or_else(String::new, |w| format!(" `{w}`")), driver.install_hint()))?;
     if !gpu.reports_statistics() {
@@ -461,39 +461,78 @@ pub fn driver_version(report: &InspectReport) -> String {
     nonempty(&p["mesa_version"]).or_else(|| nonempty(&p["device"]["driver_info"])).or_else(|| nonempty(&p["device"]["driver_version"])).unwrap_or_else(|| "?".into())
 }
 
-/// The directory of the Mesa build `make setup` made (scripts/mesa-noop.sh): `$BRDFPROF_MESA_DIR`, else
-/// `.tools/mesa` of the checkout brdfprof was built from (a link into the build cache).
+/// A Mesa build `make setup` makes (scripts/mesa-noop.sh), which some families' drivers load.
+pub struct MesaBuild {
+    /// Its link in the checkout, `.tools/mesa`.
+    pub link: &'static str,
+    /// The variable that names another build directory instead.
+    pub var: &'static str,
+    /// What it is, for messages: "Debian 12's Mesa 22.3".
+    pub what: &'static str,
+    /// What `make setup` builds in it, for messages.
+    pub drivers: &'static str,
+}
+
+/// The installed Mesa's own source package (Debian 12: 22.3.6).
+pub static MESA_DEBIAN: MesaBuild = MesaBuild {
+    link: ".tools/mesa",
+    var: "BRDFPROF_MESA_DIR",
+    what: "the installed Mesa (Debian 12: 22.3)",
+    drivers: "Turnip, PanVK and ANV from Debian's source package of the installed Mesa, ~8 minutes on 2 cores",
+};
+
+/// Why the validation layer does not run for Mesa 25.0's drivers.
+pub const MESA_25_UNVALIDATED: &str = "Debian 12's validation layer warns, on Mesa 25.0's Turnip and PanVK only, that the kernels' texel-buffer fetch (GLSL usamplerBuffer: an OpTypeSampledImage of Dim Buffer) should not be a sampled image; the same SPIR-V 1.3 kernels pass the layer on lavapipe, RADV and Mesa 22.3's drivers, so brdfprof compiles them unvalidated there and says so";
+
+/// bookworm-backports' Mesa (25.0): Adreno 7xx and Mali Valhall.
+pub static MESA_BACKPORTS: MesaBuild = MesaBuild {
+    link: ".tools/mesa25",
+    var: "BRDFPROF_MESA25_DIR",
+    what: "bookworm-backports' Mesa 25.0",
+    drivers: "Turnip and PanVK from Debian's bookworm-backports source package of Mesa 25.0, ~12 minutes on 2 cores",
+};
+
+impl MesaBuild {
+    /// Its directory: `$VAR`, else the link of the checkout brdfprof was built from (into the build cache).
+    pub fn dir(&self) -> PathBuf {
+        match std::env::var_os(self.var).filter(|v| !v.is_empty()) {
+            Some(dir) => PathBuf::from(dir),
+            None => Path::new(env!("CARGO_MANIFEST_DIR")).join(self.link),
+        }
+    }
+
+    /// A file of the build, or an error naming what is missing and what to run.
+    pub fn file(&self, driver: &str, relative: &str) -> Result<PathBuf> {
+        let path = self.dir().join(relative);
+        if !path.is_file() {
+            bail!(
+                "{driver} is not built: {} is missing. Run `make setup` (as root: it builds Mesa's drivers and their noop kernel shims once per machine; \
+                 here {}), or set {} to such a build of {}",
+                path.display(),
+                self.drivers,
+                self.var,
+                self.what
+            );
+        }
+        Ok(path)
+    }
+}
+
+/// The directory of the installed Mesa's build (`MESA_DEBIAN`).
 pub fn build_dir() -> PathBuf {
-    match std::env::var_os(BUILD_DIR_VAR).filter(|v| !v.is_empty()) {
-        Some(dir) => PathBuf::from(dir),
-        None => Path::new(env!("CARGO_MANIFEST_DIR")).join(".tools/mesa"),
-    }
+    MESA_DEBIAN.dir()
 }
 
-/// The variable that names the Mesa build directory.
+/// The variable that names the installed Mesa's build directory.
 pub const BUILD_DIR_VAR: &str = "BRDFPROF_MESA_DIR";
-
-/// A file of the Mesa build, or an error naming what is missing and what to run.
-pub fn built_file(driver: &str, relative: &str) -> Result<PathBuf> {
-    let dir = build_dir();
-    let path = dir.join(relative);
-    if !path.is_file() {
-        bail!(
-            "{driver} is not built: {} is missing. Run `make setup` (as root: it builds Mesa's Turnip, PanVK and ANV drivers and their noop \
-             kernel shims from Debian's source package of the installed Mesa, once per machine, ~8 minutes on 2 cores), or set {BUILD_DIR_VAR} to such a build",
-            path.display()
-        );
-    }
-    Ok(path)
-}
 
 /// The environment of a driver on a noop drm-shim: the loader sees only `icd` (the driver's devenv ICD file,
 /// which names `library` in the build), `shim` answers the kernel's ioctls, and `extra` selects the GPU. Each
 /// file must be in the build, or the error names it and `make setup`.
-pub fn shim_environment(driver: &str, icd: &str, library: &str, shim: &str, extra: &[(&str, String)]) -> Result<Vec<(String, String)>> {
-    let icd = built_file(driver, icd)?;
-    built_file(driver, library)?;
-    let shim = built_file(driver, shim)?;
+pub fn shim_environment(driver: &str, build: &MesaBuild, icd: &str, library: &str, shim: &str, extra: &[(&str, String)]) -> Result<Vec<(String, String)>> {
+    let icd = build.file(driver, icd)?;
+    build.file(driver, library)?;
+    let shim = build.file(driver, shim)?;
     let mut env = vec![("VK_ICD_FILENAMES".to_string(), icd.display().to_string()), ("VK_DRIVER_FILES".to_string(), icd.display().to_string()), ("LD_PRELOAD".to_string(), shim.display().to_string())];
     env.extend(extra.iter().map(|(k, v)| (k.to_string(), v.clone())));
     Ok(env)

@@ -22,6 +22,10 @@ pub struct ShimFamily {
     pub detail: &'static str,
     /// In `PREFIX:all`.
     pub default: bool,
+    /// The Mesa build whose driver compiles for it.
+    pub build: &'static mesa_noop::MesaBuild,
+    /// Why the validation layer cannot judge the driver's compilations for it, where it cannot.
+    pub without_validation: Option<&'static str>,
 }
 
 /// A driver on a noop drm-shim.
@@ -47,8 +51,6 @@ pub struct Shim {
     pub cost: fn(&Shim, &ShimFamily, &InspectReport) -> Option<TargetCost>,
     /// Statistics the compiler prints on stderr, for a driver without VK_KHR_pipeline_executable_properties.
     pub compiler_log: Option<CompilerLog>,
-    /// Why the validation layer cannot judge this driver's compilations, where it cannot.
-    pub without_validation: Option<&'static str>,
     /// Prefixes of the stderr lines the shim prints about ioctls it does not emulate (not the user's concern).
     pub noise: &'static [&'static str],
 }
@@ -89,8 +91,15 @@ impl Vendor for Shim {
     }
 
     fn status(&self) -> Result<String> {
-        self.environment(0)?;
-        Ok(format!("Mesa's {} ({} compiler) on its noop drm-shim, built by make setup in {}", self.driver, self.compiler, mesa_noop::build_dir().display()))
+        let mut builds: Vec<&mesa_noop::MesaBuild> = Vec::new();
+        for (k, f) in self.families.iter().enumerate() {
+            if !builds.iter().any(|b| std::ptr::eq(*b, f.build)) {
+                self.environment(k)?;
+                builds.push(f.build);
+            }
+        }
+        let dirs = builds.iter().map(|b| b.dir().display().to_string()).collect::<Vec<_>>().join(" and ");
+        Ok(format!("Mesa's {} ({} compiler) on its noop drm-shim, built by make setup in {dirs}", self.driver, self.compiler))
     }
 
     fn needs_verification(&self) -> bool {
@@ -134,7 +143,8 @@ impl NoopDriver for Shim {
     fn environment(&self, family: usize) -> Result<Vec<(String, String)>> {
         let mut extra: Vec<(&str, String)> = vec![(self.gpu_var, self.families[family].gpu_id.to_string())];
         extra.extend(self.extra_env.iter().map(|(k, v)| (*k, v.to_string())));
-        mesa_noop::shim_environment(&format!("{}: (Mesa's {})", self.prefix, self.driver), self.icd, self.library, self.shim, &extra)
+        let f = &self.families[family];
+        mesa_noop::shim_environment(&format!("{}:{} (Mesa's {})", self.prefix, f.name, self.driver), f.build, self.icd, self.library, self.shim, &extra)
     }
 
     fn install_hint(&self) -> String {
@@ -145,8 +155,8 @@ impl NoopDriver for Shim {
         self.compiler_log
     }
 
-    fn without_validation(&self) -> Option<&'static str> {
-        self.without_validation
+    fn without_validation(&self, family: usize) -> Option<&'static str> {
+        self.families[family].without_validation
     }
 
     fn is_noise(&self, line: &str) -> bool {
