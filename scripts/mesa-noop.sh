@@ -28,7 +28,6 @@ products="$shim_products
 src/intel/vulkan/libvulkan_intel.so src/intel/vulkan/intel_devenv_icd.x86_64.json src/intel/tools/libintel_noop_drm_shim.so"
 products25="$shim_products"
 meson_pypi="meson==1.12.1"
-backports_suite="$(. /etc/os-release && echo "$VERSION_CODENAME")-backports"
 
 as_root() {
     [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1 || {
@@ -45,17 +44,17 @@ tools() {
 
 # build NAME KEY DIR OPTIONS PRODUCTS MESON SRCDIR: meson + ninja of the products, the source tree removed after.
 build() {
-    name=$1 key=$2 dir=$3 opts=$4 prods=$5 meson=$6 srcdir=$7
-    echo "brdfprof setup: building $name (once per machine; ninja's [N/M] is the progress)" >&2
+    b_name=$1 b_key=$2 b_dir=$3 b_opts=$4 b_prods=$5 b_meson=$6 b_src=$7
+    echo "brdfprof setup: building $b_name (once per machine; ninja's [N/M] is the progress)" >&2
     # meson must run on Debian's python3, the one with python3-mako.
     # shellcheck disable=SC2086
-    PATH=/usr/bin:$PATH $meson setup "$dir/build" "$srcdir" $opts >"$dir/meson-setup.log" 2>&1 || {
-        tail -n 30 "$dir/meson-setup.log" >&2; echo "brdfprof setup: meson setup failed (log: $dir/meson-setup.log)" >&2; exit 1; }
-    PATH=/usr/bin:$PATH nice -n 10 ninja -C "$dir/build" $(for p in $prods; do printf '%s ' "$p"; done)
-    for p in $prods; do [ -e "$dir/build/$p" ] || { echo "brdfprof setup: the Mesa build did not produce $p" >&2; exit 1; }; done
+    PATH=/usr/bin:$PATH $b_meson setup "$b_dir/build" "$b_src" $b_opts >"$b_dir/meson-setup.log" 2>&1 || {
+        tail -n 30 "$b_dir/meson-setup.log" >&2; echo "brdfprof setup: meson setup failed (log: $b_dir/meson-setup.log)" >&2; exit 1; }
+    PATH=/usr/bin:$PATH nice -n 10 ninja -C "$b_dir/build" $(for p in $b_prods; do printf '%s ' "$p"; done)
+    for p in $b_prods; do [ -e "$b_dir/build/$p" ] || { echo "brdfprof setup: the Mesa build did not produce $p" >&2; exit 1; }; done
     # The source tree is not needed once built; the build directory holds what brdfprof loads.
-    rm -rf "$srcdir" "$dir"/mesa_*
-    printf '%s\n' "$key" > "$dir/.key"
+    rm -rf "$b_src" "$b_dir"/mesa_*
+    printf '%s\n' "$b_key" > "$b_dir/.key"
 }
 
 # built KEY DIR PRODUCTS
@@ -93,47 +92,52 @@ mkdir -p "$root/.tools"
 ln -sfn "$dir/build" "$root/.tools/mesa"
 echo "brdfprof setup: Mesa noop drivers present ($key) in $dir" >&2
 
-# bookworm-backports' Mesa: its source package's upstream tarball, checked against the SHA-256 of Debian's
-# signed Sources index (apt-get source --print-uris); Debian's packaging of it (the .dsc, its patches) is not
-# needed for a build of these drivers.
-backports_uris() {
-    apt-get source --print-uris "mesa/$backports_suite" 2>&1 || true
-}
-uris=$(backports_uris)
-version25=$(printf '%s\n' "$uris" | sed -n "s/^Selected version '\([^']*\)'.*/\1/p" | head -n 1)
-if [ -z "$version25" ]; then
-    # No deb-src entry for backports yet: add it (source indexes only; nothing installed comes from it).
-    as_root "$cache"
-    printf 'Types: deb-src\nURIs: http://deb.debian.org/debian\nSuites: %s\nComponents: main\nSigned-By: /usr/share/keyrings/debian-archive-keyring.gpg\n' \
-        "$backports_suite" > /etc/apt/sources.list.d/brdfprof-deb-src-backports.sources
-    apt-get update -qq
-    uris=$(backports_uris)
-    version25=$(printf '%s\n' "$uris" | sed -n "s/^Selected version '\([^']*\)'.*/\1/p" | head -n 1)
-    [ -n "$version25" ] || { echo "brdfprof setup: $backports_suite has no mesa source package:" >&2; printf '%s\n' "$uris" >&2; exit 1; }
-fi
+# bookworm-backports' Mesa, pinned (docs/targets.md's figures are this build's): its source package's upstream
+# tarball, checked against the SHA-256 of Debian's signed Sources index (apt-get source --print-uris); Debian's
+# packaging of it (the .dsc, its patches) is not needed for a build of these drivers. Best effort: without it
+# the Mesa 22.3 targets work and brdfprof names the 25.0 ones as not built.
+version25="25.0.7-2~bpo12+1"
 key25="$version25 $(printf '%s %s' "$options25" "$meson_pypi" | sha256sum | cut -c1-16)"
 dir25="$cache/mesa-noop-$(printf '%s' "$key25" | tr ' +:~' '----')"
-if ! built "$key25" "$dir25" "$products25"; then
-    as_root "$dir25"
+
+backports_build() {
+    [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1 || {
+        echo "brdfprof setup: bookworm-backports' Mesa is not built in $dir25; run make setup as root (it needs apt-get)" >&2; return 1; }
+    suite="$(. /etc/os-release && echo "${VERSION_CODENAME:-}")-backports"
+    list=/etc/apt/sources.list.d/brdfprof-deb-src-backports.sources
+    if ! LC_ALL=C apt-get source --print-uris "mesa=$version25" >/dev/null 2>&1; then
+        # A deb-src entry for backports: source indexes only, nothing installed comes from it.
+        printf 'Types: deb-src\nURIs: http://deb.debian.org/debian\nSuites: %s\nComponents: main\nSigned-By: /usr/share/keyrings/debian-archive-keyring.gpg\n' "$suite" > "$list"
+        LC_ALL=C apt-get update -qq || { rm -f "$list"; echo "brdfprof setup: apt-get update failed with $suite's deb-src entry (removed)" >&2; return 1; }
+    fi
+    uris=$(LC_ALL=C apt-get source --print-uris -qq "mesa=$version25" 2>&1) || { echo "brdfprof setup: no mesa=$version25 source package in $suite: $uris" >&2; return 1; }
     tools
     rm -rf "$dir25"
-    mkdir -p "$dir25"
-    line=$(printf '%s\n' "$uris" | grep "\.orig\.tar\." | head -n 1)
+    mkdir -p "$dir25" || return 1
+    line=$(printf '%s\n' "$uris" | grep "\.orig\.tar\.[a-z0-9]*' " | grep -v "\.asc'" | head -n 1)
     tarball=$(printf '%s' "$line" | cut -d' ' -f2)
     sum=$(printf '%s' "$line" | sed -n 's/.*SHA256:\([0-9a-f]*\).*/\1/p')
-    [ -n "$tarball" ] && [ -n "$sum" ] || { echo "brdfprof setup: no upstream tarball for mesa/$backports_suite in apt's index" >&2; exit 1; }
-    echo "brdfprof setup: fetching $tarball (Debian's mesa $version25 source package, $backports_suite) into $dir25" >&2
+    [ -n "$tarball" ] && [ -n "$sum" ] || { echo "brdfprof setup: no upstream tarball for mesa=$version25 in apt's index" >&2; return 1; }
+    echo "brdfprof setup: fetching $tarball (Debian's mesa $version25 source package, $suite) into $dir25" >&2
     # --download-only fetches and checks each file it can; only the tarball is needed (see above).
-    (cd "$dir25" && apt-get source --download-only -qq "mesa/$backports_suite" >/dev/null 2>&1) || true
-    echo "$sum  $dir25/$tarball" | sha256sum -c --quiet - || { echo "brdfprof setup: $tarball is missing or does not match Debian's index" >&2; exit 1; }
-    tar -xf "$dir25/$tarball" -C "$dir25"
+    (cd "$dir25" && LC_ALL=C apt-get source --download-only -qq "mesa=$version25" >/dev/null 2>&1) || true
+    echo "$sum  $dir25/$tarball" | sha256sum -c --quiet - || { echo "brdfprof setup: $tarball is missing or does not match Debian's index" >&2; return 1; }
+    tar -xf "$dir25/$tarball" -C "$dir25" || return 1
     src25=$(find "$dir25" -mindepth 1 -maxdepth 1 -type d -name 'mesa-*' | head -n 1)
+    [ -n "$src25" ] || { echo "brdfprof setup: $tarball unpacked no mesa-* folder" >&2; return 1; }
     # Mesa 25 needs meson >= 1.1 (Debian 12 has 1.0.1): PyPI's, pinned, in the build's own folder.
-    python3 -m pip install --quiet --disable-pip-version-check --root-user-action=ignore --no-deps --target "$dir25/meson" "$meson_pypi"
+    python3 -m pip install --quiet --disable-pip-version-check --root-user-action=ignore --no-deps --target "$dir25/meson" "$meson_pypi" || return 1
     # Exported: ninja runs meson's own script again for generated files.
     export PYTHONPATH="$dir25/meson"
     build "Turnip and PanVK and their noop shims from Mesa $version25 (about 900 steps, ~12 min on 2 cores)" "$key25" "$dir25" "$options25" "$products25" \
         "python3 $dir25/meson/bin/meson" "$src25"
+}
+
+if ! built "$key25" "$dir25" "$products25"; then
+    # In a subshell: build's `exit` on failure ends it, not the setup.
+    ( backports_build ) || echo "brdfprof setup: warning: bookworm-backports' Mesa $version25 was not built; adreno:a730/a740/a750 and mali:g610 are unavailable (the other targets are not affected); make setup tries again" >&2
 fi
-ln -sfn "$dir25/build" "$root/.tools/mesa25"
-echo "brdfprof setup: Mesa noop drivers present ($key25) in $dir25" >&2
+if built "$key25" "$dir25" "$products25"; then
+    ln -sfn "$dir25/build" "$root/.tools/mesa25"
+    echo "brdfprof setup: Mesa noop drivers present ($key25) in $dir25" >&2
+fi

@@ -139,6 +139,8 @@ pub struct FileModel {
     pub entry: Option<String>,
     /// `returns=f|f_nol`: overrides what the entry's declaration says it returns.
     pub returns: Option<Returns>,
+    /// Each parameter's default binding (`bind` in the file, else its value): what names leave out.
+    pub defaults: Vec<Binding>,
 }
 
 /// The function the kernels call for f_s: `BRDF`, or a declared entry (`entry NAME(ARG, ...)` in the file).
@@ -331,8 +333,11 @@ impl FileModel {
         if file.has_is_func {
             crate::messages::input_note(format!("{path}: its isFunc section (importance sampling) is ignored: brdfprof integrates with its own estimator"));
         }
-        let bindings = default_bindings(&file, path)?;
-        let model = FileModel { file, path: path.to_string(), bindings, label: None, entry: None, returns: None };
+        if let Some(p) = file.params.iter().find(|p| [DEFINE, ENTRY, RETURNS].contains(&p.name.as_str())) {
+            bail!("{}:{}: a parameter cannot be called `{}`: `{}=` in a model spec is brdfprof's own key", file.path.display(), p.line, p.name, p.name);
+        }
+        let defaults = default_bindings(&file, path)?;
+        let model = FileModel { file, path: path.to_string(), bindings: defaults.clone(), label: None, entry: None, returns: None, defaults };
         model.warn_new(None);
         model.with_params(&params)
     }
@@ -387,7 +392,7 @@ impl FileModel {
             }
             given.push(name);
             if name == ENTRY {
-                m.entry = Some(self.parse_entry(value.trim())?);
+                m.entry = Some(m.parse_entry(value.trim())?);
                 continue;
             }
             if name == RETURNS {
@@ -441,11 +446,10 @@ impl FileModel {
         if let Some(r) = self.returns.filter(|r| all || *r != declared) {
             s += &format!(",{RETURNS}={}", r.text());
         }
-        let defaults = default_bindings(&self.file, &self.path).unwrap_or_default();
-        for ((p, b), d) in self.file.params.iter().zip(&self.bindings).zip(defaults) {
+        for ((p, b), d) in self.file.params.iter().zip(&self.bindings).zip(&self.defaults) {
             let text = match b {
-                Binding::Value(v) if all || *b != d => v.text(),
-                Binding::Input(i) if all || *b != d => format!("@{}", i.name()),
+                Binding::Value(v) if all || b != d => v.text(),
+                Binding::Input(i) if all || b != d => format!("@{}", i.name()),
                 _ => continue,
             };
             s += &format!(",{}={text}", p.name);

@@ -66,7 +66,7 @@ const PIPES: [(&str, &str); 7] = [
 const SHOWN_BIFROST: [&str; 7] = ["Instructions", "Tuples", "Clauses", "Arithmetic cycles", "Load-store cycles", "Bound cycles", "Threads"];
 const SHOWN_VALHALL: [&str; 7] = ["Instructions", "FMA cycles", "CVT cycles", "SFU cycles", "Load-store cycles", "Bound cycles", "Threads"];
 
-/// PanVK 22.3 (Bifrost); Mesa 25.0's PanVK is a Vulkan 1.1 driver for Valhall, which the layer judges.
+/// Why PanVK 22.3 (Bifrost) runs unvalidated; Mesa 25.0's PanVK (Vulkan 1.1) for `MESA_25_UNVALIDATED`'s reason.
 const PANVK_22_UNVALIDATED: &str = "PanVK 22.3 is a Vulkan 1.0 driver, and brdfprof's kernels are SPIR-V 1.3 (Vulkan 1.1), which the layer refuses on a 1.0 device; the driver compiles them (Mesa's SPIR-V front end reads any version), so its figures stand, unvalidated";
 
 pub static MALI: Shim = Shim {
@@ -104,7 +104,7 @@ pub fn read_shaderdb(log: &str) -> Result<(Vec<DriverStat>, Vec<String>)> {
         many => bail!("the Bifrost compiler printed {} compute-shader statistics lines for one pipeline", many.len()),
     };
     let mut stats = Vec::new();
-    let mut stat = |name: &str, value: f64| stats.push(DriverStat { executable: crate::gpu::LOGGED_EXECUTABLE.into(), name: name.into(), description: format!("Bifrost compiler (bi_print_stats): {name}"), value });
+    let mut stat = |name: &str, value: f64| stats.push(DriverStat { executable: crate::gpu::LOGGED_EXECUTABLE.into(), name: name.into(), description: format!("Bifrost compiler (bi_print_stats; va_print_stats for Valhall): {name}"), value });
     for field in line.split(", ") {
         let (number, word) = field.trim().split_once(' ').ok_or_else(|| anyhow!("unreadable field `{field}` in `{line}`"))?;
         if word == "spills:fills" {

@@ -140,12 +140,14 @@ pub fn child_main(request_json: &str) -> Result<()> {
         bail!("{target}: {} reports no compiler statistics (no VK_KHR_pipeline_executable_properties)", gpu.info.name);
     }
     // A driver without VK_KHR_pipeline_executable_properties (PanVK) returns no listing: --isa says so.
-    let listings = gpu.executable_properties.is_some();
+    // PanVK 25 has the extension but its statistics and no listing come through the compiler's log.
+    let listings = gpu.executable_properties.is_some() && driver.compiler_log().is_none();
     let isa_dir = req.isa_dir.as_ref().filter(|_| listings).map(|d| d.join(driver.isa_folder(family)));
     let (mut report, isa_files) = if req.raw.is_empty() { models_report(&gpu, &shaders, &req, &target, models, isa_dir.as_deref())? } else { raw_report(&gpu, &shaders, &req, &target, isa_dir.as_deref())? };
     report.provenance["target"] = serde_json::Value::String(target.clone());
     if req.isa_dir.is_some() && !listings {
-        add_driver_note(&mut report, format!("--isa: no listing for {target}: {} has no VK_KHR_pipeline_executable_properties to return one", gpu.info.name));
+        let why = if gpu.executable_properties.is_none() { "has no VK_KHR_pipeline_executable_properties to return one" } else { "reports its compiler's statistics on stderr, not through pipeline executable properties" };
+        add_driver_note(&mut report, format!("--isa: no listing for {target}: {} {why}", gpu.info.name));
     }
     if let Some(why) = unvalidated {
         add_driver_note(&mut report, format!("the Khronos validation layer was not run for {target}: {why}"));
@@ -291,10 +293,11 @@ fn run(driver: &'static dyn NoopDriver, family: usize, models: &[Model], raw: &[
     let name = Target { vendor: driver, family }.name();
     // The driver's environment first: a driver that is not built stops here, naming what to run.
     let environment = driver.environment(family)?;
-    let inputs = super::noop_cache::ChildInputs { driver, family, models, raw, lights: request.lights, validate: request.validate, shaders: request.shaders, environment: &environment };
-    let key = match request.isa_dir {
-        Some(_) => None,
-        None => super::noop_cache::key(&inputs)?,
+    let inputs = super::noop_cache::ChildInputs { target: name.clone(), models, raw, lights: request.lights, validate: request.validate, shaders: request.shaders, environment: &environment };
+    // A child that writes files (--isa) or is asked to crash (the containment test) always runs.
+    let key = match request.isa_dir.is_some() || std::env::var_os(CRASH_AFTER_REPLY).is_some() {
+        true => None,
+        false => Some(super::noop_cache::key(&inputs)?),
     };
     let Some(key) = key else {
         let (run, messages) = spawn(driver, family, models, raw, request, environment)?;
@@ -432,7 +435,7 @@ pub fn compile(prefix: &str, families: &[usize], raw: &[super::RawKernel], reque
             let run = run?;
             let mut report = run.report;
             if let Some(note) = &run.teardown_note {
-                report.section_notes.insert("driver/".into(), note.clone());
+                add_driver_note(&mut report, note.clone());
             }
             report.cost = driver.cost(&report);
             Ok(Run { target: Target { vendor: driver, family }, report, isa_files: run.isa_files, note: run.teardown_note })

@@ -7,13 +7,15 @@
 //!   child reads and the library it names, and every `LD_PRELOAD` file, each by path, size and modification
 //!   time (a rebuilt Mesa, or another installed one, is another key);
 //! - the variables of this process that Mesa, the loader or the dynamic linker read (`MESA_*`, `RADV_*`,
-//!   `ACO_*`, `TU_*`, `IR3_*`, `PAN_*`, `BIFROST_*`, `INTEL_*`, `ANV_*`, `NIR_*`, `VK_*`, `LD_*`...), which the
-//!   child inherits;
+//!   `ACO_*`, `TU_*`, `IR3_*`, `PAN_*`, `PANVK_*`, `BIFROST_*`, `INTEL_*`, `ANV_*`, `NIR_*`, `VK_*`, `LD_*`,
+//!   `XDG_DATA_*`, `XDG_CONFIG_*`, `HOME`...), which the child inherits;
+//! - with `--validate`, each validation layer manifest the child's loader may read and its library;
+//! - spirv-opt's version (the report's `spirv-O` counts are its output);
 //! - brdfprof's executable by size and modification time (the child's analyses are its code).
 //!
-//! A request that writes files (`--isa`) or asks the child to crash (the containment test) is never cached.
+//! A request that writes files (`--isa`) or asks the child to crash (the containment test) is never cached
+//! (`mesa_noop::run` decides).
 
-use super::mesa_noop::{NoopDriver, CRASH_AFTER_REPLY};
 use super::RawKernel;
 use crate::cache::{Key, KeyBuilder};
 use crate::kernels::shade::{kernel_hash, GBufferFormat};
@@ -26,16 +28,41 @@ use std::path::{Path, PathBuf};
 pub const KIND: &str = "noop_report";
 
 /// Prefixes of the variables a Mesa driver, the Vulkan loader or the dynamic linker may read.
-const DRIVER_PREFIXES: [&str; 18] =
-    ["MESA_", "RADV_", "ACO_", "TU_", "IR3_", "FD_", "PAN_", "BIFROST_", "MIDGARD_", "INTEL_", "ANV_", "BRW_", "NIR_", "GALLIUM_", "LP_", "VK_", "LD_", "XDG_DATA"];
+const DRIVER_PREFIXES: [&str; 21] = [
+    "MESA_", "RADV_", "ACO_", "TU_", "IR3_", "FD_", "PAN_", "PANVK_", "BIFROST_", "MIDGARD_", "INTEL_", "ANV_", "BRW_", "NIR_", "GALLIUM_", "LP_", "VK_", "LD_", "XDG_DATA",
+    "XDG_CONFIG", "HOME",
+];
 
-/// The Vulkan loader's system ICD directories (where no variable names the ICDs).
-const ICD_DIRS: [&str; 4] = ["/etc/vulkan/icd.d", "/usr/local/share/vulkan/icd.d", "/usr/share/vulkan/icd.d", "/usr/local/etc/vulkan/icd.d"];
+/// The Vulkan loader's system folders (where no variable names the files), under which `vulkan/icd.d` holds
+/// the drivers' manifests and `vulkan/explicit_layer.d` the layers' (the user's `~/.local/share` too).
+const VULKAN_DIRS: [&str; 5] = ["/etc/xdg", "/etc", "/usr/local/share", "/usr/share", "/usr/local/etc"];
+
+/// The system folders of `kind` (`icd.d`), and the user's.
+fn vulkan_dirs(kind: &str, environment: &std::collections::BTreeMap<String, String>) -> Vec<PathBuf> {
+    let home = environment.get("HOME").map(|h| PathBuf::from(h).join(".local/share"));
+    VULKAN_DIRS.iter().map(PathBuf::from).chain(home).map(|d| d.join("vulkan").join(kind)).collect()
+}
+
+/// Every JSON manifest under `dirs`, sorted.
+fn manifests(dirs: &[PathBuf]) -> Vec<PathBuf> {
+    let mut all: Vec<PathBuf> = dirs.iter().flat_map(|d| std::fs::read_dir(d).into_iter().flatten().flatten().map(|e| e.path())).collect();
+    all.sort();
+    all
+}
+
+/// The validation layer's manifests and the libraries they name (`--validate` runs it in the child).
+fn layer_files(environment: &std::collections::BTreeMap<String, String>) -> Vec<PathBuf> {
+    let dirs: Vec<PathBuf> = match environment.get("VK_LAYER_PATH").filter(|s| !s.is_empty()) {
+        Some(list) => std::env::split_paths(list).collect(),
+        None => vulkan_dirs("explicit_layer.d", environment),
+    };
+    manifests(&dirs).into_iter().flat_map(|m| [manifest_library(&m, "layer"), Some(m)]).flatten().collect()
+}
 
 /// What one child is asked, as far as its figures depend on it.
 pub struct ChildInputs<'a> {
-    pub driver: &'a dyn NoopDriver,
-    pub family: usize,
+    /// `adreno:a660`.
+    pub target: String,
     pub models: &'a [Model],
     pub raw: &'a [RawKernel],
     pub lights: u32,
@@ -45,23 +72,28 @@ pub struct ChildInputs<'a> {
     pub environment: &'a [(String, String)],
 }
 
-/// The key of a child's report, or None when the request must run afresh.
-pub fn key(inputs: &ChildInputs) -> Result<Option<Key>> {
-    if std::env::var_os(CRASH_AFTER_REPLY).is_some() {
-        return Ok(None);
-    }
+/// The key of a child's report.
+pub fn key(inputs: &ChildInputs) -> Result<Key> {
     let exe = std::env::current_exe()?;
     let mut key = KeyBuilder::new(KIND)
         .part("brdfprof", env!("CARGO_PKG_VERSION"))
         .part("executable", identity(&exe))
-        .part("target", format!("{}:{}", inputs.driver.prefix(), inputs.driver.families()[inputs.family].name))
+        .part("target", &inputs.target)
+        // The SPIR-V counts of the report are spirv-opt's.
+        .part("spirv-opt", crate::spirv::spirv_opt_version().unwrap_or_default())
         .part("lights", inputs.lights.to_le_bytes())
         .part("validate", [inputs.validate as u8]);
+    // Both G-buffer forms: the report's static rows read the float one too (naga's analysis).
     for model in inputs.models {
-        key = key.part("model", model.name()).part("kernel", kernel_hash(Some(model), GBufferFormat::Packed, inputs.shaders)?);
+        key = key.part("model", model.name());
+        for format in [GBufferFormat::Packed, GBufferFormat::Float] {
+            key = key.part("kernel", kernel_hash(Some(model), format, inputs.shaders)?);
+        }
     }
     if inputs.raw.is_empty() {
-        key = key.part("memory-only kernel", kernel_hash(None, GBufferFormat::Packed, inputs.shaders)?);
+        for format in [GBufferFormat::Packed, GBufferFormat::Float] {
+            key = key.part("memory-only kernel", kernel_hash(None, format, inputs.shaders)?);
+        }
     }
     for r in inputs.raw {
         let interface = format!("{} {} {} {}", r.label, r.model.name(), r.storage_buffers, r.push_bytes);
@@ -76,7 +108,12 @@ pub fn key(inputs: &ChildInputs) -> Result<Option<Key>> {
     for file in driver_files(&environment) {
         key = key.part("driver file", identity(&file));
     }
-    Ok(Some(key.finish()))
+    if inputs.validate {
+        for file in layer_files(&environment) {
+            key = key.part("layer file", identity(&file));
+        }
+    }
+    Ok(key.finish())
 }
 
 /// A file by its path, size and modification time (nanoseconds), or that it is absent.
@@ -96,15 +133,11 @@ fn driver_files(environment: &std::collections::BTreeMap<String, String>) -> Vec
     let named = ["VK_DRIVER_FILES", "VK_ICD_FILENAMES"].iter().find_map(|v| environment.get(*v).filter(|s| !s.is_empty()));
     let icds: Vec<PathBuf> = match named {
         Some(list) => std::env::split_paths(list).collect(),
-        None => {
-            let mut all: Vec<PathBuf> = ICD_DIRS.iter().flat_map(|d| std::fs::read_dir(d).into_iter().flatten().flatten().map(|e| e.path())).collect();
-            all.sort();
-            all
-        }
+        None => manifests(&vulkan_dirs("icd.d", environment)),
     };
     let mut files = Vec::new();
     for icd in icds {
-        if let Some(library) = icd_library(&icd) {
+        if let Some(library) = manifest_library(&icd, "ICD") {
             files.push(library);
         }
         files.push(icd);
@@ -115,12 +148,20 @@ fn driver_files(environment: &std::collections::BTreeMap<String, String>) -> Vec
     files
 }
 
-/// The library an ICD file names (relative to the file's folder when the name is a relative path).
-fn icd_library(icd: &Path) -> Option<PathBuf> {
-    let text = std::fs::read_to_string(icd).ok()?;
+/// The library a manifest's `section` (`ICD`, `layer`) names: relative to the manifest's folder when it is a
+/// relative path; a bare name as the dynamic linker finds it in the system's library folders.
+fn manifest_library(manifest: &Path, section: &str) -> Option<PathBuf> {
+    let text = std::fs::read_to_string(manifest).ok()?;
     let json: serde_json::Value = serde_json::from_str(&text).ok()?;
-    let library = Path::new(json["ICD"]["library_path"].as_str()?);
-    Some(if library.is_relative() && library.components().count() > 1 { icd.parent()?.join(library) } else { library.to_path_buf() })
+    let library = Path::new(json[section]["library_path"].as_str()?);
+    if library.is_absolute() {
+        return Some(library.to_path_buf());
+    }
+    if library.components().count() > 1 {
+        return Some(manifest.parent()?.join(library));
+    }
+    let system = ["/usr/lib/x86_64-linux-gnu", "/usr/lib", "/lib/x86_64-linux-gnu", "/usr/local/lib"];
+    system.iter().map(|d| Path::new(d).join(library)).find(|p| p.exists()).or_else(|| Some(library.to_path_buf()))
 }
 
 #[cfg(test)]

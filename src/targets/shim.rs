@@ -91,15 +91,29 @@ impl Vendor for Shim {
     }
 
     fn status(&self) -> Result<String> {
-        let mut builds: Vec<&mesa_noop::MesaBuild> = Vec::new();
+        // Per Mesa build: its families are ready, or why not; the vendor is ready where any build is.
+        let mut ready: Vec<String> = Vec::new();
+        let mut missing: Vec<(String, anyhow::Error)> = Vec::new();
+        let mut seen: Vec<&mesa_noop::MesaBuild> = Vec::new();
         for (k, f) in self.families.iter().enumerate() {
-            if !builds.iter().any(|b| std::ptr::eq(*b, f.build)) {
-                self.environment(k)?;
-                builds.push(f.build);
+            if seen.iter().any(|b| std::ptr::eq(*b, f.build)) {
+                continue;
+            }
+            seen.push(f.build);
+            let names = self.families.iter().filter(|g| std::ptr::eq(g.build, f.build)).map(|g| g.name).collect::<Vec<_>>().join(", ");
+            match self.environment(k) {
+                Ok(_) => ready.push(format!("{} ({names})", f.build.dir().display())),
+                Err(e) => missing.push((names, e)),
             }
         }
-        let dirs = builds.iter().map(|b| b.dir().display().to_string()).collect::<Vec<_>>().join(" and ");
-        Ok(format!("Mesa's {} ({} compiler) on its noop drm-shim, built by make setup in {dirs}", self.driver, self.compiler))
+        if ready.is_empty() {
+            return Err(missing.into_iter().next().map(|(_, e)| e).unwrap_or_else(|| anyhow::anyhow!("{}: no family", self.prefix)));
+        }
+        let mut text = format!("Mesa's {} ({} compiler) on its noop drm-shim, built by make setup in {}", self.driver, self.compiler, ready.join(" and "));
+        for (names, e) in missing {
+            text += &format!("; not built for {names}: {e:#}");
+        }
+        Ok(text)
     }
 
     fn needs_verification(&self) -> bool {

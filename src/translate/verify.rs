@@ -50,8 +50,9 @@ impl Agreement {
     }
 }
 
-/// The version of `Agreement`'s cached form (2: `srem`), part of the cache key.
-const AGREEMENT_SCHEMA: &str = "2";
+/// The version of `Agreement`'s cached form (2: `srem`; 3: an f_nol entry's host values divided by N.L as the
+/// device's are), part of the cache key.
+const AGREEMENT_SCHEMA: &str = "3";
 
 /// The prelude variant that computes OpSMod as lavapipe does (srem).
 const SMOD_AS_SREM: &str = "BRDFPROF_SMOD_AS_SREM";
@@ -113,7 +114,8 @@ pub fn eval_agreement(gpu: &Gpu, model: &Model, shaders: &Shaders) -> Result<Agr
     let translation = prepare::eval_kernel(model, shaders)?;
     let on_device = kernels::eval_from(gpu, model, shaders, &samples, &EvalExtras::default(), RunLimits::default())?;
     let compare = |defines: &[&str]| -> Result<f64> {
-        let on_host = host::eval(&host::HostKernel::compile_with(&translation, defines)?, &samples, &EvalExtras::default())?;
+        // As f_s, as `eval_from` gives the device's (a `returns f_nol` entry divided by N.L on the host).
+        let on_host = kernels::as_f(model, host::eval(&host::HostKernel::compile_with(&translation, defines)?, &samples, &EvalExtras::default())?, &samples);
         Ok(worst_relative(&on_host, &on_device, |i, c| f64::from(on_device[i][c]).abs().max(1e-3)))
     };
     let (worst, tolerance) = (compare(&[])?, eval_tolerance(model));

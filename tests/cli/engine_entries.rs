@@ -131,3 +131,16 @@ fn bad_entry_declarations_exit_2_at_their_line() {
         assert!(!d.join("out.csv").exists(), "{}", r.stderr);
     }
 }
+
+#[test]
+fn the_translating_targets_check_and_price_an_f_nol_entry() {
+    // The translation check compares the translated eval kernel on the host with the Vulkan one, both as f_s:
+    // an f_nol entry's host values are divided by N.L as the device's are.
+    let dir = tempfile::tempdir().unwrap();
+    let out = crate::compile_only::inspect_json(dir.path(), "t", &["nvidia:sm_89", "intel:gen12lp"], &["--model", &engine()], "ptxas statistics");
+    for report in out["reports"].as_array().unwrap() {
+        let rows = report["cost"]["rows"].as_array().unwrap();
+        let row = rows.iter().find(|r| r["model"] == "engine-ggx").unwrap_or_else(|| panic!("{rows:?}"));
+        assert!(row["net_cycles_per_eval"].as_f64().unwrap() > 0.0, "{row}");
+    }
+}
