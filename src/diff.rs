@@ -25,12 +25,27 @@ pub const MAX_SAMPLES: usize = 20_000_000;
 /// The default inputs: `count` well-conditioned samples (NoV and NoL uniform in [0.05, 1], roughness uniform in
 /// [0, 1] so that the roughness floor is crossed, F0 uniform in [0, 1]^3), seeded.
 pub fn default_samples(count: usize, seed: u64) -> Vec<Sample> {
-    samples::well_conditioned(count, seed, 0.05, 0.0..1.0)
+    default_samples_in(count, seed, (0.0, 1.0))
+}
+
+/// `default_samples` with roughness uniform in [lo, hi] (`--roughness`, a file's domain).
+pub fn default_samples_in(count: usize, seed: u64, (lo, hi): (f64, f64)) -> Vec<Sample> {
+    if lo == hi {
+        let mut s = samples::well_conditioned(count, seed, 0.05, 0.0..1.0);
+        s.iter_mut().for_each(|x| x.roughness = lo as f32);
+        return s;
+    }
+    samples::well_conditioned(count, seed, 0.05, lo..hi)
 }
 
 /// The words that say what the default inputs are.
 pub fn default_samples_label(count: usize, seed: u64) -> String {
-    format!("{count} well-conditioned samples (seed {seed}; NoV, NoL in [0.05, 1], roughness in [0, 1], F0 in [0, 1]^3)")
+    default_samples_label_in(count, seed, (0.0, 1.0), "")
+}
+
+/// `default_samples_label` for roughness in [lo, hi], `why` saying where the range comes from.
+pub fn default_samples_label_in(count: usize, seed: u64, (lo, hi): (f64, f64), why: &str) -> String {
+    format!("{count} well-conditioned samples (seed {seed}; NoV, NoL in [0.05, 1], roughness in [{lo}, {hi}]{why}, F0 in [0, 1]^3)")
 }
 
 /// One model as the report names it.

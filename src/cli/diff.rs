@@ -25,6 +25,10 @@ pub struct DiffArgs {
     pub samples: usize,
     #[arg(long, default_value_t = 19, conflicts_with = "input")]
     pub seed: u64,
+    /// Perceptual roughness range of the default samples, MIN..MAX within [0, 1] (default: [0, 1], or the
+    /// range every `.brdf` model's `domain roughness` admits).
+    #[arg(long, value_parser = roughness_range, conflicts_with = "input")]
+    pub roughness: Option<(f64, f64)>,
     /// Rows listed where the models differ most.
     #[arg(long, default_value_t = 10)]
     pub worst: usize,
@@ -45,6 +49,36 @@ pub struct DiffArgs {
     pub html: super::report::HtmlArg,
     #[command(flatten)]
     pub device: DeviceArgs,
+}
+
+/// `--roughness MIN..MAX`: 0 <= MIN <= MAX <= 1.
+fn roughness_range(text: &str) -> Result<(f64, f64), String> {
+    let fail = || format!("`{text}`: give MIN..MAX with 0 <= MIN <= MAX <= 1 (e.g. 0.0525..1)");
+    let (lo, hi) = text.split_once("..").ok_or_else(fail)?;
+    let (lo, hi): (f64, f64) = (lo.trim().parse().map_err(|_| fail())?, hi.trim().parse().map_err(|_| fail())?);
+    if !(0.0..=1.0).contains(&lo) || !(0.0..=1.0).contains(&hi) || lo > hi {
+        return Err(fail());
+    }
+    Ok((lo, hi))
+}
+
+/// The default samples' roughness range: `--roughness`, else the intersection of the models' declared
+/// domains (named in the label), else [0, 1]; models whose domains do not meet are refused.
+fn roughness_of(args: &DiffArgs, models: &[&Model]) -> Result<((f64, f64), String)> {
+    if let Some(r) = args.roughness {
+        return Ok((r, " (--roughness)".into()));
+    }
+    let declared: Vec<(String, (f64, f64))> = models.iter().filter_map(|m| m.roughness_domain().map(|d| (m.label(), d))).collect();
+    if declared.is_empty() {
+        return Ok(((0.0, 1.0), String::new()));
+    }
+    let lo = declared.iter().map(|(_, d)| d.0).fold(0.0, f64::max);
+    let hi = declared.iter().map(|(_, d)| d.1).fold(1.0, f64::min);
+    let names = declared.iter().map(|(n, (a, b))| format!("{n} [{a}, {b}]")).collect::<Vec<_>>().join(", ");
+    if lo > hi {
+        bail!("the models' roughness domains do not meet ({names}); give --roughness MIN..MAX to compare them anyway");
+    }
+    Ok(((lo, hi), format!(" (the models' declared domain: {names})")))
 }
 
 /// `--tolerance`: a finite number, 0 or more.
@@ -128,11 +162,12 @@ impl Inputs {
     fn read(args: &DiffArgs, a: &Model, b: &Model) -> Result<Self> {
         let Some(path) = &args.input else {
             let none = || RowValues::default();
+            let (range, why) = roughness_of(args, &[a, b])?;
             return Ok(Inputs {
-                samples: diff::default_samples(args.samples, args.seed),
+                samples: diff::default_samples_in(args.samples, args.seed, range),
                 tangents: None,
                 lines: None,
-                label: diff::default_samples_label(args.samples, args.seed),
+                label: diff::default_samples_label_in(args.samples, args.seed, range, &why),
                 a: (a.clone(), none()),
                 b: (b.clone(), none()),
             });

@@ -125,6 +125,11 @@ impl Model {
     }
 
     /// The `.brdf` file, for a file model.
+    /// The perceptual roughness range a `.brdf` file's engine admits (`domain roughness MIN MAX`), if it declares one.
+    pub fn roughness_domain(&self) -> Option<(f64, f64)> {
+        self.file().and_then(|f| f.file.roughness_domain).map(|(lo, hi, _)| (lo, hi))
+    }
+
     pub fn file(&self) -> Option<&file_model::FileModel> {
         match self {
             Model::File(f) => Some(f),

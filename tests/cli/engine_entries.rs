@@ -120,6 +120,8 @@ fn bad_entry_declarations_exit_2_at_their_line() {
         ("bind roughness=@roughness f0=@f0", "bind gloss=@roughness", ": `bind gloss=...`: the file has no parameter `gloss`".to_string()),
         ("bind roughness=@roughness f0=@f0", "bind roughness=0.5", ": `roughness=0.5`: `bind` binds a parameter to an input".to_string()),
         ("bind roughness=@roughness f0=@f0", "tint 1 2 3", ": unknown directive `tint`".to_string()),
+        ("domain roughness 0.0525 1", "domain roughness 1 0.0525", ": `domain roughness 1 0.0525`: MIN 1 is above MAX 0.0525".to_string()),
+        ("domain roughness 0.0525 1", "domain nov 0 1", ": `domain nov`: only the roughness domain".to_string()),
         // An argument glslang refuses is reported at the entry's own line, with the file's names.
         ("entry surface_light(N, L, V, f0, roughness) returns f_nol", "entry surface_light(N, L, V, f0, gloss) returns f_nol", format!("engine.brdf:{entry_line}:")),
     ];
@@ -143,4 +145,33 @@ fn the_translating_targets_check_and_price_an_f_nol_entry() {
         let row = rows.iter().find(|r| r["model"] == "engine-ggx").unwrap_or_else(|| panic!("{rows:?}"));
         assert!(row["net_cycles_per_eval"].as_f64().unwrap() > 0.0, "{row}");
     }
+}
+
+/// The largest relative difference over the channels of a diff report.
+fn max_rel(report: &serde_json::Value) -> f64 {
+    report["difference"]["channels"].as_array().unwrap().iter().map(|c| c["max_rel"].as_f64().unwrap()).fold(0.0, f64::max)
+}
+
+#[test]
+fn diff_samples_the_files_declared_roughness_domain_unless_told_otherwise() {
+    // engine-ggx.brdf declares `domain roughness 0.0525 1` (its roughness floor): within it, it is the term
+    // library's GGX with the height-correlated Smith and Schlick; below it, the floor makes it differ.
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let spec = "d=ggx,vis=smith-ggx-correlated,f=schlick";
+    let diff = |name: &str, extra: &[&str]| -> serde_json::Value {
+        let json = d.join(format!("{name}.json"));
+        let model = engine();
+        let mut args = vec!["diff", "--model", spec, "--model", &model, "--samples", "4000", "--json", json.to_str().unwrap()];
+        args.extend(extra);
+        run_in(d, &args).ok();
+        serde_json::from_str(&std::fs::read_to_string(json).unwrap()).unwrap()
+    };
+    let within = diff("within", &[]);
+    assert!(within["input"].as_str().unwrap().contains("roughness in [0.0525, 1] (the models' declared domain: engine-ggx [0.0525, 1])"), "{}", within["input"]);
+    assert!(max_rel(&within) < 2e-3, "within the domain: {}", max_rel(&within));
+    let all = diff("all", &["--roughness", "0..1"]);
+    assert!(all["input"].as_str().unwrap().contains("roughness in [0, 1] (--roughness)"), "{}", all["input"]);
+    assert!(max_rel(&all) > 0.5, "below the floor the file differs: {}", max_rel(&all));
+    run_in(d, &["diff", "--model", spec, "--model", &engine(), "--roughness", "0.5..0.2"]).fails(2, "--roughness");
 }

@@ -247,7 +247,7 @@ pub(super) fn check_identifier(path: &Path, n: usize, name: &str, warnings: &mut
     Ok(())
 }
 
-/// The section of brdfprof's own directives (BRDF Explorer warns about it and reads on): `entry`, `bind`.
+/// The section of brdfprof's own directives (BRDF Explorer warns about it and reads on): `entry`, `bind`, `domain`.
 pub(super) const DIRECTIVES_SECTION: &str = "brdfprof";
 
 /// One line of the `brdfprof` section:
@@ -255,6 +255,7 @@ pub(super) const DIRECTIVES_SECTION: &str = "brdfprof";
 ///   argument a GLSL expression over `L V N X Y` (BRDF Explorer's entry's arguments) and the file's
 ///   parameters; `returns f_nol` when it returns f_s times N.L (an engine's light loop body).
 /// - `bind NAME=@INPUT ...`: a parameter's default binding to a kernel input, as `NAME=@INPUT` in the model spec.
+/// - `domain roughness MIN MAX`: the perceptual roughness the file's engine admits (`diff` samples within it).
 pub(super) fn parse_directive(file: &mut BrdfFile, n: usize, line: &str) -> Result<()> {
     let path = file.path.clone();
     let (word, rest) = line.split_once(char::is_whitespace).map_or((line, ""), |(w, r)| (w, r.trim()));
@@ -281,7 +282,24 @@ pub(super) fn parse_directive(file: &mut BrdfFile, n: usize, line: &str) -> Resu
                 bail!(at(&path, n, "`bind` names no parameter: `bind NAME=@INPUT ...`"));
             }
         }
-        other => bail!(at(&path, n, format!("unknown directive `{other}` in the `{DIRECTIVES_SECTION}` section (known: entry, bind)"))),
+        "domain" => {
+            let form = "`domain roughness MIN MAX`";
+            let words: Vec<&str> = rest.split_whitespace().collect();
+            let [input, min, max] = words.as_slice() else { bail!(at(&path, n, format!("`domain {rest}`: expected {form}"))) };
+            if *input != "roughness" {
+                bail!(at(&path, n, format!("`domain {input}`: only the roughness domain is declared so far ({form})")));
+            }
+            let number = |t: &str| t.parse::<f64>().ok().filter(|x| x.is_finite() && *x >= 0.0);
+            let (Some(lo), Some(hi)) = (number(min), number(max)) else { bail!(at(&path, n, format!("`domain {rest}`: MIN and MAX are finite numbers, 0 or more"))) };
+            if lo > hi {
+                bail!(at(&path, n, format!("`domain {rest}`: MIN {lo} is above MAX {hi}")));
+            }
+            if let Some((_, _, first)) = file.roughness_domain {
+                bail!(at(&path, n, format!("the roughness domain is declared twice (first at line {first})")));
+            }
+            file.roughness_domain = Some((lo, hi, n));
+        }
+        other => bail!(at(&path, n, format!("unknown directive `{other}` in the `{DIRECTIVES_SECTION}` section (known: entry, bind, domain)"))),
     }
     Ok(())
 }

@@ -83,6 +83,8 @@ pub struct BrdfFile {
     pub entries: Vec<Entry>,
     /// The shader defines `BRDF` with BRDF Explorer's signature (it may not when it declares entries).
     pub defines_brdf: bool,
+    /// The roughness the file's engine admits (`domain roughness MIN MAX`): (min, max, line).
+    pub roughness_domain: Option<(f64, f64, usize)>,
     /// Default bindings of parameters to inputs (`bind NAME=@INPUT`): (name, `@INPUT`, line).
     pub binds: Vec<(String, String, usize)>,
     /// The file has an `isFunc` section with code in it (brdfprof ignores it; BRDF Explorer samples with it).
@@ -210,6 +212,7 @@ pub fn parse_with(path: &Path, bytes: &[u8], defines: &[(String, String)]) -> Re
         shader_begin: 0,
         entries: Vec::new(),
         defines_brdf: false,
+        roughness_domain: None,
         binds: Vec::new(),
         has_is_func: false,
         warnings: Vec::new(),
