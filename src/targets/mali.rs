@@ -171,6 +171,19 @@ mod tests {
         assert!(read_shaderdb(&GGX.replace("tuples", "tupels")).unwrap_err().to_string().contains("unknown field `tupels`"));
     }
 
+    /// A row with the compiler's statistics `stats` (name, value).
+    fn pipe_row(model: &str, stats: &[(&str, f64)]) -> Row {
+        Row { model: model.into(), spec: None, stats: stats.iter().map(|(k, v)| (format!("driver/Compute Shader/{k}"), *v)).collect(), notes: Default::default() }
+    }
+
+    /// The cost table of `rows` as `target`'s child would report them.
+    fn cost_of(target: &str, device: &str, rows: Vec<Row>) -> TargetCost {
+        let mut report = crate::inspect::tests::empty_report(device);
+        report.provenance["target"] = target.into();
+        report.rows = rows;
+        super::super::Vendor::cost(&MALI, &report).unwrap()
+    }
+
     const VALHALL: &str = "SHADER-DB: MESA_SHADER_COMPUTE shader: 809 inst, 18.000000 cycles, 7.921875 fma, 3.546875 cvt, 3.500000 sfu, 0.000000 v, 0.250000 t, 18.000000 ls, 408 quadwords, 1 threads, 0 loops, 0:0 spills:fills";
 
     #[test]
@@ -178,19 +191,10 @@ mod tests {
         let (stats, _) = read_shaderdb(VALHALL).unwrap();
         let get = |n: &str| stats.iter().find(|s| s.name == n).map(|s| s.value);
         assert_eq!((get("FMA cycles"), get("SFU cycles"), get("Texture cycles"), get("Load-store cycles"), get("Bound cycles")), (Some(7.921875), Some(3.5), Some(0.25), Some(18.0), Some(18.0)));
-        let row = |model: &str, fma: f64, sfu: f64| Row {
-            model: model.into(),
-            spec: None,
-            stats: [("FMA cycles", fma), ("CVT cycles", 1.0), ("SFU cycles", sfu), ("Texture cycles", 0.0), ("Varying cycles", 0.0), ("Load-store cycles", 18.0), ("Bound cycles", 18.0)]
-                .into_iter()
-                .map(|(k, v)| (format!("driver/Compute Shader/{k}"), v))
-                .collect(),
-            notes: Default::default(),
+        let row = |model: &str, fma: f64, sfu: f64| {
+            pipe_row(model, &[("FMA cycles", fma), ("CVT cycles", 1.0), ("SFU cycles", sfu), ("Texture cycles", 0.0), ("Varying cycles", 0.0), ("Load-store cycles", 18.0), ("Bound cycles", 18.0)])
         };
-        let mut report = crate::inspect::tests::empty_report("Mali-G610 (Panfrost)");
-        report.provenance["target"] = "mali:g610".into();
-        report.rows = vec![row("ggx", 7.9, 3.5), row(BASELINE_LABEL, 1.5, 1.0)];
-        let t = super::super::Vendor::cost(&MALI, &report).unwrap();
+        let t = cost_of("mali:g610", "Mali-G610 (Panfrost)", vec![row("ggx", 7.9, 3.5), row(BASELINE_LABEL, 1.5, 1.0)]);
         let lights = f64::from(t.lights_per_kernel);
         assert_eq!(t.rows[0].net_cycles_per_eval, Some((7.9 - 1.5) / lights));
         assert_eq!(t.rows[0].bound.as_deref(), Some("FMA"));
@@ -199,19 +203,10 @@ mod tests {
 
     #[test]
     fn net_is_the_bound_of_the_added_work_per_pipe() {
-        let row = |model: &str, arith: f64, ldst: f64| Row {
-            model: model.into(),
-            spec: None,
-            stats: [("Arithmetic cycles", arith), ("Texture cycles", 0.0), ("Varying cycles", 0.0), ("Load-store cycles", ldst), ("Bound cycles", arith.max(ldst))]
-                .into_iter()
-                .map(|(k, v)| (format!("driver/Compute Shader/{k}"), v))
-                .collect(),
-            notes: Default::default(),
+        let row = |model: &str, arith: f64, ldst: f64| {
+            pipe_row(model, &[("Arithmetic cycles", arith), ("Texture cycles", 0.0), ("Varying cycles", 0.0), ("Load-store cycles", ldst), ("Bound cycles", arith.max(ldst))])
         };
-        let mut report = crate::inspect::tests::empty_report("Mali-G52 (Panfrost)");
-        report.provenance["target"] = "mali:g52".into();
-        report.rows = vec![row("ggx", 5.75, 8.0), row(BASELINE_LABEL, 1.5, 8.0)];
-        let t = super::super::Vendor::cost(&MALI, &report).unwrap();
+        let t = cost_of("mali:g52", "Mali-G52 (Panfrost)", vec![row("ggx", 5.75, 8.0), row(BASELINE_LABEL, 1.5, 8.0)]);
         let lights = f64::from(t.lights_per_kernel);
         assert_eq!(t.rows[0].cycles_per_eval, 8.0 / lights);
         // The bounds (8 and 8) would subtract to nothing; the arithmetic the BRDF adds is 4.25.

@@ -265,6 +265,8 @@ fn write_representations(gpu: &Gpu, executables: &[crate::gpu::PipelineExecutabl
 
 /// What every child of one `compile` is asked (the parts of a `Request` a child reads).
 struct Job<'a> {
+    /// The shared part of every child's cache key (`noop_cache::request_digest`); None: no child is cached.
+    cache_digest: Option<String>,
     lights: u32,
     shaders: &'a Shaders,
     validate: bool,
@@ -293,12 +295,7 @@ fn run(driver: &'static dyn NoopDriver, family: usize, models: &[Model], raw: &[
     let name = Target { vendor: driver, family }.name();
     // The driver's environment first: a driver that is not built stops here, naming what to run.
     let environment = driver.environment(family)?;
-    let inputs = super::noop_cache::ChildInputs { target: name.clone(), models, raw, lights: request.lights, validate: request.validate, shaders: request.shaders, environment: &environment };
-    // A child that writes files (--isa) or is asked to crash (the containment test) always runs.
-    let key = match request.isa_dir.is_some() || std::env::var_os(CRASH_AFTER_REPLY).is_some() {
-        true => None,
-        false => Some(super::noop_cache::key(&inputs)?),
-    };
+    let key = request.cache_digest.as_deref().map(|digest| super::noop_cache::key(digest, &name, &environment, request.validate));
     let Some(key) = key else {
         let (run, messages) = spawn(driver, family, models, raw, request, environment)?;
         messages.iter().for_each(|m| crate::messages::line(m));
@@ -412,7 +409,13 @@ fn publish(file: &Path, from: &Path, to: &Path) -> Result<PathBuf> {
 pub fn compile(prefix: &str, families: &[usize], raw: &[super::RawKernel], request: &Request) -> Result<Vec<Run>> {
     let driver = driver_of(prefix)?;
     let models: &[Model] = if raw.is_empty() { request.models } else { &[] };
-    let request = &Job { lights: request.lights, shaders: request.shaders, validate: request.validate, isa_dir: request.isa_dir };
+    // A child that writes files (--isa) or is asked to crash (the containment test) always runs; any other
+    // report is cached under a key whose kernels' part is computed once here, for every family.
+    let cache_digest = match request.isa_dir.is_some() || std::env::var_os(CRASH_AFTER_REPLY).is_some() {
+        true => None,
+        false => Some(super::noop_cache::request_digest(models, raw, request.lights, request.validate, request.shaders)?),
+    };
+    let request = &Job { lights: request.lights, shaders: request.shaders, validate: request.validate, isa_dir: request.isa_dir, cache_digest };
     let workers = std::thread::available_parallelism().map_or(1, |n| n.get()).min(families.len()).max(1);
     let next = std::sync::atomic::AtomicUsize::new(0);
     let results: std::sync::Mutex<Vec<Option<Result<ChildRun>>>> = std::sync::Mutex::new((0..families.len()).map(|_| None).collect());

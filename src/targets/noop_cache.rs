@@ -14,7 +14,7 @@
 //! - brdfprof's executable by size and modification time (the child's analyses are its code).
 //!
 //! A request that writes files (`--isa`) or asks the child to crash (the containment test) is never cached
-//! (`mesa_noop::run` decides).
+//! (`mesa_noop::compile` decides).
 
 use super::RawKernel;
 use crate::cache::{Key, KeyBuilder};
@@ -59,61 +59,55 @@ fn layer_files(environment: &std::collections::BTreeMap<String, String>) -> Vec<
     manifests(&dirs).into_iter().flat_map(|m| [manifest_library(&m, "layer"), Some(m)]).flatten().collect()
 }
 
-/// What one child is asked, as far as its figures depend on it.
-pub struct ChildInputs<'a> {
-    /// `adreno:a660`.
-    pub target: String,
-    pub models: &'a [Model],
-    pub raw: &'a [RawKernel],
-    pub lights: u32,
-    pub validate: bool,
-    pub shaders: &'a Shaders,
-    /// The driver's environment for the child.
-    pub environment: &'a [(String, String)],
-}
-
-/// The key of a child's report.
-pub fn key(inputs: &ChildInputs) -> Result<Key> {
+/// The part of a child's key that every family of one request shares: brdfprof's executable, spirv-opt's
+/// version, the light count, whether validation runs, and every kernel's SPIR-V (computed once per request).
+pub fn request_digest(models: &[Model], raw: &[RawKernel], lights: u32, validate: bool, shaders: &Shaders) -> Result<String> {
     let exe = std::env::current_exe()?;
     let mut key = KeyBuilder::new(KIND)
         .part("brdfprof", env!("CARGO_PKG_VERSION"))
         .part("executable", identity(&exe))
-        .part("target", &inputs.target)
         // The SPIR-V counts of the report are spirv-opt's.
         .part("spirv-opt", crate::spirv::spirv_opt_version().unwrap_or_default())
-        .part("lights", inputs.lights.to_le_bytes())
-        .part("validate", [inputs.validate as u8]);
+        .part("lights", lights.to_le_bytes())
+        .part("validate", [validate as u8]);
     // Both G-buffer forms: the report's static rows read the float one too (naga's analysis).
-    for model in inputs.models {
+    for model in models {
         key = key.part("model", model.name());
         for format in [GBufferFormat::Packed, GBufferFormat::Float] {
-            key = key.part("kernel", kernel_hash(Some(model), format, inputs.shaders)?);
+            key = key.part("kernel", kernel_hash(Some(model), format, shaders)?);
         }
     }
-    if inputs.raw.is_empty() {
+    if raw.is_empty() {
         for format in [GBufferFormat::Packed, GBufferFormat::Float] {
-            key = key.part("memory-only kernel", kernel_hash(None, format, inputs.shaders)?);
+            key = key.part("memory-only kernel", kernel_hash(None, format, shaders)?);
         }
     }
-    for r in inputs.raw {
+    for r in raw {
         let interface = format!("{} {} {} {}", r.label, r.model.name(), r.storage_buffers, r.push_bytes);
         key = key.part("raw", interface).part("raw words", bytemuck::cast_slice::<u32, u8>(&r.spirv));
     }
+    Ok(key.finish().hex().to_string())
+}
+
+/// The key of one child's report: the request's digest, the target (`adreno:a660`) and its driver
+/// environment, with the files and variables the child's driver and loader read.
+pub fn key(request_digest: &str, target: &str, driver_environment: &[(String, String)], validate: bool) -> Key {
+    let mut key = KeyBuilder::new(KIND).part("request", request_digest).part("target", target);
     let mut environment: std::collections::BTreeMap<String, String> =
         std::env::vars().filter(|(k, _)| DRIVER_PREFIXES.iter().any(|p| k.starts_with(p))).collect();
-    environment.extend(inputs.environment.iter().cloned());
+    environment.extend(driver_environment.iter().cloned());
     for (k, v) in &environment {
         key = key.part("env", format!("{k}={v}"));
     }
     for file in driver_files(&environment) {
         key = key.part("driver file", identity(&file));
     }
-    if inputs.validate {
+    if validate {
         for file in layer_files(&environment) {
             key = key.part("layer file", identity(&file));
         }
     }
-    Ok(key.finish())
+    key.finish()
 }
 
 /// A file by its path, size and modification time (nanoseconds), or that it is absent.

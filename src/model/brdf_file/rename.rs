@@ -79,7 +79,7 @@ impl BrdfFile {
     /// the file's names renamed. The name (the prefix, then a digit) is one no renamed name can take.
     pub fn entry_glue(&self, entry: &Entry) -> (String, String) {
         let name = format!("{}0entry", self.prefix);
-        let args: Vec<String> = entry.args.iter().map(|a| self.renamed.rename_expression(a)).collect();
+        let args: Vec<String> = entry.args.iter().map(|a| self.renamed_argument(a)).collect();
         let text = format!(
             "#line {} \"{}\"\nvec3 {name}(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) {{ return {}({}); }}\n",
             entry.line,
@@ -88,6 +88,21 @@ impl BrdfFile {
             args.join(", ")
         );
         (name, text)
+    }
+
+    /// An entry's argument with the file's parameters and globals renamed as the shader's are (`rename`: an
+    /// identifier, not after a `.`), except the entry's own arguments `L V N X Y`. An argument the tokenizer
+    /// refuses stays as written, for glslang to report at the entry's line.
+    fn renamed_argument(&self, arg: &str) -> String {
+        let Ok(tokens) = tokenize(&self.path, &[(0, arg.to_string())]) else { return arg.to_string() };
+        let mut out = arg.to_string();
+        for (i, t) in tokens.iter().enumerate().rev() {
+            let after_dot = i > 0 && tokens[i - 1].is(".");
+            if t.kind == Kind::Ident && !after_dot && !["L", "V", "N", "X", "Y"].contains(&t.text.as_str()) && self.renamed.lookup.contains(&t.text) {
+                out.replace_range(t.start..t.end, &self.glsl_name(&t.text));
+            }
+        }
+        out
     }
 
     /// `#line N "FILE"`, to put just before the renamed shader lines (it needs
@@ -177,26 +192,6 @@ impl RenamedShader {
                 Some(original) => out += original,
                 None => out += word,
             }
-            rest = &rest[start + len..];
-        }
-        out + rest
-    }
-
-    /// A GLSL expression of an entry's declaration with the file's parameters and globals renamed, except
-    /// the entry's own arguments (`L V N X Y`) and names after a `.` (swizzles, members).
-    pub fn rename_expression(&self, text: &str) -> String {
-        let mut out = String::with_capacity(text.len());
-        let mut rest = text;
-        while let Some(start) = rest.find(|c: char| c == '_' || c.is_ascii_alphanumeric()) {
-            let len = rest[start..].find(|c: char| !(c == '_' || c.is_ascii_alphanumeric())).unwrap_or(rest.len() - start);
-            let word = &rest[start..start + len];
-            let after_dot = rest[..start].trim_end().ends_with('.') || out.trim_end().ends_with('.') && rest[..start].trim().is_empty();
-            out += &rest[..start];
-            let starts_identifier = word.starts_with(|c: char| c == '_' || c.is_ascii_alphabetic());
-            if starts_identifier && !after_dot && !["L", "V", "N", "X", "Y"].contains(&word) && self.lookup.contains(word) {
-                out += &self.prefix;
-            }
-            out += word;
             rest = &rest[start + len..];
         }
         out + rest
