@@ -133,3 +133,94 @@ impl GuardSet {
         if self.on("cosine-floor") { guard_cosine(x) } else { x.clamp(0.0, 1.0) }
     }
 }
+
+/// A guard applied to a model's inputs, as an engine's caller could apply it before calling a BRDF it cannot
+/// change (a `.brdf` file): what `stability` tries on each failing input to say which guard removes the
+/// failure. Each is the input-side form of a kernel guard above, under the same name.
+pub struct InputGuard {
+    pub name: &'static str,
+    /// What it does to the inputs.
+    pub does: &'static str,
+    /// The guarded inputs, or None where the caller would not call the BRDF at all (its result is then 0).
+    pub apply: fn(&super::Sample, min_roughness: f64) -> Option<super::Sample>,
+}
+
+/// The input guards, in the order `stability` lists them.
+pub const INPUT_GUARDS: [InputGuard; 5] = [
+    InputGuard { name: "roughness-floor", does: "roughness clamped into [MIN_ROUGHNESS, 1] (0.045 fp32, 0.089 fp16)", apply: floor_roughness },
+    InputGuard { name: "cosine-floor", does: "V and L less than MIN_COSINE = 1e-4 above the horizon turned up to it", apply: floor_cosines },
+    InputGuard { name: "safe-h", does: "not called where V + L of the unit vectors is 0 (largest component below FLT_MIN in f32): no half vector", apply: skip_without_half_vector },
+    InputGuard { name: "lit-mask", does: "not called unless NoV > 0 and NoL > 0", apply: skip_unlit },
+    InputGuard { name: "f0-clamp", does: "F0 clamped into [0, 1]", apply: clamp_f0 },
+];
+
+/// Every input guard at once (in `INPUT_GUARDS` order).
+pub fn apply_all_input_guards(s: &super::Sample, min_roughness: f64) -> Option<super::Sample> {
+    INPUT_GUARDS.iter().try_fold(*s, |s, g| (g.apply)(&s, min_roughness))
+}
+
+fn floor_roughness(s: &super::Sample, min_roughness: f64) -> Option<super::Sample> {
+    Some(super::Sample { roughness: (f64::from(s.roughness).clamp(min_roughness, 1.0)) as f32, ..*s })
+}
+
+/// `x` (unit) turned about the plane of `n` and itself so that n.x = MIN_COSINE, where 0 <= n.x < MIN_COSINE.
+fn turn_up(n: DVec3, x: DVec3) -> DVec3 {
+    let c = n.dot(x);
+    if n == DVec3::ZERO || x == DVec3::ZERO || !(0.0..MIN_COSINE).contains(&c) {
+        return x;
+    }
+    let t = (x - c * n).try_normalize().unwrap_or_else(|| n.any_orthonormal_vector());
+    t * (1.0 - MIN_COSINE * MIN_COSINE).sqrt() + n * MIN_COSINE
+}
+
+fn floor_cosines(s: &super::Sample, _: f64) -> Option<super::Sample> {
+    let n = unit(s.n);
+    let f32s = |v: DVec3| v.to_array().map(|x| x as f32);
+    Some(super::Sample { v: f32s(turn_up(n, unit(s.v))), l: f32s(turn_up(n, unit(s.l))), ..*s })
+}
+
+fn skip_without_half_vector(s: &super::Sample, _: f64) -> Option<super::Sample> {
+    let (v, l) = (unit(s.v), unit(s.l));
+    let h = [0, 1, 2].map(|i| v[i] as f32 + l[i] as f32);
+    (h.iter().map(|x| f64::from(x.abs())).fold(0.0, f64::max) >= MIN_VECTOR).then_some(*s)
+}
+
+fn skip_unlit(s: &super::Sample, _: f64) -> Option<super::Sample> {
+    let n = unit(s.n);
+    (n.dot(unit(s.v)) > 0.0 && n.dot(unit(s.l)) > 0.0).then_some(*s)
+}
+
+fn clamp_f0(s: &super::Sample, _: f64) -> Option<super::Sample> {
+    Some(super::Sample { f0: s.f0.map(|x| x.clamp(0.0, 1.0)), ..*s })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::brdf::Sample;
+
+    #[test]
+    fn each_input_guard_is_a_kernel_guard_or_the_roughness_floor() {
+        for g in &INPUT_GUARDS {
+            assert!(g.name == "roughness-floor" || SWITCHES.iter().any(|s| s.name == g.name), "{} names no kernel guard", g.name);
+        }
+    }
+
+    #[test]
+    fn input_guards_do_what_they_say() {
+        let s = Sample { n: [0.0, 0.0, 2.0], v: [1.0, 0.0, 0.0], l: [-1.0, 0.0, 0.0], roughness: 0.0, f0: [1.5, -0.1, 0.5] };
+        let by = |name: &str| INPUT_GUARDS.iter().find(|g| g.name == name).unwrap().apply;
+        assert_eq!(by("roughness-floor")(&s, MIN_ROUGHNESS_F32).unwrap().roughness, MIN_ROUGHNESS_F32 as f32);
+        let up = by("cosine-floor")(&s, MIN_ROUGHNESS_F32).unwrap();
+        assert!((f64::from(up.v[2]) - MIN_COSINE).abs() < 1e-9 && (f64::from(up.l[2]) - MIN_COSINE).abs() < 1e-9, "{up:?}");
+        assert!(by("safe-h")(&s, 0.0).is_none(), "V = -L has no half vector");
+        assert!(by("safe-h")(&up, 0.0).is_some());
+        assert!(by("lit-mask")(&s, 0.0).is_none() && by("lit-mask")(&up, 0.0).is_some());
+        assert_eq!(by("f0-clamp")(&s, 0.0).unwrap().f0, [1.0, 0.0, 0.5]);
+        let below = Sample { l: [0.6, 0.0, -0.8], ..s };
+        assert_eq!(by("cosine-floor")(&below, 0.0).unwrap().l, below.l, "light below the horizon is the lit mask's");
+        // All at once: the cosine floor lifts V and L off the horizon first, so the others let it through.
+        let all = apply_all_input_guards(&s, MIN_ROUGHNESS_F32).expect("called once the cosines are floored");
+        assert_eq!((all.roughness, all.f0, all.v, all.l), (MIN_ROUGHNESS_F32 as f32, [1.0, 0.0, 0.5], up.v, up.l));
+    }
+}

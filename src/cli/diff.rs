@@ -27,7 +27,7 @@ pub struct DiffArgs {
     pub seed: u64,
     /// Perceptual roughness range of the default samples, MIN..MAX within [0, 1] (default: [0, 1], or the
     /// range every `.brdf` model's `domain roughness` admits).
-    #[arg(long, value_parser = roughness_range, conflicts_with = "input")]
+    #[arg(long, value_parser = super::roughness_range, conflicts_with = "input")]
     pub roughness: Option<(f64, f64)>,
     /// Rows listed where the models differ most.
     #[arg(long, default_value_t = 10)]
@@ -49,17 +49,6 @@ pub struct DiffArgs {
     pub html: super::report::HtmlArg,
     #[command(flatten)]
     pub device: DeviceArgs,
-}
-
-/// `--roughness MIN..MAX`: 0 <= MIN <= MAX <= 1.
-fn roughness_range(text: &str) -> Result<(f64, f64), String> {
-    let fail = || format!("`{text}`: give MIN..MAX with 0 <= MIN <= MAX <= 1 (e.g. 0.0525..1)");
-    let (lo, hi) = text.split_once("..").ok_or_else(fail)?;
-    let (lo, hi): (f64, f64) = (lo.trim().parse().map_err(|_| fail())?, hi.trim().parse().map_err(|_| fail())?);
-    if !(0.0..=1.0).contains(&lo) || !(0.0..=1.0).contains(&hi) || lo > hi {
-        return Err(fail());
-    }
-    Ok((lo, hi))
 }
 
 /// The default samples' roughness range: `--roughness`, else the intersection of the models' declared

@@ -240,6 +240,14 @@ pub struct StabilityArgs {
     /// (the report's "What each guard saves").
     #[arg(long)]
     pub unguarded: bool,
+    /// Check the models that have no f64 twin (`.brdf` files) against this built-in spec's f64 values: their
+    /// tolerances and jumps then mean what a built-in spec's do (e.g. `--reference ggx`).
+    #[arg(long, value_parser = super::reference_spec)]
+    pub reference: Option<brdfprof::brdf::ModelSpec>,
+    /// Perceptual roughness range checked, MIN..MAX within [0, 1]: hard cases and grid points outside it are
+    /// not counted (default: each `.brdf` file's `domain roughness`, else all).
+    #[arg(long, value_parser = super::roughness_range)]
+    pub roughness: Option<(f64, f64)>,
     /// Directory for stability-<device>.md/.json and the furnace, albedo and failure PNGs (default results/,
     /// refused where that would overwrite a file git tracks).
     #[arg(long)]
@@ -254,7 +262,7 @@ pub fn stability(args: &StabilityArgs) -> Result<ExitCode> {
     let out = out_dir(args.out.as_deref(), &["stability-*", "furnace-*.png", "albedo-*.png"])?;
     args.html.check()?;
     let models = if args.model.models.is_empty() { stability::default_specs().into_iter().map(Model::spec).collect() } else { args.model.models(&[])? };
-    let options = stability::StabilityOptions { models: if args.unguarded { stability::with_guard_variants(models) } else { models }, energy: !args.no_energy };
+    let options = stability::StabilityOptions { models: if args.unguarded { stability::with_guard_variants(models) } else { models }, energy: !args.no_energy, reference: args.reference, roughness: args.roughness };
     let (gpu, result) = on_device(&args.device, |gpu, progress| stability::run(gpu, &options, progress))?;
     let slug = brdfprof::targets::device_slug(&gpu.info);
     let mut files = result.write(&out, &slug)?;

@@ -34,6 +34,22 @@ pub struct DeviceArgs {
     pub validate: bool,
 }
 
+/// `--roughness MIN..MAX`: 0 <= MIN <= MAX <= 1.
+fn roughness_range(text: &str) -> Result<(f64, f64), String> {
+    let fail = || format!("`{text}`: give MIN..MAX with 0 <= MIN <= MAX <= 1 (e.g. 0.0525..1)");
+    let (lo, hi) = text.split_once("..").ok_or_else(fail)?;
+    let (lo, hi): (f64, f64) = (lo.trim().parse().map_err(|_| fail())?, hi.trim().parse().map_err(|_| fail())?);
+    if !(0.0..=1.0).contains(&lo) || !(0.0..=1.0).contains(&hi) || lo > hi {
+        return Err(fail());
+    }
+    Ok((lo, hi))
+}
+
+/// `--reference SPEC`: a built-in spec (it has the f64 twin a reference needs).
+pub fn reference_spec(text: &str) -> Result<brdfprof::brdf::ModelSpec, String> {
+    brdfprof::brdf::ModelSpec::parse(text).map_err(|e| format!("{e} (a reference is a built-in spec: a preset or D/Vis/F terms, which have an f64 twin)"))
+}
+
 /// `--device`: an empty or blank name would match every device (a substring of each), so it is refused; a
 /// compile-only target must name known families (`targets`).
 pub fn device_name(text: &str) -> Result<String, String> {

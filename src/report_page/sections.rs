@@ -288,10 +288,13 @@ fn stability_row(s: &SpecView) -> Vec<Cell> {
         count_cell(s.nan),
         count_cell(s.inf),
         count_cell(s.negative),
-        Cell::num(s.cases_out_of_tolerance.len() as f64, format!("{} of {}", s.cases_out_of_tolerance.len(), s.cases_run)),
-        count_cell(s.grid_out_of_tolerance),
-        num_cell(s.worst.deviation),
-        count_cell(s.discontinuities),
+        Cell::num(s.cases_out_of_tolerance.len() as f64, crate::stability::cases_cell(s.cases_out_of_tolerance.len(), s.cases_run, s.checked())),
+        if s.checked() { count_cell(s.grid_out_of_tolerance) } else { Cell::text("-".to_string()) },
+        if s.checked() { num_cell(s.worst.deviation) } else { Cell::text("-".to_string()) },
+        match s.jumps_checked {
+            Some(false) => Cell::text(crate::stability::jumps_cell(s.discontinuities, false)),
+            _ => count_cell(s.discontinuities),
+        },
         count_cell(s.model_jumps),
         num_cell(s.reciprocity),
         num_cell(s.energy.as_ref().and_then(|e| e.max_e)),
@@ -331,9 +334,18 @@ pub fn stability_html(i: usize, st: &StabilityView, path: &str) -> Result<String
             maps += &heat_map(s, cells)?;
         }
     }
+    let mut located = String::new();
+    for s in st.specs.iter().filter(|s| s.fails()) {
+        let Some(f) = &s.failures else { continue };
+        let items: String = f.lines().iter().map(|(depth, line)| format!("<li class=\"depth{depth}\">{}</li>", esc(line))).collect();
+        located += &format!("<li><b>{}</b><ul>{items}</ul></li>", esc(s.label()));
+    }
+    if !located.is_empty() {
+        located = format!("<h3>Where the failing specs fail</h3><p class=\"note\">Each failing hard case with its inputs, the grid's failing points, and the input guards (roughness floor, cosine floor, safe half vector, lit mask, F0 clamp, as a caller could apply them) that remove each.</p><ul class=\"failures\">{located}</ul>");
+    }
     let maps = if maps.is_empty() { "<p class=\"note\">No spec gives a bad value on the grid.</p>".to_string() } else { format!("<h3>Where the bad values are (grid of NoV x roughness, all azimuths and NoL)</h3><div class=\"heat\">{maps}</div>") };
     Ok(format!(
-        "<h3>{path}</h3><p class=\"note\">{} specs, {failing} failing (NaN, Inf or negative on valid inputs); {} hard cases; {} grid points. Deviation in units of the tolerance.</p>{}{maps}",
+        "<h3>{path}</h3><p class=\"note\">{} specs, {failing} failing (NaN, Inf or negative on valid inputs); {} hard cases; {} grid points. Deviation in units of the tolerance.</p>{}{maps}{located}",
         st.specs.len(),
         st.cases.len(),
         st.grid_points,

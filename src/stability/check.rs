@@ -1,6 +1,7 @@
 //! One model through the suite: the hard cases, the grid, steps the f64 model does not take, reciprocity.
 
 use super::catalogue::{Expect, HardCase};
+use super::failures::{self, Failures};
 use super::{grid, tolerance, base_tolerance, CaseResult, SpecStability, Worst};
 use crate::accuracy::FLOOR;
 use crate::brdf::{ModelSpec, Sample};
@@ -45,6 +46,32 @@ fn case_model(model: &Model, case: &HardCase) -> Model {
     }
 }
 
+/// What a model's results are checked against, and on which inputs.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Checks<'a> {
+    /// The expected values of a model without an f64 twin (`--reference`; a twin always comes first).
+    pub reference: Option<&'a ModelSpec>,
+    /// Perceptual roughness range of the valid inputs checked (`--roughness`, a file's `domain roughness`):
+    /// cases and grid points outside it are not counted.
+    pub roughness: Option<(f64, f64)>,
+}
+
+impl Checks<'_> {
+    /// The spec whose f64 values a case's results are checked against: the twin of the case's model, else
+    /// the reference (as it is: a file does not read the case's parameter values).
+    fn expected(&self, model: &Model, case: Option<&HardCase>) -> Option<ModelSpec> {
+        let twin = match case {
+            Some(c) => case_model(model, c).twin().copied(),
+            None => model.twin().copied(),
+        };
+        twin.or(self.reference.copied())
+    }
+
+    fn in_domain(&self, s: &Sample) -> bool {
+        self.roughness.is_none_or(|(lo, hi)| (lo..=hi).contains(&f64::from(s.roughness)))
+    }
+}
+
 /// Every hard case on the GPU, one kernel run per distinct model the cases' parameter values make.
 fn run_cases(gpu: &Gpu, model: &Model, cases: &[HardCase]) -> Result<Vec<[f32; 3]>> {
     let mut out = vec![[0f32; 3]; cases.len()];
@@ -81,29 +108,32 @@ fn worst_at(deviation: f64, got: &[f32; 3], expected: [f64; 3], input: String) -
     Worst { deviation, got: got[c], expected: expected[c], input }
 }
 
-/// Each case's verdict: against the twin (within tolerance) for valid input, finite and non-negative for
-/// invalid input; without a twin, valid cases are only tallied.
-fn judge_cases(model: &Model, cases: &[HardCase], out: &[[f32; 3]], tally: &mut Tally, worst: &mut Worst) -> Vec<CaseResult> {
+/// Each case's verdict: against the twin or reference (within tolerance) for valid input, finite and
+/// non-negative for invalid input; without either, a valid case fails only on a NaN, Inf or negative value.
+/// None for a valid case outside the roughness domain (not run as far as the report goes).
+fn judge_cases(model: &Model, checks: &Checks, cases: &[HardCase], out: &[[f32; 3]], tally: &mut Tally, worst: &mut Worst) -> Vec<Option<CaseResult>> {
     cases
         .iter()
         .zip(out)
         .enumerate()
         .map(|(i, (case, got))| {
             let valid = case.expect == Expect::Twin;
+            if valid && !checks.in_domain(&case.sample) {
+                return None;
+            }
             got.iter().for_each(|&x| tally.add(x, valid));
-            let twin = case_model(model, case).twin().copied();
-            let (expected, deviation) = match (valid, twin) {
+            let poisoned = if got.iter().any(|&x| bad(x)) { f64::INFINITY } else { 0.0 };
+            let (expected, deviation) = match (valid, checks.expected(model, Some(case))) {
                 (true, Some(s)) => {
                     let e = s.eval(&case.sample);
                     (Some(e), deviation(&s, &case.sample, got, e, i as u64))
                 }
-                (true, None) => (None, 0.0),
-                (false, _) => (None, if got.iter().any(|&x| bad(x)) { f64::INFINITY } else { 0.0 }),
+                (true, None) | (false, _) => (None, poisoned),
             };
             if let (Some(e), true) = (expected, deviation > worst.deviation) {
                 *worst = worst_at(deviation, got, e, format!("case `{}`: {:?}", case.name, case.sample));
             }
-            CaseResult { case: case.name.clone(), expected, got: *got, deviation, ok: deviation <= 1.0 }
+            Some(CaseResult { case: case.name.clone(), expected, got: *got, deviation, ok: deviation <= 1.0 })
         })
         .collect()
 }
@@ -129,10 +159,11 @@ fn grid_deviations(spec: &ModelSpec, grid: &[Sample], out: &[[f32; 3]], twin: &[
         .collect()
 }
 
-/// Bad values (NaN, Inf, negative) per [roughness][NoV] grid cell, all tallied.
-fn bad_cells(out: &[[f32; 3]], tally: &mut Tally) -> Vec<Vec<u32>> {
+/// Bad values (NaN, Inf, negative) per [roughness][NoV] grid cell, all tallied (points outside the domain
+/// neither).
+fn bad_cells(out: &[[f32; 3]], in_domain: &[bool], tally: &mut Tally) -> Vec<Vec<u32>> {
     let mut cells = vec![vec![0u32; grid::COSINES.len()]; grid::ROUGHNESS.len()];
-    for (i, g) in out.iter().enumerate() {
+    for (i, g) in out.iter().enumerate().filter(|(i, _)| in_domain[*i]) {
         g.iter().for_each(|&x| tally.add(x, true));
         if g.iter().any(|&x| bad(x)) {
             let r = i / (grid::AZIMUTHS * grid::COSINES.len() * grid::COSINES.len());
@@ -145,27 +176,31 @@ fn bad_cells(out: &[[f32; 3]], tally: &mut Tally) -> Vec<Vec<u32>> {
 
 /// Steps in f_s NoL (the radiance a renderer accumulates) along NoV, NoL and roughness (channel 0, lit points
 /// only: at a cosine of 0 the light is masked by definition), which the f64 model (`twin`, where there is
-/// one) does not take, at values out of tolerance: (discontinuities, the model's own jumps, examples).
+/// one) does not take, at values out of tolerance: (discontinuities, the model's own jumps, examples). Without
+/// an expectation every step of a finely sampled lobe would count: nothing is counted then. Series run over the
+/// points in the roughness domain.
 struct Steps {
     discontinuities: usize,
     model_jumps: usize,
     examples: Vec<String>,
 }
 
-fn scan_steps(grid: &[Sample], out: &[[f32; 3]], twin: Option<&[[f64; 3]]>, deviations: &[f64]) -> Steps {
-    let radiance = |vals: &dyn Fn(usize) -> f64, idx: &[usize]| idx.iter().map(|&i| vals(i) * (grid[i].l[2] as f64).max(0.0)).collect::<Vec<f64>>();
+fn scan_steps(grid: &[Sample], out: &[[f32; 3]], twin: Option<&[[f64; 3]]>, deviations: &[f64], in_domain: &[bool]) -> Steps {
     let mut steps = Steps { discontinuities: 0, model_jumps: 0, examples: Vec::new() };
+    let Some(twin) = twin else { return steps };
+    let radiance = |vals: &dyn Fn(usize) -> f64, idx: &[usize]| idx.iter().map(|&i| vals(i) * (grid[i].l[2] as f64).max(0.0)).collect::<Vec<f64>>();
     let mut scan = |idx: Vec<usize>, axis: &str| {
+        let idx: Vec<usize> = idx.into_iter().filter(|&i| in_domain[i]).collect();
         let g = radiance(&|i| out[i][0] as f64, &idx);
-        let model = twin.map_or_else(Vec::new, |t| grid::jumps(&radiance(&|i| t[i][0], &idx)));
+        let model = grid::jumps(&radiance(&|i| twin[i][0], &idx));
         steps.model_jumps += model.len();
         // Where both joined values are within tolerance of the twin, a step is rounding in an ill-conditioned
         // corner, not a break.
-        let off = |j: usize| twin.is_none() || deviations[idx[j]] > 1.0 || deviations[idx[j + 1]] > 1.0;
+        let off = |j: usize| deviations[idx[j]] > 1.0 || deviations[idx[j + 1]] > 1.0;
         for j in grid::jumps(&g).into_iter().filter(|j| !model.contains(j) && off(*j)) {
             steps.discontinuities += 1;
             if steps.examples.len() < 5 {
-                steps.examples.push(format!("along {axis} between {:?} and {:?}: {} -> {}", grid[idx[j]], grid[idx[j + 1]], g[j], g[j + 1]));
+                steps.examples.push(format!("along {axis} between {} and {}: {:.4e} -> {:.4e}", super::failures::describe(&grid[idx[j]]), super::failures::describe(&grid[idx[j + 1]]), g[j], g[j + 1]));
             }
         }
     };
@@ -205,8 +240,9 @@ fn reciprocity_error(forward: &[[f32; 3]], backward: &[[f32; 3]]) -> (Option<f64
     (worst, nonfinite)
 }
 
-/// Checks one model: catalogue, grid, discontinuities and reciprocity (energy is added by `run`).
-pub fn check_model(gpu: &Gpu, model: &Model, cases: &[HardCase], grid: &[Sample], reciprocity: &[Sample]) -> Result<SpecStability> {
+/// Checks one model: catalogue, grid, discontinuities, reciprocity and where it fails (energy is added by
+/// `run`).
+pub fn check_model(gpu: &Gpu, model: &Model, checks: &Checks, cases: &[HardCase], grid: &[Sample], reciprocity: &[Sample]) -> Result<SpecStability> {
     let case_out = run_cases(gpu, model, cases)?;
     let mut all: Vec<Sample> = grid.to_vec();
     all.extend_from_slice(reciprocity);
@@ -214,44 +250,78 @@ pub fn check_model(gpu: &Gpu, model: &Model, cases: &[HardCase], grid: &[Sample]
     let out = kernels::eval(gpu, model, &all, RunLimits::default())?;
     let (grid_out, rest) = out.split_at(grid.len());
     let (forward, backward) = rest.split_at(reciprocity.len());
+    let in_domain: Vec<bool> = grid.iter().map(|s| checks.in_domain(s)).collect();
 
     let (mut tally, mut worst) = (Tally::default(), Worst::default());
-    let results = judge_cases(model, cases, &case_out, &mut tally, &mut worst);
-    let spec = model.twin();
+    let judged = judge_cases(model, checks, cases, &case_out, &mut tally, &mut worst);
+    let spec = checks.expected(model, None);
     let twin: Option<Vec<[f64; 3]>> = spec.map(|s| grid.par_iter().map(|x| s.eval(x)).collect());
-    let deviations = match (spec, &twin) {
-        (Some(s), Some(t)) => grid_deviations(s, grid, grid_out, t),
+    let deviations: Vec<f64> = match (&spec, &twin) {
+        (Some(s), Some(t)) => grid_deviations(s, grid, grid_out, t).into_iter().zip(&in_domain).map(|(d, &inside)| if inside { d } else { 0.0 }).collect(),
         _ => vec![0.0; grid.len()],
     };
-    let cells = bad_cells(grid_out, &mut tally);
+    let cells = bad_cells(grid_out, &in_domain, &mut tally);
     if let (Some(t), Some((i, &d))) = (&twin, deviations.iter().enumerate().max_by(|a, b| a.1.total_cmp(b.1))) {
         if d > worst.deviation {
-            worst = worst_at(d, &grid_out[i], t[i], format!("grid: {:?}", grid[i]));
+            worst = worst_at(d, &grid_out[i], t[i], format!("grid: {}", failures::describe(&grid[i])));
         }
     }
-    let steps = scan_steps(grid, grid_out, twin.as_deref(), &deviations);
+    let steps = scan_steps(grid, grid_out, twin.as_deref(), &deviations, &in_domain);
     let any_bad = cells.iter().flatten().any(|&n| n > 0);
     let (reciprocity, reciprocity_nonfinite) = reciprocity_error(forward, backward);
+    let failures = locate_failures(gpu, model, cases, &case_out, &judged, grid, grid_out, &in_domain)?;
+    if worst.input.is_empty() {
+        if let Some(f) = failures.first() {
+            worst = Worst { deviation: f64::INFINITY, got: f.got.into_iter().find(|x| !x.is_finite() || *x < 0.0).unwrap_or(f.got[0]), expected: f64::NAN, input: format!("{}: {}", f.at, f.inputs) };
+        }
+    }
+    let results: Vec<CaseResult> = judged.iter().flatten().cloned().collect();
     Ok(SpecStability {
         label: model.label(),
         spec: model.name(),
         precision: model.precision().name().into(),
-        has_twin: spec.is_some(),
+        has_twin: model.twin().is_some(),
+        expected_from: expected_from(model, checks),
+        roughness_domain: checks.roughness,
+        cases_outside_domain: judged.iter().filter(|r| r.is_none()).count(),
+        grid_outside_domain: in_domain.iter().filter(|d| !**d).count(),
         nan: tally.nan,
         inf: tally.inf,
         negative: tally.negative,
         invalid_input_poisoned: tally.poisoned,
         cases_run: results.len(),
-        case_deviation: results.iter().map(|r| r.deviation).collect(),
+        case_deviation: judged.iter().map(|r| r.as_ref().map_or(0.0, |r| r.deviation)).collect(),
         cases_out_of_tolerance: results.into_iter().filter(|r| !r.ok).collect(),
         grid_out_of_tolerance: deviations.iter().filter(|d| **d > 1.0).count(),
         worst,
+        jumps_checked: twin.is_some(),
         discontinuities: steps.discontinuities,
         discontinuity_examples: steps.examples,
         model_jumps: steps.model_jumps,
         reciprocity,
         reciprocity_nonfinite,
         bad_cells: any_bad.then_some(cells),
+        failures,
         energy: None,
     })
+}
+
+/// Where the expected values come from, as the report says it.
+fn expected_from(model: &Model, checks: &Checks) -> Option<String> {
+    match (model.twin(), checks.reference) {
+        (Some(_), _) => Some("twin".into()),
+        (None, Some(r)) => Some(format!("reference `{}`", r.name())),
+        (None, None) => None,
+    }
+}
+
+/// The valid inputs in the domain with a NaN, Inf or negative result, and the input guards that remove them.
+#[allow(clippy::too_many_arguments)]
+fn locate_failures(gpu: &Gpu, model: &Model, cases: &[HardCase], case_out: &[[f32; 3]], judged: &[Option<CaseResult>], grid: &[Sample], grid_out: &[[f32; 3]], in_domain: &[bool]) -> Result<Failures> {
+    let case_models: Vec<(Model, &str, Sample)> = cases.iter().map(|c| (case_model(model, c), c.name.as_str(), c.sample)).collect();
+    // Invalid-input cases and those outside the domain are not failures of a valid input.
+    let counted = |i: usize| cases[i].expect == Expect::Twin && judged[i].is_some();
+    let case_out: Vec<[f32; 3]> = case_out.iter().enumerate().map(|(i, g)| if counted(i) { *g } else { [0.0; 3] }).collect();
+    let grid_out: Vec<[f32; 3]> = grid_out.iter().zip(in_domain).map(|(g, &inside)| if inside { *g } else { [0.0; 3] }).collect();
+    failures::locate(gpu, &case_models, &case_out, model, grid, &grid_out)
 }

@@ -6,10 +6,11 @@
 pub mod catalogue;
 mod check;
 pub mod energy;
+pub mod failures;
 pub mod grid;
 pub mod view;
 
-pub use check::check_model;
+pub use check::{check_model, Checks};
 
 use crate::accuracy::FLOOR;
 use crate::brdf::guards::{unit, GuardSet, SWITCHES};
@@ -119,9 +120,17 @@ pub struct SpecStability {
     /// The text that parses back to the model (`Model::name`).
     pub spec: String,
     pub precision: String,
-    /// Whether the model has an f64 twin: without one, nothing is out of tolerance (there is nothing to be
-    /// within), and every step of the GPU's results counts as a jump.
+    /// Whether the model has an f64 twin.
     pub has_twin: bool,
+    /// What its results were checked against: `twin`, `reference `SPEC`` (`--reference`, for a model
+    /// without a twin), or None: then nothing is out of tolerance (there is nothing to be within) and jumps
+    /// are not counted (every step of a finely sampled lobe would be one), only NaN, Inf and negative values.
+    pub expected_from: Option<String>,
+    /// The perceptual roughness range checked, where one was given or declared, and the valid hard cases and
+    /// grid points outside it (not counted).
+    pub roughness_domain: Option<(f64, f64)>,
+    pub cases_outside_domain: usize,
+    pub grid_outside_domain: usize,
     /// On valid inputs (catalogue and grid).
     pub nan: usize,
     pub inf: usize,
@@ -137,6 +146,8 @@ pub struct SpecStability {
     /// Grid points out of tolerance.
     pub grid_out_of_tolerance: usize,
     pub worst: Worst,
+    /// Whether jumps were looked for (with an expectation to tell the model's own steps from breaks).
+    pub jumps_checked: bool,
     /// Steps in f_s NoL along NoV, NoL or roughness that the f64 model does not take, at values out of tolerance.
     pub discontinuities: usize,
     pub discontinuity_examples: Vec<String>,
@@ -150,6 +161,9 @@ pub struct SpecStability {
     /// Bad values (NaN, Inf, negative) per (NoV, roughness) grid cell, [roughness][NoV], where any.
     #[serde(serialize_with = "sparse_cells")]
     pub bad_cells: Option<Vec<Vec<u32>>>,
+    /// Every failing valid input: hard cases by name, grid points counted (the first listed), each with its
+    /// input values and the input guards that remove it.
+    pub failures: failures::Failures,
     pub energy: Option<energy::Energy>,
 }
 
@@ -172,6 +186,10 @@ impl SpecStability {
 pub struct StabilityOptions {
     pub models: Vec<Model>,
     pub energy: bool,
+    /// Expected values for the models without an f64 twin (`--reference`).
+    pub reference: Option<ModelSpec>,
+    /// The roughness range checked (`--roughness`); else each file's declared domain, else all.
+    pub roughness: Option<(f64, f64)>,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -296,13 +314,34 @@ pub fn run(gpu: &Gpu, options: &StabilityOptions, progress: &ProgressBar) -> Res
         progress.set_position(i as u64);
         progress.set_message(model.name());
         model.check_support(&gpu.info)?;
-        specs.push(check_model(gpu, model, &cases, &grid, &reciprocity)?);
+        let checks = Checks { reference: options.reference.as_ref(), roughness: options.roughness.or(model.roughness_domain()) };
+        specs.push(check_model(gpu, model, &checks, &cases, &grid, &reciprocity)?);
     }
     if options.energy {
         energy::attach(gpu, &options.models, &mut specs, progress)?;
     }
     let guard_savings = guard_savings(&options.models, &specs, &cases);
     Ok(StabilityReport { provenance: crate::results::Provenance::new(&gpu.info), specs, grid_points: grid.len(), cases, guard_savings })
+}
+
+/// The "cases out of tolerance" cell, as the Markdown and the HTML page both write it: without a twin or
+/// reference a case is counted only for a NaN, Inf or negative value (or a poisoned invalid input).
+pub fn cases_cell(out: usize, run: usize, checked: bool) -> String {
+    if checked { format!("{out}/{run}") } else { format!("{out}/{run} (no twin)") }
+}
+
+/// The jumps cell, as the Markdown and the HTML page both write it.
+pub fn jumps_cell(n: usize, checked: bool) -> String {
+    if checked { n.to_string() } else { "- (no reference)".into() }
+}
+
+/// A heat-map cell's value on its axis (the grid's spacing is not even: each cell is labelled with its value).
+fn axis_value(x: Option<f64>) -> String {
+    match x {
+        Some(x) if x == 0.0 || (1e-2..=1.0).contains(&x) => format!("{}", (x * 1e4).round() / 1e4),
+        Some(x) => format!("{x:.0e}"),
+        None => String::new(),
+    }
 }
 
 /// The worst deviation as a table cell: in tolerances, or what the value was when it is not a number.
@@ -352,8 +391,10 @@ impl StabilityReport {
              NoV in [0.02, 1], r in [0.1, 1]; error bound of the integration; NaN/Inf cells counted); hemi r=1: the hemispherical albedo \
              at r = 1, so 1 - hemi is the energy single scattering loses; E vs CPU: max |E_gpu - E_cpu| / max(1, E_cpu) against \
              the CPU's f64 integration of the same formula at r = 0.1, 0.5, 1. A `.brdf` model has no f64 twin: its NaN, Inf \
-             and negative counts, invalid-input cases, reciprocity and E (its own Fresnel, given F0 = 1) are measured; \
-             tolerances and E vs CPU are not, and every jump counts (none can be told apart as the model's own).\n\n",
+             and negative counts (each tied to its hard case or grid point below, with the input guards that remove it), \
+             invalid-input cases, reciprocity and E (its own Fresnel, given F0 = 1) are measured; tolerances and jumps only \
+             against a `--reference` spec's f64 values, E vs CPU not at all. A roughness domain (`--roughness`, a file's \
+             `domain roughness`) leaves the valid cases and grid points outside it uncounted.\n\n",
             self.provenance.device.name,
             self.provenance.device.driver_info,
             self.specs.len(),
@@ -368,10 +409,10 @@ impl StabilityReport {
                 s.nan.to_string(),
                 s.inf.to_string(),
                 s.negative.to_string(),
-                if s.has_twin { format!("{}/{}", s.cases_out_of_tolerance.len(), s.cases_run) } else { "- (no twin)".into() },
-                if s.has_twin { s.grid_out_of_tolerance.to_string() } else { "-".into() },
-                if s.has_twin { worst_cell(&s.worst) } else { "-".into() },
-                s.discontinuities.to_string(),
+                cases_cell(s.cases_out_of_tolerance.len(), s.cases_run, s.expected_from.is_some()),
+                if s.expected_from.is_some() { s.grid_out_of_tolerance.to_string() } else { "-".into() },
+                if s.expected_from.is_some() { worst_cell(&s.worst) } else { "-".into() },
+                jumps_cell(s.discontinuities, s.jumps_checked),
                 reciprocity_cell(s),
                 max_e,
                 hemi,
@@ -380,7 +421,8 @@ impl StabilityReport {
             ]);
         }
         out += &t.markdown();
-        out += "\n## Hard cases\n\nSpecs out of tolerance per case (fp32 / fp16), with the worst one.\n\n";
+        out += &self.expectations_markdown();
+        out += "\n## Hard cases\n\nSpecs out of tolerance per case (fp32 / fp16; without a twin or reference: with a NaN, Inf or negative value), with the worst one.\n\n";
         let mut c = Table::new(["case", "expected", "fp32 out", "fp16 out", "worst spec (x tol.)"]);
         for (i, case) in self.cases.iter().enumerate() {
             let count = |p: &str| self.specs.iter().filter(|s| s.precision == p && s.case_deviation[i] > 1.0).count();
@@ -400,12 +442,37 @@ impl StabilityReport {
         out += &self.guard_savings_markdown();
         let failing = self.failing();
         if !failing.is_empty() {
-            out += "\n## Failing specs: first failing inputs\n\n";
+            let guards: Vec<String> = crate::brdf::guards::INPUT_GUARDS.iter().map(|g| format!("`{}` ({})", g.name, g.does)).collect();
+            out += &format!(
+                "\n## Failing specs: where they fail\n\nEvery valid hard case with a NaN, Inf or negative result, the grid points with one (the first {} listed), \
+                 and which of brdfprof's guards, applied to the inputs as an engine's caller could, removes each: {}; `{}`: all of them at once.\n\n",
+                failures::GRID_EXAMPLES,
+                guards.join("; "),
+                failures::ALL_GUARDS
+            );
             for s in failing {
-                out += &format!("- `{}`: {} NaN, {} Inf, {} negative; worst deviation {:.2e} x tolerance at {}\n", s.label, s.nan, s.inf, s.negative, s.worst.deviation, s.worst.input);
+                let worst = if s.expected_from.is_some() && s.worst.deviation.is_finite() { format!("; worst deviation {:.2e} x tolerance at {}", s.worst.deviation, s.worst.input) } else { String::new() };
+                out += &s.failures.view().markdown(&s.label, &format!("{} NaN, {} Inf, {} negative{worst}", s.nan, s.inf, s.negative));
             }
         }
         out
+    }
+
+    /// What the models without a twin were checked against, and the roughness domains, where any.
+    fn expectations_markdown(&self) -> String {
+        let mut lines = Vec::new();
+        for s in &self.specs {
+            let against = match (&s.expected_from, s.has_twin) {
+                (Some(e), false) => Some(format!("checked against the {e}'s f64 values")),
+                _ => None,
+            };
+            let domain = s.roughness_domain.map(|(lo, hi)| format!("roughness in [{lo}, {hi}]: {} valid hard cases and {} grid points outside it not counted", s.cases_outside_domain, s.grid_outside_domain));
+            let said: Vec<String> = against.into_iter().chain(domain).collect();
+            if !said.is_empty() {
+                lines.push(format!("- `{}`: {}\n", s.label, said.join("; ")));
+            }
+        }
+        if lines.is_empty() { String::new() } else { format!("\n{}", lines.concat()) }
     }
 
     /// The "what each guard saves" section, where specs ran without some of their guards.
@@ -432,11 +499,13 @@ impl StabilityReport {
         let failing: Vec<&SpecStability> = all.iter().copied().filter(|s| s.bad_cells.is_some()).collect();
         let title = format!("Failing specs ({}): NaN, Inf or negative results per (NoV, roughness) grid cell", failing.len());
         let columns = 6usize.min(failing.len());
+        // The title fits the figure's width: about 0.55 em per character.
+        let title_size = (300.0 * columns as f64 / (0.55 * title.len() as f64)).min(20.0) as u32;
         let rows = failing.len().div_ceil(columns);
         let (pw, ph) = (300u32, 230u32);
         crate::chart::render(path, pw * columns as u32, ph * rows as u32 + 40, |root| {
             let err = |e: &dyn std::fmt::Display| anyhow::anyhow!("heat map: {e}");
-            let root = root.titled(&title, (crate::chart::FONT, 20)).map_err(|e| err(&e))?;
+            let root = root.titled(&title, (crate::chart::FONT, title_size)).map_err(|e| err(&e))?;
             for (area, s) in root.split_evenly((rows, columns)).iter().zip(&failing) {
                 let cells = s.bad_cells.as_ref().expect("filtered above");
                 let max = cells.iter().flatten().copied().max().unwrap_or(1).max(1) as f64;
@@ -450,8 +519,12 @@ impl StabilityReport {
                 chart
                     .configure_mesh()
                     .disable_mesh()
-                    .x_desc("NoV index")
-                    .y_desc("roughness index")
+                    .x_desc("NoV")
+                    .y_desc("roughness")
+                    .x_labels(8)
+                    .y_labels(8)
+                    .x_label_formatter(&|i| axis_value(grid::COSINES.get(*i).copied()))
+                    .y_label_formatter(&|i| axis_value(grid::ROUGHNESS.get(*i).map(|&r| f64::from(r))))
                     .label_style((crate::chart::FONT, 10))
                     .draw()
                     .map_err(|e| err(&e))?;

@@ -44,6 +44,14 @@ pub struct SpecView {
     pub precision: String,
     #[serde(default)]
     pub has_twin: bool,
+    /// What it was checked against (None: nothing; reports written before it: read from `has_twin`).
+    #[serde(default)]
+    pub expected_from: Option<String>,
+    /// Whether jumps were looked for (reports written before it counted them always).
+    #[serde(default)]
+    pub jumps_checked: Option<bool>,
+    #[serde(default)]
+    pub failures: Option<crate::stability::failures::FailuresView>,
     pub nan: usize,
     pub inf: usize,
     pub negative: usize,
@@ -67,6 +75,11 @@ impl SpecView {
     /// What to call it: its label, or its spec in a report written before labels.
     pub fn label(&self) -> &str {
         if self.label.is_empty() { &self.spec } else { &self.label }
+    }
+
+    /// Whether its values were checked against expected ones (a twin or a reference).
+    pub fn checked(&self) -> bool {
+        self.has_twin || self.expected_from.is_some()
     }
 
     /// NaN, Inf or a negative value on a valid input (as `SpecStability::fails`).

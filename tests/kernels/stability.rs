@@ -19,7 +19,7 @@ fn every_fp32_spec_is_stable_over_catalogue_and_grid() {
     assert!(specs.len() >= 80, "every D x Vis and every Fresnel");
     let mut problems = Vec::new();
     for spec in &specs {
-        let r = stability::check_model(&gpu, &common::model(*spec), &cases, &grid, &reciprocity).unwrap();
+        let r = stability::check_model(&gpu, &common::model(*spec), &Default::default(), &cases, &grid, &reciprocity).unwrap();
         if r.fails() {
             problems.push(format!("{}: {} NaN, {} Inf, {} negative (worst at {})", r.spec, r.nan, r.inf, r.negative, r.worst.input));
         }
@@ -70,7 +70,7 @@ fn fp16_does_what_it_can_and_the_report_says_where_it_cannot() {
     let grid = grid::samples();
     for name in ["ggx", "cook-torrance", "burley"] {
         let spec = ModelSpec { precision: Precision::F16, ..ModelSpec::preset(name).unwrap() };
-        let r = stability::check_model(&gpu, &common::model(spec), &cases, &grid, &[]).unwrap();
+        let r = stability::check_model(&gpu, &common::model(spec), &Default::default(), &cases, &grid, &[]).unwrap();
         assert_eq!((r.negative, r.invalid_input_poisoned), (0, 0), "{spec}");
         // Every failure is visible: in the heat map of grid cells or among the failing hard cases.
         let in_cases = r.cases_out_of_tolerance.iter().any(|c| c.got.iter().any(|x| !x.is_finite()));
@@ -136,7 +136,7 @@ fn stability_says_what_each_guard_saves() {
     let presets: Vec<brdfprof::model::Model> = PRESETS.iter().take(2).map(|p| common::model(ModelSpec::preset(p.name).unwrap())).collect();
     let models = stability::with_guard_variants(presets.clone());
     assert_eq!(models.len(), presets.len() * (2 + 2 * guards::SWITCHES.len()), "each preset, off, each off alone, each on alone");
-    let options = stability::StabilityOptions { models, energy: false };
+    let options = stability::StabilityOptions { models, energy: false, reference: None, roughness: None };
     let report = stability::run(&gpu, &options, &indicatif::ProgressBar::hidden()).unwrap();
     common::assert_no_validation_messages(&gpu);
     assert_eq!(report.guard_savings.len(), presets.len() * (1 + 2 * guards::SWITCHES.len()));
@@ -160,4 +160,53 @@ fn stability_says_what_each_guard_saves() {
     }
     let md = report.markdown();
     assert!(md.contains("## What each guard saves") && md.contains("only safe-h") && md.contains("all but lit-mask"), "{md}");
+}
+
+/// Issue 32: a `.brdf` file's failures named where they happen. unclamped-ggx.brdf (written for the tests, no
+/// roughness floor) is 0/0 at roughness 0 on the peak: `stability` names each failing hard case with its input
+/// values and says the roughness floor, applied to the input, removes it; the grid's failures are counted with
+/// what each input guard removes. Within a roughness domain that leaves 0 out the file passes; against a
+/// `--reference`, tolerances and jumps are counted as for a built-in spec.
+#[test]
+fn stability_names_a_files_failing_inputs_and_the_guard_that_removes_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = common::repo_root().join("tests/fixtures/brdf/engine/unclamped-ggx.brdf");
+    let run = |extra: &[&str]| -> (Option<i32>, String, serde_json::Value) {
+        let out = common::brdfprof().args(["stability", "--validate", "--no-energy", "--model"]).arg(&file).arg("--out").arg(dir.path()).args(extra).output().unwrap();
+        let md = std::fs::read_to_string(common::device_file(dir.path(), "stability-", ".md")).unwrap();
+        let json = serde_json::from_str(&std::fs::read_to_string(common::device_file(dir.path(), "stability-", ".json")).unwrap()).unwrap();
+        (out.status.code(), md, json)
+    };
+    let html = dir.path().join("report.html");
+    let (code, md, json) = run(&["--html", html.to_str().unwrap()]);
+    assert_eq!(code, Some(1), "{md}");
+    let page = std::fs::read_to_string(&html).unwrap();
+    assert!(page.contains("Where the failing specs fail") && page.contains("removed by `roughness-floor`") && page.contains("(no twin)"), "the page says what the Markdown says");
+    let spec = &json["specs"][0];
+    let failures = &spec["failures"];
+    let cases = failures["cases"].as_array().unwrap();
+    let peak = cases.iter().find(|c| c["at"] == "roughness 0, N = H").unwrap_or_else(|| panic!("the 0/0 case is named: {failures}"));
+    assert_eq!(peak["input"]["roughness"].as_f64(), Some(0.0));
+    assert!(peak["got"].as_array().unwrap().iter().all(|x| x.is_null()), "NaN, written as null: {peak}");
+    let removed: Vec<&str> = peak["removed_by"].as_array().unwrap().iter().map(|x| x.as_str().unwrap()).collect();
+    assert_eq!(removed, ["roughness-floor", "all"], "only the roughness floor removes a 0/0 at roughness 0");
+    for c in cases {
+        assert!((c["input"]["roughness"].as_f64().unwrap()) < guards::MIN_ROUGHNESS_F32, "a failure above the floor: {c}");
+    }
+    let grid_points = failures["grid_points"].as_u64().unwrap();
+    assert!(grid_points > 0);
+    let floor = failures["grid_removed_by"].as_array().unwrap().iter().find(|g| g["guard"] == "roughness-floor").unwrap();
+    assert_eq!(floor["removes"].as_u64(), Some(grid_points), "{failures}");
+    assert!(md.contains("hard cases `roughness 0, N = H`") && md.contains("roughness 0, F0") && md.contains("removed by `roughness-floor`"), "{md}");
+    assert!(spec["jumps_checked"] == false && md.contains("- (no reference)"), "no jumps counted without a reference");
+
+    let (code, md, json) = run(&["--roughness", "0.05..1", "--reference", "d=ggx,vis=smith-ggx-correlated,f=schlick"]);
+    assert_eq!(code, Some(0), "above the floor it gives no NaN: {md}");
+    let spec = &json["specs"][0];
+    assert!(spec["cases_outside_domain"].as_u64().unwrap() > 0 && spec["grid_outside_domain"].as_u64().unwrap() > 0);
+    assert_eq!(spec["expected_from"], "reference `d=ggx,vis=smith-ggx-correlated,f=schlick`");
+    assert_eq!(spec["jumps_checked"], true);
+    let out: Vec<&str> = spec["cases_out_of_tolerance"].as_array().unwrap().iter().map(|c| c["case"].as_str().unwrap()).collect();
+    assert!(!out.contains(&"L = V") && !out.contains(&"N = H exactly"), "the same maths within tolerance of its reference where both are well conditioned: {out:?}");
+    assert!(md.contains("checked against the reference") && md.contains("not counted"), "{md}");
 }
