@@ -8,6 +8,7 @@ pub mod picture;
 pub mod view;
 
 use crate::accuracy::rel_err;
+use crate::brdf::guards::unit;
 use crate::brdf::{samples, Sample};
 use crate::model::Model;
 use serde::Serialize;
@@ -15,6 +16,8 @@ use serde::Serialize;
 /// The report's `kind`, and its shape's version (bumped when a field changes meaning or goes away).
 pub const KIND: &str = "diff";
 pub const SCHEMA: u32 = 1;
+/// The kind of `diff --reference SPEC`'s report: every model against one reference's f64 values.
+pub const SET_KIND: &str = "diff-set";
 
 /// Histogram edges of the relative difference: [0, 1e-7), [1e-7, 1e-6), ..., [0.1, 1), [1, inf).
 pub const HISTOGRAM_EDGES: [f64; 9] = [0.0, 1e-7, 1e-6, 1e-5, 1e-4, 1e-3, 1e-2, 1e-1, 1.0];
@@ -60,6 +63,84 @@ pub struct Side {
 impl Side {
     pub fn of(model: &Model) -> Self {
         Side { name: model.label(), canonical: model.canonical() }
+    }
+
+    /// A reference's side: its f64 twin's values, not its kernel's.
+    pub fn reference(model: &Model) -> Self {
+        Side { name: format!("{} (f64)", model.label()), canonical: model.canonical() }
+    }
+}
+
+/// What `brdfprof diff --reference SPEC --model ... --json` writes: each model against the reference's f64
+/// values on the same rows, one `DiffReport` each (A the reference), and one table over them.
+#[derive(Clone, Debug, Serialize)]
+pub struct DiffSet {
+    pub kind: &'static str,
+    pub schema: u32,
+    pub reference: Side,
+    pub device: String,
+    pub input: String,
+    pub rows: usize,
+    pub tolerance: Option<f64>,
+    /// Every model within it (true without a tolerance).
+    pub within_tolerance: bool,
+    pub diffs: Vec<DiffReport>,
+}
+
+impl DiffSet {
+    pub fn new(diffs: Vec<DiffReport>, tolerance: Option<f64>) -> Self {
+        let first = diffs.first().expect("a model to compare");
+        DiffSet {
+            kind: SET_KIND,
+            schema: SCHEMA,
+            reference: first.a.clone(),
+            device: first.device.clone(),
+            input: first.input.clone(),
+            rows: first.rows,
+            tolerance,
+            within_tolerance: diffs.iter().all(|d| d.within_tolerance),
+            diffs,
+        }
+    }
+
+    /// One table (a row per model: its largest and RMS relative difference over the channels, its
+    /// non-finite values, its worst row), then each model's report.
+    pub fn markdown(&self) -> String {
+        use crate::results::{sig, Table};
+        let mut out = format!(
+            "# {} models against {}\n\n{} rows of {} on {}; relative: rel_err(model, reference) = |model - reference| / max(|reference|, {}).\n\n",
+            self.diffs.len(),
+            self.reference.name,
+            self.rows,
+            self.input,
+            self.device,
+            crate::accuracy::FLOOR
+        );
+        let mut t = Table::new(["model", "max rel", "RMS rel (worst channel)", "max abs", "rows within 1e-3", "non-finite (model / one side only)", "worst row", "verdict"]);
+        for d in &self.diffs {
+            let rms = d.difference.channels.iter().map(|c| c.rms_rel).fold(0.0, f64::max);
+            let within: usize = d.histogram.counts.iter().zip(&d.histogram.edges).filter(|(_, e)| **e < 1e-3).map(|(n, _)| n).sum();
+            let nonfinite = d.difference.channels.iter().map(|c| c.b_nonfinite).sum::<usize>();
+            let one_side = d.difference.channels.iter().map(|c| c.mismatched_nonfinite).sum::<usize>();
+            let worst = d.worst.first().map_or("-".into(), |w| {
+                let (n, v, l) = (unit(w.sample.n), unit(w.sample.v), unit(w.sample.l));
+                format!("{} ({}) at NoV {:.3}, NoL {:.3}, roughness {:.3}", sig(w.rel, 3), w.channel, n.dot(v), n.dot(l), w.sample.roughness)
+            });
+            let verdict = match self.tolerance {
+                Some(_) if d.within_tolerance => "within",
+                Some(_) => "ABOVE",
+                None => "-",
+            };
+            t.row([d.b.name.clone(), sig(d.difference.max_rel, 3), sig(rms, 3), sig(d.difference.max_abs, 3), format!("{within} of {}", d.rows), format!("{nonfinite} / {one_side}"), worst, verdict.to_string()]);
+        }
+        out += &t.markdown();
+        if let Some(tol) = self.tolerance {
+            out += &format!("\n--tolerance {tol}: {}.\n", if self.within_tolerance { "every model within it" } else { "NOT every model within it" });
+        }
+        for d in &self.diffs {
+            out += &format!("\n{}", d.markdown().replacen("# ", "## ", 1));
+        }
+        out
     }
 }
 
@@ -254,19 +335,22 @@ pub struct Evaluated<'a> {
     pub lines: Option<&'a [usize]>,
     pub a_values: &'a [[f32; 3]],
     pub b_values: &'a [[f32; 3]],
+    /// A's exact values, where A is a reference (`diff --reference`): the difference is taken against them
+    /// (`a_values` are them rounded to f32, for the rows listed).
+    pub a_exact: Option<&'a [[f64; 3]]>,
 }
 
 impl DiffReport {
     /// The report of `e` on `device`, `input` saying what the inputs were.
     pub fn build(e: &Evaluated, device: &str, input: &str, worst: usize, tolerance: Option<f64>) -> Self {
         let wide = |v: &[[f32; 3]]| v.iter().map(|x| x.map(f64::from)).collect::<Vec<_>>();
-        let (a, b) = (wide(e.a_values), wide(e.b_values));
+        let (a, b) = (e.a_exact.map_or_else(|| wide(e.a_values), <[_]>::to_vec), wide(e.b_values));
         let difference = difference(&a, &b);
         let within_tolerance = tolerance.is_none_or(|t| difference.max_rel <= t && difference.unmeasured() == 0);
         DiffReport {
             kind: KIND,
             schema: SCHEMA,
-            a: Side::of(e.a),
+            a: if e.a_exact.is_some() { Side::reference(e.a) } else { Side::of(e.a) },
             b: Side::of(e.b),
             device: device.to_string(),
             input: input.to_string(),
@@ -341,6 +425,24 @@ pub fn csv(samples: &[Sample], a: &[[f32; 3]], b: &[[f32; 3]]) -> String {
     out.push_str("nx,ny,nz,vx,vy,vz,lx,ly,lz,roughness,f0r,f0g,f0b,a_r,a_g,a_b,b_r,b_g,b_b\n");
     for ((s, x), y) in samples.iter().zip(a).zip(b) {
         let fields: Vec<String> = s.n.iter().chain(&s.v).chain(&s.l).chain(std::iter::once(&s.roughness)).chain(&s.f0).chain(x).chain(y).map(f32::to_string).collect();
+        out.push_str(&fields.join(","));
+        out.push('\n');
+    }
+    out
+}
+
+/// The CSV of `diff --reference`: the inputs, the reference's r,g,b (its f64 values rounded to f32), then each
+/// model's as m1_r,m1_g,m1_b, m2_r, ... in the order given.
+pub fn csv_set(samples: &[Sample], reference: &[[f32; 3]], models: &[Vec<[f32; 3]>]) -> String {
+    let mut out = String::with_capacity(samples.len() * (100 + 40 * models.len()));
+    out.push_str("nx,ny,nz,vx,vy,vz,lx,ly,lz,roughness,f0r,f0g,f0b,ref_r,ref_g,ref_b");
+    for i in 1..=models.len() {
+        out.push_str(&format!(",m{i}_r,m{i}_g,m{i}_b"));
+    }
+    out.push('\n');
+    for (k, s) in samples.iter().enumerate() {
+        let values = std::iter::once(&reference[k]).chain(models.iter().map(|m| &m[k])).flatten();
+        let fields: Vec<String> = s.n.iter().chain(&s.v).chain(&s.l).chain(std::iter::once(&s.roughness)).chain(&s.f0).chain(values).map(f32::to_string).collect();
         out.push_str(&fields.join(","));
         out.push('\n');
     }

@@ -1,10 +1,12 @@
-//! `brdfprof diff --model A --model B`: both models on the same inputs, B measured against A.
+//! `brdfprof diff --model A --model B`: both models on the same inputs, B measured against A; or
+//! `brdfprof diff --reference SPEC --model ... --model ...`: every model against one reference's f64 values.
 
 use brdfprof::model::csv_rows::{read_rows, RowValues};
 use super::{on_device, DeviceArgs, ModelArgs};
 use anyhow::{bail, Result};
 use brdfprof::brdf::Sample;
-use brdfprof::diff::{self, DiffReport, Evaluated};
+use brdfprof::brdf::ModelSpec;
+use brdfprof::diff::{self, DiffReport, DiffSet, Evaluated};
 use brdfprof::model::Model;
 use brdfprof::{io, kernels, results};
 use clap::Args;
@@ -13,9 +15,14 @@ use std::process::ExitCode;
 
 #[derive(Args)]
 pub struct DiffArgs {
-    /// The two models, A then B (B is measured against A); specs or .brdf files, as for `eval`.
+    /// The two models, A then B (B is measured against A); specs or .brdf files, as for `eval`. With
+    /// --reference, any number of models, each measured against the reference.
     #[command(flatten)]
     pub model: ModelArgs,
+    /// Measure every --model against this built-in spec's exact f64 values (e.g. `ggx`, or
+    /// `d=ggx,vis=smith-ggx-correlated,f=schlick`), in one table.
+    #[arg(long, value_parser = super::reference_spec)]
+    pub reference: Option<ModelSpec>,
     /// CSV of inputs, as for `eval` (columns nx,ny,nz,vx,vy,vz,lx,ly,lz,roughness,f0r,f0g,f0b). Default: seeded
     /// well-conditioned samples (--samples, --seed).
     #[arg(long)]
@@ -43,7 +50,7 @@ pub struct DiffArgs {
     #[arg(long)]
     pub json: Option<PathBuf>,
     /// PNG: lit spheres of A and B, the relative difference of B against A, and both models' lobes.
-    #[arg(long)]
+    #[arg(long, conflicts_with = "reference")]
     pub png: Option<PathBuf>,
     #[command(flatten)]
     pub html: super::report::HtmlArg,
@@ -96,32 +103,35 @@ fn outputs(args: &DiffArgs, models: &[Model]) -> Result<Vec<(&'static str, PathB
 
 pub fn diff(args: &DiffArgs) -> Result<ExitCode> {
     let models = args.model.models(&[])?;
+    if let Some(reference) = &args.reference {
+        if models.is_empty() {
+            bail!("diff --reference needs at least one --model to measure against it");
+        }
+        return diff_set(args, &Model::spec(*reference), &models);
+    }
     let [a, b] = models.as_slice() else {
-        bail!("diff takes exactly two --model (A, then B measured against A); got {}", models.len());
+        bail!("diff takes exactly two --model (A, then B measured against A), or any number with --reference SPEC; got {}", models.len());
     };
     if args.input.is_none() && !(1..=diff::MAX_SAMPLES).contains(&args.samples) {
         bail!("--samples {}: give 1 to {}", args.samples, diff::MAX_SAMPLES);
     }
     let outs = outputs(args, &models)?;
-    let inputs = Inputs::read(args, a, b)?;
-    let (gpu, (va, vb)) = on_device(&args.device, |gpu, progress| {
+    let inputs = Inputs::read(args, &models)?;
+    let (gpu, values) = on_device(&args.device, |gpu, progress| {
         progress.set_message(format!("{} and {} on {} rows", a.label(), b.label(), inputs.samples.len()));
-        let eval = |(m, rows): &(Model, RowValues)| {
-            let extras = kernels::EvalExtras { tangents: inputs.tangents.as_deref(), rows: &rows.values, row_floats: rows.floats };
-            kernels::eval_with(gpu, m, &inputs.samples, &extras, kernels::RunLimits::default())
-        };
-        let values = (eval(&inputs.a)?, eval(&inputs.b)?);
+        let values = inputs.eval_all(gpu)?;
         if let Some((_, path)) = outs.iter().find(|(f, _)| *f == "--png") {
             progress.set_message("picture");
-            diff::picture::write(gpu, path, &inputs.a.0, &inputs.b.0)?;
+            diff::picture::write(gpu, path, &inputs.models[0].0, &inputs.models[1].0)?;
         }
         Ok(values)
     })?;
-    let evaluated = Evaluated { a, b, samples: &inputs.samples, lines: inputs.lines.as_deref(), a_values: &va, b_values: &vb };
+    let (va, vb) = (&values[0], &values[1]);
+    let evaluated = Evaluated { a, b, samples: &inputs.samples, lines: inputs.lines.as_deref(), a_values: va, b_values: vb, a_exact: None };
     let result = DiffReport::build(&evaluated, &gpu.info.name, &inputs.label, args.worst, args.tolerance);
     for (flag, path) in &outs {
         match *flag {
-            "--csv" => io::write_output(path, diff::csv(&inputs.samples, &va, &vb).as_bytes())?,
+            "--csv" => io::write_output(path, diff::csv(&inputs.samples, va, vb).as_bytes())?,
             "--json" => results::write_json(path, &result)?,
             _ => {}
         }
@@ -136,36 +146,89 @@ pub fn diff(args: &DiffArgs) -> Result<ExitCode> {
     Ok(if result.within_tolerance { ExitCode::SUCCESS } else { ExitCode::from(1) })
 }
 
-/// The rows both models are evaluated on, and each model with its per-row parameters (a `.brdf` file's
+/// `diff --reference`: every model on the same rows against the reference's f64 twin (no kernel of its own).
+fn diff_set(args: &DiffArgs, reference: &Model, models: &[Model]) -> Result<ExitCode> {
+    if args.input.is_none() && !(1..=diff::MAX_SAMPLES).contains(&args.samples) {
+        bail!("--samples {}: give 1 to {}", args.samples, diff::MAX_SAMPLES);
+    }
+    let twin = reference.twin().expect("a reference is a built-in spec");
+    let outs = outputs(args, models)?;
+    let inputs = Inputs::read(args, models)?;
+    let (gpu, values) = on_device(&args.device, |gpu, progress| {
+        progress.set_message(format!("{} models on {} rows", models.len(), inputs.samples.len()));
+        inputs.eval_all(gpu)
+    })?;
+    let exact: Vec<[f64; 3]> = inputs.samples.iter().map(|s| twin.eval(s)).collect();
+    let rounded: Vec<[f32; 3]> = exact.iter().map(|v| v.map(|x| x as f32)).collect();
+    let diffs: Vec<DiffReport> = models
+        .iter()
+        .zip(&values)
+        .map(|(m, v)| {
+            let e = Evaluated { a: reference, b: m, samples: &inputs.samples, lines: inputs.lines.as_deref(), a_values: &rounded, b_values: v, a_exact: Some(&exact) };
+            DiffReport::build(&e, &gpu.info.name, &inputs.label, args.worst, args.tolerance)
+        })
+        .collect();
+    let result = DiffSet::new(diffs, args.tolerance);
+    for (flag, path) in &outs {
+        match *flag {
+            "--csv" => io::write_output(path, diff::csv_set(&inputs.samples, &rounded, &values).as_bytes())?,
+            "--json" => results::write_json(path, &result)?,
+            _ => {}
+        }
+    }
+    let label = args.json.clone().unwrap_or_else(|| PathBuf::from("diff.json"));
+    args.html.write(&[super::report::just_measured(&label, &result)?], Some(&gpu))?;
+    print!("{}", result.markdown());
+    if !outs.is_empty() {
+        println!("\n{}", super::written(&outs.iter().map(|(_, p)| p.clone()).collect::<Vec<_>>()));
+    }
+    Ok(if result.within_tolerance { ExitCode::SUCCESS } else { ExitCode::from(1) })
+}
+
+/// The rows every model is evaluated on, and each model with its per-row parameters (a `.brdf` file's
 /// columns, as `eval` reads them).
 struct Inputs {
     samples: Vec<Sample>,
     tangents: Option<Vec<[f32; 3]>>,
     lines: Option<Vec<usize>>,
     label: String,
-    a: (Model, RowValues),
-    b: (Model, RowValues),
+    models: Vec<(Model, RowValues)>,
 }
 
 impl Inputs {
-    fn read(args: &DiffArgs, a: &Model, b: &Model) -> Result<Self> {
+    fn read(args: &DiffArgs, models: &[Model]) -> Result<Self> {
         let Some(path) = &args.input else {
-            let none = || RowValues::default();
-            let (range, why) = roughness_of(args, &[a, b])?;
+            let (range, why) = roughness_of(args, &models.iter().collect::<Vec<_>>())?;
             return Ok(Inputs {
                 samples: diff::default_samples_in(args.samples, args.seed, range),
                 tangents: None,
                 lines: None,
                 label: diff::default_samples_label_in(args.samples, args.seed, range, &why),
-                a: (a.clone(), none()),
-                b: (b.clone(), none()),
+                models: models.iter().map(|m| (m.clone(), RowValues::default())).collect(),
             });
         };
-        let (ma, input, ra) = read_rows(a, path, &args.model.params)?;
-        if input.samples.is_empty() {
-            bail!("--input {}: the file has a header but no rows: there is nothing to compare (as --samples 0 is refused)", path.display());
+        let mut read = Vec::new();
+        let mut rows = None;
+        for m in models {
+            let (model, input, values) = read_rows(m, path, &args.model.params)?;
+            if input.samples.is_empty() {
+                bail!("--input {}: the file has a header but no rows: there is nothing to compare (as --samples 0 is refused)", path.display());
+            }
+            rows.get_or_insert(input);
+            read.push((model, values));
         }
-        let (mb, _, rb) = read_rows(b, path, &args.model.params)?;
-        Ok(Inputs { samples: input.samples, tangents: input.tangents, lines: Some(input.lines), label: path.display().to_string(), a: (ma, ra), b: (mb, rb) })
+        let input = rows.expect("at least one model");
+        Ok(Inputs { samples: input.samples, tangents: input.tangents, lines: Some(input.lines), label: path.display().to_string(), models: read })
+    }
+
+    /// Every model's values on the rows, in order.
+    fn eval_all(&self, gpu: &brdfprof::gpu::Gpu) -> Result<Vec<Vec<[f32; 3]>>> {
+        self.models
+            .iter()
+            .map(|(m, rows)| {
+                let extras = kernels::EvalExtras { tangents: self.tangents.as_deref(), rows: &rows.values, row_floats: rows.floats };
+                kernels::eval_with(gpu, m, &self.samples, &extras, kernels::RunLimits::default())
+            })
+            .collect()
     }
 }

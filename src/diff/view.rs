@@ -67,3 +67,15 @@ pub struct DiffView {
     pub tolerance: Option<f64>,
     pub within_tolerance: bool,
 }
+
+/// `DiffSet` (`diff --reference`) as read back.
+#[derive(Clone, Debug, Deserialize)]
+pub struct DiffSetView {
+    pub reference: SideView,
+    pub device: String,
+    pub input: String,
+    pub rows: usize,
+    pub tolerance: Option<f64>,
+    pub within_tolerance: bool,
+    pub diffs: Vec<DiffView>,
+}

@@ -4,7 +4,7 @@
 
 use super::sections::num_cell;
 use super::{file_label, Input, Loaded};
-use crate::diff::view::{DiffView, WorstView};
+use crate::diff::view::{DiffSetView, DiffView, WorstView};
 use crate::gpu::Gpu;
 use crate::page::{esc, img, png_data_uri, Cell, HtmlTable};
 use crate::model::Model;
@@ -84,12 +84,45 @@ fn diff_html(i: usize, d: &DiffView, path: &str, gpu: Option<&Gpu>) -> Result<St
     Ok(s + &picture(d, gpu)?)
 }
 
+const SET_COLUMNS: [(&str, &str); 5] = [("model", "model"), ("max_rel", "max rel"), ("rms_rel", "RMS rel (worst channel)"), ("one_side", "finite on one side"), ("verdict", "verdict")];
+
+/// `diff --reference`: one table of every model against the reference (rows keyed `diffset<i>/<model>`),
+/// then each model's own section.
+fn diff_set_html(i: usize, d: &DiffSetView, path: &str, gpu: Option<&Gpu>) -> Result<String> {
+    let mut t = HtmlTable::new(&SET_COLUMNS);
+    for x in &d.diffs {
+        let rms = x.difference.channels.iter().filter_map(|c| c.rms_rel).fold(None, |m: Option<f64>, r| Some(m.map_or(r, |m| m.max(r))));
+        let one_side: usize = x.difference.channels.iter().map(|c| c.mismatched_nonfinite).sum();
+        let verdict = match d.tolerance {
+            Some(t) if x.within_tolerance => format!("within {t}"),
+            Some(t) => format!("beyond {t}"),
+            None => "-".into(),
+        };
+        t.row(format!("diffset{i}/{}", x.b.name), vec![Cell::text(x.b.name.clone()), num_cell(x.difference.max_rel), num_cell(rms), Cell::num(one_side as f64, one_side.to_string()), Cell::text(verdict)]);
+    }
+    let mut s = format!(
+        "<h3>{} models against <code>{}</code> ({path})</h3><p>{} rows: {}; on {}.</p>{}",
+        d.diffs.len(),
+        esc(&d.reference.name),
+        d.rows,
+        esc(&d.input),
+        esc(&d.device),
+        t.html()
+    );
+    for (k, x) in d.diffs.iter().enumerate() {
+        s += &diff_html(i * 1000 + k, x, path, gpu)?;
+    }
+    Ok(s)
+}
+
 /// Every diff input's section.
 pub fn diffs(inputs: &[Input], gpu: Option<&Gpu>) -> Result<String> {
     let mut s = String::new();
     for (i, input) in inputs.iter().enumerate() {
-        if let Loaded::Diff(d) = &input.loaded {
-            s += &diff_html(i, d, &file_label(&input.path), gpu)?;
+        match &input.loaded {
+            Loaded::Diff(d) => s += &diff_html(i, d, &file_label(&input.path), gpu)?,
+            Loaded::DiffSet(d) => s += &diff_set_html(i, d, &file_label(&input.path), gpu)?,
+            _ => {}
         }
     }
     Ok(s)

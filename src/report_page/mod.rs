@@ -33,6 +33,8 @@ pub enum Loaded {
     Costs(CostTable),
     /// A `brdfprof diff` result.
     Diff(Box<crate::diff::view::DiffView>),
+    /// A `brdfprof diff --reference` result: every model against one reference.
+    DiffSet(Box<crate::diff::view::DiffSetView>),
 }
 
 impl Loaded {
@@ -44,6 +46,7 @@ impl Loaded {
             Loaded::Inspect(..) => "inspect",
             Loaded::Costs(_) => "compare",
             Loaded::Diff(_) => "diff",
+            Loaded::DiffSet(_) => "diff-set",
         }
     }
 }
@@ -95,7 +98,7 @@ pub fn from_json(path: &Path, text: &str) -> Result<Input> {
     use crate::results::Kind;
     // A report that names its kind is read as that kind; older ones, without `kind`, by their keys.
     let named = match probe.kind.as_deref() {
-        None | Some("diff") => None,
+        None | Some("diff") | Some(crate::diff::SET_KIND) => None,
         Some(k) => Some(Kind::parse(k).ok_or_else(|| anyhow!("{}: at JSON path `kind`: `{k}` is not a kind of brdfprof report ({})", path.display(), Kind::ALL.map(Kind::name).join(", ")))?),
     };
     let loaded = if let Some(kind) = named {
@@ -130,6 +133,8 @@ pub fn from_json(path: &Path, text: &str) -> Result<Input> {
         Loaded::Costs(parse(path, &text, "compare")?)
     } else if probe.kind.as_deref() == Some("diff") {
         Loaded::Diff(parse(path, &text, "diff")?)
+    } else if probe.kind.as_deref() == Some(crate::diff::SET_KIND) {
+        Loaded::DiffSet(parse(path, &text, "diff --reference")?)
     } else {
         bail!("{}: not a brdfprof profile, sweep, stability, inspect, compare or diff JSON report (none of the keys `fastest`, `workload`, `grid_points`, `reports`, `kernels`, `correlations`, nor `\"kind\": \"diff\"` at its top level)", path.display());
     };
@@ -165,7 +170,7 @@ pub fn build(inputs: &[Input], gpu: Option<&Gpu>) -> Result<String> {
     }
     let diffs = diff::diffs(inputs, gpu)?;
     if !diffs.is_empty() {
-        page.section("diff", "Two models side by side (brdfprof diff)", diffs);
+        page.section("diff", "Models side by side (brdfprof diff)", diffs);
     }
     Ok(page.render())
 }

@@ -82,6 +82,10 @@ pub fn provenance(inputs: &[Input]) -> String {
                 }
             }
             Loaded::Diff(d) => s += &kv(&[("device", d.device.clone()), ("models", format!("A = {}, B = {}", d.a.canonical, d.b.canonical)), ("input", d.input.clone())]),
+            Loaded::DiffSet(d) => {
+                let models = d.diffs.iter().map(|x| x.b.canonical.clone()).collect::<Vec<_>>().join("; ");
+                s += &kv(&[("device", d.device.clone()), ("reference", d.reference.canonical.clone()), ("models", models), ("input", d.input.clone())]);
+            }
             Loaded::Costs(t) => s += &kv(&[("columns", t.columns.iter().map(|c| format!("{} ({})", c.name, c.source)).collect::<Vec<_>>().join("; "))]),
         }
     }

@@ -48,6 +48,7 @@ pub fn models_of(inputs: &[Input]) -> Vec<(String, String)> {
             Loaded::Inspect(reports, _) => reports.iter().flat_map(|r| &r.rows).filter_map(|r| r.spec.as_deref().map(|s| (s, &r.model))).for_each(|(s, m)| add(s, m)),
             Loaded::Stability(st) => st.specs.iter().filter(|s| s.fails()).for_each(|s| add(&s.spec, s.label())),
             Loaded::Diff(d) => [&d.a, &d.b].into_iter().for_each(|m| add(&m.canonical, &m.name)),
+            Loaded::DiffSet(d) => std::iter::once(&d.reference).chain(d.diffs.iter().map(|x| &x.b)).for_each(|m| add(&m.canonical, &m.name)),
             Loaded::Costs(_) => {}
         }
     }
