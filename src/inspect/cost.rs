@@ -100,8 +100,10 @@ impl TargetCost {
     }
 
     pub fn markdown(&self) -> String {
+        let all: Vec<&String> = self.columns.iter().collect();
+        let (columns, constant) = crate::inspect::fold_constant(&all, |c| self.rows.iter().map(|r| r.stats.get(*c).copied()).collect());
         let mut headers: Vec<String> = vec!["model".into()];
-        headers.extend(self.columns.iter().cloned());
+        headers.extend(columns.iter().map(|c| c.to_string()));
         headers.extend(["cycles/eval".into(), "net cycles/eval".into(), "net vs ggx".into()]);
         let bound = self.rows.iter().any(|r| r.bound.is_some());
         if bound {
@@ -111,7 +113,7 @@ impl TargetCost {
         let reference = self.row(crate::brdf::spec::REFERENCE_MODEL).and_then(|r| r.net_cycles_per_eval);
         for r in &self.rows {
             let mut cells = vec![r.model.clone()];
-            cells.extend(self.columns.iter().map(|c| r.stats.get(c).map_or("-".into(), |v| crate::inspect::format_value(*v))));
+            cells.extend(columns.iter().map(|c| r.stats.get(*c).map_or("-".into(), |v| crate::inspect::format_value(*v))));
             cells.push(sig(r.cycles_per_eval, 4));
             cells.push(r.net_cycles_per_eval.map_or("-".into(), |v| sig(v, 4)));
             cells.push(match (r.net_cycles_per_eval, reference) {
@@ -124,6 +126,7 @@ impl TargetCost {
             t.row(cells);
         }
         let mut out = format!("### {} statistics, {} ({} lights per kernel; {}; {})\n\n{}", self.compiler, self.label(), self.lights_per_kernel, self.model, self.unit, t.markdown());
+        out += &crate::inspect::constant_note(constant.iter().map(|(c, v)| (c.as_str(), *v)));
         for r in self.rows.iter().filter(|r| r.net_cycles_per_eval.is_some_and(|v| v < 0.0)) {
             out += &format!("\n{}: {}\n", r.model, NEGATIVE_NET);
         }

@@ -321,7 +321,8 @@ impl InspectReport {
         self.rows.iter().find(|r| r.model == model)
     }
 
-    /// One table per section (one row per kernel, one column per statistic), with the section's notes.
+    /// One table per section (one row per kernel, one column per statistic, a statistic equal on every kernel
+    /// folded into a line below it), with the section's notes.
     pub fn markdown(&self) -> String {
         let mut out = String::new();
         for (prefix, title) in SECTIONS {
@@ -334,6 +335,7 @@ impl InspectReport {
             if columns.is_empty() && !with_notes {
                 continue;
             }
+            let (columns, constant) = fold_constant(&columns, |c| self.rows.iter().map(|r| r.stats.get(*c).copied()).collect());
             let mut headers = vec!["model".to_string()];
             headers.extend(columns.iter().map(|c| c[prefix.len()..].to_string()));
             if with_notes {
@@ -349,6 +351,7 @@ impl InspectReport {
                 t.row(cells);
             }
             out += &t.markdown();
+            out += &constant_note(constant.iter().map(|(c, v)| (&c[prefix.len()..], *v)));
             out += "\n";
         }
         if let Some(a) = &self.cost {
@@ -371,6 +374,26 @@ impl InspectReport {
         let device = self.provenance["device"]["name"].as_str().unwrap_or("?");
         format!("{device}; shade kernel, {} lights; SPIR-V {}; tools: {}", self.lights, self.kernels, self.tools.iter().map(|(k, v)| format!("{k} = {v}")).collect::<Vec<_>>().join(", "))
     }
+}
+
+/// The columns whose value differs between rows (kept), and those equal on every one of three or more rows
+/// with that value (folded: a column that never changes says nothing per row). `values` gives a column's.
+pub fn fold_constant<'a, C: Copy>(columns: &'a [C], values: impl Fn(&C) -> Vec<Option<f64>>) -> (Vec<C>, Vec<(C, f64)>) {
+    let (mut kept, mut folded) = (Vec::new(), Vec::new());
+    for c in columns {
+        let v = values(c);
+        match v.first() {
+            Some(&Some(x)) if v.len() >= 3 && v.iter().all(|y| *y == Some(x)) => folded.push((*c, x)),
+            _ => kept.push(*c),
+        }
+    }
+    (kept, folded)
+}
+
+/// The line under a table that lists its folded columns, or nothing.
+pub fn constant_note<'a>(folded: impl Iterator<Item = (&'a str, f64)>) -> String {
+    let items: Vec<String> = folded.map(|(name, v)| format!("{name} {}", format_value(v))).collect();
+    if items.is_empty() { String::new() } else { format!("\nThe same on every kernel (not listed per row): {}.\n", items.join(", ")) }
 }
 
 #[cfg(test)]

@@ -37,5 +37,11 @@
     if (t) { tip.textContent = t.getAttribute("data-tip"); tip.style.display = "block"; }
     else { tip.style.display = "none"; }
   });
+  // Where each section lies on the page (CSS px from the top): what a reader sees on the first screen.
+  document.querySelectorAll("main > section").forEach(function (sec) {
+    var r = sec.getBoundingClientRect();
+    sec.setAttribute("data-top", String(Math.round(r.top + window.scrollY)));
+    sec.setAttribute("data-bottom", String(Math.round(r.bottom + window.scrollY)));
+  });
   document.body.setAttribute("data-ready", "1");
 })();

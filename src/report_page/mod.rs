@@ -8,6 +8,7 @@
 pub mod diff;
 pub mod sections;
 pub mod shapes;
+pub mod summary;
 
 use crate::compare::CostTable;
 use crate::gpu::Gpu;
@@ -144,7 +145,9 @@ pub fn from_json(path: &Path, text: &str) -> Result<Input> {
 /// The report page of `inputs`; with `gpu`, each model's lobes, spheres and albedo evaluated on it.
 pub fn build(inputs: &[Input], gpu: Option<&Gpu>) -> Result<String> {
     let mut page = Page::new("brdfprof report");
-    page.section("provenance", "Provenance", sections::provenance(inputs));
+    if let Some(body) = summary::summary(inputs) {
+        page.section("summary", "Summary", body);
+    }
     let costs = sections::profiles(inputs);
     if !costs.is_empty() {
         page.section("costs", "Cost per evaluation", costs);
@@ -172,6 +175,8 @@ pub fn build(inputs: &[Input], gpu: Option<&Gpu>) -> Result<String> {
     if !diffs.is_empty() {
         page.section("diff", "Models side by side (brdfprof diff)", diffs);
     }
+    // Where each figure comes from, folded: it filled the first screen when it came first.
+    page.section("provenance", "Provenance", format!("<details><summary>Device, driver, CPU, tools and command of each report ({})</summary>{}</details>", inputs.len(), sections::provenance(inputs)));
     Ok(page.render())
 }
 

@@ -36,8 +36,12 @@ pub const LOG_DECADES: f64 = 3.0;
 /// (canonical spec, label).
 pub fn models_of(inputs: &[Input]) -> Vec<(String, String)> {
     let mut out: Vec<(String, String)> = Vec::new();
+    // One card per model however many reports name it, in whatever form (`summary::model_key`).
+    let mut keys: Vec<String> = Vec::new();
     let mut add = |spec: &str, label: &str| {
-        if !out.iter().any(|(s, _)| s == spec) {
+        let key = super::summary::model_key(spec);
+        if !keys.contains(&key) {
+            keys.push(key);
             out.push((spec.to_string(), label.to_string()));
         }
     };
@@ -46,7 +50,8 @@ pub fn models_of(inputs: &[Input]) -> Vec<(String, String)> {
             Loaded::Profile(p) => p.rows.iter().filter_map(|r| r.spec.as_deref().map(|s| (s, &r.model))).for_each(|(s, m)| add(s, m)),
             Loaded::Sweep(w) => w.rows.iter().filter(|r| r.pareto).for_each(|r| add(&r.canonical, &r.label)),
             Loaded::Inspect(reports, _) => reports.iter().flat_map(|r| &r.rows).filter_map(|r| r.spec.as_deref().map(|s| (s, &r.model))).for_each(|(s, m)| add(s, m)),
-            Loaded::Stability(st) => st.specs.iter().filter(|s| s.fails()).for_each(|s| add(&s.spec, s.label())),
+            // `--unguarded`'s variants are the same model without brdfprof's guards: no card of their own.
+            Loaded::Stability(st) => st.specs.iter().filter(|s| s.fails() && !super::summary::is_guard_variant(&s.spec)).for_each(|s| add(&s.spec, s.label())),
             Loaded::Diff(d) => [&d.a, &d.b].into_iter().for_each(|m| add(&m.canonical, &m.name)),
             Loaded::DiffSet(d) => std::iter::once(&d.reference).chain(d.diffs.iter().map(|x| &x.b)).for_each(|m| add(&m.canonical, &m.name)),
             Loaded::Costs(_) => {}
@@ -144,8 +149,8 @@ fn albedo_svg(e: &energy::Energy) -> String {
     page::lines_svg(&curves, Axis { lo: 0.0, hi: 1.0, log: false }, Axis { lo: 0.0, hi: top, log: false }, "NoV", "directional albedo E (F = 1)", page::SMALL)
 }
 
-/// One model's card.
-fn model_card(gpu: &Gpu, spec: &str, label: &str) -> Result<String> {
+/// One model's card, and its lobe values (for the overlay).
+fn model_card(gpu: &Gpu, spec: &str, label: &str) -> Result<(String, Vec<[f32; 3]>)> {
     let model = Model::parse(spec)?;
     let lobes = lobe_samples();
     let (spheres, at) = sphere_samples();
@@ -153,7 +158,7 @@ fn model_card(gpu: &Gpu, spec: &str, label: &str) -> Result<String> {
     let values = kernels::eval(gpu, &model, &all, RunLimits::default())?;
     let (lobe_values, sphere_values) = values.split_at(lobes.len());
     let e = energy::energy_of(gpu, &model)?;
-    Ok(format!(
+    let card = format!(
         "<div class=\"model\" data-model=\"{}\"><h3>{}</h3><p class=\"note\"><code>{}</code></p>{}<div class=\"row\">{}{}</div></div>",
         esc(spec),
         esc(label),
@@ -161,7 +166,30 @@ fn model_card(gpu: &Gpu, spec: &str, label: &str) -> Result<String> {
         lobes_svg(lobe_values),
         spheres_html(sphere_values, &at)?,
         albedo_svg(&e)
-    ))
+    );
+    Ok((card, lobe_values.to_vec()))
+}
+
+/// Incidence angles (of `INCIDENCE`) of the overlay of every model's lobe.
+const OVERLAY_INCIDENCE: [usize; 2] = [1, 2];
+
+/// Every model's lobe in one plot per incidence angle (linear and log), a colour per model.
+fn overlay_svg(lobes: &[(String, Vec<[f32; 3]>)]) -> String {
+    let n = SLICE.count();
+    let mut plots = String::new();
+    for i in OVERLAY_INCIDENCE {
+        let curves: Vec<Curve> = lobes
+            .iter()
+            .map(|(label, v)| Curve { label: label.clone(), points: SLICE.zip(&v[i * n..(i + 1) * n]).map(|(a, f)| ((a as f64).to_radians(), f64::from(f[0]))).collect() })
+            .collect();
+        let t = INCIDENCE[i];
+        let marks = [(-t.to_radians(), format!("L{t}"))];
+        let marks: Vec<(f64, &str)> = marks.iter().map(|(a, l)| (*a, l.as_str())).collect();
+        plots += &page::polar_svg(&format!("light at {t} deg, linear"), &curves, &marks, None);
+        plots += &page::polar_svg(&format!("light at {t} deg, log ({LOG_DECADES} decades)"), &curves, &marks, Some(LOG_DECADES));
+    }
+    let legend: Vec<String> = lobes.iter().enumerate().map(|(k, (label, _))| format!("<span style=\"color:{}\">&#9632; {}</span>", page::colour(k), esc(label))).collect();
+    format!("<div class=\"model overlay\" data-model=\"overlay\"><h3>All models overlaid</h3><figure><div class=\"row\">{plots}</div><figcaption>{}</figcaption></figure></div>", legend.join(" "))
 }
 
 /// The section: a card per model (a model that cannot be evaluated, e.g. a `.brdf` file no longer there,
@@ -175,15 +203,24 @@ pub fn section(gpu: &Gpu, models: &[(String, String)]) -> Result<String> {
         SPHERE_F0[1],
         SPHERE_F0[2]
     );
+    let mut cards = String::new();
+    let mut lobes = Vec::new();
     for (spec, label) in models.iter().take(MAX_MODELS) {
         match model_card(gpu, spec, label) {
-            Ok(card) => s += &card,
+            Ok((card, lobe)) => {
+                cards += &card;
+                lobes.push((label.clone(), lobe));
+            }
             Err(e) => {
                 crate::messages::warning(format!("report: {label}: not drawn: {e:#}"));
-                let _ = write!(s, "<div class=\"model\"><h3>{}</h3><p class=\"err\">Not drawn: {}</p></div>", esc(label), esc(&format!("{e:#}")));
+                let _ = write!(cards, "<div class=\"model\"><h3>{}</h3><p class=\"err\">Not drawn: {}</p></div>", esc(label), esc(&format!("{e:#}")));
             }
         }
     }
+    if lobes.len() > 1 {
+        s += &overlay_svg(&lobes);
+    }
+    s += &cards;
     if models.len() > MAX_MODELS {
         let _ = write!(s, "<p class=\"note\">{} more model(s) not drawn (at most {MAX_MODELS}).</p>", models.len() - MAX_MODELS);
     }

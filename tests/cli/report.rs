@@ -126,3 +126,64 @@ fn a_console_error_is_seen() {
     let (_, console) = headless(&page, &dir.path().join("profile"), &["--dump-dom"]);
     assert!(console.iter().any(|l| l.contains("brdfprof-test-error")), "console lines: {console:?}");
 }
+
+/// The attribute `attr` of the element that starts with `open` in the DOM, as a number.
+fn attr_of(dom: &str, open: &str, attr: &str) -> f64 {
+    let start = dom.find(open).unwrap_or_else(|| panic!("no {open} in the DOM"));
+    let tag = &dom[start..start + dom[start..].find('>').unwrap()];
+    let at = tag.find(&format!("{attr}=\"")).unwrap_or_else(|| panic!("no {attr} on {tag}")) + attr.len() + 2;
+    tag[at..at + tag[at..].find('"').unwrap()].parse().unwrap()
+}
+
+/// Issue 32: the page a team would show. A profile, a diff of four models against a reference and a stability
+/// run with `--unguarded` (each guard variant a spec of its own): in Chromium at 1280x900 the summary (one row
+/// per model) is the first section and fits the first screen, provenance is folded at the end, each model has
+/// one card however many reports name it (guard variants none), the lobes of all models are overlaid, and
+/// stability's cells read as the Markdown's.
+#[test]
+fn the_report_opens_on_a_one_screen_summary_with_one_card_per_model() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let path = |p: &Path| p.display().to_string();
+    let engine = |name: &str| path(&common::repo_root().join("tests/fixtures/brdf/engine").join(name));
+    let (set, page) = (d.join("set.json"), d.join("report.html"));
+    let reference = "d=ggx,vis=smith-ggx-correlated,f=schlick";
+    let r = common::run(&["diff", "--reference", reference, "--model", "filament-high", "--model", "ggx", "--model", &engine("engine-ggx.brdf"), "--model", &engine("unclamped-ggx.brdf"), "--samples", "1000", "--json", &path(&set)]);
+    assert_eq!(r.code, Some(0), "{}", r.stderr);
+    let st = common::run(&["stability", "--unguarded", "--no-energy", "--model", "ggx", "--model", &engine("unclamped-ggx.brdf"), "--out", &path(d)]);
+    assert_eq!(st.code, Some(1), "the unclamped file fails: {}", st.stderr);
+    let stability = common::device_file(d, "stability-", ".json");
+    let profile = common::repo_root().join(INPUTS[0]);
+    common::run(&["report", &path(&profile), &path(&set), &path(&stability), "--out", &path(&page)]).ok();
+
+    let (dom, console) = headless(&page, &d.join("profile"), &["--dump-dom", "--window-size=1280,900"]);
+    assert!(console.is_empty(), "console messages:\n{}", console.join("\n"));
+    let first = dom.find("<section id=").unwrap();
+    assert!(dom[first..].starts_with("<section id=\"summary\""), "the summary comes first");
+    let bottom = attr_of(&dom, "<section id=\"summary\"", "data-bottom");
+    assert!(bottom <= 900.0, "the summary ends at {bottom} px: below the first screen of 900");
+    let provenance = dom.find("<section id=\"provenance\"").unwrap();
+    assert!(dom[provenance..].contains("<details>") && provenance > dom.find("<section id=\"diff\"").unwrap(), "provenance folded, last");
+
+    let rows: Vec<&str> = dom.match_indices("<tr data-row=\"summary/").map(|(i, _)| &dom[i + 22..i + 22 + dom[i + 22..].find('"').unwrap()]).collect();
+    let mut unique = rows.clone();
+    unique.sort();
+    unique.dedup();
+    assert_eq!(unique.len(), rows.len(), "a model named twice in the summary: {rows:?}");
+    for model in ["ggx", "blinn", "filament-high", "engine-ggx", "unclamped-ggx"] {
+        assert!(rows.contains(&model), "{model} has no summary row: {rows:?}");
+    }
+    let cards: Vec<&str> = dom.match_indices("<div class=\"model\" data-model=\"").map(|(i, m)| &dom[i + m.len()..i + m.len() + dom[i + m.len()..].find('"').unwrap()]).collect();
+    let mut distinct = cards.clone();
+    distinct.sort();
+    distinct.dedup();
+    assert_eq!(distinct.len(), cards.len(), "one card per model: {cards:?}");
+    assert!(cards.iter().all(|c| !c.contains("guards=")), "no card for a guard variant: {cards:?}");
+    // Every summary row's model, and the reference the diff drew against.
+    assert_eq!(cards.len(), rows.len() + 1, "cards {cards:?} for rows {rows:?}");
+    assert!(cards.contains(&reference), "{cards:?}");
+    assert!(dom.contains("data-model=\"overlay\"") && dom.contains("All models overlaid"), "the lobes overlaid");
+    let summary = &dom[first..first + dom[first..].find("</section>").unwrap()];
+    assert!(summary.contains("FAIL (") && summary.contains(">ok<"), "stability's verdict per model");
+    assert!(dom.contains("(no twin)"), "the stability table's cells read as the Markdown's");
+}

@@ -1,0 +1,148 @@
+//! The report's first screen: one row per model however many reports mention it, one column per figure the
+//! reports give (cost against the reference per device and target, accuracy against a reference, stability's
+//! verdict). Rows are keyed `summary/<label>`; each figure's cell carries its value as every table's does.
+
+use super::sections::{estimate_cell, num_cell};
+use super::{Input, Loaded};
+use crate::brdf::guards::GuardSet;
+use crate::model::Model;
+use crate::page::{Cell, HtmlTable};
+use crate::stability::view::SpecView;
+use std::collections::BTreeMap;
+
+/// Most rows and figure columns shown (the sections below hold every figure).
+const MAX_ROWS: usize = 24;
+const MAX_COLUMNS: usize = 10;
+
+/// What a model is, whatever form a report wrote it in: its canonical spec where it parses (a `.brdf`
+/// file's where the file is still there), else the text as written.
+pub fn model_key(spec: &str) -> String {
+    Model::parse(spec).map(|m| m.canonical()).unwrap_or_else(|_| spec.to_string())
+}
+
+/// A stability run's spec with some of brdfprof's guards off (`--unguarded`): a variant, not a model.
+pub fn is_guard_variant(spec: &str) -> bool {
+    Model::parse(spec).ok().and_then(|m| m.twin().map(|s| s.guards != GuardSet::ALL)).unwrap_or(false)
+}
+
+struct Column {
+    title: String,
+    cells: BTreeMap<String, Cell>,
+}
+
+#[derive(Default)]
+struct Summary {
+    /// (key, label) in order of first mention.
+    models: Vec<(String, String)>,
+    columns: Vec<Column>,
+}
+
+impl Summary {
+    fn model(&mut self, spec: &str, label: &str) -> String {
+        let key = model_key(spec);
+        if !self.models.iter().any(|(k, _)| *k == key) {
+            self.models.push((key.clone(), label.to_string()));
+        }
+        key
+    }
+
+    fn column(&mut self, title: String, cells: Vec<(String, Cell)>) {
+        if !cells.is_empty() {
+            self.columns.push(Column { title, cells: cells.into_iter().collect() });
+        }
+    }
+}
+
+fn stability_cell(s: &SpecView) -> Cell {
+    if s.fails() {
+        Cell::num((s.nan + s.inf + s.negative) as f64, format!("FAIL ({} NaN, {} Inf, {} neg.)", s.nan, s.inf, s.negative))
+    } else {
+        Cell::num(0.0, "ok")
+    }
+}
+
+/// Gathers the rows and columns: models from every report but stability first, then the specs stability
+/// failed (guard variants left out); a stability column fills in for the models it checked.
+fn gather(inputs: &[Input]) -> Summary {
+    let mut s = Summary::default();
+    for input in inputs {
+        match &input.loaded {
+            Loaded::Profile(p) => {
+                let lights = p.rows.first().map(|r| r.lights);
+                let mut cells = Vec::new();
+                for r in p.rows.iter().filter(|r| Some(r.lights) == lights && r.spec.is_some()) {
+                    let key = s.model(r.spec.as_deref().unwrap(), &r.model);
+                    cells.push((key, estimate_cell(r.net_vs_reference.as_ref().or(r.vs_reference.as_ref()))));
+                }
+                let net = if p.rows.iter().any(|r| r.net_vs_reference.is_some()) { "net cost" } else { "cost" };
+                s.column(format!("{net} vs {} ({}, {} lights)", p.reference, p.provenance.device.name, lights.unwrap_or(0)), cells);
+            }
+            Loaded::Inspect(reports, _) => {
+                for r in reports {
+                    let Some(cost) = r.cost.clone().or_else(|| crate::targets::cost_of(r)) else { continue };
+                    let specs: BTreeMap<&str, &str> = r.rows.iter().filter_map(|x| x.spec.as_deref().map(|sp| (x.model.as_str(), sp))).collect();
+                    let reference = cost.rows.iter().find(|c| c.model == crate::brdf::spec::REFERENCE_MODEL).and_then(|c| c.net_cycles_per_eval);
+                    let mut cells = Vec::new();
+                    for c in &cost.rows {
+                        let (Some(spec), Some(net), Some(base)) = (specs.get(c.model.as_str()), c.net_cycles_per_eval, reference) else { continue };
+                        let key = s.model(spec, &c.model);
+                        cells.push((key, num_cell(Some(net / base))));
+                    }
+                    let device = r.provenance["device"]["name"].as_str().unwrap_or("?");
+                    s.column(format!("{} vs {} ({device}, modelled)", cost.column_name(), crate::brdf::spec::REFERENCE_MODEL), cells);
+                }
+            }
+            Loaded::Sweep(w) => {
+                let cells = w.rows.iter().filter(|r| r.pareto).map(|r| (s.model(&r.canonical, &r.label), num_cell(r.accuracy.vs_exact.rms))).collect();
+                s.column("RMS rel. error vs exact (sweep)".into(), cells);
+            }
+            Loaded::Diff(d) => {
+                s.model(&d.a.canonical, &d.a.name);
+                let key = s.model(&d.b.canonical, &d.b.name);
+                s.column(format!("max rel. difference vs {}", d.a.name), vec![(key, num_cell(d.difference.max_rel))]);
+            }
+            Loaded::DiffSet(d) => {
+                let cells = d.diffs.iter().map(|x| (s.model(&x.b.canonical, &x.b.name), num_cell(x.difference.max_rel))).collect();
+                s.column(format!("max rel. difference vs {}", d.reference.name), cells);
+            }
+            Loaded::Stability(_) | Loaded::Costs(_) => {}
+        }
+    }
+    for input in inputs {
+        if let Loaded::Stability(st) = &input.loaded {
+            for spec in st.specs.iter().filter(|x| x.fails() && !is_guard_variant(&x.spec)) {
+                s.model(&spec.spec, spec.label());
+            }
+            let known: Vec<String> = s.models.iter().map(|(k, _)| k.clone()).collect();
+            let cells = st.specs.iter().filter(|x| !is_guard_variant(&x.spec)).map(|x| (model_key(&x.spec), stability_cell(x))).filter(|(k, _)| known.contains(k)).collect();
+            let failing = st.specs.iter().filter(|x| x.fails()).count();
+            s.column(format!("stability ({} of {} specs fail)", failing, st.specs.len()), cells);
+        }
+    }
+    s
+}
+
+/// The summary section's body, or None when no report names a model.
+pub fn summary(inputs: &[Input]) -> Option<String> {
+    let s = gather(inputs);
+    if s.models.is_empty() {
+        return None;
+    }
+    let keys: Vec<String> = (0..s.columns.len().min(MAX_COLUMNS)).map(|i| format!("c{i}")).collect();
+    let mut header: Vec<(&str, &str)> = vec![("model", "model")];
+    header.extend(keys.iter().map(String::as_str).zip(s.columns.iter().map(|c| c.title.as_str())));
+    let mut t = HtmlTable::new(&header);
+    for (key, label) in s.models.iter().take(MAX_ROWS) {
+        let mut cells = vec![Cell::text(label.clone())];
+        cells.extend(s.columns.iter().take(MAX_COLUMNS).map(|c| c.cells.get(key).cloned().unwrap_or_else(|| Cell::text("-"))));
+        t.row(format!("summary/{label}"), cells);
+    }
+    let more = match (s.models.len().saturating_sub(MAX_ROWS), s.columns.len().saturating_sub(MAX_COLUMNS)) {
+        (0, 0) => String::new(),
+        (m, c) => format!("<p class=\"note\">Not shown here: {m} more model(s), {c} more column(s); the sections below hold every figure.</p>"),
+    };
+    Some(format!(
+        "<p class=\"note\">One row per model across the reports given (each named once, by its label); a cost is a ratio to the reference model with its confidence interval where measured; modelled compile-only costs say so (<a href=\"#devices\">their rules</a>); accuracy is against the reference each report names; stability: NaN, Inf or negative values on valid inputs. Where each figure comes from: <a href=\"#provenance\">provenance</a>, at the end.</p>{}{more}",
+        t.html()
+    ))
+}
