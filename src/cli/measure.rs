@@ -248,6 +248,12 @@ pub struct StabilityArgs {
     /// not counted (default: each `.brdf` file's `domain roughness`, else all).
     #[arg(long, value_parser = super::roughness_range)]
     pub roughness: Option<(f64, f64)>,
+    /// N.V range checked, MIN..MAX within [0, 1] (default: each `.brdf` file's `domain nov`, else all).
+    #[arg(long, value_parser = super::cosine_range)]
+    pub nov: Option<(f64, f64)>,
+    /// N.L range checked, MIN..MAX within [0, 1] (default: each `.brdf` file's `domain nol`, else all).
+    #[arg(long, value_parser = super::cosine_range)]
+    pub nol: Option<(f64, f64)>,
     /// Directory for stability-<device>.md/.json and the furnace, albedo and failure PNGs (default results/,
     /// refused where that would overwrite a file git tracks).
     #[arg(long)]
@@ -262,7 +268,7 @@ pub fn stability(args: &StabilityArgs) -> Result<ExitCode> {
     let out = out_dir(args.out.as_deref(), &["stability-*", "furnace-*.png", "albedo-*.png"])?;
     args.html.check()?;
     let models = if args.model.models.is_empty() { stability::default_specs().into_iter().map(Model::spec).collect() } else { args.model.models(&[])? };
-    let options = stability::StabilityOptions { models: if args.unguarded { stability::with_guard_variants(models) } else { models }, energy: !args.no_energy, reference: args.reference, roughness: args.roughness };
+    let options = stability::StabilityOptions { models: if args.unguarded { stability::with_guard_variants(models) } else { models }, energy: !args.no_energy, reference: args.reference, roughness: args.roughness, nov: args.nov, nol: args.nol };
     let (gpu, result) = on_device(&args.device, |gpu, progress| stability::run(gpu, &options, progress))?;
     let slug = brdfprof::targets::device_slug(&gpu.info);
     let mut files = result.write(&out, &slug)?;

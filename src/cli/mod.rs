@@ -45,6 +45,11 @@ fn roughness_range(text: &str) -> Result<(f64, f64), String> {
     Ok((lo, hi))
 }
 
+/// `--nov MIN..MAX`, `--nol MIN..MAX`: a cosine range, 0 <= MIN <= MAX <= 1.
+pub fn cosine_range(text: &str) -> Result<(f64, f64), String> {
+    roughness_range(text).map_err(|_| format!("`{text}`: give MIN..MAX with 0 <= MIN <= MAX <= 1 (e.g. 0.05..1)"))
+}
+
 /// `--reference SPEC`: a built-in spec (it has the f64 twin a reference needs).
 pub fn reference_spec(text: &str) -> Result<brdfprof::brdf::ModelSpec, String> {
     brdfprof::brdf::ModelSpec::parse(text).map_err(|e| format!("{e} (a reference is a built-in spec: a preset or D/Vis/F terms, which have an f64 twin)"))

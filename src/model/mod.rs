@@ -124,12 +124,23 @@ impl Model {
         }
     }
 
-    /// The `.brdf` file, for a file model.
     /// The perceptual roughness range a `.brdf` file's engine admits (`domain roughness MIN MAX`), if it declares one.
     pub fn roughness_domain(&self) -> Option<(f64, f64)> {
         self.file().and_then(|f| f.file.roughness_domain).map(|(lo, hi, _)| (lo, hi))
     }
 
+    /// The N.V and N.L ranges a `.brdf` file's engine calls it with (`domain nov|nol MIN MAX`), where declared.
+    pub fn cosine_domains(&self) -> (Option<(f64, f64)>, Option<(f64, f64)>) {
+        let pick = |d: Option<(f64, f64, usize)>| d.map(|(lo, hi, _)| (lo, hi));
+        self.file().map_or((None, None), |f| (pick(f.file.nov_domain), pick(f.file.nol_domain)))
+    }
+
+    /// The built-in spec a `.brdf` file names as its reference (`reference SPEC`), if it does.
+    pub fn declared_reference(&self) -> Option<crate::brdf::ModelSpec> {
+        self.file().and_then(|f| f.file.reference.as_ref()).and_then(|(text, _)| crate::brdf::ModelSpec::parse(text).ok())
+    }
+
+    /// The `.brdf` file, for a file model.
     pub fn file(&self) -> Option<&file_model::FileModel> {
         match self {
             Model::File(f) => Some(f),

@@ -54,6 +54,10 @@ pub struct Checks<'a> {
     /// Perceptual roughness range of the valid inputs checked (`--roughness`, a file's `domain roughness`):
     /// cases and grid points outside it are not counted.
     pub roughness: Option<(f64, f64)>,
+    /// N.V and N.L ranges of the valid inputs checked (`--nov`, `--nol`, a file's `domain nov|nol`), of the
+    /// unit vectors.
+    pub nov: Option<(f64, f64)>,
+    pub nol: Option<(f64, f64)>,
 }
 
 impl Checks<'_> {
@@ -68,7 +72,20 @@ impl Checks<'_> {
     }
 
     fn in_domain(&self, s: &Sample) -> bool {
-        self.roughness.is_none_or(|(lo, hi)| (lo..=hi).contains(&f64::from(s.roughness)))
+        let within = |range: Option<(f64, f64)>, x: f64| range.is_none_or(|(lo, hi)| (lo..=hi).contains(&x));
+        let n = crate::brdf::guards::unit(s.n);
+        within(self.roughness, f64::from(s.roughness))
+            && (self.nov.is_none() && self.nol.is_none() || within(self.nov, n.dot(crate::brdf::guards::unit(s.v))) && within(self.nol, n.dot(crate::brdf::guards::unit(s.l))))
+    }
+
+    /// Whether any range narrows the inputs checked.
+    pub fn has_domain(&self) -> bool {
+        self.roughness.is_some() || self.nov.is_some() || self.nol.is_some()
+    }
+
+    /// The ranges as the report says them.
+    pub fn domain_text(&self) -> String {
+        [("roughness", self.roughness), ("NoV", self.nov), ("NoL", self.nol)].iter().filter_map(|(n, r)| r.map(|(lo, hi)| format!("{n} in [{lo}, {hi}]"))).collect::<Vec<_>>().join(", ")
     }
 }
 
@@ -282,7 +299,7 @@ pub fn check_model(gpu: &Gpu, model: &Model, checks: &Checks, cases: &[HardCase]
         precision: model.precision().name().into(),
         has_twin: model.twin().is_some(),
         expected_from: expected_from(model, checks),
-        roughness_domain: checks.roughness,
+        domain: checks.has_domain().then(|| checks.domain_text()),
         cases_outside_domain: judged.iter().filter(|r| r.is_none()).count(),
         grid_outside_domain: in_domain.iter().filter(|d| !**d).count(),
         nan: tally.nan,

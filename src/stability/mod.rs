@@ -126,9 +126,9 @@ pub struct SpecStability {
     /// without a twin), or None: then nothing is out of tolerance (there is nothing to be within) and jumps
     /// are not counted (every step of a finely sampled lobe would be one), only NaN, Inf and negative values.
     pub expected_from: Option<String>,
-    /// The perceptual roughness range checked, where one was given or declared, and the valid hard cases and
-    /// grid points outside it (not counted).
-    pub roughness_domain: Option<(f64, f64)>,
+    /// The input ranges checked (roughness, NoV, NoL), where any was given or declared, and the valid hard
+    /// cases and grid points outside them (not counted).
+    pub domain: Option<String>,
     pub cases_outside_domain: usize,
     pub grid_outside_domain: usize,
     /// On valid inputs (catalogue and grid).
@@ -188,8 +188,11 @@ pub struct StabilityOptions {
     pub energy: bool,
     /// Expected values for the models without an f64 twin (`--reference`).
     pub reference: Option<ModelSpec>,
-    /// The roughness range checked (`--roughness`); else each file's declared domain, else all.
+    /// The roughness, NoV and NoL ranges checked (`--roughness`, `--nov`, `--nol`); else each file's declared
+    /// domain, else all.
     pub roughness: Option<(f64, f64)>,
+    pub nov: Option<(f64, f64)>,
+    pub nol: Option<(f64, f64)>,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -314,7 +317,15 @@ pub fn run(gpu: &Gpu, options: &StabilityOptions, progress: &ProgressBar) -> Res
         progress.set_position(i as u64);
         progress.set_message(model.name());
         model.check_support(&gpu.info)?;
-        let checks = Checks { reference: options.reference.as_ref(), roughness: options.roughness.or(model.roughness_domain()) };
+        // A file's own reference and domains where the command line gives none.
+        let declared = model.declared_reference();
+        let (nov, nol) = model.cosine_domains();
+        let checks = Checks {
+            reference: options.reference.as_ref().or(declared.as_ref()),
+            roughness: options.roughness.or(model.roughness_domain()),
+            nov: options.nov.or(nov),
+            nol: options.nol.or(nol),
+        };
         specs.push(check_model(gpu, model, &checks, &cases, &grid, &reciprocity)?);
     }
     if options.energy {
@@ -393,8 +404,8 @@ impl StabilityReport {
              the CPU's f64 integration of the same formula at r = 0.1, 0.5, 1. A `.brdf` model has no f64 twin: its NaN, Inf \
              and negative counts (each tied to its hard case or grid point below, with the input guards that remove it), \
              invalid-input cases, reciprocity and E (its own Fresnel, given F0 = 1) are measured; tolerances and jumps only \
-             against a `--reference` spec's f64 values, E vs CPU not at all. A roughness domain (`--roughness`, a file's \
-             `domain roughness`) leaves the valid cases and grid points outside it uncounted.\n\n",
+             against a `--reference` spec's f64 values, E vs CPU not at all. A domain (`--roughness`, `--nov`, `--nol`, a \
+             file's `domain` lines) leaves the valid cases and grid points outside it uncounted.\n\n",
             self.provenance.device.name,
             self.provenance.device.driver_info,
             self.specs.len(),
@@ -422,7 +433,16 @@ impl StabilityReport {
         }
         out += &t.markdown();
         out += &self.expectations_markdown();
-        out += "\n## Hard cases\n\nSpecs out of tolerance per case (fp32 / fp16; without a twin or reference: with a NaN, Inf or negative value), with the worst one.\n\n";
+        out += &self.cases_markdown();
+        out += &self.guard_savings_markdown();
+        out += &self.failing_markdown();
+        out
+    }
+
+    /// The hard-case table: how many specs each case puts out of tolerance, and the worst.
+    fn cases_markdown(&self) -> String {
+        use crate::results::Table;
+        let mut out = String::from("\n## Hard cases\n\nSpecs out of tolerance per case (fp32 / fp16; without a twin or reference: with a NaN, Inf or negative value), with the worst one.\n\n");
         let mut c = Table::new(["case", "expected", "fp32 out", "fp16 out", "worst spec (x tol.)"]);
         for (i, case) in self.cases.iter().enumerate() {
             let count = |p: &str| self.specs.iter().filter(|s| s.precision == p && s.case_deviation[i] > 1.0).count();
@@ -439,7 +459,12 @@ impl StabilityReport {
             ]);
         }
         out += &c.markdown();
-        out += &self.guard_savings_markdown();
+        out
+    }
+
+    /// Where each failing spec fails, and the guards that remove each failure.
+    fn failing_markdown(&self) -> String {
+        let mut out = String::new();
         let failing = self.failing();
         if !failing.is_empty() {
             let guards: Vec<String> = crate::brdf::guards::INPUT_GUARDS.iter().map(|g| format!("`{}` ({})", g.name, g.does)).collect();
@@ -466,7 +491,7 @@ impl StabilityReport {
                 (Some(e), false) => Some(format!("checked against the {e}'s f64 values")),
                 _ => None,
             };
-            let domain = s.roughness_domain.map(|(lo, hi)| format!("roughness in [{lo}, {hi}]: {} valid hard cases and {} grid points outside it not counted", s.cases_outside_domain, s.grid_outside_domain));
+            let domain = s.domain.as_ref().map(|d| format!("{d}: {} valid hard cases and {} grid points outside it not counted", s.cases_outside_domain, s.grid_outside_domain));
             let said: Vec<String> = against.into_iter().chain(domain).collect();
             if !said.is_empty() {
                 lines.push(format!("- `{}`: {}\n", s.label, said.join("; ")));

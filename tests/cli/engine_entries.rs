@@ -121,7 +121,10 @@ fn bad_entry_declarations_exit_2_at_their_line() {
         ("bind roughness=@roughness f0=@f0", "bind roughness=0.5", ": `roughness=0.5`: `bind` binds a parameter to an input".to_string()),
         ("bind roughness=@roughness f0=@f0", "tint 1 2 3", ": unknown directive `tint`".to_string()),
         ("domain roughness 0.0525 1", "domain roughness 1 0.0525", ": `domain roughness 1 0.0525`: MIN 1 is above MAX 0.0525".to_string()),
-        ("domain roughness 0.0525 1", "domain nov 0 1", ": `domain nov`: only the roughness domain".to_string()),
+        ("domain roughness 0.0525 1", "domain hov 0 1", ": `domain hov`: the domains declared are roughness, nov and nol".to_string()),
+        ("domain roughness 0.0525 1", "domain nov 0.1 2", ": `domain nov 0.1 2`: MIN and MAX are numbers within [0, 1]".to_string()),
+        ("domain roughness 0.0525 1", "domain roughness 0.0525 1\ndomain nol 0 1\ndomain nol 0.1 1", ": the nol domain is declared twice".to_string()),
+        ("domain roughness 0.0525 1", "reference d=ggx,vis=nothing,f=schlick", ": `reference d=ggx,vis=nothing,f=schlick`:".to_string()),
         // An argument glslang refuses is reported at the entry's own line, with the file's names.
         ("entry surface_light(N, L, V, f0, roughness) returns f_nol", "entry surface_light(N, L, V, f0, gloss) returns f_nol", format!("engine.brdf:{entry_line}:")),
     ];

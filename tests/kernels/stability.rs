@@ -136,7 +136,7 @@ fn stability_says_what_each_guard_saves() {
     let presets: Vec<brdfprof::model::Model> = PRESETS.iter().take(2).map(|p| common::model(ModelSpec::preset(p.name).unwrap())).collect();
     let models = stability::with_guard_variants(presets.clone());
     assert_eq!(models.len(), presets.len() * (2 + 2 * guards::SWITCHES.len()), "each preset, off, each off alone, each on alone");
-    let options = stability::StabilityOptions { models, energy: false, reference: None, roughness: None };
+    let options = stability::StabilityOptions { models, energy: false, reference: None, roughness: None, nov: None, nol: None };
     let report = stability::run(&gpu, &options, &indicatif::ProgressBar::hidden()).unwrap();
     common::assert_no_validation_messages(&gpu);
     assert_eq!(report.guard_savings.len(), presets.len() * (1 + 2 * guards::SWITCHES.len()));
@@ -209,4 +209,18 @@ fn stability_names_a_files_failing_inputs_and_the_guard_that_removes_them() {
     let out: Vec<&str> = spec["cases_out_of_tolerance"].as_array().unwrap().iter().map(|c| c["case"].as_str().unwrap()).collect();
     assert!(!out.contains(&"L = V") && !out.contains(&"N = H exactly"), "the same maths within tolerance of its reference where both are well conditioned: {out:?}");
     assert!(md.contains("checked against the reference") && md.contains("not counted"), "{md}");
+
+    // The same domain and reference declared in the file, with grazing N.V left out too: no flag needed.
+    let declared = dir.path().join("declared.brdf");
+    let text = std::fs::read_to_string(&file).unwrap();
+    let with = text.replacen("bind roughness=@roughness f0=@f0", "bind roughness=@roughness f0=@f0\ndomain roughness 0.05 1\ndomain nov 0.1 1\nreference d=ggx,vis=smith-ggx-correlated,f=schlick", 1);
+    assert_ne!(with, text);
+    std::fs::write(&declared, with).unwrap();
+    let out = common::brdfprof().args(["stability", "--validate", "--no-energy", "--model"]).arg(&declared).arg("--out").arg(dir.path()).output().unwrap();
+    let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(common::device_file(dir.path(), "stability-", ".json")).unwrap()).unwrap();
+    let decl = &json["specs"][0];
+    assert_eq!(out.status.code(), Some(0), "{decl}");
+    assert_eq!(decl["expected_from"], spec["expected_from"], "the file's own reference");
+    assert_eq!(decl["domain"], "roughness in [0.05, 1], NoV in [0.1, 1]");
+    assert!(decl["grid_outside_domain"].as_u64() > spec["grid_outside_domain"].as_u64(), "grazing N.V left out as well: {} against {}", decl["grid_outside_domain"], spec["grid_outside_domain"]);
 }

@@ -283,23 +283,36 @@ pub(super) fn parse_directive(file: &mut BrdfFile, n: usize, line: &str) -> Resu
             }
         }
         "domain" => {
-            let form = "`domain roughness MIN MAX`";
+            let form = "`domain roughness|nov|nol MIN MAX`";
             let words: Vec<&str> = rest.split_whitespace().collect();
             let [input, min, max] = words.as_slice() else { bail!(at(&path, n, format!("`domain {rest}`: expected {form}"))) };
-            if *input != "roughness" {
-                bail!(at(&path, n, format!("`domain {input}`: only the roughness domain is declared so far ({form})")));
-            }
-            let number = |t: &str| t.parse::<f64>().ok().filter(|x| x.is_finite() && *x >= 0.0);
-            let (Some(lo), Some(hi)) = (number(min), number(max)) else { bail!(at(&path, n, format!("`domain {rest}`: MIN and MAX are finite numbers, 0 or more"))) };
+            let (slot, top) = match *input {
+                "roughness" => (&mut file.roughness_domain, f64::INFINITY),
+                "nov" => (&mut file.nov_domain, 1.0),
+                "nol" => (&mut file.nol_domain, 1.0),
+                _ => bail!(at(&path, n, format!("`domain {input}`: the domains declared are roughness, nov and nol ({form})"))),
+            };
+            let number = |t: &str| t.parse::<f64>().ok().filter(|x| x.is_finite() && *x >= 0.0 && *x <= top);
+            let (Some(lo), Some(hi)) = (number(min), number(max)) else {
+                let range = if top == 1.0 { "within [0, 1]" } else { "finite, 0 or more" };
+                bail!(at(&path, n, format!("`domain {rest}`: MIN and MAX are numbers {range}")))
+            };
             if lo > hi {
                 bail!(at(&path, n, format!("`domain {rest}`: MIN {lo} is above MAX {hi}")));
             }
-            if let Some((_, _, first)) = file.roughness_domain {
-                bail!(at(&path, n, format!("the roughness domain is declared twice (first at line {first})")));
+            if let Some((_, _, first)) = slot {
+                bail!(at(&path, n, format!("the {input} domain is declared twice (first at line {first})")));
             }
-            file.roughness_domain = Some((lo, hi, n));
+            *slot = Some((lo, hi, n));
         }
-        other => bail!(at(&path, n, format!("unknown directive `{other}` in the `{DIRECTIVES_SECTION}` section (known: entry, bind, domain)"))),
+        "reference" => {
+            if let Some((_, first)) = &file.reference {
+                bail!(at(&path, n, format!("the reference is declared twice (first at line {first})")));
+            }
+            crate::brdf::ModelSpec::parse(rest).map_err(|e| anyhow!(at(&path, n, format!("`reference {rest}`: {e} (a reference is a built-in spec: a preset or d=..,vis=..,f=..)"))))?;
+            file.reference = Some((rest.trim().to_string(), n));
+        }
+        other => bail!(at(&path, n, format!("unknown directive `{other}` in the `{DIRECTIVES_SECTION}` section (known: entry, bind, domain, reference)"))),
     }
     Ok(())
 }

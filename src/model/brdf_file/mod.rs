@@ -85,6 +85,12 @@ pub struct BrdfFile {
     pub defines_brdf: bool,
     /// The roughness the file's engine admits (`domain roughness MIN MAX`): (min, max, line).
     pub roughness_domain: Option<(f64, f64, usize)>,
+    /// The N.V and N.L its engine calls it with (`domain nov MIN MAX`, `domain nol MIN MAX`): (min, max, line).
+    pub nov_domain: Option<(f64, f64, usize)>,
+    pub nol_domain: Option<(f64, f64, usize)>,
+    /// The built-in spec it is measured against where a command takes a reference and none is given
+    /// (`reference SPEC`): (spec text, line).
+    pub reference: Option<(String, usize)>,
     /// Default bindings of parameters to inputs (`bind NAME=@INPUT`): (name, `@INPUT`, line).
     pub binds: Vec<(String, String, usize)>,
     /// The file has an `isFunc` section with code in it (brdfprof ignores it; BRDF Explorer samples with it).
@@ -213,6 +219,9 @@ pub fn parse_with(path: &Path, bytes: &[u8], defines: &[(String, String)]) -> Re
         entries: Vec::new(),
         defines_brdf: false,
         roughness_domain: None,
+        nov_domain: None,
+        nol_domain: None,
+        reference: None,
         binds: Vec::new(),
         has_is_func: false,
         warnings: Vec::new(),
