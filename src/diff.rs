@@ -25,30 +25,56 @@ pub const HISTOGRAM_EDGES: [f64; 9] = [0.0, 1e-7, 1e-6, 1e-5, 1e-4, 1e-3, 1e-2, 
 /// The largest input `diff` evaluates (both models' outputs and the statistics stay within a few GB).
 pub const MAX_SAMPLES: usize = 20_000_000;
 
-/// The default inputs: `count` well-conditioned samples (NoV and NoL uniform in [0.05, 1], roughness uniform in
-/// [0, 1] so that the roughness floor is crossed, F0 uniform in [0, 1]^3), seeded.
-pub fn default_samples(count: usize, seed: u64) -> Vec<Sample> {
-    default_samples_in(count, seed, (0.0, 1.0))
+/// The ranges the default samples are drawn from: perceptual roughness, NoV and NoL.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SampleDomain {
+    pub roughness: (f64, f64),
+    pub nov: (f64, f64),
+    pub nol: (f64, f64),
 }
 
-/// `default_samples` with roughness uniform in [lo, hi] (`--roughness`, a file's domain).
-pub fn default_samples_in(count: usize, seed: u64, (lo, hi): (f64, f64)) -> Vec<Sample> {
+/// NoV and NoL of the default samples start here: well conditioned, so that grazing rounding is not a model's
+/// error.
+pub const DEFAULT_MIN_COS: f64 = 0.05;
+
+impl Default for SampleDomain {
+    /// Roughness in [0, 1] so that the roughness floor is crossed; NoV, NoL in [DEFAULT_MIN_COS, 1].
+    fn default() -> Self {
+        SampleDomain { roughness: (0.0, 1.0), nov: (DEFAULT_MIN_COS, 1.0), nol: (DEFAULT_MIN_COS, 1.0) }
+    }
+}
+
+/// The default inputs: `count` well-conditioned samples (`SampleDomain::default()`, F0 uniform in [0, 1]^3),
+/// seeded.
+pub fn default_samples(count: usize, seed: u64) -> Vec<Sample> {
+    default_samples_in(count, seed, &SampleDomain::default())
+}
+
+/// `default_samples` within `domain` (`--roughness`, `--nov`, `--nol`, a file's domains).
+pub fn default_samples_in(count: usize, seed: u64, domain: &SampleDomain) -> Vec<Sample> {
+    let (lo, hi) = domain.roughness;
     if lo == hi {
-        let mut s = samples::well_conditioned(count, seed, 0.05, 0.0..1.0);
+        let mut s = samples::well_conditioned_in(count, seed, domain.nov, domain.nol, 0.0..1.0);
         s.iter_mut().for_each(|x| x.roughness = lo as f32);
         return s;
     }
-    samples::well_conditioned(count, seed, 0.05, lo..hi)
+    samples::well_conditioned_in(count, seed, domain.nov, domain.nol, lo..hi)
 }
 
 /// The words that say what the default inputs are.
 pub fn default_samples_label(count: usize, seed: u64) -> String {
-    default_samples_label_in(count, seed, (0.0, 1.0), "")
+    default_samples_label_in(count, seed, &SampleDomain::default(), ["", "", ""])
 }
 
-/// `default_samples_label` for roughness in [lo, hi], `why` saying where the range comes from.
-pub fn default_samples_label_in(count: usize, seed: u64, (lo, hi): (f64, f64), why: &str) -> String {
-    format!("{count} well-conditioned samples (seed {seed}; NoV, NoL in [0.05, 1], roughness in [{lo}, {hi}]{why}, F0 in [0, 1]^3)")
+/// `default_samples_label` within `domain`, `why` saying where its roughness, NoV and NoL ranges come from.
+pub fn default_samples_label_in(count: usize, seed: u64, domain: &SampleDomain, why: [&str; 3]) -> String {
+    let (r, v, l) = (domain.roughness, domain.nov, domain.nol);
+    let cosines = if v == l && why[1] == why[2] {
+        format!("NoV, NoL in [{}, {}]{}", v.0, v.1, why[1])
+    } else {
+        format!("NoV in [{}, {}]{}, NoL in [{}, {}]{}", v.0, v.1, why[1], l.0, l.1, why[2])
+    };
+    format!("{count} well-conditioned samples (seed {seed}; {cosines}, roughness in [{}, {}]{}, F0 in [0, 1]^3)", r.0, r.1, why[0])
 }
 
 /// One model as the report names it.

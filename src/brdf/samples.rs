@@ -34,12 +34,18 @@ fn to_f32(v: DVec3) -> [f32; 3] {
 /// `count` samples with NoV and NoL uniform in [min_cos, 1], roughness uniform in `roughness`, F0 uniform in
 /// [0, 1]^3, the normal uniform on the sphere.
 pub fn well_conditioned(count: usize, seed: u64, min_cos: f64, roughness: std::ops::Range<f64>) -> Vec<Sample> {
+    well_conditioned_in(count, seed, (min_cos, 1.0), (min_cos, 1.0), roughness)
+}
+
+/// `well_conditioned` with NoV uniform in [nov.0, nov.1] and NoL in [nol.0, nol.1] (an engine's domain); the
+/// same draws, so that [min_cos, 1] gives `well_conditioned`'s samples exactly.
+pub fn well_conditioned_in(count: usize, seed: u64, nov: (f64, f64), nol: (f64, f64), roughness: std::ops::Range<f64>) -> Vec<Sample> {
     let mut rng = Pcg64::seed_from_u64(seed);
     (0..count)
         .map(|_| {
             let n = random_unit(&mut rng);
-            let v = around(n, rng.random_range(min_cos..=1.0), rng.random_range(0.0..std::f64::consts::TAU));
-            let l = around(n, rng.random_range(min_cos..=1.0), rng.random_range(0.0..std::f64::consts::TAU));
+            let v = around(n, rng.random_range(nov.0..=nov.1), rng.random_range(0.0..std::f64::consts::TAU));
+            let l = around(n, rng.random_range(nol.0..=nol.1), rng.random_range(0.0..std::f64::consts::TAU));
             Sample {
                 n: to_f32(n),
                 v: to_f32(v),

@@ -36,6 +36,13 @@ pub struct DiffArgs {
     /// range every `.brdf` model's `domain roughness` admits).
     #[arg(long, value_parser = super::roughness_range, conflicts_with = "input")]
     pub roughness: Option<(f64, f64)>,
+    /// N.V range of the default samples, MIN..MAX within [0, 1] (default: [0.05, 1], or within it the range
+    /// every `.brdf` model's `domain nov` admits).
+    #[arg(long, value_parser = super::cosine_range, conflicts_with = "input")]
+    pub nov: Option<(f64, f64)>,
+    /// N.L range of the default samples, as --nov (`domain nol`).
+    #[arg(long, value_parser = super::cosine_range, conflicts_with = "input")]
+    pub nol: Option<(f64, f64)>,
     /// Rows listed where the models differ most.
     #[arg(long, default_value_t = 10)]
     pub worst: usize,
@@ -58,23 +65,33 @@ pub struct DiffArgs {
     pub device: DeviceArgs,
 }
 
-/// The default samples' roughness range: `--roughness`, else the intersection of the models' declared
-/// domains (named in the label), else [0, 1]; models whose domains do not meet are refused.
-fn roughness_of(args: &DiffArgs, models: &[&Model]) -> Result<((f64, f64), String)> {
-    if let Some(r) = args.roughness {
-        return Ok((r, " (--roughness)".into()));
+/// One range of the default samples: the flag's, else the intersection of `default` with the models' declared
+/// domains (named in the words returned), else `default`; models whose domains do not meet are refused.
+fn range_of(flag: (&str, Option<(f64, f64)>), default: (f64, f64), declared: Vec<(String, (f64, f64))>, what: &str) -> Result<((f64, f64), String)> {
+    if let Some(r) = flag.1 {
+        return Ok((r, format!(" ({})", flag.0)));
     }
-    let declared: Vec<(String, (f64, f64))> = models.iter().filter_map(|m| m.roughness_domain().map(|d| (m.label(), d))).collect();
     if declared.is_empty() {
-        return Ok(((0.0, 1.0), String::new()));
+        return Ok((default, String::new()));
     }
-    let lo = declared.iter().map(|(_, d)| d.0).fold(0.0, f64::max);
-    let hi = declared.iter().map(|(_, d)| d.1).fold(1.0, f64::min);
+    let lo = declared.iter().map(|(_, d)| d.0).fold(default.0, f64::max);
+    let hi = declared.iter().map(|(_, d)| d.1).fold(default.1, f64::min);
     let names = declared.iter().map(|(n, (a, b))| format!("{n} [{a}, {b}]")).collect::<Vec<_>>().join(", ");
     if lo > hi {
-        bail!("the models' roughness domains do not meet ({names}); give --roughness MIN..MAX to compare them anyway");
+        bail!("the models' {what} domains do not meet within [{}, {}] ({names}); give {} MIN..MAX to compare them anyway", default.0, default.1, flag.0);
     }
     Ok(((lo, hi), format!(" (the models' declared domain: {names})")))
+}
+
+/// The default samples' ranges (`--roughness`, `--nov`, `--nol`, else the models' declared domains within the
+/// defaults), and the words saying where each comes from.
+fn domain_of(args: &DiffArgs, models: &[&Model]) -> Result<(diff::SampleDomain, [String; 3])> {
+    let d = diff::SampleDomain::default();
+    let declared = |pick: &dyn Fn(&Model) -> Option<(f64, f64)>| models.iter().filter_map(|m| pick(m).map(|r| (m.label(), r))).collect::<Vec<_>>();
+    let (roughness, rw) = range_of(("--roughness", args.roughness), d.roughness, declared(&|m| m.roughness_domain()), "roughness")?;
+    let (nov, vw) = range_of(("--nov", args.nov), d.nov, declared(&|m| m.cosine_domains().0), "N.V")?;
+    let (nol, lw) = range_of(("--nol", args.nol), d.nol, declared(&|m| m.cosine_domains().1), "N.L")?;
+    Ok((diff::SampleDomain { roughness, nov, nol }, [rw, vw, lw]))
 }
 
 /// `--tolerance`: a finite number, 0 or more.
@@ -109,8 +126,14 @@ pub fn diff(args: &DiffArgs) -> Result<ExitCode> {
         }
         return diff_set(args, &Model::spec(*reference), &models);
     }
+    // One file alone is measured against the reference it names (`reference SPEC`).
+    if let [only] = models.as_slice() {
+        if let Some(reference) = only.declared_reference() {
+            return diff_set(args, &Model::spec(reference), &models);
+        }
+    }
     let [a, b] = models.as_slice() else {
-        bail!("diff takes exactly two --model (A, then B measured against A), or any number with --reference SPEC; got {}", models.len());
+        bail!("diff takes exactly two --model (A, then B measured against A), or any number with --reference SPEC (or one `.brdf` file naming its `reference`); got {}", models.len());
     };
     if args.input.is_none() && !(1..=diff::MAX_SAMPLES).contains(&args.samples) {
         bail!("--samples {}: give 1 to {}", args.samples, diff::MAX_SAMPLES);
@@ -148,6 +171,9 @@ pub fn diff(args: &DiffArgs) -> Result<ExitCode> {
 
 /// `diff --reference`: every model on the same rows against the reference's f64 twin (no kernel of its own).
 fn diff_set(args: &DiffArgs, reference: &Model, models: &[Model]) -> Result<ExitCode> {
+    if args.png.is_some() {
+        bail!("--png draws two models side by side; a diff against a reference (--reference, or a file's `reference`) has none: give a second --model for it");
+    }
     if args.input.is_none() && !(1..=diff::MAX_SAMPLES).contains(&args.samples) {
         bail!("--samples {}: give 1 to {}", args.samples, diff::MAX_SAMPLES);
     }
@@ -198,12 +224,12 @@ struct Inputs {
 impl Inputs {
     fn read(args: &DiffArgs, models: &[Model]) -> Result<Self> {
         let Some(path) = &args.input else {
-            let (range, why) = roughness_of(args, &models.iter().collect::<Vec<_>>())?;
+            let (domain, why) = domain_of(args, &models.iter().collect::<Vec<_>>())?;
             return Ok(Inputs {
-                samples: diff::default_samples_in(args.samples, args.seed, range),
+                samples: diff::default_samples_in(args.samples, args.seed, &domain),
                 tangents: None,
                 lines: None,
-                label: diff::default_samples_label_in(args.samples, args.seed, range, &why),
+                label: diff::default_samples_label_in(args.samples, args.seed, &domain, why.each_ref().map(String::as_str)),
                 models: models.iter().map(|m| (m.clone(), RowValues::default())).collect(),
             });
         };

@@ -177,4 +177,25 @@ fn diff_samples_the_files_declared_roughness_domain_unless_told_otherwise() {
     assert!(all["input"].as_str().unwrap().contains("roughness in [0, 1] (--roughness)"), "{}", all["input"]);
     assert!(max_rel(&all) > 0.5, "below the floor the file differs: {}", max_rel(&all));
     run_in(d, &["diff", "--model", spec, "--model", &engine(), "--roughness", "0.5..0.2"]).fails(2, "--roughness");
+
+    // A file that names its reference and its N.V range is diffed alone: against the reference, on samples
+    // drawn within its domains (read back from the CSV), and a range no model meets is refused.
+    let base = std::fs::read_to_string(engine()).unwrap();
+    let own = base.replacen("domain roughness 0.0525 1", &format!("domain roughness 0.0525 1\ndomain nov 0.5 1\nreference {spec}"), 1);
+    assert_ne!(own, base);
+    std::fs::write(d.join("own.brdf"), own).unwrap();
+    let (json, csv) = (d.join("own.json"), d.join("own.csv"));
+    run_in(d, &["diff", "--model", "own.brdf", "--samples", "2000", "--json", json.to_str().unwrap(), "--csv", csv.to_str().unwrap()]).ok();
+    let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(report["kind"], "diff-set", "{report}");
+    let text = report.to_string();
+    assert!(text.contains("NoV in [0.5, 1] (the models' declared domain: own [0.5, 1])") && text.contains("NoL in [0.05, 1]"), "{text}");
+    let rows: Vec<Vec<f64>> = std::fs::read_to_string(&csv).unwrap().lines().skip(1).map(|l| l.split(',').map(|x| x.parse().unwrap()).collect()).collect();
+    assert_eq!(rows.len(), 2000);
+    for r in &rows {
+        let (n, v) = ([r[0], r[1], r[2]], [r[3], r[4], r[5]]);
+        let dot: f64 = n.iter().zip(v).map(|(a, b)| a * b).sum();
+        assert!(dot > 0.5 - 1e-5 && r[9] >= 0.0525 - 1e-6, "a row outside the declared domain: {r:?}");
+    }
+    run_in(d, &["diff", "--model", "own.brdf", "--model", spec, "--nov", "0.2..0.1"]).fails(2, "--nov");
 }
