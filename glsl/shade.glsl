@@ -113,11 +113,16 @@ void main() {
     [[unroll]] for (int j = 0; j < NUM_LIGHTS; ++j) {
         vec3 L = lights[2 * j].xyz;
         vec3 colour = lights[2 * j + 1].rgb;
-        float NoL = max(dot(p.N, L), 0.0);
-#ifdef BRDF_FILE_RETURNS_F_NOL
+#if defined(BRDF_FILE_RETURNS_F_NOL)
         // The file's entry returns f_s NoL with its own cosine (returns=f_nol): taken as it is, no second NoL.
         acc += specular_brdf_unit(p.N, p.V, L, p.roughness, p.f0) * colour;
+#elif defined(BRDF_FILE)
+        // A file's f_s is weighted (f_s NoL) colour with NoL taken after the call, as its returns=f_nol form
+        // weighs its own, so that one BRDF written in either form compiles to the same code.
+        vec3 fs = (BASELINE != 0) ? vec3(1.0) : specular_brdf_unit(p.N, p.V, L, p.roughness, p.f0);
+        acc += (fs * max(dot(p.N, L), 0.0)) * colour;
 #else
+        float NoL = max(dot(p.N, L), 0.0);
         vec3 fs = (BASELINE != 0) ? vec3(1.0) : specular_brdf_unit(p.N, p.V, L, p.roughness, p.f0);
         acc += fs * (NoL * colour);
 #endif

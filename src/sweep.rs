@@ -5,6 +5,8 @@
 pub mod view;
 
 use crate::accuracy::{self, Accuracy, ExactCache, SampleSet};
+use crate::brdf::exact::ExactFresnel;
+use crate::diff::SampleDomain;
 use crate::brdf::spec::with_each_param_sample;
 use crate::brdf::{ModelSpec, Precision, Vis, D, F, THESIS_MODELS};
 use crate::chart::{self, Point};
@@ -70,8 +72,63 @@ pub fn label(model: &Model) -> String {
 #[derive(Clone, Debug)]
 pub struct SweepOptions {
     pub profile: ProfileOptions,
-    /// What models without an f64 twin (`.brdf` files) are measured against (`--reference`; default ggx).
-    pub reference: Model,
+    pub accuracy: AccuracyOptions,
+}
+
+/// What the accuracy half of a sweep measures against, and where.
+#[derive(Clone, Debug)]
+pub struct AccuracyOptions {
+    /// What every model is measured against (`--reference`); None: a spec against its own exact model, a
+    /// `.brdf` file against the reference it declares, else `DEFAULT_FILE_REFERENCE`.
+    pub reference: Option<Model>,
+    pub exact_fresnel: ExactFresnel,
+    /// The sample set's ranges, and the words saying where each comes from (a flag, the files' domains).
+    pub domain: SampleDomain,
+    pub domain_why: [String; 3],
+}
+
+impl Default for AccuracyOptions {
+    fn default() -> Self {
+        AccuracyOptions { reference: None, exact_fresnel: ExactFresnel::Physical, domain: accuracy::STANDARD_DOMAIN, domain_why: Default::default() }
+    }
+}
+
+/// A `.brdf` file that names no reference, with no `--reference`, is measured against this preset's exact model.
+pub const DEFAULT_FILE_REFERENCE: &str = "ggx";
+
+impl AccuracyOptions {
+    /// The sample set, with where its ranges come from.
+    pub fn sample_set_words(&self) -> String {
+        let why: Vec<String> = ["roughness", "NoV", "NoL"]
+            .iter()
+            .zip(&self.domain_why)
+            .filter(|(_, w)| !w.trim().is_empty())
+            .map(|(axis, w)| format!("{axis}: {}", w.trim().trim_start_matches('(').trim_end_matches(')')))
+            .collect();
+        let set = SampleSet::within(self.domain).describe();
+        if why.is_empty() { set } else { format!("{set}; {}", why.join("; ")) }
+    }
+
+    /// What "vs exact" measures against, in words.
+    pub fn against_words(&self) -> String {
+        let exact = self.exact_fresnel.describe();
+        match &self.reference {
+            Some(r) if r.twin().is_some() => format!("{}'s {exact}, for every model (--reference)", r.label()),
+            Some(r) => format!("{}'s GPU values, for every model (--reference)", r.label()),
+            None => format!("each spec's {exact}; a .brdf file: the {exact} of the reference it names, else of {DEFAULT_FILE_REFERENCE}"),
+        }
+    }
+
+    /// What `model` is measured against: None for its own exact model.
+    pub fn reference_of(&self, model: &Model) -> Option<Model> {
+        if let Some(r) = &self.reference {
+            return Some(r.clone());
+        }
+        if model.twin().is_some() {
+            return None;
+        }
+        Some(model.declared_reference().map(Model::spec).unwrap_or_else(|| Model::parse(DEFAULT_FILE_REFERENCE).expect("the default reference is a preset")))
+    }
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -98,6 +155,9 @@ pub struct SweepReport {
     /// Rows sorted by rank, then median cost.
     pub rows: Vec<SweepRow>,
     pub sample_set: String,
+    /// What "vs exact" is against (`--reference`, `--exact-fresnel`), in words.
+    pub against: String,
+    pub exact: ExactFresnel,
     pub profile: ProfileReport,
 }
 
@@ -114,18 +174,7 @@ pub fn run(gpu: &Gpu, options: &SweepOptions, progress: &ProgressBar) -> Result<
         anyhow::bail!("--lights: a sweep ranks specs at one light count (`brdfprof profile --lights 1,8,64` compares counts)");
     }
     // Accuracy first, so that the profile's budget (the whole command's) accounts for it.
-    let set = SampleSet::standard();
-    if options.profile.models.iter().any(|m| m.twin().is_none()) {
-        accuracy::check_reference(gpu, &options.reference, &set, &format!("--reference {}", options.reference.name()))?;
-    }
-    let mut cache = ExactCache::default();
-    let n = options.profile.models.len();
-    let mut accuracies = Vec::with_capacity(n);
-    for (k, spec) in options.profile.models.iter().enumerate() {
-        let against = if spec.twin().is_some() { "its f64 twin and exact references".to_string() } else { options.reference.name() };
-        progress.set_message(format!("accuracy {}/{n}: {} against {against}", k + 1, spec.name()));
-        accuracies.push(accuracy::measure(gpu, spec, &set, &mut cache, &options.reference)?);
-    }
+    let accuracies = measure_accuracy(gpu, &options.profile.models, &options.accuracy, progress)?;
     let profile = profile::run(gpu, &options.profile, progress)?;
     let specs: Vec<(usize, Model)> = options
         .profile
@@ -165,18 +214,54 @@ pub fn run(gpu: &Gpu, options: &SweepOptions, progress: &ProgressBar) -> Result<
     Ok(SweepReport {
         fastest: specs[fastest].1.name(),
         rows,
-        sample_set: "10 strata each of roughness [0.1, 1], NoV and NoL [0.05, 1], azimuth [0, pi]; 10,000 samples, seed 2023; \
-                     dielectric F0 (0.02, 0.04, 0.08) or (0.03, 0.05, 0.045); albedo cells NoV {0.1, 0.3, 0.5, 0.7, 0.9, 1} x r \
-                     {0.1, 0.25, 0.5, 0.75, 1}, F0 0.04"
-            .into(),
+        sample_set: options.accuracy.sample_set_words(),
+        against: options.accuracy.against_words(),
+        exact: options.accuracy.exact_fresnel,
         profile,
     })
+}
+
+/// The error axis's words: against the exact models with the Fresnel chosen, or the one reference every row
+/// names.
+pub fn error_axis(exact: ExactFresnel, rows: &[SweepRow]) -> String {
+    let mut named: Vec<&str> = rows.iter().filter_map(|r| r.accuracy.reference.as_deref()).collect();
+    named.sort_unstable();
+    named.dedup();
+    match (named.as_slice(), rows.iter().all(|r| r.accuracy.reference.is_some())) {
+        ([one], true) => format!("RMS relative error against {one}'s exact model"),
+        _ if exact == ExactFresnel::Own => "RMS relative error against the exact model with each spec's own Fresnel".into(),
+        _ => "RMS relative error against the exact physical model".into(),
+    }
+}
+
+/// Every model's accuracy over the options' sample set, each against what `reference_of` says.
+fn measure_accuracy(gpu: &Gpu, models: &[Model], options: &AccuracyOptions, progress: &ProgressBar) -> Result<Vec<Accuracy>> {
+    let set = SampleSet::within(options.domain);
+    let references: Vec<Option<Model>> = models.iter().map(|m| options.reference_of(m)).collect();
+    let mut checked: Vec<String> = Vec::new();
+    for r in references.iter().flatten() {
+        if !checked.contains(&r.name()) {
+            let flag = if options.reference.is_some() { "--reference" } else { "reference" };
+            accuracy::check_reference(gpu, r, &set, &format!("{flag} {}", r.name()))?;
+            checked.push(r.name());
+        }
+    }
+    let mut cache = ExactCache::new(options.exact_fresnel);
+    let n = models.len();
+    let mut out = Vec::with_capacity(n);
+    for (k, (model, reference)) in models.iter().zip(&references).enumerate() {
+        let against = reference.as_ref().map_or("its f64 twin and exact model".to_string(), Model::name);
+        progress.set_message(format!("accuracy {}/{n}: {} against {against}", k + 1, model.name()));
+        out.push(accuracy::measure(gpu, model, &set, &mut cache, reference.as_ref())?);
+    }
+    Ok(out)
 }
 
 /// The numerical error's cell: max error against the spec's own f64 formula; for a `.brdf` file, against the
 /// `--reference` spec's f64 formula, saying so (`- (vs FILE)` against another file, which has no formula).
 fn numerical_cell(a: &accuracy::Accuracy) -> String {
-    let against = a.reference.as_deref().map_or(String::new(), |r| format!(" (vs {r} f64)"));
+    // A spec's numerical error is against its own twin whatever its reference; a file's against the reference's.
+    let against = a.reference.as_deref().filter(|_| a.formula_vs_exact.is_none()).map_or(String::new(), |r| format!(" (vs {r} f64)"));
     match &a.numerical {
         None => format!("- (vs {})", a.reference.as_deref().unwrap_or("?")),
         Some(n) if n.nonfinite > 0 => format!("{} NaN/Inf{against}", n.nonfinite),
@@ -212,13 +297,13 @@ impl SweepReport {
              rank = 1 + the number of specs whose CI lies wholly below; `=` marks specs whose CI overlaps another's, so they \
              cannot be told apart. Errors are relative errors |x - ref| / max(|ref|, 1e-3) over the sample set ({}); numerical: \
              GPU against the same formula in f64 (a .brdf file: against the --reference spec's formula in f64, `vs SPEC f64`); \
-             vs exact: GPU against the exact physical model (same D, exact height-correlated Smith G2, exact Fresnel; a .brdf \
-             file: the --reference spec's exact model, or another file's GPU values); albedo: max |E_gpu - E_exact| over the albedo cells. Pareto: no spec is both cheaper and \
+             vs exact: GPU against {}; albedo: max |E_gpu - E_exact| over the albedo cells. Pareto: no spec is both cheaper and \
              more accurate (RMS vs exact).\n\n{}{}",
             self.profile.summary(),
             self.fastest,
             self.profile.rounds,
             self.sample_set,
+            self.against,
             self.table().markdown(),
             self.profile.placement_notes()
         )
@@ -262,10 +347,11 @@ impl SweepReport {
             .map(|r| r.cost_vs_fastest.median)
             .fold(f64::NEG_INFINITY, f64::max);
         let title = format!("Accuracy against cost on {} ({} evaluations per dispatch)", self.profile.provenance.device.name, self.profile.rows[0].evaluations_per_dispatch);
+        let y_desc = error_axis(self.exact, &self.rows);
         let spec = chart::Scatter {
             title: &title,
             x_desc: "cost relative to the fastest spec (median of per-round ratios, 95% CI whiskers)",
-            y_desc: "RMS relative error against the exact physical model",
+            y_desc: &y_desc,
             line: &front,
             legend: &legend,
             split_x: Some(split * 1.02),

@@ -51,6 +51,9 @@ pub struct CostSweep {
     pub rows: Vec<CostSweepRow>,
     /// Specs the family cannot compile (fp16 without shaderFloat16), with the reason.
     pub skipped: Option<String>,
+    /// The sweep's "vs exact" reference in words, and the chart's error axis.
+    pub against: String,
+    pub error_axis: String,
 }
 
 /// The target's cost of every spec of `sweep`, with the sweep's accuracy.
@@ -101,6 +104,8 @@ pub fn build(sweep: &SweepReport, target: &str, cost: &TargetCost, note: Option<
         rows,
         // The child's note names each spec with the reason; without one, the specs alone.
         skipped: (!skipped.is_empty()).then(|| note.map_or_else(|| format!("not compiled for {target}: {}", skipped.join(", ")), str::to_string)),
+        against: sweep.against.clone(),
+        error_axis: crate::sweep::error_axis(sweep.exact, &sweep.rows),
     })
 }
 
@@ -132,7 +137,7 @@ impl CostSweep {
         format!(
             "# brdfprof sweep: cost on {} ({})\n\n{} ({}); cost = {}'s estimate, {} per evaluation ({}; {} lights per kernel), \
              deterministic (no CI); relative to the cheapest spec ({}). Accuracy and the measured cost ratio: the sweep on {}. \
-             Pareto (target): no spec both fewer cycles and more accurate (RMS vs exact).\n\n{}",
+             vs exact: against {}. Pareto (target): no spec both fewer cycles and more accurate (RMS vs exact).\n\n{}",
             self.family,
             self.architecture,
             self.device,
@@ -143,6 +148,7 @@ impl CostSweep {
             self.lights_per_kernel,
             self.fastest,
             self.measured_on,
+            self.against,
             self.table().markdown()
         ) + &self.skipped.as_ref().map_or(String::new(), |s| format!("\n{s}\n"))
     }
@@ -176,7 +182,7 @@ impl CostSweep {
         let spec = chart::Scatter {
             title: &title,
             x_desc: &x_desc,
-            y_desc: "RMS relative error against the exact physical model",
+            y_desc: &self.error_axis,
             line: &front,
             legend: &legend,
             split_x: (self.rows.iter().any(|r| group(r) == 1) && split.is_finite()).then_some(split * 1.02),

@@ -4,7 +4,8 @@
 
 pub mod albedo;
 
-use crate::brdf::exact::{self, Lambda};
+use crate::brdf::exact::{self, ExactFresnel, Lambda};
+use crate::diff::SampleDomain;
 use crate::brdf::{samples, ModelSpec, Sample, D, F};
 use crate::gpu::Gpu;
 use crate::kernels::{self, AlbedoCell, RunLimits};
@@ -86,29 +87,67 @@ pub fn check_reference(gpu: &Gpu, reference: &Model, set: &SampleSet, what: &str
     Ok(())
 }
 
-/// The fixed sample set: 10 strata each in roughness [0.1, 1], NoV and NoL [0.05, 1] and azimuth [0, pi]
-/// (10,000 samples, seed 2023), and the albedo cells NoV x roughness.
+/// The sample set: 10 strata each in roughness, NoV, NoL and azimuth [0, pi] (10,000 samples, seed 2023), and
+/// the albedo cells NoV x roughness, all within a domain (`standard`: roughness [0.1, 1], NoV and NoL
+/// [0.05, 1]).
 pub struct SampleSet {
     pub samples: Vec<Sample>,
     pub cells: Vec<AlbedoCell>,
+    pub domain: SampleDomain,
 }
 
 pub const ALBEDO_NOV: [f32; 6] = [0.1, 0.3, 0.5, 0.7, 0.9, 1.0];
 pub const ALBEDO_ROUGHNESS: [f32; 5] = [0.1, 0.25, 0.5, 0.75, 1.0];
 
+/// The sweep's default domain: roughness [0.1, 1] (above every precision's floor), NoV and NoL [0.05, 1].
+pub const STANDARD_DOMAIN: SampleDomain = SampleDomain { roughness: (0.1, 1.0), nov: (0.05, 1.0), nol: (0.05, 1.0) };
+
+/// The grid values within `range`, or its two ends where none is (a narrow domain still gets albedo cells).
+fn grid_within(grid: &[f32], range: (f64, f64)) -> Vec<f32> {
+    let inside: Vec<f32> = grid.iter().copied().filter(|&x| (range.0..=range.1).contains(&(x as f64))).collect();
+    if !inside.is_empty() {
+        return inside;
+    }
+    let mut ends = vec![range.0 as f32, range.1 as f32];
+    ends.dedup();
+    ends
+}
+
 impl SampleSet {
     pub fn standard() -> Self {
-        let cells = ALBEDO_ROUGHNESS
-            .iter()
-            .flat_map(|&roughness| ALBEDO_NOV.iter().map(move |&nov| AlbedoCell { nov, roughness, f0: [0.04; 3] }))
+        Self::within(STANDARD_DOMAIN)
+    }
+
+    /// The stratified set over `domain`; the albedo cells are the standard grid's within it.
+    pub fn within(domain: SampleDomain) -> Self {
+        let noves = grid_within(&ALBEDO_NOV, domain.nov);
+        let cells = grid_within(&ALBEDO_ROUGHNESS, domain.roughness)
+            .into_iter()
+            .flat_map(|roughness| noves.iter().map(move |&nov| AlbedoCell { nov, roughness, f0: [0.04; 3] }))
             .collect();
-        SampleSet { samples: samples::stratified(10, 2023, 0.05, 0.1..1.0), cells }
+        SampleSet { samples: samples::stratified_in(10, 2023, domain.nov, domain.nol, domain.roughness), cells, domain }
+    }
+
+    /// The words that say what the set is.
+    pub fn describe(&self) -> String {
+        let (r, v, l) = (self.domain.roughness, self.domain.nov, self.domain.nol);
+        let distinct = |pick: fn(&AlbedoCell) -> f32| {
+            let mut v: Vec<f32> = self.cells.iter().map(pick).collect();
+            v.sort_by(f32::total_cmp);
+            v.dedup();
+            v.iter().map(f32::to_string).collect::<Vec<_>>().join(", ")
+        };
+        format!(
+            "10 strata each of roughness [{}, {}], NoV [{}, {}] and NoL [{}, {}], azimuth [0, pi]; {} samples, seed 2023; \
+             dielectric F0 (0.02, 0.04, 0.08) or (0.03, 0.05, 0.045); albedo cells NoV {{{}}} x r {{{}}}, F0 0.04",
+            r.0, r.1, v.0, v.1, l.0, l.1, self.samples.len(), distinct(|c| c.nov), distinct(|c| c.roughness)
+        )
     }
 }
 
-/// What the exact reference of a spec depends on: its D with the parameters it reads, and its exact Fresnel
-/// with the parameters that reads (a dielectric from F0, or a given metal). Specs differing only in Vis or in
-/// their Fresnel approximation share it.
+/// What the exact reference of a spec depends on: its D with the parameters it reads, and the Fresnel it uses
+/// (`ExactFresnel`) with the parameters that reads (a dielectric from F0, or a given metal). Specs differing
+/// only in Vis (or, with the physical Fresnel, in their Fresnel approximation) share it.
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
 struct ExactKey {
     d: D,
@@ -117,27 +156,45 @@ struct ExactKey {
 }
 
 impl ExactKey {
-    fn of(spec: &ModelSpec) -> Self {
-        let f = spec.exact_fresnel();
+    fn of(spec: &ModelSpec, fresnel: ExactFresnel) -> Self {
+        let f = fresnel.term(spec);
         let reads = spec.d.row().reads.iter().chain(f.row().reads);
         ExactKey { d: spec.d, f, params: reads.map(|&p| spec.params.get(p).bits()).collect() }
     }
 }
 
-/// Exact values and albedos over a sample set, computed once per `ExactKey`.
+/// Exact values and albedos over a sample set, computed once per `ExactKey`, with one Fresnel choice.
 #[derive(Default)]
 pub struct ExactCache {
+    pub fresnel: ExactFresnel,
     values: HashMap<ExactKey, Vec<[f64; 3]>>,
     albedo: HashMap<ExactKey, Vec<[f64; 3]>>,
 }
 
 impl ExactCache {
+    pub fn new(fresnel: ExactFresnel) -> Self {
+        ExactCache { fresnel, ..Default::default() }
+    }
+
     fn values(&mut self, spec: &ModelSpec, set: &SampleSet) -> &Vec<[f64; 3]> {
-        self.values.entry(ExactKey::of(spec)).or_insert_with(|| set.samples.par_iter().map(|s| exact::eval(spec, s)).collect())
+        let fresnel = self.fresnel;
+        self.values.entry(ExactKey::of(spec, fresnel)).or_insert_with(|| set.samples.par_iter().map(|s| exact::eval_with(spec, fresnel, s)).collect())
     }
 
     fn albedo(&mut self, spec: &ModelSpec, set: &SampleSet) -> &Vec<[f64; 3]> {
-        self.albedo.entry(ExactKey::of(spec)).or_insert_with(|| set.cells.par_iter().map(|cell| albedo_exact(spec, cell)).collect())
+        let fresnel = self.fresnel;
+        self.albedo.entry(ExactKey::of(spec, fresnel)).or_insert_with(|| set.cells.par_iter().map(|cell| albedo_exact_with(spec, fresnel, cell)).collect())
+    }
+
+    /// The values and albedos a model is measured against: a spec's exact model, or a `.brdf` file's GPU results.
+    fn reference(&mut self, gpu: &Gpu, reference: &Model, set: &SampleSet) -> Result<(Vec<[f64; 3]>, Vec<[f64; 3]>)> {
+        Ok(match reference.twin() {
+            Some(r) => (self.values(r, set).clone(), self.albedo(r, set).clone()),
+            None => (
+                kernels::eval(gpu, reference, &set.samples, RunLimits::default())?.iter().map(|g| g.map(f64::from)).collect(),
+                kernels::albedo(gpu, reference, &set.cells)?.iter().map(|a| a.e).collect(),
+            ),
+        })
     }
 }
 
@@ -146,58 +203,45 @@ pub struct Accuracy {
     /// GPU result against the same formula in f64; for a model without a twin (a `.brdf` file) measured
     /// against a spec (`reference`), against that spec's own f64 formula; None against another `.brdf` file.
     pub numerical: Option<ErrorStats>,
-    /// GPU result against the exact physical reference: what a user of the spec gets. For a model without a
-    /// twin: against `reference`.
+    /// GPU result against the exact reference: what a user of the spec gets. Against `reference` where one
+    /// was given (always for a model without a twin).
     pub vs_exact: ErrorStats,
-    /// The formula itself (f64) against the exact reference: the approximation alone (None without a twin).
+    /// The formula itself (f64) against the same reference: the approximation alone (None without a twin).
     pub formula_vs_exact: Option<ErrorStats>,
     /// max over cells and channels of |E_gpu - E_exact| (absolute; albedo is in [0, 1]).
     pub albedo_vs_exact: f64,
     /// The largest integration-error bound of the GPU albedos.
     pub albedo_error_bound: f64,
-    /// What a model without a twin was measured against: a spec (its exact f64 model) or another `.brdf`
-    /// file (evaluated on the GPU); None for a model with a twin (its own exact model).
+    /// What the model was measured against where not its own exact model: a spec (its exact f64 model) or
+    /// another `.brdf` file (evaluated on the GPU).
     pub reference: Option<String>,
 }
 
-/// Measures `model` on the GPU over `set` against its twin and exact reference; a model without a twin (a
-/// `.brdf` file) against `reference`: a spec's exact model, or another file's GPU values and albedo.
-pub fn measure(gpu: &Gpu, model: &Model, set: &SampleSet, cache: &mut ExactCache, reference: &Model) -> Result<Accuracy> {
+/// Measures `model` on the GPU over `set`: against its twin (numerical error) and against `reference` where
+/// given (a spec's exact model, or another file's GPU values and albedo), else against its own exact model. A
+/// model without a twin (a `.brdf` file) needs a reference.
+pub fn measure(gpu: &Gpu, model: &Model, set: &SampleSet, cache: &mut ExactCache, reference: Option<&Model>) -> Result<Accuracy> {
     let got: Vec<[f64; 3]> = kernels::eval(gpu, model, &set.samples, RunLimits::default())?.iter().map(|g| g.map(f64::from)).collect();
     let gpu_albedo = kernels::albedo(gpu, model, &set.cells)?;
     // A NaN difference is an infinite one, not none (f64::max would drop it).
     let albedo_diff = |exact: &[[f64; 3]]| gpu_albedo.iter().zip(exact).flat_map(|(g, x)| (0..3).map(move |c| (g.e[c] - x[c]).abs())).map(|d| if d.is_nan() { f64::INFINITY } else { d }).fold(0.0, f64::max);
     let albedo_error_bound = gpu_albedo.iter().map(|a| a.error).fold(0.0, f64::max);
-    let Some(spec) = model.twin() else {
-        let (values, albedo): (Vec<[f64; 3]>, Vec<[f64; 3]>) = match reference.twin() {
-            Some(r) => (cache.values(r, set).clone(), cache.albedo(r, set).clone()),
-            None => (
-                kernels::eval(gpu, reference, &set.samples, RunLimits::default())?.iter().map(|g| g.map(f64::from)).collect(),
-                kernels::albedo(gpu, reference, &set.cells)?.iter().map(|a| a.e).collect(),
-            ),
-        };
-        // Against a spec, the numerical error is against that spec's own f64 formula (its twin): what a file that
-        // transcribes the spec's formula should match to fp32 rounding.
-        let numerical = reference.twin().map(|r| ErrorStats::of(&set.samples, &got, &set.samples.par_iter().map(|s| r.eval(s)).collect::<Vec<_>>()));
-        return Ok(Accuracy {
-            numerical,
-            vs_exact: ErrorStats::of(&set.samples, &got, &values),
-            formula_vs_exact: None,
-            albedo_vs_exact: albedo_diff(&albedo),
-            albedo_error_bound,
-            reference: Some(reference.name()),
-        });
+    let (values, albedo) = match (reference, model.twin()) {
+        (Some(r), _) => cache.reference(gpu, r, set)?,
+        (None, Some(spec)) => (cache.values(spec, set).clone(), cache.albedo(spec, set).clone()),
+        (None, None) => anyhow::bail!("{}: a model without an f64 twin is measured against a reference; none was given", model.name()),
     };
-    let twin: Vec<[f64; 3]> = set.samples.par_iter().map(|s| spec.eval(s)).collect();
-    let exact_values = cache.values(spec, set).clone();
-    let exact_albedo = cache.albedo(spec, set).clone();
+    let twin: Option<Vec<[f64; 3]>> = model.twin().map(|spec| set.samples.par_iter().map(|s| spec.eval(s)).collect());
+    // A file against a spec: the numerical error is against that spec's own f64 formula (its twin), what a
+    // file that transcribes the spec's formula should match to fp32 rounding.
+    let numerical_against = twin.clone().or_else(|| reference.and_then(Model::twin).map(|r| set.samples.par_iter().map(|s| r.eval(s)).collect()));
     Ok(Accuracy {
-        numerical: Some(ErrorStats::of(&set.samples, &got, &twin)),
-        vs_exact: ErrorStats::of(&set.samples, &got, &exact_values),
-        formula_vs_exact: Some(ErrorStats::of(&set.samples, &twin, &exact_values)),
-        albedo_vs_exact: albedo_diff(&exact_albedo),
+        numerical: numerical_against.map(|t| ErrorStats::of(&set.samples, &got, &t)),
+        vs_exact: ErrorStats::of(&set.samples, &got, &values),
+        formula_vs_exact: twin.map(|t| ErrorStats::of(&set.samples, &t, &values)),
+        albedo_vs_exact: albedo_diff(&albedo),
         albedo_error_bound,
-        reference: None,
+        reference: reference.map(Model::name),
     })
 }
 
@@ -210,8 +254,13 @@ pub fn albedo_twin(spec: &ModelSpec, cell: &AlbedoCell) -> [f64; 3] {
 
 /// E of the exact counterpart of `spec` for one cell.
 pub fn albedo_exact(spec: &ModelSpec, cell: &AlbedoCell) -> [f64; 3] {
+    albedo_exact_with(spec, ExactFresnel::Physical, cell)
+}
+
+/// `albedo_exact` with the Fresnel `fresnel` chooses.
+pub fn albedo_exact_with(spec: &ModelSpec, fresnel: ExactFresnel, cell: &AlbedoCell) -> [f64; 3] {
     let a = exact::alpha(cell.roughness as f64);
     let lambda = Lambda::new(spec.d, a, &spec.params);
     let f0 = cell.f0.map(f64::from);
-    albedo::albedo_f64(&|c| exact::from_cosines(spec, &lambda, c, a, f0), cell.nov as f64, a)
+    albedo::albedo_f64(&|c| exact::from_cosines_with(spec, fresnel, &lambda, c, a, f0), cell.nov as f64, a)
 }

@@ -132,6 +132,45 @@ pub fn fresnel(spec: &ModelSpec, f0: [f64; 3], voh: f64) -> [f64; 3] {
     spec.exact_fresnel().eval(f0, voh, &spec.params)
 }
 
+/// Which Fresnel an exact reference multiplies its exact D G2 / (4 NoL NoV) by: the physical one the spec's F
+/// stands for (the default: the error then includes the Fresnel approximation), or the spec's own F term (the
+/// error is then the D and visibility approximations alone; `sweep --exact-fresnel own`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ExactFresnel {
+    #[default]
+    Physical,
+    Own,
+}
+
+impl ExactFresnel {
+    pub const NAMES: [&'static str; 2] = ["physical", "own"];
+
+    pub fn parse(text: &str) -> Option<Self> {
+        match text {
+            "physical" => Some(ExactFresnel::Physical),
+            "own" => Some(ExactFresnel::Own),
+            _ => None,
+        }
+    }
+
+    /// The Fresnel term the exact counterpart of `spec` uses.
+    pub fn term(self, spec: &ModelSpec) -> crate::brdf::F {
+        match self {
+            ExactFresnel::Physical => spec.exact_fresnel(),
+            ExactFresnel::Own => spec.f,
+        }
+    }
+
+    /// The words a table says the reference is, after "the" or a possessive.
+    pub fn describe(self) -> &'static str {
+        match self {
+            ExactFresnel::Physical => "exact physical model (same D, exact height-correlated Smith G2, exact Fresnel)",
+            ExactFresnel::Own => "exact model with its own Fresnel (same D and F, exact height-correlated Smith G2)",
+        }
+    }
+}
+
 /// a = r^2 for the exact model: the requested roughness, floored at the fp32 guard whatever the spec's
 /// precision (fp16's higher floor is part of what fp16 costs in accuracy).
 pub fn alpha(roughness: f64) -> f64 {
@@ -141,20 +180,30 @@ pub fn alpha(roughness: f64) -> f64 {
 
 /// The exact physical counterpart of `spec` from guarded cosines; `lambda` must be for this spec's D at `a`.
 pub fn from_cosines(spec: &ModelSpec, lambda: &Lambda, c: &Cosines, a: f64, f0: [f64; 3]) -> [f64; 3] {
+    from_cosines_with(spec, ExactFresnel::Physical, lambda, c, a, f0)
+}
+
+/// `from_cosines` with the Fresnel `fresnel` chooses.
+pub fn from_cosines_with(spec: &ModelSpec, fresnel: ExactFresnel, lambda: &Lambda, c: &Cosines, a: f64, f0: [f64; 3]) -> [f64; 3] {
     let g2 = 1.0 / (1.0 + lambda.at(c.nov) + lambda.at(c.nol));
     let dv = spec.d.eval(c.noh, c.sin2h, a, &spec.params) * g2 / (4.0 * c.nol * c.nov);
-    fresnel(spec, f0, c.voh).map(|f| dv * f)
+    fresnel.term(spec).eval(f0, c.voh, &spec.params).map(|f| dv * f)
 }
 
 /// Exact f_s for one sample, Lambda integrated directly (`from_cosines` with a tabulated `Lambda` is the
 /// fast path for many samples at one roughness).
 pub fn eval(spec: &ModelSpec, s: &Sample) -> [f64; 3] {
+    eval_with(spec, ExactFresnel::Physical, s)
+}
+
+/// `eval` with the Fresnel `fresnel` chooses.
+pub fn eval_with(spec: &ModelSpec, fresnel: ExactFresnel, s: &Sample) -> [f64; 3] {
     let Some((c, f0)) = super::spec::guarded_cosines(s) else { return [0.0; 3] };
     let a = alpha(f64::from(s.roughness));
     let p = &spec.params;
     let g2 = 1.0 / (1.0 + lambda(spec.d, c.nov, a, p) + lambda(spec.d, c.nol, a, p));
     let dv = spec.d.eval(c.noh, c.sin2h, a, p) * g2 / (4.0 * c.nol * c.nov);
-    fresnel(spec, f0, c.voh).map(|f| dv * f)
+    fresnel.term(spec).eval(f0, c.voh, p).map(|f| dv * f)
 }
 
 #[cfg(test)]

@@ -63,6 +63,11 @@ pub fn well_conditioned_in(count: usize, seed: u64, nov: (f64, f64), nol: (f64, 
 /// (0.02), plastic (0.04) and a gemstone (0.08), or 0.03, 0.05, 0.045 in alternate cells (metals are measured
 /// by the conductor and F82 terms, which take their metal's complex IOR instead).
 pub fn stratified(per_axis: usize, seed: u64, min_cos: f64, roughness: std::ops::Range<f64>) -> Vec<Sample> {
+    stratified_in(per_axis, seed, (min_cos, 1.0), (min_cos, 1.0), (roughness.start, roughness.end))
+}
+
+/// `stratified` with NoV, NoL and roughness each in its own range (a degenerate range gives its one value).
+pub fn stratified_in(per_axis: usize, seed: u64, nov_range: (f64, f64), nol_range: (f64, f64), roughness: (f64, f64)) -> Vec<Sample> {
     let mut rng = Pcg64::seed_from_u64(seed);
     let k = per_axis as f64;
     let mut out = Vec::with_capacity(per_axis.pow(4));
@@ -71,9 +76,10 @@ pub fn stratified(per_axis: usize, seed: u64, min_cos: f64, roughness: std::ops:
             for il in 0..per_axis {
                 for ia in 0..per_axis {
                     let u = |i: usize, rng: &mut Pcg64| (i as f64 + rng.random::<f64>()) / k;
-                    let r = roughness.start + (roughness.end - roughness.start) * u(ir, &mut rng);
-                    let nov = min_cos + (1.0 - min_cos) * u(iv, &mut rng);
-                    let nol = min_cos + (1.0 - min_cos) * u(il, &mut rng);
+                    let within = |(lo, hi): (f64, f64), t: f64| lo + (hi - lo) * t;
+                    let r = within(roughness, u(ir, &mut rng));
+                    let nov = within(nov_range, u(iv, &mut rng));
+                    let nol = within(nol_range, u(il, &mut rng));
                     let phi = std::f64::consts::PI * u(ia, &mut rng);
                     let n = random_unit(&mut rng);
                     let phi0: f64 = rng.random_range(0.0..std::f64::consts::TAU);

@@ -65,33 +65,10 @@ pub struct DiffArgs {
     pub device: DeviceArgs,
 }
 
-/// One range of the default samples: the flag's, else the intersection of `default` with the models' declared
-/// domains (named in the words returned), else `default`; models whose domains do not meet are refused.
-fn range_of(flag: (&str, Option<(f64, f64)>), default: (f64, f64), declared: Vec<(String, (f64, f64))>, what: &str) -> Result<((f64, f64), String)> {
-    if let Some(r) = flag.1 {
-        return Ok((r, format!(" ({})", flag.0)));
-    }
-    if declared.is_empty() {
-        return Ok((default, String::new()));
-    }
-    let lo = declared.iter().map(|(_, d)| d.0).fold(default.0, f64::max);
-    let hi = declared.iter().map(|(_, d)| d.1).fold(default.1, f64::min);
-    let names = declared.iter().map(|(n, (a, b))| format!("{n} [{a}, {b}]")).collect::<Vec<_>>().join(", ");
-    if lo > hi {
-        bail!("the models' {what} domains do not meet within [{}, {}] ({names}); give {} MIN..MAX to compare them anyway", default.0, default.1, flag.0);
-    }
-    Ok(((lo, hi), format!(" (the models' declared domain: {names})")))
-}
-
 /// The default samples' ranges (`--roughness`, `--nov`, `--nol`, else the models' declared domains within the
 /// defaults), and the words saying where each comes from.
 fn domain_of(args: &DiffArgs, models: &[&Model]) -> Result<(diff::SampleDomain, [String; 3])> {
-    let d = diff::SampleDomain::default();
-    let declared = |pick: &dyn Fn(&Model) -> Option<(f64, f64)>| models.iter().filter_map(|m| pick(m).map(|r| (m.label(), r))).collect::<Vec<_>>();
-    let (roughness, rw) = range_of(("--roughness", args.roughness), d.roughness, declared(&|m| m.roughness_domain()), "roughness")?;
-    let (nov, vw) = range_of(("--nov", args.nov), d.nov, declared(&|m| m.cosine_domains().0), "N.V")?;
-    let (nol, lw) = range_of(("--nol", args.nol), d.nol, declared(&|m| m.cosine_domains().1), "N.L")?;
-    Ok((diff::SampleDomain { roughness, nov, nol }, [rw, vw, lw]))
+    super::sample_domain([args.roughness, args.nov, args.nol], diff::SampleDomain::default(), models)
 }
 
 /// `--tolerance`: a finite number, 0 or more.

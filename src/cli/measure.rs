@@ -149,10 +149,26 @@ pub struct SweepArgs {
     /// file git tracks).
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// What a .brdf model's accuracy is measured against: a spec (its exact f64 model) or another .brdf file
-    /// (its GPU values). Built-in specs are always measured against their own exact model.
-    #[arg(long, default_value = "ggx")]
-    pub reference: String,
+    /// What every model's accuracy is measured against: a spec (its exact f64 model) or a .brdf file (its GPU
+    /// values). Default: each built-in spec against its own exact model, each .brdf file against the reference
+    /// it names (`reference SPEC`), else ggx.
+    #[arg(long)]
+    pub reference: Option<String>,
+    /// The Fresnel of the exact models: `physical` (the exact dielectric or the metal's conductor Fresnel, so
+    /// that the error includes the Fresnel approximation) or `own` (the spec's own F term: the error of its D
+    /// and visibility alone).
+    #[arg(long, default_value = "physical", value_parser = exact_fresnel)]
+    pub exact_fresnel: brdfprof::brdf::exact::ExactFresnel,
+    /// Perceptual roughness range of the sample set, MIN..MAX within [0, 1] (default [0.1, 1], or the range
+    /// every `.brdf` model's `domain roughness` admits).
+    #[arg(long, value_parser = super::roughness_range)]
+    pub roughness: Option<(f64, f64)>,
+    /// N.V range of the sample set, MIN..MAX within [0, 1] (default [0.05, 1], or every `.brdf` model's `domain nov`).
+    #[arg(long, value_parser = super::cosine_range)]
+    pub nov: Option<(f64, f64)>,
+    /// N.L range of the sample set, as --nov (`domain nol`).
+    #[arg(long, value_parser = super::cosine_range)]
+    pub nol: Option<(f64, f64)>,
     /// Also draw the table, JSON and Pareto chart with a compile-only target's modelled cycles per evaluation
     /// as the cost (radv:FAMILY, nvidia:FAMILY, intel:FAMILY, PREFIX:all; repeatable; see `devices --targets`):
     /// sweep-<device>-<compiler>-<family>.* (aco, ptxas, igc).
@@ -162,6 +178,11 @@ pub struct SweepArgs {
     pub html: super::report::HtmlArg,
     #[command(flatten)]
     pub device: DeviceArgs,
+}
+
+/// `--exact-fresnel physical|own`.
+fn exact_fresnel(text: &str) -> Result<brdfprof::brdf::exact::ExactFresnel, String> {
+    brdfprof::brdf::exact::ExactFresnel::parse(text).ok_or_else(|| format!("`{text}`: give one of {}", brdfprof::brdf::exact::ExactFresnel::NAMES.join(", ")))
 }
 
 /// The compile-only targets of `--cost-device`, in order, each once.
@@ -189,11 +210,10 @@ pub fn sweep(args: &SweepArgs) -> Result<ExitCode> {
     }
     fresh_compilation(args.timing.shader_cache);
     let models = if args.model.models.is_empty() { sweep::default_specs().into_iter().map(Model::spec).collect() } else { args.model.models(&[])? };
-    let reference = Model::parse(&args.reference).map_err(|e| anyhow::anyhow!("--reference {}: {e:#}", args.reference))?;
-    if models.iter().all(|m| m.twin().is_some()) && args.reference != "ggx" {
-        brdfprof::messages::note("--reference applies to .brdf models; built-in specs are measured against their own exact model");
-    }
-    let options = sweep::SweepOptions { profile: args.timing.options(models, &args.size, args.reps, args.budget, args.target_ci)?, reference };
+    let reference = args.reference.as_deref().map(|r| Model::parse(r).map_err(|e| anyhow::anyhow!("--reference {r}: {e:#}"))).transpose()?;
+    let (domain, why) = super::sample_domain([args.roughness, args.nov, args.nol], brdfprof::accuracy::STANDARD_DOMAIN, &models.iter().collect::<Vec<_>>())?;
+    let accuracy = sweep::AccuracyOptions { reference, exact_fresnel: args.exact_fresnel, domain, domain_why: why };
+    let options = sweep::SweepOptions { profile: args.timing.options(models, &args.size, args.reps, args.budget, args.target_ci)?, accuracy };
     let shaders = options.profile.glsl.as_deref().map(brdfprof::shaders::Shaders::from_glsl).transpose()?.unwrap_or_else(brdfprof::shaders::Shaders::embedded);
     let validate = args.device.validation();
     let (gpu, (result, costs)) = on_device(&args.device, |gpu, progress| {

@@ -50,6 +50,34 @@ pub fn cosine_range(text: &str) -> Result<(f64, f64), String> {
     roughness_range(text).map_err(|_| format!("`{text}`: give MIN..MAX with 0 <= MIN <= MAX <= 1 (e.g. 0.05..1)"))
 }
 
+/// One range of the default samples: the flag's, else the intersection of `default` with the models' declared
+/// domains (named in the words returned), else `default`; models whose domains do not meet are refused.
+fn range_of(flag: (&str, Option<(f64, f64)>), default: (f64, f64), declared: Vec<(String, (f64, f64))>, what: &str) -> Result<((f64, f64), String)> {
+    if let Some(r) = flag.1 {
+        return Ok((r, format!(" ({})", flag.0)));
+    }
+    if declared.is_empty() {
+        return Ok((default, String::new()));
+    }
+    let lo = declared.iter().map(|(_, d)| d.0).fold(default.0, f64::max);
+    let hi = declared.iter().map(|(_, d)| d.1).fold(default.1, f64::min);
+    let names = declared.iter().map(|(n, (a, b))| format!("{n} [{a}, {b}]")).collect::<Vec<_>>().join(", ");
+    if lo > hi {
+        bail!("the models' {what} domains do not meet within [{}, {}] ({names}); give {} MIN..MAX to compare them anyway", default.0, default.1, flag.0);
+    }
+    Ok(((lo, hi), format!(" (the models' declared domain: {names})")))
+}
+
+/// The sample ranges of a command (its `--roughness`, `--nov`, `--nol` flags, else the models' declared domains
+/// within `d`, else `d`), and the words saying where each comes from.
+pub fn sample_domain(flags: [Option<(f64, f64)>; 3], d: brdfprof::diff::SampleDomain, models: &[&Model]) -> Result<(brdfprof::diff::SampleDomain, [String; 3])> {
+    let declared = |pick: &dyn Fn(&Model) -> Option<(f64, f64)>| models.iter().filter_map(|m| pick(m).map(|r| (m.label(), r))).collect::<Vec<_>>();
+    let (roughness, rw) = range_of(("--roughness", flags[0]), d.roughness, declared(&|m| m.roughness_domain()), "roughness")?;
+    let (nov, vw) = range_of(("--nov", flags[1]), d.nov, declared(&|m| m.cosine_domains().0), "N.V")?;
+    let (nol, lw) = range_of(("--nol", flags[2]), d.nol, declared(&|m| m.cosine_domains().1), "N.L")?;
+    Ok((brdfprof::diff::SampleDomain { roughness, nov, nol }, [rw, vw, lw]))
+}
+
 /// `--reference SPEC`: a built-in spec (it has the f64 twin a reference needs).
 pub fn reference_spec(text: &str) -> Result<brdfprof::brdf::ModelSpec, String> {
     brdfprof::brdf::ModelSpec::parse(text).map_err(|e| format!("{e} (a reference is a built-in spec: a preset or D/Vis/F terms, which have an f64 twin)"))

@@ -258,7 +258,8 @@ pub fn sweep_html(i: usize, w: &SweepView, path: &str) -> String {
             ],
         );
     }
-    format!("<h3>{path}</h3><p class=\"note\">{} specs on {}; fastest {}.</p>{}{}", w.rows.len(), esc(&w.sample_set), esc(&w.fastest), sweep_chart(w), t.html())
+    let against = w.against.as_deref().map_or(String::new(), |a| format!(" Errors against {}.", esc(a)));
+    format!("<h3>{path}</h3><p class=\"note\">{} specs on {}; fastest {}.{against}</p>{}{}", w.rows.len(), esc(&w.sample_set), esc(&w.fastest), sweep_chart(w), t.html())
 }
 
 pub fn sweeps(inputs: &[Input]) -> String {

@@ -47,5 +47,8 @@ pub struct SweepView {
     pub fastest: String,
     pub rows: Vec<SweepRowView>,
     pub sample_set: String,
+    /// What "vs exact" is against (absent before the sweep took a reference for every model).
+    #[serde(default)]
+    pub against: Option<String>,
     pub profile: ProfileView,
 }

@@ -95,14 +95,12 @@ fn its_compiler_statistics_on_radv_are_its_twins() {
     let rows = out["rows"].as_array().unwrap();
     let row = |name: &str| rows.iter().find(|r| r["model"] == name).unwrap_or_else(|| panic!("no {name}: {rows:?}"));
     let (e, t) = (row("engine-ggx"), row("engine-ggx-f"));
-    let stat = |r: &serde_json::Value, k: &str| crate::compile_only::stat(r, "Compute Shader", k);
-    // The engine's f_s N.L times the light against the twin's f_s times (N.L times the light): the same
-    // arithmetic, associated differently, which ACO may settle with one register copy more or less.
-    for k in ["VGPRs", "SGPRs", "Spilled VGPRs", "Spilled SGPRs", "Branches"] {
-        assert_eq!(stat(e, k), stat(t, k), "{k}");
-    }
-    assert_eq!(stat(e, "Instructions") - stat(e, "Copies"), stat(t, "Instructions") - stat(t, "Copies"), "instructions other than copies");
-    assert!((stat(e, "Copies") - stat(t, "Copies")).abs() <= 1.0, "copies {} against {}", stat(e, "Copies"), stat(t, "Copies"));
+    // The engine's f_s N.L times the light against the twin's f_s times N.L times the light: the harness weighs
+    // a file's f_s as the engine form weighs its own, so ACO emits the same code (its hash is the code's; the
+    // driver's pipeline hash also covers the SPIR-V, which differs).
+    let stats = |r: &serde_json::Value| r["stats"].as_object().unwrap().iter().filter(|(k, _)| k.starts_with("driver/") && !k.ends_with("Driver pipeline hash")).map(|(k, v)| (k.clone(), v.clone())).collect::<Vec<_>>();
+    assert!(stats(e).iter().any(|(k, _)| k.ends_with("/Instructions")), "{e}");
+    assert_eq!(stats(e), stats(t), "every ACO statistic of the engine form is its twin's");
 }
 
 #[test]
@@ -198,4 +196,56 @@ fn diff_samples_the_files_declared_roughness_domain_unless_told_otherwise() {
         assert!(dot > 0.5 - 1e-5 && r[9] >= 0.0525 - 1e-6, "a row outside the declared domain: {r:?}");
     }
     run_in(d, &["diff", "--model", "own.brdf", "--model", spec, "--nov", "0.2..0.1"]).fails(2, "--nov");
+}
+
+/// The glue forms of docs/engine-brdf.md, each a test file of tests/fixtures/brdf/engine/forms/ with the twin's
+/// maths in another engine's shape.
+fn glue_forms() -> Vec<PathBuf> {
+    let mut forms: Vec<PathBuf> = std::fs::read_dir(fixture("forms")).unwrap().map(|e| e.unwrap().path()).filter(|p| p.extension().is_some_and(|x| x == "brdf")).collect();
+    forms.sort();
+    forms
+}
+
+#[test]
+fn every_glue_form_evaluates_as_its_twin_with_no_glue_written() {
+    let dir = tempfile::tempdir().unwrap();
+    let forms = glue_forms();
+    assert!(forms.len() >= 4, "the page's four forms: {forms:?}");
+    let docs = std::fs::read_to_string(common::repo_root().join("docs/engine-brdf.md")).unwrap();
+    for form in &forms {
+        let name = form.file_name().unwrap().to_str().unwrap();
+        assert!(docs.contains(&format!("forms/{name}")), "docs/engine-brdf.md works through {name}");
+        let json = dir.path().join(format!("{name}.json"));
+        let r = run_in(dir.path(), &["diff", "--samples", "2000", "--model", &twin(), "--model", form.to_str().unwrap(), "--json", json.to_str().unwrap()]).ok();
+        let j: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+        for c in j["difference"]["channels"].as_array().unwrap() {
+            assert!(c["max_rel"].as_f64().unwrap() < 1e-5, "{name} against the twin: {c}\n{}", r.stdout);
+            assert_eq!(c["a_nonfinite"].as_u64().unwrap() + c["b_nonfinite"].as_u64().unwrap(), 0, "{name}: {c}");
+        }
+    }
+}
+
+#[test]
+fn bad_out_and_scratch_arguments_exit_2_at_the_entry_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write_rows(&d.join("in.csv"), 2);
+    let base = std::fs::read_to_string(fixture("forms/accumulator.brdf")).unwrap();
+    let line = base.lines().position(|l| l.starts_with("entry ")).unwrap() + 1;
+    let call = "roughness, @scratch, @out)";
+    let cases = [
+        ("roughness, @out, @out)", format!(":{line}: entry `light_compute`: `@out` is given 2 times")),
+        ("roughness, @scratch, @scratch)", format!(":{line}: entry `light_compute` returns `void`")),
+        ("@out, @scratch, vec3(0.0))", format!(":{line}: entry `light_compute`: argument 7 is `@out` but parameter 7")),
+        ("roughness, @scratch, @diffuse)", format!(":{line}: entry `light_compute`: `@diffuse`: an argument is a GLSL expression")),
+    ];
+    for (to, needle) in cases {
+        std::fs::write(d.join("engine.brdf"), base.replacen(call, to, 1)).unwrap();
+        let r = run_in(d, &["eval", "--model", "engine.brdf", "--input", "in.csv", "--output", "out.csv"]).fails(2, &needle);
+        assert!(!d.join("out.csv").exists(), "{}", r.stderr);
+    }
+    // An `@out` that is not a vec3.
+    let float_out = base.replacen("inout vec3 specular_light", "inout float specular_light", 1).replacen("specular_light += light_color", "specular_light += ndotl; vec3 unused = light_color", 1);
+    std::fs::write(d.join("engine.brdf"), float_out).unwrap();
+    run_in(d, &["eval", "--model", "engine.brdf", "--input", "in.csv", "--output", "out.csv"]).fails(2, &format!(":{line}: entry `light_compute`: the `@out` parameter 9"));
 }

@@ -359,5 +359,5 @@ fn parse_entry(path: &Path, n: usize, text: &str) -> Result<Entry> {
         ["returns", r] => Returns::parse(r).ok_or_else(|| anyhow!(at(path, n, format!("`returns {r}`: expected f or f_nol"))))?,
         _ => bail!(at(path, n, format!("`entry {text}`: expected {form}"))),
     };
-    Ok(Entry { name: name.to_string(), args, returns, line: n })
+    Ok(Entry { name: name.to_string(), args, param_types: Vec::new(), returns, line: n })
 }

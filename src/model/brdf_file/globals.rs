@@ -32,23 +32,50 @@ pub(super) fn check_shader(file: &mut BrdfFile, begin: usize, tokens: &[Token], 
     if file.entries.is_empty() {
         return brdf;
     }
-    file.entries.iter().try_for_each(|e| check_entry(&file.path, e, &scan.globals))
+    for e in &mut file.entries {
+        e.param_types = check_entry(&file.path, e, &scan.globals)?;
+    }
+    Ok(())
 }
 
-/// A declared entry must be a function defined at global scope, returning vec3, with one parameter per argument.
-pub(super) fn check_entry(path: &Path, entry: &Entry, globals: &[Global]) -> Result<()> {
+/// An entry argument brdfprof fills in itself: `@out` takes the value, `@scratch` a value discarded.
+pub(super) const OUT_ARG: &str = "@out";
+pub(super) const SCRATCH_ARG: &str = "@scratch";
+
+/// A declared entry must be a function defined at global scope with one parameter per argument, returning
+/// vec3, or writing its value to the one `@out` argument (an `out`/`inout vec3`; its return value is then
+/// discarded). `@scratch` fills an `out`/`inout` parameter whose value is discarded. Returns each parameter's type.
+pub(super) fn check_entry(path: &Path, entry: &Entry, globals: &[Global]) -> Result<Vec<String>> {
     let defined = globals.iter().find_map(|g| match &g.kind {
-        GlobalKind::Function { defined: true, returns, params } if g.name == entry.name => Some((g.line, returns, params.len())),
+        GlobalKind::Function { defined: true, returns, params } if g.name == entry.name => Some((g.line, returns, params)),
         _ => None,
     });
-    match defined {
-        None => bail!(at(path, entry.line, format!("entry `{}`: the shader defines no function `{}` at global scope", entry.name, entry.name))),
-        Some((line, returns, _)) if returns != "vec3" => bail!(at(path, entry.line, format!("entry `{}` returns `{returns}` (line {line}); an entry returns vec3 (f_s, or f_s N.L with `returns f_nol`)", entry.name))),
-        Some((line, _, count)) if count != entry.args.len() => {
-            bail!(at(path, entry.line, format!("entry `{}` takes {count} arguments (line {line}) and the declaration gives {}", entry.name, entry.args.len())))
-        }
-        Some(_) => Ok(()),
+    let fail = |m: String| Err(anyhow::anyhow!(at(path, entry.line, m)));
+    let Some((line, returns, params)) = defined else { return fail(format!("entry `{}`: the shader defines no function `{}` at global scope", entry.name, entry.name)) };
+    if params.len() != entry.args.len() {
+        return fail(format!("entry `{}` takes {} arguments (line {line}) and the declaration gives {}", entry.name, params.len(), entry.args.len()));
     }
+    if let Some(a) = entry.args.iter().find(|a| a.starts_with('@') && ![OUT_ARG, SCRATCH_ARG].contains(&a.as_str())) {
+        return fail(format!("entry `{}`: `{a}`: an argument is a GLSL expression, `{OUT_ARG}` (the argument the function writes its value to) or `{SCRATCH_ARG}` (one whose value is discarded)", entry.name));
+    }
+    let outs = entry.args.iter().filter(|a| *a == OUT_ARG).count();
+    if outs > 1 {
+        return fail(format!("entry `{}`: `{OUT_ARG}` is given {outs} times; the value is one argument", entry.name));
+    }
+    if outs == 0 && returns != "vec3" {
+        return fail(format!("entry `{}` returns `{returns}` (line {line}); an entry returns vec3 (f_s, or f_s N.L with `returns f_nol`), or writes it to an `{OUT_ARG}` argument", entry.name));
+    }
+    let types: Vec<String> = params.iter().map(|p| p.iter().find(|t| !QUALIFIERS.contains(&t.as_str())).cloned().unwrap_or_default()).collect();
+    for (k, (arg, p)) in entry.args.iter().zip(params).enumerate() {
+        let writable = p.iter().any(|t| t == "out" || t == "inout");
+        if arg.starts_with('@') && !writable {
+            return fail(format!("entry `{}`: argument {} is `{arg}` but parameter {} (line {line}) is not `out` or `inout`", entry.name, k + 1, k + 1));
+        }
+        if arg == OUT_ARG && types[k] != "vec3" {
+            return fail(format!("entry `{}`: the `{OUT_ARG}` parameter {} (line {line}) is `{}`; the value is a vec3", entry.name, k + 1, types[k]));
+        }
+    }
+    Ok(types)
 }
 
 pub(super) const BRDF_SIGNATURE: &str = "vec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y)";

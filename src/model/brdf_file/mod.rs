@@ -124,8 +124,12 @@ pub struct Loop {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Entry {
     pub name: String,
-    /// GLSL expressions over L, V, N, X, Y and the file's parameters, one per argument of the function.
+    /// GLSL expressions over L, V, N, X, Y and the file's parameters, one per argument of the function; or
+    /// `@out` (an `out`/`inout vec3` the function writes its value to, starting at zero: an engine's
+    /// accumulator) or `@scratch` (an `out`/`inout` argument whose value is discarded: a diffuse accumulator).
     pub args: Vec<String>,
+    /// Each parameter's type as the shader declares it (filled by the shader's checks; `@scratch` needs it).
+    pub param_types: Vec<String>,
     pub returns: Returns,
     /// The 1-based file line that declares it.
     pub line: usize,

@@ -79,14 +79,31 @@ impl BrdfFile {
     /// the file's names renamed. The name (the prefix, then a digit) is one no renamed name can take.
     pub fn entry_glue(&self, entry: &Entry) -> (String, String) {
         let name = format!("{}0entry", self.prefix);
-        let args: Vec<String> = entry.args.iter().map(|a| self.renamed_argument(a)).collect();
-        let text = format!(
-            "#line {} \"{}\"\nvec3 {name}(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) {{ return {}({}); }}\n",
-            entry.line,
-            self.directive_name(),
-            self.glsl_name(&entry.name),
-            args.join(", ")
-        );
+        let mut locals = String::new();
+        let mut result = None;
+        let mut args = Vec::new();
+        for (k, a) in entry.args.iter().enumerate() {
+            if a.starts_with('@') {
+                let local = format!("{}0arg{k}", self.prefix);
+                let ty = entry.param_types.get(k).map_or("vec3", String::as_str);
+                // Numbers and vectors start at zero (an accumulator's value is then the function's own sum);
+                // any other type is declared as it is.
+                let zero = ty.starts_with("float") || ["vec2", "vec3", "vec4"].contains(&ty);
+                locals += &if zero { format!("{ty} {local} = {ty}(0.0); ") } else { format!("{ty} {local}; ") };
+                if a == super::globals::OUT_ARG {
+                    result = Some(local.clone());
+                }
+                args.push(local);
+            } else {
+                args.push(self.renamed_argument(a));
+            }
+        }
+        let call = format!("{}({})", self.glsl_name(&entry.name), args.join(", "));
+        let body = match result {
+            Some(out) => format!("{locals}{call}; return {out};"),
+            None => format!("{locals}return {call};"),
+        };
+        let text = format!("#line {} \"{}\"\nvec3 {name}(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) {{ {body} }}\n", entry.line, self.directive_name());
         (name, text)
     }
 
