@@ -46,7 +46,64 @@ pub struct PairCorrelation {
     pub models: usize,
     /// Spearman's rho of the net costs (None with fewer than 3 models in common).
     pub spearman_net: Option<f64>,
+    /// Its percentile-bootstrap 95% CI (`stats::spearman_ci`; None below 4 models).
+    #[serde(default)]
+    pub spearman_ci: Option<(f64, f64)>,
+    /// (model pairs the two order oppositely, pairs both order): the swaps behind rho.
+    #[serde(default)]
+    pub discordant: Option<(usize, usize)>,
 }
+
+impl PairCorrelation {
+    /// The rank agreement of `a` and `b` over the models both have (the memory-only kernel left out).
+    pub fn of(a: (&str, &BTreeMap<String, f64>), b: (&str, &BTreeMap<String, f64>), models: &[String]) -> Self {
+        let common: Vec<&String> = models.iter().filter(|m| *m != BASELINE_LABEL && a.1.contains_key(*m) && b.1.contains_key(*m)).collect();
+        let xs: Vec<f64> = common.iter().map(|m| a.1[*m]).collect();
+        let ys: Vec<f64> = common.iter().map(|m| b.1[*m]).collect();
+        let enough = common.len() >= 3;
+        PairCorrelation {
+            a: a.0.to_string(),
+            b: b.0.to_string(),
+            models: common.len(),
+            spearman_net: enough.then(|| crate::stats::spearman(&xs, &ys)),
+            spearman_ci: crate::stats::spearman_ci(&xs, &ys, 0.95),
+            discordant: enough.then(|| crate::stats::discordant_pairs(&xs, &ys)),
+        }
+    }
+
+    /// rho with its CI: `0.92 [0.85, 0.96]`; a rho over fewer than 4 models has no CI and says so.
+    pub fn rho_cell(&self) -> String {
+        match (self.spearman_net, self.spearman_ci) {
+            (None, _) => "- (fewer than 3 models)".into(),
+            (Some(r), Some((lo, hi))) => format!("{r:.2} [{lo:.2}, {hi:.2}]"),
+            (Some(r), None) => format!("{r:.2} (no CI: {} models)", self.models),
+        }
+    }
+
+    pub fn discordant_cell(&self) -> String {
+        self.discordant.map_or("-".into(), |(d, n)| format!("{d} of {n}"))
+    }
+}
+
+/// Each kernel's SPIR-V instruction count after spirv-opt -O (`spirv-O/total`, the light loop unrolled as the
+/// targets unroll it) net of the memory-only kernel's, from the first report that has them.
+pub fn spirv_counts(reports: &[InspectReport]) -> BTreeMap<String, f64> {
+    for r in reports {
+        let total = |m: &str| r.rows.iter().find(|x| x.model == m).and_then(|x| x.stats.get("spirv-O/total").copied());
+        let Some(base) = total(BASELINE_LABEL) else { continue };
+        let counts: BTreeMap<String, f64> = r.rows.iter().filter(|x| x.model != BASELINE_LABEL).filter_map(|x| x.stats.get("spirv-O/total").map(|t| (x.model.clone(), t - base))).collect();
+        if !counts.is_empty() {
+            return counts;
+        }
+    }
+    BTreeMap::new()
+}
+
+/// How the rank tables' CIs are made.
+pub const RHO_NOTE: &str = "CIs: percentile bootstrap over the models (4,000 draws with replacement, seed 2026); discordant pairs: model pairs the two order oppositely, of those both order (ties left out).";
+
+/// The name the SPIR-V baseline goes by in tables.
+pub const SPIRV_BASELINE: &str = "SPIR-V instructions (spirv-opt -O)";
 
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct CostTable {
@@ -54,6 +111,10 @@ pub struct CostTable {
     pub models: Vec<String>,
     pub columns: Vec<CostColumn>,
     pub correlations: Vec<PairCorrelation>,
+    /// Each column against the kernels' SPIR-V instruction count (`spirv_counts`): what a plain op count
+    /// already predicts, the baseline a compiler's ranking is read against (empty without SPIR-V counts).
+    #[serde(default)]
+    pub spirv_baseline: Vec<PairCorrelation>,
 }
 
 fn hashes(report: &InspectReport) -> BTreeMap<String, String> {
@@ -183,21 +244,21 @@ pub fn build(columns: Vec<CostColumn>) -> CostTable {
     for i in 0..columns.len() {
         for j in i + 1..columns.len() {
             let (a, b) = (&columns[i], &columns[j]);
-            let common: Vec<&String> = models.iter().filter(|m| a.net.contains_key(*m) && b.net.contains_key(*m)).collect();
-            let xs: Vec<f64> = common.iter().map(|m| a.net[*m]).collect();
-            let ys: Vec<f64> = common.iter().map(|m| b.net[*m]).collect();
-            correlations.push(PairCorrelation {
-                a: a.name.clone(),
-                b: b.name.clone(),
-                models: common.len(),
-                spearman_net: (common.len() >= 3).then(|| crate::stats::spearman(&xs, &ys)),
-            });
+            correlations.push(PairCorrelation::of((&a.name, &a.net), (&b.name, &b.net), &models));
         }
     }
-    CostTable { models, columns, correlations }
+    CostTable { models, columns, correlations, spirv_baseline: Vec::new() }
 }
 
 impl CostTable {
+    /// The table with every column's rank agreement with the SPIR-V counts (`spirv_counts`).
+    pub fn with_spirv_baseline(mut self, counts: &BTreeMap<String, f64>) -> Self {
+        if !counts.is_empty() {
+            self.spirv_baseline = self.columns.iter().map(|c| PairCorrelation::of((SPIRV_BASELINE, counts), (&c.name, &c.net), &self.models)).collect();
+        }
+        self
+    }
+
     /// Net cost relative to ggx's net cost in the same column.
     pub fn relative(&self, column: &CostColumn, model: &str) -> Option<f64> {
         let g = column.net.get(crate::brdf::spec::REFERENCE_MODEL)?;
@@ -230,11 +291,21 @@ impl CostTable {
         out += &self.columns.iter().map(|c| format!("{}: {} ({} lights)", c.name, c.source, c.lights)).collect::<Vec<_>>().join("; ");
         out += "\n\n";
         if !self.correlations.is_empty() {
-            let mut t = Table::new(["device A", "device B", "models", "Spearman rho (net cost)"]);
+            let mut t = Table::new(["device A", "device B", "models", "Spearman rho (net cost) [95% CI]", "discordant pairs"]);
             for p in &self.correlations {
-                t.row([p.a.clone(), p.b.clone(), p.models.to_string(), p.spearman_net.map_or("- (fewer than 3 models)".into(), |r| format!("{r:.2}"))]);
+                t.row([p.a.clone(), p.b.clone(), p.models.to_string(), p.rho_cell(), p.discordant_cell()]);
             }
-            out += &format!("### Rank correlation between devices\n\n{}\n", t.markdown());
+            out += &format!("### Rank correlation between devices\n\n{}\n{RHO_NOTE}\n\n", t.markdown());
+        }
+        if !self.spirv_baseline.is_empty() {
+            let mut t = Table::new(["device", "models", "Spearman rho with the SPIR-V count [95% CI]", "discordant pairs"]);
+            for p in &self.spirv_baseline {
+                t.row([p.b.clone(), p.models.to_string(), p.rho_cell(), p.discordant_cell()]);
+            }
+            out += &format!(
+                "### Against a plain SPIR-V instruction count\n\nEach device's net cost against the kernel's SPIR-V instructions after spirv-opt -O, net of the memory-only kernel's: what counting ops already predicts. A device pair agreeing no better than each agrees with this count says little about the compilers.\n\n{}\n",
+                t.markdown()
+            );
         }
         out
     }

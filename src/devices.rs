@@ -187,7 +187,7 @@ fn cost_table(reports: &[InspectReport], profile: Option<&ProfileReport>) -> Res
     for r in reports {
         columns.extend(compare::inspect_columns(r, ""));
     }
-    Ok((compare::build(columns), profile_note))
+    Ok((compare::build(columns).with_spirv_baseline(&compare::spirv_counts(reports)), profile_note))
 }
 
 /// Each device's section (a compile-only target's cost table alone: its SPIR-V and naga counts are every

@@ -25,24 +25,7 @@ pub const HISTOGRAM_EDGES: [f64; 9] = [0.0, 1e-7, 1e-6, 1e-5, 1e-4, 1e-3, 1e-2, 
 /// The largest input `diff` evaluates (both models' outputs and the statistics stay within a few GB).
 pub const MAX_SAMPLES: usize = 20_000_000;
 
-/// The ranges the default samples are drawn from: perceptual roughness, NoV and NoL.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SampleDomain {
-    pub roughness: (f64, f64),
-    pub nov: (f64, f64),
-    pub nol: (f64, f64),
-}
-
-/// NoV and NoL of the default samples start here: well conditioned, so that grazing rounding is not a model's
-/// error.
-pub const DEFAULT_MIN_COS: f64 = 0.05;
-
-impl Default for SampleDomain {
-    /// Roughness in [0, 1] so that the roughness floor is crossed; NoV, NoL in [DEFAULT_MIN_COS, 1].
-    fn default() -> Self {
-        SampleDomain { roughness: (0.0, 1.0), nov: (DEFAULT_MIN_COS, 1.0), nol: (DEFAULT_MIN_COS, 1.0) }
-    }
-}
+pub use crate::brdf::samples::{SampleDomain, DEFAULT_MIN_COS};
 
 /// The default inputs: `count` well-conditioned samples (`SampleDomain::default()`, F0 uniform in [0, 1]^3),
 /// seeded.

@@ -95,6 +95,55 @@ pub fn mann_whitney_p(a: &[f64], b: &[f64]) -> f64 {
     libm::erfc(z / std::f64::consts::SQRT_2)
 }
 
+/// Pairs that `x` and `y` order oppositely, and the pairs both order (a tie on either side is left out):
+/// Kendall's discordant pairs, the swaps behind a rank correlation.
+pub fn discordant_pairs(x: &[f64], y: &[f64]) -> (usize, usize) {
+    let (mut discordant, mut ordered) = (0, 0);
+    for i in 0..x.len() {
+        for j in i + 1..x.len() {
+            if x[i] == x[j] || y[i] == y[j] {
+                continue;
+            }
+            ordered += 1;
+            if (x[i] < x[j]) != (y[i] < y[j]) {
+                discordant += 1;
+            }
+        }
+    }
+    (discordant, ordered)
+}
+
+/// Bootstrap draws behind `spearman_ci`, and their seed (fixed, so that a table is reproducible).
+pub const BOOTSTRAP_RESAMPLES: usize = 4000;
+pub const BOOTSTRAP_SEED: u64 = 2026;
+
+/// Percentile-bootstrap CI at `level` of Spearman's rho: `BOOTSTRAP_RESAMPLES` draws of the n pairs with
+/// replacement; a draw whose ranks are all tied on one side has no rho and is left out. None below 4 pairs.
+pub fn spearman_ci(x: &[f64], y: &[f64], level: f64) -> Option<(f64, f64)> {
+    use rand::{Rng, SeedableRng};
+    let n = x.len();
+    if n < 4 {
+        return None;
+    }
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(BOOTSTRAP_SEED);
+    let mut rhos: Vec<f64> = (0..BOOTSTRAP_RESAMPLES)
+        .filter_map(|_| {
+            let idx: Vec<usize> = (0..n).map(|_| rng.random_range(0..n)).collect();
+            let (a, b): (Vec<f64>, Vec<f64>) = idx.iter().map(|&i| (x[i], y[i])).unzip();
+            Some(spearman(&a, &b)).filter(|r| r.is_finite())
+        })
+        .collect();
+    if rhos.is_empty() {
+        return None;
+    }
+    rhos.sort_by(f64::total_cmp);
+    let tail = (1.0 - level) / 2.0;
+    let m = rhos.len();
+    let lo = rhos[((tail * m as f64).floor() as usize).min(m - 1)];
+    let hi = rhos[(((1.0 - tail) * m as f64).ceil() as usize).clamp(1, m) - 1];
+    Some((lo, hi))
+}
+
 /// Spearman's rank correlation.
 pub fn spearman(x: &[f64], y: &[f64]) -> f64 {
     fn ranks(v: &[f64]) -> Vec<f64> {
@@ -147,6 +196,27 @@ mod tests {
         assert!(mann_whitney_p(&a, &b) < 1e-3);
         let c: Vec<f64> = (0..12).map(|i| 10.05 + i as f64 * 0.1).collect();
         assert!(mann_whitney_p(&a, &c) > 0.5);
+    }
+
+    #[test]
+    fn discordant_pairs_count_the_swaps() {
+        assert_eq!(discordant_pairs(&[1.0, 2.0, 3.0, 4.0], &[10.0, 20.0, 30.0, 40.0]), (0, 6));
+        // One swap of neighbours: one discordant pair; a tie leaves its pairs out.
+        assert_eq!(discordant_pairs(&[1.0, 2.0, 3.0, 4.0], &[10.0, 30.0, 20.0, 40.0]), (1, 6));
+        assert_eq!(discordant_pairs(&[1.0, 2.0, 3.0], &[5.0, 5.0, 6.0]), (0, 2));
+    }
+
+    #[test]
+    fn spearman_ci_covers_the_estimate_and_narrows_with_more_models() {
+        let x: Vec<f64> = (0..60).map(f64::from).collect();
+        // A noisy monotone relation (a fixed pseudo-random wobble).
+        let y: Vec<f64> = x.iter().map(|v| v + 15.0 * ((v * 12.9898).sin() * 43758.5453).fract()).collect();
+        let rho = spearman(&x, &y);
+        let (lo, hi) = spearman_ci(&x, &y, 0.95).unwrap();
+        assert!(lo <= rho && rho <= hi && hi <= 1.0 && lo > 0.5, "{lo} {rho} {hi}");
+        let (lo6, hi6) = spearman_ci(&x[..6], &y[..6], 0.95).unwrap();
+        assert!(hi6 - lo6 > hi - lo, "six models: [{lo6}, {hi6}] against sixty: [{lo}, {hi}]");
+        assert_eq!(spearman_ci(&x[..3], &y[..3], 0.95), None);
     }
 
     #[test]

@@ -6,7 +6,7 @@ pub mod view;
 
 use crate::accuracy::{self, Accuracy, ExactCache, SampleSet};
 use crate::brdf::exact::ExactFresnel;
-use crate::diff::SampleDomain;
+use crate::brdf::samples::SampleDomain;
 use crate::brdf::spec::with_each_param_sample;
 use crate::brdf::{ModelSpec, Precision, Vis, D, F, THESIS_MODELS};
 use crate::chart::{self, Point};

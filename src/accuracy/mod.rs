@@ -5,7 +5,7 @@
 pub mod albedo;
 
 use crate::brdf::exact::{self, ExactFresnel, Lambda};
-use crate::diff::SampleDomain;
+use crate::brdf::samples::SampleDomain;
 use crate::brdf::{samples, ModelSpec, Sample, D, F};
 use crate::gpu::Gpu;
 use crate::kernels::{self, AlbedoCell, RunLimits};

@@ -6,6 +6,26 @@ use glam::DVec3;
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 
+/// The ranges samples are drawn from: perceptual roughness, NoV and NoL (`diff`'s default samples, `sweep`'s
+/// stratified set).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SampleDomain {
+    pub roughness: (f64, f64),
+    pub nov: (f64, f64),
+    pub nol: (f64, f64),
+}
+
+/// NoV and NoL of `diff`'s default samples start here: well conditioned, so that grazing rounding is not a model's
+/// error.
+pub const DEFAULT_MIN_COS: f64 = 0.05;
+
+impl Default for SampleDomain {
+    /// `diff`'s: roughness in [0, 1] so that the roughness floor is crossed; NoV, NoL in [DEFAULT_MIN_COS, 1].
+    fn default() -> Self {
+        SampleDomain { roughness: (0.0, 1.0), nov: (DEFAULT_MIN_COS, 1.0), nol: (DEFAULT_MIN_COS, 1.0) }
+    }
+}
+
 /// Unit vector with the given cosine to `n` and azimuth `phi` about it.
 pub fn around(n: DVec3, cos_theta: f64, phi: f64) -> DVec3 {
     let (t, b) = tangent_frame(n);

@@ -34,6 +34,25 @@ pub struct Correlation {
     pub spearman_net: Option<f64>,
     /// Spearman's rho between gross Ir and gross ns per evaluation over every kernel, baseline included.
     pub spearman_gross: Option<f64>,
+    /// Their percentile-bootstrap 95% CIs (`stats::spearman_ci`; None below 4 kernels).
+    #[serde(default)]
+    pub spearman_net_ci: Option<(f64, f64)>,
+    #[serde(default)]
+    pub spearman_gross_ci: Option<(f64, f64)>,
+}
+
+/// The bootstrap CI of `rho`'s pairs.
+fn rho_ci(pairs: &[(f64, f64)]) -> Option<(f64, f64)> {
+    stats::spearman_ci(&pairs.iter().map(|p| p.0).collect::<Vec<_>>(), &pairs.iter().map(|p| p.1).collect::<Vec<_>>(), 0.95)
+}
+
+/// rho and its CI as a table's text says them.
+fn rho_text(rho: Option<f64>, ci: Option<(f64, f64)>) -> String {
+    match (rho, ci) {
+        (None, _) => "-".into(),
+        (Some(r), Some((lo, hi))) => format!("{r:.2} [95% CI {lo:.2}, {hi:.2}]"),
+        (Some(r), None) => format!("{r:.2} (no CI: fewer than 4 kernels)"),
+    }
 }
 
 /// Spearman's rho, where there are at least three pairs to rank.
@@ -102,6 +121,8 @@ pub fn correlate_with(report: &InspectReport, profile: &ProfileReport) -> Result
         reference,
         spearman_net: rho(&net),
         spearman_gross: rho(&gross),
+        spearman_net_ci: rho_ci(&net),
+        spearman_gross_ci: rho_ci(&gross),
         rows: out,
     })
 }
@@ -131,11 +152,11 @@ impl Correlation {
             ]);
         }
         format!(
-            "Timings from {} ({} lights). Spearman's rank correlation, net of the memory-only kernel (models): {}; gross (every kernel): {}.\n\n{}",
+            "Timings from {} ({} lights). Spearman's rank correlation (CIs by percentile bootstrap over the kernels), net of the memory-only kernel (models): {}; gross (every kernel): {}.\n\n{}",
             self.profile,
             self.profile_lights,
-            f(self.spearman_net),
-            f(self.spearman_gross),
+            rho_text(self.spearman_net, self.spearman_net_ci),
+            rho_text(self.spearman_gross, self.spearman_gross_ci),
             t.markdown()
         )
     }
