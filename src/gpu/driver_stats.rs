@@ -50,7 +50,8 @@ fn value(s: &vk::PipelineExecutableStatisticKHR) -> f64 {
 impl Kernel<'_> {
     /// The pipeline's executables, or None when the device lacks VK_KHR_pipeline_executable_properties.
     pub fn executables(&self) -> Result<Option<Vec<PipelineExecutable>>> {
-        if let Some(stats) = &self.logged_stats {
+        let beside = self.gpu.compiler_log.is_some_and(|l| l.beside_properties);
+        if let (Some(stats), false) = (&self.logged_stats, beside) {
             return Ok(Some(vec![PipelineExecutable { name: LOGGED_EXECUTABLE.into(), subgroup_size: 0, stats: stats.clone(), representations: Vec::new() }]));
         }
         let Some(ext) = &self.gpu.executable_properties else { return Ok(None) };
@@ -70,6 +71,10 @@ impl Kernel<'_> {
                 .collect();
             let representations = if self.captures_ir { self.representations(ext, &exe_info)? } else { Vec::new() };
             out.push(PipelineExecutable { name, subgroup_size: exe.subgroup_size, stats, representations });
+        }
+        // Logged statistics beside the extension's join the (one) compute executable's, under its name.
+        if let (Some(logged), Some(first)) = (&self.logged_stats, out.first_mut()) {
+            first.stats.extend(logged.iter().map(|s| DriverStat { executable: first.name.clone(), ..s.clone() }));
         }
         Ok(Some(out))
     }

@@ -269,7 +269,7 @@ fn create_logged_pipeline(gpu: &Gpu, name: &str, module: vk::ShaderModule, layou
     let Some(read) = gpu.compiler_log else { return Ok((create_pipeline(gpu, name, module, layout, map, data, flags)?, None)) };
     let (pipeline, log) = super::stderr_capture::capture(|| create_pipeline(gpu, name, module, layout, map, data, flags))?;
     let pipeline = pipeline?;
-    let read = read(&log).with_context(|| format!("{name}: the statistics {} printed while compiling it", gpu.info.name));
+    let read = (read.read)(&log).with_context(|| format!("{name}: the statistics {} printed while compiling it", gpu.info.name));
     // SAFETY: the pipeline was just created on this device and nothing uses it.
     let (stats, rest) = read.inspect_err(|_| unsafe { gpu.device.destroy_pipeline(pipeline, None) })?;
     super::stderr_capture::pass_on(&rest);

@@ -45,9 +45,16 @@ pub struct GpuOptions {
     pub compiler_log: Option<CompilerLog>,
 }
 
-/// Reads a driver's stderr output of one pipeline creation into its statistics (executable "Compute Shader")
-/// and the lines that are not its statistics (they go on to the real stderr).
-pub type CompilerLog = fn(&str) -> Result<(Vec<DriverStat>, Vec<String>)>;
+/// How to read a driver's stderr output of one pipeline creation.
+#[derive(Clone, Copy, Debug)]
+pub struct CompilerLog {
+    /// Its statistics (executable "Compute Shader") and the lines that are not its statistics (they go on to
+    /// the real stderr).
+    pub read: fn(&str) -> Result<(Vec<DriverStat>, Vec<String>)>,
+    /// The statistics join those of VK_KHR_pipeline_executable_properties (ACO's perfinfo schedule beside ACO's
+    /// statistics) instead of standing for them (PanVK's shader-db line).
+    pub beside_properties: bool,
+}
 
 /// Set in a process whose Vulkan devices are drivers on Mesa's noop kernel shims (`targets::mesa_noop`'s child).
 static COMPILE_ONLY_PROCESS: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);

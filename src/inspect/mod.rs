@@ -9,6 +9,7 @@ pub mod cost;
 pub mod correlate;
 pub mod driver;
 pub mod naga_info;
+pub mod schedule;
 pub mod timing;
 
 use crate::spirv;

@@ -8,7 +8,9 @@
 
 use super::cost::{self, TargetCost};
 use super::{ocloc, Request, Run, Target};
+use super::gen_isa;
 use crate::gpu::DriverStat;
+use crate::inspect::schedule::{Schedule, LATENCY, PIPE_PREFIX, RESIDENT_WAVES};
 use crate::inspect::InspectReport;
 use anyhow::{anyhow, bail, Result};
 use std::collections::BTreeMap;
@@ -24,14 +26,36 @@ pub struct Family {
     pub products: &'static str,
     /// Column of `THROUGHPUT`.
     column: usize,
+    /// Bytes of a general register (Xe-HPC: 64).
+    pub grf_bytes: u32,
+    /// Hardware threads an EU (vector engine) holds with 128 registers each; half of them in large-GRF mode.
+    pub threads: u32,
+    pub pipes: Pipes,
+    /// IGC's scheduler latencies: its Gen8-Gen11 ("legacy") table, or its Xe table.
+    pub legacy_latency: bool,
+}
+
+/// How an EU's instructions reach its pipes: the pipes of the throughput bound and of the schedule.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Pipes {
+    /// Gen9, Gen11: two SIMD-4 FPUs both run FP and integer work, one of them extended math too (Gen9
+    /// whitepaper, 5.3.2).
+    TwoFpus,
+    /// Xe-LP: one in-order pipe for FP and integer work (IGA's one SWSB distance pipe; Mesa: "On TGL all
+    /// instructions that use the RegDist synchronization mechanism are considered to be executed as a single
+    /// in-order pipeline") and the extended-math pipe.
+    OneAlu,
+    /// Xe-HPG, Xe-HPC: float, integer and long (64-bit) in-order pipes (IGA's SWSB distance pipes F@, I@,
+    /// L@; which instruction goes where as Mesa's `inferred_exec_pipe`) and the extended-math pipe.
+    ThreePipes,
 }
 
 pub const FAMILIES: [Family; 5] = [
-    Family { name: "gen9", device: "skl", architecture: "Gen9", products: "HD/UHD Graphics 5xx-6xx (Skylake to Comet Lake)", column: 0 },
-    Family { name: "gen11", device: "icllp", architecture: "Gen11", products: "Iris Plus / UHD (Ice Lake)", column: 1 },
-    Family { name: "gen12lp", device: "tgllp", architecture: "Xe-LP (Gen12LP)", products: "Iris Xe / UHD (Tiger Lake to Raptor Lake), Iris Xe MAX", column: 2 },
-    Family { name: "xe-hpg", device: "dg2", architecture: "Xe-HPG", products: "Arc A-series (Alchemist, ACM-G10)", column: 3 },
-    Family { name: "xe-hpc", device: "pvc", architecture: "Xe-HPC", products: "Data Center GPU Max (Ponte Vecchio)", column: 4 },
+    Family { name: "gen9", device: "skl", architecture: "Gen9", products: "HD/UHD Graphics 5xx-6xx (Skylake to Comet Lake)", column: 0, grf_bytes: 32, threads: 7, pipes: Pipes::TwoFpus, legacy_latency: true },
+    Family { name: "gen11", device: "icllp", architecture: "Gen11", products: "Iris Plus / UHD (Ice Lake)", column: 1, grf_bytes: 32, threads: 7, pipes: Pipes::TwoFpus, legacy_latency: true },
+    Family { name: "gen12lp", device: "tgllp", architecture: "Xe-LP (Gen12LP)", products: "Iris Xe / UHD (Tiger Lake to Raptor Lake), Iris Xe MAX", column: 2, grf_bytes: 32, threads: 7, pipes: Pipes::OneAlu, legacy_latency: false },
+    Family { name: "xe-hpg", device: "dg2", architecture: "Xe-HPG", products: "Arc A-series (Alchemist, ACM-G10)", column: 3, grf_bytes: 32, threads: 8, pipes: Pipes::ThreePipes, legacy_latency: false },
+    Family { name: "xe-hpc", device: "pvc", architecture: "Xe-HPC", products: "Data Center GPU Max (Ponte Vecchio)", column: 4, grf_bytes: 64, threads: 8, pipes: Pipes::ThreePipes, legacy_latency: false },
 ];
 
 /// The families of `THROUGHPUT`'s columns.
@@ -51,9 +75,9 @@ pub struct Rate {
 pub const THROUGHPUT: &[Rate] = &[
     Rate { row: FP32, lanes_per_clock: [8, 8, 8, 8, 16] },
     Rate { row: FP16, lanes_per_clock: [16, 16, 16, 16, 32] },
-    Rate { row: INT32, lanes_per_clock: [8, 8, 8, 8, 16] },
-    Rate { row: EM, lanes_per_clock: [2, 2, 2, 2, 4] },
-    Rate { row: EM_TWO_SOURCE, lanes_per_clock: [1, 1, 2, 2, 4] },
+    Rate { row: INT32, lanes_per_clock: [8, 4, 8, 8, 16] },
+    Rate { row: EM, lanes_per_clock: [2, 2, 2, 2, 2] },
+    Rate { row: EM_TWO_SOURCE, lanes_per_clock: [1, 1, 2, 2, 2] },
 ];
 
 const FP32: &str = "FP32 add, multiply, multiply-add";
@@ -115,41 +139,61 @@ fn row_of(class: Class, dst_type: &str, function: &str) -> Option<&'static str> 
     }
 }
 
+/// The pipe an instruction issues to on `family` (`Pipes`).
+fn pipe_of(i: &gen_isa::Instruction, family: &Family) -> Pipe {
+    match classify(&i.mnemonic) {
+        Class::Send => Pipe::Send,
+        Class::Control => Pipe::Branch,
+        Class::ExtendedMath => Pipe::ExtendedMath,
+        _ if family.pipes != Pipes::ThreePipes => Pipe::Alu,
+        // Mesa's inferred_exec_pipe: 64-bit types and dword integer multiplies on the long pipe, float
+        // destinations on the float pipe, the rest on the integer pipe.
+        _ if ["df", "q", "uq"].contains(&i.dst_type.as_str()) || (["mul", "mad", "mach"].contains(&i.mnemonic.as_str()) && ["d", "ud"].contains(&i.dst_type.as_str())) => Pipe::Long,
+        _ if ["f", "hf", "bf"].contains(&i.dst_type.as_str()) => Pipe::Float,
+        _ => Pipe::Int,
+    }
+}
+
+/// The pipe an instruction occupies and for how many EU cycles: its execution size over its row's lanes per
+/// clock, at least one cycle; None for sends, control and sync, which take one issue cycle.
+fn occupancy(i: &gen_isa::Instruction, family: &Family) -> Result<Option<(Pipe, f64)>> {
+    let Some(row) = row_of(classify(&i.mnemonic), &i.dst_type, &i.function) else { return Ok(None) };
+    let lanes = rate(row, family).ok_or_else(|| anyhow!("the throughput table has no row `{row}`"))?;
+    Ok(Some((pipe_of(i, family), (f64::from(i.exec_size) / f64::from(lanes)).max(1.0))))
+}
+
+/// Cycles until an instruction's result can be read, by IGC's scheduler tables (`XE_*`, `LEGACY_*`).
+fn latency(i: &gen_isa::Instruction, family: &Family) -> f64 {
+    let class = classify(&i.mnemonic);
+    let two_source = TWO_SOURCE_FUNCTIONS.contains(&i.function.as_str());
+    if class == Class::Send {
+        return super::sass::MEMORY.cycles;
+    }
+    if family.legacy_latency {
+        return match class {
+            Class::ExtendedMath if two_source => LEGACY_MATH_TWO_SOURCE,
+            Class::ExtendedMath => LEGACY_MATH,
+            _ => LEGACY_PIPELINE,
+        };
+    }
+    let scale = match i.exec_size {
+        0..=8 => 0.0,
+        16 => 1.0,
+        _ => 3.0,
+    };
+    let writes_arf = i.writes.iter().any(|r| matches!(r, gen_isa::Reg::Flag(_) | gen_isa::Reg::Arf(_)));
+    match class {
+        Class::ExtendedMath => XE_MATH + XE_DELTA_MATH * scale,
+        _ if writes_arf => XE_ARF,
+        Class::Fma if i.writes.iter().any(|r| matches!(r, gen_isa::Reg::Acc(_))) => XE_FPU_ACC + XE_DELTA * scale,
+        Class::Fma => XE_FPU + XE_DELTA * scale,
+        _ => XE_FPU,
+    }
+}
+
 /// The rate of row `row` on `family` (lanes per clock per EU).
 pub fn rate(row: &str, family: &Family) -> Option<u32> {
     THROUGHPUT.iter().find(|r| r.row == row).map(|r| r.lanes_per_clock[family.column])
-}
-
-/// One instruction of IGA's listing: its mnemonic, execution size and destination type.
-#[derive(Debug, PartialEq)]
-pub struct Instruction<'a> {
-    pub mnemonic: &'a str,
-    /// What follows the mnemonic's first `.` (`math.pow`: `pow`; `sync.nop`: `nop`), empty if nothing.
-    pub function: &'a str,
-    pub exec_size: u32,
-    pub dst_type: &'a str,
-}
-
-/// Parses one line of IGA's listing (`(W&f0.0) sel (16|M0) (lt)f1.0 r39.0<1>:f ...`); None for labels,
-/// comments and blank lines.
-pub fn instruction(line: &str) -> Option<Instruction<'_>> {
-    let code = line.split("//").next()?.trim();
-    if code.is_empty() || code.ends_with(':') {
-        return None;
-    }
-    let mut words = code.split_whitespace().peekable();
-    if words.peek()?.starts_with('(') {
-        words.next();
-    }
-    let op = words.next()?;
-    let (mnemonic, function) = op.split_once('.').map_or((op, ""), |(m, f)| (m, f.split('.').next().unwrap_or(f)));
-    if !mnemonic.chars().all(|c| c.is_ascii_alphanumeric()) || mnemonic.is_empty() {
-        return None;
-    }
-    let rest: Vec<&str> = words.collect();
-    let exec_size = rest.iter().find_map(|w| w.strip_prefix('(')?.split('|').next()?.parse().ok()).unwrap_or(1);
-    let dst_type = rest.iter().find(|w| w.contains(':') && !w.starts_with('{')).and_then(|w| w.rsplit(':').next()).unwrap_or("");
-    Some(Instruction { mnemonic, function, exec_size, dst_type })
 }
 
 /// The u32 words of every patch token in ocloc's PTM.txt dump, by token number (a token present twice keeps
@@ -190,7 +234,7 @@ fn instruction_bytes(line: &str) -> u64 {
 /// Whether IGA's `listing` is the whole kernel: it reaches the thread's end (a send with EOT) and its
 /// instructions fill the kernel's code (`code_bytes`, the binary's unpadded kernel size) exactly.
 pub fn check_listing(listing: &str, code_bytes: Option<usize>) -> std::result::Result<(), String> {
-    let lines: Vec<&str> = listing.lines().filter(|l| instruction(l).is_some()).collect();
+    let lines: Vec<&str> = listing.lines().filter(|l| gen_isa::instruction(l, 32).is_some()).collect();
     if !lines.iter().any(|l| l.split("//").next().is_some_and(|c| c.contains("EOT"))) {
         return Err(format!("{} instructions and no end of thread (EOT)", lines.len()));
     }
@@ -226,15 +270,60 @@ pub struct IsaStats {
     /// Lanes per `THROUGHPUT` row (None: instructions issued in one cycle each).
     pub by_row: BTreeMap<Option<&'static str>, Vec<u32>>,
     pub binary_bytes: u32,
+    /// The listing's instructions with their registers (`gen_isa`).
+    pub listing: Vec<gen_isa::Instruction>,
 }
 
+/// A pipe of `Pipes`, as the bound and the schedule count it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+enum Pipe {
+    /// FP and integer work: Xe-LP's one pipe, or Gen9/Gen11's two FPUs together.
+    Alu,
+    Float,
+    Int,
+    Long,
+    ExtendedMath,
+    Send,
+    Branch,
+}
+
+impl Pipe {
+    fn name(self, pipes: Pipes) -> &'static str {
+        match (self, pipes) {
+            (Pipe::Alu, Pipes::TwoFpus) => "FPU0 + FPU1 (FP, integer, extended math)",
+            (Pipe::Alu, _) => "ALU (FP, integer)",
+            (Pipe::Float, _) => "FP",
+            (Pipe::Int, _) => "integer",
+            (Pipe::Long, _) => "long (64-bit)",
+            (Pipe::ExtendedMath, Pipes::TwoFpus) => "FPU1 (extended math)",
+            (Pipe::ExtendedMath, _) => "extended math",
+            (Pipe::Send, _) => "send",
+            (Pipe::Branch, _) => "branch",
+        }
+    }
+}
+
+/// IGC's Xe scheduler latencies (visa/LocalScheduler/LatencyTable.h, LatenciesXe): FPU 10, FPU with an
+/// accumulator destination 6, extended math 17, flag and address destinations 16, each plus its per-width
+/// delta (1 and 4 cycles x 0/1/3 for SIMD8/16/32); the legacy (Gen8-11) table: every pipe 14, math 22, pow and
+/// fdiv 30.
+const XE_FPU: f64 = 10.0;
+const XE_FPU_ACC: f64 = 6.0;
+const XE_MATH: f64 = 17.0;
+const XE_ARF: f64 = 16.0;
+const XE_DELTA: f64 = 1.0;
+const XE_DELTA_MATH: f64 = 4.0;
+const LEGACY_PIPELINE: f64 = 14.0;
+const LEGACY_MATH: f64 = 22.0;
+const LEGACY_MATH_TWO_SOURCE: f64 = 30.0;
+
 impl IsaStats {
-    pub fn of(binary: &ocloc::Binary) -> Result<Self> {
+    pub fn of(binary: &ocloc::Binary, family: &Family) -> Result<Self> {
         let tokens = patch_tokens(&binary.tokens);
         let env = tokens.get(&EXECUTION_ENVIRONMENT).filter(|w| w.len() > GRF_WORD).ok_or_else(|| anyhow!("ocloc's patch tokens carry no execution environment (SIMD width, GRF count)"))?;
         let scratch = |t: u32| tokens.get(&t).and_then(|w| w.get(1).copied()).unwrap_or(0);
         let mut s = IsaStats { simd: env[SIMD_WORD], grf: env[GRF_WORD], scratch_bytes: scratch(MEDIA_VFE_STATE) + scratch(MEDIA_VFE_STATE_SLOT1), binary_bytes: kernel_bytes(&binary.tokens).unwrap_or(binary.bytes) as u32, ..Default::default() };
-        s.count(&binary.listing);
+        s.count(&binary.listing, family.grf_bytes);
         if s.instructions == 0 || ![8, 16, 32].contains(&s.simd) {
             bail!("IGA's listing has {} instructions and the binary says SIMD{}: not a kernel brdfprof can count", s.instructions, s.simd);
         }
@@ -243,33 +332,58 @@ impl IsaStats {
     }
 
     /// Counts IGA's listing: instructions by class, and their execution sizes by `THROUGHPUT` row.
-    fn count(&mut self, listing: &str) {
-        for i in listing.lines().filter_map(instruction) {
-            let class = classify(i.mnemonic);
+    fn count(&mut self, listing: &str, grf_bytes: u32) {
+        self.listing = gen_isa::instructions(listing, grf_bytes);
+        for i in &self.listing {
+            let class = classify(&i.mnemonic);
             self.instructions += 1;
             *self.by_class.entry(class).or_default() += 1;
             // sync waits on a scoreboard (a latency the model leaves out) and issues no work.
             if i.mnemonic != "sync" {
-                self.by_row.entry(row_of(class, i.dst_type, i.function)).or_default().push(i.exec_size);
+                self.by_row.entry(row_of(class, &i.dst_type, &i.function)).or_default().push(i.exec_size);
             }
         }
     }
 
-    /// EU cycles of one hardware thread (SIMD lanes): each instruction its execution size over its row's
-    /// lanes per clock, at least one cycle; sends and control one issue cycle each.
+    /// EU cycles of one hardware thread if no two instructions overlapped (the old serial sum, kept as a
+    /// column): each instruction its execution size over its row's lanes per clock, at least one cycle;
+    /// sends and control one issue cycle each.
     pub fn issue_cycles(&self, family: &Family) -> Result<f64> {
         let mut cycles = 0.0;
-        for (row, sizes) in &self.by_row {
-            let lanes = match row {
-                Some(r) => rate(r, family).ok_or_else(|| anyhow!("the throughput table has no row `{r}`"))?,
-                None => {
-                    cycles += sizes.len() as f64;
-                    continue;
-                }
-            };
-            cycles += sizes.iter().map(|&n| (f64::from(n) / f64::from(lanes)).max(1.0)).sum::<f64>();
+        for i in self.listing.iter().filter(|i| i.mnemonic != "sync") {
+            cycles += occupancy(i, family)?.map_or(1.0, |(_, c)| c);
         }
         Ok(cycles)
+    }
+
+    /// EU cycles per thread each pipe of the family is busy (`Pipes`): every instruction its execution size
+    /// over its row's lanes per clock (at least one cycle), sends and branches one cycle each on their own.
+    pub fn pipes(&self, family: &Family) -> Result<Vec<(String, f64)>> {
+        let mut busy: BTreeMap<Pipe, f64> = BTreeMap::new();
+        for i in self.listing.iter().filter(|i| !["sync", "nop"].contains(&i.mnemonic.as_str())) {
+            let (pipe, cycles) = occupancy(i, family)?.unwrap_or((pipe_of(i, family), 1.0));
+            *busy.entry(pipe).or_default() += cycles;
+        }
+        if family.pipes == Pipes::TwoFpus {
+            // Either FPU takes FP and integer work (half an EU's rate each), only FPU1 extended math.
+            let alu = busy.get(&Pipe::Alu).copied().unwrap_or(0.0) * 2.0;
+            let em = busy.get(&Pipe::ExtendedMath).copied().unwrap_or(0.0);
+            busy.insert(Pipe::Alu, (alu + em) / 2.0);
+        }
+        Ok(busy.into_iter().map(|(p, c)| (p.name(family.pipes).to_string(), c)).collect())
+    }
+
+    /// One thread's cycles alone in IGC's instruction order at IGC's scheduler latencies (`gen_isa`).
+    pub fn schedule_latency(&self, family: &Family) -> Result<f64> {
+        gen_isa::schedule_latency(&self.listing, |i| {
+            let pipe = occupancy(i, family)?.map(|(p, c)| (p as usize, c));
+            Ok(gen_isa::Timing { latency: latency(i, family), pipe })
+        })
+    }
+
+    /// Threads an EU holds: the family's, half of them where IGC chose more than 128 registers (large GRF).
+    pub fn resident_threads(&self, family: &Family) -> u32 {
+        if self.grf > 128 { family.threads / 2 } else { family.threads }
     }
 
     /// The statistics as driver statistics of the executable "IGC" (names lined up with `inspect::driver`'s
@@ -285,9 +399,14 @@ impl IsaStats {
             stat("Scratch Memory Size", f64::from(self.scratch_bytes)),
             stat("Binary Size", f64::from(self.binary_bytes)),
             stat("Issue Cycles", self.issue_cycles(family)?),
+            stat(LATENCY, self.schedule_latency(family)?),
+            stat(RESIDENT_WAVES, f64::from(self.resident_threads(family))),
         ];
         for c in Class::ALL {
             out.push(stat(c.name(), f64::from(self.by_class.get(&c).copied().unwrap_or(0))));
+        }
+        for (pipe, cycles) in self.pipes(family)? {
+            out.push(stat(&format!("{PIPE_PREFIX}{pipe}"), cycles));
         }
         Ok(out)
     }
@@ -320,7 +439,7 @@ pub fn compile(source: &str, family: &Family, precise: bool) -> Result<ocloc::Bi
     let what = format!("the OpenCL C translation for intel:{} (ocloc -device {})", family.name, family.device);
     let valid = |bytes: &[u8]| -> Result<()> {
         let binary: ocloc::Binary = serde_json::from_slice(bytes)?;
-        IsaStats::of(&binary).map(|_| ())
+        IsaStats::of(&binary, family).map(|_| ())
     };
     let bytes = crate::cache::get_or_build(crate::cache::Store::open_default().as_ref(), "igc", &key, &what, valid, || {
         let binary = tools.compile(source, family.device, &options, &what)?;
@@ -367,7 +486,7 @@ fn compile_checked(families: &[&Family], statics: Vec<crate::inspect::Row>, chec
                     continue;
                 }
             };
-            let stats = IsaStats::of(binary)?;
+            let stats = IsaStats::of(binary, family)?;
             row.stats.extend(crate::inspect::driver::stats(&stats.driver_stats(family)?));
             row.notes.insert("translation".into(), checked[k].agreement.clone());
             if let Some(dir) = req.isa_dir {
@@ -392,7 +511,7 @@ fn write_isa(dir: &std::path::Path, family: &Family, label: &str, source: &str, 
     std::fs::create_dir_all(&dir).map_err(|e| anyhow!("--isa: cannot create {}: {e}", dir.display()))?;
     let stem = super::file_slug(label);
     crate::io::write_output(&dir.join(format!("{stem}.cl")), source.as_bytes())?;
-    let stats = IsaStats::of(binary)?;
+    let stats = IsaStats::of(binary, family)?;
     let header = format!("// {label}: Gen ISA for {} (ocloc -device {}) by {version}, listed by IGA\n// SIMD{}, {} GRF, {} bytes scratch per thread\n", family.name, family.device, stats.simd, stats.grf, stats.scratch_bytes);
     crate::io::write_output(&dir.join(format!("{stem}.asm")), format!("{header}{}", binary.listing).as_bytes())
 }
@@ -409,8 +528,8 @@ fn report(family: &Family, rows: Vec<crate::inspect::Row>, tools: &ocloc::Tools,
     super::translated_report(&INTEL, compilation, rows, req)
 }
 
-/// The statistics the cost table shows beside cycles/eval.
-pub const SHOWN: [&str; 7] = ["SIMD Width", "Register Count", "Spill Count", "Instruction Count", "FMA and arithmetic (add, mul, mad)", "Extended math", "Issue Cycles"];
+/// The statistics the cost table shows beside cycles/eval (and the rule's figures, `cost::schedule_table`).
+pub const SHOWN: [&str; 6] = ["SIMD Width", "Register Count", "Spill Count", "Instruction Count", "Extended math", "Issue Cycles"];
 
 pub struct Intel;
 pub static INTEL: Intel = Intel;
@@ -462,16 +581,13 @@ impl super::Vendor for Intel {
             family: Some(family.name.to_string()),
             architecture: Some(family.architecture.to_string()),
             compiler: "IGC".into(),
-            model: "cycles/eval = EU cycles of one hardware thread at THROUGHPUT's lanes per clock (Intel's documents; extended math: IGC's scheduling model) / (SIMD width x lights per kernel)".into(),
+            model: format!("{}; a thread's pipes at THROUGHPUT's lanes per clock (Intel's documents; extended math: IGC's scheduling model), its latency in IGC's instruction order at IGC's scheduler latencies, threads per EU from the registers; / (SIMD width x lights per kernel); Issue Cycles: the old serial sum", crate::inspect::schedule::RULE),
             unit: "EU cycles".into(),
             lights_per_kernel: 0,
             columns: SHOWN.iter().map(|s| s.to_string()).collect(),
             rows: Vec::new(),
         };
-        cost::table(report, header, |stats, lights| {
-            let simd = cost::driver_stat(stats, "SIMD Width")?;
-            cost::driver_stat(stats, "Issue Cycles").map(|c| c / (simd * f64::from(lights)))
-        })
+        cost::schedule_table(report, header, |stats| Some((Schedule::of(stats)?, cost::driver_stat(stats, "SIMD Width")?)))
     }
 
     fn family_of(&self, report: &InspectReport) -> Option<usize> {
@@ -496,21 +612,29 @@ mod tests {
     use super::*;
 
     #[test]
-    fn iga_lines_give_mnemonic_width_and_type() {
-        let i = instruction("(W&f0.0)  sel (16|M0)   (lt)f1.0   r39.0<1>:f    r4.1<0;1,0>:f     1.0:f   {Compacted}").unwrap();
-        assert_eq!(i, Instruction { mnemonic: "sel", function: "", exec_size: 16, dst_type: "f" });
-        let m = instruction("        math.inv (32|M0)         r6.0<1>:f     r2.0<1;1,0>:f                    {F@1}").unwrap();
-        assert_eq!((m.mnemonic, m.exec_size, classify(m.mnemonic)), ("math", 32, Class::ExtendedMath));
-        let h = instruction("        mad (16|M0)              r5.0<1>:hf    r1.0<1;0>:hf   r2.0<1;0>:hf   r3.0<1;0>:hf").unwrap();
-        assert_eq!(row_of(classify(h.mnemonic), h.dst_type, h.function), Some(FP16));
-        let p = instruction("        math.pow (16|M0)         r8.0<1>:f     r2.0<1;1,0>:f     r4.0<1;1,0>:f  {F@1}").unwrap();
-        assert_eq!((p.mnemonic, p.function), ("math", "pow"));
-        assert_eq!(row_of(classify(p.mnemonic), p.dst_type, p.function), Some(EM_TWO_SOURCE));
-        assert_eq!(row_of(classify(m.mnemonic), m.dst_type, m.function), Some(EM));
-        assert!(instruction("L640:").is_none());
-        assert!(instruction("// a comment").is_none());
-        let s = instruction("        sync.nop                             null                             {Compacted,$6.dst}").unwrap();
-        assert_eq!((s.mnemonic, s.exec_size), ("sync", 1));
+    fn iga_lines_give_mnemonic_width_type_and_row() {
+        let i = gen_isa::instruction("        math.inv (32|M0)         r6.0<1>:f     r2.0<1;1,0>:f                    {F@1}", 32).unwrap();
+        assert_eq!((i.mnemonic.as_str(), i.exec_size, classify(&i.mnemonic)), ("math", 32, Class::ExtendedMath));
+        assert_eq!(row_of(classify(&i.mnemonic), &i.dst_type, &i.function), Some(EM));
+        let h = gen_isa::instruction("        mad (16|M0)              r5.0<1>:hf    r1.0<1;0>:hf   r2.0<1;0>:hf   r3.0<1;0>:hf", 32).unwrap();
+        assert_eq!(row_of(classify(&h.mnemonic), &h.dst_type, &h.function), Some(FP16));
+        let p = gen_isa::instruction("        math.pow (16|M0)         r8.0<1>:f     r2.0<1;1,0>:f     r4.0<1;1,0>:f  {F@1}", 32).unwrap();
+        assert_eq!(row_of(classify(&p.mnemonic), &p.dst_type, &p.function), Some(EM_TWO_SOURCE));
+        let s = gen_isa::instruction("        sync.nop                             null                             {Compacted,$6.dst}", 32).unwrap();
+        assert_eq!((s.mnemonic.as_str(), s.exec_size), ("sync", 1));
+    }
+
+    #[test]
+    fn pipes_follow_the_family() {
+        let family = |n: &str| FAMILIES.iter().find(|f| f.name == n).unwrap();
+        let i = |l: &str| gen_isa::instruction(l, 32).unwrap();
+        let (fmul, imul, iadd) = (i("mul (16|M0) r5.0<1>:f r1.0<8;8,1>:f r2.0<8;8,1>:f"), i("mul (16|M0) r5.0<1>:d r1.0<8;8,1>:d r2.0<8;8,1>:d"), i("add (16|M0) r5.0<1>:d r1.0<8;8,1>:d r2.0<8;8,1>:d"));
+        assert_eq!([&fmul, &imul, &iadd].map(|x| pipe_of(x, family("xe-hpg"))), [Pipe::Float, Pipe::Long, Pipe::Int]);
+        assert_eq!([&fmul, &imul, &iadd].map(|x| pipe_of(x, family("gen12lp"))), [Pipe::Alu; 3]);
+        // Xe latencies: an FPU result at SIMD16 10 + 1; a SIMD16 math 17 + 4; the legacy table 14 and 22.
+        let math = i("math.inv (16|M0) r6.0<1>:f r2.0<8;8,1>:f");
+        assert_eq!((latency(&fmul, family("gen12lp")), latency(&math, family("gen12lp"))), (11.0, 21.0));
+        assert_eq!((latency(&fmul, family("gen9")), latency(&math, family("gen9"))), (14.0, 22.0));
     }
 
     #[test]
@@ -608,14 +732,19 @@ mod throughput_fixture {
                                send.ugm (16|M0)  r9  r10  null:0  0x0  0x08200580  {$1}\n\
                                sync.nop  null  {$1.dst}\n";
         let mut s = IsaStats::default();
-        s.count(listing);
+        s.count(listing, 32);
         assert_eq!((s.instructions, s.by_class[&Class::ExtendedMath], s.by_class[&Class::Control]), (6, 2, 1));
         let family = |n: &str| FAMILIES.iter().find(|f| f.name == n).unwrap();
         // gen9: mads 16/8 = 2 each, inv 16/2 = 8, pow 16/1 = 16, send 1.
         assert_eq!(s.issue_cycles(family("gen9")).unwrap(), 2.0 + 2.0 + 8.0 + 16.0 + 1.0);
         // gen12lp: pow at the other functions' rate, 16/2 = 8.
         assert_eq!(s.issue_cycles(family("gen12lp")).unwrap(), 2.0 + 2.0 + 8.0 + 8.0 + 1.0);
-        // xe-hpc: mads 16/16 = 1, math 16/4 = 4.
-        assert_eq!(s.issue_cycles(family("xe-hpc")).unwrap(), 1.0 + 1.0 + 4.0 + 4.0 + 1.0);
+        // xe-hpc: mads 16/16 = 1, math 16/2 = 8 (IGC's model counts 8-lane passes there too).
+        assert_eq!(s.issue_cycles(family("xe-hpc")).unwrap(), 1.0 + 1.0 + 8.0 + 8.0 + 1.0);
+        // The pipes on gen9: the mads on either FPU (2 x 2 FPU-cycles each), the math on FPU1 (8 + 16):
+        // FPU1 binds at 24; on gen12lp the ALU has 4, extended math 16.
+        let pipes = |f: &str| s.pipes(family(f)).unwrap().into_iter().collect::<BTreeMap<String, f64>>();
+        assert_eq!((pipes("gen9")["FPU0 + FPU1 (FP, integer, extended math)"], pipes("gen9")["FPU1 (extended math)"]), ((8.0 + 24.0) / 2.0, 24.0));
+        assert_eq!((pipes("gen12lp")["ALU (FP, integer)"], pipes("gen12lp")["extended math"], pipes("gen12lp")["send"]), (4.0, 16.0, 1.0));
     }
 }

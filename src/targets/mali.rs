@@ -20,7 +20,7 @@
 use super::cost::{self, TargetCost};
 use super::mesa_noop::{MESA_25_UNVALIDATED, MESA_BACKPORTS, MESA_DEBIAN};
 use super::shim::{Shim, ShimFamily};
-use crate::gpu::DriverStat;
+use crate::gpu::{CompilerLog, DriverStat};
 use crate::inspect::InspectReport;
 use crate::model::BASELINE_LABEL;
 use anyhow::{anyhow, bail, Result};
@@ -91,7 +91,7 @@ pub static MALI: Shim = Shim {
     ],
     cost: cost_table,
     noise: &[],
-    compiler_log: Some(read_shaderdb),
+    compiler_log: Some(CompilerLog { read: read_shaderdb, beside_properties: false }),
 };
 
 /// One pipeline's stderr: its compute shader's `SHADER-DB:` line as statistics, the other lines passed on.

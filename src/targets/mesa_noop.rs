@@ -141,7 +141,7 @@ pub fn child_main(request_json: &str) -> Result<()> {
     }
     // A driver without VK_KHR_pipeline_executable_properties (PanVK) returns no listing: --isa says so.
     // PanVK 25 has the extension but its statistics and no listing come through the compiler's log.
-    let listings = gpu.executable_properties.is_some() && driver.compiler_log().is_none();
+    let listings = gpu.executable_properties.is_some() && driver.compiler_log().is_none_or(|l| l.beside_properties);
     let isa_dir = req.isa_dir.as_ref().filter(|_| listings).map(|d| d.join(driver.isa_folder(family)));
     let (mut report, isa_files) = if req.raw.is_empty() { models_report(&gpu, &shaders, &req, &target, models, isa_dir.as_deref())? } else { raw_report(&gpu, &shaders, &req, &target, isa_dir.as_deref())? };
     report.provenance["target"] = serde_json::Value::String(target.clone());

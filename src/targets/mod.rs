@@ -10,6 +10,8 @@
 //! the same compilers as `RawKernel`s (`compile_raw_all`).
 
 pub use crate::inspect::cost;
+pub mod aco_perfinfo;
+pub mod gen_isa;
 pub mod intel;
 pub mod nvidia;
 pub mod nvrtc;
@@ -22,6 +24,7 @@ pub mod noop_cache;
 pub mod radv;
 pub mod radv_env;
 pub mod radv_families;
+pub mod sass;
 pub mod shim;
 
 use crate::gpu::Gpu;

@@ -10,6 +10,7 @@ use super::cost::{self, TargetCost};
 use super::{nvrtc, Request, Run, Target};
 use crate::inspect::InspectReport;
 use crate::gpu::DriverStat;
+use crate::inspect::schedule::{Schedule, LATENCY, PIPE_PREFIX, RESIDENT_WAVES};
 use anyhow::{bail, Result};
 use std::collections::BTreeMap;
 
@@ -58,8 +59,11 @@ pub const THROUGHPUT: &[Rate] = &[
     Rate { row: IMAD, per_clock: [64, 64, 64, 64, 64] },
     Rate { row: SHIFT, per_clock: [64, 64, 64, 64, 64] },
     Rate { row: CMP, per_clock: [64, 64, 64, 64, 64] },
+    Rate { row: INT_MINMAX, per_clock: [64, 64, 64, 64, 128] },
     Rate { row: LOGIC, per_clock: [64, 64, 64, 64, 64] },
     Rate { row: SHUFFLE, per_clock: [32, 32, 32, 32, 32] },
+    Rate { row: CVT_F2I, per_clock: [16, 16, 16, 16, 2] },
+    Rate { row: CVT_F16_F32, per_clock: [16, 16, 16, 16, 64] },
     Rate { row: CVT, per_clock: [16, 16, 16, 16, 16] },
 ];
 
@@ -71,8 +75,14 @@ const IADD: &str = "32-bit integer add, extended-precision add, subtract, extend
 const IMAD: &str = "32-bit integer multiply, multiply-add, extended-precision multiply-add";
 const SHIFT: &str = "32-bit integer shift";
 const CMP: &str = "compare, minimum, maximum";
+/// The 13.x guide gives 12.0 its own integer minimum/maximum rate; before, the compare row's.
+const INT_MINMAX: &str = "32-bit integer minimum, maximum";
 const LOGIC: &str = "32-bit bitwise AND, OR, XOR";
 const SHUFFLE: &str = "warp shuffle";
+/// The 13.x guide's 12.0 conversions rows (footnote: "2 for float->32-bit integer type (SM > 10.0)"); before
+/// 12.0 both are "all other type conversions".
+const CVT_F2I: &str = "32-bit floating-point to 32-bit integer conversion";
+const CVT_F16_F32: &str = "16-bit to 32-bit floating-point conversion";
 const CVT: &str = "all other type conversions";
 
 /// Results one instruction of a row computes per thread: the 16-bit row counts both halves of an
@@ -118,30 +128,86 @@ impl Class {
     }
 }
 
-/// The report class of a SASS opcode (its mnemonic before the first `.`) and the `THROUGHPUT` row it issues
-/// at (None: the issue rate).
-pub fn classify(opcode: &str) -> (Class, Option<&'static str>) {
-    match opcode {
-        "FADD" | "FMUL" | "FFMA" | "FADD32I" | "FMUL32I" | "FFMA32I" | "FSWZADD" => (Class::Fp32, Some(FP32)),
-        "FMNMX" | "FSETP" | "FSET" | "FSEL" | "FCHK" => (Class::Fp32, Some(CMP)),
-        "HADD2" | "HMUL2" | "HFMA2" | "HADD2_32I" | "HMUL2_32I" | "HFMA2_32I" => (Class::Fp16, Some(FP16)),
-        "HSETP2" | "HSET2" | "HMNMX2" => (Class::Fp16, Some(CMP)),
-        "DADD" | "DMUL" | "DFMA" => (Class::Fp64, Some(FP64)),
-        "DSETP" | "DMNMX" => (Class::Fp64, Some(CMP)),
-        "MUFU" => (Class::Mufu, Some(MUFU)),
-        "IADD3" | "IADD" | "IADD32I" | "VIADD" | "LEA" | "IABS" => (Class::Integer, Some(IADD)),
-        "IMAD" | "IMUL" | "IMAD32I" | "IMUL32I" | "IMADSP" | "XMAD" => (Class::Integer, Some(IMAD)),
-        "SHF" | "SHL" | "SHR" => (Class::Integer, Some(SHIFT)),
-        "ISETP" | "IMNMX" | "VIMNMX" | "ISET" | "ICMP" => (Class::Integer, Some(CMP)),
-        "LOP3" | "LOP" | "LOP32I" => (Class::Integer, Some(LOGIC)),
-        "SHFL" => (Class::Move, Some(SHUFFLE)),
-        "F2F" | "F2I" | "I2F" | "I2FP" | "F2FP" | "F2IP" | "FRND" | "I2I" | "I2IP" => (Class::Conversion, Some(CVT)),
-        op if ["LD", "ST", "ATOM", "RED", "TEX", "TLD", "SULD", "SUST", "ULDC"].iter().any(|p| op.starts_with(p)) => (Class::Memory, None),
-        "BRA" | "BRX" | "JMP" | "JMX" | "EXIT" | "RET" | "CALL" | "BSSY" | "BSYNC" | "BREAK" | "BMOV" | "BPT" | "WARPSYNC" | "BAR" | "YIELD" | "KILL" | "NANOSLEEP" => (Class::Control, None),
+/// The SM's execution pipes as NVIDIA's Nsight Compute Kernel Profiling Guide (2.3.6 "Pipelines") names them,
+/// each instruction on the one the guide assigns it to (`classify`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Pipe {
+    /// FP32 arithmetic, IMAD/IMUL; FP16x2 from GA10x on.
+    Fma,
+    /// "On Volta, Turing and NVIDIA GA100, the FP16 pipeline performs paired FP16 instructions."
+    Fp16,
+    Fp64,
+    /// Integer add, shift, logic, compare; FP32 compare, min, max and select (not named by the guide: here, as
+    /// integer compares are); fast FP32-to-FP16 and integer-to-FP32 conversion (F2FP, I2FP).
+    Alu,
+    /// Special functions (MUFU) and the int-to-float / float-to-int conversions.
+    Xu,
+    /// Loads, stores, special-register reads, shuffles.
+    Lsu,
+    /// Constant loads.
+    Adu,
+    /// Branches and convergence barriers.
+    Cbu,
+    /// The uniform datapath.
+    Uniform,
+}
+
+impl Pipe {
+    pub const ALL: [Pipe; 9] = [Pipe::Fma, Pipe::Fp16, Pipe::Fp64, Pipe::Alu, Pipe::Xu, Pipe::Lsu, Pipe::Adu, Pipe::Cbu, Pipe::Uniform];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Pipe::Fma => "FMA",
+            Pipe::Fp16 => "FP16",
+            Pipe::Fp64 => "FP64",
+            Pipe::Alu => "ALU",
+            Pipe::Xu => "XU (MUFU, conversions)",
+            Pipe::Lsu => "LSU",
+            Pipe::Adu => "ADU",
+            Pipe::Cbu => "CBU",
+            Pipe::Uniform => "uniform",
+        }
+    }
+
+    /// The pipe on `family`: GA10x and later run FP16x2 on the FMA pipe.
+    fn on(self, family: &Family) -> Pipe {
+        if self == Pipe::Fp16 && family.compute_capability >= (8, 6) { Pipe::Fma } else { self }
+    }
+}
+
+/// The report class of a SASS opcode (`F2F.F32.F16`; its mnemonic before the first `.` decides, and for
+/// conversions its types), the `THROUGHPUT` row it issues at (None: the issue rate) and its pipe (None: the
+/// issue slot alone: moves, predicates, NOPs).
+pub fn classify(opcode: &str) -> (Class, Option<&'static str>, Option<Pipe>) {
+    let mnemonic = opcode.split('.').next().unwrap_or(opcode);
+    match mnemonic {
+        "FADD" | "FMUL" | "FFMA" | "FADD32I" | "FMUL32I" | "FFMA32I" | "FSWZADD" => (Class::Fp32, Some(FP32), Some(Pipe::Fma)),
+        "FMNMX" | "FSETP" | "FSET" | "FSEL" | "FCHK" => (Class::Fp32, Some(CMP), Some(Pipe::Alu)),
+        "HADD2" | "HMUL2" | "HFMA2" | "HADD2_32I" | "HMUL2_32I" | "HFMA2_32I" => (Class::Fp16, Some(FP16), Some(Pipe::Fp16)),
+        "HSETP2" | "HSET2" | "HMNMX2" => (Class::Fp16, Some(CMP), Some(Pipe::Fp16)),
+        "DADD" | "DMUL" | "DFMA" => (Class::Fp64, Some(FP64), Some(Pipe::Fp64)),
+        "DSETP" | "DMNMX" => (Class::Fp64, Some(CMP), Some(Pipe::Fp64)),
+        "MUFU" => (Class::Mufu, Some(MUFU), Some(Pipe::Xu)),
+        "IADD3" | "IADD" | "IADD32I" | "VIADD" | "LEA" | "IABS" => (Class::Integer, Some(IADD), Some(Pipe::Alu)),
+        "IMAD" | "IMUL" | "IMAD32I" | "IMUL32I" | "IMADSP" | "XMAD" => (Class::Integer, Some(IMAD), Some(Pipe::Fma)),
+        "SHF" | "SHL" | "SHR" => (Class::Integer, Some(SHIFT), Some(Pipe::Alu)),
+        "ISETP" | "ISET" | "ICMP" => (Class::Integer, Some(CMP), Some(Pipe::Alu)),
+        "IMNMX" | "VIMNMX" => (Class::Integer, Some(INT_MINMAX), Some(Pipe::Alu)),
+        "LOP3" | "LOP" | "LOP32I" => (Class::Integer, Some(LOGIC), Some(Pipe::Alu)),
+        "SHFL" => (Class::Move, Some(SHUFFLE), Some(Pipe::Lsu)),
+        "F2FP" | "I2FP" => (Class::Conversion, Some(LOGIC), Some(Pipe::Alu)),
+        "F2I" | "F2IP" => (Class::Conversion, Some(CVT_F2I), Some(Pipe::Xu)),
+        "F2F" if opcode.starts_with("F2F.F32.F16") => (Class::Conversion, Some(CVT_F16_F32), Some(Pipe::Xu)),
+        "F2F" | "I2F" | "FRND" | "I2I" | "I2IP" => (Class::Conversion, Some(CVT), Some(Pipe::Xu)),
+        "LDC" | "ULDC" | "LDCU" => (Class::Memory, None, Some(Pipe::Adu)),
+        "S2R" | "S2UR" | "CS2R" => (Class::Move, None, Some(Pipe::Lsu)),
+        op if ["LD", "ST", "ATOM", "RED", "TEX", "TLD", "SULD", "SUST"].iter().any(|p| op.starts_with(p)) => (Class::Memory, None, Some(Pipe::Lsu)),
+        "BRA" | "BRX" | "JMP" | "JMX" | "EXIT" | "RET" | "CALL" | "BSSY" | "BSYNC" | "BREAK" | "BMOV" | "BPT" | "WARPSYNC" | "BAR" | "YIELD" | "KILL" | "NANOSLEEP" => (Class::Control, None, Some(Pipe::Cbu)),
         // The uniform datapath's own instructions (UIADD3, ULOP3, UMOV, ...) and bit operations the table
         // has no row for: the issue rate.
-        op if op.starts_with('U') || ["BREV", "BMSK", "SGXT", "FLO", "POPC", "IDP", "IDP4A"].contains(&op) => (Class::Integer, None),
-        _ => (Class::Move, None),
+        op if op.starts_with('U') => (Class::Integer, None, Some(Pipe::Uniform)),
+        op if ["BREV", "BMSK", "SGXT", "FLO", "POPC", "IDP", "IDP4A"].contains(&op) => (Class::Integer, None, None),
+        _ => (Class::Move, None, None),
     }
 }
 
@@ -155,28 +221,14 @@ pub fn rate(row: &str, family: &Family) -> Option<u32> {
 pub struct SassStats {
     pub instructions: u32,
     pub by_class: BTreeMap<Class, u32>,
-    /// Instructions per `THROUGHPUT` row (None: issue-limited).
-    pub by_row: BTreeMap<Option<&'static str>, u32>,
+    /// Instructions per (`THROUGHPUT` row, pipe) (None: issue-limited; no pipe but the issue slot).
+    pub by_row: BTreeMap<(Option<&'static str>, Option<Pipe>), u32>,
+    /// One warp's cycles alone by ptxas' schedule (`sass::schedule_latency`).
+    pub schedule_latency: f64,
     pub registers: u32,
     pub stack_bytes: u32,
     pub spill_bytes: u32,
     pub cubin_bytes: u32,
-}
-
-/// The opcode of one nvdisasm line (`/*0090*/  @!P0 LDG.E.CONSTANT R4, [R2.64] ;`), None for other lines.
-fn opcode(line: &str) -> Option<&str> {
-    let rest = line.trim_start().strip_prefix("/*")?;
-    let (addr, rest) = rest.split_once("*/")?;
-    if addr.is_empty() || !addr.chars().all(|c| c.is_ascii_hexdigit()) {
-        return None;
-    }
-    let mut words = rest.split_whitespace();
-    let mut first = words.next()?;
-    if first.starts_with('@') {
-        first = words.next()?;
-    }
-    let op = first.trim_end_matches(';');
-    Some(op.split('.').next().unwrap_or(op))
 }
 
 /// The figure before `what` in ptxas' `-v` report ("Used 40 registers", "0 bytes spill stores"), the largest
@@ -190,40 +242,60 @@ fn ptxas_figure(log: &str, what: &str) -> u32 {
 }
 
 impl SassStats {
-    /// Counts the listing: every instruction up to the kernel's last EXIT (nvdisasm pads the section with a
-    /// branch to itself and NOPs after it).
-    pub fn of(listing: &str, ptxas_log: &str, cubin_bytes: usize) -> Self {
-        let ops: Vec<&str> = listing.lines().filter_map(opcode).collect();
-        let end = ops.iter().rposition(|o| *o == "EXIT").map_or(ops.len(), |i| i + 1);
-        let mut s = SassStats { cubin_bytes: cubin_bytes as u32, ..Default::default() };
-        for op in ops[..end].iter().filter(|o| **o != "NOP") {
-            let (class, row) = classify(op);
+    /// Counts the `-hex` listing: every instruction up to the kernel's last EXIT (nvdisasm pads the section
+    /// with a branch to itself and NOPs after it), NOPs left out of the counts (not of the schedule).
+    pub fn of(listing: &str, ptxas_log: &str, cubin_bytes: usize) -> Result<Self> {
+        let instructions = super::sass::instructions(listing)?;
+        let mut s = SassStats { cubin_bytes: cubin_bytes as u32, schedule_latency: super::sass::schedule_latency(&instructions), ..Default::default() };
+        for i in instructions.iter().filter(|i| i.mnemonic() != "NOP") {
+            let (class, row, pipe) = classify(&i.opcode);
             s.instructions += 1;
             *s.by_class.entry(class).or_default() += 1;
-            *s.by_row.entry(row).or_default() += 1;
+            *s.by_row.entry((row, pipe)).or_default() += 1;
         }
         s.registers = ptxas_figure(ptxas_log, "registers");
         s.stack_bytes = ptxas_figure(ptxas_log, "bytes stack frame");
         s.spill_bytes = ptxas_figure(ptxas_log, "bytes spill stores") + ptxas_figure(ptxas_log, "bytes spill loads");
-        s
+        Ok(s)
     }
 
-    /// SM cycles one warp's instructions take at the table's rates: the sum over rows of
-    /// count x 32 / (results per clock), the issue rate for every unlisted instruction.
+    /// SM cycles per warp of each of `n` instructions of `row`: 32 x (results per instruction) / (results per
+    /// clock per SM), at most the issue rate's.
+    fn cycles_per_instruction(row: Option<&'static str>, family: &Family) -> Result<f64> {
+        let per_clock = match row {
+            Some(r) => rate(r, family).ok_or_else(|| anyhow::anyhow!("the throughput table has no row `{r}`"))?,
+            None => ISSUE_PER_CLOCK,
+        };
+        if per_clock == 0 {
+            bail!("`{}` has no native throughput on {}", row.unwrap_or("?"), family.name);
+        }
+        let results = row.map_or(1, results_per_instruction);
+        Ok(32.0 * f64::from(results) / f64::from(per_clock.min(ISSUE_PER_CLOCK * results)))
+    }
+
+    /// SM cycles one warp's instructions take at the table's rates if no two overlapped (the old serial sum,
+    /// kept as a column): the sum over rows of count x 32 / (results per clock), the issue rate for every
+    /// unlisted instruction.
     pub fn issue_cycles(&self, family: &Family) -> Result<f64> {
         let mut cycles = 0.0;
-        for (row, n) in &self.by_row {
-            let per_clock = match row {
-                Some(r) => rate(r, family).ok_or_else(|| anyhow::anyhow!("the throughput table has no row `{r}`"))?,
-                None => ISSUE_PER_CLOCK,
-            };
-            if per_clock == 0 {
-                bail!("`{}` has no native throughput on {}", row.unwrap_or("?"), family.name);
-            }
-            let results = row.map_or(1, results_per_instruction);
-            cycles += f64::from(*n) * 32.0 * f64::from(results) / f64::from(per_clock.min(ISSUE_PER_CLOCK * results));
+        for ((row, _), n) in &self.by_row {
+            cycles += f64::from(*n) * Self::cycles_per_instruction(*row, family)?;
         }
         Ok(cycles)
+    }
+
+    /// SM cycles per warp each pipe is busy (its instructions at their rows' rates), and the issue slots
+    /// (every instruction at 32 / 128: four schedulers, one warp instruction each per clock).
+    pub fn pipes(&self, family: &Family) -> Result<Vec<(String, f64)>> {
+        let mut busy: BTreeMap<Pipe, f64> = BTreeMap::new();
+        for ((row, pipe), n) in &self.by_row {
+            if let Some(p) = pipe {
+                *busy.entry(p.on(family)).or_default() += f64::from(*n) * Self::cycles_per_instruction(*row, family)?;
+            }
+        }
+        let mut out: Vec<(String, f64)> = busy.into_iter().map(|(p, c)| (p.name().to_string(), c)).collect();
+        out.push(("issue".to_string(), f64::from(self.instructions) * 32.0 / f64::from(ISSUE_PER_CLOCK)));
+        Ok(out)
     }
 
     /// Resident warps per SM the register count allows: 65,536 registers per SM allocated per warp in units
@@ -249,9 +321,14 @@ impl SassStats {
             stat("Binary Size", f64::from(self.cubin_bytes)),
             stat("Warps per SM", f64::from(self.warps_per_sm(family))),
             stat("Issue Cycles", self.issue_cycles(family)?),
+            stat(LATENCY, self.schedule_latency),
+            stat(RESIDENT_WAVES, f64::from(self.warps_per_sm(family))),
         ];
         for c in Class::ALL {
             out.push(stat(c.name(), f64::from(self.by_class.get(&c).copied().unwrap_or(0))));
+        }
+        for (pipe, cycles) in self.pipes(family)? {
+            out.push(stat(&format!("{PIPE_PREFIX}{pipe}"), cycles));
         }
         Ok(out)
     }
@@ -286,6 +363,7 @@ pub fn compile(source: &str, family: &Family, precise: bool) -> Result<Sass> {
         .part("brdfprof", env!("CARGO_PKG_VERSION"))
         .part("nvrtc", &tools.version)
         .part("nvdisasm", &tools.nvdisasm_version)
+        .part("nvdisasm options", nvrtc::DISASSEMBLE_OPTIONS.join(" "))
         .part("options", options.join(" "))
         .part("source", source)
         .finish();
@@ -333,7 +411,7 @@ fn compile_checked(families: &[&Family], statics: Vec<crate::inspect::Row>, chec
         let mut rows = statics.clone();
         for (k, row) in rows.iter_mut().enumerate() {
             let sass = &compiled[f * checked.len() + k];
-            let stats = SassStats::of(&sass.listing, &sass.log, sass.cubin_bytes);
+            let stats = SassStats::of(&sass.listing, &sass.log, sass.cubin_bytes)?;
             row.stats.extend(crate::inspect::driver::stats(&stats.driver_stats(family)?));
             row.notes.insert("translation".into(), checked[k].agreement.clone());
             if let Some(dir) = req.isa_dir {
@@ -366,8 +444,8 @@ fn report(family: &Family, rows: Vec<crate::inspect::Row>, tools: &nvrtc::Tools,
     super::translated_report(&NVIDIA, compilation, rows, req)
 }
 
-/// The statistics the cost table shows beside cycles/eval.
-pub const SHOWN: [&str; 7] = ["Instruction Count", "Register Count", "Spill Count", "FP32 (FMA, MUL, ADD, compare)", "MUFU (special functions)", "Warps per SM", "Issue Cycles"];
+/// The statistics the cost table shows beside cycles/eval (and the rule's figures, `cost::schedule_table`).
+pub const SHOWN: [&str; 5] = ["Instruction Count", "Register Count", "Spill Count", "MUFU (special functions)", "Issue Cycles"];
 
 pub struct Nvidia;
 pub static NVIDIA: Nvidia = Nvidia;
@@ -421,13 +499,13 @@ impl super::Vendor for Nvidia {
             family: Some(family.name.to_string()),
             architecture: Some(family.architecture.to_string()),
             compiler: "ptxas".into(),
-            model: "cycles/eval = issue-limited SM cycles of a warp at the guide's throughputs / (32 x lights per kernel)".into(),
+            model: format!("{}; a warp's pipes at the CUDA guide's throughputs (Nsight Compute's pipe assignment), its latency by ptxas' stall counts and scoreboards, warps per SM from the registers; / (32 x lights per kernel); Issue Cycles: the old serial sum", crate::inspect::schedule::RULE),
             unit: "SM cycles".into(),
             lights_per_kernel: 0,
             columns: SHOWN.iter().map(|s| s.to_string()).collect(),
             rows: Vec::new(),
         };
-        cost::table(report, header, |stats, lights| cost::driver_stat(stats, "Issue Cycles").map(|c| c / (32.0 * f64::from(lights))))
+        cost::schedule_table(report, header, |stats| Some((Schedule::of(stats)?, 32.0)))
     }
 
     fn family_of(&self, report: &InspectReport) -> Option<usize> {

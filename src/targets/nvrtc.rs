@@ -153,7 +153,7 @@ impl Tools {
         let path = dir.path().join("kernel.cubin");
         std::fs::write(&path, cubin).with_context(|| format!("cannot write {}", path.display()))?;
         let mut cmd = crate::cleanup::command(self.nvdisasm.to_str().unwrap_or("nvdisasm"));
-        cmd.arg("-c").arg(&path);
+        cmd.args(DISASSEMBLE_OPTIONS).arg(&path);
         let out = crate::compile_limit::output(&mut cmd, "a cubin's SASS (nvdisasm)").with_context(|| format!("cannot run {}", self.nvdisasm.display()))?;
         if !out.status.success() {
             bail!("{} failed ({}): {}", self.nvdisasm.display(), out.status, String::from_utf8_lossy(&out.stderr).trim());
@@ -163,6 +163,10 @@ impl Tools {
         Ok(listing)
     }
 }
+
+/// nvdisasm's options: code sections only, and each instruction's two 64-bit words (its control bits:
+/// `targets::sass`).
+pub const DISASSEMBLE_OPTIONS: [&str; 2] = ["-c", "-hex"];
 
 /// Bytes of one SASS instruction (Volta and later: 128-bit).
 const SASS_INSTRUCTION_BYTES: u64 = 16;

@@ -14,7 +14,10 @@
 use super::cost::{self, TargetCost};
 use super::mesa_noop::{self, NoopDriver};
 use super::{Request, Run};
-use super::radv_families::{family_of_device, null_device_name, FAMILIES, FORCE_FAMILY_VAR};
+use super::aco_perfinfo;
+use super::radv_families::{family_of_device, null_device_name, Family, FAMILIES, FORCE_FAMILY_VAR};
+use crate::gpu::CompilerLog;
+use crate::inspect::schedule::Schedule;
 use crate::inspect::InspectReport;
 use anyhow::Result;
 use std::collections::BTreeMap;
@@ -22,8 +25,32 @@ use std::collections::BTreeMap;
 /// Invocations ACO's Inverse Throughput is normalised to.
 pub const THROUGHPUT_INVOCATIONS: f64 = 64.0;
 
-/// The ACO statistics the cost table shows beside cycles/eval.
-pub const SHOWN: [&str; 7] = ["Instructions", "VGPRs", "SGPRs", "Spilled VGPRs", "Latency", "Inverse Throughput", "Subgroups per SIMD"];
+/// The ACO statistics the cost table shows beside cycles/eval (and the rule's figures, `cost::schedule_table`).
+pub const SHOWN: [&str; 5] = ["Instructions", "VGPRs", "Spilled VGPRs", "Latency", "Inverse Throughput"];
+
+/// Asks ACO for its per-instruction schedule (`aco_perfinfo`), beside the user's own ACO_DEBUG flags.
+const PERFINFO: &str = "perfinfo";
+
+/// The rule's figures of one ACO kernel (`inspect::schedule`), from its perfinfo statistics: every
+/// instruction once at ACO's own resource costs for `family` (vector instructions twice for wave64 on
+/// GFX10+, as ACO dual-issues them for workgroups over 32 invocations), the clocks summed, ACO's num_waves.
+pub fn schedule(stats: &BTreeMap<String, f64>, family: &Family) -> Option<Schedule> {
+    use aco_perfinfo::{count_name, usage, Arch, Class, Resource, CLOCKS, WAVES};
+    let arch = Arch { gfx10: family.gfx_major() >= 10, fast_fma: family.fast_fma() };
+    let dual = if arch.gfx10 && family.wave_size == 64 { 2.0 } else { 1.0 };
+    let mut busy: BTreeMap<Resource, f64> = Resource::ALL.iter().map(|r| (*r, 0.0)).collect();
+    for c in Class::ALL {
+        let n = cost::driver_stat(stats, &count_name(c))?;
+        for (r, cycles) in usage(c, arch) {
+            *busy.entry(r).or_default() += n * cycles * if c.is_vector() { dual } else { 1.0 };
+        }
+    }
+    Some(Schedule {
+        pipes: busy.into_iter().map(|(r, c)| (r.name().to_string(), c)).collect(),
+        latency: Some(cost::driver_stat(stats, CLOCKS)?),
+        resident_waves: Some(cost::driver_stat(stats, WAVES)?),
+    })
+}
 
 pub struct Radv;
 pub static RADV: Radv = Radv;
@@ -70,19 +97,28 @@ impl super::Vendor for Radv {
 
     fn cost(&self, report: &InspectReport) -> Option<TargetCost> {
         let family = family_of_device(device_name(report));
-        let header = TargetCost {
+        let header = |model: String| TargetCost {
             device: device_name(report).to_string(),
             target: family.map(|f| format!("radv:{}", f.family)),
             family: family.map(|f| f.family.to_string()),
             architecture: family.map(|f| f.architecture.to_string()),
             compiler: "ACO".into(),
-            model: "cycles/eval = Inverse Throughput / (64 x lights per kernel)".into(),
+            model,
             unit: "SIMD cycles".into(),
             lights_per_kernel: 0,
             columns: SHOWN.iter().map(|s| s.to_string()).collect(),
             rows: Vec::new(),
         };
-        cost::table(report, header, |stats, lights| cost::driver_stat(stats, "Inverse Throughput").map(|it| it / (THROUGHPUT_INVOCATIONS * f64::from(lights))))
+        // ACO's per-instruction schedule where the report has it (the compile-only targets), else (a real
+        // RADV GPU) its Inverse Throughput, branch weights and all.
+        let perfinfo = family.filter(|f| report.rows.iter().any(|r| schedule(&r.stats, f).is_some()));
+        match perfinfo {
+            Some(f) => {
+                let rule = format!("{}; ACO's resource costs and per-instruction clocks (ACO_DEBUG=perfinfo) with every instruction once, ACO's num_waves; / (64 x lights per kernel); ACO's own Latency and Inverse Throughput (its branch weights) beside", crate::inspect::schedule::RULE);
+                cost::schedule_table(report, header(rule), |stats| Some((schedule(stats, f)?, THROUGHPUT_INVOCATIONS)))
+            }
+            None => cost::table(report, header("cycles/eval = Inverse Throughput / (64 x lights per kernel)".into()), |stats, lights| cost::driver_stat(stats, "Inverse Throughput").map(|it| it / (THROUGHPUT_INVOCATIONS * f64::from(lights)))),
+        }
     }
 
     fn family_of(&self, report: &InspectReport) -> Option<usize> {
@@ -106,7 +142,21 @@ impl NoopDriver for Radv {
     }
 
     fn environment(&self, family: usize) -> Result<Vec<(String, String)>> {
-        Ok(vec![(FORCE_FAMILY_VAR.to_string(), FAMILIES[family].family.to_string())])
+        let debug = match std::env::var("ACO_DEBUG") {
+            Ok(d) if d.split(',').any(|f| f.trim() == PERFINFO) => d,
+            Ok(d) if !d.trim().is_empty() => format!("{d},{PERFINFO}"),
+            _ => PERFINFO.to_string(),
+        };
+        Ok(vec![(FORCE_FAMILY_VAR.to_string(), FAMILIES[family].family.to_string()), ("ACO_DEBUG".to_string(), debug)])
+    }
+
+    fn compiler_log(&self) -> Option<CompilerLog> {
+        Some(CompilerLog { read: aco_perfinfo::read, beside_properties: true })
+    }
+
+    fn is_noise(&self, line: &str) -> bool {
+        // The perfinfo of RADV's own shaders, compiled when its device opens.
+        aco_perfinfo::is_printed_line(line)
     }
 
     fn isa_folder(&self, family: usize) -> String {

@@ -41,8 +41,23 @@ pub const FAMILIES: [Family; 12] = [
     t("navi22", "GFX10.3", "RDNA 2", "Radeon RX 6700 (XT)", false),
     t("vangogh", "GFX10.3", "RDNA 2 Steam Deck APU", "Steam Deck (Van Gogh)", true),
     t("rembrandt", "GFX10.3", "RDNA 2 APU", "Ryzen 6000 APUs (Radeon 680M)", false),
-    t("gfx1100", "GFX11", "RDNA 3", "Radeon RX 7900 (XT/XTX, Navi 31)", true),
+    // Mesa 22.3's ACO models GFX11 as GFX10.3 (no dual issue, the same cost table): its figures are RDNA 2's
+    // model of RDNA 3 code, not RDNA 3's.
+    t("gfx1100", "GFX11", "RDNA 3 as Mesa 22.3 models it", "Radeon RX 7900 (XT/XTX, Navi 31)", true),
 ];
+
+impl Family {
+    /// The graphics IP major version (`GFX10.3`: 10).
+    pub fn gfx_major(&self) -> u32 {
+        self.gfx.trim_start_matches("GFX").split('.').next().and_then(|v| v.parse().ok()).unwrap_or(0)
+    }
+
+    /// Whether ACO's cost model gives it full-rate v_fma_f32 before GFX10 (`has_fast_fma32` in Mesa 22.3's
+    /// aco_ir.cpp: GFX9 and later, and Tahiti, Hawaii and Carrizo).
+    pub fn fast_fma(&self) -> bool {
+        self.gfx_major() >= 9 || ["tahiti", "hawaii", "carrizo"].contains(&self.family)
+    }
+}
 
 /// A family by its name (case-insensitive).
 pub fn lookup(family: &str) -> Result<&'static Family> {
