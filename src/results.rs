@@ -143,6 +143,7 @@ pub enum Kind {
     SceneProfile,
     Sweep,
     SweepCost,
+    SweepFrontiers,
     Stability,
     Inspect,
     InspectDevices,
@@ -151,7 +152,7 @@ pub enum Kind {
 }
 
 impl Kind {
-    pub const ALL: [Kind; 9] = [Kind::Profile, Kind::SceneProfile, Kind::Sweep, Kind::SweepCost, Kind::Stability, Kind::Inspect, Kind::InspectDevices, Kind::Compare, Kind::Baseline];
+    pub const ALL: [Kind; 10] = [Kind::Profile, Kind::SceneProfile, Kind::Sweep, Kind::SweepCost, Kind::SweepFrontiers, Kind::Stability, Kind::Inspect, Kind::InspectDevices, Kind::Compare, Kind::Baseline];
 
     pub fn name(self) -> &'static str {
         match self {
@@ -159,6 +160,7 @@ impl Kind {
             Kind::SceneProfile => "scene-profile",
             Kind::Sweep => "sweep",
             Kind::SweepCost => "sweep-cost",
+            Kind::SweepFrontiers => "sweep-frontiers",
             Kind::Stability => "stability",
             Kind::Inspect => "inspect",
             Kind::InspectDevices => "inspect-devices",

@@ -190,3 +190,82 @@ impl CostSweep {
         chart::scatter_log_y(path, &spec, &points)
     }
 }
+
+/// The specs on the accuracy-cost frontier of several targets: with `sweep --cost-device A --cost-device B ...`,
+/// which specs every target's frontier holds (a choice no vendor's compiler overturns), and which only some do
+/// (where the choice depends on the GPU).
+#[derive(Clone, Debug, Serialize)]
+pub struct Frontiers {
+    /// The targets, in `--cost-device` order.
+    pub targets: Vec<String>,
+    /// Every spec on at least one frontier, by label: on which targets' frontiers (in `targets` order).
+    pub rows: Vec<FrontierRow>,
+    /// Labels on every target's frontier, and on some but not all.
+    pub on_every: Vec<String>,
+    pub on_some: Vec<String>,
+    /// The measured sweep's frontier (its device), for comparison.
+    pub measured_on: String,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct FrontierRow {
+    pub label: String,
+    pub spec: String,
+    pub on: Vec<bool>,
+    pub measured: bool,
+}
+
+impl Frontiers {
+    /// The frontiers of `sweeps` (one per target, each built by `build`).
+    pub fn of(sweeps: &[CostSweep]) -> Frontiers {
+        let mut rows: Vec<FrontierRow> = Vec::new();
+        for (k, s) in sweeps.iter().enumerate() {
+            for r in s.rows.iter().filter(|r| r.pareto) {
+                if !rows.iter().any(|x| x.label == r.label) {
+                    rows.push(FrontierRow { label: r.label.clone(), spec: r.spec.clone(), on: vec![false; sweeps.len()], measured: r.measured_pareto });
+                }
+                rows.iter_mut().find(|x| x.label == r.label).expect("just added").on[k] = true;
+            }
+        }
+        rows.sort_by(|a, b| b.on.iter().filter(|o| **o).count().cmp(&a.on.iter().filter(|o| **o).count()).then(a.label.cmp(&b.label)));
+        let on_every = rows.iter().filter(|r| r.on.iter().all(|o| *o)).map(|r| r.label.clone()).collect();
+        let on_some = rows.iter().filter(|r| !r.on.iter().all(|o| *o)).map(|r| r.label.clone()).collect();
+        Frontiers { targets: sweeps.iter().map(|s| s.target.clone()).collect(), rows, on_every, on_some, measured_on: sweeps.first().map(|s| s.measured_on.clone()).unwrap_or_default() }
+    }
+
+    pub fn markdown(&self) -> String {
+        let mut headers: Vec<String> = vec!["spec".into()];
+        headers.extend(self.targets.iter().cloned());
+        headers.push(format!("measured ({})", self.measured_on));
+        let mut t = Table::new(headers);
+        for r in &self.rows {
+            let mut cells = vec![r.label.clone()];
+            cells.extend(r.on.iter().map(|o| if *o { "yes".to_string() } else { String::new() }));
+            cells.push(if r.measured { "yes".into() } else { String::new() });
+            t.row(cells);
+        }
+        let list = |v: &[String]| if v.is_empty() { "none".to_string() } else { v.join(", ") };
+        format!(
+            "# brdfprof sweep: the accuracy-cost frontiers of {} targets
+
+A spec is on a target's frontier when no other spec is both cheaper there (its compiler's cycles per evaluation) and more accurate (RMS vs exact, the same sample set for every target).
+
+- On every target's frontier: {}
+- On some targets' only: {}
+
+{}",
+            self.targets.len(),
+            list(&self.on_every),
+            list(&self.on_some),
+            t.markdown()
+        )
+    }
+
+    /// Writes `<stem>.md` and `.json`; returns their paths.
+    pub fn write(&self, stem: &Path) -> Result<Vec<PathBuf>> {
+        let (md, json) = (stem.with_extension("md"), stem.with_extension("json"));
+        results::write_report_compact(&json, results::Kind::SweepFrontiers, self)?;
+        crate::io::write_output(&md, self.markdown().as_bytes())?;
+        Ok(vec![md, json])
+    }
+}

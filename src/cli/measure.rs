@@ -230,6 +230,7 @@ pub fn sweep(args: &SweepArgs) -> Result<ExitCode> {
     files.extend(args.html.write(&[super::report::just_measured(&out.join(format!("sweep-{slug}.json")), &result)?], Some(&gpu))?);
     print!("{}", result.markdown());
     let mut missing = false;
+    let mut swept_all = Vec::new();
     for run in &costs {
         let name = run.target.name();
         let table = run.report.cost.clone().ok_or_else(|| anyhow::anyhow!("{name}: the compiler reported no statistics the cost model reads"))?;
@@ -243,6 +244,12 @@ pub fn sweep(args: &SweepArgs) -> Result<ExitCode> {
         let family = table.family.clone().unwrap_or_else(|| name.replace(':', "-"));
         files.extend(swept.write(&out.join(format!("sweep-{slug}-{}-{family}", table.compiler.to_ascii_lowercase())))?);
         print!("\n{}", swept.markdown());
+        swept_all.push(swept);
+    }
+    if swept_all.len() > 1 {
+        let frontiers = brdfprof::sweep_cost::Frontiers::of(&swept_all);
+        files.extend(frontiers.write(&out.join(format!("sweep-{slug}-frontiers")))?);
+        print!("\n{}", frontiers.markdown());
     }
     println!("\n{}", written(&files));
     Ok(if missing { ExitCode::from(1) } else { ExitCode::SUCCESS })

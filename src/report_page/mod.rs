@@ -113,7 +113,7 @@ pub fn from_json(path: &Path, text: &str) -> Result<Input> {
                 Loaded::Inspect(m.reports, Some(m.costs))
             }
             Kind::Compare => Loaded::Costs(parse(path, &text, "compare")?),
-            Kind::SceneProfile | Kind::SweepCost | Kind::Baseline => bail!(
+            Kind::SceneProfile | Kind::SweepCost | Kind::SweepFrontiers | Kind::Baseline => bail!(
                 "{}: a `{}` report, which the HTML report does not draw (its tables are in the Markdown written beside it); give profile, sweep, stability, inspect, compare or diff reports",
                 path.display(),
                 kind.name()

@@ -524,3 +524,48 @@ impl super::Vendor for Nvidia {
         .into()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_rate_is_the_fixtures() {
+        let text = include_str!("../../tests/fixtures/nvidia-throughput.tsv");
+        let rows: Vec<Vec<&str>> = text.lines().filter(|l| !l.starts_with('#') && !l.trim().is_empty() && !l.starts_with("ratio")).map(|l| l.split('\t').collect()).collect();
+        for r in &rows {
+            let rate = THROUGHPUT.iter().find(|t| t.row == r[0]).unwrap_or_else(|| panic!("the code has no row `{}`", r[0]));
+            let figures: Vec<u32> = r[1..].iter().map(|v| v.parse().unwrap()).collect();
+            assert_eq!(rate.per_clock.to_vec(), figures, "{}", r[0]);
+        }
+        assert_eq!(rows.len(), THROUGHPUT.len(), "every row of the code is in the fixture once");
+        // FP64 is FP32 over Table 30's ratio.
+        let ratio: Vec<u32> = text.lines().find(|l| l.starts_with("ratio")).unwrap().split('\t').skip(1).map(|v| v.parse().unwrap()).collect();
+        for (k, r) in ratio.iter().enumerate() {
+            assert_eq!(rate(FP32, &FAMILIES[k]).unwrap() / r, rate(FP64, &FAMILIES[k]).unwrap(), "{}", COLUMNS[k]);
+        }
+    }
+
+    #[test]
+    fn instructions_go_to_their_pipes_at_their_rates() {
+        assert_eq!(classify("MUFU.EX2").2, Some(Pipe::Xu));
+        assert_eq!(classify("F2FP.PACK_AB").2, Some(Pipe::Alu));
+        assert_eq!(classify("IMAD.MOV.U32").2, Some(Pipe::Fma));
+        assert_eq!(classify("F2F.F32.F16").1, Some(CVT_F16_F32));
+        assert_eq!(classify("F2I.FTZ.U32.TRUNC.NTZ").1, Some(CVT_F2I));
+        assert_eq!(classify("MOV").2, None);
+        let sm = |n: &str| FAMILIES.iter().find(|f| f.name == n).unwrap();
+        let mut s = SassStats { instructions: 8, ..Default::default() };
+        s.by_row.insert((Some(FP32), Some(Pipe::Fma)), 4);
+        s.by_row.insert((Some(MUFU), Some(Pipe::Xu)), 2);
+        s.by_row.insert((Some(CVT_F2I), Some(Pipe::Xu)), 1);
+        s.by_row.insert((None, None), 1);
+        let pipes = |n: &str| s.pipes(sm(n)).unwrap().into_iter().collect::<BTreeMap<String, f64>>();
+        // sm_89: FFMA 32/128 each, MUFU 32/16, F2I 32/16; every instruction 32/128 on the issue slot.
+        assert_eq!((pipes("sm_89")["FMA"], pipes("sm_89")["XU (MUFU, conversions)"], pipes("sm_89")["issue"]), (1.0, 6.0, 2.0));
+        // sm_120: F2I at 2 per clock; sm_75: FP32 at 64.
+        assert_eq!((pipes("sm_120")["XU (MUFU, conversions)"], pipes("sm_75")["FMA"]), (4.0 + 16.0, 2.0));
+        // The serial sum adds them all: 1 + 4 + 2 + 0.25 on sm_89.
+        assert_eq!(s.issue_cycles(sm("sm_89")).unwrap(), 1.0 + 4.0 + 2.0 + 0.25);
+    }
+}

@@ -200,10 +200,26 @@ fn sweep_cost_device_draws_the_frontier_again_with_acos_cycles() {
     run_in(d, &[&base[..], &["--cost-device", "0"]].concat()).fails(2, "--cost-device 0: give a compile-only target");
     run_in(d, &[&base[..], &["--cost-device", "radv:navi31"]].concat()).fails(2, "unknown AMD family `navi31`");
     assert!(!d.join("out").exists());
-    let out = run_in(d, &[&base[..], &["--cost-device", "radv:navi21", "--cost-device", "radv:vega10"]].concat()).ok();
+    let out = run_in(d, &[&base[..], &["--cost-device", "radv:navi21", "--cost-device", "radv:vega10", "--cost-device", "nvidia:sm_89"]].concat()).ok();
     assert!(out.stdout.contains("# brdfprof sweep: cost on navi21 (RDNA 2)"), "{}", out.stdout);
+    let file = |suffix: &str| std::fs::read_dir(d.join("out")).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).find(|n| n.ends_with(suffix)).unwrap();
+    let read = |name: &str| -> serde_json::Value { serde_json::from_str(&std::fs::read_to_string(d.join("out").join(name)).unwrap()).unwrap() };
+    // The frontiers of the three targets at once: every spec on some target's frontier, with the targets
+    // whose frontier it is on as the per-target files say; the exact model on all of them.
+    let frontiers = read(&file("-frontiers.json"));
+    assert_eq!(frontiers["kind"], "sweep-frontiers");
+    assert_eq!(frontiers["targets"], serde_json::json!(["radv:navi21", "radv:vega10", "nvidia:sm_89"]));
+    let exact = frontiers["on_every"].as_array().unwrap().iter().any(|l| l.as_str().unwrap().contains("dielectric"));
+    assert!(exact, "{frontiers}");
+    for (k, suffix) in ["-aco-navi21.json", "-aco-vega10.json", "-ptxas-sm_89.json"].iter().enumerate() {
+        for r in read(&file(suffix))["rows"].as_array().unwrap() {
+            let row = frontiers["rows"].as_array().unwrap().iter().find(|x| x["label"] == r["label"]);
+            assert_eq!(row.is_some_and(|x| x["on"][k] == true), r["pareto"] == true, "{suffix} {}", r["label"]);
+        }
+    }
+    assert!(out.stdout.contains("On every target's frontier:"), "{}", out.stdout);
     for family in ["navi21", "vega10"] {
-        let stem = std::fs::read_dir(d.join("out")).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).find(|n| n.ends_with(&format!("-aco-{family}.json"))).unwrap();
+        let stem = file(&format!("-aco-{family}.json"));
         let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(d.join("out").join(&stem)).unwrap()).unwrap();
         let rows = report["rows"].as_array().unwrap();
         assert_eq!(rows.len(), 3);
