@@ -29,4 +29,5 @@ mod report;
 mod signals;
 mod translation_faults;
 mod compile_only;
+mod cost_pairs;
 mod mesa_shims;
