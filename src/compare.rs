@@ -71,12 +71,12 @@ impl PairCorrelation {
         }
     }
 
-    /// rho with its CI: `0.92 [0.85, 0.96]`; a rho over fewer than 4 models has no CI and says so.
+    /// rho with its CI: `0.92 [0.85, 0.96]`; over too few models for a CI no rho is printed (a rank
+    /// correlation of 3 models is one of 4 values, 1.00 by chance one time in six).
     pub fn rho_cell(&self) -> String {
         match (self.spearman_net, self.spearman_ci) {
-            (None, _) => "- (fewer than 3 models)".into(),
             (Some(r), Some((lo, hi))) => format!("{r:.2} [{lo:.2}, {hi:.2}]"),
-            (Some(r), None) => format!("{r:.2} (no CI: {} models)", self.models),
+            _ => format!("- ({} models: too few for a CI)", self.models),
         }
     }
 
@@ -115,6 +115,23 @@ pub struct CostTable {
     /// already predicts, the baseline a compiler's ranking is read against (empty without SPIR-V counts).
     #[serde(default)]
     pub spirv_baseline: Vec<PairCorrelation>,
+    /// Models whose kernel is another's (the same SPIR-V hash), with that model: ranked once, as the other.
+    #[serde(default)]
+    pub same_kernel: Vec<(String, String)>,
+}
+
+/// `models` with each kernel once (the first model of each SPIR-V hash any column records), and the others
+/// with the model whose kernel they are: two specs that compile to one kernel would count a tie twice.
+fn distinct_kernels(columns: &[CostColumn], models: &[String]) -> (Vec<String>, Vec<(String, String)>) {
+    let hash = |m: &String| columns.iter().find_map(|c| c.hashes.get(m).cloned());
+    let (mut distinct, mut same): (Vec<String>, Vec<(String, String)>) = (Vec::new(), Vec::new());
+    for m in models {
+        match hash(m).and_then(|h| distinct.iter().find(|d| hash(d).as_ref() == Some(&h)).cloned()) {
+            Some(first) => same.push((m.clone(), first)),
+            None => distinct.push(m.clone()),
+        }
+    }
+    (distinct, same)
 }
 
 fn hashes(report: &InspectReport) -> BTreeMap<String, String> {
@@ -240,21 +257,23 @@ pub fn build(columns: Vec<CostColumn>) -> CostTable {
     if columns.iter().any(|c| c.gross.contains_key(BASELINE_LABEL)) {
         models.push(BASELINE_LABEL.into());
     }
+    let (distinct, same_kernel) = distinct_kernels(&columns, &models);
     let mut correlations = Vec::new();
     for i in 0..columns.len() {
         for j in i + 1..columns.len() {
             let (a, b) = (&columns[i], &columns[j]);
-            correlations.push(PairCorrelation::of((&a.name, &a.net), (&b.name, &b.net), &models));
+            correlations.push(PairCorrelation::of((&a.name, &a.net), (&b.name, &b.net), &distinct));
         }
     }
-    CostTable { models, columns, correlations, spirv_baseline: Vec::new() }
+    CostTable { models, columns, correlations, spirv_baseline: Vec::new(), same_kernel }
 }
 
 impl CostTable {
     /// The table with every column's rank agreement with the SPIR-V counts (`spirv_counts`).
     pub fn with_spirv_baseline(mut self, counts: &BTreeMap<String, f64>) -> Self {
         if !counts.is_empty() {
-            self.spirv_baseline = self.columns.iter().map(|c| PairCorrelation::of((SPIRV_BASELINE, counts), (&c.name, &c.net), &self.models)).collect();
+            let distinct: Vec<String> = self.models.iter().filter(|m| !self.same_kernel.iter().any(|(s, _)| s == *m)).cloned().collect();
+            self.spirv_baseline = self.columns.iter().map(|c| PairCorrelation::of((SPIRV_BASELINE, counts), (&c.name, &c.net), &distinct)).collect();
         }
         self
     }
@@ -295,7 +314,11 @@ impl CostTable {
             for p in &self.correlations {
                 t.row([p.a.clone(), p.b.clone(), p.models.to_string(), p.rho_cell(), p.discordant_cell()]);
             }
-            out += &format!("### Rank correlation between devices\n\n{}\n{RHO_NOTE}\n\n", t.markdown());
+            let same = match self.same_kernel.is_empty() {
+                true => String::new(),
+                false => format!(" Ranked once, as the model whose kernel they are (the same SPIR-V): {}.", self.same_kernel.iter().map(|(m, f)| format!("{m} (= {f})")).collect::<Vec<_>>().join(", ")),
+            };
+            out += &format!("### Rank correlation between devices\n\n{}\n{RHO_NOTE}{same}\n\n", t.markdown());
         }
         if !self.spirv_baseline.is_empty() {
             let mut t = Table::new(["device", "models", "Spearman rho with the SPIR-V count [95% CI]", "discordant pairs"]);

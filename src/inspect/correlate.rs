@@ -51,7 +51,7 @@ fn rho_text(rho: Option<f64>, ci: Option<(f64, f64)>) -> String {
     match (rho, ci) {
         (None, _) => "-".into(),
         (Some(r), Some((lo, hi))) => format!("{r:.2} [95% CI {lo:.2}, {hi:.2}]"),
-        (Some(r), None) => format!("{r:.2} (no CI: fewer than 4 kernels)"),
+        (Some(_), None) => "- (too few kernels for a CI)".into(),
     }
 }
 

@@ -168,7 +168,8 @@ pub fn cost_table_html(table: &CostTable) -> String {
     let mut corr = HtmlTable::new(&[("a", "device A"), ("b", "device B"), ("models", "models"), ("rho", "Spearman rho (net)"), ("ci", "95% CI"), ("discordant", "discordant pairs")]);
     let ci = |p: &crate::compare::PairCorrelation| Cell::text(p.spearman_ci.map_or("-".into(), |(lo, hi)| format!("[{lo:.2}, {hi:.2}]")));
     for (k, p) in table.correlations.iter().chain(&table.spirv_baseline).enumerate() {
-        corr.row(format!("rho/{k}"), vec![Cell::text(p.a.clone()), Cell::text(p.b.clone()), count_cell(p.models), num_cell(p.spearman_net), ci(p), Cell::text(p.discordant_cell())]);
+        // A rho without its CI (too few models) is not shown.
+        corr.row(format!("rho/{k}"), vec![Cell::text(p.a.clone()), Cell::text(p.b.clone()), count_cell(p.models), num_cell(p.spearman_net.filter(|_| p.spearman_ci.is_some())), ci(p), Cell::text(p.discordant_cell())]);
     }
     let units: Vec<String> = table.columns.iter().map(|c| format!("<b>{}</b>: {} ({})", esc(&c.name), esc(&c.unit), esc(&c.source))).collect();
     format!("{}<p class=\"note\">{}</p><h3>Rank correlations</h3>{}<p class=\"note\">{}</p>", t.html(), units.join("<br>"), corr.html(), crate::compare::RHO_NOTE)
