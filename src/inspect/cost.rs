@@ -26,6 +26,10 @@ pub struct CostRow {
     /// The pipe that binds the net figure, where the vendor's rule is a bound over pipes (Mali's Bifrost).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub bound: Option<String>,
+    /// The rule's terms per wave (`inspect::schedule`: each pipe's busy cycles, then latency / resident waves),
+    /// where the vendor's rule has them.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub terms: Vec<(String, f64)>,
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
@@ -64,7 +68,7 @@ pub fn table(report: &InspectReport, header: TargetCost, cycles: impl Fn(&std::c
     for r in &report.rows {
         let Some(c) = cycles(&r.stats, lights) else { continue };
         let stats = t.columns.iter().map(|name| (name.clone(), driver_stat(&r.stats, name).unwrap_or(0.0))).collect();
-        t.rows.push(CostRow { model: r.model.clone(), stats, cycles_per_eval: c, net_cycles_per_eval: None, bound: None });
+        t.rows.push(CostRow { model: r.model.clone(), stats, cycles_per_eval: c, net_cycles_per_eval: None, bound: None, terms: Vec::new() });
     }
     if t.rows.is_empty() {
         return None;
@@ -111,6 +115,7 @@ pub fn schedule_table(report: &InspectReport, mut header: TargetCost, schedule_o
         };
         row.net_cycles_per_eval = net;
         row.bound = Some(bound);
+        row.terms = wave.terms();
     }
     Some(t)
 }
@@ -119,6 +124,15 @@ pub fn schedule_table(report: &InspectReport, mut header: TargetCost, schedule_o
 pub const NEGATIVE_NET: &str = "net cost below zero: the kernel compiled to less than the memory-only kernel (a constant BRDF, or one whose inputs the compiler found unused, lets it drop loads and work the memory-only kernel keeps); its net figures measure that, not a cost of the BRDF";
 
 impl TargetCost {
+    /// The reference model's cycles taken apart (its terms per wave, the binding one named), where the rule
+    /// has terms.
+    fn terms_note(&self) -> String {
+        let Some(r) = self.row(crate::brdf::spec::REFERENCE_MODEL).or_else(|| self.rows.first()).filter(|r| !r.terms.is_empty()) else { return String::new() };
+        let (bind, _) = r.terms.iter().fold(("", f64::NEG_INFINITY), |b, (n, v)| if *v > b.1 { (n.as_str(), *v) } else { b });
+        let parts: Vec<String> = r.terms.iter().map(|(n, v)| if n == bind { format!("**{n} {}**", sig(*v, 4)) } else { format!("{n} {}", sig(*v, 4)) }).collect();
+        format!("\n{}'s cycles per wave taken apart ({}): {}; the largest binds.\n", r.model, self.unit, parts.join(", "))
+    }
+
     /// "navi21 (RDNA 2)" or the device name.
     pub fn label(&self) -> String {
         match (&self.family, &self.architecture) {
@@ -169,6 +183,7 @@ impl TargetCost {
         }
         let mut out = format!("### {} statistics, {} ({} lights per kernel; {}; {})\n\n{}", self.compiler, self.label(), self.lights_per_kernel, self.model, self.unit, t.markdown());
         out += &crate::inspect::constant_note(constant.iter().map(|(c, v)| (c.as_str(), *v)));
+        out += &self.terms_note();
         for r in self.rows.iter().filter(|r| r.net_cycles_per_eval.is_some_and(|v| v < 0.0)) {
             out += &format!("\n{}: {}\n", r.model, NEGATIVE_NET);
         }
