@@ -171,7 +171,8 @@ pub struct SweepArgs {
     pub nol: Option<(f64, f64)>,
     /// Also draw the table, JSON and Pareto chart with a compile-only target's modelled cycles per evaluation
     /// as the cost (radv:FAMILY, nvidia:FAMILY, intel:FAMILY, PREFIX:all; repeatable; see `devices --targets`):
-    /// sweep-<device>-<compiler>-<family>.* (aco, ptxas, igc).
+    /// sweep-<device>-<compiler>-<family>.* (aco, ptxas, igc); with several, sweep-<device>-frontiers.md/.json:
+    /// the specs on every target's frontier, and those on some only.
     #[arg(long = "cost-device", value_name = "DEVICE", value_parser = super::device_name)]
     pub cost_devices: Vec<String>,
     #[command(flatten)]
