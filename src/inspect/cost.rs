@@ -120,8 +120,8 @@ pub fn schedule_table(report: &InspectReport, mut header: TargetCost, schedule_o
     Some(t)
 }
 
-/// The note beside a net cost below zero.
-pub const NEGATIVE_NET: &str = "net cost below zero: the kernel compiled to less than the memory-only kernel (a constant BRDF, or one whose inputs the compiler found unused, lets it drop loads and work the memory-only kernel keeps); its net figures measure that, not a cost of the BRDF";
+/// The note beside a net cost at or below zero.
+pub const NEGATIVE_NET: &str = "net cost not above zero: the kernel adds nothing to the memory-only kernel (on no pipe or term of the rule, where the rule has them): it compiled to as little or less (a constant BRDF, or one whose inputs the compiler found unused, lets it drop loads and work the memory-only kernel keeps); its net figures measure that, not a cost of the BRDF";
 
 impl TargetCost {
     /// The reference model's cycles taken apart (its terms per wave, the binding one named), where the rule
@@ -184,7 +184,7 @@ impl TargetCost {
         let mut out = format!("### {} statistics, {} ({} lights per kernel; {}; {})\n\n{}", self.compiler, self.label(), self.lights_per_kernel, self.model, self.unit, t.markdown());
         out += &crate::inspect::constant_note(constant.iter().map(|(c, v)| (c.as_str(), *v)));
         out += &self.terms_note();
-        for r in self.rows.iter().filter(|r| r.net_cycles_per_eval.is_some_and(|v| v < 0.0)) {
+        for r in self.rows.iter().filter(|r| r.net_cycles_per_eval.is_some_and(|v| v <= 0.0)) {
             out += &format!("\n{}: {}\n", r.model, NEGATIVE_NET);
         }
         out
