@@ -14,12 +14,20 @@ pub(super) fn translate(file: &mut BrdfFile) -> Result<Vec<(usize, String)>> {
     if let Some(p) = file.params.iter().find(|p| p.name.starts_with(front::GENERATED_PREFIX)) {
         bail!(at(&file.path, p.line, format!("`{}`: names starting with `{}` are brdfprof's own in an {} shader", p.name, front::GENERATED_PREFIX, file.language.name())));
     }
-    let spirv = match file.language {
+    let (spirv, source) = match file.language {
         Language::Hlsl => hlsl_spirv(file)?,
         _ => wgsl_spirv(file)?,
     };
+    let text = cross::to_glsl(&spirv, &file.path)?;
+    check_param_names(file, &text)?;
     let params: Vec<&str> = file.params.iter().map(|p| p.name.as_str()).collect();
-    let glsl = cross::view(&cross::to_glsl(&spirv, &file.path)?, &params, &file.path)?;
+    let glsl = cross::view(&text, &params, &file.path).map_err(|e| match e.downcast::<cross::Resource>() {
+        Ok(r) => match locate(&source, &r.name) {
+            Some(at) => anyhow!("{at}: {}", r.message()),
+            None => anyhow!("{r}"),
+        },
+        Err(e) => e,
+    })?;
     for (k, e) in file.entries.iter_mut().enumerate() {
         e.glue = Some(glue_name(k));
     }
@@ -27,13 +35,38 @@ pub(super) fn translate(file: &mut BrdfFile) -> Result<Vec<(usize, String)>> {
     Ok(glsl.into_iter().enumerate().map(|(i, l)| (i + 1, l)).collect())
 }
 
+/// The shader's source lines with their files and lines (HLSL: with its includes), where a name is looked for.
+type Source = Vec<(String, usize, String)>;
+
+/// `FILE:LINE:COLUMN` of the first whole-word occurrence of `name` in `source`.
+fn locate(source: &Source, name: &str) -> Option<String> {
+    let ident = |c: char| c.is_ascii_alphanumeric() || c == '_';
+    source.iter().find_map(|(f, n, text)| {
+        let i = text.match_indices(name).map(|(i, _)| i).find(|&i| !text[..i].ends_with(ident) && !text[i + name.len()..].starts_with(ident))?;
+        Some(format!("{f}:{n}:{}", text[..i].chars().count() + 1))
+    })
+}
+
+/// spirv-cross writes a global named like a GLSL built-in function (`length`, `dot`) as `_NAME`: a parameter
+/// of that name would then not be the composition's, so it is refused at its line.
+fn check_param_names(file: &BrdfFile, glsl: &str) -> Result<()> {
+    for p in &file.params {
+        let escaped = format!("_{}", p.name);
+        if glsl.lines().any(|l| cross::plain_declaration(l).is_some_and(|(_, n)| n == escaped)) {
+            bail!(at(&file.path, p.line, format!("parameter `{}`: the name of a GLSL built-in, which the translation into GLSL renames (`{escaped}`); give the parameter another name", p.name)));
+        }
+    }
+    Ok(())
+}
+
 fn glue_name(k: usize) -> String {
     format!("{}entry{k}", front::GENERATED_PREFIX)
 }
 
-/// The directory a model's own includes and imports are found beside.
+/// The directory a model's own includes are found beside (empty for a bare file name: the working directory,
+/// which messages then leave out).
 fn model_dir(path: &Path) -> PathBuf {
-    path.parent().filter(|d| !d.as_os_str().is_empty()).map_or_else(|| PathBuf::from("."), Path::to_path_buf)
+    path.parent().map_or_else(PathBuf::new, Path::to_path_buf)
 }
 
 /// The functions the stub calls: `BRDF` where the shader defines it, and every glue function.
@@ -57,7 +90,7 @@ fn glue(k: usize, e: &Entry, types: &[Option<String>]) -> Glue {
 /// The HLSL shader compiled: the parameters as `static` globals, the section with its includes
 /// (`front::includes`), then each entry's glue and the stub. BRDF Explorer's entry and the declared entries are
 /// checked on glslang's preprocessed text (where every macro and `#if` is resolved), at their files' lines.
-fn hlsl_spirv(file: &mut BrdfFile) -> Result<Vec<u32>> {
+fn hlsl_spirv(file: &mut BrdfFile) -> Result<(Vec<u32>, Source)> {
     let mut x = Expanded::new(&file.path);
     for p in &file.params {
         x.push(hlsl::param_decl(&p.name, p.glsl_type()), 0, p.line);
@@ -69,7 +102,9 @@ fn hlsl_spirv(file: &mut BrdfFile) -> Result<Vec<u32>> {
         x.push(hlsl::glue(g), 0, e.line);
     }
     x.push(hlsl::stub(&stub_calls(file, &glues)), 0, file.shader_begin);
-    hlsl::compile(&x, &file.defines, &file.path)?.map_err(|m| anyhow!("{m}"))
+    let spirv = hlsl::compile(&x, &file.defines, &file.path)?.map_err(|m| anyhow!("{m}"))?;
+    let source = x.lines.iter().zip(&x.origins).map(|(l, &(f, n))| (x.files[f].clone(), n, l.clone())).collect();
+    Ok((spirv, source))
 }
 
 /// On the preprocessed HLSL `pre` (line for line with `x`): the loops, `BRDF`'s signature, each entry
@@ -105,7 +140,7 @@ fn check_hlsl(file: &mut BrdfFile, x: &Expanded, pre: &str) -> Result<Vec<Glue>>
 
 /// The WGSL shader composed and compiled: the section, the parameters as private globals, each entry's glue
 /// and the stub, through naga_oil and naga (`front::wgsl`).
-fn wgsl_spirv(file: &mut BrdfFile) -> Result<Vec<u32>> {
+fn wgsl_spirv(file: &mut BrdfFile) -> Result<(Vec<u32>, Source)> {
     let mut top = wgsl::Top::new(&file.source);
     for p in &file.params {
         top.push(&wgsl::param_decl(&p.name, p.glsl_type()), p.line, &format!("parameter `{}`", p.name));
@@ -122,7 +157,8 @@ fn wgsl_spirv(file: &mut BrdfFile) -> Result<Vec<u32>> {
     }
     top.push(&wgsl::stub(&stub_calls(file, &glues)), file.shader_begin, &format!("the shader's `BRDF` as brdfprof calls it, `{WGSL_BRDF}`"));
     let module = wgsl::compose(&file.path, &top, &file.defines, &file.includes)?;
-    wgsl::emit_spirv(&module, &file.path)
+    let model = file.path.display().to_string();
+    Ok((wgsl::emit_spirv(&module, &file.path)?, file.source.iter().map(|(n, l)| (model.clone(), *n, l.clone())).collect()))
 }
 
 const WGSL_BRDF: &str = "fn BRDF(L: vec3<f32>, V: vec3<f32>, N: vec3<f32>, X: vec3<f32>, Y: vec3<f32>) -> vec3<f32>";

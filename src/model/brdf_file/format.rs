@@ -328,7 +328,8 @@ fn parse_entry(path: &Path, n: usize, text: &str) -> Result<Entry> {
     let form = "`entry NAME(ARG, ...) [returns f|f_nol]`";
     let open = text.find('(').ok_or_else(|| anyhow!(at(path, n, format!("`entry {text}`: expected {form}"))))?;
     let name = text[..open].trim();
-    if !is_identifier(name) || GLSL_KEYWORDS.contains(&name) {
+    // A WGSL shader may name an imported module's function by its path (`lighting::direct`).
+    if !name.split("::").all(is_identifier) || GLSL_KEYWORDS.contains(&name) {
         bail!(at(path, n, format!("`entry {text}`: `{name}` is not a function name")));
     }
     let mut depth = 0usize;

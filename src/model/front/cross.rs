@@ -39,6 +39,46 @@ fn declared_name(line: &str) -> &str {
     head.rsplit(' ').next().unwrap_or("")
 }
 
+/// The precision qualifiers spirv-cross writes before a relaxed-precision variable's type.
+const PRECISIONS: [&str; 3] = ["mediump ", "highp ", "lowp "];
+
+/// `TYPE NAME;` or `TYPE NAME = VALUE;` (a precision qualifier before TYPE allowed): (TYPE, NAME).
+pub fn plain_declaration(line: &str) -> Option<(&str, &str)> {
+    let l = PRECISIONS.iter().fold(line, |l, p| l.strip_prefix(p).unwrap_or(l));
+    let head = l.split(" = ").next()?.trim_end_matches(';');
+    let (ty, name) = head.split_once(' ')?;
+    (!name.contains(' ') && !ty.is_empty() && l.ends_with(';')).then_some((ty, name))
+}
+
+/// A resource (a uniform or storage block, a texture) in the shader: a model is a function of its inputs and
+/// parameters. `name` as the shader declares it (the block's name).
+#[derive(Debug)]
+pub struct Resource {
+    pub name: String,
+    pub model: String,
+}
+
+impl Resource {
+    /// The message without the model's name (for a caller that locates the resource in the source).
+    pub fn message(&self) -> String {
+        format!("the shader uses the resource `{}` (a constant buffer, structured buffer or texture): a model is a function of its inputs and parameters; declare each value it reads as a parameter", self.name)
+    }
+}
+
+impl std::fmt::Display for Resource {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}: {}", self.model, self.message())
+    }
+}
+
+impl std::error::Error for Resource {}
+
+/// The name of a resource spirv-cross declares on `line` (`layout(...) uniform Material`, `uniform sampler2D t;`).
+fn resource_name(line: &str) -> &str {
+    let l = line.rfind(')').map_or(line, |i| &line[i + 1..]);
+    l.trim().trim_end_matches(';').rsplit(' ').next().unwrap_or(l)
+}
+
 /// What `view` collects: the kept lines, the globals the stub's prologue initialises, and where the first
 /// function starts.
 #[derive(Default)]
@@ -66,8 +106,7 @@ pub fn view(glsl: &str, params: &[&str], model: &Path) -> Result<Vec<String>> {
         if l.starts_with("#version") || l.starts_with("layout(local_size") {
             i += 1;
         } else if l.starts_with("layout(") || l.starts_with("uniform ") || l.starts_with("buffer ") {
-            let name = lines[i..].iter().find(|x| x.starts_with('}')).map_or(declared_name(l), |x| declared_name(x.trim_start_matches('}')));
-            bail!("{}: the shader uses a resource (`{}`, in spirv-cross's GLSL `{l}`): a model is a function of its inputs and parameters; declare each value as a parameter", model.display(), name);
+            bail!(Resource { name: resource_name(l).to_string(), model: model.display().to_string() });
         } else if l.starts_with("struct ") {
             let end = block_end(&lines, i, "};");
             v.lines.extend(lines[i..end].iter().map(|s| s.to_string()));
@@ -77,10 +116,10 @@ pub fn view(glsl: &str, params: &[&str], model: &Path) -> Result<Vec<String>> {
             function(&mut v, &lines[i..end], model)?;
             i = end;
         } else {
-            // A parameter's own declaration: `TYPE NAME;`, or naga's zero-initialised `TYPE NAME = ZERO;`.
+            // A parameter's own declaration: `TYPE NAME;`, or naga's zero-initialised `TYPE NAME = ZERO;`, with
+            // any precision qualifier spirv-cross writes for a relaxed-precision variable.
             let name = declared_name(l);
-            let head = l.split(" = ").next().unwrap_or(l).trim_end_matches(';');
-            let own = params.contains(&name) && head.split(' ').count() == 2 && head.ends_with(&format!(" {name}"));
+            let own = params.contains(&name) && plain_declaration(l).is_some_and(|(_, n)| n == name);
             if !own {
                 v.lines.push(l.to_string());
             }
@@ -117,9 +156,10 @@ fn prologue(v: &mut View, body: &[&str], model: &Path) -> Result<()> {
             v.initialised.push(s.to_string());
             continue;
         }
-        let decl = v.lines.iter().position(|l| l.ends_with(&format!(" {lhs};")) && l.split(' ').count() == 2);
+        let decl = v.lines.iter().position(|l| plain_declaration(l).is_some_and(|(_, n)| n == lhs) && !l.contains(" = "));
         let Some(decl) = decl else { bail!("{}: spirv-cross's translation sets `{lhs}` (`{s}`), which it does not declare as a global", model.display()) };
-        let ty = v.lines.remove(decl).split(' ').next().unwrap_or("").to_string();
+        let line = v.lines.remove(decl);
+        let ty = line.rsplit_once(' ').map_or("", |(t, _)| t).to_string();
         if let Some(f) = v.first_function.as_mut().filter(|f| **f > decl) {
             *f -= 1;
         }
@@ -155,6 +195,11 @@ mod tests {
         let bad = GLSL.replace("    LUMA = _12 * 2.0;\n", "    LUMA.x = 1.0;\n");
         assert!(format!("{:#}", view(&bad, &[], Path::new("m.hlsl")).unwrap_err()).contains("`LUMA.x = 1.0;`"));
         let resource = GLSL.replace("vec3 LUMA;\n", "layout(set = 0, binding = 0, std140) uniform Mat\n{\n    float k;\n} mat;\n");
-        assert!(format!("{:#}", view(&resource, &[], Path::new("m.hlsl")).unwrap_err()).contains("uses a resource (`mat`"));
+        assert_eq!(view(&resource, &[], Path::new("m.hlsl")).unwrap_err().downcast::<Resource>().unwrap().name, "Mat");
+        let relaxed = GLSL.replace("float roughness;", "mediump float roughness;").replace("vec3 LUMA;", "mediump vec3 LUMA;");
+        let v = view(&relaxed, &["roughness"], Path::new("m.hlsl")).unwrap().join("\n");
+        assert!(!v.contains("roughness;") && v.contains("mediump vec3 LUMA = _12 * 2.0;"), "{v}");
+        assert_eq!(plain_declaration("mediump float _length;"), Some(("float", "_length")));
+        assert_eq!(plain_declaration("vec3 BRDF(vec3 L)"), None);
     }
 }

@@ -187,7 +187,8 @@ impl Expander<'_> {
         if let Some(((v, dir), rest)) = self.includes.mapped(name) {
             return format!("cannot find include `{name}`: --include-map {v}={} maps it to {}, which does not exist", dir.display(), dir.join(rest).display());
         }
-        let mut searched: Vec<String> = quoted.then(|| self.sources[from].dir.display().to_string()).into_iter().collect();
+        let shown = |d: &Path| if d.as_os_str().is_empty() { ".".to_string() } else { d.display().to_string() };
+        let mut searched: Vec<String> = quoted.then(|| shown(&self.sources[from].dir)).into_iter().collect();
         searched.extend(self.includes.dirs.iter().map(|d| d.display().to_string()));
         let hint = if name.starts_with('/') { format!("; a virtual path needs --include-map {}=DIR", name.split('/').take(2).collect::<Vec<_>>().join("/")) } else { "; add the directory with --include-dir DIR".to_string() };
         format!("cannot find include `{name}` (searched: {}){hint}", if searched.is_empty() { "no directory".to_string() } else { searched.join(", ") })

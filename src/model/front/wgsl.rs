@@ -367,6 +367,13 @@ pub fn describe() -> String {
 mod tests {
     use super::*;
 
+    /// The version Cargo.lock pins for `package`.
+    fn locked(package: &str) -> String {
+        let lock = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/Cargo.lock")).unwrap();
+        let entry = lock.split("[[package]]").find(|e| e.lines().any(|l| l.trim() == format!("name = \"{package}\""))).unwrap();
+        entry.lines().find_map(|l| l.trim().strip_prefix("version = \"")).unwrap().trim_end_matches('"').to_string()
+    }
+
     #[test]
     fn generated_text() {
         let g = Glue { name: "brdfprof_entry0".into(), callee: "lighting::direct".into(), args: vec![GlueArg::Expr("N".into()), GlueArg::Out("vec3<f32>".into())] };
@@ -378,6 +385,7 @@ mod tests {
         let defs = shader_defs(&[("A".into(), "".into()), ("B".into(), "-2".into()), ("C".into(), "3u".into())], Path::new("m")).unwrap();
         assert_eq!((defs["A"], defs["B"], defs["C"]), (ShaderDefValue::Bool(true), ShaderDefValue::Int(-2), ShaderDefValue::UInt(3)));
         assert!(format!("{:#}", shader_defs(&[("A".into(), "0.5".into())], Path::new("m")).unwrap_err()).contains("define A=0.5"));
+        assert!(describe().starts_with(&format!("naga_oil {} (", locked("naga_oil"))) && describe().contains(&format!("naga {} (", locked("naga"))), "describe() names the versions Cargo.lock pins");
         assert_eq!(declared_imports("#import a::b::{x, y}\n  #import a::c::f\n#import \"p/q.wgsl\" f, g\n// #import no\n"), ["a::b", "a::c::f", "\"p/q.wgsl\""]);
     }
 }
