@@ -151,6 +151,18 @@ fn an_hlsl_define_selects_its_branch() {
 }
 
 #[test]
+fn a_loop_in_an_included_header_is_warned_about_at_its_own_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write_rows(&d.join("in.csv"), 2);
+    std::fs::create_dir(d.join("inc")).unwrap();
+    std::fs::write(d.join("inc/sum.ush"), "#pragma once\nfloat Sum()\n{\n\tfloat s = 0;\n\t[loop] for (int i = 0; i < 100000; i++) { s += 1e-5; }\n\treturn s;\n}\n").unwrap();
+    std::fs::write(d.join("m.usf"), "#include \"sum.ush\"\nfloat3 BRDF(float3 L, float3 V, float3 N, float3 X, float3 Y) { return Sum(); }\n").unwrap();
+    let out = run_in(d, &["eval", "--model", "m.usf", "--include-dir", "inc", "--input", "in.csv", "--output", "o.csv"]).ok();
+    assert!(out.stderr.contains("inc/sum.ush:5: a `for` loop of 100000 iterations: lavapipe ends every loop after 65535 iterations"), "{}", out.stderr);
+}
+
+#[test]
 fn profile_stability_sweep_and_report_take_them_and_state_the_front_end() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
@@ -165,6 +177,8 @@ fn profile_stability_sweep_and_report_take_them_and_state_the_front_end() {
     let light = ue("ue-light.brdf");
     let out = run_with_includes(d, &["stability", "--model", &hlsl, "--model", &wgsl, "--model", &light, "--out", st.to_str().unwrap()]).ok();
     assert!(out.stdout.contains("Front ends: "), "{}", out.stdout);
+    // ue-light.brdf declares its reference and its engine's roughness domain, which stability honours.
+    assert!(out.stdout.contains("- `ue-light`: checked against the reference `ggx`'s f64 values; roughness in [0.045, 1]"), "{}", out.stdout);
     let sw = d.join("sw");
     run_with_includes(d, &["sweep", "--model", &hlsl, "--model", &wgsl, "--size", "64x64", "--budget", "3", "--out", sw.to_str().unwrap()]).ok();
     let stability = common::device_file(&st, "stability-", ".json");
