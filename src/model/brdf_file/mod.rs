@@ -35,6 +35,10 @@
 //! glslang then names the file and its own line in every message about it; `remap_log` turns those messages
 //! (or, without the directive, messages located through a line map) into `my.brdf:57: ...` with the original
 //! identifiers.
+//!
+//! An HLSL or WGSL shader (`::begin shader hlsl|wgsl`, or a plain `.hlsl`/`.ush`/`.wgsl` file read by
+//! `load_shader`) is first translated into GLSL by its front end (`foreign`, `crate::model::front`): every step
+//! above then reads that GLSL, while the checks of its entries, its loops and its messages are the source's.
 
 mod foreign;
 mod format;
