@@ -1,6 +1,7 @@
 #!/bin/sh
 # Installs what brdfprof needs (Debian 12 names): the Vulkan loader, lavapipe (Mesa's CPU Vulkan driver), the
-# Khronos validation layer, glslang, SPIRV-Tools, vulkaninfo and valgrind; g++ (runs the kernels' C translation
+# Khronos validation layer, glslang, SPIRV-Tools, spirv-cross (HLSL and WGSL models' SPIR-V back to GLSL,
+# docs/hlsl.md), vulkaninfo and valgrind; g++ (runs the kernels' C translation
 # on the CPU); Intel's OpenCL compiler (ocloc/IGC) and PoCL (OpenCL on the CPU) for the intel: targets; Chromium
 # (the HTML report is tested in it, headless); and,
 # from PyPI, NVIDIA's NVRTC and nvdisasm for the nvidia: targets, into .tools/nvidia (about 150 MB).
@@ -16,6 +17,7 @@ have_file /usr/share/vulkan/icd.d/lvp_icd.*.json /usr/share/vulkan/icd.d/lvp_icd
 have_file /usr/share/vulkan/explicit_layer.d/VkLayer_khronos_validation.json || missing="$missing vulkan-validationlayers"
 command -v glslangValidator >/dev/null 2>&1 || missing="$missing glslang-tools"
 { command -v spirv-opt && command -v spirv-val; } >/dev/null 2>&1 || missing="$missing spirv-tools"
+command -v spirv-cross >/dev/null 2>&1 || missing="$missing spirv-cross"
 command -v vulkaninfo >/dev/null 2>&1 || missing="$missing vulkan-tools"
 command -v valgrind >/dev/null 2>&1 || missing="$missing valgrind"
 command -v g++ >/dev/null 2>&1 || missing="$missing g++"
@@ -35,7 +37,7 @@ if [ -n "$missing" ]; then
         echo "brdfprof setup: missing system packages:$missing" >&2
         echo "  install them as root on Debian/Ubuntu:  apt-get install$missing" >&2
         echo "  (other systems: the Vulkan loader, Mesa's lavapipe driver, the Khronos validation layer," >&2
-        echo "   glslang, SPIRV-Tools, vulkan-tools, valgrind, g++, Intel's compute runtime (ocloc), PoCL, the" >&2
+        echo "   glslang, SPIRV-Tools, spirv-cross, vulkan-tools, valgrind, g++, Intel's compute runtime (ocloc), PoCL, the" >&2
         echo "   OpenCL ICD loader and Chromium from your package manager)" >&2
         exit 1
     fi

@@ -67,16 +67,19 @@ pub struct Side {
     pub name: String,
     /// The full form, with every parameter.
     pub canonical: String,
+    /// What translated an HLSL or WGSL model into the kernels' GLSL, with versions.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub front_end: Option<String>,
 }
 
 impl Side {
     pub fn of(model: &Model) -> Self {
-        Side { name: model.label(), canonical: model.canonical() }
+        Side { name: model.label(), canonical: model.canonical(), front_end: model.file().and_then(|f| f.file.front_end.clone()) }
     }
 
     /// A reference's side: its f64 twin's values, not its kernel's.
     pub fn reference(model: &Model) -> Self {
-        Side { name: format!("{} (f64)", model.label()), canonical: model.canonical() }
+        Side { name: format!("{} (f64)", model.label()), canonical: model.canonical(), front_end: None }
     }
 }
 
@@ -125,6 +128,9 @@ impl DiffSet {
             self.device,
             crate::accuracy::FLOOR
         );
+        for d in self.diffs.iter().filter(|d| d.b.front_end.is_some()) {
+            out += &format!("{}'s front end: {}.\n\n", d.b.name, d.b.front_end.as_deref().unwrap_or(""));
+        }
         let mut t = Table::new(["model", "max rel", "RMS rel (worst channel)", "max abs", "rows within 1e-3", "non-finite (model / one side only)", "worst row", "verdict"]);
         for d in &self.diffs {
             let rms = d.difference.channels.iter().map(|c| c.rms_rel).fold(0.0, f64::max);
@@ -378,6 +384,11 @@ impl DiffReport {
     pub fn markdown(&self) -> String {
         use crate::results::{sig, Table};
         let mut out = format!("# {} against {}\n\n{} rows of {} on {}; relative: {}.\n\n", self.b.name, self.a.name, self.rows, self.input, self.device, self.relative_to);
+        for side in [&self.a, &self.b] {
+            if let Some(f) = &side.front_end {
+                out += &format!("{}'s front end: {f}.\n\n", side.name);
+            }
+        }
         let mut t = Table::new(["channel", "max rel", "RMS rel", "max abs", "RMS abs", "non-finite (A / B / one side only)"]);
         for c in &self.difference.channels {
             t.row([c.channel.to_string(), sig(c.max_rel, 3), sig(c.rms_rel, 3), sig(c.max_abs, 3), sig(c.rms_abs, 3), format!("{} / {} / {}", c.a_nonfinite, c.b_nonfinite, c.mismatched_nonfinite)]);

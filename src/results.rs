@@ -80,6 +80,10 @@ pub struct Provenance {
     pub host_threads: usize,
     /// The command line that wrote the report.
     pub command: Vec<String>,
+    /// What translated each HLSL or WGSL model into the kernels' GLSL, with versions (model path -> front
+    /// end; docs/hlsl.md, docs/wgsl.md); absent when every model is GLSL or built in.
+    #[serde(skip_serializing_if = "BTreeMap::is_empty")]
+    pub front_ends: BTreeMap<String, String>,
 }
 
 impl Provenance {
@@ -99,8 +103,18 @@ impl Provenance {
             cpu: crate::host::HostCpu::detect(),
             host_threads: std::thread::available_parallelism().map_or(1, |n| n.get()),
             command: std::env::args().collect(),
+            front_ends: crate::model::front::used(),
         }
     }
+}
+
+/// A report's `front_ends` as a paragraph to append to its summary (empty when it has none).
+pub fn front_ends_line(front_ends: &BTreeMap<String, String>) -> String {
+    if front_ends.is_empty() {
+        return String::new();
+    }
+    let items: Vec<String> = front_ends.iter().map(|(path, front)| format!("`{path}`: {front}")).collect();
+    format!("\n\nFront ends: {}.", items.join("; "))
 }
 
 /// The file-name form of a device name: its first words, lower case ("llvmpipe (LLVM 15.0.6, 256 bits)" ->

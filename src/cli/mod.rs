@@ -168,21 +168,35 @@ pub struct ModelArgs {
     /// branches and `#define`s see it (the same as `define=NAME=VALUE` in the file's spec; docs/brdf-files.md).
     #[arg(long = "define", value_name = "NAME[=VALUE]")]
     pub defines: Vec<String>,
+    /// A directory an HLSL shader's `#include` and a WGSL shader's `#import` search, after the model file's
+    /// own (repeatable, in order; `include=DIR` in the model's spec; docs/hlsl.md, docs/wgsl.md).
+    #[arg(long = "include-dir", value_name = "DIR")]
+    pub include_dirs: Vec<String>,
+    /// A virtual include prefix and the directory it stands for, e.g. /Engine=UE/Engine/Shaders: `#include
+    /// "/Engine/Private/BRDF.ush"` reads UE/Engine/Shaders/Private/BRDF.ush (`include-map=` in the spec).
+    #[arg(long = "include-map", value_name = "VIRTUAL=DIR")]
+    pub include_maps: Vec<String>,
 }
 
 impl ModelArgs {
     /// The models asked for, or `default` when none.
     pub fn models(&self, default: &[&str]) -> Result<Vec<Model>> {
-        if self.defines.is_empty() {
+        let mut items = String::new();
+        for (flag, key, values) in [("--define", model::file_model::DEFINE, &self.defines), ("--include-dir", model::file_model::INCLUDE, &self.include_dirs), ("--include-map", model::file_model::INCLUDE_MAP, &self.include_maps)] {
+            if let Some(v) = values.iter().find(|v| v.contains(',')) {
+                bail!("{flag} {v}: a comma would end the value in the model's spec; rename the directory or give the value without one");
+            }
+            items += &values.iter().map(|v| format!(",{key}={v}")).collect::<String>();
+        }
+        if items.is_empty() {
             return model::models_from_args(&self.models, &self.params, default);
         }
-        // The defines join each .brdf model's text, so that its shader is preprocessed once, with them (a file
-        // may `#error` without them).
-        let texts: Vec<String> = self.models.iter().filter(|m| model::file_model::names_a_file(m)).cloned().collect();
-        if texts.is_empty() {
-            bail!("--define {}: a define is for a .brdf file's shader, and no --model is a .brdf file", self.defines[0]);
+        // The options join each shader file model's text, so that its shader is prepared once, with them (a
+        // file may `#error` without its defines, or include what only these directories hold).
+        if !self.models.iter().any(|m| model::file_model::names_a_file(m)) {
+            let flag = [("--define", &self.defines), ("--include-dir", &self.include_dirs), ("--include-map", &self.include_maps)].into_iter().find_map(|(f, v)| v.first().map(|v| format!("{f} {v}"))).unwrap_or_default();
+            bail!("{flag}: it is for a shader file's model, and no --model is a .brdf file, nor an .hlsl, .ush or .wgsl file");
         }
-        let items: String = self.defines.iter().map(|d| format!(",{}={d}", model::file_model::DEFINE)).collect();
         let with: Vec<String> = self.models.iter().map(|m| if model::file_model::names_a_file(m) { format!("{m}{items}") } else { m.clone() }).collect();
         model::models_from_args(&with, &self.params, default)
     }

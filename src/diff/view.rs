@@ -7,6 +7,8 @@ use serde::Deserialize;
 pub struct SideView {
     pub name: String,
     pub canonical: String,
+    #[serde(default)]
+    pub front_end: Option<String>,
 }
 
 #[derive(Clone, Debug, Deserialize)]

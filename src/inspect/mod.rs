@@ -195,6 +195,8 @@ fn tool_versions(shaders: &Shaders) -> BTreeMap<String, String> {
     if shaders.glsl_dir().is_some() {
         tools.insert("glslang".into(), crate::shaders::glslang_version().unwrap_or_else(|| "not found".into()));
     }
+    // An HLSL or WGSL model's front end (docs/hlsl.md, docs/wgsl.md).
+    tools.extend(crate::model::front::used().into_iter().map(|(path, front)| (format!("front end of {path}"), front)));
     tools
 }
 

@@ -11,7 +11,7 @@
 //! the composed source (so the file's content), every file of the GLSL tree it includes, defines, flags,
 //! glslang's and brdfprof's versions.
 
-use super::brdf_file::{self, glsl_float, BrdfFile, FileParam, FileParamKind, Returns};
+use super::brdf_file::{self, glsl_float, BrdfFile, FileParam, FileParamKind, Includes, Returns};
 use super::KernelKind;
 use crate::shaders::{self, Shaders, Spirv};
 use anyhow::{anyhow, bail, Context, Result};
@@ -234,12 +234,18 @@ fn default_bindings(file: &BrdfFile, path: &str) -> Result<Vec<Binding>> {
         .collect()
 }
 
-/// A model text's `.brdf` path and the `NAME=VALUE` fields after it. The path ends at a `.brdf` followed by a
-/// comma or the end (so a path may hold commas: `a,b/m.brdf,k=1`): the first such whose file exists
-/// (relative to `base`), else the first such. None when the text names no `.brdf` file (a spec never does).
+/// A model text's shader file path (`.brdf`, or a plain HLSL or WGSL file: `front::FILE_EXTENSIONS`) and the
+/// `NAME=VALUE` fields after it. The path ends at such an extension followed by a comma or the end (so a path
+/// may hold commas: `a,b/m.brdf,k=1`): the first such whose file exists (relative to `base`), else the first
+/// such. None when the text names no shader file (a spec never does).
 pub fn split_path<'a>(text: &'a str, base: &Path) -> Option<(&'a str, Vec<&'a str>)> {
     let lower = text.to_ascii_lowercase();
-    let ends: Vec<usize> = lower.match_indices(".brdf").map(|(i, _)| i + ".brdf".len()).filter(|&e| e == text.len() || text.as_bytes()[e] == b',').collect();
+    let mut ends: Vec<usize> = crate::model::front::FILE_EXTENSIONS
+        .iter()
+        .flat_map(|ext| lower.match_indices(&format!(".{ext}")).map(|(i, m)| i + m.len()).collect::<Vec<_>>())
+        .filter(|&e| e == text.len() || text.as_bytes()[e] == b',')
+        .collect();
+    ends.sort_unstable();
     let end = ends.iter().copied().find(|&e| base.join(text[..e].trim()).is_file()).or_else(|| ends.first().copied())?;
     let fields = text[end..].strip_prefix(',').map(|r| r.split(',').collect()).unwrap_or_default();
     Some((text[..end].trim(), fields))
@@ -254,7 +260,7 @@ pub fn names_a_file(text: &str) -> bool {
 /// without a word: within it, beyond it, or not known from the source.
 fn loop_warning(path: &str, l: &brdf_file::Loop) -> String {
     let limit = brdf_file::LAVAPIPE_LOOP_LIMIT;
-    let head = format!("{path}:{}: a `{}` loop", l.line, l.keyword);
+    let head = format!("{}:{}: a `{}` loop", l.file.as_deref().unwrap_or(path), l.line, l.keyword);
     match l.trip_count {
         Some(n) if n <= limit => format!("{head} of {n} iterations: within the {limit} iterations after which lavapipe ends every loop"),
         Some(n) => format!("{head} of {n} iterations: lavapipe ends every loop after {limit} iterations, so its results there are wrong (other drivers run it to the end)"),
@@ -270,11 +276,59 @@ pub const DEFINE: &str = "define";
 pub const ENTRY: &str = "entry";
 pub const RETURNS: &str = "returns";
 
+/// The keys of a model text that add an include directory (`include=DIR`, as `--include-dir`) and map a
+/// virtual include prefix to a directory (`include-map=VIRTUAL=DIR`, as `--include-map`), for an HLSL shader's
+/// `#include` and a WGSL shader's `#import`.
+pub const INCLUDE: &str = "include";
+pub const INCLUDE_MAP: &str = "include-map";
+
+/// The keys of a model text brdfprof reads itself (no parameter may take one's name).
+const KEYS: [&str; 5] = [DEFINE, ENTRY, RETURNS, INCLUDE, INCLUDE_MAP];
+
 /// The entry and its parameters as BRDF Explorer's files name them: no macro may take these names.
 const ENTRY_NAMES: [&str; 6] = ["BRDF", "L", "V", "N", "X", "Y"];
 
 fn is_define(item: &str) -> bool {
     item.split_once('=').is_some_and(|(k, _)| k.trim() == DEFINE)
+}
+
+/// A `define=`, `include=` or `include-map=` item: what prepares the shader.
+fn is_shader_option(item: &str) -> bool {
+    item.split_once('=').is_some_and(|(k, _)| [DEFINE, INCLUDE, INCLUDE_MAP].contains(&k.trim()))
+}
+
+/// `include=DIR` and `include-map=VIRTUAL=DIR` items over `old`: a directory given again is not repeated, a
+/// virtual prefix mapped again takes the new directory. Each directory must exist.
+fn merge_includes(path: &str, old: &Includes, items: &[String]) -> Result<Includes> {
+    let mut out = old.clone();
+    for item in items {
+        let (key, value) = item.split_once('=').map(|(k, v)| (k.trim(), v.trim())).unwrap_or((item, ""));
+        let (virtual_prefix, dir) = match key {
+            INCLUDE_MAP => value.split_once('=').map(|(v, d)| (Some(v.trim()), d.trim())).unwrap_or((None, "")),
+            _ => (None, value),
+        };
+        if dir.is_empty() || (key == INCLUDE_MAP && virtual_prefix.is_none_or(str::is_empty)) {
+            bail!("{path}: `{item}`: expected {INCLUDE}=DIR or {INCLUDE_MAP}=VIRTUAL=DIR");
+        }
+        if !Path::new(dir).is_dir() {
+            bail!("{path}: `{item}`: {dir} is not a directory");
+        }
+        match virtual_prefix {
+            Some(v) => match out.maps.iter_mut().find(|(m, _)| m == v) {
+                Some(slot) => slot.1 = PathBuf::from(dir),
+                None => out.maps.push((v.to_string(), PathBuf::from(dir))),
+            },
+            None if !out.dirs.iter().any(|d| d == Path::new(dir)) => out.dirs.push(PathBuf::from(dir)),
+            None => {}
+        }
+    }
+    Ok(out)
+}
+
+/// The file's shader options under `items` (`define=`, `include=`, `include-map=`) over `file`'s own.
+fn shader_options(path: &str, defines: &[(String, String)], includes: &Includes, items: &[String]) -> Result<(Vec<(String, String)>, Includes)> {
+    let (defs, incs): (Vec<String>, Vec<String>) = items.iter().cloned().partition(|i| is_define(i));
+    Ok((merge_defines(path, defines, &defs)?, merge_includes(path, includes, &incs)?))
 }
 
 /// `defines` (`define=NAME[=VALUE]` items) over `old`: a name given again replaces its value; a name given
@@ -328,12 +382,14 @@ impl FileModel {
     pub fn parse(text: &str) -> Result<Self> {
         let (path, fields) = split_path(text, Path::new("")).ok_or_else(|| anyhow!("`{text}` names no .brdf file"))?;
         let items = split_params(&fields)?;
-        let (defines, params): (Vec<String>, Vec<String>) = items.into_iter().partition(|i| is_define(i));
-        let file = brdf_file::load_with(Path::new(path), &merge_defines(path, &[], &defines)?)?;
+        let (options, params): (Vec<String>, Vec<String>) = items.into_iter().partition(|i| is_shader_option(i));
+        let (defines, includes) = shader_options(path, &[], &Includes::default(), &options)?;
+        let file = brdf_file::load_shader(Path::new(path), &defines, &includes)?;
+        crate::model::front::record(path, file.language);
         if file.has_is_func {
             crate::messages::input_note(format!("{path}: its isFunc section (importance sampling) is ignored: brdfprof integrates with its own estimator"));
         }
-        if let Some(p) = file.params.iter().find(|p| [DEFINE, ENTRY, RETURNS].contains(&p.name.as_str())) {
+        if let Some(p) = file.params.iter().find(|p| KEYS.contains(&p.name.as_str())) {
             bail!("{}:{}: a parameter cannot be called `{}`: `{}=` in a model spec is brdfprof's own key", file.path.display(), p.line, p.name, p.name);
         }
         let defaults = default_bindings(&file, path)?;
@@ -370,17 +426,18 @@ impl FileModel {
     }
 
     pub fn takes_param(&self, name: &str) -> bool {
-        [DEFINE, ENTRY, RETURNS].contains(&name) || self.file.params.iter().any(|p| p.name == name)
+        KEYS.contains(&name) || self.file.params.iter().any(|p| p.name == name)
     }
 
     /// Applies `NAME=VALUE` overrides and `define=NAME[=VALUE]` macros (the shader then preprocessed again); an
     /// unknown name is an error naming the file and its parameters.
     pub fn with_params(&self, params: &[String]) -> Result<Self> {
         let mut m = self.clone();
-        let (defines, params): (Vec<&String>, Vec<&String>) = params.iter().partition(|i| is_define(i));
-        if !defines.is_empty() {
-            let defines: Vec<String> = defines.into_iter().cloned().collect();
-            m.file = self.file.with_defines(&merge_defines(&self.path, &self.file.defines, &defines)?)?;
+        let (options, params): (Vec<&String>, Vec<&String>) = params.iter().partition(|i| is_shader_option(i));
+        if !options.is_empty() {
+            let options: Vec<String> = options.into_iter().cloned().collect();
+            let (defines, includes) = shader_options(&self.path, &self.file.defines, &self.file.includes, &options)?;
+            m.file = self.file.with_options(&defines, &includes)?;
             m.warn_new(Some(self));
         }
         let mut given: Vec<&str> = Vec::new();
@@ -433,10 +490,16 @@ impl FileModel {
         bail!("{}: `entry={name}`: the file declares no such entry (its entries: {}; declare one as `entry NAME(ARG, ...) returns f|f_nol` in a `::begin brdfprof` section)", self.path, known.join(", "))
     }
 
-    fn text_with(&self, all: bool) -> String {
+    /// The model text: the path, the defines, the include directories and maps (`includes`), the entry and
+    /// what it returns, then the parameters (`all`: every one; else those that differ from the defaults).
+    fn text_with(&self, all: bool, includes: bool) -> String {
         let mut s = self.path.clone();
         for (name, value) in &self.file.defines {
             s += &if value.is_empty() { format!(",{DEFINE}={name}") } else { format!(",{DEFINE}={name}={value}") };
+        }
+        if includes {
+            s += &self.file.includes.dirs.iter().map(|d| format!(",{INCLUDE}={}", d.display())).collect::<String>();
+            s += &self.file.includes.maps.iter().map(|(v, d)| format!(",{INCLUDE_MAP}={v}={}", d.display())).collect::<String>();
         }
         let default_entry = self.file.entries.first().map_or("BRDF", |e| e.name.as_str());
         if let Some(e) = self.entry.as_ref().filter(|e| all || e.as_str() != default_entry) {
@@ -459,12 +522,18 @@ impl FileModel {
 
     /// The path with the overrides that differ from the file's defaults.
     pub fn name(&self) -> String {
-        self.text_with(false)
+        self.text_with(false, true)
+    }
+
+    /// `name` without the include directories and maps (which say where files are, not what the model
+    /// computes): what a label adds after the file's stem.
+    pub fn name_without_includes(&self) -> String {
+        self.text_with(false, false)
     }
 
     /// The path with every parameter.
     pub fn canonical(&self) -> String {
-        self.text_with(true)
+        self.text_with(true, true)
     }
 
     /// The parameters compiled in as constants (bound to a value, not to an input), as `NAME=VALUE`: a kernel

@@ -8,6 +8,7 @@
 pub mod brdf_file;
 pub mod csv_rows;
 pub mod file_model;
+pub mod front;
 
 use crate::brdf::terms::{ParamValue, PARAMS};
 use crate::brdf::{ModelSpec, Precision};
@@ -187,7 +188,7 @@ impl Model {
         match self {
             Model::Spec(s, _) => s.name(),
             Model::File(f) => {
-                let name = f.name();
+                let name = f.name_without_includes();
                 let path = std::path::Path::new(&f.path);
                 let part = |p: Option<&std::ffi::OsStr>| p.map_or(f.path.clone(), |n| n.to_string_lossy().into_owned());
                 // `ggx.brdf` keeps its extension: a stem that reads as a built-in model would take that one's rows.

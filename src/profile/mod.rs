@@ -347,6 +347,6 @@ impl ProfileReport {
                 protocol::Stop::Budget => "--budget spent",
                 protocol::Stop::MaxRounds => "--max-rounds reached",
             }
-        )
+        ) + &results::front_ends_line(&self.provenance.front_ends)
     }
 }

@@ -60,6 +60,7 @@ fn provenance_items(p: &ProvenanceView) -> Vec<(&'static str, String)> {
         ("tool", p.tool.clone()),
         ("written", if p.unix_time > 0 { utc(p.unix_time) } else { String::new() }),
         ("command", p.command.as_ref().map_or_else(|| "(not recorded by the brdfprof that wrote it)".to_string(), |c| c.join(" "))),
+        ("front ends", p.front_ends.iter().map(|(m, f)| format!("{m}: {f}")).collect::<Vec<_>>().join("; ")),
     ]
 }
 
@@ -81,7 +82,10 @@ pub fn provenance(inputs: &[Input]) -> String {
                     s += &kv(&items);
                 }
             }
-            Loaded::Diff(d) => s += &kv(&[("device", d.device.clone()), ("models", format!("A = {}, B = {}", d.a.canonical, d.b.canonical)), ("input", d.input.clone())]),
+            Loaded::Diff(d) => {
+                let fronts = [&d.a, &d.b].iter().filter_map(|x| x.front_end.as_ref().map(|f| format!("{}: {f}", x.name))).collect::<Vec<_>>().join("; ");
+                s += &kv(&[("device", d.device.clone()), ("models", format!("A = {}, B = {}", d.a.canonical, d.b.canonical)), ("input", d.input.clone()), ("front ends", fronts)]);
+            }
             Loaded::DiffSet(d) => {
                 let models = d.diffs.iter().map(|x| x.b.canonical.clone()).collect::<Vec<_>>().join("; ");
                 s += &kv(&[("device", d.device.clone()), ("reference", d.reference.canonical.clone()), ("models", models), ("input", d.input.clone())]);

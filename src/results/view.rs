@@ -42,4 +42,6 @@ pub struct ProvenanceView {
     pub host_threads: usize,
     /// The command line that wrote the report (reports from before it was recorded have none).
     pub command: Option<Vec<String>>,
+    /// HLSL and WGSL models' front ends (model path -> front end).
+    pub front_ends: BTreeMap<String, String>,
 }

@@ -317,7 +317,27 @@ fn relative_to_scene(text: &str) -> String {
         return text.to_string();
     }
     let joined = dir.join(path).display().to_string();
-    std::iter::once(joined.as_str()).chain(fields).collect::<Vec<_>>().join(",")
+    let fields: Vec<String> = fields.iter().map(|f| include_relative_to(&dir, f)).collect();
+    std::iter::once(joined).chain(fields).collect::<Vec<_>>().join(",")
+}
+
+/// A model text's `include=DIR` or `include-map=VIRTUAL=DIR` field with a relative DIR made relative to the
+/// scene's directory `dir`; any other field as it is.
+fn include_relative_to(dir: &Path, field: &str) -> String {
+    let (key, value) = field.split_once('=').unwrap_or((field, ""));
+    let (prefix, d) = match key.trim() {
+        model::file_model::INCLUDE => (String::new(), value),
+        model::file_model::INCLUDE_MAP => match value.split_once('=') {
+            Some((v, d)) => (format!("{v}="), d),
+            None => return field.to_string(),
+        },
+        _ => return field.to_string(),
+    };
+    let d = Path::new(d.trim());
+    if d.is_absolute() {
+        return field.to_string();
+    }
+    format!("{}={prefix}{}", key.trim(), dir.join(d).display())
 }
 
 impl Serialize for Model {

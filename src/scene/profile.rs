@@ -244,7 +244,7 @@ impl SceneProfileReport {
             self.rounds,
             self.reps_per_round,
             self.raw.elapsed_s
-        )
+        ) + &results::front_ends_line(&self.provenance.front_ends)
     }
 
     pub fn markdown(&self) -> String {

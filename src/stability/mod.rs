@@ -412,6 +412,9 @@ impl StabilityReport {
             self.cases.len(),
             self.grid_points
         );
+        if !self.provenance.front_ends.is_empty() {
+            out += &format!("{}\n\n", crate::results::front_ends_line(&self.provenance.front_ends).trim_start());
+        }
         let mut t = Table::new(["spec", "NaN", "Inf", "neg", "cases out of tol.", "grid out of tol.", "worst (x tol.)", "jumps", "reciprocity", "max E", "hemi r=1", "E vs CPU", "verdict"]);
         for s in &self.specs {
             let (max_e, hemi, cpu) = s.energy.as_ref().map_or(("-".into(), "-".into(), "-".into()), energy_cells);

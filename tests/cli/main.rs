@@ -11,6 +11,7 @@
 mod common;
 
 mod brdf_models;
+mod shader_languages;
 mod cache;
 mod compare;
 mod devices;

@@ -55,6 +55,38 @@ fn example_files_albedo_matches_their_presets() {
     common::assert_no_validation_messages(&gpu);
 }
 
+/// The HLSL and WGSL fixtures of issue 30 (tests/fixtures/hlsl/ue, tests/fixtures/wgsl/bevy), with the
+/// directories their includes and imports are in.
+fn foreign(language: &str) -> Model {
+    let root = common::repo_root().join("tests/fixtures");
+    let ue = root.join("hlsl/ue");
+    let text = match language {
+        "hlsl" => format!("{},include={},include-map=/Engine={}", ue.join("ue-ggx.brdf").display(), ue.join("Shaders").display(), ue.join("Engine").display()),
+        _ => format!("{},include={}", root.join("wgsl/bevy/bevy-ggx.brdf").display(), root.join("wgsl/bevy/shaders").display()),
+    };
+    Model::parse(&text).unwrap()
+}
+
+#[test]
+fn hlsl_and_wgsl_files_compute_their_glsl_twins_bits_and_albedo() {
+    let gpu = common::gpu();
+    let s = samples::well_conditioned(100_000, 30, 0.05, 0.0..1.0);
+    let twin = kernels::eval(&gpu, &bound("ggx"), &s, RunLimits::default()).unwrap();
+    let cells: Vec<AlbedoCell> = [0.1f32, 0.5, 1.0].iter().flat_map(|&nov| [0.2f32, 0.6, 1.0].map(|roughness| AlbedoCell { nov, roughness, f0: [0.04, 0.5, 1.0] })).collect();
+    let twin_albedo = kernels::albedo(&gpu, &bound("ggx"), &cells).unwrap();
+    for language in ["hlsl", "wgsl"] {
+        let model = foreign(language);
+        let got = kernels::eval(&gpu, &model, &s, RunLimits::default()).unwrap();
+        let differ = got.iter().zip(&twin).filter(|(g, t)| g.map(f32::to_bits) != t.map(f32::to_bits)).count();
+        assert_eq!(differ, 0, "{language}: {differ} of {} samples differ from the GLSL twin's bits", s.len());
+        let albedo = kernels::albedo(&gpu, &model, &cells).unwrap();
+        for ((a, t), cell) in albedo.iter().zip(&twin_albedo).zip(&cells) {
+            assert_eq!(a.e, t.e, "{language}: {cell:?}");
+        }
+    }
+    common::assert_no_validation_messages(&gpu);
+}
+
 /// A file returning its tangent X (or Y) as the colour.
 fn frame_file(dir: &Path) -> Model {
     let path = dir.join("frame.brdf");

@@ -271,3 +271,54 @@ fn an_engine_entry_returning_f_nol_renders_as_its_twin_returning_f() {
     assert!(worst <= 1, "the engine form's picture differs from the f form's by {worst}/255");
     assert!(a.iter().any(|p| p[0] > 10), "a lit picture");
 }
+
+/// Copies the files of `from` (and its folders) into `to`.
+fn copy_tree(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for e in std::fs::read_dir(from).unwrap() {
+        let p = e.unwrap().path();
+        let dest = to.join(p.file_name().unwrap());
+        if p.is_dir() {
+            copy_tree(&p, &dest);
+        } else {
+            std::fs::copy(&p, &dest).unwrap();
+        }
+    }
+}
+
+#[test]
+fn hlsl_and_wgsl_materials_render_as_their_glsl_twin() {
+    // The UE-style HLSL and Bevy-style WGSL fixtures of issue 30, copied beside the scene: their include
+    // directories, as the model's path, are relative to the scene file.
+    let dir = tempfile::tempdir().unwrap();
+    copy_tree(&common::repo_root().join("tests/fixtures/hlsl/ue"), &dir.path().join("ue"));
+    copy_tree(&common::repo_root().join("tests/fixtures/wgsl/bevy"), &dir.path().join("bevy"));
+    std::fs::copy(common::repo_root().join("examples/brdf/ggx.brdf"), dir.path().join("twin.brdf")).unwrap();
+    let models = [
+        ("twin", "twin.brdf,roughness=@roughness,f0=@f0", "twin-roughness"),
+        ("ue", "ue/ue-ggx.brdf,include=ue/Shaders,include-map=/Engine=ue/Engine", "ue-ggx."),
+        ("bevy", "bevy/bevy-ggx.brdf,include=bevy/shaders", "bevy-ggx."),
+    ];
+    let mut pictures = Vec::new();
+    for (name, model, prefix) in models {
+        let scene = SMALL
+            .replace(r#""name": "small""#, &format!(r#""name": "{name}""#))
+            .replace(r#""model": "ggx""#, &format!(r#""model": "{model}""#))
+            .replace(r#""anisotropy": 0.7"#, r#""anisotropy": 0.0"#)
+            .replace(r#""models": ["ggx", "burley"]"#, &format!(r#""models": ["{model}"]"#));
+        let f = write(dir.path(), &format!("{name}.json"), &scene);
+        let out = dir.path().join("out").join(name);
+        let (code, _, err) = run(&["render", "--scene", &f, "--out", out.to_str().unwrap()]);
+        assert_eq!(code, 0, "{err}");
+        assert!(!err.contains("validation ["), "{err}");
+        let path = std::fs::read_dir(&out).unwrap().map(|e| e.unwrap().path()).find(|p| p.file_name().unwrap().to_string_lossy().starts_with(prefix)).unwrap_or_else(|| panic!("no {prefix}* in {}", out.display()));
+        pictures.push(image::open(path).unwrap().to_rgb8());
+    }
+    // Below the title, which names the model: the same pixels.
+    let below = |img: &image::RgbImage| img.enumerate_pixels().filter(|(_, y, _)| *y >= 20).map(|(_, _, p)| *p).collect::<Vec<_>>();
+    let twin = below(&pictures[0]);
+    assert!(twin.iter().any(|p| p[0] > 10), "a lit picture");
+    for (k, name) in [(1, "HLSL"), (2, "WGSL")] {
+        assert!(below(&pictures[k]) == twin, "the {name} material's picture differs from its GLSL twin's");
+    }
+}

@@ -90,8 +90,12 @@ pub(super) fn dropped_hash_line(path: &Path, n: usize, line: &str) -> String {
 }
 
 /// A blank or `#` line of the shader section: a kept directive as written, anything else empty (with a
-/// warning for a dropped `#` line).
+/// warning for a dropped `#` line). An HLSL or WGSL shader keeps every line for its own preprocessor.
 fn push_blank_or_hash_line(file: &mut BrdfFile, n: usize, raw: &str) -> Result<()> {
+    if file.language != Language::Glsl {
+        file.source.push((n, raw.to_string()));
+        return Ok(());
+    }
     let trimmed = raw.trim();
     let kept = trimmed.starts_with('#') && keeps_directive(&file.path, n, trimmed)?;
     file.source.push((n, if kept { raw.to_string() } else { String::new() }));
@@ -133,6 +137,8 @@ pub(super) fn read_sections<'a>(file: &mut BrdfFile, lines: impl Iterator<Item =
                         if let Some(first) = shader_begin {
                             bail!(at(&path, n, format!("a second shader section (the first begins at line {first})")));
                         }
+                        let word = tokens.next();
+                        file.language = Language::of_section(word).ok_or_else(|| anyhow!(at(&path, n, format!("`::begin shader {}`: the shader's language is glsl (the default), hlsl or wgsl", word.unwrap_or("")))))?;
                         shader_begin = Some(n);
                     }
                     "parameters" | "isFunc" | DIRECTIVES_SECTION => {}
@@ -322,7 +328,8 @@ fn parse_entry(path: &Path, n: usize, text: &str) -> Result<Entry> {
     let form = "`entry NAME(ARG, ...) [returns f|f_nol]`";
     let open = text.find('(').ok_or_else(|| anyhow!(at(path, n, format!("`entry {text}`: expected {form}"))))?;
     let name = text[..open].trim();
-    if !is_identifier(name) || GLSL_KEYWORDS.contains(&name) {
+    // A WGSL shader may name an imported module's function by its path (`lighting::direct`).
+    if !name.split("::").all(is_identifier) || GLSL_KEYWORDS.contains(&name) {
         bail!(at(path, n, format!("`entry {text}`: `{name}` is not a function name")));
     }
     let mut depth = 0usize;
@@ -359,5 +366,5 @@ fn parse_entry(path: &Path, n: usize, text: &str) -> Result<Entry> {
         ["returns", r] => Returns::parse(r).ok_or_else(|| anyhow!(at(path, n, format!("`returns {r}`: expected f or f_nol"))))?,
         _ => bail!(at(path, n, format!("`entry {text}`: expected {form}"))),
     };
-    Ok(Entry { name: name.to_string(), args, param_types: Vec::new(), returns, line: n })
+    Ok(Entry { name: name.to_string(), args, param_types: Vec::new(), returns, line: n, glue: None })
 }

@@ -12,7 +12,9 @@ pub(super) fn check_shader(file: &mut BrdfFile, begin: usize, tokens: &[Token], 
     if let Some(t) = tokens.iter().find(|t| t.kind == Kind::Ident && t.text == "layout") {
         bail!(at(&file.path, file.shader[t.line].0, "`layout(...)` is not supported in a .brdf shader: the kernel the file is composed into sets its own layout (work-group size, bindings); declare values in the parameters section"));
     }
-    file.loops = loops(&file.shader, tokens);
+    if file.language == Language::Glsl {
+        file.loops = loops(&file.shader, tokens);
+    }
     let params: std::collections::HashMap<&str, usize> = file.params.iter().map(|p| (p.name.as_str(), p.line)).collect();
     for g in &scan.globals {
         if let Some(line) = params.get(g.name.as_str()) {
@@ -27,15 +29,57 @@ pub(super) fn check_shader(file: &mut BrdfFile, begin: usize, tokens: &[Token], 
             bail!(at(&file.path, *line, format!("`bind {name}=...`: the file has no parameter `{name}`")));
         }
     }
-    let brdf = check_brdf(&file.path, begin, &scan.globals);
+    let lines = Lines { path: &file.path, origin: None };
+    let brdf = check_brdf(&lines, begin, &scan.globals, &GLSL_SIGNATURE);
     file.defines_brdf = brdf.is_ok();
     if file.entries.is_empty() {
         return brdf;
     }
     for e in &mut file.entries {
-        e.param_types = check_entry(&file.path, e, &scan.globals)?;
+        e.param_types = match &e.glue {
+            Some(glue) => check_glue(&lines, e, glue, &scan.globals)?,
+            None => check_entry(&lines, e, &scan.globals, &GLSL_SIGNATURE)?,
+        };
     }
     Ok(())
+}
+
+/// The function an HLSL or WGSL front end wrote for entry `e` (its arguments already checked in the shader's
+/// own language) must be in its GLSL: `vec3 glue(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y)`.
+fn check_glue(lines: &Lines, e: &Entry, glue: &str, globals: &[Global]) -> Result<Vec<String>> {
+    let view = Entry { name: glue.to_string(), args: ["L", "V", "N", "X", "Y"].map(String::from).to_vec(), param_types: Vec::new(), returns: e.returns, line: e.line, glue: None };
+    check_entry(lines, &view, globals, &GLSL_SIGNATURE).map_err(|err| anyhow::anyhow!("{err:#} (the front end's call of `{}`)", e.name))
+}
+
+/// Where the scanned lines are: the model file's own lines (GLSL), or lines of an expanded text whose
+/// `origin` gives each one's file and line (an HLSL shader with its includes).
+pub(super) struct Lines<'a> {
+    pub(super) path: &'a Path,
+    pub(super) origin: Option<&'a dyn Fn(usize) -> (String, usize)>,
+}
+
+impl Lines<'_> {
+    /// `FILE:LINE: message` for scanned line `line`.
+    pub(super) fn at(&self, line: usize, message: impl Display) -> String {
+        match self.origin {
+            Some(o) => {
+                let (f, l) = o(line);
+                format!("{f}:{l}: {message}")
+            }
+            None => at(self.path, line, message),
+        }
+    }
+
+    /// Scanned line `line` cited in a message: `line 12` in the model file, else `FILE:LINE`.
+    pub(super) fn cite(&self, line: usize) -> String {
+        match self.origin {
+            Some(o) => {
+                let (f, l) = o(line);
+                format!("{f}:{l}")
+            }
+            None => format!("line {line}"),
+        }
+    }
 }
 
 /// An entry argument brdfprof fills in itself: `@out` takes the value, `@scratch` a value discarded.
@@ -43,58 +87,79 @@ pub(super) const OUT_ARG: &str = "@out";
 pub(super) const SCRATCH_ARG: &str = "@scratch";
 
 /// A declared entry must be a function defined at global scope with one parameter per argument, returning
-/// vec3, or writing its value to the one `@out` argument (an `out`/`inout vec3`; its return value is then
-/// discarded). `@scratch` fills an `out`/`inout` parameter whose value is discarded. Returns each parameter's type.
-pub(super) fn check_entry(path: &Path, entry: &Entry, globals: &[Global]) -> Result<Vec<String>> {
+/// vec3 (`sig`'s spellings of it), or writing its value to the one `@out` argument (an `out`/`inout vec3`; its
+/// return value is then discarded). `@scratch` fills an `out`/`inout` parameter whose value is discarded.
+/// Returns each parameter's type.
+pub(super) fn check_entry(lines: &Lines, entry: &Entry, globals: &[Global], sig: &Signature) -> Result<Vec<String>> {
+    let vec3 = sig.vec3[0];
     let defined = globals.iter().find_map(|g| match &g.kind {
-        GlobalKind::Function { defined: true, returns, params } if g.name == entry.name => Some((g.line, returns, params)),
+        GlobalKind::Function { defined: true, returns, params } if g.name == entry.name => Some((lines.cite(g.line), returns, params)),
         _ => None,
     });
-    let fail = |m: String| Err(anyhow::anyhow!(at(path, entry.line, m)));
+    let fail = |m: String| Err(anyhow::anyhow!(at(lines.path, entry.line, m)));
     let Some((line, returns, params)) = defined else { return fail(format!("entry `{}`: the shader defines no function `{}` at global scope", entry.name, entry.name)) };
     if params.len() != entry.args.len() {
-        return fail(format!("entry `{}` takes {} arguments (line {line}) and the declaration gives {}", entry.name, params.len(), entry.args.len()));
+        return fail(format!("entry `{}` takes {} arguments ({line}) and the declaration gives {}", entry.name, params.len(), entry.args.len()));
     }
-    if let Some(a) = entry.args.iter().find(|a| a.starts_with('@') && ![OUT_ARG, SCRATCH_ARG].contains(&a.as_str())) {
-        return fail(format!("entry `{}`: `{a}`: an argument is a GLSL expression, `{OUT_ARG}` (the argument the function writes its value to) or `{SCRATCH_ARG}` (one whose value is discarded)", entry.name));
-    }
-    let outs = entry.args.iter().filter(|a| *a == OUT_ARG).count();
-    if outs > 1 {
-        return fail(format!("entry `{}`: `{OUT_ARG}` is given {outs} times; the value is one argument", entry.name));
-    }
-    if outs == 0 && returns != "vec3" {
-        return fail(format!("entry `{}` returns `{returns}` (line {line}); an entry returns vec3 (f_s, or f_s N.L with `returns f_nol`), or writes it to an `{OUT_ARG}` argument", entry.name));
+    let outs = check_special_args(lines.path, entry, sig.language)?;
+    if outs == 0 && !sig.vec3.contains(&returns.as_str()) {
+        return fail(format!("entry `{}` returns `{returns}` ({line}); an entry returns {vec3} (f_s, or f_s N.L with `returns f_nol`), or writes it to an `{OUT_ARG}` argument", entry.name));
     }
     let types: Vec<String> = params.iter().map(|p| p.iter().find(|t| !QUALIFIERS.contains(&t.as_str())).cloned().unwrap_or_default()).collect();
     for (k, (arg, p)) in entry.args.iter().zip(params).enumerate() {
         let writable = p.iter().any(|t| t == "out" || t == "inout");
         if arg.starts_with('@') && !writable {
-            return fail(format!("entry `{}`: argument {} is `{arg}` but parameter {} (line {line}) is not `out` or `inout`", entry.name, k + 1, k + 1));
+            return fail(format!("entry `{}`: argument {} is `{arg}` but parameter {} ({line}) is not `out` or `inout`", entry.name, k + 1, k + 1));
         }
-        if arg == OUT_ARG && types[k] != "vec3" {
-            return fail(format!("entry `{}`: the `{OUT_ARG}` parameter {} (line {line}) is `{}`; the value is a vec3", entry.name, k + 1, types[k]));
+        if arg == OUT_ARG && !sig.vec3.contains(&types[k].as_str()) {
+            return fail(format!("entry `{}`: the `{OUT_ARG}` parameter {} ({line}) is `{}`; the value is a {vec3}", entry.name, k + 1, types[k]));
         }
     }
     Ok(types)
 }
 
-pub(super) const BRDF_SIGNATURE: &str = "vec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y)";
+/// An entry's arguments of brdfprof's own: only `@out` and `@scratch`, at most one `@out` (the count returned).
+pub(super) fn check_special_args(path: &Path, entry: &Entry, language: &str) -> Result<usize> {
+    let fail = |m: String| Err(anyhow::anyhow!(at(path, entry.line, m)));
+    if let Some(a) = entry.args.iter().find(|a| a.starts_with('@') && ![OUT_ARG, SCRATCH_ARG].contains(&a.as_str())) {
+        return fail(format!("entry `{}`: `{a}`: an argument is a {language} expression, `{OUT_ARG}` (the argument the function writes its value to) or `{SCRATCH_ARG}` (one whose value is discarded)", entry.name));
+    }
+    let outs = entry.args.iter().filter(|a| *a == OUT_ARG).count();
+    if outs > 1 {
+        return fail(format!("entry `{}`: `{OUT_ARG}` is given {outs} times; the value is one argument", entry.name));
+    }
+    Ok(outs)
+}
 
-/// `BRDF` must be defined at global scope with BRDF Explorer's signature.
-pub(super) fn check_brdf(path: &Path, begin: usize, globals: &[Global]) -> Result<()> {
+/// BRDF Explorer's entry in a C-like shader language: its name, how it spells a 3-vector of floats, and the
+/// signature.
+pub(super) struct Signature {
+    pub(super) language: &'static str,
+    pub(super) vec3: &'static [&'static str],
+    pub(super) text: &'static str,
+}
+
+pub(super) const GLSL_SIGNATURE: Signature = Signature { language: "GLSL", vec3: &["vec3"], text: "vec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y)" };
+/// HLSL's, `half3` included (32-bit: glslang's and DXC's default).
+pub(super) const HLSL_SIGNATURE: Signature = Signature { language: "HLSL", vec3: &["float3", "half3"], text: "float3 BRDF(float3 L, float3 V, float3 N, float3 X, float3 Y)" };
+
+/// `BRDF` must be defined at global scope with BRDF Explorer's signature (`sig`).
+pub(super) fn check_brdf(lines: &Lines, begin: usize, globals: &[Global], sig: &Signature) -> Result<()> {
     let brdfs: Vec<&Global> = globals.iter().filter(|g| g.name == "BRDF").collect();
+    let is_vec3 = |t: &String| sig.vec3.contains(&t.as_str());
     let fits = |g: &Global| match &g.kind {
-        GlobalKind::Function { defined, returns, params } => *defined && returns == "vec3" && params.len() == 5 && params.iter().all(|p| p.iter().any(|t| t == "vec3")),
+        GlobalKind::Function { defined, returns, params } => *defined && is_vec3(returns) && params.len() == 5 && params.iter().all(|p| p.iter().any(is_vec3)),
         _ => false,
     };
+    let signature = sig.text;
     if brdfs.iter().any(|g| fits(g)) {
         return Ok(());
     }
     let defined = |g: &&&Global| matches!(g.kind, GlobalKind::Function { defined: true, .. });
     match (brdfs.iter().find(defined), brdfs.first()) {
-        (Some(g), _) => bail!(at(path, g.line, format!("`BRDF` must be defined as `{BRDF_SIGNATURE}`"))),
-        (None, Some(g)) => bail!(at(path, g.line, format!("`BRDF` is declared but not defined (BRDF Explorer calls `{BRDF_SIGNATURE}`)"))),
-        (None, None) => bail!(at(path, begin, format!("the shader defines no function `BRDF` at global scope (BRDF Explorer calls `{BRDF_SIGNATURE}`)"))),
+        (Some(g), _) => bail!(lines.at(g.line, format!("`BRDF` must be defined as `{signature}`"))),
+        (None, Some(g)) => bail!(lines.at(g.line, format!("`BRDF` is declared but not defined (BRDF Explorer calls `{signature}`)"))),
+        (None, None) => bail!(at(lines.path, begin, format!("the shader defines no function `BRDF` at global scope (BRDF Explorer calls `{signature}`)"))),
     }
 }
 

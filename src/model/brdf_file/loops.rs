@@ -31,7 +31,7 @@ pub(super) fn loops(lines: &[(usize, String)], tokens: &[Token]) -> Vec<Loop> {
             do_whiles.insert(end + 1);
         }
         let trip_count = if keyword == "for" { trip_count(&tokens[i + 1..]) } else { None };
-        out.push(Loop { line: lines[t.line].0, keyword, trip_count });
+        out.push(Loop { file: None, line: lines[t.line].0, keyword, trip_count });
     }
     out
 }

@@ -35,7 +35,12 @@
 //! glslang then names the file and its own line in every message about it; `remap_log` turns those messages
 //! (or, without the directive, messages located through a line map) into `my.brdf:57: ...` with the original
 //! identifiers.
+//!
+//! An HLSL or WGSL shader (`::begin shader hlsl|wgsl`, or a plain `.hlsl`/`.ush`/`.wgsl` file read by
+//! `load_shader`) is first translated into GLSL by its front end (`foreign`, `crate::model::front`): every step
+//! above then reads that GLSL, while the checks of its entries, its loops and its messages are the source's.
 
+mod foreign;
 mod format;
 mod globals;
 mod loops;
@@ -54,6 +59,8 @@ use tokens::*;
 
 pub use format::is_identifier;
 pub use loops::LAVAPIPE_LOOP_LIMIT;
+
+pub use crate::model::front::{Includes, Language};
 
 use anyhow::{anyhow, bail, Result};
 use sha2::{Digest, Sha256};
@@ -74,6 +81,12 @@ pub struct BrdfFile {
     pub source: Vec<(usize, String)>,
     /// The defines the shader is preprocessed with (`define=NAME=VALUE` in the model spec, `--define`).
     pub defines: Vec<(String, String)>,
+    /// The shader's language (`::begin shader hlsl|wgsl`, or a plain `.hlsl`/`.ush`/`.wgsl` file's).
+    pub language: Language,
+    /// Where an HLSL shader's `#include` and a WGSL shader's `#import` look (`include=`, `include-map=`).
+    pub includes: Includes,
+    /// What translated an HLSL or WGSL shader into the GLSL the kernels compose (`front::describe`).
+    pub front_end: Option<String>,
     /// `source` after glslang's preprocessor (`preprocess`), line for line: what every later step reads. The
     /// same as `source` when it has no directive and no define is given.
     pub shader: Vec<(usize, String)>,
@@ -104,7 +117,8 @@ pub struct BrdfFile {
     pub hash: String,
     /// What every renamed name starts with (`BrdfFile::prefix`), computed once.
     pub prefix: String,
-    /// The shader's loops (`for`, `while`, `do`), with the trip count where the source bounds it.
+    /// The shader's loops (`for`, `while`, `do`), with the trip count where the source bounds it (an HLSL
+    /// or WGSL shader's as its own source has them, includes too).
     pub loops: Vec<Loop>,
     /// The preprocessed shader with its globals and parameters renamed, computed once.
     renamed: RenamedShader,
@@ -113,6 +127,8 @@ pub struct BrdfFile {
 /// A loop of the shader: lavapipe stops every loop at `LAVAPIPE_LOOP_LIMIT` iterations.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Loop {
+    /// The file it is in, where not the model's own (an included HLSL file).
+    pub file: Option<String>,
     /// The 1-based file line of its keyword.
     pub line: usize,
     pub keyword: &'static str,
@@ -133,6 +149,9 @@ pub struct Entry {
     pub returns: Returns,
     /// The 1-based file line that declares it.
     pub line: usize,
+    /// For an HLSL or WGSL shader: the function its front end wrote around the call, `NAME(L, V, N, X, Y)`
+    /// in the GLSL it translated the shader into, which the kernels call instead.
+    pub glue: Option<String>,
 }
 
 /// What an entry returns.
@@ -198,8 +217,26 @@ pub fn load(path: &Path) -> Result<BrdfFile> {
 /// Reads and parses `path`, its shader preprocessed under `defines` (as `BrdfFile::with_defines`), in one pass:
 /// a file whose own defaults do not preprocess (an `#error` unless a macro is given) is read with its macros.
 pub fn load_with(path: &Path, defines: &[(String, String)]) -> Result<BrdfFile> {
+    load_shader(path, defines, &Includes::default())
+}
+
+/// Reads and parses `path`: a `.brdf` file, or a plain HLSL or WGSL shader file (`.hlsl`, `.hlsli`, `.ush`,
+/// `.usf`, `.wgsl`: a shader section without parameters), its includes or imports found through `includes`.
+pub fn load_shader(path: &Path, defines: &[(String, String)], includes: &Includes) -> Result<BrdfFile> {
     let bytes = crate::io::read_input(path)?;
-    parse_with(path, &bytes, defines)
+    let plain = path.extension().and_then(|e| Language::of_extension(&e.to_string_lossy()));
+    let mut file = match plain {
+        Some(language) => empty(path, &bytes, language),
+        None => read_brdf(path, &bytes)?,
+    };
+    if plain.is_some() {
+        file.source = split_lines(text_of(path, &bytes)?).enumerate().map(|(i, l)| (i + 1, l.to_string())).collect();
+        file.shader_begin = 1;
+    }
+    file.includes = includes.clone();
+    file.set_defines(defines)?;
+    file.prepare_shader()?;
+    Ok(file)
 }
 
 /// Parses a `.brdf` file's bytes; `path` is how messages name it.
@@ -209,15 +246,35 @@ pub fn parse(path: &Path, bytes: &[u8]) -> Result<BrdfFile> {
 
 /// `parse`, the shader preprocessed under `defines`.
 pub fn parse_with(path: &Path, bytes: &[u8], defines: &[(String, String)]) -> Result<BrdfFile> {
+    let mut file = read_brdf(path, bytes)?;
+    file.set_defines(defines)?;
+    file.prepare_shader()?;
+    Ok(file)
+}
+
+/// A `.brdf` file's sections, its shader not yet prepared.
+fn read_brdf(path: &Path, bytes: &[u8]) -> Result<BrdfFile> {
     let text = text_of(path, bytes)?;
     let mut lines = split_lines(text);
     check_kind(path, lines.next().unwrap_or(""))?;
-    let mut file = BrdfFile {
+    let mut file = empty(path, bytes, Language::Glsl);
+    let shader_begin = read_sections(&mut file, lines)?;
+    file.shader_begin = shader_begin.ok_or_else(|| anyhow!(at(path, 1, "no shader section (`::begin shader` ... `::end shader`)")))?;
+    file.format_warnings = std::mem::take(&mut file.warnings);
+    Ok(file)
+}
+
+/// A file of `language` with nothing read yet.
+fn empty(path: &Path, bytes: &[u8], language: Language) -> BrdfFile {
+    BrdfFile {
         path: path.to_path_buf(),
         name: path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default(),
         params: Vec::new(),
         source: Vec::new(),
         defines: Vec::new(),
+        language,
+        includes: Includes::default(),
+        front_end: None,
         shader: Vec::new(),
         shader_begin: 0,
         entries: Vec::new(),
@@ -234,20 +291,20 @@ pub fn parse_with(path: &Path, bytes: &[u8], defines: &[(String, String)]) -> Re
         prefix: String::new(),
         loops: Vec::new(),
         renamed: RenamedShader::default(),
-    };
-    let shader_begin = read_sections(&mut file, lines)?;
-    file.shader_begin = shader_begin.ok_or_else(|| anyhow!(at(path, 1, "no shader section (`::begin shader` ... `::end shader`)")))?;
-    file.format_warnings = std::mem::take(&mut file.warnings);
-    file.set_defines(defines)?;
-    file.prepare_shader()?;
-    Ok(file)
+    }
 }
 
 impl BrdfFile {
     /// The same file with its shader preprocessed under `defines` (`NAME`, `VALUE`; an empty value defines
     /// NAME as glslang's `-DNAME` does).
     pub fn with_defines(&self, defines: &[(String, String)]) -> Result<BrdfFile> {
+        self.with_options(defines, &self.includes)
+    }
+
+    /// The same file with its shader prepared again under `defines` and `includes`.
+    pub fn with_options(&self, defines: &[(String, String)], includes: &Includes) -> Result<BrdfFile> {
         let mut file = self.clone();
+        file.includes = includes.clone();
         file.set_defines(defines)?;
         file.prepare_shader()?;
         Ok(file)
@@ -267,8 +324,16 @@ impl BrdfFile {
     /// Preprocesses `source` into `shader` and reads what the shader declares; the warnings are the format's,
     /// then the shader's.
     fn prepare_shader(&mut self) -> Result<()> {
-        self.shader = preprocess(&self.path, &self.source, &self.defines)?;
         self.warnings = self.format_warnings.clone();
+        self.shader = match self.language {
+            Language::Glsl => preprocess(&self.path, &self.source, &self.defines)?,
+            // The translation's GLSL through the same preprocessor (spirv-cross writes macros for control-flow
+            // attributes); the user's defines were the front end's.
+            _ => {
+                let glsl = foreign::translate(self)?;
+                preprocess(&self.path, &glsl, &[])?
+            }
+        };
         // Tokens and globals once: the checks, the loops and the renaming all read them.
         let tokens = tokenize(&self.path, &self.shader)?;
         let scan = scan_globals(&self.path, &self.shader, &tokens)?;

@@ -69,10 +69,15 @@ fn unterminated_if(source: &[(usize, String)]) -> Option<(usize, String)> {
 
 /// The preprocessed text's lines given the file lines glslang's `#line` directives number them with.
 pub(super) fn number_preprocessed(path: &Path, source: &[(usize, String)], out: &str) -> Result<Vec<(usize, String)>> {
+    number_lines(path, source, out.lines().skip_while(|l| l.trim().is_empty()).skip(1), 0)
+}
+
+/// Preprocessed `out` lines (after any header), one per line of `source` from line `next` on, renumbered
+/// where a `#line` directive says: `source`'s lines with their preprocessed text.
+pub(super) fn number_lines<'a>(path: &Path, source: &[(usize, String)], out: impl Iterator<Item = &'a str>, mut next: usize) -> Result<Vec<(usize, String)>> {
     let mut shader: Vec<(usize, String)> = source.iter().map(|(n, _)| (*n, String::new())).collect();
     let first = source.first().map_or(1, |l| l.0);
-    let mut next: usize = 0;
-    for line in out.lines().skip_while(|l| l.trim().is_empty()).skip(1) {
+    for line in out {
         if let Some(n) = line.trim().strip_prefix("#line ") {
             next = n.split_whitespace().next().and_then(|d| d.parse().ok()).ok_or_else(|| anyhow!("{}: glslang's preprocessor wrote `{line}`", path.display()))?;
             continue;

@@ -70,7 +70,11 @@ impl BrdfFile {
     /// The name the composed source's `#line` directive gives the file: its path, with the characters a
     /// directive's string cannot hold (`"`, control characters) replaced.
     pub(super) fn directive_name(&self) -> String {
-        self.path.display().to_string().chars().map(|c| if c == '"' || c.is_control() { '_' } else { c }).collect()
+        let shown = match self.language {
+            Language::Glsl => self.path.display().to_string(),
+            other => format!("{} (its {} as GLSL)", self.path.display(), other.name()),
+        };
+        shown.chars().map(|c| if c == '"' || c.is_control() { '_' } else { c }).collect()
     }
 
     /// The function that calls a declared entry as BRDF Explorer's `BRDF(L, V, N, X, Y)` is called, and its
@@ -79,6 +83,10 @@ impl BrdfFile {
     /// the file's names renamed. The name (the prefix, then a digit) is one no renamed name can take.
     pub fn entry_glue(&self, entry: &Entry) -> (String, String) {
         let name = format!("{}0entry", self.prefix);
+        if let Some(glue) = &entry.glue {
+            let text = format!("#line {} \"{}\"\nvec3 {name}(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) {{ return {}(L, V, N, X, Y); }}\n", entry.line, self.directive_name(), self.glsl_name(glue));
+            return (name, text);
+        }
         let mut locals = String::new();
         let mut result = None;
         let mut args = Vec::new();
@@ -136,8 +144,9 @@ impl BrdfFile {
     /// messages (about the host's code) are kept as glslang wrote them, and messages located nowhere (counts,
     /// "compilation terminated", link errors that follow a failed compile) are dropped.
     pub fn remap_log(&self, renamed: &RenamedShader, log: &str, line_of: impl Fn(usize) -> Option<usize>) -> String {
-        let shown = self.path.display().to_string();
-        let ours = [shown.clone(), self.directive_name()];
+        // A translated shader's lines are its GLSL's, named so.
+        let shown = if self.language == Language::Glsl { self.path.display().to_string() } else { self.directive_name() };
+        let ours = [self.path.display().to_string(), self.directive_name()];
         let mut out = String::new();
         for line in log.lines().map(str::trim) {
             let Some((severity, rest)) = line.split_once(": ").filter(|(s, _)| ["ERROR", "WARNING", "NOTE", "UNIMPLEMENTED", "INTERNAL ERROR"].contains(s)) else {

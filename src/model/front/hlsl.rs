@@ -1,0 +1,209 @@
+//! HLSL through glslang's HLSL front end (`glslangValidator -D`), the one brdfprof already runs for GLSL: its
+//! preprocessor over the include-expanded text (`includes`), then a compute compilation of the shader with a
+//! stub entry that calls `BRDF` and each glue function. `half` is 32-bit float (glslang without
+//! `--hlsl-enable-16bit-types`, as DXC without `-enable-16bit-types`). Messages come back at FILE:LINE:COLUMN
+//! of the user's files: the line through `Expanded::origin`, the column from glslang's parse-failure column,
+//! else from the token its message names on that line.
+
+use super::includes::Expanded;
+use super::{Glue, GlueArg, STUB};
+use anyhow::{bail, Context, Result};
+use std::collections::HashMap;
+use std::path::Path;
+
+/// glslang's flags for the compilation: HLSL, a compute stage with the stub as its entry, no SPIR-V
+/// optimisation (whose HLSL legalisation would inline every function into the stub).
+pub const FLAGS: [&str; 5] = ["-D", "-V", "-Od", "-S", "comp"];
+
+/// A parameter as an HLSL global: `static` (a private global, as a GLSL global is), of its type.
+pub fn param_decl(name: &str, glsl_type: &str) -> String {
+    let ty = match glsl_type {
+        "vec3" => "float3",
+        other => other,
+    };
+    format!("static {ty} {name};")
+}
+
+/// Whether `(T)0` makes a zero of HLSL type `ty` (a scalar, vector or matrix of a numeric type).
+fn is_numeric(ty: &str) -> bool {
+    let base = ty.trim_end_matches(|c: char| c.is_ascii_digit() || c == 'x');
+    ["float", "half", "double", "int", "uint", "bool", "min16float", "min10float", "min16int", "min12int", "min16uint"].contains(&base)
+}
+
+/// A glue function, on one line: `float3 NAME(float3 L, ...) { return CALLEE(ARGS); }`, with a local for each
+/// `@out`/`@scratch` argument (zero where its type is numeric) and the `@out` one returned.
+pub fn glue(g: &Glue) -> String {
+    let mut locals = String::new();
+    let mut out = None;
+    let mut args = Vec::new();
+    for (k, a) in g.args.iter().enumerate() {
+        let local = format!("brdfprof_arg{k}");
+        match a {
+            GlueArg::Expr(e) => args.push(e.clone()),
+            GlueArg::Out(ty) | GlueArg::Scratch(ty) => {
+                locals += &if is_numeric(ty) { format!("{ty} {local} = ({ty})0; ") } else { format!("{ty} {local}; ") };
+                if matches!(a, GlueArg::Out(_)) {
+                    out = Some(local.clone());
+                }
+                args.push(local);
+            }
+        }
+    }
+    let call = format!("{}({})", g.callee, args.join(", "));
+    let body = match out {
+        Some(o) => format!("{locals}{call}; return {o};"),
+        None => format!("{locals}return {call};"),
+    };
+    format!("float3 {}(float3 L, float3 V, float3 N, float3 X, float3 Y) {{ {body} }}", g.name)
+}
+
+/// The compute entry that calls each of `calls` (functions of (L, V, N, X, Y) returning float3), on one line.
+pub fn stub(calls: &[String]) -> String {
+    let body: String = calls.iter().map(|c| format!(" v += {c}(v, v, v, v, v);")).collect();
+    format!("[numthreads(1, 1, 1)] void {STUB}() {{ float3 v = (float3)0;{body} }}")
+}
+
+/// glslang's `-D` flags for `defines` (NAME, or NAME=VALUE).
+fn define_flags(defines: &[(String, String)]) -> Vec<String> {
+    defines.iter().map(|(n, v)| if v.is_empty() { format!("-D{n}") } else { format!("-D{n}={v}") }).collect()
+}
+
+/// Runs glslangValidator on `x`'s text written to a temporary `shader.hlsl`, with `args` then the defines:
+/// Ok(Ok(stdout, the output file's bytes)) or Ok(Err(its log)) when it refuses the shader.
+fn run(x: &Expanded, defines: &[(String, String)], args: &[&str], what: &str) -> Result<std::result::Result<(String, Option<Vec<u8>>), String>> {
+    let dir = crate::cleanup::TempDir::new().context("cannot create a temporary directory for glslang")?;
+    let source = dir.path().join("shader.hlsl");
+    std::fs::write(&source, x.text()).with_context(|| format!("cannot write {}", source.display()))?;
+    let out = dir.path().join("shader.spv");
+    let mut cmd = crate::cleanup::command("glslangValidator");
+    cmd.args(args).args(["-e", STUB]).args(define_flags(defines)).arg(&source);
+    if args.contains(&"-V") {
+        cmd.arg("-o").arg(&out);
+    }
+    let result = match crate::compile_limit::output(&mut cmd, what) {
+        Ok(r) => r,
+        Err(e) if e.downcast_ref::<std::io::Error>().is_some() => bail!("cannot run glslangValidator ({e}): install glslang-tools, or run `make setup`"),
+        Err(e) => return Err(e),
+    };
+    let stdout = String::from_utf8_lossy(&result.stdout).into_owned();
+    if !result.status.success() {
+        return Ok(Err(stdout + &String::from_utf8_lossy(&result.stderr)));
+    }
+    let spirv = if args.contains(&"-V") { Some(crate::io::read_bounded(&out, crate::compile_limit::MAX_OUTPUT_BYTES as u64).context("glslang's SPIR-V")?) } else { None };
+    Ok(Ok((stdout, spirv)))
+}
+
+/// glslang's preprocessor (`-E`) on the expanded text under `defines`: Ok(the preprocessed text, line for line
+/// with `x` but for its `#line` directives) or Err(the messages at the user's files' lines).
+pub fn preprocess(x: &Expanded, defines: &[(String, String)], model: &Path) -> Result<std::result::Result<String, String>> {
+    let what = format!("{} (glslang's HLSL preprocessor)", model.display());
+    Ok(run(x, defines, &["-D", "-E", "-S", "comp"], &what)?.map(|(out, _)| out).map_err(|log| messages(&log, x)))
+}
+
+/// The shader compiled to SPIR-V (`FLAGS`, the stub as entry), or Err(the messages at the user's files' lines).
+pub fn compile(x: &Expanded, defines: &[(String, String)], model: &Path) -> Result<std::result::Result<Vec<u32>, String>> {
+    let what = format!("{} (glslang's HLSL front end)", model.display());
+    Ok(match run(x, defines, &FLAGS, &what)? {
+        Ok((_, Some(bytes))) => Ok(crate::shaders::Spirv::from_bytes(&what, &bytes)?.words.to_vec()),
+        Ok((_, None)) => bail!("{what}: glslang wrote no SPIR-V"),
+        Err(log) => Err(messages(&log, x)),
+    })
+}
+
+/// `SOURCE:LINE: message` -> (LINE, message), at the first `:digits: `.
+fn located(rest: &str) -> Option<(usize, &str)> {
+    let b = rest.as_bytes();
+    rest.match_indices(':').find_map(|(i, _)| {
+        let digits = b[i + 1..].iter().take_while(|c| c.is_ascii_digit()).count();
+        (digits > 0 && b.get(i + 1 + digits) == Some(&b':')).then(|| (rest[i + 1..i + 1 + digits].parse().ok(), rest[i + 2 + digits..].trim()))
+    }).and_then(|(n, m)| Some((n?, m)))
+}
+
+/// glslang's `FILE(LINE): error at column C, HLSL parsing failed.` lines: LINE -> C.
+fn parse_columns(log: &str) -> HashMap<usize, usize> {
+    let mut out = HashMap::new();
+    for l in log.lines() {
+        let Some((head, tail)) = l.split_once("): error at column ") else { continue };
+        let line = head.rsplit('(').next().and_then(|n| n.parse().ok());
+        let column = tail.split(',').next().and_then(|c| c.trim().parse().ok());
+        if let (Some(line), Some(column)) = (line, column) {
+            out.insert(line, column);
+        }
+    }
+    out
+}
+
+/// The 1-based column (in characters) of the token a glslang message quotes (`'foo' : unknown variable`) on
+/// `line`, if it is there.
+pub fn token_column(line: &str, message: &str) -> Option<usize> {
+    let quoted = message.strip_prefix('\'').and_then(|m| m.split('\'').next()).filter(|t| !t.is_empty())?;
+    let ident = |c: char| c.is_ascii_alphanumeric() || c == '_';
+    let whole = |i: usize| !(quoted.starts_with(ident) && (line[..i].ends_with(ident) || line[i + quoted.len()..].starts_with(ident)));
+    let i = line.match_indices(quoted).map(|(i, _)| i).find(|&i| whole(i))?;
+    Some(line[..i].chars().count() + 1)
+}
+
+/// The column of a message at `line`: its quoted token's, else glslang's parse-failure column, else the line's
+/// first non-blank character's.
+fn column(line: &str, message: &str, parse_failure: Option<usize>) -> usize {
+    let first = || line.find(|c: char| !c.is_whitespace()).map_or(1, |i| line[..i].chars().count() + 1);
+    token_column(line, message).or(parse_failure).unwrap_or_else(first)
+}
+
+/// glslang's log as `FILE:LINE:COLUMN: message` lines at the user's files (`x`'s origins), the first message
+/// of each line only (glslang's next ones at a line follow from it); brdfprof's own `#error` lines (a missing
+/// include, a cycle) as their messages. Lines located nowhere are dropped; a log with no located error is
+/// returned as it is.
+pub fn messages(log: &str, x: &Expanded) -> String {
+    let columns = parse_columns(log);
+    let mut seen: Vec<(usize, usize)> = Vec::new();
+    let mut out: Vec<String> = Vec::new();
+    for rest in log.lines().filter_map(|l| l.trim().strip_prefix("ERROR: ")) {
+        let Some((n, message)) = located(rest) else { continue };
+        let Some(&origin) = n.checked_sub(1).and_then(|i| x.origins.get(i)) else { continue };
+        if seen.contains(&origin) {
+            continue;
+        }
+        seen.push(origin);
+        let text = x.lines.get(n - 1).map_or("", String::as_str);
+        let (column, message) = match x.notes.get(&(n - 1)) {
+            Some((c, m)) => (*c, m.clone()),
+            None => (column(text, message, columns.get(&n).copied()), message.to_string()),
+        };
+        out.push(format!("{}:{}:{column}: {message}", x.files[origin.0], origin.1));
+    }
+    if out.is_empty() {
+        return log.trim().to_string();
+    }
+    out.join("\n")
+}
+
+/// The front end, with glslang's version, as reports state it.
+pub fn describe() -> String {
+    let v = crate::shaders::glslang_version().map_or_else(|| "(version unknown)".into(), |v| v.trim_start_matches("Glslang Version:").trim().to_string());
+    format!("glslang {v}'s HLSL front end (glslangValidator {}; `half` is 32-bit float, as DXC without -enable-16bit-types)", FLAGS.join(" "))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn glue_and_stub_text() {
+        let g = Glue { name: "brdfprof_entry0".into(), callee: "Light".into(), args: vec![GlueArg::Expr("N".into()), GlueArg::Scratch("Surface".into()), GlueArg::Out("float3".into())] };
+        assert_eq!(glue(&g), "float3 brdfprof_entry0(float3 L, float3 V, float3 N, float3 X, float3 Y) { Surface brdfprof_arg1; float3 brdfprof_arg2 = (float3)0; Light(N, brdfprof_arg1, brdfprof_arg2); return brdfprof_arg2; }");
+        assert_eq!(stub(&["BRDF".into()]), "[numthreads(1, 1, 1)] void brdfprof_stub() { float3 v = (float3)0; v += BRDF(v, v, v, v, v); }");
+        assert_eq!(param_decl("f0", "vec3"), "static float3 f0;");
+    }
+
+    #[test]
+    fn columns_come_from_the_parse_failure_or_the_quoted_token() {
+        assert_eq!(token_column("  return x + foo;", "'foo' : unknown variable"), Some(14));
+        assert_eq!(token_column("  return food + foo;", "'foo' : unknown variable"), Some(17));
+        assert_eq!(column("\treturn x * Gloss;", "'Gloss' : unknown variable", Some(19)), 13, "the token, not where parsing stopped");
+        assert_eq!(column("   }", "';' : Expected", None), 4);
+        assert_eq!(column("  x +* 2;", "'expression' : Expected", Some(6)), 6);
+        assert_eq!(parse_columns("x.hlsl(2): error at column 13, HLSL parsing failed."), HashMap::from([(2, 13)]));
+        assert_eq!(located("/tmp/a b/shader.hlsl:12: 'x' : y"), Some((12, "'x' : y")));
+    }
+}

@@ -1,0 +1,155 @@
+//! Front ends for a model written in HLSL or WGSL (docs/hlsl.md, docs/wgsl.md): the user's shader, its includes
+//! or imports resolved, compiled to SPIR-V by its language's own front end (glslang's HLSL front end; naga_oil
+//! and naga for WGSL), and brought back as GLSL by spirv-cross, so that it composes into brdfprof's kernels as
+//! a GLSL shader does (src/model/brdf_file/foreign.rs orchestrates; this module knows nothing of `.brdf` files).
+//!
+//! - `includes`: C `#include` for HLSL, with `#pragma once`, include guards, virtual paths and cycles.
+//! - `hlsl`: glslang's HLSL preprocessor and compiler, their messages at FILE:LINE:COLUMN.
+//! - `wgsl`: naga_oil's `#import`/`#ifdef` composition over the include directories, naga's validation and
+//!   SPIR-V, their messages at FILE:LINE:COLUMN.
+//! - `cross`: spirv-cross, and the GLSL it writes cut down to the shader's own declarations and functions.
+
+pub mod cross;
+pub mod hlsl;
+pub mod includes;
+pub mod wgsl;
+
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+use std::sync::Mutex;
+
+/// The language of a model's shader.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Language {
+    Glsl,
+    Hlsl,
+    Wgsl,
+}
+
+impl Language {
+    pub fn name(self) -> &'static str {
+        match self {
+            Language::Glsl => "GLSL",
+            Language::Hlsl => "HLSL",
+            Language::Wgsl => "WGSL",
+        }
+    }
+
+    /// The word after `::begin shader` (none: GLSL, as BRDF Explorer's files are).
+    pub fn of_section(word: Option<&str>) -> Option<Language> {
+        match word.map(str::to_ascii_lowercase).as_deref() {
+            None | Some("glsl") => Some(Language::Glsl),
+            Some("hlsl") => Some(Language::Hlsl),
+            Some("wgsl") => Some(Language::Wgsl),
+            Some(_) => None,
+        }
+    }
+
+    /// The language of a plain shader file, by its extension (`.hlsl`, `.hlsli`, `.ush`, `.usf`, `.wgsl`).
+    pub fn of_extension(ext: &str) -> Option<Language> {
+        match ext.to_ascii_lowercase().as_str() {
+            "hlsl" | "hlsli" | "ush" | "usf" => Some(Language::Hlsl),
+            "wgsl" => Some(Language::Wgsl),
+            _ => None,
+        }
+    }
+}
+
+/// The extensions a model text may name a shader file by: `.brdf`, then plain shader files.
+pub const FILE_EXTENSIONS: [&str; 6] = ["brdf", "hlsl", "hlsli", "ush", "usf", "wgsl"];
+
+/// Where `#include` (HLSL) and `#import` (WGSL) look: `--include-dir DIR` in order, and `--include-map
+/// VIRTUAL=DIR` (a name under the virtual prefix VIRTUAL is found under DIR).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Includes {
+    pub dirs: Vec<PathBuf>,
+    pub maps: Vec<(String, PathBuf)>,
+}
+
+impl Includes {
+    pub fn is_empty(&self) -> bool {
+        self.dirs.is_empty() && self.maps.is_empty()
+    }
+
+    /// The longest mapped prefix `name` lies under (`/Engine` for `/Engine/Private/BRDF.ush`), with the rest of
+    /// the name after it.
+    pub fn mapped<'a>(&self, name: &'a str) -> Option<(&(String, PathBuf), &'a str)> {
+        let under = |v: &str| name == v || (name.starts_with(v) && (v.ends_with('/') || name[v.len()..].starts_with('/')));
+        let map = self.maps.iter().filter(|(v, _)| under(v)).max_by_key(|(v, _)| v.len())?;
+        Some((map, name[map.0.len()..].trim_start_matches('/')))
+    }
+}
+
+/// A call the front end writes in the shader's language around a declared entry (`entry NAME(ARG, ...)`):
+/// a function `name(L, V, N, X, Y)` returning what `callee(args)` returns (or the `@out` argument's value).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Glue {
+    pub name: String,
+    pub callee: String,
+    pub args: Vec<GlueArg>,
+}
+
+/// An argument of a glue call: an expression of the shader's language over L, V, N, X, Y and the parameters,
+/// or a local of the parameter's type (starting at zero) whose value is returned (`@out`) or discarded
+/// (`@scratch`).
+#[derive(Clone, Debug, PartialEq)]
+pub enum GlueArg {
+    Expr(String),
+    Out(String),
+    Scratch(String),
+}
+
+/// The names a front end generates: none of the shader's own may start with this.
+pub const GENERATED_PREFIX: &str = "brdfprof_";
+
+/// The compute entry point the front ends compile the shader with (it calls `BRDF` and every glue function,
+/// so that each reaches the SPIR-V); spirv-cross's output drops it.
+pub const STUB: &str = "brdfprof_stub";
+
+/// Front ends used by this process, model path -> what translated it (`describe`), for reports' provenance.
+static USED: Mutex<BTreeMap<String, String>> = Mutex::new(BTreeMap::new());
+
+/// Records that `path`'s shader went through `language`'s front end.
+pub fn record(path: &str, language: Language) {
+    if language != Language::Glsl {
+        USED.lock().unwrap().insert(path.to_string(), describe(language));
+    }
+}
+
+/// The front ends of the HLSL and WGSL models this process read, by model path (empty when there were none).
+pub fn used() -> BTreeMap<String, String> {
+    USED.lock().unwrap().clone()
+}
+
+/// What translates a language, with versions: what reports state.
+pub fn describe(language: Language) -> String {
+    match language {
+        Language::Glsl => format!("GLSL, {}", crate::shaders::glslang_version().unwrap_or_else(|| "glslang".into())),
+        Language::Hlsl => format!("HLSL: {}; {}", hlsl::describe(), cross::describe()),
+        Language::Wgsl => format!("WGSL: {}; {}", wgsl::describe(), cross::describe()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn languages_by_section_and_extension() {
+        assert_eq!(Language::of_section(None), Some(Language::Glsl));
+        assert_eq!(Language::of_section(Some("HLSL")), Some(Language::Hlsl));
+        assert_eq!(Language::of_section(Some("wgsl")), Some(Language::Wgsl));
+        assert_eq!(Language::of_section(Some("metal")), None);
+        assert_eq!(Language::of_extension("ush"), Some(Language::Hlsl));
+        assert_eq!(Language::of_extension("brdf"), None);
+    }
+
+    #[test]
+    fn the_longest_virtual_prefix_maps_a_name() {
+        let inc = Includes { dirs: vec![], maps: vec![("/Engine".into(), "a".into()), ("/Engine/Private".into(), "b".into()), ("/Eng".into(), "c".into())] };
+        let ((v, d), rest) = inc.mapped("/Engine/Private/BRDF.ush").unwrap();
+        assert_eq!((v.as_str(), d.to_str().unwrap(), rest), ("/Engine/Private", "b", "BRDF.ush"));
+        assert_eq!(inc.mapped("/Engine/Public/X.ush").unwrap().1, "Public/X.ush");
+        assert!(inc.mapped("/EngineX/a.ush").is_none() && inc.mapped("Engine/a.ush").is_none());
+    }
+}

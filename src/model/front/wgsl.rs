@@ -1,0 +1,391 @@
+//! WGSL through naga_oil and naga (Bevy's own toolchain): naga_oil resolves `#import`, `#ifdef`/`#else`/`#endif`
+//! and `#define_import_path` (the modules found in the include directories, a quoted import as a path like an
+//! HLSL include), with `--define`s as its shader defs; naga validates the module and writes SPIR-V with its
+//! runtime checks off (no index clamping, no loop bounding: `emit_spirv`), which spirv-cross brings back as
+//! GLSL. Messages come back at FILE:LINE:COLUMN as naga_oil locates them (its preprocessor keeps every line in
+//! place); lines brdfprof appends to the shader (parameters, glue, stub) name what they came from.
+
+use super::{Glue, GlueArg, Includes, STUB};
+use anyhow::{anyhow, bail, Context, Result};
+use naga_oil::compose::{ComposableModuleDescriptor, Composer, ComposerError, NagaModuleDescriptor, ShaderDefValue, ShaderLanguage, ShaderType};
+use std::collections::{BTreeMap, HashMap};
+use std::path::{Path, PathBuf};
+
+/// Include directories are searched for modules this deep, and this many files at most.
+const MAX_DEPTH: usize = 8;
+const MAX_FILES: usize = 20_000;
+
+/// The shader naga_oil composes: the model's section at its own line numbers (blank lines before it), then
+/// the lines brdfprof appends, each with the model file's line it stands for and what it is.
+#[derive(Clone, Debug, Default)]
+pub struct Top {
+    pub text: String,
+    pub lines: usize,
+    /// 1-based line of the text -> (the model file's line, what it is).
+    pub generated: BTreeMap<usize, (usize, String)>,
+}
+
+impl Top {
+    /// The section `lines` (numbered as in the model file) at their own line numbers.
+    pub fn new(lines: &[(usize, String)]) -> Self {
+        let mut top = Top::default();
+        for (n, l) in lines {
+            while top.lines + 1 < *n {
+                top.text.push('\n');
+                top.lines += 1;
+            }
+            top.text += l;
+            top.text.push('\n');
+            top.lines += 1;
+        }
+        top
+    }
+
+    /// Appends a generated line standing for the model file's line `origin`.
+    pub fn push(&mut self, text: &str, origin: usize, what: &str) {
+        self.text += text;
+        self.text.push('\n');
+        self.lines += 1;
+        self.generated.insert(self.lines, (origin, what.to_string()));
+    }
+}
+
+/// A parameter as a WGSL module-scope private variable of its type.
+pub fn param_decl(name: &str, glsl_type: &str) -> String {
+    let ty = match glsl_type {
+        "vec3" => "vec3<f32>",
+        "float" => "f32",
+        other => other,
+    };
+    format!("var<private> {name}: {ty};")
+}
+
+/// A glue function on one line (`hlsl::glue`'s WGSL form): an `@out`/`@scratch` argument is a pointer to a
+/// local of the parameter's type, starting at its zero value.
+pub fn glue(g: &Glue) -> String {
+    let mut locals = String::new();
+    let mut out = None;
+    let mut args = Vec::new();
+    for (k, a) in g.args.iter().enumerate() {
+        let local = format!("brdfprof_arg{k}");
+        match a {
+            GlueArg::Expr(e) => args.push(e.clone()),
+            GlueArg::Out(ty) | GlueArg::Scratch(ty) => {
+                locals += &format!("var {local}: {ty} = {ty}(); ");
+                if matches!(a, GlueArg::Out(_)) {
+                    out = Some(local.clone());
+                }
+                args.push(format!("&{local}"));
+            }
+        }
+    }
+    let call = format!("{}({})", g.callee, args.join(", "));
+    let body = match out {
+        Some(o) => format!("{locals}{call}; return {o};"),
+        None => format!("{locals}return {call};"),
+    };
+    format!("fn {}(L: vec3<f32>, V: vec3<f32>, N: vec3<f32>, X: vec3<f32>, Y: vec3<f32>) -> vec3<f32> {{ {body} }}", g.name)
+}
+
+/// The compute entry that calls each of `calls`, on one line.
+pub fn stub(calls: &[String]) -> String {
+    let body: String = calls.iter().map(|c| format!(" v += {c}(v, v, v, v, v);")).collect();
+    format!("@compute @workgroup_size(1) fn {STUB}() {{ var v = vec3<f32>(0.0);{body} }}")
+}
+
+/// Whether the section defines `fn BRDF` (textually: naga checks its signature when the stub calls it).
+pub fn defines_brdf(lines: &[(usize, String)]) -> bool {
+    lines.iter().any(|(_, l)| l.trim_start().strip_prefix("fn").is_some_and(|r| r.starts_with(char::is_whitespace) && r.trim_start().strip_prefix("BRDF").is_some_and(|r| r.trim_start().starts_with('('))))
+}
+
+/// `--define`s as naga_oil's shader defs: NAME alone is true; a value is `true`, `false`, an integer (i32), or
+/// one with a `u` suffix (u32).
+pub fn shader_defs(defines: &[(String, String)], model: &Path) -> Result<HashMap<String, ShaderDefValue>> {
+    defines
+        .iter()
+        .map(|(n, v)| {
+            let value = match v.as_str() {
+                "" | "true" => ShaderDefValue::Bool(true),
+                "false" => ShaderDefValue::Bool(false),
+                v => match (v.parse::<i32>(), v.strip_suffix('u').map(str::parse::<u32>)) {
+                    (Ok(i), _) => ShaderDefValue::Int(i),
+                    (_, Some(Ok(u))) => ShaderDefValue::UInt(u),
+                    _ => bail!("{}: define {n}={v}: a WGSL shader def is true, false, an integer or an integer with a `u` suffix (naga_oil's ShaderDefValue)", model.display()),
+                },
+            };
+            Ok((n.clone(), value))
+        })
+        .collect()
+}
+
+/// Every `.wgsl` file under `dir` (to `MAX_DEPTH`, skipping hidden entries), sorted.
+fn wgsl_files(dir: &Path, depth: usize, out: &mut Vec<PathBuf>) {
+    let Ok(entries) = std::fs::read_dir(dir) else { return };
+    let mut paths: Vec<PathBuf> = entries.filter_map(|e| e.ok().map(|e| e.path())).filter(|p| !p.file_name().is_some_and(|n| n.to_string_lossy().starts_with('.'))).collect();
+    paths.sort();
+    for p in paths {
+        if out.len() >= MAX_FILES {
+            return;
+        }
+        if p.is_dir() && depth < MAX_DEPTH {
+            wgsl_files(&p, depth + 1, out);
+        } else if p.extension().is_some_and(|e| e == "wgsl") && p.is_file() {
+            out.push(p);
+        }
+    }
+}
+
+fn read_text(path: &Path) -> Result<String> {
+    String::from_utf8(crate::io::read_input(path)?).map_err(|e| anyhow!("{} is not UTF-8 text (byte {})", path.display(), e.utf8_error().valid_up_to()))
+}
+
+/// The modules the include directories (recursively) and the model's own directory declare with
+/// `#define_import_path NAME`: NAME -> its file, the first found in that order.
+fn module_index(model_dir: &Path, includes: &Includes) -> BTreeMap<String, PathBuf> {
+    let mut files = Vec::new();
+    for d in &includes.dirs {
+        wgsl_files(d, 0, &mut files);
+    }
+    wgsl_files(model_dir, MAX_DEPTH, &mut files);
+    let mut index = BTreeMap::new();
+    for f in files {
+        if let Some(name) = read_text(&f).ok().and_then(|t| naga_oil::compose::get_preprocessor_data(&t).0) {
+            index.entry(name).or_insert(f);
+        }
+    }
+    index
+}
+
+/// The file an import names: a quoted path like a quoted HLSL include (a mapped virtual prefix, else beside
+/// the model, then the include directories), a module name through the index.
+fn resolve(import: &str, model_dir: &Path, includes: &Includes, index: &BTreeMap<String, PathBuf>) -> Option<PathBuf> {
+    let Some(path) = import.strip_prefix('"').and_then(|p| p.strip_suffix('"')) else {
+        // `a::b::item` names item of module `a::b`: the longest prefix that is a module.
+        let mut name = import;
+        loop {
+            if let Some(p) = index.get(name) {
+                return Some(p.clone());
+            }
+            name = name.rsplit_once("::")?.0;
+        }
+    };
+    if let Some(((_, dir), rest)) = includes.mapped(path) {
+        return Some(dir.join(rest)).filter(|p| p.is_file());
+    }
+    std::iter::once(model_dir.join(path)).chain(includes.dirs.iter().map(|d| d.join(path))).find(|p| p.is_file())
+}
+
+/// The 1-based line and column where `text` imports `import` (its `#import` line), else 1:1.
+fn import_at(text: &str, import: &str) -> (usize, usize) {
+    let key = import.trim_matches('"').rsplit("::").last().unwrap_or(import);
+    text.lines().enumerate().find(|(_, l)| l.trim_start().starts_with("#import") && l.contains(key)).map_or((1, 1), |(i, l)| (i + 1, l.find(key).unwrap_or(0) + 1))
+}
+
+/// naga_oil composition state: the composer and the modules added or being added.
+struct Modules<'a> {
+    composer: Composer,
+    model_dir: &'a Path,
+    includes: &'a Includes,
+    index: BTreeMap<String, PathBuf>,
+    added: Vec<String>,
+    stack: Vec<String>,
+}
+
+impl Modules<'_> {
+    /// Adds the modules `text` (the file `shown`) imports, each after its own imports; an import found nowhere
+    /// is left for naga_oil to report where it is live.
+    fn add_imports_of(&mut self, text: &str, shown: &str) -> Result<()> {
+        for import in naga_oil::compose::get_preprocessor_data(text).1.into_iter().map(|i| i.import) {
+            if self.added.contains(&import) {
+                continue;
+            }
+            if let Some(k) = self.stack.iter().position(|s| *s == import) {
+                let (line, col) = import_at(text, &import);
+                bail!("{shown}:{line}:{col}: import cycle: {} -> {import}", self.stack[k..].join(" -> "));
+            }
+            let Some(path) = resolve(&import, self.model_dir, self.includes, &self.index) else { continue };
+            let source = read_text(&path).map_err(|e| {
+                let (line, col) = import_at(text, &import);
+                anyhow!("{shown}:{line}:{col}: {e:#}")
+            })?;
+            let file = path.display().to_string();
+            self.stack.push(import.clone());
+            self.add_imports_of(&source, &file)?;
+            self.stack.pop();
+            let as_name = import.starts_with('"').then(|| import.clone());
+            let desc = ComposableModuleDescriptor { source: &source, file_path: &file, language: ShaderLanguage::Wgsl, as_name, ..Default::default() };
+            if let Err(e) = self.composer.add_composable_module(desc) {
+                bail!("{}", located(&e, &self.composer, None));
+            }
+            self.added.push(import);
+        }
+        Ok(())
+    }
+}
+
+/// A naga_oil error as `FILE:LINE:COLUMN: message` (from its codespan report's `┌─ FILE:LINE:COLUMN` line),
+/// a generated line of `top` named by what it stands for.
+fn located(e: &ComposerError, composer: &Composer, top: Option<(&str, &Top)>) -> String {
+    let report = e.emit_to_string(composer);
+    let message = report.lines().find_map(|l| l.strip_prefix("error: ")).unwrap_or("").trim().to_string();
+    let notes: Vec<&str> = report.lines().filter_map(|l| l.trim().strip_prefix("= ")).collect();
+    let labels: Vec<&str> = report.lines().filter_map(|l| l.split_once('^').map(|(_, r)| r.trim_start_matches('^').trim())).filter(|l| !l.is_empty()).collect();
+    let Some(at) = report.lines().find_map(|l| l.split_once("┌─ ").map(|(_, r)| r.trim().to_string())) else {
+        return report.trim().to_string();
+    };
+    let mut parts = at.rsplitn(3, ':');
+    let (col, line, file) = (parts.next().unwrap_or("1"), parts.next().and_then(|l| l.parse::<usize>().ok()).unwrap_or(1), parts.next().unwrap_or(""));
+    let mut detail: Vec<&str> = labels.into_iter().chain(notes).filter(|d| *d != message).collect();
+    detail.dedup();
+    let tail = if detail.is_empty() { String::new() } else { format!(" ({})", detail.join("; ")) };
+    match top.filter(|(shown, _)| *shown == file).and_then(|(_, t)| t.generated.get(&line)) {
+        Some((origin, what)) => format!("{file}:{origin}:1: {what}: {message}{tail}"),
+        None => format!("{file}:{line}:{col}: {message}{tail}"),
+    }
+}
+
+/// naga_oil's composition of `top` (the model's section plus brdfprof's lines) under `defines`, its imports
+/// found through `includes` and the model's directory: the naga module, or Err(messages at FILE:LINE:COLUMN).
+pub fn compose(model: &Path, top: &Top, defines: &[(String, String)], includes: &Includes) -> Result<naga::Module> {
+    let model_dir = dir_of(model);
+    let shader_defs = shader_defs(defines, model)?;
+    let shown = model.display().to_string();
+    let mut m = Modules { composer: Composer::default(), model_dir, includes, index: module_index(model_dir, includes), added: Vec::new(), stack: Vec::new() };
+    m.add_imports_of(&top.text, &shown)?;
+    let desc = NagaModuleDescriptor { source: &top.text, file_path: &shown, shader_type: ShaderType::Wgsl, shader_defs, additional_imports: &[] };
+    m.composer.make_naga_module(desc).map_err(|e| {
+        let hint = match e.inner {
+            naga_oil::compose::ComposerErrorInner::ImportNotFound(..) => format!("; brdfprof looks for a module's `#define_import_path` in the .wgsl files of {}, and for a quoted import beside the model and in those directories", searched(model_dir, includes)),
+            _ => String::new(),
+        };
+        anyhow!("{}{hint}", located(&e, &m.composer, Some((&shown, top))))
+    })
+}
+
+/// The directories searched for modules, as a message lists them.
+fn searched(model_dir: &Path, includes: &Includes) -> String {
+    let mut dirs: Vec<String> = includes.dirs.iter().map(|d| format!("{} (and below)", d.display())).collect();
+    dirs.push(model_dir.display().to_string());
+    dirs.join(", ")
+}
+
+/// The module's SPIR-V for its stub entry: naga's validation, `override`s at their defaults, and naga's SPIR-V
+/// writer with every name kept (`DEBUG`), no index clamping (`Unchecked`, naga's default) and no loop
+/// bounding; integer division keeps WGSL's defined result for a zero divisor (naga's wrapper).
+pub fn emit_spirv(module: &naga::Module, model: &Path) -> Result<Vec<u32>> {
+    use naga::valid::{Capabilities, ValidationFlags, Validator};
+    let what = model.display();
+    let info = Validator::new(ValidationFlags::all(), Capabilities::default()).validate(module).map_err(|e| anyhow!("{what}: naga's validation: {}", e.emit_to_string("")))?;
+    let (module, info) = naga::back::pipeline_constants::process_overrides(module, &info, None, &Default::default()).map_err(|e| anyhow!("{what}: the overrides at their defaults: {e}"))?;
+    let options = naga::back::spv::Options { flags: naga::back::spv::WriterFlags::DEBUG, force_loop_bounding: false, ..Default::default() };
+    let pipeline = naga::back::spv::PipelineOptions { shader_stage: naga::ShaderStage::Compute, entry_point: STUB.to_string() };
+    naga::back::spv::write_vec(&module, &info, &options, Some(&pipeline)).with_context(|| format!("{what}: naga's SPIR-V writer"))
+}
+
+/// A naga type as WGSL writes it (scalars, vectors, matrices, structs by their undecorated name).
+fn type_text(module: &naga::Module, ty: naga::Handle<naga::Type>) -> Option<String> {
+    use naga::{ScalarKind as K, TypeInner as T};
+    let scalar = |s: naga::Scalar| match (s.kind, s.width) {
+        (K::Float, 4) => Some("f32"),
+        (K::Float, 2) => Some("f16"),
+        (K::Sint, 4) => Some("i32"),
+        (K::Uint, 4) => Some("u32"),
+        (K::Bool, _) => Some("bool"),
+        _ => None,
+    };
+    let t = &module.types[ty];
+    match t.inner {
+        T::Scalar(s) => scalar(s).map(str::to_string),
+        T::Vector { size, scalar: s } => Some(format!("vec{}<{}>", size as u8, scalar(s)?)),
+        T::Matrix { columns, rows, scalar: s } => Some(format!("mat{}x{}<{}>", columns as u8, rows as u8, scalar(s)?)),
+        T::Struct { .. } => t.name.as_deref().map(undecorated),
+        T::Pointer { base, .. } => type_text(module, base),
+        _ => None,
+    }
+}
+
+/// A naga_oil item name without its module decoration (`fooX_naga_oil_mod_XABCX` -> `foo`).
+fn undecorated(name: &str) -> String {
+    name.split("X_naga_oil_mod_X").next().unwrap_or(name).to_string()
+}
+
+/// The WGSL type of each parameter of function `callee` (its last path segment, undecorated), pointers as
+/// the type they point to; None when the module has no such function.
+fn parameter_types_in(module: &naga::Module, callee: &str) -> Option<Vec<Option<String>>> {
+    let name = callee.rsplit("::").next().unwrap_or(callee);
+    let f = module.functions.iter().map(|(_, f)| f).find(|f| f.name.as_deref().map(undecorated).as_deref() == Some(name))?;
+    Some(f.arguments.iter().map(|a| type_text(module, a.ty)).collect())
+}
+
+/// The parameter types of `callee` (as `parameter_types_in`), a function of the shader `top` or of a module it
+/// imports: naga_oil keeps only the imported functions a shader calls, so each imported module is composed on
+/// its own to find it there.
+pub fn parameter_types(model: &Path, top: &Top, defines: &[(String, String)], includes: &Includes, callee: &str) -> Result<Option<Vec<Option<String>>>> {
+    if let Some(t) = parameter_types_in(&compose(model, top, defines, includes)?, callee) {
+        return Ok(Some(t));
+    }
+    let model_dir = dir_of(model);
+    let index = module_index(model_dir, includes);
+    for import in declared_imports(&top.text) {
+        let Some(path) = resolve(&import, model_dir, includes, &index) else { continue };
+        let lines: Vec<(usize, String)> = read_text(&path)?.lines().enumerate().map(|(i, l)| (i + 1, l.to_string())).collect();
+        if let Some(t) = parameter_types_in(&compose(&path, &Top::new(&lines), defines, includes)?, callee) {
+            return Ok(Some(t));
+        }
+    }
+    Ok(None)
+}
+
+/// The module paths of `text`'s `#import` lines, used or not (naga_oil's own list holds the used ones):
+/// `#import a::b::{x, y}` -> `a::b`, `#import a::b::x` -> `a::b::x` (`resolve` finds its module), a quoted path
+/// as written.
+fn declared_imports(text: &str) -> Vec<String> {
+    text.lines()
+        .filter_map(|l| l.trim_start().strip_prefix("#import"))
+        .filter_map(|rest| {
+            let rest = rest.trim();
+            let path = match rest.find('{') {
+                Some(b) => rest[..b].trim().trim_end_matches("::"),
+                None => rest.split_whitespace().next().unwrap_or(""),
+            };
+            (!path.is_empty()).then(|| path.to_string())
+        })
+        .collect()
+}
+
+/// The directory a shader's quoted imports are found beside (`.` for a bare file name).
+fn dir_of(path: &Path) -> &Path {
+    path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or_else(|| Path::new("."))
+}
+
+/// The front end, with versions, as reports state it.
+pub fn describe() -> String {
+    "naga_oil 0.23.0 (#import, #ifdef, #define_import_path), naga 30.0.1 (wgsl-in, validation, spv-out without index clamping or loop bounding)".to_string()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The version Cargo.lock pins for `package`.
+    fn locked(package: &str) -> String {
+        let lock = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/Cargo.lock")).unwrap();
+        let entry = lock.split("[[package]]").find(|e| e.lines().any(|l| l.trim() == format!("name = \"{package}\""))).unwrap();
+        entry.lines().find_map(|l| l.trim().strip_prefix("version = \"")).unwrap().trim_end_matches('"').to_string()
+    }
+
+    #[test]
+    fn generated_text() {
+        let g = Glue { name: "brdfprof_entry0".into(), callee: "lighting::direct".into(), args: vec![GlueArg::Expr("N".into()), GlueArg::Out("vec3<f32>".into())] };
+        assert_eq!(glue(&g), "fn brdfprof_entry0(L: vec3<f32>, V: vec3<f32>, N: vec3<f32>, X: vec3<f32>, Y: vec3<f32>) -> vec3<f32> { var brdfprof_arg1: vec3<f32> = vec3<f32>(); lighting::direct(N, &brdfprof_arg1); return brdfprof_arg1; }");
+        assert_eq!(param_decl("f0", "vec3"), "var<private> f0: vec3<f32>;");
+        let top = Top::new(&[(3, "fn BRDF(L: vec3<f32>) {}".into()), (5, "x".into())]);
+        assert_eq!((top.text.as_str(), top.lines), ("\n\nfn BRDF(L: vec3<f32>) {}\n\nx\n", 5));
+        assert!(defines_brdf(&[(1, "  fn  BRDF (L: vec3<f32>".into())]) && !defines_brdf(&[(1, "fn BRDFx(".into())]));
+        let defs = shader_defs(&[("A".into(), "".into()), ("B".into(), "-2".into()), ("C".into(), "3u".into())], Path::new("m")).unwrap();
+        assert_eq!((defs["A"], defs["B"], defs["C"]), (ShaderDefValue::Bool(true), ShaderDefValue::Int(-2), ShaderDefValue::UInt(3)));
+        assert!(format!("{:#}", shader_defs(&[("A".into(), "0.5".into())], Path::new("m")).unwrap_err()).contains("define A=0.5"));
+        assert!(describe().starts_with(&format!("naga_oil {} (", locked("naga_oil"))) && describe().contains(&format!("naga {} (", locked("naga"))), "describe() names the versions Cargo.lock pins");
+        assert_eq!(declared_imports("#import a::b::{x, y}\n  #import a::c::f\n#import \"p/q.wgsl\" f, g\n// #import no\n"), ["a::b", "a::c::f", "\"p/q.wgsl\""]);
+    }
+}
