@@ -213,6 +213,11 @@ pub fn write_glsl_tree(dir: &Path) -> Result<()> {
     Ok(())
 }
 
+/// The text of an embedded glsl/ file by its path within glsl/ (`brdf.glsl`, `generated/terms.glsl`).
+pub fn embedded_glsl(rel: &str) -> Option<&'static str> {
+    GLSL_FILES.iter().find(|(r, _)| *r == rel).map(|(_, t)| *t)
+}
+
 /// `glslangValidator --version`'s first line, e.g. "Glslang Version: 11:12.0.0".
 pub fn glslang_version() -> Option<String> {
     first_line_of(crate::cleanup::command("glslangValidator").arg("--version"))

@@ -8,6 +8,7 @@ pub mod callgrind;
 pub mod cost;
 pub mod correlate;
 pub mod driver;
+pub mod lines;
 pub mod naga_info;
 pub mod schedule;
 pub mod timing;
