@@ -27,6 +27,8 @@ mod outputs;
 mod radv;
 mod report;
 mod signals;
+mod transcendentals;
+mod translation_corpus;
 mod translation_faults;
 mod compile_only;
 mod mesa_shims;
