@@ -1,6 +1,6 @@
-//! Side-effect-free selections flattened into OpSelect, as Mesa's NIR does before any Vulkan driver's backend
-//! (`nir_opt_peephole_select` with a limit of 8 instructions per side, the limit RADV, ANV, Turnip and
-//! Panfrost pass): an `if`/`else` (or an `if` alone) whose every side is one block of at most
+//! Side-effect-free selections flattened into OpSelect, as Mesa's NIR does before RADV's and lavapipe's
+//! backends (`nir_opt_peephole_select` with a limit of 8 instructions per side, as `radv_optimize_nir` and
+//! lavapipe's `optimize` call it): an `if`/`else` (or an `if` alone) whose every side is one block of at most
 //! `SIDE_LIMIT` instructions, none of which can trap, read or write memory or call, has both sides computed in
 //! its header and each OpPhi of its merge block becomes an OpSelect on the branch's condition. Every value is
 //! the one the branch computed (the speculated side's results are unused where it was not taken), so the
@@ -17,7 +17,7 @@ use rspirv::dr::{Block, Function, Instruction, Module, Operand};
 use rspirv::spirv::{GlslStd450Op, Op, SelectionControl, Word};
 
 /// The most instructions a side may have to be computed speculatively: nir_opt_peephole_select's `limit` as
-/// RADV calls it (`nir_opt_peephole_select(nir, 8, true, true)`, Mesa 22.3 radv_shader.c).
+/// RADV calls it (`nir_opt_peephole_select, 8, true, true` in `radv_optimize_nir`).
 pub const SIDE_LIMIT: usize = 8;
 
 /// `words` with every flattenable selection flattened (repeatedly: an inner one first, then the one that

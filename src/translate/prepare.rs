@@ -6,7 +6,7 @@
 //! 1. functions inlined and in SSA form, the loops `[[unroll]]` marks unrolled (`INLINE_PASSES`), as a driver
 //!    inlines everything and honours the hint;
 //! 2. side-effect-free selections of at most 8 instructions a side flattened into OpSelect (`flatten`), as
-//!    Mesa's `nir_opt_peephole_select` does for RADV, ANV, Turnip and Panfrost;
+//!    Mesa's `nir_opt_peephole_select` does for RADV;
 //! 3. identical computations merged and dead code removed (`CSE_PASSES`: spirv-opt's value numbering), so a
 //!    per-light invariant (Burley's GTR normaliser) is computed once per invocation, as ACO computes it.
 //!
