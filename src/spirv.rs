@@ -141,7 +141,7 @@ pub fn spirv_opt(words: &[u32], args: &[String]) -> Result<Vec<u32>> {
         bail!("spirv-opt {} failed: {}", args.join(" "), String::from_utf8_lossy(&out.stderr).trim());
     }
     if out.stdout.len() % 4 != 0 {
-        bail!("spirv-opt wrote {} bytes, not whole SPIR-V words", out.stdout.len());
+        bail!("spirv-opt wrote {} bytes, not whole SPIR-V words: {}", out.stdout.len(), String::from_utf8_lossy(&out.stdout[..out.stdout.len().min(300)]));
     }
     Ok(out.stdout.chunks_exact(4).map(|c| u32::from_le_bytes(c.try_into().unwrap())).collect())
 }

@@ -228,14 +228,34 @@ fn vendor_by_vendor(targets: &[Target], mut compile: impl FnMut(&dyn Vendor, &[u
     Ok(runs.into_iter().map(|r| r.expect("every target compiled")).collect())
 }
 
-/// Compiles the models' kernels for every target; results in `targets` order.
+/// Compiles the models' kernels for every target; results in `targets` order, each report's driver note with
+/// its harness share (`harness_note`).
 pub fn compile_all(targets: &[Target], request: &Request) -> Result<Vec<Run>> {
-    vendor_by_vendor(targets, |vendor, families| {
+    let mut runs = vendor_by_vendor(targets, |vendor, families| {
         if vendor.needs_verification() && request.verify_on.is_none() {
             bail!("{}: its costs are of a translation that must first run against a Vulkan device, and none was opened", vendor.prefix());
         }
         vendor.compile(families, request)
-    })
+    })?;
+    for run in &mut runs {
+        if let Some(note) = run.report.cost.as_ref().and_then(harness_note) {
+            let driver = run.report.section_notes.entry("driver/".into()).or_default();
+            *driver = if driver.is_empty() { note.clone() } else { format!("{driver}\n\n{note}") };
+            run.report.section_notes.insert(HARNESS_NOTE.into(), note);
+        }
+    }
+    Ok(runs)
+}
+
+/// The report's section note that holds `harness_note`.
+pub const HARNESS_NOTE: &str = "harness";
+
+/// The memory-only kernel's share of each kernel's cycles per evaluation on one target: the harness every
+/// kernel carries (the G-buffer and light loads, the R11G11B10F store), whose cost differs between targets.
+pub fn harness_note(cost: &TargetCost) -> Option<String> {
+    let base = cost.row(crate::model::BASELINE_LABEL)?.cycles_per_eval;
+    let shares: Vec<String> = cost.rows.iter().filter(|r| r.model != crate::model::BASELINE_LABEL && r.cycles_per_eval > 0.0).map(|r| format!("{} {:.0}%", r.model, 100.0 * base / r.cycles_per_eval)).collect();
+    (!shares.is_empty()).then(|| format!("Harness share on {} (the memory-only kernel's cycles/eval as a share of each kernel's: the G-buffer and light loads and the R11G11B10F store every kernel carries): {}.", cost.label(), shares.join(", ")))
 }
 
 /// `compile_all` for kernels outside the model set.
@@ -304,8 +324,8 @@ pub fn checked_translations(req: &Request, gpu: &Gpu, dialect: crate::translate:
         .map(|m| {
             let agreements = crate::translate::verify::check_cached(gpu, m, req.lights, req.shaders)?;
             let source = crate::translate::prepare::shade_kernel(m, req.lights, req.shaders)?.source(dialect);
-            let agreement = agreements.iter().map(|a| format!("{} {:.1e} (tolerance {:.0e}){}", a.kernel, a.worst, a.tolerance, a.note().map_or_else(String::new, |n| format!(": {n}")))).collect::<Vec<_>>().join(", ");
-            Ok(Checked { source, agreement: format!("translation checked on the host against {}: worst relative difference {agreement}", gpu.info.name) })
+            let agreement = agreements.iter().map(|a| format!("{}{}", a.summary(), a.note().map_or_else(String::new, |n| format!(": {n}")))).collect::<Vec<_>>().join("; ");
+            Ok(Checked { source, agreement: format!("translation checked on the host against {} and the translation's f64 evaluation: {agreement}", gpu.info.name) })
         })
         .collect()
 }

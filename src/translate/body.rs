@@ -459,23 +459,25 @@ impl<'m> FunctionWriter<'m> {
         Ok((off, ty, stride))
     }
 
-    /// The binding's C field and whether the translation may treat it as read-only.
-    fn binding(&self, var: Word) -> Result<(String, bool), TranslateError> {
+    /// The binding's C expression, whether the translation may treat it as read-only, and the prelude's
+    /// load prefix for it: `ldc` for constant memory (uniform and push-constant blocks), `ldro` for a
+    /// read-only storage buffer, `ld` otherwise.
+    fn binding(&self, var: Word) -> Result<(String, bool, &'static str), TranslateError> {
         match self.env.globals.get(&var) {
-            Some(GlobalRep::Buffer { field, readonly, .. }) | Some(GlobalRep::Image { field, readonly, .. }) => Ok((format!("env->{field}"), *readonly)),
+            Some(GlobalRep::Buffer { field, constant: true, .. }) => Ok((format!("BRDFPROF_CONSTANT_REF(env, {field})"), true, "ldc")),
+            Some(GlobalRep::Buffer { field, readonly, .. }) | Some(GlobalRep::Image { field, readonly, .. }) => Ok((format!("env->{field}"), *readonly, if *readonly { "ldro" } else { "ld" })),
             _ => Err(self.err("a buffer access to something that is not a binding")),
         }
     }
 
     /// A value of type `ty` read from `var` at byte offset `off`, member by member.
     fn buffer_load(&mut self, var: Word, off: &str, ty: Word, matrix_stride: Option<u32>) -> Result<String, TranslateError> {
-        let (field, readonly) = self.binding(var)?;
-        let ro = if readonly { "ro" } else { "" };
+        let (field, _, ld) = self.binding(var)?;
         match self.m.ty(ty).clone() {
-            Type::Bool => Ok(format!("(ld{ro}_u32({field}, {off}) != 0u)")),
+            Type::Bool => Ok(format!("({ld}_u32({field}, {off}) != 0u)")),
             Type::Int { .. } | Type::Float { .. } => {
                 let s = self.m.scalar(ty).map_err(|e| self.err(e.construct))?;
-                Ok(format!("ld{ro}_{}({field}, {off})", scalar_suffix(s)))
+                Ok(format!("{ld}_{}({field}, {off})", scalar_suffix(s)))
             }
             Type::Vector { elem, n } => {
                 let s = self.m.scalar(elem).map_err(|e| self.err(e.construct))?;
@@ -485,7 +487,7 @@ impl<'m> FunctionWriter<'m> {
                     let (suffix, c) = if s == Scalar::F32 { ("f32", "float") } else { ("u32", "u32") };
                     let tmp = format!("q{}_{}", self.decls.len(), self.body.len());
                     self.decls.push(format!("{c} {tmp}[4];"));
-                    writeln!(self.body, "  ld{ro}4_{suffix}({field}, {off}, {tmp});").unwrap();
+                    writeln!(self.body, "  {ld}4_{suffix}({field}, {off}, {tmp});").unwrap();
                     let cast = if s == Scalar::I32 { "(i32)" } else { "" };
                     return Ok(format!("mk_{}({})", self.m.c_type(ty)?, (0..4).map(|k| format!("{cast}{tmp}[{k}]")).collect::<Vec<_>>().join(", ")));
                 }
@@ -517,7 +519,7 @@ impl<'m> FunctionWriter<'m> {
 
     /// Statements writing `value` (a C expression of type `ty`) to `var` at byte offset `off`.
     fn buffer_store(&mut self, var: Word, off: &str, ty: Word, matrix_stride: Option<u32>, value: &str) -> Result<String, TranslateError> {
-        let (field, readonly) = self.binding(var)?;
+        let (field, readonly, _) = self.binding(var)?;
         if readonly {
             return Err(self.err("a store to a read-only binding"));
         }

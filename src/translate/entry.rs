@@ -11,8 +11,9 @@ use std::fmt::Write;
 /// How a global variable is reached from a translated function.
 #[derive(Clone, Debug)]
 pub enum GlobalRep {
-    /// A storage, uniform or push-constant buffer: `env->field` is its first byte.
-    Buffer { field: String, readonly: bool, pointee: Word },
+    /// A storage, uniform or push-constant buffer: `env->field` is its first byte; a uniform or push-constant
+    /// block (`constant`) is in the dialect's constant memory (`BRDFPROF_CONSTANT_REF`).
+    Buffer { field: String, readonly: bool, pointee: Word, constant: bool },
     /// A texel buffer of `format`.
     Image { field: String, format: TexelFormat, readonly: bool },
     /// Per-invocation memory in `Env` (private globals, built-in inputs).
@@ -64,9 +65,9 @@ impl EnvLayout {
                     let ssbo = g.class == StorageClass::StorageBuffer || m.decoration(g.pointee, Decoration::BufferBlock).is_some();
                     let readonly = !ssbo || buffer_is_readonly(m, id, g.pointee);
                     let kind = if ssbo { BindingKind::StorageBuffer { readonly } } else { BindingKind::UniformBuffer };
-                    (GlobalRep::Buffer { field: field.clone(), readonly, pointee: g.pointee }, Some((slot, kind, field)))
+                    (GlobalRep::Buffer { field: field.clone(), readonly, pointee: g.pointee, constant: !ssbo }, Some((slot, kind, field)))
                 }
-                StorageClass::PushConstant => (GlobalRep::Buffer { field: "push".into(), readonly: true, pointee: g.pointee }, Some(((u32::MAX, 0), BindingKind::PushConstant, "push".to_string()))),
+                StorageClass::PushConstant => (GlobalRep::Buffer { field: "push".into(), readonly: true, pointee: g.pointee, constant: true }, Some(((u32::MAX, 0), BindingKind::PushConstant, "push".to_string()))),
                 StorageClass::UniformConstant => {
                     let (format, storage) = texel_binding(m, g.pointee, slot, options)?;
                     let rep = GlobalRep::Image { field: field.clone(), format, readonly: !storage };
@@ -97,12 +98,25 @@ impl EnvLayout {
         Ok(layout)
     }
 
-    /// The `Env` struct.
+    /// The `Env` struct, after the constant blocks it reads (`BRDFPROF_CONSTANT_BLOCK`: CUDA's `__constant__`
+    /// arrays; nothing in the dialects whose constant memory is a kernel argument).
     pub fn declaration(&self, m: &ModuleInfo) -> Result<String, TranslateError> {
-        let mut s = String::from("typedef struct {\n");
+        let mut s = String::new();
+        for b in self.bindings.iter().filter(|b| b.kind.is_constant()) {
+            let ty = self.globals.values().find_map(|g| match g {
+                GlobalRep::Buffer { field, pointee, .. } if *field == b.field => Some(*pointee),
+                _ => None,
+            });
+            let bytes = ty.and_then(|t| block_size(m, t)).ok_or_else(|| unsupported(format!("a uniform or push-constant block ({}) whose size its layout does not give", b.field)))?;
+            writeln!(s, "BRDFPROF_CONSTANT_BLOCK({}, {bytes})", b.field).unwrap();
+        }
+        s += "typedef struct {\n";
         for b in &self.bindings {
-            let constness = if binding_readonly(&b.kind) { "const " } else { "" };
-            writeln!(s, "  GLOBAL {constness}u8* {};", b.field).unwrap();
+            match &b.kind {
+                k if k.is_constant() => writeln!(s, "  BRDFPROF_CONSTANT_FIELD({})", b.field).unwrap(),
+                BindingKind::TexelBuffer { format: TexelFormat::R11g11b10f, storage: true } => writeln!(s, "  BRDFPROF_SURFACE_FIELD({})", b.field).unwrap(),
+                k => writeln!(s, "  GLOBAL {}u8* {};", if binding_readonly(k) { "const " } else { "" }, b.field).unwrap(),
+            }
         }
         for (field, _, ty) in &self.inputs {
             writeln!(s, "  {} {field};", m.c_type(*ty)?).unwrap();
@@ -116,9 +130,10 @@ impl EnvLayout {
 
     /// Statements that fill `env` (a local `Env`) given the dialect's invocation ids `gid[k]`, `lid[k]`,
     /// `wg[k]`, `nwg[k]`, then call the entry point.
-    fn fill(&self, m: &ModuleInfo, ids: &dyn Fn(&str, u32) -> String, local_size: [u32; 3]) -> Result<String, TranslateError> {
-        let mut s = String::new();
-        for b in &self.bindings {
+    fn fill(&self, m: &ModuleInfo, dialect: Dialect, ids: &dyn Fn(&str, u32) -> String, local_size: [u32; 3]) -> Result<String, TranslateError> {
+        let mut s = String::from("  BRDFPROF_INVOCATION_BEGIN();\n");
+        // CUDA's constant blocks are module `__constant__` arrays, not `Env` fields.
+        for b in self.bindings.iter().filter(|b| !(dialect == Dialect::Cuda && b.kind.is_constant())) {
             writeln!(s, "  env.{0} = {0};", b.field).unwrap();
         }
         for (field, builtin, ty) in &self.inputs {
@@ -146,9 +161,6 @@ impl EnvLayout {
     /// The dialect's kernel entry (for the host: the function that runs every invocation of a dispatch).
     pub fn wrapper(&self, m: &ModuleInfo, dialect: Dialect, local_size: [u32; 3]) -> Result<String, TranslateError> {
         let threads = local_size.iter().product::<u32>();
-        let params = |global: &str, restrict: &str| -> String {
-            self.bindings.iter().map(|b| format!("{global}{}u8*{} {}", if binding_readonly(&b.kind) { "const " } else { "" }, if binding_readonly(&b.kind) { restrict } else { "" }, b.field)).collect::<Vec<_>>().join(", ")
-        };
         Ok(match dialect {
             Dialect::Cuda => {
                 let ids = |name: &str, k: u32| {
@@ -160,7 +172,7 @@ impl EnvLayout {
                         _ => format!("(u32)gridDim.{c}"),
                     }
                 };
-                format!("extern \"C\" __global__ void __launch_bounds__({threads}) brdfprof_kernel({}) {{\n  Env env;\n{}}}\n", params("", " __restrict__"), self.fill(m, &ids, local_size)?)
+                format!("extern \"C\" __global__ void __launch_bounds__({threads}) brdfprof_kernel({}) {{\n  Env env;\n{}}}\n", self.params(dialect), self.fill(m, dialect, &ids, local_size)?)
             }
             Dialect::OpenCl => {
                 let ids = |name: &str, k: u32| match name {
@@ -170,10 +182,27 @@ impl EnvLayout {
                     _ => format!("(u32)get_num_groups({k})"),
                 };
                 let [x, y, z] = local_size;
-                format!("__kernel __attribute__((reqd_work_group_size({x}, {y}, {z}))) void brdfprof_kernel({}) {{\n  Env env;\n{}}}\n", params("__global ", ""), self.fill(m, &ids, local_size)?)
+                format!("__kernel __attribute__((reqd_work_group_size({x}, {y}, {z}))) void brdfprof_kernel({}) {{\n  Env env;\n{}}}\n", self.params(dialect), self.fill(m, dialect, &ids, local_size)?)
             }
             Dialect::Host => self.host_wrapper(m, local_size)?,
         })
+    }
+
+    /// The kernel parameters of `dialect`'s entry, one per binding: storage buffers as global pointers
+    /// (read-only ones `__restrict__` in CUDA), constant blocks as `__constant` pointers in OpenCL C (CUDA's
+    /// are `__constant__` arrays, no parameter), a writable R11G11B10F texel buffer as a CUDA surface object.
+    fn params(&self, dialect: Dialect) -> String {
+        let param = |b: &EnvBinding| -> Option<String> {
+            let (ro, f) = (binding_readonly(&b.kind), &b.field);
+            Some(match (dialect, &b.kind) {
+                (Dialect::Cuda, k) if k.is_constant() => return None,
+                (Dialect::Cuda, BindingKind::TexelBuffer { format: TexelFormat::R11g11b10f, storage: true }) => format!("unsigned long long {f}"),
+                (Dialect::Cuda, _) => format!("{}u8*{} {f}", if ro { "const " } else { "" }, if ro { " __restrict__" } else { "" }),
+                (_, k) if k.is_constant() => format!("__constant u8* {f}"),
+                _ => format!("__global {}u8* {f}", if ro { "const " } else { "" }),
+            })
+        };
+        self.bindings.iter().filter_map(param).collect::<Vec<_>>().join(", ")
     }
 
     /// `brdfprof_host_run(bindings, groups_x, groups_y, groups_z)`: every invocation in order; returns the
@@ -195,9 +224,36 @@ impl EnvLayout {
         let [x, y, z] = local_size;
         writeln!(s, "  for (u32 wz = 0u; wz < nz; ++wz) for (u32 wy = 0u; wy < ny; ++wy) for (u32 wx = 0u; wx < nx; ++wx)").unwrap();
         writeln!(s, "  for (u32 lz = 0u; lz < {z}u; ++lz) for (u32 ly = 0u; ly < {y}u; ++ly) for (u32 lx = 0u; lx < {x}u; ++lx) {{\n  Env env;").unwrap();
-        s += &self.fill(m, &ids, local_size)?;
+        s += &self.fill(m, Dialect::Host, &ids, local_size)?;
         s += "  flags |= env.flags;\n  }\n  return flags;\n}\n";
         Ok(s)
+    }
+}
+
+impl BindingKind {
+    /// A uniform or push-constant block: in the dialect's constant memory.
+    pub fn is_constant(&self) -> bool {
+        matches!(self, BindingKind::UniformBuffer | BindingKind::PushConstant)
+    }
+}
+
+/// Bytes a block of type `ty` spans in its buffer, from its layout decorations (None: a runtime array, or a
+/// member without an Offset).
+fn block_size(m: &ModuleInfo, ty: Word) -> Option<u32> {
+    match m.ty(ty).clone() {
+        Type::Bool => Some(4),
+        Type::Int { width, .. } | Type::Float { width } => Some(width / 8),
+        Type::Vector { elem, n } => Some(n * block_size(m, elem)?),
+        Type::Array { len, .. } => Some(len * m.decoration(ty, Decoration::ArrayStride)?.first().copied()?),
+        Type::Struct { members } => members.iter().enumerate().try_fold(0, |end, (k, &t)| {
+            let offset = m.member_decoration(ty, k as u32, Decoration::Offset)?.first().copied()?;
+            let size = match (m.ty(t).clone(), m.member_decoration(ty, k as u32, Decoration::MatrixStride)) {
+                (Type::Matrix { columns, .. }, Some(stride)) => columns * stride.first().copied()?,
+                _ => block_size(m, t)?,
+            };
+            Some(end.max(offset + size))
+        }),
+        _ => None,
     }
 }
 

@@ -5,7 +5,6 @@
 //! between exact conversions, as NVIDIA and Intel evaluate fp16 transcendentals.
 
 use super::body::FunctionWriter;
-use super::constants::convert_float;
 use super::ctypes::Scalar;
 use super::ops::{as_f32, comp, fbin};
 use super::TranslateError;
@@ -44,11 +43,13 @@ fn unary_name(op: G) -> Option<&'static str> {
     })
 }
 
-/// A float function of f32 arguments in scalar kind `s`: f32 as is, f64 through `_d`, f16 through f32.
+/// A float function of f32 arguments in scalar kind `s`: f32 as is, f64 through `_d`, f16 through `_h` (the
+/// prelude's half form: the f32 function between exact conversions, common.h; the f64 reference applies
+/// half precision's rules to it).
 fn float_call(s: Scalar, name: &str, args: &[String]) -> String {
     match s {
         Scalar::F64 => format!("{name}_d({})", args.join(", ")),
-        Scalar::F16 => convert_float(Scalar::F32, s, &format!("{name}({})", args.iter().map(|a| as_f32(s, a)).collect::<Vec<_>>().join(", "))),
+        Scalar::F16 => format!("{name}_h({})", args.join(", ")),
         _ => format!("{name}({})", args.join(", ")),
     }
 }

@@ -40,10 +40,20 @@ impl HostKernel {
 
     /// `compile` with preprocessor definitions (`-DNAME`) for the prelude's variants.
     pub fn compile_with(t: &Translation, defines: &[&str]) -> Result<Self> {
+        Self::build(t, &t.source(Dialect::Host), defines)
+    }
+
+    /// The f64 reference of `t` (`Translation::reference_source`): every f32 value computed in double with its
+    /// Vulkan precision bound; a writable binding takes 4 x its bytes (`eval_reference`).
+    pub fn compile_reference(t: &Translation, defines: &[&str]) -> Result<Self> {
+        Self::build(t, &t.reference_source(), defines)
+    }
+
+    fn build(t: &Translation, source: &str, defines: &[&str]) -> Result<Self> {
         let dir = crate::cleanup::TempDir::new().context("cannot create a temporary directory for the host build")?;
         let src = dir.path().join("kernel.cpp");
         let lib = dir.path().join("kernel.so");
-        std::fs::write(&src, t.source(Dialect::Host)).with_context(|| format!("cannot write {}", src.display()))?;
+        std::fs::write(&src, source).with_context(|| format!("cannot write {}", src.display()))?;
         let mut cmd = crate::cleanup::command(HOST_COMPILER);
         // g++'s own temporaries (cc*.s) go into the build's directory, removed with it even on a signal.
         cmd.args(HOST_FLAGS).args(defines.iter().map(|d| format!("-D{d}"))).arg("-o").arg(&lib).arg(&src).env("TMPDIR", dir.path());
@@ -88,4 +98,32 @@ pub fn eval(kernel: &HostKernel, samples: &[Sample], extras: &EvalExtras) -> Res
     }
     let floats: Vec<f32> = bytemuck::pod_collect_to_vec(&output);
     Ok(floats.chunks_exact(4).map(|c| [c[0], c[1], c[2]]).collect())
+}
+
+/// One value of the f64 reference: the kernel's own operations in double, and the bound the Vulkan precision
+/// rules of those operations put on an implementation's distance from it (infinite: no bound).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Bounded {
+    pub value: f64,
+    pub bound: f64,
+}
+
+/// The (value, bound) pairs of a reference kernel's output bytes (`HostKernel::compile_reference`'s layout: 16
+/// bytes a value).
+pub fn pairs(bytes: &[u8]) -> Vec<Bounded> {
+    let doubles: Vec<f64> = bytemuck::pod_collect_to_vec(bytes);
+    doubles.chunks_exact(2).map(|p| Bounded { value: p[0], bound: p[1] }).collect()
+}
+
+/// f_s of the translated eval kernel's f64 reference for every sample (`eval` in double, with bounds).
+pub fn eval_reference(kernel: &HostKernel, samples: &[Sample], extras: &EvalExtras) -> Result<Vec<[Bounded; 3]>> {
+    let mut input = crate::kernels::pack_samples(samples, extras);
+    let mut output = vec![0u8; samples.len() * 16 * 4];
+    let mut push = (samples.len() as u32).to_ne_bytes().to_vec();
+    let groups = (samples.len() as u32).div_ceil(kernel.local_size[0].max(1));
+    let flags = kernel.run(&mut [&mut input, &mut output, &mut push], [groups, 1, 1])?;
+    if flags & 1 != 0 {
+        bail!("the f64 reference stopped an evaluation at its loop limit (2^20 iterations)");
+    }
+    Ok(pairs(&output).chunks_exact(4).map(|c| [c[0], c[1], c[2]]).collect())
 }

@@ -28,6 +28,8 @@ mod outputs;
 mod radv;
 mod report;
 mod signals;
+mod transcendentals;
+mod translation_corpus;
 mod translation_faults;
 mod compile_only;
 mod cost_pairs;

@@ -4,6 +4,21 @@
 BRDFPROF_FN float m_glsl_mod(float x, float y) { return x - y * m_floor(m_fdiv(x, y)); }
 // GLSL 4.50 8.3: t = clamp((x - e0) / (e1 - e0), 0, 1); t t (3 - 2 t).
 BRDFPROF_FN float m_smoothstep(float e0, float e1, float x) { float t = m_fmin(m_fmax(m_fdiv(x - e0, e1 - e0), 0.0f), 1.0f); return t * t * (3.0f - 2.0f * t); }
+#ifndef BRDFPROF_OWN_HALF_MATHS
+BRDFPROF_FN half_t m_smoothstep_h(half_t e0, half_t e1, half_t x) { return h_from_f32(m_smoothstep(h_to_f32(e0), h_to_f32(e1), h_to_f32(x))); }
+#endif
+#ifndef BRDFPROF_OWN_HALF_MATHS
+// GLSL's functions of halves: the f32 function between exact conversions, as NVIDIA and Intel evaluate them.
+#define BRDFPROF_HALF1(f) BRDFPROF_FN half_t f##_h(half_t x) { return h_from_f32(f(h_to_f32(x))); }
+#define BRDFPROF_HALF2(f) BRDFPROF_FN half_t f##_h(half_t x, half_t y) { return h_from_f32(f(h_to_f32(x), h_to_f32(y))); }
+BRDFPROF_HALF1(m_round) BRDFPROF_HALF1(m_rint) BRDFPROF_HALF1(m_trunc) BRDFPROF_HALF1(m_fabs) BRDFPROF_HALF1(m_floor)
+BRDFPROF_HALF1(m_ceil) BRDFPROF_HALF1(m_sin) BRDFPROF_HALF1(m_cos) BRDFPROF_HALF1(m_tan) BRDFPROF_HALF1(m_asin)
+BRDFPROF_HALF1(m_acos) BRDFPROF_HALF1(m_atan) BRDFPROF_HALF1(m_sinh) BRDFPROF_HALF1(m_cosh) BRDFPROF_HALF1(m_tanh)
+BRDFPROF_HALF1(m_asinh) BRDFPROF_HALF1(m_acosh) BRDFPROF_HALF1(m_atanh) BRDFPROF_HALF1(m_exp) BRDFPROF_HALF1(m_log)
+BRDFPROF_HALF1(m_exp2) BRDFPROF_HALF1(m_log2) BRDFPROF_HALF1(m_sqrt) BRDFPROF_HALF1(m_rsqrt)
+BRDFPROF_HALF2(m_pow) BRDFPROF_HALF2(m_atan2)
+BRDFPROF_FN half_t m_ldexp_h(half_t x, i32 e) { return h_from_f32(m_ldexp(h_to_f32(x), e)); }
+#endif
 // A dynamic index clamped into its composite (robust drivers' treatment of an out-of-bounds index).
 BRDFPROF_FN u32 m_index(u32 i, u32 n) { return i < n ? i : n - 1u; }
 #ifdef BRDFPROF_SMOD_AS_SREM
@@ -40,13 +55,18 @@ BRDFPROF_FN float uf_decode(u32 x, u32 mbits) {
   if (e == 31u) return m != 0u ? f32_from_bits(0x7fc00000u) : f32_from_bits(0x7f800000u);
   return f32_from_bits(((e + 112u) << 23) | (m << (23u - mbits)));
 }
-BRDFPROF_FN void tex_ld_r11g11b10f(GLOBAL const u8* p, u32 i, float* o) {
-  u32 t = ldro_u32(p, 4u * i);
-  o[0] = uf_decode(t & 2047u, 6u); o[1] = uf_decode((t >> 11) & 2047u, 6u); o[2] = uf_decode(t >> 22, 5u);
-}
+BRDFPROF_FN void uf_decode3(u32 t, float* o) { o[0] = uf_decode(t & 2047u, 6u); o[1] = uf_decode((t >> 11) & 2047u, 6u); o[2] = uf_decode(t >> 22, 5u); }
+#ifndef BRDFPROF_OWN_TEXELS
+BRDFPROF_FN void tex_ld_r11g11b10f(GLOBAL const u8* p, u32 i, float* o) { uf_decode3(ldro_u32(p, 4u * i), o); }
+#ifdef BRDFPROF_NATIVE_R11G11B10F
+// The dialect's formatted store and raw load of a writable R11G11B10F texel buffer (its prelude says how).
+BRDFPROF_FN void tex_ld_r11g11b10f(brdfprof_surface s, u32 i, float* o) { uf_decode3(brdfprof_surface_ld32(s, i), o); }
+BRDFPROF_FN void tex_st_r11g11b10f(brdfprof_surface s, u32 i, float r, float g, float b) { brdfprof_surface_st_rgb(s, i, r, g, b); }
+#else
 BRDFPROF_FN void tex_st_r11g11b10f(GLOBAL u8* p, u32 i, float r, float g, float b) {
   st_u32(p, 4u * i, uf_encode(r, 6u) | (uf_encode(g, 6u) << 11) | (uf_encode(b, 5u) << 22));
 }
+#endif
 BRDFPROF_FN void tex_ld_rgba32ui(GLOBAL const u8* p, u32 i, u32* o) { ldro4_u32(p, 16u * i, o); }
 BRDFPROF_FN void tex_st_rgba32ui(GLOBAL u8* p, u32 i, u32 a, u32 b, u32 c, u32 d) { st4_u32(p, 16u * i, a, b, c, d); }
 BRDFPROF_FN void tex_ld_rgba32f(GLOBAL const u8* p, u32 i, float* o) { ldro4_f32(p, 16u * i, o); }
@@ -64,3 +84,4 @@ BRDFPROF_FN void tex_st_rgba8(GLOBAL u8* p, u32 i, float a, float b, float c, fl
   for (u32 k = 0u; k < 4u; ++k) t |= (u32)m_rint(m_fmin(m_fmax(v[k], 0.0f), 1.0f) * 255.0f) << (8u * k);
   st_u32(p, 4u * i, t);
 }
+#endif

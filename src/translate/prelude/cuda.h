@@ -119,6 +119,31 @@ BRDFPROF_FN void ld4_f32(const u8* p, u32 off, float* o) { float4 v = *(const fl
 BRDFPROF_FN void ldro4_f32(const u8* p, u32 off, float* o) { float4 v = __ldg((const float4*)(p + off)); o[0] = v.x; o[1] = v.y; o[2] = v.z; o[3] = v.w; }
 BRDFPROF_FN void ld4_u32(const u8* p, u32 off, u32* o) { uint4 v = *(const uint4*)(p + off); o[0] = v.x; o[1] = v.y; o[2] = v.z; o[3] = v.w; }
 BRDFPROF_FN void ldro4_u32(const u8* p, u32 off, u32* o) { uint4 v = __ldg((const uint4*)(p + off)); o[0] = v.x; o[1] = v.y; o[2] = v.z; o[3] = v.w; }
+// Uniform and push-constant blocks in constant memory, as a CUDA author keeps them: one `__constant__` array
+// per block (the host fills it with cudaMemcpyToSymbol), read at offsets ptxas folds into `c[bank][offset]`
+// operands.
+#define BRDFPROF_CONSTANT_BLOCK(name, bytes) __constant__ __align__(16) u8 brdfprof_cb_##name[bytes];
+#define BRDFPROF_CONSTANT_FIELD(name)
+#define BRDFPROF_CONSTANT_REF(env, name) brdfprof_cb_##name
+BRDFPROF_FN u32 ldc_u32(const u8* p, u32 off) { return *(const u32*)(p + off); }
+BRDFPROF_FN i32 ldc_i32(const u8* p, u32 off) { return *(const i32*)(p + off); }
+BRDFPROF_FN float ldc_f32(const u8* p, u32 off) { return *(const float*)(p + off); }
+BRDFPROF_FN half_t ldc_f16(const u8* p, u32 off) { return h_from_bits(*(const u16*)(p + off)); }
+BRDFPROF_FN double ldc_f64(const u8* p, u32 off) { return *(const double*)(p + off); }
+BRDFPROF_FN void ldc4_f32(const u8* p, u32 off, float* o) { float4 v = *(const float4*)(p + off); o[0] = v.x; o[1] = v.y; o[2] = v.z; o[3] = v.w; }
+BRDFPROF_FN void ldc4_u32(const u8* p, u32 off, u32* o) { uint4 v = *(const uint4*)(p + off); o[0] = v.x; o[1] = v.y; o[2] = v.z; o[3] = v.w; }
+// A writable R11G11B10F texel buffer is a surface object, stored to with PTX's formatted surface store
+// (`sust.p`, SASS SUST.P: the texture unit converts to the surface's format, as NVIDIA's Vulkan driver stores
+// a storage texel buffer) and read with an unformatted 32-bit load (`suld.b`, byte addressed) decoded here.
+#define BRDFPROF_NATIVE_R11G11B10F 1
+typedef unsigned long long brdfprof_surface;
+#define BRDFPROF_SURFACE_FIELD(name) brdfprof_surface name;
+BRDFPROF_FN void brdfprof_surface_st_rgb(brdfprof_surface s, u32 i, float r, float g, float b) {
+  asm volatile("sust.p.1d.v4.b32.trap [%0, {%1}], {%2, %3, %4, %5};" :: "l"(s), "r"(i), "r"(__float_as_uint(r)), "r"(__float_as_uint(g)), "r"(__float_as_uint(b)), "r"(0u) : "memory");
+}
+BRDFPROF_FN u32 brdfprof_surface_ld32(brdfprof_surface s, u32 i) { u32 t; asm volatile("suld.b.1d.b32.trap {%0}, [%1, {%2}];" : "=r"(t) : "l"(s), "r"(4u * i) : "memory"); return t; }
+#define BRDFPROF_INVOCATION_BEGIN()
+
 BRDFPROF_FN void st_u32(u8* p, u32 off, u32 v) { *(u32*)(p + off) = v; }
 BRDFPROF_FN void st_i32(u8* p, u32 off, i32 v) { *(i32*)(p + off) = v; }
 BRDFPROF_FN void st_f32(u8* p, u32 off, float v) { *(float*)(p + off) = v; }

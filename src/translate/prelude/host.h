@@ -116,6 +116,20 @@ BRDFPROF_FN void ld4_f32(const u8* p, u32 off, float* o) { memcpy(o, p + off, 16
 BRDFPROF_FN void ld4_u32(const u8* p, u32 off, u32* o) { memcpy(o, p + off, 16); }
 #define ldro4_f32 ld4_f32
 #define ldro4_u32 ld4_u32
+// Constant blocks are bytes the caller passes, like every other binding.
+#define BRDFPROF_CONSTANT_BLOCK(name, bytes)
+#define BRDFPROF_CONSTANT_FIELD(name) const u8* name;
+#define BRDFPROF_CONSTANT_REF(env, name) ((env)->name)
+#define ldc_u32 ld_u32
+#define ldc_i32 ld_i32
+#define ldc_f32 ld_f32
+#define ldc_f16 ld_f16
+#define ldc_f64 ld_f64
+#define ldc4_f32 ld4_f32
+#define ldc4_u32 ld4_u32
+#define BRDFPROF_SURFACE_FIELD(name) u8* name;
+#define BRDFPROF_INVOCATION_BEGIN()
+
 BRDFPROF_FN void st_u32(u8* p, u32 off, u32 v) { memcpy(p + off, &v, 4); }
 BRDFPROF_FN void st_i32(u8* p, u32 off, i32 v) { memcpy(p + off, &v, 4); }
 BRDFPROF_FN void st_f32(u8* p, u32 off, float v) { memcpy(p + off, &v, 4); }

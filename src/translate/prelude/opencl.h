@@ -157,6 +157,25 @@ BRDFPROF_FN void ld4_f32(__global const u8* p, u32 off, float* o) { float4 v = *
 BRDFPROF_FN void ld4_u32(__global const u8* p, u32 off, u32* o) { uint4 v = *(__global const uint4*)(p + off); o[0] = v.x; o[1] = v.y; o[2] = v.z; o[3] = v.w; }
 #define ldro4_f32 ld4_f32
 #define ldro4_u32 ld4_u32
+// Uniform and push-constant blocks in constant memory: `__constant` kernel arguments, as an OpenCL author
+// passes them (OpenCL C 1.2 has no program-scope constant data the host can write).
+#define BRDFPROF_CONSTANT_BLOCK(name, bytes)
+#define BRDFPROF_CONSTANT_FIELD(name) __constant u8* name;
+#define BRDFPROF_CONSTANT_REF(env, name) ((env)->name)
+BRDFPROF_FN u32 ldc_u32(__constant u8* p, u32 off) { return *(__constant u32*)(p + off); }
+BRDFPROF_FN i32 ldc_i32(__constant u8* p, u32 off) { return *(__constant i32*)(p + off); }
+BRDFPROF_FN float ldc_f32(__constant u8* p, u32 off) { return *(__constant float*)(p + off); }
+BRDFPROF_FN half_t ldc_f16(__constant u8* p, u32 off) { return h_from_bits(*(__constant u16*)(p + off)); }
+#ifdef BRDFPROF_F64
+BRDFPROF_FN double ldc_f64(__constant u8* p, u32 off) { return *(__constant double*)(p + off); }
+#endif
+BRDFPROF_FN void ldc4_f32(__constant u8* p, u32 off, float* o) { float4 v = *(__constant float4*)(p + off); o[0] = v.x; o[1] = v.y; o[2] = v.z; o[3] = v.w; }
+BRDFPROF_FN void ldc4_u32(__constant u8* p, u32 off, u32* o) { uint4 v = *(__constant uint4*)(p + off); o[0] = v.x; o[1] = v.y; o[2] = v.z; o[3] = v.w; }
+// OpenCL C has no R11G11B10F image format (cl_channel_type lists no packed 11/11/10-bit float), so a
+// writable R11G11B10F texel buffer is packed in software, as an OpenCL author must.
+#define BRDFPROF_SURFACE_FIELD(name) __global u8* name;
+#define BRDFPROF_INVOCATION_BEGIN()
+
 BRDFPROF_FN void st_u32(__global u8* p, u32 off, u32 v) { *(__global u32*)(p + off) = v; }
 BRDFPROF_FN void st_i32(__global u8* p, u32 off, i32 v) { *(__global i32*)(p + off) = v; }
 BRDFPROF_FN void st_f32(__global u8* p, u32 off, float v) { *(__global float*)(p + off) = v; }
