@@ -48,6 +48,8 @@ pub struct Run<'a> {
     pub validate: bool,
     pub isa_dir: Option<&'a Path>,
     pub precise: bool,
+    /// Cost per source line on the targets that name lines (`targets::Request::lines`).
+    pub lines: bool,
 }
 
 /// Opens a local device (None: the default) and runs `work` on it; the CLI's (progress, validation check).
@@ -111,7 +113,7 @@ fn target_reports(plan: &[Planned], run: &Run, open: &OpenLocal) -> Result<Vec<I
         return Ok(Vec::new());
     }
     let compile = |verify_on: Option<&Gpu>| -> Result<Vec<InspectReport>> {
-        let request = targets::Request { models: &run.options.models, lights: run.options.lights, shaders: run.shaders, validate: run.validate, isa_dir: run.isa_dir, precise: run.precise, verify_on };
+        let request = targets::Request { models: &run.options.models, lights: run.options.lights, shaders: run.shaders, validate: run.validate, isa_dir: run.isa_dir, precise: run.precise, verify_on, lines: run.lines };
         let runs = targets::compile_all(&targets, &request)?;
         for r in &runs {
             if let Some(n) = &r.note {
@@ -203,6 +205,7 @@ fn multi_markdown(reports: &[InspectReport], costs: &CostTable, profile_note: Op
                 if let Some(n) = r.section_notes.get("driver/") {
                     text += &format!("{n}\n\n");
                 }
+                text += &r.lines_markdown();
             }
             _ => text += &r.markdown(),
         }

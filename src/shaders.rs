@@ -113,6 +113,30 @@ impl Shaders {
     }
 }
 
+impl Shaders {
+    /// The kernel `name` compiled again with glslang's `-g`: the same code with OpLine and OpString, so that
+    /// each instruction names its file and line (`inspect --lines`). From `--glsl DIR`, or from the embedded
+    /// glsl/ tree written into a temporary directory named `glsl` (file names then read `.../glsl/brdf.glsl`).
+    pub fn with_lines(&self, name: &str) -> Result<Spirv> {
+        let what = format!("{name} with line information (glslang -g)");
+        let words = match &self.glsl {
+            Some(dir) => {
+                let (source, defines) = kernel_entry(dir, name)?;
+                glslang_with(&dir.join(&source), &defines, &[], &what, &["-g"])?
+            }
+            None => {
+                let k = embedded(name)?;
+                let tmp = crate::cleanup::TempDir::new().context("cannot create a temporary directory for glslang -g")?;
+                let root = tmp.path().join("glsl");
+                write_glsl_tree(&root)?;
+                let defines: Vec<String> = k.defines.iter().map(|d| d.to_string()).collect();
+                glslang_with(&root.join(k.source), &defines, &[], &what, &["-g"])?
+            }
+        };
+        Ok(Spirv { name: format!("{name} (-g)"), words: words.into() })
+    }
+}
+
 /// `name`'s line in `dir/kernels.txt`: (source file, defines).
 pub fn kernel_entry(dir: &Path, name: &str) -> Result<(String, Vec<String>)> {
     let list = dir.join("kernels.txt");

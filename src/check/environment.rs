@@ -91,6 +91,7 @@ mod tests {
             callgrind_setup: [("workload".to_string(), "64x64 pixels x 8 lights".to_string()), ("valgrind".to_string(), "valgrind-3.19.0".to_string())].into(),
             vs_profile: None,
             cost: None,
+            lines: Vec::new(),
         }
     }
 

@@ -109,7 +109,7 @@ pub fn run(options: &CheckOptions, shaders: &Shaders, open: impl FnOnce() -> Res
 pub fn run_target(options: &CheckOptions, shaders: &Shaders, target: crate::targets::Target, validate: bool, verify_on: Option<&Gpu>) -> Result<Outcome> {
     run_measured(options, |specs, lights| {
         crate::messages::progress(format!("check: compiling for {} ({} models + baseline kernel)", target.name(), specs.len()));
-        let request = crate::targets::Request { models: &specs, lights, shaders, validate, isa_dir: None, precise: false, verify_on };
+        let request = crate::targets::Request { models: &specs, lights, shaders, validate, isa_dir: None, precise: false, verify_on, lines: false };
         let run = crate::targets::compile_all(&[target], &request)?.pop().expect("one run per target");
         let mut inspect = run.report;
         if let Some(note) = run.note {
@@ -177,6 +177,7 @@ mod tests {
             callgrind_setup: BTreeMap::new(),
             vs_profile: None,
             cost: None,
+            lines: Vec::new(),
         };
         let mut environment = BTreeMap::new();
         for g in ["callgrind", "timing"] {

@@ -89,6 +89,12 @@ pub struct InspectArgs {
     /// the precision freedom a Vulkan driver has (NVIDIA: without -use_fast_math).
     #[arg(long)]
     pub precise_math: bool,
+    /// Cost per source line: each model's kernel compiled again with line information on the nvidia: and
+    /// intel: targets (NVRTC -lineinfo, IGC -gline-tables-only), every instruction attributed to the line of the .brdf file or
+    /// of glsl/ it came from and summed per line by the cost rule; the costliest lines in the Markdown and HTML,
+    /// all of them in the JSON (`lines`). ACO (radv:) in Mesa 22.3 names no source lines.
+    #[arg(long)]
+    pub lines: bool,
     #[command(flatten)]
     pub html: super::report::HtmlArg,
 }
@@ -100,6 +106,9 @@ pub fn inspect(args: &InspectArgs) -> Result<ExitCode> {
     }
     let validate = DeviceArgs { device: None, validate: args.validate }.validation();
     let plan = devices::plan(&args.devices)?;
+    if args.lines && !plan.iter().any(|p| matches!(p, devices::Planned::Target(t) if brdfprof::targets::names_lines(t))) {
+        bail!("--lines: only the nvidia: and intel: targets' compilers name each instruction's source line; give one (e.g. --device nvidia:sm_89 --device intel:gen12lp)");
+    }
     // A compile-only target's default name is known now (`devices::slug`); a local device's only once it is open.
     let default_name = match plan.as_slice() {
         [devices::Planned::Target(t)] => format!("inspect-{}", t.slug()),
@@ -130,7 +139,7 @@ pub fn inspect(args: &InspectArgs) -> Result<ExitCode> {
         let d = DeviceArgs { device: device.map(str::to_string), validate };
         on_device_with(&d, device.is_some(), |gpu, _| work(gpu)).map(|_| ())
     };
-    let run = devices::Run { options: &options, shaders: &shaders, validate, isa_dir: args.isa.as_deref(), precise: args.precise_math };
+    let run = devices::Run { options: &options, shaders: &shaders, validate, isa_dir: args.isa.as_deref(), precise: args.precise_math, lines: args.lines };
     let result = devices::inspect(&plan, &run, &local, profile.as_ref())?;
     let stem = result.stem();
     let json = args.json.clone().unwrap_or_else(|| PathBuf::from(format!("results/{stem}.json")));

@@ -219,7 +219,7 @@ pub fn sweep(args: &SweepArgs) -> Result<ExitCode> {
     let validate = args.device.validation();
     let (gpu, (result, costs)) = on_device(&args.device, |gpu, progress| {
         // The targets' figures first (seconds): a missing compiler fails before the long measurement.
-        let request = brdfprof::targets::Request { models: &options.profile.models, lights: options.profile.lights[0], shaders: &shaders, validate, isa_dir: None, precise: false, verify_on: Some(gpu) };
+        let request = brdfprof::targets::Request { models: &options.profile.models, lights: options.profile.lights[0], shaders: &shaders, validate, isa_dir: None, precise: false, verify_on: Some(gpu), lines: false };
         let costs = brdfprof::targets::compile_all(&cost_targets, &request)?;
         Ok((sweep::run(gpu, &options, progress)?, costs))
     })?;

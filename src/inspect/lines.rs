@@ -12,15 +12,18 @@ use std::collections::BTreeMap;
 pub struct Attributed {
     /// The source file and line, None where the compiler names none (its own prologue, the harness).
     pub source: Option<(String, u32)>,
-    /// The pipe it occupies and for how many cycles (None: the issue slot alone).
-    pub pipe: Option<(String, f64)>,
-    /// Cycles of the compiler's schedule from its issue to the next instruction's.
+    /// The pipes it occupies and for how many cycles each (none: the issue slot alone).
+    pub pipes: Vec<(String, f64)>,
+    /// Cycles of the compiler's schedule spent on it: the wait before it and its own stall.
     pub schedule: f64,
+    /// Its issue cycles where the rule has an issue term (NVIDIA: 32 / 128 SM cycles per warp instruction).
+    pub issue: f64,
 }
 
 /// One source line's instructions and cycles.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct LineCost {
+    /// The file (`short`): `glsl/brdf.glsl`, or the user's file.
     pub file: String,
     pub line: u32,
     pub instructions: u32,
@@ -45,7 +48,13 @@ pub struct KernelLines {
     /// Instructions the compiler names no line for.
     pub unattributed: u32,
     pub instructions: u32,
+    /// Something the reader should know (the line-annotated compile differing from the costed one).
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub note: String,
 }
+
+/// The term name of an issue-slot bound among the pipes (NVIDIA's).
+pub const ISSUE: &str = "issue";
 
 /// Sums `instructions` per source line; `binding_pipe` is the kernel's busiest pipe (`schedule::Schedule`).
 pub fn per_line(model: &str, instructions: &[Attributed], binding_pipe: &str) -> KernelLines {
@@ -59,19 +68,21 @@ pub fn per_line(model: &str, instructions: &[Attributed], binding_pipe: &str) ->
         let entry = by_line.entry((file.clone(), *line)).or_insert_with(|| LineCost { file: file.clone(), line: *line, instructions: 0, pipes: BTreeMap::new(), binding: 0.0, schedule: 0.0, text: String::new() });
         entry.instructions += 1;
         entry.schedule += i.schedule;
-        if let Some((pipe, cycles)) = &i.pipe {
-            *entry.pipes.entry(pipe.clone()).or_default() += cycles;
-            if pipe == binding_pipe {
-                entry.binding += cycles;
-            }
+        if i.issue > 0.0 {
+            *entry.pipes.entry(ISSUE.to_string()).or_default() += i.issue;
         }
+        for (pipe, cycles) in &i.pipes {
+            *entry.pipes.entry(pipe.clone()).or_default() += cycles;
+        }
+        entry.binding = entry.pipes.get(binding_pipe).copied().unwrap_or(0.0);
     }
     let mut lines: Vec<LineCost> = by_line.into_values().collect();
     lines.sort_by(|a, b| b.binding.total_cmp(&a.binding).then(b.schedule.total_cmp(&a.schedule)).then(a.file.cmp(&b.file)).then(a.line.cmp(&b.line)));
     for l in &mut lines {
         l.text = source_text(&l.file, l.line);
+        l.file = short(&l.file);
     }
-    KernelLines { model: model.into(), binding_pipe: binding_pipe.into(), lines, unattributed, instructions: instructions.len() as u32 }
+    KernelLines { model: model.into(), binding_pipe: binding_pipe.into(), lines, unattributed, instructions: instructions.len() as u32, note: String::new() }
 }
 
 /// Line `line` of `file` trimmed, or empty where it cannot be read.
@@ -89,10 +100,10 @@ impl KernelLines {
         let mut t = crate::results::Table::new(["file:line", "instructions", &format!("{} cycles/wave", self.binding_pipe), "share", "schedule cycles/wave", "source"].map(String::from));
         for l in self.lines.iter().take(n) {
             let share = if total > 0.0 { format!("{:.0}%", 100.0 * l.binding / total) } else { "-".into() };
-            t.row([format!("{}:{}", short(&l.file), l.line), l.instructions.to_string(), crate::results::sig(l.binding, 4), share, crate::results::sig(l.schedule, 4), format!("`{}`", l.text.replace('|', "\\|").replace('`', "'"))]);
+            t.row([format!("{}:{}", l.file, l.line), l.instructions.to_string(), crate::results::sig(l.binding, 4), share, crate::results::sig(l.schedule, 4), format!("`{}`", l.text.replace('|', "\\|").replace('`', "'"))]);
         }
         format!(
-            "#### {}: the costliest source lines ({unit}; ranked by their cycles on the binding pipe, {}; {} of {} instructions name no line)\n\n{}",
+            "#### {}: the costliest source lines ({unit}; ranked by their cycles on the binding pipe, {}; {} of {} instructions are the translation's own or the compiler's and name no line)\n\n{}",
             self.model,
             self.binding_pipe,
             self.unattributed,
@@ -102,9 +113,14 @@ impl KernelLines {
     }
 }
 
-/// A file name as tables show it: glsl/'s by their name, a user's file as given.
+/// A file name as reports give it: glsl/'s (compiled from a temporary copy) by their name in the tree, a user's
+/// file relative to the working directory where it lies below it.
 fn short(file: &str) -> String {
-    file.rsplit_once("/glsl/").map_or(file.to_string(), |(_, rest)| format!("glsl/{rest}"))
+    if let Some((_, rest)) = file.rsplit_once("/glsl/") {
+        return format!("glsl/{rest}");
+    }
+    let cwd = std::env::current_dir().map(|d| format!("{}/", d.display())).unwrap_or_default();
+    file.strip_prefix(&cwd).filter(|_| !cwd.is_empty()).unwrap_or(file).to_string()
 }
 
 #[cfg(test)]
@@ -112,17 +128,22 @@ mod tests {
     use super::*;
 
     fn at(file: &str, line: u32, pipe: &str, busy: f64, schedule: f64) -> Attributed {
-        Attributed { source: Some((file.into(), line)), pipe: Some((pipe.into(), busy)), schedule }
+        Attributed { source: Some((file.into(), line)), pipes: vec![(pipe.into(), busy)], schedule, issue: 0.25 }
     }
 
     #[test]
     fn lines_sum_their_instructions_and_rank_by_the_binding_pipe() {
-        let is = [at("a.brdf", 3, "FMA", 1.0, 2.0), at("a.brdf", 5, "MUFU", 8.0, 20.0), at("a.brdf", 3, "FMA", 1.0, 1.0), at("a.brdf", 4, "FMA", 1.5, 0.0), Attributed { source: None, pipe: None, schedule: 1.0 }];
+        let is = [at("a.brdf", 3, "FMA", 1.0, 2.0), at("a.brdf", 5, "MUFU", 8.0, 20.0), at("a.brdf", 3, "FMA", 1.0, 1.0), at("a.brdf", 4, "FMA", 1.5, 0.0), Attributed { source: None, pipes: vec![], schedule: 1.0, issue: 0.25 }];
         let k = per_line("ggx", &is, "FMA");
         assert_eq!(k.lines.iter().map(|l| l.line).collect::<Vec<_>>(), [3, 4, 5]);
         assert_eq!((k.lines[0].instructions, k.lines[0].binding, k.lines[0].schedule), (2, 2.0, 3.0));
         assert_eq!((k.unattributed, k.instructions), (1, 5));
         assert_eq!(k.lines[2].pipes["MUFU"], 8.0);
-        assert!(k.markdown(2, "SM cycles").contains("| a.brdf:3 | 2"));
+        let md = k.markdown(2, "SM cycles");
+        let first = md.lines().find(|l| l.contains("a.brdf:")).unwrap_or_default();
+        assert!(first.contains("a.brdf:3") && !md.contains("a.brdf:5"), "{md}");
+        // Ranked by the issue slots where they bind: line 3's two instructions first.
+        let k = per_line("ggx", &is, ISSUE);
+        assert_eq!((k.lines[0].line, k.lines[0].binding), (3, 0.5));
     }
 }

@@ -86,6 +86,9 @@ pub struct InspectReport {
     /// model on `nvidia:` targets), where the device's statistics have one.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub cost: Option<cost::TargetCost>,
+    /// Cost per source line (`inspect --lines`), per model, where the compiler names lines.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub lines: Vec<lines::KernelLines>,
 }
 
 /// SPIR-V statistics of one specialised kernel, and naga's of `naga_kernel` (the same BRDF over the float
@@ -218,6 +221,7 @@ pub fn compiled_report(mut rows: Vec<Row>, provenance: serde_json::Value, lights
         callgrind_setup: BTreeMap::new(),
         vs_profile: None,
         cost: None,
+        lines: Vec::new(),
     }
 }
 
@@ -255,6 +259,7 @@ pub fn run(gpu: &Gpu, shaders: &Shaders, options: &InspectOptions) -> Result<Ins
         callgrind_setup,
         vs_profile: None,
         cost: None,
+        lines: Vec::new(),
     };
     Ok(report)
 }
@@ -362,6 +367,7 @@ impl InspectReport {
             out += &a.markdown();
             out += "\n";
         }
+        out += &self.lines_markdown();
         for row in &self.rows {
             if let Some(note) = row.notes.get(FOLDED_NOTE) {
                 out += &format!("{}: {note}.\n\n", row.model);
@@ -369,6 +375,25 @@ impl InspectReport {
         }
         if let Some(c) = &self.vs_profile {
             out += &format!("### Instructions vs time per evaluation\n\n{}\n", c.markdown());
+        }
+        out
+    }
+
+    /// Cost per source line (`inspect --lines`): each model's costliest lines, where the report has them.
+    pub fn lines_markdown(&self) -> String {
+        if self.lines.is_empty() {
+            return String::new();
+        }
+        let unit = self.cost.as_ref().map_or("cycles", |c| c.unit.as_str());
+        let mut out = "### Cost per source line
+
+Each instruction of the kernel compiled with line information, attributed to the line of the `.brdf` file or of glsl/ it came from; per line its cycles on the kernel's binding pipe (the share of what binds), and the schedule cycles spent issuing it (waits and stalls), per wave. The ten costliest lines of each model:\n\n".replace("\\n", "\n");
+        for k in &self.lines {
+            out += &k.markdown(10, unit);
+            if !k.note.is_empty() {
+                out += &format!("\n{}: {}\n", k.model, k.note);
+            }
+            out += "\n";
         }
         out
     }
@@ -418,6 +443,7 @@ pub(crate) mod tests {
             callgrind_setup: BTreeMap::new(),
             vs_profile: None,
             cost: None,
+            lines: vec![],
         }
     }
 }

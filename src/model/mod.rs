@@ -280,6 +280,17 @@ impl Model {
         }
     }
 
+    /// `kernel` compiled with line information (glslang `-g`): the same code and constants, each instruction
+    /// naming its file and line (the `.brdf` file's own lines for a file's shader).
+    pub fn kernel_with_lines(&self, kind: KernelKind, shaders: &Shaders) -> Result<ModelKernel> {
+        let mut k = self.kernel(kind, shaders)?;
+        k.spirv = match self {
+            Model::Spec(..) => shaders.with_lines(k.spirv.name.split(' ').next().unwrap_or(&k.spirv.name))?,
+            Model::File(f) => f.kernel_with_lines(kind, shaders)?,
+        };
+        Ok(k)
+    }
+
     /// Fails with a clear reason when the device cannot run this model's kernels.
     pub fn check_support(&self, info: &DeviceInfo) -> Result<()> {
         if self.precision() == Precision::F16 && !info.shader_float16 {

@@ -155,6 +155,10 @@ pub fn build(inputs: &[Input], gpu: Option<&Gpu>) -> Result<String> {
     if let Some(body) = sections::across_devices(inputs) {
         page.section("devices", "Across devices", body);
     }
+    let lines = sections::source_lines(inputs);
+    if !lines.is_empty() {
+        page.section("lines", "Cost per source line", lines);
+    }
     let sweeps = sections::sweeps(inputs);
     if !sweeps.is_empty() {
         page.section("sweep", "Accuracy against cost", sweeps);

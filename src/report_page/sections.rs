@@ -179,6 +179,42 @@ pub fn cost_table_html(table: &CostTable) -> String {
     format!("{}<p class=\"note\">{}</p><h3>Rank correlations</h3>{}<p class=\"note\">{}</p>", t.html(), units.join("<br>"), corr.html(), crate::compare::RHO_NOTE)
 }
 
+/// Cost per source line (`inspect --lines`): per device and model, the costliest lines with their share of
+/// the binding pipe; rows keyed `lines/<device>/<model>/<file>:<line>`.
+pub fn source_lines(inputs: &[Input]) -> String {
+    let mut out = String::new();
+    for i in inputs {
+        let Loaded::Inspect(reports, _) = &i.loaded else { continue };
+        for r in reports {
+            let device = r.provenance["device"]["name"].as_str().unwrap_or("?");
+            let unit = r.cost.as_ref().map_or("cycles", |c| c.unit.as_str());
+            for k in &r.lines {
+                let total: f64 = k.lines.iter().map(|l| l.binding).sum();
+                let mut t = HtmlTable::new(&[("line", "file:line"), ("instructions", "instructions"), ("binding", "binding pipe cycles/wave"), ("share", "share"), ("schedule", "schedule cycles/wave"), ("source", "source")]);
+                for l in k.lines.iter().take(LINES_SHOWN) {
+                    let share = (total > 0.0).then(|| 100.0 * l.binding / total);
+                    let at = format!("{}:{}", l.file, l.line);
+                    t.row(format!("lines/{device}/{}/{at}", k.model), vec![Cell::text(at), count_cell(l.instructions as usize), num_cell(Some(l.binding)), num_cell(share), num_cell(Some(l.schedule)), Cell::text(l.text.clone())]);
+                }
+                out += &format!(
+                    "<h3>{}: {}</h3>{}<p class=\"note\">{unit}; ranked by the cycles on the pipe that binds the kernel ({}), share in %; {} of {} instructions are the translation's own or the compiler's. {}</p>",
+                    esc(device),
+                    esc(&k.model),
+                    t.html(),
+                    esc(&k.binding_pipe),
+                    k.unattributed,
+                    k.instructions,
+                    esc(&k.note)
+                );
+            }
+        }
+    }
+    out
+}
+
+/// Lines per model in the HTML report's cost-per-line tables.
+const LINES_SHOWN: usize = 10;
+
 /// The cost table across devices: `compare` over the profile and inspect inputs (refusing kernels that
 /// differ, as `brdfprof compare` does), else the inspect's own table or a compare input.
 pub fn across_devices(inputs: &[Input]) -> Option<String> {

@@ -124,7 +124,7 @@ pub fn reports(gpu: &Gpu, work: &SceneWork, p: &ScenePlan, targets: &[Target], v
     }
     let raw = specs.iter().map(|v| raw_kernel(gpu, work, p, v, translate)).collect::<Result<Vec<_>>>()?;
     let shaders = crate::shaders::Shaders::embedded();
-    let request = targets::Request { models: &[], lights: 1, shaders: &shaders, validate, isa_dir, precise: false, verify_on: Some(gpu) };
+    let request = targets::Request { models: &[], lights: 1, shaders: &shaders, validate, isa_dir, precise: false, verify_on: Some(gpu), lines: false };
     let runs = targets::compile_raw_all(targets, &raw, &request)?;
     runs.into_iter().map(|run| target_report(run, &specs, p)).collect()
 }

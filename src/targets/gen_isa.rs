@@ -140,6 +140,25 @@ pub fn instructions(listing: &str, grf: u32) -> Vec<Instruction> {
     listing.lines().filter_map(|l| instruction(l, grf)).collect()
 }
 
+/// Every instruction of IGC's own listing (its shader dump, compiled with `-g`) with the source file and line
+/// its `// File: F` and `// Line N` comments name; None before the first.
+pub fn sourced_instructions(listing: &str, grf: u32) -> Vec<(Instruction, Option<(String, u32)>)> {
+    let mut file: Option<String> = None;
+    let mut line: Option<u32> = None;
+    let mut out = Vec::new();
+    for l in listing.lines() {
+        let t = l.trim();
+        if let Some(f) = t.strip_prefix("// File: ") {
+            file = Some(f.trim().to_string());
+        } else if let Some(n) = t.strip_prefix("// Line ") {
+            line = n.split(|c: char| !c.is_ascii_digit()).next().and_then(|n| n.parse().ok());
+        } else if let Some(i) = instruction(l, grf) {
+            out.push((i, file.clone().zip(line)));
+        }
+    }
+    out
+}
+
 /// Where an instruction's result takes a latency and a pipe occupancy in the schedule.
 pub struct Timing {
     /// Cycles from its start until its result can be read.
@@ -152,6 +171,13 @@ pub struct Timing {
 /// at the earliest, once the registers it reads or writes are ready and its pipe is free (`timing` gives
 /// both); the thread ends when its last instruction (the end-of-thread send) issues.
 pub fn schedule_latency(instructions: &[Instruction], timing: impl Fn(&Instruction) -> Result<Timing>) -> Result<f64> {
+    Ok(issue_times(instructions, timing)?.last().copied().unwrap_or(0.0))
+}
+
+/// The cycle each instruction starts at in `schedule_latency`'s schedule, and after them the cycle the
+/// thread ends.
+pub fn issue_times(instructions: &[Instruction], timing: impl Fn(&Instruction) -> Result<Timing>) -> Result<Vec<f64>> {
+    let mut times = Vec::with_capacity(instructions.len() + 1);
     let mut ready: std::collections::HashMap<Reg, f64> = std::collections::HashMap::new();
     let mut pipe_free: Vec<f64> = Vec::new();
     let mut t = -1.0f64;
@@ -171,9 +197,11 @@ pub fn schedule_latency(instructions: &[Instruction], timing: impl Fn(&Instructi
         for r in &i.writes {
             ready.insert(*r, start + tm.latency);
         }
+        times.push(start);
         t = start;
     }
-    Ok(t + 1.0)
+    times.push(t + 1.0);
+    Ok(times)
 }
 
 #[cfg(test)]
@@ -211,5 +239,14 @@ mod tests {
         let timing = |i: &Instruction| Ok(if i.mnemonic == "send" { Timing { latency: 320.0, pipe: None } } else { Timing { latency: 10.0, pipe: Some((0, 2.0)) } });
         // send at 0; the first mul waits for r10 (320); the second for the pipe (322); add for r30 (332).
         assert_eq!(schedule_latency(&is, timing).unwrap(), 333.0);
+        assert_eq!(issue_times(&is, timing).unwrap(), [0.0, 320.0, 322.0, 332.0, 333.0]);
+    }
+
+    #[test]
+    fn igcs_file_and_line_comments_name_the_instructions_after_them() {
+        let listing = "(W)     mov (8|M0)  r59.0<1>:ud  r0.0<1;1,0>:ud  // $1\n// File: /tmp/a.brdf\n// Line 20\n        shl (16|M0)  r64.0<1>:d  r64.0<8;8,1>:d  2:w  // $18\n// Line 11\n        math.exp (16|M0)  r60.0<1>:f  r108.0<8;8,1>:f  {$1}  // $28\n";
+        let got: Vec<(String, Option<(String, u32)>)> = sourced_instructions(listing, 32).into_iter().map(|(i, s)| (i.mnemonic, s)).collect();
+        let a = |n| Some(("/tmp/a.brdf".to_string(), n));
+        assert_eq!(got, [("mov".to_string(), None), ("shl".to_string(), a(20)), ("math".to_string(), a(11))]);
     }
 }

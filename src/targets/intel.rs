@@ -162,6 +162,21 @@ fn occupancy(i: &gen_isa::Instruction, family: &Family) -> Result<Option<(Pipe, 
     Ok(Some((pipe_of(i, family), (f64::from(i.exec_size) / f64::from(lanes)).max(1.0))))
 }
 
+/// The EU cycles per thread an instruction keeps each pipe busy (`IsaStats::pipes` sums them): its occupancy,
+/// sends and branches one cycle on their own; sync and nop none. Gen9/Gen11's two FPUs (`Pipes::TwoFpus`) both
+/// take FP and integer work, only FPU1 extended math: an ALU instruction's occupancy counts in full on the pair,
+/// extended math half of it there besides its own.
+fn pipe_cycles(i: &gen_isa::Instruction, family: &Family) -> Result<Vec<(Pipe, f64)>> {
+    if ["sync", "nop"].contains(&i.mnemonic.as_str()) {
+        return Ok(Vec::new());
+    }
+    let (pipe, cycles) = occupancy(i, family)?.unwrap_or((pipe_of(i, family), 1.0));
+    Ok(match (family.pipes, pipe) {
+        (Pipes::TwoFpus, Pipe::ExtendedMath) => vec![(pipe, cycles), (Pipe::Alu, cycles / 2.0)],
+        _ => vec![(pipe, cycles)],
+    })
+}
+
 /// Cycles until an instruction's result can be read, by IGC's scheduler tables (`XE_*`, `LEGACY_*`).
 fn latency(i: &gen_isa::Instruction, family: &Family) -> f64 {
     let class = classify(&i.mnemonic);
@@ -360,15 +375,10 @@ impl IsaStats {
     /// over its row's lanes per clock (at least one cycle), sends and branches one cycle each on their own.
     pub fn pipes(&self, family: &Family) -> Result<Vec<(String, f64)>> {
         let mut busy: BTreeMap<Pipe, f64> = BTreeMap::new();
-        for i in self.listing.iter().filter(|i| !["sync", "nop"].contains(&i.mnemonic.as_str())) {
-            let (pipe, cycles) = occupancy(i, family)?.unwrap_or((pipe_of(i, family), 1.0));
-            *busy.entry(pipe).or_default() += cycles;
-        }
-        if family.pipes == Pipes::TwoFpus {
-            // Either FPU takes FP and integer work (half an EU's rate each), only FPU1 extended math.
-            let alu = busy.get(&Pipe::Alu).copied().unwrap_or(0.0) * 2.0;
-            let em = busy.get(&Pipe::ExtendedMath).copied().unwrap_or(0.0);
-            busy.insert(Pipe::Alu, (alu + em) / 2.0);
+        for i in &self.listing {
+            for (pipe, cycles) in pipe_cycles(i, family)? {
+                *busy.entry(pipe).or_default() += cycles;
+            }
         }
         Ok(busy.into_iter().map(|(p, c)| (p.name(family.pipes).to_string(), c)).collect())
     }
@@ -427,6 +437,12 @@ pub fn options(precise: bool) -> String {
 /// Compiles the OpenCL C `source` for `family` and lists its ISA, under the compile limit, or takes both
 /// from the cache: the key covers the source, the options, ocloc's and IGC's versions and brdfprof's.
 pub fn compile(source: &str, family: &Family, precise: bool) -> Result<ocloc::Binary> {
+    compile_as(source, family, precise, false)
+}
+
+/// `compile`, with IGC's listing naming each instruction's source line (line tables, its shader dump) where
+/// `lines`.
+pub fn compile_as(source: &str, family: &Family, precise: bool, lines: bool) -> Result<ocloc::Binary> {
     let tools = ocloc::tools()?;
     let options = options(precise);
     let key = crate::cache::KeyBuilder::new("igc")
@@ -434,6 +450,7 @@ pub fn compile(source: &str, family: &Family, precise: bool) -> Result<ocloc::Bi
         .part("ocloc", &tools.version)
         .part("device", family.device)
         .part("options", &options)
+        .part("lines", if lines { ocloc::LINE_TABLES } else { "" })
         .part("source", source)
         .finish();
     let what = format!("the OpenCL C translation for intel:{} (ocloc -device {})", family.name, family.device);
@@ -442,7 +459,7 @@ pub fn compile(source: &str, family: &Family, precise: bool) -> Result<ocloc::Bi
         IsaStats::of(&binary, family).map(|_| ())
     };
     let bytes = crate::cache::get_or_build(crate::cache::Store::open_default().as_ref(), "igc", &key, &what, valid, || {
-        let binary = tools.compile(source, family.device, &options, &what)?;
+        let binary = if lines { tools.compile_with_lines(source, family.device, &options, &what)? } else { tools.compile(source, family.device, &options, &what)? };
         Ok(serde_json::to_vec(&binary)?)
     })?;
     Ok(serde_json::from_slice(&bytes)?)
@@ -460,7 +477,48 @@ pub fn inspect(families: &[&Family], req: &Request) -> Result<Vec<InspectReport>
     let gpu = req.verify_on.ok_or_else(|| anyhow!("intel: no Vulkan device to check the translation against"))?;
     let checked = super::checked_translations(req, gpu, crate::translate::Dialect::OpenCl)?;
     let statics = crate::inspect::kernels_of(req.models).into_iter().map(|m| crate::inspect::static_row(req.shaders, m, req.lights)).collect::<Result<Vec<_>>>()?;
-    compile_checked(families, statics, &checked, tools, req)
+    let mut reports = compile_checked(families, statics, &checked, tools, req)?;
+    if req.lines {
+        for (report, family) in reports.iter_mut().zip(families) {
+            report.lines = super::per_model_lines(req, crate::translate::Dialect::OpenCl, |m, source| {
+                let binary = compile_as(source, family, req.precise, true)?;
+                let mut k = line_costs(&m.label(), &binary, family)?;
+                k.note = super::same_code_note(report, &m.label(), "Instruction Count", k.instructions);
+                Ok(k)
+            })?;
+        }
+    }
+    Ok(reports)
+}
+
+/// Cost per source line of a kernel compiled with `compile_as(.., lines)`: each instruction of IGC's listing on
+/// its pipes (`pipe_cycles`), its schedule cycles (the wait for its registers and pipe, and its issue cycle in
+/// `IsaStats::schedule_latency`'s schedule), summed per line; the translation's own lines and IGC's prologue
+/// name none. Lines are ranked on the pipe that binds the kernel.
+pub fn line_costs(model: &str, binary: &ocloc::Binary, family: &Family) -> Result<crate::inspect::lines::KernelLines> {
+    use crate::inspect::lines::{per_line, Attributed};
+    let stats = IsaStats::of(binary, family)?;
+    let listing = binary.lines_listings.get(&stats.simd).ok_or_else(|| anyhow!("IGC's shader dump has no SIMD{} listing (it has {:?})", stats.simd, binary.lines_listings.keys().collect::<Vec<_>>()))?;
+    let sourced = gen_isa::sourced_instructions(listing, family.grf_bytes);
+    if sourced.is_empty() {
+        bail!("IGC's listing with line information has no instructions");
+    }
+    let instructions: Vec<gen_isa::Instruction> = sourced.iter().map(|(i, _)| i.clone()).collect();
+    let binding = stats.pipes(family)?.into_iter().fold(("-".to_string(), f64::NEG_INFINITY), |b, p| if p.1 > b.1 { p } else { b }).0;
+    let times = gen_isa::issue_times(&instructions, |i| {
+        let pipe = occupancy(i, family)?.map(|(p, c)| (p as usize, c));
+        Ok(gen_isa::Timing { latency: latency(i, family), pipe })
+    })?;
+    let mut attributed = Vec::new();
+    let mut previous = -1.0;
+    for (k, (i, source)) in sourced.into_iter().enumerate() {
+        // The cycles since the previous instruction started: its one issue cycle and any wait before it.
+        let schedule = times[k] - previous;
+        previous = times[k];
+        let pipes = pipe_cycles(&i, family)?.into_iter().map(|(p, c)| (p.name(family.pipes).to_string(), c)).collect();
+        attributed.push(Attributed { source: super::user_source(source.as_slice()), pipes, schedule, issue: 0.0 });
+    }
+    Ok(per_line(model, &attributed, &binding))
 }
 
 /// Every checked translation compiled for each family, its statistics added to its row (`statics`, in the

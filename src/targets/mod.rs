@@ -63,6 +63,9 @@ pub struct Request<'a> {
     /// The Vulkan device translations are checked against before their cost is reported (vendors that
     /// compile a translation need one).
     pub verify_on: Option<&'a Gpu>,
+    /// Cost per source line (`inspect --lines`): each model's kernel compiled again with line information
+    /// where the vendor's compiler gives it (`InspectReport::lines`).
+    pub lines: bool,
 }
 
 /// A kernel from outside the model set (a scene's kernels, `scene::compile`), ready for every vendor: its
@@ -274,6 +277,41 @@ pub(crate) fn raw_translations(vendor: &dyn Vendor, kernels: &[RawKernel], diale
         checked.push(Checked { source: t.translation.source(dialect), agreement: t.agreement.clone() });
     }
     Ok((rows, checked))
+}
+
+/// Whether the target's compiler names each instruction's source line (`Request::lines`): the translating
+/// vendors (NVRTC `-lineinfo`, IGC `-gline-tables-only`); ACO in Mesa 22.3 carries no source lines, nor do ir3, Bifrost or brw
+/// there.
+pub fn names_lines(target: &Target) -> bool {
+    target.vendor.needs_verification()
+}
+
+/// Each model's (not the memory-only kernel's) cost per source line: its shade kernel translated into
+/// `dialect` with `#line` directives (`prepare::shade_kernel_with_lines`), compiled and attributed by `lines`.
+pub(crate) fn per_model_lines(req: &Request, dialect: crate::translate::Dialect, mut lines: impl FnMut(&Model, &str) -> Result<crate::inspect::lines::KernelLines>) -> Result<Vec<crate::inspect::lines::KernelLines>> {
+    let mut out = Vec::new();
+    for m in req.models {
+        let source = crate::translate::prepare::shade_kernel_with_lines(Some(m), req.lights, req.shaders)?.source_with_lines(dialect);
+        out.push(lines(m, &source)?);
+    }
+    Ok(out)
+}
+
+/// A note where the line-annotated compile of `model` has another count of `statistic` (`counted`) than the
+/// costed one in `report`: the lines then describe slightly other code.
+pub(crate) fn same_code_note(report: &InspectReport, model: &str, statistic: &str, counted: u32) -> String {
+    let costed = report.rows.iter().find(|r| r.model == model).and_then(|r| cost::driver_stat(&r.stats, statistic));
+    match costed {
+        Some(c) if c != f64::from(counted) => format!("the line-annotated compile has {counted} instructions where the costed one has {c}: its lines describe that compile"),
+        _ => String::new(),
+    }
+}
+
+/// The line an instruction is charged to: the innermost of `chain` (its location, then the call sites it was
+/// inlined at) that is a source's, not the translation's own (`TRANSLATION_FILE`: its prelude helpers and
+/// entry); None where every one is the translation's.
+pub(crate) fn user_source(chain: &[(String, u32)]) -> Option<(String, u32)> {
+    chain.iter().find(|(file, line)| !file.ends_with(crate::translate::TRANSLATION_FILE) && *line > 0).cloned()
 }
 
 /// The compile-only target a report was made for, if any.

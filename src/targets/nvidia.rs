@@ -261,7 +261,7 @@ impl SassStats {
 
     /// SM cycles per warp of each of `n` instructions of `row`: 32 x (results per instruction) / (results per
     /// clock per SM), at most the issue rate's.
-    fn cycles_per_instruction(row: Option<&'static str>, family: &Family) -> Result<f64> {
+    pub fn cycles_per_instruction(row: Option<&'static str>, family: &Family) -> Result<f64> {
         let per_clock = match row {
             Some(r) => rate(r, family).ok_or_else(|| anyhow::anyhow!("the throughput table has no row `{r}`"))?,
             None => ISSUE_PER_CLOCK,
@@ -346,6 +346,9 @@ pub fn options(family: &Family, precise: bool) -> Vec<String> {
     o
 }
 
+/// NVRTC's option that keeps each instruction's source line in the cubin (`inspect --lines`).
+pub const LINE_INFO: &str = "-lineinfo";
+
 /// A kernel compiled for `family`: the SASS listing, ptxas' log and the cubin's size.
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize, PartialEq)]
 pub struct Sass {
@@ -357,13 +360,21 @@ pub struct Sass {
 /// Compiles the CUDA C++ `source` for `family` and disassembles it, under the compile limit, or takes both from
 /// the cache: the key covers the source, the options, NVRTC's and nvdisasm's versions and brdfprof's.
 pub fn compile(source: &str, family: &Family, precise: bool) -> Result<Sass> {
+    compile_as(source, family, precise, false)
+}
+
+/// `compile`, with each instruction's source line (`-lineinfo`, nvdisasm `--print-line-info`) where `lines`.
+pub fn compile_as(source: &str, family: &Family, precise: bool, lines: bool) -> Result<Sass> {
     let tools = nvrtc::tools()?;
-    let options = options(family, precise);
+    let mut options = options(family, precise);
+    if lines {
+        options.push(LINE_INFO.into());
+    }
     let key = crate::cache::KeyBuilder::new("sass")
         .part("brdfprof", env!("CARGO_PKG_VERSION"))
         .part("nvrtc", &tools.version)
         .part("nvdisasm", &tools.nvdisasm_version)
-        .part("nvdisasm options", nvrtc::DISASSEMBLE_OPTIONS.join(" "))
+        .part("nvdisasm options", format!("{}{}", nvrtc::DISASSEMBLE_OPTIONS.join(" "), if lines { nvrtc::LINE_INFO } else { "" }))
         .part("options", options.join(" "))
         .part("source", source)
         .finish();
@@ -377,7 +388,7 @@ pub fn compile(source: &str, family: &Family, precise: bool) -> Result<Sass> {
     };
     let bytes = crate::cache::get_or_build(crate::cache::Store::open_default().as_ref(), "sass", &key, &what, valid, || {
         let compiled = crate::compile_limit::bounded(&what, || tools.compile(source, "brdfprof_kernel.cu", &options))?;
-        let listing = tools.disassemble(&compiled.cubin)?;
+        let listing = tools.disassemble(&compiled.cubin, lines)?;
         Ok(serde_json::to_vec(&Sass { listing, log: compiled.log, cubin_bytes: compiled.cubin.len() })?)
     })?;
     Ok(serde_json::from_slice(&bytes)?)
@@ -395,7 +406,50 @@ pub fn inspect(families: &[&Family], req: &Request) -> Result<Vec<InspectReport>
     let gpu = req.verify_on.ok_or_else(|| anyhow::anyhow!("nvidia: no Vulkan device to check the translation against"))?;
     let checked = super::checked_translations(req, gpu, crate::translate::Dialect::Cuda)?;
     let statics = crate::inspect::kernels_of(req.models).into_iter().map(|m| crate::inspect::static_row(req.shaders, m, req.lights)).collect::<Result<Vec<_>>>()?;
-    compile_checked(families, statics, &checked, tools, req)
+    let mut reports = compile_checked(families, statics, &checked, tools, req)?;
+    if req.lines {
+        for (report, family) in reports.iter_mut().zip(families) {
+            report.lines = super::per_model_lines(req, crate::translate::Dialect::Cuda, |m, source| {
+                let sass = compile_as(source, family, req.precise, true)?;
+                let mut k = line_costs(&m.label(), &sass, family)?;
+                k.note = super::same_code_note(report, &m.label(), "Instruction Count", k.instructions - nops(&sass.listing)?);
+                Ok(k)
+            })?;
+        }
+    }
+    Ok(reports)
+}
+
+/// NOPs in a listing (in the line costs' instructions, not in `Instruction Count`).
+fn nops(listing: &str) -> Result<u32> {
+    Ok(super::sass::instructions(listing)?.iter().filter(|i| i.mnemonic() == "NOP").count() as u32)
+}
+
+/// Cost per source line of a kernel compiled with line information (`compile_as` with `lines`): each SASS
+/// instruction on its pipe at its row's rate and its issue slot, its schedule cycles (the scoreboard wait before
+/// it and its stall), summed per line; the translation's own lines and NVRTC's prologue name none.
+pub fn line_costs(model: &str, sass: &Sass, family: &Family) -> Result<crate::inspect::lines::KernelLines> {
+    use crate::inspect::lines::{per_line, Attributed};
+    let instructions = super::sass::instructions(&sass.listing)?;
+    let stats = SassStats::of(&sass.listing, &sass.log, sass.cubin_bytes)?;
+    let binding = stats.pipes(family)?.into_iter().fold(("-".to_string(), f64::NEG_INFINITY), |b, p| if p.1 > b.1 { p } else { b }).0;
+    let times = super::sass::issue_times(&instructions);
+    let mut attributed = Vec::new();
+    let mut previous_end = 0.0;
+    for (k, i) in instructions.iter().enumerate() {
+        let stall = f64::from(i.control.stall.max(1));
+        let schedule = times[k] - previous_end + stall;
+        previous_end = times[k] + stall;
+        let (_, row, pipe) = classify(&i.opcode);
+        let counted = i.mnemonic() != "NOP";
+        let pipes = match (pipe, counted) {
+            (Some(p), true) => vec![(p.on(family).name().to_string(), SassStats::cycles_per_instruction(row, family)?)],
+            _ => vec![],
+        };
+        let issue = if counted { 32.0 / f64::from(ISSUE_PER_CLOCK) } else { 0.0 };
+        attributed.push(Attributed { source: super::user_source(&i.sources), pipes, schedule, issue });
+    }
+    Ok(per_line(model, &attributed, &binding))
 }
 
 /// Every checked translation compiled for each family, its statistics added to its row (`statics`, in the

@@ -147,13 +147,14 @@ impl Tools {
         }
     }
 
-    /// nvdisasm's listing of `cubin` (`-c`: code sections only).
-    pub fn disassemble(&self, cubin: &[u8]) -> Result<String> {
+    /// nvdisasm's listing of `cubin` (`DISASSEMBLE_OPTIONS`; with `line_info`, `--print-line-info` too: each
+    /// instruction's source file and line where the cubin carries them, NVRTC's `-lineinfo`).
+    pub fn disassemble(&self, cubin: &[u8], line_info: bool) -> Result<String> {
         let dir = crate::cleanup::TempDir::new().context("cannot create a temporary directory for nvdisasm")?;
         let path = dir.path().join("kernel.cubin");
         std::fs::write(&path, cubin).with_context(|| format!("cannot write {}", path.display()))?;
         let mut cmd = crate::cleanup::command(self.nvdisasm.to_str().unwrap_or("nvdisasm"));
-        cmd.args(DISASSEMBLE_OPTIONS).arg(&path);
+        cmd.args(DISASSEMBLE_OPTIONS).args(line_info.then_some(LINE_INFO)).arg(&path);
         let out = crate::compile_limit::output(&mut cmd, "a cubin's SASS (nvdisasm)").with_context(|| format!("cannot run {}", self.nvdisasm.display()))?;
         if !out.status.success() {
             bail!("{} failed ({}): {}", self.nvdisasm.display(), out.status, String::from_utf8_lossy(&out.stderr).trim());
@@ -167,6 +168,9 @@ impl Tools {
 /// nvdisasm's options: code sections only, and each instruction's two 64-bit words (its control bits:
 /// `targets::sass`).
 pub const DISASSEMBLE_OPTIONS: [&str; 2] = ["-c", "-hex"];
+
+/// nvdisasm's option that names each instruction's source line.
+pub const LINE_INFO: &str = "--print-line-info-inline";
 
 /// Bytes of one SASS instruction (Volta and later: 128-bit).
 const SASS_INSTRUCTION_BYTES: u64 = 16;

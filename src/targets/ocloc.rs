@@ -83,6 +83,9 @@ pub fn tools() -> Result<&'static Tools> {
     TOOLS.get_or_init(load).as_ref().map_err(|e| anyhow!("{e}"))
 }
 
+/// The OpenCL build option that keeps source lines and nothing else of the debug information.
+pub const LINE_TABLES: &str = "-gline-tables-only";
+
 /// What one compilation produced.
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize, PartialEq)]
 pub struct Binary {
@@ -94,6 +97,10 @@ pub struct Binary {
     pub bytes: usize,
     /// ocloc's build log (warnings).
     pub log: String,
+    /// IGC's own listings of the kernel with their `// File:` and `// Line` comments (`compile_with_lines`), by
+    /// SIMD width (IGC dumps every width it compiled); empty otherwise.
+    #[serde(default, skip_serializing_if = "std::collections::BTreeMap::is_empty")]
+    pub lines_listings: std::collections::BTreeMap<u32, String>,
 }
 
 /// A kernel the device cannot compile for a reason of the device's own (fp64 where it has none): the family
@@ -112,27 +119,47 @@ impl std::fmt::Display for Unsupported {
 impl std::error::Error for Unsupported {}
 
 impl Tools {
-    fn run(&self, args: &[&std::ffi::OsStr], cwd: &Path, what: &str) -> Result<std::process::Output> {
+    fn run(&self, args: &[&std::ffi::OsStr], cwd: &Path, what: &str, dump: Option<&Path>) -> Result<std::process::Output> {
         let mut cmd = crate::cleanup::command(self.ocloc.to_str().unwrap_or("ocloc"));
         cmd.args(args).current_dir(cwd).env("LD_LIBRARY_PATH", &self.iga_dir);
+        if let Some(dir) = dump {
+            // IGC's debug knobs (read from the environment): its shader dumps, into `dir`.
+            cmd.env("IGC_ShaderDumpEnable", "1").env("IGC_DumpToCustomDir", dir);
+        }
         let out = crate::compile_limit::output(&mut cmd, what).with_context(|| format!("cannot run {}", self.ocloc.display()))?;
         Ok(out)
     }
 
     /// Compiles the OpenCL C `source` for ocloc device `device` (`tgllp`) with `options` and disassembles it.
     pub fn compile(&self, source: &str, device: &str, options: &str, what: &str) -> Result<Binary> {
+        self.compile_in(source, device, options, what, false)
+    }
+
+    /// `compile` with line tables and IGC's shader dump, whose listing of the kernel at the SIMD width IGC chose
+    /// names each instruction's source file and line (`Binary::lines_listing`); ocloc's own listing carries
+    /// none. `-gline-tables-only`, not `-g`: full debug information changes IGC's code (ggx on tgllp: 1012
+    /// instructions against 879), line tables alone do not.
+    pub fn compile_with_lines(&self, source: &str, device: &str, options: &str, what: &str) -> Result<Binary> {
+        self.compile_in(source, device, &format!("{options} {LINE_TABLES}"), what, true)
+    }
+
+    fn compile_in(&self, source: &str, device: &str, options: &str, what: &str, lines: bool) -> Result<Binary> {
         let dir = crate::cleanup::TempDir::new().context("cannot create a temporary directory for ocloc")?;
         let src = dir.path().join("brdfprof_kernel.cl");
         std::fs::write(&src, source).with_context(|| format!("cannot write {}", src.display()))?;
         let out_dir = dir.path().join("out");
         let os = |s: &str| std::ffi::OsString::from(s);
         let args = [os("compile"), os("-file"), src.clone().into_os_string(), os("-device"), os(device), os("-options"), os(options), os("-q"), os("-out_dir"), out_dir.clone().into_os_string()];
-        let out = self.run(&args.iter().map(|a| a.as_os_str()).collect::<Vec<_>>(), dir.path(), what)?;
+        let dump_dir = dir.path().join("igc-dump");
+        let dump_into = lines.then_some(dump_dir.as_path());
+        let out = self.run(&args.iter().map(|a| a.as_os_str()).collect::<Vec<_>>(), dir.path(), what, dump_into)?;
         let log = format!("{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
+        // The shader dump's own notice is not the compiler's.
+        let log: String = log.lines().filter(|l| !l.starts_with("ShaderDumpEnable Warning")).collect::<Vec<_>>().join("\n");
         if !out.status.success() {
             // -q hides the compiler's messages: the failure is compiled again without it, for the reason.
             let loud: Vec<&std::ffi::OsStr> = args.iter().filter(|a| a.as_os_str() != "-q").map(|a| a.as_os_str()).collect();
-            let again = self.run(&loud, dir.path(), what)?;
+            let again = self.run(&loud, dir.path(), what, None)?;
             let log = format!("{}{}", String::from_utf8_lossy(&again.stdout), String::from_utf8_lossy(&again.stderr));
             let errors: Vec<&str> = log.lines().filter(|l| l.contains("error:")).take(5).collect();
             if let Some(e) = errors.iter().find(|l| l.contains("cl_khr_fp64")) {
@@ -149,12 +176,34 @@ impl Tools {
         let bytes = std::fs::metadata(&bin).map_err(|e| no_binary(e.to_string()))?.len() as usize;
         let dump = dir.path().join("disasm");
         let args = [os("disasm"), os("-file"), bin.into_os_string(), os("-device"), os(device), os("-dump"), dump.clone().into_os_string()];
-        let out = self.run(&args.iter().map(|a| a.as_os_str()).collect::<Vec<_>>(), dir.path(), &format!("{what}: its ISA (ocloc disasm)"))?;
+        let out = self.run(&args.iter().map(|a| a.as_os_str()).collect::<Vec<_>>(), dir.path(), &format!("{what}: its ISA (ocloc disasm)"), None)?;
         let read = |name: &str| crate::io::read_bounded(&dump.join(name), crate::compile_limit::MAX_OUTPUT_BYTES as u64).map(|b| String::from_utf8_lossy(&b).into_owned());
         let listing = read("brdfprof_kernel_KernelHeap.asm").map_err(|e| {
             anyhow!("{}: `ocloc disasm` for {device} wrote no ISA listing ({e}; it needs {} to load IGA): {}", self.ocloc.display(), self.iga_dir.join("libiga64.so").display(), String::from_utf8_lossy(&out.stderr).trim())
         })?;
         let tokens = read("PTM.txt").map_err(|e| anyhow!("{}: `ocloc disasm` for {device} wrote no patch tokens ({e})", self.ocloc.display()))?;
-        Ok(Binary { listing, tokens, bytes, log: log.trim().to_string() })
+        let mut binary = Binary { listing, tokens, bytes, log: log.trim().to_string(), lines_listings: Default::default() };
+        if lines {
+            binary.lines_listings = dumped_listings(&dump_dir).with_context(|| format!("{what}: IGC's shader dump in {}", dump_dir.display()))?;
+        }
+        Ok(binary)
     }
+}
+
+/// IGC's dumped listings of the kernel (`*_simd{W}_entry_*.asm`), by SIMD width W, each bounded in size.
+fn dumped_listings(dir: &Path) -> Result<std::collections::BTreeMap<u32, String>> {
+    let mut out = std::collections::BTreeMap::new();
+    for entry in std::fs::read_dir(dir).with_context(|| format!("cannot read {}", dir.display()))? {
+        let path = entry?.path();
+        let Some(name) = path.file_name().and_then(|n| n.to_str()) else { continue };
+        let width = name.split_once("_simd").and_then(|(_, rest)| rest.split_once("_entry_")).filter(|_| name.ends_with(".asm")).and_then(|(w, _)| w.parse::<u32>().ok());
+        if let Some(w) = width {
+            let bytes = crate::io::read_bounded(&path, crate::compile_limit::MAX_OUTPUT_BYTES as u64)?;
+            out.insert(w, String::from_utf8_lossy(&bytes).into_owned());
+        }
+    }
+    if out.is_empty() {
+        bail!("IGC wrote no listing (*_simd*_entry_*.asm)");
+    }
+    Ok(out)
 }

@@ -19,6 +19,10 @@ use anyhow::{anyhow, bail, Result};
 pub struct Instruction {
     pub opcode: String,
     pub control: Control,
+    /// The source files and lines nvdisasm's `--print-line-info-inline` names for it, innermost first: each
+    /// `//## File "F", line N inlined at "G", line M` line of its chain gives the inlined location, then the
+    /// outermost one; empty where it names none.
+    pub sources: Vec<(String, u32)>,
 }
 
 impl Instruction {
@@ -80,19 +84,39 @@ fn hex_word(text: &str) -> Option<u64> {
 /// out), NOPs included (a NOP's stall counts too).
 pub fn instructions(listing: &str) -> Result<Vec<Instruction>> {
     let mut out = Vec::new();
+    let mut sources: Vec<(String, u32)> = Vec::new();
+    let mut in_chain = false;
     let mut lines = listing.lines().peekable();
     while let Some(line) = lines.next() {
+        if let Some(s) = line_info(line) {
+            // A chain's lines follow one another: the first starts a new one.
+            if !in_chain {
+                sources.clear();
+            }
+            sources.push(s);
+            in_chain = true;
+            continue;
+        }
+        in_chain = false;
         let Some((_, opcode, low)) = instruction_line(line) else { continue };
         let high = lines.peek().and_then(|l| hex_word(l));
         let (Some(_), Some(high)) = (low, high) else {
             bail!("nvdisasm's listing has no `-hex` words for `{}`", line.trim());
         };
         lines.next();
-        out.push(Instruction { opcode, control: Control::decode(high) });
+        out.push(Instruction { opcode, control: Control::decode(high), sources: sources.clone() });
     }
     let end = out.iter().rposition(|i| i.opcode == "EXIT").ok_or_else(|| anyhow!("a SASS listing without EXIT"))?;
     out.truncate(end + 1);
     Ok(out)
+}
+
+/// The file and line of nvdisasm's line comment (`\t//## File "/tmp/x.brdf", line 12`, perhaps followed by
+/// ` inlined at "F", line M`: its caller, which the chain's next line names).
+fn line_info(line: &str) -> Option<(String, u32)> {
+    let rest = line.trim_start().strip_prefix("//## File \"")?;
+    let (file, rest) = rest.split_once("\", line ")?;
+    Some((file.to_string(), rest.split(|c: char| !c.is_ascii_digit()).next()?.parse().ok()?))
 }
 
 /// The latency brdfprof assumes for a variable-latency result (released through a scoreboard), in cycles,
@@ -128,6 +152,14 @@ pub fn variable_latency(instruction: &Instruction) -> &'static VariableLatency {
 /// predecessor and not before the scoreboards it waits for are released; a result released through a
 /// scoreboard takes `variable_latency`. Every instruction once (a branch's both sides; no loop repeated).
 pub fn schedule_latency(instructions: &[Instruction]) -> f64 {
+    let times = issue_times(instructions);
+    times.last().copied().unwrap_or(0.0)
+}
+
+/// The cycle each instruction issues at in `schedule_latency`'s schedule, and after them the cycle the warp
+/// ends (the last instruction's issue plus its stall).
+pub fn issue_times(instructions: &[Instruction]) -> Vec<f64> {
+    let mut times = Vec::with_capacity(instructions.len() + 1);
     let mut released = [0.0f64; 6];
     let mut t = 0.0f64;
     for i in instructions {
@@ -142,9 +174,11 @@ pub fn schedule_latency(instructions: &[Instruction]) -> f64 {
         if let Some(b) = i.control.read_barrier.filter(|b| *b < 6) {
             released[b as usize] = released[b as usize].max(t + SOURCES_READ.cycles);
         }
+        times.push(t);
         t += f64::from(i.control.stall.max(1));
     }
-    t
+    times.push(t);
+    times
 }
 
 #[cfg(test)]

@@ -36,6 +36,8 @@ pub(super) struct FunctionWriter<'m> {
     phi_temps: HashSet<Word>,
     pub body: String,
     pub location: Option<Location>,
+    /// Write `#line` directives (`TranslateOptions::line_directives`).
+    line_directives: bool,
     phis: HashMap<Word, Vec<(Word, Vec<(Word, Word)>)>>,
     params: HashSet<Word>,
     ret: Word,
@@ -44,7 +46,7 @@ pub(super) struct FunctionWriter<'m> {
 }
 
 impl<'m> FunctionWriter<'m> {
-    pub fn new(m: &'m ModuleInfo, env: &'m EnvLayout, f: &'m Function) -> Self {
+    pub fn new(m: &'m ModuleInfo, env: &'m EnvLayout, f: &'m Function, line_directives: bool) -> Self {
         let def = f.def.as_ref().expect("a function has its OpFunction");
         let id = def.result_id.unwrap_or(0);
         let mut phis: HashMap<Word, Vec<(Word, Vec<(Word, Word)>)>> = HashMap::new();
@@ -65,8 +67,10 @@ impl<'m> FunctionWriter<'m> {
             decls: Vec::new(),
             declared: HashSet::new(),
             phi_temps: HashSet::new(),
-            body: String::new(),
+            // Statements before the function's first OpLine are the translation's own.
+            body: if line_directives { format!("#line 1 \"{}\"\n", super::TRANSLATION_FILE) } else { String::new() },
             location: None,
+            line_directives,
             phis,
             params: f.parameters.iter().filter_map(|p| p.result_id).collect(),
             ret: def.result_type.unwrap_or(0),
@@ -95,7 +99,8 @@ impl<'m> FunctionWriter<'m> {
                 _ => params.push(format!("{} p{id}", self.m.c_type(ty)?)),
             }
         }
-        let signature = format!("BRDFPROF_FN {} {}({})", self.m.c_type(self.ret)?, self.name, params.join(", "));
+        let qualifiers = if self.line_directives { LINED_FN } else { "BRDFPROF_FN" };
+        let signature = format!("{qualifiers} {} {}({})", self.m.c_type(self.ret)?, self.name, params.join(", "));
         for (i, b) in f.blocks.iter().enumerate() {
             let label = b.label.as_ref().and_then(|l| l.result_id).unwrap_or(0);
             if i > 0 {
@@ -179,8 +184,13 @@ impl<'m> FunctionWriter<'m> {
         match inst.class.opcode {
             Line => {
                 let file = self.m.strings.get(&Self::id(inst, 0)).cloned().unwrap_or_default();
-                self.location = Some(Location { file, line: Self::lit(inst, 1) });
+                let here = Location { file, line: Self::lit(inst, 1) };
+                if self.line_directives && self.location.as_ref() != Some(&here) {
+                    writeln!(self.body, "#line {} \"{}\"", here.line, absolute_source(&here.file)).unwrap();
+                }
+                self.location = Some(here);
             }
+            NoLine if self.line_directives && self.location.take().is_some() => writeln!(self.body, "#line 1 \"{}\"", super::TRANSLATION_FILE).unwrap(),
             NoLine | Nop | SelectionMerge | LoopMerge | Phi => {}
             Variable => self.variable(inst)?,
             Load => self.load(inst)?,
@@ -636,4 +646,16 @@ fn one(s: Scalar) -> String {
         Scalar::I32 => "1".into(),
         _ => "1u".into(),
     }
+}
+
+/// The qualifiers of the module's own functions where they carry `#line` directives
+/// (`Translation::source_with_lines` defines it): the prelude's helpers may then differ from them.
+pub(super) const LINED_FN: &str = "BRDFPROF_LINED_FN";
+
+/// A source name as a `#line` directive gives it to a C compiler: absolute (the compilers run in their own
+/// directories and would otherwise resolve it there), with forward slashes and no quotes.
+fn absolute_source(file: &str) -> String {
+    let path = std::path::Path::new(file);
+    let path = if path.is_relative() { std::env::current_dir().map(|d| d.join(path)).unwrap_or_else(|_| path.to_path_buf()) } else { path.to_path_buf() };
+    path.to_string_lossy().replace('\\', "/").replace('"', "")
 }

@@ -116,8 +116,20 @@ pub fn shade_kernel_as(model: Option<&Model>, lights: u32, shaders: &Shaders, ho
     let (per_dispatch, accumulate) = shade::steady_block(lights);
     let k = shade::shade_kernel(model, GBufferFormat::Packed, per_dispatch, accumulate, shaders)?;
     // The G-buffer's texel view (`shade::bindings`): four 32-bit words per pixel.
-    let options = TranslateOptions { texel_formats: [((0, 0), TexelFormat::Rgba32ui)].into() };
+    let options = TranslateOptions { texel_formats: [((0, 0), TexelFormat::Rgba32ui)].into(), line_directives: false };
     translated(model, KernelKind::Shade, (&k.spirv.words, &k.constants), &options, how, shaders)
+}
+
+/// `shade_kernel` with each statement's source line (`#line`, from the kernel compiled again with glslang's
+/// `-g`), for `inspect --lines`: the same code as `shade_kernel`'s, whose compilers' line information then maps
+/// machine instructions to the `.brdf` file's lines and glsl/'s.
+pub fn shade_kernel_with_lines(model: Option<&Model>, lights: u32, shaders: &Shaders) -> Result<Translation> {
+    let (per_dispatch, accumulate) = shade::steady_block(lights);
+    let mut k = shade::shade_kernel(model, GBufferFormat::Packed, per_dispatch, accumulate, shaders)?;
+    let reference = Model::reference();
+    k.spirv = model.unwrap_or(&reference).kernel_with_lines(KernelKind::Shade, shaders)?.spirv;
+    let options = TranslateOptions { texel_formats: [((0, 0), TexelFormat::Rgba32ui)].into(), line_directives: true };
+    translated(model, KernelKind::Shade, (&k.spirv.words, &k.constants), &options, Preparation::Flattened, shaders)
 }
 
 /// The file's line and own name of a translation error located in its composed kernel: `file.brdf:LINE`

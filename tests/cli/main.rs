@@ -12,6 +12,7 @@ mod common;
 
 mod brdf_models;
 mod shader_languages;
+mod source_lines;
 mod cache;
 mod compare;
 mod devices;

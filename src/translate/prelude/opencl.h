@@ -7,7 +7,11 @@ typedef uint u32;
 typedef int i32;
 typedef ulong u64;
 #define GLOBAL __global
+// inspect --lines defines BRDFPROF_FN first (the helpers without debug information) and BRDFPROF_LINED_FN
+// (the module's own functions, which carry #line directives): Translation::source_with_lines.
+#ifndef BRDFPROF_FN
 #define BRDFPROF_FN static inline
+#endif
 #ifdef BRDFPROF_EXECUTED
 // brdfprof runs this build itself (PoCL): an invocation stops after 2^20 loop iterations, as on the host;
 // the build a compiler only costs has no such counter.
