@@ -478,16 +478,11 @@ pub fn inspect(families: &[&Family], req: &Request) -> Result<Vec<InspectReport>
     let checked = super::checked_translations(req, gpu, crate::translate::Dialect::OpenCl)?;
     let statics = crate::inspect::kernels_of(req.models).into_iter().map(|m| crate::inspect::static_row(req.shaders, m, req.lights)).collect::<Result<Vec<_>>>()?;
     let mut reports = compile_checked(families, statics, &checked, tools, req)?;
-    if req.lines {
-        for (report, family) in reports.iter_mut().zip(families) {
-            report.lines = super::per_model_lines(req, crate::translate::Dialect::OpenCl, |m, source| {
-                let binary = compile_as(source, family, req.precise, true)?;
-                let mut k = line_costs(&m.label(), &binary, family)?;
-                k.note = super::same_code_note(report, &m.label(), "Instruction Count", k.instructions);
-                Ok(k)
-            })?;
-        }
-    }
+    super::add_lines(&mut reports, families, req, crate::translate::Dialect::OpenCl, |m, source, family| {
+        let k = line_costs(&m.label(), &compile_as(source, family, req.precise, true)?, family)?;
+        let counted = k.instructions;
+        Ok((k, counted))
+    })?;
     Ok(reports)
 }
 

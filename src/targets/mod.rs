@@ -288,13 +288,31 @@ pub fn names_lines(target: &Target) -> bool {
 
 /// Each model's (not the memory-only kernel's) cost per source line: its shade kernel translated into
 /// `dialect` with `#line` directives (`prepare::shade_kernel_with_lines`), compiled and attributed by `lines`.
-pub(crate) fn per_model_lines(req: &Request, dialect: crate::translate::Dialect, mut lines: impl FnMut(&Model, &str) -> Result<crate::inspect::lines::KernelLines>) -> Result<Vec<crate::inspect::lines::KernelLines>> {
+fn per_model_lines(req: &Request, dialect: crate::translate::Dialect, mut lines: impl FnMut(&Model, &str) -> Result<crate::inspect::lines::KernelLines>) -> Result<Vec<crate::inspect::lines::KernelLines>> {
     let mut out = Vec::new();
     for m in req.models {
         let source = crate::translate::prepare::shade_kernel_with_lines(Some(m), req.lights, req.shaders)?.source_with_lines(dialect);
         out.push(lines(m, &source)?);
     }
     Ok(out)
+}
+
+/// Each family's report given its models' cost per source line when `req.lines`: `lines` compiles a model's
+/// line-annotated `dialect` source for a family and returns its lines and the instructions the costed compile
+/// counts for it (`same_code_note` compares the two).
+pub(crate) fn add_lines<F>(reports: &mut [InspectReport], families: &[&F], req: &Request, dialect: crate::translate::Dialect, mut lines: impl FnMut(&Model, &str, &F) -> Result<(crate::inspect::lines::KernelLines, u32)>) -> Result<()> {
+    if !req.lines {
+        return Ok(());
+    }
+    for (report, family) in reports.iter_mut().zip(families) {
+        let per_model = per_model_lines(req, dialect, |m, source| {
+            let (mut k, counted) = lines(m, source, family)?;
+            k.note = same_code_note(report, &m.label(), "Instruction Count", counted);
+            Ok(k)
+        })?;
+        report.lines = per_model;
+    }
+    Ok(())
 }
 
 /// A note where the line-annotated compile of `model` has another count of `statistic` (`counted`) than the
