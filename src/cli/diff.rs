@@ -15,7 +15,8 @@ use std::process::ExitCode;
 
 #[derive(Args)]
 pub struct DiffArgs {
-    /// The two models, A then B (B is measured against A); specs or .brdf files, as for `eval`. With
+    /// The two models, A then B (B is measured against A); specs or model files (.brdf, .hlsl, .ush, .wgsl,
+    /// ...), as for `eval`. With
     /// --reference, any number of models, each measured against the reference.
     #[command(flatten)]
     pub model: ModelArgs,

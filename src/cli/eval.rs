@@ -13,8 +13,8 @@ pub struct EvalArgs {
     #[command(flatten)]
     pub model: ModelArgs,
     /// CSV with columns nx,ny,nz,vx,vy,vz,lx,ly,lz, and roughness and f0r,f0g,f0b where the model reads them
-    /// (a conductor's Fresnel reads no F0; a .brdf file what its bindings read) (any order; others ignored). For a
-    /// .brdf model: optional tx,ty,tz (the tangent X, made orthogonal to N; Y = N x X; without them X is
+    /// (a conductor's Fresnel reads no F0; a model file what its bindings read) (any order; others ignored). For
+    /// a model file (.brdf, .hlsl, .ush, .wgsl, ...): optional tx,ty,tz (the tangent X, made orthogonal to N; Y = N x X; without them X is
     /// Duff et al. 2017's basis), and a column named like a parameter (NAMEr,NAMEg,NAMEb for a colour) sets
     /// it per row.
     #[arg(long)]

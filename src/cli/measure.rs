@@ -149,9 +149,9 @@ pub struct SweepArgs {
     /// file git tracks).
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// What every model's accuracy is measured against: a spec (its exact f64 model) or a .brdf file (its GPU
-    /// values). Default: each built-in spec against its own exact model, each .brdf file against the reference
-    /// it names (`reference SPEC`), else ggx.
+    /// What every model's accuracy is measured against: a spec (its exact f64 model) or a model file (.brdf,
+    /// .hlsl, .ush, .wgsl, ...: its GPU values). Default: each built-in spec against its own exact model, each
+    /// model file against the reference its .brdf names (`reference SPEC`), else ggx.
     #[arg(long)]
     pub reference: Option<String>,
     /// The Fresnel of the exact models: `physical` (the exact dielectric or the metal's conductor Fresnel, so

@@ -155,17 +155,19 @@ pub fn on_device_with<T>(device: &DeviceArgs, compile_only_ok: bool, work: impl 
 #[derive(Args, Clone)]
 pub struct ModelArgs {
     /// Model spec: a preset (ggx, blinn, cook-torrance, burley, ue-default-lit, filament-high, filament-low)
-    /// or d=..,vis=..,f=..,precision=..; see `brdfprof models`. Or a BRDF Explorer file,
-    /// PATH.brdf[,NAME=VALUE|@roughness|@alpha|@f0|@basecolor|@metallic...].
+    /// or d=..,vis=..,f=..,precision=..; see `brdfprof models`. Or a model file,
+    /// PATH[,NAME=VALUE|@roughness|@alpha|@f0|@basecolor|@metallic...]: a BRDF Explorer .brdf file (its shader
+    /// in GLSL, HLSL or WGSL), or a plain HLSL (.hlsl, .hlsli, .ush, .usf) or WGSL (.wgsl) shader file.
     #[arg(long = "model")]
     pub models: Vec<String>,
     /// Parameter override applied to every model that takes it, e.g. gamma=1.5 (GTR exponent), metal=copper,
-    /// precision=f16; for a .brdf file one of its parameters (a colour as r,g,b) or a binding such as
+    /// precision=f16; for a model file one of its parameters (a colour as r,g,b) or a binding such as
     /// roughness=@roughness.
     #[arg(long = "param")]
     pub params: Vec<String>,
-    /// A macro for every .brdf file's shader, NAME or NAME=VALUE, as glslang's -D: the shader's `#if`
-    /// branches and `#define`s see it (the same as `define=NAME=VALUE` in the file's spec; docs/brdf-files.md).
+    /// A macro for every model file's shader (.brdf, .hlsl, .ush, .wgsl, ...), NAME or NAME=VALUE: glslang's -D
+    /// for GLSL and HLSL, a naga_oil shader def for WGSL (whose `#ifdef` asks only whether NAME is defined); the
+    /// same as `define=NAME=VALUE` in the file's spec (docs/brdf-files.md, docs/wgsl.md).
     #[arg(long = "define", value_name = "NAME[=VALUE]")]
     pub defines: Vec<String>,
     /// A directory an HLSL shader's `#include` and a WGSL shader's `#import` search, after the model file's

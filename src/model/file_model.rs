@@ -380,7 +380,7 @@ fn split_params(rest: &[&str]) -> Result<Vec<String>> {
 impl FileModel {
     /// `PATH.brdf[,NAME=VALUE...]`: the file with its defaults, then the overrides.
     pub fn parse(text: &str) -> Result<Self> {
-        let (path, fields) = split_path(text, Path::new("")).ok_or_else(|| anyhow!("`{text}` names no .brdf file"))?;
+        let (path, fields) = split_path(text, Path::new("")).ok_or_else(|| anyhow!("`{text}` names no model file (.{})", crate::model::front::FILE_EXTENSIONS.join(", .")))?;
         let items = split_params(&fields)?;
         let (options, params): (Vec<String>, Vec<String>) = items.into_iter().partition(|i| is_shader_option(i));
         let (defines, includes) = shader_options(path, &[], &Includes::default(), &options)?;
@@ -577,6 +577,10 @@ impl FileModel {
                 }
             }
         }
+        // A global initialiser that reads a parameter set per call or per row runs again once it is set
+        // (brdf_file::inits): GLSL ran it at the start of `main`, before.
+        let bound: Vec<&str> = self.file.params.iter().zip(&self.bindings).filter(|(_, b)| !matches!(b, Binding::Value(_))).map(|(p, _)| p.name.as_str()).collect();
+        bind.extend(renamed.initialisers.iter().filter(|i| bound.iter().any(|b| i.reads.contains(*b))).map(|i| i.assignment.clone()));
         s += &format!("#define BRDF_FILE_BIND {}\n", bind.join(" "));
         s += &format!("#define EVAL_STRIDE {}\n#define BRDF_FILE_ROWS(base) {}\n", 4 + row_floats.div_ceil(4), rows.join(" "));
         let entry = self.entry();
@@ -856,6 +860,8 @@ mod tests {
         assert_eq!(FileModel::parse(&m.canonical()).unwrap(), m);
         assert_eq!(FileModel::parse(&m.name()).unwrap(), m);
         assert_eq!(FileModel::parse(&path).unwrap().name(), path, "defaults are not repeated in the name");
+        let e = format!("{:#}", FileModel::parse("m.txt,r=1").unwrap_err());
+        assert!(e.contains("names no model file (.brdf, .hlsl, .hlsli, .ush, .usf, .wgsl)"), "{e}");
     }
 
     #[test]

@@ -271,13 +271,223 @@ fn errors_in_hlsl_and_wgsl_exit_2_at_file_line_and_column() {
         assert!(!d.join("x.csv").exists());
     }
     // Headers that include each other behind include guards are no cycle; an `#include` in a branch the
-    // preprocessor does not take may name a file that does not exist.
+    // preprocessor does not take may name a file that does not exist (missing.brdf without its live
+    // `#include "Nowhere.ush"`, which glslang would stop at first), and one in a branch it takes is reported.
     run_in(d, &["eval", "--model", &hlsl("guarded.brdf"), "--input", "in.csv", "--output", "g.csv"]).ok();
-    assert!(!run_in(d, &["eval", "--model", &hlsl("missing.brdf"), "--input", "in.csv", "--output", "x.csv"]).stderr.contains("Ancient.ush"));
+    let missing = std::fs::read_to_string(hlsl("missing.brdf")).unwrap();
+    assert!(missing.contains("#include \"Nowhere.ush\"\n") && missing.contains("#define ENGINE_VERSION 5"));
+    std::fs::write(d.join("dead.brdf"), missing.replace("#include \"Nowhere.ush\"\n", "\n")).unwrap();
+    run_in(d, &["eval", "--model", "dead.brdf", "--input", "in.csv", "--output", "dead.csv"]).ok();
+    std::fs::write(d.join("live.brdf"), missing.replace("#include \"Nowhere.ush\"\n", "\n").replace("ENGINE_VERSION 5", "ENGINE_VERSION 3")).unwrap();
+    let live = run_in(d, &["eval", "--model", "live.brdf", "--input", "in.csv", "--output", "x.csv"]).fails(2, "live.brdf:7:10: cannot find include `Ancient.ush` (searched: .)");
+    assert!(!live.stderr.contains("missing #endif"), "glslang stops at the include's #error: {}", live.stderr);
     // Without the map, the virtual path is named with what would find it.
     run_in(d, &["eval", "--model", &ue("ue-ggx.brdf"), "--include-dir", &ue("Shaders"), "--input", "in.csv", "--output", "x.csv"])
         .fails(2, &format!("{}:7:10: cannot find include `/Engine/Private/Common.ush` (searched: ", ue("Shaders/SpecularTerms.ush")))
         .fails(2, "a virtual path needs --include-map /Engine=DIR");
     run_in(d, &["eval", "--model", "ggx", "--include-dir", ".", "--input", "in.csv", "--output", "x.csv"]).fails(2, "--include-dir .: it is for a shader file's model");
     run_in(d, &["eval", "--model", &ue("ue-ggx.brdf"), "--include-dir", "no-such-dir", "--input", "in.csv", "--output", "x.csv"]).fails(2, "no-such-dir is not a directory");
+}
+
+/// `write(dir, [(path, text)])`: the files of a test, folders made as needed.
+fn write(dir: &Path, files: &[(&str, &str)]) {
+    for (name, text) in files {
+        let p = dir.join(name);
+        std::fs::create_dir_all(p.parent().unwrap()).unwrap();
+        std::fs::write(p, text).unwrap();
+    }
+}
+
+/// One row per light direction (lx, ly, lz) with N = V = +z.
+fn write_lights(path: &Path, lights: &[[f64; 3]]) {
+    let rows: String = lights.iter().map(|l| format!("0,0,1,0,0,1,{},{},{}\n", l[0], l[1], l[2])).collect();
+    std::fs::write(path, format!("nx,ny,nz,vx,vy,vz,lx,ly,lz\n{rows}")).unwrap();
+}
+
+const HLSL_BRDF: &str = "float3 BRDF(float3 L, float3 V, float3 N, float3 X, float3 Y)";
+const WGSL_BRDF: &str = "fn BRDF(L: vec3<f32>, V: vec3<f32>, N: vec3<f32>, X: vec3<f32>, Y: vec3<f32>) -> vec3<f32>";
+
+#[test]
+fn hlsl_fmod_and_float_remainder_keep_the_sign_of_the_dividend() {
+    // HLSL's fmod and float % are C's (DXC's OpFRem), not GLSL's mod; integer % truncates.
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write_lights(&d.join("in.csv"), &[[-0.6, 0.0, 0.8], [0.6, 0.0, 0.8]]);
+    let hlsl = format!("{HLSL_BRDF}\n{{\n\tfloat a = L.x * 3.0;\n\tint i = (int)round(L.x * 10.0);\n\treturn float3(fmod(a, 1.0), a % 1.0, (float)(i % 4));\n}}\n");
+    let wgsl = format!("{WGSL_BRDF} {{\n    let a = L.x * 3.0;\n    let i = i32(round(L.x * 10.0));\n    return vec3<f32>(a % 1.0, a % 1.0, f32(i % 4));\n}}\n");
+    write(d, &[("m.hlsl", &hlsl), ("m.wgsl", &wgsl)]);
+    for m in ["m.hlsl", "m.wgsl"] {
+        run_in(d, &["eval", "--model", m, "--input", "in.csv", "--output", "o.csv"]).ok();
+        let v = values(&d.join("o.csv"));
+        for (row, want) in v.iter().zip([[-0.8, -0.8, -2.0], [0.8, 0.8, 2.0]]) {
+            assert!((0..3).all(|c| (row[c] - want[c]).abs() < 1e-5), "{m}: {row:?}, expected {want:?}");
+        }
+    }
+}
+
+#[test]
+fn an_include_or_an_if_inside_a_comment_is_none() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write_lights(&d.join("in.csv"), &[[0.0, 0.6, 0.8]]);
+    // The commented-out include of a `#pragma once` header must not use up its one inclusion, a commented-out
+    // header's own `*/` must not end the comment, and a commented `#if` opens nothing.
+    let model = format!("analytic\n::begin shader hlsl\n/* previously:\n#include \"a.ush\"\n#include \"old.ush\"\n#if 0\n*/\n#include \"a.ush\" /* the header\n   of A */\n{HLSL_BRDF} {{ return A() * dot(N, L); }}\n::end shader\n");
+    write(d, &[("m.brdf", &model), ("a.ush", "#pragma once\nfloat A() { return 2; }\n"), ("old.ush", "/* old header */\nfloat Old() { return 1; }\n")]);
+    run_in(d, &["eval", "--model", "m.brdf", "--input", "in.csv", "--output", "o.csv"]).ok();
+    assert!(values(&d.join("o.csv")).iter().all(|v| (v[0] - 1.6).abs() < 1e-6), "{:?}", values(&d.join("o.csv")));
+}
+
+#[test]
+fn pragma_once_holds_across_spellings_of_one_path_and_angle_includes_search_the_include_dirs_alone() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write_lights(&d.join("in.csv"), &[[0.0, 0.6, 0.8]]);
+    let includes = ["a.ush", "./a.ush", "sub/../a.ush", "<b.ush>", "b.ush", "/Eng/Private/c.ush", "/Eng/Private/../Private/c.ush"];
+    let lines: String = includes.iter().map(|i| if i.starts_with('<') { format!("#include {i}\n") } else { format!("#include \"{i}\"\n") }).collect();
+    let model = format!("analytic\n::begin shader hlsl\n{lines}{HLSL_BRDF} {{ return A() + B() + C(); }}\n::end shader\n");
+    let angle = format!("analytic\n::begin shader hlsl\n#include <a.ush>\n{HLSL_BRDF} {{ return A(); }}\n::end shader\n");
+    write(d, &[("m.brdf", &model), ("n.brdf", &angle), ("a.ush", "#pragma once\nfloat A() { return 1; }\n"), ("sub/x.ush", ""), ("inc/b.ush", "#pragma once\nfloat B() { return 2; }\n"), ("eng/Private/c.ush", "#pragma once\nfloat C() { return 4; }\n")]);
+    let flags = ["--include-dir", "inc", "--include-map", "/Eng=eng", "--input", "in.csv"];
+    let args = |m: &'static str| ["eval", "--model", m, "--output", "o.csv"].into_iter().chain(flags).collect::<Vec<_>>();
+    run_in(d, &args("m.brdf")).ok();
+    assert!(values(&d.join("o.csv")).iter().all(|v| *v == [7.0; 3]), "{:?}", values(&d.join("o.csv")));
+    // `<a.ush>` is not looked for beside the model.
+    run_in(d, &args("n.brdf")).fails(2, "n.brdf:3:10: cannot find include `a.ush` (searched: inc)");
+}
+
+#[test]
+fn an_include_guard_with_an_else_of_its_own_is_no_guard() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write_lights(&d.join("in.csv"), &[[0.0, 0.6, 0.8]]);
+    let model = format!("analytic\n::begin shader hlsl\n#include \"g.ush\"\n#include \"g.ush\"\n{HLSL_BRDF} {{ return A() + A2(); }}\n::end shader\n");
+    write(d, &[("m.brdf", &model), ("g.ush", "#ifndef A_H\n#define A_H\nfloat A() { return 1; }\n#else\nfloat A2() { return 2; }\n#endif\n")]);
+    run_in(d, &["eval", "--model", "m.brdf", "--input", "in.csv", "--output", "o.csv"]).ok();
+    assert!(values(&d.join("o.csv")).iter().all(|v| *v == [3.0; 3]));
+}
+
+#[test]
+fn a_line_directive_in_an_hlsl_header_is_dropped_with_a_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write_lights(&d.join("in.csv"), &[[0.0, 0.6, 0.8]]);
+    let model = format!("analytic\n::begin shader hlsl\n#include \"lined.ush\"\n{HLSL_BRDF} {{ return H(); }}\n::end shader\n");
+    write(d, &[("m.brdf", &model), ("lined.ush", "#pragma once\n#line 500\nfloat H() { return 1; }\n"), ("bad.ush", "#pragma once\n#line 500\nfloat H() { return nope; }\n")]);
+    let out = run_in(d, &["eval", "--model", "m.brdf", "--input", "in.csv", "--output", "o.csv"]).ok();
+    assert!(out.stderr.contains("lined.ush:2: `#line 500` is dropped: brdfprof numbers the file's lines itself"), "{}", out.stderr);
+    // An error after it is at the header's own line.
+    std::fs::write(d.join("m.brdf"), model.replace("lined.ush", "bad.ush")).unwrap();
+    run_in(d, &["eval", "--model", "m.brdf", "--input", "in.csv", "--output", "x.csv"]).fails(2, "bad.ush:3:20: 'nope' : unknown variable");
+}
+
+#[test]
+fn generated_hlsl_lines_are_named_and_resources_and_keywords_are_refused_at_their_lines() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write_lights(&d.join("in.csv"), &[[0.0, 0.6, 0.8]]);
+    // An unknown name in an entry's argument: the `entry` line, named, not a column of the generated glue.
+    let light = std::fs::read_to_string(ue("ue-light.brdf")).unwrap();
+    let line = light.lines().position(|l| l.starts_with("entry SpecularLight(")).unwrap() + 1;
+    std::fs::write(d.join("light.brdf"), light.replace("entry SpecularLight(N, V, L, Roughness,", "entry SpecularLight(N, V, L, Rough,")).unwrap();
+    run_with_includes(d, &["eval", "--model", "light.brdf", "--input", "in.csv", "--output", "x.csv"]).fails(2, &format!("light.brdf:{line}:1: entry `SpecularLight`: 'Rough' : unknown variable"));
+    let param = |name: &str| format!("analytic\n::begin parameters\nfloat {name} 0 1 0.5\n::end parameters\n::begin shader hlsl\n{HLSL_BRDF} {{ return {name} * dot(N, L); }}\n::end shader\n");
+    write(d, &[("kw.brdf", &param("texture")), ("g.hlsl", &format!("/* Gloss: how glossy */\nfloat Gloss;\n{HLSL_BRDF} {{ return Gloss * dot(N, L); }}\n"))]);
+    run_in(d, &["eval", "--model", "kw.brdf", "--input", "in.csv", "--output", "x.csv"]).fails(2, "kw.brdf:3: parameter `texture`: a keyword of HLSL");
+    // A global without `static` is a uniform of HLSL's $Global constant buffer: its declaration, not a comment.
+    run_in(d, &["eval", "--model", "g.hlsl", "--input", "in.csv", "--output", "x.csv"]).fails(2, "g.hlsl:2:7: `Gloss` is a global without `static`").fails(2, "declare it `static`");
+    assert!(!d.join("x.csv").exists());
+}
+
+#[test]
+fn wgsl_loops_are_warned_about_in_imported_modules_and_nested_comments_hide_theirs() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write_lights(&d.join("in.csv"), &[[0.0, 0.6, 0.8]]);
+    let sum = "#define_import_path loopy::sum\nfn total() -> f32 {\n    var s = 0.0;\n    for (var i: i32 = 0; i < 100000; i++) { s += 1e-5; }\n    return s;\n}\nfn unused() -> f32 {\n    var s = 0.0;\n    loop { s += 1.0; if s > 3.0 { break; } }\n    return s;\n}\n";
+    let lexed = format!("/* outer /* inner */ for (;;) {{}} */\nconst K = 0x1.8p1f;\n{WGSL_BRDF} {{ return vec3<f32>(K) * dot(N, L); }}\n");
+    write(d, &[("mods/sum.wgsl", sum), ("m.wgsl", &format!("#import loopy::sum::total\n{WGSL_BRDF} {{ return vec3<f32>(total()); }}\n")), ("lex.wgsl", &lexed)]);
+    let out = run_in(d, &["eval", "--model", "m.wgsl", "--include-dir", "mods", "--input", "in.csv", "--output", "o.csv"]).ok();
+    assert!(out.stderr.contains("mods/sum.wgsl:4: a `for` loop of 100000 iterations: lavapipe ends every loop after 65535 iterations"), "{}", out.stderr);
+    assert!(!out.stderr.contains("sum.wgsl:9"), "a function the composition leaves out: {}", out.stderr);
+    let out = run_in(d, &["eval", "--model", "lex.wgsl", "--input", "in.csv", "--output", "o.csv"]).ok();
+    assert!(!out.stderr.contains("loop"), "a `for` in a nested comment: {}", out.stderr);
+}
+
+#[test]
+fn a_wgsl_brdf_of_another_signature_is_refused_at_its_fn_in_wgsl() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write_lights(&d.join("in.csv"), &[[0.0, 0.6, 0.8]]);
+    write(d, &[("n3.wgsl", "// the BRDF\n  fn BRDF(L: vec3<f32>, V: vec3<f32>, N: vec3<f32>, X: vec3<f32>, Y: vec3<f32>) -> f32 { return 1.0; }\n")]);
+    run_in(d, &["eval", "--model", "n3.wgsl", "--input", "in.csv", "--output", "x.csv"])
+        .fails(2, &format!("n3.wgsl:2:3: `BRDF` must be defined as `{WGSL_BRDF}`"))
+        .fails(2, "-> f32`");
+}
+
+#[test]
+fn a_quoted_wgsl_import_is_found_beside_the_importing_module() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write_lights(&d.join("in.csv"), &[[0.0, 0.6, 0.8]]);
+    // m.wgsl imports "mods/a.wgsl" (beside it), which imports "b.wgsl" beside itself, as an HLSL include is found;
+    // n.wgsl, named bare, finds the module `named::c` declared beside it.
+    write(d, &[
+        ("m.wgsl", &format!("#import \"mods/a.wgsl\"::a\n{WGSL_BRDF} {{ return vec3<f32>(a()); }}\n")),
+        ("mods/a.wgsl", "#import \"b.wgsl\"::b\nfn a() -> f32 { return b() + 1.0; }\n"),
+        ("mods/b.wgsl", "fn b() -> f32 { return 2.0; }\n"),
+        ("n.wgsl", &format!("#import named::c::c\n{WGSL_BRDF} {{ return vec3<f32>(c()); }}\n")),
+        ("c.wgsl", "#define_import_path named::c\nfn c() -> f32 { return 5.0; }\n"),
+    ]);
+    run_in(d, &["eval", "--model", "m.wgsl", "--input", "in.csv", "--output", "o.csv"]).ok();
+    assert!(values(&d.join("o.csv")).iter().all(|v| *v == [3.0; 3]), "{:?}", values(&d.join("o.csv")));
+    run_in(d, &["eval", "--model", "n.wgsl", "--input", "in.csv", "--output", "o.csv"]).ok();
+    assert!(values(&d.join("o.csv")).iter().all(|v| *v == [5.0; 3]));
+}
+
+#[test]
+fn a_global_initialiser_reading_a_bound_parameter_sees_its_value_in_glsl_and_hlsl() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write_rows(&d.join("in.csv"), 50);
+    let params = "analytic\n::begin parameters\nfloat k 0 1 0.5\n::end parameters\n";
+    write(d, &[
+        ("twin.brdf", &format!("{params}::begin shader\nvec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) {{ return vec3(k * k * 2.0 + dot(N, L)); }}\n::end shader\n")),
+        ("glsl.brdf", &format!("{params}::begin shader\nfloat k2 = k * k, k4 = k2 * 2.0;\nfloat twice(float x) {{ return x * 2.0; }}\nfloat k3 = twice(k2);\nvec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) {{ return vec3((k4 + k3) * 0.5 + dot(N, L)); }}\n::end shader\n")),
+        ("hlsl.brdf", &format!("{params}::begin shader hlsl\nstatic float k2 = k * k;\n{HLSL_BRDF} {{ return k2 * 2.0 + dot(N, L); }}\n::end shader\n")),
+    ]);
+    // Bound to an input (set per call), and per CSV row (a column named `k`).
+    let rows = std::fs::read_to_string(d.join("in.csv")).unwrap();
+    let with_k: String = rows.lines().enumerate().map(|(i, l)| if i == 0 { "nx,ny,nz,vx,vy,vz,lx,ly,lz,k\n".to_string() } else { format!("{},{}\n", l.split(',').take(9).collect::<Vec<_>>().join(","), (i % 7) as f64 / 7.0) }).collect();
+    std::fs::write(d.join("k.csv"), with_k).unwrap();
+    for (binding, input) in [(",k=@roughness", "in.csv"), ("", "k.csv")] {
+        let eval = |m: &str, out: &str| run_in(d, &["eval", "--model", &format!("{m}{binding}"), "--input", input, "--output", out]).ok();
+        eval("twin.brdf", "twin.csv");
+        let twin = values(&d.join("twin.csv"));
+        assert!(twin.windows(2).any(|w| w[0][0] != w[1][0]));
+        for m in ["glsl.brdf", "hlsl.brdf"] {
+            eval(m, "o.csv");
+            let worst = twin.iter().zip(values(&d.join("o.csv"))).map(|(a, b)| common::rel_err(b[0], a[0])).fold(0.0, f64::max);
+            assert!(worst < 1e-6, "{m}{binding} on {input}: worst relative difference {worst:e} from the twin");
+        }
+    }
+}
+
+#[test]
+fn reserved_define_names_are_refused_and_help_and_messages_name_every_model_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write_lights(&d.join("in.csv"), &[[0.0, 0.6, 0.8]]);
+    run_in(d, &["eval", "--model", &ue("ue-ggx-constant.hlsl"), "--define", "brdfprof_stub=x", "--input", "in.csv", "--output", "x.csv"])
+        .fails(2, "`define=brdfprof_stub`: names starting with `brdfprof_` (in any case) are brdfprof's own");
+    run_in(d, &["eval", "--model", &bevy("bevy-ggx.brdf"), "--define", "BRDFPROF_ONCE_1", "--input", "in.csv", "--output", "x.csv"]).fails(2, "are brdfprof's own");
+    // A name of brdfprof's own in the shader itself, at its line and column, in either language.
+    write(d, &[
+        ("s.hlsl", &format!("float Brdfprof_Stub() {{ return 1; }}\n{HLSL_BRDF} {{ return Brdfprof_Stub() * dot(N, L); }}\n")),
+        ("s.wgsl", &format!("/* brdfprof_note */\n  fn brdfprof_stub() -> f32 {{ return 1.0; }}\n{WGSL_BRDF} {{ return vec3<f32>(brdfprof_stub()); }}\n")),
+    ]);
+    run_in(d, &["eval", "--model", "s.hlsl", "--input", "in.csv", "--output", "x.csv"]).fails(2, "s.hlsl:1:7: `Brdfprof_Stub`: names starting with `brdfprof_` (in any case) are brdfprof's own");
+    run_in(d, &["eval", "--model", "s.wgsl", "--input", "in.csv", "--output", "x.csv"]).fails(2, "s.wgsl:2:6: `brdfprof_stub`: names starting with `brdfprof_`");
+    let help = run_in(d, &["eval", "--help"]).ok().stdout;
+    assert!(help.contains(".hlsl") && help.contains(".wgsl") && !help.contains("every .brdf file"), "{help}");
 }

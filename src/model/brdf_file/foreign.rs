@@ -14,6 +14,7 @@ pub(super) fn translate(file: &mut BrdfFile) -> Result<Vec<(usize, String)>> {
     if let Some(p) = file.params.iter().find(|p| p.name.starts_with(front::GENERATED_PREFIX)) {
         bail!(at(&file.path, p.line, format!("`{}`: names starting with `{}` are brdfprof's own in an {} shader", p.name, front::GENERATED_PREFIX, file.language.name())));
     }
+    check_reserved_names(file)?;
     let (spirv, source) = match file.language {
         Language::Hlsl => hlsl_spirv(file)?,
         _ => wgsl_spirv(file)?,
@@ -22,7 +23,7 @@ pub(super) fn translate(file: &mut BrdfFile) -> Result<Vec<(usize, String)>> {
     check_param_names(file, &text)?;
     let params: Vec<&str> = file.params.iter().map(|p| p.name.as_str()).collect();
     let glsl = cross::view(&text, &params, &file.path).map_err(|e| match e.downcast::<cross::Resource>() {
-        Ok(r) => match locate(&source, &r.name) {
+        Ok(r) => match locate(&source, r.declared()) {
             Some(at) => anyhow!("{at}: {}", r.message()),
             None => anyhow!("{r}"),
         },
@@ -35,13 +36,28 @@ pub(super) fn translate(file: &mut BrdfFile) -> Result<Vec<(usize, String)>> {
     Ok(glsl.into_iter().enumerate().map(|(i, l)| (i + 1, l)).collect())
 }
 
+/// Refuses a name of the section's code starting with `brdfprof_` (in any case): brdfprof writes such names into
+/// the shader (its stub, the entries' glue, the include guards), where the user's would clash with them.
+/// `#include` and `#import` lines name files, not identifiers.
+fn check_reserved_names(file: &BrdfFile) -> Result<()> {
+    let code: Vec<(usize, String)> = file.source.iter().map(|(n, l)| (*n, if l.trim_start().starts_with("#include") || l.trim_start().starts_with("#import") { String::new() } else { l.clone() })).collect();
+    let tokens = if file.language == Language::Wgsl { tokenize_wgsl(&file.path, &code)? } else { tokenize(&file.path, &code)? };
+    let reserved = |t: &&Token| t.kind == Kind::Ident && t.text.to_ascii_lowercase().starts_with(front::GENERATED_PREFIX);
+    let Some(t) = tokens.iter().find(reserved) else { return Ok(()) };
+    let (n, text) = &code[t.line];
+    let column = text[..t.start].chars().count() + 1;
+    bail!("{}:{n}:{column}: `{}`: names starting with `{}` (in any case) are brdfprof's own (the stub, glue and include guards it writes into the shader); give it another name", file.path.display(), t.text, front::GENERATED_PREFIX)
+}
+
 /// The shader's source lines with their files and lines (HLSL: with its includes), where a name is looked for.
 type Source = Vec<(String, usize, String)>;
 
-/// `FILE:LINE:COLUMN` of the first whole-word occurrence of `name` in `source`.
+/// `FILE:LINE:COLUMN` of the first whole-word occurrence of `name` in `source`'s code (not in a comment).
 fn locate(source: &Source, name: &str) -> Option<String> {
     let ident = |c: char| c.is_ascii_alphanumeric() || c == '_';
-    source.iter().find_map(|(f, n, text)| {
+    let code = front::includes::code_lines(&source.iter().map(|(_, n, text)| (*n, text.clone())).collect::<Vec<_>>());
+    source.iter().zip(code).find_map(|((f, n, _), code)| {
+        let text = code.text;
         let i = text.match_indices(name).map(|(i, _)| i).find(|&i| !text[..i].ends_with(ident) && !text[i + name.len()..].starts_with(ident))?;
         Some(format!("{f}:{n}:{}", text[..i].chars().count() + 1))
     })
@@ -63,12 +79,6 @@ fn glue_name(k: usize) -> String {
     format!("{}entry{k}", front::GENERATED_PREFIX)
 }
 
-/// The directory a model's own includes are found beside (empty for a bare file name: the working directory,
-/// which messages then leave out).
-fn model_dir(path: &Path) -> PathBuf {
-    path.parent().map_or_else(PathBuf::new, Path::to_path_buf)
-}
-
 /// The functions the stub calls: `BRDF` where the shader defines it, and every glue function.
 fn stub_calls(file: &BrdfFile, glues: &[Glue]) -> Vec<String> {
     file.defines_brdf.then(|| "BRDF".to_string()).into_iter().chain(glues.iter().map(|g| g.name.clone())).collect()
@@ -88,20 +98,28 @@ fn glue(k: usize, e: &Entry, types: &[Option<String>]) -> Glue {
 }
 
 /// The HLSL shader compiled: the parameters as `static` globals, the section with its includes
-/// (`front::includes`), then each entry's glue and the stub. BRDF Explorer's entry and the declared entries are
-/// checked on glslang's preprocessed text (where every macro and `#if` is resolved), at their files' lines.
+/// (`front::includes`; each `#line` dropped with a warning, as in a GLSL shader), then each entry's glue and
+/// the stub, each line brdfprof writes named by what it stands for in messages. BRDF Explorer's entry and the
+/// declared entries are checked on glslang's preprocessed text (where every macro and `#if` is resolved), at
+/// their files' lines.
 fn hlsl_spirv(file: &mut BrdfFile) -> Result<(Vec<u32>, Source)> {
     let mut x = Expanded::new(&file.path);
     for p in &file.params {
-        x.push(hlsl::param_decl(&p.name, p.glsl_type()), 0, p.line);
+        if hlsl::is_keyword(&p.name) {
+            bail!(at(&file.path, p.line, format!("parameter `{}`: a keyword of HLSL (glslang's HLSL front end reads it as one), so no variable of the shader can be named so; give the parameter another name", p.name)));
+        }
+        x.push_generated(hlsl::param_decl(&p.name, p.glsl_type()), p.line, format!("parameter `{}`", p.name));
     }
-    x.include_section(&model_dir(&file.path), &file.source, &file.includes)?;
+    x.include_section(&front::dir_of(&file.path), &file.source, &file.includes)?;
+    for (f, n, text) in &x.dropped {
+        file.warnings.push(dropped_hash_line(Path::new(&x.files[*f]), *n, text));
+    }
     let pre = hlsl::preprocess(&x, &file.defines, &file.path)?.map_err(|m| anyhow!("{m}"))?;
     let glues = check_hlsl(file, &x, &pre)?;
     for (g, e) in glues.iter().zip(&file.entries) {
-        x.push(hlsl::glue(g), 0, e.line);
+        x.push_generated(hlsl::glue(g), e.line, format!("entry `{}`", e.name));
     }
-    x.push(hlsl::stub(&stub_calls(file, &glues)), 0, file.shader_begin);
+    x.push_generated(hlsl::stub(&stub_calls(file, &glues)), file.shader_begin, format!("the shader's `BRDF` as brdfprof calls it, `{}`", globals::HLSL_SIGNATURE.text));
     let spirv = hlsl::compile(&x, &file.defines, &file.path)?.map_err(|m| anyhow!("{m}"))?;
     let source = x.lines.iter().zip(&x.origins).map(|(l, &(f, n))| (x.files[f].clone(), n, l.clone())).collect();
     Ok((spirv, source))
@@ -139,46 +157,88 @@ fn check_hlsl(file: &mut BrdfFile, x: &Expanded, pre: &str) -> Result<Vec<Glue>>
 }
 
 /// The WGSL shader composed and compiled: the section, the parameters as private globals, each entry's glue
-/// and the stub, through naga_oil and naga (`front::wgsl`).
+/// and the stub, through naga_oil and naga (`front::wgsl`). The shader with its parameters alone is composed
+/// first: `BRDF`'s signature and the entries' parameter types are read from naga's module of it.
 fn wgsl_spirv(file: &mut BrdfFile) -> Result<(Vec<u32>, Source)> {
     let mut top = wgsl::Top::new(&file.source);
     for p in &file.params {
         top.push(&wgsl::param_decl(&p.name, p.glsl_type()), p.line, &format!("parameter `{}`", p.name));
     }
-    let tokens = tokenize(&file.path, &file.source)?;
-    file.loops = loops(&file.source, &tokens);
-    file.defines_brdf = wgsl::defines_brdf(&file.source);
-    if file.entries.is_empty() && !file.defines_brdf {
-        bail!(at(&file.path, file.shader_begin, format!("the shader defines no function `BRDF` at global scope (brdfprof calls `{WGSL_BRDF}`)")));
-    }
-    let glues = wgsl_glues(file, &top)?;
+    let bare = wgsl::compose(&file.path, &top, &file.defines, &file.includes)?;
+    file.defines_brdf = check_wgsl_brdf(file, &top, &bare.module)?;
+    let glues = wgsl_glues(file, &top, &bare.module)?;
     for (g, e) in glues.iter().zip(&file.entries) {
         top.push(&wgsl::glue(g), e.line, &format!("entry `{}`", e.name));
     }
     top.push(&wgsl::stub(&stub_calls(file, &glues)), file.shader_begin, &format!("the shader's `BRDF` as brdfprof calls it, `{WGSL_BRDF}`"));
-    let module = wgsl::compose(&file.path, &top, &file.defines, &file.includes)?;
+    let composed = wgsl::compose(&file.path, &top, &file.defines, &file.includes)?;
+    file.loops = wgsl_loops_of(file, &top, &composed)?;
     let model = file.path.display().to_string();
-    Ok((wgsl::emit_spirv(&module, &file.path)?, file.source.iter().map(|(n, l)| (model.clone(), *n, l.clone())).collect()))
+    Ok((wgsl::emit_spirv(&composed.module, &file.path)?, file.source.iter().map(|(n, l)| (model.clone(), *n, l.clone())).collect()))
 }
 
 const WGSL_BRDF: &str = "fn BRDF(L: vec3<f32>, V: vec3<f32>, N: vec3<f32>, X: vec3<f32>, Y: vec3<f32>) -> vec3<f32>";
 
+/// Whether the shader defines `BRDF` with BRDF Explorer's signature in WGSL (five `vec3<f32>` to a
+/// `vec3<f32>`, as naga's module `bare` types it). Without entries it must: a `BRDF` of another signature is
+/// refused at its `fn` (FILE:LINE:COLUMN), a shader without one at the section's first line.
+fn check_wgsl_brdf(file: &BrdfFile, top: &wgsl::Top, bare: &naga::Module) -> Result<bool> {
+    let vec3 = Some("vec3<f32>".to_string());
+    let found = wgsl::signature(bare, "BRDF");
+    if found.as_ref().is_some_and(|(params, result)| params.len() == 5 && params.iter().all(|(_, t)| *t == vec3) && *result == vec3) {
+        return Ok(true);
+    }
+    if !file.entries.is_empty() {
+        return Ok(false);
+    }
+    let Some((params, result)) = found else {
+        bail!(at(&file.path, file.shader_begin, format!("the shader defines no function `BRDF` at global scope (brdfprof calls `{WGSL_BRDF}`)")));
+    };
+    let shown = |t: &Option<String>| t.clone().unwrap_or_else(|| "?".into());
+    let params: Vec<String> = params.iter().map(|(n, t)| format!("{n}: {}", shown(t))).collect();
+    let actual = format!("fn BRDF({}){}", params.join(", "), result.as_ref().map_or(String::new(), |r| format!(" -> {r}")));
+    let lines: Vec<(usize, String)> = wgsl::preprocessed(&top.text, &file.defines, &file.path).lines().enumerate().map(|(i, l)| (i + 1, l.to_string())).collect();
+    let tokens = tokenize_wgsl(&file.path, &lines)?;
+    let at_fn = tokens.windows(2).find(|w| w[0].text == "fn" && w[1].text == "BRDF").map(|w| (lines[w[0].line].0, lines[w[0].line].1[..w[0].start].chars().count() + 1));
+    let (line, column) = at_fn.unwrap_or((file.shader_begin, 1));
+    bail!("{}:{line}:{column}: `BRDF` must be defined as `{WGSL_BRDF}`; the shader's is `{actual}`", file.path.display())
+}
+
+/// The WGSL shader's loops and those of the modules it imports, each at its own file and line, read from
+/// naga_oil's preprocessed text (an `#ifdef` branch not taken has none); a module's only in the functions the
+/// composition kept (naga_oil leaves out the imported functions nothing calls).
+fn wgsl_loops_of(file: &BrdfFile, top: &wgsl::Top, composed: &wgsl::Composed) -> Result<Vec<Loop>> {
+    let model = file.path.display().to_string();
+    let kept = wgsl::function_names(&composed.module);
+    let mut out = Vec::new();
+    for (k, (shown, text)) in std::iter::once((&model, &top.text)).chain(composed.files.iter().map(|(f, t)| (f, t))).enumerate() {
+        let lines: Vec<(usize, String)> = wgsl::preprocessed(text, &file.defines, &file.path).lines().enumerate().map(|(i, l)| (i + 1, l.to_string())).collect();
+        let tokens = tokenize_wgsl(Path::new(shown), &lines)?;
+        for (l, function) in wgsl_loops(&lines, &tokens) {
+            if k == 0 || function.is_some_and(|f| kept.contains(&f)) {
+                out.push(Loop { file: (k > 0).then(|| shown.clone()), ..l });
+            }
+        }
+    }
+    Ok(out)
+}
+
 /// Each entry's glue. An entry with `@out`/`@scratch` arguments needs its function's parameter types, read
-/// from naga's module of the shader composed once without glue; any other is checked by naga at its call.
-fn wgsl_glues(file: &BrdfFile, top: &wgsl::Top) -> Result<Vec<Glue>> {
+/// from naga's module of the shader composed without glue (`bare`); any other is checked by naga at its call.
+fn wgsl_glues(file: &BrdfFile, top: &wgsl::Top, bare: &naga::Module) -> Result<Vec<Glue>> {
     let mut glues = Vec::new();
     for (k, e) in file.entries.iter().enumerate() {
         globals::check_special_args(&file.path, e, "WGSL")?;
-        let types = if e.args.iter().any(|a| a.starts_with('@')) { wgsl_types(file, top, e)? } else { Vec::new() };
+        let types = if e.args.iter().any(|a| a.starts_with('@')) { wgsl_types(file, top, bare, e)? } else { Vec::new() };
         glues.push(glue(k, e, &types));
     }
     Ok(glues)
 }
 
 /// The types of entry `e`'s function's parameters, checked against its `@out`/`@scratch` arguments.
-fn wgsl_types(file: &BrdfFile, top: &wgsl::Top, e: &Entry) -> Result<Vec<Option<String>>> {
+fn wgsl_types(file: &BrdfFile, top: &wgsl::Top, bare: &naga::Module, e: &Entry) -> Result<Vec<Option<String>>> {
     let fail = |m: String| anyhow!(at(&file.path, e.line, m));
-    let found = wgsl::parameter_types(&file.path, top, &file.defines, &file.includes, &e.name)?;
+    let found = wgsl::parameter_types(&file.path, top, bare, &file.defines, &file.includes, &e.name)?;
     let types = found.ok_or_else(|| fail(format!("entry `{}`: neither the shader nor a module it imports defines a function `{}`", e.name, e.name)))?;
     if types.len() != e.args.len() {
         return Err(fail(format!("entry `{}` takes {} arguments and the declaration gives {}", e.name, types.len(), e.args.len())));

@@ -36,8 +36,33 @@ pub(super) fn loops(lines: &[(usize, String)], tokens: &[Token]) -> Vec<Loop> {
     out
 }
 
-/// A literal of the loop header (an optional `-`, then a number: `10`, `0x10`, `5u`, `0.5f`, `1e5`) at
-/// `tokens[*at]`, advancing past it.
+/// WGSL's loops (`for`, `while`, `loop`), each with its trip count where `trip_count` can read it and the
+/// function it is in (the last `fn NAME` before it at the top level).
+pub(super) fn wgsl_loops(lines: &[(usize, String)], tokens: &[Token]) -> Vec<(Loop, Option<String>)> {
+    let mut out = Vec::new();
+    let (mut function, mut depth) = (None, 0usize);
+    for (i, t) in tokens.iter().enumerate() {
+        match t.text.as_str() {
+            "{" if t.kind == Kind::Punct => depth += 1,
+            "}" if t.kind == Kind::Punct => depth = depth.saturating_sub(1),
+            "fn" if depth == 0 && t.kind == Kind::Ident => function = tokens.get(i + 1).filter(|n| n.kind == Kind::Ident).map(|n| n.text.clone()),
+            "for" | "while" | "loop" if t.kind == Kind::Ident => {
+                let keyword = match t.text.as_str() {
+                    "for" => "for",
+                    "while" => "while",
+                    _ => "loop",
+                };
+                let trip_count = if keyword == "for" { trip_count(&tokens[i + 1..]) } else { None };
+                out.push((Loop { file: None, line: lines[t.line].0, keyword, trip_count }, function.clone()));
+            }
+            _ => {}
+        }
+    }
+    out
+}
+
+/// A literal of the loop header (an optional `-`, then a number: `10`, `0x10`, `5u`, `0.5f`, `1e5`, WGSL's
+/// `7i`) at `tokens[*at]`, advancing past it.
 pub(super) fn literal(tokens: &[Token], at: &mut usize) -> Option<f64> {
     let negative = tokens.get(*at).is_some_and(|t| t.is("-"));
     if negative {
@@ -45,15 +70,16 @@ pub(super) fn literal(tokens: &[Token], at: &mut usize) -> Option<f64> {
     }
     let t = tokens.get(*at).filter(|t| t.kind == Kind::Number)?;
     *at += 1;
-    let text = t.text.trim_end_matches(['u', 'U', 'f', 'F']).trim_end_matches("lf").trim_end_matches("LF");
-    let x = match text.strip_prefix("0x").or_else(|| text.strip_prefix("0X")) {
-        Some(h) => u64::from_str_radix(h, 16).ok()? as f64,
-        None => text.parse::<f64>().ok()?,
+    let x = match t.text.strip_prefix("0x").or_else(|| t.text.strip_prefix("0X")) {
+        // A hex digit `f` is no suffix.
+        Some(h) => u64::from_str_radix(h.trim_end_matches(['u', 'U', 'i']), 16).ok()? as f64,
+        None => t.text.trim_end_matches("lf").trim_end_matches("LF").trim_end_matches(['u', 'U', 'f', 'F', 'h', 'i']).parse::<f64>().ok()?,
     };
     Some(if negative { -x } else { x })
 }
 
-/// The iterations of `( [const] [TYPE] I = A ; I OP B ; STEP )` (`tokens` start at the `(`), OP one of
+/// The iterations of `( [const] [TYPE] I = A ; I OP B ; STEP )` (WGSL's `(var I[: TYPE] = A; ...)` too;
+/// `tokens` start at the `(`), OP one of
 /// `<`, `<=`, `>`, `>=`, `!=`, STEP `I++`, `++I`, `I--`, `--I`, `I += D`, `I -= D`, with A, B, D literals;
 /// None for any other header, or a loop that never ends.
 pub(super) fn trip_count(tokens: &[Token]) -> Option<u64> {
@@ -61,9 +87,10 @@ pub(super) fn trip_count(tokens: &[Token]) -> Option<u64> {
     if !is(0, "(") {
         return None;
     }
-    // Init: the variable is the identifier before `=`.
-    let eq = (1..tokens.len().min(5)).find(|&j| is(j, "="))?;
-    let var = tokens.get(eq - 1).filter(|t| t.kind == Kind::Ident)?.text.clone();
+    // Init: the variable is the identifier before `=`, or before WGSL's `: TYPE` (`var i: i32 = 0`).
+    let eq = (1..tokens.len().min(7)).find(|&j| is(j, "="))?;
+    let typed = eq >= 3 && is(eq - 2, ":");
+    let var = tokens.get(if typed { eq - 3 } else { eq - 1 }).filter(|t| t.kind == Kind::Ident)?.text.clone();
     let mut at = eq + 1;
     let start = literal(tokens, &mut at)?;
     if !is(at, ";") || !is(at + 1, &var) {

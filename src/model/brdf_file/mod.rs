@@ -43,6 +43,7 @@
 mod foreign;
 mod format;
 mod globals;
+mod inits;
 mod loops;
 mod preprocess;
 mod rename;
@@ -58,6 +59,7 @@ use rename::*;
 use tokens::*;
 
 pub use format::is_identifier;
+pub use inits::Initialiser;
 pub use loops::LAVAPIPE_LOOP_LIMIT;
 
 pub use crate::model::front::{Includes, Language};
@@ -207,6 +209,9 @@ pub struct RenamedShader {
     pub renamed: Vec<String>,
     /// `renamed` as a set, for `original_names`.
     lookup: HashSet<String>,
+    /// The non-`const` globals' initialisers, as assignments in the renamed names, with the parameters each
+    /// reads (`inits`): the composition runs those that read a bound parameter again after the bindings.
+    pub initialisers: Vec<Initialiser>,
 }
 
 /// Reads and parses `path`.
@@ -310,9 +315,13 @@ impl BrdfFile {
         Ok(file)
     }
 
-    /// `defines`, refused where one is named like a parameter.
+    /// `defines`, refused where one is named like a parameter or takes a name of brdfprof's own (`brdfprof_`,
+    /// in any case: the front ends' stub, glue and arguments, the includes' `BRDFPROF_ONCE_` guards).
     fn set_defines(&mut self, defines: &[(String, String)]) -> Result<()> {
         for (name, _) in defines {
+            if name.to_ascii_lowercase().starts_with(crate::model::front::GENERATED_PREFIX) {
+                bail!("{}: `define={name}`: names starting with `{}` (in any case) are brdfprof's own (the functions and guards it writes into the shader); give the macro another name", self.path.display(), crate::model::front::GENERATED_PREFIX);
+            }
             if let Some(p) = self.params.iter().find(|p| &p.name == name) {
                 bail!("{}: `define={name}`: `{name}` is the file's parameter (line {}); a macro of that name would replace it in the shader", self.path.display(), p.line);
             }
@@ -340,6 +349,7 @@ impl BrdfFile {
         check_shader(self, self.shader_begin, &tokens, &scan)?;
         self.prefix = self.choose_prefix();
         self.renamed = self.rename(&tokens, &scan);
+        self.renamed.initialisers = inits::initialisers(self, &tokens)?;
         Ok(())
     }
 }

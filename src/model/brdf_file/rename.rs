@@ -59,7 +59,7 @@ impl BrdfFile {
             lines[line].1.replace_range(start..end, &text);
         }
         let lookup = renamed.iter().cloned().collect();
-        RenamedShader { lines, prefix, renamed, lookup }
+        RenamedShader { lines, prefix, renamed, lookup, initialisers: Vec::new() }
     }
 
     /// `const TYPE NAME = DEFAULT;` for each parameter, under its GLSL name: the simplest composition.

@@ -454,3 +454,34 @@ fn renaming_is_linear_in_the_number_of_functions() {
     assert!(f.renamed_shader().text().contains("float brdf_f_f39999(float x)"));
     assert!(large / small < 11.0, "10,000 functions: {small:.3} s, 40,000: {large:.3} s (linear: about 4x; quadratic: 16x)");
 }
+
+#[test]
+fn wgsl_tokens_nest_their_comments_and_wgsl_loop_headers_are_counted() {
+    let lines = |t: &str| t.lines().enumerate().map(|(i, l)| (i + 1, l.to_string())).collect::<Vec<_>>();
+    let text = lines("/* a /* b */ for (;;) {} */ x\nfn f() -> f32 {\n  for (var i: i32 = 0; i < 100000; i++) {}\n  loop { break; }\n  while (true) {}\n  for (var j = 0x1Fu; j > 0u; j--) {}\n  return 0x1.8p-1f;\n}\n");
+    let tokens = tokenize_wgsl(Path::new("m.wgsl"), &text).unwrap();
+    assert_eq!(tokens[0].text, "x");
+    assert!(tokens.iter().any(|t| t.text == "0x1.8p-1f"), "a hex float with a signed exponent is one number");
+    let got: Vec<(usize, &str, Option<u64>, Option<String>)> = wgsl_loops(&text, &tokens).into_iter().map(|(l, f)| (l.line, l.keyword, l.trip_count, f)).collect();
+    let f = Some("f".to_string());
+    assert_eq!(got, [(3, "for", Some(100000), f.clone()), (4, "loop", None, f.clone()), (5, "while", None, f.clone()), (6, "for", Some(31), f)]);
+    // GLSL's block comments do not nest: `*/` ends the first.
+    assert_eq!(tokenize(Path::new("m.glsl"), &lines("/* a /* b */ c */")).unwrap().iter().map(|t| t.text.as_str()).collect::<String>(), "c*/");
+}
+
+#[test]
+fn global_initialisers_know_the_parameters_they_read_through_globals_and_functions() {
+    let shader = "float a = k * 2.0, b[2] = float[2](a, 1.0);\nconst float c = 3.0;\nfloat d = c * 2.0;\nfloat twice(float x) { return x * r; }\nstruct S { float k; };\nfloat e = twice(d);\nfloat g;\nfloat h = g + 1.0;\n";
+    let f = ok(&file("float k 0 1 0.5\nfloat r 0 1 0.5\n", &format!("{shader}{BRDF}")));
+    let got: Vec<(&str, Vec<&str>, &str)> = f.renamed_shader().initialisers.iter().map(|i| (i.name.as_str(), i.reads.iter().map(String::as_str).collect(), i.assignment.as_str())).collect();
+    assert_eq!(
+        got,
+        [
+            ("a", vec!["k"], "brdf_f_a = brdf_f_k * 2.0;"),
+            ("b", vec!["k"], "brdf_f_b = float[2](brdf_f_a, 1.0);"),
+            ("d", vec![], "brdf_f_d = brdf_f_c * 2.0;"),
+            ("e", vec!["r"], "brdf_f_e = brdf_f_twice(brdf_f_d);"),
+            ("h", vec![], "brdf_f_h = brdf_f_g + 1.0;"),
+        ]
+    );
+}

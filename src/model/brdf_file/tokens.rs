@@ -30,15 +30,31 @@ impl Token {
 /// Tokens of `lines` without comments. GLSL has no strings; anything not an identifier or a number is a
 /// one-character punctuation token (multi-character operators do not matter to what reads the tokens).
 pub(super) fn tokenize(path: &Path, lines: &[(usize, String)]) -> Result<Vec<Token>> {
+    tokenize_as(path, lines, false)
+}
+
+/// WGSL's tokens (`tokenize`), whose block comments nest (`/* a /* b */ c */` is one comment).
+pub(super) fn tokenize_wgsl(path: &Path, lines: &[(usize, String)]) -> Result<Vec<Token>> {
+    tokenize_as(path, lines, true)
+}
+
+fn tokenize_as(path: &Path, lines: &[(usize, String)], nested: bool) -> Result<Vec<Token>> {
     let mut tokens = Vec::new();
     let mut comment_from: Option<usize> = None;
+    let mut depth = 0usize;
     for (li, (n, text)) in lines.iter().enumerate() {
         let b = text.as_bytes();
         let mut i = 0;
         while i < b.len() {
             if comment_from.is_some() {
                 if b[i..].starts_with(b"*/") {
-                    comment_from = None;
+                    depth -= 1;
+                    if depth == 0 {
+                        comment_from = None;
+                    }
+                    i += 2;
+                } else if nested && b[i..].starts_with(b"/*") {
+                    depth += 1;
                     i += 2;
                 } else {
                     i += 1;
@@ -55,6 +71,7 @@ pub(super) fn tokenize(path: &Path, lines: &[(usize, String)]) -> Result<Vec<Tok
             }
             if b[i..].starts_with(b"/*") {
                 comment_from = Some(*n);
+                depth = 1;
                 i += 2;
                 continue;
             }
@@ -81,12 +98,13 @@ pub(super) fn tokenize(path: &Path, lines: &[(usize, String)]) -> Result<Vec<Tok
 }
 
 /// The end of the number starting at `i`: digits, letters (exponents, hex digits, suffixes), `.`, and a sign
-/// right after a decimal exponent.
+/// right after a decimal exponent (or a hex float's binary one, WGSL's `0x1.8p-1`).
 pub(super) fn number_end(b: &[u8], mut i: usize) -> usize {
     let hex = b[i..].starts_with(b"0x") || b[i..].starts_with(b"0X");
     i += 1;
     while i < b.len() {
-        let sign_of_exponent = (b[i] == b'+' || b[i] == b'-') && matches!(b[i - 1], b'e' | b'E') && !hex;
+        let exponent = if hex { matches!(b[i - 1], b'p' | b'P') } else { matches!(b[i - 1], b'e' | b'E') };
+        let sign_of_exponent = (b[i] == b'+' || b[i] == b'-') && exponent;
         if b[i].is_ascii_alphanumeric() || b[i] == b'.' || b[i] == b'_' || sign_of_exponent {
             i += 1;
         } else {

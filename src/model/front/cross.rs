@@ -55,13 +55,27 @@ pub fn plain_declaration(line: &str) -> Option<(&str, &str)> {
 #[derive(Debug)]
 pub struct Resource {
     pub name: String,
+    /// The members of a block (`uniform _Global { float Gloss; }`: `Gloss`), in order.
+    pub members: Vec<String>,
     pub model: String,
 }
+
+/// The block spirv-cross names HLSL's implicit constant buffer `$Global`, which holds every global declared
+/// without `static` (or `const`): HLSL's globals are uniforms unless `static`.
+pub const HLSL_GLOBALS: &str = "_Global";
 
 impl Resource {
     /// The message without the model's name (for a caller that locates the resource in the source).
     pub fn message(&self) -> String {
-        format!("the shader uses the resource `{}` (a constant buffer, structured buffer or texture): a model is a function of its inputs and parameters; declare each value it reads as a parameter", self.name)
+        match self.members.first().filter(|_| self.name == HLSL_GLOBALS) {
+            Some(m) => format!("`{m}` is a global without `static`, which HLSL makes a uniform of its implicit constant buffer $Global (a resource): a model is a function of its inputs and parameters; declare it `static` (a private global of the shader) or make it a parameter of the file"),
+            None => format!("the shader uses the resource `{}` (a constant buffer, structured buffer or texture): a model is a function of its inputs and parameters; declare each value it reads as a parameter", self.name),
+        }
+    }
+
+    /// The name the message is about, as the shader declares it: the global of `$Global`, else the resource.
+    pub fn declared(&self) -> &str {
+        self.members.first().filter(|_| self.name == HLSL_GLOBALS).unwrap_or(&self.name)
     }
 }
 
@@ -77,6 +91,15 @@ impl std::error::Error for Resource {}
 fn resource_name(line: &str) -> &str {
     let l = line.rfind(')').map_or(line, |i| &line[i + 1..]);
     l.trim().trim_end_matches(';').rsplit(' ').next().unwrap_or(l)
+}
+
+/// The members of the block declared at `lines[0]` (`layout(...) uniform B` then `{`, one member a line, `}`):
+/// none for a declaration that is no block.
+fn block_members(lines: &[&str]) -> Vec<String> {
+    if lines.get(1) != Some(&"{") {
+        return Vec::new();
+    }
+    lines[2..].iter().take_while(|l| !l.starts_with('}')).map(|l| declared_name(l).to_string()).filter(|n| !n.is_empty()).collect()
 }
 
 /// What `view` collects: the kept lines, the globals the stub's prologue initialises, and where the first
@@ -106,7 +129,7 @@ pub fn view(glsl: &str, params: &[&str], model: &Path) -> Result<Vec<String>> {
         if l.starts_with("#version") || l.starts_with("layout(local_size") {
             i += 1;
         } else if l.starts_with("layout(") || l.starts_with("uniform ") || l.starts_with("buffer ") {
-            bail!(Resource { name: resource_name(l).to_string(), model: model.display().to_string() });
+            bail!(Resource { name: resource_name(l).to_string(), members: block_members(&lines[i..]), model: model.display().to_string() });
         } else if l.starts_with("struct ") {
             let end = block_end(&lines, i, "};");
             v.lines.extend(lines[i..end].iter().map(|s| s.to_string()));
@@ -195,7 +218,12 @@ mod tests {
         let bad = GLSL.replace("    LUMA = _12 * 2.0;\n", "    LUMA.x = 1.0;\n");
         assert!(format!("{:#}", view(&bad, &[], Path::new("m.hlsl")).unwrap_err()).contains("`LUMA.x = 1.0;`"));
         let resource = GLSL.replace("vec3 LUMA;\n", "layout(set = 0, binding = 0, std140) uniform Mat\n{\n    float k;\n} mat;\n");
-        assert_eq!(view(&resource, &[], Path::new("m.hlsl")).unwrap_err().downcast::<Resource>().unwrap().name, "Mat");
+        let r = view(&resource, &[], Path::new("m.hlsl")).unwrap_err().downcast::<Resource>().unwrap();
+        assert_eq!((r.name.as_str(), r.members.as_slice(), r.declared()), ("Mat", ["k".to_string()].as_slice(), "Mat"));
+        let globals = GLSL.replace("vec3 LUMA;\n", "layout(set = 0, binding = 0, std140) uniform _Global\n{\n    float Gloss;\n    vec3 Tint;\n} _31;\n");
+        let r = view(&globals, &[], Path::new("m.hlsl")).unwrap_err().downcast::<Resource>().unwrap();
+        assert_eq!(r.declared(), "Gloss");
+        assert!(r.message().starts_with("`Gloss` is a global without `static`"), "{}", r.message());
         let relaxed = GLSL.replace("float roughness;", "mediump float roughness;").replace("vec3 LUMA;", "mediump vec3 LUMA;");
         let v = view(&relaxed, &["roughness"], Path::new("m.hlsl")).unwrap().join("\n");
         assert!(!v.contains("roughness;") && v.contains("mediump vec3 LUMA = _12 * 2.0;"), "{v}");

@@ -24,6 +24,34 @@ pub fn param_decl(name: &str, glsl_type: &str) -> String {
     format!("static {ty} {name};")
 }
 
+/// The words glslang's HLSL front end reads as keywords or reserves (its scanner's keyword map and reserved
+/// set, glslang/HLSL/hlslScanContext.cpp), besides the numeric vector and matrix types (`is_keyword`): no
+/// variable can take one of these names.
+const KEYWORDS: &[&str] = &[
+    "static", "const", "unorm", "snorm", "extern", "uniform", "volatile", "precise", "shared", "groupshared", "linear", "centroid",
+    "nointerpolation", "noperspective", "sample", "row_major", "column_major", "packoffset", "in", "out", "inout", "layout",
+    "globallycoherent", "inline", "point", "line", "triangle", "lineadj", "triangleadj", "PointStream", "LineStream", "TriangleStream",
+    "InputPatch", "OutputPatch", "Buffer", "vector", "matrix", "void", "string", "uint64_t", "dword", "sampler", "sampler1D",
+    "sampler2D", "sampler3D", "samplerCUBE", "sampler_state", "SamplerState", "SamplerComparisonState", "texture", "Texture1D",
+    "Texture1DArray", "Texture2D", "Texture2DArray", "Texture3D", "TextureCube", "TextureCubeArray", "Texture2DMS", "Texture2DMSArray",
+    "RWTexture1D", "RWTexture1DArray", "RWTexture2D", "RWTexture2DArray", "RWTexture3D", "RWBuffer", "SubpassInput", "SubpassInputMS",
+    "AppendStructuredBuffer", "ByteAddressBuffer", "ConsumeStructuredBuffer", "RWByteAddressBuffer", "RWStructuredBuffer",
+    "StructuredBuffer", "TextureBuffer", "class", "struct", "cbuffer", "ConstantBuffer", "tbuffer", "typedef", "this", "namespace",
+    "true", "false", "for", "do", "while", "break", "continue", "if", "else", "discard", "return", "switch", "case", "default",
+    "auto", "catch", "char", "const_cast", "enum", "explicit", "friend", "goto", "long", "mutable", "new", "operator", "private",
+    "protected", "public", "reinterpret_cast", "short", "signed", "sizeof", "static_cast", "template", "throw", "try", "typename",
+    "union", "unsigned", "using", "virtual",
+];
+
+/// The scalar types whose vectors (`float3`) and matrices (`half2x4`) are keywords too.
+const NUMERIC: [&str; 11] = ["bool", "int", "uint", "half", "float", "double", "min16float", "min10float", "min16int", "min12int", "min16uint"];
+
+/// Whether glslang's HLSL front end reads `name` as a keyword (or reserves it): `texture`, `sample`, `float3`.
+pub fn is_keyword(name: &str) -> bool {
+    let dims = |d: &str| matches!(d.as_bytes(), [b'1'..=b'4'] | [b'1'..=b'4', b'x', b'1'..=b'4']);
+    KEYWORDS.contains(&name) || NUMERIC.iter().any(|t| name.strip_prefix(t).is_some_and(|d| d.is_empty() || dims(d)))
+}
+
 /// Whether `(T)0` makes a zero of HLSL type `ty` (a scalar, vector or matrix of a numeric type).
 fn is_numeric(ty: &str) -> bool {
     let base = ty.trim_end_matches(|c: char| c.is_ascii_digit() || c == 'x');
@@ -104,10 +132,39 @@ pub fn preprocess(x: &Expanded, defines: &[(String, String)], model: &Path) -> R
 pub fn compile(x: &Expanded, defines: &[(String, String)], model: &Path) -> Result<std::result::Result<Vec<u32>, String>> {
     let what = format!("{} (glslang's HLSL front end)", model.display());
     Ok(match run(x, defines, &FLAGS, &what)? {
-        Ok((_, Some(bytes))) => Ok(crate::shaders::Spirv::from_bytes(&what, &bytes)?.words.to_vec()),
+        Ok((_, Some(bytes))) => {
+            let mut words = crate::shaders::Spirv::from_bytes(&what, &bytes)?.words.to_vec();
+            c_remainders(&mut words);
+            Ok(words)
+        }
         Ok((_, None)) => bail!("{what}: glslang wrote no SPIR-V"),
         Err(log) => Err(messages(&log, x)),
     })
+}
+
+/// HLSL's `%` and `fmod` are C's remainder, with the sign of the dividend (`x - y * trunc(x / y)`: SPIR-V's
+/// OpFRem, and OpSRem for signed integers, as DXC's DXIL `frem`/`srem`), but glslang's HLSL front end emits
+/// GLSL's `mod`, with the sign of the divisor (OpFMod, OpSMod): `fmod(-0.5, 1.0)` would be 0.5 and `-6 % 4`
+/// 2, where HLSL gives -0.5 and -2. DXC's SPIR-V back end made the same mistake for `fmod` and fixed it
+/// (DirectXShaderCompiler PR #2990, "[spirv] Fix incorrect opcode generation for fmod() function"). HLSL has no
+/// GLSL `mod`, so no OpFMod or OpSMod of glslang's HLSL is meant: each is rewritten to OpFRem or OpSRem (same
+/// operands). Unsigned `%` (OpUMod) is right as it is. Returns how many were rewritten.
+pub fn c_remainders(words: &mut [u32]) -> usize {
+    use rspirv::spirv::Op;
+    let (mut i, mut rewritten) = (5, 0);
+    while i < words.len() {
+        let to = match words[i] & 0xffff {
+            op if op == Op::FMod as u32 => Some(Op::FRem),
+            op if op == Op::SMod as u32 => Some(Op::SRem),
+            _ => None,
+        };
+        if let Some(op) = to {
+            words[i] = (words[i] & 0xffff_0000) | op as u32;
+            rewritten += 1;
+        }
+        i += ((words[i] >> 16) as usize).max(1);
+    }
+    rewritten
 }
 
 /// `SOURCE:LINE: message` -> (LINE, message), at the first `:digits: `.
@@ -152,7 +209,9 @@ fn column(line: &str, message: &str, parse_failure: Option<usize>) -> usize {
 
 /// glslang's log as `FILE:LINE:COLUMN: message` lines at the user's files (`x`'s origins), the first message
 /// of each line only (glslang's next ones at a line follow from it); brdfprof's own `#error` lines (a missing
-/// include, a cycle) as their messages. Lines located nowhere are dropped; a log with no located error is
+/// include, a cycle) as their messages, and nothing after the first (glslang stops there); a line brdfprof wrote (a parameter, an entry's glue) at its model
+/// file line's column 1, saying what it stands for (`FILE:15:1: entry \`Light\`: 'x' : unknown variable`), as
+/// WGSL's are. Lines located nowhere are dropped; a log with no located error is
 /// returned as it is.
 pub fn messages(log: &str, x: &Expanded) -> String {
     let columns = parse_columns(log);
@@ -166,11 +225,16 @@ pub fn messages(log: &str, x: &Expanded) -> String {
         }
         seen.push(origin);
         let text = x.lines.get(n - 1).map_or("", String::as_str);
-        let (column, message) = match x.notes.get(&(n - 1)) {
-            Some((c, m)) => (*c, m.clone()),
-            None => (column(text, message, columns.get(&n).copied()), message.to_string()),
+        let (column, message) = match (x.notes.get(&(n - 1)), x.generated.get(&(n - 1))) {
+            (Some((c, m)), _) => (*c, m.clone()),
+            // A line brdfprof wrote: named by what it stands for, at the start of the model file's line.
+            (None, Some(what)) => (1, format!("{what}: {message}")),
+            (None, None) => (column(text, message, columns.get(&n).copied()), message.to_string()),
         };
         out.push(format!("{}:{}:{column}: {message}", x.files[origin.0], origin.1));
+        if x.notes.contains_key(&(n - 1)) {
+            break; // glslang stops at brdfprof's `#error`: what it says after (`missing #endif`) follows from it
+        }
     }
     if out.is_empty() {
         return log.trim().to_string();
@@ -194,6 +258,21 @@ mod tests {
         assert_eq!(glue(&g), "float3 brdfprof_entry0(float3 L, float3 V, float3 N, float3 X, float3 Y) { Surface brdfprof_arg1; float3 brdfprof_arg2 = (float3)0; Light(N, brdfprof_arg1, brdfprof_arg2); return brdfprof_arg2; }");
         assert_eq!(stub(&["BRDF".into()]), "[numthreads(1, 1, 1)] void brdfprof_stub() { float3 v = (float3)0; v += BRDF(v, v, v, v, v); }");
         assert_eq!(param_decl("f0", "vec3"), "static float3 f0;");
+    }
+
+    #[test]
+    fn glslangs_gl_remainders_become_cs_and_hlsl_keywords_are_known() {
+        use rspirv::spirv::Op;
+        let inst = |op: Op| [(5 << 16) | op as u32, 1, 2, 3, 4];
+        let mut words: Vec<u32> = vec![0x0723_0203, 0x0001_0000, 0, 10, 0];
+        for op in [Op::FMod, Op::SMod, Op::UMod, Op::FAdd] {
+            words.extend(inst(op));
+        }
+        assert_eq!(c_remainders(&mut words), 2);
+        let ops: Vec<u32> = words[5..].chunks(5).map(|c| c[0] & 0xffff).collect();
+        assert_eq!(ops, [Op::FRem, Op::SRem, Op::UMod, Op::FAdd].map(|o| o as u32));
+        assert!(is_keyword("texture") && is_keyword("sample") && is_keyword("half3x4") && is_keyword("min16float2") && is_keyword("template"));
+        assert!(!is_keyword("Roughness") && !is_keyword("float5") && !is_keyword("half3x5") && !is_keyword("floatx"));
     }
 
     #[test]

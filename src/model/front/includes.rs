@@ -2,9 +2,12 @@
 //! front end ignores `#pragma once` (a header included twice is then a redefinition) and knows no virtual paths
 //! (UE's `/Engine/Private/...`). The result is one text, line for line with the files it came from
 //! (`Expanded::origin`), which glslang then preprocesses as it would the files themselves:
+//! - Directives are read outside comments only, as a C preprocessor reads them (an `#include` in a `/* */`
+//!   comment is no inclusion, and an `#if` there opens nothing).
 //! - `#include "NAME"` is looked for beside the including file, then in each `--include-dir` in order;
 //!   `#include <NAME>` in the include directories alone; a NAME under a mapped virtual prefix (`--include-map
-//!   /Engine=DIR`) under DIR alone.
+//!   /Engine=DIR`) under DIR alone (`Includes::find`, which WGSL's quoted imports share).
+//! - `#line` is dropped, as in a GLSL shader (`Expanded::dropped`): brdfprof maps every line to its file.
 //! - The `#include` line becomes an empty line and the file's lines follow. A file with `#pragma once` is wrapped
 //!   in a guard of its own (`#ifndef BRDFPROF_ONCE_k` ... `#endif`), so that whichever of its inclusions the
 //!   preprocessor reaches first is the one that counts, whatever `#if`s surround them.
@@ -34,6 +37,11 @@ pub struct Expanded {
     pub origins: Vec<(usize, usize)>,
     /// The `#error` lines brdfprof wrote (a missing include, a cycle): line index -> (1-based column, message).
     pub notes: HashMap<usize, (usize, String)>,
+    /// Lines brdfprof wrote itself (parameters, an entry's glue, the stub): line index -> what each stands for
+    /// (`parameter \`Roughness\``), which messages name instead of a column in text the user never wrote.
+    pub generated: HashMap<usize, String>,
+    /// The `#line` directives dropped: (file index, 1-based line, the directive as written).
+    pub dropped: Vec<(usize, usize, String)>,
 }
 
 impl Expanded {
@@ -45,6 +53,12 @@ impl Expanded {
     pub fn push(&mut self, text: impl Into<String>, file: usize, line: usize) {
         self.lines.push(text.into());
         self.origins.push((file, line));
+    }
+
+    /// Appends a line brdfprof wrote, standing for the model file's line `line`, saying what it is.
+    pub fn push_generated(&mut self, text: impl Into<String>, line: usize, what: impl Into<String>) {
+        self.generated.insert(self.lines.len(), what.into());
+        self.push(text, 0, line);
     }
 
     /// The whole text, one line per line.
@@ -60,7 +74,7 @@ impl Expanded {
     /// Appends the model's section `lines` (numbered as in its file), each `#include` resolved from `dir` (the
     /// model file's directory) and `includes`.
     pub fn include_section(&mut self, dir: &Path, lines: &[(usize, String)], includes: &Includes) -> Result<()> {
-        let model = Source { dir: dir.to_path_buf(), lines: lines.to_vec(), once: false, guard: None };
+        let model = Source { dir: dir.to_path_buf(), code: code_lines(lines), lines: lines.to_vec(), once: false, guard: None };
         let mut x = Expander { includes, sources: vec![model], by_path: HashMap::new(), stack: vec![0], done: HashSet::new(), undefined: HashSet::new(), out: std::mem::take(self) };
         let result = x.expand(0, 0);
         *self = x.out;
@@ -72,6 +86,8 @@ impl Expanded {
 struct Source {
     dir: PathBuf,
     lines: Vec<(usize, String)>,
+    /// Each line's code outside comments (`code_lines`), where directives are read.
+    code: Vec<Code>,
     once: bool,
     /// The macro of a classic include guard around the whole file (`#ifndef X` / `#define X` ... `#endif`).
     guard: Option<String>,
@@ -98,14 +114,25 @@ pub fn directive(line: &str) -> Option<(&str, &str)> {
 }
 
 impl Expander<'_> {
-    /// Appends source `idx`'s lines; `outer` is the `#if` depth around its inclusion.
+    /// Appends source `idx`'s lines; `outer` is the `#if` depth around its inclusion. Directives are read from
+    /// each line's code outside comments; where a directive line brdfprof replaces opens a `/*` comment, a `/*`
+    /// line after it (after an included file's lines) lets the comment go on as in the file.
     fn expand(&mut self, idx: usize, outer: usize) -> Result<()> {
-        let lines = self.sources[idx].lines.clone();
+        let (lines, code) = (self.sources[idx].lines.clone(), self.sources[idx].code.clone());
         let mut depth = 0usize;
-        for (n, text) in &lines {
-            match directive(text) {
-                Some(("include", rest)) => self.include(idx, *n, text, rest, outer + depth)?,
-                Some(("pragma", rest)) if rest.trim() == "once" => self.out.push("", idx, *n),
+        for ((n, text), code) in lines.iter().zip(&code) {
+            match directive(&code.text) {
+                Some(("include", rest)) => {
+                    self.include(idx, *n, text, rest, outer + depth)?;
+                    if code.opens_comment {
+                        self.out.push("/*", idx, *n);
+                    }
+                }
+                Some(("pragma", rest)) if rest.trim() == "once" => self.replace(idx, *n, code),
+                Some(("line", _)) => {
+                    self.out.dropped.push((idx, *n, text.trim().to_string()));
+                    self.replace(idx, *n, code);
+                }
                 Some((d, rest)) => {
                     match d {
                         "if" | "ifdef" | "ifndef" => depth += 1,
@@ -122,6 +149,11 @@ impl Expander<'_> {
             }
         }
         Ok(())
+    }
+
+    /// A directive line brdfprof consumes, as an empty line (or `/*` where the line opens a comment).
+    fn replace(&mut self, idx: usize, n: usize, code: &Code) {
+        self.out.push(if code.opens_comment { "/*" } else { "" }, idx, n);
     }
 
     /// One `#include` line of source `from`, at the `#if` depth `depth`.
@@ -172,26 +204,22 @@ impl Expander<'_> {
         self.out.push("#error brdfprof_include", from, n);
     }
 
-    /// Where `name` is found: under its mapped virtual prefix alone; else beside source `from` (a quoted name),
-    /// then in each include directory.
+    /// Where `name` is found (`Includes::find`: beside source `from` for a quoted name), with how messages
+    /// name it.
     fn resolve(&self, from: usize, name: &str, quoted: bool) -> Option<(PathBuf, String)> {
-        if let Some(((_, dir), rest)) = self.includes.mapped(name) {
-            let p = dir.join(rest);
-            return p.is_file().then(|| (p.clone(), p.display().to_string()));
-        }
-        let beside = quoted.then(|| self.sources[from].dir.join(name));
-        beside.into_iter().chain(self.includes.dirs.iter().map(|d| d.join(name))).find(|p| p.is_file()).map(|p| (p.clone(), p.display().to_string()))
+        let p = self.includes.find(name, quoted.then(|| self.sources[from].dir.as_path()))?;
+        Some((p.clone(), p.display().to_string()))
     }
 
     fn not_found(&self, from: usize, name: &str, quoted: bool) -> String {
-        if let Some(((v, dir), rest)) = self.includes.mapped(name) {
-            return format!("cannot find include `{name}`: --include-map {v}={} maps it to {}, which does not exist", dir.display(), dir.join(rest).display());
-        }
-        let shown = |d: &Path| if d.as_os_str().is_empty() { ".".to_string() } else { d.display().to_string() };
-        let mut searched: Vec<String> = quoted.then(|| shown(&self.sources[from].dir)).into_iter().collect();
-        searched.extend(self.includes.dirs.iter().map(|d| d.display().to_string()));
-        let hint = if name.starts_with('/') { format!("; a virtual path needs --include-map {}=DIR", name.split('/').take(2).collect::<Vec<_>>().join("/")) } else { "; add the directory with --include-dir DIR".to_string() };
-        format!("cannot find include `{name}` (searched: {}){hint}", if searched.is_empty() { "no directory".to_string() } else { searched.join(", ") })
+        let hint = if self.includes.mapped(name).is_some() {
+            String::new()
+        } else if name.starts_with('/') {
+            format!("; a virtual path needs --include-map {}=DIR", name.split('/').take(2).collect::<Vec<_>>().join("/"))
+        } else {
+            "; add the directory with --include-dir DIR".to_string()
+        };
+        format!("cannot find include `{name}`{}{hint}", self.includes.searched(name, quoted.then(|| self.sources[from].dir.as_path())))
     }
 
     /// The message of a cycle that reaches source `idx` again through `#include "name"`.
@@ -217,10 +245,10 @@ impl Expander<'_> {
         let bytes = crate::io::read_input(path).map_err(fail)?;
         let text = String::from_utf8(bytes).map_err(|e| fail(anyhow!("{} is not UTF-8 text (byte {})", path.display(), e.utf8_error().valid_up_to())))?;
         let lines: Vec<(usize, String)> = text.strip_prefix('\u{feff}').unwrap_or(&text).split('\n').map(|l| l.strip_suffix('\r').unwrap_or(l).to_string()).enumerate().map(|(i, l)| (i + 1, l)).collect();
-        let once = lines.iter().any(|(_, l)| directive(l).is_some_and(|(d, r)| d == "pragma" && r.trim() == "once"));
-        let guard = guard_macro(&lines);
-        let dir = path.parent().map_or_else(PathBuf::new, Path::to_path_buf);
-        self.sources.push(Source { dir, lines, once, guard });
+        let code = code_lines(&lines);
+        let once = code.iter().any(|c| directive(&c.text).is_some_and(|(d, r)| d == "pragma" && r.trim() == "once"));
+        let guard = guard_macro(&code);
+        self.sources.push(Source { dir: super::dir_of(path), lines, code, once, guard });
         self.out.files.push(shown);
         self.by_path.insert(key, self.sources.len() - 1);
         Ok(self.sources.len() - 1)
@@ -239,49 +267,52 @@ fn include_name(rest: &str) -> Option<(&str, bool)> {
     (rest[1..].len() > name.len() && !name.is_empty()).then_some((name, quoted))
 }
 
-/// The lines without comments (`//` and `/* */`, which may span lines).
-fn code_lines(lines: &[(usize, String)]) -> Vec<String> {
-    let mut out = Vec::with_capacity(lines.len());
-    let mut in_block = false;
-    for (_, l) in lines {
-        let mut code = String::new();
-        let mut rest = l.as_str();
-        loop {
-            if in_block {
-                match rest.find("*/") {
-                    Some(e) => {
-                        rest = &rest[e + 2..];
-                        in_block = false;
-                    }
-                    None => break,
-                }
-            }
-            let (line_c, block_c) = (rest.find("//"), rest.find("/*"));
-            match (line_c, block_c) {
-                (Some(a), b) if b.is_none_or(|b| a < b) => {
-                    code += &rest[..a];
-                    break;
-                }
-                (_, Some(b)) => {
-                    code += &rest[..b];
-                    rest = &rest[b + 2..];
-                    in_block = true;
-                }
-                _ => {
-                    code += rest;
-                    break;
-                }
-            }
-        }
-        out.push(code);
-    }
-    out
+/// A line's code: its text outside comments (each character of a `/* */` comment a space, so that columns
+/// stay those of the line; a `//` comment cut off), and whether it ends inside a `/*` comment.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Code {
+    pub text: String,
+    pub opens_comment: bool,
 }
 
-/// The macro of a classic include guard around the whole file: its first code is `#ifndef X` (or
-/// `#if !defined(X)`), then `#define X`, and the `#endif` that closes it is its last code.
-pub fn guard_macro(lines: &[(usize, String)]) -> Option<String> {
-    let code: Vec<String> = code_lines(lines).into_iter().map(|l| l.trim().to_string()).filter(|l| !l.is_empty()).collect();
+/// Each line's code (`//` and `/* */` comments, which may span lines, outside string literals).
+pub fn code_lines(lines: &[(usize, String)]) -> Vec<Code> {
+    let mut in_block = false;
+    lines
+        .iter()
+        .map(|(_, l)| {
+            let (b, mut text, mut i) = (l.as_bytes(), String::new(), 0);
+            let blank = |text: &mut String, from: usize, to: usize| text.extend(l[from..to].chars().map(|_| ' '));
+            while i < b.len() {
+                if in_block {
+                    let close = l[i..].find("*/").map(|e| i + e + 2);
+                    blank(&mut text, i, close.unwrap_or(b.len()));
+                    (i, in_block) = (close.unwrap_or(b.len()), close.is_none());
+                } else if l[i..].starts_with("//") {
+                    break;
+                } else if l[i..].starts_with("/*") {
+                    blank(&mut text, i, i + 2);
+                    (i, in_block) = (i + 2, true);
+                } else if b[i] == b'"' {
+                    let end = l[i + 1..].find('"').map_or(b.len(), |e| i + e + 2);
+                    text += &l[i..end];
+                    i = end;
+                } else {
+                    let c = l[i..].chars().next().unwrap_or(' ');
+                    text.push(c);
+                    i += c.len_utf8();
+                }
+            }
+            Code { text, opens_comment: in_block }
+        })
+        .collect()
+}
+
+/// The macro of a classic include guard around the whole file (`code`: its lines' code): its first code is
+/// `#ifndef X` (or `#if !defined(X)`), then `#define X`, the `#endif` that closes it is its last code, and
+/// no `#else` or `#elif` of its own gives a second inclusion something.
+pub fn guard_macro(code: &[Code]) -> Option<String> {
+    let code: Vec<&str> = code.iter().map(|c| c.text.trim()).filter(|l| !l.is_empty()).collect();
     let (first, second, last) = (code.first()?, code.get(1)?, code.last()?);
     let name = match directive(first)? {
         ("ifndef", r) => r.trim().to_string(),
@@ -297,6 +328,7 @@ pub fn guard_macro(lines: &[(usize, String)]) -> Option<String> {
         match directive(l).map(|(d, _)| d) {
             Some("if" | "ifdef" | "ifndef") => depth += 1,
             Some("endif") => depth -= 1,
+            Some("else" | "elif") if depth == 1 => return None,
             _ => {}
         }
         if depth == 0 && k + 1 < code.len() {
@@ -322,11 +354,15 @@ mod tests {
 
     #[test]
     fn include_guards_are_recognised_only_around_the_whole_file() {
-        assert_eq!(guard_macro(&lines("// licence\n/* more\n */\n#ifndef A_H\n#define A_H\nfloat a;\n#endif // A_H\n")), Some("A_H".into()));
-        assert_eq!(guard_macro(&lines("#if !defined(B)\n#define B 1\n#endif\n")), Some("B".into()));
-        assert_eq!(guard_macro(&lines("#ifndef A\n#define A\n#endif\nfloat b;\n")), None, "code after the guard");
-        assert_eq!(guard_macro(&lines("#ifndef A\n#define A\n#endif\n#ifndef C\n#endif\n")), None, "two blocks");
-        assert_eq!(guard_macro(&lines("#ifndef A\n#define B\n#endif\n")), None);
+        let guard = |text: &str| guard_macro(&code_lines(&lines(text)));
+        assert_eq!(guard("// licence\n/* more\n */\n#ifndef A_H\n#define A_H\nfloat a;\n#endif // A_H\n"), Some("A_H".into()));
+        assert_eq!(guard("#if !defined(B)\n#define B 1\n#endif\n"), Some("B".into()));
+        assert_eq!(guard("#ifndef A\n#define A\n#endif\nfloat b;\n"), None, "code after the guard");
+        assert_eq!(guard("#ifndef A\n#define A\n#endif\n#ifndef C\n#endif\n"), None, "two blocks");
+        assert_eq!(guard("#ifndef A\n#define B\n#endif\n"), None);
+        assert_eq!(guard("#ifndef A\n#define A\nfloat a;\n#else\nfloat b;\n#endif\n"), None, "a second inclusion is not empty");
+        assert_eq!(guard("#ifndef A\n#define A\n#if Q\n#else\n#endif\n#endif\n"), Some("A".into()), "an #else of an inner #if");
+        assert_eq!(guard("/*\n#endif */\n#ifndef A\n#define A\n/* #else */\n#endif\n"), Some("A".into()), "directives in comments are none");
     }
 
     #[test]
@@ -345,6 +381,22 @@ mod tests {
         let at = x.lines.iter().position(|l| l.contains("PI = 3.14")).unwrap();
         assert_eq!(x.origin(at), Some((d.join("engine/Private/Common.ush").display().to_string().as_str(), 2)));
         assert_eq!(x.origin(x.lines.len() - 1), Some((d.join("m.hlsl").display().to_string().as_str(), 3)));
+    }
+
+    #[test]
+    fn directives_are_read_outside_comments_only_and_line_directives_are_dropped() {
+        let dir = tempfile::tempdir().unwrap();
+        let d = dir.path();
+        std::fs::write(d.join("a.ush"), "#pragma once\nfloat a;\n").unwrap();
+        std::fs::write(d.join("old.ush"), "/* old */\nfloat old;\n").unwrap();
+        let x = expand(d, "/*\n#include \"a.ush\"\n#include \"old.ush\"\n#if 0\n*/\n#include \"a.ush\" /* the header\n of a */\n#line 90\nfloat b;\n", &Includes::default());
+        let text = x.text();
+        assert_eq!(text.matches("float a;").count(), 1, "{text}");
+        assert!(!text.contains("float old;") && !text.contains("#line") && x.notes.is_empty(), "{text}");
+        let after = x.lines.iter().position(|l| l == "#endif").unwrap() + 1;
+        assert_eq!((x.lines[after].as_str(), x.lines[after + 1].as_str()), ("/*", " of a */"), "the comment the #include line opens goes on");
+        assert_eq!(x.dropped, [(0, 8, "#line 90".to_string())]);
+        assert_eq!(code_lines(&lines("x = \"//\"; // c\n/* a */ #include \"b\"")), [Code { text: "x = \"//\"; ".into(), opens_comment: false }, Code { text: "        #include \"b\"".into(), opens_comment: false }]);
     }
 
     #[test]

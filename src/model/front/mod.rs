@@ -15,7 +15,7 @@ pub mod includes;
 pub mod wgsl;
 
 use std::collections::BTreeMap;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
 /// The language of a model's shader.
@@ -78,6 +78,40 @@ impl Includes {
         let map = self.maps.iter().filter(|(v, _)| under(v)).max_by_key(|(v, _)| v.len())?;
         Some((map, name[map.0.len()..].trim_start_matches('/')))
     }
+}
+
+impl Includes {
+    /// The one lookup of a file a shader names, for HLSL's `#include` and WGSL's quoted `#import`: a name under
+    /// a mapped virtual prefix under its DIR alone; any other in `beside` (the including file's directory, for
+    /// `#include "NAME"` and a quoted import; None for `#include <NAME>`), then in each include directory in
+    /// order.
+    pub fn find(&self, name: &str, beside: Option<&Path>) -> Option<PathBuf> {
+        if let Some(((_, dir), rest)) = self.mapped(name) {
+            return Some(dir.join(rest)).filter(|p| p.is_file());
+        }
+        beside.map(|d| d.join(name)).into_iter().chain(self.dirs.iter().map(|d| d.join(name))).find(|p| p.is_file())
+    }
+
+    /// Where `find` looked for `name`, as a message goes on after the name: `: --include-map V=DIR maps it to
+    /// P, which does not exist`, or ` (searched: DIR, ...)`.
+    pub fn searched(&self, name: &str, beside: Option<&Path>) -> String {
+        if let Some(((v, dir), rest)) = self.mapped(name) {
+            return format!(": --include-map {v}={} maps it to {}, which does not exist", dir.display(), dir.join(rest).display());
+        }
+        let dirs: Vec<String> = beside.map(shown_dir).into_iter().chain(self.dirs.iter().map(|d| shown_dir(d))).collect();
+        format!(" (searched: {})", if dirs.is_empty() { "no directory".to_string() } else { dirs.join(", ") })
+    }
+}
+
+/// The directory a shader file's own includes and imports are found beside: its parent, empty for a bare file
+/// name (the working directory, which paths then do not spell out).
+pub fn dir_of(path: &Path) -> PathBuf {
+    path.parent().map_or_else(PathBuf::new, Path::to_path_buf)
+}
+
+/// A directory as messages name it (`.` for the empty one, the working directory).
+pub fn shown_dir(dir: &Path) -> String {
+    if dir.as_os_str().is_empty() { ".".to_string() } else { dir.display().to_string() }
 }
 
 /// A call the front end writes in the shader's language around a declared entry (`entry NAME(ARG, ...)`):

@@ -93,13 +93,10 @@ pub fn stub(calls: &[String]) -> String {
     format!("@compute @workgroup_size(1) fn {STUB}() {{ var v = vec3<f32>(0.0);{body} }}")
 }
 
-/// Whether the section defines `fn BRDF` (textually: naga checks its signature when the stub calls it).
-pub fn defines_brdf(lines: &[(usize, String)]) -> bool {
-    lines.iter().any(|(_, l)| l.trim_start().strip_prefix("fn").is_some_and(|r| r.starts_with(char::is_whitespace) && r.trim_start().strip_prefix("BRDF").is_some_and(|r| r.trim_start().starts_with('('))))
-}
-
 /// `--define`s as naga_oil's shader defs: NAME alone is true; a value is `true`, `false`, an integer (i32), or
-/// one with a `u` suffix (u32).
+/// one with a `u` suffix (u32). naga_oil's `#ifdef NAME` asks only whether NAME is defined, so `NAME=false`
+/// takes an `#ifdef NAME` branch too (as Bevy's `ShaderDefVal::Bool(_, false)` does); it is for `#if NAME ==
+/// false`.
 pub fn shader_defs(defines: &[(String, String)], model: &Path) -> Result<HashMap<String, ShaderDefValue>> {
     defines
         .iter()
@@ -118,10 +115,12 @@ pub fn shader_defs(defines: &[(String, String)], model: &Path) -> Result<HashMap
         .collect()
 }
 
-/// Every `.wgsl` file under `dir` (to `MAX_DEPTH`, skipping hidden entries), sorted.
+/// Every `.wgsl` file under `dir` (to `MAX_DEPTH`, skipping hidden entries; the empty directory is the working
+/// one, whose files are named without `./`), sorted.
 fn wgsl_files(dir: &Path, depth: usize, out: &mut Vec<PathBuf>) {
-    let Ok(entries) = std::fs::read_dir(dir) else { return };
-    let mut paths: Vec<PathBuf> = entries.filter_map(|e| e.ok().map(|e| e.path())).filter(|p| !p.file_name().is_some_and(|n| n.to_string_lossy().starts_with('.'))).collect();
+    let Ok(entries) = std::fs::read_dir(if dir.as_os_str().is_empty() { Path::new(".") } else { dir }) else { return };
+    let named = |p: PathBuf| if dir.as_os_str().is_empty() { p.strip_prefix(".").map(Path::to_path_buf).unwrap_or(p) } else { p };
+    let mut paths: Vec<PathBuf> = entries.filter_map(|e| e.ok().map(|e| named(e.path()))).filter(|p| !p.file_name().is_some_and(|n| n.to_string_lossy().starts_with('.'))).collect();
     paths.sort();
     for p in paths {
         if out.len() >= MAX_FILES {
@@ -156,9 +155,9 @@ fn module_index(model_dir: &Path, includes: &Includes) -> BTreeMap<String, PathB
     index
 }
 
-/// The file an import names: a quoted path like a quoted HLSL include (a mapped virtual prefix, else beside
-/// the model, then the include directories), a module name through the index.
-fn resolve(import: &str, model_dir: &Path, includes: &Includes, index: &BTreeMap<String, PathBuf>) -> Option<PathBuf> {
+/// The file an import names: a quoted path as a quoted HLSL include is found (`Includes::find`, beside the
+/// importing file `dir`), a module name through the index.
+fn resolve(import: &str, dir: &Path, includes: &Includes, index: &BTreeMap<String, PathBuf>) -> Option<PathBuf> {
     let Some(path) = import.strip_prefix('"').and_then(|p| p.strip_suffix('"')) else {
         // `a::b::item` names item of module `a::b`: the longest prefix that is a module.
         let mut name = import;
@@ -169,10 +168,7 @@ fn resolve(import: &str, model_dir: &Path, includes: &Includes, index: &BTreeMap
             name = name.rsplit_once("::")?.0;
         }
     };
-    if let Some(((_, dir), rest)) = includes.mapped(path) {
-        return Some(dir.join(rest)).filter(|p| p.is_file());
-    }
-    std::iter::once(model_dir.join(path)).chain(includes.dirs.iter().map(|d| d.join(path))).find(|p| p.is_file())
+    includes.find(path, Some(dir))
 }
 
 /// The 1-based line and column where `text` imports `import` (its `#import` line), else 1:1.
@@ -184,17 +180,18 @@ fn import_at(text: &str, import: &str) -> (usize, usize) {
 /// naga_oil composition state: the composer and the modules added or being added.
 struct Modules<'a> {
     composer: Composer,
-    model_dir: &'a Path,
     includes: &'a Includes,
     index: BTreeMap<String, PathBuf>,
     added: Vec<String>,
     stack: Vec<String>,
+    /// Each module's file as messages name it, and its text, in the order added.
+    files: Vec<(String, String)>,
 }
 
 impl Modules<'_> {
-    /// Adds the modules `text` (the file `shown`) imports, each after its own imports; an import found nowhere
-    /// is left for naga_oil to report where it is live.
-    fn add_imports_of(&mut self, text: &str, shown: &str) -> Result<()> {
+    /// Adds the modules `text` (the file `shown`, in directory `dir`) imports, each after its own imports; an
+    /// import found nowhere is left for naga_oil to report where it is live.
+    fn add_imports_of(&mut self, text: &str, shown: &str, dir: &Path) -> Result<()> {
         for import in naga_oil::compose::get_preprocessor_data(text).1.into_iter().map(|i| i.import) {
             if self.added.contains(&import) {
                 continue;
@@ -203,14 +200,14 @@ impl Modules<'_> {
                 let (line, col) = import_at(text, &import);
                 bail!("{shown}:{line}:{col}: import cycle: {} -> {import}", self.stack[k..].join(" -> "));
             }
-            let Some(path) = resolve(&import, self.model_dir, self.includes, &self.index) else { continue };
+            let Some(path) = resolve(&import, dir, self.includes, &self.index) else { continue };
             let source = read_text(&path).map_err(|e| {
                 let (line, col) = import_at(text, &import);
                 anyhow!("{shown}:{line}:{col}: {e:#}")
             })?;
             let file = path.display().to_string();
             self.stack.push(import.clone());
-            self.add_imports_of(&source, &file)?;
+            self.add_imports_of(&source, &file, &super::dir_of(&path))?;
             self.stack.pop();
             let as_name = import.starts_with('"').then(|| import.clone());
             let desc = ComposableModuleDescriptor { source: &source, file_path: &file, language: ShaderLanguage::Wgsl, as_name, ..Default::default() };
@@ -218,6 +215,7 @@ impl Modules<'_> {
                 bail!("{}", located(&e, &self.composer, None));
             }
             self.added.push(import);
+            self.files.push((file, source));
         }
         Ok(())
     }
@@ -244,29 +242,44 @@ fn located(e: &ComposerError, composer: &Composer, top: Option<(&str, &Top)>) ->
     }
 }
 
+/// A composed shader: naga's module, and the files of the modules it imports (as messages name them, with
+/// their text).
+pub struct Composed {
+    pub module: naga::Module,
+    pub files: Vec<(String, String)>,
+}
+
 /// naga_oil's composition of `top` (the model's section plus brdfprof's lines) under `defines`, its imports
 /// found through `includes` and the model's directory: the naga module, or Err(messages at FILE:LINE:COLUMN).
-pub fn compose(model: &Path, top: &Top, defines: &[(String, String)], includes: &Includes) -> Result<naga::Module> {
-    let model_dir = dir_of(model);
+pub fn compose(model: &Path, top: &Top, defines: &[(String, String)], includes: &Includes) -> Result<Composed> {
+    let model_dir = super::dir_of(model);
     let shader_defs = shader_defs(defines, model)?;
     let shown = model.display().to_string();
-    let mut m = Modules { composer: Composer::default(), model_dir, includes, index: module_index(model_dir, includes), added: Vec::new(), stack: Vec::new() };
-    m.add_imports_of(&top.text, &shown)?;
+    let mut m = Modules { composer: Composer::default(), includes, index: module_index(&model_dir, includes), added: Vec::new(), stack: Vec::new(), files: Vec::new() };
+    m.add_imports_of(&top.text, &shown, &model_dir)?;
     let desc = NagaModuleDescriptor { source: &top.text, file_path: &shown, shader_type: ShaderType::Wgsl, shader_defs, additional_imports: &[] };
-    m.composer.make_naga_module(desc).map_err(|e| {
+    let module = m.composer.make_naga_module(desc).map_err(|e| {
         let hint = match e.inner {
-            naga_oil::compose::ComposerErrorInner::ImportNotFound(..) => format!("; brdfprof looks for a module's `#define_import_path` in the .wgsl files of {}, and for a quoted import beside the model and in those directories", searched(model_dir, includes)),
+            naga_oil::compose::ComposerErrorInner::ImportNotFound(..) => format!("; brdfprof looks for a module's `#define_import_path` in the .wgsl files of {}, and for a quoted import as for an HLSL include (beside the importing file, in the include directories, under a mapped prefix)", searched(&model_dir, includes)),
             _ => String::new(),
         };
         anyhow!("{}{hint}", located(&e, &m.composer, Some((&shown, top))))
-    })
+    })?;
+    Ok(Composed { module, files: m.files })
 }
 
 /// The directories searched for modules, as a message lists them.
 fn searched(model_dir: &Path, includes: &Includes) -> String {
     let mut dirs: Vec<String> = includes.dirs.iter().map(|d| format!("{} (and below)", d.display())).collect();
-    dirs.push(model_dir.display().to_string());
+    dirs.push(super::shown_dir(model_dir));
     dirs.join(", ")
+}
+
+/// `text` through naga_oil's preprocessor under `defines`: `#ifdef` branches not taken and directives blanked,
+/// line for line (the text itself where it does not preprocess, which composing it has reported).
+pub fn preprocessed(text: &str, defines: &[(String, String)], model: &Path) -> String {
+    let defs = shader_defs(defines, model).unwrap_or_default();
+    naga_oil::compose::preprocess::Preprocessor::default().preprocess(text, &defs).map_or_else(|_| text.to_string(), |p| p.preprocessed_source)
 }
 
 /// The module's SPIR-V for its stub entry: naga's validation, `override`s at their defaults, and naga's SPIR-V
@@ -309,27 +322,38 @@ fn undecorated(name: &str) -> String {
     name.split("X_naga_oil_mod_X").next().unwrap_or(name).to_string()
 }
 
-/// The WGSL type of each parameter of function `callee` (its last path segment, undecorated), pointers as
-/// the type they point to; None when the module has no such function.
-fn parameter_types_in(module: &naga::Module, callee: &str) -> Option<Vec<Option<String>>> {
+/// A function's parameters (name, WGSL type where `type_text` writes one; a pointer as its pointee) and its
+/// result type, as naga's module has them.
+pub type Signature = (Vec<(String, Option<String>)>, Option<String>);
+
+/// The signature of function `callee` (its last path segment, undecorated) in `module`; None when there is no
+/// such function.
+pub fn signature(module: &naga::Module, callee: &str) -> Option<Signature> {
     let name = callee.rsplit("::").next().unwrap_or(callee);
     let f = module.functions.iter().map(|(_, f)| f).find(|f| f.name.as_deref().map(undecorated).as_deref() == Some(name))?;
-    Some(f.arguments.iter().map(|a| type_text(module, a.ty)).collect())
+    let params = f.arguments.iter().map(|a| (a.name.clone().unwrap_or_default(), type_text(module, a.ty))).collect();
+    Some((params, f.result.as_ref().and_then(|r| type_text(module, r.ty))))
 }
 
-/// The parameter types of `callee` (as `parameter_types_in`), a function of the shader `top` or of a module it
-/// imports: naga_oil keeps only the imported functions a shader calls, so each imported module is composed on
-/// its own to find it there.
-pub fn parameter_types(model: &Path, top: &Top, defines: &[(String, String)], includes: &Includes, callee: &str) -> Result<Option<Vec<Option<String>>>> {
-    if let Some(t) = parameter_types_in(&compose(model, top, defines, includes)?, callee) {
+/// The undecorated names of `module`'s functions: what the composition kept.
+pub fn function_names(module: &naga::Module) -> std::collections::HashSet<String> {
+    module.functions.iter().filter_map(|(_, f)| f.name.as_deref().map(undecorated)).collect()
+}
+
+/// The parameter types of `callee` (as `signature`), a function of the shader composed as `bare` or of a
+/// module the shader `top` imports: naga_oil keeps only the imported functions a shader calls, so each
+/// imported module is composed on its own to find it there.
+pub fn parameter_types(model: &Path, top: &Top, bare: &naga::Module, defines: &[(String, String)], includes: &Includes, callee: &str) -> Result<Option<Vec<Option<String>>>> {
+    let types = |m: &naga::Module| signature(m, callee).map(|(p, _)| p.into_iter().map(|(_, t)| t).collect());
+    if let Some(t) = types(bare) {
         return Ok(Some(t));
     }
-    let model_dir = dir_of(model);
-    let index = module_index(model_dir, includes);
+    let model_dir = super::dir_of(model);
+    let index = module_index(&model_dir, includes);
     for import in declared_imports(&top.text) {
-        let Some(path) = resolve(&import, model_dir, includes, &index) else { continue };
+        let Some(path) = resolve(&import, &model_dir, includes, &index) else { continue };
         let lines: Vec<(usize, String)> = read_text(&path)?.lines().enumerate().map(|(i, l)| (i + 1, l.to_string())).collect();
-        if let Some(t) = parameter_types_in(&compose(&path, &Top::new(&lines), defines, includes)?, callee) {
+        if let Some(t) = types(&compose(&path, &Top::new(&lines), defines, includes)?.module) {
             return Ok(Some(t));
         }
     }
@@ -351,11 +375,6 @@ fn declared_imports(text: &str) -> Vec<String> {
             (!path.is_empty()).then(|| path.to_string())
         })
         .collect()
-}
-
-/// The directory a shader's quoted imports are found beside (`.` for a bare file name).
-fn dir_of(path: &Path) -> &Path {
-    path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or_else(|| Path::new("."))
 }
 
 /// The front end, with versions, as reports state it.
@@ -381,7 +400,6 @@ mod tests {
         assert_eq!(param_decl("f0", "vec3"), "var<private> f0: vec3<f32>;");
         let top = Top::new(&[(3, "fn BRDF(L: vec3<f32>) {}".into()), (5, "x".into())]);
         assert_eq!((top.text.as_str(), top.lines), ("\n\nfn BRDF(L: vec3<f32>) {}\n\nx\n", 5));
-        assert!(defines_brdf(&[(1, "  fn  BRDF (L: vec3<f32>".into())]) && !defines_brdf(&[(1, "fn BRDFx(".into())]));
         let defs = shader_defs(&[("A".into(), "".into()), ("B".into(), "-2".into()), ("C".into(), "3u".into())], Path::new("m")).unwrap();
         assert_eq!((defs["A"], defs["B"], defs["C"]), (ShaderDefValue::Bool(true), ShaderDefValue::Int(-2), ShaderDefValue::UInt(3)));
         assert!(format!("{:#}", shader_defs(&[("A".into(), "0.5".into())], Path::new("m")).unwrap_err()).contains("define A=0.5"));
