@@ -293,7 +293,8 @@ impl Model {
 
     /// Fails with a clear reason when the device cannot run this model's kernels.
     pub fn check_support(&self, info: &DeviceInfo) -> Result<()> {
-        if self.precision() == Precision::F16 && !info.shader_float16 {
+        let half = self.precision() == Precision::F16 || matches!(self, Model::File(f) if f.file.uses_float16());
+        if half && !info.shader_float16 {
             bail!("{self}: device `{}` has no shaderFloat16, so fp16 arithmetic cannot run there", info.name);
         }
         Ok(())

@@ -300,6 +300,13 @@ fn empty(path: &Path, bytes: &[u8], language: Language) -> BrdfFile {
 }
 
 impl BrdfFile {
+    /// Whether the shader, as the kernels compose it (an HLSL or WGSL one after its front end), computes in half
+    /// precision (`float16_t`, `f16vec*`, `f16mat*`: WGSL's `enable f16`, GLSL's explicit 16-bit types), which a
+    /// device without shaderFloat16 cannot run.
+    pub fn uses_float16(&self) -> bool {
+        self.shader.iter().any(|(_, line)| line.split(|c: char| !(c.is_ascii_alphanumeric() || c == '_')).any(|w| w == "float16_t" || w.starts_with("f16vec") || w.starts_with("f16mat")))
+    }
+
     /// The same file with its shader preprocessed under `defines` (`NAME`, `VALUE`; an empty value defines
     /// NAME as glslang's `-DNAME` does).
     pub fn with_defines(&self, defines: &[(String, String)]) -> Result<BrdfFile> {

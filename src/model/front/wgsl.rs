@@ -255,7 +255,7 @@ pub fn compose(model: &Path, top: &Top, defines: &[(String, String)], includes: 
     let model_dir = super::dir_of(model);
     let shader_defs = shader_defs(defines, model)?;
     let shown = model.display().to_string();
-    let mut m = Modules { composer: Composer::default(), includes, index: module_index(&model_dir, includes), added: Vec::new(), stack: Vec::new(), files: Vec::new() };
+    let mut m = Modules { composer: Composer::default().with_capabilities(SHADER_CAPABILITIES), includes, index: module_index(&model_dir, includes), added: Vec::new(), stack: Vec::new(), files: Vec::new() };
     m.add_imports_of(&top.text, &shown, &model_dir)?;
     let desc = NagaModuleDescriptor { source: &top.text, file_path: &shown, shader_type: ShaderType::Wgsl, shader_defs, additional_imports: &[] };
     let module = m.composer.make_naga_module(desc).map_err(|e| {
@@ -267,6 +267,10 @@ pub fn compose(model: &Path, top: &Top, defines: &[(String, String)], includes: 
     })?;
     Ok(Composed { module, files: m.files })
 }
+
+/// What naga may accept in a user's WGSL: its defaults (multisampled shading, cube array textures) and `enable f16` (the kernels run where the device has
+/// shaderFloat16, as for a GLSL model's fp16, `Model::check_support`).
+const SHADER_CAPABILITIES: naga::valid::Capabilities = naga::valid::Capabilities::SHADER_FLOAT16.union(naga::valid::Capabilities::MULTISAMPLED_SHADING).union(naga::valid::Capabilities::CUBE_ARRAY_TEXTURES);
 
 /// The directories searched for modules, as a message lists them.
 fn searched(model_dir: &Path, includes: &Includes) -> String {
@@ -286,9 +290,9 @@ pub fn preprocessed(text: &str, defines: &[(String, String)], model: &Path) -> S
 /// writer with every name kept (`DEBUG`), no index clamping (`Unchecked`, naga's default) and no loop
 /// bounding; integer division keeps WGSL's defined result for a zero divisor (naga's wrapper).
 pub fn emit_spirv(module: &naga::Module, model: &Path) -> Result<Vec<u32>> {
-    use naga::valid::{Capabilities, ValidationFlags, Validator};
+    use naga::valid::{ValidationFlags, Validator};
     let what = model.display();
-    let info = Validator::new(ValidationFlags::all(), Capabilities::default()).validate(module).map_err(|e| anyhow!("{what}: naga's validation: {}", e.emit_to_string("")))?;
+    let info = Validator::new(ValidationFlags::all(), SHADER_CAPABILITIES).validate(module).map_err(|e| anyhow!("{what}: naga's validation: {}", e.emit_to_string("")))?;
     let (module, info) = naga::back::pipeline_constants::process_overrides(module, &info, None, &Default::default()).map_err(|e| anyhow!("{what}: the overrides at their defaults: {e}"))?;
     let options = naga::back::spv::Options { flags: naga::back::spv::WriterFlags::DEBUG, force_loop_bounding: false, ..Default::default() };
     let pipeline = naga::back::spv::PipelineOptions { shader_stage: naga::ShaderStage::Compute, entry_point: STUB.to_string() };
