@@ -308,6 +308,13 @@ pub(crate) fn add_lines<F>(reports: &mut [InspectReport], families: &[&F], req: 
         let per_model = per_model_lines(req, dialect, |m, source| {
             let (mut k, counted) = lines(m, source, family)?;
             k.note = same_code_note(report, &m.label(), "Instruction Count", counted);
+            if let Model::File(f) = m {
+                // An HLSL or WGSL shader's lines are those of the GLSL its front end wrote: their text is the file
+                // model's, not on disk.
+                for l in k.lines.iter_mut().filter(|l| l.text.is_empty()) {
+                    l.text = f.file.front_end_line(&l.file, l.line).unwrap_or_default().to_string();
+                }
+            }
             Ok(k)
         })?;
         report.lines = per_model;

@@ -66,3 +66,19 @@ fn lines_need_a_target_whose_compiler_names_them() {
         common::run(&["inspect", "--no-callgrind", "--lines", "--device", device, "--model", path.to_str().unwrap()]).fails(2, "--lines");
     }
 }
+
+/// An HLSL model's lines are those of the GLSL its front end wrote (docs/hlsl.md), named so and shown with that
+/// GLSL's text, since no file on disk holds it.
+#[test]
+fn an_hlsl_models_lines_are_its_front_ends_glsl_with_their_text() {
+    let dir = tempfile::tempdir().unwrap();
+    let ue = common::repo_root().join("tests/fixtures/hlsl/ue");
+    let at = |p: &str| ue.join(p).display().to_string();
+    let engine = format!("/Engine={}", at("Engine"));
+    let all = inspect_json(dir.path(), "hlsl", &["nvidia:sm_89"], &["--lines", "--model", &at("ue-ggx.brdf"), "--include-dir", &at("Shaders"), "--include-map", &engine], "Cost per source line");
+    // One device: the JSON is its report.
+    let k = all["lines"].as_array().unwrap().iter().find(|k| k["model"] == "ue-ggx").unwrap().clone();
+    let own: Vec<&serde_json::Value> = k["lines"].as_array().unwrap().iter().filter(|l| l["file"].as_str().unwrap().ends_with("ue-ggx.brdf (its HLSL as GLSL)")).collect();
+    assert!(!own.is_empty(), "{k}");
+    assert!(own.iter().all(|l| !l["text"].as_str().unwrap().is_empty()), "every front-end line has its GLSL text: {own:?}");
+}

@@ -300,6 +300,19 @@ fn empty(path: &Path, bytes: &[u8], language: Language) -> BrdfFile {
 }
 
 impl BrdfFile {
+    /// The text of line `line` of the GLSL an HLSL or WGSL shader's front end wrote (`shader`, numbered as the
+    /// composed kernel's `#line` directive names it: `directive_name`), where `file` is that name as a compiler
+    /// reported it (perhaps made absolute or relative to the working directory); None for a GLSL shader, whose
+    /// file can be read.
+    pub fn front_end_line(&self, file: &str, line: u32) -> Option<&str> {
+        let name = self.directive_name();
+        let same = file == name || name.ends_with(file) || file.ends_with(&name);
+        if self.language == Language::Glsl || !same {
+            return None;
+        }
+        self.shader.iter().find(|(n, _)| *n == line as usize).map(|(_, text)| text.trim())
+    }
+
     /// Whether the shader, as the kernels compose it (an HLSL or WGSL one after its front end), computes in half
     /// precision (`float16_t`, `f16vec*`, `f16mat*`: WGSL's `enable f16`, GLSL's explicit 16-bit types), which a
     /// device without shaderFloat16 cannot run.

@@ -69,7 +69,7 @@ impl BrdfFile {
 
     /// The name the composed source's `#line` directive gives the file: its path, with the characters a
     /// directive's string cannot hold (`"`, control characters) replaced.
-    pub(super) fn directive_name(&self) -> String {
+    pub(crate) fn directive_name(&self) -> String {
         let shown = match self.language {
             Language::Glsl => self.path.display().to_string(),
             other => format!("{} (its {} as GLSL)", self.path.display(), other.name()),
