@@ -21,31 +21,18 @@ fn twin() -> String {
 /// Seeded rows over the hemisphere with N.L, N.V in (0.05, 1] and roughness at or above the engine's floor.
 fn write_rows(path: &Path, n: usize) {
     let mut s = String::from("nx,ny,nz,vx,vy,vz,lx,ly,lz,roughness,f0r,f0g,f0b\n");
-    let mut x: u64 = 0x9e37_79b9_7f4a_7c15;
-    let next = |x: &mut u64| {
-        *x ^= *x << 13;
-        *x ^= *x >> 7;
-        *x ^= *x << 17;
-        (*x >> 11) as f64 / (1u64 << 53) as f64
-    };
-    let dir = |x: &mut u64| {
-        let (c, phi) = (0.05 + 0.95 * next(x), std::f64::consts::TAU * next(x));
+    let mut next = common::uniform(0x9e37_79b9_7f4a_7c15);
+    let dir = |next: &mut dyn FnMut() -> f64| {
+        let (c, phi) = (0.05 + 0.95 * next(), std::f64::consts::TAU * next());
         let s = (1.0 - c * c).sqrt();
         [s * phi.cos(), s * phi.sin(), c]
     };
     for _ in 0..n {
-        let (v, l) = (dir(&mut x), dir(&mut x));
-        let (r, f0) = (0.06 + 0.94 * next(&mut x), 0.02 + 0.9 * next(&mut x));
+        let (v, l) = (dir(&mut next), dir(&mut next));
+        let (r, f0) = (0.06 + 0.94 * next(), 0.02 + 0.9 * next());
         s += &format!("0,0,1,{},{},{},{},{},{},{r},{f0},0.5,0.9\n", v[0], v[1], v[2], l[0], l[1], l[2]);
     }
     std::fs::write(path, s).unwrap();
-}
-
-fn values(path: &Path) -> Vec<[f64; 3]> {
-    std::fs::read_to_string(path).unwrap().lines().skip(1).map(|l| {
-        let v: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
-        [v[0], v[1], v[2]]
-    }).collect()
 }
 
 #[test]
@@ -56,7 +43,7 @@ fn an_entry_returning_f_nol_evaluates_as_its_twin_returning_f() {
     for (model, out) in [(engine(), "engine.csv"), (twin(), "twin.csv")] {
         run_in(d, &["eval", "--model", &model, "--input", "in.csv", "--output", out]).ok();
     }
-    let (a, b) = (values(&d.join("engine.csv")), values(&d.join("twin.csv")));
+    let (a, b) = (common::csv_values(&d.join("engine.csv")), common::csv_values(&d.join("twin.csv")));
     assert_eq!(a.len(), 2000);
     let worst = a.iter().zip(&b).flat_map(|(x, y)| (0..3).map(move |c| common::rel_err(x[c], y[c]))).fold(0.0, f64::max);
     // The division by N.L happens on the host in f64; the rest is the same fp32 maths in another order.
@@ -79,7 +66,7 @@ fn the_files_bindings_are_its_defaults_and_entry_and_returns_are_named_where_the
     let forced = format!("{},returns=f", engine());
     run_in(d, &["eval", "--model", &forced, "--input", "in.csv", "--output", "f.csv"]).ok();
     run_in(d, &["eval", "--model", &engine(), "--input", "in.csv", "--output", "fnol.csv"]).ok();
-    let (f, g) = (values(&d.join("f.csv")), values(&d.join("fnol.csv")));
+    let (f, g) = (common::csv_values(&d.join("f.csv")), common::csv_values(&d.join("fnol.csv")));
     assert!(f.iter().zip(&g).all(|(x, y)| x[0] < y[0]), "{f:?} {g:?}");
     // The twin's BRDF can be chosen by name; an unknown entry is refused naming the declared ones.
     run_in(d, &["eval", "--model", &format!("{},entry=BRDF", twin()), "--input", "in.csv", "--output", "t.csv"]).ok();

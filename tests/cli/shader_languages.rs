@@ -43,13 +43,7 @@ fn run_with_includes(dir: &Path, args: &[&str]) -> common::Run {
 /// roughness in [0, 1], F0 per channel.
 fn write_rows(path: &Path, n: usize) {
     let mut s = String::from("nx,ny,nz,vx,vy,vz,lx,ly,lz,roughness,f0r,f0g,f0b\n");
-    let mut x: u64 = 0x2545_f491_4f6c_dd1d;
-    let mut next = || {
-        x ^= x << 13;
-        x ^= x >> 7;
-        x ^= x << 17;
-        (x >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut next = common::uniform(0x2545_f491_4f6c_dd1d);
     for _ in 0..n {
         let v: Vec<f64> = (0..13).map(|_| next()).collect();
         let d = |k: usize| [2.0 * v[k] - 1.0, 2.0 * v[k + 1] - 1.0, 2.0 * v[k + 2] - 0.6];
@@ -57,13 +51,6 @@ fn write_rows(path: &Path, n: usize) {
         s += &format!("{},{},{},{},{},{},{},{},{},{},{},{},{}\n", nn[0], nn[1], nn[2], vv[0], vv[1], vv[2], ll[0], ll[1], ll[2], v[9], v[10], v[11], v[12]);
     }
     std::fs::write(path, s).unwrap();
-}
-
-fn values(path: &Path) -> Vec<[f64; 3]> {
-    std::fs::read_to_string(path).unwrap().lines().skip(1).map(|l| {
-        let v: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
-        [v[0], v[1], v[2]]
-    }).collect()
 }
 
 #[test]
@@ -76,7 +63,7 @@ fn hlsl_and_wgsl_evaluate_bit_for_bit_as_their_glsl_twin() {
         run_with_includes(d, &["eval", "--model", m, "--input", "in.csv", "--output", out]).ok();
     }
     let twin_bytes = std::fs::read(d.join("twin.csv")).unwrap();
-    assert!(values(&d.join("twin.csv")).iter().filter(|v| v[0] > 0.0).count() > 500, "lit rows");
+    assert!(common::csv_values(&d.join("twin.csv")).iter().filter(|v| v[0] > 0.0).count() > 500, "lit rows");
     for out in ["hlsl.csv", "wgsl.csv"] {
         assert!(std::fs::read(d.join(out)).unwrap() == twin_bytes, "{out} differs from the GLSL twin's rows");
     }
@@ -97,7 +84,7 @@ fn engine_entries_in_hlsl_and_wgsl_need_no_glue() {
     let d = dir.path();
     write_rows(&d.join("in.csv"), 2000);
     run_with_includes(d, &["eval", "--model", &ue("ue-ggx.brdf"), "--input", "in.csv", "--output", "f.csv"]).ok();
-    let f = values(&d.join("f.csv"));
+    let f = common::csv_values(&d.join("f.csv"));
     let rows: Vec<Vec<f64>> = std::fs::read_to_string(d.join("in.csv")).unwrap().lines().skip(1).map(|l| l.split(',').map(|x| x.parse().unwrap()).collect()).collect();
     let nol = |r: &Vec<f64>| {
         let unit = |a: &[f64]| {
@@ -111,7 +98,7 @@ fn engine_entries_in_hlsl_and_wgsl_need_no_glue() {
     // in WGSL: f_s N.L, divided by N.L on the host in f64.
     for (model, out) in [(ue("ue-light.brdf"), "a.csv"), (format!("{},entry=SpecularLight", ue("ue-light.brdf")), "b.csv"), (bevy("bevy-light.brdf"), "c.csv")] {
         run_with_includes(d, &["eval", "--model", &model, "--input", "in.csv", "--output", out]).ok();
-        let g = values(&d.join(out));
+        let g = common::csv_values(&d.join(out));
         let worst = f.iter().zip(&g).zip(&rows).filter(|(_, r)| nol(r) >= 0.05).flat_map(|((x, y), _)| (0..3).map(move |c| common::rel_err(y[c], x[c]))).fold(0.0, f64::max);
         assert!(worst < 1e-5, "{model}: worst relative difference {worst:e} from the f form");
     }
@@ -146,8 +133,8 @@ fn an_hlsl_define_selects_its_branch() {
     run_in(d, &["eval", "--model", "q.hlsl", "--input", "in.csv", "--output", "a.csv"]).ok();
     run_in(d, &["eval", "--model", "q.hlsl", "--define", "QUALITY=2", "--input", "in.csv", "--output", "b.csv"]).ok();
     run_in(d, &["eval", "--model", "q.hlsl,define=QUALITY=3", "--input", "in.csv", "--output", "c.csv"]).ok();
-    assert!(values(&d.join("a.csv")).iter().all(|v| *v == [1.0; 3]));
-    assert!(values(&d.join("b.csv")).iter().chain(&values(&d.join("c.csv"))).all(|v| *v == [2.0; 3]));
+    assert!(common::csv_values(&d.join("a.csv")).iter().all(|v| *v == [1.0; 3]));
+    assert!(common::csv_values(&d.join("b.csv")).iter().chain(&common::csv_values(&d.join("c.csv"))).all(|v| *v == [2.0; 3]));
 }
 
 #[test]
@@ -318,7 +305,7 @@ fn hlsl_fmod_and_float_remainder_keep_the_sign_of_the_dividend() {
     write(d, &[("m.hlsl", &hlsl), ("m.wgsl", &wgsl)]);
     for m in ["m.hlsl", "m.wgsl"] {
         run_in(d, &["eval", "--model", m, "--input", "in.csv", "--output", "o.csv"]).ok();
-        let v = values(&d.join("o.csv"));
+        let v = common::csv_values(&d.join("o.csv"));
         for (row, want) in v.iter().zip([[-0.8, -0.8, -2.0], [0.8, 0.8, 2.0]]) {
             assert!((0..3).all(|c| (row[c] - want[c]).abs() < 1e-5), "{m}: {row:?}, expected {want:?}");
         }
@@ -335,7 +322,7 @@ fn an_include_or_an_if_inside_a_comment_is_none() {
     let model = format!("analytic\n::begin shader hlsl\n/* previously:\n#include \"a.ush\"\n#include \"old.ush\"\n#if 0\n*/\n#include \"a.ush\" /* the header\n   of A */\n{HLSL_BRDF} {{ return A() * dot(N, L); }}\n::end shader\n");
     write(d, &[("m.brdf", &model), ("a.ush", "#pragma once\nfloat A() { return 2; }\n"), ("old.ush", "/* old header */\nfloat Old() { return 1; }\n")]);
     run_in(d, &["eval", "--model", "m.brdf", "--input", "in.csv", "--output", "o.csv"]).ok();
-    assert!(values(&d.join("o.csv")).iter().all(|v| (v[0] - 1.6).abs() < 1e-6), "{:?}", values(&d.join("o.csv")));
+    assert!(common::csv_values(&d.join("o.csv")).iter().all(|v| (v[0] - 1.6).abs() < 1e-6), "{:?}", common::csv_values(&d.join("o.csv")));
 }
 
 #[test]
@@ -351,7 +338,7 @@ fn pragma_once_holds_across_spellings_of_one_path_and_angle_includes_search_the_
     let flags = ["--include-dir", "inc", "--include-map", "/Eng=eng", "--input", "in.csv"];
     let args = |m: &'static str| ["eval", "--model", m, "--output", "o.csv"].into_iter().chain(flags).collect::<Vec<_>>();
     run_in(d, &args("m.brdf")).ok();
-    assert!(values(&d.join("o.csv")).iter().all(|v| *v == [7.0; 3]), "{:?}", values(&d.join("o.csv")));
+    assert!(common::csv_values(&d.join("o.csv")).iter().all(|v| *v == [7.0; 3]), "{:?}", common::csv_values(&d.join("o.csv")));
     // `<a.ush>` is not looked for beside the model.
     run_in(d, &args("n.brdf")).fails(2, "n.brdf:3:10: cannot find include `a.ush` (searched: inc)");
 }
@@ -364,7 +351,7 @@ fn an_include_guard_with_an_else_of_its_own_is_no_guard() {
     let model = format!("analytic\n::begin shader hlsl\n#include \"g.ush\"\n#include \"g.ush\"\n{HLSL_BRDF} {{ return A() + A2(); }}\n::end shader\n");
     write(d, &[("m.brdf", &model), ("g.ush", "#ifndef A_H\n#define A_H\nfloat A() { return 1; }\n#else\nfloat A2() { return 2; }\n#endif\n")]);
     run_in(d, &["eval", "--model", "m.brdf", "--input", "in.csv", "--output", "o.csv"]).ok();
-    assert!(values(&d.join("o.csv")).iter().all(|v| *v == [3.0; 3]));
+    assert!(common::csv_values(&d.join("o.csv")).iter().all(|v| *v == [3.0; 3]));
 }
 
 #[test]
@@ -440,9 +427,9 @@ fn a_quoted_wgsl_import_is_found_beside_the_importing_module() {
         ("c.wgsl", "#define_import_path named::c\nfn c() -> f32 { return 5.0; }\n"),
     ]);
     run_in(d, &["eval", "--model", "m.wgsl", "--input", "in.csv", "--output", "o.csv"]).ok();
-    assert!(values(&d.join("o.csv")).iter().all(|v| *v == [3.0; 3]), "{:?}", values(&d.join("o.csv")));
+    assert!(common::csv_values(&d.join("o.csv")).iter().all(|v| *v == [3.0; 3]), "{:?}", common::csv_values(&d.join("o.csv")));
     run_in(d, &["eval", "--model", "n.wgsl", "--input", "in.csv", "--output", "o.csv"]).ok();
-    assert!(values(&d.join("o.csv")).iter().all(|v| *v == [5.0; 3]));
+    assert!(common::csv_values(&d.join("o.csv")).iter().all(|v| *v == [5.0; 3]));
 }
 
 #[test]
@@ -463,11 +450,11 @@ fn a_global_initialiser_reading_a_bound_parameter_sees_its_value_in_glsl_and_hls
     for (binding, input) in [(",k=@roughness", "in.csv"), ("", "k.csv")] {
         let eval = |m: &str, out: &str| run_in(d, &["eval", "--model", &format!("{m}{binding}"), "--input", input, "--output", out]).ok();
         eval("twin.brdf", "twin.csv");
-        let twin = values(&d.join("twin.csv"));
+        let twin = common::csv_values(&d.join("twin.csv"));
         assert!(twin.windows(2).any(|w| w[0][0] != w[1][0]));
         for m in ["glsl.brdf", "hlsl.brdf"] {
             eval(m, "o.csv");
-            let worst = twin.iter().zip(values(&d.join("o.csv"))).map(|(a, b)| common::rel_err(b[0], a[0])).fold(0.0, f64::max);
+            let worst = twin.iter().zip(common::csv_values(&d.join("o.csv"))).map(|(a, b)| common::rel_err(b[0], a[0])).fold(0.0, f64::max);
             assert!(worst < 1e-6, "{m}{binding} on {input}: worst relative difference {worst:e} from the twin");
         }
     }

@@ -118,3 +118,22 @@ impl Worst {
         }
     }
 }
+
+/// Uniform numbers in [0, 1) from a xorshift64 generator seeded with `seed`: the tests' reproducible samples.
+pub fn uniform(seed: u64) -> impl FnMut() -> f64 {
+    let mut x = seed;
+    move || {
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        (x >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+/// The first three columns of every row of a CSV `eval` wrote (its header skipped): the outputs.
+pub fn csv_values(path: &Path) -> Vec<[f64; 3]> {
+    std::fs::read_to_string(path).unwrap().lines().skip(1).map(|l| {
+        let v: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
+        [v[0], v[1], v[2]]
+    }).collect()
+}
