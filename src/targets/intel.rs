@@ -478,10 +478,14 @@ pub fn inspect(families: &[&Family], req: &Request) -> Result<Vec<InspectReport>
     let checked = super::checked_translations(req, gpu, crate::translate::Dialect::OpenCl)?;
     let statics = crate::inspect::kernels_of(req.models).into_iter().map(|m| crate::inspect::static_row(req.shaders, m, req.lights)).collect::<Result<Vec<_>>>()?;
     let mut reports = compile_checked(families, statics, &checked, tools, req)?;
-    super::add_lines(&mut reports, families, req, crate::translate::Dialect::OpenCl, |m, source, family| {
-        let k = line_costs(&m.label(), &compile_as(source, family, req.precise, true)?, family)?;
-        let counted = k.instructions;
-        Ok((k, counted))
+    super::add_lines(&mut reports, families, req, &checked, crate::translate::Dialect::OpenCl, |m, source, costed, family| {
+        let binary = compile_as(source, family, req.precise, true)?;
+        let lines = line_costs(&m.label(), &binary, family)?;
+        let shape = |i: gen_isa::Instruction| format!("{}.{} ({}) :{}", i.mnemonic, i.function, i.exec_size, i.dst_type);
+        let costed = gen_isa::instructions(&compile(costed, family, req.precise)?.listing, family.grf_bytes).into_iter().map(shape).collect();
+        let simd = IsaStats::of(&binary, family)?.simd;
+        let annotated = gen_isa::sourced_instructions(binary.lines_listings.get(&simd).map_or("", String::as_str), family.grf_bytes).into_iter().map(|(i, _)| shape(i)).collect();
+        Ok(super::LineCompile { lines, costed, annotated })
     })?;
     Ok(reports)
 }

@@ -286,50 +286,44 @@ pub fn names_lines(target: &Target) -> bool {
     target.vendor.needs_verification()
 }
 
-/// Each model's (not the memory-only kernel's) cost per source line: its shade kernel translated into
-/// `dialect` with `#line` directives (`prepare::shade_kernel_with_lines`), compiled and attributed by `lines`.
-fn per_model_lines(req: &Request, dialect: crate::translate::Dialect, mut lines: impl FnMut(&Model, &str) -> Result<crate::inspect::lines::KernelLines>) -> Result<Vec<crate::inspect::lines::KernelLines>> {
-    let mut out = Vec::new();
-    for m in req.models {
-        let source = crate::translate::prepare::shade_kernel_with_lines(Some(m), req.lights, req.shaders)?.source_with_lines(dialect);
-        out.push(lines(m, &source)?);
-    }
-    Ok(out)
-}
 
-/// Each family's report given its models' cost per source line when `req.lines`: `lines` compiles a model's
-/// line-annotated `dialect` source for a family and returns its lines and the instructions the costed compile
-/// counts for it (`same_code_note` compares the two).
-pub(crate) fn add_lines<F>(reports: &mut [InspectReport], families: &[&F], req: &Request, dialect: crate::translate::Dialect, mut lines: impl FnMut(&Model, &str, &F) -> Result<(crate::inspect::lines::KernelLines, u32)>) -> Result<()> {
+/// Each family's report given its models' cost per source line when `req.lines`. The line-annotated translation
+/// is not executed; its lines are reported for the checked, costed code only where the two compiles give the
+/// same instruction sequence, else a note says they differ. `lines` compiles a model's line-annotated `dialect`
+/// source (with its checked translation, `checked`, in the order of `kernels_of`) for a family and returns its
+/// lines with both compiles' instruction sequences (the costed one's first).
+pub(crate) fn add_lines<F>(reports: &mut [InspectReport], families: &[&F], req: &Request, checked: &[Checked], dialect: crate::translate::Dialect, mut lines: impl FnMut(&Model, &str, &str, &F) -> Result<LineCompile>) -> Result<()> {
     if !req.lines {
         return Ok(());
     }
     for (report, family) in reports.iter_mut().zip(families) {
-        let per_model = per_model_lines(req, dialect, |m, source| {
-            let (mut k, counted) = lines(m, source, family)?;
-            k.note = same_code_note(report, &m.label(), "Instruction Count", counted);
+        let mut per_model = Vec::new();
+        for (m, checked) in req.models.iter().zip(checked) {
+            let source = crate::translate::prepare::shade_kernel_with_lines(Some(m), req.lights, req.shaders)?.source_with_lines(dialect);
+            let LineCompile { mut lines, costed, annotated } = lines(m, &source, &checked.source, family)?;
+            if costed != annotated {
+                lines.note = format!("the line-annotated compile is not the costed code ({} instructions against {}, not in the same sequence): its lines describe that compile", annotated.len(), costed.len());
+            }
             if let Model::File(f) = m {
                 // An HLSL or WGSL shader's lines are those of the GLSL its front end wrote: their text is the file
                 // model's, not on disk.
-                for l in k.lines.iter_mut().filter(|l| l.text.is_empty()) {
+                for l in lines.lines.iter_mut().filter(|l| l.text.is_empty()) {
                     l.text = f.file.front_end_line(&l.file, l.line).unwrap_or_default().to_string();
                 }
             }
-            Ok(k)
-        })?;
+            per_model.push(lines);
+        }
         report.lines = per_model;
     }
     Ok(())
 }
 
-/// A note where the line-annotated compile of `model` has another count of `statistic` (`counted`) than the
-/// costed one in `report`: the lines then describe slightly other code.
-pub(crate) fn same_code_note(report: &InspectReport, model: &str, statistic: &str, counted: u32) -> String {
-    let costed = report.rows.iter().find(|r| r.model == model).and_then(|r| cost::driver_stat(&r.stats, statistic));
-    match costed {
-        Some(c) if c != f64::from(counted) => format!("the line-annotated compile has {counted} instructions where the costed one has {c}: its lines describe that compile"),
-        _ => String::new(),
-    }
+/// A model's line costs and the instruction sequences (one entry per instruction: its opcode and what the
+/// vendor's listing says of its width and type) of the costed compile and of the line-annotated one.
+pub(crate) struct LineCompile {
+    pub lines: crate::inspect::lines::KernelLines,
+    pub costed: Vec<String>,
+    pub annotated: Vec<String>,
 }
 
 /// The line an instruction is charged to: the innermost of `chain` (its location, then the call sites it was

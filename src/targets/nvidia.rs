@@ -407,19 +407,12 @@ pub fn inspect(families: &[&Family], req: &Request) -> Result<Vec<InspectReport>
     let checked = super::checked_translations(req, gpu, crate::translate::Dialect::Cuda)?;
     let statics = crate::inspect::kernels_of(req.models).into_iter().map(|m| crate::inspect::static_row(req.shaders, m, req.lights)).collect::<Result<Vec<_>>>()?;
     let mut reports = compile_checked(families, statics, &checked, tools, req)?;
-    super::add_lines(&mut reports, families, req, crate::translate::Dialect::Cuda, |m, source, family| {
+    super::add_lines(&mut reports, families, req, &checked, crate::translate::Dialect::Cuda, |m, source, costed, family| {
         let sass = compile_as(source, family, req.precise, true)?;
-        let k = line_costs(&m.label(), &sass, family)?;
-        // The line costs hold the NOPs, Instruction Count does not.
-        let counted = k.instructions - nops(&sass.listing)?;
-        Ok((k, counted))
+        let opcodes = |listing: &str| -> Result<Vec<String>> { Ok(super::sass::instructions(listing)?.into_iter().map(|i| i.opcode).collect()) };
+        Ok(super::LineCompile { lines: line_costs(&m.label(), &sass, family)?, costed: opcodes(&compile(costed, family, req.precise)?.listing)?, annotated: opcodes(&sass.listing)? })
     })?;
     Ok(reports)
-}
-
-/// NOPs in a listing (in the line costs' instructions, not in `Instruction Count`).
-fn nops(listing: &str) -> Result<u32> {
-    Ok(super::sass::instructions(listing)?.iter().filter(|i| i.mnemonic() == "NOP").count() as u32)
 }
 
 /// Cost per source line of a kernel compiled with line information (`compile_as` with `lines`): each SASS

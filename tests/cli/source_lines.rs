@@ -30,7 +30,7 @@ fn the_planted_line_comes_first_on_every_target_that_names_lines() {
         assert_eq!(kernels.len(), 2, "{target}: ggx and the file");
         for k in kernels {
             let what = format!("{target} {}", k["model"]);
-            // The line-annotated compile is the costed code: the same instruction count, no note.
+            // The line-annotated compile is the costed code: the same instruction sequence, no note.
             assert_eq!(k.get("note"), None, "{what}: {}", k["note"]);
             let lines = k["lines"].as_array().unwrap();
             let counted: u64 = lines.iter().map(|l| l["instructions"].as_u64().unwrap()).sum::<u64>() + k["unattributed"].as_u64().unwrap();
