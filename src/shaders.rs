@@ -152,7 +152,7 @@ pub fn kernel_entry(dir: &Path, name: &str) -> Result<(String, Vec<String>)> {
 }
 
 /// Compiles `source` with glslang (`GLSLANG_FLAGS`, `-D` for each define, `-I` for each include directory)
-/// under the compile limit (`compile_limit`; `what` names the compilation in its messages) and returns the
+/// under the compile limit (`launch`; `what` names the compilation in its messages) and returns the
 /// SPIR-V words; a failure carries glslang's own messages.
 pub fn glslang(source: &Path, defines: &[String], includes: &[&Path], what: &str) -> Result<Vec<u32>> {
     glslang_with(source, defines, includes, what, &[])
@@ -171,7 +171,7 @@ pub fn glslang_with(source: &Path, defines: &[String], includes: &[&Path], what:
         cmd.arg(format!("-I{}", i.display()));
     }
     cmd.arg("-o").arg(&out).arg(source);
-    let result = match crate::compile_limit::output(&mut cmd, what) {
+    let result = match crate::launch::output(&mut cmd, what) {
         Ok(r) => r,
         Err(e) if e.downcast_ref::<std::io::Error>().is_some() => bail!("cannot run glslangValidator ({e}): install glslang-tools, or run `make setup`"),
         Err(e) => return Err(e),
@@ -179,7 +179,7 @@ pub fn glslang_with(source: &Path, defines: &[String], includes: &[&Path], what:
     if !result.status.success() {
         bail!(GlslangError { source: source.to_path_buf(), log: format!("{}{}", String::from_utf8_lossy(&result.stdout), String::from_utf8_lossy(&result.stderr)) });
     }
-    let bytes = crate::io::read_bounded(&out, crate::compile_limit::MAX_OUTPUT_BYTES as u64).with_context(|| format!("glslang's output {}", out.display()))?;
+    let bytes = crate::io::read_bounded(&out, crate::launch::MAX_OUTPUT_BYTES as u64).with_context(|| format!("glslang's output {}", out.display()))?;
     Ok(Spirv::from_bytes(&source.display().to_string(), &bytes)?.words.to_vec())
 }
 
@@ -197,7 +197,7 @@ pub fn glslang_preprocess(text: &str, defines: &[String], what: &str) -> Result<
         cmd.arg(format!("-D{d}"));
     }
     cmd.arg(&source);
-    let result = match crate::compile_limit::output(&mut cmd, what) {
+    let result = match crate::launch::output(&mut cmd, what) {
         Ok(r) => r,
         Err(e) if e.downcast_ref::<std::io::Error>().is_some() => bail!("cannot run glslangValidator ({e}): install glslang-tools, or run `make setup`"),
         Err(e) => return Err(e),
@@ -250,7 +250,7 @@ pub fn glslang_version() -> Option<String> {
 /// The first non-empty line a tool prints, or None when it cannot run.
 pub fn first_line_of(cmd: &mut Command) -> Option<String> {
     let what = format!("{:?} --version", cmd.get_program());
-    let out = crate::compile_limit::output_quick(cmd, &what).ok()?;
+    let out = crate::launch::output_quick(cmd, &what).ok()?;
     let text = String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr);
     text.lines().map(str::trim).find(|l| !l.is_empty()).map(str::to_string)
 }

@@ -132,7 +132,7 @@ pub fn spirv_opt(words: &[u32], args: &[String]) -> Result<Vec<u32>> {
     cmd.args(args).args(["-", "-o", "-"]);
     let bytes: Vec<u8> = words.iter().flat_map(|w| w.to_le_bytes()).collect();
     let shown = if args.len() > 3 { format!("{} ...", args[..3].join(" ")) } else { args.join(" ") };
-    let out = match crate::compile_limit::output_with_input(&mut cmd, bytes, &format!("spirv-opt {shown}")) {
+    let out = match crate::launch::output_with_input(&mut cmd, bytes, &format!("spirv-opt {shown}")) {
         Ok(out) => out,
         Err(e) if e.downcast_ref::<std::io::Error>().is_some() => bail!("cannot run spirv-opt ({e}): install spirv-tools, or run `make setup`"),
         Err(e) => return Err(e),

@@ -293,7 +293,7 @@ impl TimingArgs {
 
 /// `--compile-timeout`: seconds, more than 0 and at most a day.
 pub fn compile_timeout(text: &str) -> Result<Duration, String> {
-    brdfprof::compile_limit::parse(text)
+    brdfprof::launch::parse(text)
 }
 
 /// Everything before a command runs: the signal handler (children have none: they die with brdfprof), the
@@ -305,7 +305,7 @@ pub fn prepare(child: bool, compile_timeout: Option<Duration>) -> Result<()> {
     } else {
         brdfprof::cleanup::install_signal_handler()?;
     }
-    brdfprof::compile_limit::init(compile_timeout)?;
+    brdfprof::launch::init(compile_timeout)?;
     check_env_seconds(brdfprof::gpu::FENCE_TIMEOUT_ENV)?;
     brdfprof::host::memory_limit()?;
     if !child {
@@ -318,7 +318,7 @@ pub fn prepare(child: bool, compile_timeout: Option<Duration>) -> Result<()> {
 /// An environment variable that holds seconds, when set: more than 0, at most a day.
 fn check_env_seconds(var: &str) -> Result<()> {
     match std::env::var(var) {
-        Ok(v) if !v.trim().is_empty() => brdfprof::compile_limit::parse(&v).map(|_| ()).map_err(|e| anyhow!("{var}={e}")),
+        Ok(v) if !v.trim().is_empty() => brdfprof::launch::parse(&v).map(|_| ()).map_err(|e| anyhow!("{var}={e}")),
         _ => Ok(()),
     }
 }

@@ -110,7 +110,7 @@ pub fn child_main(request_json: &str) -> Result<()> {
         bail!("`brdfprof {CHILD_COMMAND}` only measures under valgrind; `brdfprof inspect` runs it there");
     }
     // LLVM runs many times slower under valgrind: each compilation gets that much more time.
-    crate::compile_limit::scale(VALGRIND_SLOWDOWN);
+    crate::launch::scale(VALGRIND_SLOWDOWN);
     let models = req.models.iter().map(|s| Model::parse(s).map_err(|e| anyhow!("{s}: {e:#}"))).collect::<Result<Vec<_>>>()?;
     let shaders = match &req.glsl {
         Some(dir) => Shaders::from_glsl(dir)?,
@@ -222,11 +222,11 @@ pub fn run(models: &[Model], lights: u32, shaders: &Shaders, options: &Callgrind
         .arg(serde_json::to_string(&req)?)
         .env("LP_NUM_THREADS", "0")
         .env("MESA_SHADER_CACHE_DISABLE", "true");
-    crate::compile_limit::export(&mut cmd);
+    crate::launch::export(&mut cmd);
     let _tmp = cleanup::child_tmpdir(&mut cmd)?;
     // The child compiles and runs every kernel under valgrind, each compilation under the scaled limit.
-    let limit = crate::compile_limit::limit() * VALGRIND_SLOWDOWN * (models.len() as u32 + 2);
-    let output = crate::compile_limit::output_within(&mut cmd, "the callgrind run (valgrind)", limit).context("cannot run valgrind")?;
+    let limit = crate::launch::limit() * VALGRIND_SLOWDOWN * (models.len() as u32 + 2);
+    let output = crate::launch::output_within(&mut cmd, "the callgrind run (valgrind)", limit).context("cannot run valgrind")?;
     let stdout = String::from_utf8_lossy(&output.stdout);
     let stderr = String::from_utf8_lossy(&output.stderr);
     if !output.status.success() {
@@ -261,7 +261,7 @@ fn read_dumps(dir: &Path) -> Result<BTreeMap<String, u64>> {
     for entry in std::fs::read_dir(dir)? {
         let path = entry?.path();
         // A tool's file, read as its output is: a regular file within the launcher's bound.
-        let text = String::from_utf8_lossy(&crate::io::read_bounded(&path, crate::compile_limit::MAX_OUTPUT_BYTES as u64).with_context(|| format!("callgrind's dump {}", path.display()))?).into_owned();
+        let text = String::from_utf8_lossy(&crate::io::read_bounded(&path, crate::launch::MAX_OUTPUT_BYTES as u64).with_context(|| format!("callgrind's dump {}", path.display()))?).into_owned();
         let dump = parse_dump(&text).with_context(|| format!("{}", path.display()))?;
         if let Some(label) = dump.trigger.as_deref().and_then(|l| l.strip_prefix("Client Request: ")) {
             dumps.insert(label.to_string(), dump.jit_ir());

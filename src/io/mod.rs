@@ -228,7 +228,7 @@ pub fn tracked_by_git(dir: &Path, pattern: &str) -> Vec<PathBuf> {
     if !dir.is_dir() {
         return Vec::new();
     }
-    let out = crate::compile_limit::output_quick(crate::cleanup::command("git").arg("-C").arg(dir).args(["ls-files", "-z", "--"]).arg(pattern), "git ls-files");
+    let out = crate::launch::output_quick(crate::cleanup::command("git").arg("-C").arg(dir).args(["ls-files", "-z", "--"]).arg(pattern), "git ls-files");
     match out {
         Ok(o) if o.status.success() => o.stdout.split(|&b| b == 0).filter(|n| !n.is_empty()).map(|n| dir.join(std::ffi::OsStr::from_bytes(n))).collect(),
         _ => Vec::new(),

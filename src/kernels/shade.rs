@@ -57,9 +57,9 @@ pub fn steady_block(lights: u32) -> (u32, bool) {
 pub const PUSH_BYTES: u32 = 32;
 /// shade.glsl's bindings: the G-buffer, the radiance, one block of lights.
 pub fn bindings(format: GBufferFormat) -> [Binding; 3] {
-    use ash::vk::Format;
+    use crate::gpu::TexelFormat;
     match format {
-        GBufferFormat::Packed => [Binding::TexelRead(Format::R32G32B32A32_UINT), Binding::TexelStorage(Format::B10G11R11_UFLOAT_PACK32), Binding::UniformDynamic],
+        GBufferFormat::Packed => [Binding::TexelRead(TexelFormat::Rgba32Uint), Binding::TexelStorage(TexelFormat::B10g11r11Ufloat), Binding::UniformDynamic],
         GBufferFormat::Float => [Binding::Storage, Binding::Storage, Binding::UniformDynamic],
     }
 }

@@ -11,7 +11,7 @@
 //! the radiance as R11G11B10F (an HDR lighting target of UE5, Frostbite and others): 16 bytes in, 4 out.
 //! `Float` keeps every value as an f32 in storage buffers (48 bytes in, 16 out), for comparison.
 
-use crate::util::hash01;
+use crate::brdf::samples::hash01;
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 use serde::Serialize;

@@ -3,7 +3,7 @@
 //! are decoded from PNG (8/16 bit) and EXR files, with view vectors derived from depth or position and the camera.
 
 use super::format::{Camera, GBufferSource, ImageFiles, Procedural, Scene, MAX_SIZE};
-use crate::util::hash01;
+use crate::brdf::samples::hash01;
 use anyhow::{anyhow, bail, Result};
 use glam::Vec3;
 use image::{ColorType, DynamicImage, ImageDecoder, ImageFormat};

@@ -141,12 +141,12 @@ pub fn child_main(request_json: &str) -> Result<()> {
     }
     // A driver without VK_KHR_pipeline_executable_properties (PanVK) returns no listing: --isa says so.
     // PanVK 25 has the extension but its statistics and no listing come through the compiler's log.
-    let listings = gpu.executable_properties.is_some() && driver.compiler_log().is_none_or(|l| l.beside_properties);
+    let listings = gpu.has_executable_properties() && driver.compiler_log().is_none_or(|l| l.beside_properties);
     let isa_dir = req.isa_dir.as_ref().filter(|_| listings).map(|d| d.join(driver.isa_folder(family)));
     let (mut report, isa_files) = if req.raw.is_empty() { models_report(&gpu, &shaders, &req, &target, models, isa_dir.as_deref())? } else { raw_report(&gpu, &shaders, &req, &target, isa_dir.as_deref())? };
     report.provenance["target"] = serde_json::Value::String(target.clone());
     if req.isa_dir.is_some() && !listings {
-        let why = if gpu.executable_properties.is_none() { "has no VK_KHR_pipeline_executable_properties to return one" } else { "reports its compiler's statistics on stderr, not through pipeline executable properties" };
+        let why = if !gpu.has_executable_properties() { "has no VK_KHR_pipeline_executable_properties to return one" } else { "reports its compiler's statistics on stderr, not through pipeline executable properties" };
         add_driver_note(&mut report, format!("--isa: no listing for {target}: {} {why}", gpu.info.name));
     }
     if let Some(why) = unvalidated {
@@ -215,7 +215,7 @@ fn raw_report(gpu: &Gpu, shaders: &Shaders, req: &NoopRequest, target: &str, isa
             skipped.push(format!("{} ({e:#})", r.label));
             continue;
         }
-        let bytes = crate::io::read_bounded(&r.path, crate::compile_limit::MAX_OUTPUT_BYTES as u64).with_context(|| format!("the {target} child cannot read {}", r.path.display()))?;
+        let bytes = crate::io::read_bounded(&r.path, crate::launch::MAX_OUTPUT_BYTES as u64).with_context(|| format!("the {target} child cannot read {}", r.path.display()))?;
         let words: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes);
         let kernel = Kernel::with_capture(gpu, &r.label, &words, &Default::default(), &crate::gpu::Binding::storage(r.storage_buffers), r.push_bytes, isa_dir.is_some())?;
         let mut row = crate::inspect::Row { model: r.label.clone(), spec: None, stats: Default::default(), notes: Default::default() };
@@ -258,7 +258,7 @@ fn write_representations(gpu: &Gpu, executables: &[crate::gpu::PipelineExecutabl
         }
     }
     if files.is_empty() {
-        bail!("{}: the driver returned no internal representation for {label}{}", gpu.info.name, if gpu.executable_properties.is_none() { " (it has no VK_KHR_pipeline_executable_properties: --isa has nothing to write for it)" } else { "" });
+        bail!("{}: the driver returned no internal representation for {label}{}", gpu.info.name, if !gpu.has_executable_properties() { " (it has no VK_KHR_pipeline_executable_properties: --isa has nothing to write for it)" } else { "" });
     }
     Ok(files)
 }
@@ -356,11 +356,11 @@ fn spawn(driver: &'static dyn NoopDriver, family: usize, models: &[Model], raw: 
         .env("MESA_SHADER_CACHE_DISABLE", "true");
     // The child compiles each kernel under the compile limit itself; the whole child gets one limit per
     // kernel (models, the memory-only kernel, their ISA captures) and a few seconds to start.
-    crate::compile_limit::export(&mut cmd);
+    crate::launch::export(&mut cmd);
     let kernels = (models.len() as u32 + 1 + raw.len() as u32) * if request.isa_dir.is_some() { 2 } else { 1 };
-    let limit = crate::compile_limit::limit() * kernels + std::time::Duration::from_secs(10);
+    let limit = crate::launch::limit() * kernels + std::time::Duration::from_secs(10);
     let what = format!("the kernels for {name} ({}, in a child process)", driver.compiler());
-    let output = crate::compile_limit::output_within(&mut cmd, &what, limit).with_context(|| format!("cannot run brdfprof's {name} child"))?;
+    let output = crate::launch::output_within(&mut cmd, &what, limit).with_context(|| format!("cannot run brdfprof's {name} child"))?;
     let stdout = String::from_utf8_lossy(&output.stdout);
     let stderr = String::from_utf8_lossy(&output.stderr);
     let reply: Option<NoopReply> = stdout.lines().rev().find_map(|l| serde_json::from_str(l).ok());
@@ -398,7 +398,7 @@ fn is_banner(line: &str) -> bool {
 /// Writes a file the child wrote under `from` as this process' output under `to`.
 fn publish(file: &Path, from: &Path, to: &Path) -> Result<PathBuf> {
     let rel = file.strip_prefix(from).map_err(|_| anyhow!("the compile-only child wrote {} outside its ISA directory", file.display()))?;
-    let bytes = crate::io::read_bounded(file, crate::compile_limit::MAX_OUTPUT_BYTES as u64).with_context(|| format!("cannot read the compile-only child's {}", file.display()))?;
+    let bytes = crate::io::read_bounded(file, crate::launch::MAX_OUTPUT_BYTES as u64).with_context(|| format!("cannot read the compile-only child's {}", file.display()))?;
     let path = to.join(rel);
     crate::io::write_output(&path, &bytes)?;
     Ok(path)

@@ -387,7 +387,7 @@ pub fn compile_as(source: &str, family: &Family, precise: bool, lines: bool) -> 
         Ok(())
     };
     let bytes = crate::cache::get_or_build(crate::cache::Store::open_default().as_ref(), "sass", &key, &what, valid, || {
-        let compiled = crate::compile_limit::bounded(&what, || tools.compile(source, "brdfprof_kernel.cu", &options))?;
+        let compiled = crate::launch::bounded(&what, || tools.compile(source, "brdfprof_kernel.cu", &options))?;
         let listing = tools.disassemble(&compiled.cubin, lines)?;
         Ok(serde_json::to_vec(&Sass { listing, log: compiled.log, cubin_bytes: compiled.cubin.len() })?)
     })?;

@@ -87,7 +87,7 @@ fn load() -> std::result::Result<Tools, String> {
     // Its last line names the build ("Build cuda_13.5.r13.5/compiler.37..."): the cache keys on it.
     let mut cmd = crate::cleanup::command(&nvdisasm.to_string_lossy());
     cmd.arg("--version");
-    let out = crate::compile_limit::output_quick(&mut cmd, &format!("{} --version", nvdisasm.display())).map_err(|e| not_installed(&format!("{e:#}")))?;
+    let out = crate::launch::output_quick(&mut cmd, &format!("{} --version", nvdisasm.display())).map_err(|e| not_installed(&format!("{e:#}")))?;
     let nvdisasm_version = String::from_utf8_lossy(&out.stdout).lines().last().map(str::to_string).filter(|l| out.status.success() && l.starts_with("Build ")).ok_or_else(|| {
         not_installed(&format!("{} --version printed no build line ({}): not NVIDIA's nvdisasm", nvdisasm.display(), out.status))
     })?;
@@ -155,7 +155,7 @@ impl Tools {
         std::fs::write(&path, cubin).with_context(|| format!("cannot write {}", path.display()))?;
         let mut cmd = crate::cleanup::command(self.nvdisasm.to_str().unwrap_or("nvdisasm"));
         cmd.args(DISASSEMBLE_OPTIONS).args(line_info.then_some(LINE_INFO)).arg(&path);
-        let out = crate::compile_limit::output(&mut cmd, "a cubin's SASS (nvdisasm)").with_context(|| format!("cannot run {}", self.nvdisasm.display()))?;
+        let out = crate::launch::output(&mut cmd, "a cubin's SASS (nvdisasm)").with_context(|| format!("cannot run {}", self.nvdisasm.display()))?;
         if !out.status.success() {
             bail!("{} failed ({}): {}", self.nvdisasm.display(), out.status, String::from_utf8_lossy(&out.stderr).trim());
         }

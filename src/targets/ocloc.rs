@@ -1,7 +1,7 @@
 //! Intel's offline compiler (`ocloc`, Debian's intel-opencl-icd: IGC, Intel's production OpenCL/Level Zero
 //! compiler) run as a process on OpenCL C, with no Intel GPU or driver, and its disassembler (`ocloc disasm`,
 //! which lists the ISA through IGA, `libiga64.so`, and the binary's patch tokens). Every run is under the
-//! compile limit (`compile_limit::output`).
+//! compile limit (`launch::output`).
 
 use anyhow::{anyhow, bail, Context, Result};
 use std::path::{Path, PathBuf};
@@ -68,7 +68,7 @@ fn load() -> std::result::Result<Tools, String> {
     let dir = crate::cleanup::TempDir::new().map_err(|e| not_installed(&format!("no temporary directory: {e}")))?;
     let mut cmd = crate::cleanup::command(ocloc.to_str().unwrap_or("ocloc"));
     cmd.args(["query", "OCL_DRIVER_VERSION"]).current_dir(dir.path());
-    let out = crate::compile_limit::output(&mut cmd, "ocloc's version query").map_err(|e| not_installed(&format!("cannot run {}: {e:#}", ocloc.display())))?;
+    let out = crate::launch::output(&mut cmd, "ocloc's version query").map_err(|e| not_installed(&format!("cannot run {}: {e:#}", ocloc.display())))?;
     let driver = std::fs::read_to_string(dir.path().join("OCL_DRIVER_VERSION")).unwrap_or_default();
     let driver = driver.trim_matches(|c: char| c.is_whitespace() || c == '\0');
     if !out.status.success() || driver.is_empty() {
@@ -126,7 +126,7 @@ impl Tools {
             // IGC's debug knobs (read from the environment): its shader dumps, into `dir`.
             cmd.env("IGC_ShaderDumpEnable", "1").env("IGC_DumpToCustomDir", dir);
         }
-        let out = crate::compile_limit::output(&mut cmd, what).with_context(|| format!("cannot run {}", self.ocloc.display()))?;
+        let out = crate::launch::output(&mut cmd, what).with_context(|| format!("cannot run {}", self.ocloc.display()))?;
         Ok(out)
     }
 
@@ -177,7 +177,7 @@ impl Tools {
         let dump = dir.path().join("disasm");
         let args = [os("disasm"), os("-file"), bin.into_os_string(), os("-device"), os(device), os("-dump"), dump.clone().into_os_string()];
         let out = self.run(&args.iter().map(|a| a.as_os_str()).collect::<Vec<_>>(), dir.path(), &format!("{what}: its ISA (ocloc disasm)"), None)?;
-        let read = |name: &str| crate::io::read_bounded(&dump.join(name), crate::compile_limit::MAX_OUTPUT_BYTES as u64).map(|b| String::from_utf8_lossy(&b).into_owned());
+        let read = |name: &str| crate::io::read_bounded(&dump.join(name), crate::launch::MAX_OUTPUT_BYTES as u64).map(|b| String::from_utf8_lossy(&b).into_owned());
         let listing = read("brdfprof_kernel_KernelHeap.asm").map_err(|e| {
             anyhow!("{}: `ocloc disasm` for {device} wrote no ISA listing ({e}; it needs {} to load IGA): {}", self.ocloc.display(), self.iga_dir.join("libiga64.so").display(), String::from_utf8_lossy(&out.stderr).trim())
         })?;
@@ -198,7 +198,7 @@ fn dumped_listings(dir: &Path) -> Result<std::collections::BTreeMap<u32, String>
         let Some(name) = path.file_name().and_then(|n| n.to_str()) else { continue };
         let width = name.split_once("_simd").and_then(|(_, rest)| rest.split_once("_entry_")).filter(|_| name.ends_with(".asm")).and_then(|(w, _)| w.parse::<u32>().ok());
         if let Some(w) = width {
-            let bytes = crate::io::read_bounded(&path, crate::compile_limit::MAX_OUTPUT_BYTES as u64)?;
+            let bytes = crate::io::read_bounded(&path, crate::launch::MAX_OUTPUT_BYTES as u64)?;
             out.insert(w, String::from_utf8_lossy(&bytes).into_owned());
         }
     }

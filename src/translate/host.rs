@@ -18,7 +18,7 @@ pub fn build_identity() -> String {
     static IDENTITY: std::sync::OnceLock<String> = std::sync::OnceLock::new();
     IDENTITY
         .get_or_init(|| {
-            let out = crate::compile_limit::output_quick(crate::cleanup::command(HOST_COMPILER).arg("--version"), "g++ --version");
+            let out = crate::launch::output_quick(crate::cleanup::command(HOST_COMPILER).arg("--version"), "g++ --version");
             let version = out.ok().and_then(|o| String::from_utf8_lossy(&o.stdout).lines().next().map(str::to_string)).unwrap_or_else(|| format!("{HOST_COMPILER} (version unknown)"));
             format!("{version} {}", HOST_FLAGS.join(" "))
         })
@@ -57,7 +57,7 @@ impl HostKernel {
         let mut cmd = crate::cleanup::command(HOST_COMPILER);
         // g++'s own temporaries (cc*.s) go into the build's directory, removed with it even on a signal.
         cmd.args(HOST_FLAGS).args(defines.iter().map(|d| format!("-D{d}"))).arg("-o").arg(&lib).arg(&src).env("TMPDIR", dir.path());
-        let out = crate::compile_limit::output(&mut cmd, "the host build of the translation (g++)")
+        let out = crate::launch::output(&mut cmd, "the host build of the translation (g++)")
             .map_err(|e| if e.downcast_ref::<std::io::Error>().is_some() { anyhow!("cannot run {HOST_COMPILER} ({e}): install g++ (Debian: apt-get install g++), or run `make setup`") } else { e })?;
         if !out.status.success() {
             let log = String::from_utf8_lossy(&out.stderr);

@@ -83,8 +83,8 @@ pub fn run(engine: Engine, local_size: [u32; 3], buffers: &mut [&mut [u8]], grou
     // PoCL's kernel cache too: it leaves empty `tempfile_*` behind in it on every build, which would pile up
     // in the user's ~/.cache/pocl; in the run's directory they go with it.
     cmd.arg(CHILD_COMMAND).arg(dir.path()).env("TMPDIR", dir.path()).env("POCL_CACHE_DIR", dir.path().join("pocl"));
-    crate::compile_limit::export(&mut cmd);
-    let out = crate::compile_limit::output(&mut cmd, what).with_context(|| format!("{what}: cannot run the child process"))?;
+    crate::launch::export(&mut cmd);
+    let out = crate::launch::output(&mut cmd, what).with_context(|| format!("{what}: cannot run the child process"))?;
     if !out.status.success() {
         bail!(failure(what, &out));
     }

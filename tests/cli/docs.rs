@@ -132,8 +132,8 @@ fn every_docs_page_is_linked_from_readme_and_every_relative_link_leads_somewhere
     assert!(broken.is_empty(), "broken relative links:\n{}", broken.join("\n"));
 }
 
-/// Issue 31 item 10: every environment variable brdfprof reads (a `"BRDFPROF_..."` string in src/ that is
-/// not a macro of the translation's C preludes) is in docs/commands.md's table of them.
+/// Every environment variable brdfprof reads (a `"BRDFPROF_..."` string in src/ or crates/ that is not
+/// a macro of the translation's C preludes) is in docs/commands.md's table of them.
 #[test]
 fn every_environment_variable_brdfprof_reads_is_documented() {
     fn walk(dir: &Path, out: &mut Vec<std::path::PathBuf>) {
@@ -148,7 +148,9 @@ fn every_environment_variable_brdfprof_reads_is_documented() {
     }
     let table = read("docs/commands.md");
     let mut files = Vec::new();
-    walk(&common::repo_root().join("src"), &mut files);
+    for dir in common::source_dirs() {
+        walk(&dir, &mut files);
+    }
     let macros: String = files.iter().filter(|f| f.extension().is_some_and(|x| x == "h")).map(|f| std::fs::read_to_string(f).unwrap()).collect();
     let mut missing = BTreeSet::new();
     for f in files.iter().filter(|f| f.extension().is_some_and(|x| x == "rs")) {

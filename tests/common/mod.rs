@@ -93,6 +93,16 @@ pub fn repo_root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
+/// The Rust source folders of the workspace: the application's src/ and each leaf crate's src/.
+pub fn source_dirs() -> Vec<PathBuf> {
+    let root = repo_root();
+    let mut dirs = vec![root.join("src")];
+    let mut crates: Vec<PathBuf> = std::fs::read_dir(root.join("crates")).unwrap().map(|e| e.unwrap().path().join("src")).collect();
+    crates.sort();
+    dirs.extend(crates);
+    dirs
+}
+
 /// A model of the term library.
 pub fn model(spec: ModelSpec) -> Model {
     Model::spec(spec)

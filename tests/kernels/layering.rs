@@ -1,5 +1,6 @@
 //! The layer order of src/: no module names (`crate::X`, in a `use` line or a path) a top-level module above
-//! it, and no two files of one folder name each other (`super::X` / `crate::DIR::X`).
+//! it, and no two files of one folder name each other (`super::X` / `crate::DIR::X`). Below src/, the leaf
+//! crates of crates/ are kept apart by the compiler; the test here holds what each may depend on.
 
 use crate::common;
 use std::collections::{BTreeMap, BTreeSet};
@@ -7,7 +8,7 @@ use std::path::{Path, PathBuf};
 
 /// Top-level modules of src/, lowest first: a module may use only those before it. Written once, here.
 const LAYERS: &[&str] = &[
-    "util", "messages", "cleanup", "compile_limit", "host", "stats", "gpu", "brdf", "io", "chart", "page", "cache", "shaders", "model", "kernels", "spirv", "accuracy",
+    "host", "stats", "io", "chart", "page", "cache", "shaders", "model", "kernels", "spirv", "accuracy",
     "results", "profile", "inspect", "translate", "targets", "compare", "devices", "check", "sweep", "sweep_cost", "stability", "scene", "diff", "report_page",
 ];
 
@@ -96,4 +97,28 @@ fn no_two_files_of_a_folder_use_each_other() {
         }
     }
     assert!(circles.is_empty(), "{}", circles.join("\n"));
+}
+
+/// The crates below the application and the heavy dependencies each may name: only the Vulkan backend touches
+/// ash; none of them names naga, naga_oil or plotters, nor the application or a crate beside it that it does not list.
+#[test]
+fn leaf_crates_keep_their_dependencies() {
+    const HEAVY: &[&str] = &["ash", "naga", "naga_oil", "plotters", "brdfprof"];
+    const ALLOWED: &[(&str, &[&str])] = &[("brdf", &[]), ("process", &[]), ("spirv-c", &[]), ("vulkan", &["ash", "brdfprof-process"])];
+    let root = common::repo_root().join("crates");
+    let mut found = BTreeSet::new();
+    for e in std::fs::read_dir(&root).unwrap() {
+        let dir = e.unwrap().path();
+        let name = dir.file_name().unwrap().to_string_lossy().to_string();
+        let allowed = ALLOWED.iter().find(|(n, _)| *n == name).unwrap_or_else(|| panic!("crates/{name} is not in ALLOWED (tests/kernels/layering.rs)")).1;
+        found.insert(name.clone());
+        let manifest = std::fs::read_to_string(dir.join("Cargo.toml")).unwrap();
+        let deps = manifest.split("[dependencies]").nth(1).unwrap_or("").split("\n[").next().unwrap_or("");
+        for line in deps.lines() {
+            let dep = line.split(|c: char| c == '=' || c == '.' || c.is_whitespace()).next().unwrap_or("");
+            let heavy = HEAVY.contains(&dep) || (dep.starts_with("brdfprof-") && !allowed.contains(&dep));
+            assert!(!heavy || allowed.contains(&dep), "crates/{name} depends on {dep}, which it may not name");
+        }
+    }
+    assert_eq!(found.len(), ALLOWED.len(), "a crate of ALLOWED is missing from crates/");
 }

@@ -21,7 +21,7 @@ pub fn to_glsl(words: &[u32], model: &Path) -> Result<String> {
     let mut cmd = crate::cleanup::command("spirv-cross");
     cmd.arg(&path).args(FLAGS);
     let what = format!("{} (spirv-cross)", model.display());
-    let out = match crate::compile_limit::output(&mut cmd, &what) {
+    let out = match crate::launch::output(&mut cmd, &what) {
         Ok(o) => o,
         Err(e) if e.downcast_ref::<std::io::Error>().is_some() => bail!("cannot run spirv-cross ({e}): install spirv-cross, or run `make setup`"),
         Err(e) => return Err(e),

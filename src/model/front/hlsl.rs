@@ -108,7 +108,7 @@ fn run(x: &Expanded, defines: &[(String, String)], args: &[&str], what: &str) ->
     if args.contains(&"-V") {
         cmd.arg("-o").arg(&out);
     }
-    let result = match crate::compile_limit::output(&mut cmd, what) {
+    let result = match crate::launch::output(&mut cmd, what) {
         Ok(r) => r,
         Err(e) if e.downcast_ref::<std::io::Error>().is_some() => bail!("cannot run glslangValidator ({e}): install glslang-tools, or run `make setup`"),
         Err(e) => return Err(e),
@@ -117,7 +117,7 @@ fn run(x: &Expanded, defines: &[(String, String)], args: &[&str], what: &str) ->
     if !result.status.success() {
         return Ok(Err(stdout + &String::from_utf8_lossy(&result.stderr)));
     }
-    let spirv = if args.contains(&"-V") { Some(crate::io::read_bounded(&out, crate::compile_limit::MAX_OUTPUT_BYTES as u64).context("glslang's SPIR-V")?) } else { None };
+    let spirv = if args.contains(&"-V") { Some(crate::io::read_bounded(&out, crate::launch::MAX_OUTPUT_BYTES as u64).context("glslang's SPIR-V")?) } else { None };
     Ok(Ok((stdout, spirv)))
 }
 

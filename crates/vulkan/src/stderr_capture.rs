@@ -39,7 +39,7 @@ pub fn capture<T>(work: impl FnOnce() -> T) -> Result<(T, String)> {
     }
     let mut text = String::new();
     file.rewind().context("reading the captured stderr")?;
-    file.take(crate::compile_limit::MAX_OUTPUT_BYTES as u64).read_to_string(&mut text).context("reading the captured stderr")?;
+    file.take(brdfprof_process::launch::MAX_OUTPUT_BYTES as u64).read_to_string(&mut text).context("reading the captured stderr")?;
     Ok((value, text))
 }
 

@@ -46,9 +46,27 @@ pub enum Binding {
     UniformDynamic,
     /// A buffer read through a typed view (`samplerBuffer` + texelFetch): the format conversion is the
     /// texture path's, as a G-buffer render target's is.
-    TexelRead(vk::Format),
+    TexelRead(TexelFormat),
     /// A buffer read and written through a typed view (`imageBuffer` + imageLoad/imageStore).
-    TexelStorage(vk::Format),
+    TexelStorage(TexelFormat),
+}
+
+/// The formats of texel-buffer views the kernels use, named here so that no caller needs Vulkan's types.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TexelFormat {
+    /// Four 32-bit unsigned integers (a packed G-buffer texel).
+    Rgba32Uint,
+    /// Packed unsigned 11/11/10-bit floats (an HDR radiance target).
+    B10g11r11Ufloat,
+}
+
+impl TexelFormat {
+    fn vk(self) -> vk::Format {
+        match self {
+            TexelFormat::Rgba32Uint => vk::Format::R32G32B32A32_UINT,
+            TexelFormat::B10g11r11Ufloat => vk::Format::B10G11R11_UFLOAT_PACK32,
+        }
+    }
 }
 
 impl Binding {
@@ -68,7 +86,7 @@ impl Binding {
 
     fn texel_format(self) -> Option<vk::Format> {
         match self {
-            Binding::TexelRead(f) | Binding::TexelStorage(f) => Some(f),
+            Binding::TexelRead(f) | Binding::TexelStorage(f) => Some(f.vk()),
             _ => None,
         }
     }
@@ -279,7 +297,7 @@ fn create_logged_pipeline(gpu: &Gpu, name: &str, module: vk::ShaderModule, layou
 fn create_pipeline(gpu: &Gpu, name: &str, module: vk::ShaderModule, layout: vk::PipelineLayout, map: &[vk::SpecializationMapEntry], data: &[u8], flags: vk::PipelineCreateFlags) -> Result<vk::Pipeline> {
     let device = &gpu.device;
     let what = format!("{name} (pipeline creation on {})", gpu.info.name);
-    let created = crate::compile_limit::bounded(&what, || {
+    let created = brdfprof_process::launch::bounded(&what, || {
         let spec_info = vk::SpecializationInfo::default().map_entries(map).data(data);
         let stage = vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::COMPUTE).module(module).name(c"main").specialization_info(&spec_info);
         let info = vk::ComputePipelineCreateInfo::default().stage(stage).layout(layout).flags(flags);

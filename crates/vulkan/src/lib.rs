@@ -8,7 +8,7 @@ mod stderr_capture;
 mod timing;
 
 pub use driver_stats::{DriverStat, PipelineExecutable, LOGGED_EXECUTABLE};
-pub use kernel::{Binding, Bindings, ChunkPlan, Kernel, SpecConstants, WORKGROUP};
+pub use kernel::{Binding, Bindings, ChunkPlan, Kernel, SpecConstants, TexelFormat, WORKGROUP};
 pub use memory::{Buffer, MemoryKind};
 pub use timing::Timestamps;
 
@@ -121,9 +121,9 @@ pub struct Gpu {
     instance: ash::Instance,
     debug: Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT, *mut Messages)>,
     messages: Messages,
-    pub physical: vk::PhysicalDevice,
+    pub(crate) physical: vk::PhysicalDevice,
     pub info: DeviceInfo,
-    pub device: ash::Device,
+    pub(crate) device: ash::Device,
     pub(crate) executable_properties: Option<ash::khr::pipeline_executable_properties::Device>,
     pub(crate) compiler_log: Option<CompilerLog>,
     queue: vk::Queue,
@@ -249,7 +249,7 @@ unsafe extern "system" fn on_validation_message(
         .and_then(|d| unsafe { d.message_as_c_str() })
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default();
-    crate::messages::line(&format!("vulkan validation [{severity:?}]: {text}"));
+    brdfprof_process::messages::line(&format!("vulkan validation [{severity:?}]: {text}"));
     if let Some(messages) = unsafe { (user as *const Messages).as_ref() } {
         messages.lock().unwrap().push(text);
     }
@@ -357,6 +357,12 @@ fn create_device(instance: &ash::Instance, physical: vk::PhysicalDevice, family:
 }
 
 impl Gpu {
+    /// Whether the device returns pipeline executables (VK_KHR_pipeline_executable_properties): its
+    /// compiler's statistics and internal representations.
+    pub fn has_executable_properties(&self) -> bool {
+        self.executable_properties.is_some()
+    }
+
     pub fn new(options: &GpuOptions) -> Result<Self> {
         let entry = load_entry()?;
         let instance = create_instance(&entry, options.validation)?;
@@ -421,7 +427,7 @@ impl Gpu {
 
     /// Validation messages recorded so far (empty without validation).
     /// Whether the device can use `format` as a uniform texel buffer (`storage`: a storage texel buffer).
-    pub fn texel_buffer_support(&self, format: vk::Format, storage: bool) -> bool {
+    pub(crate) fn texel_buffer_support(&self, format: vk::Format, storage: bool) -> bool {
         // SAFETY: the physical device belongs to this instance.
         let props = unsafe { self.instance.get_physical_device_format_properties(self.physical, format) };
         let wanted = if storage { vk::FormatFeatureFlags::STORAGE_TEXEL_BUFFER } else { vk::FormatFeatureFlags::UNIFORM_TEXEL_BUFFER };
@@ -485,7 +491,7 @@ impl Gpu {
         let limit = fence_timeout();
         // SAFETY: the fence belongs to this device and was just submitted with work.
         match unsafe { self.device.wait_for_fences(&[fence], true, limit.as_nanos().min(u64::MAX as u128) as u64) } {
-            Err(vk::Result::TIMEOUT) => crate::cleanup::stop(
+            Err(vk::Result::TIMEOUT) => brdfprof_process::cleanup::stop(
                 2,
                 &format!(
                     "brdfprof: error: {} did not finish a submission within {} s ({FENCE_TIMEOUT_ENV}; default {} s): the device may be hung; stopped",
@@ -502,9 +508,9 @@ impl Gpu {
     /// limit, saying what compiles once it takes a while (`compile_limit::Watch`); past the limit the command
     /// stops (`cleanup::stop`, exit status 2), as a pipeline creation past it does.
     fn wait_compiling(&self, fence: vk::Fence, kernels: &[String]) -> ash::prelude::VkResult<()> {
-        let limit = crate::compile_limit::limit();
+        let limit = brdfprof_process::launch::limit();
         let what = format!("{} (lavapipe compiles a pipeline at its first dispatch)", kernels.join(", "));
-        let mut watch = crate::compile_limit::Watch::new(&what);
+        let mut watch = brdfprof_process::launch::Watch::new(&what);
         loop {
             // SAFETY: the fence belongs to this device and was just submitted with work.
             match unsafe { self.device.wait_for_fences(&[fence], true, 100_000_000) } {
@@ -512,7 +518,7 @@ impl Gpu {
                 other => return other,
             }
             if watch.elapsed() >= limit {
-                crate::cleanup::stop(2, &format!("brdfprof: error: {}", crate::compile_limit::over_limit(&what, limit)));
+                brdfprof_process::cleanup::stop(2, &format!("brdfprof: error: {}", brdfprof_process::launch::over_limit(&what, limit)));
             }
             watch.tick(limit);
         }

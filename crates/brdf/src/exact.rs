@@ -155,7 +155,7 @@ impl ExactFresnel {
     }
 
     /// The Fresnel term the exact counterpart of `spec` uses.
-    pub fn term(self, spec: &ModelSpec) -> crate::brdf::F {
+    pub fn term(self, spec: &ModelSpec) -> crate::F {
         match self {
             ExactFresnel::Physical => spec.exact_fresnel(),
             ExactFresnel::Own => spec.f,
@@ -210,8 +210,8 @@ pub fn eval_with(spec: &ModelSpec, fresnel: ExactFresnel, s: &Sample) -> [f64; 3
 mod tests {
     use super::*;
 
-    use crate::brdf::spec::{with_each_param_sample, ModelSpec};
-    use crate::brdf::{F, Vis};
+    use crate::spec::{with_each_param_sample, ModelSpec};
+    use crate::{F, Vis};
 
     /// Every D with each sample of the parameters it reads.
     fn every_d() -> Vec<ModelSpec> {

@@ -197,7 +197,7 @@ fn clamp_f0(s: &super::Sample, _: f64) -> Option<super::Sample> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::brdf::Sample;
+    use crate::Sample;
 
     #[test]
     fn each_input_guard_is_a_kernel_guard_or_the_roughness_floor() {
