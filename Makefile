@@ -1,12 +1,18 @@
-# brdfprof: `make run` sets up and runs the main job (a profile on the default device);
-# `make test` sets up and runs the tests (lavapipe, validation layer on).
+# brdfprof: `make run` sets up and runs the main job (a profile on the default device; it needs no Mesa build);
+# `make test` sets up, builds Mesa's noop drivers (`make mesa`) and runs the tests (lavapipe, validation layer on).
 CARGO ?= cargo
 BIN := target/release/brdfprof
 
-.PHONY: setup build run test spv baseline
+.PHONY: setup mesa build run test spv baseline
 
+# System packages and NVIDIA's compiler wheels: all that `make run` needs (it builds no Mesa).
 setup:
 	@sh scripts/setup.sh
+
+# Mesa's Turnip, PanVK and ANV on noop drm-shims, for the adreno:, mali: and anv: targets only: ~20 min on 2 cores,
+# once per machine (cached in ~/.cache/brdfprof), so `run` does not wait for it; `test` and `baseline` use them.
+mesa: setup
+	@sh scripts/mesa-noop.sh
 
 build: setup
 	$(CARGO) build --release --locked
@@ -17,7 +23,8 @@ run: build
 	$(BIN) devices
 	$(BIN) profile --json $(RUN_JSON)
 
-test: setup
+# The tests compile on every target, the adreno:, mali: and anv: ones included, so they need `mesa`.
+test: setup mesa
 	$(CARGO) test --release --locked
 
 # Regenerate glsl/generated/ from the Rust tables and recompile glsl/ into spv/ (needs glslang); commit both.
@@ -30,7 +37,7 @@ spv:
 BASELINE := results/baseline-llvmpipe.json
 # The compile-only targets' baselines (ACO for navi21 and vangogh, ptxas for sm_89, IGC for gen12lp, ir3 for a660, Bifrost for g52, brw for tgl; no GPU needed) likewise.
 TARGET_BASELINES := radv:navi21 radv:vangogh nvidia:sm_89 intel:gen12lp adreno:a660 mali:g52 anv:tgl
-baseline: build
+baseline: build mesa
 	$(BIN) check --baseline $(BASELINE) --save-baseline $(BASELINE); test $$? -le 1
 	for t in $(TARGET_BASELINES); do \
 		f=results/baseline-$$(echo $$t | tr : -).json; \

@@ -1,5 +1,6 @@
 #!/bin/sh
-# Builds Mesa's Vulkan drivers that brdfprof runs on Mesa's noop drm-shims, once per machine (docs/targets.md,
+# `make mesa` (which `make test` and `make baseline` run; `make setup` and `make run` do not, ~20 min on 2 cores):
+# builds Mesa's Vulkan drivers that brdfprof runs on Mesa's noop drm-shims, once per machine (docs/targets.md,
 # "Mesa's drivers on noop devices"), from Debian's source packages; nothing in them is patched, the options
 # below are the whole recipe:
 # - the installed Mesa's own source package (Debian 12: 22.3.6): Turnip (Adreno 6xx), PanVK (Mali Bifrost)
@@ -31,13 +32,13 @@ meson_pypi="meson==1.12.1"
 
 as_root() {
     [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1 || {
-        echo "brdfprof setup: the Mesa noop drivers are not built in $1; run make setup as root (it needs apt-get)" >&2; exit 1; }
+        echo "brdfprof mesa: the Mesa noop drivers are not built in $1; run make mesa as root (it needs apt-get)" >&2; exit 1; }
 }
 
 # The build tools of both builds, from Debian.
 tools() {
     export DEBIAN_FRONTEND=noninteractive
-    echo "brdfprof setup: installing Mesa's build tools (meson, ninja, mako, yaml, bison, flex, libdrm, expat, zlib, zstd)" >&2
+    echo "brdfprof mesa: installing Mesa's build tools (meson, ninja, mako, yaml, bison, flex, libdrm, expat, zlib, zstd)" >&2
     apt-get install -y -qq dpkg-dev meson ninja-build python3-mako python3-yaml python3-packaging python3-pip xz-utils bison flex \
         libdrm-dev libexpat1-dev zlib1g-dev libzstd-dev pkg-config >/dev/null
 }
@@ -45,13 +46,13 @@ tools() {
 # build NAME KEY DIR OPTIONS PRODUCTS MESON SRCDIR: meson + ninja of the products, the source tree removed after.
 build() {
     b_name=$1 b_key=$2 b_dir=$3 b_opts=$4 b_prods=$5 b_meson=$6 b_src=$7
-    echo "brdfprof setup: building $b_name (once per machine; ninja's [N/M] is the progress)" >&2
+    echo "brdfprof mesa: building $b_name (once per machine; ninja's [N/M] is the progress)" >&2
     # meson must run on Debian's python3, the one with python3-mako.
     # shellcheck disable=SC2086
     PATH=/usr/bin:$PATH $b_meson setup "$b_dir/build" "$b_src" $b_opts >"$b_dir/meson-setup.log" 2>&1 || {
-        tail -n 30 "$b_dir/meson-setup.log" >&2; echo "brdfprof setup: meson setup failed (log: $b_dir/meson-setup.log)" >&2; exit 1; }
+        tail -n 30 "$b_dir/meson-setup.log" >&2; echo "brdfprof mesa: meson setup failed (log: $b_dir/meson-setup.log)" >&2; exit 1; }
     PATH=/usr/bin:$PATH nice -n 10 ninja -C "$b_dir/build" $(for p in $b_prods; do printf '%s ' "$p"; done)
-    for p in $b_prods; do [ -e "$b_dir/build/$p" ] || { echo "brdfprof setup: the Mesa build did not produce $p" >&2; exit 1; }; done
+    for p in $b_prods; do [ -e "$b_dir/build/$p" ] || { echo "brdfprof mesa: the Mesa build did not produce $p" >&2; exit 1; }; done
     # The source tree is not needed once built; the build directory holds what brdfprof loads.
     rm -rf "$b_src" "$b_dir"/mesa_*
     printf '%s\n' "$b_key" > "$b_dir/.key"
@@ -64,7 +65,7 @@ built() {
 }
 
 version=$(dpkg-query -W -f='${Version}' mesa-vulkan-drivers 2>/dev/null) || {
-    echo "brdfprof setup: mesa-vulkan-drivers is not installed; run the first part of make setup as root" >&2; exit 1; }
+    echo "brdfprof mesa: mesa-vulkan-drivers is not installed; run make setup as root first" >&2; exit 1; }
 key="$version $(printf '%s' "$options" | sha256sum | cut -c1-16)"
 dir="$cache/mesa-noop-$(printf '%s' "$key" | tr ' +:~' '----')"
 
@@ -82,15 +83,15 @@ if ! built "$key" "$dir" "$products"; then
     tools
     rm -rf "$dir"
     mkdir -p "$dir"
-    echo "brdfprof setup: fetching Debian's source package mesa=$version into $dir" >&2
+    echo "brdfprof mesa: fetching Debian's source package mesa=$version into $dir" >&2
     (cd "$dir" && apt-get source -qq "mesa=$version" >/dev/null)
     srcdir=$(find "$dir" -mindepth 1 -maxdepth 1 -type d -name 'mesa-*' | head -n 1)
-    [ -n "$srcdir" ] || { echo "brdfprof setup: apt-get source mesa=$version unpacked nothing in $dir" >&2; exit 1; }
+    [ -n "$srcdir" ] || { echo "brdfprof mesa: apt-get source mesa=$version unpacked nothing in $dir" >&2; exit 1; }
     build "Turnip, PanVK, ANV and their noop shims from Mesa $version (about 1000 steps, ~8 min on 2 cores)" "$key" "$dir" "$options" "$products" meson "$srcdir"
 fi
 mkdir -p "$root/.tools"
 ln -sfn "$dir/build" "$root/.tools/mesa"
-echo "brdfprof setup: Mesa noop drivers present ($key) in $dir" >&2
+echo "brdfprof mesa: Mesa noop drivers present ($key) in $dir" >&2
 
 # bookworm-backports' Mesa, pinned (docs/targets.md's figures are this build's): its source package's upstream
 # tarball, checked against the SHA-256 of Debian's signed Sources index (apt-get source --print-uris); Debian's
@@ -102,29 +103,29 @@ dir25="$cache/mesa-noop-$(printf '%s' "$key25" | tr ' +:~' '----')"
 
 backports_build() {
     [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1 || {
-        echo "brdfprof setup: bookworm-backports' Mesa is not built in $dir25; run make setup as root (it needs apt-get)" >&2; return 1; }
+        echo "brdfprof mesa: bookworm-backports' Mesa is not built in $dir25; run make mesa as root (it needs apt-get)" >&2; return 1; }
     suite="$(. /etc/os-release && echo "${VERSION_CODENAME:-}")-backports"
     list=/etc/apt/sources.list.d/brdfprof-deb-src-backports.sources
     if ! LC_ALL=C apt-get source --print-uris "mesa=$version25" >/dev/null 2>&1; then
         # A deb-src entry for backports: source indexes only, nothing installed comes from it.
         printf 'Types: deb-src\nURIs: http://deb.debian.org/debian\nSuites: %s\nComponents: main\nSigned-By: /usr/share/keyrings/debian-archive-keyring.gpg\n' "$suite" > "$list"
-        LC_ALL=C apt-get update -qq || { rm -f "$list"; echo "brdfprof setup: apt-get update failed with $suite's deb-src entry (removed)" >&2; return 1; }
+        LC_ALL=C apt-get update -qq || { rm -f "$list"; echo "brdfprof mesa: apt-get update failed with $suite's deb-src entry (removed)" >&2; return 1; }
     fi
-    uris=$(LC_ALL=C apt-get source --print-uris -qq "mesa=$version25" 2>&1) || { echo "brdfprof setup: no mesa=$version25 source package in $suite: $uris" >&2; return 1; }
+    uris=$(LC_ALL=C apt-get source --print-uris -qq "mesa=$version25" 2>&1) || { echo "brdfprof mesa: no mesa=$version25 source package in $suite: $uris" >&2; return 1; }
     tools
     rm -rf "$dir25"
     mkdir -p "$dir25" || return 1
     line=$(printf '%s\n' "$uris" | grep "\.orig\.tar\.[a-z0-9]*' " | grep -v "\.asc'" | head -n 1)
     tarball=$(printf '%s' "$line" | cut -d' ' -f2)
     sum=$(printf '%s' "$line" | sed -n 's/.*SHA256:\([0-9a-f]*\).*/\1/p')
-    [ -n "$tarball" ] && [ -n "$sum" ] || { echo "brdfprof setup: no upstream tarball for mesa=$version25 in apt's index" >&2; return 1; }
-    echo "brdfprof setup: fetching $tarball (Debian's mesa $version25 source package, $suite) into $dir25" >&2
+    [ -n "$tarball" ] && [ -n "$sum" ] || { echo "brdfprof mesa: no upstream tarball for mesa=$version25 in apt's index" >&2; return 1; }
+    echo "brdfprof mesa: fetching $tarball (Debian's mesa $version25 source package, $suite) into $dir25" >&2
     # --download-only fetches and checks each file it can; only the tarball is needed (see above).
     (cd "$dir25" && LC_ALL=C apt-get source --download-only -qq "mesa=$version25" >/dev/null 2>&1) || true
-    echo "$sum  $dir25/$tarball" | sha256sum -c --quiet - || { echo "brdfprof setup: $tarball is missing or does not match Debian's index" >&2; return 1; }
+    echo "$sum  $dir25/$tarball" | sha256sum -c --quiet - || { echo "brdfprof mesa: $tarball is missing or does not match Debian's index" >&2; return 1; }
     tar -xf "$dir25/$tarball" -C "$dir25" || return 1
     src25=$(find "$dir25" -mindepth 1 -maxdepth 1 -type d -name 'mesa-*' | head -n 1)
-    [ -n "$src25" ] || { echo "brdfprof setup: $tarball unpacked no mesa-* folder" >&2; return 1; }
+    [ -n "$src25" ] || { echo "brdfprof mesa: $tarball unpacked no mesa-* folder" >&2; return 1; }
     # Mesa 25 needs meson >= 1.1 (Debian 12 has 1.0.1): PyPI's, pinned, in the build's own folder.
     python3 -m pip install --quiet --disable-pip-version-check --root-user-action=ignore --no-deps --target "$dir25/meson" "$meson_pypi" || return 1
     # Exported: ninja runs meson's own script again for generated files.
@@ -135,9 +136,9 @@ backports_build() {
 
 if ! built "$key25" "$dir25" "$products25"; then
     # In a subshell: build's `exit` on failure ends it, not the setup.
-    ( backports_build ) || echo "brdfprof setup: warning: bookworm-backports' Mesa $version25 was not built; adreno:a730/a740/a750 and mali:g610 are unavailable (the other targets are not affected); make setup tries again" >&2
+    ( backports_build ) || echo "brdfprof mesa: warning: bookworm-backports' Mesa $version25 was not built; adreno:a730/a740/a750 and mali:g610 are unavailable (the other targets are not affected); make mesa tries again" >&2
 fi
 if built "$key25" "$dir25" "$products25"; then
     ln -sfn "$dir25/build" "$root/.tools/mesa25"
-    echo "brdfprof setup: Mesa noop drivers present ($key25) in $dir25" >&2
+    echo "brdfprof mesa: Mesa noop drivers present ($key25) in $dir25" >&2
 fi

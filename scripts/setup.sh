@@ -6,6 +6,7 @@
 # (the HTML report is tested in it, headless); and,
 # from PyPI, NVIDIA's NVRTC and nvdisasm for the nvidia: targets, into .tools/nvidia (about 150 MB).
 # As root with apt-get it installs what is missing; otherwise it says exactly what to install and fails.
+# Mesa's noop drivers (adreno:, mali:, anv:) are not built here: `make mesa` (scripts/mesa-noop.sh), ~20 min once.
 set -eu
 
 missing=""
@@ -63,4 +64,3 @@ if [ -n "$iga" ]; then
     ln -sf "$iga" "$root/.tools/intel/libiga64.so"
 fi
 echo "brdfprof setup: system packages present" >&2
-sh "$root/scripts/mesa-noop.sh"

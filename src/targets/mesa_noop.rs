@@ -1,7 +1,7 @@
 //! "A Mesa Vulkan driver on a device that only compiles, in a child process", written once for every driver
 //! that runs so: RADV on its null winsys (`RADV_FORCE_FAMILY`), and Turnip (Adreno), PanVK (Mali) and ANV
 //! (Intel) on Mesa's noop drm-shims (`LD_PRELOAD` of the shim, `VK_ICD_FILENAMES` naming the driver that
-//! `make setup` built, the GPU id in the driver's variable). Each driver is one file (`radv.rs`, `adreno.rs`,
+//! `make mesa` built, the GPU id in the driver's variable). Each driver is one file (`radv.rs`, `adreno.rs`,
 //! `mali.rs`, `anv.rs`) implementing `NoopDriver`: its families, the environment that selects one, and how its
 //! cost is read; this file runs the child, reads its report and contains its crashes.
 //!
@@ -467,7 +467,7 @@ pub fn driver_version(report: &InspectReport) -> String {
     nonempty(&p["mesa_version"]).or_else(|| nonempty(&p["device"]["driver_info"])).or_else(|| nonempty(&p["device"]["driver_version"])).unwrap_or_else(|| "?".into())
 }
 
-/// A Mesa build `make setup` makes (scripts/mesa-noop.sh), which some families' drivers load.
+/// A Mesa build `make mesa` makes (scripts/mesa-noop.sh), which some families' drivers load.
 pub struct MesaBuild {
     /// Its link in the checkout, `.tools/mesa`.
     pub link: &'static str,
@@ -475,7 +475,7 @@ pub struct MesaBuild {
     pub var: &'static str,
     /// What it is, for messages: "Debian 12's Mesa 22.3".
     pub what: &'static str,
-    /// What `make setup` builds in it, for messages.
+    /// What `make mesa` builds in it, for messages.
     pub drivers: &'static str,
 }
 
@@ -512,7 +512,7 @@ impl MesaBuild {
         let path = self.dir().join(relative);
         if !path.is_file() {
             bail!(
-                "{driver} is not built: {} is missing. Run `make setup` (as root: it builds Mesa's drivers and their noop kernel shims once per machine; \
+                "{driver} is not built: {} is missing. Run `make mesa` (as root: it builds Mesa's drivers and their noop kernel shims once per machine; \
                  here {}), or set {} to such a build of {}",
                 path.display(),
                 self.drivers,
@@ -534,7 +534,7 @@ pub const BUILD_DIR_VAR: &str = "BRDFPROF_MESA_DIR";
 
 /// The environment of a driver on a noop drm-shim: the loader sees only `icd` (the driver's devenv ICD file,
 /// which names `library` in the build), `shim` answers the kernel's ioctls, and `extra` selects the GPU. Each
-/// file must be in the build, or the error names it and `make setup`.
+/// file must be in the build, or the error names it and `make mesa`.
 pub fn shim_environment(driver: &str, build: &MesaBuild, icd: &str, library: &str, shim: &str, extra: &[(&str, String)]) -> Result<Vec<(String, String)>> {
     let icd = build.file(driver, icd)?;
     build.file(driver, library)?;

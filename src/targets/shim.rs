@@ -1,4 +1,4 @@
-//! A Mesa Vulkan driver on Mesa's noop drm-shim, as data: the files of the build `make setup` made, the
+//! A Mesa Vulkan driver on Mesa's noop drm-shim, as data: the files of the build `make mesa` made, the
 //! variable that picks the GPU, the families, and the driver's cost rule. `adreno.rs`, `mali.rs` and `anv.rs`
 //! are one `Shim` each; the child process, its environment checks and crash handling are `mesa_noop`'s.
 
@@ -109,7 +109,7 @@ impl Vendor for Shim {
         if ready.is_empty() {
             return Err(missing.into_iter().next().map(|(_, e)| e).unwrap_or_else(|| anyhow::anyhow!("{}: no family", self.prefix)));
         }
-        let mut text = format!("Mesa's {} ({} compiler) on its noop drm-shim, built by make setup in {}", self.driver, self.compiler, ready.join(" and "));
+        let mut text = format!("Mesa's {} ({} compiler) on its noop drm-shim, built by make mesa in {}", self.driver, self.compiler, ready.join(" and "));
         for (names, e) in missing {
             text += &format!("; not built for {names}: {e:#}");
         }
@@ -162,7 +162,7 @@ impl NoopDriver for Shim {
     }
 
     fn install_hint(&self) -> String {
-        format!("`make setup` builds Mesa's drivers and their noop shims (once per machine); `brdfprof devices --targets` says whether {}: is ready", self.prefix)
+        format!("`make mesa` builds Mesa's drivers and their noop shims (once per machine, ~20 min); `brdfprof devices --targets` says whether {}: is ready", self.prefix)
     }
 
     fn compiler_log(&self) -> Option<CompilerLog> {

@@ -1,4 +1,4 @@
-//! Mesa's Turnip (adreno:), PanVK (mali:) and ANV (anv:) on Mesa's noop drm-shims, built by `make setup`:
+//! Mesa's Turnip (adreno:), PanVK (mali:) and ANV (anv:) on Mesa's noop drm-shims, built by `make mesa`:
 //! the drivers' real compilers (ir3, Bifrost, brw) compile brdfprof's unchanged SPIR-V in child processes, and
 //! their statistics and cost rules reach every compile-only command. Nothing here mocks a driver: a missing
 //! or broken build is a real directory without (or with a broken) driver.
@@ -96,8 +96,45 @@ fn isa_writes_ir3_and_brw_listings_and_says_panvk_has_none() {
     assert!(note.contains("--isa: no listing for mali:g610"), "{note}");
 }
 
+/// A fresh machine: `make setup` and `make run` build no Mesa; asking for an adreno:, mali: or anv: target then
+/// exits 2 naming `make mesa` (the Makefile target that builds them), not `make setup`. Needs no build: both
+/// builds' variables name an empty folder.
 #[test]
-fn a_missing_or_broken_build_exits_2_naming_make_setup() {
+fn without_a_mesa_build_every_shim_target_exits_2_naming_make_mesa() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let empty = d.join("empty");
+    std::fs::create_dir(&empty).unwrap();
+    for (device, icd) in [("adreno:a660", "freedreno_devenv_icd"), ("mali:g52", "panfrost_devenv_icd"), ("anv:tgl", "intel_devenv_icd"), ("adreno:a740", "freedreno_devenv_icd"), ("mali:g610", "panfrost_devenv_icd")] {
+        let out = common::brdfprof()
+            .args(["inspect", "--no-callgrind", "--model", "ggx", "--device", device, "--json", "r.json", "--markdown", "r.md"])
+            .current_dir(d)
+            .env(targets::mesa_noop::MESA_DEBIAN.var, &empty)
+            .env(targets::mesa_noop::MESA_BACKPORTS.var, &empty)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{device}: {stderr}");
+        assert!(stderr.contains("is not built") && stderr.contains("`make mesa`") && stderr.contains(icd), "{device}: {stderr}");
+        assert!(!stderr.contains("make setup"), "{device}: `make setup` builds no Mesa: {stderr}");
+    }
+    assert!(!d.join("r.json").exists() && !d.join("r.md").exists());
+    // devices --targets says so too.
+    let out = common::brdfprof().args(["devices", "--targets"]).env(targets::mesa_noop::MESA_DEBIAN.var, &empty).env(targets::mesa_noop::MESA_BACKPORTS.var, &empty).output().unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("is not built") && stdout.contains("`make mesa`"), "{stdout}");
+    // The Makefile has that target, running the script; `make run` does not need it, `make test` does.
+    let makefile = std::fs::read_to_string(common::repo_root().join("Makefile")).unwrap();
+    let rule = |target: &str| makefile.lines().find(|l| l.starts_with(&format!("{target}:"))).unwrap_or_else(|| panic!("no `{target}:` rule in the Makefile")).to_string();
+    assert!(rule("mesa").contains("setup") && makefile.contains("sh scripts/mesa-noop.sh"), "{makefile}");
+    assert!(rule("test").split_whitespace().any(|w| w == "mesa"), "{}", rule("test"));
+    assert!(!rule("run").contains("mesa") && !rule("build").contains("mesa") && !rule("setup").contains("mesa"), "{makefile}");
+    let setup = std::fs::read_to_string(common::repo_root().join("scripts/setup.sh")).unwrap();
+    assert!(!setup.lines().any(|l| !l.trim_start().starts_with('#') && l.contains("mesa-noop.sh")), "scripts/setup.sh runs scripts/mesa-noop.sh");
+}
+
+#[test]
+fn a_missing_or_broken_build_exits_2_naming_make_mesa() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let inspect_with = |build: &Path, device: &str| {
@@ -107,13 +144,13 @@ fn a_missing_or_broken_build_exits_2_naming_make_setup() {
     // No build at all.
     let (code, stderr) = inspect_with(&d.join("nothing"), "adreno:a660");
     assert_eq!(code, Some(2), "{stderr}");
-    assert!(stderr.contains("is not built") && stderr.contains("make setup") && stderr.contains("freedreno_devenv_icd"), "{stderr}");
+    assert!(stderr.contains("is not built") && stderr.contains("make mesa") && stderr.contains("freedreno_devenv_icd"), "{stderr}");
     // bookworm-backports' build (Adreno 7xx, Valhall) missing: the families on it say so, naming its variable.
     for device in ["adreno:a740", "mali:g610"] {
         let out = common::brdfprof().args(["inspect", "--no-callgrind", "--model", "ggx", "--device", device, "--json", "r.json", "--markdown", "r.md"]).current_dir(d).env(targets::mesa_noop::MESA_BACKPORTS.var, d.join("nothing")).output().unwrap();
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(2), "{stderr}");
-        assert!(stderr.contains("is not built") && stderr.contains("make setup") && stderr.contains("BRDFPROF_MESA25_DIR") && stderr.contains("Mesa 25.0"), "{stderr}");
+        assert!(stderr.contains("is not built") && stderr.contains("make mesa") && stderr.contains("BRDFPROF_MESA25_DIR") && stderr.contains("Mesa 25.0"), "{stderr}");
     }
     // The driver and its ICD file present, the shim absent.
     let real = targets::mesa_noop::build_dir();
@@ -124,14 +161,14 @@ fn a_missing_or_broken_build_exits_2_naming_make_setup() {
     }
     let (code, stderr) = inspect_with(&partial, "anv:tgl");
     assert_eq!(code, Some(2), "{stderr}");
-    assert!(stderr.contains("libintel_noop_drm_shim.so is missing") && stderr.contains("make setup"), "{stderr}");
+    assert!(stderr.contains("libintel_noop_drm_shim.so is missing") && stderr.contains("make mesa"), "{stderr}");
     // A shim that is not a library: the driver finds no GPU, and the child's failure names what to run.
     let shim = partial.join("src/intel/tools/libintel_noop_drm_shim.so");
     std::fs::create_dir_all(shim.parent().unwrap()).unwrap();
     std::fs::write(&shim, b"not a shared object").unwrap();
     let (code, stderr) = inspect_with(&partial, "anv:tgl");
     assert_eq!(code, Some(2), "{stderr}");
-    assert!(stderr.contains("anv:tgl") && stderr.contains("make setup"), "{stderr}");
+    assert!(stderr.contains("anv:tgl") && stderr.contains("make mesa"), "{stderr}");
     assert!(!d.join("r.json").exists() && !d.join("r.md").exists());
     // devices --targets says which vendor is not ready and why.
     let out = common::brdfprof().args(["devices", "--targets"]).env(targets::mesa_noop::BUILD_DIR_VAR, d.join("nothing")).output().unwrap();
