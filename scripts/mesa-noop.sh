@@ -1,13 +1,13 @@
 #!/bin/sh
 # `make mesa` (which `make test` and `make baseline` run; `make setup` and `make run` do not, ~20 min on 2 cores):
-# builds Mesa's Vulkan drivers that brdfprof runs on Mesa's noop drm-shims, once per machine (docs/targets.md,
+# builds Mesa's Vulkan drivers that brdfprof runs on Mesa's noop drm-shims, once per machine (docs/targets/mesa-noop.md,
 # "Mesa's drivers on noop devices"), from Debian's source packages; nothing in them is patched, the options
 # below are the whole recipe:
 # - the installed Mesa's own source package (Debian 12: 22.3.6): Turnip (Adreno 6xx), PanVK (Mali Bifrost)
 #   and ANV (Intel), linked as .tools/mesa;
 # - bookworm-backports' Mesa (25.0.7): Turnip (Adreno 7xx) and PanVK (Mali Valhall), linked as .tools/mesa25.
 #   Its meson (>= 1.1) comes from PyPI into the build's own folder; its ANV is not built: Mesa 25's Intel
-#   driver needs libclc and LLVM's SPIR-V translator (docs/targets.md).
+#   driver needs libclc and LLVM's SPIR-V translator (docs/targets/mesa-noop.md).
 # Each build lives outside the checkout, in $BRDFPROF_MESA_CACHE (default ~/.cache/brdfprof), keyed on the
 # source version and the options; a second run finds the key and does nothing.
 set -eu
@@ -93,7 +93,7 @@ mkdir -p "$root/.tools"
 ln -sfn "$dir/build" "$root/.tools/mesa"
 echo "brdfprof mesa: Mesa noop drivers present ($key) in $dir" >&2
 
-# bookworm-backports' Mesa, pinned (docs/targets.md's figures are this build's): its source package's upstream
+# bookworm-backports' Mesa, pinned (docs/targets/mesa-noop.md's figures are this build's): its source package's upstream
 # tarball, checked against the SHA-256 of Debian's signed Sources index (apt-get source --print-uris); Debian's
 # packaging of it (the .dsc, its patches) is not needed for a build of these drivers. Best effort: without it
 # the Mesa 22.3 targets work and brdfprof names the 25.0 ones as not built.

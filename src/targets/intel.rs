@@ -70,7 +70,7 @@ pub struct Rate {
 
 /// Lanes per clock per EU/vector engine (sources per row and column in `tests/fixtures/intel-throughput.tsv`,
 /// which transcribes the documents with their sections and the figures each rate is computed from; a test
-/// ties every entry here to it and recomputes it; docs/targets.md says which figures are stated and which
+/// ties every entry here to it and recomputes it; docs/targets/intel.md says which figures are stated and which
 /// derived).
 pub const THROUGHPUT: &[Rate] = &[
     Rate { row: FP32, lanes_per_clock: [8, 8, 8, 8, 16] },

@@ -83,7 +83,7 @@ pub static MALI: Shim = Shim {
     // Bifrost v7's G76 (0x7211) and G31 (0x7093) gave G52's statistics for every kernel of the presets and
     // the sweep; v6's G72 schedules differently (5 of the sweep's 58 kernels within 1.5% in cycles) and runs one
     // thread per core where v7 runs two (bi_print_stats: two only on v7 with <= 32 work registers), so it is
-    // listed and they are not (docs/targets.md).
+    // listed and they are not (docs/targets/mali.md).
     families: &[
         ShimFamily { name: "g52", gpu_id: "0x7212", architecture: "Bifrost (v7)", products: "Mali-G52 (Rockchip RK3566/RK3568, Amlogic S922X)", detail: "PAN_GPU_ID=0x7212, Bifrost v7", default: true, build: &MESA_DEBIAN, without_validation: Some(PANVK_22_UNVALIDATED) },
         ShimFamily { name: "g72", gpu_id: "0x6221", architecture: "Bifrost (v6)", products: "Mali-G72 (Exynos 9810, Kirin 970, Helio P60)", detail: "PAN_GPU_ID=0x6221, Bifrost v6", default: true, build: &MESA_DEBIAN, without_validation: Some(PANVK_22_UNVALIDATED) },

@@ -48,7 +48,7 @@ pub struct Rate {
 
 /// The rows the cost model uses, with the guide's labels and figures (CUDA C++ Programming Guide v12.x,
 /// 5.4.1, for 7.5 to 9.0; CUDA C++ Best Practices Guide v13.x, 12.1.1, for 12.0; sources and their copies in
-/// docs/targets.md). `tests/fixtures/nvidia-throughput.tsv` transcribes the same table with its citation, and
+/// docs/targets/nvidia.md). `tests/fixtures/nvidia-throughput.tsv` transcribes the same table with its citation, and
 /// a test ties every entry here to it.
 pub const THROUGHPUT: &[Rate] = &[
     Rate { row: FP16, per_clock: [128, 256, 128, 256, 128] },

@@ -1,6 +1,6 @@
 //! README and docs/ against the tree: README stays short, its Layout names every top-level folder and
-//! everything directly in `src/` and nothing that does not exist, every docs page is linked from README, and
-//! every relative link (with its `#anchor`) of README and docs/ leads somewhere.
+//! everything directly in `src/` and nothing that does not exist, every docs page (docs/targets/ too) is linked
+//! from README, and every relative link (with its `#anchor`) of README and docs/ leads somewhere.
 
 use crate::common;
 use std::collections::BTreeSet;
@@ -97,16 +97,29 @@ fn relative_links(text: &str) -> Vec<String> {
     text.split("](").skip(1).filter_map(|s| s.split(')').next()).filter(|t| !t.contains("://") && !t.starts_with("mailto:")).map(str::to_string).collect()
 }
 
+/// The Markdown pages under `folder` and its folders (docs/targets/: one page per compile-only vendor), as paths
+/// from the repository root.
+fn docs_pages(root: &Path, folder: &str) -> Vec<String> {
+    let mut pages = Vec::new();
+    for (name, is_dir) in entries(&root.join(folder)) {
+        let path = format!("{folder}/{name}");
+        if is_dir {
+            pages.extend(docs_pages(root, &path));
+        } else if name.ends_with(".md") {
+            pages.push(path);
+        }
+    }
+    pages
+}
+
 #[test]
 fn every_docs_page_is_linked_from_readme_and_every_relative_link_leads_somewhere() {
     let root = common::repo_root();
     let mut pages = vec!["README.md".to_string()];
     let mut docs = BTreeSet::new();
-    for (name, is_dir) in entries(&root.join("docs")) {
-        if !is_dir && name.ends_with(".md") {
-            docs.insert(format!("docs/{name}"));
-            pages.push(format!("docs/{name}"));
-        }
+    for page in docs_pages(&root, "docs") {
+        docs.insert(page.clone());
+        pages.push(page);
     }
     pages.push("glsl/README.md".to_string());
     let linked: BTreeSet<String> = relative_links(&read("README.md")).iter().map(|t| t.split('#').next().unwrap().to_string()).collect();
