@@ -1,6 +1,7 @@
-//! The brdfprof command line: one function per command (`cli`), each parsing its arguments, calling the library
-//! and writing its reports. Exit status: 0 success; 1 the command ran and found a problem (stability,
-//! regression); 2 bad input or anything that stopped the command from measuring.
+//! The brdfprof command line: one file and function per command (`cli/<command>.rs`; the arguments several
+//! share in `cli/args.rs`), each parsing its arguments, calling the library and writing its reports. Exit
+//! status: 0 success; 1 the command ran and found a problem (stability, regression); 2 bad input or anything
+//! that stopped the command from measuring.
 
 mod cli;
 
@@ -14,14 +15,14 @@ struct Cli {
     command: Command,
     /// Seconds any one compilation may take (glslang, the driver's pipeline creation, a compile-only child)
     /// before the command stops with exit status 2, naming it (default 60; also BRDFPROF_COMPILE_TIMEOUT).
-    #[arg(long, global = true, value_name = "SECONDS", value_parser = cli::compile_timeout)]
+    #[arg(long, global = true, value_name = "SECONDS", value_parser = cli::args::compile_timeout)]
     compile_timeout: Option<std::time::Duration>,
 }
 
 #[derive(Subcommand)]
 enum Command {
     /// List Vulkan devices with the properties that matter for profiling.
-    Devices(cli::info::DevicesArgs),
+    Devices(cli::devices::DevicesArgs),
     /// List the terms (with citations) and presets that model specs can name.
     Models,
     /// Evaluate f_s of one model on the GPU for every row of a CSV file.
@@ -31,21 +32,21 @@ enum Command {
     /// outputs, JSON report and a picture (lit spheres, difference maps, lobes). Exit 1 above --tolerance.
     Diff(cli::diff::DiffArgs),
     /// Measure the cost per BRDF evaluation of models over a synthetic G-buffer lit by several lights.
-    Profile(cli::measure::ProfileArgs),
+    Profile(cli::profile::ProfileArgs),
     /// Time and measure the accuracy of many model specs in one interleaved run: table, JSON and a chart of
     /// error against cost with the Pareto frontier, under --out (default results/).
-    Sweep(cli::measure::SweepArgs),
+    Sweep(cli::sweep::SweepArgs),
     /// Run the hard-case catalogue, dense grids, reciprocity and energy checks on the GPU for every spec
     /// (default: every D x Vis and every Fresnel on ggx, fp32 and fp16). Exit 1 when any spec yields NaN, Inf
     /// or a negative value on a valid input.
-    Stability(cli::measure::StabilityArgs),
+    Stability(cli::stability::StabilityArgs),
     /// Instruction counts of each model's specialised shading kernel: SPIR-V by class (glslang and
     /// spirv-opt -O), naga's analysis, driver statistics, and on lavapipe the CPU instructions executed per
     /// BRDF evaluation (callgrind).
-    Inspect(cli::counts::InspectArgs),
+    Inspect(cli::inspect::InspectArgs),
     /// Measures the counts and a short timing run and compares them with a saved baseline: exit 0 no
     /// regression, 1 regression, 2 could not measure.
-    Check(cli::counts::CheckArgs),
+    Check(cli::check::CheckArgs),
     /// Merge saved profile and inspect JSON reports (other machines, GPUs, compile-only AMD targets) into one
     /// cost table across devices with rank correlations, its JSON and a PNG chart; refuses reports whose
     /// kernels differ.
@@ -58,7 +59,7 @@ enum Command {
     Scene(cli::scene::SceneArgs),
     /// Render a scene: a tone-mapped sRGB PNG per model, the comparison grid, difference heat maps against ggx
     /// and polar lobe plots, under --out (default results/scenes/<scene name>/).
-    Render(cli::scene::RenderArgs),
+    Render(cli::render::RenderArgs),
     /// The disk cache of compiled kernels: `show` (directory, entries, size) or `clear`.
     Cache(cli::cache::CacheArgs),
     #[command(name = "__callgrind-child", hide = true)]
@@ -85,25 +86,25 @@ fn main() -> ExitCode {
         return cli::finish(Err(e));
     }
     let result = match cli.command {
-        Command::Devices(args) => cli::info::devices(&args),
-        Command::Models => cli::info::models(),
+        Command::Devices(args) => cli::devices::devices(&args),
+        Command::Models => cli::models::models(),
         Command::Eval(args) => cli::eval::eval(&args),
         Command::Diff(args) => cli::diff::diff(&args),
-        Command::Profile(args) => cli::measure::profile(&args),
-        Command::Sweep(args) => cli::measure::sweep(&args),
-        Command::Stability(args) => cli::measure::stability(&args),
-        Command::Inspect(args) => cli::counts::inspect(&args),
-        Command::Check(args) => cli::counts::check(&args),
+        Command::Profile(args) => cli::profile::profile(&args),
+        Command::Sweep(args) => cli::sweep::sweep(&args),
+        Command::Stability(args) => cli::stability::stability(&args),
+        Command::Inspect(args) => cli::inspect::inspect(&args),
+        Command::Check(args) => cli::check::check(&args),
         Command::Compare(args) => cli::compare::compare(&args),
         Command::Report(args) => cli::report::report(&args),
         Command::Scene(args) => cli::scene::scene(&args),
-        Command::Render(args) => cli::scene::render(&args),
+        Command::Render(args) => cli::render::render(&args),
         Command::Cache(args) => cli::cache::cache(&args),
-        Command::CallgrindChild { request } => brdfprof::inspect::callgrind::child_main(&request).map(|_| ExitCode::SUCCESS),
-        Command::NoopChild { request } => brdfprof::targets::mesa_noop::child_main(&request).map(|_| ExitCode::SUCCESS),
-        Command::RunTranslation { dir } => brdfprof::translate::runner::child_main(&dir).map(|_| ExitCode::SUCCESS),
-        Command::ProbeVulkan => brdfprof::targets::radv_env::probe_main().map(|_| ExitCode::SUCCESS),
-        Command::GenerateGlsl { dir } => cli::info::generate_glsl(&dir),
+        Command::CallgrindChild { request } => cli::hidden::callgrind_child(&request),
+        Command::NoopChild { request } => cli::hidden::noop_child(&request),
+        Command::RunTranslation { dir } => cli::hidden::run_translation(&dir),
+        Command::ProbeVulkan => cli::hidden::probe_vulkan(),
+        Command::GenerateGlsl { dir } => cli::hidden::generate_glsl(&dir),
     };
     cli::finish(result)
 }

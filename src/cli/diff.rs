@@ -2,7 +2,8 @@
 //! `brdfprof diff --reference SPEC --model ... --model ...`: every model against one reference's f64 values.
 
 use brdfprof::model::csv_rows::{read_rows, RowValues};
-use super::{on_device, DeviceArgs, ModelArgs};
+use super::args::{cosine_range, reference_spec, roughness_range, DeviceArgs, HtmlArg, ModelArgs};
+use super::on_device;
 use anyhow::{bail, Result};
 use brdfprof::brdf::Sample;
 use brdfprof::brdf::ModelSpec;
@@ -22,7 +23,7 @@ pub struct DiffArgs {
     pub model: ModelArgs,
     /// Measure every --model against this built-in spec's exact f64 values (e.g. `ggx`, or
     /// `d=ggx,vis=smith-ggx-correlated,f=schlick`), in one table.
-    #[arg(long, value_parser = super::reference_spec)]
+    #[arg(long, value_parser = reference_spec)]
     pub reference: Option<ModelSpec>,
     /// CSV of inputs, as for `eval` (columns nx,ny,nz,vx,vy,vz,lx,ly,lz,roughness,f0r,f0g,f0b). Default: seeded
     /// well-conditioned samples (--samples, --seed).
@@ -35,14 +36,14 @@ pub struct DiffArgs {
     pub seed: u64,
     /// Perceptual roughness range of the default samples, MIN..MAX within [0, 1] (default: [0, 1], or the
     /// range every `.brdf` model's `domain roughness` admits).
-    #[arg(long, value_parser = super::roughness_range, conflicts_with = "input")]
+    #[arg(long, value_parser = roughness_range, conflicts_with = "input")]
     pub roughness: Option<(f64, f64)>,
     /// N.V range of the default samples, MIN..MAX within [0, 1] (default: [0.05, 1], or within it the range
     /// every `.brdf` model's `domain nov` admits).
-    #[arg(long, value_parser = super::cosine_range, conflicts_with = "input")]
+    #[arg(long, value_parser = cosine_range, conflicts_with = "input")]
     pub nov: Option<(f64, f64)>,
     /// N.L range of the default samples, as --nov (`domain nol`).
-    #[arg(long, value_parser = super::cosine_range, conflicts_with = "input")]
+    #[arg(long, value_parser = cosine_range, conflicts_with = "input")]
     pub nol: Option<(f64, f64)>,
     /// Rows listed where the models differ most.
     #[arg(long, default_value_t = 10)]
@@ -61,7 +62,7 @@ pub struct DiffArgs {
     #[arg(long, conflicts_with = "reference")]
     pub png: Option<PathBuf>,
     #[command(flatten)]
-    pub html: super::report::HtmlArg,
+    pub html: HtmlArg,
     #[command(flatten)]
     pub device: DeviceArgs,
 }
@@ -139,7 +140,7 @@ pub fn diff(args: &DiffArgs) -> Result<ExitCode> {
     }
     // The page reads the result back through its JSON view, as `brdfprof report` reads a saved one.
     let label = args.json.clone().unwrap_or_else(|| PathBuf::from("diff.json"));
-    args.html.write(&[super::report::just_measured(&label, &result)?], Some(&gpu))?;
+    args.html.write(&[super::just_measured(&label, &result)?], Some(&gpu))?;
     print!("{}", result.markdown());
     if !outs.is_empty() {
         println!("\n{}", super::written(&outs.iter().map(|(_, p)| p.clone()).collect::<Vec<_>>()));
@@ -181,7 +182,7 @@ fn diff_set(args: &DiffArgs, reference: &Model, models: &[Model]) -> Result<Exit
         }
     }
     let label = args.json.clone().unwrap_or_else(|| PathBuf::from("diff.json"));
-    args.html.write(&[super::report::just_measured(&label, &result)?], Some(&gpu))?;
+    args.html.write(&[super::just_measured(&label, &result)?], Some(&gpu))?;
     print!("{}", result.markdown());
     if !outs.is_empty() {
         println!("\n{}", super::written(&outs.iter().map(|(_, p)| p.clone()).collect::<Vec<_>>()));

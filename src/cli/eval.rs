@@ -1,6 +1,7 @@
 //! `brdfprof eval`: f_s of one model for every row of a CSV file.
 
-use super::{on_device, DeviceArgs, ModelArgs};
+use super::args::{DeviceArgs, ModelArgs};
+use super::on_device;
 use anyhow::{bail, Result};
 use brdfprof::model::{csv_rows, Model};
 use brdfprof::{io, kernels, messages};

@@ -1,54 +1,35 @@
-//! What every command shares: the device, model and timing arguments, and the one sequence that opens the
-//! device, shows progress, runs the work and checks the validation layer.
+//! What the commands share besides their arguments (those are in `args`): the sequence every command runs in
+//! (`prepare`, `finish`), the one that opens the device, shows progress, runs the work and checks the validation
+//! layer (`on_device`), and the checks and names of their outputs. Each public command is in its own file,
+//! `cli/<command>.rs`; the hidden ones are in `hidden`.
 
+pub mod args;
 pub mod cache;
+pub mod check;
 pub mod compare;
-pub mod counts;
+pub mod devices;
 pub mod diff;
 pub mod eval;
-pub mod info;
-pub mod measure;
+pub mod hidden;
+pub mod inspect;
+pub mod models;
+pub mod profile;
+pub mod render;
 pub mod report;
 pub mod scene;
+pub mod stability;
+pub mod sweep;
 
 use anyhow::{anyhow, bail, Result};
-use brdfprof::gpu::{Gpu, GpuOptions};
+use args::DeviceArgs;
+use brdfprof::gpu::Gpu;
 use brdfprof::targets;
 use brdfprof::io;
-use brdfprof::model::{self, Model};
-use brdfprof::profile::protocol::ProtocolOptions;
-use brdfprof::profile::ProfileOptions;
-use clap::Args;
+use brdfprof::model::Model;
+use brdfprof::report_page::{self, Input};
 use indicatif::{ProgressBar, ProgressStyle};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::time::Duration;
-
-#[derive(Args, Clone)]
-pub struct DeviceArgs {
-    /// Device index (see `brdfprof devices`) or a case-insensitive substring of its name.
-    /// Default: the first discrete or integrated GPU, else lavapipe.
-    #[arg(long, value_parser = device_name)]
-    pub device: Option<String>,
-    /// Run under the Khronos validation layer and fail on any message (also BRDFPROF_VALIDATION=1).
-    #[arg(long)]
-    pub validate: bool,
-}
-
-/// `--roughness MIN..MAX`: 0 <= MIN <= MAX <= 1.
-fn roughness_range(text: &str) -> Result<(f64, f64), String> {
-    let fail = || format!("`{text}`: give MIN..MAX with 0 <= MIN <= MAX <= 1 (e.g. 0.0525..1)");
-    let (lo, hi) = text.split_once("..").ok_or_else(fail)?;
-    let (lo, hi): (f64, f64) = (lo.trim().parse().map_err(|_| fail())?, hi.trim().parse().map_err(|_| fail())?);
-    if !(0.0..=1.0).contains(&lo) || !(0.0..=1.0).contains(&hi) || lo > hi {
-        return Err(fail());
-    }
-    Ok((lo, hi))
-}
-
-/// `--nov MIN..MAX`, `--nol MIN..MAX`: a cosine range, 0 <= MIN <= MAX <= 1.
-pub fn cosine_range(text: &str) -> Result<(f64, f64), String> {
-    roughness_range(text).map_err(|_| format!("`{text}`: give MIN..MAX with 0 <= MIN <= MAX <= 1 (e.g. 0.05..1)"))
-}
 
 /// One range of the default samples: the flag's, else the intersection of `default` with the models' declared
 /// domains (named in the words returned), else `default`; models whose domains do not meet are refused.
@@ -78,21 +59,6 @@ pub fn sample_domain(flags: [Option<(f64, f64)>; 3], d: brdfprof::diff::SampleDo
     Ok((brdfprof::diff::SampleDomain { roughness, nov, nol }, [rw, vw, lw]))
 }
 
-/// `--reference SPEC`: a built-in spec (it has the f64 twin a reference needs).
-pub fn reference_spec(text: &str) -> Result<brdfprof::brdf::ModelSpec, String> {
-    brdfprof::brdf::ModelSpec::parse(text).map_err(|e| format!("{e} (a reference is a built-in spec: a preset or D/Vis/F terms, which have an f64 twin)"))
-}
-
-/// `--device`: an empty or blank name would match every device (a substring of each), so it is refused; a
-/// compile-only target must name known families (`targets`).
-pub fn device_name(text: &str) -> Result<String, String> {
-    if text.trim().is_empty() {
-        return Err("empty; give an index or a name substring (see `brdfprof devices`)".into());
-    }
-    targets::parse(text).map_err(|e| format!("{e:#}"))?;
-    Ok(text.to_string())
-}
-
 /// The error of a command that must execute kernels given a compile-only device.
 pub fn compiles_only_error(device: &str) -> anyhow::Error {
     anyhow!(
@@ -101,35 +67,6 @@ pub fn compiles_only_error(device: &str) -> anyhow::Error {
          from `brdfprof devices` here",
         targets::prefixes()
     )
-}
-
-impl DeviceArgs {
-    /// Validation asked for by the flag or the environment.
-    pub fn validation(&self) -> bool {
-        self.validate || std::env::var("BRDFPROF_VALIDATION").is_ok_and(|v| !v.is_empty() && v != "0")
-    }
-
-    /// Opens the device for a command that executes kernels: a compile-only device is refused.
-    pub fn open(&self) -> Result<Gpu> {
-        self.open_with(false)
-    }
-
-    /// Opens the device; `compile_only_ok`: the command only compiles (inspect, check), so RADV's null device
-    /// (the user's own RADV_FORCE_FAMILY and an explicit `--device`) will do. A compile-only target is never
-    /// opened here: the commands that take it compile through `targets`.
-    pub fn open_with(&self, compile_only_ok: bool) -> Result<Gpu> {
-        if self.device.as_deref().is_some_and(|d| d.trim().is_empty()) {
-            bail!("--device: empty; give an index or a name substring (see `brdfprof devices`)");
-        }
-        if let Some(d) = self.device.as_deref().filter(|d| targets::is_compile_only(d)) {
-            return Err(compiles_only_error(d));
-        }
-        let gpu = Gpu::new(&GpuOptions { device: self.device.clone(), validation: self.validation(), ..Default::default() })?;
-        if gpu.info.compile_only() && !compile_only_ok {
-            return Err(compiles_only_error(&format!("{} ({})", self.device.as_deref().unwrap_or("?"), gpu.info.name)));
-        }
-        Ok(gpu)
-    }
 }
 
 /// Opens the device, runs `work` with a progress bar, and fails if the validation layer said anything.
@@ -150,150 +87,6 @@ pub fn on_device_with<T>(device: &DeviceArgs, compile_only_ok: bool, work: impl 
     let result = result?;
     gpu.check_validation()?;
     Ok((gpu, result))
-}
-
-#[derive(Args, Clone)]
-pub struct ModelArgs {
-    /// Model spec: a preset (ggx, blinn, cook-torrance, burley, ue-default-lit, filament-high, filament-low)
-    /// or d=..,vis=..,f=..,precision=..; see `brdfprof models`. Or a model file,
-    /// PATH[,NAME=VALUE|@roughness|@alpha|@f0|@basecolor|@metallic...]: a BRDF Explorer .brdf file (its shader
-    /// in GLSL, HLSL or WGSL), or a plain HLSL (.hlsl, .hlsli, .ush, .usf) or WGSL (.wgsl) shader file.
-    #[arg(long = "model")]
-    pub models: Vec<String>,
-    /// Parameter override applied to every model that takes it, e.g. gamma=1.5 (GTR exponent), metal=copper,
-    /// precision=f16; for a model file one of its parameters (a colour as r,g,b) or a binding such as
-    /// roughness=@roughness.
-    #[arg(long = "param")]
-    pub params: Vec<String>,
-    /// A macro for every model file's shader (.brdf, .hlsl, .ush, .wgsl, ...), NAME or NAME=VALUE: glslang's -D
-    /// for GLSL and HLSL, a naga_oil shader def for WGSL (whose `#ifdef` asks only whether NAME is defined); the
-    /// same as `define=NAME=VALUE` in the file's spec (docs/brdf-files.md, docs/wgsl.md).
-    #[arg(long = "define", value_name = "NAME[=VALUE]")]
-    pub defines: Vec<String>,
-    /// A directory an HLSL shader's `#include` and a WGSL shader's `#import` search, after the model file's
-    /// own (repeatable, in order; `include=DIR` in the model's spec; docs/hlsl.md, docs/wgsl.md).
-    #[arg(long = "include-dir", value_name = "DIR")]
-    pub include_dirs: Vec<String>,
-    /// A virtual include prefix and the directory it stands for, e.g. /Engine=UE/Engine/Shaders: `#include
-    /// "/Engine/Private/BRDF.ush"` reads UE/Engine/Shaders/Private/BRDF.ush (`include-map=` in the spec).
-    #[arg(long = "include-map", value_name = "VIRTUAL=DIR")]
-    pub include_maps: Vec<String>,
-}
-
-impl ModelArgs {
-    /// The models asked for, or `default` when none.
-    pub fn models(&self, default: &[&str]) -> Result<Vec<Model>> {
-        let mut items = String::new();
-        for (flag, key, values) in [("--define", model::file_model::DEFINE, &self.defines), ("--include-dir", model::file_model::INCLUDE, &self.include_dirs), ("--include-map", model::file_model::INCLUDE_MAP, &self.include_maps)] {
-            if let Some(v) = values.iter().find(|v| v.contains(',')) {
-                bail!("{flag} {v}: a comma would end the value in the model's spec; rename the directory or give the value without one");
-            }
-            items += &values.iter().map(|v| format!(",{key}={v}")).collect::<String>();
-        }
-        if items.is_empty() {
-            return model::models_from_args(&self.models, &self.params, default);
-        }
-        // The options join each shader file model's text, so that its shader is prepared once, with them (a
-        // file may `#error` without its defines, or include what only these directories hold).
-        if !self.models.iter().any(|m| model::file_model::names_a_file(m)) {
-            let flag = [("--define", &self.defines), ("--include-dir", &self.include_dirs), ("--include-map", &self.include_maps)].into_iter().find_map(|(f, v)| v.first().map(|v| format!("{f} {v}"))).unwrap_or_default();
-            bail!("{flag}: it is for a shader file's model, and no --model is a .brdf file, nor an .hlsl, .ush or .wgsl file");
-        }
-        let with: Vec<String> = self.models.iter().map(|m| if model::file_model::names_a_file(m) { format!("{m}{items}") } else { m.clone() }).collect();
-        model::models_from_args(&with, &self.params, default)
-    }
-}
-
-/// Size and protocol of a timed run, shared by `profile` and `sweep`.
-#[derive(Args, Clone)]
-pub struct TimingArgs {
-    /// Directional lights per pixel (run in blocks of 8 per dispatch, each block's loop unrolled). A
-    /// comma-separated list (e.g. 1,8,64) times every count in the same interleaved rounds.
-    #[arg(long, value_delimiter = ',', default_value = "8")]
-    pub lights: Vec<u32>,
-    /// G-buffer layout: packed as engines store it (octahedral normal, RGBA8 material and base colour, V from
-    /// the pixel and the camera, R11G11B10F out: 16 bytes in, 4 out), or float (48 bytes in, 16 out).
-    #[arg(long, value_enum, default_value = "packed")]
-    pub gbuffer: brdfprof::kernels::shade::GBufferFormat,
-    /// Minimum and maximum number of interleaved rounds.
-    #[arg(long, default_value_t = 12)]
-    pub min_rounds: usize,
-    #[arg(long, default_value_t = 400)]
-    pub max_rounds: usize,
-    /// Seed of the interleaving order.
-    #[arg(long, default_value_t = 1)]
-    pub seed: u64,
-    /// Independently compiled pipelines per kernel, all timed every round (the faster counts): guards against
-    /// one JIT compilation landing badly placed, seen to double a kernel's time on lavapipe.
-    #[arg(long, default_value_t = 2)]
-    pub instances: usize,
-    /// Keep Mesa's on-disk shader cache (timed runs switch it off by default; see `fresh_compilation`).
-    #[arg(long)]
-    pub shader_cache: bool,
-    /// Compile the shading kernels from this GLSL directory (a copy of glsl/, with its kernels.txt) with
-    /// glslang instead of using the embedded SPIR-V: time an edited kernel against the built-in one.
-    #[arg(long)]
-    pub glsl: Option<std::path::PathBuf>,
-    /// Also time each spec without brdfprof's guards (`guards=off`, docs/guards.md), listed next to it and
-    /// timed in the same interleaved rounds.
-    #[arg(long)]
-    pub unguarded: bool,
-}
-
-/// `models` with, after each built-in spec that keeps a guard, the same spec with `guards=off` (a `.brdf`
-/// file has no brdfprof guards to remove), when `unguarded`.
-pub fn with_unguarded(models: Vec<Model>, unguarded: bool) -> Vec<Model> {
-    if !unguarded {
-        return models;
-    }
-    let mut out = Vec::with_capacity(2 * models.len());
-    for m in models {
-        let off = m.twin().filter(|s| s.guards != brdfprof::brdf::guards::GuardSet::NONE).map(|s| Model::spec(brdfprof::brdf::ModelSpec { guards: brdfprof::brdf::guards::GuardSet::NONE, ..*s }));
-        out.push(m);
-        out.extend(off);
-    }
-    let mut seen = Vec::new();
-    out.retain(|m| if seen.contains(m) { false } else { seen.push(m.clone()); true });
-    out
-}
-
-impl TimingArgs {
-    pub fn options(&self, models: Vec<Model>, size: &str, reps: usize, budget: f64, target_ci: f64) -> Result<ProfileOptions> {
-        let (width, height) = parse_size("--size", size)?;
-        use brdfprof::profile::workload::MAX_LIGHTS;
-        if self.lights.iter().any(|&l| l == 0 || l > MAX_LIGHTS) {
-            bail!("--lights {}: each count must be 1 to {MAX_LIGHTS}", self.lights.iter().map(u32::to_string).collect::<Vec<_>>().join(","));
-        }
-        let mut seen = std::collections::BTreeSet::new();
-        if let Some(l) = self.lights.iter().find(|l| !seen.insert(**l)) {
-            bail!("--lights: {l} is given twice");
-        }
-        let min_rounds = self.min_rounds.max(1);
-        Ok(ProfileOptions {
-            models: with_unguarded(models, self.unguarded),
-            width,
-            height,
-            lights: self.lights.clone(),
-            format: self.gbuffer,
-            protocol: ProtocolOptions {
-                min_rounds,
-                max_rounds: self.max_rounds.max(min_rounds),
-                reps: reps.max(1),
-                budget: parse_budget(budget)?,
-                started: command_started(),
-                seed: self.seed,
-            },
-            target_rel_ci: target_ci,
-            max_chunk: None,
-            instances: self.instances.max(1),
-            glsl: self.glsl.clone(),
-        })
-    }
-}
-
-/// `--compile-timeout`: seconds, more than 0 and at most a day.
-pub fn compile_timeout(text: &str) -> Result<Duration, String> {
-    brdfprof::launch::parse(text)
 }
 
 /// Everything before a command runs: the signal handler (children have none: they die with brdfprof), the
@@ -343,27 +136,6 @@ pub fn command_started() -> std::time::Instant {
     *STARTED.get_or_init(std::time::Instant::now)
 }
 
-/// `--budget` in seconds: positive and finite.
-pub fn parse_budget(seconds: f64) -> Result<Duration> {
-    if !(seconds.is_finite() && seconds > 0.0 && seconds <= 86_400.0) {
-        bail!("--budget {seconds}: give seconds, more than 0 and at most 86400");
-    }
-    Ok(Duration::from_secs_f64(seconds))
-}
-
-/// `WIDTHxHEIGHT`, both at least 1; `flag` names the option in errors.
-pub fn parse_size(flag: &str, text: &str) -> Result<(u32, u32)> {
-    let parse = || -> Option<(u32, u32)> {
-        let (w, h) = text.split_once(['x', 'X'])?;
-        Some((w.trim().parse().ok()?, h.trim().parse().ok()?))
-    };
-    match parse() {
-        Some((w, h)) if w > 0 && h > 0 => Ok((w, h)),
-        Some((w, h)) => Err(anyhow!("{flag} `{text}`: width and height must be at least 1 (got {w}x{h})")),
-        None => Err(anyhow!("{flag} `{text}`: expected WIDTHxHEIGHT, e.g. 1920x1080")),
-    }
-}
-
 /// Timed runs compile every pipeline afresh (MESA_SHADER_CACHE_DISABLE=true unless the user set it or asked
 /// to keep the cache): with Mesa's on-disk shader cache a process runs binaries an earlier process compiled,
 /// and on lavapipe that moved one scene effect's cost from 0.3 to 19 ns/pixel between runs, where fresh
@@ -397,4 +169,38 @@ pub fn check_output(flag: &str, path: Option<&Path>, default_dir: &str, default_
 /// "written: a, b, c" for a command's outputs.
 pub fn written(paths: &[std::path::PathBuf]) -> String {
     format!("written: {}", paths.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", "))
+}
+
+/// `--out`, checked writable; else the default results/, refused where the command's `files` there (patterns,
+/// `*` for the device) match a file git tracks.
+pub fn out_dir(given: Option<&std::path::Path>, files: &[&str]) -> Result<PathBuf> {
+    if let Some(out) = given {
+        io::check_output_dir("--out", out)?;
+        return Ok(out.to_path_buf());
+    }
+    let out = PathBuf::from(DEFAULT_OUT);
+    io::check_output_dir("--out (default results)", &out)?;
+    io::refuse_tracked_default("--out", &out, &files.iter().map(|f| f.to_string()).collect::<Vec<_>>())?;
+    Ok(out)
+}
+
+/// The compile-only targets of `--cost-device`, in order, each once.
+pub fn cost_targets(devices: &[String]) -> Result<Vec<brdfprof::targets::Target>> {
+    let mut out: Vec<brdfprof::targets::Target> = Vec::new();
+    for d in devices {
+        let Some(ts) = brdfprof::targets::parse(d)? else {
+            anyhow::bail!("--cost-device {d}: give a compile-only target ({}FAMILY or PREFIX:all; see `brdfprof devices --targets`); the command's own --device is the one that measures", brdfprof::targets::prefixes());
+        };
+        for t in ts {
+            if !out.contains(&t) {
+                out.push(t);
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// The report just measured, read back as its saved JSON would be.
+pub fn just_measured(json: &Path, report: &impl serde::Serialize) -> Result<Input> {
+    report_page::from_report(json, report)
 }

@@ -1,13 +1,12 @@
-//! `brdfprof report RESULTS.json... --out report.html`, and the `--html FILE` of the measuring commands: one
-//! self-contained HTML page of saved (or just measured) results.
+//! `brdfprof report RESULTS.json... --out report.html`: one self-contained HTML page of saved results (the
+//! measuring commands' `--html FILE`, `args::HtmlArg`, draws the same page of what they just measured).
 
-use super::DeviceArgs;
+use super::args::DeviceArgs;
 use anyhow::Result;
-use brdfprof::gpu::Gpu;
-use brdfprof::report_page::{self, Input};
+use brdfprof::report_page;
 use brdfprof::io;
 use clap::Args;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::ExitCode;
 
 #[derive(Args)]
@@ -25,33 +24,6 @@ pub struct ReportArgs {
     pub device: DeviceArgs,
 }
 
-/// `--html FILE`: the flag's help, shared by the commands that take it.
-#[derive(Args, Clone, Default)]
-pub struct HtmlArg {
-    /// Also write the results as one self-contained HTML page (as `brdfprof report` draws it).
-    #[arg(long, value_name = "FILE")]
-    pub html: Option<PathBuf>,
-}
-
-impl HtmlArg {
-    /// Refuses a bad path before anything is measured.
-    pub fn check(&self) -> Result<()> {
-        self.html.as_deref().map_or(Ok(()), |p| io::check_output_path("--html", p))
-    }
-
-    /// Writes the page of `inputs` (lobes and spheres on `gpu`) where asked; returns its path.
-    pub fn write(&self, inputs: &[Input], gpu: Option<&Gpu>) -> Result<Option<PathBuf>> {
-        let Some(path) = &self.html else { return Ok(None) };
-        let bytes = report_page::write(inputs, path, gpu)?;
-        brdfprof::messages::progress(format!("HTML report: {} ({bytes} bytes)", path.display()));
-        Ok(Some(path.clone()))
-    }
-}
-
-/// The report just measured, read back as its saved JSON would be.
-pub fn just_measured(json: &Path, report: &impl serde::Serialize) -> Result<Input> {
-    report_page::from_report(json, report)
-}
 
 pub fn report(args: &ReportArgs) -> Result<ExitCode> {
     io::check_output_path("--out", &args.out)?;

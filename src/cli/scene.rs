@@ -1,8 +1,8 @@
-//! `brdfprof scene` and `render` (`profile --scene` is in `measure`).
+//! `brdfprof scene`: a scene file checked, or the scene format explained (`render` draws a scene, `profile
+//! --scene` times it).
 
-use super::{on_device, written, DeviceArgs};
 use anyhow::{bail, Result};
-use brdfprof::{io, scene};
+use brdfprof::scene;
 use clap::Args;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -21,33 +21,5 @@ pub fn scene(args: &SceneArgs) -> Result<ExitCode> {
         (Some(f), false) => print!("{}", scene::check(f)?),
         (None, false) => bail!("give a scene file to check, or --explain"),
     }
-    Ok(ExitCode::SUCCESS)
-}
-
-#[derive(Args)]
-pub struct RenderArgs {
-    #[arg(long)]
-    pub scene: PathBuf,
-    #[arg(long)]
-    pub out: Option<PathBuf>,
-    #[command(flatten)]
-    pub device: DeviceArgs,
-}
-
-pub fn render(args: &RenderArgs) -> Result<ExitCode> {
-    let scene = scene::Scene::load(&args.scene)?;
-    let out = args.out.clone().unwrap_or_else(|| PathBuf::from("results/scenes").join(scene.name()));
-    io::check_output_dir(if args.out.is_some() { "--out" } else { "--out (default results/scenes/<scene name>)" }, &out)?;
-    if args.out.is_none() {
-        io::refuse_tracked_default("--out", &out, &["*".to_string()])?;
-    }
-    let (_, result) = on_device(&args.device, |gpu, progress| scene::render::render(gpu, &scene, &out, progress))?;
-    for n in &result.notes {
-        brdfprof::messages::note(n);
-    }
-    for w in &result.warnings {
-        brdfprof::messages::warning(w);
-    }
-    println!("{}", written(&result.files));
     Ok(ExitCode::SUCCESS)
 }

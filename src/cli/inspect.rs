@@ -1,49 +1,16 @@
-//! `brdfprof inspect` and `check`: instruction counts of the kernels, and the regression gate on them.
+//! `brdfprof inspect`: instruction counts of each model's shading kernel, on devices and compile-only targets.
 
-use super::{check_output, fresh_compilation, on_device_with, parse_size, DeviceArgs, ModelArgs};
+use super::args::{device_name, CountArgs, DeviceArgs, HtmlArg, ModelArgs};
+use super::{check_output, just_measured, on_device_with};
 use brdfprof::gpu::Gpu;
 use brdfprof::devices;
-use anyhow::{anyhow, bail, Result};
+use anyhow::{bail, Result};
 use brdfprof::brdf::THESIS_MODELS;
-use brdfprof::inspect::callgrind::CallgrindOptions;
-use brdfprof::check::{self, CheckOptions, Thresholds};
-use brdfprof::inspect::timing::TimingOptions;
 use brdfprof::inspect::{self, InspectOptions};
-use brdfprof::shaders::Shaders;
 use brdfprof::{io, results};
 use clap::Args;
 use std::path::PathBuf;
 use std::process::ExitCode;
-
-/// What `inspect` and `check` share: the kernels measured and how.
-#[derive(Args, Clone)]
-pub struct CountArgs {
-    /// Directional lights per pixel (default 8; `check` defaults to the baseline's).
-    #[arg(long)]
-    pub lights: Option<u32>,
-    /// Compile the kernels from this GLSL directory (a copy of glsl/, with its kernels.txt) with glslang
-    /// instead of using the embedded SPIR-V.
-    #[arg(long)]
-    pub glsl: Option<PathBuf>,
-    /// Skip the callgrind run.
-    #[arg(long)]
-    pub no_callgrind: bool,
-    /// G-buffer of the callgrind dispatch, WIDTHxHEIGHT.
-    #[arg(long, default_value = "64x64")]
-    pub callgrind_size: String,
-}
-
-impl CountArgs {
-    fn shaders(&self) -> Result<Shaders> {
-        self.glsl.as_deref().map_or_else(|| Ok(Shaders::embedded()), Shaders::from_glsl)
-    }
-
-    /// How to run the callgrind child (None: --no-callgrind); it inherits validation from the parent.
-    fn callgrind(&self, validate: bool) -> Result<Option<CallgrindOptions>> {
-        let (width, height) = parse_size("--callgrind-size", &self.callgrind_size)?;
-        Ok((!self.no_callgrind).then_some(CallgrindOptions { width, height, device: None, validate }))
-    }
-}
 
 #[derive(Args)]
 pub struct InspectArgs {
@@ -77,7 +44,7 @@ pub struct InspectArgs {
     /// (`radv:FAMILY`: Mesa RADV's compiler for an AMD family; `nvidia:FAMILY`: NVIDIA's compiler for a compute
     /// capability; `intel:FAMILY`: Intel's IGC for a GPU generation; `PREFIX:all` for the default set; see `devices --targets`). Default: the first discrete or
     /// integrated GPU, else lavapipe.
-    #[arg(long = "device", value_name = "DEVICE", value_parser = super::device_name)]
+    #[arg(long = "device", value_name = "DEVICE", value_parser = device_name)]
     pub devices: Vec<String>,
     /// Run under the Khronos validation layer and fail on any message (also BRDFPROF_VALIDATION=1).
     #[arg(long)]
@@ -96,7 +63,7 @@ pub struct InspectArgs {
     #[arg(long)]
     pub lines: bool,
     #[command(flatten)]
-    pub html: super::report::HtmlArg,
+    pub html: HtmlArg,
 }
 
 pub fn inspect(args: &InspectArgs) -> Result<ExitCode> {
@@ -146,7 +113,7 @@ pub fn inspect(args: &InspectArgs) -> Result<ExitCode> {
     let markdown = args.markdown.clone().unwrap_or_else(|| PathBuf::from(format!("results/{stem}.md")));
     let value = result.json_value()?;
     results::write_json(&json, &value)?;
-    let input = super::report::just_measured(&json, &value)?;
+    let input = just_measured(&json, &value)?;
     if args.html.html.is_some() {
         // The lobes and spheres are drawn on the default local device (the inspected ones may only compile).
         let gpu = DeviceArgs { device: None, validate }.open()?;
@@ -160,70 +127,4 @@ pub fn inspect(args: &InspectArgs) -> Result<ExitCode> {
     print!("{}", result.markdown);
     println!("JSON: {}\nMarkdown: {}{}", json.display(), markdown.display(), args.chart.as_ref().map_or(String::new(), |c| format!("\nChart: {}", c.display())));
     Ok(ExitCode::SUCCESS)
-}
-
-#[derive(Args)]
-pub struct CheckArgs {
-    /// Baseline to compare with (from `check --save-baseline`).
-    #[arg(long)]
-    pub baseline: Option<PathBuf>,
-    /// Write this run as a baseline (atomically), whatever the comparison found.
-    #[arg(long)]
-    pub save_baseline: Option<PathBuf>,
-    /// Regression threshold of a statistic or a section, e.g. spirv/total=0.02, callgrind=0.005, timing=0.1
-    /// (defaults: 0.01 for counts, 0.05 for timings).
-    #[arg(long = "threshold")]
-    pub thresholds: Vec<String>,
-    /// Compare timings and callgrind counts even when the baseline comes from another environment.
-    #[arg(long)]
-    pub force: bool,
-    /// Models (default: the baseline's, else the thesis models).
-    #[command(flatten)]
-    pub model: ModelArgs,
-    #[command(flatten)]
-    pub counts: CountArgs,
-    /// Interleaved timing rounds (at least 9 for the significance test; 0 skips timing).
-    #[arg(long, default_value_t = 15)]
-    pub rounds: usize,
-    /// Timed dispatches of each kernel per round.
-    #[arg(long, default_value_t = 3)]
-    pub reps: usize,
-    /// G-buffer of the timing run, WIDTHxHEIGHT.
-    #[arg(long, default_value = "960x540")]
-    pub timing_size: String,
-    /// Keep Mesa's on-disk shader cache (timed runs switch it off by default; see `fresh_compilation`).
-    #[arg(long)]
-    pub shader_cache: bool,
-    #[command(flatten)]
-    pub device: DeviceArgs,
-}
-
-pub fn check(args: &CheckArgs) -> Result<ExitCode> {
-    if let Some(p) = &args.save_baseline {
-        io::check_output_path("--save-baseline", p)?;
-    }
-    fresh_compilation(args.shader_cache);
-    let (width, height) = parse_size("--timing-size", &args.timing_size)?;
-    let options = CheckOptions {
-        baseline: args.baseline.clone(),
-        save: args.save_baseline.clone(),
-        thresholds: Thresholds::parse(&args.thresholds)?,
-        force: args.force,
-        models: args.model.models(&[]).map_err(|e| anyhow!("{e:#}"))?,
-        lights: args.counts.lights,
-        callgrind: args.counts.callgrind(args.device.validation())?,
-        timing: TimingOptions { width, height, lights: 0, rounds: args.rounds, reps: args.reps, seed: 1 },
-    };
-    let shaders = args.counts.shaders()?;
-    let outcome = match args.device.device.as_deref().map(brdfprof::targets::parse).transpose()?.flatten() {
-        Some(ts) if ts.len() == 1 => {
-            // A target that compiles a translation checks it against the default device first.
-            let verify = if ts[0].vendor.needs_verification() { Some(DeviceArgs { device: None, validate: args.device.validate }.open()?) } else { None };
-            check::run_target(&options, &shaders, ts[0], args.device.validation(), verify.as_ref())?
-        }
-        Some(_) => bail!("--device {}: check compares one family with its baseline; give one target, e.g. radv:navi21", args.device.device.as_deref().unwrap_or_default()),
-        None => check::run(&options, &shaders, || args.device.open_with(true))?,
-    };
-    print!("{}", outcome.text);
-    Ok(ExitCode::from(outcome.exit))
 }
