@@ -3,7 +3,8 @@
 //! and, with `--profile`, a profile's measured costs beside them.
 
 use crate::inspect::correlate::{self, ProfileReport};
-use crate::inspect::{InspectOptions, InspectReport};
+use crate::inspect::InspectOptions;
+use crate::schema::InspectReport;
 use crate::compare::{self, CostTable};
 use crate::gpu::Gpu;
 use crate::shaders::Shaders;

@@ -23,6 +23,7 @@ pub mod kernels;
 pub mod model;
 pub mod profile;
 pub mod results;
+pub mod schema;
 pub mod shaders;
 pub mod spirv;
 pub mod stability;

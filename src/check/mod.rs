@@ -149,7 +149,7 @@ fn run_measured(options: &CheckOptions, measure: impl FnOnce(Vec<Model>, u32) ->
 mod tests {
     use super::*;
     use crate::inspect::timing::TimingRun;
-    use crate::inspect::{InspectReport, Row};
+    use crate::schema::{InspectReport, Row};
     use crate::results;
     use std::collections::BTreeMap;
     use std::path::Path;

@@ -6,12 +6,13 @@
 //! (`THROUGHPUT`, the one place those figures live). These are "Intel's OpenCL compiler (IGC), same maths" figures: Mesa's ANV, Intel's Vulkan driver on
 //! Linux, compiles SPIR-V with its own compiler (brw); Intel's Windows Vulkan driver uses IGC.
 
-use super::cost::{self, TargetCost};
+use super::cost;
+use crate::schema::cost::TargetCost;
 use super::{ocloc, Request, Run, Target};
 use super::gen_isa;
 use crate::gpu::DriverStat;
-use crate::inspect::schedule::{Schedule, LATENCY, PIPE_PREFIX, RESIDENT_WAVES};
-use crate::inspect::InspectReport;
+use super::cost::schedule::{Schedule, LATENCY, PIPE_PREFIX, RESIDENT_WAVES};
+use crate::schema::InspectReport;
 use anyhow::{anyhow, bail, Result};
 use std::collections::BTreeMap;
 
@@ -396,7 +397,7 @@ impl IsaStats {
         if self.grf > 128 { family.threads / 2 } else { family.threads }
     }
 
-    /// The statistics as driver statistics of the executable "IGC" (names lined up with `inspect::driver`'s
+    /// The statistics as driver statistics of the executable "IGC" (names lined up with `schema::driver`'s
     /// aliases, so that the gate reads registers, instructions, spills and code size as for any driver).
     pub fn driver_stats(&self, family: &Family) -> Result<Vec<DriverStat>> {
         let stat = |name: &str, value: f64| DriverStat { executable: "IGC".into(), name: name.into(), description: String::new(), value };
@@ -494,8 +495,8 @@ pub fn inspect(families: &[&Family], req: &Request) -> Result<Vec<InspectReport>
 /// its pipes (`pipe_cycles`), its schedule cycles (the wait for its registers and pipe, and its issue cycle in
 /// `IsaStats::schedule_latency`'s schedule), summed per line; the translation's own lines and IGC's prologue
 /// name none. Lines are ranked on the pipe that binds the kernel.
-pub fn line_costs(model: &str, binary: &ocloc::Binary, family: &Family) -> Result<crate::inspect::lines::KernelLines> {
-    use crate::inspect::lines::{per_line, Attributed};
+pub fn line_costs(model: &str, binary: &ocloc::Binary, family: &Family) -> Result<crate::schema::lines::KernelLines> {
+    use super::cost::lines::{per_line, Attributed};
     let stats = IsaStats::of(binary, family)?;
     let listing = binary.lines_listings.get(&stats.simd).ok_or_else(|| anyhow!("IGC's shader dump has no SIMD{} listing (it has {:?})", stats.simd, binary.lines_listings.keys().collect::<Vec<_>>()))?;
     let sourced = gen_isa::sourced_instructions(listing, family.grf_bytes);
@@ -522,7 +523,7 @@ pub fn line_costs(model: &str, binary: &ocloc::Binary, family: &Family) -> Resul
 
 /// Every checked translation compiled for each family, its statistics added to its row (`statics`, in the
 /// same order), as one report per family.
-fn compile_checked(families: &[&Family], statics: Vec<crate::inspect::Row>, checked: &[super::Checked], tools: &ocloc::Tools, req: &Request) -> Result<Vec<InspectReport>> {
+fn compile_checked(families: &[&Family], statics: Vec<crate::schema::Row>, checked: &[super::Checked], tools: &ocloc::Tools, req: &Request) -> Result<Vec<InspectReport>> {
     let jobs: Vec<(usize, usize)> = (0..families.len()).flat_map(|f| (0..checked.len()).map(move |k| (f, k))).collect();
     // Each job is an ocloc process: one per core.
     use rayon::prelude::*;
@@ -544,7 +545,7 @@ fn compile_checked(families: &[&Family], statics: Vec<crate::inspect::Row>, chec
                 }
             };
             let stats = IsaStats::of(binary, family)?;
-            row.stats.extend(crate::inspect::driver::stats(&stats.driver_stats(family)?));
+            row.stats.extend(crate::schema::driver::stats(&stats.driver_stats(family)?));
             row.notes.insert("translation".into(), checked[k].agreement.clone());
             if let Some(dir) = req.isa_dir {
                 write_isa(dir, family, &row.model, &checked[k].source, binary, &tools.version)?;
@@ -573,7 +574,7 @@ fn write_isa(dir: &std::path::Path, family: &Family, label: &str, source: &str, 
     crate::io::write_output(&dir.join(format!("{stem}.asm")), format!("{header}{}", binary.listing).as_bytes())
 }
 
-fn report(family: &Family, rows: Vec<crate::inspect::Row>, tools: &ocloc::Tools, req: &Request) -> InspectReport {
+fn report(family: &Family, rows: Vec<crate::schema::Row>, tools: &ocloc::Tools, req: &Request) -> InspectReport {
     let options = options(req.precise);
     let compilation = super::Compilation {
         target: format!("intel:{}", family.name),
@@ -638,7 +639,7 @@ impl super::Vendor for Intel {
             family: Some(family.name.to_string()),
             architecture: Some(family.architecture.to_string()),
             compiler: "IGC".into(),
-            model: format!("{}; a thread's pipes at THROUGHPUT's lanes per clock (Intel's documents; extended math: IGC's scheduling model), its latency in IGC's instruction order at IGC's scheduler latencies, threads per EU from the registers; / (SIMD width x lights per kernel); Issue Cycles: the old serial sum", crate::inspect::schedule::RULE),
+            model: format!("{}; a thread's pipes at THROUGHPUT's lanes per clock (Intel's documents; extended math: IGC's scheduling model), its latency in IGC's instruction order at IGC's scheduler latencies, threads per EU from the registers; / (SIMD width x lights per kernel); Issue Cycles: the old serial sum", super::cost::schedule::RULE),
             unit: "EU cycles".into(),
             lights_per_kernel: 0,
             columns: SHOWN.iter().map(|s| s.to_string()).collect(),

@@ -16,7 +16,8 @@
 //! (Mesa 22.3 RADV's vkDeviceWaitIdle calls through a null pointer there), and a child that still crashes after
 //! printing its complete report is accepted with a note, so the user gets the report and exit 0.
 
-use crate::inspect::{InspectOptions, InspectReport};
+use crate::inspect::InspectOptions;
+use crate::schema::InspectReport;
 use crate::cleanup;
 use crate::gpu::{CompilerLog, Gpu, GpuOptions, Kernel};
 use crate::model::Model;
@@ -218,12 +219,12 @@ fn raw_report(gpu: &Gpu, shaders: &Shaders, req: &NoopRequest, target: &str, isa
         let bytes = crate::io::read_bounded(&r.path, crate::launch::MAX_OUTPUT_BYTES as u64).with_context(|| format!("the {target} child cannot read {}", r.path.display()))?;
         let words: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes);
         let kernel = Kernel::with_capture(gpu, &r.label, &words, &Default::default(), &crate::gpu::Binding::storage(r.storage_buffers), r.push_bytes, isa_dir.is_some())?;
-        let mut row = crate::inspect::Row { model: r.label.clone(), spec: None, stats: Default::default(), notes: Default::default() };
+        let mut row = crate::schema::Row { model: r.label.clone(), spec: None, stats: Default::default(), notes: Default::default() };
         let executables = kernel.executables()?.ok_or_else(|| anyhow!("{} reports no pipeline statistics", gpu.info.name))?;
         if let Some(dir) = isa_dir {
             isa_files.extend(write_representations(gpu, &executables, &r.label, dir)?);
         }
-        row.stats.extend(crate::inspect::driver::executable_stats(executables));
+        row.stats.extend(crate::schema::driver::executable_stats(executables));
         rows.push(row);
     }
     let provenance = serde_json::to_value(crate::results::Provenance::new(&gpu.info))?;

@@ -9,7 +9,7 @@
 //! statistics depend on (the gate's fingerprint). Kernels from outside the model set (a scene's kernels) reach
 //! the same compilers as `RawKernel`s (`compile_raw_all`).
 
-pub use crate::inspect::cost;
+pub mod cost;
 pub mod aco_perfinfo;
 pub mod gen_isa;
 pub mod intel;
@@ -28,11 +28,11 @@ pub mod sass;
 pub mod shim;
 
 use crate::gpu::Gpu;
-use crate::inspect::InspectReport;
+use crate::schema::InspectReport;
 use crate::model::Model;
 use crate::shaders::Shaders;
 use anyhow::{anyhow, bail, Result};
-use cost::TargetCost;
+use crate::schema::cost::TargetCost;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
@@ -268,12 +268,12 @@ pub fn compile_raw_all(targets: &[Target], kernels: &[RawKernel], request: &Requ
 
 /// The rows (label, the agreement as the note) and the `dialect` sources of raw kernels, for a vendor that
 /// compiles their translations.
-pub(crate) fn raw_translations(vendor: &dyn Vendor, kernels: &[RawKernel], dialect: crate::translate::Dialect) -> Result<(Vec<crate::inspect::Row>, Vec<Checked>)> {
+pub(crate) fn raw_translations(vendor: &dyn Vendor, kernels: &[RawKernel], dialect: crate::translate::Dialect) -> Result<(Vec<crate::schema::Row>, Vec<Checked>)> {
     let mut rows = Vec::new();
     let mut checked = Vec::new();
     for k in kernels {
         let t = k.translation.as_ref().ok_or_else(|| anyhow!("{}: {} compiles the kernel's translation, and none was checked", k.label, vendor.prefix()))?;
-        rows.push(crate::inspect::Row { model: k.label.clone(), spec: Some(k.model.canonical()), stats: BTreeMap::new(), notes: [("translation".to_string(), t.agreement.clone())].into() });
+        rows.push(crate::schema::Row { model: k.label.clone(), spec: Some(k.model.canonical()), stats: BTreeMap::new(), notes: [("translation".to_string(), t.agreement.clone())].into() });
         checked.push(Checked { source: t.translation.source(dialect), agreement: t.agreement.clone() });
     }
     Ok((rows, checked))
@@ -321,7 +321,7 @@ pub(crate) fn add_lines<F>(reports: &mut [InspectReport], families: &[&F], req: 
 /// A model's line costs and the instruction sequences (one entry per instruction: its opcode and what the
 /// vendor's listing says of its width and type) of the costed compile and of the line-annotated one.
 pub(crate) struct LineCompile {
-    pub lines: crate::inspect::lines::KernelLines,
+    pub lines: crate::schema::lines::KernelLines,
     pub costed: Vec<String>,
     pub annotated: Vec<String>,
 }
@@ -402,7 +402,7 @@ pub(crate) struct Compilation {
 
 /// The inspect report of a target that compiles the kernels' C translation: provenance, notes (callgrind does
 /// not apply: nothing executes), the rows and the vendor's cost table.
-pub(crate) fn translated_report(vendor: &dyn Vendor, c: Compilation, rows: Vec<crate::inspect::Row>, req: &Request) -> InspectReport {
+pub(crate) fn translated_report(vendor: &dyn Vendor, c: Compilation, rows: Vec<crate::schema::Row>, req: &Request) -> InspectReport {
     let provenance = serde_json::json!({
         "tool": format!("brdfprof {}", env!("CARGO_PKG_VERSION")),
         "device": c.device,

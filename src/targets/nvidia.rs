@@ -6,11 +6,12 @@
 //! maths" figures: NVIDIA's Vulkan driver compiles SPIR-V with its own front end, and no public comparison of
 //! the two exists.
 
-use super::cost::{self, TargetCost};
+use super::cost;
+use crate::schema::cost::TargetCost;
 use super::{nvrtc, Request, Run, Target};
-use crate::inspect::InspectReport;
+use crate::schema::InspectReport;
 use crate::gpu::DriverStat;
-use crate::inspect::schedule::{Schedule, LATENCY, PIPE_PREFIX, RESIDENT_WAVES};
+use super::cost::schedule::{Schedule, LATENCY, PIPE_PREFIX, RESIDENT_WAVES};
 use anyhow::{bail, Result};
 use std::collections::BTreeMap;
 
@@ -309,7 +310,7 @@ impl SassStats {
     }
 
     /// The statistics as driver statistics of the executable "SASS" (their names line up with the aliases
-    /// of `inspect::driver`, so that the gate reads registers, instructions, spills and code size as for any
+    /// of `schema::driver`, so that the gate reads registers, instructions, spills and code size as for any
     /// driver).
     pub fn driver_stats(&self, family: &Family) -> Result<Vec<DriverStat>> {
         let stat = |name: &str, value: f64| DriverStat { executable: "SASS".into(), name: name.into(), description: String::new(), value };
@@ -418,8 +419,8 @@ pub fn inspect(families: &[&Family], req: &Request) -> Result<Vec<InspectReport>
 /// Cost per source line of a kernel compiled with line information (`compile_as` with `lines`): each SASS
 /// instruction on its pipe at its row's rate and its issue slot, its schedule cycles (the scoreboard wait before
 /// it and its stall), summed per line; the translation's own lines and NVRTC's prologue name none.
-pub fn line_costs(model: &str, sass: &Sass, family: &Family) -> Result<crate::inspect::lines::KernelLines> {
-    use crate::inspect::lines::{per_line, Attributed};
+pub fn line_costs(model: &str, sass: &Sass, family: &Family) -> Result<crate::schema::lines::KernelLines> {
+    use super::cost::lines::{per_line, Attributed};
     let instructions = super::sass::instructions(&sass.listing)?;
     let stats = SassStats::of(&sass.listing, &sass.log, sass.cubin_bytes)?;
     let binding = stats.pipes(family)?.into_iter().fold(("-".to_string(), f64::NEG_INFINITY), |b, p| if p.1 > b.1 { p } else { b }).0;
@@ -444,7 +445,7 @@ pub fn line_costs(model: &str, sass: &Sass, family: &Family) -> Result<crate::in
 
 /// Every checked translation compiled for each family, its statistics added to its row (`statics`, in the
 /// same order), as one report per family.
-fn compile_checked(families: &[&Family], statics: Vec<crate::inspect::Row>, checked: &[super::Checked], tools: &nvrtc::Tools, req: &Request) -> Result<Vec<InspectReport>> {
+fn compile_checked(families: &[&Family], statics: Vec<crate::schema::Row>, checked: &[super::Checked], tools: &nvrtc::Tools, req: &Request) -> Result<Vec<InspectReport>> {
     let jobs: Vec<(usize, usize)> = (0..families.len()).flat_map(|f| (0..checked.len()).map(move |k| (f, k))).collect();
     // NVRTC compiles distinct programs concurrently (its API is thread-safe); one job per core.
     use rayon::prelude::*;
@@ -456,7 +457,7 @@ fn compile_checked(families: &[&Family], statics: Vec<crate::inspect::Row>, chec
         for (k, row) in rows.iter_mut().enumerate() {
             let sass = &compiled[f * checked.len() + k];
             let stats = SassStats::of(&sass.listing, &sass.log, sass.cubin_bytes)?;
-            row.stats.extend(crate::inspect::driver::stats(&stats.driver_stats(family)?));
+            row.stats.extend(crate::schema::driver::stats(&stats.driver_stats(family)?));
             row.notes.insert("translation".into(), checked[k].agreement.clone());
             if let Some(dir) = req.isa_dir {
                 write_isa(dir, family, &row.model, &checked[k].source, sass)?;
@@ -476,7 +477,7 @@ fn write_isa(dir: &std::path::Path, family: &Family, label: &str, source: &str, 
     crate::io::write_output(&dir.join(format!("{stem}.sass")), format!("// {label}: SASS for {} by {}\n{}\n{}", family.name, nvrtc::tools()?.version, sass.log.trim(), sass.listing).as_bytes())
 }
 
-fn report(family: &Family, rows: Vec<crate::inspect::Row>, tools: &nvrtc::Tools, req: &Request) -> InspectReport {
+fn report(family: &Family, rows: Vec<crate::schema::Row>, tools: &nvrtc::Tools, req: &Request) -> InspectReport {
     let options = options(family, req.precise).join(" ");
     let compilation = super::Compilation {
         target: format!("nvidia:{}", family.name),
@@ -543,7 +544,7 @@ impl super::Vendor for Nvidia {
             family: Some(family.name.to_string()),
             architecture: Some(family.architecture.to_string()),
             compiler: "ptxas".into(),
-            model: format!("{}; a warp's pipes at the CUDA guide's throughputs (Nsight Compute's pipe assignment), its latency by ptxas' stall counts and scoreboards, warps per SM from the registers; / (32 x lights per kernel); Issue Cycles: the old serial sum", crate::inspect::schedule::RULE),
+            model: format!("{}; a warp's pipes at the CUDA guide's throughputs (Nsight Compute's pipe assignment), its latency by ptxas' stall counts and scoreboards, warps per SM from the registers; / (32 x lights per kernel); Issue Cycles: the old serial sum", super::cost::schedule::RULE),
             unit: "SM cycles".into(),
             lights_per_kernel: 0,
             columns: SHOWN.iter().map(|s| s.to_string()).collect(),

@@ -2,11 +2,11 @@
 //! variable that picks the GPU, the families, and the driver's cost rule. `adreno.rs`, `mali.rs` and `anv.rs`
 //! are one `Shim` each; the child process, its environment checks and crash handling are `mesa_noop`'s.
 
-use super::cost::TargetCost;
+use crate::schema::cost::TargetCost;
 use super::mesa_noop::{self, NoopDriver};
 use super::{Family, Request, Run, Vendor};
 use crate::gpu::CompilerLog;
-use crate::inspect::InspectReport;
+use crate::schema::InspectReport;
 use anyhow::Result;
 use std::collections::BTreeMap;
 

@@ -5,7 +5,7 @@
 //! that binds, and a branch weight or a translation artefact cannot reverse it.
 
 use crate::compile_only::inspect_json;
-use brdfprof::inspect::schedule::Schedule;
+use brdfprof::targets::cost::schedule::Schedule;
 use brdfprof::targets::radv_families::FAMILIES as AMD;
 
 const PAIRS: [(&str, &str); 3] = [("base", "plus-sqrt"), ("base", "plus-division"), ("mul5", "pow5")];
