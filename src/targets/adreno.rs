@@ -15,7 +15,7 @@
 use super::cost;
 use crate::schema::cost::TargetCost;
 use super::mesa_noop::{MESA_25_UNVALIDATED, MESA_BACKPORTS, MESA_DEBIAN};
-use super::shim::{Shim, ShimFamily};
+use super::mesa_noop::shim::{Shim, ShimFamily};
 use crate::schema::InspectReport;
 
 /// The statistics shown beside cycles/eval (Turnip's names).

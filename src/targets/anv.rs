@@ -11,7 +11,7 @@
 
 use super::cost;
 use crate::schema::cost::TargetCost;
-use super::shim::{Shim, ShimFamily};
+use super::mesa_noop::shim::{Shim, ShimFamily};
 use crate::schema::InspectReport;
 
 /// The statistics shown beside cycles/eval (ANV's names).

@@ -9,23 +9,14 @@
 //! statistics depend on (the gate's fingerprint). Kernels from outside the model set (a scene's kernels) reach
 //! the same compilers as `RawKernel`s (`compile_raw_all`).
 
-pub mod cost;
-pub mod aco_perfinfo;
-pub mod gen_isa;
-pub mod intel;
-pub mod nvidia;
-pub mod nvrtc;
-pub mod ocloc;
 pub mod adreno;
 pub mod anv;
+pub mod cost;
+pub mod intel;
 pub mod mali;
 pub mod mesa_noop;
-pub mod noop_cache;
+pub mod nvidia;
 pub mod radv;
-pub mod radv_env;
-pub mod radv_families;
-pub mod sass;
-pub mod shim;
 
 use crate::gpu::Gpu;
 use crate::schema::InspectReport;
@@ -354,7 +345,7 @@ pub fn inspect_device(gpu: &Gpu, shaders: &Shaders, options: &crate::inspect::In
 /// A lower-case file-name-safe form of a device name ("llvmpipe (LLVM 15.0.6, 256 bits)" -> "llvmpipe").
 pub fn device_slug(device: &crate::gpu::DeviceInfo) -> String {
     // RADV's compile-only devices are all "Null hardware (RADV <FAMILY>)": the family tells them apart.
-    if let Some(t) = radv_families::family_of_device(&device.name) {
+    if let Some(t) = radv::families::family_of_device(&device.name) {
         return format!("radv-{}", t.family);
     }
     crate::results::name_slug(&device.name)

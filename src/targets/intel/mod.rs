@@ -6,10 +6,12 @@
 //! (`THROUGHPUT`, the one place those figures live). These are "Intel's OpenCL compiler (IGC), same maths" figures: Mesa's ANV, Intel's Vulkan driver on
 //! Linux, compiles SPIR-V with its own compiler (brw); Intel's Windows Vulkan driver uses IGC.
 
+pub mod gen_isa;
+pub mod ocloc;
+
 use super::cost;
 use crate::schema::cost::TargetCost;
-use super::{ocloc, Request, Run, Target};
-use super::gen_isa;
+use super::{Request, Run, Target};
 use crate::gpu::DriverStat;
 use super::cost::schedule::{Schedule, LATENCY, PIPE_PREFIX, RESIDENT_WAVES};
 use crate::schema::InspectReport;
@@ -183,7 +185,7 @@ fn latency(i: &gen_isa::Instruction, family: &Family) -> f64 {
     let class = classify(&i.mnemonic);
     let two_source = TWO_SOURCE_FUNCTIONS.contains(&i.function.as_str());
     if class == Class::Send {
-        return super::sass::MEMORY.cycles;
+        return super::nvidia::sass::MEMORY.cycles;
     }
     if family.legacy_latency {
         return match class {
@@ -720,7 +722,7 @@ mod throughput_fixture {
     }
 
     fn fixture() -> Vec<Entry> {
-        include_str!("../../tests/fixtures/intel-throughput.tsv")
+        include_str!("../../../tests/fixtures/intel-throughput.tsv")
             .lines()
             .filter(|l| !l.starts_with('#') && !l.trim().is_empty())
             .map(|l| {
@@ -760,7 +762,7 @@ mod throughput_fixture {
     #[test]
     fn every_rate_is_the_fixtures_computed_from_its_cited_figures() {
         let rows = fixture();
-        let header = include_str!("../../tests/fixtures/intel-throughput.tsv");
+        let header = include_str!("../../../tests/fixtures/intel-throughput.tsv");
         for e in &rows {
             let what = format!("{} on {}", e.row, e.family);
             assert!(["stated", "derived"].contains(&e.basis.as_str()), "{what}: basis `{}` (a rate is the source's figure or computed from it)", e.basis);

@@ -3,8 +3,8 @@
 //! are one `Shim` each; the child process, its environment checks and crash handling are `mesa_noop`'s.
 
 use crate::schema::cost::TargetCost;
-use super::mesa_noop::{self, NoopDriver};
-use super::{Family, Request, Run, Vendor};
+use super::NoopDriver;
+use crate::targets::{mesa_noop, Family, Request, Run, Vendor};
 use crate::gpu::CompilerLog;
 use crate::schema::InspectReport;
 use anyhow::Result;
@@ -124,7 +124,7 @@ impl Vendor for Shim {
         mesa_noop::compile(self.prefix, families, &[], request)
     }
 
-    fn compile_raw(&self, families: &[usize], kernels: &[super::RawKernel], request: &Request) -> Result<Vec<Run>> {
+    fn compile_raw(&self, families: &[usize], kernels: &[crate::targets::RawKernel], request: &Request) -> Result<Vec<Run>> {
         if kernels.is_empty() {
             anyhow::bail!("{}: no raw kernel to compile", self.prefix);
         }

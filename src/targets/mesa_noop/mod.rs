@@ -16,6 +16,9 @@
 //! (Mesa 22.3 RADV's vkDeviceWaitIdle calls through a null pointer there), and a child that still crashes after
 //! printing its complete report is accepted with a note, so the user gets the report and exit 0.
 
+pub mod cache;
+pub mod shim;
+
 use crate::inspect::InspectOptions;
 use crate::schema::InspectReport;
 use crate::cleanup;
@@ -266,7 +269,7 @@ fn write_representations(gpu: &Gpu, executables: &[crate::gpu::PipelineExecutabl
 
 /// What every child of one `compile` is asked (the parts of a `Request` a child reads).
 struct Job<'a> {
-    /// The shared part of every child's cache key (`noop_cache::request_digest`); None: no child is cached.
+    /// The shared part of every child's cache key (`cache::request_digest`); None: no child is cached.
     cache_digest: Option<String>,
     lights: u32,
     shaders: &'a Shaders,
@@ -296,7 +299,7 @@ fn run(driver: &'static dyn NoopDriver, family: usize, models: &[Model], raw: &[
     let name = Target { vendor: driver, family }.name();
     // The driver's environment first: a driver that is not built stops here, naming what to run.
     let environment = driver.environment(family)?;
-    let key = request.cache_digest.as_deref().map(|digest| super::noop_cache::key(digest, &name, &environment, request.validate));
+    let key = request.cache_digest.as_deref().map(|digest| cache::key(digest, &name, &environment, request.validate));
     let Some(key) = key else {
         let (run, messages) = spawn(driver, family, models, raw, request, environment)?;
         messages.iter().for_each(|m| crate::messages::line(m));
@@ -313,7 +316,7 @@ fn run(driver: &'static dyn NoopDriver, family: usize, models: &[Model], raw: &[
     };
     let mut teardown_note = None;
     let mut built = false;
-    let bytes = crate::cache::get_or_build(store.as_ref(), super::noop_cache::KIND, &key, &what, valid, || {
+    let bytes = crate::cache::get_or_build(store.as_ref(), cache::KIND, &key, &what, valid, || {
         let (run, messages) = spawn(driver, family, models, raw, request, environment)?;
         teardown_note = run.teardown_note;
         built = true;
@@ -322,7 +325,7 @@ fn run(driver: &'static dyn NoopDriver, family: usize, models: &[Model], raw: &[
     let mut cached: CachedChild = serde_json::from_slice(&bytes)?;
     cached.messages.iter().for_each(|m| crate::messages::line(m));
     if let (false, Some(store)) = (built, &store) {
-        cached.report.provenance["cache_entry"] = serde_json::Value::String(store.path(super::noop_cache::KIND, &key).display().to_string());
+        cached.report.provenance["cache_entry"] = serde_json::Value::String(store.path(cache::KIND, &key).display().to_string());
     }
     Ok(ChildRun { report: cached.report, isa_files: Vec::new(), teardown_note })
 }
@@ -414,7 +417,7 @@ pub fn compile(prefix: &str, families: &[usize], raw: &[super::RawKernel], reque
     // report is cached under a key whose kernels' part is computed once here, for every family.
     let cache_digest = match request.isa_dir.is_some() || std::env::var_os(CRASH_AFTER_REPLY).is_some() {
         true => None,
-        false => Some(super::noop_cache::request_digest(models, raw, request.lights, request.validate, request.shaders)?),
+        false => Some(cache::request_digest(models, raw, request.lights, request.validate, request.shaders)?),
     };
     let request = &Job { lights: request.lights, shaders: request.shaders, validate: request.validate, isa_dir: request.isa_dir, cache_digest };
     let workers = std::thread::available_parallelism().map_or(1, |n| n.get()).min(families.len()).max(1);

@@ -6,9 +6,12 @@
 //! maths" figures: NVIDIA's Vulkan driver compiles SPIR-V with its own front end, and no public comparison of
 //! the two exists.
 
+pub mod nvrtc;
+pub mod sass;
+
 use super::cost;
 use crate::schema::cost::TargetCost;
-use super::{nvrtc, Request, Run, Target};
+use super::{Request, Run, Target};
 use crate::schema::InspectReport;
 use crate::gpu::DriverStat;
 use super::cost::schedule::{Schedule, LATENCY, PIPE_PREFIX, RESIDENT_WAVES};
@@ -246,8 +249,8 @@ impl SassStats {
     /// Counts the `-hex` listing: every instruction up to the kernel's last EXIT (nvdisasm pads the section
     /// with a branch to itself and NOPs after it), NOPs left out of the counts (not of the schedule).
     pub fn of(listing: &str, ptxas_log: &str, cubin_bytes: usize) -> Result<Self> {
-        let instructions = super::sass::instructions(listing)?;
-        let mut s = SassStats { cubin_bytes: cubin_bytes as u32, schedule_latency: super::sass::schedule_latency(&instructions), ..Default::default() };
+        let instructions = sass::instructions(listing)?;
+        let mut s = SassStats { cubin_bytes: cubin_bytes as u32, schedule_latency: sass::schedule_latency(&instructions), ..Default::default() };
         for i in instructions.iter().filter(|i| i.mnemonic() != "NOP") {
             let (class, row, pipe) = classify(&i.opcode);
             s.instructions += 1;
@@ -410,7 +413,7 @@ pub fn inspect(families: &[&Family], req: &Request) -> Result<Vec<InspectReport>
     let mut reports = compile_checked(families, statics, &checked, tools, req)?;
     super::add_lines(&mut reports, families, req, &checked, crate::translate::Dialect::Cuda, |m, source, costed, family| {
         let sass = compile_as(source, family, req.precise, true)?;
-        let opcodes = |listing: &str| -> Result<Vec<String>> { Ok(super::sass::instructions(listing)?.into_iter().map(|i| i.opcode).collect()) };
+        let opcodes = |listing: &str| -> Result<Vec<String>> { Ok(sass::instructions(listing)?.into_iter().map(|i| i.opcode).collect()) };
         Ok(super::LineCompile { lines: line_costs(&m.label(), &sass, family)?, costed: opcodes(&compile(costed, family, req.precise)?.listing)?, annotated: opcodes(&sass.listing)? })
     })?;
     Ok(reports)
@@ -421,10 +424,10 @@ pub fn inspect(families: &[&Family], req: &Request) -> Result<Vec<InspectReport>
 /// it and its stall), summed per line; the translation's own lines and NVRTC's prologue name none.
 pub fn line_costs(model: &str, sass: &Sass, family: &Family) -> Result<crate::schema::lines::KernelLines> {
     use super::cost::lines::{per_line, Attributed};
-    let instructions = super::sass::instructions(&sass.listing)?;
+    let instructions = sass::instructions(&sass.listing)?;
     let stats = SassStats::of(&sass.listing, &sass.log, sass.cubin_bytes)?;
     let binding = stats.pipes(family)?.into_iter().fold(("-".to_string(), f64::NEG_INFINITY), |b, p| if p.1 > b.1 { p } else { b }).0;
-    let times = super::sass::issue_times(&instructions);
+    let times = sass::issue_times(&instructions);
     let mut attributed = Vec::new();
     let mut previous_end = 0.0;
     for (k, i) in instructions.iter().enumerate() {
@@ -576,7 +579,7 @@ mod tests {
 
     #[test]
     fn every_rate_is_the_fixtures() {
-        let text = include_str!("../../tests/fixtures/nvidia-throughput.tsv");
+        let text = include_str!("../../../tests/fixtures/nvidia-throughput.tsv");
         let rows: Vec<Vec<&str>> = text.lines().filter(|l| !l.starts_with('#') && !l.trim().is_empty() && !l.starts_with("ratio")).map(|l| l.split('\t').collect()).collect();
         for r in &rows {
             let rate = THROUGHPUT.iter().find(|t| t.row == r[0]).unwrap_or_else(|| panic!("the code has no row `{}`", r[0]));

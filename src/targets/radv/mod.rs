@@ -11,12 +11,15 @@
 //! 64 invocations whatever the wave size, so one evaluation (one invocation x one light) costs
 //! `Inverse Throughput / (64 x lights per kernel)` SIMD cycles.
 
+pub mod aco_perfinfo;
+pub mod env;
+pub mod families;
+
 use super::cost;
 use crate::schema::cost::TargetCost;
 use super::mesa_noop::{self, NoopDriver};
 use super::{Request, Run};
-use super::aco_perfinfo;
-use super::radv_families::{family_of_device, null_device_name, Family, FAMILIES, FORCE_FAMILY_VAR};
+use families::{family_of_device, null_device_name, Family, FAMILIES, FORCE_FAMILY_VAR};
 use crate::gpu::CompilerLog;
 use super::cost::schedule::Schedule;
 use crate::schema::InspectReport;
