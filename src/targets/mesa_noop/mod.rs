@@ -294,7 +294,7 @@ struct CachedChild {
 }
 
 /// Runs the child for one target and reads its report, or takes both from the kernel cache when nothing that
-/// reaches the driver changed (`noop_cache`); the child's messages reach the user either way.
+/// reaches the driver changed (`cache`); the child's messages reach the user either way.
 fn run(driver: &'static dyn NoopDriver, family: usize, models: &[Model], raw: &[super::RawKernel], request: &Job) -> Result<ChildRun> {
     let name = Target { vendor: driver, family }.name();
     // The driver's environment first: a driver that is not built stops here, naming what to run.
