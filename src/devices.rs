@@ -150,7 +150,7 @@ pub fn inspect(plan: &[Planned], run: &Run, open: &OpenLocal, profile: Option<&P
             Planned::Local(device) => {
                 let mut report = None;
                 open(device.as_deref(), &mut |gpu| {
-                    report = Some(targets::inspect_device(gpu, run.shaders, run.options)?);
+                    report = Some(crate::inspect::run(gpu, run.shaders, run.options)?);
                     Ok(())
                 })?;
                 reports.push(report.expect("the device ran"));

@@ -19,6 +19,7 @@ pub mod page;
 pub mod report_page;
 pub mod inspect;
 pub mod io;
+pub mod kernel_stats;
 pub mod kernels;
 pub mod model;
 pub mod profile;

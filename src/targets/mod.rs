@@ -276,14 +276,6 @@ pub fn cost_of(report: &InspectReport) -> Option<TargetCost> {
     VENDORS.iter().find_map(|v| v.cost(report))
 }
 
-/// `inspect` on a Vulkan device of this machine, with the cost table its vendor's model gives, if any (a real
-/// RADV GPU reports ACO's statistics).
-pub fn inspect_device(gpu: &Gpu, shaders: &Shaders, options: &crate::inspect::InspectOptions) -> Result<InspectReport> {
-    let mut report = crate::inspect::run(gpu, shaders, options)?;
-    report.cost = cost_of(&report);
-    Ok(report)
-}
-
 /// A lower-case file-name-safe form of a device name ("llvmpipe (LLVM 15.0.6, 256 bits)" -> "llvmpipe").
 pub fn device_slug(device: &crate::gpu::DeviceInfo) -> String {
     // RADV's compile-only devices are all "Null hardware (RADV <FAMILY>)": the family tells them apart.

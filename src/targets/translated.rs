@@ -8,7 +8,7 @@
 use super::cost::{self, schedule::{self, Schedule}};
 use super::{Family, RawKernel, Request, Run, Target, Vendor};
 use crate::gpu::{DriverStat, Gpu};
-use crate::inspect::{compiled_report, kernels_of, static_row};
+use crate::kernel_stats::{compiled_report, kernels_of, static_row};
 use crate::model::Model;
 use crate::schema::cost::TargetCost;
 use crate::schema::{InspectReport, Row};

@@ -19,7 +19,6 @@
 pub mod cache;
 pub mod shim;
 
-use crate::inspect::InspectOptions;
 use crate::schema::InspectReport;
 use crate::cleanup;
 use crate::gpu::{CompilerLog, Gpu, GpuOptions, Kernel};
@@ -182,7 +181,8 @@ fn models_report(gpu: &Gpu, shaders: &Shaders, req: &NoopRequest, target: &str, 
             isa_files.extend(write_isa(gpu, shaders, model, req.lights, dir)?);
         }
     }
-    let mut report = super::inspect_device(gpu, shaders, &InspectOptions { models: models.clone(), lights: req.lights, callgrind: None })?;
+    let mut report = crate::kernel_stats::device_report(gpu, shaders, &models, req.lights, None)?;
+    report.cost = super::cost_of(&report);
     if !skipped.is_empty() {
         let why = skipped.iter().map(|m| format!("{} ({:#})", m.name(), m.check_support(&gpu.info).unwrap_err())).collect::<Vec<_>>().join("; ");
         report.section_notes.insert("driver/".into(), format!("not compiled for {target}: {why}"));
@@ -232,7 +232,7 @@ fn raw_report(gpu: &Gpu, shaders: &Shaders, req: &NoopRequest, target: &str, isa
     }
     let provenance = serde_json::to_value(crate::results::Provenance::new(&gpu.info))?;
     let notes = if skipped.is_empty() { Default::default() } else { [("driver/".to_string(), format!("not compiled for {target}: {}", skipped.join("; ")))].into() };
-    Ok((crate::inspect::compiled_report(rows, provenance, req.lights, shaders, Default::default(), notes), isa_files))
+    Ok((crate::kernel_stats::compiled_report(rows, provenance, req.lights, shaders, Default::default(), notes), isa_files))
 }
 
 /// Set in a child's environment, it dies of SIGSEGV after printing its report, as Mesa 22.3's teardown of
