@@ -5,8 +5,8 @@
 //! whose kernels differ (each report records a SHA-256 of every model's kernel: SPIR-V and the
 //! specialisation constants that select the model).
 
-use crate::inspect::InspectReport;
-use crate::inspect::HASH_NOTE;
+use crate::schema::InspectReport;
+use crate::schema::HASH_NOTE;
 use crate::profile::view::ProfileView;
 use crate::model::BASELINE_LABEL;
 use crate::results::{sig, Table};

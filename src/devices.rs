@@ -3,7 +3,8 @@
 //! and, with `--profile`, a profile's measured costs beside them.
 
 use crate::inspect::correlate::{self, ProfileReport};
-use crate::inspect::{InspectOptions, InspectReport};
+use crate::inspect::InspectOptions;
+use crate::schema::InspectReport;
 use crate::compare::{self, CostTable};
 use crate::gpu::Gpu;
 use crate::shaders::Shaders;
@@ -149,7 +150,7 @@ pub fn inspect(plan: &[Planned], run: &Run, open: &OpenLocal, profile: Option<&P
             Planned::Local(device) => {
                 let mut report = None;
                 open(device.as_deref(), &mut |gpu| {
-                    report = Some(targets::inspect_device(gpu, run.shaders, run.options)?);
+                    report = Some(crate::inspect::run(gpu, run.shaders, run.options)?);
                     Ok(())
                 })?;
                 reports.push(report.expect("the device ran"));

@@ -4,7 +4,7 @@
 //! The accuracy is the sweep's own (measured on the device that executed it).
 
 use crate::chart::{self, Point};
-use crate::targets::cost::TargetCost;
+use crate::schema::cost::TargetCost;
 use crate::results::{self, Table};
 use crate::sweep::{pareto_front, SweepReport};
 use anyhow::Result;
@@ -118,7 +118,7 @@ impl CostSweep {
         for r in &self.rows {
             // The model's label (`name=`, a file's stem) as every table names it; the spec is in the JSON.
             let mut cells = vec![r.label.clone()];
-            cells.extend(self.columns.iter().map(|c| r.stats.get(c).map_or("-".into(), |v| crate::inspect::format_value(*v))));
+            cells.extend(self.columns.iter().map(|c| r.stats.get(c).map_or("-".into(), |v| crate::schema::format_value(*v))));
             cells.extend([
                 results::sig(r.cycles_per_eval, 4),
                 r.net_cycles_per_eval.map_or("-".into(), |v| results::sig(v, 4)),

@@ -1,8 +1,8 @@
 //! The baseline file: every count, the timing ratios and the environment they were measured in.
 
-use crate::inspect::callgrind::CallgrindRun;
+use crate::schema::callgrind::CallgrindRun;
 use crate::inspect::timing::TimingRun;
-use crate::inspect::InspectReport;
+use crate::schema::InspectReport;
 use crate::model::Model;
 use anyhow::{anyhow, bail, Context, Result};
 use serde::{Deserialize, Serialize};

@@ -2,7 +2,7 @@
 
 use crate::inspect::callgrind;
 use crate::inspect::timing::TimingRun;
-use crate::inspect::InspectReport;
+use crate::schema::InspectReport;
 use std::collections::BTreeMap;
 
 /// The fingerprint key only a successful callgrind run can fill in (the CPU features valgrind shows the JIT).
@@ -70,7 +70,7 @@ pub fn environment(inspect: &InspectReport, timing: Option<&TimingRun>) -> BTree
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::inspect::callgrind::CallgrindRun;
+    use crate::schema::callgrind::CallgrindRun;
 
     fn report(host_model: &str, jit: &[&str], device: &str) -> InspectReport {
         InspectReport {

@@ -81,7 +81,7 @@ fn plan(options: &CheckOptions, old: Option<&Baseline>) -> Result<(Vec<Model>, u
 /// Measures this build: every count, then the timing run.
 pub fn measure(gpu: &Gpu, shaders: &Shaders, models: Vec<Model>, lights: u32, options: &CheckOptions) -> Result<Baseline> {
     crate::messages::progress(format!("check: counting instructions ({} models + baseline kernel{})", models.len(), if options.callgrind.is_some() { ", callgrind" } else { "" }));
-    let inspect = crate::targets::inspect_device(gpu, shaders, &InspectOptions { models: models.clone(), lights, callgrind: options.callgrind.clone() })?;
+    let inspect = crate::inspect::run(gpu, shaders, &InspectOptions { models: models.clone(), lights, callgrind: options.callgrind.clone() })?;
     let timing = if options.timing.rounds > 0 {
         crate::messages::progress(format!("check: timing {} rounds", options.timing.rounds));
         Some(timing::run(gpu, shaders, &models, &TimingOptions { lights, ..options.timing.clone() })?)
@@ -149,7 +149,7 @@ fn run_measured(options: &CheckOptions, measure: impl FnOnce(Vec<Model>, u32) ->
 mod tests {
     use super::*;
     use crate::inspect::timing::TimingRun;
-    use crate::inspect::{InspectReport, Row};
+    use crate::schema::{InspectReport, Row};
     use crate::results;
     use std::collections::BTreeMap;
     use std::path::Path;

@@ -3,7 +3,7 @@
 use super::baseline::Baseline;
 use super::compare::{rel_change, Change, Comparison, GroupStatus};
 use super::thresholds::{ALPHA, MIN_TIMING_ROUNDS, TIMING_KEY};
-use crate::inspect::format_value;
+use crate::schema::format_value;
 use crate::results::{self, Table};
 use std::path::Path;
 

@@ -21,9 +21,9 @@ pub fn run_translation(dir: &str) -> Result<ExitCode> {
     brdfprof::translate::runner::child_main(dir).map(|_| ExitCode::SUCCESS)
 }
 
-/// `__probe-vulkan`: the devices enumerated, where RADV might abort the process (`targets::radv_env`).
+/// `__probe-vulkan`: the devices enumerated, where RADV might abort the process (`targets::radv::env`).
 pub fn probe_vulkan() -> Result<ExitCode> {
-    brdfprof::targets::radv_env::probe_main().map(|_| ExitCode::SUCCESS)
+    brdfprof::targets::radv::env::probe_main().map(|_| ExitCode::SUCCESS)
 }
 
 /// Writes glsl/generated/ (`make spv`).

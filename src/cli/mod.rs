@@ -102,7 +102,7 @@ pub fn prepare(child: bool, compile_timeout: Option<Duration>) -> Result<()> {
     check_env_seconds(brdfprof::gpu::FENCE_TIMEOUT_ENV)?;
     brdfprof::host::memory_limit()?;
     if !child {
-        brdfprof::targets::radv_env::sanitise()?;
+        brdfprof::targets::radv::env::sanitise()?;
     }
     brdfprof::io::stage_outputs();
     Ok(())

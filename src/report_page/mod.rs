@@ -13,7 +13,7 @@ pub mod summary;
 use crate::compare::CostTable;
 use crate::gpu::Gpu;
 use crate::page::{self, Page};
-use crate::inspect::InspectReport;
+use crate::schema::InspectReport;
 use crate::profile::view::ProfileView;
 use crate::stability::view::StabilityView;
 use crate::sweep::view::SweepView;

@@ -12,10 +12,11 @@
 //! one instruction issued per wave per cycle and no other wave hiding the stalls; "Max Waves Per Core" (from
 //! registers) is beside it to say how much latency other waves could hide.
 
-use super::cost::{self, TargetCost};
+use super::cost;
+use crate::schema::cost::TargetCost;
 use super::mesa_noop::{MESA_25_UNVALIDATED, MESA_BACKPORTS, MESA_DEBIAN};
-use super::shim::{Shim, ShimFamily};
-use crate::inspect::InspectReport;
+use super::mesa_noop::shim::{Shim, ShimFamily};
+use crate::schema::InspectReport;
 
 /// The statistics shown beside cycles/eval (Turnip's names).
 const SHOWN: [&str; 6] = ["Instruction Count", "NOPs Count", "Estimated cycles stalled on SS", "Estimated cycles stalled on SY", "Registers used", "Max Waves Per Core"];
@@ -58,7 +59,7 @@ pub static ADRENO: Shim = Shim {
 fn cycles_per_eval(stats: &std::collections::BTreeMap<String, f64>, lights: u32) -> Option<f64> {
     let instructions = cost::driver_stat(stats, "Instruction Count")?;
     let stalls = cost::driver_stat(stats, "Estimated cycles stalled on SS").unwrap_or(0.0) + cost::driver_stat(stats, "Estimated cycles stalled on SY").unwrap_or(0.0);
-    let fibres = stats.get(crate::inspect::driver::SUBGROUP_SIZE).copied().filter(|s| *s > 0.0)?;
+    let fibres = stats.get(crate::schema::driver::SUBGROUP_SIZE).copied().filter(|s| *s > 0.0)?;
     Some((instructions + stalls) / (fibres * f64::from(lights)))
 }
 
@@ -70,7 +71,7 @@ fn cost_table(shim: &Shim, family: &ShimFamily, report: &InspectReport) -> Optio
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::inspect::Row;
+    use crate::schema::Row;
 
     #[test]
     fn issue_cycles_are_instructions_plus_stalls_per_fibre_and_light() {
@@ -81,14 +82,14 @@ mod tests {
                 ("driver/CS/Instruction Count".to_string(), instructions),
                 ("driver/CS/Estimated cycles stalled on SS".to_string(), ss),
                 ("driver/CS/Estimated cycles stalled on SY".to_string(), sy),
-                (crate::inspect::driver::SUBGROUP_SIZE.to_string(), fibres),
+                (crate::schema::driver::SUBGROUP_SIZE.to_string(), fibres),
             ]
             .into(),
             notes: Default::default(),
         };
-        let mut report = crate::inspect::tests::empty_report("Turnip Adreno (TM) 660");
+        let mut report = crate::schema::tests::empty_report("Turnip Adreno (TM) 660");
         report.provenance["target"] = "adreno:a660".into();
-        report.rows = vec![row("ggx", 1000.0, 20.0, 4.0, 64.0), row(crate::inspect::BASELINE_LABEL, 300.0, 0.0, 20.0, 128.0)];
+        report.rows = vec![row("ggx", 1000.0, 20.0, 4.0, 64.0), row(crate::model::BASELINE_LABEL, 300.0, 0.0, 20.0, 128.0)];
         let t = super::super::Vendor::cost(&ADRENO, &report).unwrap();
         let lights = f64::from(t.lights_per_kernel);
         assert_eq!(t.target.as_deref(), Some("adreno:a660"));

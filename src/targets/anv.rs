@@ -9,9 +9,10 @@
 //! `cycles/eval = Cycle Count / (SIMD width x lights per kernel)`, the SIMD width being the executable's
 //! subgroupSize (ANV reports the dispatch width there).
 
-use super::cost::{self, TargetCost};
-use super::shim::{Shim, ShimFamily};
-use crate::inspect::InspectReport;
+use super::cost;
+use crate::schema::cost::TargetCost;
+use super::mesa_noop::shim::{Shim, ShimFamily};
+use crate::schema::InspectReport;
 
 /// The statistics shown beside cycles/eval (ANV's names).
 const SHOWN: [&str; 5] = ["Instruction Count", "SEND Count", "Cycle Count", "Spill Count", "Fill Count"];
@@ -47,7 +48,7 @@ pub static ANV: Shim = Shim {
 /// brw's Cycle Count per invocation and light (the module's rule).
 fn cycles_per_eval(stats: &std::collections::BTreeMap<String, f64>, lights: u32) -> Option<f64> {
     let cycles = cost::driver_stat(stats, "Cycle Count")?;
-    let simd = stats.get(crate::inspect::driver::SUBGROUP_SIZE).copied().filter(|s| *s > 0.0)?;
+    let simd = stats.get(crate::schema::driver::SUBGROUP_SIZE).copied().filter(|s| *s > 0.0)?;
     Some(cycles / (simd * f64::from(lights)))
 }
 
@@ -59,19 +60,19 @@ fn cost_table(shim: &Shim, family: &ShimFamily, report: &InspectReport) -> Optio
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::inspect::Row;
+    use crate::schema::Row;
 
     #[test]
     fn cycles_per_eval_is_cycle_count_per_lane_and_light() {
         let row = |model: &str, cycles: f64, simd: f64| Row {
             model: model.into(),
             spec: None,
-            stats: [("driver/Compute Shader/Cycle Count".to_string(), cycles), (crate::inspect::driver::SUBGROUP_SIZE.to_string(), simd)].into(),
+            stats: [("driver/Compute Shader/Cycle Count".to_string(), cycles), (crate::schema::driver::SUBGROUP_SIZE.to_string(), simd)].into(),
             notes: Default::default(),
         };
-        let mut report = crate::inspect::tests::empty_report("Intel(R) Xe Graphics (TGL GT2)");
+        let mut report = crate::schema::tests::empty_report("Intel(R) Xe Graphics (TGL GT2)");
         report.provenance["target"] = "anv:tgl".into();
-        report.rows = vec![row("ggx", 5286.0, 16.0), row(crate::inspect::BASELINE_LABEL, 1994.0, 16.0)];
+        report.rows = vec![row("ggx", 5286.0, 16.0), row(crate::model::BASELINE_LABEL, 1994.0, 16.0)];
         let t = super::super::Vendor::cost(&ANV, &report).unwrap();
         let lights = f64::from(t.lights_per_kernel);
         assert_eq!(t.family.as_deref(), Some("tgl"));

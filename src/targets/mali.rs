@@ -17,11 +17,12 @@
 //! Valhall's statistics are `va_print_stats`' (same file, Mesa 25.0): FMA and CVT at 64 per cycle, SFU 16,
 //! varying 16, texture 4, load/store 1 ("Mali G78 peak performance"), the bound their max, read by the same rule.
 
-use super::cost::{self, TargetCost};
+use super::cost;
+use crate::schema::cost::TargetCost;
 use super::mesa_noop::{MESA_25_UNVALIDATED, MESA_BACKPORTS, MESA_DEBIAN};
-use super::shim::{Shim, ShimFamily};
+use super::mesa_noop::shim::{Shim, ShimFamily};
 use crate::gpu::{CompilerLog, DriverStat};
-use crate::inspect::InspectReport;
+use crate::schema::InspectReport;
 use crate::model::BASELINE_LABEL;
 use anyhow::{anyhow, bail, Result};
 
@@ -155,7 +156,7 @@ fn cost_table(shim: &Shim, family: &ShimFamily, report: &InspectReport) -> Optio
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::inspect::Row;
+    use crate::schema::Row;
 
     const GGX: &str = "SHADER-DB: MESA_SHADER_COMPUTE shader: 174 inst, 145 tuples, 23 clauses, 8.000000 cycles, 5.750000 arith, 0.000000 texture, 0.000000 vary, 8.000000 ldst, 121 quadwords, 2 threads, 3 preloads, 0 loops, 1:2 spills:fills";
 
@@ -178,7 +179,7 @@ mod tests {
 
     /// The cost table of `rows` as `target`'s child would report them.
     fn cost_of(target: &str, device: &str, rows: Vec<Row>) -> TargetCost {
-        let mut report = crate::inspect::tests::empty_report(device);
+        let mut report = crate::schema::tests::empty_report(device);
         report.provenance["target"] = target.into();
         report.rows = rows;
         super::super::Vendor::cost(&MALI, &report).unwrap()

@@ -1,38 +1,31 @@
 //! Compile-only targets: GPU families whose production compiler brdfprof runs without the GPU, one `Vendor`
-//! each (`radv`: Mesa RADV's ACO in a child process; `nvidia`: NVRTC and ptxas on the kernels' CUDA C++
-//! translation; `intel`: IGC through ocloc on their OpenCL C translation; `adreno`, `mali`, `anv`: Mesa's
-//! Turnip, PanVK and ANV on Mesa's noop drm-shims, in child processes like RADV's, `mesa_noop`), listed once
-//! in `VENDORS`. A target is `--device PREFIX:FAMILY` (or `PREFIX:all`, or
+//! per `--device` prefix, each in its own file or folder (`radv`: Mesa RADV's ACO in a child process; `nvidia`:
+//! NVRTC and ptxas on the kernels' CUDA C++ translation; `intel`: IGC through ocloc on their OpenCL C
+//! translation; `adreno`, `mali`, `anv`: Mesa's Turnip, PanVK and ANV on Mesa's noop drm-shims), listed once in
+//! `VENDORS`. Two runtimes carry them: `mesa_noop`, the child process every Mesa driver runs in, and
+//! `translated`, the one `Vendor` of the translating vendors, each of them a `Translator`. A target is `--device PREFIX:FAMILY` (or `PREFIX:all`, or
 //! `PREFIX:a,b`); `devices --targets`, `inspect`, `check`, `sweep --cost-device`, `profile --scene --cost-device` and `compare` reach the vendors
 //! only through this module: a vendor is its families, how it compiles every kernel for them (an `inspect`
 //! report per family, with its compiler's statistics under `driver/`), its cost model (`cost`), and what its
 //! statistics depend on (the gate's fingerprint). Kernels from outside the model set (a scene's kernels) reach
 //! the same compilers as `RawKernel`s (`compile_raw_all`).
 
-pub use crate::inspect::cost;
-pub mod aco_perfinfo;
-pub mod gen_isa;
-pub mod intel;
-pub mod nvidia;
-pub mod nvrtc;
-pub mod ocloc;
 pub mod adreno;
 pub mod anv;
+pub mod cost;
+pub mod intel;
 pub mod mali;
 pub mod mesa_noop;
-pub mod noop_cache;
+pub mod nvidia;
 pub mod radv;
-pub mod radv_env;
-pub mod radv_families;
-pub mod sass;
-pub mod shim;
+pub mod translated;
 
 use crate::gpu::Gpu;
-use crate::inspect::InspectReport;
+use crate::schema::InspectReport;
 use crate::model::Model;
 use crate::shaders::Shaders;
 use anyhow::{anyhow, bail, Result};
-use cost::TargetCost;
+use crate::schema::cost::TargetCost;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
@@ -133,7 +126,7 @@ pub trait Vendor: Sync {
     }
 }
 
-/// Every vendor: the one list (a new compiler lands here and in its own file).
+/// Every vendor: the one list (a new compiler lands here and in its own file or folder).
 pub static VENDORS: [&dyn Vendor; 6] = [&radv::RADV, &nvidia::NVIDIA, &intel::INTEL, &adreno::ADRENO, &mali::MALI, &anv::ANV];
 
 /// One family of one vendor.
@@ -266,71 +259,11 @@ pub fn compile_raw_all(targets: &[Target], kernels: &[RawKernel], request: &Requ
     vendor_by_vendor(targets, |vendor, families| vendor.compile_raw(families, kernels, request))
 }
 
-/// The rows (label, the agreement as the note) and the `dialect` sources of raw kernels, for a vendor that
-/// compiles their translations.
-pub(crate) fn raw_translations(vendor: &dyn Vendor, kernels: &[RawKernel], dialect: crate::translate::Dialect) -> Result<(Vec<crate::inspect::Row>, Vec<Checked>)> {
-    let mut rows = Vec::new();
-    let mut checked = Vec::new();
-    for k in kernels {
-        let t = k.translation.as_ref().ok_or_else(|| anyhow!("{}: {} compiles the kernel's translation, and none was checked", k.label, vendor.prefix()))?;
-        rows.push(crate::inspect::Row { model: k.label.clone(), spec: Some(k.model.canonical()), stats: BTreeMap::new(), notes: [("translation".to_string(), t.agreement.clone())].into() });
-        checked.push(Checked { source: t.translation.source(dialect), agreement: t.agreement.clone() });
-    }
-    Ok((rows, checked))
-}
-
 /// Whether the target's compiler names each instruction's source line (`Request::lines`): the translating
 /// vendors (NVRTC `-lineinfo`, IGC `-gline-tables-only`); ACO in Mesa 22.3 carries no source lines, nor do ir3, Bifrost or brw
 /// there.
 pub fn names_lines(target: &Target) -> bool {
     target.vendor.needs_verification()
-}
-
-
-/// Each family's report given its models' cost per source line when `req.lines`. The line-annotated translation
-/// is not executed; its lines are reported for the checked, costed code only where the two compiles give the
-/// same instruction sequence, else a note says they differ. `lines` compiles a model's line-annotated `dialect`
-/// source (with its checked translation, `checked`, in the order of `kernels_of`) for a family and returns its
-/// lines with both compiles' instruction sequences (the costed one's first).
-pub(crate) fn add_lines<F>(reports: &mut [InspectReport], families: &[&F], req: &Request, checked: &[Checked], dialect: crate::translate::Dialect, mut lines: impl FnMut(&Model, &str, &str, &F) -> Result<LineCompile>) -> Result<()> {
-    if !req.lines {
-        return Ok(());
-    }
-    for (report, family) in reports.iter_mut().zip(families) {
-        let mut per_model = Vec::new();
-        for (m, checked) in req.models.iter().zip(checked) {
-            let source = crate::translate::prepare::shade_kernel_with_lines(Some(m), req.lights, req.shaders)?.source_with_lines(dialect);
-            let LineCompile { mut lines, costed, annotated } = lines(m, &source, &checked.source, family)?;
-            if costed != annotated {
-                lines.note = format!("the line-annotated compile is not the costed code ({} instructions against {}, not in the same sequence): its lines describe that compile", annotated.len(), costed.len());
-            }
-            if let Model::File(f) = m {
-                // An HLSL or WGSL shader's lines are those of the GLSL its front end wrote: their text is the file
-                // model's, not on disk.
-                for l in lines.lines.iter_mut().filter(|l| l.text.is_empty()) {
-                    l.text = f.file.front_end_line(&l.file, l.line).unwrap_or_default().to_string();
-                }
-            }
-            per_model.push(lines);
-        }
-        report.lines = per_model;
-    }
-    Ok(())
-}
-
-/// A model's line costs and the instruction sequences (one entry per instruction: its opcode and what the
-/// vendor's listing says of its width and type) of the costed compile and of the line-annotated one.
-pub(crate) struct LineCompile {
-    pub lines: crate::inspect::lines::KernelLines,
-    pub costed: Vec<String>,
-    pub annotated: Vec<String>,
-}
-
-/// The line an instruction is charged to: the innermost of `chain` (its location, then the call sites it was
-/// inlined at) that is a source's, not the translation's own (`TRANSLATION_FILE`: its prelude helpers and
-/// entry); None where every one is the translation's.
-pub(crate) fn user_source(chain: &[(String, u32)]) -> Option<(String, u32)> {
-    chain.iter().find(|(file, line)| !file.ends_with(crate::translate::TRANSLATION_FILE) && *line > 0).cloned()
 }
 
 /// The compile-only target a report was made for, if any.
@@ -343,18 +276,10 @@ pub fn cost_of(report: &InspectReport) -> Option<TargetCost> {
     VENDORS.iter().find_map(|v| v.cost(report))
 }
 
-/// `inspect` on a Vulkan device of this machine, with the cost table its vendor's model gives, if any (a real
-/// RADV GPU reports ACO's statistics).
-pub fn inspect_device(gpu: &Gpu, shaders: &Shaders, options: &crate::inspect::InspectOptions) -> Result<InspectReport> {
-    let mut report = crate::inspect::run(gpu, shaders, options)?;
-    report.cost = cost_of(&report);
-    Ok(report)
-}
-
 /// A lower-case file-name-safe form of a device name ("llvmpipe (LLVM 15.0.6, 256 bits)" -> "llvmpipe").
 pub fn device_slug(device: &crate::gpu::DeviceInfo) -> String {
     // RADV's compile-only devices are all "Null hardware (RADV <FAMILY>)": the family tells them apart.
-    if let Some(t) = radv_families::family_of_device(&device.name) {
+    if let Some(t) = radv::families::family_of_device(&device.name) {
         return format!("radv-{}", t.family);
     }
     crate::results::name_slug(&device.name)
@@ -364,56 +289,4 @@ pub fn device_slug(device: &crate::gpu::DeviceInfo) -> String {
 pub fn file_slug(label: &str) -> String {
     let s: String = label.chars().map(|c| if c.is_ascii_alphanumeric() || c == '.' { c.to_ascii_lowercase() } else { '-' }).collect();
     s.trim_matches('-').to_string()
-}
-
-/// One kernel's translation in a dialect, checked against its Vulkan kernel, ready for every family.
-pub struct Checked {
-    pub source: String,
-    /// The row note: the device checked on and the worst difference.
-    pub agreement: String,
-}
-
-/// Every kernel of `req` (the models' and the memory-only one) translated into `dialect`, after the
-/// translation (its body is the same text in every dialect) agreed with the Vulkan kernel on `gpu`.
-pub fn checked_translations(req: &Request, gpu: &Gpu, dialect: crate::translate::Dialect) -> Result<Vec<Checked>> {
-    crate::inspect::kernels_of(req.models)
-        .into_iter()
-        .map(|m| {
-            let agreements = crate::translate::verify::check_cached(gpu, m, req.lights, req.shaders)?;
-            let source = crate::translate::prepare::shade_kernel(m, req.lights, req.shaders)?.source(dialect);
-            let agreement = agreements.iter().map(|a| format!("{}{}", a.summary(), a.note().map_or_else(String::new, |n| format!(": {n}")))).collect::<Vec<_>>().join("; ");
-            Ok(Checked { source, agreement: format!("translation checked on the host against {} and the translation's f64 evaluation: {agreement}", gpu.info.name) })
-        })
-        .collect()
-}
-
-/// What a translating target (NVIDIA, Intel) says about its compilation, for `translated_report`.
-pub(crate) struct Compilation {
-    /// `nvidia:sm_89`, `intel:gen12lp`.
-    pub target: String,
-    /// The report's `provenance.device` and `provenance.compiler`.
-    pub device: serde_json::Value,
-    pub compiler: serde_json::Value,
-    /// The `driver/` section's note: which compiler, on what, with which options.
-    pub driver_note: String,
-    /// The compiler in the report's tool list: (name, version).
-    pub tool: (String, String),
-}
-
-/// The inspect report of a target that compiles the kernels' C translation: provenance, notes (callgrind does
-/// not apply: nothing executes), the rows and the vendor's cost table.
-pub(crate) fn translated_report(vendor: &dyn Vendor, c: Compilation, rows: Vec<crate::inspect::Row>, req: &Request) -> InspectReport {
-    let provenance = serde_json::json!({
-        "tool": format!("brdfprof {}", env!("CARGO_PKG_VERSION")),
-        "device": c.device,
-        "target": c.target,
-        "compiler": c.compiler,
-        "host_cpu": crate::host::HostCpu::detect().describe(),
-    });
-    let mut notes = std::collections::BTreeMap::new();
-    notes.insert("driver/".into(), c.driver_note);
-    notes.insert("callgrind/".into(), format!("not applicable: {} compiles only, nothing executes", c.target));
-    let mut report = crate::inspect::compiled_report(rows, provenance, req.lights, req.shaders, [c.tool].into(), notes);
-    report.cost = vendor.cost(&report);
-    report
 }

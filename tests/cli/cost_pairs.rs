@@ -5,8 +5,8 @@
 //! that binds, and a branch weight or a translation artefact cannot reverse it.
 
 use crate::compile_only::inspect_json;
-use brdfprof::inspect::schedule::Schedule;
-use brdfprof::targets::radv_families::FAMILIES as AMD;
+use brdfprof::targets::cost::schedule::Schedule;
+use brdfprof::targets::radv::families::FAMILIES as AMD;
 
 const PAIRS: [(&str, &str); 3] = [("base", "plus-sqrt"), ("base", "plus-division"), ("mul5", "pow5")];
 
@@ -20,7 +20,7 @@ fn classes(target: &str, row: &serde_json::Value) -> Vec<f64> {
     let s = stats(row);
     let get = |k: String| s.get(&k).copied().unwrap_or_else(|| panic!("{target} {}: no {k}", row["model"]));
     match target {
-        "radv:navi21" => brdfprof::targets::aco_perfinfo::Class::ALL.iter().map(|c| get(format!("driver/Compute Shader/{}", brdfprof::targets::aco_perfinfo::count_name(*c)))).collect(),
+        "radv:navi21" => brdfprof::targets::radv::aco_perfinfo::Class::ALL.iter().map(|c| get(format!("driver/Compute Shader/{}", brdfprof::targets::radv::aco_perfinfo::count_name(*c)))).collect(),
         "nvidia:sm_89" => brdfprof::targets::nvidia::Class::ALL.iter().map(|c| get(format!("driver/SASS/{}", c.name()))).collect(),
         _ => brdfprof::targets::intel::Class::ALL.iter().map(|c| get(format!("driver/IGC/{}", c.name()))).collect(),
     }

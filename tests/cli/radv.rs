@@ -3,7 +3,7 @@
 //! family, deterministic, and every command that must execute refuses the device.
 
 use crate::common::{self, run, run_in};
-use brdfprof::targets::radv_families::FAMILIES as TARGETS;
+use brdfprof::targets::radv::families::FAMILIES as TARGETS;
 use std::path::Path;
 
 const KERNELS: [&str; 5] = ["ggx", "blinn", "cook-torrance", "burley", "baseline"];
@@ -63,7 +63,7 @@ fn inspect_reports_aco_statistics_for_rdna2_gfx9_and_rdna3_identical_across_runs
 /// = Inverse Throughput / (64 x 8) (ACO rounds the statistic). Where ACO branches (GCN and Vega do in the
 /// built-in kernels, RDNA does not), its weights are below 1 and the re-count is at least ACO's.
 fn aco_schedule_is_acos_own_without_branches(family: &str, rows: &[serde_json::Value], costs: &[serde_json::Value]) {
-    use brdfprof::targets::aco_perfinfo::Resource;
+    use brdfprof::targets::radv::aco_perfinfo::Resource;
     let target = TARGETS.iter().find(|t| t.family == family).unwrap();
     for row in rows {
         let model = row["model"].as_str().unwrap();

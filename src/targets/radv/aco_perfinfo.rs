@@ -4,7 +4,7 @@
 //! block-weighted totals behind its Latency and Inverse Throughput statistics (usage per resource, latency,
 //! waves). The totals weigh each block by ACO's guesses (a loop 8 times, each side of a divergent branch 0.75,
 //! a uniform branch 0.5); brdfprof re-adds the same per-instruction figures with every instruction once, as it
-//! counts NVIDIA's and Intel's listings (`inspect::schedule`): the clocks summed give the schedule latency,
+//! counts NVIDIA's and Intel's listings (`cost::schedule`): the clocks summed give the schedule latency,
 //! and each instruction's class (ACO's `aco_opcodes.py`, `CLASSES` below) gives its resource usage by ACO's
 //! own table (`get_perf_info`). On a kernel without branches or loops both agree with ACO's totals exactly
 //! (tested).

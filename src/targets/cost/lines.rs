@@ -1,10 +1,10 @@
 //! Cost per source line (`inspect --lines`): every machine instruction a compiler emitted, attributed to the
 //! line of the user's `.brdf` file (or of glsl/) it came from, and summed per line by the figures of the cost
-//! rule (`inspect::schedule`): the cycles each instruction keeps its pipe busy, and the cycles the compiler's
+//! rule (`schedule`): the cycles each instruction keeps its pipe busy, and the cycles the compiler's
 //! schedule spends issuing it (its stall and the waits before it). A line's share of the pipe that binds is what
 //! removing it would save in throughput; its schedule cycles, what it adds to one wave's latency.
 
-use serde::{Deserialize, Serialize};
+use crate::schema::lines::{KernelLines, LineCost};
 use std::collections::BTreeMap;
 
 /// One instruction with where it came from and what it costs (per wave, in the target's unit).
@@ -19,40 +19,6 @@ pub struct Attributed {
     /// Its issue cycles where the rule has an issue term (NVIDIA: 32 / 128 SM cycles per warp instruction).
     pub issue: f64,
 }
-
-/// One source line's instructions and cycles.
-#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
-pub struct LineCost {
-    /// The file (`short`): `glsl/brdf.glsl`, or the user's file.
-    pub file: String,
-    pub line: u32,
-    pub instructions: u32,
-    /// Busy cycles per wave the line's instructions add to each pipe.
-    pub pipes: BTreeMap<String, f64>,
-    /// The line's cycles on the kernel's binding pipe (`KernelLines::binding_pipe`).
-    pub binding: f64,
-    /// Schedule cycles per wave spent issuing the line's instructions.
-    pub schedule: f64,
-    /// The line's text, where the file could be read.
-    #[serde(default, skip_serializing_if = "String::is_empty")]
-    pub text: String,
-}
-
-/// A kernel's lines, costliest first (by their cycles on the binding pipe, then their schedule cycles).
-#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
-pub struct KernelLines {
-    pub model: String,
-    /// The pipe whose cycles the lines are ranked by: the kernel's busiest.
-    pub binding_pipe: String,
-    pub lines: Vec<LineCost>,
-    /// Instructions the compiler names no line for.
-    pub unattributed: u32,
-    pub instructions: u32,
-    /// Something the reader should know (the line-annotated compile differing from the costed one).
-    #[serde(default, skip_serializing_if = "String::is_empty")]
-    pub note: String,
-}
-
 /// The term name of an issue-slot bound among the pipes (NVIDIA's).
 pub const ISSUE: &str = "issue";
 
@@ -92,27 +58,6 @@ fn source_text(file: &str, line: u32) -> String {
     let text = crate::io::read_bounded(path, 64 << 20).ok().map(|b| String::from_utf8_lossy(&b).into_owned()).or_else(embedded);
     text.and_then(|t| t.lines().nth(line.saturating_sub(1) as usize).map(|l| l.trim().to_string())).unwrap_or_default()
 }
-
-impl KernelLines {
-    /// The costliest `n` lines as a Markdown table, with the share of the binding pipe each takes.
-    pub fn markdown(&self, n: usize, unit: &str) -> String {
-        let total: f64 = self.lines.iter().map(|l| l.binding).sum();
-        let mut t = crate::results::Table::new(["file:line", "instructions", &format!("{} cycles/wave", self.binding_pipe), "share", "schedule cycles/wave", "source"].map(String::from));
-        for l in self.lines.iter().take(n) {
-            let share = if total > 0.0 { format!("{:.0}%", 100.0 * l.binding / total) } else { "-".into() };
-            t.row([format!("{}:{}", l.file, l.line), l.instructions.to_string(), crate::results::sig(l.binding, 4), share, crate::results::sig(l.schedule, 4), format!("`{}`", l.text.replace('|', "\\|").replace('`', "'"))]);
-        }
-        format!(
-            "#### {}: the costliest source lines ({unit}; ranked by their cycles on the binding pipe, {}; {} of {} instructions are the translation's own or the compiler's and name no line)\n\n{}",
-            self.model,
-            self.binding_pipe,
-            self.unattributed,
-            self.instructions,
-            t.markdown()
-        )
-    }
-}
-
 /// A file name as reports give it: glsl/'s (compiled from a temporary copy) by their name in the tree, a user's
 /// file relative to the working directory where it lies below it.
 fn short(file: &str) -> String {

@@ -6,11 +6,14 @@
 //! maths" figures: NVIDIA's Vulkan driver compiles SPIR-V with its own front end, and no public comparison of
 //! the two exists.
 
-use super::cost::{self, TargetCost};
-use super::{nvrtc, Request, Run, Target};
-use crate::inspect::InspectReport;
+pub mod nvrtc;
+pub mod sass;
+
+use super::cost::schedule::{LATENCY, PIPE_PREFIX, RESIDENT_WAVES};
+use super::translated::{Compilation, LineCompile, Translated, Translator};
 use crate::gpu::DriverStat;
-use crate::inspect::schedule::{Schedule, LATENCY, PIPE_PREFIX, RESIDENT_WAVES};
+use crate::model::Model;
+use crate::translate::Dialect;
 use anyhow::{bail, Result};
 use std::collections::BTreeMap;
 
@@ -245,8 +248,8 @@ impl SassStats {
     /// Counts the `-hex` listing: every instruction up to the kernel's last EXIT (nvdisasm pads the section
     /// with a branch to itself and NOPs after it), NOPs left out of the counts (not of the schedule).
     pub fn of(listing: &str, ptxas_log: &str, cubin_bytes: usize) -> Result<Self> {
-        let instructions = super::sass::instructions(listing)?;
-        let mut s = SassStats { cubin_bytes: cubin_bytes as u32, schedule_latency: super::sass::schedule_latency(&instructions), ..Default::default() };
+        let instructions = sass::instructions(listing)?;
+        let mut s = SassStats { cubin_bytes: cubin_bytes as u32, schedule_latency: sass::schedule_latency(&instructions), ..Default::default() };
         for i in instructions.iter().filter(|i| i.mnemonic() != "NOP") {
             let (class, row, pipe) = classify(&i.opcode);
             s.instructions += 1;
@@ -309,7 +312,7 @@ impl SassStats {
     }
 
     /// The statistics as driver statistics of the executable "SASS" (their names line up with the aliases
-    /// of `inspect::driver`, so that the gate reads registers, instructions, spills and code size as for any
+    /// of `schema::driver`, so that the gate reads registers, instructions, spills and code size as for any
     /// driver).
     pub fn driver_stats(&self, family: &Family) -> Result<Vec<DriverStat>> {
         let stat = |name: &str, value: f64| DriverStat { executable: "SASS".into(), name: name.into(), description: String::new(), value };
@@ -394,36 +397,15 @@ pub fn compile_as(source: &str, family: &Family, precise: bool, lines: bool) -> 
     Ok(serde_json::from_slice(&bytes)?)
 }
 
-/// The device name of a family's reports.
-pub fn device_name(family: &Family) -> String {
-    format!("NVIDIA {} ({}), compile-only", family.name, family.architecture)
-}
-
-/// Every kernel (the models' and the memory-only one) compiled by NVIDIA's compiler for each family, as
-/// `inspect` reports (one per family, in order), after each translation agreed with its Vulkan kernel.
-pub fn inspect(families: &[&Family], req: &Request) -> Result<Vec<InspectReport>> {
-    let tools = nvrtc::tools()?;
-    let gpu = req.verify_on.ok_or_else(|| anyhow::anyhow!("nvidia: no Vulkan device to check the translation against"))?;
-    let checked = super::checked_translations(req, gpu, crate::translate::Dialect::Cuda)?;
-    let statics = crate::inspect::kernels_of(req.models).into_iter().map(|m| crate::inspect::static_row(req.shaders, m, req.lights)).collect::<Result<Vec<_>>>()?;
-    let mut reports = compile_checked(families, statics, &checked, tools, req)?;
-    super::add_lines(&mut reports, families, req, &checked, crate::translate::Dialect::Cuda, |m, source, costed, family| {
-        let sass = compile_as(source, family, req.precise, true)?;
-        let opcodes = |listing: &str| -> Result<Vec<String>> { Ok(super::sass::instructions(listing)?.into_iter().map(|i| i.opcode).collect()) };
-        Ok(super::LineCompile { lines: line_costs(&m.label(), &sass, family)?, costed: opcodes(&compile(costed, family, req.precise)?.listing)?, annotated: opcodes(&sass.listing)? })
-    })?;
-    Ok(reports)
-}
-
 /// Cost per source line of a kernel compiled with line information (`compile_as` with `lines`): each SASS
 /// instruction on its pipe at its row's rate and its issue slot, its schedule cycles (the scoreboard wait before
 /// it and its stall), summed per line; the translation's own lines and NVRTC's prologue name none.
-pub fn line_costs(model: &str, sass: &Sass, family: &Family) -> Result<crate::inspect::lines::KernelLines> {
-    use crate::inspect::lines::{per_line, Attributed};
-    let instructions = super::sass::instructions(&sass.listing)?;
+pub fn line_costs(model: &str, sass: &Sass, family: &Family) -> Result<crate::schema::lines::KernelLines> {
+    use super::cost::lines::{per_line, Attributed};
+    let instructions = sass::instructions(&sass.listing)?;
     let stats = SassStats::of(&sass.listing, &sass.log, sass.cubin_bytes)?;
     let binding = stats.pipes(family)?.into_iter().fold(("-".to_string(), f64::NEG_INFINITY), |b, p| if p.1 > b.1 { p } else { b }).0;
-    let times = super::sass::issue_times(&instructions);
+    let times = sass::issue_times(&instructions);
     let mut attributed = Vec::new();
     let mut previous_end = 0.0;
     for (k, i) in instructions.iter().enumerate() {
@@ -437,135 +419,81 @@ pub fn line_costs(model: &str, sass: &Sass, family: &Family) -> Result<crate::in
             _ => vec![],
         };
         let issue = if counted { 32.0 / f64::from(ISSUE_PER_CLOCK) } else { 0.0 };
-        attributed.push(Attributed { source: super::user_source(&i.sources), pipes, schedule, issue });
+        attributed.push(Attributed { source: super::translated::user_source(&i.sources), pipes, schedule, issue });
     }
     Ok(per_line(model, &attributed, &binding))
 }
 
-/// Every checked translation compiled for each family, its statistics added to its row (`statics`, in the
-/// same order), as one report per family.
-fn compile_checked(families: &[&Family], statics: Vec<crate::inspect::Row>, checked: &[super::Checked], tools: &nvrtc::Tools, req: &Request) -> Result<Vec<InspectReport>> {
-    let jobs: Vec<(usize, usize)> = (0..families.len()).flat_map(|f| (0..checked.len()).map(move |k| (f, k))).collect();
-    // NVRTC compiles distinct programs concurrently (its API is thread-safe); one job per core.
-    use rayon::prelude::*;
-    let (sources, precise): (Vec<&str>, bool) = (checked.iter().map(|c| c.source.as_str()).collect(), req.precise);
-    let compiled = jobs.par_iter().map(|&(f, k)| compile(sources[k], families[f], precise)).collect::<Result<Vec<_>>>()?;
-    let mut reports = Vec::new();
-    for (f, family) in families.iter().enumerate() {
-        let mut rows = statics.clone();
-        for (k, row) in rows.iter_mut().enumerate() {
-            let sass = &compiled[f * checked.len() + k];
-            let stats = SassStats::of(&sass.listing, &sass.log, sass.cubin_bytes)?;
-            row.stats.extend(crate::inspect::driver::stats(&stats.driver_stats(family)?));
-            row.notes.insert("translation".into(), checked[k].agreement.clone());
-            if let Some(dir) = req.isa_dir {
-                write_isa(dir, family, &row.model, &checked[k].source, sass)?;
-            }
-        }
-        reports.push(report(family, rows, tools, req));
-    }
-    Ok(reports)
-}
-
-/// Writes the kernel's CUDA C++ translation and its SASS to DIR/nvidia-<family>/<kernel>.{cu,sass}.
-fn write_isa(dir: &std::path::Path, family: &Family, label: &str, source: &str, sass: &Sass) -> Result<()> {
-    let dir = dir.join(format!("nvidia-{}", family.name));
-    std::fs::create_dir_all(&dir).map_err(|e| anyhow::anyhow!("--isa: cannot create {}: {e}", dir.display()))?;
-    let stem = super::file_slug(label);
-    crate::io::write_output(&dir.join(format!("{stem}.cu")), source.as_bytes())?;
-    crate::io::write_output(&dir.join(format!("{stem}.sass")), format!("// {label}: SASS for {} by {}\n{}\n{}", family.name, nvrtc::tools()?.version, sass.log.trim(), sass.listing).as_bytes())
-}
-
-fn report(family: &Family, rows: Vec<crate::inspect::Row>, tools: &nvrtc::Tools, req: &Request) -> InspectReport {
-    let options = options(family, req.precise).join(" ");
-    let compilation = super::Compilation {
-        target: format!("nvidia:{}", family.name),
-        device: serde_json::json!({"name": device_name(family), "driver_name": "NVRTC", "driver_info": format!("{} ({options})", tools.version), "driver_version": tools.version}),
-        compiler: serde_json::json!({"name": tools.version, "options": options, "translation": "brdfprof's SPIR-V to CUDA C++ translation"}),
-        driver_note: format!("NVIDIA's CUDA compiler ({}, ptxas) on the kernels' CUDA C++ translation, same maths; options: {options}", tools.version),
-        tool: ("nvrtc".to_string(), tools.version.clone()),
-    };
-    super::translated_report(&NVIDIA, compilation, rows, req)
-}
-
-/// The statistics the cost table shows beside cycles/eval (and the rule's figures, `cost::schedule_table`).
-pub const SHOWN: [&str; 5] = ["Instruction Count", "Register Count", "Spill Count", "MUFU (special functions)", "Issue Cycles"];
-
+/// NVIDIA's translated targets: `FAMILIES` and `THROUGHPUT`, NVRTC and ptxas, and the SASS parser (`SassStats`).
 pub struct Nvidia;
-pub static NVIDIA: Nvidia = Nvidia;
+pub static NVIDIA: Translated<Nvidia> = Translated::new();
 
-impl super::Vendor for Nvidia {
-    fn prefix(&self) -> &'static str {
-        "nvidia"
+impl Translator for Nvidia {
+    type Family = Family;
+    type Binary = Sass;
+    type Tools = nvrtc::Tools;
+
+    const PREFIX: &'static str = "nvidia";
+    const NAME: &'static str = "NVIDIA";
+    const TITLE: &'static str = "NVIDIA: NVRTC and ptxas (NVIDIA's PyPI wheels) on the kernels' CUDA C++ translation, checked on the host first (no NVIDIA GPU or driver needed)";
+    const DIALECT: Dialect = Dialect::Cuda;
+    const COMPILER: &'static str = "ptxas";
+    const UNIT: &'static str = "SM cycles";
+    const RULE: &'static str = "a warp's pipes at the CUDA guide's throughputs (Nsight Compute's pipe assignment), its latency by ptxas' stall counts and scoreboards, warps per SM from the registers; / (32 x lights per kernel); Issue Cycles: the old serial sum";
+    const SHOWN: &'static [&'static str] = &["Instruction Count", "Register Count", "Spill Count", "MUFU (special functions)", "Issue Cycles"];
+    const ISA_EXTENSIONS: (&'static str, &'static str) = ("cu", "sass");
+
+    fn families() -> &'static [Family] {
+        &FAMILIES
     }
 
-    fn name(&self) -> &'static str {
-        "NVIDIA"
+    fn family(f: &Family) -> super::Family {
+        super::Family { name: f.name, architecture: f.architecture, products: f.products, detail: format!("compute capability {}.{}", f.compute_capability.0, f.compute_capability.1), default: true }
     }
 
-    fn title(&self) -> &'static str {
-        "NVIDIA: NVRTC and ptxas (NVIDIA's PyPI wheels) on the kernels' CUDA C++ translation, checked on the host first (no NVIDIA GPU or driver needed)"
+    fn tools() -> Result<&'static nvrtc::Tools> {
+        nvrtc::tools()
     }
 
-    fn families(&self) -> Vec<super::Family> {
-        FAMILIES
-            .iter()
-            .map(|f| super::Family { name: f.name, architecture: f.architecture, products: f.products, detail: format!("compute capability {}.{}", f.compute_capability.0, f.compute_capability.1), default: true })
-            .collect()
-    }
-
-    fn status(&self) -> Result<String> {
+    fn status() -> Result<String> {
         Ok(format!("{} and nvdisasm under {}", nvrtc::tools()?.version, nvrtc::install_dir().display()))
     }
 
-    fn needs_verification(&self) -> bool {
-        true
+    fn vendor() -> &'static dyn super::Vendor {
+        &NVIDIA
     }
 
-    fn compile(&self, families: &[usize], request: &Request) -> Result<Vec<Run>> {
-        let chosen: Vec<&Family> = families.iter().map(|&k| &FAMILIES[k]).collect();
-        let reports = inspect(&chosen, request)?;
-        Ok(reports.into_iter().zip(families).map(|(report, &family)| Run { target: Target { vendor: &NVIDIA, family }, report, isa_files: Vec::new(), note: None }).collect())
+    fn compile(source: &str, family: &Family, precise: bool) -> Result<Sass> {
+        compile(source, family, precise)
     }
 
-    fn compile_raw(&self, families: &[usize], kernels: &[super::RawKernel], request: &Request) -> Result<Vec<Run>> {
-        let chosen: Vec<&Family> = families.iter().map(|&k| &FAMILIES[k]).collect();
-        let (rows, checked) = super::raw_translations(self, kernels, crate::translate::Dialect::Cuda)?;
-        let reports = compile_checked(&chosen, rows, &checked, nvrtc::tools()?, request)?;
-        Ok(reports.into_iter().zip(families).map(|(report, &family)| Run { target: Target { vendor: &NVIDIA, family }, report, isa_files: Vec::new(), note: None }).collect())
+    fn driver_stats(sass: &Sass, family: &Family) -> Result<Vec<DriverStat>> {
+        SassStats::of(&sass.listing, &sass.log, sass.cubin_bytes)?.driver_stats(family)
     }
 
-    fn cost(&self, report: &InspectReport) -> Option<TargetCost> {
-        let family = &FAMILIES[self.family_of(report)?];
-        let header = TargetCost {
-            device: device_name(family),
-            target: Some(format!("nvidia:{}", family.name)),
-            family: Some(family.name.to_string()),
-            architecture: Some(family.architecture.to_string()),
-            compiler: "ptxas".into(),
-            model: format!("{}; a warp's pipes at the CUDA guide's throughputs (Nsight Compute's pipe assignment), its latency by ptxas' stall counts and scoreboards, warps per SM from the registers; / (32 x lights per kernel); Issue Cycles: the old serial sum", crate::inspect::schedule::RULE),
-            unit: "SM cycles".into(),
-            lights_per_kernel: 0,
-            columns: SHOWN.iter().map(|s| s.to_string()).collect(),
-            rows: Vec::new(),
-        };
-        cost::schedule_table(report, header, |stats| Some((Schedule::of(stats)?, 32.0)))
+    fn lanes(_: &BTreeMap<String, f64>) -> Option<f64> {
+        Some(32.0)
     }
 
-    fn family_of(&self, report: &InspectReport) -> Option<usize> {
-        let target = report.provenance["target"].as_str()?.strip_prefix("nvidia:")?;
-        FAMILIES.iter().position(|f| f.name == target)
+    fn compilation(family: &Family, device: String, tools: &nvrtc::Tools, precise: bool) -> Compilation {
+        let options = options(family, precise).join(" ");
+        Compilation {
+            target: format!("nvidia:{}", family.name),
+            device: serde_json::json!({"name": device, "driver_name": "NVRTC", "driver_info": format!("{} ({options})", tools.version), "driver_version": tools.version}),
+            compiler: serde_json::json!({"name": tools.version, "options": options, "translation": "brdfprof's SPIR-V to CUDA C++ translation"}),
+            driver_note: format!("NVIDIA's CUDA compiler ({}, ptxas) on the kernels' CUDA C++ translation, same maths; options: {options}", tools.version),
+            tool: ("nvrtc".to_string(), tools.version.clone()),
+        }
     }
 
-    fn fingerprint(&self, report: &InspectReport) -> BTreeMap<String, String> {
-        // ptxas' output depends on the architecture, NVRTC's version and options, and the translation.
-        let p = &report.provenance;
-        [
-            ("device".to_string(), p["device"]["name"].as_str().unwrap_or("?").to_string()),
-            ("compiler".to_string(), p["compiler"]["name"].as_str().unwrap_or("?").to_string()),
-            ("options".to_string(), p["compiler"]["options"].as_str().unwrap_or("?").to_string()),
-        ]
-        .into()
+    fn isa_listing(family: &Family, label: &str, sass: &Sass, tools: &nvrtc::Tools) -> Result<String> {
+        Ok(format!("// {label}: SASS for {} by {}\n{}\n{}", family.name, tools.version, sass.log.trim(), sass.listing))
+    }
+
+    fn line_compile(m: &Model, source: &str, costed: &str, family: &Family, precise: bool) -> Result<LineCompile> {
+        let sass = compile_as(source, family, precise, true)?;
+        let opcodes = |listing: &str| -> Result<Vec<String>> { Ok(sass::instructions(listing)?.into_iter().map(|i| i.opcode).collect()) };
+        Ok(LineCompile { lines: line_costs(&m.label(), &sass, family)?, costed: opcodes(&compile(costed, family, precise)?.listing)?, annotated: opcodes(&sass.listing)? })
     }
 }
 
@@ -575,7 +503,7 @@ mod tests {
 
     #[test]
     fn every_rate_is_the_fixtures() {
-        let text = include_str!("../../tests/fixtures/nvidia-throughput.tsv");
+        let text = include_str!("../../../tests/fixtures/nvidia-throughput.tsv");
         let rows: Vec<Vec<&str>> = text.lines().filter(|l| !l.starts_with('#') && !l.trim().is_empty() && !l.starts_with("ratio")).map(|l| l.split('\t').collect()).collect();
         for r in &rows {
             let rate = THROUGHPUT.iter().find(|t| t.row == r[0]).unwrap_or_else(|| panic!("the code has no row `{}`", r[0]));

@@ -2,11 +2,11 @@
 //! variable that picks the GPU, the families, and the driver's cost rule. `adreno.rs`, `mali.rs` and `anv.rs`
 //! are one `Shim` each; the child process, its environment checks and crash handling are `mesa_noop`'s.
 
-use super::cost::TargetCost;
-use super::mesa_noop::{self, NoopDriver};
-use super::{Family, Request, Run, Vendor};
+use crate::schema::cost::TargetCost;
+use super::NoopDriver;
+use crate::targets::{mesa_noop, Family, Request, Run, Vendor};
 use crate::gpu::CompilerLog;
-use crate::inspect::InspectReport;
+use crate::schema::InspectReport;
 use anyhow::Result;
 use std::collections::BTreeMap;
 
@@ -124,7 +124,7 @@ impl Vendor for Shim {
         mesa_noop::compile(self.prefix, families, &[], request)
     }
 
-    fn compile_raw(&self, families: &[usize], kernels: &[super::RawKernel], request: &Request) -> Result<Vec<Run>> {
+    fn compile_raw(&self, families: &[usize], kernels: &[crate::targets::RawKernel], request: &Request) -> Result<Vec<Run>> {
         if kernels.is_empty() {
             anyhow::bail!("{}: no raw kernel to compile", self.prefix);
         }

@@ -16,7 +16,10 @@
 //! (Mesa 22.3 RADV's vkDeviceWaitIdle calls through a null pointer there), and a child that still crashes after
 //! printing its complete report is accepted with a note, so the user gets the report and exit 0.
 
-use crate::inspect::{InspectOptions, InspectReport};
+pub mod cache;
+pub mod shim;
+
+use crate::schema::InspectReport;
 use crate::cleanup;
 use crate::gpu::{CompilerLog, Gpu, GpuOptions, Kernel};
 use crate::model::Model;
@@ -178,7 +181,8 @@ fn models_report(gpu: &Gpu, shaders: &Shaders, req: &NoopRequest, target: &str, 
             isa_files.extend(write_isa(gpu, shaders, model, req.lights, dir)?);
         }
     }
-    let mut report = super::inspect_device(gpu, shaders, &InspectOptions { models: models.clone(), lights: req.lights, callgrind: None })?;
+    let mut report = crate::kernel_stats::device_report(gpu, shaders, &models, req.lights, None)?;
+    report.cost = super::cost_of(&report);
     if !skipped.is_empty() {
         let why = skipped.iter().map(|m| format!("{} ({:#})", m.name(), m.check_support(&gpu.info).unwrap_err())).collect::<Vec<_>>().join("; ");
         report.section_notes.insert("driver/".into(), format!("not compiled for {target}: {why}"));
@@ -218,17 +222,17 @@ fn raw_report(gpu: &Gpu, shaders: &Shaders, req: &NoopRequest, target: &str, isa
         let bytes = crate::io::read_bounded(&r.path, crate::launch::MAX_OUTPUT_BYTES as u64).with_context(|| format!("the {target} child cannot read {}", r.path.display()))?;
         let words: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes);
         let kernel = Kernel::with_capture(gpu, &r.label, &words, &Default::default(), &crate::gpu::Binding::storage(r.storage_buffers), r.push_bytes, isa_dir.is_some())?;
-        let mut row = crate::inspect::Row { model: r.label.clone(), spec: None, stats: Default::default(), notes: Default::default() };
+        let mut row = crate::schema::Row { model: r.label.clone(), spec: None, stats: Default::default(), notes: Default::default() };
         let executables = kernel.executables()?.ok_or_else(|| anyhow!("{} reports no pipeline statistics", gpu.info.name))?;
         if let Some(dir) = isa_dir {
             isa_files.extend(write_representations(gpu, &executables, &r.label, dir)?);
         }
-        row.stats.extend(crate::inspect::driver::executable_stats(executables));
+        row.stats.extend(crate::schema::driver::executable_stats(executables));
         rows.push(row);
     }
     let provenance = serde_json::to_value(crate::results::Provenance::new(&gpu.info))?;
     let notes = if skipped.is_empty() { Default::default() } else { [("driver/".to_string(), format!("not compiled for {target}: {}", skipped.join("; ")))].into() };
-    Ok((crate::inspect::compiled_report(rows, provenance, req.lights, shaders, Default::default(), notes), isa_files))
+    Ok((crate::kernel_stats::compiled_report(rows, provenance, req.lights, shaders, Default::default(), notes), isa_files))
 }
 
 /// Set in a child's environment, it dies of SIGSEGV after printing its report, as Mesa 22.3's teardown of
@@ -265,7 +269,7 @@ fn write_representations(gpu: &Gpu, executables: &[crate::gpu::PipelineExecutabl
 
 /// What every child of one `compile` is asked (the parts of a `Request` a child reads).
 struct Job<'a> {
-    /// The shared part of every child's cache key (`noop_cache::request_digest`); None: no child is cached.
+    /// The shared part of every child's cache key (`cache::request_digest`); None: no child is cached.
     cache_digest: Option<String>,
     lights: u32,
     shaders: &'a Shaders,
@@ -290,12 +294,12 @@ struct CachedChild {
 }
 
 /// Runs the child for one target and reads its report, or takes both from the kernel cache when nothing that
-/// reaches the driver changed (`noop_cache`); the child's messages reach the user either way.
+/// reaches the driver changed (`cache`); the child's messages reach the user either way.
 fn run(driver: &'static dyn NoopDriver, family: usize, models: &[Model], raw: &[super::RawKernel], request: &Job) -> Result<ChildRun> {
     let name = Target { vendor: driver, family }.name();
     // The driver's environment first: a driver that is not built stops here, naming what to run.
     let environment = driver.environment(family)?;
-    let key = request.cache_digest.as_deref().map(|digest| super::noop_cache::key(digest, &name, &environment, request.validate));
+    let key = request.cache_digest.as_deref().map(|digest| cache::key(digest, &name, &environment, request.validate));
     let Some(key) = key else {
         let (run, messages) = spawn(driver, family, models, raw, request, environment)?;
         messages.iter().for_each(|m| crate::messages::line(m));
@@ -312,7 +316,7 @@ fn run(driver: &'static dyn NoopDriver, family: usize, models: &[Model], raw: &[
     };
     let mut teardown_note = None;
     let mut built = false;
-    let bytes = crate::cache::get_or_build(store.as_ref(), super::noop_cache::KIND, &key, &what, valid, || {
+    let bytes = crate::cache::get_or_build(store.as_ref(), cache::KIND, &key, &what, valid, || {
         let (run, messages) = spawn(driver, family, models, raw, request, environment)?;
         teardown_note = run.teardown_note;
         built = true;
@@ -321,7 +325,7 @@ fn run(driver: &'static dyn NoopDriver, family: usize, models: &[Model], raw: &[
     let mut cached: CachedChild = serde_json::from_slice(&bytes)?;
     cached.messages.iter().for_each(|m| crate::messages::line(m));
     if let (false, Some(store)) = (built, &store) {
-        cached.report.provenance["cache_entry"] = serde_json::Value::String(store.path(super::noop_cache::KIND, &key).display().to_string());
+        cached.report.provenance["cache_entry"] = serde_json::Value::String(store.path(cache::KIND, &key).display().to_string());
     }
     Ok(ChildRun { report: cached.report, isa_files: Vec::new(), teardown_note })
 }
@@ -413,7 +417,7 @@ pub fn compile(prefix: &str, families: &[usize], raw: &[super::RawKernel], reque
     // report is cached under a key whose kernels' part is computed once here, for every family.
     let cache_digest = match request.isa_dir.is_some() || std::env::var_os(CRASH_AFTER_REPLY).is_some() {
         true => None,
-        false => Some(super::noop_cache::request_digest(models, raw, request.lights, request.validate, request.shaders)?),
+        false => Some(cache::request_digest(models, raw, request.lights, request.validate, request.shaders)?),
     };
     let request = &Job { lights: request.lights, shaders: request.shaders, validate: request.validate, isa_dir: request.isa_dir, cache_digest };
     let workers = std::thread::available_parallelism().map_or(1, |n| n.get()).min(families.len()).max(1);

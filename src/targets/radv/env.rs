@@ -1,14 +1,14 @@
 //! The user's environment cannot crash brdfprof. Mesa's RADV reads `RADV_FORCE_FAMILY` when the Vulkan
 //! loader enumerates devices and aborts the process (`radv: Unknown family`, SIGABRT) for a value it does not
 //! know, an empty one included. Before any Vulkan call, a value that is not one of brdfprof's compile-only
-//! families (`radv_families::FAMILIES`, which Mesa accepts) is tried in a child process (`PROBE_COMMAND`): a family
+//! families (`families::FAMILIES`, which Mesa accepts) is tried in a child process (`PROBE_COMMAND`): a family
 //! Mesa knows but brdfprof does not list (`hawaii`) is kept, a value that kills the child is removed from this
 //! process' environment (and so from its children's) with a warning. The other Mesa variables brdfprof sets
 //! for its children (`MESA_SHADER_CACHE_DISABLE`, `LP_NUM_THREADS`) are read by Mesa as numbers or booleans
 //! with defaults, and any value of them runs (`tests/cli/devices.rs` tries garbage, empty, negative and huge
 //! values).
 
-use super::radv_families::{FAMILIES, FORCE_FAMILY_VAR};
+use super::families::{FAMILIES, FORCE_FAMILY_VAR};
 use anyhow::{Context, Result};
 
 /// The hidden subcommand of the probe: enumerate the Vulkan devices and exit.

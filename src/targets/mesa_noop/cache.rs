@@ -16,7 +16,7 @@
 //! A request that writes files (`--isa`) or asks the child to crash (the containment test) is never cached
 //! (`mesa_noop::compile` decides).
 
-use super::RawKernel;
+use crate::targets::RawKernel;
 use crate::cache::{Key, KeyBuilder};
 use crate::kernels::shade::{kernel_hash, GBufferFormat};
 use crate::model::Model;

@@ -166,7 +166,7 @@ impl Tools {
 }
 
 /// nvdisasm's options: code sections only, and each instruction's two 64-bit words (its control bits:
-/// `targets::sass`).
+/// `nvidia::sass`).
 pub const DISASSEMBLE_OPTIONS: [&str; 2] = ["-c", "-hex"];
 
 /// nvdisasm's option that names each instruction's source line.

@@ -6,12 +6,15 @@
 //! (`THROUGHPUT`, the one place those figures live). These are "Intel's OpenCL compiler (IGC), same maths" figures: Mesa's ANV, Intel's Vulkan driver on
 //! Linux, compiles SPIR-V with its own compiler (brw); Intel's Windows Vulkan driver uses IGC.
 
-use super::cost::{self, TargetCost};
-use super::{ocloc, Request, Run, Target};
-use super::gen_isa;
+pub mod gen_isa;
+pub mod ocloc;
+
+use super::cost;
+use super::cost::schedule::{LATENCY, PIPE_PREFIX, RESIDENT_WAVES};
+use super::translated::{Compilation, LineCompile, Translated, Translator};
 use crate::gpu::DriverStat;
-use crate::inspect::schedule::{Schedule, LATENCY, PIPE_PREFIX, RESIDENT_WAVES};
-use crate::inspect::InspectReport;
+use crate::model::Model;
+use crate::translate::Dialect;
 use anyhow::{anyhow, bail, Result};
 use std::collections::BTreeMap;
 
@@ -182,7 +185,7 @@ fn latency(i: &gen_isa::Instruction, family: &Family) -> f64 {
     let class = classify(&i.mnemonic);
     let two_source = TWO_SOURCE_FUNCTIONS.contains(&i.function.as_str());
     if class == Class::Send {
-        return super::sass::MEMORY.cycles;
+        return super::nvidia::sass::MEMORY.cycles;
     }
     if family.legacy_latency {
         return match class {
@@ -396,7 +399,7 @@ impl IsaStats {
         if self.grf > 128 { family.threads / 2 } else { family.threads }
     }
 
-    /// The statistics as driver statistics of the executable "IGC" (names lined up with `inspect::driver`'s
+    /// The statistics as driver statistics of the executable "IGC" (names lined up with `schema::driver`'s
     /// aliases, so that the gate reads registers, instructions, spills and code size as for any driver).
     pub fn driver_stats(&self, family: &Family) -> Result<Vec<DriverStat>> {
         let stat = |name: &str, value: f64| DriverStat { executable: "IGC".into(), name: name.into(), description: String::new(), value };
@@ -465,37 +468,12 @@ pub fn compile_as(source: &str, family: &Family, precise: bool, lines: bool) -> 
     Ok(serde_json::from_slice(&bytes)?)
 }
 
-/// The device name of a family's reports.
-pub fn device_name(family: &Family) -> String {
-    format!("Intel {} ({}), compile-only", family.name, family.architecture)
-}
-
-/// Every kernel (the models' and the memory-only one) compiled by IGC for each family, as `inspect` reports
-/// (one per family, in order), after each translation agreed with its Vulkan kernel.
-pub fn inspect(families: &[&Family], req: &Request) -> Result<Vec<InspectReport>> {
-    let tools = ocloc::tools()?;
-    let gpu = req.verify_on.ok_or_else(|| anyhow!("intel: no Vulkan device to check the translation against"))?;
-    let checked = super::checked_translations(req, gpu, crate::translate::Dialect::OpenCl)?;
-    let statics = crate::inspect::kernels_of(req.models).into_iter().map(|m| crate::inspect::static_row(req.shaders, m, req.lights)).collect::<Result<Vec<_>>>()?;
-    let mut reports = compile_checked(families, statics, &checked, tools, req)?;
-    super::add_lines(&mut reports, families, req, &checked, crate::translate::Dialect::OpenCl, |m, source, costed, family| {
-        let binary = compile_as(source, family, req.precise, true)?;
-        let lines = line_costs(&m.label(), &binary, family)?;
-        let shape = |i: gen_isa::Instruction| format!("{}.{} ({}) :{}", i.mnemonic, i.function, i.exec_size, i.dst_type);
-        let costed = gen_isa::instructions(&compile(costed, family, req.precise)?.listing, family.grf_bytes).into_iter().map(shape).collect();
-        let simd = IsaStats::of(&binary, family)?.simd;
-        let annotated = gen_isa::sourced_instructions(binary.lines_listings.get(&simd).map_or("", String::as_str), family.grf_bytes).into_iter().map(|(i, _)| shape(i)).collect();
-        Ok(super::LineCompile { lines, costed, annotated })
-    })?;
-    Ok(reports)
-}
-
 /// Cost per source line of a kernel compiled with `compile_as(.., lines)`: each instruction of IGC's listing on
 /// its pipes (`pipe_cycles`), its schedule cycles (the wait for its registers and pipe, and its issue cycle in
 /// `IsaStats::schedule_latency`'s schedule), summed per line; the translation's own lines and IGC's prologue
 /// name none. Lines are ranked on the pipe that binds the kernel.
-pub fn line_costs(model: &str, binary: &ocloc::Binary, family: &Family) -> Result<crate::inspect::lines::KernelLines> {
-    use crate::inspect::lines::{per_line, Attributed};
+pub fn line_costs(model: &str, binary: &ocloc::Binary, family: &Family) -> Result<crate::schema::lines::KernelLines> {
+    use super::cost::lines::{per_line, Attributed};
     let stats = IsaStats::of(binary, family)?;
     let listing = binary.lines_listings.get(&stats.simd).ok_or_else(|| anyhow!("IGC's shader dump has no SIMD{} listing (it has {:?})", stats.simd, binary.lines_listings.keys().collect::<Vec<_>>()))?;
     let sourced = gen_isa::sourced_instructions(listing, family.grf_bytes);
@@ -515,152 +493,94 @@ pub fn line_costs(model: &str, binary: &ocloc::Binary, family: &Family) -> Resul
         let schedule = times[k] - previous;
         previous = times[k];
         let pipes = pipe_cycles(&i, family)?.into_iter().map(|(p, c)| (p.name(family.pipes).to_string(), c)).collect();
-        attributed.push(Attributed { source: super::user_source(source.as_slice()), pipes, schedule, issue: 0.0 });
+        attributed.push(Attributed { source: super::translated::user_source(source.as_slice()), pipes, schedule, issue: 0.0 });
     }
     Ok(per_line(model, &attributed, &binding))
 }
 
-/// Every checked translation compiled for each family, its statistics added to its row (`statics`, in the
-/// same order), as one report per family.
-fn compile_checked(families: &[&Family], statics: Vec<crate::inspect::Row>, checked: &[super::Checked], tools: &ocloc::Tools, req: &Request) -> Result<Vec<InspectReport>> {
-    let jobs: Vec<(usize, usize)> = (0..families.len()).flat_map(|f| (0..checked.len()).map(move |k| (f, k))).collect();
-    // Each job is an ocloc process: one per core.
-    use rayon::prelude::*;
-    let (sources, precise): (Vec<&str>, bool) = (checked.iter().map(|c| c.source.as_str()).collect(), req.precise);
-    let compiled: Vec<Result<ocloc::Binary>> = jobs.par_iter().map(|&(f, k)| compile(sources[k], families[f], precise)).collect();
-    // A family without what a kernel needs (fp64) leaves it out with the reason; any other failure stops.
-    let compiled: Vec<std::result::Result<ocloc::Binary, String>> =
-        compiled.into_iter().map(|r| r.map(Ok).or_else(|e| e.downcast_ref::<ocloc::Unsupported>().map(|u| Err(u.reason.clone())).ok_or(e))).collect::<Result<_>>()?;
-    let mut reports = Vec::new();
-    for (f, family) in families.iter().enumerate() {
-        let mut rows = statics.clone();
-        let mut left_out = Vec::new();
-        for (k, row) in rows.iter_mut().enumerate() {
-            let binary = match &compiled[f * checked.len() + k] {
-                Ok(b) => b,
-                Err(why) => {
-                    left_out.push((row.model.clone(), why.clone()));
-                    continue;
-                }
-            };
-            let stats = IsaStats::of(binary, family)?;
-            row.stats.extend(crate::inspect::driver::stats(&stats.driver_stats(family)?));
-            row.notes.insert("translation".into(), checked[k].agreement.clone());
-            if let Some(dir) = req.isa_dir {
-                write_isa(dir, family, &row.model, &checked[k].source, binary, &tools.version)?;
-            }
-        }
-        rows.retain(|r| !left_out.iter().any(|(m, _)| *m == r.model));
-        let mut report = report(family, rows, tools, req);
-        if !left_out.is_empty() {
-            let note = format!("not compiled for intel:{}: {}", family.name, left_out.iter().map(|(m, why)| format!("{m} ({why})")).collect::<Vec<_>>().join("; "));
-            crate::messages::warning(&note);
-            report.section_notes.insert("driver/".into(), note);
-        }
-        reports.push(report);
-    }
-    Ok(reports)
-}
-
-/// Writes the kernel's OpenCL C translation and IGA's listing to DIR/intel-<family>/<kernel>.{cl,asm}.
-fn write_isa(dir: &std::path::Path, family: &Family, label: &str, source: &str, binary: &ocloc::Binary, version: &str) -> Result<()> {
-    let dir = dir.join(format!("intel-{}", family.name));
-    std::fs::create_dir_all(&dir).map_err(|e| anyhow!("--isa: cannot create {}: {e}", dir.display()))?;
-    let stem = super::file_slug(label);
-    crate::io::write_output(&dir.join(format!("{stem}.cl")), source.as_bytes())?;
-    let stats = IsaStats::of(binary, family)?;
-    let header = format!("// {label}: Gen ISA for {} (ocloc -device {}) by {version}, listed by IGA\n// SIMD{}, {} GRF, {} bytes scratch per thread\n", family.name, family.device, stats.simd, stats.grf, stats.scratch_bytes);
-    crate::io::write_output(&dir.join(format!("{stem}.asm")), format!("{header}{}", binary.listing).as_bytes())
-}
-
-fn report(family: &Family, rows: Vec<crate::inspect::Row>, tools: &ocloc::Tools, req: &Request) -> InspectReport {
-    let options = options(req.precise);
-    let compilation = super::Compilation {
-        target: format!("intel:{}", family.name),
-        device: serde_json::json!({"name": device_name(family), "driver_name": "IGC (ocloc)", "driver_info": format!("{} (-device {}; {options})", tools.version, family.device), "driver_version": tools.version}),
-        compiler: serde_json::json!({"name": tools.version, "options": options, "device": family.device, "translation": "brdfprof's SPIR-V to OpenCL C translation"}),
-        driver_note: format!("Intel's OpenCL compiler (IGC, {}) on the kernels' OpenCL C translation, same maths; -device {}; options: {options}", tools.version, family.device),
-        tool: ("ocloc".to_string(), tools.version.clone()),
-    };
-    super::translated_report(&INTEL, compilation, rows, req)
-}
-
-/// The statistics the cost table shows beside cycles/eval (and the rule's figures, `cost::schedule_table`).
-pub const SHOWN: [&str; 6] = ["SIMD Width", "Register Count", "Spill Count", "Instruction Count", "Extended math", "Issue Cycles"];
-
+/// Intel's translated targets: `FAMILIES` and `THROUGHPUT`, IGC through ocloc, and IGA's listing parser
+/// (`IsaStats`).
 pub struct Intel;
-pub static INTEL: Intel = Intel;
+pub static INTEL: Translated<Intel> = Translated::new();
 
-impl super::Vendor for Intel {
-    fn prefix(&self) -> &'static str {
-        "intel"
+impl Translator for Intel {
+    type Family = Family;
+    type Binary = ocloc::Binary;
+    type Tools = ocloc::Tools;
+
+    const PREFIX: &'static str = "intel";
+    const NAME: &'static str = "Intel";
+    const TITLE: &'static str = "Intel: IGC through ocloc (Debian's intel-opencl-icd) on the kernels' OpenCL C translation, checked on the host first (no Intel GPU or driver needed)";
+    const DIALECT: Dialect = Dialect::OpenCl;
+    const COMPILER: &'static str = "IGC";
+    const UNIT: &'static str = "EU cycles";
+    const RULE: &'static str = "a thread's pipes at THROUGHPUT's lanes per clock (Intel's documents; extended math: IGC's scheduling model), its latency in IGC's instruction order at IGC's scheduler latencies, threads per EU from the registers; / (SIMD width x lights per kernel); Issue Cycles: the old serial sum";
+    const SHOWN: &'static [&'static str] = &["SIMD Width", "Register Count", "Spill Count", "Instruction Count", "Extended math", "Issue Cycles"];
+    const ISA_EXTENSIONS: (&'static str, &'static str) = ("cl", "asm");
+
+    fn families() -> &'static [Family] {
+        &FAMILIES
     }
 
-    fn name(&self) -> &'static str {
-        "Intel"
+    fn family(f: &Family) -> super::Family {
+        super::Family { name: f.name, architecture: f.architecture, products: f.products, detail: format!("ocloc -device {}", f.device), default: true }
     }
 
-    fn title(&self) -> &'static str {
-        "Intel: IGC through ocloc (Debian's intel-opencl-icd) on the kernels' OpenCL C translation, checked on the host first (no Intel GPU or driver needed)"
+    fn tools() -> Result<&'static ocloc::Tools> {
+        ocloc::tools()
     }
 
-    fn families(&self) -> Vec<super::Family> {
-        FAMILIES.iter().map(|f| super::Family { name: f.name, architecture: f.architecture, products: f.products, detail: format!("ocloc -device {}", f.device), default: true }).collect()
-    }
-
-    fn status(&self) -> Result<String> {
+    fn status() -> Result<String> {
         let t = ocloc::tools()?;
         Ok(format!("{} at {}, IGA from {}", t.version, t.ocloc.display(), t.iga_dir.display()))
     }
 
-    fn needs_verification(&self) -> bool {
-        true
+    fn vendor() -> &'static dyn super::Vendor {
+        &INTEL
     }
 
-    fn compile(&self, families: &[usize], request: &Request) -> Result<Vec<Run>> {
-        let chosen: Vec<&Family> = families.iter().map(|&k| &FAMILIES[k]).collect();
-        let reports = inspect(&chosen, request)?;
-        Ok(reports.into_iter().zip(families).map(|(report, &family)| Run { target: Target { vendor: &INTEL, family }, report, isa_files: Vec::new(), note: None }).collect())
+    fn compile(source: &str, family: &Family, precise: bool) -> Result<ocloc::Binary> {
+        compile(source, family, precise)
     }
 
-    fn compile_raw(&self, families: &[usize], kernels: &[super::RawKernel], request: &Request) -> Result<Vec<Run>> {
-        let chosen: Vec<&Family> = families.iter().map(|&k| &FAMILIES[k]).collect();
-        let (rows, checked) = super::raw_translations(self, kernels, crate::translate::Dialect::OpenCl)?;
-        let reports = compile_checked(&chosen, rows, &checked, ocloc::tools()?, request)?;
-        Ok(reports.into_iter().zip(families).map(|(report, &family)| Run { target: Target { vendor: &INTEL, family }, report, isa_files: Vec::new(), note: None }).collect())
+    /// A family without what a kernel needs (fp64).
+    fn unsupported(error: &anyhow::Error) -> Option<String> {
+        error.downcast_ref::<ocloc::Unsupported>().map(|u| u.reason.clone())
     }
 
-    fn cost(&self, report: &InspectReport) -> Option<TargetCost> {
-        let family = &FAMILIES[self.family_of(report)?];
-        let header = TargetCost {
-            device: device_name(family),
-            target: Some(format!("intel:{}", family.name)),
-            family: Some(family.name.to_string()),
-            architecture: Some(family.architecture.to_string()),
-            compiler: "IGC".into(),
-            model: format!("{}; a thread's pipes at THROUGHPUT's lanes per clock (Intel's documents; extended math: IGC's scheduling model), its latency in IGC's instruction order at IGC's scheduler latencies, threads per EU from the registers; / (SIMD width x lights per kernel); Issue Cycles: the old serial sum", crate::inspect::schedule::RULE),
-            unit: "EU cycles".into(),
-            lights_per_kernel: 0,
-            columns: SHOWN.iter().map(|s| s.to_string()).collect(),
-            rows: Vec::new(),
-        };
-        cost::schedule_table(report, header, |stats| Some((Schedule::of(stats)?, cost::driver_stat(stats, "SIMD Width")?)))
+    fn driver_stats(binary: &ocloc::Binary, family: &Family) -> Result<Vec<DriverStat>> {
+        IsaStats::of(binary, family)?.driver_stats(family)
     }
 
-    fn family_of(&self, report: &InspectReport) -> Option<usize> {
-        let target = report.provenance["target"].as_str()?.strip_prefix("intel:")?;
-        FAMILIES.iter().position(|f| f.name == target)
+    fn lanes(stats: &BTreeMap<String, f64>) -> Option<f64> {
+        cost::driver_stat(stats, "SIMD Width")
     }
 
-    fn fingerprint(&self, report: &InspectReport) -> BTreeMap<String, String> {
-        // IGC's output depends on the device, ocloc's (IGC's) version and options, and the translation.
-        let p = &report.provenance;
-        [
-            ("device".to_string(), p["device"]["name"].as_str().unwrap_or("?").to_string()),
-            ("compiler".to_string(), p["compiler"]["name"].as_str().unwrap_or("?").to_string()),
-            ("options".to_string(), p["compiler"]["options"].as_str().unwrap_or("?").to_string()),
-        ]
-        .into()
+    fn compilation(family: &Family, device: String, tools: &ocloc::Tools, precise: bool) -> Compilation {
+        let options = options(precise);
+        Compilation {
+            target: format!("intel:{}", family.name),
+            device: serde_json::json!({"name": device, "driver_name": "IGC (ocloc)", "driver_info": format!("{} (-device {}; {options})", tools.version, family.device), "driver_version": tools.version}),
+            compiler: serde_json::json!({"name": tools.version, "options": options, "device": family.device, "translation": "brdfprof's SPIR-V to OpenCL C translation"}),
+            driver_note: format!("Intel's OpenCL compiler (IGC, {}) on the kernels' OpenCL C translation, same maths; -device {}; options: {options}", tools.version, family.device),
+            tool: ("ocloc".to_string(), tools.version.clone()),
+        }
+    }
+
+    fn isa_listing(family: &Family, label: &str, binary: &ocloc::Binary, tools: &ocloc::Tools) -> Result<String> {
+        let stats = IsaStats::of(binary, family)?;
+        let header = format!("// {label}: Gen ISA for {} (ocloc -device {}) by {}, listed by IGA\n// SIMD{}, {} GRF, {} bytes scratch per thread\n", family.name, family.device, tools.version, stats.simd, stats.grf, stats.scratch_bytes);
+        Ok(format!("{header}{}", binary.listing))
+    }
+
+    fn line_compile(m: &Model, source: &str, costed: &str, family: &Family, precise: bool) -> Result<LineCompile> {
+        let binary = compile_as(source, family, precise, true)?;
+        let lines = line_costs(&m.label(), &binary, family)?;
+        let shape = |i: gen_isa::Instruction| format!("{}.{} ({}) :{}", i.mnemonic, i.function, i.exec_size, i.dst_type);
+        let costed = gen_isa::instructions(&compile(costed, family, precise)?.listing, family.grf_bytes).into_iter().map(shape).collect();
+        let simd = IsaStats::of(&binary, family)?.simd;
+        let annotated = gen_isa::sourced_instructions(binary.lines_listings.get(&simd).map_or("", String::as_str), family.grf_bytes).into_iter().map(|(i, _)| shape(i)).collect();
+        Ok(LineCompile { lines, costed, annotated })
     }
 }
 
@@ -719,7 +639,7 @@ mod throughput_fixture {
     }
 
     fn fixture() -> Vec<Entry> {
-        include_str!("../../tests/fixtures/intel-throughput.tsv")
+        include_str!("../../../tests/fixtures/intel-throughput.tsv")
             .lines()
             .filter(|l| !l.starts_with('#') && !l.trim().is_empty())
             .map(|l| {
@@ -759,7 +679,7 @@ mod throughput_fixture {
     #[test]
     fn every_rate_is_the_fixtures_computed_from_its_cited_figures() {
         let rows = fixture();
-        let header = include_str!("../../tests/fixtures/intel-throughput.tsv");
+        let header = include_str!("../../../tests/fixtures/intel-throughput.tsv");
         for e in &rows {
             let what = format!("{} on {}", e.row, e.family);
             assert!(["stated", "derived"].contains(&e.basis.as_str()), "{what}: basis `{}` (a rate is the source's figure or computed from it)", e.basis);

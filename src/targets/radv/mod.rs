@@ -11,14 +11,18 @@
 //! 64 invocations whatever the wave size, so one evaluation (one invocation x one light) costs
 //! `Inverse Throughput / (64 x lights per kernel)` SIMD cycles.
 
-use super::cost::{self, TargetCost};
+pub mod aco_perfinfo;
+pub mod env;
+pub mod families;
+
+use super::cost;
+use crate::schema::cost::TargetCost;
 use super::mesa_noop::{self, NoopDriver};
 use super::{Request, Run};
-use super::aco_perfinfo;
-use super::radv_families::{family_of_device, null_device_name, Family, FAMILIES, FORCE_FAMILY_VAR};
+use families::{family_of_device, null_device_name, Family, FAMILIES, FORCE_FAMILY_VAR};
 use crate::gpu::CompilerLog;
-use crate::inspect::schedule::Schedule;
-use crate::inspect::InspectReport;
+use super::cost::schedule::Schedule;
+use crate::schema::InspectReport;
 use anyhow::Result;
 use std::collections::BTreeMap;
 
@@ -31,7 +35,7 @@ pub const SHOWN: [&str; 5] = ["Instructions", "VGPRs", "Spilled VGPRs", "Latency
 /// Asks ACO for its per-instruction schedule (`aco_perfinfo`), beside the user's own ACO_DEBUG flags.
 const PERFINFO: &str = "perfinfo";
 
-/// The rule's figures of one ACO kernel (`inspect::schedule`), from its perfinfo statistics: every
+/// The rule's figures of one ACO kernel (`cost::schedule`), from its perfinfo statistics: every
 /// instruction once at ACO's own resource costs for `family` (vector instructions twice for wave64 on
 /// GFX10+, as ACO dual-issues them for workgroups over 32 invocations), the clocks summed, ACO's num_waves.
 pub fn schedule(stats: &BTreeMap<String, f64>, family: &Family) -> Option<Schedule> {
@@ -114,7 +118,7 @@ impl super::Vendor for Radv {
         let perfinfo = family.filter(|f| report.rows.iter().any(|r| schedule(&r.stats, f).is_some()));
         match perfinfo {
             Some(f) => {
-                let rule = format!("{}; ACO's resource costs and per-instruction clocks (ACO_DEBUG=perfinfo) with every instruction once, ACO's num_waves; / (64 x lights per kernel); ACO's own Latency and Inverse Throughput (its branch weights) beside", crate::inspect::schedule::RULE);
+                let rule = format!("{}; ACO's resource costs and per-instruction clocks (ACO_DEBUG=perfinfo) with every instruction once, ACO's num_waves; / (64 x lights per kernel); ACO's own Latency and Inverse Throughput (its branch weights) beside", super::cost::schedule::RULE);
                 cost::schedule_table(report, header(rule), |stats| Some((schedule(stats, f)?, THROUGHPUT_INVOCATIONS)))
             }
             None => cost::table(report, header("cycles/eval = Inverse Throughput / (64 x lights per kernel)".into()), |stats, lights| cost::driver_stat(stats, "Inverse Throughput").map(|it| it / (THROUGHPUT_INVOCATIONS * f64::from(lights)))),
@@ -179,7 +183,7 @@ impl NoopDriver for Radv {
 mod tests {
     use super::super::{parse, Vendor};
     use super::*;
-    use crate::inspect::Row;
+    use crate::schema::Row;
 
     #[test]
     fn parses_families_all_and_lists() {
@@ -203,8 +207,8 @@ mod tests {
             stats: [("driver/Compute Shader/Inverse Throughput".to_string(), it), ("driver/Compute Shader/VGPRs".to_string(), 40.0)].into(),
             notes: BTreeMap::new(),
         };
-        let mut report = crate::inspect::tests::empty_report("Null hardware (RADV NAVI21)");
-        report.rows = vec![row("ggx", 1536.0), row(crate::inspect::BASELINE_LABEL, 512.0)];
+        let mut report = crate::schema::tests::empty_report("Null hardware (RADV NAVI21)");
+        report.rows = vec![row("ggx", 1536.0), row(crate::model::BASELINE_LABEL, 512.0)];
         let t = RADV.cost(&report).unwrap();
         assert_eq!(t.family.as_deref(), Some("navi21"));
         assert_eq!(t.rows[0].cycles_per_eval, 3.0);

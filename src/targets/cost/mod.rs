@@ -1,0 +1,83 @@
+//! The cost rule: a compile-only target's cost table (`schema::cost`) from a report's statistics, by a
+//! per-kernel rule of the vendor's or by the one rule of `schedule`, and each instruction's cost attributed
+//! to its source line (`lines`). Each vendor supplies its figures (ACO's inverse throughput, NVIDIA's and
+//! Intel's pipes and schedules, ...); this module turns them into the table every report shows.
+
+pub mod lines;
+pub mod schedule;
+
+use crate::kernels::shade::steady_block;
+use crate::model::BASELINE_LABEL;
+use crate::schema::cost::{CostRow, TargetCost};
+use crate::schema::InspectReport;
+use schedule::{Schedule, LATENCY, RESIDENT_WAVES};
+
+/// A row's statistics by key.
+type Stats = std::collections::BTreeMap<String, f64>;
+
+/// The value of driver statistic `name` of any executable, summed (a compute pipeline has one).
+pub fn driver_stat(stats: &std::collections::BTreeMap<String, f64>, name: &str) -> Option<f64> {
+    let suffix = format!("/{name}");
+    let v: Vec<f64> = stats.iter().filter(|(k, _)| k.starts_with("driver/") && k.ends_with(&suffix) && k.matches('/').count() == 2).map(|(_, v)| *v).collect();
+    (!v.is_empty()).then(|| v.iter().sum())
+}
+
+/// A cost table of `report` from a per-kernel rule: `cycles(stats, lights per kernel)` (None: the kernel has no
+/// figure, e.g. the driver reported none) and the statistics `columns` shown beside it.
+pub fn table(report: &InspectReport, header: TargetCost, cycles: impl Fn(&std::collections::BTreeMap<String, f64>, u32) -> Option<f64>) -> Option<TargetCost> {
+    let lights = steady_block(report.lights).0;
+    let mut t = TargetCost { lights_per_kernel: lights, rows: Vec::new(), ..header };
+    for r in &report.rows {
+        let Some(c) = cycles(&r.stats, lights) else { continue };
+        let stats = t.columns.iter().map(|name| (name.clone(), driver_stat(&r.stats, name).unwrap_or(0.0))).collect();
+        t.rows.push(CostRow { model: r.model.clone(), stats, cycles_per_eval: c, net_cycles_per_eval: None, bound: None, terms: Vec::new() });
+    }
+    if t.rows.is_empty() {
+        return None;
+    }
+    if let Some(base) = t.rows.iter().find(|r| r.model == BASELINE_LABEL).map(|r| r.cycles_per_eval) {
+        for r in t.rows.iter_mut().filter(|r| r.model != BASELINE_LABEL) {
+            r.net_cycles_per_eval = Some(r.cycles_per_eval - base);
+        }
+    }
+    Some(t)
+}
+
+/// Columns `schedule_table` adds to a row's statistics: the rule's figures per wave.
+pub const BUSIEST_PIPE: &str = "busiest pipe (cycles/wave)";
+pub const HIDDEN_LATENCY: &str = "latency / waves";
+
+/// A cost table under `schedule`'s rule (`schedule::RULE`): per kernel, cycles per wave = max(busiest pipe,
+/// schedule latency / resident waves) over the figures `schedule_of(stats)` gives with the lanes of one wave,
+/// divided by those lanes and the lights per kernel; net = the largest term the kernel adds to the memory-only
+/// kernel's (per evaluation: kernels may differ in width), that term named in `bound`.
+pub fn schedule_table(report: &InspectReport, mut header: TargetCost, schedule_of: impl Fn(&Stats) -> Option<(Schedule, f64)>) -> Option<TargetCost> {
+    let lights = f64::from(steady_block(report.lights).0);
+    let per_eval = |stats: &Stats| schedule_of(stats).map(|(s, lanes)| (s.scaled(1.0 / (lanes * lights)), s));
+    let figures = |model: &str| report.rows.iter().find(|r| r.model == model).and_then(|r| per_eval(&r.stats));
+    let base = figures(BASELINE_LABEL).map(|(e, _)| e);
+    for c in [BUSIEST_PIPE, LATENCY, RESIDENT_WAVES, HIDDEN_LATENCY] {
+        if !header.columns.iter().any(|x| x == c) {
+            header.columns.push(c.to_string());
+        }
+    }
+    let mut t = table(report, header, |stats, _| per_eval(stats).map(|(e, _)| e.cycles().1))?;
+    for row in &mut t.rows {
+        let Some((eval, wave)) = figures(&row.model) else { continue };
+        row.stats.insert(BUSIEST_PIPE.into(), wave.throughput().1);
+        row.stats.insert(LATENCY.into(), wave.latency.unwrap_or(f64::NAN));
+        row.stats.insert(RESIDENT_WAVES.into(), wave.resident_waves.unwrap_or(f64::NAN));
+        row.stats.insert(HIDDEN_LATENCY.into(), wave.hidden_latency().unwrap_or(f64::NAN));
+        let (bound, net) = match &base {
+            Some(b) if row.model != BASELINE_LABEL => {
+                let (name, v) = eval.net(b);
+                (name, Some(v))
+            }
+            _ => (eval.cycles().0, None),
+        };
+        row.net_cycles_per_eval = net;
+        row.bound = Some(bound);
+        row.terms = wave.terms();
+    }
+    Some(t)
+}
