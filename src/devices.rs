@@ -95,8 +95,8 @@ impl Inspected {
     /// The JSON written: the one device's report, or the combined report of several.
     pub fn json_value(&self) -> Result<serde_json::Value> {
         let (kind, mut value) = match &self.multi {
-            None => (crate::results::Kind::Inspect, serde_json::to_value(&self.reports[0])?),
-            Some(m) => (crate::results::Kind::InspectDevices, serde_json::to_value(m)?),
+            None => (crate::export::json::Kind::Inspect, serde_json::to_value(&self.reports[0])?),
+            Some(m) => (crate::export::json::Kind::InspectDevices, serde_json::to_value(m)?),
         };
         if let Some(map) = value.as_object_mut() {
             map.insert("kind".into(), kind.name().into());
@@ -222,5 +222,5 @@ pub fn slug(report: &InspectReport) -> String {
     if let Some(t) = targets::of_report(report) {
         return t.slug();
     }
-    crate::results::name_slug(report.provenance["device"]["name"].as_str().unwrap_or("device"))
+    crate::export::name_slug(report.provenance["device"]["name"].as_str().unwrap_or("device"))
 }

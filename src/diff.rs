@@ -118,7 +118,7 @@ impl DiffSet {
     /// One table (a row per model: its largest and RMS relative difference over the channels, its
     /// non-finite values, its worst row), then each model's report.
     pub fn markdown(&self) -> String {
-        use crate::results::{sig, Table};
+        use crate::export::markdown::{sig, Table};
         let mut out = format!(
             "# {} models against {}\n\n{} rows of {} on {}; relative: rel_err(model, reference) = |model - reference| / max(|reference|, {}).\n\n",
             self.diffs.len(),
@@ -382,7 +382,7 @@ impl DiffReport {
 
     /// The report as Markdown: the channel table, the twins' figures, the histogram and the worst rows.
     pub fn markdown(&self) -> String {
-        use crate::results::{sig, Table};
+        use crate::export::markdown::{sig, Table};
         let mut out = format!("# {} against {}\n\n{} rows of {} on {}; relative: {}.\n\n", self.b.name, self.a.name, self.rows, self.input, self.device, self.relative_to);
         for side in [&self.a, &self.b] {
             if let Some(f) = &side.front_end {
@@ -412,7 +412,7 @@ impl DiffReport {
 
     fn histogram_markdown(&self) -> String {
         let h = &self.histogram;
-        let mut t = crate::results::Table::new(["largest relative difference of a row", "rows", ""]);
+        let mut t = crate::export::markdown::Table::new(["largest relative difference of a row", "rows", ""]);
         let most = h.counts.iter().copied().max().unwrap_or(0).max(1);
         for (i, &n) in h.counts.iter().enumerate() {
             let range = match h.edges.get(i + 1) {
@@ -428,12 +428,12 @@ impl DiffReport {
         if self.worst.is_empty() {
             return String::new();
         }
-        let mut t = crate::results::Table::new(["row", "n", "v", "l", "roughness", "f0", "A", "B", "rel (channel)"]);
+        let mut t = crate::export::markdown::Table::new(["row", "n", "v", "l", "roughness", "f0", "A", "B", "rel (channel)"]);
         for w in &self.worst {
             let v3 = |v: [f32; 3]| format!("{} {} {}", v[0], v[1], v[2]);
             let s = &w.sample;
             let row = w.line.map_or(w.index.to_string(), |l| format!("line {l}"));
-            t.row([row, v3(s.n), v3(s.v), v3(s.l), s.roughness.to_string(), v3(s.f0), v3(w.a), v3(w.b), format!("{} ({})", crate::results::sig(w.rel, 3), w.channel)]);
+            t.row([row, v3(s.n), v3(s.v), v3(s.l), s.roughness.to_string(), v3(s.f0), v3(w.a), v3(w.b), format!("{} ({})", crate::export::markdown::sig(w.rel, 3), w.channel)]);
         }
         format!("\nRows where they differ most:\n\n{}", t.markdown())
     }

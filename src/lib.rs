@@ -1,7 +1,7 @@
 //! brdfprof: evaluates and profiles specular BRDFs in Vulkan compute kernels.
 //!
 //! Data flows CLI (`main.rs`, `cli/`) -> models (`model`: a `brdf` spec) -> kernels (`kernels`, `shaders`, on
-//! `gpu`) -> the measurement protocol (`profile`) -> reports (`report`).
+//! `gpu`) -> the measurement protocol (`profile`) -> reports (`export`, every output format).
 
 pub use brdfprof_brdf as brdf;
 pub use brdfprof_process::{cleanup, launch, messages};
@@ -9,20 +9,18 @@ pub use brdfprof_vulkan as gpu;
 
 pub mod accuracy;
 pub mod cache;
-pub mod chart;
 pub mod check;
 pub mod compare;
 pub mod devices;
 pub mod diff;
+pub mod export;
 pub mod host;
-pub mod page;
 pub mod report_page;
 pub mod inspect;
 pub mod io;
 pub mod kernels;
 pub mod model;
 pub mod profile;
-pub mod results;
 pub mod shaders;
 pub mod spirv;
 pub mod stability;

@@ -9,11 +9,12 @@ use crate::brdf::exact::ExactFresnel;
 use crate::brdf::samples::SampleDomain;
 use crate::brdf::spec::with_each_param_sample;
 use crate::brdf::{ModelSpec, Precision, Vis, D, F, THESIS_MODELS};
-use crate::chart::{self, Point};
+use crate::export::png::{self, Point};
 use crate::gpu::Gpu;
 use crate::model::Model;
 use crate::profile::{self, ProfileOptions, ProfileReport};
-use crate::results::{self, Table};
+use crate::export::json;
+use crate::export::markdown::{self, Table};
 use crate::stats::{self, Estimate};
 use anyhow::Result;
 use indicatif::ProgressBar;
@@ -279,9 +280,9 @@ impl SweepReport {
             t.row([
                 format!("{}{}", r.rank, if r.tied { "=" } else { "" }),
                 r.spec.clone(),
-                results::estimate(&r.ns_per_eval, 3),
-                r.net_ns_per_eval.as_ref().map_or("-".into(), |e| results::sig(e.median, 3)),
-                results::estimate(&r.cost_vs_fastest, 3),
+                markdown::estimate(&r.ns_per_eval, 3),
+                r.net_ns_per_eval.as_ref().map_or("-".into(), |e| markdown::sig(e.median, 3)),
+                markdown::estimate(&r.cost_vs_fastest, 3),
                 numerical_cell(a),
                 a.vs_exact.cell(),
                 format!("{:.1e}", a.albedo_vs_exact),
@@ -311,7 +312,7 @@ impl SweepReport {
 
     /// Writes sweep-<device>.md, .json and .png under `out`; returns their paths.
     pub fn write(&self, out: &Path, device: &str) -> Result<Vec<std::path::PathBuf>> {
-        results::write_md_json_png(&out.join(format!("sweep-{device}")), results::Kind::Sweep, self, &self.markdown(), |png| self.chart(png))
+        json::write_md_json_png(&out.join(format!("sweep-{device}")), json::Kind::Sweep, self, &self.markdown(), |png| self.chart(png))
     }
 
     /// Approximation error (RMS vs exact, log) against cost, every point labelled, the frontier drawn.
@@ -348,7 +349,7 @@ impl SweepReport {
             .fold(f64::NEG_INFINITY, f64::max);
         let title = format!("Accuracy against cost on {} ({} evaluations per dispatch)", self.profile.provenance.device.name, self.profile.rows[0].evaluations_per_dispatch);
         let y_desc = error_axis(self.exact, &self.rows);
-        let spec = chart::Scatter {
+        let spec = png::Scatter {
             title: &title,
             x_desc: "cost relative to the fastest spec (median of per-round ratios, 95% CI whiskers)",
             y_desc: &y_desc,
@@ -356,7 +357,7 @@ impl SweepReport {
             legend: &legend,
             split_x: Some(split * 1.02),
         };
-        chart::scatter_log_y(path, &spec, &points)
+        png::scatter_log_y(path, &spec, &points)
     }
 }
 

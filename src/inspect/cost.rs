@@ -6,7 +6,7 @@
 use crate::inspect::InspectReport;
 use crate::kernels::shade::steady_block;
 use crate::model::BASELINE_LABEL;
-use crate::results::{sig, Table};
+use crate::export::markdown::{sig, Table};
 use serde::{Deserialize, Serialize};
 use super::schedule::{Schedule, LATENCY, RESIDENT_WAVES};
 

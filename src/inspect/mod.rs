@@ -17,7 +17,8 @@ use crate::spirv;
 use crate::gpu::Gpu;
 use crate::model::{Model, ModelKernel};
 use crate::kernels::shade::{self, shade_kernel, steady_block, GBufferFormat};
-use crate::results::{self, Provenance, Table};
+use crate::export::json::Provenance;
+use crate::export::markdown::{self, Table};
 use crate::shaders::Shaders;
 use anyhow::{Context, Result};
 use callgrind::{CallgrindOptions, CallgrindRun};
@@ -62,7 +63,7 @@ pub struct Row {
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct InspectReport {
-    /// Where it was measured (results::Provenance, kept as JSON so that baselines read back whatever it holds).
+    /// Where it was measured (json::Provenance, kept as JSON so that baselines read back whatever it holds).
     pub provenance: serde_json::Value,
     /// Where the SPIR-V came from.
     pub kernels: String,
@@ -322,7 +323,7 @@ pub fn is_lavapipe(info: &crate::gpu::DeviceInfo) -> bool {
 
 /// Formats a statistic: whole numbers as integers, others with 4 significant digits.
 pub fn format_value(v: f64) -> String {
-    if v.fract() == 0.0 && v.abs() < 1e15 { format!("{}", v as i64) } else { results::sig(v, 4) }
+    if v.fract() == 0.0 && v.abs() < 1e15 { format!("{}", v as i64) } else { markdown::sig(v, 4) }
 }
 
 impl InspectReport {

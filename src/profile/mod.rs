@@ -9,7 +9,8 @@ pub mod workload;
 
 use crate::gpu::Gpu;
 use crate::model::Model;
-use crate::results::{self, Provenance, Table};
+use crate::export::json::Provenance;
+use crate::export::markdown::{self, Table};
 use crate::shaders::Shaders;
 use crate::stats::{self, Estimate};
 use anyhow::Result;
@@ -248,11 +249,11 @@ impl ProfileReport {
         for row in &self.rows {
             let mut cells = vec![
                 row.model.clone(),
-                results::estimate(&row.ns_per_eval, 3),
-                results::sig(row.evals_per_second / 1e6, 3),
-                results::estimate(&row.vs_reference, 3),
-                row.net_ns_per_eval.as_ref().map_or("-".into(), |e| results::estimate(e, 3)),
-                row.net_vs_reference.as_ref().map_or("-".into(), |e| results::estimate(e, 3)),
+                markdown::estimate(&row.ns_per_eval, 3),
+                markdown::sig(row.evals_per_second / 1e6, 3),
+                markdown::estimate(&row.vs_reference, 3),
+                row.net_ns_per_eval.as_ref().map_or("-".into(), |e| markdown::estimate(e, 3)),
+                row.net_vs_reference.as_ref().map_or("-".into(), |e| markdown::estimate(e, 3)),
                 row.harness_share.as_ref().map_or("-".into(), |e| format!("{:.0}%", 100.0 * e.median)),
             ];
             if several {
@@ -283,7 +284,7 @@ impl ProfileReport {
             let mut cells = vec![if name == workload::BASELINE_LABEL { format!("{name} (gross)") } else { format!("{name} (net)") }];
             for &l in counts {
                 let row = self.rows.iter().find(|r| r.model == name && r.lights == l);
-                cells.push(row.map_or("-".into(), |r| results::estimate(r.net_ns_per_eval.as_ref().unwrap_or(&r.ns_per_eval), 3)));
+                cells.push(row.map_or("-".into(), |r| markdown::estimate(r.net_ns_per_eval.as_ref().unwrap_or(&r.ns_per_eval), 3)));
             }
             t.row(cells);
         }
@@ -347,6 +348,6 @@ impl ProfileReport {
                 protocol::Stop::Budget => "--budget spent",
                 protocol::Stop::MaxRounds => "--max-rounds reached",
             }
-        ) + &results::front_ends_line(&self.provenance.front_ends)
+        ) + &markdown::front_ends_line(&self.provenance.front_ends)
     }
 }

@@ -1,7 +1,7 @@
 //! The profile report (`ProfileReport`) as read back by `brdfprof report` and `--html`: the fields a reader
 //! shows, typed. Figures that can be NaN or Inf (written as JSON null) are Options.
 
-use crate::results::view::ProvenanceView;
+use crate::export::json::ProvenanceView;
 use crate::stats::Estimate;
 use serde::Deserialize;
 use std::collections::BTreeMap;

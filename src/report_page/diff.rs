@@ -6,9 +6,9 @@ use super::sections::num_cell;
 use super::{file_label, Input, Loaded};
 use crate::diff::view::{DiffSetView, DiffView, WorstView};
 use crate::gpu::Gpu;
-use crate::page::{esc, img, png_data_uri, Cell, HtmlTable};
+use crate::export::html::{esc, img, png_data_uri, Cell, HtmlTable};
 use crate::model::Model;
-use crate::results::sig;
+use crate::export::markdown::sig;
 use anyhow::Result;
 use std::fmt::Write;
 

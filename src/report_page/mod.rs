@@ -12,7 +12,7 @@ pub mod summary;
 
 use crate::compare::CostTable;
 use crate::gpu::Gpu;
-use crate::page::{self, Page};
+use crate::export::html::{self, Page};
 use crate::inspect::InspectReport;
 use crate::profile::view::ProfileView;
 use crate::stability::view::StabilityView;
@@ -96,7 +96,7 @@ pub fn from_report(label: &Path, report: &impl serde::Serialize) -> Result<Input
 pub fn from_json(path: &Path, text: &str) -> Result<Input> {
     let text = text.to_string();
     let probe: Probe = serde_json::from_str(&text).map_err(|e| anyhow!("{}: not a JSON object: line {}, column {}: {e}", path.display(), e.line(), e.column()))?;
-    use crate::results::Kind;
+    use crate::export::json::Kind;
     // A report that names its kind is read as that kind; older ones, without `kind`, by their keys.
     let named = match probe.kind.as_deref() {
         None | Some("diff") | Some(crate::diff::SET_KIND) => None,
@@ -211,7 +211,7 @@ pub fn utc(unix: u64) -> String {
 
 /// A file's name for headings.
 pub fn file_label(path: &Path) -> String {
-    page::esc(&path.display().to_string())
+    html::esc(&path.display().to_string())
 }
 
 #[cfg(test)]

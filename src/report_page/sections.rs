@@ -5,10 +5,10 @@
 
 use super::{file_label, utc, Input, Loaded};
 use crate::compare::CostTable;
-use crate::page::{self, esc, Axis, Cell, HtmlTable, Point};
+use crate::export::html::{self, esc, Axis, Cell, HtmlTable, Point};
 use crate::profile::view::{ProfileView, RowView};
-use crate::results::sig;
-use crate::results::view::ProvenanceView;
+use crate::export::markdown::sig;
+use crate::export::json::ProvenanceView;
 use crate::stability::view::{SpecView, StabilityView};
 use crate::stats::Estimate;
 use crate::sweep::view::{ErrorView, SweepView};
@@ -261,7 +261,7 @@ pub fn sweep_chart(w: &SweepView) -> String {
     let (Some(x), Some(y)) = (Axis::fit(points.iter().filter(drawable).map(|p| p.x), true), Axis::fit(points.iter().filter(drawable).map(|p| p.y), true)) else {
         return "<p class=\"note\">No spec has a finite, positive cost and error to draw.</p>".into();
     };
-    let mut s = page::scatter_svg(&points, x, y, "net ns per evaluation (log)", "RMS relative error vs exact (log)", page::WIDE);
+    let mut s = html::scatter_svg(&points, x, y, "net ns per evaluation (log)", "RMS relative error vs exact (log)", html::WIDE);
     let _ = write!(s, "<p class=\"note\">Red: the Pareto frontier (no spec both cheaper and more accurate). Hover a point for its spec, cost and error.{}</p>", if left_out > 0 { format!(" {left_out} spec(s) with an infinite, zero or NaN figure are not drawn.") } else { String::new() });
     s
 }
@@ -358,13 +358,13 @@ fn heat_map(s: &SpecView, triples: &[[u32; 3]]) -> Result<String> {
     for &[r, v, n] in triples.iter().filter(|t| (t[0] as usize) < ROUGHNESS.len() && (t[1] as usize) < COSINES.len()) {
         // Roughness up the image (row 0 at the bottom), NoV to the right.
         let k = (((h - 1 - r) * w + v) * 3) as usize;
-        let c = crate::scene::render::viridis((1.0 + n as f32).ln() / (1.0 + max).ln());
+        let c = crate::export::raster::viridis((1.0 + n as f32).ln() / (1.0 + max).ln());
         rgb[k..k + 3].copy_from_slice(&c);
     }
     let total: u32 = triples.iter().map(|t| t[2]).sum();
-    let uri = page::png_data_uri(w, h, &rgb)?;
+    let uri = html::png_data_uri(w, h, &rgb)?;
     let caption = format!("{}: {total} bad values (NaN, Inf, negative) in {} cells; NoV {}..{} right, roughness {}..{} up; most in a cell {max}", s.label(), triples.len(), COSINES[0], COSINES[COSINES.len() - 1], ROUGHNESS[0], ROUGHNESS[ROUGHNESS.len() - 1]);
-    Ok(format!("<figure>{}<figcaption>{}</figcaption></figure>", page::img(&uri, w, h, 6, &caption), esc(s.label())))
+    Ok(format!("<figure>{}<figcaption>{}</figcaption></figure>", html::img(&uri, w, h, 6, &caption), esc(s.label())))
 }
 
 /// One stability report: the summary table (rows keyed `stability<i>/<spec>`) and a heat map per spec with

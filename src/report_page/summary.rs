@@ -6,7 +6,7 @@ use super::sections::{estimate_cell, num_cell};
 use super::{Input, Loaded};
 use crate::brdf::guards::GuardSet;
 use crate::model::Model;
-use crate::page::{Cell, HtmlTable};
+use crate::export::html::{Cell, HtmlTable};
 use crate::stability::view::SpecView;
 use std::collections::BTreeMap;
 

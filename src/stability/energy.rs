@@ -5,7 +5,7 @@
 
 use super::SpecStability;
 use crate::brdf::{ModelSpec, F};
-use crate::chart;
+use crate::export::png;
 use crate::gpu::Gpu;
 use crate::kernels::{self, AlbedoCell};
 use crate::model::Model;
@@ -161,9 +161,9 @@ pub fn furnace_png(path: &Path, entries: &[(String, &Energy)]) -> Result<()> {
     let (cell, label_w, header) = (64i32, 420i32, 60i32);
     let width = (label_w + cell * ROUGHNESS.len() as i32 + 20) as u32;
     let height = (header + cell * entries.len() as i32 + 60) as u32;
-    chart::render(path, width, height, |root| {
+    png::render(path, width, height, |root| {
         let err = |e: &dyn std::fmt::Display| anyhow!("furnace: {e}");
-        let text = |s: &str, x: i32, y: i32, size: i32| Text::new(s.to_string(), (x, y), (chart::FONT, size).into_font());
+        let text = |s: &str, x: i32, y: i32, size: i32| Text::new(s.to_string(), (x, y), (png::FONT, size).into_font());
         root.draw(&text("White furnace: E(NoV) with F = 1 (white = lossless, grey = loss, red = gain, magenta = non-finite)", 10, 10, 16)).map_err(|e| err(&e))?;
         for (j, r) in ROUGHNESS.iter().enumerate() {
             root.draw(&text(&format!("r = {r}"), label_w + j as i32 * cell + 8, header - 24, 16)).map_err(|e| err(&e))?;
@@ -199,5 +199,5 @@ pub fn albedo_chart(path: &Path, entries: &[(String, &Energy)]) -> Result<()> {
             (format!("r = {r}"), series)
         })
         .collect();
-    chart::line_panels(path, "Directional albedo E(NoV) with F = 1", "NoV", "E", &panels, (0.0, 1.3))
+    png::line_panels(path, "Directional albedo E(NoV) with F = 1", "NoV", "E", &panels, (0.0, 1.3))
 }

@@ -197,7 +197,7 @@ pub struct StabilityOptions {
 
 #[derive(Clone, Debug, Serialize)]
 pub struct StabilityReport {
-    pub provenance: crate::results::Provenance,
+    pub provenance: crate::export::json::Provenance,
     pub specs: Vec<SpecStability>,
     pub grid_points: usize,
     pub cases: Vec<HardCase>,
@@ -289,7 +289,7 @@ impl StabilityReport {
     pub fn write(&self, out: &std::path::Path, device: &str) -> Result<Vec<std::path::PathBuf>> {
         let stem = out.join(format!("stability-{device}"));
         let mut written = vec![stem.with_extension("md"), stem.with_extension("json")];
-        crate::results::write_report_compact(&written[1], crate::results::Kind::Stability, self)?;
+        crate::export::json::write_report_compact(&written[1], crate::export::json::Kind::Stability, self)?;
         crate::io::write_output(&written[0], self.markdown().as_bytes())?;
         let entries = self.energy_entries();
         if !entries.is_empty() {
@@ -332,7 +332,7 @@ pub fn run(gpu: &Gpu, options: &StabilityOptions, progress: &ProgressBar) -> Res
         energy::attach(gpu, &options.models, &mut specs, progress)?;
     }
     let guard_savings = guard_savings(&options.models, &specs, &cases);
-    Ok(StabilityReport { provenance: crate::results::Provenance::new(&gpu.info), specs, grid_points: grid.len(), cases, guard_savings })
+    Ok(StabilityReport { provenance: crate::export::json::Provenance::new(&gpu.info), specs, grid_points: grid.len(), cases, guard_savings })
 }
 
 /// The "cases out of tolerance" cell, as the Markdown and the HTML page both write it: without a twin or
@@ -368,7 +368,7 @@ fn worst_cell(w: &Worst) -> String {
 
 /// The max E, hemispherical albedo and E-vs-CPU cells, NaN/Inf cells counted (never a gain, never "inf").
 fn energy_cells(e: &energy::Energy) -> (String, String, String) {
-    use crate::results::sig;
+    use crate::export::markdown::sig;
     let nonfinite = if e.nonfinite > 0 { format!(" ({} of {} cells NaN/Inf)", e.nonfinite, e.cells()) } else { String::new() };
     let max_e = match e.max_e {
         Some(m) => format!("{}{} (±{:.0e}){nonfinite}", sig(m, 3), if e.gains_energy { " gain" } else { "" }, e.error_bound),
@@ -390,7 +390,7 @@ fn reciprocity_cell(s: &SpecStability) -> String {
 
 impl StabilityReport {
     pub fn markdown(&self) -> String {
-        use crate::results::Table;
+        use crate::export::markdown::Table;
         let mut out = format!(
             "# brdfprof stability\n\n{} ({}), {} specs; {} hard cases and {} grid points each.\n\n\
              NaN/Inf/neg: results on valid inputs (a spec with any fails, and the command exits 1). Out of tolerance: cases and \
@@ -413,7 +413,7 @@ impl StabilityReport {
             self.grid_points
         );
         if !self.provenance.front_ends.is_empty() {
-            out += &format!("{}\n\n", crate::results::front_ends_line(&self.provenance.front_ends).trim_start());
+            out += &format!("{}\n\n", crate::export::markdown::front_ends_line(&self.provenance.front_ends).trim_start());
         }
         let mut t = Table::new(["spec", "NaN", "Inf", "neg", "cases out of tol.", "grid out of tol.", "worst (x tol.)", "jumps", "reciprocity", "max E", "hemi r=1", "E vs CPU", "verdict"]);
         for s in &self.specs {
@@ -444,7 +444,7 @@ impl StabilityReport {
 
     /// The hard-case table: how many specs each case puts out of tolerance, and the worst.
     fn cases_markdown(&self) -> String {
-        use crate::results::Table;
+        use crate::export::markdown::Table;
         let mut out = String::from("\n## Hard cases\n\nSpecs out of tolerance per case (fp32 / fp16; without a twin or reference: with a NaN, Inf or negative value), with the worst one.\n\n");
         let mut c = Table::new(["case", "expected", "fp32 out", "fp16 out", "worst spec (x tol.)"]);
         for (i, case) in self.cases.iter().enumerate() {
@@ -508,7 +508,7 @@ impl StabilityReport {
         if self.guard_savings.is_empty() {
             return String::new();
         }
-        let mut t = crate::results::Table::new(["spec", "guards", "NaN", "Inf", "neg", "grid out of tol. (more)", "hard cases out of tolerance only without them"]);
+        let mut t = crate::export::markdown::Table::new(["spec", "guards", "NaN", "Inf", "neg", "grid out of tol. (more)", "hard cases out of tolerance only without them"]);
         for g in &self.guard_savings {
             let cases = if g.cases.is_empty() { "-".to_string() } else { g.cases.join("; ") };
             t.row([g.spec.clone(), describe_guards(&g.off), g.nan.to_string(), g.inf.to_string(), g.negative.to_string(), g.grid_out_of_tolerance.to_string(), cases]);
@@ -531,14 +531,14 @@ impl StabilityReport {
         let title_size = (300.0 * columns as f64 / (0.55 * title.len() as f64)).min(20.0) as u32;
         let rows = failing.len().div_ceil(columns);
         let (pw, ph) = (300u32, 230u32);
-        crate::chart::render(path, pw * columns as u32, ph * rows as u32 + 40, |root| {
+        crate::export::png::render(path, pw * columns as u32, ph * rows as u32 + 40, |root| {
             let err = |e: &dyn std::fmt::Display| anyhow::anyhow!("heat map: {e}");
-            let root = root.titled(&title, (crate::chart::FONT, title_size)).map_err(|e| err(&e))?;
+            let root = root.titled(&title, (crate::export::png::FONT, title_size)).map_err(|e| err(&e))?;
             for (area, s) in root.split_evenly((rows, columns)).iter().zip(&failing) {
                 let cells = s.bad_cells.as_ref().expect("filtered above");
                 let max = cells.iter().flatten().copied().max().unwrap_or(1).max(1) as f64;
                 let mut chart = ChartBuilder::on(area)
-                    .caption(&s.label, (crate::chart::FONT, 12))
+                    .caption(&s.label, (crate::export::png::FONT, 12))
                     .margin(6)
                     .x_label_area_size(28)
                     .y_label_area_size(36)
@@ -553,7 +553,7 @@ impl StabilityReport {
                     .y_labels(8)
                     .x_label_formatter(&|i| axis_value(grid::COSINES.get(*i).copied()))
                     .y_label_formatter(&|i| axis_value(grid::ROUGHNESS.get(*i).map(|&r| f64::from(r))))
-                    .label_style((crate::chart::FONT, 10))
+                    .label_style((crate::export::png::FONT, 10))
                     .draw()
                     .map_err(|e| err(&e))?;
                 chart

@@ -1,7 +1,7 @@
 //! The stability report (`StabilityReport`) as read back by `brdfprof report` and `--html`. Values that are
 //! NaN or Inf are written as JSON null and read as None.
 
-use crate::results::view::ProvenanceView;
+use crate::export::json::ProvenanceView;
 use serde::Deserialize;
 
 #[derive(Clone, Debug, Deserialize)]

@@ -1,63 +1,11 @@
-//! Report plumbing shared by every command: Markdown tables, number formatting, the environment a run was
-//! measured in, and atomic JSON output.
+//! Saved JSON reports: their `kind`, the provenance every report records (where and how it was measured),
+//! and atomic writes, pretty or compact.
 
 use crate::gpu::DeviceInfo;
-use crate::stats::Estimate;
 use anyhow::Result;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::Path;
-
-pub mod view;
-
-/// A Markdown table.
-#[derive(Clone, Debug, Default)]
-pub struct Table {
-    pub headers: Vec<String>,
-    pub rows: Vec<Vec<String>>,
-}
-
-impl Table {
-    pub fn new<S: Into<String>>(headers: impl IntoIterator<Item = S>) -> Self {
-        Table { headers: headers.into_iter().map(Into::into).collect(), rows: Vec::new() }
-    }
-
-    pub fn row<S: Into<String>>(&mut self, cells: impl IntoIterator<Item = S>) {
-        self.rows.push(cells.into_iter().map(Into::into).collect());
-    }
-
-    pub fn markdown(&self) -> String {
-        let widths: Vec<usize> = (0..self.headers.len())
-            .map(|c| self.rows.iter().map(|r| r[c].chars().count()).chain([self.headers[c].chars().count(), 3]).max().unwrap())
-            .collect();
-        let line = |cells: &[String]| {
-            let padded: Vec<String> = cells.iter().zip(&widths).map(|(c, w)| format!("{c:<w$}")).collect();
-            format!("| {} |\n", padded.join(" | "))
-        };
-        let rule: Vec<String> = widths.iter().map(|w| "-".repeat(*w)).collect();
-        let mut out = line(&self.headers);
-        out += &line(&rule);
-        for r in &self.rows {
-            out += &line(r);
-        }
-        out
-    }
-}
-
-/// `x` with `digits` significant digits.
-pub fn sig(x: f64, digits: usize) -> String {
-    if x == 0.0 || !x.is_finite() {
-        return format!("{x}");
-    }
-    let magnitude = x.abs().log10().floor() as i32;
-    let decimals = (digits as i32 - 1 - magnitude).max(0) as usize;
-    format!("{x:.decimals$}")
-}
-
-/// "median [lo, hi]".
-pub fn estimate(e: &Estimate, digits: usize) -> String {
-    format!("{} [{}, {}]", sig(e.median, digits), sig(e.lo, digits), sig(e.hi, digits))
-}
 
 /// Environment variables that change what a Vulkan driver does (Mesa, lavapipe, loader, vendors).
 pub fn driver_environment() -> BTreeMap<String, String> {
@@ -106,24 +54,6 @@ impl Provenance {
             front_ends: crate::model::front::used(),
         }
     }
-}
-
-/// A report's `front_ends` as a paragraph to append to its summary (empty when it has none).
-pub fn front_ends_line(front_ends: &BTreeMap<String, String>) -> String {
-    if front_ends.is_empty() {
-        return String::new();
-    }
-    let items: Vec<String> = front_ends.iter().map(|(path, front)| format!("`{path}`: {front}")).collect();
-    format!("\n\nFront ends: {}.", items.join("; "))
-}
-
-/// The file-name form of a device name: its first words, lower case ("llvmpipe (LLVM 15.0.6, 256 bits)" ->
-/// "llvmpipe").
-pub fn name_slug(name: &str) -> String {
-    let first = name.split(['(', ',']).next().unwrap_or("device").trim().to_lowercase();
-    let slug: String = first.chars().map(|c| if c.is_ascii_alphanumeric() { c } else { '-' }).collect();
-    let slug = slug.trim_matches('-').to_string();
-    if slug.is_empty() { "device".into() } else { slug }
 }
 
 /// Compact JSON, for reports whose numeric arrays would balloon when pretty-printed.
@@ -207,6 +137,50 @@ pub fn write_report_compact(path: &Path, kind: Kind, value: &impl Serialize) -> 
     crate::io::write_output(path, with_kind(kind, value, false)?.as_bytes())
 }
 
+/// A report's provenance as read back (`brdfprof report`, `--html`): every field optional, so that a report
+/// written by an older brdfprof (or a compile-only target's, with less to say) still reads.
+#[derive(Clone, Debug, Default, Deserialize)]
+#[serde(default)]
+pub struct DeviceView {
+    pub name: String,
+    pub device_type: String,
+    pub driver_name: String,
+    pub driver_info: String,
+    pub driver_version: String,
+    pub api_version: String,
+    pub shader_float16: bool,
+}
+
+#[derive(Clone, Debug, Default, Deserialize)]
+#[serde(default)]
+pub struct CpuView {
+    pub vendor: String,
+    pub family: String,
+    pub model: String,
+    pub stepping: String,
+    pub model_name: String,
+    pub features: Vec<String>,
+}
+
+/// `report::Provenance` as read back.
+#[derive(Clone, Debug, Default, Deserialize)]
+#[serde(default)]
+pub struct ProvenanceView {
+    pub tool: String,
+    pub unix_time: u64,
+    pub device: DeviceView,
+    pub mesa_version: Option<String>,
+    pub llvm_version: Option<String>,
+    pub env: BTreeMap<String, String>,
+    pub cpu: Option<CpuView>,
+    pub host_cpu: Option<String>,
+    pub host_threads: usize,
+    /// The command line that wrote the report (reports from before it was recorded have none).
+    pub command: Option<Vec<String>>,
+    /// HLSL and WGSL models' front ends (model path -> front end).
+    pub front_ends: BTreeMap<String, String>,
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -228,19 +202,5 @@ mod tests {
         for k in Kind::ALL {
             assert_eq!(Kind::parse(k.name()), Some(k));
         }
-    }
-
-    #[test]
-    fn significant_digits() {
-        assert_eq!(sig(1234.5, 3), "1234");
-        assert_eq!(sig(1.2345, 3), "1.23");
-        assert_eq!(sig(0.0012345, 3), "0.00123");
-    }
-
-    #[test]
-    fn table_is_aligned_markdown() {
-        let mut t = Table::new(["a", "long header"]);
-        t.row(["1", "2"]);
-        assert_eq!(t.markdown(), "| a   | long header |\n| --- | ----------- |\n| 1   | 2           |\n");
     }
 }
