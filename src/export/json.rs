@@ -13,8 +13,11 @@ pub fn driver_environment() -> BTreeMap<String, String> {
     std::env::vars().filter(|(k, _)| PREFIXES.iter().any(|p| k.starts_with(p))).collect()
 }
 
-/// What a report records about where it was measured.
-#[derive(Clone, Debug, Serialize)]
+/// What a report records about where it was measured. `report` and `--html` read it back as this same type:
+/// a field that an older brdfprof, or a compile-only target with less to say, did not write reads as its
+/// default, and the Options below are always Some when written (so they serialize as the bare value).
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+#[serde(default)]
 pub struct Provenance {
     pub tool: String,
     pub unix_time: u64,
@@ -23,11 +26,12 @@ pub struct Provenance {
     pub llvm_version: Option<String>,
     pub env: BTreeMap<String, String>,
     pub host_cpu: Option<String>,
-    /// Family, model, stepping and vector features: lavapipe's costs are this CPU's.
-    pub cpu: crate::host::HostCpu,
+    /// Family, model, stepping and vector features: lavapipe's costs are this CPU's (None: a report from
+    /// before it was recorded).
+    pub cpu: Option<crate::host::HostCpu>,
     pub host_threads: usize,
-    /// The command line that wrote the report.
-    pub command: Vec<String>,
+    /// The command line that wrote the report (None: a report from before it was recorded).
+    pub command: Option<Vec<String>>,
     /// What translated each HLSL or WGSL model into the kernels' GLSL, with versions (model path -> front
     /// end; docs/hlsl.md, docs/wgsl.md); absent when every model is GLSL or built in.
     #[serde(skip_serializing_if = "BTreeMap::is_empty")]
@@ -48,9 +52,9 @@ impl Provenance {
             llvm_version: llvm,
             env: driver_environment(),
             host_cpu,
-            cpu: crate::host::HostCpu::detect(),
+            cpu: Some(crate::host::HostCpu::detect()),
             host_threads: std::thread::available_parallelism().map_or(1, |n| n.get()),
-            command: std::env::args().collect(),
+            command: Some(std::env::args().collect()),
             front_ends: crate::model::front::used(),
         }
     }
@@ -135,50 +139,6 @@ pub fn write_report(path: &Path, kind: Kind, value: &impl Serialize) -> Result<(
 /// `write_json_compact` of a saved report, its `kind` first.
 pub fn write_report_compact(path: &Path, kind: Kind, value: &impl Serialize) -> Result<()> {
     crate::io::write_output(path, with_kind(kind, value, false)?.as_bytes())
-}
-
-/// A report's provenance as read back (`brdfprof report`, `--html`): every field optional, so that a report
-/// written by an older brdfprof (or a compile-only target's, with less to say) still reads.
-#[derive(Clone, Debug, Default, Deserialize)]
-#[serde(default)]
-pub struct DeviceView {
-    pub name: String,
-    pub device_type: String,
-    pub driver_name: String,
-    pub driver_info: String,
-    pub driver_version: String,
-    pub api_version: String,
-    pub shader_float16: bool,
-}
-
-#[derive(Clone, Debug, Default, Deserialize)]
-#[serde(default)]
-pub struct CpuView {
-    pub vendor: String,
-    pub family: String,
-    pub model: String,
-    pub stepping: String,
-    pub model_name: String,
-    pub features: Vec<String>,
-}
-
-/// `report::Provenance` as read back.
-#[derive(Clone, Debug, Default, Deserialize)]
-#[serde(default)]
-pub struct ProvenanceView {
-    pub tool: String,
-    pub unix_time: u64,
-    pub device: DeviceView,
-    pub mesa_version: Option<String>,
-    pub llvm_version: Option<String>,
-    pub env: BTreeMap<String, String>,
-    pub cpu: Option<CpuView>,
-    pub host_cpu: Option<String>,
-    pub host_threads: usize,
-    /// The command line that wrote the report (reports from before it was recorded have none).
-    pub command: Option<Vec<String>>,
-    /// HLSL and WGSL models' front ends (model path -> front end).
-    pub front_ends: BTreeMap<String, String>,
 }
 
 #[cfg(test)]

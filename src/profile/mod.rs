@@ -9,6 +9,7 @@ pub mod workload;
 
 use crate::gpu::Gpu;
 use crate::model::Model;
+use crate::host::HostCpu;
 use crate::export::json::Provenance;
 use crate::export::markdown::{self, Table};
 use crate::shaders::Shaders;
@@ -331,8 +332,8 @@ impl ProfileReport {
             self.provenance.device.name,
             self.provenance.device.driver_name,
             self.provenance.device.driver_info,
-            self.provenance.cpu.describe(),
-            self.provenance.cpu.vector_width(),
+            self.provenance.cpu.as_ref().map_or_else(String::new, HostCpu::describe),
+            self.provenance.cpu.as_ref().map_or("", HostCpu::vector_width),
             self.provenance.host_threads,
             w.width,
             w.height,

@@ -1,7 +1,7 @@
 //! The profile report (`ProfileReport`) as read back by `brdfprof report` and `--html`: the fields a reader
 //! shows, typed. Figures that can be NaN or Inf (written as JSON null) are Options.
 
-use crate::export::json::ProvenanceView;
+use crate::export::json::Provenance;
 use crate::stats::Estimate;
 use serde::Deserialize;
 use std::collections::BTreeMap;
@@ -31,7 +31,7 @@ pub struct RowView {
 /// `ProfileReport` as read back.
 #[derive(Clone, Debug, Deserialize)]
 pub struct ProfileView {
-    pub provenance: ProvenanceView,
+    pub provenance: Provenance,
     pub reference: String,
     pub workload: WorkloadView,
     pub rounds: usize,

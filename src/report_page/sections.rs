@@ -8,7 +8,7 @@ use crate::compare::CostTable;
 use crate::export::html::{self, esc, Axis, Cell, HtmlTable, Point};
 use crate::profile::view::{ProfileView, RowView};
 use crate::export::markdown::sig;
-use crate::export::json::ProvenanceView;
+use crate::export::json::Provenance;
 use crate::stability::view::{SpecView, StabilityView};
 use crate::stats::Estimate;
 use crate::sweep::view::{ErrorView, SweepView};
@@ -46,7 +46,7 @@ fn kv(items: &[(&str, String)]) -> String {
     s + "</dl>"
 }
 
-fn provenance_items(p: &ProvenanceView) -> Vec<(&'static str, String)> {
+fn provenance_items(p: &Provenance) -> Vec<(&'static str, String)> {
     let d = &p.device;
     let cpu = p.cpu.as_ref().map_or_else(|| p.host_cpu.clone().unwrap_or_default(), |c| format!("{} (family {}, model {}, stepping {}; {})", c.model_name, c.family, c.model, c.stepping, c.features.join(" ")));
     vec![
@@ -75,7 +75,7 @@ pub fn provenance(inputs: &[Input]) -> String {
             Loaded::Stability(st) => s += &kv(&provenance_items(&st.provenance)),
             Loaded::Inspect(reports, _) => {
                 for r in reports {
-                    let p: ProvenanceView = serde_json::from_value(r.provenance.clone()).unwrap_or_default();
+                    let p: Provenance = serde_json::from_value(r.provenance.clone()).unwrap_or_default();
                     let mut items = provenance_items(&p);
                     items.push(("compilers", r.tools.iter().map(|(k, v)| format!("{k}: {v}")).collect::<Vec<_>>().join("; ")));
                     items.push(("kernels", r.kernels.clone()));

@@ -1,7 +1,7 @@
 //! The stability report (`StabilityReport`) as read back by `brdfprof report` and `--html`. Values that are
 //! NaN or Inf are written as JSON null and read as None.
 
-use crate::export::json::ProvenanceView;
+use crate::export::json::Provenance;
 use serde::Deserialize;
 
 #[derive(Clone, Debug, Deserialize)]
@@ -91,7 +91,7 @@ impl SpecView {
 /// `StabilityReport` as read back.
 #[derive(Clone, Debug, Deserialize)]
 pub struct StabilityView {
-    pub provenance: ProvenanceView,
+    pub provenance: Provenance,
     pub specs: Vec<SpecView>,
     pub grid_points: usize,
     pub cases: Vec<CaseView>,
