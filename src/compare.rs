@@ -7,7 +7,7 @@
 
 use crate::inspect::InspectReport;
 use crate::inspect::HASH_NOTE;
-use crate::profile::view::ProfileView;
+use crate::profile::ProfileReport;
 use crate::model::BASELINE_LABEL;
 use crate::export::markdown::{sig, Table};
 use anyhow::{anyhow, bail, Result};
@@ -175,7 +175,7 @@ pub fn inspect_columns(report: &InspectReport, source: &str) -> Vec<CostColumn> 
 }
 
 /// The cost columns of a `profile` report, read back typed: ns/eval per light count.
-pub fn profile_columns(view: &ProfileView, source: &str) -> Vec<CostColumn> {
+pub fn profile_columns(view: &ProfileReport, source: &str) -> Vec<CostColumn> {
     let device = Some(view.provenance.device.name.as_str()).filter(|n| !n.is_empty()).unwrap_or("?").to_string();
     let short = device.split([' ', '(']).next().unwrap_or("?").to_string();
     let mut lights: Vec<u32> = view.rows.iter().map(|r| r.lights).collect();
@@ -404,7 +404,7 @@ pub fn load_columns(path: &Path) -> Result<Vec<CostColumn>> {
         if value.get("kernel_sha256").is_none() {
             bail!("{}: a profile report that records no kernel hashes (written by an older brdfprof); its kernels cannot be matched with the others'. Measure it again", path.display());
         }
-        let view: ProfileView = serde_json::from_value(value).map_err(|e| anyhow!("{}: not a brdfprof profile report ({e})", path.display()))?;
+        let view: ProfileReport = serde_json::from_value(value).map_err(|e| anyhow!("{}: not a brdfprof profile report ({e})", path.display()))?;
         profile_columns(&view, &source)
     } else if let Some(reports) = value.get("reports").and_then(|r| r.as_array()) {
         let mut out = Vec::new();

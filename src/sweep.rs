@@ -2,7 +2,6 @@
 //! profile protocol) and measured for accuracy (`accuracy`), and the result is a table, a JSON file and a chart
 //! of error against cost with the Pareto frontier.
 
-pub mod view;
 
 use crate::accuracy::{self, Accuracy, ExactCache, SampleSet};
 use crate::brdf::exact::ExactFresnel;
@@ -18,7 +17,7 @@ use crate::export::markdown::{self, Table};
 use crate::stats::{self, Estimate};
 use anyhow::Result;
 use indicatif::ProgressBar;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::path::Path;
 
 /// The default set: every D with each of its sensible visibility terms and Schlick's Fresnel; every Fresnel
@@ -132,7 +131,8 @@ impl AccuracyOptions {
     }
 }
 
-#[derive(Clone, Debug, Serialize)]
+/// A sweep report is read back (`report`, `--html`) as these same types.
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct SweepRow {
     pub spec: String,
     pub canonical: String,
@@ -150,14 +150,17 @@ pub struct SweepRow {
     pub pareto: bool,
 }
 
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct SweepReport {
     pub fastest: String,
     /// Rows sorted by rank, then median cost.
     pub rows: Vec<SweepRow>,
     pub sample_set: String,
-    /// What "vs exact" is against (`--reference`, `--exact-fresnel`), in words.
+    /// What "vs exact" is against (`--reference`, `--exact-fresnel`), in words; empty in a report written
+    /// before the sweep took a reference for every model.
+    #[serde(default)]
     pub against: String,
+    #[serde(skip_deserializing)]
     pub exact: ExactFresnel,
     pub profile: ProfileReport,
 }

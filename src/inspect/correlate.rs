@@ -3,7 +3,7 @@
 //! between them, gross and net of the memory-only kernel.
 
 use super::InspectReport;
-use crate::profile::view::ProfileView;
+use crate::profile::ProfileReport as ProfileView;
 use crate::stats;
 use anyhow::{anyhow, bail, Context, Result};
 use serde::{Deserialize, Serialize};

@@ -14,9 +14,9 @@ use crate::compare::CostTable;
 use crate::gpu::Gpu;
 use crate::export::html::{self, Page};
 use crate::inspect::InspectReport;
-use crate::profile::view::ProfileView;
+use crate::profile::ProfileReport;
 use crate::stability::view::StabilityView;
-use crate::sweep::view::SweepView;
+use crate::sweep::SweepReport;
 use anyhow::{anyhow, bail, Result};
 use serde::de::{DeserializeOwned, IgnoredAny};
 use serde::Deserialize;
@@ -25,8 +25,8 @@ use std::path::{Path, PathBuf};
 
 /// What a results file holds.
 pub enum Loaded {
-    Profile(Box<ProfileView>),
-    Sweep(Box<SweepView>),
+    Profile(Box<ProfileReport>),
+    Sweep(Box<SweepReport>),
     Stability(Box<StabilityView>),
     /// One inspect report per device, and with several devices the inspect's own cost table.
     Inspect(Vec<InspectReport>, Option<CostTable>),

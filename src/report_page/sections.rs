@@ -6,12 +6,14 @@
 use super::{file_label, utc, Input, Loaded};
 use crate::compare::CostTable;
 use crate::export::html::{self, esc, Axis, Cell, HtmlTable, Point};
-use crate::profile::view::{ProfileView, RowView};
+use crate::profile::{ProfileReport, Row};
 use crate::export::markdown::sig;
 use crate::export::json::Provenance;
 use crate::stability::view::{SpecView, StabilityView};
 use crate::stats::Estimate;
-use crate::sweep::view::{ErrorView, SweepView};
+use crate::accuracy::ErrorStats;
+use crate::io::finite;
+use crate::sweep::SweepReport;
 use anyhow::Result;
 use std::fmt::Write;
 
@@ -107,20 +109,20 @@ const PROFILE_COLUMNS: [(&str, &str); 7] = [
     ("harness", "harness share [CI]"),
 ];
 
-fn profile_row(r: &RowView) -> Vec<Cell> {
+fn profile_row(r: &Row) -> Vec<Cell> {
     vec![
         Cell::text(r.model.clone()),
         Cell::text(r.spec.clone().unwrap_or_else(|| "memory-only kernel".into())),
         estimate_cell(Some(&r.ns_per_eval)),
         estimate_cell(r.net_ns_per_eval.as_ref()),
-        estimate_cell(r.vs_reference.as_ref()),
+        estimate_cell(Some(&r.vs_reference)),
         estimate_cell(r.net_vs_reference.as_ref()),
         estimate_cell(r.harness_share.as_ref()),
     ]
 }
 
 /// One profile report's tables, a table per light count; rows keyed `profile<i>/<lights>/<model>`.
-pub fn profile_tables(i: usize, p: &ProfileView, path: &str) -> String {
+pub fn profile_tables(i: usize, p: &ProfileReport, path: &str) -> String {
     let w = &p.workload;
     let mut s = format!(
         "<h3>{path}</h3><p class=\"note\">{}x{} G-buffer, {} rounds, {:.0}% confidence intervals of the median over rounds; reference {}; net = minus the memory-only kernel (loads, light loop, stores).</p>",
@@ -236,8 +238,8 @@ pub fn across_devices(inputs: &[Input]) -> Option<String> {
     }
 }
 
-fn err_text(e: &ErrorView) -> String {
-    match (e.rms, e.max) {
+fn err_text(e: &ErrorStats) -> String {
+    match (finite(e.rms), finite(e.max)) {
         (Some(r), Some(m)) => format!("RMS {}, max {}", sig(r, DIGITS), sig(m, DIGITS)),
         _ => format!("infinite ({} NaN/Inf values)", e.nonfinite),
     }
@@ -245,13 +247,13 @@ fn err_text(e: &ErrorView) -> String {
 
 /// The sweep's error-against-cost chart: net ns/eval (gross where there is no net) against the RMS relative
 /// error against the exact reference, both log; the Pareto frontier emphasised.
-pub fn sweep_chart(w: &SweepView) -> String {
+pub fn sweep_chart(w: &SweepReport) -> String {
     let points: Vec<Point> = w
         .rows
         .iter()
         .map(|r| {
             let cost = r.net_ns_per_eval.as_ref().unwrap_or(&r.ns_per_eval);
-            let err = r.accuracy.vs_exact.rms.unwrap_or(f64::INFINITY);
+            let err = finite(r.accuracy.vs_exact.rms).unwrap_or(f64::INFINITY);
             let tip = format!("{}\nspec: {}\ncost: {} [{}, {}] ns/eval{}\nerror vs exact: {}", r.label, r.canonical, sig(cost.median, DIGITS), sig(cost.lo, DIGITS), sig(cost.hi, DIGITS), if r.net_ns_per_eval.is_some() { " net" } else { "" }, err_text(&r.accuracy.vs_exact));
             Point { x: cost.median, y: err, label: r.label.clone(), tip, emphasis: r.pareto }
         })
@@ -280,7 +282,7 @@ const SWEEP_COLUMNS: [(&str, &str); 10] = [
 ];
 
 /// One sweep: the chart and the table; rows keyed `sweep<i>/<label>`.
-pub fn sweep_html(i: usize, w: &SweepView, path: &str) -> String {
+pub fn sweep_html(i: usize, w: &SweepReport, path: &str) -> String {
     let mut t = HtmlTable::new(&SWEEP_COLUMNS);
     for r in &w.rows {
         let a = &r.accuracy;
@@ -292,15 +294,15 @@ pub fn sweep_html(i: usize, w: &SweepView, path: &str) -> String {
                 estimate_cell(Some(&r.ns_per_eval)),
                 estimate_cell(r.net_ns_per_eval.as_ref()),
                 estimate_cell(Some(&r.cost_vs_fastest)),
-                num_cell(a.vs_exact.rms),
-                num_cell(a.vs_exact.max),
-                num_cell(a.numerical.as_ref().and_then(|n| n.rms)),
-                num_cell(a.albedo_vs_exact),
+                num_cell(finite(a.vs_exact.rms)),
+                num_cell(finite(a.vs_exact.max)),
+                num_cell(a.numerical.as_ref().and_then(|n| finite(n.rms))),
+                num_cell(finite(a.albedo_vs_exact)),
                 Cell::text(if r.pareto { "yes" } else { "" }),
             ],
         );
     }
-    let against = w.against.as_deref().map_or(String::new(), |a| format!(" Errors against {}.", esc(a)));
+    let against = if w.against.is_empty() { String::new() } else { format!(" Errors against {}.", esc(&w.against)) };
     format!("<h3>{path}</h3><p class=\"note\">{} specs on {}; fastest {}.{against}</p>{}{}", w.rows.len(), esc(&w.sample_set), esc(&w.fastest), sweep_chart(w), t.html())
 }
 

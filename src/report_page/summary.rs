@@ -72,7 +72,7 @@ fn gather(inputs: &[Input]) -> Summary {
                 let mut cells = Vec::new();
                 for r in p.rows.iter().filter(|r| Some(r.lights) == lights && r.spec.is_some()) {
                     let key = s.model(r.spec.as_deref().unwrap(), &r.model);
-                    cells.push((key, estimate_cell(r.net_vs_reference.as_ref().or(r.vs_reference.as_ref()))));
+                    cells.push((key, estimate_cell(r.net_vs_reference.as_ref().or(Some(&r.vs_reference)))));
                 }
                 let net = if p.rows.iter().any(|r| r.net_vs_reference.is_some()) { "net cost" } else { "cost" };
                 s.column(format!("{net} vs {} ({}, {} lights)", p.reference, p.provenance.device.name, lights.unwrap_or(0)), cells);
@@ -93,7 +93,7 @@ fn gather(inputs: &[Input]) -> Summary {
                 }
             }
             Loaded::Sweep(w) => {
-                let cells = w.rows.iter().filter(|r| r.pareto).map(|r| (s.model(&r.canonical, &r.label), num_cell(r.accuracy.vs_exact.rms))).collect();
+                let cells = w.rows.iter().filter(|r| r.pareto).map(|r| (s.model(&r.canonical, &r.label), num_cell(crate::io::finite(r.accuracy.vs_exact.rms)))).collect();
                 s.column("RMS rel. error vs exact (sweep)".into(), cells);
             }
             Loaded::Diff(d) => {
