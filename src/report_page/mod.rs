@@ -15,7 +15,7 @@ use crate::gpu::Gpu;
 use crate::export::html::{self, Page};
 use crate::inspect::InspectReport;
 use crate::profile::ProfileReport;
-use crate::stability::view::StabilityView;
+use crate::stability::StabilityReport;
 use crate::sweep::SweepReport;
 use anyhow::{anyhow, bail, Result};
 use serde::de::{DeserializeOwned, IgnoredAny};
@@ -27,7 +27,7 @@ use std::path::{Path, PathBuf};
 pub enum Loaded {
     Profile(Box<ProfileReport>),
     Sweep(Box<SweepReport>),
-    Stability(Box<StabilityView>),
+    Stability(Box<StabilityReport>),
     /// One inspect report per device, and with several devices the inspect's own cost table.
     Inspect(Vec<InspectReport>, Option<CostTable>),
     /// A `brdfprof compare` table.

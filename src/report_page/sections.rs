@@ -9,7 +9,7 @@ use crate::export::html::{self, esc, Axis, Cell, HtmlTable, Point};
 use crate::profile::{ProfileReport, Row};
 use crate::export::markdown::sig;
 use crate::export::json::Provenance;
-use crate::stability::view::{SpecView, StabilityView};
+use crate::stability::{cell_triples, SpecStability, StabilityReport};
 use crate::stats::Estimate;
 use crate::accuracy::ErrorStats;
 use crate::io::finite;
@@ -331,7 +331,7 @@ const STABILITY_COLUMNS: [(&str, &str); 12] = [
     ("verdict", "verdict"),
 ];
 
-fn stability_row(s: &SpecView) -> Vec<Cell> {
+fn stability_row(s: &SpecStability) -> Vec<Cell> {
     vec![
         Cell::text(s.label().to_string()),
         count_cell(s.nan),
@@ -339,11 +339,8 @@ fn stability_row(s: &SpecView) -> Vec<Cell> {
         count_cell(s.negative),
         Cell::num(s.cases_out_of_tolerance.len() as f64, crate::stability::cases_cell(s.cases_out_of_tolerance.len(), s.cases_run, s.checked())),
         if s.checked() { count_cell(s.grid_out_of_tolerance) } else { Cell::text("-".to_string()) },
-        if s.checked() { num_cell(s.worst.deviation) } else { Cell::text("-".to_string()) },
-        match s.jumps_checked {
-            Some(false) => Cell::text(crate::stability::jumps_cell(s.discontinuities, false)),
-            _ => count_cell(s.discontinuities),
-        },
+        if s.checked() { num_cell(finite(s.worst.deviation)) } else { Cell::text("-".to_string()) },
+        if s.jumps_checked { count_cell(s.discontinuities) } else { Cell::text(crate::stability::jumps_cell(s.discontinuities, false)) },
         count_cell(s.model_jumps),
         num_cell(s.reciprocity),
         num_cell(s.energy.as_ref().and_then(|e| e.max_e)),
@@ -352,7 +349,7 @@ fn stability_row(s: &SpecView) -> Vec<Cell> {
 }
 
 /// The bad values of a spec over (roughness, NoV) as a heat map image: white none, viridis by log count.
-fn heat_map(s: &SpecView, triples: &[[u32; 3]]) -> Result<String> {
+fn heat_map(s: &SpecStability, triples: &[[u32; 3]]) -> Result<String> {
     use crate::stability::grid::{COSINES, ROUGHNESS};
     let (w, h) = (COSINES.len() as u32, ROUGHNESS.len() as u32);
     let max = triples.iter().map(|t| t[2]).max().unwrap_or(1).max(1) as f32;
@@ -371,7 +368,7 @@ fn heat_map(s: &SpecView, triples: &[[u32; 3]]) -> Result<String> {
 
 /// One stability report: the summary table (rows keyed `stability<i>/<spec>`) and a heat map per spec with
 /// bad values.
-pub fn stability_html(i: usize, st: &StabilityView, path: &str) -> Result<String> {
+pub fn stability_html(i: usize, st: &StabilityReport, path: &str) -> Result<String> {
     let mut t = HtmlTable::new(&STABILITY_COLUMNS);
     for s in &st.specs {
         t.row(format!("stability{i}/{}", s.spec), stability_row(s));
@@ -379,13 +376,16 @@ pub fn stability_html(i: usize, st: &StabilityView, path: &str) -> Result<String
     let failing = st.specs.iter().filter(|s| s.fails()).count();
     let mut maps = String::new();
     for s in &st.specs {
-        if let Some(cells) = s.bad_cells.as_ref().filter(|c| !c.is_empty()) {
-            maps += &heat_map(s, cells)?;
+        if let Some(triples) = s.bad_cells.as_deref().map(cell_triples).filter(|t| !t.is_empty()) {
+            maps += &heat_map(s, &triples)?;
         }
     }
     let mut located = String::new();
     for s in st.specs.iter().filter(|s| s.fails()) {
-        let Some(f) = &s.failures else { continue };
+        let f = &s.failures;
+        if f.is_empty() {
+            continue;
+        }
         let items: String = f.lines().iter().map(|(depth, line)| format!("<li class=\"depth{depth}\">{}</li>", esc(line))).collect();
         located += &format!("<li><b>{}</b><ul>{items}</ul></li>", esc(s.label()));
     }

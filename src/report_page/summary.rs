@@ -7,7 +7,7 @@ use super::{Input, Loaded};
 use crate::brdf::guards::GuardSet;
 use crate::model::Model;
 use crate::export::html::{Cell, HtmlTable};
-use crate::stability::view::SpecView;
+use crate::stability::SpecStability;
 use std::collections::BTreeMap;
 
 /// Most rows and figure columns shown (the sections below hold every figure).
@@ -53,7 +53,7 @@ impl Summary {
     }
 }
 
-fn stability_cell(s: &SpecView) -> Cell {
+fn stability_cell(s: &SpecStability) -> Cell {
     if s.fails() {
         Cell::num((s.nan + s.inf + s.negative) as f64, format!("FAIL ({} NaN, {} Inf, {} neg.)", s.nan, s.inf, s.negative))
     } else {

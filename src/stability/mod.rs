@@ -8,7 +8,6 @@ mod check;
 pub mod energy;
 pub mod failures;
 pub mod grid;
-pub mod view;
 
 pub use check::{check_model, Checks};
 
@@ -24,7 +23,7 @@ use catalogue::{Expect, HardCase};
 use indicatif::ProgressBar;
 use rand::{Rng, SeedableRng};
 
-use serde::Serialize;
+use serde::{Deserialize, Deserializer, Serialize};
 
 /// Every D with every Vis (Schlick Fresnel), and every Fresnel term on the reference preset (with each metal
 /// where it reads one), in fp32 and fp16: every spec the term library offers up to the choice of Fresnel.
@@ -94,33 +93,46 @@ pub fn tolerance(spec: &ModelSpec, s: &Sample, channel: usize, expected: f64, se
     base.max(4.0 * sensitivity(spec, s, channel, unit_epsilon(spec.precision), seed))
 }
 
-#[derive(Clone, Debug, Serialize)]
+/// A stability report is read back (`report`, `--html`) as these same types: what no reader shows is skipped,
+/// a figure written as null (NaN or Inf) reads as NaN (`io::finite`), and what an older report lacks takes the
+/// default it stood for then.
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct CaseResult {
     pub case: String,
+    #[serde(skip_deserializing)]
     pub expected: Option<[f64; 3]>,
+    #[serde(skip_deserializing)]
     pub got: [f32; 3],
     /// Largest |got - expected| / tolerance over the channels (NaN/Inf count as infinite).
+    #[serde(default = "crate::io::nan", deserialize_with = "crate::io::nan_if_null")]
     pub deviation: f64,
+    #[serde(skip_deserializing)]
     pub ok: bool,
 }
 
-#[derive(Clone, Debug, Default, Serialize)]
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+#[serde(default)]
 pub struct Worst {
     /// |got - expected| in units of the tolerance.
+    #[serde(default = "crate::io::nan", deserialize_with = "crate::io::nan_if_null")]
     pub deviation: f64,
+    #[serde(skip_deserializing)]
     pub got: f32,
+    #[serde(skip_deserializing)]
     pub expected: f64,
     pub input: String,
 }
 
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct SpecStability {
-    /// What tables and charts call it (`Model::label`).
+    /// What tables and charts call it (`Model::label`; empty in a report written before labels).
+    #[serde(default)]
     pub label: String,
     /// The text that parses back to the model (`Model::name`).
     pub spec: String,
     pub precision: String,
     /// Whether the model has an f64 twin.
+    #[serde(default)]
     pub has_twin: bool,
     /// What its results were checked against: `twin`, `reference `SPEC`` (`--reference`, for a model
     /// without a twin), or None: then nothing is out of tolerance (there is nothing to be within) and jumps
@@ -128,14 +140,18 @@ pub struct SpecStability {
     pub expected_from: Option<String>,
     /// The input ranges checked (roughness, NoV, NoL), where any was given or declared, and the valid hard
     /// cases and grid points outside them (not counted).
+    #[serde(skip_deserializing)]
     pub domain: Option<String>,
+    #[serde(skip_deserializing)]
     pub cases_outside_domain: usize,
+    #[serde(skip_deserializing)]
     pub grid_outside_domain: usize,
     /// On valid inputs (catalogue and grid).
     pub nan: usize,
     pub inf: usize,
     pub negative: usize,
     /// Non-finite or negative results from invalid inputs (NaN/Inf in), reported, not failing.
+    #[serde(default)]
     pub invalid_input_poisoned: usize,
     /// Hard cases run, and the results of those out of tolerance (or poisoned, for invalid input).
     pub cases_run: usize,
@@ -145,40 +161,86 @@ pub struct SpecStability {
     pub case_deviation: Vec<f64>,
     /// Grid points out of tolerance.
     pub grid_out_of_tolerance: usize,
+    #[serde(default = "no_worst")]
     pub worst: Worst,
-    /// Whether jumps were looked for (with an expectation to tell the model's own steps from breaks).
+    /// Whether jumps were looked for (with an expectation to tell the model's own steps from breaks; reports
+    /// written before it counted them always).
+    #[serde(default = "always", deserialize_with = "true_if_null")]
     pub jumps_checked: bool,
     /// Steps in f_s NoL along NoV, NoL or roughness that the f64 model does not take, at values out of tolerance.
+    #[serde(default)]
     pub discontinuities: usize,
+    #[serde(skip_deserializing)]
     pub discontinuity_examples: Vec<String>,
     /// Steps the f64 model takes too, between lit points (the formula's and its guards' own).
+    #[serde(default)]
     pub model_jumps: usize,
     /// max |f(v, l) - f(l, v)| / max(|f|, 1e-3) over the reciprocity samples whose values are finite (None
     /// when none is).
     pub reciprocity: Option<f64>,
     /// Reciprocity values (sample pairs x channels) left out because either side is NaN or Inf.
+    #[serde(skip_deserializing)]
     pub reciprocity_nonfinite: usize,
-    /// Bad values (NaN, Inf, negative) per (NoV, roughness) grid cell, [roughness][NoV], where any.
-    #[serde(serialize_with = "sparse_cells")]
+    /// Bad values (NaN, Inf, negative) per (NoV, roughness) grid cell, [roughness][NoV], where any; written
+    /// (and read back) as `cell_triples`.
+    #[serde(serialize_with = "sparse_cells", deserialize_with = "dense_cells", default)]
     pub bad_cells: Option<Vec<Vec<u32>>>,
     /// Every failing valid input: hard cases by name, grid points counted (the first listed), each with its
-    /// input values and the input guards that remove it.
+    /// input values and the input guards that remove it (empty in a report written before they were listed).
+    #[serde(default)]
     pub failures: failures::Failures,
     pub energy: Option<energy::Energy>,
 }
 
-/// Bad cells as [roughness index, NoV index, count] triples of the non-empty cells.
+/// Bad cells as [roughness index, NoV index, count] triples of the non-empty cells, row by row.
+pub fn cell_triples(cells: &[Vec<u32>]) -> Vec<[u32; 3]> {
+    cells.iter().enumerate().flat_map(|(r, row)| row.iter().enumerate().filter(|(_, n)| **n > 0).map(move |(v, n)| [r as u32, v as u32, *n])).collect()
+}
+
 fn sparse_cells<S: serde::Serializer>(cells: &Option<Vec<Vec<u32>>>, s: S) -> Result<S::Ok, S::Error> {
-    let triples: Option<Vec<[u32; 3]>> = cells.as_ref().map(|c| {
-        c.iter().enumerate().flat_map(|(r, row)| row.iter().enumerate().filter(|(_, n)| **n > 0).map(move |(v, n)| [r as u32, v as u32, *n])).collect()
-    });
-    triples.serialize(s)
+    cells.as_deref().map(cell_triples).serialize(s)
+}
+
+/// `cell_triples` back to cells, each row as long as the longest index read needs.
+fn dense_cells<'de, D: Deserializer<'de>>(d: D) -> Result<Option<Vec<Vec<u32>>>, D::Error> {
+    Ok(Option::<Vec<[u32; 3]>>::deserialize(d)?.map(|triples| {
+        let rows = triples.iter().map(|t| t[0] as usize + 1).max().unwrap_or(0);
+        let columns = triples.iter().map(|t| t[1] as usize + 1).max().unwrap_or(0);
+        let mut cells = vec![vec![0; columns]; rows];
+        for [r, v, n] in triples {
+            cells[r as usize][v as usize] = n;
+        }
+        cells
+    }))
+}
+
+/// What a report without a worst deviation reads as: none known.
+fn no_worst() -> Worst {
+    Worst { deviation: f64::NAN, ..Worst::default() }
+}
+
+fn always() -> bool {
+    true
+}
+
+fn true_if_null<'de, D: Deserializer<'de>>(d: D) -> Result<bool, D::Error> {
+    Ok(Option::<bool>::deserialize(d)?.unwrap_or(true))
 }
 
 impl SpecStability {
     /// NaN, Inf or a negative value on a valid input.
     pub fn fails(&self) -> bool {
         self.nan + self.inf + self.negative > 0
+    }
+
+    /// What to call it: its label, or its spec in a report written before labels.
+    pub fn label(&self) -> &str {
+        if self.label.is_empty() { &self.spec } else { &self.label }
+    }
+
+    /// Whether its values were checked against expected ones (a twin or a reference).
+    pub fn checked(&self) -> bool {
+        self.has_twin || self.expected_from.is_some()
     }
 }
 
@@ -195,13 +257,14 @@ pub struct StabilityOptions {
     pub nol: Option<(f64, f64)>,
 }
 
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct StabilityReport {
     pub provenance: crate::export::json::Provenance,
     pub specs: Vec<SpecStability>,
     pub grid_points: usize,
     pub cases: Vec<HardCase>,
     /// What each guard saves, where a spec ran with and without some of its guards (`with_guard_variants`).
+    #[serde(skip_deserializing)]
     pub guard_savings: Vec<GuardSaving>,
 }
 
@@ -480,7 +543,7 @@ impl StabilityReport {
             );
             for s in failing {
                 let worst = if s.expected_from.is_some() && s.worst.deviation.is_finite() { format!("; worst deviation {:.2e} x tolerance at {}", s.worst.deviation, s.worst.input) } else { String::new() };
-                out += &s.failures.view().markdown(&s.label, &format!("{} NaN, {} Inf, {} negative{worst}", s.nan, s.inf, s.negative));
+                out += &s.failures.markdown(&s.label, &format!("{} NaN, {} Inf, {} negative{worst}", s.nan, s.inf, s.negative));
             }
         }
         out
