@@ -55,23 +55,15 @@ pub struct Run<'a> {
 /// Opens a local device (None: the default) and runs `work` on it; the CLI's (progress, validation check).
 pub type OpenLocal<'a> = dyn Fn(Option<&str>, &mut dyn FnMut(&Gpu) -> Result<()>) -> Result<()> + 'a;
 
-/// The JSON of `inspect` over several devices.
-#[derive(Serialize)]
+/// The JSON of `inspect` over several devices, and what `report` reads back (`format` is not read).
+#[derive(Clone, Debug, Serialize, serde::Deserialize)]
 pub struct MultiReport {
+    #[serde(skip_deserializing)]
     pub format: &'static str,
     pub reports: Vec<InspectReport>,
     pub costs: CostTable,
     /// Why a `--profile` report is not in the cost table, if it is not.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub profile_note: Option<String>,
-}
-
-/// `MultiReport` as read back (`brdfprof report`, `--html`).
-#[derive(Clone, Debug, serde::Deserialize)]
-pub struct MultiView {
-    pub reports: Vec<InspectReport>,
-    pub costs: CostTable,
-    #[serde(default)]
     pub profile_note: Option<String>,
 }
 

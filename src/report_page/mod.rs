@@ -1,9 +1,10 @@
 //! One HTML report from saved results (`brdfprof report`, and `--html` on the measuring commands): provenance,
 //! cost tables with their confidence intervals, the cost table across devices with rank correlations, the
 //! sweep's accuracy-against-cost chart, per-model lobes, lit spheres and directional albedo, and stability
-//! heat maps. Reports are read back through the typed views their writers own (`profile::view`,
-//! `sweep::view`, `stability::view`, `inspect`). Lobes, spheres and albedo are evaluated at report time by the
-//! GPU kernels on the device given (docs/report.md says why).
+//! heat maps. Reports are read back as the very types their commands write (`ProfileReport`, `SweepReport`,
+//! `StabilityReport`, `InspectReport`, `DiffReport`), so a field cannot be written one way and read another.
+//! Lobes, spheres and albedo are evaluated at report time by the GPU kernels on the device given
+//! (docs/report.md says why).
 
 pub mod diff;
 pub mod sections;
@@ -33,9 +34,9 @@ pub enum Loaded {
     /// A `brdfprof compare` table.
     Costs(CostTable),
     /// A `brdfprof diff` result.
-    Diff(Box<crate::diff::view::DiffView>),
+    Diff(Box<crate::diff::DiffReport>),
     /// A `brdfprof diff --reference` result: every model against one reference.
-    DiffSet(Box<crate::diff::view::DiffSetView>),
+    DiffSet(Box<crate::diff::DiffSet>),
 }
 
 impl Loaded {
@@ -86,7 +87,7 @@ pub fn load(path: &Path) -> Result<Input> {
     from_json(path, &text)
 }
 
-/// A report just measured, read back through its view as a saved one would be (`--html`): what the page
+/// A report just measured, read back through its JSON as a saved one would be (`--html`): what the page
 /// shows is what the JSON says.
 pub fn from_report(label: &Path, report: &impl serde::Serialize) -> Result<Input> {
     from_json(label, &serde_json::to_string(report)?)
@@ -109,7 +110,7 @@ pub fn from_json(path: &Path, text: &str) -> Result<Input> {
             Kind::Stability => Loaded::Stability(parse(path, &text, "stability")?),
             Kind::Inspect => Loaded::Inspect(vec![parse(path, &text, "inspect")?], None),
             Kind::InspectDevices => {
-                let m: crate::devices::MultiView = parse(path, &text, "inspect (several devices)")?;
+                let m: crate::devices::MultiReport = parse(path, &text, "inspect (several devices)")?;
                 Loaded::Inspect(m.reports, Some(m.costs))
             }
             Kind::Compare => Loaded::Costs(parse(path, &text, "compare")?),
@@ -126,7 +127,7 @@ pub fn from_json(path: &Path, text: &str) -> Result<Input> {
     } else if probe.grid_points.is_some() {
         Loaded::Stability(parse(path, &text, "stability")?)
     } else if probe.reports.is_some() {
-        let m: crate::devices::MultiView = parse(path, &text, "inspect (several devices)")?;
+        let m: crate::devices::MultiReport = parse(path, &text, "inspect (several devices)")?;
         Loaded::Inspect(m.reports, Some(m.costs))
     } else if probe.kernels.is_some() {
         Loaded::Inspect(vec![parse(path, &text, "inspect")?], None)

@@ -7,6 +7,7 @@ use super::{Input, Loaded};
 use crate::brdf::guards::GuardSet;
 use crate::model::Model;
 use crate::export::html::{Cell, HtmlTable};
+use crate::io::finite;
 use crate::stability::SpecStability;
 use std::collections::BTreeMap;
 
@@ -93,16 +94,16 @@ fn gather(inputs: &[Input]) -> Summary {
                 }
             }
             Loaded::Sweep(w) => {
-                let cells = w.rows.iter().filter(|r| r.pareto).map(|r| (s.model(&r.canonical, &r.label), num_cell(crate::io::finite(r.accuracy.vs_exact.rms)))).collect();
+                let cells = w.rows.iter().filter(|r| r.pareto).map(|r| (s.model(&r.canonical, &r.label), num_cell(finite(r.accuracy.vs_exact.rms)))).collect();
                 s.column("RMS rel. error vs exact (sweep)".into(), cells);
             }
             Loaded::Diff(d) => {
                 s.model(&d.a.canonical, &d.a.name);
                 let key = s.model(&d.b.canonical, &d.b.name);
-                s.column(format!("max rel. difference vs {}", d.a.name), vec![(key, num_cell(d.difference.max_rel))]);
+                s.column(format!("max rel. difference vs {}", d.a.name), vec![(key, num_cell(finite(d.difference.max_rel)))]);
             }
             Loaded::DiffSet(d) => {
-                let cells = d.diffs.iter().map(|x| (s.model(&x.b.canonical, &x.b.name), num_cell(x.difference.max_rel))).collect();
+                let cells = d.diffs.iter().map(|x| (s.model(&x.b.canonical, &x.b.name), num_cell(finite(x.difference.max_rel)))).collect();
                 s.column(format!("max rel. difference vs {}", d.reference.name), cells);
             }
             Loaded::Stability(_) | Loaded::Costs(_) => {}
