@@ -9,7 +9,7 @@ use crate::export::html::{self, esc, Axis, Cell, HtmlTable, Point};
 use crate::profile::{ProfileReport, Row};
 use crate::export::markdown::sig;
 use crate::export::json::Provenance;
-use crate::stability::{cell_triples, SpecStability, StabilityReport};
+use crate::stability::{SpecStability, StabilityReport};
 use crate::stats::Estimate;
 use crate::accuracy::ErrorStats;
 use crate::io::finite;
@@ -376,8 +376,8 @@ pub fn stability_html(i: usize, st: &StabilityReport, path: &str) -> Result<Stri
     let failing = st.specs.iter().filter(|s| s.fails()).count();
     let mut maps = String::new();
     for s in &st.specs {
-        if let Some(triples) = s.bad_cells.as_deref().map(cell_triples).filter(|t| !t.is_empty()) {
-            maps += &heat_map(s, &triples)?;
+        if let Some(cells) = s.bad_cell_triples.as_ref().filter(|c| !c.is_empty()) {
+            maps += &heat_map(s, cells)?;
         }
     }
     let mut located = String::new();

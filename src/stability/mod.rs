@@ -182,9 +182,13 @@ pub struct SpecStability {
     #[serde(skip_deserializing)]
     pub reciprocity_nonfinite: usize,
     /// Bad values (NaN, Inf, negative) per (NoV, roughness) grid cell, [roughness][NoV], where any; written
-    /// (and read back) as `cell_triples`.
-    #[serde(serialize_with = "sparse_cells", deserialize_with = "dense_cells", default)]
+    /// as `cell_triples`.
+    #[serde(serialize_with = "sparse_cells", skip_deserializing)]
     pub bad_cells: Option<Vec<Vec<u32>>>,
+    /// `bad_cells` as read back: the triples as written (None in a measured report). Kept sparse because the
+    /// grid the report was measured on need not be this build's, and the page draws from the triples.
+    #[serde(rename = "bad_cells", skip_serializing)]
+    pub bad_cell_triples: Option<Vec<[u32; 3]>>,
     /// Every failing valid input: hard cases by name, grid points counted (the first listed), each with its
     /// input values and the input guards that remove it (empty in a report written before they were listed).
     #[serde(default)]
@@ -193,25 +197,12 @@ pub struct SpecStability {
 }
 
 /// Bad cells as [roughness index, NoV index, count] triples of the non-empty cells, row by row.
-pub fn cell_triples(cells: &[Vec<u32>]) -> Vec<[u32; 3]> {
+fn cell_triples(cells: &[Vec<u32>]) -> Vec<[u32; 3]> {
     cells.iter().enumerate().flat_map(|(r, row)| row.iter().enumerate().filter(|(_, n)| **n > 0).map(move |(v, n)| [r as u32, v as u32, *n])).collect()
 }
 
 fn sparse_cells<S: serde::Serializer>(cells: &Option<Vec<Vec<u32>>>, s: S) -> Result<S::Ok, S::Error> {
     cells.as_deref().map(cell_triples).serialize(s)
-}
-
-/// `cell_triples` back to cells, each row as long as the longest index read needs.
-fn dense_cells<'de, D: Deserializer<'de>>(d: D) -> Result<Option<Vec<Vec<u32>>>, D::Error> {
-    Ok(Option::<Vec<[u32; 3]>>::deserialize(d)?.map(|triples| {
-        let rows = triples.iter().map(|t| t[0] as usize + 1).max().unwrap_or(0);
-        let columns = triples.iter().map(|t| t[1] as usize + 1).max().unwrap_or(0);
-        let mut cells = vec![vec![0; columns]; rows];
-        for [r, v, n] in triples {
-            cells[r as usize][v as usize] = n;
-        }
-        cells
-    }))
 }
 
 /// What a report without a worst deviation reads as: none known.
