@@ -7,9 +7,9 @@
 
 use crate::schema::InspectReport;
 use crate::schema::HASH_NOTE;
-use crate::profile::view::ProfileView;
+use crate::profile::ProfileReport;
 use crate::model::BASELINE_LABEL;
-use crate::results::{sig, Table};
+use crate::export::markdown::{sig, Table};
 use anyhow::{anyhow, bail, Result};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
@@ -175,7 +175,7 @@ pub fn inspect_columns(report: &InspectReport, source: &str) -> Vec<CostColumn> 
 }
 
 /// The cost columns of a `profile` report, read back typed: ns/eval per light count.
-pub fn profile_columns(view: &ProfileView, source: &str) -> Vec<CostColumn> {
+pub fn profile_columns(view: &ProfileReport, source: &str) -> Vec<CostColumn> {
     let device = Some(view.provenance.device.name.as_str()).filter(|n| !n.is_empty()).unwrap_or("?").to_string();
     let short = device.split([' ', '(']).next().unwrap_or("?").to_string();
     let mut lights: Vec<u32> = view.rows.iter().map(|r| r.lights).collect();
@@ -341,11 +341,11 @@ impl CostTable {
         let values: Vec<Vec<Option<f64>>> = models.iter().map(|m| self.columns.iter().map(|c| self.relative(c, m)).collect()).collect();
         let max = values.iter().flatten().flatten().fold(1.0f64, |a, &b| a.max(b)) * 1.1;
         let width = (300 + 60 * models.len() as u32 * self.columns.len().max(1) as u32 / 2).clamp(800, 2400) + LEGEND_WIDTH as u32;
-        crate::chart::render(path, width, 600, |root| {
+        crate::export::png::render(path, width, 600, |root| {
             let e = |e: DrawingAreaErrorKind<_>| anyhow!("{e}");
             // The legend goes in a right margin of its own, so that it never hides a bar.
             let mut chart = ChartBuilder::on(root)
-                .caption("BRDF cost net of the memory-only kernel, relative to ggx, per device", (crate::chart::FONT, 20))
+                .caption("BRDF cost net of the memory-only kernel, relative to ggx, per device", (crate::export::png::FONT, 20))
                 .margin(15)
                 .margin_right(LEGEND_WIDTH)
                 .x_label_area_size(90)
@@ -357,12 +357,12 @@ impl CostTable {
                 .disable_x_mesh()
                 .x_labels(0)
                 .y_desc("net cost / ggx's net cost")
-                .label_style((crate::chart::FONT, 13))
+                .label_style((crate::export::png::FONT, 13))
                 .draw()
                 .map_err(e)?;
             let n = self.columns.len().max(1) as f64;
             for (j, c) in self.columns.iter().enumerate() {
-                let colour = crate::chart::palette(j);
+                let colour = crate::export::png::palette(j);
                 let bars: Vec<_> = values
                     .iter()
                     .enumerate()
@@ -375,7 +375,7 @@ impl CostTable {
                 chart.draw_series(bars).map_err(e)?;
                 let (lx, ly) = (width as i32 - LEGEND_WIDTH + 10, 50 + 18 * j as i32);
                 root.draw(&Rectangle::new([(lx, ly - 5), (lx + 12, ly + 7)], colour.filled())).map_err(e)?;
-                root.draw(&Text::new(c.name.clone(), (lx + 18, ly - 5), (crate::chart::FONT, 13))).map_err(e)?;
+                root.draw(&Text::new(c.name.clone(), (lx + 18, ly - 5), (crate::export::png::FONT, 13))).map_err(e)?;
             }
             chart.draw_series(std::iter::once(PathElement::new(vec![(0.0, 1.0), (models.len() as f64, 1.0)], BLACK.mix(0.5)))).map_err(e)?;
             // Model names under their groups (long specs wrapped at commas).
@@ -383,7 +383,7 @@ impl CostTable {
                 let (px, py) = chart.backend_coord(&(i as f64 + 0.5, 0.0));
                 for (k, part) in m.split_inclusive(',').enumerate() {
                     let w = 7 * part.len() as i32;
-                    root.draw(&Text::new(part.to_string(), (px - w / 2, py + 8 + 16 * k as i32), (crate::chart::FONT, 13))).map_err(e)?;
+                    root.draw(&Text::new(part.to_string(), (px - w / 2, py + 8 + 16 * k as i32), (crate::export::png::FONT, 13))).map_err(e)?;
                 }
             }
             Ok(())
@@ -404,7 +404,7 @@ pub fn load_columns(path: &Path) -> Result<Vec<CostColumn>> {
         if value.get("kernel_sha256").is_none() {
             bail!("{}: a profile report that records no kernel hashes (written by an older brdfprof); its kernels cannot be matched with the others'. Measure it again", path.display());
         }
-        let view: ProfileView = serde_json::from_value(value).map_err(|e| anyhow!("{}: not a brdfprof profile report ({e})", path.display()))?;
+        let view: ProfileReport = serde_json::from_value(value).map_err(|e| anyhow!("{}: not a brdfprof profile report ({e})", path.display()))?;
         profile_columns(&view, &source)
     } else if let Some(reports) = value.get("reports").and_then(|r| r.as_array()) {
         let mut out = Vec::new();

@@ -56,23 +56,15 @@ pub struct Run<'a> {
 /// Opens a local device (None: the default) and runs `work` on it; the CLI's (progress, validation check).
 pub type OpenLocal<'a> = dyn Fn(Option<&str>, &mut dyn FnMut(&Gpu) -> Result<()>) -> Result<()> + 'a;
 
-/// The JSON of `inspect` over several devices.
-#[derive(Serialize)]
+/// The JSON of `inspect` over several devices, and what `report` reads back (`format` is not read).
+#[derive(Clone, Debug, Serialize, serde::Deserialize)]
 pub struct MultiReport {
+    #[serde(skip_deserializing)]
     pub format: &'static str,
     pub reports: Vec<InspectReport>,
     pub costs: CostTable,
     /// Why a `--profile` report is not in the cost table, if it is not.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub profile_note: Option<String>,
-}
-
-/// `MultiReport` as read back (`brdfprof report`, `--html`).
-#[derive(Clone, Debug, serde::Deserialize)]
-pub struct MultiView {
-    pub reports: Vec<InspectReport>,
-    pub costs: CostTable,
-    #[serde(default)]
     pub profile_note: Option<String>,
 }
 
@@ -96,8 +88,8 @@ impl Inspected {
     /// The JSON written: the one device's report, or the combined report of several.
     pub fn json_value(&self) -> Result<serde_json::Value> {
         let (kind, mut value) = match &self.multi {
-            None => (crate::results::Kind::Inspect, serde_json::to_value(&self.reports[0])?),
-            Some(m) => (crate::results::Kind::InspectDevices, serde_json::to_value(m)?),
+            None => (crate::export::json::Kind::Inspect, serde_json::to_value(&self.reports[0])?),
+            Some(m) => (crate::export::json::Kind::InspectDevices, serde_json::to_value(m)?),
         };
         if let Some(map) = value.as_object_mut() {
             map.insert("kind".into(), kind.name().into());
@@ -223,5 +215,5 @@ pub fn slug(report: &InspectReport) -> String {
     if let Some(t) = targets::of_report(report) {
         return t.slug();
     }
-    crate::results::name_slug(report.provenance["device"]["name"].as_str().unwrap_or("device"))
+    crate::export::name_slug(report.provenance["device"]["name"].as_str().unwrap_or("device"))
 }

@@ -5,13 +5,12 @@
 //! rounding. docs/diff.md documents the JSON report (`"kind": "diff"`).
 
 pub mod picture;
-pub mod view;
 
 use crate::accuracy::rel_err;
 use crate::brdf::guards::unit;
 use crate::brdf::{samples, Sample};
 use crate::model::Model;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// The report's `kind`, and its shape's version (bumped when a field changes meaning or goes away).
 pub const KIND: &str = "diff";
@@ -61,7 +60,7 @@ pub fn default_samples_label_in(count: usize, seed: u64, domain: &SampleDomain, 
 }
 
 /// One model as the report names it.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Side {
     /// The label in tables and file names (`name=` or the shortest spec).
     pub name: String,
@@ -85,9 +84,11 @@ impl Side {
 
 /// What `brdfprof diff --reference SPEC --model ... --json` writes: each model against the reference's f64
 /// values on the same rows, one `DiffReport` each (A the reference), and one table over them.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct DiffSet {
+    #[serde(skip_deserializing)]
     pub kind: &'static str,
+    #[serde(skip_deserializing)]
     pub schema: u32,
     pub reference: Side,
     pub device: String,
@@ -118,7 +119,7 @@ impl DiffSet {
     /// One table (a row per model: its largest and RMS relative difference over the channels, its
     /// non-finite values, its worst row), then each model's report.
     pub fn markdown(&self) -> String {
-        use crate::results::{sig, Table};
+        use crate::export::markdown::{sig, Table};
         let mut out = format!(
             "# {} models against {}\n\n{} rows of {} on {}; relative: rel_err(model, reference) = |model - reference| / max(|reference|, {}).\n\n",
             self.diffs.len(),
@@ -160,42 +161,53 @@ impl DiffSet {
 }
 
 /// One channel's figures: |b - a| and rel_err(b, a), max and RMS over the rows whose values are both finite.
-#[derive(Clone, Debug, Default, Serialize, PartialEq)]
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
 pub struct ChannelStats {
-    pub channel: &'static str,
+    pub channel: String,
+    #[serde(default = "crate::io::nan", deserialize_with = "crate::io::nan_if_null")]
     pub max_abs: f64,
+    #[serde(default = "crate::io::nan", deserialize_with = "crate::io::nan_if_null")]
     pub rms_abs: f64,
+    #[serde(default = "crate::io::nan", deserialize_with = "crate::io::nan_if_null")]
     pub max_rel: f64,
+    #[serde(default = "crate::io::nan", deserialize_with = "crate::io::nan_if_null")]
     pub rms_rel: f64,
     /// Rows where A's value is NaN or Inf, where B's is, and where exactly one of them is (a difference no
     /// number measures: the statistics above leave those rows out, and `within_tolerance` fails on them).
+    #[serde(skip_deserializing)]
     pub a_nonfinite: usize,
+    #[serde(skip_deserializing)]
     pub b_nonfinite: usize,
     pub mismatched_nonfinite: usize,
     /// Rows where both are non-finite and not the same infinity (NaN on both sides): no difference measures
     /// them, so no tolerance can be claimed for them.
+    #[serde(skip_deserializing)]
     pub unmeasured: usize,
 }
 
 /// A row where the models differ most (largest relative difference over its channels).
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct WorstRow {
     /// 0-based index into the inputs.
     pub index: usize,
     /// The CSV line of the row, for `--input`.
     pub line: Option<usize>,
     pub sample: Sample,
+    #[serde(deserialize_with = "nan_if_null_rgb")]
     pub a: [f32; 3],
+    #[serde(deserialize_with = "nan_if_null_rgb")]
     pub b: [f32; 3],
     /// The channel with the largest relative difference, and that difference (infinite where one side is not
     /// finite).
-    pub channel: &'static str,
+    pub channel: String,
+    #[serde(default = "crate::io::nan", deserialize_with = "crate::io::nan_if_null")]
     pub rel: f64,
+    #[serde(skip_deserializing)]
     pub abs: f64,
 }
 
 /// Rows by their largest relative difference over the channels.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Histogram {
     /// Lower edges of the bins; the last bin is [last edge, inf).
     pub edges: Vec<f64>,
@@ -207,18 +219,23 @@ pub struct Histogram {
 }
 
 /// The statistics of B against A over a set of rows.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Difference {
     pub channels: Vec<ChannelStats>,
     /// Largest relative difference over every channel (infinite when a row is non-finite on one side only).
+    #[serde(default = "crate::io::nan", deserialize_with = "crate::io::nan_if_null")]
     pub max_rel: f64,
+    #[serde(skip_deserializing)]
     pub max_abs: f64,
 }
 
-/// What `brdfprof diff --json` writes (docs/diff.md).
-#[derive(Clone, Debug, Serialize)]
+/// What `brdfprof diff --json` writes (docs/diff.md), and what `report` reads back: what no reader shows is
+/// skipped, and a figure written as null (NaN or Inf) reads as NaN (`io::finite`).
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct DiffReport {
+    #[serde(skip_deserializing)]
     pub kind: &'static str,
+    #[serde(skip_deserializing)]
     pub schema: u32,
     pub a: Side,
     pub b: Side,
@@ -230,6 +247,7 @@ pub struct DiffReport {
     pub relative_to: String,
     pub difference: Difference,
     /// The f64 twins' difference on the same inputs, where both models have twins.
+    #[serde(skip_deserializing)]
     pub twins: Option<Difference>,
     pub worst: Vec<WorstRow>,
     pub histogram: Histogram,
@@ -239,6 +257,11 @@ pub struct DiffReport {
 }
 
 pub const CHANNELS: [&str; 3] = ["r", "g", "b"];
+
+/// A model's values as read back: a NaN or Inf, written as null, reads as NaN.
+fn nan_if_null_rgb<'de, D: serde::Deserializer<'de>>(d: D) -> std::result::Result<[f32; 3], D::Error> {
+    Ok(<[Option<f32>; 3]>::deserialize(d)?.map(|x| x.unwrap_or(f32::NAN)))
+}
 
 /// The relative difference of one value pair: rel_err(b, a), 0 for equal values (infinities included),
 /// infinite when exactly one is finite, and None when both are non-finite and differ (no measure applies).
@@ -270,7 +293,7 @@ pub fn difference(a: &[[f64; 3]], b: &[[f64; 3]]) -> Difference {
 }
 
 fn channel_stats(c: usize, a: &[[f64; 3]], b: &[[f64; 3]]) -> ChannelStats {
-    let mut s = ChannelStats { channel: CHANNELS[c], ..Default::default() };
+    let mut s = ChannelStats { channel: CHANNELS[c].to_string(), ..Default::default() };
     let (mut sum_abs, mut sum_rel, mut n) = (0.0, 0.0, 0usize);
     for (x, y) in a.iter().zip(b).map(|(x, y)| (x[c], y[c])) {
         s.a_nonfinite += !x.is_finite() as usize;
@@ -329,7 +352,7 @@ pub fn worst_rows(samples: &[Sample], lines: Option<&[usize]>, a: &[[f32; 3]], b
             sample: samples[i],
             a: a[i],
             b: b[i],
-            channel: CHANNELS[c],
+            channel: CHANNELS[c].to_string(),
             rel,
             abs: (f64::from(b[i][c]) - f64::from(a[i][c])).abs(),
         })
@@ -382,7 +405,7 @@ impl DiffReport {
 
     /// The report as Markdown: the channel table, the twins' figures, the histogram and the worst rows.
     pub fn markdown(&self) -> String {
-        use crate::results::{sig, Table};
+        use crate::export::markdown::{sig, Table};
         let mut out = format!("# {} against {}\n\n{} rows of {} on {}; relative: {}.\n\n", self.b.name, self.a.name, self.rows, self.input, self.device, self.relative_to);
         for side in [&self.a, &self.b] {
             if let Some(f) = &side.front_end {
@@ -412,7 +435,7 @@ impl DiffReport {
 
     fn histogram_markdown(&self) -> String {
         let h = &self.histogram;
-        let mut t = crate::results::Table::new(["largest relative difference of a row", "rows", ""]);
+        let mut t = crate::export::markdown::Table::new(["largest relative difference of a row", "rows", ""]);
         let most = h.counts.iter().copied().max().unwrap_or(0).max(1);
         for (i, &n) in h.counts.iter().enumerate() {
             let range = match h.edges.get(i + 1) {
@@ -428,12 +451,12 @@ impl DiffReport {
         if self.worst.is_empty() {
             return String::new();
         }
-        let mut t = crate::results::Table::new(["row", "n", "v", "l", "roughness", "f0", "A", "B", "rel (channel)"]);
+        let mut t = crate::export::markdown::Table::new(["row", "n", "v", "l", "roughness", "f0", "A", "B", "rel (channel)"]);
         for w in &self.worst {
             let v3 = |v: [f32; 3]| format!("{} {} {}", v[0], v[1], v[2]);
             let s = &w.sample;
             let row = w.line.map_or(w.index.to_string(), |l| format!("line {l}"));
-            t.row([row, v3(s.n), v3(s.v), v3(s.l), s.roughness.to_string(), v3(s.f0), v3(w.a), v3(w.b), format!("{} ({})", crate::results::sig(w.rel, 3), w.channel)]);
+            t.row([row, v3(s.n), v3(s.v), v3(s.l), s.roughness.to_string(), v3(s.f0), v3(w.a), v3(w.b), format!("{} ({})", crate::export::markdown::sig(w.rel, 3), w.channel)]);
         }
         format!("\nRows where they differ most:\n\n{}", t.markdown())
     }

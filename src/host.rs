@@ -1,10 +1,11 @@
 //! The host CPU, as reports record it: lavapipe's costs are the CPU's (its JIT targets the host's vector
 //! units), so a figure without the CPU that made it cannot be compared.
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
-/// What /proc/cpuinfo and CPUID say about the host.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+/// What /proc/cpuinfo and CPUID say about the host (read back from saved reports with a missing field empty).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
 pub struct HostCpu {
     pub vendor: String,
     pub family: String,

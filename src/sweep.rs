@@ -2,22 +2,22 @@
 //! profile protocol) and measured for accuracy (`accuracy`), and the result is a table, a JSON file and a chart
 //! of error against cost with the Pareto frontier.
 
-pub mod view;
 
 use crate::accuracy::{self, Accuracy, ExactCache, SampleSet};
 use crate::brdf::exact::ExactFresnel;
 use crate::brdf::samples::SampleDomain;
 use crate::brdf::spec::with_each_param_sample;
 use crate::brdf::{ModelSpec, Precision, Vis, D, F, THESIS_MODELS};
-use crate::chart::{self, Point};
+use crate::export::png::{self, Point};
 use crate::gpu::Gpu;
 use crate::model::Model;
 use crate::profile::{self, ProfileOptions, ProfileReport};
-use crate::results::{self, Table};
+use crate::export::json;
+use crate::export::markdown::{self, Table};
 use crate::stats::{self, Estimate};
 use anyhow::Result;
 use indicatif::ProgressBar;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::path::Path;
 
 /// The default set: every D with each of its sensible visibility terms and Schlick's Fresnel; every Fresnel
@@ -131,7 +131,8 @@ impl AccuracyOptions {
     }
 }
 
-#[derive(Clone, Debug, Serialize)]
+/// A sweep report is read back (`report`, `--html`) as these same types.
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct SweepRow {
     pub spec: String,
     pub canonical: String,
@@ -149,14 +150,17 @@ pub struct SweepRow {
     pub pareto: bool,
 }
 
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct SweepReport {
     pub fastest: String,
     /// Rows sorted by rank, then median cost.
     pub rows: Vec<SweepRow>,
     pub sample_set: String,
-    /// What "vs exact" is against (`--reference`, `--exact-fresnel`), in words.
+    /// What "vs exact" is against (`--reference`, `--exact-fresnel`), in words; empty in a report written
+    /// before the sweep took a reference for every model.
+    #[serde(default)]
     pub against: String,
+    #[serde(skip_deserializing)]
     pub exact: ExactFresnel,
     pub profile: ProfileReport,
 }
@@ -279,9 +283,9 @@ impl SweepReport {
             t.row([
                 format!("{}{}", r.rank, if r.tied { "=" } else { "" }),
                 r.spec.clone(),
-                results::estimate(&r.ns_per_eval, 3),
-                r.net_ns_per_eval.as_ref().map_or("-".into(), |e| results::sig(e.median, 3)),
-                results::estimate(&r.cost_vs_fastest, 3),
+                markdown::estimate(&r.ns_per_eval, 3),
+                r.net_ns_per_eval.as_ref().map_or("-".into(), |e| markdown::sig(e.median, 3)),
+                markdown::estimate(&r.cost_vs_fastest, 3),
                 numerical_cell(a),
                 a.vs_exact.cell(),
                 format!("{:.1e}", a.albedo_vs_exact),
@@ -311,7 +315,7 @@ impl SweepReport {
 
     /// Writes sweep-<device>.md, .json and .png under `out`; returns their paths.
     pub fn write(&self, out: &Path, device: &str) -> Result<Vec<std::path::PathBuf>> {
-        results::write_md_json_png(&out.join(format!("sweep-{device}")), results::Kind::Sweep, self, &self.markdown(), |png| self.chart(png))
+        json::write_md_json_png(&out.join(format!("sweep-{device}")), json::Kind::Sweep, self, &self.markdown(), |png| self.chart(png))
     }
 
     /// Approximation error (RMS vs exact, log) against cost, every point labelled, the frontier drawn.
@@ -348,7 +352,7 @@ impl SweepReport {
             .fold(f64::NEG_INFINITY, f64::max);
         let title = format!("Accuracy against cost on {} ({} evaluations per dispatch)", self.profile.provenance.device.name, self.profile.rows[0].evaluations_per_dispatch);
         let y_desc = error_axis(self.exact, &self.rows);
-        let spec = chart::Scatter {
+        let spec = png::Scatter {
             title: &title,
             x_desc: "cost relative to the fastest spec (median of per-round ratios, 95% CI whiskers)",
             y_desc: &y_desc,
@@ -356,7 +360,7 @@ impl SweepReport {
             legend: &legend,
             split_x: Some(split * 1.02),
         };
-        chart::scatter_log_y(path, &spec, &points)
+        png::scatter_log_y(path, &spec, &points)
     }
 }
 

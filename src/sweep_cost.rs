@@ -3,9 +3,10 @@
 //! time. Those figures are deterministic: no CI, no noise, the same on every machine with the same compiler.
 //! The accuracy is the sweep's own (measured on the device that executed it).
 
-use crate::chart::{self, Point};
+use crate::export::png::{self, Point};
 use crate::schema::cost::TargetCost;
-use crate::results::{self, Table};
+use crate::export::json;
+use crate::export::markdown::{self, Table};
 use crate::sweep::{pareto_front, SweepReport};
 use anyhow::Result;
 use serde::Serialize;
@@ -120,8 +121,8 @@ impl CostSweep {
             let mut cells = vec![r.label.clone()];
             cells.extend(self.columns.iter().map(|c| r.stats.get(c).map_or("-".into(), |v| crate::schema::format_value(*v))));
             cells.extend([
-                results::sig(r.cycles_per_eval, 4),
-                r.net_cycles_per_eval.map_or("-".into(), |v| results::sig(v, 4)),
+                markdown::sig(r.cycles_per_eval, 4),
+                r.net_cycles_per_eval.map_or("-".into(), |v| markdown::sig(v, 4)),
                 format!("{:.3}", r.cost_vs_fastest),
                 format!("{:.3}", r.measured_cost_vs_fastest),
                 r.accuracy.vs_exact.cell(),
@@ -155,7 +156,7 @@ impl CostSweep {
 
     /// Writes `<stem>.md`, `.json` and `.png`; returns their paths.
     pub fn write(&self, stem: &Path) -> Result<Vec<PathBuf>> {
-        results::write_md_json_png(stem, results::Kind::SweepCost, self, &self.markdown(), |png| self.chart(png))
+        json::write_md_json_png(stem, json::Kind::SweepCost, self, &self.markdown(), |png| self.chart(png))
     }
 
     pub fn chart(&self, path: &Path) -> Result<()> {
@@ -179,7 +180,7 @@ impl CostSweep {
         let split = self.rows.iter().filter(|r| group(r) == 0).map(|r| r.cost_vs_fastest).fold(f64::NEG_INFINITY, f64::max);
         let title = format!("Accuracy against {}'s cost on {} ({})", self.compiler, self.target, self.architecture);
         let x_desc = format!("{} cycles per evaluation relative to the cheapest spec (deterministic)", self.compiler);
-        let spec = chart::Scatter {
+        let spec = png::Scatter {
             title: &title,
             x_desc: &x_desc,
             y_desc: &self.error_axis,
@@ -187,7 +188,7 @@ impl CostSweep {
             legend: &legend,
             split_x: (self.rows.iter().any(|r| group(r) == 1) && split.is_finite()).then_some(split * 1.02),
         };
-        chart::scatter_log_y(path, &spec, &points)
+        png::scatter_log_y(path, &spec, &points)
     }
 }
 
@@ -264,7 +265,7 @@ A spec is on a target's frontier when no other spec is both cheaper there (its c
     /// Writes `<stem>.md` and `.json`; returns their paths.
     pub fn write(&self, stem: &Path) -> Result<Vec<PathBuf>> {
         let (md, json) = (stem.with_extension("md"), stem.with_extension("json"));
-        results::write_report_compact(&json, results::Kind::SweepFrontiers, self)?;
+        json::write_report_compact(&json, json::Kind::SweepFrontiers, self)?;
         crate::io::write_output(&md, self.markdown().as_bytes())?;
         Ok(vec![md, json])
     }

@@ -12,7 +12,7 @@ use crate::kernels::{self, AlbedoCell, RunLimits};
 use crate::model::Model;
 use anyhow::Result;
 use rayon::prelude::*;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
 
 /// Relative error |x - reference| / max(|reference|, FLOOR), the measure used everywhere.
@@ -23,16 +23,22 @@ pub fn rel_err(x: f64, reference: f64) -> f64 {
     if e.is_nan() { f64::INFINITY } else { e }
 }
 
-#[derive(Clone, Debug, Default, Serialize)]
+/// Read back from sweep reports too: an infinite error, written as null, reads as NaN (`io::finite`).
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
 pub struct ErrorStats {
     /// Over every value; a NaN or Inf value counts as an infinite error (`nonfinite` says how many there are).
+    #[serde(default = "crate::io::nan", deserialize_with = "crate::io::nan_if_null")]
     pub max: f64,
+    #[serde(default = "crate::io::nan", deserialize_with = "crate::io::nan_if_null")]
     pub rms: f64,
-    /// The sample with the largest error.
+    /// The sample with the largest error (not read back).
+    #[serde(skip_deserializing)]
     pub worst: String,
     /// Values (samples x channels) that are NaN or Inf.
+    #[serde(default)]
     pub nonfinite: usize,
     /// Values compared.
+    #[serde(default)]
     pub values: usize,
 }
 
@@ -198,7 +204,7 @@ impl ExactCache {
     }
 }
 
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Accuracy {
     /// GPU result against the same formula in f64; for a model without a twin (a `.brdf` file) measured
     /// against a spec (`reference`), against that spec's own f64 formula; None against another `.brdf` file.
@@ -209,8 +215,10 @@ pub struct Accuracy {
     /// The formula itself (f64) against the same reference: the approximation alone (None without a twin).
     pub formula_vs_exact: Option<ErrorStats>,
     /// max over cells and channels of |E_gpu - E_exact| (absolute; albedo is in [0, 1]).
+    #[serde(default = "crate::io::nan", deserialize_with = "crate::io::nan_if_null")]
     pub albedo_vs_exact: f64,
-    /// The largest integration-error bound of the GPU albedos.
+    /// The largest integration-error bound of the GPU albedos (not read back).
+    #[serde(skip_deserializing)]
     pub albedo_error_bound: f64,
     /// What the model was measured against where not its own exact model: a spec (its exact f64 model) or
     /// another `.brdf` file (evaluated on the GPU).

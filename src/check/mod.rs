@@ -28,7 +28,7 @@ use crate::inspect::InspectOptions;
 use crate::brdf::spec::THESIS_MODELS;
 use crate::gpu::Gpu;
 use crate::model::Model;
-use crate::results as reports;
+use crate::export::json;
 use crate::shaders::Shaders;
 use anyhow::{anyhow, bail, Result};
 use std::path::PathBuf;
@@ -139,7 +139,7 @@ fn run_measured(options: &CheckOptions, measure: impl FnOnce(Vec<Model>, u32) ->
         _ => Outcome { text: format!("{}\n\n{}", new.inspect.summary(), new.inspect.markdown()), exit: 0 },
     };
     if let Some(path) = &options.save {
-        reports::write_report(path, reports::Kind::Baseline, &new)?;
+        json::write_report(path, json::Kind::Baseline, &new)?;
         crate::messages::progress(format!("check: baseline saved to {}", path.display()));
     }
     Ok(outcome)
@@ -150,7 +150,7 @@ mod tests {
     use super::*;
     use crate::inspect::timing::TimingRun;
     use crate::schema::{InspectReport, Row};
-    use crate::results;
+    use crate::export::json;
     use std::collections::BTreeMap;
     use std::path::Path;
 
@@ -306,7 +306,7 @@ mod tests {
         assert!(e.contains("format `brdfprof-check-baseline/0`"), "{e}");
         let good = baseline(vec![row("ggx", &[("spirv/total", 1.0)])], None, "cpu");
         let p = dir.path().join("good.json");
-        results::write_json(&p, &good).unwrap();
+        json::write_json(&p, &good).unwrap();
         assert_eq!(load(&p).unwrap().inspect.rows, good.inspect.rows);
         let e = load(&write("bad.json", &std::fs::read_to_string(&p).unwrap().replace("\"spirv/total\": 1.0", "\"spirv/total\": \"x\""))).unwrap_err().to_string();
         assert!(e.contains("corrupt") && e.contains("bad.json"), "{e}");

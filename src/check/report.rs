@@ -4,7 +4,7 @@ use super::baseline::Baseline;
 use super::compare::{rel_change, Change, Comparison, GroupStatus};
 use super::thresholds::{ALPHA, MIN_TIMING_ROUNDS, TIMING_KEY};
 use crate::schema::format_value;
-use crate::results::{self, Table};
+use crate::export::markdown::{self, Table};
 use std::path::Path;
 
 fn percent(rel: f64) -> String {
@@ -25,10 +25,10 @@ impl Comparison {
             format!(
                 "{} {TIMING_KEY}: {} -> {} ({}, p = {}, threshold {})",
                 t.model,
-                results::sig(t.old_median, 4),
-                results::sig(t.new_median, 4),
+                markdown::sig(t.old_median, 4),
+                markdown::sig(t.new_median, 4),
                 percent(t.change),
-                results::sig(t.p.unwrap_or(1.0), 2),
+                markdown::sig(t.p.unwrap_or(1.0), 2),
                 percent(t.threshold)
             )
         });
@@ -160,10 +160,10 @@ impl Comparison {
         for c in &self.timing {
             t.row([
                 c.model.clone(),
-                format!("{} [{}]", results::sig(c.old_median, 4), c.n_old),
-                format!("{} [{}]", results::sig(c.new_median, 4), c.n_new),
+                format!("{} [{}]", markdown::sig(c.old_median, 4), c.n_old),
+                format!("{} [{}]", markdown::sig(c.new_median, 4), c.n_new),
                 percent(c.change),
-                c.p.map_or("-".into(), |p| results::sig(p, 2)),
+                c.p.map_or("-".into(), |p| markdown::sig(p, 2)),
                 percent(c.threshold),
                 c.verdict().into(),
             ]);

@@ -3,7 +3,7 @@
 
 use super::check_output;
 use anyhow::Result;
-use brdfprof::{compare, io, results};
+use brdfprof::{compare, io, export::json};
 use clap::Args;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -40,7 +40,7 @@ pub fn compare(args: &CompareArgs) -> Result<ExitCode> {
     let chart = args.chart.clone().unwrap_or_else(|| PathBuf::from("results/compare.png"));
     let files: Vec<String> = args.files.iter().map(|f| f.display().to_string()).collect();
     let text = format!("# brdfprof compare\n\n{}\n\n{}", files.join(", "), table.markdown());
-    results::write_report(&json, results::Kind::Compare, &table)?;
+    json::write_report(&json, json::Kind::Compare, &table)?;
     io::write_output(&markdown, text.as_bytes())?;
     table.chart(&chart)?;
     print!("{text}");

@@ -1,7 +1,7 @@
 //! `brdfprof devices`: the Vulkan devices, or with `--targets` the compile-only targets.
 
 use anyhow::Result;
-use brdfprof::{gpu, results};
+use brdfprof::{gpu, export::markdown};
 use clap::Args;
 use std::process::ExitCode;
 
@@ -19,7 +19,7 @@ fn targets_table() -> String {
          needed; nothing executes). Commands that compile take them: inspect, check, sweep --cost-device, profile --scene --cost-device.\n\n");
     for v in brdfprof::targets::VENDORS {
         let status = v.status().unwrap_or_else(|e| format!("{e:#}"));
-        let mut t = results::Table::new(["--device", "architecture", "products", "compiler", &format!("in {}:all", v.prefix())]);
+        let mut t = markdown::Table::new(["--device", "architecture", "products", "compiler", &format!("in {}:all", v.prefix())]);
         for f in v.families() {
             t.row([format!("{}:{}", v.prefix(), f.name), f.architecture.into(), f.products.into(), f.detail, if f.default { "yes".into() } else { String::new() }]);
         }
@@ -35,7 +35,7 @@ pub fn devices(args: &DevicesArgs) -> Result<ExitCode> {
     }
     let infos = gpu::list_devices()?;
     let default = gpu::select_device(&infos, None).ok();
-    let mut t = results::Table::new([
+    let mut t = markdown::Table::new([
         "index", "name", "type", "driver", "API", "timestampPeriod ns", "ts bits", "maxStorageBufferRange", "maxWorkGroupCount.x", "fp16", "fp64", "exec. stats",
     ]);
     for d in &infos {

@@ -9,7 +9,7 @@ use brdfprof::brdf::Sample;
 use brdfprof::brdf::ModelSpec;
 use brdfprof::diff::{self, DiffReport, DiffSet, Evaluated};
 use brdfprof::model::Model;
-use brdfprof::{io, kernels, results};
+use brdfprof::{io, kernels, export::json};
 use clap::Args;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -134,7 +134,7 @@ pub fn diff(args: &DiffArgs) -> Result<ExitCode> {
     for (flag, path) in &outs {
         match *flag {
             "--csv" => io::write_output(path, diff::csv(&inputs.samples, va, vb).as_bytes())?,
-            "--json" => results::write_json(path, &result)?,
+            "--json" => json::write_json(path, &result)?,
             _ => {}
         }
     }
@@ -177,7 +177,7 @@ fn diff_set(args: &DiffArgs, reference: &Model, models: &[Model]) -> Result<Exit
     for (flag, path) in &outs {
         match *flag {
             "--csv" => io::write_output(path, diff::csv_set(&inputs.samples, &rounded, &values).as_bytes())?,
-            "--json" => results::write_json(path, &result)?,
+            "--json" => json::write_json(path, &result)?,
             _ => {}
         }
     }

@@ -7,7 +7,7 @@ use brdfprof::devices;
 use anyhow::{bail, Result};
 use brdfprof::brdf::THESIS_MODELS;
 use brdfprof::inspect::{self, InspectOptions};
-use brdfprof::{io, results};
+use brdfprof::{io, export::json};
 use clap::Args;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -112,7 +112,7 @@ pub fn inspect(args: &InspectArgs) -> Result<ExitCode> {
     let json = args.json.clone().unwrap_or_else(|| PathBuf::from(format!("results/{stem}.json")));
     let markdown = args.markdown.clone().unwrap_or_else(|| PathBuf::from(format!("results/{stem}.md")));
     let value = result.json_value()?;
-    results::write_json(&json, &value)?;
+    json::write_json(&json, &value)?;
     let input = just_measured(&json, &value)?;
     if args.html.html.is_some() {
         // The lobes and spheres are drawn on the default local device (the inspected ones may only compile).

@@ -3,11 +3,11 @@
 use anyhow::Result;
 use brdfprof::brdf::terms::{ParamKind, PARAMS};
 use brdfprof::brdf::{spec, Metal, ModelSpec, D, F, Vis};
-use brdfprof::results;
+use brdfprof::export::markdown;
 use std::process::ExitCode;
 
 fn section(out: &mut String, title: &str, headers: &[&str], rows: Vec<Vec<String>>) {
-    let mut t = results::Table::new(headers.iter().copied());
+    let mut t = markdown::Table::new(headers.iter().copied());
     for r in rows {
         t.row(r);
     }

@@ -5,7 +5,7 @@ use super::args::{device_name, DeviceArgs, HtmlArg, ModelArgs, TimingArgs};
 use super::{check_output, cost_targets, fresh_compilation, just_measured, on_device};
 use anyhow::{bail, Result};
 use brdfprof::brdf::THESIS_MODELS;
-use brdfprof::{io, profile, results, scene};
+use brdfprof::{io, profile, export::json, scene};
 use clap::Args;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -67,7 +67,7 @@ pub fn profile(args: &ProfileArgs) -> Result<ExitCode> {
     let options = args.timing.options(args.model.models(&THESIS_MODELS)?, size, args.reps, args.budget, args.target_ci)?;
     let (gpu, result) = on_device(&args.device, |gpu, progress| profile::run(gpu, &options, progress))?;
     let path = args.json.clone().unwrap_or_else(|| PathBuf::from(format!("{}/profile-{}.json", super::DEFAULT_OUT, brdfprof::targets::device_slug(&gpu.info))));
-    results::write_report(&path, results::Kind::Profile, &result)?;
+    json::write_report(&path, json::Kind::Profile, &result)?;
     args.html.write(&[just_measured(&path, &result)?], Some(&gpu))?;
     println!("{}\n", result.summary());
     print!("{}{}", result.table().markdown(), result.placement_notes());
@@ -106,7 +106,7 @@ fn profile_scene(args: &ProfileArgs, path: &std::path::Path) -> Result<ExitCode>
     let options = scene::profile::SceneProfileOptions { protocol: base.protocol, target_rel_ci: args.target_ci, max_chunk: None, instances: base.instances, cost_targets, validate: args.device.validation(), isa_dir: args.isa.clone() };
     let (gpu, result) = on_device(&args.device, |gpu, progress| scene::profile::run(gpu, &scene, &options, progress))?;
     let path = args.json.clone().unwrap_or_else(|| PathBuf::from(format!("{}/scene-{}-{}.json", super::DEFAULT_OUT, scene.name(), brdfprof::targets::device_slug(&gpu.info))));
-    results::write_report(&path, results::Kind::SceneProfile, &result)?;
+    json::write_report(&path, json::Kind::SceneProfile, &result)?;
     println!("{}\n", result.summary());
     print!("{}", result.markdown());
     println!("\nJSON: {}", path.display());

@@ -1,15 +1,15 @@
 //! The diff picture: for each of a few roughness values a lit sphere of A, one of B and a heat map of B's
 //! relative difference against A (largest channel, one scale for every map, its colour bar at the right), and
-//! below them the polar lobe plot of both models (`scene::render::lobe_curves`). Everything is evaluated on
+//! below them the polar lobe plot of both models (`kernels::lobe_curves`). Everything is evaluated on
 //! the device by the models' eval kernels.
 
 use crate::accuracy::rel_err;
 use crate::brdf::Sample;
-use crate::chart;
+use crate::export::png;
 use crate::gpu::Gpu;
 use crate::kernels::{self, RunLimits};
 use crate::model::Model;
-use crate::scene::render::{blit, colour_bar, draw_lobes, label, lobe_curves, tone_map, viridis, LOBE_PANEL};
+use crate::export::raster::{blit, colour_bar, draw_lobes, label, tone_map, viridis, LOBE_PANEL};
 use anyhow::Result;
 use glam::DVec3;
 use plotters::prelude::*;
@@ -60,7 +60,7 @@ fn radiance(gpu: &Gpu, model: &Model, pixels: &[Option<Sample>]) -> Result<Vec<[
 /// Writes the picture of B against A to `path`.
 pub fn write(gpu: &Gpu, path: &Path, a: &Model, b: &Model) -> Result<()> {
     let (w, h, px) = pixels(gpu, a, b)?;
-    chart::write_png(path, w, h, px)
+    png::write_png(path, w, h, px)
 }
 
 /// The picture of B against A: (width, height, 8-bit RGB pixels).
@@ -76,11 +76,11 @@ pub fn pixels(gpu: &Gpu, a: &Model, b: &Model) -> Result<(u32, u32, Vec<u8>)> {
         diffs.push(ra.iter().zip(&rb).zip(&pixels).map(|((x, y), p)| p.map(|_| rel(x, y))).collect());
     }
     let scale = diffs.iter().flatten().flatten().copied().fold(0.0f32, |m, x| if x.is_finite() { m.max(x) } else { m });
-    let panels = lobe_curves(gpu, &[a.clone(), b.clone()], &ROUGHNESS)?;
+    let panels = kernels::lobe_curves(gpu, &[a.clone(), b.clone()], &ROUGHNESS)?;
     let names = [a.label(), b.label()];
     let width = LOBE_PANEL.0 * ROUGHNESS.len() as u32;
     let size = (width + 70, TOP + LOBE_PANEL.1 + 40);
-    let px = chart::pixels(size.0, size.1, |root| {
+    let px = png::pixels(size.0, size.1, |root| {
         let title = format!("B = {} against A = {}: lit spheres and |B - A| / max(|A|, 1e-3) (largest channel)", names[1], names[0]);
         label(root, &title, 10, 8, 18, BLACK)?;
         for (g, r) in ROUGHNESS.iter().enumerate() {

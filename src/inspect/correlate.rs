@@ -2,7 +2,7 @@
 //! a `brdfprof profile` JSON report (ns per evaluation) model by model, and gives Spearman's rank correlation
 //! between them, gross and net of the memory-only kernel.
 
-use crate::profile::view::ProfileView;
+use crate::profile::ProfileReport as ProfileView;
 use crate::schema::correlation::{CostRow, Correlation};
 use crate::schema::InspectReport;
 use crate::stats;

@@ -11,6 +11,23 @@ use std::io::Write;
 use std::os::unix::ffi::OsStrExt;
 use std::path::{Path, PathBuf};
 
+/// Reading back a report's figures: JSON writes a NaN or Inf as null, which would fail an f64 field, so a
+/// figure read with `#[serde(default = "crate::io::nan", deserialize_with = "crate::io::nan_if_null")]` is NaN
+/// where the report wrote null or (an older report) nothing, and `finite` tells the two kinds apart again.
+pub fn nan_if_null<'de, D: serde::Deserializer<'de>>(d: D) -> std::result::Result<f64, D::Error> {
+    Ok(<Option<f64> as serde::Deserialize>::deserialize(d)?.unwrap_or(f64::NAN))
+}
+
+/// What a figure missing from a report reads as (see `nan_if_null`).
+pub fn nan() -> f64 {
+    f64::NAN
+}
+
+/// A figure as read back: None where the report wrote null (NaN or Inf) or nothing.
+pub fn finite(x: f64) -> Option<f64> {
+    x.is_finite().then_some(x)
+}
+
 /// The `eval` output: header `r,g,b`, one row per sample (shortest text that reads back to the same f32).
 pub fn format_rgb_csv(rows: &[[f32; 3]]) -> String {
     let mut out = String::with_capacity(rows.len() * 32 + 8);

@@ -9,7 +9,7 @@ pub mod naga_info;
 use crate::gpu::Gpu;
 use crate::kernels::shade::{self, shade_kernel, steady_block, GBufferFormat};
 use crate::model::{Model, ModelKernel, BASELINE_LABEL};
-use crate::results::Provenance;
+use crate::export::json::Provenance;
 use crate::schema::callgrind::CallgrindRun;
 use crate::schema::{driver, InspectReport, Row, FOLDED_NOTE, HASH_NOTE, SECTIONS};
 use crate::shaders::Shaders;

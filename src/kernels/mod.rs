@@ -255,3 +255,31 @@ pub fn reduce_albedo(gpu: &Gpu, kernel: &Kernel, cells: usize, bind: impl Fn(u64
     }
     Ok(results)
 }
+
+/// View angle of the lobe plots, from the normal.
+pub const LOBE_VIEW_DEG: f64 = 45.0;
+
+/// One panel of the lobe plot: its roughness and, per model, (theta_l, f_s NoL) in the plane of incidence.
+pub type LobePanel = (f32, Vec<Vec<(f64, f64)>>);
+
+/// The lobe plot's curves, evaluated on the device: per roughness, per model, f_s NoL (red channel) at every
+/// half degree of the plane of incidence, view at 45 degrees, F0 = 1.
+pub fn lobe_curves(gpu: &Gpu, models: &[Model], roughness: &[f32]) -> Result<Vec<LobePanel>> {
+    let theta_v = LOBE_VIEW_DEG.to_radians();
+    let v = [-(theta_v.sin()) as f32, 0.0, theta_v.cos() as f32];
+    let angles: Vec<f64> = (0..=358).map(|i| (-89.5 + i as f64 * 0.5).to_radians()).collect();
+    let mut panels = Vec::new();
+    for &r in roughness {
+        let samples: Vec<Sample> = angles
+            .iter()
+            .map(|t| Sample { n: [0.0, 0.0, 1.0], v, l: [t.sin() as f32, 0.0, t.cos() as f32], roughness: r, f0: [1.0; 3] })
+            .collect();
+        let mut curves = Vec::new();
+        for m in models {
+            let fs = eval(gpu, m, &samples, RunLimits::default())?;
+            curves.push(angles.iter().zip(&fs).map(|(t, f)| (*t, f[0] as f64 * t.cos())).collect::<Vec<_>>());
+        }
+        panels.push((r, curves));
+    }
+    Ok(panels)
+}

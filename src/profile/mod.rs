@@ -4,12 +4,13 @@
 
 pub mod gbuffer;
 pub mod protocol;
-pub mod view;
 pub mod workload;
 
 use crate::gpu::Gpu;
 use crate::model::Model;
-use crate::results::{self, Provenance, Table};
+use crate::host::HostCpu;
+use crate::export::json::Provenance;
+use crate::export::markdown::{self, Table};
 use crate::shaders::Shaders;
 use crate::stats::{self, Estimate};
 use anyhow::Result;
@@ -17,7 +18,7 @@ use indicatif::ProgressBar;
 use gbuffer::GBufferFormat;
 use protocol::{ProtocolOptions, RawTimes};
 use workload::{Variant, Workload};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 pub use crate::brdf::spec::REFERENCE_MODEL;
 /// The harness share above which `harness_warning` speaks.
@@ -45,16 +46,20 @@ pub struct ProfileOptions {
     pub glsl: Option<std::path::PathBuf>,
 }
 
-/// One row of the table.
-#[derive(Clone, Debug, Serialize)]
+/// One row of the table. Reports are read back (`report`, `compare`, `inspect --profile`) as these same types:
+/// what no reader shows is not read (`skip_deserializing`, its default), so an older report's shape of it never
+/// matters.
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Row {
     /// The spec's name (a preset name where one matches), or "baseline".
     pub model: String,
     pub spec: Option<String>,
     /// Lights per pixel of this row's workload, and the evaluations one run of it makes.
     pub lights: u32,
+    #[serde(skip_deserializing)]
     pub evaluations_per_dispatch: u64,
     pub ns_per_eval: Estimate,
+    #[serde(skip_deserializing)]
     pub evals_per_second: f64,
     /// Cost / reference cost, per round.
     pub vs_reference: Estimate,
@@ -66,42 +71,66 @@ pub struct Row {
     /// decode, light loop, stores) takes.
     pub harness_share: Option<Estimate>,
     /// Median over rounds of slowest / fastest instance: how much JIT code placement alone moved this kernel.
+    #[serde(skip_deserializing)]
     pub instance_spread: f64,
 }
 
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct WorkloadSize {
     pub width: u32,
     pub height: u32,
+    #[serde(skip_deserializing)]
     pub pixels: u64,
     /// Every light count measured (each row says which it is).
     pub lights: Vec<u32>,
     /// How the G-buffer is stored, and the bytes per pixel the kernel reads and writes.
+    #[serde(skip_deserializing, default = "unread_gbuffer")]
     pub gbuffer: GBufferFormat,
+    #[serde(default)]
     pub bytes_per_pixel: u64,
+    #[serde(skip_deserializing)]
     pub output_bytes_per_pixel: u64,
     /// Lights per dispatch: the profile's lights run as blocks of at most this many (`workload::light_blocks`).
+    #[serde(skip_deserializing)]
     pub light_block: u32,
+    #[serde(skip_deserializing)]
     pub chunks: usize,
 }
 
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct ProfileReport {
     pub provenance: Provenance,
     pub reference: String,
     pub workload: WorkloadSize,
     pub rounds: usize,
+    #[serde(skip_deserializing)]
     pub reps_per_round: usize,
     /// Pipelines per kernel (see `ProfileOptions::instances`).
+    #[serde(skip_deserializing)]
     pub instances: usize,
     pub confidence_level: f64,
     pub rows: Vec<Row>,
     /// Labels of the variants, indexing `raw.ns`.
+    #[serde(skip_deserializing)]
     pub labels: Vec<String>,
     /// Model (and "baseline") -> SHA-256 of its kernel (`workload::kernel_hash`): `brdfprof compare` joins
     /// reports of the same kernels only.
+    #[serde(default)]
     pub kernel_sha256: std::collections::BTreeMap<String, String>,
+    #[serde(skip_deserializing)]
     pub raw: RawTimes,
+}
+
+/// The G-buffer format a read-back report's workload is given (no reader shows it).
+fn unread_gbuffer() -> GBufferFormat {
+    GBufferFormat::Packed
+}
+
+impl ProfileReport {
+    /// The rows of models (not the memory-only kernel), in report order.
+    pub fn model_rows(&self) -> impl Iterator<Item = &Row> {
+        self.rows.iter().filter(|r| r.spec.is_some())
+    }
 }
 
 /// Per-round medians of a variant's dispatch times, per evaluation.
@@ -248,11 +277,11 @@ impl ProfileReport {
         for row in &self.rows {
             let mut cells = vec![
                 row.model.clone(),
-                results::estimate(&row.ns_per_eval, 3),
-                results::sig(row.evals_per_second / 1e6, 3),
-                results::estimate(&row.vs_reference, 3),
-                row.net_ns_per_eval.as_ref().map_or("-".into(), |e| results::estimate(e, 3)),
-                row.net_vs_reference.as_ref().map_or("-".into(), |e| results::estimate(e, 3)),
+                markdown::estimate(&row.ns_per_eval, 3),
+                markdown::sig(row.evals_per_second / 1e6, 3),
+                markdown::estimate(&row.vs_reference, 3),
+                row.net_ns_per_eval.as_ref().map_or("-".into(), |e| markdown::estimate(e, 3)),
+                row.net_vs_reference.as_ref().map_or("-".into(), |e| markdown::estimate(e, 3)),
                 row.harness_share.as_ref().map_or("-".into(), |e| format!("{:.0}%", 100.0 * e.median)),
             ];
             if several {
@@ -283,7 +312,7 @@ impl ProfileReport {
             let mut cells = vec![if name == workload::BASELINE_LABEL { format!("{name} (gross)") } else { format!("{name} (net)") }];
             for &l in counts {
                 let row = self.rows.iter().find(|r| r.model == name && r.lights == l);
-                cells.push(row.map_or("-".into(), |r| results::estimate(r.net_ns_per_eval.as_ref().unwrap_or(&r.ns_per_eval), 3)));
+                cells.push(row.map_or("-".into(), |r| markdown::estimate(r.net_ns_per_eval.as_ref().unwrap_or(&r.ns_per_eval), 3)));
             }
             t.row(cells);
         }
@@ -330,8 +359,8 @@ impl ProfileReport {
             self.provenance.device.name,
             self.provenance.device.driver_name,
             self.provenance.device.driver_info,
-            self.provenance.cpu.describe(),
-            self.provenance.cpu.vector_width(),
+            self.provenance.cpu.as_ref().map_or_else(String::new, HostCpu::describe),
+            self.provenance.cpu.as_ref().map_or("", HostCpu::vector_width),
             self.provenance.host_threads,
             w.width,
             w.height,
@@ -347,6 +376,6 @@ impl ProfileReport {
                 protocol::Stop::Budget => "--budget spent",
                 protocol::Stop::MaxRounds => "--max-rounds reached",
             }
-        ) + &results::front_ends_line(&self.provenance.front_ends)
+        ) + &markdown::front_ends_line(&self.provenance.front_ends)
     }
 }

@@ -4,11 +4,12 @@
 
 use super::sections::num_cell;
 use super::{file_label, Input, Loaded};
-use crate::diff::view::{DiffSetView, DiffView, WorstView};
+use crate::diff::{DiffReport, DiffSet, WorstRow};
 use crate::gpu::Gpu;
-use crate::page::{esc, img, png_data_uri, Cell, HtmlTable};
+use crate::io::finite;
+use crate::export::html::{esc, img, png_data_uri, Cell, HtmlTable};
 use crate::model::Model;
-use crate::results::sig;
+use crate::export::markdown::sig;
 use anyhow::Result;
 use std::fmt::Write;
 
@@ -22,25 +23,32 @@ fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
-fn worst_row(w: &WorstView) -> Vec<Cell> {
+/// An f32 of the report as the page shows it: the f64 its JSON text reads as (None where it wrote null), so
+/// that the page shows the JSON's numbers, not the f32's binary expansion.
+fn as_written(x: f32) -> Option<f64> {
+    serde_json::to_string(&x).ok().and_then(|text| serde_json::from_str(&text).ok())
+}
+
+fn worst_row(w: &WorstRow) -> Vec<Cell> {
     let value = |x: Option<f64>| x.map_or("NaN/Inf".into(), |x| sig(x, 4));
     let c = ["r", "g", "b"].iter().position(|c| *c == w.channel).unwrap_or(0);
     let s = &w.sample;
+    let v3 = |v: [f32; 3]| v.map(|x| as_written(x).unwrap_or(f64::NAN));
     vec![
         Cell::num(w.index as f64, w.index.to_string()),
         w.line.map_or(Cell::text("-"), |l| Cell::num(l as f64, l.to_string())),
-        num_cell(Some(dot(s.n, s.v))),
-        num_cell(Some(dot(s.n, s.l))),
-        num_cell(Some(s.roughness)),
-        Cell::text(s.f0.map(|x| sig(x, 3)).join(", ")),
+        num_cell(Some(dot(v3(s.n), v3(s.v)))),
+        num_cell(Some(dot(v3(s.n), v3(s.l)))),
+        num_cell(as_written(s.roughness)),
+        Cell::text(v3(s.f0).map(|x| sig(x, 3)).join(", ")),
         Cell::text(w.channel.clone()),
-        Cell::text(format!("{} / {}", value(w.a[c]), value(w.b[c]))),
-        num_cell(w.rel),
+        Cell::text(format!("{} / {}", value(as_written(w.a[c])), value(as_written(w.b[c])))),
+        num_cell(finite(w.rel)),
     ]
 }
 
 /// The histogram as a table: one row per bin, its lower edge and count.
-fn histogram(i: usize, d: &DiffView) -> String {
+fn histogram(i: usize, d: &DiffReport) -> String {
     let mut t = HtmlTable::new(&[("from", "rel from"), ("to", "to"), ("rows", "rows")]);
     let h = &d.histogram;
     for (k, (&edge, &count)) in h.edges.iter().zip(&h.counts).enumerate() {
@@ -51,7 +59,7 @@ fn histogram(i: usize, d: &DiffView) -> String {
 }
 
 /// The picture of B against A drawn on `gpu` (a PNG data: URI), or why not.
-fn picture(d: &DiffView, gpu: Option<&Gpu>) -> Result<String> {
+fn picture(d: &DiffReport, gpu: Option<&Gpu>) -> Result<String> {
     let Some(gpu) = gpu else { return Ok("<p class=\"note\">Picture not drawn: the report was built without a device (--no-gpu).</p>".into()) };
     let (a, b) = (Model::parse(&d.a.canonical)?, Model::parse(&d.b.canonical)?);
     let (w, h, px) = crate::diff::picture::pixels(gpu, &a, &b)?;
@@ -59,7 +67,7 @@ fn picture(d: &DiffView, gpu: Option<&Gpu>) -> Result<String> {
     Ok(format!("<figure>{}<figcaption>{}</figcaption></figure>", img(&png_data_uri(w, h, &px)?, w, h, 1, &alt), esc(&alt)))
 }
 
-fn diff_html(i: usize, d: &DiffView, path: &str, gpu: Option<&Gpu>) -> Result<String> {
+fn diff_html(i: usize, d: &DiffReport, path: &str, gpu: Option<&Gpu>) -> Result<String> {
     let mut s = String::new();
     let verdict = match (d.tolerance, d.within_tolerance) {
         (Some(t), true) => format!("within --tolerance {t}"),
@@ -73,7 +81,7 @@ fn diff_html(i: usize, d: &DiffView, path: &str, gpu: Option<&Gpu>) -> Result<St
     );
     let mut t = HtmlTable::new(&CHANNEL_COLUMNS);
     for c in &d.difference.channels {
-        t.row(format!("diff{i}/{}", c.channel), vec![Cell::text(c.channel.clone()), num_cell(c.max_rel), num_cell(c.rms_rel), num_cell(c.max_abs), num_cell(c.rms_abs), Cell::num(c.mismatched_nonfinite as f64, c.mismatched_nonfinite.to_string())]);
+        t.row(format!("diff{i}/{}", c.channel), vec![Cell::text(c.channel.clone()), num_cell(finite(c.max_rel)), num_cell(finite(c.rms_rel)), num_cell(finite(c.max_abs)), num_cell(finite(c.rms_abs)), Cell::num(c.mismatched_nonfinite as f64, c.mismatched_nonfinite.to_string())]);
     }
     s += &t.html();
     let mut w = HtmlTable::new(&WORST_COLUMNS);
@@ -88,17 +96,17 @@ const SET_COLUMNS: [(&str, &str); 5] = [("model", "model"), ("max_rel", "max rel
 
 /// `diff --reference`: one table of every model against the reference (rows keyed `diffset<i>/<model>`),
 /// then each model's own section.
-fn diff_set_html(i: usize, d: &DiffSetView, path: &str, gpu: Option<&Gpu>) -> Result<String> {
+fn diff_set_html(i: usize, d: &DiffSet, path: &str, gpu: Option<&Gpu>) -> Result<String> {
     let mut t = HtmlTable::new(&SET_COLUMNS);
     for x in &d.diffs {
-        let rms = x.difference.channels.iter().filter_map(|c| c.rms_rel).fold(None, |m: Option<f64>, r| Some(m.map_or(r, |m| m.max(r))));
+        let rms = x.difference.channels.iter().filter_map(|c| finite(c.rms_rel)).fold(None, |m: Option<f64>, r| Some(m.map_or(r, |m| m.max(r))));
         let one_side: usize = x.difference.channels.iter().map(|c| c.mismatched_nonfinite).sum();
         let verdict = match d.tolerance {
             Some(t) if x.within_tolerance => format!("within {t}"),
             Some(t) => format!("beyond {t}"),
             None => "-".into(),
         };
-        t.row(format!("diffset{i}/{}", x.b.name), vec![Cell::text(x.b.name.clone()), num_cell(x.difference.max_rel), num_cell(rms), Cell::num(one_side as f64, one_side.to_string()), Cell::text(verdict)]);
+        t.row(format!("diffset{i}/{}", x.b.name), vec![Cell::text(x.b.name.clone()), num_cell(finite(x.difference.max_rel)), num_cell(rms), Cell::num(one_side as f64, one_side.to_string()), Cell::text(verdict)]);
     }
     let mut s = format!(
         "<h3>{} models against <code>{}</code> ({path})</h3><p>{} rows: {}; on {}.</p>{}",

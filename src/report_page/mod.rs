@@ -1,9 +1,10 @@
 //! One HTML report from saved results (`brdfprof report`, and `--html` on the measuring commands): provenance,
 //! cost tables with their confidence intervals, the cost table across devices with rank correlations, the
 //! sweep's accuracy-against-cost chart, per-model lobes, lit spheres and directional albedo, and stability
-//! heat maps. Reports are read back through the typed views their writers own (`profile::view`,
-//! `sweep::view`, `stability::view`, `inspect`). Lobes, spheres and albedo are evaluated at report time by the
-//! GPU kernels on the device given (docs/report.md says why).
+//! heat maps. Reports are read back as the very types their commands write (`ProfileReport`, `SweepReport`,
+//! `StabilityReport`, `InspectReport`, `DiffReport`), so a field cannot be written one way and read another.
+//! Lobes, spheres and albedo are evaluated at report time by the GPU kernels on the device given
+//! (docs/report.md says why).
 
 pub mod diff;
 pub mod sections;
@@ -12,11 +13,11 @@ pub mod summary;
 
 use crate::compare::CostTable;
 use crate::gpu::Gpu;
-use crate::page::{self, Page};
+use crate::export::html::{self, Page};
 use crate::schema::InspectReport;
-use crate::profile::view::ProfileView;
-use crate::stability::view::StabilityView;
-use crate::sweep::view::SweepView;
+use crate::profile::ProfileReport;
+use crate::stability::StabilityReport;
+use crate::sweep::SweepReport;
 use anyhow::{anyhow, bail, Result};
 use serde::de::{DeserializeOwned, IgnoredAny};
 use serde::Deserialize;
@@ -25,17 +26,17 @@ use std::path::{Path, PathBuf};
 
 /// What a results file holds.
 pub enum Loaded {
-    Profile(Box<ProfileView>),
-    Sweep(Box<SweepView>),
-    Stability(Box<StabilityView>),
+    Profile(Box<ProfileReport>),
+    Sweep(Box<SweepReport>),
+    Stability(Box<StabilityReport>),
     /// One inspect report per device, and with several devices the inspect's own cost table.
     Inspect(Vec<InspectReport>, Option<CostTable>),
     /// A `brdfprof compare` table.
     Costs(CostTable),
     /// A `brdfprof diff` result.
-    Diff(Box<crate::diff::view::DiffView>),
+    Diff(Box<crate::diff::DiffReport>),
     /// A `brdfprof diff --reference` result: every model against one reference.
-    DiffSet(Box<crate::diff::view::DiffSetView>),
+    DiffSet(Box<crate::diff::DiffSet>),
 }
 
 impl Loaded {
@@ -86,7 +87,7 @@ pub fn load(path: &Path) -> Result<Input> {
     from_json(path, &text)
 }
 
-/// A report just measured, read back through its view as a saved one would be (`--html`): what the page
+/// A report just measured, read back through its JSON as a saved one would be (`--html`): what the page
 /// shows is what the JSON says.
 pub fn from_report(label: &Path, report: &impl serde::Serialize) -> Result<Input> {
     from_json(label, &serde_json::to_string(report)?)
@@ -96,7 +97,7 @@ pub fn from_report(label: &Path, report: &impl serde::Serialize) -> Result<Input
 pub fn from_json(path: &Path, text: &str) -> Result<Input> {
     let text = text.to_string();
     let probe: Probe = serde_json::from_str(&text).map_err(|e| anyhow!("{}: not a JSON object: line {}, column {}: {e}", path.display(), e.line(), e.column()))?;
-    use crate::results::Kind;
+    use crate::export::json::Kind;
     // A report that names its kind is read as that kind; older ones, without `kind`, by their keys.
     let named = match probe.kind.as_deref() {
         None | Some("diff") | Some(crate::diff::SET_KIND) => None,
@@ -109,7 +110,7 @@ pub fn from_json(path: &Path, text: &str) -> Result<Input> {
             Kind::Stability => Loaded::Stability(parse(path, &text, "stability")?),
             Kind::Inspect => Loaded::Inspect(vec![parse(path, &text, "inspect")?], None),
             Kind::InspectDevices => {
-                let m: crate::devices::MultiView = parse(path, &text, "inspect (several devices)")?;
+                let m: crate::devices::MultiReport = parse(path, &text, "inspect (several devices)")?;
                 Loaded::Inspect(m.reports, Some(m.costs))
             }
             Kind::Compare => Loaded::Costs(parse(path, &text, "compare")?),
@@ -126,7 +127,7 @@ pub fn from_json(path: &Path, text: &str) -> Result<Input> {
     } else if probe.grid_points.is_some() {
         Loaded::Stability(parse(path, &text, "stability")?)
     } else if probe.reports.is_some() {
-        let m: crate::devices::MultiView = parse(path, &text, "inspect (several devices)")?;
+        let m: crate::devices::MultiReport = parse(path, &text, "inspect (several devices)")?;
         Loaded::Inspect(m.reports, Some(m.costs))
     } else if probe.kernels.is_some() {
         Loaded::Inspect(vec![parse(path, &text, "inspect")?], None)
@@ -211,7 +212,7 @@ pub fn utc(unix: u64) -> String {
 
 /// A file's name for headings.
 pub fn file_label(path: &Path) -> String {
-    page::esc(&path.display().to_string())
+    html::esc(&path.display().to_string())
 }
 
 #[cfg(test)]

@@ -5,13 +5,15 @@
 
 use super::{file_label, utc, Input, Loaded};
 use crate::compare::CostTable;
-use crate::page::{self, esc, Axis, Cell, HtmlTable, Point};
-use crate::profile::view::{ProfileView, RowView};
-use crate::results::sig;
-use crate::results::view::ProvenanceView;
-use crate::stability::view::{SpecView, StabilityView};
+use crate::export::html::{self, esc, Axis, Cell, HtmlTable, Point};
+use crate::profile::{ProfileReport, Row};
+use crate::export::markdown::sig;
+use crate::export::json::Provenance;
+use crate::stability::{SpecStability, StabilityReport};
 use crate::stats::Estimate;
-use crate::sweep::view::{ErrorView, SweepView};
+use crate::accuracy::ErrorStats;
+use crate::io::finite;
+use crate::sweep::SweepReport;
 use anyhow::Result;
 use std::fmt::Write;
 
@@ -46,7 +48,7 @@ fn kv(items: &[(&str, String)]) -> String {
     s + "</dl>"
 }
 
-fn provenance_items(p: &ProvenanceView) -> Vec<(&'static str, String)> {
+fn provenance_items(p: &Provenance) -> Vec<(&'static str, String)> {
     let d = &p.device;
     let cpu = p.cpu.as_ref().map_or_else(|| p.host_cpu.clone().unwrap_or_default(), |c| format!("{} (family {}, model {}, stepping {}; {})", c.model_name, c.family, c.model, c.stepping, c.features.join(" ")));
     vec![
@@ -75,7 +77,7 @@ pub fn provenance(inputs: &[Input]) -> String {
             Loaded::Stability(st) => s += &kv(&provenance_items(&st.provenance)),
             Loaded::Inspect(reports, _) => {
                 for r in reports {
-                    let p: ProvenanceView = serde_json::from_value(r.provenance.clone()).unwrap_or_default();
+                    let p: Provenance = serde_json::from_value(r.provenance.clone()).unwrap_or_default();
                     let mut items = provenance_items(&p);
                     items.push(("compilers", r.tools.iter().map(|(k, v)| format!("{k}: {v}")).collect::<Vec<_>>().join("; ")));
                     items.push(("kernels", r.kernels.clone()));
@@ -107,20 +109,20 @@ const PROFILE_COLUMNS: [(&str, &str); 7] = [
     ("harness", "harness share [CI]"),
 ];
 
-fn profile_row(r: &RowView) -> Vec<Cell> {
+fn profile_row(r: &Row) -> Vec<Cell> {
     vec![
         Cell::text(r.model.clone()),
         Cell::text(r.spec.clone().unwrap_or_else(|| "memory-only kernel".into())),
         estimate_cell(Some(&r.ns_per_eval)),
         estimate_cell(r.net_ns_per_eval.as_ref()),
-        estimate_cell(r.vs_reference.as_ref()),
+        estimate_cell(Some(&r.vs_reference)),
         estimate_cell(r.net_vs_reference.as_ref()),
         estimate_cell(r.harness_share.as_ref()),
     ]
 }
 
 /// One profile report's tables, a table per light count; rows keyed `profile<i>/<lights>/<model>`.
-pub fn profile_tables(i: usize, p: &ProfileView, path: &str) -> String {
+pub fn profile_tables(i: usize, p: &ProfileReport, path: &str) -> String {
     let w = &p.workload;
     let mut s = format!(
         "<h3>{path}</h3><p class=\"note\">{}x{} G-buffer, {} rounds, {:.0}% confidence intervals of the median over rounds; reference {}; net = minus the memory-only kernel (loads, light loop, stores).</p>",
@@ -236,8 +238,8 @@ pub fn across_devices(inputs: &[Input]) -> Option<String> {
     }
 }
 
-fn err_text(e: &ErrorView) -> String {
-    match (e.rms, e.max) {
+fn err_text(e: &ErrorStats) -> String {
+    match (finite(e.rms), finite(e.max)) {
         (Some(r), Some(m)) => format!("RMS {}, max {}", sig(r, DIGITS), sig(m, DIGITS)),
         _ => format!("infinite ({} NaN/Inf values)", e.nonfinite),
     }
@@ -245,13 +247,13 @@ fn err_text(e: &ErrorView) -> String {
 
 /// The sweep's error-against-cost chart: net ns/eval (gross where there is no net) against the RMS relative
 /// error against the exact reference, both log; the Pareto frontier emphasised.
-pub fn sweep_chart(w: &SweepView) -> String {
+pub fn sweep_chart(w: &SweepReport) -> String {
     let points: Vec<Point> = w
         .rows
         .iter()
         .map(|r| {
             let cost = r.net_ns_per_eval.as_ref().unwrap_or(&r.ns_per_eval);
-            let err = r.accuracy.vs_exact.rms.unwrap_or(f64::INFINITY);
+            let err = finite(r.accuracy.vs_exact.rms).unwrap_or(f64::INFINITY);
             let tip = format!("{}\nspec: {}\ncost: {} [{}, {}] ns/eval{}\nerror vs exact: {}", r.label, r.canonical, sig(cost.median, DIGITS), sig(cost.lo, DIGITS), sig(cost.hi, DIGITS), if r.net_ns_per_eval.is_some() { " net" } else { "" }, err_text(&r.accuracy.vs_exact));
             Point { x: cost.median, y: err, label: r.label.clone(), tip, emphasis: r.pareto }
         })
@@ -261,7 +263,7 @@ pub fn sweep_chart(w: &SweepView) -> String {
     let (Some(x), Some(y)) = (Axis::fit(points.iter().filter(drawable).map(|p| p.x), true), Axis::fit(points.iter().filter(drawable).map(|p| p.y), true)) else {
         return "<p class=\"note\">No spec has a finite, positive cost and error to draw.</p>".into();
     };
-    let mut s = page::scatter_svg(&points, x, y, "net ns per evaluation (log)", "RMS relative error vs exact (log)", page::WIDE);
+    let mut s = html::scatter_svg(&points, x, y, "net ns per evaluation (log)", "RMS relative error vs exact (log)", html::WIDE);
     let _ = write!(s, "<p class=\"note\">Red: the Pareto frontier (no spec both cheaper and more accurate). Hover a point for its spec, cost and error.{}</p>", if left_out > 0 { format!(" {left_out} spec(s) with an infinite, zero or NaN figure are not drawn.") } else { String::new() });
     s
 }
@@ -280,7 +282,7 @@ const SWEEP_COLUMNS: [(&str, &str); 10] = [
 ];
 
 /// One sweep: the chart and the table; rows keyed `sweep<i>/<label>`.
-pub fn sweep_html(i: usize, w: &SweepView, path: &str) -> String {
+pub fn sweep_html(i: usize, w: &SweepReport, path: &str) -> String {
     let mut t = HtmlTable::new(&SWEEP_COLUMNS);
     for r in &w.rows {
         let a = &r.accuracy;
@@ -292,15 +294,15 @@ pub fn sweep_html(i: usize, w: &SweepView, path: &str) -> String {
                 estimate_cell(Some(&r.ns_per_eval)),
                 estimate_cell(r.net_ns_per_eval.as_ref()),
                 estimate_cell(Some(&r.cost_vs_fastest)),
-                num_cell(a.vs_exact.rms),
-                num_cell(a.vs_exact.max),
-                num_cell(a.numerical.as_ref().and_then(|n| n.rms)),
-                num_cell(a.albedo_vs_exact),
+                num_cell(finite(a.vs_exact.rms)),
+                num_cell(finite(a.vs_exact.max)),
+                num_cell(a.numerical.as_ref().and_then(|n| finite(n.rms))),
+                num_cell(finite(a.albedo_vs_exact)),
                 Cell::text(if r.pareto { "yes" } else { "" }),
             ],
         );
     }
-    let against = w.against.as_deref().map_or(String::new(), |a| format!(" Errors against {}.", esc(a)));
+    let against = if w.against.is_empty() { String::new() } else { format!(" Errors against {}.", esc(&w.against)) };
     format!("<h3>{path}</h3><p class=\"note\">{} specs on {}; fastest {}.{against}</p>{}{}", w.rows.len(), esc(&w.sample_set), esc(&w.fastest), sweep_chart(w), t.html())
 }
 
@@ -329,7 +331,7 @@ const STABILITY_COLUMNS: [(&str, &str); 12] = [
     ("verdict", "verdict"),
 ];
 
-fn stability_row(s: &SpecView) -> Vec<Cell> {
+fn stability_row(s: &SpecStability) -> Vec<Cell> {
     vec![
         Cell::text(s.label().to_string()),
         count_cell(s.nan),
@@ -337,11 +339,8 @@ fn stability_row(s: &SpecView) -> Vec<Cell> {
         count_cell(s.negative),
         Cell::num(s.cases_out_of_tolerance.len() as f64, crate::stability::cases_cell(s.cases_out_of_tolerance.len(), s.cases_run, s.checked())),
         if s.checked() { count_cell(s.grid_out_of_tolerance) } else { Cell::text("-".to_string()) },
-        if s.checked() { num_cell(s.worst.deviation) } else { Cell::text("-".to_string()) },
-        match s.jumps_checked {
-            Some(false) => Cell::text(crate::stability::jumps_cell(s.discontinuities, false)),
-            _ => count_cell(s.discontinuities),
-        },
+        if s.checked() { num_cell(finite(s.worst.deviation)) } else { Cell::text("-".to_string()) },
+        if s.jumps_checked { count_cell(s.discontinuities) } else { Cell::text(crate::stability::jumps_cell(s.discontinuities, false)) },
         count_cell(s.model_jumps),
         num_cell(s.reciprocity),
         num_cell(s.energy.as_ref().and_then(|e| e.max_e)),
@@ -350,7 +349,7 @@ fn stability_row(s: &SpecView) -> Vec<Cell> {
 }
 
 /// The bad values of a spec over (roughness, NoV) as a heat map image: white none, viridis by log count.
-fn heat_map(s: &SpecView, triples: &[[u32; 3]]) -> Result<String> {
+fn heat_map(s: &SpecStability, triples: &[[u32; 3]]) -> Result<String> {
     use crate::stability::grid::{COSINES, ROUGHNESS};
     let (w, h) = (COSINES.len() as u32, ROUGHNESS.len() as u32);
     let max = triples.iter().map(|t| t[2]).max().unwrap_or(1).max(1) as f32;
@@ -358,18 +357,18 @@ fn heat_map(s: &SpecView, triples: &[[u32; 3]]) -> Result<String> {
     for &[r, v, n] in triples.iter().filter(|t| (t[0] as usize) < ROUGHNESS.len() && (t[1] as usize) < COSINES.len()) {
         // Roughness up the image (row 0 at the bottom), NoV to the right.
         let k = (((h - 1 - r) * w + v) * 3) as usize;
-        let c = crate::scene::render::viridis((1.0 + n as f32).ln() / (1.0 + max).ln());
+        let c = crate::export::raster::viridis((1.0 + n as f32).ln() / (1.0 + max).ln());
         rgb[k..k + 3].copy_from_slice(&c);
     }
     let total: u32 = triples.iter().map(|t| t[2]).sum();
-    let uri = page::png_data_uri(w, h, &rgb)?;
+    let uri = html::png_data_uri(w, h, &rgb)?;
     let caption = format!("{}: {total} bad values (NaN, Inf, negative) in {} cells; NoV {}..{} right, roughness {}..{} up; most in a cell {max}", s.label(), triples.len(), COSINES[0], COSINES[COSINES.len() - 1], ROUGHNESS[0], ROUGHNESS[ROUGHNESS.len() - 1]);
-    Ok(format!("<figure>{}<figcaption>{}</figcaption></figure>", page::img(&uri, w, h, 6, &caption), esc(s.label())))
+    Ok(format!("<figure>{}<figcaption>{}</figcaption></figure>", html::img(&uri, w, h, 6, &caption), esc(s.label())))
 }
 
 /// One stability report: the summary table (rows keyed `stability<i>/<spec>`) and a heat map per spec with
 /// bad values.
-pub fn stability_html(i: usize, st: &StabilityView, path: &str) -> Result<String> {
+pub fn stability_html(i: usize, st: &StabilityReport, path: &str) -> Result<String> {
     let mut t = HtmlTable::new(&STABILITY_COLUMNS);
     for s in &st.specs {
         t.row(format!("stability{i}/{}", s.spec), stability_row(s));
@@ -377,13 +376,16 @@ pub fn stability_html(i: usize, st: &StabilityView, path: &str) -> Result<String
     let failing = st.specs.iter().filter(|s| s.fails()).count();
     let mut maps = String::new();
     for s in &st.specs {
-        if let Some(cells) = s.bad_cells.as_ref().filter(|c| !c.is_empty()) {
+        if let Some(cells) = s.bad_cell_triples.as_ref().filter(|c| !c.is_empty()) {
             maps += &heat_map(s, cells)?;
         }
     }
     let mut located = String::new();
     for s in st.specs.iter().filter(|s| s.fails()) {
-        let Some(f) = &s.failures else { continue };
+        let f = &s.failures;
+        if f.is_empty() {
+            continue;
+        }
         let items: String = f.lines().iter().map(|(depth, line)| format!("<li class=\"depth{depth}\">{}</li>", esc(line))).collect();
         located += &format!("<li><b>{}</b><ul>{items}</ul></li>", esc(s.label()));
     }

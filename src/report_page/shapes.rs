@@ -6,7 +6,7 @@
 use super::{Input, Loaded};
 use crate::brdf::Sample;
 use crate::gpu::Gpu;
-use crate::page::{self, esc, Axis, Curve};
+use crate::export::html::{self, esc, Axis, Curve};
 use crate::kernels::{self, RunLimits};
 use crate::model::Model;
 use crate::stability::energy;
@@ -113,9 +113,9 @@ fn lobes_svg(values: &[[f32; 3]]) -> String {
     let peak = curves.iter().flat_map(|c| c.points.iter().map(|p| p.1)).filter(|v| v.is_finite()).fold(0.0f64, f64::max);
     let marks: Vec<(f64, String)> = INCIDENCE.iter().map(|t| (-t.to_radians(), format!("L{t}"))).collect();
     let marks: Vec<(f64, &str)> = marks.iter().map(|(a, l)| (*a, l.as_str())).collect();
-    let linear = page::polar_svg(&format!("f_s, linear (peak {})", crate::results::sig(peak, 3)), &curves, &marks, None);
-    let log = page::polar_svg(&format!("f_s, log ({LOG_DECADES} decades below the peak)"), &curves, &marks, Some(LOG_DECADES));
-    let legend: Vec<String> = INCIDENCE.iter().enumerate().map(|(i, t)| format!("<span style=\"color:{}\">&#9632; light at {t}&deg;</span>", page::colour(i))).collect();
+    let linear = html::polar_svg(&format!("f_s, linear (peak {})", crate::export::markdown::sig(peak, 3)), &curves, &marks, None);
+    let log = html::polar_svg(&format!("f_s, log ({LOG_DECADES} decades below the peak)"), &curves, &marks, Some(LOG_DECADES));
+    let legend: Vec<String> = INCIDENCE.iter().enumerate().map(|(i, t)| format!("<span style=\"color:{}\">&#9632; light at {t}&deg;</span>", html::colour(i))).collect();
     format!("<figure><div class=\"row\">{linear}{log}</div><figcaption>{}</figcaption></figure>", legend.join(" "))
 }
 
@@ -126,13 +126,13 @@ fn spheres_html(values: &[[f32; 3]], at: &[(usize, usize, f32)]) -> Result<Strin
     for (f, &(k, p, nol)) in values.iter().zip(at) {
         let radiance = f.map(|c| if c.is_finite() { c * nol.max(0.0) * std::f32::consts::PI } else { f32::NAN });
         // NaN or Inf shows magenta: a sphere must say where the model breaks.
-        let rgb = if radiance.iter().all(|c| c.is_finite()) { crate::scene::render::tone_map(radiance, 1.0) } else { [255, 0, 255] };
+        let rgb = if radiance.iter().all(|c| c.is_finite()) { crate::export::raster::tone_map(radiance, 1.0) } else { [255, 0, 255] };
         images[k][p * 3..p * 3 + 3].copy_from_slice(&rgb);
     }
     let mut s = String::from("<div class=\"row\">");
     for (img, r) in images.iter().zip(SPHERE_ROUGHNESS) {
-        let uri = page::png_data_uri(SPHERE_PX, SPHERE_PX, img)?;
-        let _ = write!(s, "<figure>{}<figcaption>r = {r}</figcaption></figure>", page::img(&uri, SPHERE_PX, SPHERE_PX, 2, &format!("lit sphere, roughness {r}")));
+        let uri = html::png_data_uri(SPHERE_PX, SPHERE_PX, img)?;
+        let _ = write!(s, "<figure>{}<figcaption>r = {r}</figcaption></figure>", html::img(&uri, SPHERE_PX, SPHERE_PX, 2, &format!("lit sphere, roughness {r}")));
     }
     Ok(s + "</div>")
 }
@@ -146,7 +146,7 @@ fn albedo_svg(e: &energy::Energy) -> String {
         .map(|(row, r)| Curve { label: format!("r = {r}"), points: energy::NOV.iter().zip(row).map(|(v, x)| (f64::from(*v), f64::from(*x))).collect() })
         .collect();
     let top = e.max_e.unwrap_or(1.0).max(1.0) * 1.05;
-    page::lines_svg(&curves, Axis { lo: 0.0, hi: 1.0, log: false }, Axis { lo: 0.0, hi: top, log: false }, "NoV", "directional albedo E (F = 1)", page::SMALL)
+    html::lines_svg(&curves, Axis { lo: 0.0, hi: 1.0, log: false }, Axis { lo: 0.0, hi: top, log: false }, "NoV", "directional albedo E (F = 1)", html::SMALL)
 }
 
 /// One model's card, and its lobe values (for the overlay).
@@ -185,10 +185,10 @@ fn overlay_svg(lobes: &[(String, Vec<[f32; 3]>)]) -> String {
         let t = INCIDENCE[i];
         let marks = [(-t.to_radians(), format!("L{t}"))];
         let marks: Vec<(f64, &str)> = marks.iter().map(|(a, l)| (*a, l.as_str())).collect();
-        plots += &page::polar_svg(&format!("light at {t} deg, linear"), &curves, &marks, None);
-        plots += &page::polar_svg(&format!("light at {t} deg, log ({LOG_DECADES} decades)"), &curves, &marks, Some(LOG_DECADES));
+        plots += &html::polar_svg(&format!("light at {t} deg, linear"), &curves, &marks, None);
+        plots += &html::polar_svg(&format!("light at {t} deg, log ({LOG_DECADES} decades)"), &curves, &marks, Some(LOG_DECADES));
     }
-    let legend: Vec<String> = lobes.iter().enumerate().map(|(k, (label, _))| format!("<span style=\"color:{}\">&#9632; {}</span>", page::colour(k), esc(label))).collect();
+    let legend: Vec<String> = lobes.iter().enumerate().map(|(k, (label, _))| format!("<span style=\"color:{}\">&#9632; {}</span>", html::colour(k), esc(label))).collect();
     format!("<div class=\"model overlay\" data-model=\"overlay\"><h3>All models overlaid</h3><figure><div class=\"row\">{plots}</div><figcaption>{}</figcaption></figure></div>", legend.join(" "))
 }
 

@@ -6,8 +6,9 @@ use super::sections::{estimate_cell, num_cell};
 use super::{Input, Loaded};
 use crate::brdf::guards::GuardSet;
 use crate::model::Model;
-use crate::page::{Cell, HtmlTable};
-use crate::stability::view::SpecView;
+use crate::export::html::{Cell, HtmlTable};
+use crate::io::finite;
+use crate::stability::SpecStability;
 use std::collections::BTreeMap;
 
 /// Most rows and figure columns shown (the sections below hold every figure).
@@ -53,7 +54,7 @@ impl Summary {
     }
 }
 
-fn stability_cell(s: &SpecView) -> Cell {
+fn stability_cell(s: &SpecStability) -> Cell {
     if s.fails() {
         Cell::num((s.nan + s.inf + s.negative) as f64, format!("FAIL ({} NaN, {} Inf, {} neg.)", s.nan, s.inf, s.negative))
     } else {
@@ -72,7 +73,7 @@ fn gather(inputs: &[Input]) -> Summary {
                 let mut cells = Vec::new();
                 for r in p.rows.iter().filter(|r| Some(r.lights) == lights && r.spec.is_some()) {
                     let key = s.model(r.spec.as_deref().unwrap(), &r.model);
-                    cells.push((key, estimate_cell(r.net_vs_reference.as_ref().or(r.vs_reference.as_ref()))));
+                    cells.push((key, estimate_cell(r.net_vs_reference.as_ref().or(Some(&r.vs_reference)))));
                 }
                 let net = if p.rows.iter().any(|r| r.net_vs_reference.is_some()) { "net cost" } else { "cost" };
                 s.column(format!("{net} vs {} ({}, {} lights)", p.reference, p.provenance.device.name, lights.unwrap_or(0)), cells);
@@ -93,16 +94,16 @@ fn gather(inputs: &[Input]) -> Summary {
                 }
             }
             Loaded::Sweep(w) => {
-                let cells = w.rows.iter().filter(|r| r.pareto).map(|r| (s.model(&r.canonical, &r.label), num_cell(r.accuracy.vs_exact.rms))).collect();
+                let cells = w.rows.iter().filter(|r| r.pareto).map(|r| (s.model(&r.canonical, &r.label), num_cell(finite(r.accuracy.vs_exact.rms)))).collect();
                 s.column("RMS rel. error vs exact (sweep)".into(), cells);
             }
             Loaded::Diff(d) => {
                 s.model(&d.a.canonical, &d.a.name);
                 let key = s.model(&d.b.canonical, &d.b.name);
-                s.column(format!("max rel. difference vs {}", d.a.name), vec![(key, num_cell(d.difference.max_rel))]);
+                s.column(format!("max rel. difference vs {}", d.a.name), vec![(key, num_cell(finite(d.difference.max_rel)))]);
             }
             Loaded::DiffSet(d) => {
-                let cells = d.diffs.iter().map(|x| (s.model(&x.b.canonical, &x.b.name), num_cell(x.difference.max_rel))).collect();
+                let cells = d.diffs.iter().map(|x| (s.model(&x.b.canonical, &x.b.name), num_cell(finite(x.difference.max_rel)))).collect();
                 s.column(format!("max rel. difference vs {}", d.reference.name), cells);
             }
             Loaded::Stability(_) | Loaded::Costs(_) => {}

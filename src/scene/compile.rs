@@ -12,7 +12,7 @@ use crate::gpu::Gpu;
 use crate::kernels;
 use crate::model::KernelKind;
 use crate::profile::protocol::Timed;
-use crate::results::Table;
+use crate::export::markdown::Table;
 use crate::targets::{self, CheckedTranslation, RawKernel, Target};
 use crate::translate::{self, host::HostKernel, verify};
 use anyhow::{anyhow, bail, Result};

@@ -15,7 +15,8 @@ use crate::kernels::{self, RunLimits};
 use crate::model::KernelKind;
 use crate::profile::protocol::{self, ProtocolOptions, RawTimes};
 use crate::profile::LEVEL;
-use crate::results::{self, Provenance, Table};
+use crate::export::json::Provenance;
+use crate::export::markdown::{self, Table};
 use crate::stats::{self, Estimate};
 use anyhow::Result;
 use indicatif::ProgressBar;
@@ -244,7 +245,7 @@ impl SceneProfileReport {
             self.rounds,
             self.reps_per_round,
             self.raw.elapsed_s
-        ) + &results::front_ends_line(&self.provenance.front_ends)
+        ) + &markdown::front_ends_line(&self.provenance.front_ends)
     }
 
     pub fn markdown(&self) -> String {
@@ -262,11 +263,11 @@ impl SceneProfileReport {
                 k.pixels.to_string(),
                 k.dispatches.to_string(),
                 k.spirv_instructions.map_or("-".into(), |n| n.to_string()),
-                results::estimate(&k.ns_per_pixel, 3),
-                results::estimate(&k.frame_share, 2),
+                markdown::estimate(&k.ns_per_pixel, 3),
+                markdown::estimate(&k.frame_share, 2),
             ]);
         }
-        out += &format!("\n{}\nwhole frame: {} ns per shaded pixel\n", t.markdown(), results::estimate(&self.frame_ns_per_pixel, 3));
+        out += &format!("\n{}\nwhole frame: {} ns per shaded pixel\n", t.markdown(), markdown::estimate(&self.frame_ns_per_pixel, 3));
         if self.effects.is_empty() {
             out += "\nNo material calls for an effect: none is compiled in.\n";
         } else {
@@ -275,15 +276,15 @@ impl SceneProfileReport {
                 e.row([
                     r.model.clone(),
                     r.effect.clone(),
-                    results::estimate(&r.extra_ns_per_pixel, 3),
-                    results::estimate(&r.extra_fraction, 2),
+                    markdown::estimate(&r.extra_ns_per_pixel, 3),
+                    markdown::estimate(&r.extra_fraction, 2),
                     r.extra_spirv_instructions.map_or("-".into(), |n| format!("{n:+}")),
                 ]);
             }
             out += &format!("\nCost of each effect (kernel as compiled minus the kernel without it, per round):\n\n{}", e.markdown());
         }
-        let measured = |model: &str| self.kernels.iter().find(|k| k.model == model).map_or("-".into(), |k| results::estimate(&k.ns_per_pixel, 3));
-        let measured_effect = |model: &str, effect: &str| self.effects.iter().find(|e| e.model == model && e.effect == effect).map_or("-".into(), |e| results::estimate(&e.extra_ns_per_pixel, 3));
+        let measured = |model: &str| self.kernels.iter().find(|k| k.model == model).map_or("-".into(), |k| markdown::estimate(&k.ns_per_pixel, 3));
+        let measured_effect = |model: &str, effect: &str| self.effects.iter().find(|e| e.model == model && e.effect == effect).map_or("-".into(), |e| markdown::estimate(&e.extra_ns_per_pixel, 3));
         out + &compile::markdown(&self.targets, measured, measured_effect, &self.provenance.device.name)
     }
 }

@@ -45,9 +45,9 @@ fn rho_text(rho: Option<f64>, ci: Option<(f64, f64)>) -> String {
 
 impl Correlation {
     pub fn markdown(&self) -> String {
-        let f = |v: Option<f64>| v.map_or("-".to_string(), |v| crate::results::sig(v, 3));
+        let f = |v: Option<f64>| v.map_or("-".to_string(), |v| crate::export::markdown::sig(v, 3));
         let reference = &self.reference;
-        let mut t = crate::results::Table::new([
+        let mut t = crate::export::markdown::Table::new([
             "model".to_string(),
             "Ir/eval".into(),
             "net Ir/eval".into(),

@@ -3,7 +3,7 @@
 //! from its own statistics and model (`targets::cost`); `inspect`, `compare` and `sweep --cost-device` read
 //! only this.
 
-use crate::results::{sig, Table};
+use crate::export::markdown::{sig, Table};
 use serde::{Deserialize, Serialize};
 
 /// One kernel's figures.

@@ -9,7 +9,7 @@ pub mod cost;
 pub mod driver;
 pub mod lines;
 
-use crate::results::{self, Table};
+use crate::export::markdown::{self, Table};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
@@ -74,7 +74,7 @@ pub const FOLDED_NOTE: &str = "folded";
 
 /// Formats a statistic: whole numbers as integers, others with 4 significant digits.
 pub fn format_value(v: f64) -> String {
-    if v.fract() == 0.0 && v.abs() < 1e15 { format!("{}", v as i64) } else { results::sig(v, 4) }
+    if v.fract() == 0.0 && v.abs() < 1e15 { format!("{}", v as i64) } else { markdown::sig(v, 4) }
 }
 
 impl InspectReport {

@@ -5,7 +5,7 @@
 
 use crate::brdf::terms::{Param, ParamKind, ParamValue, PARAMS};
 use crate::brdf::Sample;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -16,14 +16,22 @@ pub enum Expect {
     FiniteNonNegative,
 }
 
-#[derive(Clone, Debug, Serialize)]
+/// Read back from stability reports by name only (the rest takes its default).
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct HardCase {
     pub name: String,
+    #[serde(skip_deserializing)]
     pub sample: Sample,
     /// Parameter values for this case (applied to the specs whose terms read them; the spec's own otherwise).
     #[serde(skip)]
     pub overrides: Vec<(Param, ParamValue)>,
+    #[serde(skip_deserializing, default = "unread_expect")]
     pub expect: Expect,
+}
+
+/// What a read-back hard case expects (no reader asks).
+fn unread_expect() -> Expect {
+    Expect::Twin
 }
 
 /// Unit vector at cosine `cos` to +z and azimuth `phi`, in f32.

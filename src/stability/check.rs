@@ -318,6 +318,7 @@ pub fn check_model(gpu: &Gpu, model: &Model, checks: &Checks, cases: &[HardCase]
         reciprocity,
         reciprocity_nonfinite,
         bad_cells: any_bad.then_some(cells),
+        bad_cell_triples: None,
         failures,
         energy: None,
     })

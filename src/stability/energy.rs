@@ -5,7 +5,7 @@
 
 use super::SpecStability;
 use crate::brdf::{ModelSpec, F};
-use crate::chart;
+use crate::export::png;
 use crate::gpu::Gpu;
 use crate::kernels::{self, AlbedoCell};
 use crate::model::Model;
@@ -13,33 +13,47 @@ use anyhow::{anyhow, Result};
 use indicatif::ProgressBar;
 use plotters::prelude::*;
 use rayon::prelude::*;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::path::Path;
 
 pub const NOV: [f32; 16] = [0.02, 0.05, 0.1, 0.15, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.85, 0.9, 0.95, 0.98, 1.0];
 pub const ROUGHNESS: [f32; 5] = [0.1, 0.25, 0.5, 0.75, 1.0];
 
-#[derive(Clone, Debug, Serialize)]
+/// Read back from stability reports too: what no reader shows is skipped, and null figures read as NaN.
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Energy {
     /// E[r][nov] over ROUGHNESS x NOV, with F = 1 (f32 is precise enough for integrals good to 1e-3).
+    #[serde(deserialize_with = "nan_if_null_cells")]
     pub e: Vec<Vec<f32>>,
     /// The largest integration-error estimate of the cells.
+    #[serde(skip_deserializing)]
     pub error_bound: f64,
     /// The largest E of the finite cells (None when no cell is finite).
     pub max_e: Option<f64>,
     /// (NoV, roughness) of max_e.
+    #[serde(skip_deserializing)]
     pub max_at: (f32, f32),
     /// Cells whose E is NaN or Inf (left out of max_e; never a gain or a loss).
+    #[serde(skip_deserializing)]
     pub nonfinite: usize,
     /// max_e > 1 + error_bound.
     pub gains_energy: bool,
     /// Hemispherical albedo 2 * integral of E(mu) mu dmu at r = 1 (1 - this is the energy lost to single scattering).
+    #[serde(default = "crate::io::nan", deserialize_with = "crate::io::nan_if_null")]
     pub hemispherical_at_r1: f64,
     /// Check against the CPU's f64 integration of the same formula at r in {0.1, 0.5, 1}: the largest
     /// |E_gpu - E_cpu| / max(1, E_cpu) over the finite cells, and how many cells were not finite; None for a
     /// model without an f64 twin (a `.brdf` file).
+    #[serde(skip_deserializing)]
     pub cpu_check: Option<f64>,
+    #[serde(skip_deserializing)]
     pub cpu_check_nonfinite: usize,
+}
+
+/// `e` as read back: a NaN or Inf cell, written as null, reads as NaN.
+fn nan_if_null_cells<'de, D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Vec<Vec<f32>>, D::Error> {
+    let cells = Vec::<Vec<Option<f32>>>::deserialize(d)?;
+    Ok(cells.into_iter().map(|row| row.into_iter().map(|x| x.unwrap_or(f32::NAN)).collect()).collect())
 }
 
 impl Energy {
@@ -161,9 +175,9 @@ pub fn furnace_png(path: &Path, entries: &[(String, &Energy)]) -> Result<()> {
     let (cell, label_w, header) = (64i32, 420i32, 60i32);
     let width = (label_w + cell * ROUGHNESS.len() as i32 + 20) as u32;
     let height = (header + cell * entries.len() as i32 + 60) as u32;
-    chart::render(path, width, height, |root| {
+    png::render(path, width, height, |root| {
         let err = |e: &dyn std::fmt::Display| anyhow!("furnace: {e}");
-        let text = |s: &str, x: i32, y: i32, size: i32| Text::new(s.to_string(), (x, y), (chart::FONT, size).into_font());
+        let text = |s: &str, x: i32, y: i32, size: i32| Text::new(s.to_string(), (x, y), (png::FONT, size).into_font());
         root.draw(&text("White furnace: E(NoV) with F = 1 (white = lossless, grey = loss, red = gain, magenta = non-finite)", 10, 10, 16)).map_err(|e| err(&e))?;
         for (j, r) in ROUGHNESS.iter().enumerate() {
             root.draw(&text(&format!("r = {r}"), label_w + j as i32 * cell + 8, header - 24, 16)).map_err(|e| err(&e))?;
@@ -199,5 +213,5 @@ pub fn albedo_chart(path: &Path, entries: &[(String, &Energy)]) -> Result<()> {
             (format!("r = {r}"), series)
         })
         .collect();
-    chart::line_panels(path, "Directional albedo E(NoV) with F = 1", "NoV", "E", &panels, (0.0, 1.3))
+    png::line_panels(path, "Directional albedo E(NoV) with F = 1", "NoV", "E", &panels, (0.0, 1.3))
 }

@@ -16,15 +16,17 @@ pub const GRID_EXAMPLES: usize = 5;
 /// The name `Failure::removed_by` and `GridRemoval` give every input guard at once.
 pub const ALL_GUARDS: &str = "all";
 
-/// One failing input.
-#[derive(Clone, Debug, Serialize)]
+/// One failing input; read back from stability reports by what the Markdown and the HTML page show.
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Failure {
     /// The hard case's name, or `grid` for a grid point.
     pub at: String,
+    #[serde(skip_deserializing)]
     pub input: Sample,
     /// The input as a reader checks it: vectors, cosines, |V + L|, roughness, F0.
     pub inputs: String,
     /// The model's result (NaN and Inf written as null), and as text (NaN and Inf by name).
+    #[serde(skip_deserializing)]
     pub got: [f32; 3],
     pub result: String,
     /// The input guards that each remove it alone, then `all` if all of them together do.
@@ -39,7 +41,7 @@ pub struct GridRemoval {
 }
 
 /// Every failing input of one model.
-#[derive(Clone, Debug, Default, Serialize)]
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
 pub struct Failures {
     /// Every hard case with a NaN, Inf or negative result, in catalogue order.
     pub cases: Vec<Failure>,
@@ -160,33 +162,8 @@ fn distinct(all: impl Iterator<Item = Failure>) -> Vec<Failure> {
     out
 }
 
-/// `Failure` as read back (and as both the Markdown and the HTML page write it).
-#[derive(Clone, Debug, Deserialize)]
-pub struct FailureView {
-    pub at: String,
-    pub inputs: String,
-    pub result: String,
-    pub removed_by: Vec<String>,
-}
-
-/// `Failures` as read back.
-#[derive(Clone, Debug, Default, Deserialize)]
-pub struct FailuresView {
-    pub cases: Vec<FailureView>,
-    pub grid_points: usize,
-    pub grid_examples: Vec<FailureView>,
-    pub grid_removed_by: Vec<GridRemoval>,
-}
-
-impl Failures {
-    pub fn view(&self) -> FailuresView {
-        let v = |f: &Failure| FailureView { at: f.at.clone(), inputs: f.inputs.clone(), result: f.result.clone(), removed_by: f.removed_by.clone() };
-        FailuresView { cases: self.cases.iter().map(v).collect(), grid_points: self.grid_points, grid_examples: self.grid_examples.iter().map(v).collect(), grid_removed_by: self.grid_removed_by.clone() }
-    }
-}
-
 /// The guards that remove a failure, as a sentence's end.
-fn removed_text(f: &FailureView) -> String {
+fn removed_text(f: &Failure) -> String {
     let alone: Vec<&str> = f.removed_by.iter().map(String::as_str).filter(|n| *n != ALL_GUARDS).collect();
     match (alone.as_slice(), f.removed_by.iter().any(|n| n == ALL_GUARDS)) {
         ([], false) => "no input guard removes it".into(),
@@ -195,12 +172,12 @@ fn removed_text(f: &FailureView) -> String {
     }
 }
 
-impl FailuresView {
+impl Failures {
     /// One spec's failures as (depth, Markdown text) list items: each failing hard case (cases on the same
     /// inputs, a term parameter's cases for a model that reads none, share one), then the grid.
     pub fn lines(&self) -> Vec<(usize, String)> {
         let mut out = Vec::new();
-        let same = |a: &FailureView, b: &FailureView| a.inputs == b.inputs && a.removed_by == b.removed_by && a.result == b.result;
+        let same = |a: &Failure, b: &Failure| a.inputs == b.inputs && a.removed_by == b.removed_by && a.result == b.result;
         for (i, f) in self.cases.iter().enumerate() {
             if self.cases[..i].iter().any(|o| same(o, f)) {
                 continue;

@@ -8,7 +8,6 @@ mod check;
 pub mod energy;
 pub mod failures;
 pub mod grid;
-pub mod view;
 
 pub use check::{check_model, Checks};
 
@@ -24,7 +23,7 @@ use catalogue::{Expect, HardCase};
 use indicatif::ProgressBar;
 use rand::{Rng, SeedableRng};
 
-use serde::Serialize;
+use serde::{Deserialize, Deserializer, Serialize};
 
 /// Every D with every Vis (Schlick Fresnel), and every Fresnel term on the reference preset (with each metal
 /// where it reads one), in fp32 and fp16: every spec the term library offers up to the choice of Fresnel.
@@ -94,33 +93,46 @@ pub fn tolerance(spec: &ModelSpec, s: &Sample, channel: usize, expected: f64, se
     base.max(4.0 * sensitivity(spec, s, channel, unit_epsilon(spec.precision), seed))
 }
 
-#[derive(Clone, Debug, Serialize)]
+/// A stability report is read back (`report`, `--html`) as these same types: what no reader shows is skipped,
+/// a figure written as null (NaN or Inf) reads as NaN (`io::finite`), and what an older report lacks takes the
+/// default it stood for then.
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct CaseResult {
     pub case: String,
+    #[serde(skip_deserializing)]
     pub expected: Option<[f64; 3]>,
+    #[serde(skip_deserializing)]
     pub got: [f32; 3],
     /// Largest |got - expected| / tolerance over the channels (NaN/Inf count as infinite).
+    #[serde(default = "crate::io::nan", deserialize_with = "crate::io::nan_if_null")]
     pub deviation: f64,
+    #[serde(skip_deserializing)]
     pub ok: bool,
 }
 
-#[derive(Clone, Debug, Default, Serialize)]
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+#[serde(default)]
 pub struct Worst {
     /// |got - expected| in units of the tolerance.
+    #[serde(default = "crate::io::nan", deserialize_with = "crate::io::nan_if_null")]
     pub deviation: f64,
+    #[serde(skip_deserializing)]
     pub got: f32,
+    #[serde(skip_deserializing)]
     pub expected: f64,
     pub input: String,
 }
 
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct SpecStability {
-    /// What tables and charts call it (`Model::label`).
+    /// What tables and charts call it (`Model::label`; empty in a report written before labels).
+    #[serde(default)]
     pub label: String,
     /// The text that parses back to the model (`Model::name`).
     pub spec: String,
     pub precision: String,
     /// Whether the model has an f64 twin.
+    #[serde(default)]
     pub has_twin: bool,
     /// What its results were checked against: `twin`, `reference `SPEC`` (`--reference`, for a model
     /// without a twin), or None: then nothing is out of tolerance (there is nothing to be within) and jumps
@@ -128,14 +140,18 @@ pub struct SpecStability {
     pub expected_from: Option<String>,
     /// The input ranges checked (roughness, NoV, NoL), where any was given or declared, and the valid hard
     /// cases and grid points outside them (not counted).
+    #[serde(skip_deserializing)]
     pub domain: Option<String>,
+    #[serde(skip_deserializing)]
     pub cases_outside_domain: usize,
+    #[serde(skip_deserializing)]
     pub grid_outside_domain: usize,
     /// On valid inputs (catalogue and grid).
     pub nan: usize,
     pub inf: usize,
     pub negative: usize,
     /// Non-finite or negative results from invalid inputs (NaN/Inf in), reported, not failing.
+    #[serde(default)]
     pub invalid_input_poisoned: usize,
     /// Hard cases run, and the results of those out of tolerance (or poisoned, for invalid input).
     pub cases_run: usize,
@@ -145,40 +161,77 @@ pub struct SpecStability {
     pub case_deviation: Vec<f64>,
     /// Grid points out of tolerance.
     pub grid_out_of_tolerance: usize,
+    #[serde(default = "no_worst")]
     pub worst: Worst,
-    /// Whether jumps were looked for (with an expectation to tell the model's own steps from breaks).
+    /// Whether jumps were looked for (with an expectation to tell the model's own steps from breaks; reports
+    /// written before it counted them always).
+    #[serde(default = "always", deserialize_with = "true_if_null")]
     pub jumps_checked: bool,
     /// Steps in f_s NoL along NoV, NoL or roughness that the f64 model does not take, at values out of tolerance.
+    #[serde(default)]
     pub discontinuities: usize,
+    #[serde(skip_deserializing)]
     pub discontinuity_examples: Vec<String>,
     /// Steps the f64 model takes too, between lit points (the formula's and its guards' own).
+    #[serde(default)]
     pub model_jumps: usize,
     /// max |f(v, l) - f(l, v)| / max(|f|, 1e-3) over the reciprocity samples whose values are finite (None
     /// when none is).
     pub reciprocity: Option<f64>,
     /// Reciprocity values (sample pairs x channels) left out because either side is NaN or Inf.
+    #[serde(skip_deserializing)]
     pub reciprocity_nonfinite: usize,
-    /// Bad values (NaN, Inf, negative) per (NoV, roughness) grid cell, [roughness][NoV], where any.
-    #[serde(serialize_with = "sparse_cells")]
+    /// Bad values (NaN, Inf, negative) per (NoV, roughness) grid cell, [roughness][NoV], where any; written
+    /// as `cell_triples`.
+    #[serde(serialize_with = "sparse_cells", skip_deserializing)]
     pub bad_cells: Option<Vec<Vec<u32>>>,
+    /// `bad_cells` as read back: the triples as written (None in a measured report). Kept sparse because the
+    /// grid the report was measured on need not be this build's, and the page draws from the triples.
+    #[serde(rename = "bad_cells", skip_serializing)]
+    pub bad_cell_triples: Option<Vec<[u32; 3]>>,
     /// Every failing valid input: hard cases by name, grid points counted (the first listed), each with its
-    /// input values and the input guards that remove it.
+    /// input values and the input guards that remove it (empty in a report written before they were listed).
+    #[serde(default)]
     pub failures: failures::Failures,
     pub energy: Option<energy::Energy>,
 }
 
-/// Bad cells as [roughness index, NoV index, count] triples of the non-empty cells.
+/// Bad cells as [roughness index, NoV index, count] triples of the non-empty cells, row by row.
+fn cell_triples(cells: &[Vec<u32>]) -> Vec<[u32; 3]> {
+    cells.iter().enumerate().flat_map(|(r, row)| row.iter().enumerate().filter(|(_, n)| **n > 0).map(move |(v, n)| [r as u32, v as u32, *n])).collect()
+}
+
 fn sparse_cells<S: serde::Serializer>(cells: &Option<Vec<Vec<u32>>>, s: S) -> Result<S::Ok, S::Error> {
-    let triples: Option<Vec<[u32; 3]>> = cells.as_ref().map(|c| {
-        c.iter().enumerate().flat_map(|(r, row)| row.iter().enumerate().filter(|(_, n)| **n > 0).map(move |(v, n)| [r as u32, v as u32, *n])).collect()
-    });
-    triples.serialize(s)
+    cells.as_deref().map(cell_triples).serialize(s)
+}
+
+/// What a report without a worst deviation reads as: none known.
+fn no_worst() -> Worst {
+    Worst { deviation: f64::NAN, ..Worst::default() }
+}
+
+fn always() -> bool {
+    true
+}
+
+fn true_if_null<'de, D: Deserializer<'de>>(d: D) -> Result<bool, D::Error> {
+    Ok(Option::<bool>::deserialize(d)?.unwrap_or(true))
 }
 
 impl SpecStability {
     /// NaN, Inf or a negative value on a valid input.
     pub fn fails(&self) -> bool {
         self.nan + self.inf + self.negative > 0
+    }
+
+    /// What to call it: its label, or its spec in a report written before labels.
+    pub fn label(&self) -> &str {
+        if self.label.is_empty() { &self.spec } else { &self.label }
+    }
+
+    /// Whether its values were checked against expected ones (a twin or a reference).
+    pub fn checked(&self) -> bool {
+        self.has_twin || self.expected_from.is_some()
     }
 }
 
@@ -195,13 +248,14 @@ pub struct StabilityOptions {
     pub nol: Option<(f64, f64)>,
 }
 
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct StabilityReport {
-    pub provenance: crate::results::Provenance,
+    pub provenance: crate::export::json::Provenance,
     pub specs: Vec<SpecStability>,
     pub grid_points: usize,
     pub cases: Vec<HardCase>,
     /// What each guard saves, where a spec ran with and without some of its guards (`with_guard_variants`).
+    #[serde(skip_deserializing)]
     pub guard_savings: Vec<GuardSaving>,
 }
 
@@ -289,7 +343,7 @@ impl StabilityReport {
     pub fn write(&self, out: &std::path::Path, device: &str) -> Result<Vec<std::path::PathBuf>> {
         let stem = out.join(format!("stability-{device}"));
         let mut written = vec![stem.with_extension("md"), stem.with_extension("json")];
-        crate::results::write_report_compact(&written[1], crate::results::Kind::Stability, self)?;
+        crate::export::json::write_report_compact(&written[1], crate::export::json::Kind::Stability, self)?;
         crate::io::write_output(&written[0], self.markdown().as_bytes())?;
         let entries = self.energy_entries();
         if !entries.is_empty() {
@@ -332,7 +386,7 @@ pub fn run(gpu: &Gpu, options: &StabilityOptions, progress: &ProgressBar) -> Res
         energy::attach(gpu, &options.models, &mut specs, progress)?;
     }
     let guard_savings = guard_savings(&options.models, &specs, &cases);
-    Ok(StabilityReport { provenance: crate::results::Provenance::new(&gpu.info), specs, grid_points: grid.len(), cases, guard_savings })
+    Ok(StabilityReport { provenance: crate::export::json::Provenance::new(&gpu.info), specs, grid_points: grid.len(), cases, guard_savings })
 }
 
 /// The "cases out of tolerance" cell, as the Markdown and the HTML page both write it: without a twin or
@@ -368,7 +422,7 @@ fn worst_cell(w: &Worst) -> String {
 
 /// The max E, hemispherical albedo and E-vs-CPU cells, NaN/Inf cells counted (never a gain, never "inf").
 fn energy_cells(e: &energy::Energy) -> (String, String, String) {
-    use crate::results::sig;
+    use crate::export::markdown::sig;
     let nonfinite = if e.nonfinite > 0 { format!(" ({} of {} cells NaN/Inf)", e.nonfinite, e.cells()) } else { String::new() };
     let max_e = match e.max_e {
         Some(m) => format!("{}{} (±{:.0e}){nonfinite}", sig(m, 3), if e.gains_energy { " gain" } else { "" }, e.error_bound),
@@ -390,7 +444,7 @@ fn reciprocity_cell(s: &SpecStability) -> String {
 
 impl StabilityReport {
     pub fn markdown(&self) -> String {
-        use crate::results::Table;
+        use crate::export::markdown::Table;
         let mut out = format!(
             "# brdfprof stability\n\n{} ({}), {} specs; {} hard cases and {} grid points each.\n\n\
              NaN/Inf/neg: results on valid inputs (a spec with any fails, and the command exits 1). Out of tolerance: cases and \
@@ -413,7 +467,7 @@ impl StabilityReport {
             self.grid_points
         );
         if !self.provenance.front_ends.is_empty() {
-            out += &format!("{}\n\n", crate::results::front_ends_line(&self.provenance.front_ends).trim_start());
+            out += &format!("{}\n\n", crate::export::markdown::front_ends_line(&self.provenance.front_ends).trim_start());
         }
         let mut t = Table::new(["spec", "NaN", "Inf", "neg", "cases out of tol.", "grid out of tol.", "worst (x tol.)", "jumps", "reciprocity", "max E", "hemi r=1", "E vs CPU", "verdict"]);
         for s in &self.specs {
@@ -444,7 +498,7 @@ impl StabilityReport {
 
     /// The hard-case table: how many specs each case puts out of tolerance, and the worst.
     fn cases_markdown(&self) -> String {
-        use crate::results::Table;
+        use crate::export::markdown::Table;
         let mut out = String::from("\n## Hard cases\n\nSpecs out of tolerance per case (fp32 / fp16; without a twin or reference: with a NaN, Inf or negative value), with the worst one.\n\n");
         let mut c = Table::new(["case", "expected", "fp32 out", "fp16 out", "worst spec (x tol.)"]);
         for (i, case) in self.cases.iter().enumerate() {
@@ -480,7 +534,7 @@ impl StabilityReport {
             );
             for s in failing {
                 let worst = if s.expected_from.is_some() && s.worst.deviation.is_finite() { format!("; worst deviation {:.2e} x tolerance at {}", s.worst.deviation, s.worst.input) } else { String::new() };
-                out += &s.failures.view().markdown(&s.label, &format!("{} NaN, {} Inf, {} negative{worst}", s.nan, s.inf, s.negative));
+                out += &s.failures.markdown(&s.label, &format!("{} NaN, {} Inf, {} negative{worst}", s.nan, s.inf, s.negative));
             }
         }
         out
@@ -508,7 +562,7 @@ impl StabilityReport {
         if self.guard_savings.is_empty() {
             return String::new();
         }
-        let mut t = crate::results::Table::new(["spec", "guards", "NaN", "Inf", "neg", "grid out of tol. (more)", "hard cases out of tolerance only without them"]);
+        let mut t = crate::export::markdown::Table::new(["spec", "guards", "NaN", "Inf", "neg", "grid out of tol. (more)", "hard cases out of tolerance only without them"]);
         for g in &self.guard_savings {
             let cases = if g.cases.is_empty() { "-".to_string() } else { g.cases.join("; ") };
             t.row([g.spec.clone(), describe_guards(&g.off), g.nan.to_string(), g.inf.to_string(), g.negative.to_string(), g.grid_out_of_tolerance.to_string(), cases]);
@@ -531,14 +585,14 @@ impl StabilityReport {
         let title_size = (300.0 * columns as f64 / (0.55 * title.len() as f64)).min(20.0) as u32;
         let rows = failing.len().div_ceil(columns);
         let (pw, ph) = (300u32, 230u32);
-        crate::chart::render(path, pw * columns as u32, ph * rows as u32 + 40, |root| {
+        crate::export::png::render(path, pw * columns as u32, ph * rows as u32 + 40, |root| {
             let err = |e: &dyn std::fmt::Display| anyhow::anyhow!("heat map: {e}");
-            let root = root.titled(&title, (crate::chart::FONT, title_size)).map_err(|e| err(&e))?;
+            let root = root.titled(&title, (crate::export::png::FONT, title_size)).map_err(|e| err(&e))?;
             for (area, s) in root.split_evenly((rows, columns)).iter().zip(&failing) {
                 let cells = s.bad_cells.as_ref().expect("filtered above");
                 let max = cells.iter().flatten().copied().max().unwrap_or(1).max(1) as f64;
                 let mut chart = ChartBuilder::on(area)
-                    .caption(&s.label, (crate::chart::FONT, 12))
+                    .caption(&s.label, (crate::export::png::FONT, 12))
                     .margin(6)
                     .x_label_area_size(28)
                     .y_label_area_size(36)
@@ -553,7 +607,7 @@ impl StabilityReport {
                     .y_labels(8)
                     .x_label_formatter(&|i| axis_value(grid::COSINES.get(*i).copied()))
                     .y_label_formatter(&|i| axis_value(grid::ROUGHNESS.get(*i).map(|&r| f64::from(r))))
-                    .label_style((crate::chart::FONT, 10))
+                    .label_style((crate::export::png::FONT, 10))
                     .draw()
                     .map_err(|e| err(&e))?;
                 chart

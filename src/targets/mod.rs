@@ -282,7 +282,7 @@ pub fn device_slug(device: &crate::gpu::DeviceInfo) -> String {
     if let Some(t) = radv::families::family_of_device(&device.name) {
         return format!("radv-{}", t.family);
     }
-    crate::results::name_slug(&device.name)
+    crate::export::name_slug(&device.name)
 }
 
 /// File-name form of a kernel label.

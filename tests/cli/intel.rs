@@ -134,7 +134,7 @@ fn inspect_charts_the_cost_across_devices() {
     let img = image::open(d.join("c.png")).unwrap().to_rgb8();
     assert!(img.width() >= 800 && img.height() >= 600, "{}x{}", img.width(), img.height());
     for device in 0..2 {
-        let c = brdfprof::chart::palette(device);
+        let c = brdfprof::export::png::palette(device);
         let n = img.pixels().filter(|p| p.0 == [c.0, c.1, c.2]).count();
         assert!(n > 2_000, "device {device}'s colour covers {n} pixels: its bars are missing");
     }

@@ -8,8 +8,8 @@ use std::path::{Path, PathBuf};
 
 /// Top-level modules of src/, lowest first: a module may use only those before it. Written once, here.
 const LAYERS: &[&str] = &[
-    "host", "stats", "io", "chart", "page", "cache", "shaders", "model", "kernels", "spirv", "accuracy",
-    "results", "schema", "kernel_stats", "profile", "translate", "targets", "inspect", "compare", "devices", "check", "sweep", "sweep_cost", "stability", "scene", "diff", "report_page",
+    "host", "stats", "io", "cache", "shaders", "model", "kernels", "spirv", "accuracy",
+    "export", "schema", "kernel_stats", "profile", "translate", "targets", "inspect", "compare", "devices", "check", "sweep", "sweep_cost", "stability", "scene", "diff", "report_page",
 ];
 
 pub fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {

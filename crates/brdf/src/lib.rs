@@ -12,7 +12,7 @@ pub use terms::{Cosines, Metal, D, F, Vis};
 
 /// One BRDF query as the kernels receive it: world-space vectors (normalised by the kernel), perceptual
 /// roughness and an RGB F0, all in f32.
-#[derive(Clone, Copy, Debug, PartialEq, Default, serde::Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Default, serde::Serialize, serde::Deserialize)]
 pub struct Sample {
     pub n: [f32; 3],
     pub v: [f32; 3],

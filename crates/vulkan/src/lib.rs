@@ -14,7 +14,7 @@ pub use timing::Timestamps;
 
 use anyhow::{anyhow, bail, Context, Result};
 use ash::vk;
-use serde::Serialize;
+use serde::{Deserialize, Deserializer, Serialize};
 use std::ffi::{c_void, CStr};
 use std::sync::{Arc, Mutex};
 
@@ -64,8 +64,10 @@ pub fn mark_compile_only_process() {
     COMPILE_ONLY_PROCESS.store(true, std::sync::atomic::Ordering::Relaxed);
 }
 
-/// What `brdfprof devices` lists, and what every report records about the device it measured.
-#[derive(Clone, Debug, Serialize)]
+/// What `brdfprof devices` lists, and what every report records about the device it measured. Read back
+/// from saved reports too: a field an older or a compile-only target's report lacks reads as its default.
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+#[serde(default)]
 pub struct DeviceInfo {
     pub index: usize,
     pub name: String,
@@ -76,7 +78,8 @@ pub struct DeviceInfo {
     pub driver_info: String,
     pub driver_version: String,
     pub api_version: String,
-    /// Nanoseconds per timestamp tick.
+    /// Nanoseconds per timestamp tick (NaN where the device's is not finite, written as null).
+    #[serde(deserialize_with = "null_as_nan")]
     pub timestamp_period: f32,
     /// Valid bits of timestamps on the compute queue (0: no timestamps).
     pub timestamp_valid_bits: u32,
@@ -89,6 +92,11 @@ pub struct DeviceInfo {
     pub shader_float16: bool,
     pub shader_float64: bool,
     pub pipeline_executable_properties: bool,
+}
+
+/// JSON writes a non-finite float as null; it reads back as NaN rather than failing the whole report.
+fn null_as_nan<'de, D: Deserializer<'de>>(d: D) -> Result<f32, D::Error> {
+    Ok(Option::<f32>::deserialize(d)?.unwrap_or(f32::NAN))
 }
 
 impl DeviceInfo {

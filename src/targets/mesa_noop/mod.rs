@@ -230,7 +230,7 @@ fn raw_report(gpu: &Gpu, shaders: &Shaders, req: &NoopRequest, target: &str, isa
         row.stats.extend(crate::schema::driver::executable_stats(executables));
         rows.push(row);
     }
-    let provenance = serde_json::to_value(crate::results::Provenance::new(&gpu.info))?;
+    let provenance = serde_json::to_value(crate::export::json::Provenance::new(&gpu.info))?;
     let notes = if skipped.is_empty() { Default::default() } else { [("driver/".to_string(), format!("not compiled for {target}: {}", skipped.join("; ")))].into() };
     Ok((crate::kernel_stats::compiled_report(rows, provenance, req.lights, shaders, Default::default(), notes), isa_files))
 }

@@ -316,8 +316,8 @@ pub struct Page {
     sections: Vec<Section>,
 }
 
-const CSS: &str = include_str!("page/page.css");
-const SCRIPT: &str = include_str!("page/page.js");
+const CSS: &str = include_str!("page.css");
+const SCRIPT: &str = include_str!("page.js");
 
 impl Page {
     pub fn new(title: impl Into<String>) -> Self {

@@ -1,63 +1,11 @@
-//! Report plumbing shared by every command: Markdown tables, number formatting, the environment a run was
-//! measured in, and atomic JSON output.
+//! Saved JSON reports: their `kind`, the provenance every report records (where and how it was measured),
+//! and atomic writes, pretty or compact.
 
 use crate::gpu::DeviceInfo;
-use crate::stats::Estimate;
 use anyhow::Result;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::Path;
-
-pub mod view;
-
-/// A Markdown table.
-#[derive(Clone, Debug, Default)]
-pub struct Table {
-    pub headers: Vec<String>,
-    pub rows: Vec<Vec<String>>,
-}
-
-impl Table {
-    pub fn new<S: Into<String>>(headers: impl IntoIterator<Item = S>) -> Self {
-        Table { headers: headers.into_iter().map(Into::into).collect(), rows: Vec::new() }
-    }
-
-    pub fn row<S: Into<String>>(&mut self, cells: impl IntoIterator<Item = S>) {
-        self.rows.push(cells.into_iter().map(Into::into).collect());
-    }
-
-    pub fn markdown(&self) -> String {
-        let widths: Vec<usize> = (0..self.headers.len())
-            .map(|c| self.rows.iter().map(|r| r[c].chars().count()).chain([self.headers[c].chars().count(), 3]).max().unwrap())
-            .collect();
-        let line = |cells: &[String]| {
-            let padded: Vec<String> = cells.iter().zip(&widths).map(|(c, w)| format!("{c:<w$}")).collect();
-            format!("| {} |\n", padded.join(" | "))
-        };
-        let rule: Vec<String> = widths.iter().map(|w| "-".repeat(*w)).collect();
-        let mut out = line(&self.headers);
-        out += &line(&rule);
-        for r in &self.rows {
-            out += &line(r);
-        }
-        out
-    }
-}
-
-/// `x` with `digits` significant digits.
-pub fn sig(x: f64, digits: usize) -> String {
-    if x == 0.0 || !x.is_finite() {
-        return format!("{x}");
-    }
-    let magnitude = x.abs().log10().floor() as i32;
-    let decimals = (digits as i32 - 1 - magnitude).max(0) as usize;
-    format!("{x:.decimals$}")
-}
-
-/// "median [lo, hi]".
-pub fn estimate(e: &Estimate, digits: usize) -> String {
-    format!("{} [{}, {}]", sig(e.median, digits), sig(e.lo, digits), sig(e.hi, digits))
-}
 
 /// Environment variables that change what a Vulkan driver does (Mesa, lavapipe, loader, vendors).
 pub fn driver_environment() -> BTreeMap<String, String> {
@@ -65,8 +13,11 @@ pub fn driver_environment() -> BTreeMap<String, String> {
     std::env::vars().filter(|(k, _)| PREFIXES.iter().any(|p| k.starts_with(p))).collect()
 }
 
-/// What a report records about where it was measured.
-#[derive(Clone, Debug, Serialize)]
+/// What a report records about where it was measured. `report` and `--html` read it back as this same type:
+/// a field that an older brdfprof, or a compile-only target with less to say, did not write reads as its
+/// default, and the Options below are always Some when written (so they serialize as the bare value).
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+#[serde(default)]
 pub struct Provenance {
     pub tool: String,
     pub unix_time: u64,
@@ -75,11 +26,12 @@ pub struct Provenance {
     pub llvm_version: Option<String>,
     pub env: BTreeMap<String, String>,
     pub host_cpu: Option<String>,
-    /// Family, model, stepping and vector features: lavapipe's costs are this CPU's.
-    pub cpu: crate::host::HostCpu,
+    /// Family, model, stepping and vector features: lavapipe's costs are this CPU's (None: a report from
+    /// before it was recorded).
+    pub cpu: Option<crate::host::HostCpu>,
     pub host_threads: usize,
-    /// The command line that wrote the report.
-    pub command: Vec<String>,
+    /// The command line that wrote the report (None: a report from before it was recorded).
+    pub command: Option<Vec<String>>,
     /// What translated each HLSL or WGSL model into the kernels' GLSL, with versions (model path -> front
     /// end; docs/hlsl.md, docs/wgsl.md); absent when every model is GLSL or built in.
     #[serde(skip_serializing_if = "BTreeMap::is_empty")]
@@ -100,30 +52,12 @@ impl Provenance {
             llvm_version: llvm,
             env: driver_environment(),
             host_cpu,
-            cpu: crate::host::HostCpu::detect(),
+            cpu: Some(crate::host::HostCpu::detect()),
             host_threads: std::thread::available_parallelism().map_or(1, |n| n.get()),
-            command: std::env::args().collect(),
+            command: Some(std::env::args().collect()),
             front_ends: crate::model::front::used(),
         }
     }
-}
-
-/// A report's `front_ends` as a paragraph to append to its summary (empty when it has none).
-pub fn front_ends_line(front_ends: &BTreeMap<String, String>) -> String {
-    if front_ends.is_empty() {
-        return String::new();
-    }
-    let items: Vec<String> = front_ends.iter().map(|(path, front)| format!("`{path}`: {front}")).collect();
-    format!("\n\nFront ends: {}.", items.join("; "))
-}
-
-/// The file-name form of a device name: its first words, lower case ("llvmpipe (LLVM 15.0.6, 256 bits)" ->
-/// "llvmpipe").
-pub fn name_slug(name: &str) -> String {
-    let first = name.split(['(', ',']).next().unwrap_or("device").trim().to_lowercase();
-    let slug: String = first.chars().map(|c| if c.is_ascii_alphanumeric() { c } else { '-' }).collect();
-    let slug = slug.trim_matches('-').to_string();
-    if slug.is_empty() { "device".into() } else { slug }
 }
 
 /// Compact JSON, for reports whose numeric arrays would balloon when pretty-printed.
@@ -228,19 +162,5 @@ mod tests {
         for k in Kind::ALL {
             assert_eq!(Kind::parse(k.name()), Some(k));
         }
-    }
-
-    #[test]
-    fn significant_digits() {
-        assert_eq!(sig(1234.5, 3), "1234");
-        assert_eq!(sig(1.2345, 3), "1.23");
-        assert_eq!(sig(0.0012345, 3), "0.00123");
-    }
-
-    #[test]
-    fn table_is_aligned_markdown() {
-        let mut t = Table::new(["a", "long header"]);
-        t.row(["1", "2"]);
-        assert_eq!(t.markdown(), "| a   | long header |\n| --- | ----------- |\n| 1   | 2           |\n");
     }
 }

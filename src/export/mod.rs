@@ -1,0 +1,18 @@
+//! Every output format in one place: Markdown tables (markdown), saved JSON reports (json), self-contained
+//! HTML pages (html), PNG charts (png) and the pixel helpers pictures share (raster). What a command measured
+//! stays with the command; only how it is written out lives here.
+
+pub mod html;
+pub mod json;
+pub mod markdown;
+pub mod png;
+pub mod raster;
+
+/// The file-name form of a device name: its first words, lower case ("llvmpipe (LLVM 15.0.6, 256 bits)" ->
+/// "llvmpipe").
+pub fn name_slug(name: &str) -> String {
+    let first = name.split(['(', ',']).next().unwrap_or("device").trim().to_lowercase();
+    let slug: String = first.chars().map(|c| if c.is_ascii_alphanumeric() { c } else { '-' }).collect();
+    let slug = slug.trim_matches('-').to_string();
+    if slug.is_empty() { "device".into() } else { slug }
+}
