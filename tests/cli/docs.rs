@@ -1,5 +1,5 @@
 //! README and docs/ against the tree: README stays short, its Layout names every top-level folder and
-//! everything directly in `src/` and nothing that does not exist, every docs page (docs/targets/ too) is linked
+//! everything directly in `src/` and `crates/` and nothing that does not exist, every docs page (docs/targets/ too) is linked
 //! from README, and every relative link (with its `#anchor`) of README and docs/ leads somewhere.
 
 use crate::common;
@@ -65,7 +65,7 @@ fn readme_is_short_and_its_test_command_is_what_ci_runs() {
 }
 
 #[test]
-fn readme_layout_names_every_top_level_folder_and_src_entry_and_only_real_paths() {
+fn readme_layout_names_every_top_level_folder_src_and_crates_entry_and_only_real_paths() {
     let root = common::repo_root();
     let named = layout_paths(&read("README.md"));
     let missing: Vec<&String> = named.iter().filter(|p| !root.join(p).exists()).collect();
@@ -78,9 +78,11 @@ fn readme_layout_names_every_top_level_folder_and_src_entry_and_only_real_paths(
             unnamed.push(format!("{name}/"));
         }
     }
-    for (name, _) in entries(&root.join("src")) {
-        if !named.contains(&format!("src/{name}")) {
-            unnamed.push(format!("src/{name}"));
+    for folder in ["src", "crates"] {
+        for (name, _) in entries(&root.join(folder)) {
+            if !named.contains(&format!("{folder}/{name}")) {
+                unnamed.push(format!("{folder}/{name}"));
+            }
         }
     }
     assert!(unnamed.is_empty(), "README's Layout misses {unnamed:?}: give each a line");
