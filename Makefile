@@ -3,7 +3,7 @@
 CARGO ?= cargo
 BIN := target/release/brdfprof
 
-.PHONY: setup mesa build run test spv baseline
+.PHONY: setup mesa build run test test-crates spv baseline
 
 # System packages and NVIDIA's compiler wheels: all that `make run` needs (it builds no Mesa).
 setup:
@@ -25,7 +25,13 @@ run: build
 
 # The tests compile on every target, the adreno:, mali: and anv: ones included, so they need `mesa`.
 test: setup mesa
-	$(CARGO) test --release --locked
+	$(CARGO) test --release --locked --workspace
+
+# The leaf crates' own tests (BRDF mathematics, process layer, SPIR-V to C writer): no Vulkan driver, no Mesa,
+# none of ash, naga or plotters to compile; the quick loop for changes below the application.
+LEAF_CRATES := brdfprof-brdf brdfprof-process brdfprof-spirv-c
+test-crates:
+	$(CARGO) test --release --locked $(addprefix -p ,$(LEAF_CRATES))
 
 # Regenerate glsl/generated/ from the Rust tables and recompile glsl/ into spv/ (needs glslang); commit both.
 spv:
