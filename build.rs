@@ -25,7 +25,10 @@ fn main() {
             println!("cargo:warning={} is missing: run `make spv` (needs glslangValidator)", spv.display());
             "&[]".to_string()
         };
-        out += &format!("    KernelSource {{ name: {name:?}, source: {source:?}, defines: &[{}], spirv: {bytes} }},\n", defines.join(", "));
+        out += &format!(
+            "    KernelSource {{ name: {name:?}, source: {source:?}, defines: &[{}], spirv: {bytes} }},\n",
+            defines.join(", ")
+        );
     }
     out += "];\n\n/// Every file under glsl/ (relative path, text).\npub const GLSL_FILES: &[(&str, &str)] = &[\n";
     let mut files = Vec::new();

@@ -16,7 +16,7 @@
 //! `~/.cache/brdfprof/kernels`; an empty `BRDFPROF_CACHE_DIR` turns the disk cache off. `brdfprof cache
 //! show|clear` lists and removes brdfprof's entries there (`entries`, `clear`), nothing else.
 
-use anyhow::{anyhow, bail, Context, Result};
+use anyhow::{Context, Result, anyhow, bail};
 use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
 
@@ -69,7 +69,10 @@ pub enum Lookup {
     Hit(Vec<u8>),
     Miss,
     /// The entry exists but cannot be trusted: why.
-    Bad { path: PathBuf, why: String },
+    Bad {
+        path: PathBuf,
+        why: String,
+    },
 }
 
 /// The cache directory brdfprof uses, or None when the disk cache is off (an empty `BRDFPROF_CACHE_DIR`) or
@@ -109,17 +112,26 @@ fn valid_kind(kind: &str) -> bool {
 /// `<64 hex digits>.<kind>`: (key, kind).
 fn entry_name(name: &str) -> Option<(&str, &str)> {
     let (key, kind) = name.split_once('.')?;
-    (key.len() == 64 && key.bytes().all(|b| b.is_ascii_hexdigit() && !b.is_ascii_uppercase()) && valid_kind(kind)).then_some((key, kind))
+    (key.len() == 64 && key.bytes().all(|b| b.is_ascii_hexdigit() && !b.is_ascii_uppercase()) && valid_kind(kind))
+        .then_some((key, kind))
 }
 
 /// `.<key>.<kind>.<pid>.<n>.tmp`: a temporary of `put`.
 fn is_temporary(name: &str) -> bool {
-    name.strip_prefix('.').and_then(|n| n.strip_suffix(".tmp")).and_then(|n| n.split_once('.')).is_some_and(|(key, rest)| entry_name(&format!("{key}.{}", rest.split('.').next().unwrap_or(""))).is_some())
+    name.strip_prefix('.')
+        .and_then(|n| n.strip_suffix(".tmp"))
+        .and_then(|n| n.split_once('.'))
+        .is_some_and(|(key, rest)| entry_name(&format!("{key}.{}", rest.split('.').next().unwrap_or(""))).is_some())
 }
 
 /// The entry's header and payload, as `put` writes them.
 fn encode(kind: &str, key: &Key, payload: &[u8]) -> Vec<u8> {
-    let header = format!("{MAGIC}\nkind: {kind}\nkey: {}\nlength: {}\nsha256: {}\n\n", key.hex(), payload.len(), hex(&Sha256::digest(payload)));
+    let header = format!(
+        "{MAGIC}\nkind: {kind}\nkey: {}\nlength: {}\nsha256: {}\n\n",
+        key.hex(),
+        payload.len(),
+        hex(&Sha256::digest(payload))
+    );
     [header.as_bytes(), payload].concat()
 }
 
@@ -133,14 +145,18 @@ fn read_entry(path: &Path) -> std::result::Result<Option<Vec<u8>>, String> {
     use std::io::Read;
     match std::fs::symlink_metadata(path) {
         Err(_) => return Ok(None),
-        Ok(m) if !m.file_type().is_file() => return Err("not a regular file (a symbolic link, directory or device)".into()),
+        Ok(m) if !m.file_type().is_file() => {
+            return Err("not a regular file (a symbolic link, directory or device)".into());
+        }
         Ok(_) => {}
     }
     let mut file = std::fs::File::open(path).map_err(|e| format!("cannot be read ({e})"))?;
     let mut bytes = Vec::new();
     (&mut file).take(MAX_HEADER).read_to_end(&mut bytes).map_err(|e| format!("cannot be read ({e})"))?;
     let Some(end) = bytes.windows(2).position(|w| w == b"\n\n") else { return Ok(Some(bytes)) };
-    let length = std::str::from_utf8(&bytes[..end]).ok().and_then(|h| h.lines().find_map(|l| l.strip_prefix("length: ")?.parse::<u64>().ok()));
+    let length = std::str::from_utf8(&bytes[..end])
+        .ok()
+        .and_then(|h| h.lines().find_map(|l| l.strip_prefix("length: ")?.parse::<u64>().ok()));
     let Some(length) = length else { return Ok(Some(bytes)) };
     let total = (end as u64).saturating_add(3).saturating_add(length);
     if (bytes.len() as u64) > total {
@@ -153,13 +169,21 @@ fn read_entry(path: &Path) -> std::result::Result<Option<Vec<u8>>, String> {
 
 /// The payload of an entry for `kind` and (when given) `key`, or why it cannot be trusted.
 fn decode<'a>(bytes: &'a [u8], kind: &str, key: Option<&str>) -> std::result::Result<&'a [u8], String> {
-    let end = bytes.windows(2).position(|w| w == b"\n\n").ok_or("no header (not a brdfprof cache entry, or cut short)")?;
+    let end =
+        bytes.windows(2).position(|w| w == b"\n\n").ok_or("no header (not a brdfprof cache entry, or cut short)")?;
     let header = std::str::from_utf8(&bytes[..end]).map_err(|_| "the header is not text")?;
     let mut lines = header.lines();
     if lines.next() != Some(MAGIC) {
         return Err(format!("not a `{MAGIC}` entry"));
     }
-    let mut field = |name: &str| lines.next().and_then(|l| l.strip_prefix(name)).and_then(|l| l.strip_prefix(": ")).map(str::to_string).ok_or(format!("no `{name}` line"));
+    let mut field = |name: &str| {
+        lines
+            .next()
+            .and_then(|l| l.strip_prefix(name))
+            .and_then(|l| l.strip_prefix(": "))
+            .map(str::to_string)
+            .ok_or(format!("no `{name}` line"))
+    };
     let (k, found_key, length, sum) = (field("kind")?, field("key")?, field("length")?, field("sha256")?);
     if k != kind {
         return Err(format!("an entry of kind `{k}` where `{kind}` belongs"));
@@ -216,12 +240,14 @@ impl Store {
         if !valid_kind(kind) {
             bail!("cache kind `{kind}`: lowercase letters, digits and _ only");
         }
-        std::fs::create_dir_all(&self.dir).with_context(|| format!("cannot create the cache directory {}", self.dir.display()))?;
+        std::fs::create_dir_all(&self.dir)
+            .with_context(|| format!("cannot create the cache directory {}", self.dir.display()))?;
         static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
         let n = NEXT.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
         let tmp = self.dir.join(format!(".{}.{kind}.{}.{n}.tmp", key.hex(), std::process::id()));
         let _guard = crate::cleanup::PathGuard::new(&tmp);
-        let result = std::fs::write(&tmp, encode(kind, key, payload)).and_then(|_| std::fs::rename(&tmp, self.path(kind, key)));
+        let result =
+            std::fs::write(&tmp, encode(kind, key, payload)).and_then(|_| std::fs::rename(&tmp, self.path(kind, key)));
         if result.is_err() {
             let _ = std::fs::remove_file(&tmp);
         }
@@ -288,7 +314,14 @@ impl Store {
 /// `build`'s output, stored. A damaged entry is discarded, rebuilt and replaced, with a warning naming its
 /// file; a store that cannot be written costs a rebuild next time, nothing else. `what` names the output in
 /// messages.
-pub fn get_or_build(store: Option<&Store>, kind: &str, key: &Key, what: &str, valid: impl Fn(&[u8]) -> Result<()>, build: impl FnOnce() -> Result<Vec<u8>>) -> Result<Vec<u8>> {
+pub fn get_or_build(
+    store: Option<&Store>,
+    kind: &str,
+    key: &Key,
+    what: &str,
+    valid: impl Fn(&[u8]) -> Result<()>,
+    build: impl FnOnce() -> Result<Vec<u8>>,
+) -> Result<Vec<u8>> {
     let Some(store) = store else { return build() };
     match store.get(kind, key) {
         Lookup::Hit(payload) => match valid(&payload) {
@@ -307,7 +340,10 @@ pub fn get_or_build(store: Option<&Store>, kind: &str, key: &Key, what: &str, va
 
 fn damaged(store: &Store, kind: &str, key: &Key, what: &str, why: &str) {
     let path = store.path(kind, key);
-    crate::messages::warning(format!("the cache entry {} ({what}) is damaged ({why}); discarded, compiled again and replaced", path.display()));
+    crate::messages::warning(format!(
+        "the cache entry {} ({what}) is damaged ({why}); discarded, compiled again and replaced",
+        path.display()
+    ));
     store.discard(kind, key);
 }
 
@@ -347,7 +383,9 @@ mod tests {
         let store = Store::at(dir.path());
         store.put("spv", &key("x"), b"payload").unwrap();
         std::fs::copy(store.path("spv", &key("x")), store.path("spv", &key("y"))).unwrap();
-        assert!(matches!(store.get("spv", &key("y")), Lookup::Bad { why, .. } if why.contains("under another key's name")));
+        assert!(
+            matches!(store.get("spv", &key("y")), Lookup::Bad { why, .. } if why.contains("under another key's name"))
+        );
     }
 
     /// Issue 31 item 6: an entry that is a symbolic link (here to an endless file) is damaged, not read; an
@@ -363,7 +401,9 @@ mod tests {
         long.extend(std::iter::repeat_n(b'!', 1 << 20));
         std::fs::write(store.path("spv", &key("x")), &long).unwrap();
         assert_eq!(read_entry(&store.path("spv", &key("x"))).unwrap().unwrap().len(), long.len() - (1 << 20) + 1);
-        assert!(matches!(store.get("spv", &key("x")), Lookup::Bad { why, .. } if why.contains("bytes of payload where the header says 7")));
+        assert!(
+            matches!(store.get("spv", &key("x")), Lookup::Bad { why, .. } if why.contains("bytes of payload where the header says 7"))
+        );
     }
 
     /// The property the cache exists for: whatever happens to an entry's bytes, `get` returns the payload

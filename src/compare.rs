@@ -5,12 +5,12 @@
 //! whose kernels differ (each report records a SHA-256 of every model's kernel: SPIR-V and the
 //! specialisation constants that select the model).
 
-use crate::schema::InspectReport;
-use crate::schema::HASH_NOTE;
-use crate::profile::ProfileReport;
+use crate::export::markdown::{Table, sig};
 use crate::model::BASELINE_LABEL;
-use crate::export::markdown::{sig, Table};
-use anyhow::{anyhow, bail, Result};
+use crate::profile::ProfileReport;
+use crate::schema::HASH_NOTE;
+use crate::schema::InspectReport;
+use anyhow::{Result, anyhow, bail};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 use std::collections::BTreeMap;
@@ -57,7 +57,8 @@ pub struct PairCorrelation {
 impl PairCorrelation {
     /// The rank agreement of `a` and `b` over the models both have (the memory-only kernel left out).
     pub fn of(a: (&str, &BTreeMap<String, f64>), b: (&str, &BTreeMap<String, f64>), models: &[String]) -> Self {
-        let common: Vec<&String> = models.iter().filter(|m| *m != BASELINE_LABEL && a.1.contains_key(*m) && b.1.contains_key(*m)).collect();
+        let common: Vec<&String> =
+            models.iter().filter(|m| *m != BASELINE_LABEL && a.1.contains_key(*m) && b.1.contains_key(*m)).collect();
         let xs: Vec<f64> = common.iter().map(|m| a.1[*m]).collect();
         let ys: Vec<f64> = common.iter().map(|m| b.1[*m]).collect();
         let enough = common.len() >= 3;
@@ -91,7 +92,12 @@ pub fn spirv_counts(reports: &[InspectReport]) -> BTreeMap<String, f64> {
     for r in reports {
         let total = |m: &str| r.rows.iter().find(|x| x.model == m).and_then(|x| x.stats.get("spirv-O/total").copied());
         let Some(base) = total(BASELINE_LABEL) else { continue };
-        let counts: BTreeMap<String, f64> = r.rows.iter().filter(|x| x.model != BASELINE_LABEL).filter_map(|x| x.stats.get("spirv-O/total").map(|t| (x.model.clone(), t - base))).collect();
+        let counts: BTreeMap<String, f64> = r
+            .rows
+            .iter()
+            .filter(|x| x.model != BASELINE_LABEL)
+            .filter_map(|x| x.stats.get("spirv-O/total").map(|t| (x.model.clone(), t - base)))
+            .collect();
         if !counts.is_empty() {
             return counts;
         }
@@ -158,14 +164,22 @@ pub fn inspect_columns(report: &InspectReport, source: &str) -> Vec<CostColumn> 
             lights: report.lights,
         });
     }
-    let gross: BTreeMap<String, f64> = report.rows.iter().filter_map(|r| r.stats.get("callgrind/ir-per-eval").map(|v| (r.model.clone(), *v))).collect();
+    let gross: BTreeMap<String, f64> = report
+        .rows
+        .iter()
+        .filter_map(|r| r.stats.get("callgrind/ir-per-eval").map(|v| (r.model.clone(), *v)))
+        .collect();
     if !gross.is_empty() {
         out.push(CostColumn {
             name: "callgrind Ir/eval".into(),
             unit: "x86 instructions of lavapipe's JIT code per evaluation".into(),
             source: format!("{source}{device}"),
             gross,
-            net: report.rows.iter().filter_map(|r| r.stats.get("callgrind/net-ir-per-eval").map(|v| (r.model.clone(), *v))).collect(),
+            net: report
+                .rows
+                .iter()
+                .filter_map(|r| r.stats.get("callgrind/net-ir-per-eval").map(|v| (r.model.clone(), *v)))
+                .collect(),
             net_ci: BTreeMap::new(),
             hashes: hashes(report),
             lights: report.lights,
@@ -211,7 +225,11 @@ pub fn profile_columns(view: &ProfileReport, source: &str) -> Vec<CostColumn> {
 pub fn check_kernels(columns: &[CostColumn]) -> Result<()> {
     for c in columns {
         if c.hashes.is_empty() {
-            bail!("{} ({}): records no kernel hashes (written by an older brdfprof); its kernels cannot be matched with the others'. Measure it again", c.name, c.source);
+            bail!(
+                "{} ({}): records no kernel hashes (written by an older brdfprof); its kernels cannot be matched with the others'. Measure it again",
+                c.name,
+                c.source
+            );
         }
     }
     let mut seen: BTreeMap<&str, (&str, &CostColumn)> = BTreeMap::new();
@@ -221,7 +239,11 @@ pub fn check_kernels(columns: &[CostColumn]) -> Result<()> {
         for (model, h) in &c.hashes {
             match seen.get(model.as_str()) {
                 Some((h0, c0)) if *h0 != h.as_str() => {
-                    differ.entry(c0.name.as_str()).or_default().push(format!("`{model}` ({} vs {})", &h0[..12.min(h0.len())], &h[..12.min(h.len())]));
+                    differ.entry(c0.name.as_str()).or_default().push(format!(
+                        "`{model}` ({} vs {})",
+                        &h0[..12.min(h0.len())],
+                        &h[..12.min(h.len())]
+                    ));
                 }
                 Some(_) => {}
                 None => {
@@ -231,7 +253,14 @@ pub fn check_kernels(columns: &[CostColumn]) -> Result<()> {
         }
         if let Some((other, models)) = differ.into_iter().next() {
             let c0 = columns.iter().find(|x| x.name == other).expect("a column seen before");
-            bail!("the kernels differ: {} SPIR-V hashes in {} ({}) and {} ({}); compare reports of the same kernels", models.join(", "), c0.name, c0.source, c.name, c.source);
+            bail!(
+                "the kernels differ: {} SPIR-V hashes in {} ({}) and {} ({}); compare reports of the same kernels",
+                models.join(", "),
+                c0.name,
+                c0.source,
+                c.name,
+                c.source
+            );
         }
     }
     Ok(())
@@ -250,7 +279,12 @@ pub fn build(columns: Vec<CostColumn>) -> CostTable {
     // Row order: the reference first, then by name as the first column orders them (cheapest net first).
     let first = columns.first().cloned();
     models.sort_by(|a, b| {
-        let key = |m: &String| (m != crate::brdf::spec::REFERENCE_MODEL, first.as_ref().and_then(|c| c.net.get(m).copied()).unwrap_or(f64::INFINITY));
+        let key = |m: &String| {
+            (
+                m != crate::brdf::spec::REFERENCE_MODEL,
+                first.as_ref().and_then(|c| c.net.get(m).copied()).unwrap_or(f64::INFINITY),
+            )
+        };
         let (ka, kb) = (key(a), key(b));
         ka.0.cmp(&kb.0).then(ka.1.total_cmp(&kb.1)).then(a.cmp(b))
     });
@@ -272,8 +306,13 @@ impl CostTable {
     /// The table with every column's rank agreement with the SPIR-V counts (`spirv_counts`).
     pub fn with_spirv_baseline(mut self, counts: &BTreeMap<String, f64>) -> Self {
         if !counts.is_empty() {
-            let distinct: Vec<String> = self.models.iter().filter(|m| !self.same_kernel.iter().any(|(s, _)| s == *m)).cloned().collect();
-            self.spirv_baseline = self.columns.iter().map(|c| PairCorrelation::of((SPIRV_BASELINE, counts), (&c.name, &c.net), &distinct)).collect();
+            let distinct: Vec<String> =
+                self.models.iter().filter(|m| !self.same_kernel.iter().any(|(s, _)| s == *m)).cloned().collect();
+            self.spirv_baseline = self
+                .columns
+                .iter()
+                .map(|c| PairCorrelation::of((SPIRV_BASELINE, counts), (&c.name, &c.net), &distinct))
+                .collect();
         }
         self
     }
@@ -307,21 +346,31 @@ impl CostTable {
         }
         let mut out = format!("### Cost per BRDF evaluation across devices\n\n{}\n", t.markdown());
         out += "Sources: ";
-        out += &self.columns.iter().map(|c| format!("{}: {} ({} lights)", c.name, c.source, c.lights)).collect::<Vec<_>>().join("; ");
+        out += &self
+            .columns
+            .iter()
+            .map(|c| format!("{}: {} ({} lights)", c.name, c.source, c.lights))
+            .collect::<Vec<_>>()
+            .join("; ");
         out += "\n\n";
         if !self.correlations.is_empty() {
-            let mut t = Table::new(["device A", "device B", "models", "Spearman rho (net cost) [95% CI]", "discordant pairs"]);
+            let mut t =
+                Table::new(["device A", "device B", "models", "Spearman rho (net cost) [95% CI]", "discordant pairs"]);
             for p in &self.correlations {
                 t.row([p.a.clone(), p.b.clone(), p.models.to_string(), p.rho_cell(), p.discordant_cell()]);
             }
             let same = match self.same_kernel.is_empty() {
                 true => String::new(),
-                false => format!(" Ranked once, as the model whose kernel they are (the same SPIR-V): {}.", self.same_kernel.iter().map(|(m, f)| format!("{m} (= {f})")).collect::<Vec<_>>().join(", ")),
+                false => format!(
+                    " Ranked once, as the model whose kernel they are (the same SPIR-V): {}.",
+                    self.same_kernel.iter().map(|(m, f)| format!("{m} (= {f})")).collect::<Vec<_>>().join(", ")
+                ),
             };
             out += &format!("### Rank correlation between devices\n\n{}\n{RHO_NOTE}{same}\n\n", t.markdown());
         }
         if !self.spirv_baseline.is_empty() {
-            let mut t = Table::new(["device", "models", "Spearman rho with the SPIR-V count [95% CI]", "discordant pairs"]);
+            let mut t =
+                Table::new(["device", "models", "Spearman rho with the SPIR-V count [95% CI]", "discordant pairs"]);
             for p in &self.spirv_baseline {
                 t.row([p.b.clone(), p.models.to_string(), p.rho_cell(), p.discordant_cell()]);
             }
@@ -338,14 +387,19 @@ impl CostTable {
         use plotters::prelude::*;
         const LEGEND_WIDTH: i32 = 230;
         let models: Vec<&String> = self.models.iter().filter(|m| *m != BASELINE_LABEL).collect();
-        let values: Vec<Vec<Option<f64>>> = models.iter().map(|m| self.columns.iter().map(|c| self.relative(c, m)).collect()).collect();
+        let values: Vec<Vec<Option<f64>>> =
+            models.iter().map(|m| self.columns.iter().map(|c| self.relative(c, m)).collect()).collect();
         let max = values.iter().flatten().flatten().fold(1.0f64, |a, &b| a.max(b)) * 1.1;
-        let width = (300 + 60 * models.len() as u32 * self.columns.len().max(1) as u32 / 2).clamp(800, 2400) + LEGEND_WIDTH as u32;
+        let width = (300 + 60 * models.len() as u32 * self.columns.len().max(1) as u32 / 2).clamp(800, 2400)
+            + LEGEND_WIDTH as u32;
         crate::export::png::render(path, width, 600, |root| {
             let e = |e: DrawingAreaErrorKind<_>| anyhow!("{e}");
             // The legend goes in a right margin of its own, so that it never hides a bar.
             let mut chart = ChartBuilder::on(root)
-                .caption("BRDF cost net of the memory-only kernel, relative to ggx, per device", (crate::export::png::FONT, 20))
+                .caption(
+                    "BRDF cost net of the memory-only kernel, relative to ggx, per device",
+                    (crate::export::png::FONT, 20),
+                )
                 .margin(15)
                 .margin_right(LEGEND_WIDTH)
                 .x_label_area_size(90)
@@ -377,13 +431,23 @@ impl CostTable {
                 root.draw(&Rectangle::new([(lx, ly - 5), (lx + 12, ly + 7)], colour.filled())).map_err(e)?;
                 root.draw(&Text::new(c.name.clone(), (lx + 18, ly - 5), (crate::export::png::FONT, 13))).map_err(e)?;
             }
-            chart.draw_series(std::iter::once(PathElement::new(vec![(0.0, 1.0), (models.len() as f64, 1.0)], BLACK.mix(0.5)))).map_err(e)?;
+            chart
+                .draw_series(std::iter::once(PathElement::new(
+                    vec![(0.0, 1.0), (models.len() as f64, 1.0)],
+                    BLACK.mix(0.5),
+                )))
+                .map_err(e)?;
             // Model names under their groups (long specs wrapped at commas).
             for (i, m) in models.iter().enumerate() {
                 let (px, py) = chart.backend_coord(&(i as f64 + 0.5, 0.0));
                 for (k, part) in m.split_inclusive(',').enumerate() {
                     let w = 7 * part.len() as i32;
-                    root.draw(&Text::new(part.to_string(), (px - w / 2, py + 8 + 16 * k as i32), (crate::export::png::FONT, 13))).map_err(e)?;
+                    root.draw(&Text::new(
+                        part.to_string(),
+                        (px - w / 2, py + 8 + 16 * k as i32),
+                        (crate::export::png::FONT, 13),
+                    ))
+                    .map_err(e)?;
                 }
             }
             Ok(())
@@ -394,17 +458,24 @@ impl CostTable {
 /// The columns of one saved JSON report: a `profile` report, an `inspect` report, an `inspect` report of
 /// several devices, or a `check` baseline (its inspect part).
 pub fn load_columns(path: &Path) -> Result<Vec<CostColumn>> {
-    let text = String::from_utf8(crate::io::read_bounded(path, crate::io::MAX_REPORT_BYTES)?).map_err(|_| anyhow!("{}: not UTF-8 text: not a brdfprof JSON report", path.display()))?;
-    let value: serde_json::Value = serde_json::from_str(&text).map_err(|e| anyhow!("{}: not valid JSON ({e})", path.display()))?;
+    let text = String::from_utf8(crate::io::read_bounded(path, crate::io::MAX_REPORT_BYTES)?)
+        .map_err(|_| anyhow!("{}: not UTF-8 text: not a brdfprof JSON report", path.display()))?;
+    let value: serde_json::Value =
+        serde_json::from_str(&text).map_err(|e| anyhow!("{}: not valid JSON ({e})", path.display()))?;
     let source = format!("{}: ", path.display());
     let inspect_of = |v: &serde_json::Value| -> Result<InspectReport> {
-        serde_json::from_value(v.clone()).map_err(|e| anyhow!("{}: not a brdfprof inspect report ({e})", path.display()))
+        serde_json::from_value(v.clone())
+            .map_err(|e| anyhow!("{}: not a brdfprof inspect report ({e})", path.display()))
     };
     let columns = if value.get("raw").is_some() && value.get("workload").is_some() {
         if value.get("kernel_sha256").is_none() {
-            bail!("{}: a profile report that records no kernel hashes (written by an older brdfprof); its kernels cannot be matched with the others'. Measure it again", path.display());
+            bail!(
+                "{}: a profile report that records no kernel hashes (written by an older brdfprof); its kernels cannot be matched with the others'. Measure it again",
+                path.display()
+            );
         }
-        let view: ProfileReport = serde_json::from_value(value).map_err(|e| anyhow!("{}: not a brdfprof profile report ({e})", path.display()))?;
+        let view: ProfileReport = serde_json::from_value(value)
+            .map_err(|e| anyhow!("{}: not a brdfprof profile report ({e})", path.display()))?;
         profile_columns(&view, &source)
     } else if let Some(reports) = value.get("reports").and_then(|r| r.as_array()) {
         let mut out = Vec::new();
@@ -418,7 +489,10 @@ pub fn load_columns(path: &Path) -> Result<Vec<CostColumn>> {
         inspect_columns(&inspect_of(&value)?, &source)
     };
     if columns.is_empty() {
-        bail!("{}: no cost per evaluation in it (a profile report, or an inspect report with ACO statistics or callgrind counts)", path.display());
+        bail!(
+            "{}: no cost per evaluation in it (a profile report, or an inspect report with ACO statistics or callgrind counts)",
+            path.display()
+        );
     }
     Ok(columns)
 }
@@ -449,7 +523,13 @@ impl CostColumn {
     /// finite or above the gross one (the memory-only kernel cannot cost less than nothing), a CI that does
     /// not hold its median.
     pub fn check_figures(&self) -> Result<()> {
-        let fail = |model: &str, why: String| anyhow!("{} ({}): `{model}`: {why}; not a figure a measurement gives (an edited or damaged report?)", self.name, self.source);
+        let fail = |model: &str, why: String| {
+            anyhow!(
+                "{} ({}): `{model}`: {why}; not a figure a measurement gives (an edited or damaged report?)",
+                self.name,
+                self.source
+            )
+        };
         for (model, &g) in &self.gross {
             if !(g.is_finite() && g > 0.0) {
                 return Err(fail(model, format!("cost {g}")));
@@ -460,7 +540,9 @@ impl CostColumn {
             if !n.is_finite() || n > gross {
                 return Err(fail(model, format!("net cost {n} (gross {gross})")));
             }
-            if let Some(&(lo, hi)) = self.net_ci.get(model).filter(|(lo, hi)| !(lo.is_finite() && hi.is_finite() && *lo <= n && n <= *hi)) {
+            if let Some(&(lo, hi)) =
+                self.net_ci.get(model).filter(|(lo, hi)| !(lo.is_finite() && hi.is_finite() && *lo <= n && n <= *hi))
+            {
                 return Err(fail(model, format!("net cost {n} outside its confidence interval [{lo}, {hi}]")));
             }
         }
@@ -480,7 +562,11 @@ pub fn from_files(files: &[PathBuf]) -> Result<CostTable> {
             c.check_figures()?;
             // Two files of the same device: keep both, told apart by their file.
             if columns.iter().any(|o| o.name == c.name) {
-                c.name = format!("{} [{}]", c.name, f.file_name().map_or_else(|| f.display().to_string(), |n| n.to_string_lossy().into_owned()));
+                c.name = format!(
+                    "{} [{}]",
+                    c.name,
+                    f.file_name().map_or_else(|| f.display().to_string(), |n| n.to_string_lossy().into_owned())
+                );
             }
             columns.push(c);
         }

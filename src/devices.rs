@@ -2,14 +2,14 @@
 //! targets (`targets`), one report each, then one cost table across them with every pair's rank correlation
 //! and, with `--profile`, a profile's measured costs beside them.
 
-use crate::inspect::correlate::{self, ProfileReport};
-use crate::inspect::InspectOptions;
-use crate::schema::InspectReport;
 use crate::compare::{self, CostTable};
 use crate::gpu::Gpu;
+use crate::inspect::InspectOptions;
+use crate::inspect::correlate::{self, ProfileReport};
+use crate::schema::InspectReport;
 use crate::shaders::Shaders;
 use crate::targets::{self, Target};
-use anyhow::{anyhow, Result};
+use anyhow::{Result, anyhow};
 use serde::Serialize;
 use std::path::Path;
 
@@ -101,12 +101,22 @@ impl Inspected {
 /// The compile-only targets' runs: the default Vulkan device opened first for the targets whose costs are of
 /// a translation that must run before it is believed.
 fn target_reports(plan: &[Planned], run: &Run, open: &OpenLocal) -> Result<Vec<InspectReport>> {
-    let targets: Vec<Target> = plan.iter().filter_map(|p| if let Planned::Target(t) = p { Some(*t) } else { None }).collect();
+    let targets: Vec<Target> =
+        plan.iter().filter_map(|p| if let Planned::Target(t) = p { Some(*t) } else { None }).collect();
     if targets.is_empty() {
         return Ok(Vec::new());
     }
     let compile = |verify_on: Option<&Gpu>| -> Result<Vec<InspectReport>> {
-        let request = targets::Request { models: &run.options.models, lights: run.options.lights, shaders: run.shaders, validate: run.validate, isa_dir: run.isa_dir, precise: run.precise, verify_on, lines: run.lines };
+        let request = targets::Request {
+            models: &run.options.models,
+            lights: run.options.lights,
+            shaders: run.shaders,
+            validate: run.validate,
+            isa_dir: run.isa_dir,
+            precise: run.precise,
+            verify_on,
+            lines: run.lines,
+        };
         let runs = targets::compile_all(&targets, &request)?;
         for r in &runs {
             if let Some(n) = &r.note {

@@ -8,7 +8,7 @@ pub mod picture;
 
 use crate::accuracy::rel_err;
 use crate::brdf::guards::unit;
-use crate::brdf::{samples, Sample};
+use crate::brdf::{Sample, samples};
 use crate::model::Model;
 use serde::{Deserialize, Serialize};
 
@@ -24,7 +24,7 @@ pub const HISTOGRAM_EDGES: [f64; 9] = [0.0, 1e-7, 1e-6, 1e-5, 1e-4, 1e-3, 1e-2, 
 /// The largest input `diff` evaluates (both models' outputs and the statistics stay within a few GB).
 pub const MAX_SAMPLES: usize = 20_000_000;
 
-pub use crate::brdf::samples::{SampleDomain, DEFAULT_MIN_COS};
+pub use crate::brdf::samples::{DEFAULT_MIN_COS, SampleDomain};
 
 /// The default inputs: `count` well-conditioned samples (`SampleDomain::default()`, F0 uniform in [0, 1]^3),
 /// seeded.
@@ -56,7 +56,10 @@ pub fn default_samples_label_in(count: usize, seed: u64, domain: &SampleDomain, 
     } else {
         format!("NoV in [{}, {}]{}, NoL in [{}, {}]{}", v.0, v.1, why[1], l.0, l.1, why[2])
     };
-    format!("{count} well-conditioned samples (seed {seed}; {cosines}, roughness in [{}, {}]{}, F0 in [0, 1]^3)", r.0, r.1, why[0])
+    format!(
+        "{count} well-conditioned samples (seed {seed}; {cosines}, roughness in [{}, {}]{}, F0 in [0, 1]^3)",
+        r.0, r.1, why[0]
+    )
 }
 
 /// One model as the report names it.
@@ -73,7 +76,11 @@ pub struct Side {
 
 impl Side {
     pub fn of(model: &Model) -> Self {
-        Side { name: model.label(), canonical: model.canonical(), front_end: model.file().and_then(|f| f.file.front_end.clone()) }
+        Side {
+            name: model.label(),
+            canonical: model.canonical(),
+            front_end: model.file().and_then(|f| f.file.front_end.clone()),
+        }
     }
 
     /// A reference's side: its f64 twin's values, not its kernel's.
@@ -119,7 +126,7 @@ impl DiffSet {
     /// One table (a row per model: its largest and RMS relative difference over the channels, its
     /// non-finite values, its worst row), then each model's report.
     pub fn markdown(&self) -> String {
-        use crate::export::markdown::{sig, Table};
+        use crate::export::markdown::{Table, sig};
         let mut out = format!(
             "# {} models against {}\n\n{} rows of {} on {}; relative: rel_err(model, reference) = |model - reference| / max(|reference|, {}).\n\n",
             self.diffs.len(),
@@ -132,26 +139,55 @@ impl DiffSet {
         for d in self.diffs.iter().filter(|d| d.b.front_end.is_some()) {
             out += &format!("{}'s front end: {}.\n\n", d.b.name, d.b.front_end.as_deref().unwrap_or(""));
         }
-        let mut t = Table::new(["model", "max rel", "RMS rel (worst channel)", "max abs", "rows within 1e-3", "non-finite (model / one side only)", "worst row", "verdict"]);
+        let mut t = Table::new([
+            "model",
+            "max rel",
+            "RMS rel (worst channel)",
+            "max abs",
+            "rows within 1e-3",
+            "non-finite (model / one side only)",
+            "worst row",
+            "verdict",
+        ]);
         for d in &self.diffs {
             let rms = d.difference.channels.iter().map(|c| c.rms_rel).fold(0.0, f64::max);
-            let within: usize = d.histogram.counts.iter().zip(&d.histogram.edges).filter(|(_, e)| **e < 1e-3).map(|(n, _)| n).sum();
+            let within: usize =
+                d.histogram.counts.iter().zip(&d.histogram.edges).filter(|(_, e)| **e < 1e-3).map(|(n, _)| n).sum();
             let nonfinite = d.difference.channels.iter().map(|c| c.b_nonfinite).sum::<usize>();
             let one_side = d.difference.channels.iter().map(|c| c.mismatched_nonfinite).sum::<usize>();
             let worst = d.worst.first().map_or("-".into(), |w| {
                 let (n, v, l) = (unit(w.sample.n), unit(w.sample.v), unit(w.sample.l));
-                format!("{} ({}) at NoV {:.3}, NoL {:.3}, roughness {:.3}", sig(w.rel, 3), w.channel, n.dot(v), n.dot(l), w.sample.roughness)
+                format!(
+                    "{} ({}) at NoV {:.3}, NoL {:.3}, roughness {:.3}",
+                    sig(w.rel, 3),
+                    w.channel,
+                    n.dot(v),
+                    n.dot(l),
+                    w.sample.roughness
+                )
             });
             let verdict = match self.tolerance {
                 Some(_) if d.within_tolerance => "within",
                 Some(_) => "ABOVE",
                 None => "-",
             };
-            t.row([d.b.name.clone(), sig(d.difference.max_rel, 3), sig(rms, 3), sig(d.difference.max_abs, 3), format!("{within} of {}", d.rows), format!("{nonfinite} / {one_side}"), worst, verdict.to_string()]);
+            t.row([
+                d.b.name.clone(),
+                sig(d.difference.max_rel, 3),
+                sig(rms, 3),
+                sig(d.difference.max_abs, 3),
+                format!("{within} of {}", d.rows),
+                format!("{nonfinite} / {one_side}"),
+                worst,
+                verdict.to_string(),
+            ]);
         }
         out += &t.markdown();
         if let Some(tol) = self.tolerance {
-            out += &format!("\n--tolerance {tol}: {}.\n", if self.within_tolerance { "every model within it" } else { "NOT every model within it" });
+            out += &format!(
+                "\n--tolerance {tol}: {}.\n",
+                if self.within_tolerance { "every model within it" } else { "NOT every model within it" }
+            );
         }
         for d in &self.diffs {
             out += &format!("\n{}", d.markdown().replacen("# ", "## ", 1));
@@ -289,7 +325,11 @@ pub fn difference(a: &[[f64; 3]], b: &[[f64; 3]]) -> Difference {
     let channels: Vec<ChannelStats> = (0..3).map(|c| channel_stats(c, a, b)).collect();
     let worst = |f: fn(&ChannelStats) -> f64| channels.iter().map(f).fold(0.0, f64::max);
     let mismatched = channels.iter().any(|c| c.mismatched_nonfinite > 0);
-    Difference { max_rel: if mismatched { f64::INFINITY } else { worst(|c| c.max_rel) }, max_abs: worst(|c| c.max_abs), channels }
+    Difference {
+        max_rel: if mismatched { f64::INFINITY } else { worst(|c| c.max_rel) },
+        max_abs: worst(|c| c.max_abs),
+        channels,
+    }
 }
 
 fn channel_stats(c: usize, a: &[[f64; 3]], b: &[[f64; 3]]) -> ChannelStats {
@@ -325,7 +365,12 @@ fn row_rel(a: [f64; 3], b: [f64; 3]) -> Option<(usize, f64)> {
 
 /// The histogram of rows by `row_rel`.
 pub fn histogram(a: &[[f64; 3]], b: &[[f64; 3]]) -> Histogram {
-    let mut h = Histogram { edges: HISTOGRAM_EDGES.to_vec(), counts: vec![0; HISTOGRAM_EDGES.len()], identical: 0, nonfinite: 0 };
+    let mut h = Histogram {
+        edges: HISTOGRAM_EDGES.to_vec(),
+        counts: vec![0; HISTOGRAM_EDGES.len()],
+        identical: 0,
+        nonfinite: 0,
+    };
     for (x, y) in a.iter().zip(b) {
         h.identical += (x == y) as usize;
         match row_rel(*x, *y) {
@@ -337,7 +382,13 @@ pub fn histogram(a: &[[f64; 3]], b: &[[f64; 3]]) -> Histogram {
 }
 
 /// The `count` rows with the largest `row_rel`, largest first (ties: the earlier row first).
-pub fn worst_rows(samples: &[Sample], lines: Option<&[usize]>, a: &[[f32; 3]], b: &[[f32; 3]], count: usize) -> Vec<WorstRow> {
+pub fn worst_rows(
+    samples: &[Sample],
+    lines: Option<&[usize]>,
+    a: &[[f32; 3]],
+    b: &[[f32; 3]],
+    count: usize,
+) -> Vec<WorstRow> {
     let wide = |v: &[f32; 3]| v.map(f64::from);
     let mut ranked: Vec<(usize, usize, f64)> = (0..samples.len())
         .map(|i| row_rel(wide(&a[i]), wide(&b[i])).map_or((i, 0, f64::INFINITY), |(c, r)| (i, c, r)))
@@ -405,20 +456,35 @@ impl DiffReport {
 
     /// The report as Markdown: the channel table, the twins' figures, the histogram and the worst rows.
     pub fn markdown(&self) -> String {
-        use crate::export::markdown::{sig, Table};
-        let mut out = format!("# {} against {}\n\n{} rows of {} on {}; relative: {}.\n\n", self.b.name, self.a.name, self.rows, self.input, self.device, self.relative_to);
+        use crate::export::markdown::{Table, sig};
+        let mut out = format!(
+            "# {} against {}\n\n{} rows of {} on {}; relative: {}.\n\n",
+            self.b.name, self.a.name, self.rows, self.input, self.device, self.relative_to
+        );
         for side in [&self.a, &self.b] {
             if let Some(f) = &side.front_end {
                 out += &format!("{}'s front end: {f}.\n\n", side.name);
             }
         }
-        let mut t = Table::new(["channel", "max rel", "RMS rel", "max abs", "RMS abs", "non-finite (A / B / one side only)"]);
+        let mut t =
+            Table::new(["channel", "max rel", "RMS rel", "max abs", "RMS abs", "non-finite (A / B / one side only)"]);
         for c in &self.difference.channels {
-            t.row([c.channel.to_string(), sig(c.max_rel, 3), sig(c.rms_rel, 3), sig(c.max_abs, 3), sig(c.rms_abs, 3), format!("{} / {} / {}", c.a_nonfinite, c.b_nonfinite, c.mismatched_nonfinite)]);
+            t.row([
+                c.channel.to_string(),
+                sig(c.max_rel, 3),
+                sig(c.rms_rel, 3),
+                sig(c.max_abs, 3),
+                sig(c.rms_abs, 3),
+                format!("{} / {} / {}", c.a_nonfinite, c.b_nonfinite, c.mismatched_nonfinite),
+            ]);
         }
         out += &t.markdown();
         if let Some(tw) = &self.twins {
-            out += &format!("\nf64 twins on the same rows (the formulas' own difference): max rel {}, max abs {}.\n", sig(tw.max_rel, 3), sig(tw.max_abs, 3));
+            out += &format!(
+                "\nf64 twins on the same rows (the formulas' own difference): max rel {}, max abs {}.\n",
+                sig(tw.max_rel, 3),
+                sig(tw.max_abs, 3)
+            );
         }
         out += &self.histogram_markdown();
         out += &self.worst_markdown();
@@ -427,7 +493,10 @@ impl DiffReport {
             out += &match (self.within_tolerance, unmeasured) {
                 (true, _) => format!("\nWithin --tolerance {tol} (max rel {}).\n", sig(self.difference.max_rel, 3)),
                 (false, 0) => format!("\nABOVE --tolerance {tol} (max rel {}).\n", sig(self.difference.max_rel, 3)),
-                (false, n) => format!("\nNOT within --tolerance {tol}: {n} values are NaN on both sides, which no difference measures (max rel {} over the rest).\n", sig(self.difference.max_rel, 3)),
+                (false, n) => format!(
+                    "\nNOT within --tolerance {tol}: {n} values are NaN on both sides, which no difference measures (max rel {} over the rest).\n",
+                    sig(self.difference.max_rel, 3)
+                ),
             };
         }
         out
@@ -444,19 +513,36 @@ impl DiffReport {
             };
             t.row([range, n.to_string(), "#".repeat((40 * n).div_ceil(most))]);
         }
-        format!("\n{} of {} rows identical; {} finite on one side only.\n\n{}", h.identical, self.rows, h.nonfinite, t.markdown())
+        format!(
+            "\n{} of {} rows identical; {} finite on one side only.\n\n{}",
+            h.identical,
+            self.rows,
+            h.nonfinite,
+            t.markdown()
+        )
     }
 
     fn worst_markdown(&self) -> String {
         if self.worst.is_empty() {
             return String::new();
         }
-        let mut t = crate::export::markdown::Table::new(["row", "n", "v", "l", "roughness", "f0", "A", "B", "rel (channel)"]);
+        let mut t =
+            crate::export::markdown::Table::new(["row", "n", "v", "l", "roughness", "f0", "A", "B", "rel (channel)"]);
         for w in &self.worst {
             let v3 = |v: [f32; 3]| format!("{} {} {}", v[0], v[1], v[2]);
             let s = &w.sample;
             let row = w.line.map_or(w.index.to_string(), |l| format!("line {l}"));
-            t.row([row, v3(s.n), v3(s.v), v3(s.l), s.roughness.to_string(), v3(s.f0), v3(w.a), v3(w.b), format!("{} ({})", crate::export::markdown::sig(w.rel, 3), w.channel)]);
+            t.row([
+                row,
+                v3(s.n),
+                v3(s.v),
+                v3(s.l),
+                s.roughness.to_string(),
+                v3(s.f0),
+                v3(w.a),
+                v3(w.b),
+                format!("{} ({})", crate::export::markdown::sig(w.rel, 3), w.channel),
+            ]);
         }
         format!("\nRows where they differ most:\n\n{}", t.markdown())
     }
@@ -467,7 +553,16 @@ pub fn csv(samples: &[Sample], a: &[[f32; 3]], b: &[[f32; 3]]) -> String {
     let mut out = String::with_capacity(samples.len() * 160);
     out.push_str("nx,ny,nz,vx,vy,vz,lx,ly,lz,roughness,f0r,f0g,f0b,a_r,a_g,a_b,b_r,b_g,b_b\n");
     for ((s, x), y) in samples.iter().zip(a).zip(b) {
-        let fields: Vec<String> = s.n.iter().chain(&s.v).chain(&s.l).chain(std::iter::once(&s.roughness)).chain(&s.f0).chain(x).chain(y).map(f32::to_string).collect();
+        let fields: Vec<String> =
+            s.n.iter()
+                .chain(&s.v)
+                .chain(&s.l)
+                .chain(std::iter::once(&s.roughness))
+                .chain(&s.f0)
+                .chain(x)
+                .chain(y)
+                .map(f32::to_string)
+                .collect();
         out.push_str(&fields.join(","));
         out.push('\n');
     }
@@ -485,7 +580,15 @@ pub fn csv_set(samples: &[Sample], reference: &[[f32; 3]], models: &[Vec<[f32; 3
     out.push('\n');
     for (k, s) in samples.iter().enumerate() {
         let values = std::iter::once(&reference[k]).chain(models.iter().map(|m| &m[k])).flatten();
-        let fields: Vec<String> = s.n.iter().chain(&s.v).chain(&s.l).chain(std::iter::once(&s.roughness)).chain(&s.f0).chain(values).map(f32::to_string).collect();
+        let fields: Vec<String> =
+            s.n.iter()
+                .chain(&s.v)
+                .chain(&s.l)
+                .chain(std::iter::once(&s.roughness))
+                .chain(&s.f0)
+                .chain(values)
+                .map(f32::to_string)
+                .collect();
         out.push_str(&fields.join(","));
         out.push('\n');
     }

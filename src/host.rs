@@ -37,7 +37,10 @@ impl HostCpu {
 
     /// "vendor family F model M stepping S (model name)".
     pub fn describe(&self) -> String {
-        format!("{} family {} model {} stepping {} ({})", self.vendor, self.family, self.model, self.stepping, self.model_name)
+        format!(
+            "{} family {} model {} stepping {} ({})",
+            self.vendor, self.family, self.model, self.stepping, self.model_name
+        )
     }
 
     /// The widest vector extension present: "AVX-512", "AVX2", ...
@@ -62,7 +65,10 @@ pub fn cpu_features() -> Vec<String> {
     macro_rules! probe {
         ($($name:tt),*) => { $( if std::arch::is_x86_feature_detected!($name) { f.push($name.to_string()); } )* };
     }
-    probe!("sse4.1", "sse4.2", "popcnt", "avx", "avx2", "fma", "f16c", "bmi1", "bmi2", "avx512f", "avx512dq", "avx512bw", "avx512vl", "avx512cd");
+    probe!(
+        "sse4.1", "sse4.2", "popcnt", "avx", "avx2", "fma", "f16c", "bmi1", "bmi2", "avx512f", "avx512dq", "avx512bw",
+        "avx512vl", "avx512cd"
+    );
     f
 }
 
@@ -87,7 +93,11 @@ pub const MEMORY_LIMIT_ENV: &str = "BRDFPROF_MEMORY_LIMIT";
 /// `MEMORY_LIMIT_ENV` when set: a whole number of bytes (an error names the variable otherwise).
 pub fn memory_limit() -> anyhow::Result<Option<u64>> {
     match std::env::var(MEMORY_LIMIT_ENV) {
-        Ok(v) if !v.trim().is_empty() => v.trim().parse::<u64>().map(Some).map_err(|_| anyhow::anyhow!("{MEMORY_LIMIT_ENV}={v}: give a whole number of bytes")),
+        Ok(v) if !v.trim().is_empty() => v
+            .trim()
+            .parse::<u64>()
+            .map(Some)
+            .map_err(|_| anyhow::anyhow!("{MEMORY_LIMIT_ENV}={v}: give a whole number of bytes")),
         _ => Ok(None),
     }
 }

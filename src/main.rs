@@ -81,7 +81,13 @@ enum Command {
 fn main() -> ExitCode {
     cli::command_started();
     let cli = Cli::parse();
-    let child = matches!(cli.command, Command::CallgrindChild { .. } | Command::NoopChild { .. } | Command::RunTranslation { .. } | Command::ProbeVulkan);
+    let child = matches!(
+        cli.command,
+        Command::CallgrindChild { .. }
+            | Command::NoopChild { .. }
+            | Command::RunTranslation { .. }
+            | Command::ProbeVulkan
+    );
     if let Err(e) = cli::prepare(child, cli.compile_timeout) {
         return cli::finish(Err(e));
     }

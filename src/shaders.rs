@@ -2,7 +2,7 @@
 //! time with glslang (from another GLSL directory, `--glsl DIR`, or composed for a `.brdf` model), and the
 //! GLSL sources themselves, embedded so that kernels can be composed without a checkout.
 
-use anyhow::{anyhow, bail, Context, Result};
+use anyhow::{Context, Result, anyhow, bail};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -92,7 +92,11 @@ impl Shaders {
     pub fn describe(&self) -> String {
         match &self.glsl {
             None => "embedded spv/".into(),
-            Some(dir) => format!("compiled at run time from {} ({})", dir.display(), glslang_version().unwrap_or_else(|| "glslang".into())),
+            Some(dir) => format!(
+                "compiled at run time from {} ({})",
+                dir.display(),
+                glslang_version().unwrap_or_else(|| "glslang".into())
+            ),
         }
     }
 
@@ -126,7 +130,8 @@ impl Shaders {
             }
             None => {
                 let k = embedded(name)?;
-                let tmp = crate::cleanup::TempDir::new().context("cannot create a temporary directory for glslang -g")?;
+                let tmp =
+                    crate::cleanup::TempDir::new().context("cannot create a temporary directory for glslang -g")?;
                 let root = tmp.path().join("glsl");
                 write_glsl_tree(&root)?;
                 let defines: Vec<String> = k.defines.iter().map(|d| d.to_string()).collect();
@@ -159,7 +164,13 @@ pub fn glslang(source: &Path, defines: &[String], includes: &[&Path], what: &str
 }
 
 /// `glslang` with `extra` flags after brdfprof's own (`-g`: line information for the translation's messages).
-pub fn glslang_with(source: &Path, defines: &[String], includes: &[&Path], what: &str, extra: &[&str]) -> Result<Vec<u32>> {
+pub fn glslang_with(
+    source: &Path,
+    defines: &[String],
+    includes: &[&Path],
+    what: &str,
+    extra: &[&str],
+) -> Result<Vec<u32>> {
     let out_dir = crate::cleanup::TempDir::new().context("cannot create a temporary directory for glslang's output")?;
     let out = out_dir.path().join("out.spv");
     let mut cmd = crate::cleanup::command("glslangValidator");
@@ -173,13 +184,19 @@ pub fn glslang_with(source: &Path, defines: &[String], includes: &[&Path], what:
     cmd.arg("-o").arg(&out).arg(source);
     let result = match crate::launch::output(&mut cmd, what) {
         Ok(r) => r,
-        Err(e) if e.downcast_ref::<std::io::Error>().is_some() => bail!("cannot run glslangValidator ({e}): install glslang-tools, or run `make setup`"),
+        Err(e) if e.downcast_ref::<std::io::Error>().is_some() => {
+            bail!("cannot run glslangValidator ({e}): install glslang-tools, or run `make setup`")
+        }
         Err(e) => return Err(e),
     };
     if !result.status.success() {
-        bail!(GlslangError { source: source.to_path_buf(), log: format!("{}{}", String::from_utf8_lossy(&result.stdout), String::from_utf8_lossy(&result.stderr)) });
+        bail!(GlslangError {
+            source: source.to_path_buf(),
+            log: format!("{}{}", String::from_utf8_lossy(&result.stdout), String::from_utf8_lossy(&result.stderr))
+        });
     }
-    let bytes = crate::io::read_bounded(&out, crate::launch::MAX_OUTPUT_BYTES as u64).with_context(|| format!("glslang's output {}", out.display()))?;
+    let bytes = crate::io::read_bounded(&out, crate::launch::MAX_OUTPUT_BYTES as u64)
+        .with_context(|| format!("glslang's output {}", out.display()))?;
     Ok(Spirv::from_bytes(&source.display().to_string(), &bytes)?.words.to_vec())
 }
 
@@ -188,7 +205,8 @@ pub fn glslang_with(source: &Path, defines: &[String], includes: &[&Path], what:
 /// `-E` cannot be combined with `-V`, so `VULKAN=100`, which glslang defines when it compiles for Vulkan, is
 /// given here as a define: a `#ifdef VULKAN` selects what the kernel compilation will see.
 pub fn glslang_preprocess(text: &str, defines: &[String], what: &str) -> Result<std::result::Result<String, String>> {
-    let dir = crate::cleanup::TempDir::new().context("cannot create a temporary directory for glslang's preprocessor")?;
+    let dir =
+        crate::cleanup::TempDir::new().context("cannot create a temporary directory for glslang's preprocessor")?;
     let source = dir.path().join("shader.comp");
     std::fs::write(&source, text).with_context(|| format!("cannot write {}", source.display()))?;
     let mut cmd = crate::cleanup::command("glslangValidator");
@@ -199,7 +217,9 @@ pub fn glslang_preprocess(text: &str, defines: &[String], what: &str) -> Result<
     cmd.arg(&source);
     let result = match crate::launch::output(&mut cmd, what) {
         Ok(r) => r,
-        Err(e) if e.downcast_ref::<std::io::Error>().is_some() => bail!("cannot run glslangValidator ({e}): install glslang-tools, or run `make setup`"),
+        Err(e) if e.downcast_ref::<std::io::Error>().is_some() => {
+            bail!("cannot run glslangValidator ({e}): install glslang-tools, or run `make setup`")
+        }
         Err(e) => return Err(e),
     };
     let stdout = String::from_utf8_lossy(&result.stdout).into_owned();

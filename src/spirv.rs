@@ -5,43 +5,90 @@
 //! every instruction inside a function body is counted by class.
 
 use crate::gpu::SpecConstants;
-use anyhow::{anyhow, bail, Result};
+use anyhow::{Result, anyhow, bail};
 use rspirv::dr::{Module, Operand};
 use rspirv::spirv::{Decoration, GlslStd450Op, Op};
 use std::collections::BTreeMap;
 
 /// spirv-opt passes that keep only the code a frozen specialisation runs, without optimising it further.
-pub const SPECIALISE_PASSES: [&str; 5] = ["--freeze-spec-const", "--fold-spec-const-op-composite", "--eliminate-dead-branches", "--eliminate-dead-code-aggressive", "--eliminate-dead-functions"];
+pub const SPECIALISE_PASSES: [&str; 5] = [
+    "--freeze-spec-const",
+    "--fold-spec-const-op-composite",
+    "--eliminate-dead-branches",
+    "--eliminate-dead-code-aggressive",
+    "--eliminate-dead-functions",
+];
 
 /// The class an instruction is counted in.
 pub fn class_of(op: Op) -> &'static str {
     use Op::*;
     match op {
-        FAdd | FSub | FMul | FDiv | FRem | FMod | FNegate | VectorTimesScalar | MatrixTimesScalar | VectorTimesMatrix
-        | MatrixTimesVector | MatrixTimesMatrix | OuterProduct | Dot | Transpose => "float-arith",
+        FAdd | FSub | FMul | FDiv | FRem | FMod | FNegate | VectorTimesScalar | MatrixTimesScalar
+        | VectorTimesMatrix | MatrixTimesVector | MatrixTimesMatrix | OuterProduct | Dot | Transpose => "float-arith",
         IAdd | ISub | IMul | SDiv | UDiv | SRem | SMod | UMod | SNegate | ShiftLeftLogical | ShiftRightLogical
         | ShiftRightArithmetic | BitwiseAnd | BitwiseOr | BitwiseXor | Not | IAddCarry | ISubBorrow | UMulExtended
         | SMulExtended | BitFieldInsert | BitFieldSExtract | BitFieldUExtract | BitReverse | BitCount => "int-arith",
         ExtInst => "ext",
-        FConvert | ConvertFToU | ConvertFToS | ConvertSToF | ConvertUToF | UConvert | SConvert | Bitcast | QuantizeToF16
-        | SatConvertSToU | SatConvertUToS => "conversion",
-        Load | Store | AccessChain | InBoundsAccessChain | PtrAccessChain | InBoundsPtrAccessChain | CopyMemory
-        | CopyMemorySized | Variable | ArrayLength | AtomicLoad | AtomicStore => "memory",
+        FConvert | ConvertFToU | ConvertFToS | ConvertSToF | ConvertUToF | UConvert | SConvert | Bitcast
+        | QuantizeToF16 | SatConvertSToU | SatConvertUToS => "conversion",
+        Load
+        | Store
+        | AccessChain
+        | InBoundsAccessChain
+        | PtrAccessChain
+        | InBoundsPtrAccessChain
+        | CopyMemory
+        | CopyMemorySized
+        | Variable
+        | ArrayLength
+        | AtomicLoad
+        | AtomicStore => "memory",
         CompositeConstruct | CompositeExtract | CompositeInsert | VectorShuffle | VectorExtractDynamic
         | VectorInsertDynamic | CopyObject | CopyLogical => "composite",
         Branch | BranchConditional | Switch | Phi | LoopMerge | SelectionMerge | Return | ReturnValue | Kill
         | TerminateInvocation | Unreachable | FunctionCall => "control",
-        FOrdEqual | FUnordEqual | FOrdNotEqual | FUnordNotEqual | FOrdLessThan | FUnordLessThan | FOrdGreaterThan
-        | FUnordGreaterThan | FOrdLessThanEqual | FUnordLessThanEqual | FOrdGreaterThanEqual | FUnordGreaterThanEqual
-        | IEqual | INotEqual | SLessThan | SLessThanEqual | SGreaterThan | SGreaterThanEqual | ULessThan
-        | ULessThanEqual | UGreaterThan | UGreaterThanEqual | LogicalAnd | LogicalOr | LogicalNot | LogicalEqual
-        | LogicalNotEqual | Select | Any | All | IsNan | IsInf | IsFinite | IsNormal | SignBitSet => "compare-logic",
+        FOrdEqual
+        | FUnordEqual
+        | FOrdNotEqual
+        | FUnordNotEqual
+        | FOrdLessThan
+        | FUnordLessThan
+        | FOrdGreaterThan
+        | FUnordGreaterThan
+        | FOrdLessThanEqual
+        | FUnordLessThanEqual
+        | FOrdGreaterThanEqual
+        | FUnordGreaterThanEqual
+        | IEqual
+        | INotEqual
+        | SLessThan
+        | SLessThanEqual
+        | SGreaterThan
+        | SGreaterThanEqual
+        | ULessThan
+        | ULessThanEqual
+        | UGreaterThan
+        | UGreaterThanEqual
+        | LogicalAnd
+        | LogicalOr
+        | LogicalNot
+        | LogicalEqual
+        | LogicalNotEqual
+        | Select
+        | Any
+        | All
+        | IsNan
+        | IsInf
+        | IsFinite
+        | IsNormal
+        | SignBitSet => "compare-logic",
         _ => "other",
     }
 }
 
 /// The classes, in report order (extended instructions are counted by name instead of as one class).
-pub const CLASSES: [&str; 8] = ["float-arith", "int-arith", "conversion", "memory", "composite", "control", "compare-logic", "other"];
+pub const CLASSES: [&str; 8] =
+    ["float-arith", "int-arith", "conversion", "memory", "composite", "control", "compare-logic", "other"];
 
 /// Counts of one module: instructions inside function bodies (OpLabel, OpFunction, OpFunctionParameter and
 /// OpFunctionEnd excluded), per class, and GLSL.std.450 extended instructions per name.
@@ -57,7 +104,10 @@ pub struct Counts {
 impl Counts {
     /// `prefix/total`, `prefix/functions`, `prefix/<class>`, `prefix/glsl.<Name>`: the statistic keys.
     pub fn stats(&self, prefix: &str) -> Vec<(String, f64)> {
-        let mut out = vec![(format!("{prefix}/total"), self.total as f64), (format!("{prefix}/functions"), self.functions as f64)];
+        let mut out = vec![
+            (format!("{prefix}/total"), self.total as f64),
+            (format!("{prefix}/functions"), self.functions as f64),
+        ];
         out.extend(CLASSES.iter().map(|c| (format!("{prefix}/{c}"), *self.classes.get(c).unwrap_or(&0) as f64)));
         out.extend(self.glsl.iter().map(|(name, n)| (format!("{prefix}/glsl.{name}"), *n as f64)));
         out
@@ -87,7 +137,9 @@ pub fn count(words: &[u32]) -> Result<Counts> {
             continue;
         }
         let glsl = match inst.operands.as_slice() {
-            [Operand::IdRef(set), Operand::LiteralExtInstInteger(n), ..] if glsl_sets.contains(set) => GlslStd450Op::from_u32(*n),
+            [Operand::IdRef(set), Operand::LiteralExtInstInteger(n), ..] if glsl_sets.contains(set) => {
+                GlslStd450Op::from_u32(*n)
+            }
             _ => None,
         };
         match glsl {
@@ -107,11 +159,14 @@ pub fn spec_default_values(words: &[u32], constants: &SpecConstants) -> Result<S
         .iter()
         .filter(|a| a.class.opcode == Op::Decorate)
         .filter_map(|a| match a.operands.as_slice() {
-            [Operand::IdRef(target), Operand::Decoration(Decoration::SpecId), Operand::LiteralBit32(id)] => Some((*id, *target)),
+            [Operand::IdRef(target), Operand::Decoration(Decoration::SpecId), Operand::LiteralBit32(id)] => {
+                Some((*id, *target))
+            }
             _ => None,
         })
         .collect();
-    let types: BTreeMap<u32, &rspirv::dr::Instruction> = module.types_global_values.iter().filter_map(|i| i.result_id.map(|id| (id, i))).collect();
+    let types: BTreeMap<u32, &rspirv::dr::Instruction> =
+        module.types_global_values.iter().filter_map(|i| i.result_id.map(|id| (id, i))).collect();
     let mut items = Vec::new();
     for (id, bytes) in constants.values() {
         let Some(constant) = target_of_spec_id.get(&id).and_then(|t| types.get(t)) else { continue };
@@ -119,7 +174,9 @@ pub fn spec_default_values(words: &[u32], constants: &SpecConstants) -> Result<S
         let text = match ty {
             Some(Op::TypeFloat) => format!("{:?}", f32::from_ne_bytes(bytes)),
             Some(Op::TypeInt) => i32::from_ne_bytes(bytes).to_string(),
-            other => bail!("specialisation constant {id} has type {other:?}; brdfprof only sets 32-bit int and float constants"),
+            other => bail!(
+                "specialisation constant {id} has type {other:?}; brdfprof only sets 32-bit int and float constants"
+            ),
         };
         items.push(format!("{id}:{text}"));
     }
@@ -134,14 +191,20 @@ pub fn spirv_opt(words: &[u32], args: &[String]) -> Result<Vec<u32>> {
     let shown = if args.len() > 3 { format!("{} ...", args[..3].join(" ")) } else { args.join(" ") };
     let out = match crate::launch::output_with_input(&mut cmd, bytes, &format!("spirv-opt {shown}")) {
         Ok(out) => out,
-        Err(e) if e.downcast_ref::<std::io::Error>().is_some() => bail!("cannot run spirv-opt ({e}): install spirv-tools, or run `make setup`"),
+        Err(e) if e.downcast_ref::<std::io::Error>().is_some() => {
+            bail!("cannot run spirv-opt ({e}): install spirv-tools, or run `make setup`")
+        }
         Err(e) => return Err(e),
     };
     if !out.status.success() {
         bail!("spirv-opt {} failed: {}", args.join(" "), String::from_utf8_lossy(&out.stderr).trim());
     }
     if out.stdout.len() % 4 != 0 {
-        bail!("spirv-opt wrote {} bytes, not whole SPIR-V words: {}", out.stdout.len(), String::from_utf8_lossy(&out.stdout[..out.stdout.len().min(300)]));
+        bail!(
+            "spirv-opt wrote {} bytes, not whole SPIR-V words: {}",
+            out.stdout.len(),
+            String::from_utf8_lossy(&out.stdout[..out.stdout.len().min(300)])
+        );
     }
     Ok(out.stdout.chunks_exact(4).map(|c| u32::from_le_bytes(c.try_into().unwrap())).collect())
 }
@@ -150,7 +213,8 @@ pub fn spirv_opt(words: &[u32], args: &[String]) -> Result<Vec<u32>> {
 pub fn specialise(words: &[u32], constants: &SpecConstants) -> Result<Vec<u32>> {
     let values = spec_default_values(words, constants)?;
     // A module none of whose constants is set (a .brdf model's eval kernel) keeps its defaults.
-    let mut args = if values.is_empty() { Vec::new() } else { vec!["--set-spec-const-default-value".to_string(), values] };
+    let mut args =
+        if values.is_empty() { Vec::new() } else { vec!["--set-spec-const-default-value".to_string(), values] };
     args.extend(SPECIALISE_PASSES.iter().map(|s| s.to_string()));
     spirv_opt(words, &args)
 }
@@ -168,9 +232,9 @@ pub fn spirv_opt_version() -> Option<String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::kernels::shade::{GBufferFormat, shade_kernel};
     use crate::kernels::{constants, embedded};
     use crate::model::Model;
-    use crate::kernels::shade::{shade_kernel, GBufferFormat};
 
     fn frozen(model: Option<&str>, lights: u32) -> Vec<u32> {
         let m = model.map(|m| Model::parse(m).unwrap());
@@ -180,10 +244,16 @@ mod tests {
 
     #[test]
     fn spec_values_follow_the_module_types() {
-        let k = shade_kernel(Some(&Model::parse("burley,gamma=2").unwrap()), GBufferFormat::Packed, 4, false, embedded()).unwrap();
+        let k =
+            shade_kernel(Some(&Model::parse("burley,gamma=2").unwrap()), GBufferFormat::Packed, 4, false, embedded())
+                .unwrap();
         let text = spec_default_values(&k.spirv.words, &k.constants).unwrap();
         assert!(text.contains("3:2.0"), "{text}");
-        assert!(text.contains(&format!("{}:4", constants::NUM_LIGHTS.id)) && text.contains(&format!("{}:0", constants::BASELINE.id)), "{text}");
+        assert!(
+            text.contains(&format!("{}:4", constants::NUM_LIGHTS.id))
+                && text.contains(&format!("{}:0", constants::BASELINE.id)),
+            "{text}"
+        );
     }
 
     #[test]
@@ -194,8 +264,17 @@ mod tests {
         let baseline = count(&frozen(None, 8)).unwrap();
         let whole = count(&words).unwrap();
         // GTR's D raises to the power gamma; GGX's D has no pow.
-        assert!(burley.glsl.get("Pow").copied().unwrap_or(0) > ggx.glsl.get("Pow").copied().unwrap_or(0), "{burley:?} {ggx:?}");
-        assert!(baseline.total < ggx.total && ggx.total < whole.total, "{} {} {}", baseline.total, ggx.total, whole.total);
+        assert!(
+            burley.glsl.get("Pow").copied().unwrap_or(0) > ggx.glsl.get("Pow").copied().unwrap_or(0),
+            "{burley:?} {ggx:?}"
+        );
+        assert!(
+            baseline.total < ggx.total && ggx.total < whole.total,
+            "{} {} {}",
+            baseline.total,
+            ggx.total,
+            whole.total
+        );
         assert_eq!(ggx.total, ggx.classes.values().sum::<u64>() + ggx.glsl.values().sum::<u64>());
     }
 

@@ -2,18 +2,17 @@
 //! profile protocol) and measured for accuracy (`accuracy`), and the result is a table, a JSON file and a chart
 //! of error against cost with the Pareto frontier.
 
-
 use crate::accuracy::{self, Accuracy, ExactCache, SampleSet};
 use crate::brdf::exact::ExactFresnel;
 use crate::brdf::samples::SampleDomain;
 use crate::brdf::spec::with_each_param_sample;
-use crate::brdf::{ModelSpec, Precision, Vis, D, F, THESIS_MODELS};
+use crate::brdf::{D, F, ModelSpec, Precision, THESIS_MODELS, Vis};
+use crate::export::json;
+use crate::export::markdown::{self, Table};
 use crate::export::png::{self, Point};
 use crate::gpu::Gpu;
 use crate::model::Model;
 use crate::profile::{self, ProfileOptions, ProfileReport};
-use crate::export::json;
-use crate::export::markdown::{self, Table};
 use crate::stats::{self, Estimate};
 use anyhow::Result;
 use indicatif::ProgressBar;
@@ -42,7 +41,11 @@ pub fn default_specs() -> Vec<ModelSpec> {
             push(s);
         }
     }
-    let exact_dielectric = F::ALL.iter().copied().find(|f| f.row().is_exact && f.row().reads.is_empty()).expect("the table has an exact dielectric Fresnel");
+    let exact_dielectric = F::ALL
+        .iter()
+        .copied()
+        .find(|f| f.row().is_exact && f.row().reads.is_empty())
+        .expect("the table has an exact dielectric Fresnel");
     for &vis in Vis::ALL {
         if let Some(d) = vis.row().exact_for {
             push(ModelSpec::new(d, vis, exact_dielectric));
@@ -89,7 +92,12 @@ pub struct AccuracyOptions {
 
 impl Default for AccuracyOptions {
     fn default() -> Self {
-        AccuracyOptions { reference: None, exact_fresnel: ExactFresnel::Physical, domain: accuracy::STANDARD_DOMAIN, domain_why: Default::default() }
+        AccuracyOptions {
+            reference: None,
+            exact_fresnel: ExactFresnel::Physical,
+            domain: accuracy::STANDARD_DOMAIN,
+            domain_why: Default::default(),
+        }
     }
 }
 
@@ -115,7 +123,9 @@ impl AccuracyOptions {
         match &self.reference {
             Some(r) if r.twin().is_some() => format!("{}'s {exact}, for every model (--reference)", r.label()),
             Some(r) => format!("{}'s GPU values, for every model (--reference)", r.label()),
-            None => format!("each spec's {exact}; a .brdf file: the {exact} of the reference it names, else of {DEFAULT_FILE_REFERENCE}"),
+            None => format!(
+                "each spec's {exact}; a .brdf file: the {exact} of the reference it names, else of {DEFAULT_FILE_REFERENCE}"
+            ),
         }
     }
 
@@ -127,7 +137,12 @@ impl AccuracyOptions {
         if model.twin().is_some() {
             return None;
         }
-        Some(model.declared_reference().map(Model::spec).unwrap_or_else(|| Model::parse(DEFAULT_FILE_REFERENCE).expect("the default reference is a preset")))
+        Some(
+            model
+                .declared_reference()
+                .map(Model::spec)
+                .unwrap_or_else(|| Model::parse(DEFAULT_FILE_REFERENCE).expect("the default reference is a preset")),
+        )
     }
 }
 
@@ -167,15 +182,14 @@ pub struct SweepReport {
 
 /// Indices of the points not dominated in (cost, error), both to be minimised.
 pub fn pareto_front(points: &[(f64, f64)]) -> Vec<bool> {
-    points
-        .iter()
-        .map(|&(c, e)| !points.iter().any(|&(c2, e2)| c2 <= c && e2 <= e && (c2 < c || e2 < e)))
-        .collect()
+    points.iter().map(|&(c, e)| !points.iter().any(|&(c2, e2)| c2 <= c && e2 <= e && (c2 < c || e2 < e))).collect()
 }
 
 pub fn run(gpu: &Gpu, options: &SweepOptions, progress: &ProgressBar) -> Result<SweepReport> {
     if options.profile.lights.len() != 1 {
-        anyhow::bail!("--lights: a sweep ranks specs at one light count (`brdfprof profile --lights 1,8,64` compares counts)");
+        anyhow::bail!(
+            "--lights: a sweep ranks specs at one light count (`brdfprof profile --lights 1,8,64` compares counts)"
+        );
     }
     // Accuracy first, so that the profile's budget (the whole command's) accounts for it.
     let accuracies = measure_accuracy(gpu, &options.profile.models, &options.accuracy, progress)?;
@@ -207,7 +221,8 @@ pub fn run(gpu: &Gpu, options: &SweepOptions, progress: &ProgressBar) -> Result<
             pareto: false,
         });
     }
-    let front = pareto_front(&rows.iter().map(|r| (r.cost_vs_fastest.median, r.accuracy.vs_exact.rms)).collect::<Vec<_>>());
+    let front =
+        pareto_front(&rows.iter().map(|r| (r.cost_vs_fastest.median, r.accuracy.vs_exact.rms)).collect::<Vec<_>>());
     let cis: Vec<Estimate> = rows.iter().map(|r| r.cost_vs_fastest).collect();
     for (k, row) in rows.iter_mut().enumerate() {
         row.pareto = front[k];
@@ -233,13 +248,20 @@ pub fn error_axis(exact: ExactFresnel, rows: &[SweepRow]) -> String {
     named.dedup();
     match (named.as_slice(), rows.iter().all(|r| r.accuracy.reference.is_some())) {
         ([one], true) => format!("RMS relative error against {one}'s exact model"),
-        _ if exact == ExactFresnel::Own => "RMS relative error against the exact model with each spec's own Fresnel".into(),
+        _ if exact == ExactFresnel::Own => {
+            "RMS relative error against the exact model with each spec's own Fresnel".into()
+        }
         _ => "RMS relative error against the exact physical model".into(),
     }
 }
 
 /// Every model's accuracy over the options' sample set, each against what `reference_of` says.
-fn measure_accuracy(gpu: &Gpu, models: &[Model], options: &AccuracyOptions, progress: &ProgressBar) -> Result<Vec<Accuracy>> {
+fn measure_accuracy(
+    gpu: &Gpu,
+    models: &[Model],
+    options: &AccuracyOptions,
+    progress: &ProgressBar,
+) -> Result<Vec<Accuracy>> {
     let set = SampleSet::within(options.domain);
     let references: Vec<Option<Model>> = models.iter().map(|m| options.reference_of(m)).collect();
     let mut checked: Vec<String> = Vec::new();
@@ -265,7 +287,11 @@ fn measure_accuracy(gpu: &Gpu, models: &[Model], options: &AccuracyOptions, prog
 /// `--reference` spec's f64 formula, saying so (`- (vs FILE)` against another file, which has no formula).
 fn numerical_cell(a: &accuracy::Accuracy) -> String {
     // A spec's numerical error is against its own twin whatever its reference; a file's against the reference's.
-    let against = a.reference.as_deref().filter(|_| a.formula_vs_exact.is_none()).map_or(String::new(), |r| format!(" (vs {r} f64)"));
+    let against = a
+        .reference
+        .as_deref()
+        .filter(|_| a.formula_vs_exact.is_none())
+        .map_or(String::new(), |r| format!(" (vs {r} f64)"));
     match &a.numerical {
         None => format!("- (vs {})", a.reference.as_deref().unwrap_or("?")),
         Some(n) if n.nonfinite > 0 => format!("{} NaN/Inf{against}", n.nonfinite),
@@ -276,7 +302,15 @@ fn numerical_cell(a: &accuracy::Accuracy) -> String {
 impl SweepReport {
     pub fn table(&self) -> Table {
         let mut t = Table::new([
-            "rank", "spec", "ns/eval [95% CI]", "net ns/eval", "cost vs fastest [95% CI]", "numerical max err", "vs exact: max / RMS err", "albedo err", "Pareto",
+            "rank",
+            "spec",
+            "ns/eval [95% CI]",
+            "net ns/eval",
+            "cost vs fastest [95% CI]",
+            "numerical max err",
+            "vs exact: max / RMS err",
+            "albedo err",
+            "Pareto",
         ]);
         for r in &self.rows {
             let a = &r.accuracy;
@@ -315,7 +349,13 @@ impl SweepReport {
 
     /// Writes sweep-<device>.md, .json and .png under `out`; returns their paths.
     pub fn write(&self, out: &Path, device: &str) -> Result<Vec<std::path::PathBuf>> {
-        json::write_md_json_png(&out.join(format!("sweep-{device}")), json::Kind::Sweep, self, &self.markdown(), |png| self.chart(png))
+        json::write_md_json_png(
+            &out.join(format!("sweep-{device}")),
+            json::Kind::Sweep,
+            self,
+            &self.markdown(),
+            |png| self.chart(png),
+        )
     }
 
     /// Approximation error (RMS vs exact, log) against cost, every point labelled, the frontier drawn.
@@ -339,9 +379,15 @@ impl SweepReport {
                 highlight: r.pareto || thesis.contains(&r.spec),
             })
             .collect();
-        let mut front: Vec<(f64, f64)> = self.rows.iter().filter(|r| r.pareto).map(|r| (r.cost_vs_fastest.median, r.accuracy.vs_exact.rms)).collect();
+        let mut front: Vec<(f64, f64)> = self
+            .rows
+            .iter()
+            .filter(|r| r.pareto)
+            .map(|r| (r.cost_vs_fastest.median, r.accuracy.vs_exact.rms))
+            .collect();
         front.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let mut legend: Vec<(usize, String)> = D::ALL.iter().map(|d| (*d as usize, format!("D = {}", d.name()))).collect();
+        let mut legend: Vec<(usize, String)> =
+            D::ALL.iter().map(|d| (*d as usize, format!("D = {}", d.name()))).collect();
         legend.push((D::ALL.len(), "fp16, other models".into()));
         // fp16 (and anything beyond the costliest fp32 spec) goes to the side panel.
         let split = self
@@ -350,7 +396,10 @@ impl SweepReport {
             .filter(|r| !r.canonical.contains("precision=f16"))
             .map(|r| r.cost_vs_fastest.median)
             .fold(f64::NEG_INFINITY, f64::max);
-        let title = format!("Accuracy against cost on {} ({} evaluations per dispatch)", self.profile.provenance.device.name, self.profile.rows[0].evaluations_per_dispatch);
+        let title = format!(
+            "Accuracy against cost on {} ({} evaluations per dispatch)",
+            self.profile.provenance.device.name, self.profile.rows[0].evaluations_per_dispatch
+        );
         let y_desc = error_axis(self.exact, &self.rows);
         let spec = png::Scatter {
             title: &title,

@@ -3,11 +3,11 @@
 //! time. Those figures are deterministic: no CI, no noise, the same on every machine with the same compiler.
 //! The accuracy is the sweep's own (measured on the device that executed it).
 
-use crate::export::png::{self, Point};
-use crate::schema::cost::TargetCost;
 use crate::export::json;
 use crate::export::markdown::{self, Table};
-use crate::sweep::{pareto_front, SweepReport};
+use crate::export::png::{self, Point};
+use crate::schema::cost::TargetCost;
+use crate::sweep::{SweepReport, pareto_front};
 use anyhow::Result;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
@@ -104,7 +104,8 @@ pub fn build(sweep: &SweepReport, target: &str, cost: &TargetCost, note: Option<
         fastest: rows.first().map(|r| r.spec.clone()).unwrap_or_default(),
         rows,
         // The child's note names each spec with the reason; without one, the specs alone.
-        skipped: (!skipped.is_empty()).then(|| note.map_or_else(|| format!("not compiled for {target}: {}", skipped.join(", ")), str::to_string)),
+        skipped: (!skipped.is_empty())
+            .then(|| note.map_or_else(|| format!("not compiled for {target}: {}", skipped.join(", ")), str::to_string)),
         against: sweep.against.clone(),
         error_axis: crate::sweep::error_axis(sweep.exact, &sweep.rows),
     })
@@ -114,12 +115,25 @@ impl CostSweep {
     pub fn table(&self) -> Table {
         let mut headers: Vec<String> = vec!["spec".into()];
         headers.extend(self.columns.iter().cloned());
-        headers.extend(["cycles/eval", "net cycles/eval", "cost vs fastest", "measured cost vs fastest", "vs exact: max / RMS err", "Pareto (target)", "Pareto (measured)"].map(String::from));
+        headers.extend(
+            [
+                "cycles/eval",
+                "net cycles/eval",
+                "cost vs fastest",
+                "measured cost vs fastest",
+                "vs exact: max / RMS err",
+                "Pareto (target)",
+                "Pareto (measured)",
+            ]
+            .map(String::from),
+        );
         let mut t = Table::new(headers);
         for r in &self.rows {
             // The model's label (`name=`, a file's stem) as every table names it; the spec is in the JSON.
             let mut cells = vec![r.label.clone()];
-            cells.extend(self.columns.iter().map(|c| r.stats.get(c).map_or("-".into(), |v| crate::schema::format_value(*v))));
+            cells.extend(
+                self.columns.iter().map(|c| r.stats.get(c).map_or("-".into(), |v| crate::schema::format_value(*v))),
+            );
             cells.extend([
                 markdown::sig(r.cycles_per_eval, 4),
                 r.net_cycles_per_eval.map_or("-".into(), |v| markdown::sig(v, 4)),
@@ -175,9 +189,11 @@ impl CostSweep {
                 highlight: r.pareto || thesis.contains(&r.spec),
             })
             .collect();
-        let front: Vec<(f64, f64)> = self.rows.iter().filter(|r| r.pareto).map(|r| (r.cost_vs_fastest, r.accuracy.vs_exact.rms)).collect();
+        let front: Vec<(f64, f64)> =
+            self.rows.iter().filter(|r| r.pareto).map(|r| (r.cost_vs_fastest, r.accuracy.vs_exact.rms)).collect();
         let legend = vec![(0, "fp32".to_string()), (1, "fp16".to_string())];
-        let split = self.rows.iter().filter(|r| group(r) == 0).map(|r| r.cost_vs_fastest).fold(f64::NEG_INFINITY, f64::max);
+        let split =
+            self.rows.iter().filter(|r| group(r) == 0).map(|r| r.cost_vs_fastest).fold(f64::NEG_INFINITY, f64::max);
         let title = format!("Accuracy against {}'s cost on {} ({})", self.compiler, self.target, self.architecture);
         let x_desc = format!("{} cycles per evaluation relative to the cheapest spec (deterministic)", self.compiler);
         let spec = png::Scatter {
@@ -223,15 +239,28 @@ impl Frontiers {
         for (k, s) in sweeps.iter().enumerate() {
             for r in s.rows.iter().filter(|r| r.pareto) {
                 if !rows.iter().any(|x| x.label == r.label) {
-                    rows.push(FrontierRow { label: r.label.clone(), spec: r.spec.clone(), on: vec![false; sweeps.len()], measured: r.measured_pareto });
+                    rows.push(FrontierRow {
+                        label: r.label.clone(),
+                        spec: r.spec.clone(),
+                        on: vec![false; sweeps.len()],
+                        measured: r.measured_pareto,
+                    });
                 }
                 rows.iter_mut().find(|x| x.label == r.label).expect("just added").on[k] = true;
             }
         }
-        rows.sort_by(|a, b| b.on.iter().filter(|o| **o).count().cmp(&a.on.iter().filter(|o| **o).count()).then(a.label.cmp(&b.label)));
+        rows.sort_by(|a, b| {
+            b.on.iter().filter(|o| **o).count().cmp(&a.on.iter().filter(|o| **o).count()).then(a.label.cmp(&b.label))
+        });
         let on_every = rows.iter().filter(|r| r.on.iter().all(|o| *o)).map(|r| r.label.clone()).collect();
         let on_some = rows.iter().filter(|r| !r.on.iter().all(|o| *o)).map(|r| r.label.clone()).collect();
-        Frontiers { targets: sweeps.iter().map(|s| s.target.clone()).collect(), rows, on_every, on_some, measured_on: sweeps.first().map(|s| s.measured_on.clone()).unwrap_or_default() }
+        Frontiers {
+            targets: sweeps.iter().map(|s| s.target.clone()).collect(),
+            rows,
+            on_every,
+            on_some,
+            measured_on: sweeps.first().map(|s| s.measured_on.clone()).unwrap_or_default(),
+        }
     }
 
     pub fn markdown(&self) -> String {

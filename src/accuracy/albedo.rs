@@ -4,8 +4,8 @@
 //! the angles where reflected directions start and finish falling below the horizon) and, for each theta_h, in the
 //! azimuth over exactly the range that stays above the horizon, so the integrand is smooth on every piece.
 
-use crate::brdf::guards::guard_cosine;
 use crate::brdf::Cosines;
+use crate::brdf::guards::guard_cosine;
 use gauss_quad::legendre::GaussLegendre;
 use std::f64::consts::{FRAC_PI_2, PI};
 use std::sync::OnceLock;
@@ -59,7 +59,13 @@ pub fn albedo_f64(f: &impl Fn(&Cosines) -> [f64; 3], nov: f64, a: f64) -> [f64; 
                 if (2.0 * th).cos() >= 0.0 { PI } else { 0.0 }
             } else {
                 let x = -cos_v * (2.0 * th).cos() / denom;
-                if x <= -1.0 { PI } else if x >= 1.0 { 0.0 } else { x.acos() }
+                if x <= -1.0 {
+                    PI
+                } else if x >= 1.0 {
+                    0.0
+                } else {
+                    x.acos()
+                }
             };
             if phi_max <= 0.0 {
                 return [0.0; 3];
@@ -70,7 +76,13 @@ pub fn albedo_f64(f: &impl Fn(&Cosines) -> [f64; 3], nov: f64, a: f64) -> [f64; 
                 if nol <= 0.0 || voh <= 0.0 {
                     return [0.0; 3];
                 }
-                let c = Cosines { nov: guard_cosine(cos_v), nol: guard_cosine(nol), noh: guard_cosine(cos_h), voh: guard_cosine(voh), sin2h: sin_h * sin_h };
+                let c = Cosines {
+                    nov: guard_cosine(cos_v),
+                    nol: guard_cosine(nol),
+                    noh: guard_cosine(cos_h),
+                    voh: guard_cosine(voh),
+                    sin2h: sin_h * sin_h,
+                };
                 f(&c).map(|x| x * nol * 4.0 * voh)
             });
             // Both halves of the azimuth, and the solid-angle factor sin(theta_h).
@@ -86,7 +98,7 @@ pub fn albedo_f64(f: &impl Fn(&Cosines) -> [f64; 3], nov: f64, a: f64) -> [f64; 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::brdf::{ModelSpec, D, F, Vis};
+    use crate::brdf::{D, F, ModelSpec, Vis};
 
     #[test]
     fn a_lambertian_brdf_reflects_everything() {

@@ -6,7 +6,7 @@ pub mod albedo;
 
 use crate::brdf::exact::{self, ExactFresnel, Lambda};
 use crate::brdf::samples::SampleDomain;
-use crate::brdf::{samples, ModelSpec, Sample, D, F};
+use crate::brdf::{D, F, ModelSpec, Sample, samples};
 use crate::gpu::Gpu;
 use crate::kernels::{self, AlbedoCell, RunLimits};
 use crate::model::Model;
@@ -146,7 +146,15 @@ impl SampleSet {
         format!(
             "10 strata each of roughness [{}, {}], NoV [{}, {}] and NoL [{}, {}], azimuth [0, pi]; {} samples, seed 2023; \
              dielectric F0 (0.02, 0.04, 0.08) or (0.03, 0.05, 0.045); albedo cells NoV {{{}}} x r {{{}}}, F0 0.04",
-            r.0, r.1, v.0, v.1, l.0, l.1, self.samples.len(), distinct(|c| c.nov), distinct(|c| c.roughness)
+            r.0,
+            r.1,
+            v.0,
+            v.1,
+            l.0,
+            l.1,
+            self.samples.len(),
+            distinct(|c| c.nov),
+            distinct(|c| c.roughness)
         )
     }
 }
@@ -184,12 +192,16 @@ impl ExactCache {
 
     fn values(&mut self, spec: &ModelSpec, set: &SampleSet) -> &Vec<[f64; 3]> {
         let fresnel = self.fresnel;
-        self.values.entry(ExactKey::of(spec, fresnel)).or_insert_with(|| set.samples.par_iter().map(|s| exact::eval_with(spec, fresnel, s)).collect())
+        self.values
+            .entry(ExactKey::of(spec, fresnel))
+            .or_insert_with(|| set.samples.par_iter().map(|s| exact::eval_with(spec, fresnel, s)).collect())
     }
 
     fn albedo(&mut self, spec: &ModelSpec, set: &SampleSet) -> &Vec<[f64; 3]> {
         let fresnel = self.fresnel;
-        self.albedo.entry(ExactKey::of(spec, fresnel)).or_insert_with(|| set.cells.par_iter().map(|cell| albedo_exact_with(spec, fresnel, cell)).collect())
+        self.albedo
+            .entry(ExactKey::of(spec, fresnel))
+            .or_insert_with(|| set.cells.par_iter().map(|cell| albedo_exact_with(spec, fresnel, cell)).collect())
     }
 
     /// The values and albedos a model is measured against: a spec's exact model, or a `.brdf` file's GPU results.
@@ -197,7 +209,10 @@ impl ExactCache {
         Ok(match reference.twin() {
             Some(r) => (self.values(r, set).clone(), self.albedo(r, set).clone()),
             None => (
-                kernels::eval(gpu, reference, &set.samples, RunLimits::default())?.iter().map(|g| g.map(f64::from)).collect(),
+                kernels::eval(gpu, reference, &set.samples, RunLimits::default())?
+                    .iter()
+                    .map(|g| g.map(f64::from))
+                    .collect(),
                 kernels::albedo(gpu, reference, &set.cells)?.iter().map(|a| a.e).collect(),
             ),
         })
@@ -228,21 +243,40 @@ pub struct Accuracy {
 /// Measures `model` on the GPU over `set`: against its twin (numerical error) and against `reference` where
 /// given (a spec's exact model, or another file's GPU values and albedo), else against its own exact model. A
 /// model without a twin (a `.brdf` file) needs a reference.
-pub fn measure(gpu: &Gpu, model: &Model, set: &SampleSet, cache: &mut ExactCache, reference: Option<&Model>) -> Result<Accuracy> {
-    let got: Vec<[f64; 3]> = kernels::eval(gpu, model, &set.samples, RunLimits::default())?.iter().map(|g| g.map(f64::from)).collect();
+pub fn measure(
+    gpu: &Gpu,
+    model: &Model,
+    set: &SampleSet,
+    cache: &mut ExactCache,
+    reference: Option<&Model>,
+) -> Result<Accuracy> {
+    let got: Vec<[f64; 3]> =
+        kernels::eval(gpu, model, &set.samples, RunLimits::default())?.iter().map(|g| g.map(f64::from)).collect();
     let gpu_albedo = kernels::albedo(gpu, model, &set.cells)?;
     // A NaN difference is an infinite one, not none (f64::max would drop it).
-    let albedo_diff = |exact: &[[f64; 3]]| gpu_albedo.iter().zip(exact).flat_map(|(g, x)| (0..3).map(move |c| (g.e[c] - x[c]).abs())).map(|d| if d.is_nan() { f64::INFINITY } else { d }).fold(0.0, f64::max);
+    let albedo_diff = |exact: &[[f64; 3]]| {
+        gpu_albedo
+            .iter()
+            .zip(exact)
+            .flat_map(|(g, x)| (0..3).map(move |c| (g.e[c] - x[c]).abs()))
+            .map(|d| if d.is_nan() { f64::INFINITY } else { d })
+            .fold(0.0, f64::max)
+    };
     let albedo_error_bound = gpu_albedo.iter().map(|a| a.error).fold(0.0, f64::max);
     let (values, albedo) = match (reference, model.twin()) {
         (Some(r), _) => cache.reference(gpu, r, set)?,
         (None, Some(spec)) => (cache.values(spec, set).clone(), cache.albedo(spec, set).clone()),
-        (None, None) => anyhow::bail!("{}: a model without an f64 twin is measured against a reference; none was given", model.name()),
+        (None, None) => anyhow::bail!(
+            "{}: a model without an f64 twin is measured against a reference; none was given",
+            model.name()
+        ),
     };
     let twin: Option<Vec<[f64; 3]>> = model.twin().map(|spec| set.samples.par_iter().map(|s| spec.eval(s)).collect());
     // A file against a spec: the numerical error is against that spec's own f64 formula (its twin), what a
     // file that transcribes the spec's formula should match to fp32 rounding.
-    let numerical_against = twin.clone().or_else(|| reference.and_then(Model::twin).map(|r| set.samples.par_iter().map(|s| r.eval(s)).collect()));
+    let numerical_against = twin
+        .clone()
+        .or_else(|| reference.and_then(Model::twin).map(|r| set.samples.par_iter().map(|s| r.eval(s)).collect()));
     Ok(Accuracy {
         numerical: numerical_against.map(|t| ErrorStats::of(&set.samples, &got, &t)),
         vs_exact: ErrorStats::of(&set.samples, &got, &values),

@@ -1,10 +1,10 @@
 //! The baseline file: every count, the timing ratios and the environment they were measured in.
 
-use crate::schema::callgrind::CallgrindRun;
 use crate::inspect::timing::TimingRun;
-use crate::schema::InspectReport;
 use crate::model::Model;
-use anyhow::{anyhow, bail, Context, Result};
+use crate::schema::InspectReport;
+use crate::schema::callgrind::CallgrindRun;
+use anyhow::{Context, Result, anyhow, bail};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -25,11 +25,18 @@ pub struct Baseline {
 /// Reads and checks a baseline file; every error names the file and what is wrong with it.
 pub fn load(path: &Path) -> Result<Baseline> {
     let name = path.display();
-    let text = String::from_utf8(crate::io::read_bounded(path, crate::io::MAX_REPORT_BYTES).with_context(|| format!("baseline {name}: cannot read it"))?).map_err(|_| anyhow::anyhow!("baseline {name}: not UTF-8 text: not a brdfprof baseline"))?;
-    let value: serde_json::Value = serde_json::from_str(&text).map_err(|e| anyhow!("baseline {name}: corrupt, not valid JSON ({e})"))?;
+    let text = String::from_utf8(
+        crate::io::read_bounded(path, crate::io::MAX_REPORT_BYTES)
+            .with_context(|| format!("baseline {name}: cannot read it"))?,
+    )
+    .map_err(|_| anyhow::anyhow!("baseline {name}: not UTF-8 text: not a brdfprof baseline"))?;
+    let value: serde_json::Value =
+        serde_json::from_str(&text).map_err(|e| anyhow!("baseline {name}: corrupt, not valid JSON ({e})"))?;
     match value.get("format").and_then(|f| f.as_str()) {
         Some(FORMAT) => {}
-        Some(other) => bail!("baseline {name}: format `{other}`, this brdfprof reads `{FORMAT}`; save a new one with --save-baseline"),
+        Some(other) => bail!(
+            "baseline {name}: format `{other}`, this brdfprof reads `{FORMAT}`; save a new one with --save-baseline"
+        ),
         None => bail!("baseline {name}: not a brdfprof check baseline (no `format` field; expected `{FORMAT}`)"),
     }
     let baseline: Baseline = serde_json::from_value(value).map_err(|e| anyhow!("baseline {name}: corrupt ({e})"))?;
@@ -99,7 +106,13 @@ fn validate_callgrind(cg: &CallgrindRun) -> Result<()> {
 }
 
 fn validate_timing(b: &Baseline, t: &TimingRun) -> Result<()> {
-    for (field, v) in [("width", t.width as usize), ("height", t.height as usize), ("lights", t.lights as usize), ("rounds", t.rounds), ("reps", t.reps)] {
+    for (field, v) in [
+        ("width", t.width as usize),
+        ("height", t.height as usize),
+        ("lights", t.lights as usize),
+        ("rounds", t.rounds),
+        ("reps", t.reps),
+    ] {
         if v == 0 {
             bail!("timing.{field} is 0; a timing run has at least 1");
         }

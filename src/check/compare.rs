@@ -2,7 +2,7 @@
 
 use super::baseline::Baseline;
 use super::environment::{JIT_FEATURES, MESA};
-use super::thresholds::{group_of, is_gated, Thresholds, ALPHA, GROUPS, MIN_TIMING_ROUNDS, TIMING_KEY};
+use super::thresholds::{ALPHA, GROUPS, MIN_TIMING_ROUNDS, TIMING_KEY, Thresholds, group_of, is_gated};
 use crate::inspect::timing::TimingRun;
 use crate::stats;
 use std::collections::BTreeMap;
@@ -170,11 +170,14 @@ pub(super) fn rel_change(old: f64, new: f64) -> f64 {
 /// Compares two runs statistic by statistic.
 pub fn compare(old: &Baseline, new: &Baseline, thresholds: &Thresholds, force: bool) -> Comparison {
     let groups = group_status(old, new, force);
-    let compared = |g: &str| groups.iter().any(|(name, s)| name == g && matches!(s, GroupStatus::Compared | GroupStatus::Forced(_)));
+    let compared = |g: &str| {
+        groups.iter().any(|(name, s)| name == g && matches!(s, GroupStatus::Compared | GroupStatus::Forced(_)))
+    };
     let mut changes = Vec::new();
     let mut notes = Vec::new();
     let new_models: Vec<&str> = new.inspect.rows.iter().map(|r| r.model.as_str()).collect();
-    let only_old = old.inspect.rows.iter().map(|r| r.model.clone()).filter(|m| !new_models.contains(&m.as_str())).collect();
+    let only_old =
+        old.inspect.rows.iter().map(|r| r.model.clone()).filter(|m| !new_models.contains(&m.as_str())).collect();
     let only_new = new.inspect.rows.iter().map(|r| r.model.clone()).filter(|m| old.inspect.row(m).is_none()).collect();
     // Column order: the new run's, then keys only the baseline has.
     let mut columns = new.inspect.columns.clone();
@@ -184,11 +187,28 @@ pub fn compare(old: &Baseline, new: &Baseline, thresholds: &Thresholds, force: b
         for key in columns.iter().filter(|k| compared(group_of(k))) {
             // A SPIR-V count a kernel lacks is 0; elsewhere a missing statistic was not measured.
             let zero = key.starts_with("spirv").then_some(0.0);
-            let (Some(o), Some(n)) = (old_row.stats.get(key).copied().or(zero), new_row.stats.get(key).copied().or(zero)) else { continue };
-            changes.push(Change { model: old_row.model.clone(), key: key.clone(), old: o, new: n, rel: rel_change(o, n), threshold: thresholds.get(key), gated: is_gated(key) });
+            let (Some(o), Some(n)) =
+                (old_row.stats.get(key).copied().or(zero), new_row.stats.get(key).copied().or(zero))
+            else {
+                continue;
+            };
+            changes.push(Change {
+                model: old_row.model.clone(),
+                key: key.clone(),
+                old: o,
+                new: n,
+                rel: rel_change(o, n),
+                threshold: thresholds.get(key),
+                gated: is_gated(key),
+            });
         }
         if compared("naga") && old_row.notes.get("naga") != new_row.notes.get("naga") {
-            notes.push(format!("{}: naga's verdict changed from `{}` to `{}` (reported only)", old_row.model, old_row.notes.get("naga").map_or("-", |s| s), new_row.notes.get("naga").map_or("-", |s| s)));
+            notes.push(format!(
+                "{}: naga's verdict changed from `{}` to `{}` (reported only)",
+                old_row.model,
+                old_row.notes.get("naga").map_or("-", |s| s),
+                new_row.notes.get("naga").map_or("-", |s| s)
+            ));
         }
     }
     let timing = match (&old.timing, &new.timing, compared("timing")) {
@@ -219,4 +239,3 @@ fn compare_timing(old: &TimingRun, new: &TimingRun, thresholds: &Thresholds) -> 
         })
         .collect()
 }
-

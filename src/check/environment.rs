@@ -20,17 +20,29 @@ pub fn environment(inspect: &InspectReport, timing: Option<&TimingRun>) -> BTree
     let p = &inspect.provenance;
     let text = |v: &serde_json::Value| v.as_str().map(str::to_string).unwrap_or_else(|| v.to_string());
     let device = text(&p["device"]["name"]);
-    let driver = format!("{} {} ({})", text(&p["device"]["driver_name"]), text(&p["device"]["driver_info"]), text(&p["device"]["driver_version"]));
-    let env: Vec<String> = p["env"].as_object().map(|m| m.iter().map(|(k, v)| format!("{k}={}", text(v))).collect()).unwrap_or_default();
+    let driver = format!(
+        "{} {} ({})",
+        text(&p["device"]["driver_name"]),
+        text(&p["device"]["driver_info"]),
+        text(&p["device"]["driver_version"])
+    );
+    let env: Vec<String> =
+        p["env"].as_object().map(|m| m.iter().map(|(k, v)| format!("{k}={}", text(v))).collect()).unwrap_or_default();
     let machine = |extra: Vec<(&str, String)>| -> BTreeMap<String, String> {
-        let mut m: BTreeMap<String, String> = [("device", device.clone()), ("driver", driver.clone())].into_iter().map(|(k, v)| (k.to_string(), v)).collect();
+        let mut m: BTreeMap<String, String> = [("device", device.clone()), ("driver", driver.clone())]
+            .into_iter()
+            .map(|(k, v)| (k.to_string(), v))
+            .collect();
         m.extend(extra.into_iter().map(|(k, v)| (k.to_string(), v)));
         m
     };
     let mut out = BTreeMap::new();
     out.insert("spirv".into(), BTreeMap::new());
     out.insert("naga".into(), BTreeMap::new());
-    out.insert("spirv-O".into(), [("spirv-opt".to_string(), inspect.tools.get("spirv-opt").cloned().unwrap_or_default())].into());
+    out.insert(
+        "spirv-O".into(),
+        [("spirv-opt".to_string(), inspect.tools.get("spirv-opt").cloned().unwrap_or_default())].into(),
+    );
     if let Some(target) = crate::targets::of_report(inspect) {
         // A compile-only target: its compiler's output depends on what the vendor says (the family and the
         // compiler's version), not on the host.
@@ -66,7 +78,6 @@ pub fn environment(inspect: &InspectReport, timing: Option<&TimingRun>) -> BTree
     out
 }
 
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -87,8 +98,17 @@ mod tests {
             columns: vec![],
             rows: vec![],
             section_notes: BTreeMap::new(),
-            callgrind: Some(CallgrindRun { kernels: vec![], evaluations: 1, jit_cpu_features: jit.iter().map(|s| s.to_string()).collect(), valgrind: "valgrind-3.19.0".into() }),
-            callgrind_setup: [("workload".to_string(), "64x64 pixels x 8 lights".to_string()), ("valgrind".to_string(), "valgrind-3.19.0".to_string())].into(),
+            callgrind: Some(CallgrindRun {
+                kernels: vec![],
+                evaluations: 1,
+                jit_cpu_features: jit.iter().map(|s| s.to_string()).collect(),
+                valgrind: "valgrind-3.19.0".into(),
+            }),
+            callgrind_setup: [
+                ("workload".to_string(), "64x64 pixels x 8 lights".to_string()),
+                ("valgrind".to_string(), "valgrind-3.19.0".to_string()),
+            ]
+            .into(),
             vs_profile: None,
             cost: None,
             lines: Vec::new(),
@@ -100,7 +120,10 @@ mod tests {
         let lvp = "llvmpipe (LLVM 15.0.6, 256 bits)";
         let amd = environment(&report("AMD EPYC family 26 model 2", &["avx", "avx2"], lvp), None);
         let intel = environment(&report("Intel Xeon family 6 model 207", &["avx", "avx2"], lvp), None);
-        assert_eq!(amd["callgrind"], intel["callgrind"], "the same JIT features and tools on another CPU model gate alike");
+        assert_eq!(
+            amd["callgrind"], intel["callgrind"],
+            "the same JIT features and tools on another CPU model gate alike"
+        );
         assert!(!amd["callgrind"].contains_key("host-cpu"));
         for key in ["device", "driver", "driver-env", JIT_FEATURES, "valgrind", "workload"] {
             assert!(amd["callgrind"].contains_key(key), "{key}");
@@ -112,6 +135,13 @@ mod tests {
     #[test]
     fn a_compile_only_device_is_keyed_on_its_family_and_mesa_only() {
         let navi = environment(&report("any", &[], "Null hardware (RADV NAVI21)"), None);
-        assert_eq!(navi["driver"], [("device".to_string(), "Null hardware (RADV NAVI21)".to_string()), (MESA.to_string(), "22.3.6".to_string())].into());
+        assert_eq!(
+            navi["driver"],
+            [
+                ("device".to_string(), "Null hardware (RADV NAVI21)".to_string()),
+                (MESA.to_string(), "22.3.6".to_string())
+            ]
+            .into()
+        );
     }
 }

@@ -17,20 +17,23 @@ mod environment;
 mod report;
 mod thresholds;
 
-pub use baseline::{load, Baseline, FORMAT};
-pub use compare::{compare, Change, Comparison, GroupStatus, TimingChange};
+pub use baseline::{Baseline, FORMAT, load};
+pub use compare::{Change, Comparison, GroupStatus, TimingChange, compare};
 pub use environment::{environment, host_cpu};
-pub use thresholds::{group_of, is_gated, Thresholds, ALPHA, DEFAULT_COUNT_THRESHOLD, DEFAULT_TIMING_THRESHOLD, GROUPS, MIN_TIMING_ROUNDS, TIMING_KEY};
+pub use thresholds::{
+    ALPHA, DEFAULT_COUNT_THRESHOLD, DEFAULT_TIMING_THRESHOLD, GROUPS, MIN_TIMING_ROUNDS, TIMING_KEY, Thresholds,
+    group_of, is_gated,
+};
 
+use crate::brdf::spec::THESIS_MODELS;
+use crate::export::json;
+use crate::gpu::Gpu;
+use crate::inspect::InspectOptions;
 use crate::inspect::callgrind::CallgrindOptions;
 use crate::inspect::timing::{self, TimingOptions};
-use crate::inspect::InspectOptions;
-use crate::brdf::spec::THESIS_MODELS;
-use crate::gpu::Gpu;
 use crate::model::Model;
-use crate::export::json;
 use crate::shaders::Shaders;
-use anyhow::{anyhow, bail, Result};
+use anyhow::{Result, anyhow, bail};
 use std::path::PathBuf;
 
 /// Everything `check` measures.
@@ -59,7 +62,10 @@ pub struct Outcome {
 fn plan(options: &CheckOptions, old: Option<&Baseline>) -> Result<(Vec<Model>, u32)> {
     let lights = match (options.lights, old) {
         (Some(l), Some(b)) if l != b.inspect.lights => {
-            bail!("--lights {l}: the baseline was measured with {} lights; a check compares like with like (save a new baseline instead)", b.inspect.lights)
+            bail!(
+                "--lights {l}: the baseline was measured with {} lights; a check compares like with like (save a new baseline instead)",
+                b.inspect.lights
+            )
         }
         (Some(l), _) => l,
         (None, Some(b)) => b.inspect.lights,
@@ -71,7 +77,12 @@ fn plan(options: &CheckOptions, old: Option<&Baseline>) -> Result<(Vec<Model>, u
     let specs = if !options.models.is_empty() {
         options.models.clone()
     } else if let Some(b) = old {
-        b.inspect.rows.iter().filter_map(|r| r.spec.as_deref()).map(|s| Model::parse(s).map_err(|e| anyhow!("{s}: {e}"))).collect::<Result<_>>()?
+        b.inspect
+            .rows
+            .iter()
+            .filter_map(|r| r.spec.as_deref())
+            .map(|s| Model::parse(s).map_err(|e| anyhow!("{s}: {e}")))
+            .collect::<Result<_>>()?
     } else {
         THESIS_MODELS.iter().map(|m| Model::parse(m)).collect::<Result<_>>()?
     };
@@ -79,9 +90,23 @@ fn plan(options: &CheckOptions, old: Option<&Baseline>) -> Result<(Vec<Model>, u
 }
 
 /// Measures this build: every count, then the timing run.
-pub fn measure(gpu: &Gpu, shaders: &Shaders, models: Vec<Model>, lights: u32, options: &CheckOptions) -> Result<Baseline> {
-    crate::messages::progress(format!("check: counting instructions ({} models + baseline kernel{})", models.len(), if options.callgrind.is_some() { ", callgrind" } else { "" }));
-    let inspect = crate::inspect::run(gpu, shaders, &InspectOptions { models: models.clone(), lights, callgrind: options.callgrind.clone() })?;
+pub fn measure(
+    gpu: &Gpu,
+    shaders: &Shaders,
+    models: Vec<Model>,
+    lights: u32,
+    options: &CheckOptions,
+) -> Result<Baseline> {
+    crate::messages::progress(format!(
+        "check: counting instructions ({} models + baseline kernel{})",
+        models.len(),
+        if options.callgrind.is_some() { ", callgrind" } else { "" }
+    ));
+    let inspect = crate::inspect::run(
+        gpu,
+        shaders,
+        &InspectOptions { models: models.clone(), lights, callgrind: options.callgrind.clone() },
+    )?;
     let timing = if options.timing.rounds > 0 {
         crate::messages::progress(format!("check: timing {} rounds", options.timing.rounds));
         Some(timing::run(gpu, shaders, &models, &TimingOptions { lights, ..options.timing.clone() })?)
@@ -106,17 +131,38 @@ pub fn run(options: &CheckOptions, shaders: &Shaders, open: impl FnOnce() -> Res
 /// `run` on a compile-only target (`--device radv:FAMILY`, `nvidia:FAMILY`): its compiler's statistics
 /// (`targets`), no timing and no callgrind (nothing executes). `verify_on`: the Vulkan device a target's
 /// translation is checked against first.
-pub fn run_target(options: &CheckOptions, shaders: &Shaders, target: crate::targets::Target, validate: bool, verify_on: Option<&Gpu>) -> Result<Outcome> {
+pub fn run_target(
+    options: &CheckOptions,
+    shaders: &Shaders,
+    target: crate::targets::Target,
+    validate: bool,
+    verify_on: Option<&Gpu>,
+) -> Result<Outcome> {
     run_measured(options, |specs, lights| {
-        crate::messages::progress(format!("check: compiling for {} ({} models + baseline kernel)", target.name(), specs.len()));
-        let request = crate::targets::Request { models: &specs, lights, shaders, validate, isa_dir: None, precise: false, verify_on, lines: false };
+        crate::messages::progress(format!(
+            "check: compiling for {} ({} models + baseline kernel)",
+            target.name(),
+            specs.len()
+        ));
+        let request = crate::targets::Request {
+            models: &specs,
+            lights,
+            shaders,
+            validate,
+            isa_dir: None,
+            precise: false,
+            verify_on,
+            lines: false,
+        };
         let run = crate::targets::compile_all(&[target], &request)?.pop().expect("one run per target");
         let mut inspect = run.report;
         if let Some(note) = run.note {
             crate::messages::note(note);
         }
         for group in ["callgrind/", "timing/"] {
-            inspect.section_notes.insert(group.into(), format!("not applicable: {} compiles only, nothing executes", target.name()));
+            inspect
+                .section_notes
+                .insert(group.into(), format!("not applicable: {} compiles only, nothing executes", target.name()));
         }
         let environment = environment(&inspect, None);
         Ok(Baseline { format: FORMAT.into(), inspect, timing: None, environment })
@@ -148,9 +194,9 @@ fn run_measured(options: &CheckOptions, measure: impl FnOnce(Vec<Model>, u32) ->
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::export::json;
     use crate::inspect::timing::TimingRun;
     use crate::schema::{InspectReport, Row};
-    use crate::export::json;
     use std::collections::BTreeMap;
     use std::path::Path;
 
@@ -164,7 +210,12 @@ mod tests {
     }
 
     fn baseline(rows: Vec<Row>, timing: Option<TimingRun>, host: &str) -> Baseline {
-        let columns = rows.iter().flat_map(|r| r.stats.keys().cloned()).collect::<std::collections::BTreeSet<_>>().into_iter().collect();
+        let columns = rows
+            .iter()
+            .flat_map(|r| r.stats.keys().cloned())
+            .collect::<std::collections::BTreeSet<_>>()
+            .into_iter()
+            .collect();
         let inspect = InspectReport {
             provenance: serde_json::json!({"device": {"name": "llvmpipe (LLVM 15.0.6, 256 bits)"}}),
             kernels: "embedded spv/".into(),
@@ -213,7 +264,9 @@ mod tests {
         assert_eq!(t.get("callgrind/ir-per-eval"), DEFAULT_COUNT_THRESHOLD);
         assert_eq!(t.get(TIMING_KEY), 0.2);
         assert_eq!(Thresholds::default().get(TIMING_KEY), DEFAULT_TIMING_THRESHOLD);
-        assert!(Thresholds::parse(&["bogus/x=0.1".into()]).unwrap_err().to_string().contains("unknown statistic `bogus/x`"));
+        assert!(
+            Thresholds::parse(&["bogus/x=0.1".into()]).unwrap_err().to_string().contains("unknown statistic `bogus/x`")
+        );
         assert!(Thresholds::parse(&["spirv=abc".into()]).unwrap_err().to_string().contains("not a number"));
         assert!(Thresholds::parse(&["spirv=-1".into()]).is_err());
         assert!(Thresholds::parse(&["spirv".into()]).is_err());
@@ -221,8 +274,16 @@ mod tests {
 
     #[test]
     fn counts_regress_beyond_their_threshold_only() {
-        let old = baseline(vec![row("ggx", &[("spirv/total", 100.0), ("spirv/functions", 10.0), ("spirv/glsl.Exp", 1.0)])], None, "cpu");
-        let new = baseline(vec![row("ggx", &[("spirv/total", 100.9), ("spirv/functions", 20.0), ("spirv/glsl.Pow", 1.0)])], None, "cpu");
+        let old = baseline(
+            vec![row("ggx", &[("spirv/total", 100.0), ("spirv/functions", 10.0), ("spirv/glsl.Exp", 1.0)])],
+            None,
+            "cpu",
+        );
+        let new = baseline(
+            vec![row("ggx", &[("spirv/total", 100.9), ("spirv/functions", 20.0), ("spirv/glsl.Pow", 1.0)])],
+            None,
+            "cpu",
+        );
         let cmp = compare(&old, &new, &Thresholds::default(), false);
         let regressions = cmp.regressions();
         // +0.9% total is within 1%; functions are reported only; Pow appeared (+inf); Exp went away (helped).
@@ -238,12 +299,22 @@ mod tests {
 
     #[test]
     fn machine_dependent_groups_compare_only_in_the_same_environment() {
-        let old = baseline(vec![row("ggx", &[("spirv/total", 100.0), ("callgrind/ir-per-eval", 60.0)])], Some(timing(&[("ggx", around(1.0))])), "cpu A");
-        let mut new = baseline(vec![row("ggx", &[("spirv/total", 100.0), ("callgrind/ir-per-eval", 70.0)])], Some(timing(&[("ggx", around(1.5))])), "cpu B");
+        let old = baseline(
+            vec![row("ggx", &[("spirv/total", 100.0), ("callgrind/ir-per-eval", 60.0)])],
+            Some(timing(&[("ggx", around(1.0))])),
+            "cpu A",
+        );
+        let mut new = baseline(
+            vec![row("ggx", &[("spirv/total", 100.0), ("callgrind/ir-per-eval", 70.0)])],
+            Some(timing(&[("ggx", around(1.5))])),
+            "cpu B",
+        );
         let cmp = compare(&old, &new, &Thresholds::default(), false);
         assert_eq!(cmp.exit_code(), 0, "{:?}", cmp.regressions());
         let status = |c: &Comparison, g: &str| c.groups.iter().find(|(n, _)| n == g).unwrap().1.clone();
-        assert!(matches!(status(&cmp, "callgrind"), GroupStatus::NotComparable(d) if d.contains("host-cpu: baseline `cpu A`, now `cpu B`")));
+        assert!(
+            matches!(status(&cmp, "callgrind"), GroupStatus::NotComparable(d) if d.contains("host-cpu: baseline `cpu A`, now `cpu B`"))
+        );
         assert!(matches!(status(&cmp, "timing"), GroupStatus::NotComparable(_)));
         assert!(matches!(status(&cmp, "spirv"), GroupStatus::Compared));
         // Forced, or in the same environment, both regress.
@@ -258,7 +329,11 @@ mod tests {
     fn timings_need_significance_and_size() {
         let old = baseline(vec![row("ggx", &[])], Some(timing(&[("ggx", around(1.0)), ("blinn", around(1.2))])), "cpu");
         // ggx +10% (significant, beyond 5%): regression; blinn +2% (significant, within 5%): not.
-        let new = baseline(vec![row("ggx", &[])], Some(timing(&[("ggx", around(1.1)), ("blinn", around(1.2 * 1.02))])), "cpu");
+        let new = baseline(
+            vec![row("ggx", &[])],
+            Some(timing(&[("ggx", around(1.1)), ("blinn", around(1.2 * 1.02))])),
+            "cpu",
+        );
         let cmp = compare(&old, &new, &Thresholds::default(), false);
         let by = |m: &str| cmp.timing.iter().find(|t| t.model == m).unwrap().clone();
         assert!(by("ggx").is_regression() && by("ggx").p.unwrap() < 1e-3);
@@ -266,7 +341,12 @@ mod tests {
         assert_eq!(cmp.exit_code(), 1);
         // Fewer than 9 rounds: no test, no verdict.
         let short = |c: f64| timing(&[("ggx", around(c)[..8].to_vec())]);
-        let cmp = compare(&baseline(vec![row("ggx", &[])], Some(short(1.0)), "cpu"), &baseline(vec![row("ggx", &[])], Some(short(2.0)), "cpu"), &Thresholds::default(), false);
+        let cmp = compare(
+            &baseline(vec![row("ggx", &[])], Some(short(1.0)), "cpu"),
+            &baseline(vec![row("ggx", &[])], Some(short(2.0)), "cpu"),
+            &Thresholds::default(),
+            false,
+        );
         assert_eq!((cmp.timing[0].p, cmp.exit_code()), (None, 0));
     }
 
@@ -277,7 +357,10 @@ mod tests {
         new.inspect.section_notes.insert("callgrind/".into(), "could not measure: valgrind crashed".into());
         let cmp = compare(&old, &new, &Thresholds::default(), false);
         assert_eq!(cmp.exit_code(), 2);
-        assert!(cmp.report(Path::new("b.json"), &new).contains("COULD NOT MEASURE: callgrind: could not measure: valgrind crashed"));
+        assert!(
+            cmp.report(Path::new("b.json"), &new)
+                .contains("COULD NOT MEASURE: callgrind: could not measure: valgrind crashed")
+        );
         // On another machine the figures would not have been compared anyway: no failure.
         let elsewhere = baseline(vec![row("ggx", &[])], None, "another cpu");
         let mut new_elsewhere = elsewhere.clone();
@@ -308,7 +391,12 @@ mod tests {
         let p = dir.path().join("good.json");
         json::write_json(&p, &good).unwrap();
         assert_eq!(load(&p).unwrap().inspect.rows, good.inspect.rows);
-        let e = load(&write("bad.json", &std::fs::read_to_string(&p).unwrap().replace("\"spirv/total\": 1.0", "\"spirv/total\": \"x\""))).unwrap_err().to_string();
+        let e = load(&write(
+            "bad.json",
+            &std::fs::read_to_string(&p).unwrap().replace("\"spirv/total\": 1.0", "\"spirv/total\": \"x\""),
+        ))
+        .unwrap_err()
+        .to_string();
         assert!(e.contains("corrupt") && e.contains("bad.json"), "{e}");
     }
 
@@ -325,9 +413,14 @@ mod tests {
             load(&p).err().map(|e| e.to_string()).unwrap_or_else(|| "accepted".into())
         };
         assert_eq!(refused(&|_| {}), "accepted");
-        let stat = |key: &'static str, x: f64| move |v: &mut serde_json::Value| v["inspect"]["rows"][0]["stats"][key] = x.into();
+        let stat = |key: &'static str, x: f64| {
+            move |v: &mut serde_json::Value| v["inspect"]["rows"][0]["stats"][key] = x.into()
+        };
         let e = refused(&stat("spirv/total", -1.0));
-        assert!(e.contains("b.json: corrupt (row `ggx`: statistic spirv/total is -1; a count cannot be negative)"), "{e}");
+        assert!(
+            e.contains("b.json: corrupt (row `ggx`: statistic spirv/total is -1; a count cannot be negative)"),
+            "{e}"
+        );
         let e = refused(&stat("callgrind/ir-per-eval", -67.5));
         assert!(e.contains("statistic callgrind/ir-per-eval is -67.5; a count cannot be negative"), "{e}");
         let e = refused(&stat("naga/expressions", 1.5));

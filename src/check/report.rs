@@ -1,10 +1,10 @@
 //! The shader-db-style report of a comparison.
 
 use super::baseline::Baseline;
-use super::compare::{rel_change, Change, Comparison, GroupStatus};
+use super::compare::{Change, Comparison, GroupStatus, rel_change};
 use super::thresholds::{ALPHA, MIN_TIMING_ROUNDS, TIMING_KEY};
-use crate::schema::format_value;
 use crate::export::markdown::{self, Table};
+use crate::schema::format_value;
 use std::path::Path;
 
 fn percent(rel: f64) -> String {
@@ -16,11 +16,17 @@ fn percent(rel: f64) -> String {
 
 impl Comparison {
     pub fn regressions(&self) -> Vec<String> {
-        let counts = self
-            .changes
-            .iter()
-            .filter(|c| c.is_regression())
-            .map(|c| format!("{} {}: {} -> {} ({}, threshold {})", c.model, c.key, format_value(c.old), format_value(c.new), percent(c.rel), percent(c.threshold)));
+        let counts = self.changes.iter().filter(|c| c.is_regression()).map(|c| {
+            format!(
+                "{} {}: {} -> {} ({}, threshold {})",
+                c.model,
+                c.key,
+                format_value(c.old),
+                format_value(c.new),
+                percent(c.rel),
+                percent(c.threshold)
+            )
+        });
         let timing = self.timing.iter().filter(|t| t.is_regression()).map(|t| {
             format!(
                 "{} {TIMING_KEY}: {} -> {} ({}, p = {}, threshold {})",
@@ -37,7 +43,10 @@ impl Comparison {
 
     /// Groups that should have been measured and were not.
     pub fn not_measured(&self) -> Vec<String> {
-        self.groups.iter().filter_map(|(g, s)| if let GroupStatus::NotMeasured(why) = s { Some(format!("{g}: {why}")) } else { None }).collect()
+        self.groups
+            .iter()
+            .filter_map(|(g, s)| if let GroupStatus::NotMeasured(why) = s { Some(format!("{g}: {why}")) } else { None })
+            .collect()
     }
 
     /// 1 on any regression, else 2 when a group could not be measured, else 0.
@@ -59,7 +68,13 @@ impl Comparison {
         out += &self.helped_hurt_section();
         out += &self.totals_section();
         out += &self.timing_section();
-        for note in self.notes.iter().chain(self.only_old.iter().map(|m| format!("{m}: in the baseline only, not measured now")).collect::<Vec<_>>().iter()) {
+        for note in self.notes.iter().chain(
+            self.only_old
+                .iter()
+                .map(|m| format!("{m}: in the baseline only, not measured now"))
+                .collect::<Vec<_>>()
+                .iter(),
+        ) {
             out += &format!("Note: {note}\n");
         }
         for m in &self.only_new {
@@ -86,7 +101,12 @@ impl Comparison {
 
     fn changes_section(&self) -> String {
         let changed: Vec<&Change> = self.changes.iter().filter(|c| c.old != c.new).collect();
-        let out = format!("## Changes\n\n{} statistics compared over {} models, {} changed.\n\n", self.changes.len(), self.models().len(), changed.len());
+        let out = format!(
+            "## Changes\n\n{} statistics compared over {} models, {} changed.\n\n",
+            self.changes.len(),
+            self.models().len(),
+            changed.len()
+        );
         if changed.is_empty() {
             return out;
         }
@@ -101,7 +121,15 @@ impl Comparison {
             } else {
                 "helped"
             };
-            t.row([c.model.clone(), c.key.clone(), format_value(c.old), format_value(c.new), percent(c.rel), percent(c.threshold), verdict.into()]);
+            t.row([
+                c.model.clone(),
+                c.key.clone(),
+                format_value(c.old),
+                format_value(c.new),
+                percent(c.rel),
+                percent(c.threshold),
+                verdict.into(),
+            ]);
         }
         out + &t.markdown() + "\n"
     }
@@ -117,9 +145,24 @@ impl Comparison {
         let mut helped: Vec<&Change> = self.changes.iter().filter(|c| c.new < c.old).collect();
         hurt.sort_by(|a, b| b.rel.total_cmp(&a.rel));
         helped.sort_by(|a, b| a.rel.total_cmp(&b.rel));
-        let line = |c: &&Change| format!("- {} {}: {} -> {} ({})\n", c.model, c.key, format_value(c.old), format_value(c.new), percent(c.rel));
+        let line = |c: &&Change| {
+            format!(
+                "- {} {}: {} -> {} ({})\n",
+                c.model,
+                c.key,
+                format_value(c.old),
+                format_value(c.new),
+                percent(c.rel)
+            )
+        };
         let list = |cs: &[&Change]| if cs.is_empty() { "(none)\n".to_string() } else { cs.iter().map(line).collect() };
-        format!("## Hurt ({}), largest change first\n\n{}\n## Helped ({}), largest change first\n\n{}\n", hurt.len(), list(&hurt), helped.len(), list(&helped))
+        format!(
+            "## Hurt ({}), largest change first\n\n{}\n## Helped ({}), largest change first\n\n{}\n",
+            hurt.len(),
+            list(&hurt),
+            helped.len(),
+            list(&helped)
+        )
     }
 
     /// Totals of every statistic that changed somewhere (and of the headline totals), over all models and
@@ -138,11 +181,23 @@ impl Comparison {
             let of_key: Vec<&Change> = self.changes.iter().filter(|c| c.key == key).collect();
             let sum = |cs: &[&Change]| (cs.iter().map(|c| c.old).sum::<f64>(), cs.iter().map(|c| c.new).sum::<f64>());
             let (o, n) = sum(&of_key);
-            all.row([key.to_string(), of_key.len().to_string(), format_value(o), format_value(n), percent(rel_change(o, n))]);
+            all.row([
+                key.to_string(),
+                of_key.len().to_string(),
+                format_value(o),
+                format_value(n),
+                percent(rel_change(o, n)),
+            ]);
             let changed: Vec<&Change> = of_key.iter().copied().filter(|c| c.old != c.new).collect();
             if !changed.is_empty() {
                 let (o, n) = sum(&changed);
-                affected.row([key.to_string(), changed.len().to_string(), format_value(o), format_value(n), percent(rel_change(o, n))]);
+                affected.row([
+                    key.to_string(),
+                    changed.len().to_string(),
+                    format_value(o),
+                    format_value(n),
+                    percent(rel_change(o, n)),
+                ]);
             }
         }
         let mut out = format!("## Totals over all models\n\n{}\n", all.markdown());
@@ -156,7 +211,8 @@ impl Comparison {
         if self.timing.is_empty() {
             return String::new();
         }
-        let mut t = Table::new(["model", "old median [rounds]", "new median [rounds]", "change", "p", "threshold", "verdict"]);
+        let mut t =
+            Table::new(["model", "old median [rounds]", "new median [rounds]", "change", "p", "threshold", "verdict"]);
         for c in &self.timing {
             t.row([
                 c.model.clone(),
@@ -192,4 +248,3 @@ impl Comparison {
         out
     }
 }
-

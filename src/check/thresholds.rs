@@ -1,6 +1,6 @@
 //! Which statistics can regress, and by how much before they do.
 
-use anyhow::{anyhow, bail, Result};
+use anyhow::{Result, anyhow, bail};
 
 /// Significance level of the timing test.
 pub const ALPHA: f64 = 0.05;
@@ -27,7 +27,6 @@ const GATED_DRIVER_KEYS: [&str; 11] = [
     "driver/issue-cycles",
 ];
 
-
 /// The group of a statistic key.
 pub fn group_of(key: &str) -> &str {
     key.split('/').next().unwrap_or(key)
@@ -52,12 +51,19 @@ impl Thresholds {
     pub fn parse(items: &[String]) -> Result<Self> {
         let mut entries = Vec::new();
         for item in items {
-            let (key, value) = item.split_once('=').ok_or_else(|| anyhow!("--threshold `{item}`: expected STAT=FRACTION, e.g. spirv/total=0.02"))?;
+            let (key, value) = item
+                .split_once('=')
+                .ok_or_else(|| anyhow!("--threshold `{item}`: expected STAT=FRACTION, e.g. spirv/total=0.02"))?;
             let (key, value) = (key.trim(), value.trim());
             if !GROUPS.contains(&group_of(key)) {
-                bail!("--threshold `{item}`: unknown statistic `{key}`: give a group ({}) or a key such as spirv/total", GROUPS.join(", "));
+                bail!(
+                    "--threshold `{item}`: unknown statistic `{key}`: give a group ({}) or a key such as spirv/total",
+                    GROUPS.join(", ")
+                );
             }
-            let fraction: f64 = value.parse().map_err(|_| anyhow!("--threshold `{item}`: `{value}` is not a number (a fraction: 0.01 is 1%)"))?;
+            let fraction: f64 = value
+                .parse()
+                .map_err(|_| anyhow!("--threshold `{item}`: `{value}` is not a number (a fraction: 0.01 is 1%)"))?;
             if !(fraction.is_finite() && fraction >= 0.0) {
                 bail!("--threshold `{item}`: the fraction must be finite and not negative");
             }
@@ -69,7 +75,10 @@ impl Thresholds {
     /// The threshold of `key`: its own, else its group's, else the default.
     pub fn get(&self, key: &str) -> f64 {
         let find = |k: &str| self.entries.iter().rev().find(|(e, _)| e == k).map(|(_, v)| *v);
-        find(key).or_else(|| find(group_of(key))).unwrap_or(if group_of(key) == "timing" { DEFAULT_TIMING_THRESHOLD } else { DEFAULT_COUNT_THRESHOLD })
+        find(key).or_else(|| find(group_of(key))).unwrap_or(if group_of(key) == "timing" {
+            DEFAULT_TIMING_THRESHOLD
+        } else {
+            DEFAULT_COUNT_THRESHOLD
+        })
     }
 }
-

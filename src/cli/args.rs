@@ -3,13 +3,13 @@
 //! limit).
 
 use super::{command_started, compiles_only_error};
-use anyhow::{anyhow, bail, Result};
+use anyhow::{Result, anyhow, bail};
 use brdfprof::gpu::{Gpu, GpuOptions};
 use brdfprof::inspect::callgrind::CallgrindOptions;
 use brdfprof::io;
 use brdfprof::model::{self, Model};
-use brdfprof::profile::protocol::ProtocolOptions;
 use brdfprof::profile::ProfileOptions;
+use brdfprof::profile::protocol::ProtocolOptions;
 use brdfprof::report_page::{self, Input};
 use brdfprof::shaders::Shaders;
 use brdfprof::targets;
@@ -46,7 +46,8 @@ pub fn cosine_range(text: &str) -> Result<(f64, f64), String> {
 
 /// `--reference SPEC`: a built-in spec (it has the f64 twin a reference needs).
 pub fn reference_spec(text: &str) -> Result<brdfprof::brdf::ModelSpec, String> {
-    brdfprof::brdf::ModelSpec::parse(text).map_err(|e| format!("{e} (a reference is a built-in spec: a preset or D/Vis/F terms, which have an f64 twin)"))
+    brdfprof::brdf::ModelSpec::parse(text)
+        .map_err(|e| format!("{e} (a reference is a built-in spec: a preset or D/Vis/F terms, which have an f64 twin)"))
 }
 
 /// `--device`: an empty or blank name would match every device (a substring of each), so it is refused; a
@@ -80,7 +81,8 @@ impl DeviceArgs {
         if let Some(d) = self.device.as_deref().filter(|d| targets::is_compile_only(d)) {
             return Err(compiles_only_error(d));
         }
-        let gpu = Gpu::new(&GpuOptions { device: self.device.clone(), validation: self.validation(), ..Default::default() })?;
+        let gpu =
+            Gpu::new(&GpuOptions { device: self.device.clone(), validation: self.validation(), ..Default::default() })?;
         if gpu.info.compile_only() && !compile_only_ok {
             return Err(compiles_only_error(&format!("{} ({})", self.device.as_deref().unwrap_or("?"), gpu.info.name)));
         }
@@ -120,9 +122,15 @@ impl ModelArgs {
     /// The models asked for, or `default` when none.
     pub fn models(&self, default: &[&str]) -> Result<Vec<Model>> {
         let mut items = String::new();
-        for (flag, key, values) in [("--define", model::file_model::DEFINE, &self.defines), ("--include-dir", model::file_model::INCLUDE, &self.include_dirs), ("--include-map", model::file_model::INCLUDE_MAP, &self.include_maps)] {
+        for (flag, key, values) in [
+            ("--define", model::file_model::DEFINE, &self.defines),
+            ("--include-dir", model::file_model::INCLUDE, &self.include_dirs),
+            ("--include-map", model::file_model::INCLUDE_MAP, &self.include_maps),
+        ] {
             if let Some(v) = values.iter().find(|v| v.contains(',')) {
-                bail!("{flag} {v}: a comma would end the value in the model's spec; rename the directory or give the value without one");
+                bail!(
+                    "{flag} {v}: a comma would end the value in the model's spec; rename the directory or give the value without one"
+                );
             }
             items += &values.iter().map(|v| format!(",{key}={v}")).collect::<String>();
         }
@@ -132,10 +140,23 @@ impl ModelArgs {
         // The options join each shader file model's text, so that its shader is prepared once, with them (a
         // file may `#error` without its defines, or include what only these directories hold).
         if !self.models.iter().any(|m| model::file_model::names_a_file(m)) {
-            let flag = [("--define", &self.defines), ("--include-dir", &self.include_dirs), ("--include-map", &self.include_maps)].into_iter().find_map(|(f, v)| v.first().map(|v| format!("{f} {v}"))).unwrap_or_default();
-            bail!("{flag}: it is for a shader file's model, and no --model is a .brdf file, nor an .hlsl, .ush or .wgsl file");
+            let flag = [
+                ("--define", &self.defines),
+                ("--include-dir", &self.include_dirs),
+                ("--include-map", &self.include_maps),
+            ]
+            .into_iter()
+            .find_map(|(f, v)| v.first().map(|v| format!("{f} {v}")))
+            .unwrap_or_default();
+            bail!(
+                "{flag}: it is for a shader file's model, and no --model is a .brdf file, nor an .hlsl, .ush or .wgsl file"
+            );
         }
-        let with: Vec<String> = self.models.iter().map(|m| if model::file_model::names_a_file(m) { format!("{m}{items}") } else { m.clone() }).collect();
+        let with: Vec<String> = self
+            .models
+            .iter()
+            .map(|m| if model::file_model::names_a_file(m) { format!("{m}{items}") } else { m.clone() })
+            .collect();
         model::models_from_args(&with, &self.params, default)
     }
 }
@@ -184,21 +205,41 @@ pub fn with_unguarded(models: Vec<Model>, unguarded: bool) -> Vec<Model> {
     }
     let mut out = Vec::with_capacity(2 * models.len());
     for m in models {
-        let off = m.twin().filter(|s| s.guards != brdfprof::brdf::guards::GuardSet::NONE).map(|s| Model::spec(brdfprof::brdf::ModelSpec { guards: brdfprof::brdf::guards::GuardSet::NONE, ..*s }));
+        let off = m
+            .twin()
+            .filter(|s| s.guards != brdfprof::brdf::guards::GuardSet::NONE)
+            .map(|s| Model::spec(brdfprof::brdf::ModelSpec { guards: brdfprof::brdf::guards::GuardSet::NONE, ..*s }));
         out.push(m);
         out.extend(off);
     }
     let mut seen = Vec::new();
-    out.retain(|m| if seen.contains(m) { false } else { seen.push(m.clone()); true });
+    out.retain(|m| {
+        if seen.contains(m) {
+            false
+        } else {
+            seen.push(m.clone());
+            true
+        }
+    });
     out
 }
 
 impl TimingArgs {
-    pub fn options(&self, models: Vec<Model>, size: &str, reps: usize, budget: f64, target_ci: f64) -> Result<ProfileOptions> {
+    pub fn options(
+        &self,
+        models: Vec<Model>,
+        size: &str,
+        reps: usize,
+        budget: f64,
+        target_ci: f64,
+    ) -> Result<ProfileOptions> {
         let (width, height) = parse_size("--size", size)?;
         use brdfprof::profile::workload::MAX_LIGHTS;
         if self.lights.iter().any(|&l| l == 0 || l > MAX_LIGHTS) {
-            bail!("--lights {}: each count must be 1 to {MAX_LIGHTS}", self.lights.iter().map(u32::to_string).collect::<Vec<_>>().join(","));
+            bail!(
+                "--lights {}: each count must be 1 to {MAX_LIGHTS}",
+                self.lights.iter().map(u32::to_string).collect::<Vec<_>>().join(",")
+            );
         }
         let mut seen = std::collections::BTreeSet::new();
         if let Some(l) = self.lights.iter().find(|l| !seen.insert(**l)) {
@@ -282,7 +323,6 @@ impl CountArgs {
         Ok((!self.no_callgrind).then_some(CallgrindOptions { width, height, device: None, validate }))
     }
 }
-
 
 /// `--html FILE`: the flag's help, shared by the commands that take it.
 #[derive(Args, Clone, Default)]

@@ -32,14 +32,20 @@ fn origin() -> &'static str {
 
 pub fn cache(args: &CacheArgs) -> Result<ExitCode> {
     let Some(store) = Store::open_default() else {
-        println!("the disk cache is off (BRDFPROF_CACHE_DIR is empty, or no home directory is known): nothing to show or clear");
+        println!(
+            "the disk cache is off (BRDFPROF_CACHE_DIR is empty, or no home directory is known): nothing to show or clear"
+        );
         return Ok(ExitCode::SUCCESS);
     };
     match args.action {
         CacheAction::Show => show(&store),
         CacheAction::Clear => {
             let (files, bytes) = store.clear()?;
-            println!("removed {files} cache entr{} ({bytes} bytes) from {}", if files == 1 { "y" } else { "ies" }, store.dir().display());
+            println!(
+                "removed {files} cache entr{} ({bytes} bytes) from {}",
+                if files == 1 { "y" } else { "ies" },
+                store.dir().display()
+            );
         }
     }
     Ok(ExitCode::SUCCESS)
@@ -58,8 +64,16 @@ fn show(store: &Store) {
     }
     println!("directory: {} ({})", store.dir().display(), origin());
     let per_kind = kinds.iter().map(|(k, n)| format!("{k}: {n}")).collect::<Vec<_>>().join(", ");
-    println!("entries: {}{}", entries.len(), if per_kind.is_empty() { String::new() } else { format!(" ({per_kind})") });
-    let human = if bytes >= 1 << 20 { format!("{:.1} MiB", bytes as f64 / (1u64 << 20) as f64) } else { format!("{:.1} KiB", bytes as f64 / 1024.0) };
+    println!(
+        "entries: {}{}",
+        entries.len(),
+        if per_kind.is_empty() { String::new() } else { format!(" ({per_kind})") }
+    );
+    let human = if bytes >= 1 << 20 {
+        format!("{:.1} MiB", bytes as f64 / (1u64 << 20) as f64)
+    } else {
+        format!("{:.1} KiB", bytes as f64 / 1024.0)
+    };
     println!("total size: {bytes} bytes ({human})");
     for e in entries.iter().filter(|e| e.damaged.is_some()) {
         println!("damaged (replaced when next used): {} ({})", e.path.display(), e.damaged.as_deref().unwrap_or(""));

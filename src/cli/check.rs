@@ -1,8 +1,8 @@
 //! `brdfprof check`: the regression gate on the instruction counts and a short timing run, against a baseline.
 
-use super::args::{parse_size, CountArgs, DeviceArgs, ModelArgs};
+use super::args::{CountArgs, DeviceArgs, ModelArgs, parse_size};
 use super::fresh_compilation;
-use anyhow::{anyhow, bail, Result};
+use anyhow::{Result, anyhow, bail};
 use brdfprof::check::{self, CheckOptions, Thresholds};
 use brdfprof::inspect::timing::TimingOptions;
 use brdfprof::io;
@@ -66,10 +66,17 @@ pub fn check(args: &CheckArgs) -> Result<ExitCode> {
     let outcome = match args.device.device.as_deref().map(brdfprof::targets::parse).transpose()?.flatten() {
         Some(ts) if ts.len() == 1 => {
             // A target that compiles a translation checks it against the default device first.
-            let verify = if ts[0].vendor.needs_verification() { Some(DeviceArgs { device: None, validate: args.device.validate }.open()?) } else { None };
+            let verify = if ts[0].vendor.needs_verification() {
+                Some(DeviceArgs { device: None, validate: args.device.validate }.open()?)
+            } else {
+                None
+            };
             check::run_target(&options, &shaders, ts[0], args.device.validation(), verify.as_ref())?
         }
-        Some(_) => bail!("--device {}: check compares one family with its baseline; give one target, e.g. radv:navi21", args.device.device.as_deref().unwrap_or_default()),
+        Some(_) => bail!(
+            "--device {}: check compares one family with its baseline; give one target, e.g. radv:navi21",
+            args.device.device.as_deref().unwrap_or_default()
+        ),
         None => check::run(&options, &shaders, || args.device.open_with(true))?,
     };
     print!("{}", outcome.text);

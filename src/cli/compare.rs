@@ -3,7 +3,7 @@
 
 use super::check_output;
 use anyhow::Result;
-use brdfprof::{compare, io, export::json};
+use brdfprof::{compare, export::json, io};
 use clap::Args;
 use std::path::PathBuf;
 use std::process::ExitCode;

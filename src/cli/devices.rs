@@ -1,7 +1,7 @@
 //! `brdfprof devices`: the Vulkan devices, or with `--targets` the compile-only targets.
 
 use anyhow::Result;
-use brdfprof::{gpu, export::markdown};
+use brdfprof::{export::markdown, gpu};
 use clap::Args;
 use std::process::ExitCode;
 
@@ -15,13 +15,27 @@ pub struct DevicesArgs {
 
 /// `devices --targets`: every vendor's families (`targets::VENDORS`) and whether its compiler is installed.
 fn targets_table() -> String {
-    let mut out = String::from("Compile-only targets: each vendor's production compiler for GPU families this machine does not have (no GPU \
-         needed; nothing executes). Commands that compile take them: inspect, check, sweep --cost-device, profile --scene --cost-device.\n\n");
+    let mut out = String::from(
+        "Compile-only targets: each vendor's production compiler for GPU families this machine does not have (no GPU \
+         needed; nothing executes). Commands that compile take them: inspect, check, sweep --cost-device, profile --scene --cost-device.\n\n",
+    );
     for v in brdfprof::targets::VENDORS {
         let status = v.status().unwrap_or_else(|e| format!("{e:#}"));
-        let mut t = markdown::Table::new(["--device", "architecture", "products", "compiler", &format!("in {}:all", v.prefix())]);
+        let mut t = markdown::Table::new([
+            "--device",
+            "architecture",
+            "products",
+            "compiler",
+            &format!("in {}:all", v.prefix()),
+        ]);
         for f in v.families() {
-            t.row([format!("{}:{}", v.prefix(), f.name), f.architecture.into(), f.products.into(), f.detail, if f.default { "yes".into() } else { String::new() }]);
+            t.row([
+                format!("{}:{}", v.prefix(), f.name),
+                f.architecture.into(),
+                f.products.into(),
+                f.detail,
+                if f.default { "yes".into() } else { String::new() },
+            ]);
         }
         out += &format!("## {}\n\n{}\n\nCompiler: {status}\n\n{}\n", v.prefix(), v.title(), t.markdown());
     }
@@ -36,10 +50,27 @@ pub fn devices(args: &DevicesArgs) -> Result<ExitCode> {
     let infos = gpu::list_devices()?;
     let default = gpu::select_device(&infos, None).ok();
     let mut t = markdown::Table::new([
-        "index", "name", "type", "driver", "API", "timestampPeriod ns", "ts bits", "maxStorageBufferRange", "maxWorkGroupCount.x", "fp16", "fp64", "exec. stats",
+        "index",
+        "name",
+        "type",
+        "driver",
+        "API",
+        "timestampPeriod ns",
+        "ts bits",
+        "maxStorageBufferRange",
+        "maxWorkGroupCount.x",
+        "fp16",
+        "fp64",
+        "exec. stats",
     ]);
     for d in &infos {
-        let mark = if Some(d.index) == default { " (default)" } else if d.compile_only() { " (compiles only)" } else { "" };
+        let mark = if Some(d.index) == default {
+            " (default)"
+        } else if d.compile_only() {
+            " (compiles only)"
+        } else {
+            ""
+        };
         t.row([
             format!("{}{mark}", d.index),
             d.name.clone(),

@@ -1,15 +1,15 @@
 //! `brdfprof diff --model A --model B`: both models on the same inputs, B measured against A; or
 //! `brdfprof diff --reference SPEC --model ... --model ...`: every model against one reference's f64 values.
 
-use brdfprof::model::csv_rows::{read_rows, RowValues};
-use super::args::{cosine_range, reference_spec, roughness_range, DeviceArgs, HtmlArg, ModelArgs};
+use super::args::{DeviceArgs, HtmlArg, ModelArgs, cosine_range, reference_spec, roughness_range};
 use super::on_device;
-use anyhow::{bail, Result};
-use brdfprof::brdf::Sample;
+use anyhow::{Result, bail};
 use brdfprof::brdf::ModelSpec;
+use brdfprof::brdf::Sample;
 use brdfprof::diff::{self, DiffReport, DiffSet, Evaluated};
 use brdfprof::model::Model;
-use brdfprof::{io, kernels, export::json};
+use brdfprof::model::csv_rows::{RowValues, read_rows};
+use brdfprof::{export::json, io, kernels};
 use clap::Args;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -112,7 +112,10 @@ pub fn diff(args: &DiffArgs) -> Result<ExitCode> {
         }
     }
     let [a, b] = models.as_slice() else {
-        bail!("diff takes exactly two --model (A, then B measured against A), or any number with --reference SPEC (or one `.brdf` file naming its `reference`); got {}", models.len());
+        bail!(
+            "diff takes exactly two --model (A, then B measured against A), or any number with --reference SPEC (or one `.brdf` file naming its `reference`); got {}",
+            models.len()
+        );
     };
     if args.input.is_none() && !(1..=diff::MAX_SAMPLES).contains(&args.samples) {
         bail!("--samples {}: give 1 to {}", args.samples, diff::MAX_SAMPLES);
@@ -129,7 +132,15 @@ pub fn diff(args: &DiffArgs) -> Result<ExitCode> {
         Ok(values)
     })?;
     let (va, vb) = (&values[0], &values[1]);
-    let evaluated = Evaluated { a, b, samples: &inputs.samples, lines: inputs.lines.as_deref(), a_values: va, b_values: vb, a_exact: None };
+    let evaluated = Evaluated {
+        a,
+        b,
+        samples: &inputs.samples,
+        lines: inputs.lines.as_deref(),
+        a_values: va,
+        b_values: vb,
+        a_exact: None,
+    };
     let result = DiffReport::build(&evaluated, &gpu.info.name, &inputs.label, args.worst, args.tolerance);
     for (flag, path) in &outs {
         match *flag {
@@ -151,7 +162,9 @@ pub fn diff(args: &DiffArgs) -> Result<ExitCode> {
 /// `diff --reference`: every model on the same rows against the reference's f64 twin (no kernel of its own).
 fn diff_set(args: &DiffArgs, reference: &Model, models: &[Model]) -> Result<ExitCode> {
     if args.png.is_some() {
-        bail!("--png draws two models side by side; a diff against a reference (--reference, or a file's `reference`) has none: give a second --model for it");
+        bail!(
+            "--png draws two models side by side; a diff against a reference (--reference, or a file's `reference`) has none: give a second --model for it"
+        );
     }
     if args.input.is_none() && !(1..=diff::MAX_SAMPLES).contains(&args.samples) {
         bail!("--samples {}: give 1 to {}", args.samples, diff::MAX_SAMPLES);
@@ -169,7 +182,15 @@ fn diff_set(args: &DiffArgs, reference: &Model, models: &[Model]) -> Result<Exit
         .iter()
         .zip(&values)
         .map(|(m, v)| {
-            let e = Evaluated { a: reference, b: m, samples: &inputs.samples, lines: inputs.lines.as_deref(), a_values: &rounded, b_values: v, a_exact: Some(&exact) };
+            let e = Evaluated {
+                a: reference,
+                b: m,
+                samples: &inputs.samples,
+                lines: inputs.lines.as_deref(),
+                a_values: &rounded,
+                b_values: v,
+                a_exact: Some(&exact),
+            };
             DiffReport::build(&e, &gpu.info.name, &inputs.label, args.worst, args.tolerance)
         })
         .collect();
@@ -208,7 +229,12 @@ impl Inputs {
                 samples: diff::default_samples_in(args.samples, args.seed, &domain),
                 tangents: None,
                 lines: None,
-                label: diff::default_samples_label_in(args.samples, args.seed, &domain, why.each_ref().map(String::as_str)),
+                label: diff::default_samples_label_in(
+                    args.samples,
+                    args.seed,
+                    &domain,
+                    why.each_ref().map(String::as_str),
+                ),
                 models: models.iter().map(|m| (m.clone(), RowValues::default())).collect(),
             });
         };
@@ -217,13 +243,22 @@ impl Inputs {
         for m in models {
             let (model, input, values) = read_rows(m, path, &args.model.params)?;
             if input.samples.is_empty() {
-                bail!("--input {}: the file has a header but no rows: there is nothing to compare (as --samples 0 is refused)", path.display());
+                bail!(
+                    "--input {}: the file has a header but no rows: there is nothing to compare (as --samples 0 is refused)",
+                    path.display()
+                );
             }
             rows.get_or_insert(input);
             read.push((model, values));
         }
         let input = rows.expect("at least one model");
-        Ok(Inputs { samples: input.samples, tangents: input.tangents, lines: Some(input.lines), label: path.display().to_string(), models: read })
+        Ok(Inputs {
+            samples: input.samples,
+            tangents: input.tangents,
+            lines: Some(input.lines),
+            label: path.display().to_string(),
+            models: read,
+        })
     }
 
     /// Every model's values on the rows, in order.
@@ -231,7 +266,11 @@ impl Inputs {
         self.models
             .iter()
             .map(|(m, rows)| {
-                let extras = kernels::EvalExtras { tangents: self.tangents.as_deref(), rows: &rows.values, row_floats: rows.floats };
+                let extras = kernels::EvalExtras {
+                    tangents: self.tangents.as_deref(),
+                    rows: &rows.values,
+                    row_floats: rows.floats,
+                };
                 kernels::eval_with(gpu, m, &self.samples, &extras, kernels::RunLimits::default())
             })
             .collect()

@@ -2,8 +2,8 @@
 
 use super::args::{DeviceArgs, ModelArgs};
 use super::on_device;
-use anyhow::{bail, Result};
-use brdfprof::model::{csv_rows, Model};
+use anyhow::{Result, bail};
+use brdfprof::model::{Model, csv_rows};
 use brdfprof::{io, kernels, messages};
 use clap::Args;
 use std::path::PathBuf;
@@ -38,18 +38,23 @@ pub fn eval(args: &EvalArgs) -> Result<ExitCode> {
     io::check_not_input("--output", &args.output, &inputs)?;
     let shown = model.name();
     let (model, input, rows) = csv_rows::read_rows(model, &args.input, &args.model.params)?;
-    let extras = kernels::EvalExtras { tangents: input.tangents.as_deref(), rows: &rows.values, row_floats: rows.floats };
+    let extras =
+        kernels::EvalExtras { tangents: input.tangents.as_deref(), rows: &rows.values, row_floats: rows.floats };
     let (device, values) = if args.device.device.as_deref() == Some(OPENCL_DEVICE) {
         let (device, values, smod) = on_opencl(&model, &input.samples, &extras)?;
         // Two executions of one source: where they disagree, the user is told (issue 31 item 2).
         let vulkan = DeviceArgs { device: None, validate: args.device.validate };
-        let (gpu, on_vulkan) = on_device(&vulkan, |gpu, _| kernels::eval_with(gpu, &model, &input.samples, &extras, kernels::RunLimits::default()))?;
+        let (gpu, on_vulkan) = on_device(&vulkan, |gpu, _| {
+            kernels::eval_with(gpu, &model, &input.samples, &extras, kernels::RunLimits::default())
+        })?;
         if let Some(w) = disagreement(&model, &values, &on_vulkan, &input.lines, (&device, &gpu.info.name), smod) {
             messages::warning(w);
         }
         (device, values)
     } else {
-        let (gpu, values) = on_device(&args.device, |gpu, _| kernels::eval_with(gpu, &model, &input.samples, &extras, kernels::RunLimits::default()))?;
+        let (gpu, values) = on_device(&args.device, |gpu, _| {
+            kernels::eval_with(gpu, &model, &input.samples, &extras, kernels::RunLimits::default())
+        })?;
         (gpu.info.name.clone(), values)
     };
     io::write_output(&args.output, io::format_rgb_csv(&values).as_bytes())?;
@@ -68,12 +73,27 @@ pub const OPENCL_DEVICE: &str = "opencl";
 
 /// The warning when the OpenCL and Vulkan executions of `model` differ beyond the translation check's
 /// tolerance (`verify::eval_tolerance`) on any row; None when they agree.
-fn disagreement(model: &Model, opencl: &[[f32; 3]], vulkan: &[[f32; 3]], lines: &[usize], (cl, vk): (&str, &str), smod: bool) -> Option<String> {
+fn disagreement(
+    model: &Model,
+    opencl: &[[f32; 3]],
+    vulkan: &[[f32; 3]],
+    lines: &[usize],
+    (cl, vk): (&str, &str),
+    smod: bool,
+) -> Option<String> {
     let tolerance = brdfprof::translate::verify::eval_tolerance(model);
-    let row_worst = |i: usize| brdfprof::translate::verify::worst_relative(&opencl[i..=i], &vulkan[i..=i], |_, c| f64::from(vulkan[i][c]).abs().max(1e-3));
+    let row_worst = |i: usize| {
+        brdfprof::translate::verify::worst_relative(&opencl[i..=i], &vulkan[i..=i], |_, c| {
+            f64::from(vulkan[i][c]).abs().max(1e-3)
+        })
+    };
     let over: Vec<usize> = (0..opencl.len()).filter(|&i| !(row_worst(i) <= tolerance)).collect();
     let &first = over.first()?;
-    let srem = if !smod { "" } else { "; the kernel takes integer `%`, which lavapipe computes as srem (the dividend's sign) where SPIR-V's OpSMod and the translation take the divisor's: on negative operands the two differ by design (docs/translation.md)" };
+    let srem = if !smod {
+        ""
+    } else {
+        "; the kernel takes integer `%`, which lavapipe computes as srem (the dividend's sign) where SPIR-V's OpSMod and the translation take the divisor's: on negative operands the two differ by design (docs/translation.md)"
+    };
     Some(format!(
         "{} of {} rows differ between {cl} and Vulkan on {vk} by more than {tolerance:.0e} relative (first: line {}, OpenCL {:?}, Vulkan {:?}){srem}",
         over.len(),
@@ -84,7 +104,11 @@ fn disagreement(model: &Model, opencl: &[[f32; 3]], vulkan: &[[f32; 3]], lines: 
     ))
 }
 
-fn on_opencl(model: &Model, samples: &[brdfprof::brdf::Sample], extras: &kernels::EvalExtras) -> Result<(String, Vec<[f32; 3]>, bool)> {
+fn on_opencl(
+    model: &Model,
+    samples: &[brdfprof::brdf::Sample],
+    extras: &kernels::EvalExtras,
+) -> Result<(String, Vec<[f32; 3]>, bool)> {
     use brdfprof::translate::{opencl, prepare};
     let translation = prepare::eval_kernel(model, kernels::embedded())?;
     let kernel = opencl::ClKernel::build(&translation, false)?;

@@ -1,13 +1,13 @@
 //! `brdfprof inspect`: instruction counts of each model's shading kernel, on devices and compile-only targets.
 
-use super::args::{device_name, CountArgs, DeviceArgs, HtmlArg, ModelArgs};
+use super::args::{CountArgs, DeviceArgs, HtmlArg, ModelArgs, device_name};
 use super::{check_output, just_measured, on_device_with};
-use brdfprof::gpu::Gpu;
-use brdfprof::devices;
-use anyhow::{bail, Result};
+use anyhow::{Result, bail};
 use brdfprof::brdf::THESIS_MODELS;
+use brdfprof::devices;
+use brdfprof::gpu::Gpu;
 use brdfprof::inspect::{self, InspectOptions};
-use brdfprof::{io, export::json};
+use brdfprof::{export::json, io};
 use clap::Args;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -73,8 +73,11 @@ pub fn inspect(args: &InspectArgs) -> Result<ExitCode> {
     }
     let validate = DeviceArgs { device: None, validate: args.validate }.validation();
     let plan = devices::plan(&args.devices)?;
-    if args.lines && !plan.iter().any(|p| matches!(p, devices::Planned::Target(t) if brdfprof::targets::names_lines(t))) {
-        bail!("--lines: only the nvidia: and intel: targets' compilers name each instruction's source line; give one (e.g. --device nvidia:sm_89 --device intel:gen12lp)");
+    if args.lines && !plan.iter().any(|p| matches!(p, devices::Planned::Target(t) if brdfprof::targets::names_lines(t)))
+    {
+        bail!(
+            "--lines: only the nvidia: and intel: targets' compilers name each instruction's source line; give one (e.g. --device nvidia:sm_89 --device intel:gen12lp)"
+        );
     }
     // A compile-only target's default name is known now (`devices::slug`); a local device's only once it is open.
     let default_name = match plan.as_slice() {
@@ -87,17 +90,27 @@ pub fn inspect(args: &InspectArgs) -> Result<ExitCode> {
     args.html.check()?;
     if let Some(chart) = &args.chart {
         if plan.len() < 2 {
-            bail!("--chart {}: the chart compares devices; give several --device (e.g. --device radv:all --device nvidia:all)", chart.display());
+            bail!(
+                "--chart {}: the chart compares devices; give several --device (e.g. --device radv:all --device nvidia:all)",
+                chart.display()
+            );
         }
         io::check_output_path("--chart", chart)?;
     }
     if let Some(dir) = &args.isa {
         if !plan.iter().any(|p| matches!(p, devices::Planned::Target(_))) {
-            bail!("--isa {}: the listings are a compile-only target's; give one, e.g. --device radv:navi21 or nvidia:sm_89 (see `brdfprof devices --targets`)", dir.display());
+            bail!(
+                "--isa {}: the listings are a compile-only target's; give one, e.g. --device radv:navi21 or nvidia:sm_89 (see `brdfprof devices --targets`)",
+                dir.display()
+            );
         }
         io::check_output_dir("--isa", dir)?;
     }
-    let models = if args.sweep_specs { brdfprof::sweep::default_specs().into_iter().map(brdfprof::model::Model::spec).collect() } else { args.model.models(&THESIS_MODELS)? };
+    let models = if args.sweep_specs {
+        brdfprof::sweep::default_specs().into_iter().map(brdfprof::model::Model::spec).collect()
+    } else {
+        args.model.models(&THESIS_MODELS)?
+    };
     let options = InspectOptions { models, lights, callgrind: args.counts.callgrind(validate)? };
     let profile = args.profile.as_deref().map(inspect::correlate::load_profile).transpose()?;
     let shaders = args.counts.shaders()?;
@@ -106,7 +119,14 @@ pub fn inspect(args: &InspectArgs) -> Result<ExitCode> {
         let d = DeviceArgs { device: device.map(str::to_string), validate };
         on_device_with(&d, device.is_some(), |gpu, _| work(gpu)).map(|_| ())
     };
-    let run = devices::Run { options: &options, shaders: &shaders, validate, isa_dir: args.isa.as_deref(), precise: args.precise_math, lines: args.lines };
+    let run = devices::Run {
+        options: &options,
+        shaders: &shaders,
+        validate,
+        isa_dir: args.isa.as_deref(),
+        precise: args.precise_math,
+        lines: args.lines,
+    };
     let result = devices::inspect(&plan, &run, &local, profile.as_ref())?;
     let stem = result.stem();
     let json = args.json.clone().unwrap_or_else(|| PathBuf::from(format!("results/{stem}.json")));
@@ -125,6 +145,11 @@ pub fn inspect(args: &InspectArgs) -> Result<ExitCode> {
         multi.costs.chart(chart)?;
     }
     print!("{}", result.markdown);
-    println!("JSON: {}\nMarkdown: {}{}", json.display(), markdown.display(), args.chart.as_ref().map_or(String::new(), |c| format!("\nChart: {}", c.display())));
+    println!(
+        "JSON: {}\nMarkdown: {}{}",
+        json.display(),
+        markdown.display(),
+        args.chart.as_ref().map_or(String::new(), |c| format!("\nChart: {}", c.display()))
+    );
     Ok(ExitCode::SUCCESS)
 }

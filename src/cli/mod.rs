@@ -20,20 +20,25 @@ pub mod scene;
 pub mod stability;
 pub mod sweep;
 
-use anyhow::{anyhow, bail, Result};
+use anyhow::{Result, anyhow, bail};
 use args::DeviceArgs;
 use brdfprof::gpu::Gpu;
-use brdfprof::targets;
 use brdfprof::io;
 use brdfprof::model::Model;
 use brdfprof::report_page::{self, Input};
+use brdfprof::targets;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 /// One range of the default samples: the flag's, else the intersection of `default` with the models' declared
 /// domains (named in the words returned), else `default`; models whose domains do not meet are refused.
-fn range_of(flag: (&str, Option<(f64, f64)>), default: (f64, f64), declared: Vec<(String, (f64, f64))>, what: &str) -> Result<((f64, f64), String)> {
+fn range_of(
+    flag: (&str, Option<(f64, f64)>),
+    default: (f64, f64),
+    declared: Vec<(String, (f64, f64))>,
+    what: &str,
+) -> Result<((f64, f64), String)> {
     if let Some(r) = flag.1 {
         return Ok((r, format!(" ({})", flag.0)));
     }
@@ -44,16 +49,28 @@ fn range_of(flag: (&str, Option<(f64, f64)>), default: (f64, f64), declared: Vec
     let hi = declared.iter().map(|(_, d)| d.1).fold(default.1, f64::min);
     let names = declared.iter().map(|(n, (a, b))| format!("{n} [{a}, {b}]")).collect::<Vec<_>>().join(", ");
     if lo > hi {
-        bail!("the models' {what} domains do not meet within [{}, {}] ({names}); give {} MIN..MAX to compare them anyway", default.0, default.1, flag.0);
+        bail!(
+            "the models' {what} domains do not meet within [{}, {}] ({names}); give {} MIN..MAX to compare them anyway",
+            default.0,
+            default.1,
+            flag.0
+        );
     }
     Ok(((lo, hi), format!(" (the models' declared domain: {names})")))
 }
 
 /// The sample ranges of a command (its `--roughness`, `--nov`, `--nol` flags, else the models' declared domains
 /// within `d`, else `d`), and the words saying where each comes from.
-pub fn sample_domain(flags: [Option<(f64, f64)>; 3], d: brdfprof::diff::SampleDomain, models: &[&Model]) -> Result<(brdfprof::diff::SampleDomain, [String; 3])> {
-    let declared = |pick: &dyn Fn(&Model) -> Option<(f64, f64)>| models.iter().filter_map(|m| pick(m).map(|r| (m.label(), r))).collect::<Vec<_>>();
-    let (roughness, rw) = range_of(("--roughness", flags[0]), d.roughness, declared(&|m| m.roughness_domain()), "roughness")?;
+pub fn sample_domain(
+    flags: [Option<(f64, f64)>; 3],
+    d: brdfprof::diff::SampleDomain,
+    models: &[&Model],
+) -> Result<(brdfprof::diff::SampleDomain, [String; 3])> {
+    let declared = |pick: &dyn Fn(&Model) -> Option<(f64, f64)>| {
+        models.iter().filter_map(|m| pick(m).map(|r| (m.label(), r))).collect::<Vec<_>>()
+    };
+    let (roughness, rw) =
+        range_of(("--roughness", flags[0]), d.roughness, declared(&|m| m.roughness_domain()), "roughness")?;
     let (nov, vw) = range_of(("--nov", flags[1]), d.nov, declared(&|m| m.cosine_domains().0), "N.V")?;
     let (nol, lw) = range_of(("--nol", flags[2]), d.nol, declared(&|m| m.cosine_domains().1), "N.L")?;
     Ok((brdfprof::diff::SampleDomain { roughness, nov, nol }, [rw, vw, lw]))
@@ -75,9 +92,14 @@ pub fn on_device<T>(device: &DeviceArgs, work: impl FnOnce(&Gpu, &ProgressBar) -
 }
 
 /// `on_device`; `compile_only_ok`: the work only compiles, so a compile-only device will do.
-pub fn on_device_with<T>(device: &DeviceArgs, compile_only_ok: bool, work: impl FnOnce(&Gpu, &ProgressBar) -> Result<T>) -> Result<(Gpu, T)> {
+pub fn on_device_with<T>(
+    device: &DeviceArgs,
+    compile_only_ok: bool,
+    work: impl FnOnce(&Gpu, &ProgressBar) -> Result<T>,
+) -> Result<(Gpu, T)> {
     let gpu = device.open_with(compile_only_ok)?;
-    let progress = ProgressBar::new(0).with_style(ProgressStyle::with_template("{spinner} {elapsed} {pos} {msg}").expect("valid progress template"));
+    let progress = ProgressBar::new(0)
+        .with_style(ProgressStyle::with_template("{spinner} {elapsed} {pos} {msg}").expect("valid progress template"));
     progress.enable_steady_tick(Duration::from_millis(200));
     let bar = progress.clone();
     let messages = brdfprof::messages::ProgressGuard::new(move |print| bar.suspend(print));
@@ -189,7 +211,10 @@ pub fn cost_targets(devices: &[String]) -> Result<Vec<brdfprof::targets::Target>
     let mut out: Vec<brdfprof::targets::Target> = Vec::new();
     for d in devices {
         let Some(ts) = brdfprof::targets::parse(d)? else {
-            anyhow::bail!("--cost-device {d}: give a compile-only target ({}FAMILY or PREFIX:all; see `brdfprof devices --targets`); the command's own --device is the one that measures", brdfprof::targets::prefixes());
+            anyhow::bail!(
+                "--cost-device {d}: give a compile-only target ({}FAMILY or PREFIX:all; see `brdfprof devices --targets`); the command's own --device is the one that measures",
+                brdfprof::targets::prefixes()
+            );
         };
         for t in ts {
             if !out.contains(&t) {

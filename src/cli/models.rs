@@ -1,8 +1,8 @@
 //! `brdfprof models`: the terms (with citations), parameters, metals and presets that model specs can name.
 
 use anyhow::Result;
-use brdfprof::brdf::terms::{ParamKind, PARAMS};
-use brdfprof::brdf::{spec, Metal, ModelSpec, D, F, Vis};
+use brdfprof::brdf::terms::{PARAMS, ParamKind};
+use brdfprof::brdf::{D, F, Metal, ModelSpec, Vis, spec};
 use brdfprof::export::markdown;
 use std::process::ExitCode;
 
@@ -17,11 +17,28 @@ fn section(out: &mut String, title: &str, headers: &[&str], rows: Vec<Vec<String
 /// Every term with its citation, the parameters, metals and presets: the term tables as text.
 pub fn models_text() -> String {
     let mut out = String::new();
-    let rows = |names: Vec<&str>, cites: Vec<&str>| names.into_iter().zip(cites).map(|(n, c)| vec![n.to_string(), c.to_string()]).collect();
+    let rows = |names: Vec<&str>, cites: Vec<&str>| {
+        names.into_iter().zip(cites).map(|(n, c)| vec![n.to_string(), c.to_string()]).collect()
+    };
     section(&mut out, "D (d=)", &["name", "source"], rows(D::names(), D::ALL.iter().map(|t| t.citation()).collect()));
-    section(&mut out, "Visibility (vis=)", &["name", "source"], rows(Vis::names(), Vis::ALL.iter().map(|t| t.citation()).collect()));
-    section(&mut out, "Fresnel (f=; a term that reads the metal also as f=NAME-<metal>)", &["name", "source"], rows(F::names(), F::ALL.iter().map(|t| t.citation()).collect()));
-    section(&mut out, "Metals (metal=)", &["name", "source"], rows(Metal::names(), Metal::ALL.iter().map(|t| t.citation()).collect()));
+    section(
+        &mut out,
+        "Visibility (vis=)",
+        &["name", "source"],
+        rows(Vis::names(), Vis::ALL.iter().map(|t| t.citation()).collect()),
+    );
+    section(
+        &mut out,
+        "Fresnel (f=; a term that reads the metal also as f=NAME-<metal>)",
+        &["name", "source"],
+        rows(F::names(), F::ALL.iter().map(|t| t.citation()).collect()),
+    );
+    section(
+        &mut out,
+        "Metals (metal=)",
+        &["name", "source"],
+        rows(Metal::names(), Metal::ALL.iter().map(|t| t.citation()).collect()),
+    );
     let params = PARAMS
         .iter()
         .map(|p| {
@@ -33,8 +50,24 @@ pub fn models_text() -> String {
         })
         .collect();
     section(&mut out, "Parameters (read by the terms that use them)", &["key", "values", "about"], params);
-    section(&mut out, "Precision (precision=)", &["name", "source"], vec![vec!["f32".into(), "fp32 arithmetic".into()], vec!["f16".into(), "fp16 arithmetic (needs shaderFloat16)".into()]]);
-    let presets = spec::PRESETS.iter().map(|p| vec![p.name.to_string(), format!("{} = {}", p.source, ModelSpec::preset(p.name).expect("a preset").canonical())]).collect();
+    section(
+        &mut out,
+        "Precision (precision=)",
+        &["name", "source"],
+        vec![
+            vec!["f32".into(), "fp32 arithmetic".into()],
+            vec!["f16".into(), "fp16 arithmetic (needs shaderFloat16)".into()],
+        ],
+    );
+    let presets = spec::PRESETS
+        .iter()
+        .map(|p| {
+            vec![
+                p.name.to_string(),
+                format!("{} = {}", p.source, ModelSpec::preset(p.name).expect("a preset").canonical()),
+            ]
+        })
+        .collect();
     section(&mut out, "Presets", &["name", "source"], presets);
     out
 }

@@ -1,11 +1,11 @@
 //! `brdfprof profile`: the cost per BRDF evaluation of models over a synthetic G-buffer, or with `--scene` of a
 //! scene's kernels and effects.
 
-use super::args::{device_name, DeviceArgs, HtmlArg, ModelArgs, TimingArgs};
+use super::args::{DeviceArgs, HtmlArg, ModelArgs, TimingArgs, device_name};
 use super::{check_output, cost_targets, fresh_compilation, just_measured, on_device};
-use anyhow::{bail, Result};
+use anyhow::{Result, bail};
 use brdfprof::brdf::THESIS_MODELS;
-use brdfprof::{io, profile, export::json, scene};
+use brdfprof::{export::json, io, profile, scene};
 use clap::Args;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -58,15 +58,20 @@ pub fn profile(args: &ProfileArgs) -> Result<ExitCode> {
     }
     if !args.cost_devices.is_empty() || args.isa.is_some() {
         let device = args.cost_devices.first().map_or("radv:navi21", String::as_str);
-        bail!("--cost-device and --isa apply to --scene; for models, `brdfprof inspect --device {device} [--isa DIR]` gives the compile-only targets' figures and listings");
+        bail!(
+            "--cost-device and --isa apply to --scene; for models, `brdfprof inspect --device {device} [--isa DIR]` gives the compile-only targets' figures and listings"
+        );
     }
     check_output("--json", args.json.as_deref(), "results", "profile-<device>.json")?;
     args.html.check()?;
     fresh_compilation(args.timing.shader_cache);
     let size = args.size.as_deref().unwrap_or("960x540");
-    let options = args.timing.options(args.model.models(&THESIS_MODELS)?, size, args.reps, args.budget, args.target_ci)?;
+    let options =
+        args.timing.options(args.model.models(&THESIS_MODELS)?, size, args.reps, args.budget, args.target_ci)?;
     let (gpu, result) = on_device(&args.device, |gpu, progress| profile::run(gpu, &options, progress))?;
-    let path = args.json.clone().unwrap_or_else(|| PathBuf::from(format!("{}/profile-{}.json", super::DEFAULT_OUT, brdfprof::targets::device_slug(&gpu.info))));
+    let path = args.json.clone().unwrap_or_else(|| {
+        PathBuf::from(format!("{}/profile-{}.json", super::DEFAULT_OUT, brdfprof::targets::device_slug(&gpu.info)))
+    });
     json::write_report(&path, json::Kind::Profile, &result)?;
     args.html.write(&[just_measured(&path, &result)?], Some(&gpu))?;
     println!("{}\n", result.summary());
@@ -84,18 +89,26 @@ pub fn profile(args: &ProfileArgs) -> Result<ExitCode> {
 
 fn profile_scene(args: &ProfileArgs, path: &std::path::Path) -> Result<ExitCode> {
     if !args.model.models.is_empty() || !args.model.params.is_empty() {
-        bail!("--scene: the scene's materials choose the models; --model and --param do not apply (edit the scene file)");
+        bail!(
+            "--scene: the scene's materials choose the models; --model and --param do not apply (edit the scene file)"
+        );
     }
     if args.size.is_some() {
         bail!("--scene: the G-buffer size is the scene's; --size does not apply");
     }
     if let Some(html) = &args.html.html {
-        bail!("--html {}: the HTML report does not draw scene profiles; the scene's tables are in the JSON and printed Markdown (`brdfprof render --scene` draws its pictures)", html.display());
+        bail!(
+            "--html {}: the HTML report does not draw scene profiles; the scene's tables are in the JSON and printed Markdown (`brdfprof render --scene` draws its pictures)",
+            html.display()
+        );
     }
     let cost_targets = cost_targets(&args.cost_devices)?;
     if let Some(dir) = &args.isa {
         if cost_targets.is_empty() {
-            bail!("--isa {}: the listings are a compile-only target's; give --cost-device too (e.g. --cost-device radv:navi21)", dir.display());
+            bail!(
+                "--isa {}: the listings are a compile-only target's; give --cost-device too (e.g. --cost-device radv:navi21)",
+                dir.display()
+            );
         }
         io::check_output_dir("--isa", dir)?;
     }
@@ -103,9 +116,24 @@ fn profile_scene(args: &ProfileArgs, path: &std::path::Path) -> Result<ExitCode>
     check_output("--json", args.json.as_deref(), "results", &format!("scene-{}-<device>.json", scene.name()))?;
     fresh_compilation(args.timing.shader_cache);
     let base = args.timing.options(Vec::new(), "1x1", args.reps, args.budget, args.target_ci)?;
-    let options = scene::profile::SceneProfileOptions { protocol: base.protocol, target_rel_ci: args.target_ci, max_chunk: None, instances: base.instances, cost_targets, validate: args.device.validation(), isa_dir: args.isa.clone() };
+    let options = scene::profile::SceneProfileOptions {
+        protocol: base.protocol,
+        target_rel_ci: args.target_ci,
+        max_chunk: None,
+        instances: base.instances,
+        cost_targets,
+        validate: args.device.validation(),
+        isa_dir: args.isa.clone(),
+    };
     let (gpu, result) = on_device(&args.device, |gpu, progress| scene::profile::run(gpu, &scene, &options, progress))?;
-    let path = args.json.clone().unwrap_or_else(|| PathBuf::from(format!("{}/scene-{}-{}.json", super::DEFAULT_OUT, scene.name(), brdfprof::targets::device_slug(&gpu.info))));
+    let path = args.json.clone().unwrap_or_else(|| {
+        PathBuf::from(format!(
+            "{}/scene-{}-{}.json",
+            super::DEFAULT_OUT,
+            scene.name(),
+            brdfprof::targets::device_slug(&gpu.info)
+        ))
+    });
     json::write_report(&path, json::Kind::SceneProfile, &result)?;
     println!("{}\n", result.summary());
     print!("{}", result.markdown());

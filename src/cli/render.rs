@@ -21,7 +21,10 @@ pub struct RenderArgs {
 pub fn render(args: &RenderArgs) -> Result<ExitCode> {
     let scene = scene::Scene::load(&args.scene)?;
     let out = args.out.clone().unwrap_or_else(|| PathBuf::from("results/scenes").join(scene.name()));
-    io::check_output_dir(if args.out.is_some() { "--out" } else { "--out (default results/scenes/<scene name>)" }, &out)?;
+    io::check_output_dir(
+        if args.out.is_some() { "--out" } else { "--out (default results/scenes/<scene name>)" },
+        &out,
+    )?;
     if args.out.is_none() {
         io::refuse_tracked_default("--out", &out, &["*".to_string()])?;
     }

@@ -3,8 +3,8 @@
 
 use super::args::DeviceArgs;
 use anyhow::Result;
-use brdfprof::report_page;
 use brdfprof::io;
+use brdfprof::report_page;
 use clap::Args;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -23,7 +23,6 @@ pub struct ReportArgs {
     #[command(flatten)]
     pub device: DeviceArgs,
 }
-
 
 pub fn report(args: &ReportArgs) -> Result<ExitCode> {
     io::check_output_path("--out", &args.out)?;

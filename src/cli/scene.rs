@@ -1,7 +1,7 @@
 //! `brdfprof scene`: a scene file checked, or the scene format explained (`render` draws a scene, `profile
 //! --scene` times it).
 
-use anyhow::{bail, Result};
+use anyhow::{Result, bail};
 use brdfprof::scene;
 use clap::Args;
 use std::path::PathBuf;

@@ -1,6 +1,6 @@
 //! `brdfprof stability`: the hard-case catalogue, dense grids, reciprocity and energy checks on the GPU.
 
-use super::args::{cosine_range, reference_spec, roughness_range, DeviceArgs, HtmlArg, ModelArgs};
+use super::args::{DeviceArgs, HtmlArg, ModelArgs, cosine_range, reference_spec, roughness_range};
 use super::{just_measured, on_device, out_dir, written};
 use anyhow::Result;
 use brdfprof::model::Model;
@@ -48,8 +48,19 @@ pub struct StabilityArgs {
 pub fn stability(args: &StabilityArgs) -> Result<ExitCode> {
     let out = out_dir(args.out.as_deref(), &["stability-*", "furnace-*.png", "albedo-*.png"])?;
     args.html.check()?;
-    let models = if args.model.models.is_empty() { stability::default_specs().into_iter().map(Model::spec).collect() } else { args.model.models(&[])? };
-    let options = stability::StabilityOptions { models: if args.unguarded { stability::with_guard_variants(models) } else { models }, energy: !args.no_energy, reference: args.reference, roughness: args.roughness, nov: args.nov, nol: args.nol };
+    let models = if args.model.models.is_empty() {
+        stability::default_specs().into_iter().map(Model::spec).collect()
+    } else {
+        args.model.models(&[])?
+    };
+    let options = stability::StabilityOptions {
+        models: if args.unguarded { stability::with_guard_variants(models) } else { models },
+        energy: !args.no_energy,
+        reference: args.reference,
+        roughness: args.roughness,
+        nov: args.nov,
+        nol: args.nol,
+    };
     let (gpu, result) = on_device(&args.device, |gpu, progress| stability::run(gpu, &options, progress))?;
     let slug = brdfprof::targets::device_slug(&gpu.info);
     let mut files = result.write(&out, &slug)?;

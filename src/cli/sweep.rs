@@ -1,7 +1,7 @@
 //! `brdfprof sweep`: many model specs timed in one interleaved run and measured for accuracy; error against
 //! cost and the Pareto frontier, also with compile-only targets' modelled cost.
 
-use super::args::{cosine_range, device_name, roughness_range, DeviceArgs, HtmlArg, ModelArgs, TimingArgs};
+use super::args::{DeviceArgs, HtmlArg, ModelArgs, TimingArgs, cosine_range, device_name, roughness_range};
 use super::{cost_targets, fresh_compilation, just_measured, on_device, out_dir, written};
 use anyhow::Result;
 use brdfprof::model::Model;
@@ -68,7 +68,8 @@ pub struct SweepArgs {
 
 /// `--exact-fresnel physical|own`.
 fn exact_fresnel(text: &str) -> Result<brdfprof::brdf::exact::ExactFresnel, String> {
-    brdfprof::brdf::exact::ExactFresnel::parse(text).ok_or_else(|| format!("`{text}`: give one of {}", brdfprof::brdf::exact::ExactFresnel::NAMES.join(", ")))
+    brdfprof::brdf::exact::ExactFresnel::parse(text)
+        .ok_or_else(|| format!("`{text}`: give one of {}", brdfprof::brdf::exact::ExactFresnel::NAMES.join(", ")))
 }
 
 pub fn sweep(args: &SweepArgs) -> Result<ExitCode> {
@@ -79,21 +80,54 @@ pub fn sweep(args: &SweepArgs) -> Result<ExitCode> {
         return Err(super::compiles_only_error(d));
     }
     fresh_compilation(args.timing.shader_cache);
-    let models = if args.model.models.is_empty() { sweep::default_specs().into_iter().map(Model::spec).collect() } else { args.model.models(&[])? };
-    let reference = args.reference.as_deref().map(|r| Model::parse(r).map_err(|e| anyhow::anyhow!("--reference {r}: {e:#}"))).transpose()?;
-    let (domain, why) = super::sample_domain([args.roughness, args.nov, args.nol], brdfprof::accuracy::STANDARD_DOMAIN, &models.iter().collect::<Vec<_>>())?;
+    let models = if args.model.models.is_empty() {
+        sweep::default_specs().into_iter().map(Model::spec).collect()
+    } else {
+        args.model.models(&[])?
+    };
+    let reference = args
+        .reference
+        .as_deref()
+        .map(|r| Model::parse(r).map_err(|e| anyhow::anyhow!("--reference {r}: {e:#}")))
+        .transpose()?;
+    let (domain, why) = super::sample_domain(
+        [args.roughness, args.nov, args.nol],
+        brdfprof::accuracy::STANDARD_DOMAIN,
+        &models.iter().collect::<Vec<_>>(),
+    )?;
     let accuracy = sweep::AccuracyOptions { reference, exact_fresnel: args.exact_fresnel, domain, domain_why: why };
-    let options = sweep::SweepOptions { profile: args.timing.options(models, &args.size, args.reps, args.budget, args.target_ci)?, accuracy };
-    let shaders = options.profile.glsl.as_deref().map(brdfprof::shaders::Shaders::from_glsl).transpose()?.unwrap_or_else(brdfprof::shaders::Shaders::embedded);
+    let options = sweep::SweepOptions {
+        profile: args.timing.options(models, &args.size, args.reps, args.budget, args.target_ci)?,
+        accuracy,
+    };
+    let shaders = options
+        .profile
+        .glsl
+        .as_deref()
+        .map(brdfprof::shaders::Shaders::from_glsl)
+        .transpose()?
+        .unwrap_or_else(brdfprof::shaders::Shaders::embedded);
     let validate = args.device.validation();
     let (gpu, (result, costs)) = on_device(&args.device, |gpu, progress| {
         // The targets' figures first (seconds): a missing compiler fails before the long measurement.
-        let request = brdfprof::targets::Request { models: &options.profile.models, lights: options.profile.lights[0], shaders: &shaders, validate, isa_dir: None, precise: false, verify_on: Some(gpu), lines: false };
+        let request = brdfprof::targets::Request {
+            models: &options.profile.models,
+            lights: options.profile.lights[0],
+            shaders: &shaders,
+            validate,
+            isa_dir: None,
+            precise: false,
+            verify_on: Some(gpu),
+            lines: false,
+        };
         let costs = brdfprof::targets::compile_all(&cost_targets, &request)?;
         Ok((sweep::run(gpu, &options, progress)?, costs))
     })?;
     for r in result.rows.iter().filter(|r| r.accuracy.vs_exact.nonfinite > 0) {
-        brdfprof::messages::warning(format!("{}: {} of {} values on the sample set are NaN or Inf", r.spec, r.accuracy.vs_exact.nonfinite, r.accuracy.vs_exact.values));
+        brdfprof::messages::warning(format!(
+            "{}: {} of {} values on the sample set are NaN or Inf",
+            r.spec, r.accuracy.vs_exact.nonfinite, r.accuracy.vs_exact.values
+        ));
     }
     let slug = brdfprof::targets::device_slug(&gpu.info);
     let mut files = result.write(&out, &slug)?;
@@ -103,8 +137,13 @@ pub fn sweep(args: &SweepArgs) -> Result<ExitCode> {
     let mut swept_all = Vec::new();
     for run in &costs {
         let name = run.target.name();
-        let table = run.report.cost.clone().ok_or_else(|| anyhow::anyhow!("{name}: the compiler reported no statistics the cost model reads"))?;
-        let note = run.report.section_notes.get("driver/").map(String::as_str).filter(|n| n.starts_with("not compiled"));
+        let table = run
+            .report
+            .cost
+            .clone()
+            .ok_or_else(|| anyhow::anyhow!("{name}: the compiler reported no statistics the cost model reads"))?;
+        let note =
+            run.report.section_notes.get("driver/").map(String::as_str).filter(|n| n.starts_with("not compiled"));
         let swept = brdfprof::sweep_cost::build(&result, &name, &table, note)?;
         if let Some(skipped) = &swept.skipped {
             // Every model asked for is in every table, or the command says which is not, and exits 1.

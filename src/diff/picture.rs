@@ -6,10 +6,10 @@
 use crate::accuracy::rel_err;
 use crate::brdf::Sample;
 use crate::export::png;
+use crate::export::raster::{LOBE_PANEL, blit, colour_bar, draw_lobes, label, tone_map, viridis};
 use crate::gpu::Gpu;
 use crate::kernels::{self, RunLimits};
 use crate::model::Model;
-use crate::export::raster::{blit, colour_bar, draw_lobes, label, tone_map, viridis, LOBE_PANEL};
 use anyhow::Result;
 use glam::DVec3;
 use plotters::prelude::*;
@@ -36,7 +36,13 @@ fn sphere(roughness: f32) -> Vec<Option<Sample>> {
             let t = |k: u32| (k as f64 + 0.5) / TILE as f64 * 2.0 - 1.0;
             let (x, y) = (t(i % TILE), -t(i / TILE));
             let r2 = x * x + y * y;
-            (r2 < 1.0).then(|| Sample { n: [x as f32, y as f32, (1.0 - r2).sqrt() as f32], v: [0.0, 0.0, 1.0], l, roughness, f0: F0 })
+            (r2 < 1.0).then(|| Sample {
+                n: [x as f32, y as f32, (1.0 - r2).sqrt() as f32],
+                v: [0.0, 0.0, 1.0],
+                l,
+                roughness,
+                f0: F0,
+            })
         })
         .collect()
 }
@@ -70,9 +76,16 @@ pub fn pixels(gpu: &Gpu, a: &Model, b: &Model) -> Result<(u32, u32, Vec<u8>)> {
     for r in ROUGHNESS {
         let pixels = sphere(r);
         let (ra, rb) = (radiance(gpu, a, &pixels)?, radiance(gpu, b, &pixels)?);
-        let display = |v: &[[f32; 3]]| v.iter().zip(&pixels).map(|(c, p)| if p.is_some() { tone_map(c.map(|x| x * INTENSITY), 1.0) } else { BACKGROUND }).collect::<Vec<_>>();
+        let display = |v: &[[f32; 3]]| {
+            v.iter()
+                .zip(&pixels)
+                .map(|(c, p)| if p.is_some() { tone_map(c.map(|x| x * INTENSITY), 1.0) } else { BACKGROUND })
+                .collect::<Vec<_>>()
+        };
         shown.push([display(&ra), display(&rb)]);
-        let rel = |x: &[f32; 3], y: &[f32; 3]| (0..3).map(|c| rel_err(f64::from(y[c]), f64::from(x[c]))).fold(0.0, f64::max) as f32;
+        let rel = |x: &[f32; 3], y: &[f32; 3]| {
+            (0..3).map(|c| rel_err(f64::from(y[c]), f64::from(x[c]))).fold(0.0, f64::max) as f32
+        };
         diffs.push(ra.iter().zip(&rb).zip(&pixels).map(|((x, y), p)| p.map(|_| rel(x, y))).collect());
     }
     let scale = diffs.iter().flatten().flatten().copied().fold(0.0f32, |m, x| if x.is_finite() { m.max(x) } else { m });
@@ -81,12 +94,23 @@ pub fn pixels(gpu: &Gpu, a: &Model, b: &Model) -> Result<(u32, u32, Vec<u8>)> {
     let width = LOBE_PANEL.0 * ROUGHNESS.len() as u32;
     let size = (width + 70, TOP + LOBE_PANEL.1 + 40);
     let px = png::pixels(size.0, size.1, |root| {
-        let title = format!("B = {} against A = {}: lit spheres and |B - A| / max(|A|, 1e-3) (largest channel)", names[1], names[0]);
+        let title = format!(
+            "B = {} against A = {}: lit spheres and |B - A| / max(|A|, 1e-3) (largest channel)",
+            names[1], names[0]
+        );
         label(root, &title, 10, 8, 18, BLACK)?;
         for (g, r) in ROUGHNESS.iter().enumerate() {
             let x0 = (g as u32 * LOBE_PANEL.0 + 10) as i32;
-            let map: Vec<[u8; 3]> = diffs[g].iter().map(|d| d.map_or(BACKGROUND, |x| if x.is_finite() { viridis(if scale > 0.0 { x / scale } else { 0.0 }) } else { [255, 0, 255] })).collect();
-            for (k, (px, what)) in [(&shown[g][0], "A"), (&shown[g][1], "B"), (&map, "B vs A")].into_iter().enumerate() {
+            let map: Vec<[u8; 3]> = diffs[g]
+                .iter()
+                .map(|d| {
+                    d.map_or(BACKGROUND, |x| {
+                        if x.is_finite() { viridis(if scale > 0.0 { x / scale } else { 0.0 }) } else { [255, 0, 255] }
+                    })
+                })
+                .collect();
+            for (k, (px, what)) in [(&shown[g][0], "A"), (&shown[g][1], "B"), (&map, "B vs A")].into_iter().enumerate()
+            {
                 let x = x0 + (k as u32 * (TILE + 10)) as i32;
                 label(root, &format!("{what}, r = {r}"), x, 42, 13, BLACK)?;
                 blit(root, x, 62, TILE, px)?;

@@ -41,9 +41,12 @@ pub struct Provenance {
 impl Provenance {
     pub fn new(device: &DeviceInfo) -> Self {
         let (mesa, llvm) = device.mesa_llvm();
-        let host_cpu = std::fs::read_to_string("/proc/cpuinfo")
-            .ok()
-            .and_then(|t| t.lines().find(|l| l.starts_with("model name")).and_then(|l| l.split(':').nth(1)).map(|s| s.trim().to_string()));
+        let host_cpu = std::fs::read_to_string("/proc/cpuinfo").ok().and_then(|t| {
+            t.lines()
+                .find(|l| l.starts_with("model name"))
+                .and_then(|l| l.split(':').nth(1))
+                .map(|s| s.trim().to_string())
+        });
         Provenance {
             tool: format!("brdfprof {}", env!("CARGO_PKG_VERSION")),
             unix_time: std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_secs()),
@@ -69,7 +72,13 @@ pub fn write_json_compact(path: &Path, value: &impl Serialize) -> Result<()> {
 
 /// Writes `<stem>.md` (`markdown`), `<stem>.json` (`value`, compact) and `<stem>.png` (`chart`); returns their
 /// paths.
-pub fn write_md_json_png(stem: &Path, kind: Kind, value: &impl Serialize, markdown: &str, chart: impl FnOnce(&Path) -> Result<()>) -> Result<Vec<std::path::PathBuf>> {
+pub fn write_md_json_png(
+    stem: &Path,
+    kind: Kind,
+    value: &impl Serialize,
+    markdown: &str,
+    chart: impl FnOnce(&Path) -> Result<()>,
+) -> Result<Vec<std::path::PathBuf>> {
     let (md, json, png) = (stem.with_extension("md"), stem.with_extension("json"), stem.with_extension("png"));
     write_report_compact(&json, kind, value)?;
     crate::io::write_output(&md, markdown.as_bytes())?;
@@ -100,7 +109,18 @@ pub enum Kind {
 }
 
 impl Kind {
-    pub const ALL: [Kind; 10] = [Kind::Profile, Kind::SceneProfile, Kind::Sweep, Kind::SweepCost, Kind::SweepFrontiers, Kind::Stability, Kind::Inspect, Kind::InspectDevices, Kind::Compare, Kind::Baseline];
+    pub const ALL: [Kind; 10] = [
+        Kind::Profile,
+        Kind::SceneProfile,
+        Kind::Sweep,
+        Kind::SweepCost,
+        Kind::SweepFrontiers,
+        Kind::Stability,
+        Kind::Inspect,
+        Kind::InspectDevices,
+        Kind::Compare,
+        Kind::Baseline,
+    ];
 
     pub fn name(self) -> &'static str {
         match self {
@@ -125,10 +145,15 @@ impl Kind {
 /// `value`'s JSON text with `"kind"` as its first key (`value` must serialize as an object without one).
 fn with_kind(kind: Kind, value: &impl Serialize, pretty: bool) -> Result<String> {
     let text = if pretty { serde_json::to_string_pretty(value)? } else { serde_json::to_string(value)? };
-    let rest = text.strip_prefix('{').ok_or_else(|| anyhow::anyhow!("a {} report that is not a JSON object", kind.name()))?;
+    let rest =
+        text.strip_prefix('{').ok_or_else(|| anyhow::anyhow!("a {} report that is not a JSON object", kind.name()))?;
     let empty = rest.trim_start().starts_with('}');
     let sep = if empty { "" } else { "," };
-    Ok(if pretty { format!("{{\n  \"kind\": \"{}\"{sep}{rest}\n", kind.name()) } else { format!("{{\"kind\":\"{}\"{sep}{rest}\n", kind.name()) })
+    Ok(if pretty {
+        format!("{{\n  \"kind\": \"{}\"{sep}{rest}\n", kind.name())
+    } else {
+        format!("{{\"kind\":\"{}\"{sep}{rest}\n", kind.name())
+    })
 }
 
 /// `write_json` of a saved report, its `kind` first.

@@ -1,7 +1,7 @@
 //! PNG charts and images. Plotters draws into an RGB buffer (DejaVu Sans embedded, so no system fonts are
 //! needed); the `image` crate encodes it and `io::write_output` writes it.
 
-use anyhow::{anyhow, Result};
+use anyhow::{Result, anyhow};
 use plotters::prelude::*;
 use plotters::style::FontStyle;
 use std::path::Path;
@@ -19,20 +19,30 @@ fn register_font() {
 
 /// Encodes an RGB8 buffer as PNG and writes it atomically.
 pub fn write_png(path: &Path, width: u32, height: u32, rgb: Vec<u8>) -> Result<()> {
-    let image = image::RgbImage::from_raw(width, height, rgb).ok_or_else(|| anyhow!("image buffer of the wrong size"))?;
+    let image =
+        image::RgbImage::from_raw(width, height, rgb).ok_or_else(|| anyhow!("image buffer of the wrong size"))?;
     let mut bytes = std::io::Cursor::new(Vec::new());
     image.write_to(&mut bytes, image::ImageFormat::Png)?;
     crate::io::write_output(path, bytes.get_ref())
 }
 
 /// Draws with plotters into a fresh white `width` x `height` canvas and writes it as PNG.
-pub fn render(path: &Path, width: u32, height: u32, draw: impl FnOnce(&DrawingArea<BitMapBackend, plotters::coord::Shift>) -> Result<()>) -> Result<()> {
+pub fn render(
+    path: &Path,
+    width: u32,
+    height: u32,
+    draw: impl FnOnce(&DrawingArea<BitMapBackend, plotters::coord::Shift>) -> Result<()>,
+) -> Result<()> {
     let buffer = pixels(width, height, draw)?;
     write_png(path, width, height, buffer)
 }
 
 /// What `render` draws, as 8-bit RGB pixels (for a page that embeds the picture instead of writing a file).
-pub fn pixels(width: u32, height: u32, draw: impl FnOnce(&DrawingArea<BitMapBackend, plotters::coord::Shift>) -> Result<()>) -> Result<Vec<u8>> {
+pub fn pixels(
+    width: u32,
+    height: u32,
+    draw: impl FnOnce(&DrawingArea<BitMapBackend, plotters::coord::Shift>) -> Result<()>,
+) -> Result<Vec<u8>> {
     register_font();
     let mut buffer = vec![255u8; (width * height * 3) as usize];
     {
@@ -47,8 +57,16 @@ pub fn pixels(width: u32, height: u32, draw: impl FnOnce(&DrawingArea<BitMapBack
 /// A distinct colour per group (Tableau 10).
 pub fn palette(i: usize) -> RGBColor {
     const P: [(u8, u8, u8); 10] = [
-        (31, 119, 180), (255, 127, 14), (44, 160, 44), (214, 39, 40), (148, 103, 189),
-        (140, 86, 75), (227, 119, 194), (127, 127, 127), (188, 189, 34), (23, 190, 207),
+        (31, 119, 180),
+        (255, 127, 14),
+        (44, 160, 44),
+        (214, 39, 40),
+        (148, 103, 189),
+        (140, 86, 75),
+        (227, 119, 194),
+        (127, 127, 127),
+        (188, 189, 34),
+        (23, 190, 207),
     ];
     // Past the ten base colours, the same hues lighter (then darker), so that up to 30 series differ.
     let (r, g, b) = P[i % P.len()];
@@ -96,7 +114,11 @@ fn pinned(points: &[Point], y_top: f64) -> Vec<Point> {
         .iter()
         .filter(|p| p.x.is_finite())
         .map(|p| {
-            let (y, label) = if p.y.is_finite() { (p.y.max(Y_FLOOR), p.label.clone()) } else { (y_top / 1.5, format!("{} (non-finite)", p.label)) };
+            let (y, label) = if p.y.is_finite() {
+                (p.y.max(Y_FLOOR), p.label.clone())
+            } else {
+                (y_top / 1.5, format!("{} (non-finite)", p.label))
+            };
             Point { y, label, ..p.clone() }
         })
         .collect()
@@ -104,7 +126,9 @@ fn pinned(points: &[Point], y_top: f64) -> Vec<Point> {
 
 /// The x range of `pts`, whiskers included, padded for labels.
 fn x_range(pts: &[&Point]) -> (f64, f64) {
-    let (lo, hi) = pts.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| (lo.min(p.x_lo.min(p.x)), hi.max(p.x_hi.max(p.x))));
+    let (lo, hi) = pts
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| (lo.min(p.x_lo.min(p.x)), hi.max(p.x_hi.max(p.x))));
     let pad = (hi - lo).max(1e-3) * 0.04;
     (lo - pad, hi + pad * 6.0)
 }
@@ -112,7 +136,18 @@ fn x_range(pts: &[&Point]) -> (f64, f64) {
 /// Places a label at the first candidate offset from (px, py) whose box overlaps no placed box; returns its
 /// top-left corner.
 fn place(placed: &mut Vec<(i32, i32, i32, i32)>, (px, py): (i32, i32), width: i32) -> (i32, i32) {
-    let candidates = [(10, -8), (10, 10), (10, -26), (10, 28), (-10 - width, -8), (-10 - width, 10), (10, -44), (10, 46), (-10 - width, -26), (-10 - width, 28)];
+    let candidates = [
+        (10, -8),
+        (10, 10),
+        (10, -26),
+        (10, 28),
+        (-10 - width, -8),
+        (-10 - width, 10),
+        (10, -44),
+        (10, 46),
+        (-10 - width, -26),
+        (-10 - width, 28),
+    ];
     let boxed = |(dx, dy): (i32, i32)| (px + dx, py + dy - TEXT_H / 2, px + dx + width, py + dy + TEXT_H / 2);
     let free = |c: (i32, i32)| {
         let b = boxed(c);
@@ -127,7 +162,14 @@ fn place(placed: &mut Vec<(i32, i32, i32, i32)>, (px, py): (i32, i32), width: i3
 type Area<'a> = DrawingArea<BitMapBackend<'a>, plotters::coord::Shift>;
 
 /// One panel: axes, the frontier (main panel), whiskers and points by group, and their labels or numbers.
-fn scatter_panel(area: &Area, spec: &Scatter, pts: &[&Point], numbers: &[(usize, &Point)], (y0, y1): (f64, f64), main: bool) -> Result<()> {
+fn scatter_panel(
+    area: &Area,
+    spec: &Scatter,
+    pts: &[&Point],
+    numbers: &[(usize, &Point)],
+    (y0, y1): (f64, f64),
+    main: bool,
+) -> Result<()> {
     let err = |e: &dyn std::fmt::Display| anyhow!("chart: {e}");
     let (x0, x1) = x_range(pts);
     let mut chart = ChartBuilder::on(area)
@@ -155,8 +197,14 @@ fn scatter_panel(area: &Area, spec: &Scatter, pts: &[&Point], numbers: &[(usize,
     for (group, name) in spec.legend {
         let colour = palette(*group);
         let members: Vec<&&Point> = pts.iter().filter(|p| p.group == *group).collect();
-        chart.draw_series(members.iter().map(|p| PathElement::new(vec![(p.x_lo, p.y), (p.x_hi, p.y)], colour.stroke_width(2)))).map_err(|e| err(&e))?;
-        let series = chart.draw_series(members.iter().map(|p| Circle::new((p.x, p.y), 7, colour.filled()))).map_err(|e| err(&e))?;
+        chart
+            .draw_series(
+                members.iter().map(|p| PathElement::new(vec![(p.x_lo, p.y), (p.x_hi, p.y)], colour.stroke_width(2))),
+            )
+            .map_err(|e| err(&e))?;
+        let series = chart
+            .draw_series(members.iter().map(|p| Circle::new((p.x, p.y), 7, colour.filled())))
+            .map_err(|e| err(&e))?;
         if main {
             series.label(name.clone()).legend(move |(x, y)| Circle::new((x + 15, y), 7, colour.filled()));
         }
@@ -166,7 +214,11 @@ fn scatter_panel(area: &Area, spec: &Scatter, pts: &[&Point], numbers: &[(usize,
     let mut order: Vec<&&Point> = pts.iter().collect();
     order.sort_by(|a, b| b.highlight.cmp(&a.highlight).then(b.y.total_cmp(&a.y)));
     for p in order {
-        let text = if p.highlight { p.label.clone() } else { numbers.iter().find(|(_, q)| std::ptr::eq(*q, *p)).map_or(String::new(), |(n, _)| n.to_string()) };
+        let text = if p.highlight {
+            p.label.clone()
+        } else {
+            numbers.iter().find(|(_, q)| std::ptr::eq(*q, *p)).map_or(String::new(), |(n, _)| n.to_string())
+        };
         let at = chart.backend_coord(&(p.x, p.y));
         let (x, y) = place(&mut placed, at, CHAR_W * text.chars().count() as i32);
         let base = area.get_base_pixel();
@@ -174,7 +226,14 @@ fn scatter_panel(area: &Area, spec: &Scatter, pts: &[&Point], numbers: &[(usize,
         area.draw(&Text::new(text, (x - base.0, y - base.1), font)).map_err(|e| err(&e))?;
     }
     if main {
-        chart.configure_series_labels().position(SeriesLabelPosition::UpperRight).label_font((FONT, 22)).background_style(WHITE.mix(0.85)).border_style(BLACK).draw().map_err(|e| err(&e))?;
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperRight)
+            .label_font((FONT, 22))
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .draw()
+            .map_err(|e| err(&e))?;
     }
     Ok(())
 }
@@ -196,15 +255,20 @@ fn scatter_key(area: &Area, numbers: &[(usize, &Point)]) -> Result<()> {
 /// overflowed) are pinned to the top edge; points beyond `split_x` go to a side panel.
 pub fn scatter_log_y(path: &Path, spec: &Scatter, points: &[Point]) -> Result<()> {
     let (w, h) = (2400u32, 1600u32);
-    let finite: Vec<f64> = points.iter().filter(|p| p.x.is_finite() && p.y.is_finite()).map(|p| p.y.max(Y_FLOOR)).collect();
+    let finite: Vec<f64> =
+        points.iter().filter(|p| p.x.is_finite() && p.y.is_finite()).map(|p| p.y.max(Y_FLOOR)).collect();
     if finite.is_empty() {
         return Err(anyhow!("chart {}: no point with finite coordinates", path.display()));
     }
-    let ys = (finite.iter().copied().fold(f64::INFINITY, f64::min) / 3.0, finite.iter().copied().fold(f64::NEG_INFINITY, f64::max) * 3.0);
+    let ys = (
+        finite.iter().copied().fold(f64::INFINITY, f64::min) / 3.0,
+        finite.iter().copied().fold(f64::NEG_INFINITY, f64::max) * 3.0,
+    );
     let pinned = pinned(points, ys.1);
     let split = spec.split_x.filter(|s| pinned.iter().any(|p| p.x > *s));
     let (main_pts, side_pts): (Vec<&Point>, Vec<&Point>) = pinned.iter().partition(|p| split.is_none_or(|s| p.x <= s));
-    let numbers: Vec<(usize, &Point)> = pinned.iter().filter(|p| !p.highlight).enumerate().map(|(i, p)| (i + 1, p)).collect();
+    let numbers: Vec<(usize, &Point)> =
+        pinned.iter().filter(|p| !p.highlight).enumerate().map(|(i, p)| (i + 1, p)).collect();
     render(path, w, h, |root| {
         let root = root.titled(spec.title, (FONT, 34)).map_err(|e| anyhow!("chart: {e}"))?;
         let (plots, key) = root.split_horizontally((w as f64 * 0.74) as u32);
@@ -220,7 +284,14 @@ pub fn scatter_log_y(path: &Path, spec: &Scatter, points: &[Point]) -> Result<()
 }
 
 /// Line chart: one series per (name, points), linear axes.
-pub fn lines(path: &Path, title: &str, x_desc: &str, y_desc: &str, series: &[(String, Vec<(f64, f64)>)], y_range: (f64, f64)) -> Result<()> {
+pub fn lines(
+    path: &Path,
+    title: &str,
+    x_desc: &str,
+    y_desc: &str,
+    series: &[(String, Vec<(f64, f64)>)],
+    y_range: (f64, f64),
+) -> Result<()> {
     let (x0, x1) = series
         .iter()
         .flat_map(|(_, p)| p.iter().map(|q| q.0))
@@ -234,7 +305,14 @@ pub fn lines(path: &Path, title: &str, x_desc: &str, y_desc: &str, series: &[(St
             .y_label_area_size(80)
             .build_cartesian_2d(x0..x1, y_range.0..y_range.1)
             .map_err(|e| err(&e))?;
-        chart.configure_mesh().x_desc(x_desc).y_desc(y_desc).axis_desc_style((FONT, 20)).label_style((FONT, 16)).draw().map_err(|e| err(&e))?;
+        chart
+            .configure_mesh()
+            .x_desc(x_desc)
+            .y_desc(y_desc)
+            .axis_desc_style((FONT, 20))
+            .label_style((FONT, 16))
+            .draw()
+            .map_err(|e| err(&e))?;
         for (i, (name, pts)) in series.iter().enumerate() {
             let colour = palette(i);
             chart
@@ -243,13 +321,26 @@ pub fn lines(path: &Path, title: &str, x_desc: &str, y_desc: &str, series: &[(St
                 .label(name.clone())
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 30, y)], colour.stroke_width(3)));
         }
-        chart.configure_series_labels().label_font((FONT, 18)).background_style(WHITE.mix(0.85)).border_style(BLACK).draw().map_err(|e| err(&e))?;
+        chart
+            .configure_series_labels()
+            .label_font((FONT, 18))
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .draw()
+            .map_err(|e| err(&e))?;
         Ok(())
     })
 }
 
 /// Line charts side by side: one panel per (title, series), linear axes, a shared y range.
-pub fn line_panels(path: &Path, title: &str, x_desc: &str, y_desc: &str, panels: &[(String, Vec<(String, Vec<(f64, f64)>)>)], y_range: (f64, f64)) -> Result<()> {
+pub fn line_panels(
+    path: &Path,
+    title: &str,
+    x_desc: &str,
+    y_desc: &str,
+    panels: &[(String, Vec<(String, Vec<(f64, f64)>)>)],
+    y_range: (f64, f64),
+) -> Result<()> {
     let width = 520 * panels.len() as u32;
     render(path, width, 620, |root| {
         let err = |e: &dyn std::fmt::Display| anyhow!("chart: {e}");
@@ -273,7 +364,14 @@ pub fn line_panels(path: &Path, title: &str, x_desc: &str, y_desc: &str, panels:
                     .label(label.clone())
                     .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2)));
             }
-            chart.configure_series_labels().position(SeriesLabelPosition::LowerRight).label_font((FONT, 12)).background_style(WHITE.mix(0.8)).border_style(BLACK).draw().map_err(|e| err(&e))?;
+            chart
+                .configure_series_labels()
+                .position(SeriesLabelPosition::LowerRight)
+                .label_font((FONT, 12))
+                .background_style(WHITE.mix(0.8))
+                .border_style(BLACK)
+                .draw()
+                .map_err(|e| err(&e))?;
         }
         Ok(())
     })
@@ -286,10 +384,29 @@ mod tests {
     #[test]
     fn scatter_with_non_finite_points_finishes() {
         let dir = tempfile::tempdir().unwrap();
-        let point = |x: f64, y: f64, label: &str, group, highlight| Point { x, x_lo: x * 0.98, x_hi: x * 1.02, y, label: label.into(), group, highlight };
-        let points = vec![point(1.0, 0.1, "a", 0, true), point(2.0, f64::INFINITY, "b", 1, false), point(1.5, f64::NAN, "c", 1, false)];
+        let point = |x: f64, y: f64, label: &str, group, highlight| Point {
+            x,
+            x_lo: x * 0.98,
+            x_hi: x * 1.02,
+            y,
+            label: label.into(),
+            group,
+            highlight,
+        };
+        let points = vec![
+            point(1.0, 0.1, "a", 0, true),
+            point(2.0, f64::INFINITY, "b", 1, false),
+            point(1.5, f64::NAN, "c", 1, false),
+        ];
         let path = dir.path().join("s.png");
-        let spec = Scatter { title: "t", x_desc: "x", y_desc: "y", line: &[(1.0, 0.1)], legend: &[(0, "g".into())], split_x: Some(1.8) };
+        let spec = Scatter {
+            title: "t",
+            x_desc: "x",
+            y_desc: "y",
+            line: &[(1.0, 0.1)],
+            legend: &[(0, "g".into())],
+            split_x: Some(1.8),
+        };
         scatter_log_y(&path, &spec, &points).unwrap();
         assert!(image::open(&path).is_ok());
     }

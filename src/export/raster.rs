@@ -4,8 +4,8 @@
 
 use super::markdown::sig;
 use super::png::{self, FONT};
-use crate::kernels::{LobePanel, LOBE_VIEW_DEG};
-use anyhow::{anyhow, Result};
+use crate::kernels::{LOBE_VIEW_DEG, LobePanel};
+use anyhow::{Result, anyhow};
 use plotters::prelude::*;
 
 /// ACES filmic tone curve, Narkowicz 2015 fit: x (2.51 x + 0.03) / (x (2.43 x + 0.59) + 0.14), clamped to [0, 1].
@@ -25,7 +25,13 @@ pub fn tone_map(rgb: [f32; 3], exposure: f32) -> [u8; 3] {
 }
 
 /// Draws an RGB picture (w x h, row-major) at (x0, y0) of a plotters area.
-pub fn blit(root: &DrawingArea<BitMapBackend, plotters::coord::Shift>, x0: i32, y0: i32, w: u32, px: &[[u8; 3]]) -> Result<()> {
+pub fn blit(
+    root: &DrawingArea<BitMapBackend, plotters::coord::Shift>,
+    x0: i32,
+    y0: i32,
+    w: u32,
+    px: &[[u8; 3]],
+) -> Result<()> {
     for (i, c) in px.iter().enumerate() {
         let (x, y) = ((i as u32 % w) as i32, (i as u32 / w) as i32);
         root.draw_pixel((x0 + x, y0 + y), &RGBColor(c[0], c[1], c[2])).map_err(|e| anyhow!("{e}"))?;
@@ -33,15 +39,29 @@ pub fn blit(root: &DrawingArea<BitMapBackend, plotters::coord::Shift>, x0: i32, 
     Ok(())
 }
 
-pub fn label(root: &DrawingArea<BitMapBackend, plotters::coord::Shift>, text: &str, x: i32, y: i32, size: i32, colour: RGBColor) -> Result<()> {
+pub fn label(
+    root: &DrawingArea<BitMapBackend, plotters::coord::Shift>,
+    text: &str,
+    x: i32,
+    y: i32,
+    size: i32,
+    colour: RGBColor,
+) -> Result<()> {
     root.draw(&Text::new(text.to_string(), (x, y), (FONT, size).into_font().color(&colour))).map_err(|e| anyhow!("{e}"))
 }
 
 /// Viridis colour map (matplotlib's, 9 control points, linear in between) for t in [0, 1].
 pub fn viridis(t: f32) -> [u8; 3] {
     const P: [[f32; 3]; 9] = [
-        [68.0, 1.0, 84.0], [71.0, 44.0, 122.0], [59.0, 81.0, 139.0], [44.0, 113.0, 142.0], [33.0, 144.0, 141.0],
-        [39.0, 173.0, 129.0], [92.0, 200.0, 99.0], [170.0, 220.0, 50.0], [253.0, 231.0, 37.0],
+        [68.0, 1.0, 84.0],
+        [71.0, 44.0, 122.0],
+        [59.0, 81.0, 139.0],
+        [44.0, 113.0, 142.0],
+        [33.0, 144.0, 141.0],
+        [39.0, 173.0, 129.0],
+        [92.0, 200.0, 99.0],
+        [170.0, 220.0, 50.0],
+        [253.0, 231.0, 37.0],
     ];
     let x = t.clamp(0.0, 1.0) * 8.0;
     let i = (x as usize).min(7);
@@ -51,10 +71,17 @@ pub fn viridis(t: f32) -> [u8; 3] {
 
 /// A vertical viridis bar from 0 (bottom) to `scale` (top), the top labelled with `markdown::sig` (three
 /// significant figures: a scale of 0.003 reads 0.003, not 0.00).
-pub fn colour_bar(root: &DrawingArea<BitMapBackend, plotters::coord::Shift>, x0: i32, y0: i32, h: i32, scale: f32) -> Result<()> {
+pub fn colour_bar(
+    root: &DrawingArea<BitMapBackend, plotters::coord::Shift>,
+    x0: i32,
+    y0: i32,
+    h: i32,
+    scale: f32,
+) -> Result<()> {
     for y in 0..h {
         let c = viridis(1.0 - y as f32 / (h - 1) as f32);
-        root.draw(&Rectangle::new([(x0, y0 + y), (x0 + 14, y0 + y + 1)], RGBColor(c[0], c[1], c[2]).filled())).map_err(|e| anyhow!("{e}"))?;
+        root.draw(&Rectangle::new([(x0, y0 + y), (x0 + 14, y0 + y + 1)], RGBColor(c[0], c[1], c[2]).filled()))
+            .map_err(|e| anyhow!("{e}"))?;
     }
     label(root, &sig(f64::from(scale), 3), x0 + 16, y0, 12, BLACK)?;
     label(root, "0", x0 + 16, y0 + h - 12, 12, BLACK)
@@ -64,10 +91,16 @@ pub fn colour_bar(root: &DrawingArea<BitMapBackend, plotters::coord::Shift>, x0:
 pub const LOBE_PANEL: (u32, u32) = (420, 300);
 
 /// Draws `kernels::lobe_curves` (one curve per label) into `root`: a title, then the panels side by side.
-pub fn draw_lobes(root: &DrawingArea<BitMapBackend, plotters::coord::Shift>, labels: &[String], panels: &[LobePanel]) -> Result<()> {
+pub fn draw_lobes(
+    root: &DrawingArea<BitMapBackend, plotters::coord::Shift>,
+    labels: &[String],
+    panels: &[LobePanel],
+) -> Result<()> {
     let theta_v = LOBE_VIEW_DEG.to_radians();
     let err = |e: &dyn std::fmt::Display| anyhow!("lobes: {e}");
-    let root = root.titled("f_s NoL in the plane of incidence (view at 45 deg, F0 = 1); each panel scaled to its peak", (FONT, 18)).map_err(|e| err(&e))?;
+    let root = root
+        .titled("f_s NoL in the plane of incidence (view at 45 deg, F0 = 1); each panel scaled to its peak", (FONT, 18))
+        .map_err(|e| err(&e))?;
     for (area, (r, curves)) in root.split_evenly((1, panels.len())).iter().zip(panels) {
         let peak = curves.iter().flatten().map(|p| p.1).fold(0.0f64, f64::max).max(1e-30);
         let mut chart = ChartBuilder::on(area)
@@ -84,7 +117,13 @@ pub fn draw_lobes(root: &DrawingArea<BitMapBackend, plotters::coord::Shift>, lab
         }
         let view = [(0.0, 0.0), (-theta_v.sin() * 1.1, theta_v.cos() * 1.1)];
         chart.draw_series(LineSeries::new(view, BLACK.stroke_width(2))).map_err(|e| err(&e))?;
-        chart.draw_series(std::iter::once(Text::new("V", (-theta_v.sin() * 1.12, theta_v.cos() * 1.12 + 0.05), (FONT, 14)))).map_err(|e| err(&e))?;
+        chart
+            .draw_series(std::iter::once(Text::new(
+                "V",
+                (-theta_v.sin() * 1.12, theta_v.cos() * 1.12 + 0.05),
+                (FONT, 14),
+            )))
+            .map_err(|e| err(&e))?;
         for (i, (label, c)) in labels.iter().zip(curves).enumerate() {
             let colour = png::palette(i);
             let pts = c.iter().map(|(t, y)| {
@@ -97,7 +136,14 @@ pub fn draw_lobes(root: &DrawingArea<BitMapBackend, plotters::coord::Shift>, lab
                 .label(label.clone())
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], colour.stroke_width(2)));
         }
-        chart.configure_series_labels().position(SeriesLabelPosition::UpperLeft).label_font((FONT, 12)).background_style(WHITE.mix(0.8)).border_style(BLACK).draw().map_err(|e| err(&e))?;
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperLeft)
+            .label_font((FONT, 12))
+            .background_style(WHITE.mix(0.8))
+            .border_style(BLACK)
+            .draw()
+            .map_err(|e| err(&e))?;
     }
     Ok(())
 }

@@ -13,14 +13,14 @@
 
 use crate::cleanup;
 use crate::gpu::{Gpu, GpuOptions};
-use crate::model::Model;
-use crate::shaders::Shaders;
-use crate::profile::gbuffer;
 use crate::kernels::shade::GBufferFormat;
+use crate::model::Model;
+use crate::profile::gbuffer;
 use crate::profile::protocol::Timed;
 use crate::profile::workload::{Variant, Workload};
 use crate::schema::callgrind::{CallgrindRun, KernelIr};
-use anyhow::{anyhow, bail, Context, Result};
+use crate::shaders::Shaders;
+use anyhow::{Context, Result, anyhow, bail};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -112,13 +112,19 @@ pub fn child_main(request_json: &str) -> Result<()> {
     }
     // LLVM runs many times slower under valgrind: each compilation gets that much more time.
     crate::launch::scale(VALGRIND_SLOWDOWN);
-    let models = req.models.iter().map(|s| Model::parse(s).map_err(|e| anyhow!("{s}: {e:#}"))).collect::<Result<Vec<_>>>()?;
+    let models =
+        req.models.iter().map(|s| Model::parse(s).map_err(|e| anyhow!("{s}: {e:#}"))).collect::<Result<Vec<_>>>()?;
     let shaders = match &req.glsl {
         Some(dir) => Shaders::from_glsl(dir)?,
         None => Shaders::embedded(),
     };
     let gpu = Gpu::new(&GpuOptions { device: req.device.clone(), validation: req.validate, ..Default::default() })?;
-    let work = Workload::upload(&gpu, &gbuffer::synthetic(req.width, req.height, GBufferFormat::Packed), &gbuffer::lights(req.lights), None)?;
+    let work = Workload::upload(
+        &gpu,
+        &gbuffer::synthetic(req.width, req.height, GBufferFormat::Packed),
+        &gbuffer::lights(req.lights),
+        None,
+    )?;
     let mut all: Vec<Option<&Model>> = models.iter().map(Some).collect();
     all.push(None);
     let mut labels = Vec::new();
@@ -159,7 +165,9 @@ impl Default for CallgrindOptions {
 pub fn valgrind_version() -> Result<String> {
     crate::shaders::first_line_of(cleanup::command("valgrind").arg("--version"))
         .filter(|v| v.starts_with("valgrind"))
-        .ok_or_else(|| anyhow!("valgrind not found: install valgrind (Debian: `apt-get install valgrind`), or run `make setup`"))
+        .ok_or_else(|| {
+            anyhow!("valgrind not found: install valgrind (Debian: `apt-get install valgrind`), or run `make setup`")
+        })
 }
 
 /// Runs the child under callgrind and reads what it dumped. Labels follow `Model::name`.
@@ -183,18 +191,27 @@ pub fn run(models: &[Model], lights: u32, shaders: &Shaders, options: &Callgrind
     let exe = std::env::current_exe().context("cannot find brdfprof's own executable")?;
     // --vgdb=no: no vgdb FIFOs in TMPDIR, which a killed valgrind would leave behind.
     let mut cmd = cleanup::command("valgrind");
-    cmd.args(["--tool=callgrind", "--vgdb=no", "--instr-atstart=no", "--dump-line=no", "--dump-instr=no", "--compress-strings=no", "--compress-pos=no"])
-        .arg(format!("--callgrind-out-file={}", out_file.display()))
-        .arg(&exe)
-        .arg(CHILD_COMMAND)
-        .arg(serde_json::to_string(&req)?)
-        .env("LP_NUM_THREADS", "0")
-        .env("MESA_SHADER_CACHE_DISABLE", "true");
+    cmd.args([
+        "--tool=callgrind",
+        "--vgdb=no",
+        "--instr-atstart=no",
+        "--dump-line=no",
+        "--dump-instr=no",
+        "--compress-strings=no",
+        "--compress-pos=no",
+    ])
+    .arg(format!("--callgrind-out-file={}", out_file.display()))
+    .arg(&exe)
+    .arg(CHILD_COMMAND)
+    .arg(serde_json::to_string(&req)?)
+    .env("LP_NUM_THREADS", "0")
+    .env("MESA_SHADER_CACHE_DISABLE", "true");
     crate::launch::export(&mut cmd);
     let _tmp = cleanup::child_tmpdir(&mut cmd)?;
     // The child compiles and runs every kernel under valgrind, each compilation under the scaled limit.
     let limit = crate::launch::limit() * VALGRIND_SLOWDOWN * (models.len() as u32 + 2);
-    let output = crate::launch::output_within(&mut cmd, "the callgrind run (valgrind)", limit).context("cannot run valgrind")?;
+    let output =
+        crate::launch::output_within(&mut cmd, "the callgrind run (valgrind)", limit).context("cannot run valgrind")?;
     let stdout = String::from_utf8_lossy(&output.stdout);
     let stderr = String::from_utf8_lossy(&output.stderr);
     if !output.status.success() {
@@ -213,9 +230,12 @@ pub fn run(models: &[Model], lights: u32, shaders: &Shaders, options: &Callgrind
         .iter()
         .zip(names)
         .map(|(dump_label, label)| {
-            let jit_ir = *dumps.get(dump_label).ok_or_else(|| anyhow!("callgrind wrote no dump `{dump_label}` ({label})"))?;
+            let jit_ir =
+                *dumps.get(dump_label).ok_or_else(|| anyhow!("callgrind wrote no dump `{dump_label}` ({label})"))?;
             if jit_ir == 0 {
-                bail!("callgrind's dump for {label} has no JIT code (no call from {DRIVER_OBJECT} into anonymous code)");
+                bail!(
+                    "callgrind's dump for {label} has no JIT code (no call from {DRIVER_OBJECT} into anonymous code)"
+                );
             }
             Ok(KernelIr { label, jit_ir })
         })
@@ -229,7 +249,11 @@ fn read_dumps(dir: &Path) -> Result<BTreeMap<String, u64>> {
     for entry in std::fs::read_dir(dir)? {
         let path = entry?.path();
         // A tool's file, read as its output is: a regular file within the launcher's bound.
-        let text = String::from_utf8_lossy(&crate::io::read_bounded(&path, crate::launch::MAX_OUTPUT_BYTES as u64).with_context(|| format!("callgrind's dump {}", path.display()))?).into_owned();
+        let text = String::from_utf8_lossy(
+            &crate::io::read_bounded(&path, crate::launch::MAX_OUTPUT_BYTES as u64)
+                .with_context(|| format!("callgrind's dump {}", path.display()))?,
+        )
+        .into_owned();
         let dump = parse_dump(&text).with_context(|| format!("{}", path.display()))?;
         if let Some(label) = dump.trigger.as_deref().and_then(|l| l.strip_prefix("Client Request: ")) {
             dumps.insert(label.to_string(), dump.jit_ir());

@@ -3,20 +3,26 @@
 //! between them, gross and net of the memory-only kernel.
 
 use crate::profile::ProfileReport as ProfileView;
-use crate::schema::correlation::{CostRow, Correlation};
 use crate::schema::InspectReport;
+use crate::schema::correlation::{Correlation, CostRow};
 use crate::stats;
-use anyhow::{anyhow, bail, Context, Result};
+use anyhow::{Context, Result, anyhow, bail};
 use std::path::Path;
 
 /// The bootstrap CI of `rho`'s pairs.
 fn rho_ci(pairs: &[(f64, f64)]) -> Option<(f64, f64)> {
-    stats::spearman_ci(&pairs.iter().map(|p| p.0).collect::<Vec<_>>(), &pairs.iter().map(|p| p.1).collect::<Vec<_>>(), 0.95)
+    stats::spearman_ci(
+        &pairs.iter().map(|p| p.0).collect::<Vec<_>>(),
+        &pairs.iter().map(|p| p.1).collect::<Vec<_>>(),
+        0.95,
+    )
 }
 
 /// Spearman's rho, where there are at least three pairs to rank.
 fn rho(pairs: &[(f64, f64)]) -> Option<f64> {
-    (pairs.len() >= 3).then(|| stats::spearman(&pairs.iter().map(|p| p.0).collect::<Vec<_>>(), &pairs.iter().map(|p| p.1).collect::<Vec<_>>()))
+    (pairs.len() >= 3).then(|| {
+        stats::spearman(&pairs.iter().map(|p| p.0).collect::<Vec<_>>(), &pairs.iter().map(|p| p.1).collect::<Vec<_>>())
+    })
 }
 
 /// A `brdfprof profile` report, read (before anything is measured, so that a bad file fails at once).
@@ -28,12 +34,17 @@ pub struct ProfileReport {
 /// Reads the profile report at `path`: JSON with a `rows` array.
 pub fn load_profile(path: &Path) -> Result<ProfileReport> {
     let file = path.display().to_string();
-    let text = String::from_utf8(crate::io::read_bounded(path, crate::io::MAX_REPORT_BYTES).with_context(|| format!("--profile {file}"))?).map_err(|_| anyhow::anyhow!("--profile {file}: not UTF-8 text: not a brdfprof profile report"))?;
-    let json: serde_json::Value = serde_json::from_str(&text).map_err(|e| anyhow!("--profile {file}: not valid JSON ({e})"))?;
+    let text = String::from_utf8(
+        crate::io::read_bounded(path, crate::io::MAX_REPORT_BYTES).with_context(|| format!("--profile {file}"))?,
+    )
+    .map_err(|_| anyhow::anyhow!("--profile {file}: not UTF-8 text: not a brdfprof profile report"))?;
+    let json: serde_json::Value =
+        serde_json::from_str(&text).map_err(|e| anyhow!("--profile {file}: not valid JSON ({e})"))?;
     if !json["rows"].is_array() {
         bail!("--profile {file}: no `rows` array (is it a `brdfprof profile` report?)");
     }
-    let view = serde_json::from_value(json).map_err(|e| anyhow!("--profile {file}: not a brdfprof profile report ({e})"))?;
+    let view =
+        serde_json::from_value(json).map_err(|e| anyhow!("--profile {file}: not a brdfprof profile report ({e})"))?;
     Ok(ProfileReport { file, view })
 }
 
@@ -85,4 +96,3 @@ pub fn correlate_with(report: &InspectReport, profile: &ProfileReport) -> Result
         rows: out,
     })
 }
-

@@ -34,7 +34,10 @@ pub struct InspectOptions {
 pub fn run(gpu: &Gpu, shaders: &Shaders, options: &InspectOptions) -> Result<InspectReport> {
     let mut report = match &options.callgrind {
         Some(cg) => {
-            let mut measure = |rows: &mut [Row], notes: &mut BTreeMap<String, String>, setup: &mut BTreeMap<String, String>| measure_callgrind(gpu, shaders, options, cg, rows, notes, setup);
+            let mut measure =
+                |rows: &mut [Row], notes: &mut BTreeMap<String, String>, setup: &mut BTreeMap<String, String>| {
+                    measure_callgrind(gpu, shaders, options, cg, rows, notes, setup)
+                };
             kernel_stats::device_report(gpu, shaders, &options.models, options.lights, Some(&mut measure))?
         }
         None => kernel_stats::device_report(gpu, shaders, &options.models, options.lights, None)?,
@@ -53,7 +56,6 @@ fn measure_callgrind(
     notes: &mut BTreeMap<String, String>,
     setup: &mut BTreeMap<String, String>,
 ) -> Option<CallgrindRun> {
-
     if !is_lavapipe(&gpu.info) {
         notes.insert("callgrind/".into(), format!("not applicable: {} is not lavapipe (llvmpipe)", gpu.info.name));
         return None;
@@ -84,4 +86,3 @@ fn measure_callgrind(
 pub fn is_lavapipe(info: &crate::gpu::DeviceInfo) -> bool {
     info.is_cpu() && info.name.starts_with("llvmpipe")
 }
-

@@ -12,14 +12,14 @@
 
 use super::BASELINE_LABEL;
 use crate::gpu::Gpu;
+use crate::kernels::shade::GBufferFormat;
 use crate::model::Model;
 use crate::profile::gbuffer;
-use crate::kernels::shade::GBufferFormat;
 use crate::profile::protocol::{self, ProtocolOptions};
 use crate::profile::workload::{Variant, Workload};
 use crate::shaders::Shaders;
 use crate::stats;
-use anyhow::{bail, Result};
+use anyhow::{Result, bail};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::time::Duration;
@@ -68,7 +68,12 @@ pub fn run(gpu: &Gpu, shaders: &Shaders, models: &[Model], options: &TimingOptio
     if options.rounds == 0 {
         bail!("a timing run needs at least one round");
     }
-    let work = Workload::upload(gpu, &gbuffer::synthetic(options.width, options.height, GBufferFormat::Packed), &gbuffer::lights(options.lights), None)?;
+    let work = Workload::upload(
+        gpu,
+        &gbuffer::synthetic(options.width, options.height, GBufferFormat::Packed),
+        &gbuffer::lights(options.lights),
+        None,
+    )?;
     let mut all: Vec<Option<&Model>> = models.iter().map(Some).collect();
     all.push(None);
     let variants = all.iter().map(|m| Variant::new(gpu, &work, *m, shaders, 1)).collect::<Result<Vec<_>>>()?;
@@ -88,7 +93,10 @@ pub fn run(gpu: &Gpu, shaders: &Shaders, models: &[Model], options: &TimingOptio
     let ns_per_eval = round_ns.iter().map(|(k, t)| (k.clone(), stats::median(t) / evals)).collect();
     let models: Vec<String> = (0..base).map(label).collect();
     let (reference, reference_ns) = reference_of(&models, &round_ns);
-    let ratios = models.iter().map(|m| (m.clone(), round_ns[m].iter().zip(&reference_ns).map(|(a, r)| a / r).collect())).collect();
+    let ratios = models
+        .iter()
+        .map(|m| (m.clone(), round_ns[m].iter().zip(&reference_ns).map(|(a, r)| a / r).collect()))
+        .collect();
     Ok(TimingRun {
         reference,
         width: options.width,

@@ -3,14 +3,15 @@
 //! RFC 4180 says (`"nx"`, `"0.5"`, `""` for a quote inside quotes; a quoted field cannot span lines). Every
 //! error names the file, the line and the column (`in.csv:3: column 6 `vz`: `x` is not a number`).
 
-use crate::brdf::guards::MIN_VECTOR;
 use crate::brdf::Sample;
-use anyhow::{anyhow, bail, Result};
+use crate::brdf::guards::MIN_VECTOR;
+use anyhow::{Result, anyhow, bail};
 use std::borrow::Cow;
 use std::path::Path;
 
 /// Columns `eval` needs, in any order; others are ignored.
-pub const SAMPLE_COLUMNS: [&str; 13] = ["nx", "ny", "nz", "vx", "vy", "vz", "lx", "ly", "lz", "roughness", "f0r", "f0g", "f0b"];
+pub const SAMPLE_COLUMNS: [&str; 13] =
+    ["nx", "ny", "nz", "vx", "vy", "vz", "lx", "ly", "lz", "roughness", "f0r", "f0g", "f0b"];
 
 /// Optional tangent columns: all three or none.
 pub const TANGENT_COLUMNS: [&str; 3] = ["tx", "ty", "tz"];
@@ -98,7 +99,9 @@ pub fn parse_eval_csv_with(bytes: &[u8], name: &str, columns: &Columns) -> Resul
     let bom = if bytes.starts_with(BOM) { BOM.len() } else { 0 };
     let mut lines = split_lines(&bytes[bom..]);
     let mut decoded = std::iter::from_fn(move || {
-        lines.find(|(_, l)| !l.trim_ascii().is_empty()).map(|(line, bytes)| decode(name, line, bytes, if line == 1 { bom } else { 0 }))
+        lines
+            .find(|(_, l)| !l.trim_ascii().is_empty())
+            .map(|(line, bytes)| decode(name, line, bytes, if line == 1 { bom } else { 0 }))
     });
     let (header_line, header) = decoded
         .next()
@@ -122,7 +125,11 @@ pub fn parse_eval_csv_with(bytes: &[u8], name: &str, columns: &Columns) -> Resul
 fn decode<'a>(name: &str, line: usize, bytes: &'a [u8], offset: usize) -> Result<(usize, &'a str)> {
     std::str::from_utf8(bytes).map(|s| (line, s)).map_err(|e| {
         let at = e.valid_up_to();
-        anyhow!("{name}:{line}: byte column {}: byte 0x{:02x} is not UTF-8 (save the file as UTF-8)", offset + at + 1, bytes[at])
+        anyhow!(
+            "{name}:{line}: byte column {}: byte 0x{:02x} is not UTF-8 (save the file as UTF-8)",
+            offset + at + 1,
+            bytes[at]
+        )
     })
 }
 
@@ -134,7 +141,8 @@ pub fn split_fields(line: &str) -> Result<Vec<Cow<'_, str>>, (usize, &'static st
     loop {
         let start = rest.trim_start_matches([' ', '\t']);
         let (field, after) = if let Some(quoted) = start.strip_prefix('"') {
-            let (field, after) = unquote(quoted).ok_or((fields.len() + 1, "a quoted field is not closed on its line"))?;
+            let (field, after) =
+                unquote(quoted).ok_or((fields.len() + 1, "a quoted field is not closed on its line"))?;
             let after = after.trim_start_matches([' ', '\t']);
             if !(after.is_empty() || after.starts_with(',')) {
                 return Err((fields.len() + 1, "text after the closing quote (a quote inside quotes is written \"\")"));
@@ -200,18 +208,40 @@ impl Layout {
             }
         }
         let find = |c: &str| names.iter().position(|n| n == c);
-        let needed: Vec<&str> = SAMPLE_COLUMNS.iter().enumerate().filter(|(k, c)| *k < 9 || !columns.unread.contains(c)).map(|(_, c)| *c).collect();
+        let needed: Vec<&str> = SAMPLE_COLUMNS
+            .iter()
+            .enumerate()
+            .filter(|(k, c)| *k < 9 || !columns.unread.contains(c))
+            .map(|(_, c)| *c)
+            .collect();
         let missing: Vec<&str> = needed.iter().copied().filter(|c| find(c).is_none()).collect();
         if !missing.is_empty() {
-            bail!("{name}:{line}: header lacks column(s) {} (the model reads {})", missing.join(", "), needed.join(","));
+            bail!(
+                "{name}:{line}: header lacks column(s) {} (the model reads {})",
+                missing.join(", "),
+                needed.join(",")
+            );
         }
         let samples = SAMPLE_COLUMNS.map(find); // absent ones are unread material columns (checked above)
         let tangents = match TANGENT_COLUMNS.map(find) {
             [Some(x), Some(y), Some(z)] => Some([x, y, z]),
             [None, None, None] => None,
             found => {
-                let has = |want: bool| TANGENT_COLUMNS.iter().zip(found).filter(|(_, f)| f.is_some() == want).map(|(c, _)| *c).collect::<Vec<_>>().join(", ");
-                bail!("{name}:{line}: header has tangent column(s) {} but lacks {} (tangents need all of {})", has(true), has(false), TANGENT_COLUMNS.join(","));
+                let has = |want: bool| {
+                    TANGENT_COLUMNS
+                        .iter()
+                        .zip(found)
+                        .filter(|(_, f)| f.is_some() == want)
+                        .map(|(c, _)| *c)
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                };
+                bail!(
+                    "{name}:{line}: header has tangent column(s) {} but lacks {} (tangents need all of {})",
+                    has(true),
+                    has(false),
+                    TANGENT_COLUMNS.join(",")
+                );
             }
         };
         let mut wanted: Vec<(String, usize)> = Vec::new();
@@ -245,7 +275,13 @@ impl Layout {
                 bail!("{name}:{line}: column {} `{}`: {} is outside [0, 1]", col + 1, SAMPLE_COLUMNS[k], v[k]);
             }
         }
-        input.samples.push(Sample { n: [v[0], v[1], v[2]], v: [v[3], v[4], v[5]], l: [v[6], v[7], v[8]], roughness: v[9], f0: [v[10], v[11], v[12]] });
+        input.samples.push(Sample {
+            n: [v[0], v[1], v[2]],
+            v: [v[3], v[4], v[5]],
+            l: [v[6], v[7], v[8]],
+            roughness: v[9],
+            f0: [v[10], v[11], v[12]],
+        });
         input.lines.push(line);
         if let (Some(cols), Some(out)) = (self.tangents, input.tangents.as_mut()) {
             let t = [value(cols[0])?, value(cols[1])?, value(cols[2])?];
@@ -262,7 +298,8 @@ impl Layout {
 /// A finite number; errors name the line, the 0-based field `col` (shown 1-based) and its column.
 fn number(name: &str, line: usize, col: usize, column: &str, raw: &str) -> Result<f32> {
     let raw = raw.trim();
-    let x: f32 = raw.parse().map_err(|_| anyhow!("{name}:{line}: column {} `{column}`: `{raw}` is not a number", col + 1))?;
+    let x: f32 =
+        raw.parse().map_err(|_| anyhow!("{name}:{line}: column {} `{column}`: `{raw}` is not a number", col + 1))?;
     if !x.is_finite() {
         bail!("{name}:{line}: column {} `{column}`: `{raw}` is not finite", col + 1);
     }
@@ -273,12 +310,18 @@ fn number(name: &str, line: usize, col: usize, column: &str, raw: &str) -> Resul
 /// smaller values to zero).
 fn nonzero(name: &str, line: usize, columns: &str, v: &[f32]) -> Result<()> {
     let largest = v.iter().fold(0f32, |m, x| m.max(x.abs()));
-    let shown = v.iter().map(|&x| if x != 0.0 && x.abs() < 1e-4 { format!("{x:e}") } else { x.to_string() }).collect::<Vec<_>>().join(", ");
+    let shown = v
+        .iter()
+        .map(|&x| if x != 0.0 && x.abs() < 1e-4 { format!("{x:e}") } else { x.to_string() })
+        .collect::<Vec<_>>()
+        .join(", ");
     if largest == 0.0 {
         bail!("{name}:{line}: columns {columns}: zero-length vector ({shown})");
     }
     if f64::from(largest) < MIN_VECTOR {
-        bail!("{name}:{line}: columns {columns}: vector too short to normalise ({shown}): its largest component is below {MIN_VECTOR:e} (FLT_MIN), where GPUs may flush values to zero; scale it up");
+        bail!(
+            "{name}:{line}: columns {columns}: vector too short to normalise ({shown}): its largest component is below {MIN_VECTOR:e} (FLT_MIN), where GPUs may flush values to zero; scale it up"
+        );
     }
     Ok(())
 }
@@ -296,7 +339,8 @@ mod tests {
 
     #[test]
     fn columns_in_any_order_and_extra_ignored() {
-        let s = parse_samples_csv(format!("{HEADER}\n0.5,0,0,1,0,0.6,0.8,0.6,0,0.8,0.04,0.05,0.06,hello\n"), "in.csv").unwrap();
+        let s = parse_samples_csv(format!("{HEADER}\n0.5,0,0,1,0,0.6,0.8,0.6,0,0.8,0.04,0.05,0.06,hello\n"), "in.csv")
+            .unwrap();
         assert_eq!(s.len(), 1);
         assert_eq!((s[0].roughness, s[0].n, s[0].f0), (0.5, [0.0, 0.0, 1.0], [0.04, 0.05, 0.06]));
     }
@@ -323,7 +367,9 @@ mod tests {
         let e = err(&bytes);
         assert!(e.contains("in.csv:3: byte column 11: byte 0xff is not UTF-8"), "{e}");
         // A multi-byte character is fine where it is ignored; the header's column counts the BOM.
-        assert!(parse_samples_csv(format!("{HEADER}\n0.5,0,0,1,0,0.6,0.8,0.6,0,0.8,0.04,0.05,0.06,é\n"), "in.csv").is_ok());
+        assert!(
+            parse_samples_csv(format!("{HEADER}\n0.5,0,0,1,0,0.6,0.8,0.6,0,0.8,0.04,0.05,0.06,é\n"), "in.csv").is_ok()
+        );
         let e = err(b"\xEF\xBB\xBFnx,\xc3\n");
         assert!(e.contains("in.csv:1: byte column 7: byte 0xc3"), "{e}");
     }
@@ -354,20 +400,31 @@ mod tests {
         assert_eq!(input.tangents, Some(vec![[1.0, 0.0, 0.0], [0.0, 2.0, 0.0]]));
         assert_eq!(input.columns, vec![("aniso".to_string(), vec![0.5, -1.0])]);
         assert_eq!(parse_eval_csv(format!("{HEADER}\n{ROW}\n").as_bytes(), "in.csv", &[]).unwrap().tangents, None);
-        let e = parse_eval_csv(format!("{HEADER},tz,tx\n{ROW},0,1\n").as_bytes(), "in.csv", &[]).unwrap_err().to_string();
+        let e =
+            parse_eval_csv(format!("{HEADER},tz,tx\n{ROW},0,1\n").as_bytes(), "in.csv", &[]).unwrap_err().to_string();
         assert!(e.contains("in.csv:1: header has tangent column(s) tx, tz but lacks ty"), "{e}");
-        let e = parse_eval_csv(format!("{HEADER},tx,ty,tz\n{ROW},0,0,0\n").as_bytes(), "in.csv", &[]).unwrap_err().to_string();
+        let e = parse_eval_csv(format!("{HEADER},tx,ty,tz\n{ROW},0,0,0\n").as_bytes(), "in.csv", &[])
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("in.csv:2: columns tx,ty,tz: zero-length vector"), "{e}");
-        let e = parse_eval_csv(format!("{HEADER},tx,ty,tz\n{ROW},1,inf,0\n").as_bytes(), "in.csv", &[]).unwrap_err().to_string();
+        let e = parse_eval_csv(format!("{HEADER},tx,ty,tz\n{ROW},1,inf,0\n").as_bytes(), "in.csv", &[])
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("in.csv:2: column 16 `ty`: `inf` is not finite"), "{e}");
-        let e = parse_eval_csv(format!("{HEADER},aniso\n{ROW},nan\n").as_bytes(), "in.csv", &["aniso"]).unwrap_err().to_string();
+        let e = parse_eval_csv(format!("{HEADER},aniso\n{ROW},nan\n").as_bytes(), "in.csv", &["aniso"])
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("in.csv:2: column 15 `aniso`: `nan` is not finite"), "{e}");
     }
 
     #[test]
     fn a_tiny_vector_is_named_for_what_it_is() {
         let e = err(format!("{HEADER}\n0.5,0,0,1e-40,0,0.6,0.8,0.6,0,0.8,0.04,0.05,0.06,x\n"));
-        assert!(e.contains("in.csv:2: columns nx,ny,nz: vector too short to normalise (0, 0, 1e-40)") && e.contains("FLT_MIN"), "{e}");
+        assert!(
+            e.contains("in.csv:2: columns nx,ny,nz: vector too short to normalise (0, 0, 1e-40)")
+                && e.contains("FLT_MIN"),
+            "{e}"
+        );
         assert!(!e.contains("zero-length"), "{e}");
     }
 
@@ -383,7 +440,15 @@ mod tests {
     fn relaxed_sample_columns_need_only_be_finite() {
         let row = "5,0,0,1,0,0.6,0.8,0.6,0,0.8,0.04,0.05,0.06,x";
         assert!(err(format!("{HEADER}\n{row}\n")).contains("column 1 `roughness`: 5 is outside [0, 1]"));
-        let input = parse_eval_csv_with(format!("{HEADER}\n{row}\n").as_bytes(), "in.csv", &Columns { optional: &["roughness"], relaxed: &["roughness"], unread: &[] }).unwrap();
-        assert_eq!((input.columns.clone(), input.column_numbers.clone()), (vec![("roughness".to_string(), vec![5.0])], vec![1]));
+        let input = parse_eval_csv_with(
+            format!("{HEADER}\n{row}\n").as_bytes(),
+            "in.csv",
+            &Columns { optional: &["roughness"], relaxed: &["roughness"], unread: &[] },
+        )
+        .unwrap();
+        assert_eq!(
+            (input.columns.clone(), input.column_numbers.clone()),
+            (vec![("roughness".to_string(), vec![5.0])], vec![1])
+        );
     }
 }

@@ -4,9 +4,12 @@
 
 pub mod csv;
 
-pub use csv::{parse_eval_csv, parse_samples_csv, read_eval_csv, read_eval_csv_with, read_samples_csv, Columns, EvalInput, SAMPLE_COLUMNS, TANGENT_COLUMNS};
+pub use csv::{
+    Columns, EvalInput, SAMPLE_COLUMNS, TANGENT_COLUMNS, parse_eval_csv, parse_samples_csv, read_eval_csv,
+    read_eval_csv_with, read_samples_csv,
+};
 
-use anyhow::{anyhow, bail, Context, Result};
+use anyhow::{Context, Result, anyhow, bail};
 use std::io::Write;
 use std::os::unix::ffi::OsStrExt;
 use std::path::{Path, PathBuf};
@@ -42,9 +45,14 @@ pub fn format_rgb_csv(rows: &[[f32; 3]]) -> String {
 /// symbolic links), and for a dangling symbolic link the missing file it points to.
 pub fn read_input(path: &Path) -> Result<Vec<u8>> {
     if let Err(e) = std::fs::metadata(path) {
-        let dangling = std::fs::symlink_metadata(path).is_ok_and(|m| m.file_type().is_symlink()) && e.kind() == std::io::ErrorKind::NotFound;
+        let dangling = std::fs::symlink_metadata(path).is_ok_and(|m| m.file_type().is_symlink())
+            && e.kind() == std::io::ErrorKind::NotFound;
         return Err(match std::fs::read_link(path).ok().filter(|_| dangling) {
-            Some(to) => anyhow!("cannot read {}: it is a symbolic link to {}, which does not exist ({e})", path.display(), to.display()),
+            Some(to) => anyhow!(
+                "cannot read {}: it is a symbolic link to {}, which does not exist ({e})",
+                path.display(),
+                to.display()
+            ),
             None => anyhow!("cannot read {}: {e}", path.display()),
         });
     }
@@ -73,7 +81,11 @@ pub fn read_bounded(path: &Path, max: u64) -> Result<Vec<u8>> {
         bail!("cannot read {}: not a regular file (a device, FIFO or socket)", path.display());
     }
     if meta.len() > max {
-        bail!("cannot read {}: {} bytes, more than the {max} bytes brdfprof reads from such a file", path.display(), meta.len());
+        bail!(
+            "cannot read {}: {} bytes, more than the {max} bytes brdfprof reads from such a file",
+            path.display(),
+            meta.len()
+        );
     }
     let mut bytes = Vec::with_capacity(meta.len() as usize);
     file.take(max + 1).read_to_end(&mut bytes).map_err(|e| anyhow!("cannot read {}: {e}", path.display()))?;
@@ -93,7 +105,8 @@ fn link_target(path: &Path) -> Result<PathBuf> {
     for _ in 0..MAX_LINKS {
         match std::fs::symlink_metadata(&target) {
             Ok(m) if m.file_type().is_symlink() => {
-                let next = std::fs::read_link(&target).with_context(|| format!("cannot read the symbolic link {}", target.display()))?;
+                let next = std::fs::read_link(&target)
+                    .with_context(|| format!("cannot read the symbolic link {}", target.display()))?;
                 target = target.parent().map_or_else(|| next.clone(), |dir| dir.join(&next));
             }
             _ => return Ok(target),
@@ -114,7 +127,10 @@ pub fn write_output(path: &Path, bytes: &[u8]) -> Result<()> {
     match std::fs::metadata(&target) {
         Ok(m) if m.is_dir() => bail!("cannot write {}: it is a directory", path.display()),
         Ok(m) if !m.is_file() => {
-            let mut f = std::fs::OpenOptions::new().write(true).open(&target).with_context(|| format!("cannot open {}", path.display()))?;
+            let mut f = std::fs::OpenOptions::new()
+                .write(true)
+                .open(&target)
+                .with_context(|| format!("cannot open {}", path.display()))?;
             f.write_all(bytes).and_then(|_| f.flush()).with_context(|| format!("cannot write {}", path.display()))
         }
         Ok(m) => write_atomic(&target, bytes, Some(m.permissions())),
@@ -151,7 +167,8 @@ pub fn commit_outputs() -> Result<()> {
         let mut result = Ok(());
         for s in &all {
             if result.is_ok() {
-                result = std::fs::rename(&s.tmp, &s.target).with_context(|| format!("cannot write {}", s.target.display()));
+                result =
+                    std::fs::rename(&s.tmp, &s.target).with_context(|| format!("cannot write {}", s.target.display()));
             }
             if result.is_err() {
                 let _ = std::fs::remove_file(&s.tmp);
@@ -245,9 +262,17 @@ pub fn tracked_by_git(dir: &Path, pattern: &str) -> Vec<PathBuf> {
     if !dir.is_dir() {
         return Vec::new();
     }
-    let out = crate::launch::output_quick(crate::cleanup::command("git").arg("-C").arg(dir).args(["ls-files", "-z", "--"]).arg(pattern), "git ls-files");
+    let out = crate::launch::output_quick(
+        crate::cleanup::command("git").arg("-C").arg(dir).args(["ls-files", "-z", "--"]).arg(pattern),
+        "git ls-files",
+    );
     match out {
-        Ok(o) if o.status.success() => o.stdout.split(|&b| b == 0).filter(|n| !n.is_empty()).map(|n| dir.join(std::ffi::OsStr::from_bytes(n))).collect(),
+        Ok(o) if o.status.success() => o
+            .stdout
+            .split(|&b| b == 0)
+            .filter(|n| !n.is_empty())
+            .map(|n| dir.join(std::ffi::OsStr::from_bytes(n)))
+            .collect(),
         _ => Vec::new(),
     }
 }
@@ -258,7 +283,11 @@ pub fn tracked_by_git(dir: &Path, pattern: &str) -> Vec<PathBuf> {
 pub fn refuse_tracked_default(flag: &str, dir: &Path, files: &[String]) -> Result<()> {
     for f in files {
         if let Some(t) = tracked_by_git(dir, f).first() {
-            bail!("{flag} not given: the default output {} would overwrite {}, a file git tracks; name the output with {flag} PATH", dir.join(f).display(), t.display());
+            bail!(
+                "{flag} not given: the default output {} would overwrite {}, a file git tracks; name the output with {flag} PATH",
+                dir.join(f).display(),
+                t.display()
+            );
         }
     }
     Ok(())
@@ -305,7 +334,11 @@ pub fn check_not_input(flag: &str, output: &Path, inputs: &[(&str, &Path)]) -> R
     let Ok(out) = std::fs::metadata(output) else { return Ok(()) };
     for (input_flag, input) in inputs {
         if std::fs::metadata(input).is_ok_and(|m| (m.dev(), m.ino()) == (out.dev(), out.ino())) {
-            bail!("{flag} {}: is the same file as {input_flag} {}; writing it would replace the input. Give another output path", output.display(), input.display());
+            bail!(
+                "{flag} {}: is the same file as {input_flag} {}; writing it would replace the input. Give another output path",
+                output.display(),
+                input.display()
+            );
         }
     }
     Ok(())
@@ -331,7 +364,8 @@ fn creatable(flag: &str, output: &Path, dir: &Path) -> Result<()> {
 
 /// `dir` admits new entries (permissions, read-only file systems).
 fn writable(flag: &str, output: &Path, dir: &Path) -> Result<()> {
-    let c = std::ffi::CString::new(dir.as_os_str().as_bytes()).map_err(|_| anyhow!("{flag} {}: the path contains a NUL byte", output.display()))?;
+    let c = std::ffi::CString::new(dir.as_os_str().as_bytes())
+        .map_err(|_| anyhow!("{flag} {}: the path contains a NUL byte", output.display()))?;
     // SAFETY: `c` is a NUL-terminated path that outlives the call.
     if unsafe { libc::access(c.as_ptr(), libc::W_OK | libc::X_OK) } != 0 {
         bail!("{flag} {}: cannot write in {} ({})", output.display(), dir.display(), std::io::Error::last_os_error());
@@ -421,7 +455,10 @@ mod tests {
         let file = d.join("file");
         std::fs::write(&file, "x").unwrap();
         assert!(check_output_path("--json", &d.join("new.json")).is_ok());
-        assert!(check_output_path("--json", &d.join("a/b/new.json")).is_ok(), "missing directories are created on writing");
+        assert!(
+            check_output_path("--json", &d.join("a/b/new.json")).is_ok(),
+            "missing directories are created on writing"
+        );
         assert!(check_output_path("--json", &file).is_ok());
         let e = check_output_path("--json", d).unwrap_err().to_string();
         assert_eq!(e, format!("--json {}: is a directory; give a file path", d.display()));

@@ -6,12 +6,12 @@
 
 pub mod naga_info;
 
-use crate::gpu::Gpu;
-use crate::kernels::shade::{self, shade_kernel, steady_block, GBufferFormat};
-use crate::model::{Model, ModelKernel, BASELINE_LABEL};
 use crate::export::json::Provenance;
+use crate::gpu::Gpu;
+use crate::kernels::shade::{self, GBufferFormat, shade_kernel, steady_block};
+use crate::model::{BASELINE_LABEL, Model, ModelKernel};
 use crate::schema::callgrind::CallgrindRun;
-use crate::schema::{driver, InspectReport, Row, FOLDED_NOTE, HASH_NOTE, SECTIONS};
+use crate::schema::{FOLDED_NOTE, HASH_NOTE, InspectReport, Row, SECTIONS, driver};
 use crate::shaders::Shaders;
 use crate::spirv;
 use anyhow::{Context, Result};
@@ -24,7 +24,9 @@ fn static_stats(kernel: &ModelKernel, naga_kernel: &ModelKernel, row: &mut Row) 
     let frozen = spirv::specialise(&kernel.spirv.words, &kernel.constants).with_context(|| model.clone())?;
     row.stats.extend(spirv::count(&frozen)?.stats("spirv"));
     row.stats.extend(spirv::count(&spirv::optimise(&frozen).with_context(|| model.clone())?)?.stats("spirv-O"));
-    let naga = naga_info::analyse(&spirv::specialise(&naga_kernel.spirv.words, &naga_kernel.constants).with_context(|| model.clone())?);
+    let naga = naga_info::analyse(
+        &spirv::specialise(&naga_kernel.spirv.words, &naga_kernel.constants).with_context(|| model.clone())?,
+    );
     row.stats.extend(naga.stats());
     row.notes.insert("naga".into(), naga.verdict());
     Ok(())
@@ -35,7 +37,14 @@ fn driver_stats(gpu: &Gpu, kernel: &ModelKernel, row: &mut Row) -> Result<()> {
     if !gpu.reports_statistics() {
         return Ok(());
     }
-    let pipeline = crate::gpu::Kernel::new(gpu, &kernel.spirv.name, &kernel.spirv.words, &kernel.constants, &shade::bindings(GBufferFormat::Packed), shade::PUSH_BYTES)?;
+    let pipeline = crate::gpu::Kernel::new(
+        gpu,
+        &kernel.spirv.name,
+        &kernel.spirv.words,
+        &kernel.constants,
+        &shade::bindings(GBufferFormat::Packed),
+        shade::PUSH_BYTES,
+    )?;
     if let Some(executables) = pipeline.executables()? {
         row.stats.extend(driver::executable_stats(executables));
     }
@@ -69,7 +78,10 @@ pub fn static_row(shaders: &Shaders, model: Option<&Model>, lights: u32) -> Resu
     let float_kernel = shade_kernel(model, GBufferFormat::Float, per_dispatch, accumulate, shaders)?;
     row.notes.insert(HASH_NOTE.into(), shade::kernel_hash(model, GBufferFormat::Packed, shaders)?);
     if let Some(folded) = model.and_then(Model::file).map(|f| f.folded()).filter(|f| !f.is_empty()) {
-        let note = format!("parameters compiled in as constants, so the figures are for these values (the compiler may fold them): {}; bind one to an input (NAME=@roughness, ...) to cost it as one", folded.join(", "));
+        let note = format!(
+            "parameters compiled in as constants, so the figures are for these values (the compiler may fold them): {}; bind one to an input (NAME=@roughness, ...) to cost it as one",
+            folded.join(", ")
+        );
         crate::messages::note_once(format!("{}: {note}", row.model));
         row.notes.insert(FOLDED_NOTE.into(), note);
     }
@@ -129,7 +141,14 @@ fn tool_versions(shaders: &Shaders) -> BTreeMap<String, String> {
 
 /// The report of a compile-only target that compiles in this process (no Vulkan device of its own): the
 /// static rows with the target compiler's statistics added under `driver/`, nothing executed.
-pub fn compiled_report(mut rows: Vec<Row>, provenance: serde_json::Value, lights: u32, shaders: &Shaders, mut tools: BTreeMap<String, String>, section_notes: BTreeMap<String, String>) -> InspectReport {
+pub fn compiled_report(
+    mut rows: Vec<Row>,
+    provenance: serde_json::Value,
+    lights: u32,
+    shaders: &Shaders,
+    mut tools: BTreeMap<String, String>,
+    section_notes: BTreeMap<String, String>,
+) -> InspectReport {
     let emitted = emitted_keys(&mut rows);
     tools.extend(tool_versions(shaders));
     InspectReport {
@@ -150,12 +169,22 @@ pub fn compiled_report(mut rows: Vec<Row>, provenance: serde_json::Value, lights
 
 /// A callgrind measurement of a device report's kernels: it adds its figures to the rows and says how it went
 /// in the section notes and the setup.
-pub type Callgrind<'a> = &'a mut dyn FnMut(&mut [Row], &mut BTreeMap<String, String>, &mut BTreeMap<String, String>) -> Option<CallgrindRun>;
+pub type Callgrind<'a> =
+    &'a mut dyn FnMut(&mut [Row], &mut BTreeMap<String, String>, &mut BTreeMap<String, String>) -> Option<CallgrindRun>;
 
 /// A Vulkan device's report of the models' kernels and the memory-only one: every static statistic, the
 /// driver's, and callgrind's where `callgrind` measures them (None: not measured).
-pub fn device_report(gpu: &Gpu, shaders: &Shaders, models: &[Model], lights: u32, callgrind: Option<Callgrind>) -> Result<InspectReport> {
-    let mut rows = kernels_of(models).into_iter().map(|model| kernel_row(gpu, shaders, model, lights)).collect::<Result<Vec<_>>>()?;
+pub fn device_report(
+    gpu: &Gpu,
+    shaders: &Shaders,
+    models: &[Model],
+    lights: u32,
+    callgrind: Option<Callgrind>,
+) -> Result<InspectReport> {
+    let mut rows = kernels_of(models)
+        .into_iter()
+        .map(|model| kernel_row(gpu, shaders, model, lights))
+        .collect::<Result<Vec<_>>>()?;
     let mut emitted = emitted_keys(&mut rows);
     let mut section_notes = BTreeMap::new();
     if !gpu.reports_statistics() {

@@ -41,14 +41,27 @@ impl WithConstant for SpecConstants {
 }
 
 /// A pipeline of `model`'s kernel of `kind`, with `extra` constants on top of the model's.
-pub fn model_kernel<'g>(gpu: &'g Gpu, model: &Model, kind: KernelKind, extra: impl FnOnce(SpecConstants) -> SpecConstants, bindings: u32, push_bytes: u32) -> Result<Kernel<'g>> {
+pub fn model_kernel<'g>(
+    gpu: &'g Gpu,
+    model: &Model,
+    kind: KernelKind,
+    extra: impl FnOnce(SpecConstants) -> SpecConstants,
+    bindings: u32,
+    push_bytes: u32,
+) -> Result<Kernel<'g>> {
     model.check_support(&gpu.info)?;
     let k = model.kernel(kind, embedded())?;
     kernel(gpu, &k.spirv, &extra(k.constants), bindings, push_bytes)
 }
 
 /// A pipeline of `spirv` with `bindings` storage buffers.
-pub fn kernel<'g>(gpu: &'g Gpu, spirv: &Spirv, constants: &SpecConstants, bindings: u32, push_bytes: u32) -> Result<Kernel<'g>> {
+pub fn kernel<'g>(
+    gpu: &'g Gpu,
+    spirv: &Spirv,
+    constants: &SpecConstants,
+    bindings: u32,
+    push_bytes: u32,
+) -> Result<Kernel<'g>> {
     Kernel::new(gpu, &spirv.name, &spirv.words, constants, &Binding::storage(bindings), push_bytes)
 }
 
@@ -65,7 +78,15 @@ const MAX_BATCH_BYTES: u64 = 1 << 30;
 
 /// Runs an elementwise kernel (binding 0: `in_stride` bytes per element, binding 1: `out_stride`, push constant:
 /// element count) over `input`, returning the raw output bytes.
-fn run_elementwise(gpu: &Gpu, kernel: &Kernel, input: &[u8], in_stride: u64, out_stride: u64, n: u64, limits: RunLimits) -> Result<Vec<u8>> {
+fn run_elementwise(
+    gpu: &Gpu,
+    kernel: &Kernel,
+    input: &[u8],
+    in_stride: u64,
+    out_stride: u64,
+    n: u64,
+    limits: RunLimits,
+) -> Result<Vec<u8>> {
     let mut output = Vec::with_capacity((n * out_stride) as usize);
     let batch = (MAX_BATCH_BYTES.min(gpu.info.max_memory_allocation_size.max(1 << 27)) / in_stride).max(1);
     let mut first = 0;
@@ -78,7 +99,12 @@ fn run_elementwise(gpu: &Gpu, kernel: &Kernel, input: &[u8], in_stride: u64, out
         let sets = plan
             .chunks
             .iter()
-            .map(|&(start, len)| kernel.bind(&[(&inputs, start * in_stride, len * in_stride), (&outputs, start * out_stride, len * out_stride)]))
+            .map(|&(start, len)| {
+                kernel.bind(&[
+                    (&inputs, start * in_stride, len * in_stride),
+                    (&outputs, start * out_stride, len * out_stride),
+                ])
+            })
             .collect::<Result<Vec<_>>>()?;
         gpu.submit(|cmd| {
             for (set, &(_, len)) in sets.iter().zip(&plan.chunks) {
@@ -132,18 +158,32 @@ pub fn eval(gpu: &Gpu, model: &Model, samples: &[Sample], limits: RunLimits) -> 
 }
 
 /// `eval` with a `.brdf` model's tangents and per-row parameters.
-pub fn eval_with(gpu: &Gpu, model: &Model, samples: &[Sample], extras: &EvalExtras, limits: RunLimits) -> Result<Vec<[f32; 3]>> {
+pub fn eval_with(
+    gpu: &Gpu,
+    model: &Model,
+    samples: &[Sample],
+    extras: &EvalExtras,
+    limits: RunLimits,
+) -> Result<Vec<[f32; 3]>> {
     eval_from(gpu, model, embedded(), samples, extras, limits)
 }
 
 /// `eval_with` on the kernels of `shaders` (the embedded ones, or a `--glsl DIR`).
-pub fn eval_from(gpu: &Gpu, model: &Model, shaders: &Shaders, samples: &[Sample], extras: &EvalExtras, limits: RunLimits) -> Result<Vec<[f32; 3]>> {
+pub fn eval_from(
+    gpu: &Gpu,
+    model: &Model,
+    shaders: &Shaders,
+    samples: &[Sample],
+    extras: &EvalExtras,
+    limits: RunLimits,
+) -> Result<Vec<[f32; 3]>> {
     assert_eq!(extras.rows.len(), samples.len() * extras.row_floats, "one row of parameters per sample");
     model.check_support(&gpu.info)?;
     let k = model.kernel(KernelKind::Eval, shaders)?;
     let kernel = self::kernel(gpu, &k.spirv, &k.constants, 2, 4)?;
     let in_stride = 16 * extras.stride() as u64;
-    let out = run_elementwise(gpu, &kernel, &pack_samples(samples, extras), in_stride, 16, samples.len() as u64, limits)?;
+    let out =
+        run_elementwise(gpu, &kernel, &pack_samples(samples, extras), in_stride, 16, samples.len() as u64, limits)?;
     let floats: Vec<f32> = bytemuck::pod_collect_to_vec(&out);
     Ok(as_f(model, floats.chunks_exact(4).map(|c| [c[0], c[1], c[2]]).collect(), samples))
 }
@@ -193,7 +233,15 @@ pub fn terms(gpu: &Gpu, model: &Model, inputs: &[TermInput]) -> Result<Vec<TermO
         .iter()
         .flat_map(|t| [t.nov, t.nol, t.noh, t.voh, t.roughness, t.f0[0], t.f0[1], t.f0[2], t.sin2h, 0.0, 0.0, 0.0])
         .collect();
-    let out = run_elementwise(gpu, &kernel, bytemuck::cast_slice(&floats), 48, 32, inputs.len() as u64, RunLimits::default())?;
+    let out = run_elementwise(
+        gpu,
+        &kernel,
+        bytemuck::cast_slice(&floats),
+        48,
+        32,
+        inputs.len() as u64,
+        RunLimits::default(),
+    )?;
     let floats: Vec<f32> = bytemuck::pod_collect_to_vec(&out);
     Ok(floats.chunks_exact(8).map(|c| TermOutput { d: c[0], vis: c[1], f: [c[4], c[5], c[6]] }).collect())
 }
@@ -219,16 +267,25 @@ pub const ALBEDO_GRID: u32 = 256;
 
 /// Directional albedo of `model` for every cell, integrated on the GPU.
 pub fn albedo(gpu: &Gpu, model: &Model, cells: &[AlbedoCell]) -> Result<Vec<Albedo>> {
-    let kernel = model_kernel(gpu, model, KernelKind::Albedo, |c| c.with(constants::ALBEDO_N, ALBEDO_GRID as f64), 2, 4)?;
-    let floats: Vec<f32> = cells.iter().flat_map(|c| [c.nov, c.roughness, 0.0, 0.0, c.f0[0], c.f0[1], c.f0[2], 0.0]).collect();
+    let kernel =
+        model_kernel(gpu, model, KernelKind::Albedo, |c| c.with(constants::ALBEDO_N, ALBEDO_GRID as f64), 2, 4)?;
+    let floats: Vec<f32> =
+        cells.iter().flat_map(|c| [c.nov, c.roughness, 0.0, 0.0, c.f0[0], c.f0[1], c.f0[2], 0.0]).collect();
     let inputs = Buffer::with_data(gpu, bytemuck::cast_slice(&floats), MemoryKind::Device)?;
-    reduce_albedo(gpu, &kernel, cells.len(), |first, count, rows| kernel.bind(&[(&inputs, first * 32, count * 32), (rows, 0, rows.size)]))
+    reduce_albedo(gpu, &kernel, cells.len(), |first, count, rows| {
+        kernel.bind(&[(&inputs, first * 32, count * 32), (rows, 0, rows.size)])
+    })
 }
 
 /// Dispatches an albedo kernel (ALBEDO_GRID rows per cell, two vec4 out per row: the row's mean and its even
 /// columns' mean) over `cells` cells in chunks within maxComputeWorkGroupCount.x, and reduces each cell to E and
 /// its half-resolution error estimate. `bind(first cell, cells, rows buffer)` binds one chunk.
-pub fn reduce_albedo(gpu: &Gpu, kernel: &Kernel, cells: usize, bind: impl Fn(u64, u64, &Buffer) -> Result<Bindings>) -> Result<Vec<Albedo>> {
+pub fn reduce_albedo(
+    gpu: &Gpu,
+    kernel: &Kernel,
+    cells: usize,
+    bind: impl Fn(u64, u64, &Buffer) -> Result<Bindings>,
+) -> Result<Vec<Albedo>> {
     let n = ALBEDO_GRID as u64;
     let mut results = Vec::with_capacity(cells);
     let per_dispatch = (gpu.info.max_compute_work_group_count[0] as u64 * crate::gpu::WORKGROUP as u64 / n).max(1);
@@ -272,7 +329,13 @@ pub fn lobe_curves(gpu: &Gpu, models: &[Model], roughness: &[f32]) -> Result<Vec
     for &r in roughness {
         let samples: Vec<Sample> = angles
             .iter()
-            .map(|t| Sample { n: [0.0, 0.0, 1.0], v, l: [t.sin() as f32, 0.0, t.cos() as f32], roughness: r, f0: [1.0; 3] })
+            .map(|t| Sample {
+                n: [0.0, 0.0, 1.0],
+                v,
+                l: [t.sin() as f32, 0.0, t.cos() as f32],
+                roughness: r,
+                f0: [1.0; 3],
+            })
             .collect();
         let mut curves = Vec::new();
         for m in models {

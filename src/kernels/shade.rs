@@ -2,7 +2,7 @@
 //! light blocks it unrolls, the kernel of a model with its constants set, and the hash that names it.
 //! `profile` times it, `inspect`, `check`, `sweep` and the compile-only targets compile it; all build it here.
 
-use super::{constants, WithConstant};
+use super::{WithConstant, constants};
 use crate::gpu::Binding;
 use crate::model::{KernelKind, Model, ModelKernel};
 use crate::shaders::Shaders;
@@ -59,7 +59,11 @@ pub const PUSH_BYTES: u32 = 32;
 pub fn bindings(format: GBufferFormat) -> [Binding; 3] {
     use crate::gpu::TexelFormat;
     match format {
-        GBufferFormat::Packed => [Binding::TexelRead(TexelFormat::Rgba32Uint), Binding::TexelStorage(TexelFormat::B10g11r11Ufloat), Binding::UniformDynamic],
+        GBufferFormat::Packed => [
+            Binding::TexelRead(TexelFormat::Rgba32Uint),
+            Binding::TexelStorage(TexelFormat::B10g11r11Ufloat),
+            Binding::UniformDynamic,
+        ],
         GBufferFormat::Float => [Binding::Storage, Binding::Storage, Binding::UniformDynamic],
     }
 }
@@ -75,7 +79,13 @@ fn shade_kind(format: GBufferFormat) -> KernelKind {
 /// glsl/shade.glsl for `model` (None: the memory-only baseline, compiled with the reference model's selectors,
 /// which it never runs) over `format`, lighting `lights` lights per dispatch and adding to the radiance of an
 /// earlier block when `accumulate`, with every specialisation constant set.
-pub fn shade_kernel(model: Option<&Model>, format: GBufferFormat, lights: u32, accumulate: bool, shaders: &Shaders) -> Result<ModelKernel> {
+pub fn shade_kernel(
+    model: Option<&Model>,
+    format: GBufferFormat,
+    lights: u32,
+    accumulate: bool,
+    shaders: &Shaders,
+) -> Result<ModelKernel> {
     let reference = Model::reference();
     let mut k = model.unwrap_or(&reference).kernel(shade_kind(format), shaders)?;
     k.constants = k

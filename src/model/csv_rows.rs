@@ -1,12 +1,12 @@
 //! An eval CSV bound to a model: the samples and tangents, the material columns the model reads (and only
 //! those required), and for a `.brdf` model each parameter with a column named like it read per row.
 
+use super::Model;
 use super::brdf_file::{FileParam, FileParamKind};
 use super::file_model::{Binding, FileModel, Input};
-use super::Model;
 use crate::io::{self, Columns, EvalInput};
 use crate::messages;
-use anyhow::{bail, Result};
+use anyhow::{Result, bail};
 use std::path::Path;
 
 /// Parameters read per CSV row: `floats` values per row, rows one after another.
@@ -23,11 +23,15 @@ pub fn read_rows(model: &Model, path: &Path, params: &[String]) -> Result<(Model
     let Some(file) = model.file() else {
         let input = io::read_eval_csv_with(path, &Columns { unread: &unread, ..Columns::default() })?;
         if input.tangents.is_some() {
-            messages::note(format!("{}: columns tx,ty,tz are read by .brdf models only; {model} is isotropic", path.display()));
+            messages::note(format!(
+                "{}: columns tx,ty,tz are read by .brdf models only; {model} is isotropic",
+                path.display()
+            ));
         }
         return Ok((model.clone(), input, RowValues::default()));
     };
-    let columns: Vec<String> = file.file.params.iter().filter(|p| !geometry_column(file, p)).flat_map(|p| p.columns()).collect();
+    let columns: Vec<String> =
+        file.file.params.iter().filter(|p| !geometry_column(file, p)).flat_map(|p| p.columns()).collect();
     let optional: Vec<&str> = columns.iter().map(String::as_str).collect();
     let relaxed = relaxed_columns(file, &columns);
     let input = io::read_eval_csv_with(path, &Columns { optional: &optional, relaxed: &relaxed, unread: &unread })?;
@@ -39,13 +43,28 @@ pub fn read_rows(model: &Model, path: &Path, params: &[String]) -> Result<(Model
     let mut from_columns = Vec::new();
     for (p, binding) in file.file.params.iter().zip(&file.bindings) {
         let Binding::Value(value) = binding else { continue };
-        let cols: Vec<(usize, &Vec<f32>)> = p.columns().iter().filter_map(|c| input.columns.iter().position(|(n, _)| n == c)).map(|k| (input.column_numbers[k], &input.columns[k].1)).collect();
+        let cols: Vec<(usize, &Vec<f32>)> = p
+            .columns()
+            .iter()
+            .filter_map(|c| input.columns.iter().position(|(n, _)| n == c))
+            .map(|k| (input.column_numbers[k], &input.columns[k].1))
+            .collect();
         if !cols.is_empty() && cols.len() != p.columns().len() {
-            bail!("{}: a colour parameter `{}` is set per row by all of {} or none", path.display(), p.name, p.columns().join(","));
+            bail!(
+                "{}: a colour parameter `{}` is set per row by all of {} or none",
+                path.display(),
+                p.name,
+                p.columns().join(",")
+            );
         }
         let overridden = given(&p.name) || *value != p.default_value();
         if !cols.is_empty() && overridden {
-            messages::note(format!("the value given for {} overrides the column(s) {} of {}", p.name, p.columns().join(","), path.display()));
+            messages::note(format!(
+                "the value given for {} overrides the column(s) {} of {}",
+                p.name,
+                p.columns().join(","),
+                path.display()
+            ));
         }
         let values = if !cols.is_empty() && !overridden {
             check_column(path, &input, p, cols[0])?;
@@ -109,11 +128,19 @@ fn check_column(path: &Path, input: &EvalInput, p: &FileParam, (column, values):
     match p.kind {
         FileParamKind::Bool { .. } => {
             if let Some(i) = values.iter().position(|&x| x != 0.0 && x != 1.0) {
-                bail!("{}:{}: column {column} `{}`: {} is not a bool (0 or 1), which parameter `{}` is", path.display(), input.lines[i], p.name, values[i], p.name);
+                bail!(
+                    "{}:{}: column {column} `{}`: {} is not a bool (0 or 1), which parameter `{}` is",
+                    path.display(),
+                    input.lines[i],
+                    p.name,
+                    values[i],
+                    p.name
+                );
             }
         }
         FileParamKind::Float { min, max, .. } => {
-            let outside: Vec<usize> = (0..values.len()).filter(|&i| !(min..=max).contains(&f64::from(values[i]))).collect();
+            let outside: Vec<usize> =
+                (0..values.len()).filter(|&i| !(min..=max).contains(&f64::from(values[i]))).collect();
             if let Some(&i) = outside.first() {
                 messages::warning(format!(
                     "{}: column {column} `{}`: {} of {} rows are outside the file's range [{min}, {max}] (BRDF Explorer's slider bounds), the first at line {} ({}); used as given",

@@ -11,10 +11,10 @@
 //! the composed source (so the file's content), every file of the GLSL tree it includes, defines, flags,
 //! glslang's and brdfprof's versions.
 
-use super::brdf_file::{self, glsl_float, BrdfFile, FileParam, FileParamKind, Includes, Returns};
 use super::KernelKind;
+use super::brdf_file::{self, BrdfFile, FileParam, FileParamKind, Includes, Returns, glsl_float};
 use crate::shaders::{self, Shaders, Spirv};
-use anyhow::{anyhow, bail, Context, Result};
+use anyhow::{Context, Result, anyhow, bail};
 use glam::DVec3;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -155,10 +155,15 @@ impl FileParam {
     /// Parses a `--param` value for this parameter: a number, 0/1, `r,g,b`, or `@INPUT`.
     fn parse_binding(&self, file: &str, text: &str) -> Result<Binding> {
         let text = text.trim();
-        let fail = |why: String| anyhow!("{file}: parameter `{}` ({} at line {}): {why}", self.name, self.kind_name(), self.line);
+        let fail = |why: String| {
+            anyhow!("{file}: parameter `{}` ({} at line {}): {why}", self.name, self.kind_name(), self.line)
+        };
         if let Some(input) = text.strip_prefix('@') {
             let i = Input::ALL.iter().copied().find(|i| i.name() == input).ok_or_else(|| {
-                fail(format!("unknown input `@{input}`; inputs are {}", Input::ALL.iter().map(|i| format!("@{}", i.name())).collect::<Vec<_>>().join(", ")))
+                fail(format!(
+                    "unknown input `@{input}`; inputs are {}",
+                    Input::ALL.iter().map(|i| format!("@{}", i.name())).collect::<Vec<_>>().join(", ")
+                ))
             })?;
             if i.glsl_as(&self.kind).is_none() {
                 return Err(fail(format!("a bool cannot be bound to `@{input}`")));
@@ -171,7 +176,10 @@ impl FileParam {
                 return Err(fail(format!("`{t}` is not finite")));
             }
             if x.abs() > f64::from(f32::MAX) {
-                return Err(fail(format!("`{t}` is beyond fp32's range (at most {:e} in magnitude), in which the kernels compute", f32::MAX)));
+                return Err(fail(format!(
+                    "`{t}` is beyond fp32's range (at most {:e} in magnitude), in which the kernels compute",
+                    f32::MAX
+                )));
             }
             Ok(x)
         };
@@ -192,7 +200,10 @@ impl FileParam {
         };
         if let (FileParamKind::Float { min, max, .. }, Value::Float(x)) = (self.kind, value) {
             if !(min..=max).contains(&x) {
-                crate::messages::input_warning(format!("{file}: {} = {x} is outside the file's range [{min}, {max}] (BRDF Explorer's slider bounds); used as given", self.name));
+                crate::messages::input_warning(format!(
+                    "{file}: {} = {x} is outside the file's range [{min}, {max}] (BRDF Explorer's slider bounds); used as given",
+                    self.name
+                ));
             }
         }
         Ok(Binding::Value(value))
@@ -228,7 +239,9 @@ fn default_bindings(file: &BrdfFile, path: &str) -> Result<Vec<Binding>> {
     file.params
         .iter()
         .map(|p| match file.binds.iter().find(|(name, _, _)| name == &p.name) {
-            Some((_, input, line)) => p.parse_binding(path, input).map_err(|e| anyhow!("{}:{line}: `bind`: {e:#}", file.path.display())),
+            Some((_, input, line)) => {
+                p.parse_binding(path, input).map_err(|e| anyhow!("{}:{line}: `bind`: {e:#}", file.path.display()))
+            }
             None => Ok(Binding::Value(p.default_value())),
         })
         .collect()
@@ -246,7 +259,8 @@ pub fn split_path<'a>(text: &'a str, base: &Path) -> Option<(&'a str, Vec<&'a st
         .filter(|&e| e == text.len() || text.as_bytes()[e] == b',')
         .collect();
     ends.sort_unstable();
-    let end = ends.iter().copied().find(|&e| base.join(text[..e].trim()).is_file()).or_else(|| ends.first().copied())?;
+    let end =
+        ends.iter().copied().find(|&e| base.join(text[..e].trim()).is_file()).or_else(|| ends.first().copied())?;
     let fields = text[end..].strip_prefix(',').map(|r| r.split(',').collect()).unwrap_or_default();
     Some((text[..end].trim(), fields))
 }
@@ -262,9 +276,15 @@ fn loop_warning(path: &str, l: &brdf_file::Loop) -> String {
     let limit = brdf_file::LAVAPIPE_LOOP_LIMIT;
     let head = format!("{}:{}: a `{}` loop", l.file.as_deref().unwrap_or(path), l.line, l.keyword);
     match l.trip_count {
-        Some(n) if n <= limit => format!("{head} of {n} iterations: within the {limit} iterations after which lavapipe ends every loop"),
-        Some(n) => format!("{head} of {n} iterations: lavapipe ends every loop after {limit} iterations, so its results there are wrong (other drivers run it to the end)"),
-        None => format!("{head} whose iterations brdfprof cannot bound from the source: lavapipe ends every loop after {limit} iterations without a word, so a longer loop gives wrong results there"),
+        Some(n) if n <= limit => {
+            format!("{head} of {n} iterations: within the {limit} iterations after which lavapipe ends every loop")
+        }
+        Some(n) => format!(
+            "{head} of {n} iterations: lavapipe ends every loop after {limit} iterations, so its results there are wrong (other drivers run it to the end)"
+        ),
+        None => format!(
+            "{head} whose iterations brdfprof cannot bound from the source: lavapipe ends every loop after {limit} iterations without a word, so a longer loop gives wrong results there"
+        ),
     }
 }
 
@@ -326,7 +346,12 @@ fn merge_includes(path: &str, old: &Includes, items: &[String]) -> Result<Includ
 }
 
 /// The file's shader options under `items` (`define=`, `include=`, `include-map=`) over `file`'s own.
-fn shader_options(path: &str, defines: &[(String, String)], includes: &Includes, items: &[String]) -> Result<(Vec<(String, String)>, Includes)> {
+fn shader_options(
+    path: &str,
+    defines: &[(String, String)],
+    includes: &Includes,
+    items: &[String],
+) -> Result<(Vec<(String, String)>, Includes)> {
     let (defs, incs): (Vec<String>, Vec<String>) = items.iter().cloned().partition(|i| is_define(i));
     Ok((merge_defines(path, defines, &defs)?, merge_includes(path, includes, &incs)?))
 }
@@ -340,16 +365,22 @@ fn merge_defines(path: &str, old: &[(String, String)], defines: &[String]) -> Re
         let macro_text = item.split_once('=').map_or("", |(_, v)| v.trim());
         let (name, value) = macro_text.split_once('=').map_or((macro_text, ""), |(n, v)| (n.trim(), v.trim()));
         if !brdf_file::is_identifier(name) || name.starts_with("GL_") || name.contains("__") {
-            bail!("{path}: `{item}`: expected define=NAME or define=NAME=VALUE with NAME an identifier (not GL_... and without `__`, which GLSL reserves)");
+            bail!(
+                "{path}: `{item}`: expected define=NAME or define=NAME=VALUE with NAME an identifier (not GL_... and without `__`, which GLSL reserves)"
+            );
         }
         if value.contains(['\n', '\r']) {
             bail!("{path}: `{item}`: a define's value is one line");
         }
         if value.ends_with('\\') {
-            bail!("{path}: `{item}`: the value ends with a backslash, which would continue the macro onto the shader's next line; drop it");
+            bail!(
+                "{path}: `{item}`: the value ends with a backslash, which would continue the macro onto the shader's next line; drop it"
+            );
         }
         if ENTRY_NAMES.contains(&name) {
-            bail!("{path}: `{item}`: `{name}` is a name of the entry `vec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y)`, which a macro of that name would rewrite; choose another macro name");
+            bail!(
+                "{path}: `{item}`: `{name}` is a name of the entry `vec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y)`, which a macro of that name would rewrite; choose another macro name"
+            );
         }
         if given.iter().any(|g| g == name) {
             bail!("{path}: `define={name}` is given twice; give each macro once");
@@ -380,20 +411,38 @@ fn split_params(rest: &[&str]) -> Result<Vec<String>> {
 impl FileModel {
     /// `PATH.brdf[,NAME=VALUE...]`: the file with its defaults, then the overrides.
     pub fn parse(text: &str) -> Result<Self> {
-        let (path, fields) = split_path(text, Path::new("")).ok_or_else(|| anyhow!("`{text}` names no model file (.{})", crate::model::front::FILE_EXTENSIONS.join(", .")))?;
+        let (path, fields) = split_path(text, Path::new("")).ok_or_else(|| {
+            anyhow!("`{text}` names no model file (.{})", crate::model::front::FILE_EXTENSIONS.join(", ."))
+        })?;
         let items = split_params(&fields)?;
         let (options, params): (Vec<String>, Vec<String>) = items.into_iter().partition(|i| is_shader_option(i));
         let (defines, includes) = shader_options(path, &[], &Includes::default(), &options)?;
         let file = brdf_file::load_shader(Path::new(path), &defines, &includes)?;
         crate::model::front::record(path, file.language);
         if file.has_is_func {
-            crate::messages::input_note(format!("{path}: its isFunc section (importance sampling) is ignored: brdfprof integrates with its own estimator"));
+            crate::messages::input_note(format!(
+                "{path}: its isFunc section (importance sampling) is ignored: brdfprof integrates with its own estimator"
+            ));
         }
         if let Some(p) = file.params.iter().find(|p| KEYS.contains(&p.name.as_str())) {
-            bail!("{}:{}: a parameter cannot be called `{}`: `{}=` in a model spec is brdfprof's own key", file.path.display(), p.line, p.name, p.name);
+            bail!(
+                "{}:{}: a parameter cannot be called `{}`: `{}=` in a model spec is brdfprof's own key",
+                file.path.display(),
+                p.line,
+                p.name,
+                p.name
+            );
         }
         let defaults = default_bindings(&file, path)?;
-        let model = FileModel { file, path: path.to_string(), bindings: defaults.clone(), label: None, entry: None, returns: None, defaults };
+        let model = FileModel {
+            file,
+            path: path.to_string(),
+            bindings: defaults.clone(),
+            label: None,
+            entry: None,
+            returns: None,
+            defaults,
+        };
         model.warn_new(None);
         model.with_params(&params)
     }
@@ -417,7 +466,8 @@ impl FileModel {
     /// Prints the file's warnings and loop warnings that `before` (the model it was made from) did not have.
     fn warn_new(&self, before: Option<&FileModel>) {
         let loops = |m: &FileModel| m.file.loops.iter().map(|l| loop_warning(&m.path, l)).collect::<Vec<_>>();
-        let old: Vec<String> = before.map(|b| b.file.warnings.iter().cloned().chain(loops(b)).collect()).unwrap_or_default();
+        let old: Vec<String> =
+            before.map(|b| b.file.warnings.iter().cloned().chain(loops(b)).collect()).unwrap_or_default();
         for w in self.file.warnings.iter().cloned().chain(loops(self)) {
             if !old.contains(&w) {
                 crate::messages::input_warning(w);
@@ -442,10 +492,15 @@ impl FileModel {
         }
         let mut given: Vec<&str> = Vec::new();
         for p in &params {
-            let (name, value) = p.split_once('=').ok_or_else(|| anyhow!("{}: `{p}`: expected NAME=VALUE", self.path))?;
+            let (name, value) =
+                p.split_once('=').ok_or_else(|| anyhow!("{}: `{p}`: expected NAME=VALUE", self.path))?;
             let name = name.trim();
             if given.contains(&name) {
-                bail!("{}: `{name}` is given twice ({}); give each parameter once", self.path, params.iter().map(|p| p.as_str()).collect::<Vec<_>>().join(", "));
+                bail!(
+                    "{}: `{name}` is given twice ({}); give each parameter once",
+                    self.path,
+                    params.iter().map(|p| p.as_str()).collect::<Vec<_>>().join(", ")
+                );
             }
             given.push(name);
             if name == ENTRY {
@@ -453,12 +508,18 @@ impl FileModel {
                 continue;
             }
             if name == RETURNS {
-                m.returns = Some(Returns::parse(value.trim()).ok_or_else(|| anyhow!("{}: `returns={}`: expected returns=f or returns=f_nol", self.path, value.trim()))?);
+                m.returns = Some(Returns::parse(value.trim()).ok_or_else(|| {
+                    anyhow!("{}: `returns={}`: expected returns=f or returns=f_nol", self.path, value.trim())
+                })?);
                 continue;
             }
             let k = self.file.params.iter().position(|q| q.name == name).ok_or_else(|| {
                 let known = self.file.params.iter().map(|q| q.name.as_str()).collect::<Vec<_>>();
-                anyhow!("{}: no parameter `{name}` (the file's parameters: {})", self.path, if known.is_empty() { "none".to_string() } else { known.join(", ") })
+                anyhow!(
+                    "{}: no parameter `{name}` (the file's parameters: {})",
+                    self.path,
+                    if known.is_empty() { "none".to_string() } else { known.join(", ") }
+                )
             })?;
             m.bindings[k] = self.file.params[k].parse_binding(&self.path, value)?;
         }
@@ -486,8 +547,16 @@ impl FileModel {
         if declared.contains(&name) || (name == "BRDF" && self.file.defines_brdf) {
             return Ok(name.to_string());
         }
-        let known = declared.iter().map(|d| d.to_string()).chain(self.file.defines_brdf.then(|| "BRDF".to_string())).collect::<Vec<_>>();
-        bail!("{}: `entry={name}`: the file declares no such entry (its entries: {}; declare one as `entry NAME(ARG, ...) returns f|f_nol` in a `::begin brdfprof` section)", self.path, known.join(", "))
+        let known = declared
+            .iter()
+            .map(|d| d.to_string())
+            .chain(self.file.defines_brdf.then(|| "BRDF".to_string()))
+            .collect::<Vec<_>>();
+        bail!(
+            "{}: `entry={name}`: the file declares no such entry (its entries: {}; declare one as `entry NAME(ARG, ...) returns f|f_nol` in a `::begin brdfprof` section)",
+            self.path,
+            known.join(", ")
+        )
     }
 
     /// The model text: the path, the defines, the include directories and maps (`includes`), the entry and
@@ -499,7 +568,13 @@ impl FileModel {
         }
         if includes {
             s += &self.file.includes.dirs.iter().map(|d| format!(",{INCLUDE}={}", d.display())).collect::<String>();
-            s += &self.file.includes.maps.iter().map(|(v, d)| format!(",{INCLUDE_MAP}={v}={}", d.display())).collect::<String>();
+            s += &self
+                .file
+                .includes
+                .maps
+                .iter()
+                .map(|(v, d)| format!(",{INCLUDE_MAP}={v}={}", d.display()))
+                .collect::<String>();
         }
         let default_entry = self.file.entries.first().map_or("BRDF", |e| e.name.as_str());
         if let Some(e) = self.entry.as_ref().filter(|e| all || e.as_str() != default_entry) {
@@ -539,7 +614,14 @@ impl FileModel {
     /// The parameters compiled in as constants (bound to a value, not to an input), as `NAME=VALUE`: a kernel
     /// costed with them is costed for those values, which its compiler may fold away.
     pub fn folded(&self) -> Vec<String> {
-        self.file.params.iter().zip(&self.bindings).filter_map(|(p, b)| if let Binding::Value(v) = b { Some(format!("{}={}", p.name, v.text())) } else { None }).collect()
+        self.file
+            .params
+            .iter()
+            .zip(&self.bindings)
+            .filter_map(
+                |(p, b)| if let Binding::Value(v) = b { Some(format!("{}={}", p.name, v.text())) } else { None },
+            )
+            .collect()
     }
 
     /// The binding of parameter `name`.
@@ -550,7 +632,8 @@ impl FileModel {
     /// The source composed for `kind`: the preamble, the file, then the kernel's own source (from `glsl/`).
     fn compose(&self, kind: KernelKind, kernel_source: &str) -> Result<String> {
         let renamed = self.file.renamed_shader();
-        let mut s = String::from("#version 450\n#extension GL_GOOGLE_include_directive : require\n#define BRDF_FILE 1\n");
+        let mut s =
+            String::from("#version 450\n#extension GL_GOOGLE_include_directive : require\n#define BRDF_FILE 1\n");
         let mut bind = Vec::new();
         let mut rows = Vec::new();
         let mut row_floats = 0;
@@ -579,10 +662,27 @@ impl FileModel {
         }
         // A global initialiser that reads a parameter set per call or per row runs again once it is set
         // (brdf_file::inits): GLSL ran it at the start of `main`, before.
-        let bound: Vec<&str> = self.file.params.iter().zip(&self.bindings).filter(|(_, b)| !matches!(b, Binding::Value(_))).map(|(p, _)| p.name.as_str()).collect();
-        bind.extend(renamed.initialisers.iter().filter(|i| bound.iter().any(|b| i.reads.contains(*b))).map(|i| i.assignment.clone()));
+        let bound: Vec<&str> = self
+            .file
+            .params
+            .iter()
+            .zip(&self.bindings)
+            .filter(|(_, b)| !matches!(b, Binding::Value(_)))
+            .map(|(p, _)| p.name.as_str())
+            .collect();
+        bind.extend(
+            renamed
+                .initialisers
+                .iter()
+                .filter(|i| bound.iter().any(|b| i.reads.contains(*b)))
+                .map(|i| i.assignment.clone()),
+        );
         s += &format!("#define BRDF_FILE_BIND {}\n", bind.join(" "));
-        s += &format!("#define EVAL_STRIDE {}\n#define BRDF_FILE_ROWS(base) {}\n", 4 + row_floats.div_ceil(4), rows.join(" "));
+        s += &format!(
+            "#define EVAL_STRIDE {}\n#define BRDF_FILE_ROWS(base) {}\n",
+            4 + row_floats.div_ceil(4),
+            rows.join(" ")
+        );
         let entry = self.entry();
         let glue = entry.declared.map(|e| self.file.entry_glue(e));
         let function = glue.as_ref().map_or_else(|| self.file.glsl_name("BRDF"), |(name, _)| name.clone());
@@ -644,8 +744,16 @@ impl FileModel {
     /// glslang on the composed source: written beside a copy of the embedded tree (or with `--glsl DIR` on the
     /// include path), so that the kernel's `#include "brdf.glsl"` resolves as in glsl/. Errors name the file's
     /// lines and its own identifiers.
-    fn compile(&self, tree: &GlslTree, kind: KernelKind, composed: &str, defines: &[String], extra: &[&str]) -> Result<Vec<u32>> {
-        let dir = crate::cleanup::TempDir::new().context("cannot create a temporary directory for the composed kernel")?;
+    fn compile(
+        &self,
+        tree: &GlslTree,
+        kind: KernelKind,
+        composed: &str,
+        defines: &[String],
+        extra: &[&str],
+    ) -> Result<Vec<u32>> {
+        let dir =
+            crate::cleanup::TempDir::new().context("cannot create a temporary directory for the composed kernel")?;
         let root = tree.materialise(&dir.path().join("glsl"))?;
         let src = dir.path().join("composed");
         std::fs::create_dir_all(&src).with_context(|| format!("cannot create {}", src.display()))?;
@@ -664,7 +772,12 @@ impl FileModel {
                     if root.starts_with(dir.path()) {
                         log = log.replace(&format!("{}/", root.display()), "glsl/");
                     }
-                    bail!("{}: glslang cannot compile the file's shader into the {} kernel:\n{}", self.path, kind.base(), log.trim_end())
+                    bail!(
+                        "{}: glslang cannot compile the file's shader into the {} kernel:\n{}",
+                        self.path,
+                        kind.base(),
+                        log.trim_end()
+                    )
                 }
                 None => Err(e),
             },
@@ -709,9 +822,14 @@ impl GlslTree {
         match self {
             GlslTree::Embedded => {
                 let rel = rel.to_string_lossy();
-                shaders::GLSL_FILES.iter().find(|(p, _)| *p == rel).map(|(_, t)| t.to_string()).ok_or_else(|| anyhow!("the embedded glsl/ has no {rel}"))
+                shaders::GLSL_FILES
+                    .iter()
+                    .find(|(p, _)| *p == rel)
+                    .map(|(_, t)| t.to_string())
+                    .ok_or_else(|| anyhow!("the embedded glsl/ has no {rel}"))
             }
-            GlslTree::Dir(root) => std::fs::read_to_string(root.join(rel)).with_context(|| format!("cannot read {}", root.join(rel).display())),
+            GlslTree::Dir(root) => std::fs::read_to_string(root.join(rel))
+                .with_context(|| format!("cannot read {}", root.join(rel).display())),
         }
     }
 
@@ -740,10 +858,13 @@ impl GlslTree {
     fn included(&self, composed: &str) -> Vec<(String, Option<String>)> {
         let mut out: Vec<(String, Option<String>)> = Vec::new();
         // The composed source sits outside the tree: its includes resolve from the root.
-        let mut pending: Vec<(Option<PathBuf>, String)> = include_names(composed).into_iter().map(|n| (None, n)).collect();
+        let mut pending: Vec<(Option<PathBuf>, String)> =
+            include_names(composed).into_iter().map(|n| (None, n)).collect();
         while let Some((from, name)) = pending.pop() {
             let beside = from.as_ref().and_then(|f| f.parent()).map(|d| normalise(&d.join(&name)));
-            let found = beside.filter(|p| self.exists(p)).or_else(|| Some(normalise(Path::new(&name))).filter(|p| self.exists(p)));
+            let found = beside
+                .filter(|p| self.exists(p))
+                .or_else(|| Some(normalise(Path::new(&name))).filter(|p| self.exists(p)));
             let shown = found.as_ref().map_or(format!("missing: {name}"), |p| p.display().to_string());
             if out.iter().any(|(s, _)| *s == shown) {
                 continue;
@@ -868,7 +989,15 @@ mod tests {
     fn bad_bindings_are_refused_naming_the_parameter() {
         let dir = tempfile::tempdir().unwrap();
         let m = FileModel::parse(&file(dir.path())).unwrap();
-        for (p, needle) in [("b=@roughness", "a bool cannot be bound"), ("b=2", "a bool is 0 or 1"), ("c=1,2", "a colour is r,g,b"), ("r=nan", "is not finite"), ("r=x", "is not a number"), ("q=1", "no parameter `q`"), ("r", "expected NAME=VALUE")] {
+        for (p, needle) in [
+            ("b=@roughness", "a bool cannot be bound"),
+            ("b=2", "a bool is 0 or 1"),
+            ("c=1,2", "a colour is r,g,b"),
+            ("r=nan", "is not finite"),
+            ("r=x", "is not a number"),
+            ("q=1", "no parameter `q`"),
+            ("r", "expected NAME=VALUE"),
+        ] {
             let e = format!("{:#}", m.with_params(&[p.to_string()]).unwrap_err());
             assert!(e.contains(needle) && e.contains("m.brdf"), "{p}: {e}");
         }
@@ -902,7 +1031,11 @@ mod tests {
         let e = format!("{:#}", FileModel::parse(&format!("{path},r=0.1,r=0.2")).unwrap_err());
         assert!(e.contains("`r` is given twice (r=0.1, r=0.2)"), "{e}");
         let m = FileModel::parse(&format!("{path},r=0.1")).unwrap();
-        assert_eq!(m.with_params(&["r=0.3".into()]).unwrap().binding("r"), Some(Binding::Value(Value::Float(0.3))), "--param overrides the text");
+        assert_eq!(
+            m.with_params(&["r=0.3".into()]).unwrap().binding("r"),
+            Some(Binding::Value(Value::Float(0.3))),
+            "--param overrides the text"
+        );
         for bad in ["r=1e39", "r=-3.5e38", "c=0,1e39,0"] {
             let e = format!("{:#}", m.with_params(&[bad.into()]).unwrap_err());
             assert!(e.contains("is beyond fp32's range"), "{bad}: {e}");
@@ -942,8 +1075,15 @@ mod tests {
         };
         let original = key();
         assert_eq!(original, embedded, "a copy of the tree keys as the embedded tree does");
-        let included: Vec<String> = tree.included(&m.compose(KernelKind::Eval, &tree.read(Path::new("eval.comp")).unwrap()).unwrap()).into_iter().map(|(f, _)| f).collect();
-        assert!(included.iter().any(|f| f == "brdf.glsl") && included.iter().any(|f| f.starts_with("generated/")), "{included:?}");
+        let included: Vec<String> = tree
+            .included(&m.compose(KernelKind::Eval, &tree.read(Path::new("eval.comp")).unwrap()).unwrap())
+            .into_iter()
+            .map(|(f, _)| f)
+            .collect();
+        assert!(
+            included.iter().any(|f| f == "brdf.glsl") && included.iter().any(|f| f.starts_with("generated/")),
+            "{included:?}"
+        );
         let edit = |rel: &str| {
             let p = glsl.join(rel);
             let text = std::fs::read_to_string(&p).unwrap();

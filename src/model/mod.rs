@@ -10,11 +10,11 @@ pub mod csv_rows;
 pub mod file_model;
 pub mod front;
 
-use crate::brdf::terms::{ParamValue, PARAMS};
+use crate::brdf::terms::{PARAMS, ParamValue};
 use crate::brdf::{ModelSpec, Precision};
 use crate::gpu::{DeviceInfo, SpecConstants};
 use crate::shaders::{Shaders, Spirv};
-use anyhow::{anyhow, bail, Result};
+use anyhow::{Result, anyhow, bail};
 use std::fmt;
 use std::sync::Arc;
 
@@ -86,7 +86,8 @@ impl From<ModelSpec> for Model {
 
 /// The specialisation constants that select `spec`'s terms and set the parameters they read.
 pub fn spec_constants(spec: &ModelSpec) -> SpecConstants {
-    let mut c = SpecConstants::default().int(0, spec.d.id() as i32).int(1, spec.vis.id() as i32).int(2, spec.f.id() as i32);
+    let mut c =
+        SpecConstants::default().int(0, spec.d.id() as i32).int(1, spec.vis.id() as i32).int(2, spec.f.id() as i32);
     c = c.int(crate::brdf::guards::GUARDS_CONSTANT_ID, spec.guards.0 as i32);
     for p in &PARAMS {
         c = match spec.params.get(p.param) {
@@ -138,7 +139,9 @@ impl Model {
 
     /// The built-in spec a `.brdf` file names as its reference (`reference SPEC`), if it does.
     pub fn declared_reference(&self) -> Option<crate::brdf::ModelSpec> {
-        self.file().and_then(|f| f.file.reference.as_ref()).and_then(|(text, _)| crate::brdf::ModelSpec::parse(text).ok())
+        self.file()
+            .and_then(|f| f.file.reference.as_ref())
+            .and_then(|(text, _)| crate::brdf::ModelSpec::parse(text).ok())
     }
 
     /// The `.brdf` file, for a file model.
@@ -192,7 +195,9 @@ impl Model {
                 let path = std::path::Path::new(&f.path);
                 let part = |p: Option<&std::ffi::OsStr>| p.map_or(f.path.clone(), |n| n.to_string_lossy().into_owned());
                 // `ggx.brdf` keeps its extension: a stem that reads as a built-in model would take that one's rows.
-                let stem = Some(part(path.file_stem())).filter(|s| ModelSpec::parse(s).is_err()).unwrap_or_else(|| part(path.file_name()));
+                let stem = Some(part(path.file_stem()))
+                    .filter(|s| ModelSpec::parse(s).is_err())
+                    .unwrap_or_else(|| part(path.file_name()));
                 stem + &name[f.path.len()..]
             }
         }
@@ -206,8 +211,13 @@ impl Model {
         let (roughness, f0) = match self {
             Model::Spec(s, _) => (true, s.reads_f0()),
             Model::File(f) => {
-                let reads = |inputs: &[file_model::Input]| f.bindings.iter().any(|b| matches!(b, file_model::Binding::Input(i) if inputs.contains(i)));
-                (reads(&[file_model::Input::Roughness, file_model::Input::Alpha]), reads(&[file_model::Input::F0, file_model::Input::BaseColor]))
+                let reads = |inputs: &[file_model::Input]| {
+                    f.bindings.iter().any(|b| matches!(b, file_model::Binding::Input(i) if inputs.contains(i)))
+                };
+                (
+                    reads(&[file_model::Input::Roughness, file_model::Input::Alpha]),
+                    reads(&[file_model::Input::F0, file_model::Input::BaseColor]),
+                )
             }
         };
         let mut unread = Vec::new();
@@ -253,7 +263,9 @@ impl Model {
     /// Applies `key=value` overrides (`--param`).
     pub fn with_params(&self, params: &[String]) -> Result<Self> {
         match self {
-            Model::Spec(s, l) => s.with_params(params).map(|s| Model::Spec(s, l.clone())).map_err(|e| anyhow!("{}: {e:#}", s.name())),
+            Model::Spec(s, l) => {
+                s.with_params(params).map(|s| Model::Spec(s, l.clone())).map_err(|e| anyhow!("{}: {e:#}", s.name()))
+            }
             Model::File(f) => f.with_params(params).map(|f| Model::File(Arc::new(f))),
         }
     }
@@ -261,7 +273,9 @@ impl Model {
     /// Whether an override key is a parameter of this model (so that `--param` skips models it does not fit).
     pub fn takes_param(&self, key: &str) -> bool {
         match self {
-            Model::Spec(s, _) => ["d", "vis", "f", "precision", "guards"].contains(&key) || s.reads().iter().any(|p| p.name() == key),
+            Model::Spec(s, _) => {
+                ["d", "vis", "f", "precision", "guards"].contains(&key) || s.reads().iter().any(|p| p.name() == key)
+            }
             Model::File(f) => f.takes_param(key),
         }
     }
@@ -273,7 +287,11 @@ impl Model {
                 if kind == KernelKind::SceneTerms && s.precision != Precision::F32 {
                     bail!("the scene terms kernel is compiled in fp32 only");
                 }
-                let name = if kind == KernelKind::SceneTerms { "scene_terms_f32".to_string() } else { format!("{}_{}", kind.base(), s.precision.name()) };
+                let name = if kind == KernelKind::SceneTerms {
+                    "scene_terms_f32".to_string()
+                } else {
+                    format!("{}_{}", kind.base(), s.precision.name())
+                };
                 Ok(ModelKernel { spirv: shaders.get(&name)?, constants: spec_constants(s) })
             }
             Model::File(f) => Ok(ModelKernel { spirv: f.kernel(kind, shaders)?, constants: SpecConstants::default() }),
@@ -310,22 +328,36 @@ impl fmt::Display for Model {
 /// The models of `--model` (or `default` when none is given), with `--param` overrides applied to each model
 /// that takes them; an override no model takes is an error.
 pub fn models_from_args(models: &[String], params: &[String], default: &[&str]) -> Result<Vec<Model>> {
-    let names: Vec<String> = if models.is_empty() { default.iter().map(|s| s.to_string()).collect() } else { models.to_vec() };
-    let parsed = names.iter().map(|m| Model::parse(m).map_err(|e| anyhow!("--model {m}: {e:#}"))).collect::<Result<Vec<_>>>()?;
+    let names: Vec<String> =
+        if models.is_empty() { default.iter().map(|s| s.to_string()).collect() } else { models.to_vec() };
+    let parsed =
+        names.iter().map(|m| Model::parse(m).map_err(|e| anyhow!("--model {m}: {e:#}"))).collect::<Result<Vec<_>>>()?;
     for p in params {
-        let key = p.split_once('=').map(|(k, _)| k.trim()).ok_or_else(|| anyhow!("--param `{p}`: expected KEY=VALUE"))?;
+        let key =
+            p.split_once('=').map(|(k, _)| k.trim()).ok_or_else(|| anyhow!("--param `{p}`: expected KEY=VALUE"))?;
         if !parsed.iter().any(|m| m.takes_param(key)) {
             let described = |m: &Model| match m.file() {
-                Some(f) => format!("{}, whose parameters are {}", f.path, f.file.params.iter().map(|q| q.name.as_str()).collect::<Vec<_>>().join(", ")),
+                Some(f) => format!(
+                    "{}, whose parameters are {}",
+                    f.path,
+                    f.file.params.iter().map(|q| q.name.as_str()).collect::<Vec<_>>().join(", ")
+                ),
                 None => m.name(),
             };
-            bail!("--param {p}: no model takes `{key}` ({})", parsed.iter().map(described).collect::<Vec<_>>().join("; "));
+            bail!(
+                "--param {p}: no model takes `{key}` ({})",
+                parsed.iter().map(described).collect::<Vec<_>>().join("; ")
+            );
         }
     }
     parsed
         .iter()
         .map(|m| {
-            let mine: Vec<String> = params.iter().filter(|p| p.split_once('=').is_some_and(|(k, _)| m.takes_param(k.trim()))).cloned().collect();
+            let mine: Vec<String> = params
+                .iter()
+                .filter(|p| p.split_once('=').is_some_and(|(k, _)| m.takes_param(k.trim())))
+                .cloned()
+                .collect();
             m.with_params(&mine).map_err(|e| anyhow!("--param: {e:#}"))
         })
         .collect::<Result<Vec<_>>>()
@@ -355,7 +387,9 @@ fn split_label(text: &str) -> Result<(String, Option<String>)> {
     if let Some(l) = &label {
         let safe = |c: char| c.is_ascii_alphanumeric() || "-_.+".contains(c);
         if l.is_empty() || l.len() > 64 || !l.chars().all(safe) || l.starts_with(['-', '.']) {
-            bail!("`{text}`: {LABEL_KEY}={l}: a label is 1 to 64 of A-Z a-z 0-9 - _ . + (not starting with - or .), as it names output files");
+            bail!(
+                "`{text}`: {LABEL_KEY}={l}: a label is 1 to 64 of A-Z a-z 0-9 - _ . + (not starting with - or .), as it names output files"
+            );
         }
         if l == BASELINE_LABEL {
             bail!("`{text}`: {LABEL_KEY}={l} is the memory-only baseline kernel's label; give another name");
@@ -369,7 +403,12 @@ fn split_label(text: &str) -> Result<(String, Option<String>)> {
 pub fn check_labels(models: &[Model], flag: &str) -> Result<()> {
     for (i, m) in models.iter().enumerate() {
         if let Some(o) = models[..i].iter().find(|o| o.label() == m.label() && *o != m) {
-            bail!("{flag} {} and {flag} {}: both are labelled `{}`; give one of them its own {LABEL_KEY}=", o.name(), m.name(), m.label());
+            bail!(
+                "{flag} {} and {flag} {}: both are labelled `{}`; give one of them its own {LABEL_KEY}=",
+                o.name(),
+                m.name(),
+                m.label()
+            );
         }
     }
     Ok(())
@@ -383,17 +422,29 @@ mod tests {
 
     #[test]
     fn a_label_names_the_model_but_not_its_maths() {
-        for (text, plain) in [("ggx,name=mine", "ggx"), ("d=beckmann,vis=vcavity,name=ct_2", "cook-torrance"), ("blinn, name = b+1", "blinn")] {
+        for (text, plain) in [
+            ("ggx,name=mine", "ggx"),
+            ("d=beckmann,vis=vcavity,name=ct_2", "cook-torrance"),
+            ("blinn, name = b+1", "blinn"),
+        ] {
             let m = Model::parse(text).unwrap();
             let p = Model::parse(plain).unwrap();
             assert_eq!(m.label(), text.rsplit('=').next().unwrap().trim(), "{text}");
             assert_eq!(m.canonical(), p.canonical(), "{text}: the label is not part of the canonical spec");
-            assert_eq!(format!("{:?}", spec_constants(m.twin().unwrap())), format!("{:?}", spec_constants(p.twin().unwrap())), "{text}: the same kernel constants");
+            assert_eq!(
+                format!("{:?}", spec_constants(m.twin().unwrap())),
+                format!("{:?}", spec_constants(p.twin().unwrap())),
+                "{text}: the same kernel constants"
+            );
             assert_eq!(Model::parse(&m.name()).unwrap(), m, "{text}: its name reads back, label included");
             assert_ne!(m, p, "{text}");
         }
         assert_eq!(Model::parse("ggx").unwrap().label(), "ggx");
-        assert_eq!(Model::parse("ggx,name=ggx").unwrap(), Model::reference(), "a label that is the model's own name is no label");
+        assert_eq!(
+            Model::parse("ggx,name=ggx").unwrap(),
+            Model::reference(),
+            "a label that is the model's own name is no label"
+        );
     }
 
     #[test]
@@ -405,19 +456,36 @@ mod tests {
         assert_eq!(named.canonical(), m.canonical());
         assert_eq!(Model::parse(&named.name()).unwrap(), named);
         let bound = m.with_params(&["roughness=0.25".into()]).unwrap();
-        assert_eq!(bound.label(), "ggx.brdf,roughness=0.25", "the stem with the parameters that differ from the file's");
+        assert_eq!(
+            bound.label(),
+            "ggx.brdf,roughness=0.25",
+            "the stem with the parameters that differ from the file's"
+        );
     }
 
     #[test]
     fn bad_and_clashing_labels_are_errors_naming_the_flag() {
-        for (text, why) in [("ggx,name=", "a label is"), ("ggx,name=a/b", "a label is"), ("ggx,name=x,name=y", "given twice"), ("ggx,name=baseline", "baseline"), ("ggx,name=blinn", "would read as the model `blinn`")] {
+        for (text, why) in [
+            ("ggx,name=", "a label is"),
+            ("ggx,name=a/b", "a label is"),
+            ("ggx,name=x,name=y", "given twice"),
+            ("ggx,name=baseline", "baseline"),
+            ("ggx,name=blinn", "would read as the model `blinn`"),
+        ] {
             let e = format!("{:#}", Model::parse(text).unwrap_err());
             assert!(e.contains(why), "{text}: {e}");
         }
         let e = format!("{:#}", models_from_args(&["ggx,name=a".into(), "blinn,name=a".into()], &[], &[]).unwrap_err());
         assert!(e.contains("--model ggx,name=a and --model blinn,name=a") && e.contains("labelled `a`"), "{e}");
-        assert_eq!(models_from_args(&["ggx".into(), "ggx".into()], &[], &[]).unwrap().len(), 2, "the same model twice is not a clash");
-        let e = format!("{:#}", models_from_args(&[format!("{FILE},name=x"), "blinn,name=x".into()], &[], &[]).unwrap_err());
+        assert_eq!(
+            models_from_args(&["ggx".into(), "ggx".into()], &[], &[]).unwrap().len(),
+            2,
+            "the same model twice is not a clash"
+        );
+        let e = format!(
+            "{:#}",
+            models_from_args(&[format!("{FILE},name=x"), "blinn,name=x".into()], &[], &[]).unwrap_err()
+        );
         assert!(e.contains("labelled `x`"), "{e}");
     }
 }

@@ -78,7 +78,13 @@ pub fn surface(camera: &Camera, width: u32, height: u32, x: u32, y: u32) -> Surf
     if d2 < 1.0 {
         let r = (col as f32 + 0.5) / SPHERE_COLUMNS as f32;
         let (base, metallic) = ROW_MATERIALS[rowi.min(SPHERE_ROWS - 1) as usize];
-        Surface { normal: Vec3::new(px, py, (1.0 - d2).sqrt()).normalize(), view, roughness: (r + 0.04 * (noise - 0.5)).clamp(0.0, 1.0), metallic, base: base.into() }
+        Surface {
+            normal: Vec3::new(px, py, (1.0 - d2).sqrt()).normalize(),
+            view,
+            roughness: (r + 0.04 * (noise - 0.5)).clamp(0.0, 1.0),
+            metallic,
+            base: base.into(),
+        }
     } else {
         // Floor: a bumpy plane facing the camera at a grazing tilt.
         let jitter = Vec2::new(hash01(id ^ 0x9e37_79b9) - 0.5, hash01(id ^ 0x7f4a_7c15) - 0.5);
@@ -251,7 +257,10 @@ mod tests {
                 let u = unpack(&packed.words[i..i + 4], &camera, x, y);
                 // snorm16 octahedral: < 1e-4 rad; unorm8: half a step.
                 assert!(angle(u.normal, s.normal) < 1e-4, "normal at ({x}, {y}): {:?} vs {:?}", u.normal, s.normal);
-                assert!((u.roughness - s.roughness).abs() <= 0.5 / 255.0 + 1e-6 && (u.metallic - s.metallic).abs() <= 0.5 / 255.0 + 1e-6);
+                assert!(
+                    (u.roughness - s.roughness).abs() <= 0.5 / 255.0 + 1e-6
+                        && (u.metallic - s.metallic).abs() <= 0.5 / 255.0 + 1e-6
+                );
                 assert!((u.base - s.base).abs().max_element() <= 0.5 / 255.0 + 1e-6);
                 assert_eq!(u.view, s.view, "V is reconstructed exactly as it was made");
             }

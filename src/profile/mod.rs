@@ -6,19 +6,19 @@ pub mod gbuffer;
 pub mod protocol;
 pub mod workload;
 
-use crate::gpu::Gpu;
-use crate::model::Model;
-use crate::host::HostCpu;
 use crate::export::json::Provenance;
 use crate::export::markdown::{self, Table};
+use crate::gpu::Gpu;
+use crate::host::HostCpu;
+use crate::model::Model;
 use crate::shaders::Shaders;
 use crate::stats::{self, Estimate};
 use anyhow::Result;
-use indicatif::ProgressBar;
 use gbuffer::GBufferFormat;
+use indicatif::ProgressBar;
 use protocol::{ProtocolOptions, RawTimes};
-use workload::{Variant, Workload};
 use serde::{Deserialize, Serialize};
+use workload::{Variant, Workload};
 
 pub use crate::brdf::spec::REFERENCE_MODEL;
 /// The harness share above which `harness_warning` speaks.
@@ -164,9 +164,14 @@ fn analyse(raw: &RawTimes, specs: &[Option<Model>], group: &Group) -> Vec<Row> {
             let (net, net_ratio, share) = match (&baseline_t, Some(i) != baseline) {
                 (Some(b), true) => {
                     let net: Vec<f64> = t.iter().zip(b).map(|(a, b)| a - b).collect();
-                    let net_ratio: Vec<f64> = net.iter().zip(reference_t.iter().zip(b)).map(|(n, (r, b))| n / (r - b)).collect();
+                    let net_ratio: Vec<f64> =
+                        net.iter().zip(reference_t.iter().zip(b)).map(|(n, (r, b))| n / (r - b)).collect();
                     let share: Vec<f64> = b.iter().zip(&t).map(|(b, a)| b / a).collect();
-                    (Some(stats::median_ci(&net, LEVEL)), Some(stats::median_ci(&net_ratio, LEVEL)), Some(stats::median_ci(&share, LEVEL)))
+                    (
+                        Some(stats::median_ci(&net, LEVEL)),
+                        Some(stats::median_ci(&net_ratio, LEVEL)),
+                        Some(stats::median_ci(&share, LEVEL)),
+                    )
                 }
                 _ => (None, None, None),
             };
@@ -207,7 +212,11 @@ pub fn run(gpu: &Gpu, options: &ProfileOptions, progress: &ProgressBar) -> Resul
     workload::check_size(&gpu.info, options.width, options.height, options.format, options.lights.len())?;
     progress.set_message("building the G-buffer");
     let gbuffer = gbuffer::synthetic(options.width, options.height, options.format);
-    let works = options.lights.iter().map(|&l| Workload::upload(gpu, &gbuffer, &gbuffer::lights(l), options.max_chunk)).collect::<Result<Vec<_>>>()?;
+    let works = options
+        .lights
+        .iter()
+        .map(|&l| Workload::upload(gpu, &gbuffer, &gbuffer::lights(l), options.max_chunk))
+        .collect::<Result<Vec<_>>>()?;
     drop(gbuffer);
     let from_glsl = options.glsl.as_deref().map(Shaders::from_glsl).transpose()?;
     let shaders = from_glsl.as_ref().unwrap_or_else(|| crate::kernels::embedded());
@@ -216,16 +225,32 @@ pub fn run(gpu: &Gpu, options: &ProfileOptions, progress: &ProgressBar) -> Resul
     for work in &works {
         let first = variants.len();
         for spec in models.iter().map(Some).chain([None]) {
-            progress.set_message(format!("compiling kernels ({} of {})", variants.len() + 1, works.len() * (models.len() + 1)));
+            progress.set_message(format!(
+                "compiling kernels ({} of {})",
+                variants.len() + 1,
+                works.len() * (models.len() + 1)
+            ));
             let v = Variant::new(gpu, work, spec, shaders, options.instances)?;
             labels.push(if several { format!("{} ({} lights)", v.label, work.light_count) } else { v.label.clone() });
             variants.push(v);
             specs.push(spec.cloned());
         }
         let reference = first + models.iter().position(|m| *m == reference_model).unwrap();
-        groups.push(Group { lights: work.light_count, evaluations: work.evaluations(), variants: first..variants.len(), reference, baseline: variants.len() - 1 });
+        groups.push(Group {
+            lights: work.light_count,
+            evaluations: work.evaluations(),
+            variants: first..variants.len(),
+            reference,
+            baseline: variants.len() - 1,
+        });
     }
-    let raw = protocol::measure_with_progress(gpu, &variants, &options.protocol, |raw| resolved(&analyse_all(raw, &specs, &groups), options.target_rel_ci), progress)?;
+    let raw = protocol::measure_with_progress(
+        gpu,
+        &variants,
+        &options.protocol,
+        |raw| resolved(&analyse_all(raw, &specs, &groups), options.target_rel_ci),
+        progress,
+    )?;
     let rows = analyse_all(&raw, &specs, &groups);
     let mut kernel_sha256 = std::collections::BTreeMap::new();
     for spec in models.iter().map(Some).chain([None]) {
@@ -309,10 +334,16 @@ impl ProfileReport {
             }
         }
         for name in names {
-            let mut cells = vec![if name == workload::BASELINE_LABEL { format!("{name} (gross)") } else { format!("{name} (net)") }];
+            let mut cells = vec![if name == workload::BASELINE_LABEL {
+                format!("{name} (gross)")
+            } else {
+                format!("{name} (net)")
+            }];
             for &l in counts {
                 let row = self.rows.iter().find(|r| r.model == name && r.lights == l);
-                cells.push(row.map_or("-".into(), |r| markdown::estimate(r.net_ns_per_eval.as_ref().unwrap_or(&r.ns_per_eval), 3)));
+                cells.push(row.map_or("-".into(), |r| {
+                    markdown::estimate(r.net_ns_per_eval.as_ref().unwrap_or(&r.ns_per_eval), 3)
+                }));
             }
             t.row(cells);
         }
@@ -338,14 +369,19 @@ impl ProfileReport {
     /// A warning when the memory-only kernel takes more than `HARNESS_WARNING` of a model's time: then the
     /// gross figures mostly measure loads and stores, and what helps.
     pub fn harness_warning(&self) -> String {
-        let worst = self.rows.iter().filter_map(|r| r.harness_share.map(|s| (r, s.median))).max_by(|a, b| a.1.total_cmp(&b.1));
+        let worst =
+            self.rows.iter().filter_map(|r| r.harness_share.map(|s| (r, s.median))).max_by(|a, b| a.1.total_cmp(&b.1));
         match worst {
             Some((row, share)) if share > HARNESS_WARNING => format!(
                 "warning: the memory-only kernel is {:.0}% of {}'s time (more than {:.0}%): the gross ns/eval mostly measure the harness (G-buffer loads and decode, light loads, stores), not the BRDF. Read the net columns; raise --lights to share the per-pixel cost among more evaluations{}.\n",
                 100.0 * share,
                 row.model,
                 100.0 * HARNESS_WARNING,
-                if self.workload.gbuffer == GBufferFormat::Float { "; drop --gbuffer float (the packed G-buffer reads a third of the bytes)" } else { "" }
+                if self.workload.gbuffer == GBufferFormat::Float {
+                    "; drop --gbuffer float (the packed G-buffer reads a third of the bytes)"
+                } else {
+                    ""
+                }
             ),
             _ => String::new(),
         }

@@ -8,8 +8,8 @@
 use crate::gpu::{Binding, Bindings, Commands, Gpu, Kernel, SpecConstants, Timestamps};
 use crate::shaders::Spirv;
 use anyhow::Result;
-use rand::seq::SliceRandom;
 use rand::SeedableRng;
+use rand::seq::SliceRandom;
 use serde::Serialize;
 use std::time::{Duration, Instant};
 
@@ -46,7 +46,10 @@ impl<'g> Pipelines<'g> {
     ) -> Result<Self> {
         let instances = (0..count.max(1))
             .map(|_| {
-                let compiled = kernels.iter().map(|(spirv, c)| Kernel::new(gpu, &spirv.name, &spirv.words, c, bindings, push_bytes)).collect::<Result<Vec<_>>>()?;
+                let compiled = kernels
+                    .iter()
+                    .map(|(spirv, c)| Kernel::new(gpu, &spirv.name, &spirv.words, c, bindings, push_bytes))
+                    .collect::<Result<Vec<_>>>()?;
                 let steps = plan(&compiled)?;
                 Ok((compiled, steps))
             })
@@ -139,7 +142,9 @@ impl RawTimes {
     pub fn instance_spread(&self, variant: usize) -> f64 {
         let spreads: Vec<f64> = self.instance_ns[variant]
             .iter()
-            .map(|r| r.iter().copied().fold(f64::NEG_INFINITY, f64::max) / r.iter().copied().fold(f64::INFINITY, f64::min))
+            .map(|r| {
+                r.iter().copied().fold(f64::NEG_INFINITY, f64::max) / r.iter().copied().fold(f64::INFINITY, f64::min)
+            })
             .collect();
         if spreads.is_empty() { 1.0 } else { crate::stats::median(&spreads) }
     }
@@ -149,7 +154,13 @@ impl RawTimes {
 /// stops when it returns true, at `max_rounds`, or when the budget is spent (even before `min_rounds`).
 /// `measure`, showing its rounds on `progress` (position, seconds of rounds so far): what profile and scene
 /// profile both show.
-pub fn measure_with_progress<V: Timed>(gpu: &Gpu, variants: &[V], options: &ProtocolOptions, converged: impl FnMut(&RawTimes) -> bool, progress: &indicatif::ProgressBar) -> Result<RawTimes> {
+pub fn measure_with_progress<V: Timed>(
+    gpu: &Gpu,
+    variants: &[V],
+    options: &ProtocolOptions,
+    converged: impl FnMut(&RawTimes) -> bool,
+    progress: &indicatif::ProgressBar,
+) -> Result<RawTimes> {
     progress.set_length(options.max_rounds as u64);
     measure(gpu, variants, options, converged, |raw| {
         progress.set_position(raw.rounds() as u64);
@@ -166,7 +177,8 @@ pub fn measure<V: Timed>(
 ) -> Result<RawTimes> {
     let v = variants.len();
     let mut raw = RawTimes { ns: vec![Vec::new(); v], instance_ns: vec![Vec::new(); v], ..Default::default() };
-    let slots: Vec<(usize, usize)> = variants.iter().enumerate().flat_map(|(i, var)| (0..var.instances()).map(move |k| (i, k))).collect();
+    let slots: Vec<(usize, usize)> =
+        variants.iter().enumerate().flat_map(|(i, var)| (0..var.instances()).map(move |k| (i, k))).collect();
     for &(i, k) in &slots {
         let warm = variants[i].run_once(gpu, k)?;
         if k == 0 {
@@ -264,4 +276,3 @@ pub trait Timed {
         Ok(start.elapsed())
     }
 }
-

@@ -13,7 +13,9 @@ use crate::model::Model;
 use crate::shaders::Shaders;
 use anyhow::Result;
 
-pub use crate::kernels::shade::{bindings, kernel_hash, light_blocks, shade_kernel, steady_block, LIGHT_BLOCK, PUSH_BYTES};
+pub use crate::kernels::shade::{
+    LIGHT_BLOCK, PUSH_BYTES, bindings, kernel_hash, light_blocks, shade_kernel, steady_block,
+};
 
 /// The most lights a profile takes: 512 dispatches per run, 128 KiB of lights. Compilation does not grow
 /// with the count (one block kernel), the run time does.
@@ -45,7 +47,13 @@ fn host_bytes_per_pixel(format: GBufferFormat, light_counts: u64) -> u64 {
 
 /// Refuses, before anything is allocated, a G-buffer that cannot be one device allocation or would not fit in
 /// the memory this machine has available, naming the size and the limit.
-pub fn check_size(info: &crate::gpu::DeviceInfo, width: u32, height: u32, format: GBufferFormat, light_counts: usize) -> Result<()> {
+pub fn check_size(
+    info: &crate::gpu::DeviceInfo,
+    width: u32,
+    height: u32,
+    format: GBufferFormat,
+    light_counts: usize,
+) -> Result<()> {
     let pixels = width as u64 * height as u64;
     let padded = pixels.div_ceil(crate::gpu::WORKGROUP as u64) * crate::gpu::WORKGROUP as u64;
     let side = |max_pixels: u64| {
@@ -57,14 +65,20 @@ pub fn check_size(info: &crate::gpu::DeviceInfo, width: u32, height: u32, format
         let most = info.max_memory_allocation_size / format.bytes_in();
         anyhow::bail!(
             "--size {width}x{height}: the {} G-buffer is {bytes} bytes, more than one allocation on `{}` may be ({} bytes, maxMemoryAllocationSize); at most {most} pixels (about {})",
-            format.name(), info.name, info.max_memory_allocation_size, side(most)
+            format.name(),
+            info.name,
+            info.max_memory_allocation_size,
+            side(most)
         );
     }
     if let Some((available, source)) = crate::host::memory_budget() {
         let need = pixels * host_bytes_per_pixel(format, light_counts as u64);
         if need > available {
             let most = available / host_bytes_per_pixel(format, light_counts as u64);
-            anyhow::bail!("--size {width}x{height}: building and uploading the G-buffer needs about {need} bytes of memory and {available} are available ({source}); at most about {most} pixels here (about {})", side(most));
+            anyhow::bail!(
+                "--size {width}x{height}: building and uploading the G-buffer needs about {need} bytes of memory and {available} are available ({source}); at most about {most} pixels here (about {})",
+                side(most)
+            );
         }
     }
     Ok(())
@@ -146,7 +160,16 @@ pub fn light_buffer(lights: &[f32]) -> Vec<f32> {
 /// The push constants of a dispatch over the chunk starting at pixel `first_pixel` of a picture `width`
 /// wide, with the camera's (scale x, offset x, scale y, offset y) (glsl/shade.glsl `Push`).
 pub fn push_constants(first_pixel: u64, width: u32, camera: [f32; 4]) -> Vec<u8> {
-    let words: [u32; 8] = [first_pixel as u32, width, 0, 0, camera[0].to_bits(), camera[1].to_bits(), camera[2].to_bits(), camera[3].to_bits()];
+    let words: [u32; 8] = [
+        first_pixel as u32,
+        width,
+        0,
+        0,
+        camera[0].to_bits(),
+        camera[1].to_bits(),
+        camera[2].to_bits(),
+        camera[3].to_bits(),
+    ];
     bytemuck::cast_slice(&words).to_vec()
 }
 
@@ -172,7 +195,13 @@ pub use crate::model::BASELINE_LABEL;
 impl<'g> Variant<'g> {
     /// The shading kernels for `model` (None: the memory-only baseline) from `shaders`, as `instances`
     /// independent pipelines.
-    pub fn new(gpu: &'g Gpu, work: &Workload<'g>, model: Option<&Model>, shaders: &Shaders, instances: usize) -> Result<Self> {
+    pub fn new(
+        gpu: &'g Gpu,
+        work: &Workload<'g>,
+        model: Option<&Model>,
+        shaders: &Shaders,
+        instances: usize,
+    ) -> Result<Self> {
         if let Some(m) = model {
             m.check_support(&gpu.info)?;
         }
@@ -203,7 +232,11 @@ impl<'g> Variant<'g> {
                     chunks
                         .iter()
                         .map(|&(first, len)| {
-                            k.bind(&[(&work.gbuffer, first * f.bytes_in(), len * f.bytes_in()), (&work.radiance, first * f.bytes_out(), len * f.bytes_out()), (&work.lights, 0, BLOCK_BYTES)])
+                            k.bind(&[
+                                (&work.gbuffer, first * f.bytes_in(), len * f.bytes_in()),
+                                (&work.radiance, first * f.bytes_out(), len * f.bytes_out()),
+                                (&work.lights, 0, BLOCK_BYTES),
+                            ])
                         })
                         .collect::<Result<Vec<_>>>()
                 })
@@ -213,11 +246,25 @@ impl<'g> Variant<'g> {
                 .zip(&kind_of)
                 .map(|(&(first_light, _), &k)| {
                     let offsets = vec![(first_light as u64 / LIGHT_BLOCK as u64 * BLOCK_BYTES) as u32];
-                    chunks.iter().zip(&sets[k]).map(|(&(first, len), &set)| Dispatch { kernel: k, set, offsets: offsets.clone(), push: work.push(first), invocations: len }).collect()
+                    chunks
+                        .iter()
+                        .zip(&sets[k])
+                        .map(|(&(first, len), &set)| Dispatch {
+                            kernel: k,
+                            set,
+                            offsets: offsets.clone(),
+                            push: work.push(first),
+                            invocations: len,
+                        })
+                        .collect()
                 })
                 .collect())
         })?;
-        Ok(Variant { label: model.map_or_else(|| BASELINE_LABEL.to_string(), Model::label), model: model.cloned(), pipelines })
+        Ok(Variant {
+            label: model.map_or_else(|| BASELINE_LABEL.to_string(), Model::label),
+            model: model.cloned(),
+            pipelines,
+        })
     }
 }
 

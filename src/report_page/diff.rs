@@ -3,21 +3,36 @@
 //! lit-sphere and lobe picture of B against A (`diff::picture`).
 
 use super::sections::num_cell;
-use super::{file_label, Input, Loaded};
+use super::{Input, Loaded, file_label};
 use crate::diff::{DiffReport, DiffSet, WorstRow};
+use crate::export::html::{Cell, HtmlTable, esc, img, png_data_uri};
+use crate::export::markdown::sig;
 use crate::gpu::Gpu;
 use crate::io::finite;
-use crate::export::html::{esc, img, png_data_uri, Cell, HtmlTable};
 use crate::model::Model;
-use crate::export::markdown::sig;
 use anyhow::Result;
 use std::fmt::Write;
 
-const CHANNEL_COLUMNS: [(&str, &str); 6] =
-    [("channel", "channel"), ("max_rel", "max rel"), ("rms_rel", "RMS rel"), ("max_abs", "max |B - A|"), ("rms_abs", "RMS |B - A|"), ("mismatched", "finite on one side")];
+const CHANNEL_COLUMNS: [(&str, &str); 6] = [
+    ("channel", "channel"),
+    ("max_rel", "max rel"),
+    ("rms_rel", "RMS rel"),
+    ("max_abs", "max |B - A|"),
+    ("rms_abs", "RMS |B - A|"),
+    ("mismatched", "finite on one side"),
+];
 
-const WORST_COLUMNS: [(&str, &str); 9] =
-    [("index", "row"), ("line", "CSV line"), ("nov", "NoV"), ("nol", "NoL"), ("roughness", "roughness"), ("f0", "F0"), ("channel", "channel"), ("a_b", "A / B"), ("rel", "rel")];
+const WORST_COLUMNS: [(&str, &str); 9] = [
+    ("index", "row"),
+    ("line", "CSV line"),
+    ("nov", "NoV"),
+    ("nol", "NoL"),
+    ("roughness", "roughness"),
+    ("f0", "F0"),
+    ("channel", "channel"),
+    ("a_b", "A / B"),
+    ("rel", "rel"),
+];
 
 fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
@@ -53,18 +68,27 @@ fn histogram(i: usize, d: &DiffReport) -> String {
     let h = &d.histogram;
     for (k, (&edge, &count)) in h.edges.iter().zip(&h.counts).enumerate() {
         let to = h.edges.get(k + 1).map_or(Cell::text("inf"), |&e| Cell::num(e, sig(e, 3)));
-        t.row(format!("diff{i}/bin{k}"), vec![Cell::num(edge, sig(edge, 3)), to, Cell::num(count as f64, count.to_string())]);
+        t.row(
+            format!("diff{i}/bin{k}"),
+            vec![Cell::num(edge, sig(edge, 3)), to, Cell::num(count as f64, count.to_string())],
+        );
     }
     format!("<p>{} rows identical in value; {} finite on one side only.</p>{}", h.identical, h.nonfinite, t.html())
 }
 
 /// The picture of B against A drawn on `gpu` (a PNG data: URI), or why not.
 fn picture(d: &DiffReport, gpu: Option<&Gpu>) -> Result<String> {
-    let Some(gpu) = gpu else { return Ok("<p class=\"note\">Picture not drawn: the report was built without a device (--no-gpu).</p>".into()) };
+    let Some(gpu) = gpu else {
+        return Ok("<p class=\"note\">Picture not drawn: the report was built without a device (--no-gpu).</p>".into());
+    };
     let (a, b) = (Model::parse(&d.a.canonical)?, Model::parse(&d.b.canonical)?);
     let (w, h, px) = crate::diff::picture::pixels(gpu, &a, &b)?;
     let alt = format!("B = {} against A = {}: lit spheres, relative difference and lobes", d.b.name, d.a.name);
-    Ok(format!("<figure>{}<figcaption>{}</figcaption></figure>", img(&png_data_uri(w, h, &px)?, w, h, 1, &alt), esc(&alt)))
+    Ok(format!(
+        "<figure>{}<figcaption>{}</figcaption></figure>",
+        img(&png_data_uri(w, h, &px)?, w, h, 1, &alt),
+        esc(&alt)
+    ))
 }
 
 fn diff_html(i: usize, d: &DiffReport, path: &str, gpu: Option<&Gpu>) -> Result<String> {
@@ -77,36 +101,78 @@ fn diff_html(i: usize, d: &DiffReport, path: &str, gpu: Option<&Gpu>) -> Result<
     let _ = write!(
         s,
         "<h3>B = <code>{}</code> against A = <code>{}</code> ({path})</h3><p>{} rows: {}; on {}; {}; {verdict}. A: <code>{}</code>; B: <code>{}</code>.</p>",
-        esc(&d.b.name), esc(&d.a.name), d.rows, esc(&d.input), esc(&d.device), esc(&d.relative_to), esc(&d.a.canonical), esc(&d.b.canonical)
+        esc(&d.b.name),
+        esc(&d.a.name),
+        d.rows,
+        esc(&d.input),
+        esc(&d.device),
+        esc(&d.relative_to),
+        esc(&d.a.canonical),
+        esc(&d.b.canonical)
     );
     let mut t = HtmlTable::new(&CHANNEL_COLUMNS);
     for c in &d.difference.channels {
-        t.row(format!("diff{i}/{}", c.channel), vec![Cell::text(c.channel.clone()), num_cell(finite(c.max_rel)), num_cell(finite(c.rms_rel)), num_cell(finite(c.max_abs)), num_cell(finite(c.rms_abs)), Cell::num(c.mismatched_nonfinite as f64, c.mismatched_nonfinite.to_string())]);
+        t.row(
+            format!("diff{i}/{}", c.channel),
+            vec![
+                Cell::text(c.channel.clone()),
+                num_cell(finite(c.max_rel)),
+                num_cell(finite(c.rms_rel)),
+                num_cell(finite(c.max_abs)),
+                num_cell(finite(c.rms_abs)),
+                Cell::num(c.mismatched_nonfinite as f64, c.mismatched_nonfinite.to_string()),
+            ],
+        );
     }
     s += &t.html();
     let mut w = HtmlTable::new(&WORST_COLUMNS);
     for (k, row) in d.worst.iter().enumerate() {
         w.row(format!("diff{i}/worst{k}"), worst_row(row));
     }
-    let _ = write!(s, "<h4>Rows where they differ most</h4>{}<h4>Rows by their largest relative difference</h4>{}", w.html(), histogram(i, d));
+    let _ = write!(
+        s,
+        "<h4>Rows where they differ most</h4>{}<h4>Rows by their largest relative difference</h4>{}",
+        w.html(),
+        histogram(i, d)
+    );
     Ok(s + &picture(d, gpu)?)
 }
 
-const SET_COLUMNS: [(&str, &str); 5] = [("model", "model"), ("max_rel", "max rel"), ("rms_rel", "RMS rel (worst channel)"), ("one_side", "finite on one side"), ("verdict", "verdict")];
+const SET_COLUMNS: [(&str, &str); 5] = [
+    ("model", "model"),
+    ("max_rel", "max rel"),
+    ("rms_rel", "RMS rel (worst channel)"),
+    ("one_side", "finite on one side"),
+    ("verdict", "verdict"),
+];
 
 /// `diff --reference`: one table of every model against the reference (rows keyed `diffset<i>/<model>`),
 /// then each model's own section.
 fn diff_set_html(i: usize, d: &DiffSet, path: &str, gpu: Option<&Gpu>) -> Result<String> {
     let mut t = HtmlTable::new(&SET_COLUMNS);
     for x in &d.diffs {
-        let rms = x.difference.channels.iter().filter_map(|c| finite(c.rms_rel)).fold(None, |m: Option<f64>, r| Some(m.map_or(r, |m| m.max(r))));
+        let rms = x
+            .difference
+            .channels
+            .iter()
+            .filter_map(|c| finite(c.rms_rel))
+            .fold(None, |m: Option<f64>, r| Some(m.map_or(r, |m| m.max(r))));
         let one_side: usize = x.difference.channels.iter().map(|c| c.mismatched_nonfinite).sum();
         let verdict = match d.tolerance {
             Some(t) if x.within_tolerance => format!("within {t}"),
             Some(t) => format!("beyond {t}"),
             None => "-".into(),
         };
-        t.row(format!("diffset{i}/{}", x.b.name), vec![Cell::text(x.b.name.clone()), num_cell(finite(x.difference.max_rel)), num_cell(rms), Cell::num(one_side as f64, one_side.to_string()), Cell::text(verdict)]);
+        t.row(
+            format!("diffset{i}/{}", x.b.name),
+            vec![
+                Cell::text(x.b.name.clone()),
+                num_cell(finite(x.difference.max_rel)),
+                num_cell(rms),
+                Cell::num(one_side as f64, one_side.to_string()),
+                Cell::text(verdict),
+            ],
+        );
     }
     let mut s = format!(
         "<h3>{} models against <code>{}</code> ({path})</h3><p>{} rows: {}; on {}.</p>{}",

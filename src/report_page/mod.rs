@@ -12,17 +12,16 @@ pub mod shapes;
 pub mod summary;
 
 use crate::compare::CostTable;
-use crate::gpu::Gpu;
 use crate::export::html::{self, Page};
-use crate::schema::InspectReport;
+use crate::gpu::Gpu;
 use crate::profile::ProfileReport;
+use crate::schema::InspectReport;
 use crate::stability::StabilityReport;
 use crate::sweep::SweepReport;
-use anyhow::{anyhow, bail, Result};
-use serde::de::{DeserializeOwned, IgnoredAny};
+use anyhow::{Result, anyhow, bail};
 use serde::Deserialize;
+use serde::de::{DeserializeOwned, IgnoredAny};
 use std::path::{Path, PathBuf};
-
 
 /// What a results file holds.
 pub enum Loaded {
@@ -76,14 +75,22 @@ pub const MAX_INPUT_BYTES: u64 = crate::io::MAX_REPORT_BYTES;
 
 fn parse<T: DeserializeOwned>(path: &Path, text: &str, kind: &str) -> Result<T> {
     let de = &mut serde_json::Deserializer::from_str(text);
-    serde_path_to_error::deserialize(de).map_err(|e| anyhow!("{}: not a brdfprof {kind} report: at JSON path `{}`: {}", path.display(), e.path(), e.inner()))
+    serde_path_to_error::deserialize(de).map_err(|e| {
+        anyhow!("{}: not a brdfprof {kind} report: at JSON path `{}`: {}", path.display(), e.path(), e.inner())
+    })
 }
 
 /// Reads a profile, sweep, stability, inspect (one device or several) or compare JSON report.
 pub fn load(path: &Path) -> Result<Input> {
     // A regular file within the bound (`report /dev/zero` read without end before).
     let bytes = crate::io::read_bounded(path, MAX_INPUT_BYTES)?;
-    let text = String::from_utf8(bytes).map_err(|e| anyhow!("{}: not UTF-8 text at byte {}: not a brdfprof JSON report", path.display(), e.utf8_error().valid_up_to()))?;
+    let text = String::from_utf8(bytes).map_err(|e| {
+        anyhow!(
+            "{}: not UTF-8 text at byte {}: not a brdfprof JSON report",
+            path.display(),
+            e.utf8_error().valid_up_to()
+        )
+    })?;
     from_json(path, &text)
 }
 
@@ -96,12 +103,19 @@ pub fn from_report(label: &Path, report: &impl serde::Serialize) -> Result<Input
 /// Reads a report's JSON text; `path` names it in errors.
 pub fn from_json(path: &Path, text: &str) -> Result<Input> {
     let text = text.to_string();
-    let probe: Probe = serde_json::from_str(&text).map_err(|e| anyhow!("{}: not a JSON object: line {}, column {}: {e}", path.display(), e.line(), e.column()))?;
+    let probe: Probe = serde_json::from_str(&text)
+        .map_err(|e| anyhow!("{}: not a JSON object: line {}, column {}: {e}", path.display(), e.line(), e.column()))?;
     use crate::export::json::Kind;
     // A report that names its kind is read as that kind; older ones, without `kind`, by their keys.
     let named = match probe.kind.as_deref() {
         None | Some("diff") | Some(crate::diff::SET_KIND) => None,
-        Some(k) => Some(Kind::parse(k).ok_or_else(|| anyhow!("{}: at JSON path `kind`: `{k}` is not a kind of brdfprof report ({})", path.display(), Kind::ALL.map(Kind::name).join(", ")))?),
+        Some(k) => Some(Kind::parse(k).ok_or_else(|| {
+            anyhow!(
+                "{}: at JSON path `kind`: `{k}` is not a kind of brdfprof report ({})",
+                path.display(),
+                Kind::ALL.map(Kind::name).join(", ")
+            )
+        })?),
     };
     let loaded = if let Some(kind) = named {
         match kind {
@@ -138,7 +152,10 @@ pub fn from_json(path: &Path, text: &str) -> Result<Input> {
     } else if probe.kind.as_deref() == Some(crate::diff::SET_KIND) {
         Loaded::DiffSet(parse(path, &text, "diff --reference")?)
     } else {
-        bail!("{}: not a brdfprof profile, sweep, stability, inspect, compare or diff JSON report (none of the keys `fastest`, `workload`, `grid_points`, `reports`, `kernels`, `correlations`, nor `\"kind\": \"diff\"` at its top level)", path.display());
+        bail!(
+            "{}: not a brdfprof profile, sweep, stability, inspect, compare or diff JSON report (none of the keys `fastest`, `workload`, `grid_points`, `reports`, `kernels`, `correlations`, nor `\"kind\": \"diff\"` at its top level)",
+            path.display()
+        );
     };
     Ok(Input { path: path.to_path_buf(), loaded })
 }
@@ -181,7 +198,15 @@ pub fn build(inputs: &[Input], gpu: Option<&Gpu>) -> Result<String> {
         page.section("diff", "Models side by side (brdfprof diff)", diffs);
     }
     // Where each figure comes from, folded: it filled the first screen when it came first.
-    page.section("provenance", "Provenance", format!("<details><summary>Device, driver, CPU, tools and command of each report ({})</summary>{}</details>", inputs.len(), sections::provenance(inputs)));
+    page.section(
+        "provenance",
+        "Provenance",
+        format!(
+            "<details><summary>Device, driver, CPU, tools and command of each report ({})</summary>{}</details>",
+            inputs.len(),
+            sections::provenance(inputs)
+        ),
+    );
     Ok(page.render())
 }
 

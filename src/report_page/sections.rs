@@ -3,16 +3,16 @@
 //! Every figure shown in a table carries its value (`data-v`) and the row and column it belongs to, so that
 //! the browser test reads it back and checks it against the JSON.
 
-use super::{file_label, utc, Input, Loaded};
+use super::{Input, Loaded, file_label, utc};
+use crate::accuracy::ErrorStats;
 use crate::compare::CostTable;
-use crate::export::html::{self, esc, Axis, Cell, HtmlTable, Point};
-use crate::profile::{ProfileReport, Row};
-use crate::export::markdown::sig;
+use crate::export::html::{self, Axis, Cell, HtmlTable, Point, esc};
 use crate::export::json::Provenance;
+use crate::export::markdown::sig;
+use crate::io::finite;
+use crate::profile::{ProfileReport, Row};
 use crate::stability::{SpecStability, StabilityReport};
 use crate::stats::Estimate;
-use crate::accuracy::ErrorStats;
-use crate::io::finite;
 use crate::sweep::SweepReport;
 use anyhow::Result;
 use std::fmt::Write;
@@ -23,7 +23,9 @@ pub const DIGITS: usize = 3;
 /// "median [lo, hi]" as a cell whose value is the median.
 pub fn estimate_cell(e: Option<&Estimate>) -> Cell {
     match e {
-        Some(e) => Cell::num(e.median, format!("{} [{}, {}]", sig(e.median, DIGITS), sig(e.lo, DIGITS), sig(e.hi, DIGITS))),
+        Some(e) => {
+            Cell::num(e.median, format!("{} [{}, {}]", sig(e.median, DIGITS), sig(e.lo, DIGITS), sig(e.hi, DIGITS)))
+        }
         None => Cell::text("-"),
     }
 }
@@ -50,18 +52,38 @@ fn kv(items: &[(&str, String)]) -> String {
 
 fn provenance_items(p: &Provenance) -> Vec<(&'static str, String)> {
     let d = &p.device;
-    let cpu = p.cpu.as_ref().map_or_else(|| p.host_cpu.clone().unwrap_or_default(), |c| format!("{} (family {}, model {}, stepping {}; {})", c.model_name, c.family, c.model, c.stepping, c.features.join(" ")));
+    let cpu = p.cpu.as_ref().map_or_else(
+        || p.host_cpu.clone().unwrap_or_default(),
+        |c| {
+            format!(
+                "{} (family {}, model {}, stepping {}; {})",
+                c.model_name,
+                c.family,
+                c.model,
+                c.stepping,
+                c.features.join(" ")
+            )
+        },
+    );
     vec![
         ("device", format!("{} ({})", d.name, d.device_type)),
         ("driver", format!("{} {} ({})", d.driver_name, d.driver_version, d.driver_info)),
         ("Vulkan", d.api_version.clone()),
-        ("Mesa / LLVM", format!("{} / {}", p.mesa_version.as_deref().unwrap_or("-"), p.llvm_version.as_deref().unwrap_or("-"))),
+        (
+            "Mesa / LLVM",
+            format!("{} / {}", p.mesa_version.as_deref().unwrap_or("-"), p.llvm_version.as_deref().unwrap_or("-")),
+        ),
         ("CPU", cpu),
         ("host threads", if p.host_threads > 0 { p.host_threads.to_string() } else { String::new() }),
         ("driver environment", p.env.iter().map(|(k, v)| format!("{k}={v}")).collect::<Vec<_>>().join(" ")),
         ("tool", p.tool.clone()),
         ("written", if p.unix_time > 0 { utc(p.unix_time) } else { String::new() }),
-        ("command", p.command.as_ref().map_or_else(|| "(not recorded by the brdfprof that wrote it)".to_string(), |c| c.join(" "))),
+        (
+            "command",
+            p.command
+                .as_ref()
+                .map_or_else(|| "(not recorded by the brdfprof that wrote it)".to_string(), |c| c.join(" ")),
+        ),
         ("front ends", p.front_ends.iter().map(|(m, f)| format!("{m}: {f}")).collect::<Vec<_>>().join("; ")),
     ]
 }
@@ -70,7 +92,8 @@ fn provenance_items(p: &Provenance) -> Vec<(&'static str, String)> {
 pub fn provenance(inputs: &[Input]) -> String {
     let mut s = String::new();
     for (i, input) in inputs.iter().enumerate() {
-        let _ = write!(s, "<h3 data-input=\"{i}\">{} <code>{}</code></h3>", input.loaded.kind(), file_label(&input.path));
+        let _ =
+            write!(s, "<h3 data-input=\"{i}\">{} <code>{}</code></h3>", input.loaded.kind(), file_label(&input.path));
         match &input.loaded {
             Loaded::Profile(p) => s += &kv(&provenance_items(&p.provenance)),
             Loaded::Sweep(w) => s += &kv(&provenance_items(&w.profile.provenance)),
@@ -79,20 +102,42 @@ pub fn provenance(inputs: &[Input]) -> String {
                 for r in reports {
                     let p: Provenance = serde_json::from_value(r.provenance.clone()).unwrap_or_default();
                     let mut items = provenance_items(&p);
-                    items.push(("compilers", r.tools.iter().map(|(k, v)| format!("{k}: {v}")).collect::<Vec<_>>().join("; ")));
+                    items.push((
+                        "compilers",
+                        r.tools.iter().map(|(k, v)| format!("{k}: {v}")).collect::<Vec<_>>().join("; "),
+                    ));
                     items.push(("kernels", r.kernels.clone()));
                     s += &kv(&items);
                 }
             }
             Loaded::Diff(d) => {
-                let fronts = [&d.a, &d.b].iter().filter_map(|x| x.front_end.as_ref().map(|f| format!("{}: {f}", x.name))).collect::<Vec<_>>().join("; ");
-                s += &kv(&[("device", d.device.clone()), ("models", format!("A = {}, B = {}", d.a.canonical, d.b.canonical)), ("input", d.input.clone()), ("front ends", fronts)]);
+                let fronts = [&d.a, &d.b]
+                    .iter()
+                    .filter_map(|x| x.front_end.as_ref().map(|f| format!("{}: {f}", x.name)))
+                    .collect::<Vec<_>>()
+                    .join("; ");
+                s += &kv(&[
+                    ("device", d.device.clone()),
+                    ("models", format!("A = {}, B = {}", d.a.canonical, d.b.canonical)),
+                    ("input", d.input.clone()),
+                    ("front ends", fronts),
+                ]);
             }
             Loaded::DiffSet(d) => {
                 let models = d.diffs.iter().map(|x| x.b.canonical.clone()).collect::<Vec<_>>().join("; ");
-                s += &kv(&[("device", d.device.clone()), ("reference", d.reference.canonical.clone()), ("models", models), ("input", d.input.clone())]);
+                s += &kv(&[
+                    ("device", d.device.clone()),
+                    ("reference", d.reference.canonical.clone()),
+                    ("models", models),
+                    ("input", d.input.clone()),
+                ]);
             }
-            Loaded::Costs(t) => s += &kv(&[("columns", t.columns.iter().map(|c| format!("{} ({})", c.name, c.source)).collect::<Vec<_>>().join("; "))]),
+            Loaded::Costs(t) => {
+                s += &kv(&[(
+                    "columns",
+                    t.columns.iter().map(|c| format!("{} ({})", c.name, c.source)).collect::<Vec<_>>().join("; "),
+                )])
+            }
         }
     }
     s
@@ -171,14 +216,43 @@ pub fn cost_table_html(table: &CostTable) -> String {
         }
         t.row(format!("devices/{m}"), cells);
     }
-    let mut corr = HtmlTable::new(&[("a", "device A"), ("b", "device B"), ("models", "models"), ("rho", "Spearman rho (net)"), ("ci", "95% CI"), ("discordant", "discordant pairs")]);
-    let ci = |p: &crate::compare::PairCorrelation| Cell::text(p.spearman_ci.map_or("-".into(), |(lo, hi)| format!("[{lo:.2}, {hi:.2}]")));
+    let mut corr = HtmlTable::new(&[
+        ("a", "device A"),
+        ("b", "device B"),
+        ("models", "models"),
+        ("rho", "Spearman rho (net)"),
+        ("ci", "95% CI"),
+        ("discordant", "discordant pairs"),
+    ]);
+    let ci = |p: &crate::compare::PairCorrelation| {
+        Cell::text(p.spearman_ci.map_or("-".into(), |(lo, hi)| format!("[{lo:.2}, {hi:.2}]")))
+    };
     for (k, p) in table.correlations.iter().chain(&table.spirv_baseline).enumerate() {
         // A rho without its CI (too few models) is not shown.
-        corr.row(format!("rho/{k}"), vec![Cell::text(p.a.clone()), Cell::text(p.b.clone()), count_cell(p.models), num_cell(p.spearman_net.filter(|_| p.spearman_ci.is_some())), ci(p), Cell::text(p.discordant_cell())]);
+        corr.row(
+            format!("rho/{k}"),
+            vec![
+                Cell::text(p.a.clone()),
+                Cell::text(p.b.clone()),
+                count_cell(p.models),
+                num_cell(p.spearman_net.filter(|_| p.spearman_ci.is_some())),
+                ci(p),
+                Cell::text(p.discordant_cell()),
+            ],
+        );
     }
-    let units: Vec<String> = table.columns.iter().map(|c| format!("<b>{}</b>: {} ({})", esc(&c.name), esc(&c.unit), esc(&c.source))).collect();
-    format!("{}<p class=\"note\">{}</p><h3>Rank correlations</h3>{}<p class=\"note\">{}</p>", t.html(), units.join("<br>"), corr.html(), crate::compare::RHO_NOTE)
+    let units: Vec<String> = table
+        .columns
+        .iter()
+        .map(|c| format!("<b>{}</b>: {} ({})", esc(&c.name), esc(&c.unit), esc(&c.source)))
+        .collect();
+    format!(
+        "{}<p class=\"note\">{}</p><h3>Rank correlations</h3>{}<p class=\"note\">{}</p>",
+        t.html(),
+        units.join("<br>"),
+        corr.html(),
+        crate::compare::RHO_NOTE
+    )
 }
 
 /// Cost per source line (`inspect --lines`): per device and model, the costliest lines with their share of
@@ -192,11 +266,28 @@ pub fn source_lines(inputs: &[Input]) -> String {
             let unit = r.cost.as_ref().map_or("cycles", |c| c.unit.as_str());
             for k in &r.lines {
                 let total: f64 = k.lines.iter().map(|l| l.binding).sum();
-                let mut t = HtmlTable::new(&[("line", "file:line"), ("instructions", "instructions"), ("binding", "binding pipe cycles/wave"), ("share", "share"), ("schedule", "schedule cycles/wave"), ("source", "source")]);
+                let mut t = HtmlTable::new(&[
+                    ("line", "file:line"),
+                    ("instructions", "instructions"),
+                    ("binding", "binding pipe cycles/wave"),
+                    ("share", "share"),
+                    ("schedule", "schedule cycles/wave"),
+                    ("source", "source"),
+                ]);
                 for l in k.lines.iter().take(LINES_SHOWN) {
                     let share = (total > 0.0).then(|| 100.0 * l.binding / total);
                     let at = format!("{}:{}", l.file, l.line);
-                    t.row(format!("lines/{device}/{}/{at}", k.model), vec![Cell::text(at), count_cell(l.instructions as usize), num_cell(Some(l.binding)), num_cell(share), num_cell(Some(l.schedule)), Cell::text(l.text.clone())]);
+                    t.row(
+                        format!("lines/{device}/{}/{at}", k.model),
+                        vec![
+                            Cell::text(at),
+                            count_cell(l.instructions as usize),
+                            num_cell(Some(l.binding)),
+                            num_cell(share),
+                            num_cell(Some(l.schedule)),
+                            Cell::text(l.text.clone()),
+                        ],
+                    );
                 }
                 out += &format!(
                     "<h3>{}: {}</h3>{}<p class=\"note\">{unit}; ranked by the cycles on the pipe that binds the kernel ({}), share in %; {} of {} instructions are the translation's own or the compiler's. {}</p>",
@@ -220,8 +311,13 @@ const LINES_SHOWN: usize = 10;
 /// The cost table across devices: `compare` over the profile and inspect inputs (refusing kernels that
 /// differ, as `brdfprof compare` does), else the inspect's own table or a compare input.
 pub fn across_devices(inputs: &[Input]) -> Option<String> {
-    let joinable: Vec<std::path::PathBuf> = inputs.iter().filter(|i| matches!(i.loaded, Loaded::Profile(_) | Loaded::Inspect(..))).map(|i| i.path.clone()).collect();
-    let has_devices = inputs.iter().any(|i| matches!(i.loaded, Loaded::Inspect(..) | Loaded::Costs(_))) || joinable.len() > 1;
+    let joinable: Vec<std::path::PathBuf> = inputs
+        .iter()
+        .filter(|i| matches!(i.loaded, Loaded::Profile(_) | Loaded::Inspect(..)))
+        .map(|i| i.path.clone())
+        .collect();
+    let has_devices =
+        inputs.iter().any(|i| matches!(i.loaded, Loaded::Inspect(..) | Loaded::Costs(_))) || joinable.len() > 1;
     if !has_devices {
         return None;
     }
@@ -232,7 +328,10 @@ pub fn across_devices(inputs: &[Input]) -> Option<String> {
     match crate::compare::from_files(&joinable) {
         Ok(t) => Some(cost_table_html(&t)),
         Err(e) => {
-            let why = format!("<p class=\"err\">The profile and inspect reports given were not joined: {}</p>", esc(&format!("{e:#}")));
+            let why = format!(
+                "<p class=\"err\">The profile and inspect reports given were not joined: {}</p>",
+                esc(&format!("{e:#}"))
+            );
             Some(why + &own.map_or_else(String::new, |t| cost_table_html(&t)))
         }
     }
@@ -254,17 +353,44 @@ pub fn sweep_chart(w: &SweepReport) -> String {
         .map(|r| {
             let cost = r.net_ns_per_eval.as_ref().unwrap_or(&r.ns_per_eval);
             let err = finite(r.accuracy.vs_exact.rms).unwrap_or(f64::INFINITY);
-            let tip = format!("{}\nspec: {}\ncost: {} [{}, {}] ns/eval{}\nerror vs exact: {}", r.label, r.canonical, sig(cost.median, DIGITS), sig(cost.lo, DIGITS), sig(cost.hi, DIGITS), if r.net_ns_per_eval.is_some() { " net" } else { "" }, err_text(&r.accuracy.vs_exact));
+            let tip = format!(
+                "{}\nspec: {}\ncost: {} [{}, {}] ns/eval{}\nerror vs exact: {}",
+                r.label,
+                r.canonical,
+                sig(cost.median, DIGITS),
+                sig(cost.lo, DIGITS),
+                sig(cost.hi, DIGITS),
+                if r.net_ns_per_eval.is_some() { " net" } else { "" },
+                err_text(&r.accuracy.vs_exact)
+            );
             Point { x: cost.median, y: err, label: r.label.clone(), tip, emphasis: r.pareto }
         })
         .collect();
     let drawable = |p: &&Point| p.x.is_finite() && p.x > 0.0 && p.y.is_finite() && p.y > 0.0;
     let left_out = points.len() - points.iter().filter(drawable).count();
-    let (Some(x), Some(y)) = (Axis::fit(points.iter().filter(drawable).map(|p| p.x), true), Axis::fit(points.iter().filter(drawable).map(|p| p.y), true)) else {
+    let (Some(x), Some(y)) = (
+        Axis::fit(points.iter().filter(drawable).map(|p| p.x), true),
+        Axis::fit(points.iter().filter(drawable).map(|p| p.y), true),
+    ) else {
         return "<p class=\"note\">No spec has a finite, positive cost and error to draw.</p>".into();
     };
-    let mut s = html::scatter_svg(&points, x, y, "net ns per evaluation (log)", "RMS relative error vs exact (log)", html::WIDE);
-    let _ = write!(s, "<p class=\"note\">Red: the Pareto frontier (no spec both cheaper and more accurate). Hover a point for its spec, cost and error.{}</p>", if left_out > 0 { format!(" {left_out} spec(s) with an infinite, zero or NaN figure are not drawn.") } else { String::new() });
+    let mut s = html::scatter_svg(
+        &points,
+        x,
+        y,
+        "net ns per evaluation (log)",
+        "RMS relative error vs exact (log)",
+        html::WIDE,
+    );
+    let _ = write!(
+        s,
+        "<p class=\"note\">Red: the Pareto frontier (no spec both cheaper and more accurate). Hover a point for its spec, cost and error.{}</p>",
+        if left_out > 0 {
+            format!(" {left_out} spec(s) with an infinite, zero or NaN figure are not drawn.")
+        } else {
+            String::new()
+        }
+    );
     s
 }
 
@@ -303,7 +429,14 @@ pub fn sweep_html(i: usize, w: &SweepReport, path: &str) -> String {
         );
     }
     let against = if w.against.is_empty() { String::new() } else { format!(" Errors against {}.", esc(&w.against)) };
-    format!("<h3>{path}</h3><p class=\"note\">{} specs on {}; fastest {}.{against}</p>{}{}", w.rows.len(), esc(&w.sample_set), esc(&w.fastest), sweep_chart(w), t.html())
+    format!(
+        "<h3>{path}</h3><p class=\"note\">{} specs on {}; fastest {}.{against}</p>{}{}",
+        w.rows.len(),
+        esc(&w.sample_set),
+        esc(&w.fastest),
+        sweep_chart(w),
+        t.html()
+    )
 }
 
 pub fn sweeps(inputs: &[Input]) -> String {
@@ -337,14 +470,27 @@ fn stability_row(s: &SpecStability) -> Vec<Cell> {
         count_cell(s.nan),
         count_cell(s.inf),
         count_cell(s.negative),
-        Cell::num(s.cases_out_of_tolerance.len() as f64, crate::stability::cases_cell(s.cases_out_of_tolerance.len(), s.cases_run, s.checked())),
+        Cell::num(
+            s.cases_out_of_tolerance.len() as f64,
+            crate::stability::cases_cell(s.cases_out_of_tolerance.len(), s.cases_run, s.checked()),
+        ),
         if s.checked() { count_cell(s.grid_out_of_tolerance) } else { Cell::text("-".to_string()) },
         if s.checked() { num_cell(finite(s.worst.deviation)) } else { Cell::text("-".to_string()) },
-        if s.jumps_checked { count_cell(s.discontinuities) } else { Cell::text(crate::stability::jumps_cell(s.discontinuities, false)) },
+        if s.jumps_checked {
+            count_cell(s.discontinuities)
+        } else {
+            Cell::text(crate::stability::jumps_cell(s.discontinuities, false))
+        },
         count_cell(s.model_jumps),
         num_cell(s.reciprocity),
         num_cell(s.energy.as_ref().and_then(|e| e.max_e)),
-        Cell::text(if s.fails() { "FAIL" } else if s.energy.as_ref().is_some_and(|e| e.gains_energy) { "gains energy" } else { "ok" }),
+        Cell::text(if s.fails() {
+            "FAIL"
+        } else if s.energy.as_ref().is_some_and(|e| e.gains_energy) {
+            "gains energy"
+        } else {
+            "ok"
+        }),
     ]
 }
 
@@ -362,7 +508,15 @@ fn heat_map(s: &SpecStability, triples: &[[u32; 3]]) -> Result<String> {
     }
     let total: u32 = triples.iter().map(|t| t[2]).sum();
     let uri = html::png_data_uri(w, h, &rgb)?;
-    let caption = format!("{}: {total} bad values (NaN, Inf, negative) in {} cells; NoV {}..{} right, roughness {}..{} up; most in a cell {max}", s.label(), triples.len(), COSINES[0], COSINES[COSINES.len() - 1], ROUGHNESS[0], ROUGHNESS[ROUGHNESS.len() - 1]);
+    let caption = format!(
+        "{}: {total} bad values (NaN, Inf, negative) in {} cells; NoV {}..{} right, roughness {}..{} up; most in a cell {max}",
+        s.label(),
+        triples.len(),
+        COSINES[0],
+        COSINES[COSINES.len() - 1],
+        ROUGHNESS[0],
+        ROUGHNESS[ROUGHNESS.len() - 1]
+    );
     Ok(format!("<figure>{}<figcaption>{}</figcaption></figure>", html::img(&uri, w, h, 6, &caption), esc(s.label())))
 }
 
@@ -386,13 +540,22 @@ pub fn stability_html(i: usize, st: &StabilityReport, path: &str) -> Result<Stri
         if f.is_empty() {
             continue;
         }
-        let items: String = f.lines().iter().map(|(depth, line)| format!("<li class=\"depth{depth}\">{}</li>", esc(line))).collect();
+        let items: String =
+            f.lines().iter().map(|(depth, line)| format!("<li class=\"depth{depth}\">{}</li>", esc(line))).collect();
         located += &format!("<li><b>{}</b><ul>{items}</ul></li>", esc(s.label()));
     }
     if !located.is_empty() {
-        located = format!("<h3>Where the failing specs fail</h3><p class=\"note\">Each failing hard case with its inputs, the grid's failing points, and the input guards (roughness floor, cosine floor, safe half vector, lit mask, F0 clamp, as a caller could apply them) that remove each.</p><ul class=\"failures\">{located}</ul>");
+        located = format!(
+            "<h3>Where the failing specs fail</h3><p class=\"note\">Each failing hard case with its inputs, the grid's failing points, and the input guards (roughness floor, cosine floor, safe half vector, lit mask, F0 clamp, as a caller could apply them) that remove each.</p><ul class=\"failures\">{located}</ul>"
+        );
     }
-    let maps = if maps.is_empty() { "<p class=\"note\">No spec gives a bad value on the grid.</p>".to_string() } else { format!("<h3>Where the bad values are (grid of NoV x roughness, all azimuths and NoL)</h3><div class=\"heat\">{maps}</div>") };
+    let maps = if maps.is_empty() {
+        "<p class=\"note\">No spec gives a bad value on the grid.</p>".to_string()
+    } else {
+        format!(
+            "<h3>Where the bad values are (grid of NoV x roughness, all azimuths and NoL)</h3><div class=\"heat\">{maps}</div>"
+        )
+    };
     Ok(format!(
         "<h3>{path}</h3><p class=\"note\">{} specs, {failing} failing (NaN, Inf or negative on valid inputs); {} hard cases; {} grid points. Deviation in units of the tolerance.</p>{}{maps}{located}",
         st.specs.len(),

@@ -5,8 +5,8 @@
 
 use super::{Input, Loaded};
 use crate::brdf::Sample;
+use crate::export::html::{self, Axis, Curve, esc};
 use crate::gpu::Gpu;
-use crate::export::html::{self, esc, Axis, Curve};
 use crate::kernels::{self, RunLimits};
 use crate::model::Model;
 use crate::stability::energy;
@@ -47,13 +47,25 @@ pub fn models_of(inputs: &[Input]) -> Vec<(String, String)> {
     };
     for input in inputs {
         match &input.loaded {
-            Loaded::Profile(p) => p.rows.iter().filter_map(|r| r.spec.as_deref().map(|s| (s, &r.model))).for_each(|(s, m)| add(s, m)),
+            Loaded::Profile(p) => {
+                p.rows.iter().filter_map(|r| r.spec.as_deref().map(|s| (s, &r.model))).for_each(|(s, m)| add(s, m))
+            }
             Loaded::Sweep(w) => w.rows.iter().filter(|r| r.pareto).for_each(|r| add(&r.canonical, &r.label)),
-            Loaded::Inspect(reports, _) => reports.iter().flat_map(|r| &r.rows).filter_map(|r| r.spec.as_deref().map(|s| (s, &r.model))).for_each(|(s, m)| add(s, m)),
+            Loaded::Inspect(reports, _) => reports
+                .iter()
+                .flat_map(|r| &r.rows)
+                .filter_map(|r| r.spec.as_deref().map(|s| (s, &r.model)))
+                .for_each(|(s, m)| add(s, m)),
             // `--unguarded`'s variants are the same model without brdfprof's guards: no card of their own.
-            Loaded::Stability(st) => st.specs.iter().filter(|s| s.fails() && !super::summary::is_guard_variant(&s.spec)).for_each(|s| add(&s.spec, s.label())),
+            Loaded::Stability(st) => st
+                .specs
+                .iter()
+                .filter(|s| s.fails() && !super::summary::is_guard_variant(&s.spec))
+                .for_each(|s| add(&s.spec, s.label())),
             Loaded::Diff(d) => [&d.a, &d.b].into_iter().for_each(|m| add(&m.canonical, &m.name)),
-            Loaded::DiffSet(d) => std::iter::once(&d.reference).chain(d.diffs.iter().map(|x| &x.b)).for_each(|m| add(&m.canonical, &m.name)),
+            Loaded::DiffSet(d) => std::iter::once(&d.reference)
+                .chain(d.diffs.iter().map(|x| &x.b))
+                .for_each(|m| add(&m.canonical, &m.name)),
             Loaded::Costs(_) => {}
         }
     }
@@ -73,7 +85,13 @@ fn lobe_samples() -> Vec<Sample> {
         let l = [-(ti.sin()) as f32, 0.0, ti.cos() as f32];
         for a in SLICE {
             let a = (a as f64).to_radians();
-            out.push(Sample { n: [0.0, 0.0, 1.0], v: [a.sin() as f32, 0.0, a.cos() as f32], l, roughness: LOBE_ROUGHNESS, f0: LOBE_F0 });
+            out.push(Sample {
+                n: [0.0, 0.0, 1.0],
+                v: [a.sin() as f32, 0.0, a.cos() as f32],
+                l,
+                roughness: LOBE_ROUGHNESS,
+                f0: LOBE_F0,
+            });
         }
     }
     out
@@ -108,14 +126,35 @@ fn lobes_svg(values: &[[f32; 3]]) -> String {
     let curves: Vec<Curve> = INCIDENCE
         .iter()
         .enumerate()
-        .map(|(i, ti)| Curve { label: format!("light at {ti} deg"), points: SLICE.zip(&values[i * n..(i + 1) * n]).map(|(a, f)| ((a as f64).to_radians(), f64::from(f[0]))).collect() })
+        .map(|(i, ti)| Curve {
+            label: format!("light at {ti} deg"),
+            points: SLICE
+                .zip(&values[i * n..(i + 1) * n])
+                .map(|(a, f)| ((a as f64).to_radians(), f64::from(f[0])))
+                .collect(),
+        })
         .collect();
-    let peak = curves.iter().flat_map(|c| c.points.iter().map(|p| p.1)).filter(|v| v.is_finite()).fold(0.0f64, f64::max);
+    let peak =
+        curves.iter().flat_map(|c| c.points.iter().map(|p| p.1)).filter(|v| v.is_finite()).fold(0.0f64, f64::max);
     let marks: Vec<(f64, String)> = INCIDENCE.iter().map(|t| (-t.to_radians(), format!("L{t}"))).collect();
     let marks: Vec<(f64, &str)> = marks.iter().map(|(a, l)| (*a, l.as_str())).collect();
-    let linear = html::polar_svg(&format!("f_s, linear (peak {})", crate::export::markdown::sig(peak, 3)), &curves, &marks, None);
-    let log = html::polar_svg(&format!("f_s, log ({LOG_DECADES} decades below the peak)"), &curves, &marks, Some(LOG_DECADES));
-    let legend: Vec<String> = INCIDENCE.iter().enumerate().map(|(i, t)| format!("<span style=\"color:{}\">&#9632; light at {t}&deg;</span>", html::colour(i))).collect();
+    let linear = html::polar_svg(
+        &format!("f_s, linear (peak {})", crate::export::markdown::sig(peak, 3)),
+        &curves,
+        &marks,
+        None,
+    );
+    let log = html::polar_svg(
+        &format!("f_s, log ({LOG_DECADES} decades below the peak)"),
+        &curves,
+        &marks,
+        Some(LOG_DECADES),
+    );
+    let legend: Vec<String> = INCIDENCE
+        .iter()
+        .enumerate()
+        .map(|(i, t)| format!("<span style=\"color:{}\">&#9632; light at {t}&deg;</span>", html::colour(i)))
+        .collect();
     format!("<figure><div class=\"row\">{linear}{log}</div><figcaption>{}</figcaption></figure>", legend.join(" "))
 }
 
@@ -126,27 +165,44 @@ fn spheres_html(values: &[[f32; 3]], at: &[(usize, usize, f32)]) -> Result<Strin
     for (f, &(k, p, nol)) in values.iter().zip(at) {
         let radiance = f.map(|c| if c.is_finite() { c * nol.max(0.0) * std::f32::consts::PI } else { f32::NAN });
         // NaN or Inf shows magenta: a sphere must say where the model breaks.
-        let rgb = if radiance.iter().all(|c| c.is_finite()) { crate::export::raster::tone_map(radiance, 1.0) } else { [255, 0, 255] };
+        let rgb = if radiance.iter().all(|c| c.is_finite()) {
+            crate::export::raster::tone_map(radiance, 1.0)
+        } else {
+            [255, 0, 255]
+        };
         images[k][p * 3..p * 3 + 3].copy_from_slice(&rgb);
     }
     let mut s = String::from("<div class=\"row\">");
     for (img, r) in images.iter().zip(SPHERE_ROUGHNESS) {
         let uri = html::png_data_uri(SPHERE_PX, SPHERE_PX, img)?;
-        let _ = write!(s, "<figure>{}<figcaption>r = {r}</figcaption></figure>", html::img(&uri, SPHERE_PX, SPHERE_PX, 2, &format!("lit sphere, roughness {r}")));
+        let _ = write!(
+            s,
+            "<figure>{}<figcaption>r = {r}</figcaption></figure>",
+            html::img(&uri, SPHERE_PX, SPHERE_PX, 2, &format!("lit sphere, roughness {r}"))
+        );
     }
     Ok(s + "</div>")
 }
 
 /// E(NoV) per roughness (F = 1), from the albedo kernel.
 fn albedo_svg(e: &energy::Energy) -> String {
-    let curves: Vec<Curve> = e
-        .e
-        .iter()
-        .zip(energy::ROUGHNESS)
-        .map(|(row, r)| Curve { label: format!("r = {r}"), points: energy::NOV.iter().zip(row).map(|(v, x)| (f64::from(*v), f64::from(*x))).collect() })
-        .collect();
+    let curves: Vec<Curve> =
+        e.e.iter()
+            .zip(energy::ROUGHNESS)
+            .map(|(row, r)| Curve {
+                label: format!("r = {r}"),
+                points: energy::NOV.iter().zip(row).map(|(v, x)| (f64::from(*v), f64::from(*x))).collect(),
+            })
+            .collect();
     let top = e.max_e.unwrap_or(1.0).max(1.0) * 1.05;
-    html::lines_svg(&curves, Axis { lo: 0.0, hi: 1.0, log: false }, Axis { lo: 0.0, hi: top, log: false }, "NoV", "directional albedo E (F = 1)", html::SMALL)
+    html::lines_svg(
+        &curves,
+        Axis { lo: 0.0, hi: 1.0, log: false },
+        Axis { lo: 0.0, hi: top, log: false },
+        "NoV",
+        "directional albedo E (F = 1)",
+        html::SMALL,
+    )
 }
 
 /// One model's card, and its lobe values (for the overlay).
@@ -180,16 +236,34 @@ fn overlay_svg(lobes: &[(String, Vec<[f32; 3]>)]) -> String {
     for i in OVERLAY_INCIDENCE {
         let curves: Vec<Curve> = lobes
             .iter()
-            .map(|(label, v)| Curve { label: label.clone(), points: SLICE.zip(&v[i * n..(i + 1) * n]).map(|(a, f)| ((a as f64).to_radians(), f64::from(f[0]))).collect() })
+            .map(|(label, v)| Curve {
+                label: label.clone(),
+                points: SLICE
+                    .zip(&v[i * n..(i + 1) * n])
+                    .map(|(a, f)| ((a as f64).to_radians(), f64::from(f[0])))
+                    .collect(),
+            })
             .collect();
         let t = INCIDENCE[i];
         let marks = [(-t.to_radians(), format!("L{t}"))];
         let marks: Vec<(f64, &str)> = marks.iter().map(|(a, l)| (*a, l.as_str())).collect();
         plots += &html::polar_svg(&format!("light at {t} deg, linear"), &curves, &marks, None);
-        plots += &html::polar_svg(&format!("light at {t} deg, log ({LOG_DECADES} decades)"), &curves, &marks, Some(LOG_DECADES));
+        plots += &html::polar_svg(
+            &format!("light at {t} deg, log ({LOG_DECADES} decades)"),
+            &curves,
+            &marks,
+            Some(LOG_DECADES),
+        );
     }
-    let legend: Vec<String> = lobes.iter().enumerate().map(|(k, (label, _))| format!("<span style=\"color:{}\">&#9632; {}</span>", html::colour(k), esc(label))).collect();
-    format!("<div class=\"model overlay\" data-model=\"overlay\"><h3>All models overlaid</h3><figure><div class=\"row\">{plots}</div><figcaption>{}</figcaption></figure></div>", legend.join(" "))
+    let legend: Vec<String> = lobes
+        .iter()
+        .enumerate()
+        .map(|(k, (label, _))| format!("<span style=\"color:{}\">&#9632; {}</span>", html::colour(k), esc(label)))
+        .collect();
+    format!(
+        "<div class=\"model overlay\" data-model=\"overlay\"><h3>All models overlaid</h3><figure><div class=\"row\">{plots}</div><figcaption>{}</figcaption></figure></div>",
+        legend.join(" ")
+    )
 }
 
 /// The section: a card per model (a model that cannot be evaluated, e.g. a `.brdf` file no longer there,
@@ -213,7 +287,12 @@ pub fn section(gpu: &Gpu, models: &[(String, String)]) -> Result<String> {
             }
             Err(e) => {
                 crate::messages::warning(format!("report: {label}: not drawn: {e:#}"));
-                let _ = write!(cards, "<div class=\"model\"><h3>{}</h3><p class=\"err\">Not drawn: {}</p></div>", esc(label), esc(&format!("{e:#}")));
+                let _ = write!(
+                    cards,
+                    "<div class=\"model\"><h3>{}</h3><p class=\"err\">Not drawn: {}</p></div>",
+                    esc(label),
+                    esc(&format!("{e:#}"))
+                );
             }
         }
     }
@@ -222,7 +301,11 @@ pub fn section(gpu: &Gpu, models: &[(String, String)]) -> Result<String> {
     }
     s += &cards;
     if models.len() > MAX_MODELS {
-        let _ = write!(s, "<p class=\"note\">{} more model(s) not drawn (at most {MAX_MODELS}).</p>", models.len() - MAX_MODELS);
+        let _ = write!(
+            s,
+            "<p class=\"note\">{} more model(s) not drawn (at most {MAX_MODELS}).</p>",
+            models.len() - MAX_MODELS
+        );
     }
     Ok(s + "</div>")
 }

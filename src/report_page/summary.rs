@@ -5,9 +5,9 @@
 use super::sections::{estimate_cell, num_cell};
 use super::{Input, Loaded};
 use crate::brdf::guards::GuardSet;
-use crate::model::Model;
 use crate::export::html::{Cell, HtmlTable};
 use crate::io::finite;
+use crate::model::Model;
 use crate::stability::SpecStability;
 use std::collections::BTreeMap;
 
@@ -56,7 +56,10 @@ impl Summary {
 
 fn stability_cell(s: &SpecStability) -> Cell {
     if s.fails() {
-        Cell::num((s.nan + s.inf + s.negative) as f64, format!("FAIL ({} NaN, {} Inf, {} neg.)", s.nan, s.inf, s.negative))
+        Cell::num(
+            (s.nan + s.inf + s.negative) as f64,
+            format!("FAIL ({} NaN, {} Inf, {} neg.)", s.nan, s.inf, s.negative),
+        )
     } else {
         Cell::num(0.0, "ok")
     }
@@ -76,34 +79,65 @@ fn gather(inputs: &[Input]) -> Summary {
                     cells.push((key, estimate_cell(r.net_vs_reference.as_ref().or(Some(&r.vs_reference)))));
                 }
                 let net = if p.rows.iter().any(|r| r.net_vs_reference.is_some()) { "net cost" } else { "cost" };
-                s.column(format!("{net} vs {} ({}, {} lights)", p.reference, p.provenance.device.name, lights.unwrap_or(0)), cells);
+                s.column(
+                    format!("{net} vs {} ({}, {} lights)", p.reference, p.provenance.device.name, lights.unwrap_or(0)),
+                    cells,
+                );
             }
             Loaded::Inspect(reports, _) => {
                 for r in reports {
                     let Some(cost) = r.cost.clone().or_else(|| crate::targets::cost_of(r)) else { continue };
-                    let specs: BTreeMap<&str, &str> = r.rows.iter().filter_map(|x| x.spec.as_deref().map(|sp| (x.model.as_str(), sp))).collect();
-                    let reference = cost.rows.iter().find(|c| c.model == crate::brdf::spec::REFERENCE_MODEL).and_then(|c| c.net_cycles_per_eval);
+                    let specs: BTreeMap<&str, &str> =
+                        r.rows.iter().filter_map(|x| x.spec.as_deref().map(|sp| (x.model.as_str(), sp))).collect();
+                    let reference = cost
+                        .rows
+                        .iter()
+                        .find(|c| c.model == crate::brdf::spec::REFERENCE_MODEL)
+                        .and_then(|c| c.net_cycles_per_eval);
                     let mut cells = Vec::new();
                     for c in &cost.rows {
-                        let (Some(spec), Some(net), Some(base)) = (specs.get(c.model.as_str()), c.net_cycles_per_eval, reference) else { continue };
+                        let (Some(spec), Some(net), Some(base)) =
+                            (specs.get(c.model.as_str()), c.net_cycles_per_eval, reference)
+                        else {
+                            continue;
+                        };
                         let key = s.model(spec, &c.model);
                         cells.push((key, num_cell(Some(net / base))));
                     }
                     let device = r.provenance["device"]["name"].as_str().unwrap_or("?");
-                    s.column(format!("{} vs {} ({device}, modelled)", cost.column_name(), crate::brdf::spec::REFERENCE_MODEL), cells);
+                    s.column(
+                        format!(
+                            "{} vs {} ({device}, modelled)",
+                            cost.column_name(),
+                            crate::brdf::spec::REFERENCE_MODEL
+                        ),
+                        cells,
+                    );
                 }
             }
             Loaded::Sweep(w) => {
-                let cells = w.rows.iter().filter(|r| r.pareto).map(|r| (s.model(&r.canonical, &r.label), num_cell(finite(r.accuracy.vs_exact.rms)))).collect();
+                let cells = w
+                    .rows
+                    .iter()
+                    .filter(|r| r.pareto)
+                    .map(|r| (s.model(&r.canonical, &r.label), num_cell(finite(r.accuracy.vs_exact.rms))))
+                    .collect();
                 s.column("RMS rel. error vs exact (sweep)".into(), cells);
             }
             Loaded::Diff(d) => {
                 s.model(&d.a.canonical, &d.a.name);
                 let key = s.model(&d.b.canonical, &d.b.name);
-                s.column(format!("max rel. difference vs {}", d.a.name), vec![(key, num_cell(finite(d.difference.max_rel)))]);
+                s.column(
+                    format!("max rel. difference vs {}", d.a.name),
+                    vec![(key, num_cell(finite(d.difference.max_rel)))],
+                );
             }
             Loaded::DiffSet(d) => {
-                let cells = d.diffs.iter().map(|x| (s.model(&x.b.canonical, &x.b.name), num_cell(finite(x.difference.max_rel)))).collect();
+                let cells = d
+                    .diffs
+                    .iter()
+                    .map(|x| (s.model(&x.b.canonical, &x.b.name), num_cell(finite(x.difference.max_rel))))
+                    .collect();
                 s.column(format!("max rel. difference vs {}", d.reference.name), cells);
             }
             Loaded::Stability(_) | Loaded::Costs(_) => {}
@@ -115,7 +149,13 @@ fn gather(inputs: &[Input]) -> Summary {
                 s.model(&spec.spec, spec.label());
             }
             let known: Vec<String> = s.models.iter().map(|(k, _)| k.clone()).collect();
-            let cells = st.specs.iter().filter(|x| !is_guard_variant(&x.spec)).map(|x| (model_key(&x.spec), stability_cell(x))).filter(|(k, _)| known.contains(k)).collect();
+            let cells = st
+                .specs
+                .iter()
+                .filter(|x| !is_guard_variant(&x.spec))
+                .map(|x| (model_key(&x.spec), stability_cell(x)))
+                .filter(|(k, _)| known.contains(k))
+                .collect();
             let failing = st.specs.iter().filter(|x| x.fails()).count();
             s.column(format!("stability ({} of {} specs fail)", failing, st.specs.len()), cells);
         }
@@ -135,12 +175,16 @@ pub fn summary(inputs: &[Input]) -> Option<String> {
     let mut t = HtmlTable::new(&header);
     for (key, label) in s.models.iter().take(MAX_ROWS) {
         let mut cells = vec![Cell::text(label.clone())];
-        cells.extend(s.columns.iter().take(MAX_COLUMNS).map(|c| c.cells.get(key).cloned().unwrap_or_else(|| Cell::text("-"))));
+        cells.extend(
+            s.columns.iter().take(MAX_COLUMNS).map(|c| c.cells.get(key).cloned().unwrap_or_else(|| Cell::text("-"))),
+        );
         t.row(format!("summary/{label}"), cells);
     }
     let more = match (s.models.len().saturating_sub(MAX_ROWS), s.columns.len().saturating_sub(MAX_COLUMNS)) {
         (0, 0) => String::new(),
-        (m, c) => format!("<p class=\"note\">Not shown here: {m} more model(s), {c} more column(s); the sections below hold every figure.</p>"),
+        (m, c) => format!(
+            "<p class=\"note\">Not shown here: {m} more model(s), {c} more column(s); the sections below hold every figure.</p>"
+        ),
     };
     Some(format!(
         "<p class=\"note\">One row per model across the reports given (each named once, by its label); a cost is a ratio to the reference model with its confidence interval where measured; modelled compile-only costs say so (<a href=\"#devices\">their rules</a>); accuracy is against the reference each report names; stability: NaN, Inf or negative values on valid inputs. Where each figure comes from: <a href=\"#provenance\">provenance</a>, at the end.</p>{}{more}",

@@ -6,16 +6,16 @@
 //! kernel on the measuring device before its cost is reported (only when such a target is asked for).
 
 use super::plan::{Effect, ScenePlan};
-use super::run::{HostInputs, SceneVariant, SceneWork, PUSH_BYTES, RADIANCE, STORAGE_BUFFERS};
+use super::run::{HostInputs, PUSH_BYTES, RADIANCE, STORAGE_BUFFERS, SceneVariant, SceneWork};
 use super::terms::Switches;
+use crate::export::markdown::Table;
 use crate::gpu::Gpu;
 use crate::kernels;
 use crate::model::KernelKind;
 use crate::profile::protocol::Timed;
-use crate::export::markdown::Table;
 use crate::targets::{self, CheckedTranslation, RawKernel, Target};
 use crate::translate::{self, host::HostKernel, verify};
-use anyhow::{anyhow, bail, Result};
+use anyhow::{Result, anyhow, bail};
 use serde::{Deserialize, Serialize};
 
 /// Relative tolerance of the host run against the Vulkan kernel, over each pixel's brightest channel: the float
@@ -54,7 +54,12 @@ pub fn variant_specs(p: &ScenePlan) -> Vec<VariantSpec> {
         let name = kp.model.label();
         out.push(VariantSpec { kernel: k, without: None, switches: kp.switches, label: name.clone() });
         for e in Effect::ALL.into_iter().filter(|e| e.is_on(&kp.switches)) {
-            out.push(VariantSpec { kernel: k, without: Some(e), switches: e.off(kp.switches), label: format!("{name} without {}", e.name()) });
+            out.push(VariantSpec {
+                kernel: k,
+                without: Some(e),
+                switches: e.off(kp.switches),
+                label: format!("{name} without {}", e.name()),
+            });
         }
     }
     out
@@ -104,7 +109,14 @@ pub struct SceneTargetReport {
 
 /// The variants compiled for every target: RADV from the frozen SPIR-V, the others from the translation,
 /// checked on the host against `gpu` first.
-pub fn reports(gpu: &Gpu, work: &SceneWork, p: &ScenePlan, targets: &[Target], validate: bool, isa_dir: Option<&std::path::Path>) -> Result<Vec<SceneTargetReport>> {
+pub fn reports(
+    gpu: &Gpu,
+    work: &SceneWork,
+    p: &ScenePlan,
+    targets: &[Target],
+    validate: bool,
+    isa_dir: Option<&std::path::Path>,
+) -> Result<Vec<SceneTargetReport>> {
     if targets.is_empty() {
         return Ok(Vec::new());
     }
@@ -124,7 +136,16 @@ pub fn reports(gpu: &Gpu, work: &SceneWork, p: &ScenePlan, targets: &[Target], v
     }
     let raw = specs.iter().map(|v| raw_kernel(gpu, work, p, v, translate)).collect::<Result<Vec<_>>>()?;
     let shaders = crate::shaders::Shaders::embedded();
-    let request = targets::Request { models: &[], lights: 1, shaders: &shaders, validate, isa_dir, precise: false, verify_on: Some(gpu), lines: false };
+    let request = targets::Request {
+        models: &[],
+        lights: 1,
+        shaders: &shaders,
+        validate,
+        isa_dir,
+        precise: false,
+        verify_on: Some(gpu),
+        lines: false,
+    };
     let runs = targets::compile_raw_all(targets, &raw, &request)?;
     runs.into_iter().map(|run| target_report(run, &specs, p)).collect()
 }
@@ -138,36 +159,69 @@ fn raw_kernel(gpu: &Gpu, work: &SceneWork, p: &ScenePlan, v: &VariantSpec, trans
     let mk = model.kernel(KernelKind::Scene, kernels::embedded())?;
     let constants = p.constants(mk.constants, v.switches);
     let spirv = crate::spirv::specialise(&mk.spirv.words, &constants)?;
-    let translation = if translate { Some(checked_translation(gpu, work, p, v, &mk.spirv.words, &constants)?) } else { None };
-    Ok(RawKernel { label: v.label.clone(), model, spirv, storage_buffers: STORAGE_BUFFERS, push_bytes: PUSH_BYTES, translation })
+    let translation =
+        if translate { Some(checked_translation(gpu, work, p, v, &mk.spirv.words, &constants)?) } else { None };
+    Ok(RawKernel {
+        label: v.label.clone(),
+        model,
+        spirv,
+        storage_buffers: STORAGE_BUFFERS,
+        push_bytes: PUSH_BYTES,
+        translation,
+    })
 }
 
 /// The variant's translation, after it agreed with the Vulkan kernel over the kernel's pixels.
-fn checked_translation(gpu: &Gpu, work: &SceneWork, p: &ScenePlan, v: &VariantSpec, words: &[u32], constants: &crate::gpu::SpecConstants) -> Result<CheckedTranslation> {
-    let translation = translate::translate(&translate::prepare::prepared(words, constants)?, &Default::default()).map_err(|e| anyhow!("{}: {e}", v.label))?;
+fn checked_translation(
+    gpu: &Gpu,
+    work: &SceneWork,
+    p: &ScenePlan,
+    v: &VariantSpec,
+    words: &[u32],
+    constants: &crate::gpu::SpecConstants,
+) -> Result<CheckedTranslation> {
+    let translation = translate::translate(&translate::prepare::prepared(words, constants)?, &Default::default())
+        .map_err(|e| anyhow!("{}: {e}", v.label))?;
     let a = agreement_cached(gpu, work, p, v, &translation, words, &format!("{constants:?}"))?;
     let (worst, tolerance) = (a.worst, tolerance(p.kernels[v.kernel].model.precision()));
-    let srem = verify::srem_explains(&translation, worst, tolerance, |defines| Ok(agreement(gpu, work, p, v, &translation, work.host_inputs(v.kernel)?, defines)?.worst))?;
+    let srem = verify::srem_explains(&translation, worst, tolerance, |defines| {
+        Ok(agreement(gpu, work, p, v, &translation, work.host_inputs(v.kernel)?, defines)?.worst)
+    })?;
     if srem {
         verify::warn_srem(&v.label, "scene", &gpu.info.name, worst);
     } else if !(worst <= tolerance) {
         bail!(
             "{}: the C translation of the scene kernel disagrees with the Vulkan kernel on {} (worst relative difference {worst:.3e}, tolerance {tolerance:.0e}): its cost is not reported. This is a translator defect; please report it with the scene",
-            v.label, gpu.info.name
+            v.label,
+            gpu.info.name
         );
     }
-    let agreement = format!("translation checked on the host against {} over the kernel's {} pixels ({} lit): worst relative difference {worst:.1e} (tolerance {tolerance:.0e})", gpu.info.name, a.pixels, a.lit);
+    let agreement = format!(
+        "translation checked on the host against {} over the kernel's {} pixels ({} lit): worst relative difference {worst:.1e} (tolerance {tolerance:.0e})",
+        gpu.info.name, a.pixels, a.lit
+    );
     Ok(CheckedTranslation { translation, agreement })
 }
 
 /// `agreement`, or its result from the cache: the key covers the host translation, the Vulkan kernel's SPIR-V
 /// and constants, the device and its driver, and the kernel's inputs.
-fn agreement_cached(gpu: &Gpu, work: &SceneWork, p: &ScenePlan, v: &VariantSpec, t: &translate::Translation, words: &[u32], constants: &str) -> Result<Agreement> {
+fn agreement_cached(
+    gpu: &Gpu,
+    work: &SceneWork,
+    p: &ScenePlan,
+    v: &VariantSpec,
+    t: &translate::Translation,
+    words: &[u32],
+    constants: &str,
+) -> Result<Agreement> {
     let inputs = work.host_inputs(v.kernel)?;
     let (buffers, push, invocations) = &inputs;
     let mut key = crate::cache::KeyBuilder::new("scene_agreement")
         .part("brdfprof", env!("CARGO_PKG_VERSION"))
-        .part("device", format!("{} {} {} {}", gpu.info.name, gpu.info.driver_name, gpu.info.driver_info, gpu.info.driver_version))
+        .part(
+            "device",
+            format!("{} {} {} {}", gpu.info.name, gpu.info.driver_name, gpu.info.driver_info, gpu.info.driver_version),
+        )
         .part("host", format!("{} {}", t.source(translate::Dialect::Host), translate::host::build_identity()))
         .part("spirv", bytemuck::cast_slice::<u32, u8>(words))
         .part("constants", constants)
@@ -178,14 +232,29 @@ fn agreement_cached(gpu: &Gpu, work: &SceneWork, p: &ScenePlan, v: &VariantSpec,
     }
     let what = format!("the check of {}'s translation", v.label);
     let valid = |bytes: &[u8]| serde_json::from_slice::<Agreement>(bytes).map(|_| ()).map_err(anyhow::Error::from);
-    let bytes = crate::cache::get_or_build(crate::cache::Store::open_default().as_ref(), "scene_agreement", &key.finish(), &what, valid, || Ok(serde_json::to_vec(&agreement(gpu, work, p, v, t, inputs.clone(), &[])?)?))?;
+    let bytes = crate::cache::get_or_build(
+        crate::cache::Store::open_default().as_ref(),
+        "scene_agreement",
+        &key.finish(),
+        &what,
+        valid,
+        || Ok(serde_json::to_vec(&agreement(gpu, work, p, v, t, inputs.clone(), &[])?)?),
+    )?;
     Ok(serde_json::from_slice(&bytes)?)
 }
 
 /// The worst relative difference between the translation run on the host over `inputs` (the kernel's buffers,
 /// `SceneWork::host_inputs`) and the Vulkan kernel on `gpu`, over every pixel of the kernel and each pixel's
 /// brightest channel.
-fn agreement(gpu: &Gpu, work: &SceneWork, p: &ScenePlan, v: &VariantSpec, t: &translate::Translation, inputs: HostInputs, defines: &[&str]) -> Result<Agreement> {
+fn agreement(
+    gpu: &Gpu,
+    work: &SceneWork,
+    p: &ScenePlan,
+    v: &VariantSpec,
+    t: &translate::Translation,
+    inputs: HostInputs,
+    defines: &[&str],
+) -> Result<Agreement> {
     SceneVariant::new(gpu, work, p, v.kernel, v.switches, v.label.clone(), 1)?.run_once(gpu, 0)?;
     let on_device = work.radiance(v.kernel)?;
     let (mut inputs, mut push, invocations) = inputs;
@@ -193,9 +262,15 @@ fn agreement(gpu: &Gpu, work: &SceneWork, p: &ScenePlan, v: &VariantSpec, t: &tr
     // The translation's bindings in its order (those the specialised kernel still uses), push constants last.
     let mut owned: Vec<Vec<u8>> = Vec::new();
     for b in t.bindings.iter().filter(|b| b.slot.0 != u32::MAX) {
-        owned.push(inputs.remove(&b.slot).ok_or_else(|| anyhow!("{}: the translation binds {:?}, which the scene kernel has not", v.label, b.slot))?);
+        owned.push(inputs.remove(&b.slot).ok_or_else(|| {
+            anyhow!("{}: the translation binds {:?}, which the scene kernel has not", v.label, b.slot)
+        })?);
     }
-    let radiance_at = t.bindings.iter().position(|b| b.slot == RADIANCE).ok_or_else(|| anyhow!("{}: the translation writes no radiance", v.label))?;
+    let radiance_at = t
+        .bindings
+        .iter()
+        .position(|b| b.slot == RADIANCE)
+        .ok_or_else(|| anyhow!("{}: the translation writes no radiance", v.label))?;
     let groups = (invocations as u32).div_ceil(host.local_size()[0].max(1));
     let mut buffers: Vec<&mut [u8]> = owned.iter_mut().map(Vec::as_mut_slice).collect();
     buffers.push(push.as_mut_slice());
@@ -212,23 +287,45 @@ fn agreement(gpu: &Gpu, work: &SceneWork, p: &ScenePlan, v: &VariantSpec, t: &tr
 /// reason is in the notes).
 fn target_report(run: targets::Run, specs: &[VariantSpec], p: &ScenePlan) -> Result<SceneTargetReport> {
     let name = run.target.name();
-    let cost = run.report.cost.clone().ok_or_else(|| anyhow!("{name}: the compiler reported no statistics the cost model reads"))?;
+    let cost = run
+        .report
+        .cost
+        .clone()
+        .ok_or_else(|| anyhow!("{name}: the compiler reported no statistics the cost model reads"))?;
     let cycles = |label: &str| cost.row(label).map(|r| r.cycles_per_eval);
     let mut kernels = Vec::new();
     let mut effects = Vec::new();
     for v in specs {
         let kernel = p.kernels[v.kernel].model.label();
         match (v.without, cycles(&v.label), cycles(&kernel)) {
-            (None, Some(c), _) => kernels.push(TargetKernelRow { model: v.label.clone(), cycles_per_pixel: c, stats: cost.row(&v.label).map(|r| r.stats.clone()).unwrap_or_default() }),
-            (Some(e), Some(without), Some(with)) => effects.push(TargetEffectRow { model: kernel, effect: e.name().into(), extra_cycles_per_pixel: with - without, extra_fraction: (with - without) / without }),
+            (None, Some(c), _) => kernels.push(TargetKernelRow {
+                model: v.label.clone(),
+                cycles_per_pixel: c,
+                stats: cost.row(&v.label).map(|r| r.stats.clone()).unwrap_or_default(),
+            }),
+            (Some(e), Some(without), Some(with)) => effects.push(TargetEffectRow {
+                model: kernel,
+                effect: e.name().into(),
+                extra_cycles_per_pixel: with - without,
+                extra_fraction: (with - without) / without,
+            }),
             _ => {}
         }
     }
-    let translation = run.report.rows.iter().filter_map(|r| Some((r.model.clone(), r.notes.get("translation")?.clone()))).collect();
+    let translation =
+        run.report.rows.iter().filter_map(|r| Some((r.model.clone(), r.notes.get("translation")?.clone()))).collect();
     let p = &run.report.provenance;
     // RADV's reports carry Mesa's version where the translating targets name their compiler and options.
-    let version = p["compiler"]["name"].as_str().or_else(|| p["mesa_version"].as_str().map(|m| m.trim_start_matches("Mesa ")));
-    let mut notes: Vec<String> = run.report.section_notes.get("driver/").filter(|n| n.starts_with("not compiled")).cloned().into_iter().collect();
+    let version =
+        p["compiler"]["name"].as_str().or_else(|| p["mesa_version"].as_str().map(|m| m.trim_start_matches("Mesa ")));
+    let mut notes: Vec<String> = run
+        .report
+        .section_notes
+        .get("driver/")
+        .filter(|n| n.starts_with("not compiled"))
+        .cloned()
+        .into_iter()
+        .collect();
     notes.extend(run.note);
     Ok(SceneTargetReport {
         target: name,
@@ -248,7 +345,12 @@ fn target_report(run: targets::Run, specs: &[VariantSpec], p: &ScenePlan) -> Res
 /// The kernels' and the effects' tables across targets, beside the measured figures (`measured(kernel)`:
 /// ns/pixel; `measured_effect(kernel, effect)`: extra ns/pixel), as Markdown; "-" where a target left a kernel
 /// out.
-pub fn markdown(reports: &[SceneTargetReport], measured: impl Fn(&str) -> String, measured_effect: impl Fn(&str, &str) -> String, device: &str) -> String {
+pub fn markdown(
+    reports: &[SceneTargetReport],
+    measured: impl Fn(&str) -> String,
+    measured_effect: impl Fn(&str, &str) -> String,
+    device: &str,
+) -> String {
     if reports.is_empty() {
         return String::new();
     }
@@ -256,28 +358,47 @@ pub fn markdown(reports: &[SceneTargetReport], measured: impl Fn(&str) -> String
     let mut effects: Vec<(&str, &str)> = Vec::new();
     for r in reports {
         kernels.extend(r.kernels.iter().map(|k| k.model.as_str()).filter(|m| !kernels.contains(m)).collect::<Vec<_>>());
-        effects.extend(r.effects.iter().map(|e| (e.model.as_str(), e.effect.as_str())).filter(|x| !effects.contains(x)).collect::<Vec<_>>());
+        effects.extend(
+            r.effects
+                .iter()
+                .map(|e| (e.model.as_str(), e.effect.as_str()))
+                .filter(|x| !effects.contains(x))
+                .collect::<Vec<_>>(),
+        );
     }
     let mut head = vec!["kernel".to_string(), format!("{device} ns/pixel")];
     head.extend(reports.iter().map(|r| format!("{} cycles/pixel", r.target)));
     let mut t = Table::new(head);
     for k in &kernels {
         let mut row = vec![k.to_string(), measured(k)];
-        row.extend(reports.iter().map(|r| r.kernels.iter().find(|x| x.model == *k).map_or("-".into(), |x| format!("{:.2}", x.cycles_per_pixel))));
+        row.extend(reports.iter().map(|r| {
+            r.kernels.iter().find(|x| x.model == *k).map_or("-".into(), |x| format!("{:.2}", x.cycles_per_pixel))
+        }));
         t.row(row);
     }
-    let mut out = format!("\nOn compile-only targets (modelled cycles per shaded pixel, every light included; each target's cost rule, compiler and options in the JSON):\n\n{}", t.markdown());
+    let mut out = format!(
+        "\nOn compile-only targets (modelled cycles per shaded pixel, every light included; each target's cost rule, compiler and options in the JSON):\n\n{}",
+        t.markdown()
+    );
     if !effects.is_empty() {
         let mut head = vec!["kernel".to_string(), "effect".to_string(), format!("{device} +ns/pixel")];
         head.extend(reports.iter().map(|r| format!("{} +cycles/pixel (+fraction)", r.target)));
         let mut e = Table::new(head);
         for (model, effect) in &effects {
             let mut row = vec![model.to_string(), effect.to_string(), measured_effect(model, effect)];
-            let cell = |r: &SceneTargetReport| r.effects.iter().find(|x| x.model == *model && x.effect == *effect).map_or("-".into(), |x| format!("{:+.2} ({:+.2})", x.extra_cycles_per_pixel, x.extra_fraction));
+            let cell = |r: &SceneTargetReport| {
+                r.effects
+                    .iter()
+                    .find(|x| x.model == *model && x.effect == *effect)
+                    .map_or("-".into(), |x| format!("{:+.2} ({:+.2})", x.extra_cycles_per_pixel, x.extra_fraction))
+            };
             row.extend(reports.iter().map(cell));
             e.row(row);
         }
-        out += &format!("\nWhat each effect adds on each target (kernel as compiled minus the kernel without it):\n\n{}", e.markdown());
+        out += &format!(
+            "\nWhat each effect adds on each target (kernel as compiled minus the kernel without it):\n\n{}",
+            e.markdown()
+        );
     }
     for r in reports {
         for n in &r.notes {

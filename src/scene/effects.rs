@@ -6,7 +6,7 @@ use super::plan::{self, E_TABLE_MU, E_TABLE_R};
 use super::terms::{ETable, Switches};
 use crate::brdf::F;
 use crate::gpu::{Buffer, Gpu, MemoryKind};
-use crate::kernels::{self, constants, Albedo, AlbedoCell, WithConstant};
+use crate::kernels::{self, Albedo, AlbedoCell, WithConstant, constants};
 use crate::model::{KernelKind, Model};
 use anyhow::Result;
 
@@ -42,7 +42,13 @@ pub struct FurnaceCell {
 
 /// The directional albedo of the scene's shading (scene.glsl `shade`) for `model` with `switches`, per cell,
 /// integrated on the GPU with albedo.comp's estimator; `table` is E for energy compensation (when switched on).
-pub fn scene_albedo(gpu: &Gpu, model: &Model, switches: Switches, table: Option<&ETable>, cells: &[FurnaceCell]) -> Result<Vec<Albedo>> {
+pub fn scene_albedo(
+    gpu: &Gpu,
+    model: &Model,
+    switches: Switches,
+    table: Option<&ETable>,
+    cells: &[FurnaceCell],
+) -> Result<Vec<Albedo>> {
     let kernel = kernels::model_kernel(
         gpu,
         model,
@@ -60,11 +66,28 @@ pub fn scene_albedo(gpu: &Gpu, model: &Model, switches: Switches, table: Option<
         .iter()
         .flat_map(|c| {
             let (f, d) = (c.f0, c.diffuse_colour);
-            [c.nov, c.roughness, c.anisotropy, c.coat, f[0], f[1], f[2], c.coat_roughness, d[0], d[1], d[2], c.diffuse as f32]
+            [
+                c.nov,
+                c.roughness,
+                c.anisotropy,
+                c.coat,
+                f[0],
+                f[1],
+                f[2],
+                c.coat_roughness,
+                d[0],
+                d[1],
+                d[2],
+                c.diffuse as f32,
+            ]
         })
         .collect();
     let inputs = Buffer::with_data(gpu, bytemuck::cast_slice(&floats), MemoryKind::Device)?;
-    let table_buf = Buffer::with_data(gpu, bytemuck::cast_slice(table.map_or(&[1.0f32; 4][..], |t| &t.values)), MemoryKind::Device)?;
+    let table_buf = Buffer::with_data(
+        gpu,
+        bytemuck::cast_slice(table.map_or(&[1.0f32; 4][..], |t| &t.values)),
+        MemoryKind::Device,
+    )?;
     kernels::reduce_albedo(gpu, &kernel, cells.len(), |first, count, rows| {
         kernel.bind(&[(&inputs, first * 48, count * 48), (rows, 0, rows.size), (&table_buf, 0, table_buf.size)])
     })
@@ -76,8 +99,15 @@ pub const TERM_OUT: usize = 24;
 
 /// Every scene.glsl term on its own for each sample (layouts in glsl/scene_terms.comp), with `model` selecting
 /// the Fresnel of `specular_anisotropic` and `table` the E table of `e_lookup`; for the tests against the twins.
-pub fn scene_terms(gpu: &Gpu, model: &Model, table: &ETable, samples: &[[f32; TERM_IN]]) -> Result<Vec<[f32; TERM_OUT]>> {
-    let extra = |c: crate::gpu::SpecConstants| c.with(constants::E_TABLE_MU, table.mu_nodes as f64).with(constants::E_TABLE_R, table.r_nodes as f64);
+pub fn scene_terms(
+    gpu: &Gpu,
+    model: &Model,
+    table: &ETable,
+    samples: &[[f32; TERM_IN]],
+) -> Result<Vec<[f32; TERM_OUT]>> {
+    let extra = |c: crate::gpu::SpecConstants| {
+        c.with(constants::E_TABLE_MU, table.mu_nodes as f64).with(constants::E_TABLE_R, table.r_nodes as f64)
+    };
     let kernel = kernels::model_kernel(gpu, model, KernelKind::SceneTerms, extra, 3, 4)?;
     let n = samples.len() as u64;
     let per_dispatch = gpu.info.max_compute_work_group_count[0] as u64 * crate::gpu::WORKGROUP as u64;
@@ -86,7 +116,8 @@ pub fn scene_terms(gpu: &Gpu, model: &Model, table: &ETable, samples: &[[f32; TE
     let inputs = Buffer::with_data(gpu, bytemuck::cast_slice(&flat), MemoryKind::Device)?;
     let outputs = Buffer::new(gpu, n * TERM_OUT as u64 * 4, MemoryKind::Device)?;
     let table_buf = Buffer::with_data(gpu, bytemuck::cast_slice(&table.values), MemoryKind::Device)?;
-    let set = kernel.bind(&[(&inputs, 0, inputs.size), (&outputs, 0, outputs.size), (&table_buf, 0, table_buf.size)])?;
+    let set =
+        kernel.bind(&[(&inputs, 0, inputs.size), (&outputs, 0, outputs.size), (&table_buf, 0, table_buf.size)])?;
     gpu.submit(|cmd| kernel.dispatch(cmd, set, &(n as u32).to_ne_bytes(), n))?;
     let v: Vec<f32> = outputs.read_as(0, samples.len() * TERM_OUT)?;
     Ok(v.chunks_exact(TERM_OUT).map(|c| c.try_into().unwrap()).collect())

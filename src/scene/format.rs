@@ -4,8 +4,8 @@
 //! `brdfprof scene --explain` prints `explain_text()` (docs/scenes.md's format block) with an example.
 
 use crate::model;
-use anyhow::{anyhow, bail, Result};
-use serde::{de, Deserialize, Deserializer, Serialize};
+use anyhow::{Result, anyhow, bail};
+use serde::{Deserialize, Deserializer, Serialize, de};
 use std::path::{Path, PathBuf};
 
 /// A scene as read from its file.
@@ -40,7 +40,13 @@ pub enum GBufferSource {
 pub enum Procedural {
     /// Thesis Fig. 5.2: one row of spheres per material in `rows`, `columns` roughness steps r = (c + 0.5) /
     /// columns along each row (the material's own roughness is not used here), before a backdrop of `floor`.
-    SphereGrid { size: Size, rows: Vec<String>, #[serde(default = "default_columns")] columns: u32, floor: String },
+    SphereGrid {
+        size: Size,
+        rows: Vec<String>,
+        #[serde(default = "default_columns")]
+        columns: u32,
+        floor: String,
+    },
     /// Thesis "metal statues": statues (pedestal, body, head) of the `statues` materials in a row on a floor.
     Statues { size: Size, statues: Vec<String>, floor: String },
     /// Thesis "Old West": a street of rough wooden and plaster buildings with roofs, on dirt ground.
@@ -87,8 +93,13 @@ impl TryFrom<RawProcedural> for Procedural {
             ProceduralKind::OldWest => &["ground", "walls", "roofs"],
         };
         let given = [
-            ("rows", r.rows.is_some()), ("columns", r.columns.is_some()), ("floor", r.floor.is_some()), ("statues", r.statues.is_some()),
-            ("ground", r.ground.is_some()), ("walls", r.walls.is_some()), ("roofs", r.roofs.is_some()),
+            ("rows", r.rows.is_some()),
+            ("columns", r.columns.is_some()),
+            ("floor", r.floor.is_some()),
+            ("statues", r.statues.is_some()),
+            ("ground", r.ground.is_some()),
+            ("walls", r.walls.is_some()),
+            ("roofs", r.roofs.is_some()),
         ];
         if let Some((extra, _)) = given.iter().find(|(k, g)| *g && !allowed.contains(k)) {
             return Err(format!("`{extra}` is not a field of kind {kind} (its fields: size, {})", allowed.join(", ")));
@@ -102,10 +113,17 @@ impl TryFrom<RawProcedural> for Procedural {
                 columns: r.columns.unwrap_or_else(default_columns),
                 floor: need(r.floor, "floor")?,
             },
-            ProceduralKind::Statues => Procedural::Statues { size: r.size, statues: needv(r.statues, "statues")?, floor: need(r.floor, "floor")? },
-            ProceduralKind::OldWest => {
-                Procedural::OldWest { size: r.size, ground: need(r.ground, "ground")?, walls: needv(r.walls, "walls")?, roofs: need(r.roofs, "roofs")? }
-            }
+            ProceduralKind::Statues => Procedural::Statues {
+                size: r.size,
+                statues: needv(r.statues, "statues")?,
+                floor: need(r.floor, "floor")?,
+            },
+            ProceduralKind::OldWest => Procedural::OldWest {
+                size: r.size,
+                ground: need(r.ground, "ground")?,
+                walls: needv(r.walls, "walls")?,
+                roofs: need(r.roofs, "roofs")?,
+            },
         })
     }
 }
@@ -187,9 +205,21 @@ fn default_fov() -> f32 {
 #[serde(tag = "type", rename_all = "kebab-case", try_from = "RawLight")]
 pub enum Light {
     /// Radiance `colour * intensity` arriving along `direction` (the direction the light travels).
-    Directional { direction: [f32; 3], #[serde(default = "white")] colour: [f32; 3], #[serde(default = "one")] intensity: f32 },
+    Directional {
+        direction: [f32; 3],
+        #[serde(default = "white")]
+        colour: [f32; 3],
+        #[serde(default = "one")]
+        intensity: f32,
+    },
     /// Intensity `colour * intensity` at `position`, falling off as 1/d^2.
-    Point { position: [f32; 3], #[serde(default = "white")] colour: [f32; 3], #[serde(default = "one")] intensity: f32 },
+    Point {
+        position: [f32; 3],
+        #[serde(default = "white")]
+        colour: [f32; 3],
+        #[serde(default = "one")]
+        intensity: f32,
+    },
     /// A point light restricted to a cone around `direction`: full inside `inner_angle_deg`, zero outside
     /// `outer_angle_deg` (half-angles), smooth in between.
     Spot {
@@ -206,7 +236,14 @@ pub enum Light {
     },
     /// A sphere area light: specular by Karis' representative point with its normalisation, diffuse as a point
     /// light at the centre, 1/d^2 falloff.
-    Sphere { position: [f32; 3], radius: f32, #[serde(default = "white")] colour: [f32; 3], #[serde(default = "one")] intensity: f32 },
+    Sphere {
+        position: [f32; 3],
+        radius: f32,
+        #[serde(default = "white")]
+        colour: [f32; 3],
+        #[serde(default = "one")]
+        intensity: f32,
+    },
 }
 
 #[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
@@ -243,16 +280,24 @@ impl TryFrom<RawLight> for Light {
             LightType::Sphere => ("sphere", &["position", "radius"]),
         };
         let given = [
-            ("direction", r.direction.is_some()), ("position", r.position.is_some()), ("radius", r.radius.is_some()),
-            ("inner_angle_deg", r.inner_angle_deg.is_some()), ("outer_angle_deg", r.outer_angle_deg.is_some()),
+            ("direction", r.direction.is_some()),
+            ("position", r.position.is_some()),
+            ("radius", r.radius.is_some()),
+            ("inner_angle_deg", r.inner_angle_deg.is_some()),
+            ("outer_angle_deg", r.outer_angle_deg.is_some()),
         ];
         if let Some((extra, _)) = given.iter().find(|(k, g)| *g && !allowed.contains(k)) {
-            return Err(format!("a {kind} light has no `{extra}` (its fields: {}, colour, intensity)", allowed.join(", ")));
+            return Err(format!(
+                "a {kind} light has no `{extra}` (its fields: {}, colour, intensity)",
+                allowed.join(", ")
+            ));
         }
         let need = |v: Option<[f32; 3]>, k: &str| v.ok_or_else(|| format!("a {kind} light needs `{k}`"));
         let (colour, intensity) = (r.colour, r.intensity);
         Ok(match r.r#type {
-            LightType::Directional => Light::Directional { direction: need(r.direction, "direction")?, colour, intensity },
+            LightType::Directional => {
+                Light::Directional { direction: need(r.direction, "direction")?, colour, intensity }
+            }
             LightType::Point => Light::Point { position: need(r.position, "position")?, colour, intensity },
             LightType::Spot => Light::Spot {
                 position: need(r.position, "position")?,
@@ -262,7 +307,12 @@ impl TryFrom<RawLight> for Light {
                 colour,
                 intensity,
             },
-            LightType::Sphere => Light::Sphere { position: need(r.position, "position")?, radius: r.radius.ok_or("a sphere light needs `radius`")?, colour, intensity },
+            LightType::Sphere => Light::Sphere {
+                position: need(r.position, "position")?,
+                radius: r.radius.ok_or("a sphere light needs `radius`")?,
+                colour,
+                intensity,
+            },
         })
     }
 }
@@ -542,7 +592,10 @@ pub struct RenderSettings {
 }
 
 fn thesis_models() -> Vec<Model> {
-    crate::brdf::THESIS_MODELS.iter().map(|m| Model(model::Model::parse(m).expect("thesis models are presets"))).collect()
+    crate::brdf::THESIS_MODELS
+        .iter()
+        .map(|m| Model(model::Model::parse(m).expect("thesis models are presets")))
+        .collect()
 }
 fn lobe_roughness() -> Vec<Unit> {
     [0.2, 0.4, 0.6, 0.8].map(Unit).to_vec()
@@ -550,7 +603,13 @@ fn lobe_roughness() -> Vec<Unit> {
 
 impl Default for RenderSettings {
     fn default() -> Self {
-        RenderSettings { exposure: 1.0, models: thesis_models(), grid: Vec::new(), lobe_roughness: lobe_roughness(), background: [0.0; 3] }
+        RenderSettings {
+            exposure: 1.0,
+            models: thesis_models(),
+            grid: Vec::new(),
+            lobe_roughness: lobe_roughness(),
+            background: [0.0; 3],
+        }
     }
 }
 
@@ -566,7 +625,9 @@ impl Scene {
     /// Reads and checks a scene file; errors name the file and the JSON path.
     pub fn load(path: &Path) -> Result<Scene> {
         let bytes = crate::io::read_input(path).map_err(|e| anyhow!("scene file: {e}"))?;
-        let text = String::from_utf8(bytes).map_err(|e| anyhow!("cannot read scene file {}: not UTF-8 at byte {}", path.display(), e.utf8_error().valid_up_to()))?;
+        let text = String::from_utf8(bytes).map_err(|e| {
+            anyhow!("cannot read scene file {}: not UTF-8 at byte {}", path.display(), e.utf8_error().valid_up_to())
+        })?;
         let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
         Scene::parse(&text, &path.display().to_string(), dir, path.to_path_buf())
     }
@@ -587,7 +648,9 @@ impl Scene {
     /// The scene's name (a plain file name: it names output files): its `name`, else the file stem, else
     /// "scene".
     pub fn name(&self) -> String {
-        let stem = || self.path.file_stem().map(|s| s.to_string_lossy().into_owned()).filter(|s| plain_name_fault(s).is_none());
+        let stem = || {
+            self.path.file_stem().map(|s| s.to_string_lossy().into_owned()).filter(|s| plain_name_fault(s).is_none())
+        };
         self.file.name.clone().or_else(stem).unwrap_or_else(|| "scene".into())
     }
 
@@ -619,7 +682,9 @@ fn plain_name_fault(name: &str) -> Option<&'static str> {
 /// file name: no path that escapes or reaches elsewhere.
 fn check_name(f: &SceneFile) -> Result<()> {
     match f.name.as_deref().map(|n| (n, plain_name_fault(n))) {
-        Some((n, Some(why))) => bail!("name: {n:?} is not a plain file name: {why} (it names the scene's output files)"),
+        Some((n, Some(why))) => {
+            bail!("name: {n:?} is not a plain file name: {why} (it names the scene's output files)")
+        }
         _ => Ok(()),
     }
 }
@@ -649,7 +714,11 @@ pub const MAX_LIGHTS: usize = 128;
 
 /// `path: no material named ...` unless `name` is one of the scene's materials.
 fn need(f: &SceneFile, path: String, name: &str) -> Result<()> {
-    if f.materials.iter().any(|m| m.name == name) { Ok(()) } else { bail!("{path}: no material named `{name}` (materials are {})", names(f)) }
+    if f.materials.iter().any(|m| m.name == name) {
+        Ok(())
+    } else {
+        bail!("{path}: no material named `{name}` (materials are {})", names(f))
+    }
 }
 
 /// Each of `names` (at `path[i]`) must be a material; `what` says what at least one of them is.
@@ -672,7 +741,10 @@ fn check_materials(materials: &[Material]) -> Result<()> {
             bail!("materials[{i}].name: `{}` is used by an earlier material", m.name);
         }
         let field = if !m.define.is_empty() && m.model.0.file().is_none() {
-            bail!("materials[{i}].define: a define is for a .brdf model's shader, and `{}` is a built-in spec", m.model.0.name());
+            bail!(
+                "materials[{i}].define: a define is for a .brdf model's shader, and `{}` is a built-in spec",
+                m.model.0.name()
+            );
         } else if m.gamma.is_some() {
             "gamma"
         } else if m.define.is_empty() {
@@ -682,7 +754,10 @@ fn check_materials(materials: &[Material]) -> Result<()> {
         };
         let model = m.try_model().map_err(|e| anyhow!("materials[{i}].{field}: {e:#}"))?;
         if m.effects.anisotropy.0 != 0.0 && !model.takes_anisotropy() {
-            bail!("materials[{i}].effects.anisotropy: anisotropic GGX replaces the model's D and Vis, so it needs d=ggx (model `{}`)", model.name());
+            bail!(
+                "materials[{i}].effects.anisotropy: anisotropic GGX replaces the model's D and Vis, so it needs d=ggx (model `{}`)",
+                model.name()
+            );
         }
     }
     Ok(())
@@ -758,7 +833,9 @@ fn check_light(p: &str, l: &Light) -> Result<()> {
                 bail!("{p}: position must be finite and direction finite and non-zero");
             }
             if !(*inner_angle_deg >= 0.0 && inner_angle_deg <= outer_angle_deg && *outer_angle_deg <= 90.0) {
-                bail!("{p}: need 0 <= inner_angle_deg ({inner_angle_deg}) <= outer_angle_deg ({outer_angle_deg}) <= 90");
+                bail!(
+                    "{p}: need 0 <= inner_angle_deg ({inner_angle_deg}) <= outer_angle_deg ({outer_angle_deg}) <= 90"
+                );
             }
             (colour, intensity)
         }
@@ -843,12 +920,18 @@ mod tests {
     /// A material's `define` reaches a `.brdf` model's shader as `--define` does; a built-in spec refuses it.
     #[test]
     fn a_material_define_preprocesses_its_file() {
-        let file = GOOD.replace(r#""model": "ggx"}"#, r#""model": "tests/fixtures/brdf/quality-switch.brdf", "define": {"QUALITY_LEVEL": 1}}"#);
+        let file = GOOD.replace(
+            r#""model": "ggx"}"#,
+            r#""model": "tests/fixtures/brdf/quality-switch.brdf", "define": {"QUALITY_LEVEL": 1}}"#,
+        );
         let s = parse(&file).unwrap();
         let m = s.file.materials[0].model();
         assert!(m.canonical().contains(",define=QUALITY_LEVEL=1"), "{}", m.canonical());
         let shader = m.file().unwrap().file.shader.iter().map(|l| l.1.clone()).collect::<Vec<_>>().join("\n");
-        assert!(shader.contains("pow5(1.0 - VoH)") || shader.replace(' ', "").contains("pow5(1.0-VoH)"), "the high branch: {shader}");
+        assert!(
+            shader.contains("pow5(1.0 - VoH)") || shader.replace(' ', "").contains("pow5(1.0-VoH)"),
+            "the high branch: {shader}"
+        );
         let spec = GOOD.replace(r#""model": "ggx"}"#, r#""model": "ggx", "define": {"Q": 1}}"#);
         let e = parse(&spec).unwrap_err().to_string();
         assert!(e.contains("materials[0].define") && e.contains("built-in spec"), "{e}");
@@ -903,7 +986,10 @@ mod tests {
             (r#""a\u0000b""#, r#""a\0b""#, "NUL"),
         ] {
             let e = parse(&named(json)).unwrap_err().to_string();
-            assert!(e.starts_with(&format!("t.json: name: {shown} is not a plain file name")) && e.contains(why), "{json}: {e}");
+            assert!(
+                e.starts_with(&format!("t.json: name: {shown} is not a plain file name")) && e.contains(why),
+                "{json}: {e}"
+            );
         }
         assert_eq!(parse(&named(r#""my scene""#)).unwrap().name(), "my scene");
         assert_eq!(parse(GOOD).unwrap().name(), "t", "default: the file stem");

@@ -2,9 +2,9 @@
 //! metallic and material. Procedural scenes are ray-cast on the CPU (spheres, boxes and planes); image G-buffers
 //! are decoded from PNG (8/16 bit) and EXR files, with view vectors derived from depth or position and the camera.
 
-use super::format::{Camera, GBufferSource, ImageFiles, Procedural, Scene, MAX_SIZE};
+use super::format::{Camera, GBufferSource, ImageFiles, MAX_SIZE, Procedural, Scene};
 use crate::brdf::samples::hash01;
-use anyhow::{anyhow, bail, Result};
+use anyhow::{Result, anyhow, bail};
 use glam::Vec3;
 use image::{ColorType, DynamicImage, ImageDecoder, ImageFormat};
 use rayon::prelude::*;
@@ -87,11 +87,20 @@ impl Rays {
 
 #[derive(Clone, Copy, Debug)]
 enum Shape {
-    Sphere { centre: V3, radius: f32 },
+    Sphere {
+        centre: V3,
+        radius: f32,
+    },
     /// Axis-aligned box.
-    Box { min: V3, max: V3 },
+    Box {
+        min: V3,
+        max: V3,
+    },
     /// Plane through `point` facing `normal` (unit), one-sided.
-    Plane { point: V3, normal: V3 },
+    Plane {
+        point: V3,
+        normal: V3,
+    },
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -180,7 +189,12 @@ fn cuboid(min: [f32; 3], max: [f32; 3], material: u32, noise: f32) -> Object {
     Object { shape: Shape::Box { min: min.into(), max: max.into() }, material, roughness: None, noise }
 }
 fn plane(point: [f32; 3], normal: [f32; 3], material: u32, noise: f32) -> Object {
-    Object { shape: Shape::Plane { point: point.into(), normal: Vec3::from(normal).normalize() }, material, roughness: None, noise }
+    Object {
+        shape: Shape::Plane { point: point.into(), normal: Vec3::from(normal).normalize() },
+        material,
+        roughness: None,
+        noise,
+    }
 }
 
 fn sphere_grid(scene: &Scene, rows: &[String], columns: u32, floor: &str, aspect: f32) -> Layout {
@@ -200,7 +214,10 @@ fn sphere_grid(scene: &Scene, rows: &[String], columns: u32, floor: &str, aspect
     let fov = 30f32;
     let half_h = (n_rows / 2.0 + 0.15).max((columns as f32 / 2.0 + 0.15) / aspect);
     let dist = half_h / (fov.to_radians() / 2.0).tan() + 0.45;
-    Layout { objects, camera: Camera { position: [0.0, 0.0, dist], look_at: [0.0, 0.0, 0.0], up: [0.0, 1.0, 0.0], fov_y_deg: fov } }
+    Layout {
+        objects,
+        camera: Camera { position: [0.0, 0.0, dist], look_at: [0.0, 0.0, 0.0], up: [0.0, 1.0, 0.0], fov_y_deg: fov },
+    }
 }
 
 fn statues(scene: &Scene, names: &[String], floor: &str) -> Layout {
@@ -221,7 +238,12 @@ fn statues(scene: &Scene, names: &[String], floor: &str) -> Layout {
     let width = 1.6 * n + 1.0;
     Layout {
         objects,
-        camera: Camera { position: [0.0, 2.6, width * 0.95 + 1.5], look_at: [0.0, 0.9, -0.6], up: [0.0, 1.0, 0.0], fov_y_deg: 40.0 },
+        camera: Camera {
+            position: [0.0, 2.6, width * 0.95 + 1.5],
+            look_at: [0.0, 0.9, -0.6],
+            up: [0.0, 1.0, 0.0],
+            fov_y_deg: 40.0,
+        },
     }
 }
 
@@ -270,7 +292,12 @@ fn ray_cast(scene: &Scene, layout: &Layout, camera: &Camera, width: u32, height:
                 }
             }
             *px = match best {
-                None => Pixel { position: (rays.eye + d * 1e4).to_array(), normal: (-d.normalize()).to_array(), material: BACKGROUND, ..Default::default() },
+                None => Pixel {
+                    position: (rays.eye + d * 1e4).to_array(),
+                    normal: (-d.normalize()).to_array(),
+                    material: BACKGROUND,
+                    ..Default::default()
+                },
                 Some((h, obj)) => {
                     let m = &mats[obj.material as usize];
                     let id = (y as u32).wrapping_mul(width).wrapping_add(x as u32);
@@ -359,8 +386,12 @@ pub fn check_host(scene: &Scene) -> Result<()> {
 /// The G-buffer's size, from the scene file or its normal image's header.
 pub fn size(scene: &Scene) -> Result<(u32, u32)> {
     match &scene.file.gbuffer {
-        GBufferSource::Procedural(Procedural::SphereGrid { size, .. } | Procedural::Statues { size, .. } | Procedural::OldWest { size, .. }) => Ok((size.0[0], size.0[1])),
-        GBufferSource::Images(files) => plane_header(&scene.dir.join(&files.normal), "normal", PlaneKind::Vector).map(|h| (h.width, h.height)),
+        GBufferSource::Procedural(
+            Procedural::SphereGrid { size, .. } | Procedural::Statues { size, .. } | Procedural::OldWest { size, .. },
+        ) => Ok((size.0[0], size.0[1])),
+        GBufferSource::Images(files) => {
+            plane_header(&scene.dir.join(&files.normal), "normal", PlaneKind::Vector).map(|h| (h.width, h.height))
+        }
     }
 }
 
@@ -481,7 +512,11 @@ fn describe(format: Option<ImageFormat>, colour: ColorType) -> String {
         (true, false) => "RGB",
         (true, true) => "RGBA",
     };
-    let depth = if matches!(colour, ColorType::Rgb32F | ColorType::Rgba32F) { "float".to_string() } else { format!("{}-bit", bits_per_channel(colour)) };
+    let depth = if matches!(colour, ColorType::Rgb32F | ColorType::Rgba32F) {
+        "float".to_string()
+    } else {
+        format!("{}-bit", bits_per_channel(colour))
+    };
     let format = format.map_or("image", |f| f.extensions_str().first().copied().unwrap_or("image"));
     let article = if depth.starts_with('8') { "an" } else { "a" };
     format!("{article} {depth} {channels} {}", format.to_uppercase())
@@ -507,7 +542,9 @@ fn open_plane(path: &Path, what: &str, kind: PlaneKind) -> Result<(impl ImageDec
     let decoder = reader.into_decoder().map_err(|e| anyhow!("cannot decode image {shown}: {e}"))?;
     let ((width, height), colour) = (decoder.dimensions(), decoder.color_type());
     if width == 0 || height == 0 || width > MAX_SIZE || height > MAX_SIZE {
-        bail!("{shown}: the {what} image is {width}x{height}; G-buffer images must be 1 to {MAX_SIZE} pixels wide and high");
+        bail!(
+            "{shown}: the {what} image is {width}x{height}; G-buffer images must be 1 to {MAX_SIZE} pixels wide and high"
+        );
     }
     let float = matches!(colour, ColorType::Rgb32F | ColorType::Rgba32F);
     if !kind.accepts(float, colour) {
@@ -525,7 +562,8 @@ pub fn plane_header(path: &Path, what: &str, kind: PlaneKind) -> Result<PlaneHea
 /// checked first (`open_plane`). Errors name the file.
 pub fn read_plane(path: &Path, what: &str, kind: PlaneKind) -> Result<Plane> {
     let (decoder, header, float) = open_plane(path, what, kind)?;
-    let img = DynamicImage::from_decoder(decoder).map_err(|e| anyhow!("cannot decode image {}: {e}", path.display()))?;
+    let img =
+        DynamicImage::from_decoder(decoder).map_err(|e| anyhow!("cannot decode image {}: {e}", path.display()))?;
     let rgba: Vec<[f32; 4]> = img.into_rgba32f().pixels().map(|p| p.0).collect();
     Ok(Plane { width: header.width, height: header.height, float, rgba, path: path.to_path_buf() })
 }
@@ -542,7 +580,13 @@ fn check_material_ids(m: &Plane, w: u32, materials: usize) -> Result<()> {
         k != 255 && k >= materials
     });
     if let Some((i, c)) = bad {
-        bail!("{}: pixel ({}, {}) names material {} but the scene has {materials} materials", m.path.display(), i as u32 % w, i as u32 / w, (c[0] * 255.0).round());
+        bail!(
+            "{}: pixel ({}, {}) names material {} but the scene has {materials} materials",
+            m.path.display(),
+            i as u32 % w,
+            i as u32 / w,
+            (c[0] * 255.0).round()
+        );
     }
     Ok(())
 }
@@ -558,17 +602,28 @@ fn planes(files: &ImageFiles) -> Vec<(&PathBuf, &'static str, PlaneKind)> {
         (&files.material, "material", PlaneKind::MaterialId),
         (&files.tangent, "tangent", PlaneKind::Vector),
     ];
-    std::iter::once((&files.normal, "normal", PlaneKind::Vector)).chain(optional.into_iter().filter_map(|(p, what, kind)| p.as_ref().map(|p| (p, what, kind)))).collect()
+    std::iter::once((&files.normal, "normal", PlaneKind::Vector))
+        .chain(optional.into_iter().filter_map(|(p, what, kind)| p.as_ref().map(|p| (p, what, kind))))
+        .collect()
 }
 
 /// Every plane's header: the same size as the normal image's, and the memory to decode them available.
 fn check_headers(scene: &Scene, files: &ImageFiles) -> Result<()> {
     let planes = planes(files);
-    let headers = planes.iter().map(|(p, what, kind)| plane_header(&scene.dir.join(p), what, *kind)).collect::<Result<Vec<_>>>()?;
+    let headers = planes
+        .iter()
+        .map(|(p, what, kind)| plane_header(&scene.dir.join(p), what, *kind))
+        .collect::<Result<Vec<_>>>()?;
     let (w, h) = (headers[0].width, headers[0].height);
     for ((p, _, _), header) in planes.iter().zip(&headers).skip(1) {
         if (header.width, header.height) != (w, h) {
-            bail!("{} is {}x{}, but the normal image {} is {w}x{h}", scene.dir.join(p).display(), header.width, header.height, scene.dir.join(&files.normal).display());
+            bail!(
+                "{} is {}x{}, but the normal image {} is {w}x{h}",
+                scene.dir.join(p).display(),
+                header.width,
+                header.height,
+                scene.dir.join(&files.normal).display()
+            );
         }
     }
     check_image_memory(&scene.path.display().to_string(), &headers)
@@ -587,11 +642,19 @@ fn load_images(scene: &Scene, files: &ImageFiles) -> Result<GBuffer> {
     let (w, h) = (normal.width, normal.height);
     let same = |plane: Plane| -> Result<Plane> {
         if (plane.width, plane.height) != (w, h) {
-            bail!("{} is {}x{}, but the normal image {} is {w}x{h}", plane.path.display(), plane.width, plane.height, normal.path.display());
+            bail!(
+                "{} is {}x{}, but the normal image {} is {w}x{h}",
+                plane.path.display(),
+                plane.width,
+                plane.height,
+                normal.path.display()
+            );
         }
         Ok(plane)
     };
-    let optional = |p: &Option<PathBuf>, what: &str, kind: PlaneKind| p.as_ref().map(|p| open(p, what, kind).and_then(same)).transpose();
+    let optional = |p: &Option<PathBuf>, what: &str, kind: PlaneKind| {
+        p.as_ref().map(|p| open(p, what, kind).and_then(same)).transpose()
+    };
     let roughness = optional(&files.roughness, "roughness", PlaneKind::Grey)?;
     let base = optional(&files.base_colour, "base_colour", PlaneKind::Colour)?;
     let metallic = optional(&files.metallic, "metallic", PlaneKind::Grey)?;
@@ -618,21 +681,36 @@ fn load_images(scene: &Scene, files: &ImageFiles) -> Result<GBuffer> {
             let pos = match (&depth, &position) {
                 (Some(d), _) => {
                     let c = d.rgba[i][0];
-                    let z = if d.float { c } else { let [near, far] = files.depth_range.unwrap(); near + c * (far - near) };
+                    let z = if d.float {
+                        c
+                    } else {
+                        let [near, far] = files.depth_range.unwrap();
+                        near + c * (far - near)
+                    };
                     (Vec3::from(camera.position) + dir * z).to_array()
                 }
                 (_, Some(p)) => [p.rgba[i][0], p.rgba[i][1], p.rgba[i][2]],
                 _ => unreachable!("checked: depth or position"),
             };
             if mat == 255 {
-                return Pixel { position: pos, normal: (-dir.normalize()).to_array(), material: BACKGROUND, ..Default::default() };
+                return Pixel {
+                    position: pos,
+                    normal: (-dir.normalize()).to_array(),
+                    material: BACKGROUND,
+                    ..Default::default()
+                };
             }
             let m = &mats[mat as usize];
             let n = decode_vector(&normal, i);
-            let t = tangent.as_ref().map(|t| decode_vector(t, i)).filter(|t| *t != Vec3::ZERO && t.dot(n).abs() < 0.999);
+            let t =
+                tangent.as_ref().map(|t| decode_vector(t, i)).filter(|t| *t != Vec3::ZERO && t.dot(n).abs() < 0.999);
             let base_colour = base.as_ref().map_or(m.base_colour.0, |b| {
                 let c = b.rgba[i];
-                if b.float { [c[0], c[1], c[2]] } else { [srgb_to_linear(c[0]), srgb_to_linear(c[1]), srgb_to_linear(c[2])] }
+                if b.float {
+                    [c[0], c[1], c[2]]
+                } else {
+                    [srgb_to_linear(c[0]), srgb_to_linear(c[1]), srgb_to_linear(c[2])]
+                }
             });
             Pixel {
                 position: pos,
@@ -695,18 +773,39 @@ mod tests {
         ImageBuffer::<Luma<u16>, _>::from_raw(2, 2, vec![1u16; 4]).unwrap().save(p("grey16.png")).unwrap();
         ImageBuffer::<Rgb<u8>, _>::from_raw(2, 2, vec![1u8; 12]).unwrap().save(p("rgb8.png")).unwrap();
         ImageBuffer::<Rgb<f32>, _>::from_raw(2, 2, vec![1f32; 12]).unwrap().save(p("rgb.exr")).unwrap();
-        let refused = |file: &str, what: &str, kind: PlaneKind| read_plane(&p(file), what, kind).err().map(|e| e.to_string()).unwrap_or_default();
+        let refused = |file: &str, what: &str, kind: PlaneKind| {
+            read_plane(&p(file), what, kind).err().map(|e| e.to_string()).unwrap_or_default()
+        };
         let e = refused("grey8.png", "normal", PlaneKind::Vector);
-        assert_eq!(e, format!("{}: the normal image must be RGB or RGBA: a PNG (8 or 16 bit) or an EXR; this file is an 8-bit grey PNG", p("grey8.png").display()));
+        assert_eq!(
+            e,
+            format!(
+                "{}: the normal image must be RGB or RGBA: a PNG (8 or 16 bit) or an EXR; this file is an 8-bit grey PNG",
+                p("grey8.png").display()
+            )
+        );
         let e = refused("grey8.png", "depth", PlaneKind::Depth);
-        assert!(e.contains("grey8.png: the depth image must be an EXR (R is read) or a 16-bit PNG; this file is an 8-bit grey PNG"), "{e}");
+        assert!(
+            e.contains(
+                "grey8.png: the depth image must be an EXR (R is read) or a 16-bit PNG; this file is an 8-bit grey PNG"
+            ),
+            "{e}"
+        );
         let e = refused("rgb8.png", "roughness", PlaneKind::Grey);
         assert!(e.contains("the roughness image must be grey") && e.contains("8-bit RGB PNG"), "{e}");
         let e = refused("grey16.png", "material", PlaneKind::MaterialId);
         assert!(e.contains("an 8-bit grey PNG; this file is a 16-bit grey PNG"), "{e}");
         let e = refused("grey16.png", "position", PlaneKind::Position);
         assert!(e.contains("the position image must be an EXR"), "{e}");
-        for (file, kind) in [("rgb8.png", PlaneKind::Vector), ("rgb.exr", PlaneKind::Vector), ("grey16.png", PlaneKind::Depth), ("rgb.exr", PlaneKind::Depth), ("grey8.png", PlaneKind::Grey), ("grey8.png", PlaneKind::MaterialId), ("grey8.png", PlaneKind::Colour)] {
+        for (file, kind) in [
+            ("rgb8.png", PlaneKind::Vector),
+            ("rgb.exr", PlaneKind::Vector),
+            ("grey16.png", PlaneKind::Depth),
+            ("rgb.exr", PlaneKind::Depth),
+            ("grey8.png", PlaneKind::Grey),
+            ("grey8.png", PlaneKind::MaterialId),
+            ("grey8.png", PlaneKind::Colour),
+        ] {
             assert!(read_plane(&p(file), "plane", kind).is_ok(), "{file} as {kind:?}");
         }
     }
@@ -718,10 +817,19 @@ mod tests {
         // 16385 x 16385 would decode to 268 MB; the data is cut short, so only a header check can name the size.
         std::fs::write(&path, png_header_only(MAX_SIZE + 1, MAX_SIZE + 1)).unwrap();
         let e = read_plane(&path, "normal", PlaneKind::Vector).err().unwrap().to_string();
-        assert_eq!(e, format!("{}: the normal image is 16385x16385; G-buffer images must be 1 to 16384 pixels wide and high", path.display()));
+        assert_eq!(
+            e,
+            format!(
+                "{}: the normal image is 16385x16385; G-buffer images must be 1 to 16384 pixels wide and high",
+                path.display()
+            )
+        );
         std::fs::write(&path, png_header_only(MAX_SIZE, 2)).unwrap();
         let e = read_plane(&path, "normal", PlaneKind::Grey).err().unwrap().to_string();
-        assert!(e.starts_with(&format!("cannot decode image {}", path.display())), "within the limit, the (cut) data is decoded: {e}");
+        assert!(
+            e.starts_with(&format!("cannot decode image {}", path.display())),
+            "within the limit, the (cut) data is decoded: {e}"
+        );
     }
 
     #[test]

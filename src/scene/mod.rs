@@ -14,7 +14,7 @@ pub mod run;
 pub mod spirv;
 pub mod terms;
 
-pub use format::{explain_text, Scene};
+pub use format::{Scene, explain_text};
 
 /// `brdfprof scene FILE`: checks the scene, builds its G-buffer and says what would be compiled in (no device).
 pub fn check(path: &std::path::Path) -> anyhow::Result<String> {
@@ -22,7 +22,14 @@ pub fn check(path: &std::path::Path) -> anyhow::Result<String> {
     let g = gbuffer::build(&scene)?;
     let p = plan::plan(&scene, &g, None);
     let shaded: usize = p.kernels.iter().map(|k| k.pixels.len()).sum();
-    let mut out = format!("{}: {}x{} G-buffer, {} pixels shaded, {} lights\ncompiled in:\n", scene.name(), g.width, g.height, shaded, p.counts.total());
+    let mut out = format!(
+        "{}: {}x{} G-buffer, {} pixels shaded, {} lights\ncompiled in:\n",
+        scene.name(),
+        g.width,
+        g.height,
+        shaded,
+        p.counts.total()
+    );
     for line in p.describe(&scene).iter().chain(&p.notes) {
         out += &format!("  {line}\n");
     }

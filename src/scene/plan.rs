@@ -4,11 +4,11 @@
 //! `ENERGY_COMPENSATION`, `DIFFUSE`, `CLEAR_COAT`). The plan also packs the lights and each kernel's pixels.
 
 use super::format::{Light, Scene};
-use super::gbuffer::{GBuffer, BACKGROUND};
+use super::gbuffer::{BACKGROUND, GBuffer};
 use super::terms::{self, KernelLight, Switches};
 use crate::gpu::{DeviceInfo, SpecConstants};
-use crate::kernels::constants::{self as k, Constant};
 use crate::kernels::WithConstant;
+use crate::kernels::constants::{self as k, Constant};
 use crate::model::Model;
 use anyhow::Result;
 use glam::DVec3;
@@ -115,12 +115,18 @@ pub fn pack_lights(lights: &[Light]) -> (LightCounts, Vec<f32>, Vec<KernelLight>
                 Light::Directional { direction, colour, intensity } => {
                     counts.directional += 1;
                     let (d, c) = (unit3(direction), rgb(colour, intensity));
-                    ([d[0], d[1], d[2], 0.0, c[0], c[1], c[2], 0.0, 0.0, 0.0, 0.0, 0.0], KernelLight::Directional { direction: f64s(d), radiance: f64s(c) })
+                    (
+                        [d[0], d[1], d[2], 0.0, c[0], c[1], c[2], 0.0, 0.0, 0.0, 0.0, 0.0],
+                        KernelLight::Directional { direction: f64s(d), radiance: f64s(c) },
+                    )
                 }
                 Light::Point { position: p, colour, intensity } => {
                     counts.point += 1;
                     let c = rgb(colour, intensity);
-                    ([p[0], p[1], p[2], 0.0, c[0], c[1], c[2], 0.0, 0.0, 0.0, 0.0, 0.0], KernelLight::Point { position: f64s(p), intensity: f64s(c) })
+                    (
+                        [p[0], p[1], p[2], 0.0, c[0], c[1], c[2], 0.0, 0.0, 0.0, 0.0, 0.0],
+                        KernelLight::Point { position: f64s(p), intensity: f64s(c) },
+                    )
                 }
                 Light::Spot { position: p, direction, inner_angle_deg, outer_angle_deg, colour, intensity } => {
                     counts.spot += 1;
@@ -129,13 +135,22 @@ pub fn pack_lights(lights: &[Light]) -> (LightCounts, Vec<f32>, Vec<KernelLight>
                     let (scale, offset) = (scale as f32, offset as f32);
                     (
                         [p[0], p[1], p[2], offset, c[0], c[1], c[2], 0.0, a[0], a[1], a[2], scale],
-                        KernelLight::Spot { position: f64s(p), intensity: f64s(c), axis: f64s(a), scale: scale as f64, offset: offset as f64 },
+                        KernelLight::Spot {
+                            position: f64s(p),
+                            intensity: f64s(c),
+                            axis: f64s(a),
+                            scale: scale as f64,
+                            offset: offset as f64,
+                        },
                     )
                 }
                 Light::Sphere { position: p, radius, colour, intensity } => {
                     counts.sphere += 1;
                     let c = rgb(colour, intensity);
-                    ([p[0], p[1], p[2], radius, c[0], c[1], c[2], 0.0, 0.0, 0.0, 0.0, 0.0], KernelLight::Sphere { position: f64s(p), radius: radius as f64, intensity: f64s(c) })
+                    (
+                        [p[0], p[1], p[2], radius, c[0], c[1], c[2], 0.0, 0.0, 0.0, 0.0, 0.0],
+                        KernelLight::Sphere { position: f64s(p), radius: radius as f64, intensity: f64s(c) },
+                    )
                 }
             };
             data.extend_from_slice(&v);
@@ -175,7 +190,12 @@ pub fn plan(scene: &Scene, gbuffer: &GBuffer, model: Option<&Model>) -> ScenePla
         let k = match kernels.iter().position(|k| k.model == *spec) {
             Some(k) => k,
             None => {
-                kernels.push(KernelPlan { model: spec.clone(), materials: Vec::new(), pixels: Vec::new(), switches: Switches::default() });
+                kernels.push(KernelPlan {
+                    model: spec.clone(),
+                    materials: Vec::new(),
+                    pixels: Vec::new(),
+                    switches: Switches::default(),
+                });
                 kernels.len() - 1
             }
         };
@@ -195,7 +215,13 @@ pub fn plan(scene: &Scene, gbuffer: &GBuffer, model: Option<&Model>) -> ScenePla
         lobes.dedup();
         k.switches = Switches {
             anisotropy: k.materials.iter().any(|&i| anisotropy[i] != 0.0),
-            energy: if energy == 0 { 0 } else if energy == ms.len() { 1 } else { 2 },
+            energy: if energy == 0 {
+                0
+            } else if energy == ms.len() {
+                1
+            } else {
+                2
+            },
             diffuse: if lobes.len() == 1 { lobes[0].id() } else { 3 },
             clear_coat: ms.iter().any(|m| m.effects.clear_coat.is_some_and(|c| c.strength.0 > 0.0)),
         };
@@ -222,7 +248,12 @@ impl ScenePlan {
     /// model's own constants `model`.
     pub fn constants(&self, model: SpecConstants, switches: Switches) -> SpecConstants {
         let c = &self.counts;
-        let lights = [(k::NUM_DIRECTIONAL, c.directional), (k::NUM_POINT, c.point), (k::NUM_SPOT, c.spot), (k::NUM_SPHERE, c.sphere)];
+        let lights = [
+            (k::NUM_DIRECTIONAL, c.directional),
+            (k::NUM_POINT, c.point),
+            (k::NUM_SPOT, c.spot),
+            (k::NUM_SPHERE, c.sphere),
+        ];
         effect_constants(lights.into_iter().fold(model, |m, (k, n)| m.with(k, n as f64)), switches)
     }
 
@@ -237,7 +268,16 @@ impl ScenePlan {
                 let m = &mats[p.material as usize];
                 let (coat, coat_r) = m.effects.clear_coat.map_or((0.0, 1.0), |c| (c.strength.0, c.roughness.0));
                 let t = p.tangent;
-                [t[0], t[1], t[2], self.anisotropy[p.material as usize], coat, coat_r, m.effects.diffuse.id() as f32, m.effects.energy_compensation as i32 as f32]
+                [
+                    t[0],
+                    t[1],
+                    t[2],
+                    self.anisotropy[p.material as usize],
+                    coat,
+                    coat_r,
+                    m.effects.diffuse.id() as f32,
+                    m.effects.energy_compensation as i32 as f32,
+                ]
             })
             .collect()
     }
@@ -258,8 +298,13 @@ impl ScenePlan {
                     .iter()
                     .filter(|e| e.is_on(&k.switches))
                     .map(|e| match e {
-                        Effect::EnergyCompensation if k.switches.energy == 2 => "energy-compensation (per pixel)".to_string(),
-                        Effect::Diffuse => format!("diffuse ({})", ["none", "lambert", "burley", "per pixel"][k.switches.diffuse as usize]),
+                        Effect::EnergyCompensation if k.switches.energy == 2 => {
+                            "energy-compensation (per pixel)".to_string()
+                        }
+                        Effect::Diffuse => format!(
+                            "diffuse ({})",
+                            ["none", "lambert", "burley", "per pixel"][k.switches.diffuse as usize]
+                        ),
                         e => e.name().to_string(),
                     })
                     .collect();
@@ -282,7 +327,7 @@ impl ScenePlan {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::{gbuffer, Scene};
+    use crate::scene::{Scene, gbuffer};
 
     #[test]
     fn fp16_without_shader_float16_is_a_clear_error() {
@@ -292,11 +337,26 @@ mod tests {
         let g = gbuffer::build(&s).unwrap();
         let p = plan(&s, &g, None);
         let mut info = crate::gpu::DeviceInfo {
-            index: 0, name: "no-fp16 device".into(), device_type: "cpu".into(), vendor_id: 0, device_id: 0, driver_name: String::new(),
-            driver_info: String::new(), driver_version: String::new(), api_version: String::new(), timestamp_period: 1.0,
-            timestamp_valid_bits: 64, max_storage_buffer_range: 1 << 27, max_texel_buffer_elements: 1 << 27, max_compute_work_group_count: [65535; 3],
-            max_compute_work_group_invocations: 256, min_storage_buffer_offset_alignment: 16, max_memory_allocation_size: 1 << 30,
-            shader_float16: false, shader_float64: false, pipeline_executable_properties: false,
+            index: 0,
+            name: "no-fp16 device".into(),
+            device_type: "cpu".into(),
+            vendor_id: 0,
+            device_id: 0,
+            driver_name: String::new(),
+            driver_info: String::new(),
+            driver_version: String::new(),
+            api_version: String::new(),
+            timestamp_period: 1.0,
+            timestamp_valid_bits: 64,
+            max_storage_buffer_range: 1 << 27,
+            max_texel_buffer_elements: 1 << 27,
+            max_compute_work_group_count: [65535; 3],
+            max_compute_work_group_invocations: 256,
+            min_storage_buffer_offset_alignment: 16,
+            max_memory_allocation_size: 1 << 30,
+            shader_float16: false,
+            shader_float64: false,
+            pipeline_executable_properties: false,
         };
         let e = p.check_device(&info).unwrap_err().to_string();
         assert!(e.contains("fp16") && e.contains("shaderFloat16") && e.contains("no-fp16 device"), "{e}");
@@ -318,7 +378,11 @@ mod tests {
         let g = gbuffer::build(&s).unwrap();
         let p = plan(&s, &g, None);
         let names: Vec<String> = p.kernels.iter().map(|k| k.model.name()).collect();
-        assert_eq!(names, ["ggx", "blinn", "burley"], "one kernel per model covering pixels; the unused material adds none");
+        assert_eq!(
+            names,
+            ["ggx", "blinn", "burley"],
+            "one kernel per model covering pixels; the unused material adds none"
+        );
         assert_eq!(p.kernels[0].switches, Switches { anisotropy: false, energy: 2, diffuse: 1, clear_coat: false });
         assert_eq!(p.kernels[1].switches, Switches { clear_coat: true, ..Default::default() });
         assert_eq!(p.kernels[2].switches, Switches::default());

@@ -4,19 +4,19 @@
 //! and an effect's cost is, per round, (time with it - time without it) / pixels of its kernel, reported as a
 //! median with a distribution-free 95% CI over rounds.
 
+use super::compile;
 use super::format::Scene;
 use super::gbuffer::{self, GBuffer};
-use super::compile;
 use super::plan::{self, Effect, ScenePlan};
 use super::run::{self, SceneVariant, SceneWork};
 use super::spirv;
+use crate::export::json::Provenance;
+use crate::export::markdown::{self, Table};
 use crate::gpu::Gpu;
 use crate::kernels::{self, RunLimits};
 use crate::model::KernelKind;
-use crate::profile::protocol::{self, ProtocolOptions, RawTimes};
 use crate::profile::LEVEL;
-use crate::export::json::Provenance;
-use crate::export::markdown::{self, Table};
+use crate::profile::protocol::{self, ProtocolOptions, RawTimes};
 use crate::stats::{self, Estimate};
 use anyhow::Result;
 use indicatif::ProgressBar;
@@ -100,7 +100,8 @@ struct Analysis {
 }
 
 fn analyse(raw: &RawTimes, slots: &[Slot], pixels: &[u64]) -> Analysis {
-    let full: Vec<usize> = (0..pixels.len()).map(|k| slots.iter().position(|s| s.kernel == k && s.without.is_none()).unwrap()).collect();
+    let full: Vec<usize> =
+        (0..pixels.len()).map(|k| slots.iter().position(|s| s.kernel == k && s.without.is_none()).unwrap()).collect();
     let full_t: Vec<Vec<f64>> = full.iter().map(|&v| raw.round_medians(v)).collect();
     let rounds = raw.rounds();
     let frame_t: Vec<f64> = (0..rounds).map(|r| full_t.iter().map(|t| t[r]).sum()).collect();
@@ -133,7 +134,12 @@ fn resolved(a: &Analysis, target: f64) -> bool {
 }
 
 /// Every kernel of the plan as compiled and, for each effect it compiles in, without that effect.
-fn variants<'g>(gpu: &'g Gpu, work: &SceneWork<'g>, p: &ScenePlan, instances: usize) -> Result<(Vec<Slot>, Vec<SceneVariant<'g>>)> {
+fn variants<'g>(
+    gpu: &'g Gpu,
+    work: &SceneWork<'g>,
+    p: &ScenePlan,
+    instances: usize,
+) -> Result<(Vec<Slot>, Vec<SceneVariant<'g>>)> {
     let (mut slots, mut variants) = (Vec::new(), Vec::new());
     for v in compile::variant_specs(p) {
         slots.push(Slot { kernel: v.kernel, without: v.without });
@@ -162,7 +168,12 @@ fn slot_of(slots: &[Slot], k: usize, without: Option<Effect>) -> usize {
 }
 
 /// Loads the G-buffer, plans, compiles and times the scene.
-pub fn run(gpu: &Gpu, scene: &Scene, options: &SceneProfileOptions, progress: &ProgressBar) -> Result<SceneProfileReport> {
+pub fn run(
+    gpu: &Gpu,
+    scene: &Scene,
+    options: &SceneProfileOptions,
+    progress: &ProgressBar,
+) -> Result<SceneProfileReport> {
     progress.set_message("building the G-buffer");
     let g: GBuffer = gbuffer::build_for(scene, &gpu.info)?;
     let p: ScenePlan = plan::plan(scene, &g, None);
@@ -172,11 +183,18 @@ pub fn run(gpu: &Gpu, scene: &Scene, options: &SceneProfileOptions, progress: &P
     let work = SceneWork::upload(gpu, scene, &g, &p, &tables, RunLimits { max_chunk: options.max_chunk })?;
     // The targets' figures first (seconds): a missing compiler fails before the long measurement.
     progress.set_message("compile-only targets");
-    let targets = compile::reports(gpu, &work, &p, &options.cost_targets, options.validate, options.isa_dir.as_deref())?;
+    let targets =
+        compile::reports(gpu, &work, &p, &options.cost_targets, options.validate, options.isa_dir.as_deref())?;
     progress.set_message("compiling kernels");
     let (slots, variants) = variants(gpu, &work, &p, options.instances)?;
     let pixels: Vec<u64> = work.kernels.iter().map(|k| k.count).collect();
-    let raw = protocol::measure_with_progress(gpu, &variants, &options.protocol, |raw| resolved(&analyse(raw, &slots, &pixels), options.target_rel_ci), progress)?;
+    let raw = protocol::measure_with_progress(
+        gpu,
+        &variants,
+        &options.protocol,
+        |raw| resolved(&analyse(raw, &slots, &pixels), options.target_rel_ci),
+        progress,
+    )?;
     let a = analyse(&raw, &slots, &pixels);
     let instructions = instructions(&p, &variants);
     let compiled = p.describe(scene);
@@ -204,7 +222,9 @@ pub fn run(gpu: &Gpu, scene: &Scene, options: &SceneProfileOptions, progress: &P
             effect: e.name().into(),
             extra_ns_per_pixel: extra,
             extra_fraction: frac,
-            extra_spirv_instructions: instructions[slot_of(&slots, k, None)].zip(instructions[slot_of(&slots, k, Some(e))]).map(|(a, b)| a as i64 - b as i64),
+            extra_spirv_instructions: instructions[slot_of(&slots, k, None)]
+                .zip(instructions[slot_of(&slots, k, Some(e))])
+                .map(|(a, b)| a as i64 - b as i64),
         })
         .collect();
     Ok(SceneProfileReport {
@@ -256,7 +276,14 @@ impl SceneProfileReport {
         for n in &self.notes {
             out += &format!("- note: {n}\n");
         }
-        let mut t = Table::new(["kernel", "pixels", "dispatches", "SPIR-V instr.", "ns/pixel [95% CI]", "share of frame [95% CI]"]);
+        let mut t = Table::new([
+            "kernel",
+            "pixels",
+            "dispatches",
+            "SPIR-V instr.",
+            "ns/pixel [95% CI]",
+            "share of frame [95% CI]",
+        ]);
         for k in &self.kernels {
             t.row([
                 k.model.clone(),
@@ -267,11 +294,21 @@ impl SceneProfileReport {
                 markdown::estimate(&k.frame_share, 2),
             ]);
         }
-        out += &format!("\n{}\nwhole frame: {} ns per shaded pixel\n", t.markdown(), markdown::estimate(&self.frame_ns_per_pixel, 3));
+        out += &format!(
+            "\n{}\nwhole frame: {} ns per shaded pixel\n",
+            t.markdown(),
+            markdown::estimate(&self.frame_ns_per_pixel, 3)
+        );
         if self.effects.is_empty() {
             out += "\nNo material calls for an effect: none is compiled in.\n";
         } else {
-            let mut e = Table::new(["kernel", "effect", "+ns/pixel [95% CI]", "+fraction of kernel [95% CI]", "+SPIR-V instr."]);
+            let mut e = Table::new([
+                "kernel",
+                "effect",
+                "+ns/pixel [95% CI]",
+                "+fraction of kernel [95% CI]",
+                "+SPIR-V instr.",
+            ]);
             for r in &self.effects {
                 e.row([
                     r.model.clone(),
@@ -281,10 +318,23 @@ impl SceneProfileReport {
                     r.extra_spirv_instructions.map_or("-".into(), |n| format!("{n:+}")),
                 ]);
             }
-            out += &format!("\nCost of each effect (kernel as compiled minus the kernel without it, per round):\n\n{}", e.markdown());
+            out += &format!(
+                "\nCost of each effect (kernel as compiled minus the kernel without it, per round):\n\n{}",
+                e.markdown()
+            );
         }
-        let measured = |model: &str| self.kernels.iter().find(|k| k.model == model).map_or("-".into(), |k| markdown::estimate(&k.ns_per_pixel, 3));
-        let measured_effect = |model: &str, effect: &str| self.effects.iter().find(|e| e.model == model && e.effect == effect).map_or("-".into(), |e| markdown::estimate(&e.extra_ns_per_pixel, 3));
+        let measured = |model: &str| {
+            self.kernels
+                .iter()
+                .find(|k| k.model == model)
+                .map_or("-".into(), |k| markdown::estimate(&k.ns_per_pixel, 3))
+        };
+        let measured_effect = |model: &str, effect: &str| {
+            self.effects
+                .iter()
+                .find(|e| e.model == model && e.effect == effect)
+                .map_or("-".into(), |e| markdown::estimate(&e.extra_ns_per_pixel, 3))
+        };
         out + &compile::markdown(&self.targets, measured, measured_effect, &self.provenance.device.name)
     }
 }

@@ -8,11 +8,11 @@ use super::format::{Light, Model, Scene};
 use super::gbuffer::{self, GBuffer};
 use super::plan;
 use super::run;
-use crate::model::Model as BrdfModel;
 use crate::export::png;
-use crate::export::raster::{blit, colour_bar, draw_lobes, label, tone_map, viridis, LOBE_PANEL};
+use crate::export::raster::{LOBE_PANEL, blit, colour_bar, draw_lobes, label, tone_map, viridis};
 use crate::gpu::Gpu;
 use crate::kernels::{self, RunLimits};
+use crate::model::Model as BrdfModel;
 use anyhow::Result;
 use indicatif::ProgressBar;
 use plotters::prelude::*;
@@ -26,7 +26,12 @@ fn slug(spec: &BrdfModel) -> String {
 }
 
 /// Renders `scene` over `g` with every material's model replaced by `model` (the scene's own models when None).
-pub fn radiance(gpu: &Gpu, scene: &Scene, g: &GBuffer, model: Option<&BrdfModel>) -> Result<(Vec<[f32; 3]>, Vec<String>)> {
+pub fn radiance(
+    gpu: &Gpu,
+    scene: &Scene,
+    g: &GBuffer,
+    model: Option<&BrdfModel>,
+) -> Result<(Vec<[f32; 3]>, Vec<String>)> {
     let p = plan::plan(scene, g, model);
     let tables = run::e_tables(gpu, &p)?;
     Ok((run::shade(gpu, scene, g, &p, &tables, RunLimits::default())?, p.notes))
@@ -55,7 +60,10 @@ pub const NON_FINITE_COLOUR: [u8; 3] = [255, 0, 255];
 /// Tone-mapped pixels, non-finite ones in `NON_FINITE_COLOUR`, and how many those are.
 fn display(hdr: &[[f32; 3]], exposure: f32) -> (Vec<[u8; 3]>, usize) {
     let bad = |c: &[f32; 3]| c.iter().any(|x| !x.is_finite());
-    (hdr.iter().map(|c| if bad(c) { NON_FINITE_COLOUR } else { tone_map(*c, exposure) }).collect(), hdr.iter().filter(|c| bad(c)).count())
+    (
+        hdr.iter().map(|c| if bad(c) { NON_FINITE_COLOUR } else { tone_map(*c, exposure) }).collect(),
+        hdr.iter().filter(|c| bad(c)).count(),
+    )
 }
 
 /// Difference heat maps against the reference model, in displayed luminance (what a viewer sees), one shared
@@ -87,9 +95,19 @@ fn difference_maps(g: &GBuffer, models: &[BrdfModel], displayed: &[Vec<[u8; 3]>]
 }
 
 /// The comparison grid: one sphere per material (rows) and model (columns), under a studio rig.
-fn comparison_grid(gpu: &Gpu, scene: &Scene, models: &[BrdfModel], out: &Path, warnings: &mut Vec<String>) -> Result<PathBuf> {
+fn comparison_grid(
+    gpu: &Gpu,
+    scene: &Scene,
+    models: &[BrdfModel],
+    out: &Path,
+    warnings: &mut Vec<String>,
+) -> Result<PathBuf> {
     let settings = &scene.file.render;
-    let rows: Vec<String> = if settings.grid.is_empty() { scene.file.materials.iter().map(|m| m.name.clone()).collect() } else { settings.grid.clone() };
+    let rows: Vec<String> = if settings.grid.is_empty() {
+        scene.file.materials.iter().map(|m| m.name.clone()).collect()
+    } else {
+        settings.grid.clone()
+    };
     let mut studio = scene.clone();
     studio.file.lights = studio_lights();
     studio.file.render.background = [0.1, 0.1, 0.11];
@@ -103,7 +121,11 @@ fn comparison_grid(gpu: &Gpu, scene: &Scene, models: &[BrdfModel], out: &Path, w
             let (hdr, _) = radiance(gpu, &studio, &closeup, Some(m))?;
             let (px, bad) = display(&hdr, settings.exposure);
             if bad > 0 {
-                warnings.push(format!("grid.png: {} on {name}: {bad} of {} pixels are NaN or Inf (drawn magenta)", m.name(), hdr.len()));
+                warnings.push(format!(
+                    "grid.png: {} on {name}: {bad} of {} pixels are NaN or Inf (drawn magenta)",
+                    m.name(),
+                    hdr.len()
+                ));
             }
             tiles.push(px);
         }
@@ -143,7 +165,13 @@ pub fn render(gpu: &Gpu, scene: &Scene, out: &Path, progress: &ProgressBar) -> R
         let (px, bad) = display(&hdr, exposure);
         let path = out.join(format!("{}.png", slug(m)));
         if bad > 0 {
-            warnings.push(format!("{}: {} of {} pixels are NaN or Inf (drawn magenta in {})", m.name(), bad, hdr.len(), path.display()));
+            warnings.push(format!(
+                "{}: {} of {} pixels are NaN or Inf (drawn magenta in {})",
+                m.name(),
+                bad,
+                hdr.len(),
+                path.display()
+            ));
         }
         let title = format!("{}: {} ({})", scene.name(), m.label(), m.canonical());
         png::render(&path, g.width, g.height, |root| {

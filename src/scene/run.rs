@@ -3,11 +3,11 @@
 //! compiled with some switches and bound chunk by chunk (bindings within maxStorageBufferRange, dispatches within
 //! maxComputeWorkGroupCount), so a 4K or larger G-buffer runs as several dispatches of one pipeline.
 
+use super::effects;
 use super::format::Scene;
 use super::gbuffer::{GBuffer, PIXEL_BYTES};
 use super::plan::ScenePlan;
 use super::terms::{ETable, Switches};
-use super::effects;
 use crate::gpu::{Binding, Buffer, ChunkPlan, Commands, Gpu, MemoryKind};
 use crate::kernels::{self, RunLimits};
 use crate::model::KernelKind;
@@ -51,7 +51,14 @@ pub fn e_tables(gpu: &Gpu, plan: &ScenePlan) -> Result<Vec<Option<ETable>>> {
 }
 
 impl<'g> SceneWork<'g> {
-    pub fn upload(gpu: &'g Gpu, scene: &Scene, gbuffer: &GBuffer, plan: &ScenePlan, tables: &[Option<ETable>], limits: RunLimits) -> Result<Self> {
+    pub fn upload(
+        gpu: &'g Gpu,
+        scene: &Scene,
+        gbuffer: &GBuffer,
+        plan: &ScenePlan,
+        tables: &[Option<ETable>],
+        limits: RunLimits,
+    ) -> Result<Self> {
         let wg = crate::gpu::WORKGROUP as u64;
         let mut kernels = Vec::new();
         for (k, kp) in plan.kernels.iter().enumerate() {
@@ -61,7 +68,20 @@ impl<'g> SceneWork<'g> {
             for &i in &kp.pixels {
                 let p = &gbuffer.pixels[i as usize];
                 let (nn, pos, b) = (p.normal, p.position, p.base_colour);
-                data.extend_from_slice(&[nn[0], nn[1], nn[2], p.roughness, pos[0], pos[1], pos[2], p.metallic, b[0], b[1], b[2], 0.0]);
+                data.extend_from_slice(&[
+                    nn[0],
+                    nn[1],
+                    nn[2],
+                    p.roughness,
+                    pos[0],
+                    pos[1],
+                    pos[2],
+                    p.metallic,
+                    b[0],
+                    b[1],
+                    b[2],
+                    0.0,
+                ]);
             }
             let mut extras = plan.extras(scene, gbuffer, k);
             for _ in n..padded {
@@ -82,7 +102,11 @@ impl<'g> SceneWork<'g> {
         }
         let light_data: &[f32] = if plan.light_data.is_empty() { &[0.0; 12] } else { &plan.light_data };
         let c = gbuffer.camera.position;
-        Ok(SceneWork { lights: Buffer::with_data(gpu, bytemuck::cast_slice(light_data), MemoryKind::Device)?, kernels, camera: [c[0], c[1], c[2], 0.0] })
+        Ok(SceneWork {
+            lights: Buffer::with_data(gpu, bytemuck::cast_slice(light_data), MemoryKind::Device)?,
+            kernels,
+            camera: [c[0], c[1], c[2], 0.0],
+        })
     }
 
     /// Pixels shaded in all kernels together.
@@ -101,7 +125,13 @@ impl<'g> SceneWork<'g> {
     pub fn host_inputs(&self, k: usize) -> Result<HostInputs> {
         let kb = &self.kernels[k];
         let bytes = |b: &Buffer| b.read_as::<u8>(0, b.size as usize);
-        let buffers = [((0, 0), bytes(&kb.pixels)?), (RADIANCE, vec![0u8; kb.radiance.size as usize]), ((0, 2), bytes(&self.lights)?), ((0, 3), bytes(&kb.extras)?), ((0, 4), bytes(&kb.table)?)];
+        let buffers = [
+            ((0, 0), bytes(&kb.pixels)?),
+            (RADIANCE, vec![0u8; kb.radiance.size as usize]),
+            ((0, 2), bytes(&self.lights)?),
+            ((0, 3), bytes(&kb.extras)?),
+            ((0, 4), bytes(&kb.table)?),
+        ];
         Ok((buffers.into(), bytemuck::cast::<[f32; 4], [u8; 16]>(self.camera).to_vec(), kb.radiance.size / OUT_BYTES))
     }
 
@@ -124,26 +154,35 @@ pub struct SceneVariant<'g> {
 }
 
 impl<'g> SceneVariant<'g> {
-    pub fn new(gpu: &'g Gpu, work: &SceneWork<'g>, plan: &ScenePlan, k: usize, switches: Switches, label: String, instances: usize) -> Result<Self> {
+    pub fn new(
+        gpu: &'g Gpu,
+        work: &SceneWork<'g>,
+        plan: &ScenePlan,
+        k: usize,
+        switches: Switches,
+        label: String,
+        instances: usize,
+    ) -> Result<Self> {
         let model = &plan.kernels[k].model;
         model.check_support(&gpu.info)?;
         let kb = &work.kernels[k];
         let push: [u8; 16] = bytemuck::cast(work.camera);
         let mk = model.kernel(KernelKind::Scene, kernels::embedded())?;
         let kernel = [(mk.spirv, plan.constants(mk.constants, switches))];
-        let pipelines = Pipelines::compile(gpu, &kernel, &Binding::storage(STORAGE_BUFFERS), PUSH_BYTES, instances, |k| {
-            let chunk = |&(first, len): &(u64, u64)| -> Result<Dispatch> {
-                let set = k[0].bind(&[
-                    (&kb.pixels, first * PIXEL_BYTES, len * PIXEL_BYTES),
-                    (&kb.radiance, first * OUT_BYTES, len * OUT_BYTES),
-                    (&work.lights, 0, work.lights.size),
-                    (&kb.extras, first * EXTRA_BYTES, len * EXTRA_BYTES),
-                    (&kb.table, 0, kb.table.size),
-                ])?;
-                Ok(Dispatch { kernel: 0, set, offsets: Vec::new(), push: push.to_vec(), invocations: len })
-            };
-            Ok(vec![kb.chunks.chunks.iter().map(chunk).collect::<Result<Vec<_>>>()?])
-        })?;
+        let pipelines =
+            Pipelines::compile(gpu, &kernel, &Binding::storage(STORAGE_BUFFERS), PUSH_BYTES, instances, |k| {
+                let chunk = |&(first, len): &(u64, u64)| -> Result<Dispatch> {
+                    let set = k[0].bind(&[
+                        (&kb.pixels, first * PIXEL_BYTES, len * PIXEL_BYTES),
+                        (&kb.radiance, first * OUT_BYTES, len * OUT_BYTES),
+                        (&work.lights, 0, work.lights.size),
+                        (&kb.extras, first * EXTRA_BYTES, len * EXTRA_BYTES),
+                        (&kb.table, 0, kb.table.size),
+                    ])?;
+                    Ok(Dispatch { kernel: 0, set, offsets: Vec::new(), push: push.to_vec(), invocations: len })
+                };
+                Ok(vec![kb.chunks.chunks.iter().map(chunk).collect::<Result<Vec<_>>>()?])
+            })?;
         Ok(SceneVariant { label, kernel_index: k, switches, pipelines })
     }
 }
@@ -160,7 +199,14 @@ impl Timed for SceneVariant<'_> {
 
 /// Shades the whole G-buffer (every kernel of the plan, as compiled) and returns the radiance per G-buffer
 /// pixel, row-major; pixels no surface covers get `background`.
-pub fn shade(gpu: &Gpu, scene: &Scene, gbuffer: &GBuffer, plan: &ScenePlan, tables: &[Option<ETable>], limits: RunLimits) -> Result<Vec<[f32; 3]>> {
+pub fn shade(
+    gpu: &Gpu,
+    scene: &Scene,
+    gbuffer: &GBuffer,
+    plan: &ScenePlan,
+    tables: &[Option<ETable>],
+    limits: RunLimits,
+) -> Result<Vec<[f32; 3]>> {
     plan.check_device(&gpu.info)?;
     let work = SceneWork::upload(gpu, scene, gbuffer, plan, tables, limits)?;
     let bg = scene.file.render.background;

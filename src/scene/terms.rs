@@ -2,9 +2,9 @@
 //! kernel's per-pixel shading built from them. tests/scenes/terms.rs ties each GLSL term to its twin, and the
 //! whole kernel (every light type, every effect) to `shade_pixel`.
 
-use crate::brdf::guards::{self, MIN_COSINE};
-use crate::brdf::terms::{d_ggx, schlick_weight, Params};
 use crate::brdf::ModelSpec;
+use crate::brdf::guards::{self, MIN_COSINE};
+use crate::brdf::terms::{Params, d_ggx, schlick_weight};
 use glam::DVec3;
 use std::f64::consts::PI;
 
@@ -38,7 +38,16 @@ pub fn d_ggx_anisotropic(noh: f64, toh: f64, boh: f64, at: f64, ab: f64) -> f64 
 /// Anisotropic height-correlated Smith GGX [Heitz 2014, eq. 99]:
 /// 0.5 / (NoL |(at ToV, ab BoV, NoV)| + NoV |(at ToL, ab BoL, NoL)|).
 #[allow(clippy::too_many_arguments)]
-pub fn vis_smith_ggx_correlated_anisotropic(tov: f64, bov: f64, nov: f64, tol: f64, bol: f64, nol: f64, at: f64, ab: f64) -> f64 {
+pub fn vis_smith_ggx_correlated_anisotropic(
+    tov: f64,
+    bov: f64,
+    nov: f64,
+    tol: f64,
+    bol: f64,
+    nol: f64,
+    at: f64,
+    ab: f64,
+) -> f64 {
     let lv = nol * DVec3::new(at * tov, ab * bov, nov).length();
     let ll = nov * DVec3::new(at * tol, ab * bol, nol).length();
     0.5 / (lv + ll)

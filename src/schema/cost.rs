@@ -3,7 +3,7 @@
 //! from its own statistics and model (`targets::cost`); `inspect`, `compare` and `sweep --cost-device` read
 //! only this.
 
-use crate::export::markdown::{sig, Table};
+use crate::export::markdown::{Table, sig};
 use serde::{Deserialize, Serialize};
 
 /// One kernel's figures.
@@ -53,10 +53,24 @@ impl TargetCost {
     /// The reference model's cycles taken apart (its terms per wave, the binding one named), where the rule
     /// has terms.
     fn terms_note(&self) -> String {
-        let Some(r) = self.row(crate::brdf::spec::REFERENCE_MODEL).or_else(|| self.rows.first()).filter(|r| !r.terms.is_empty()) else { return String::new() };
-        let (bind, _) = r.terms.iter().fold(("", f64::NEG_INFINITY), |b, (n, v)| if *v > b.1 { (n.as_str(), *v) } else { b });
-        let parts: Vec<String> = r.terms.iter().map(|(n, v)| if n == bind { format!("**{n} {}**", sig(*v, 4)) } else { format!("{n} {}", sig(*v, 4)) }).collect();
-        format!("\n{}'s cycles per wave taken apart ({}): {}; the largest binds.\n", r.model, self.unit, parts.join(", "))
+        let Some(r) =
+            self.row(crate::brdf::spec::REFERENCE_MODEL).or_else(|| self.rows.first()).filter(|r| !r.terms.is_empty())
+        else {
+            return String::new();
+        };
+        let (bind, _) =
+            r.terms.iter().fold(("", f64::NEG_INFINITY), |b, (n, v)| if *v > b.1 { (n.as_str(), *v) } else { b });
+        let parts: Vec<String> = r
+            .terms
+            .iter()
+            .map(|(n, v)| if n == bind { format!("**{n} {}**", sig(*v, 4)) } else { format!("{n} {}", sig(*v, 4)) })
+            .collect();
+        format!(
+            "\n{}'s cycles per wave taken apart ({}): {}; the largest binds.\n",
+            r.model,
+            self.unit,
+            parts.join(", ")
+        )
     }
 
     /// "navi21 (RDNA 2)" or the device name.
@@ -83,7 +97,8 @@ impl TargetCost {
 
     pub fn markdown(&self) -> String {
         let all: Vec<&String> = self.columns.iter().collect();
-        let (columns, constant) = super::fold_constant(&all, |c| self.rows.iter().map(|r| r.stats.get(*c).copied()).collect());
+        let (columns, constant) =
+            super::fold_constant(&all, |c| self.rows.iter().map(|r| r.stats.get(*c).copied()).collect());
         let mut headers: Vec<String> = vec!["model".into()];
         headers.extend(columns.iter().map(|c| c.to_string()));
         headers.extend(["cycles/eval".into(), "net cycles/eval".into(), "net vs ggx".into()]);
@@ -107,7 +122,15 @@ impl TargetCost {
             }
             t.row(cells);
         }
-        let mut out = format!("### {} statistics, {} ({} lights per kernel; {}; {})\n\n{}", self.compiler, self.label(), self.lights_per_kernel, self.model, self.unit, t.markdown());
+        let mut out = format!(
+            "### {} statistics, {} ({} lights per kernel; {}; {})\n\n{}",
+            self.compiler,
+            self.label(),
+            self.lights_per_kernel,
+            self.model,
+            self.unit,
+            t.markdown()
+        );
         out += &super::constant_note(constant.iter().map(|(c, v)| (c.as_str(), *v)));
         out += &self.terms_note();
         for r in self.rows.iter().filter(|r| r.net_cycles_per_eval.is_some_and(|v| v <= 0.0)) {

@@ -28,9 +28,11 @@ pub const ALIASES: &[(&str, &[&str])] = &[
 /// Statistic keys: `driver/<executable>/<name>` for each statistic, `driver/<alias>` for each alias that some
 /// statistic matched.
 pub fn stats(all: &[DriverStat]) -> Vec<(String, f64)> {
-    let mut out: Vec<(String, f64)> = all.iter().map(|s| (format!("driver/{}/{}", s.executable, s.name), s.value)).collect();
+    let mut out: Vec<(String, f64)> =
+        all.iter().map(|s| (format!("driver/{}/{}", s.executable, s.name), s.value)).collect();
     for (alias, names) in ALIASES {
-        let matching: Vec<f64> = all.iter().filter(|s| names.iter().any(|n| n.eq_ignore_ascii_case(&s.name))).map(|s| s.value).collect();
+        let matching: Vec<f64> =
+            all.iter().filter(|s| names.iter().any(|n| n.eq_ignore_ascii_case(&s.name))).map(|s| s.value).collect();
         if !matching.is_empty() {
             out.push((format!("driver/{alias}"), matching.iter().sum()));
         }
@@ -60,7 +62,13 @@ mod tests {
     #[test]
     fn vendor_names_line_up_under_aliases() {
         // RADV/ACO names.
-        let radv = stats(&[stat("VGPRs", 24.0), stat("SGPRs", 16.0), stat("Spilled VGPRs", 2.0), stat("Spilled SGPRs", 1.0), stat("Instructions", 310.0)]);
+        let radv = stats(&[
+            stat("VGPRs", 24.0),
+            stat("SGPRs", 16.0),
+            stat("Spilled VGPRs", 2.0),
+            stat("Spilled SGPRs", 1.0),
+            stat("Instructions", 310.0),
+        ]);
         let get = |s: &[(String, f64)], k: &str| s.iter().find(|(key, _)| key == k).map(|(_, v)| *v);
         assert_eq!(get(&radv, "driver/registers"), Some(24.0));
         assert_eq!(get(&radv, "driver/spills"), Some(3.0));

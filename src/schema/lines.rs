@@ -41,10 +41,27 @@ impl KernelLines {
     /// The costliest `n` lines as a Markdown table, with the share of the binding pipe each takes.
     pub fn markdown(&self, n: usize, unit: &str) -> String {
         let total: f64 = self.lines.iter().map(|l| l.binding).sum();
-        let mut t = crate::export::markdown::Table::new(["file:line", "instructions", &format!("{} cycles/wave", self.binding_pipe), "share", "schedule cycles/wave", "source"].map(String::from));
+        let mut t = crate::export::markdown::Table::new(
+            [
+                "file:line",
+                "instructions",
+                &format!("{} cycles/wave", self.binding_pipe),
+                "share",
+                "schedule cycles/wave",
+                "source",
+            ]
+            .map(String::from),
+        );
         for l in self.lines.iter().take(n) {
             let share = if total > 0.0 { format!("{:.0}%", 100.0 * l.binding / total) } else { "-".into() };
-            t.row([format!("{}:{}", l.file, l.line), l.instructions.to_string(), crate::export::markdown::sig(l.binding, 4), share, crate::export::markdown::sig(l.schedule, 4), format!("`{}`", l.text.replace('|', "\\|").replace('`', "'"))]);
+            t.row([
+                format!("{}:{}", l.file, l.line),
+                l.instructions.to_string(),
+                crate::export::markdown::sig(l.binding, 4),
+                share,
+                crate::export::markdown::sig(l.schedule, 4),
+                format!("`{}`", l.text.replace('|', "\\|").replace('`', "'")),
+            ]);
         }
         format!(
             "#### {}: the costliest source lines ({unit}; ranked by their cycles on the binding pipe, {}; {} of {} instructions are the translation's own or the compiler's and name no line)\n\n{}",

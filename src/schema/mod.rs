@@ -19,8 +19,14 @@ pub const HASH_NOTE: &str = "kernel-sha256";
 /// Statistic sections, in report order: key prefix and title.
 pub const SECTIONS: [(&str, &str); 5] = [
     ("spirv/", "SPIR-V instructions, glslang's output specialised (frozen spec constants, dead code removed)"),
-    ("spirv-O/", "SPIR-V instructions after spirv-opt -O (the [[unroll]] light loop unrolled: about NUM_LIGHTS copies of the BRDF)"),
-    ("naga/", "naga (SPIR-V front end and validator) on the specialised float-G-buffer kernel (same BRDF; naga 30 reads no texel buffers)"),
+    (
+        "spirv-O/",
+        "SPIR-V instructions after spirv-opt -O (the [[unroll]] light loop unrolled: about NUM_LIGHTS copies of the BRDF)",
+    ),
+    (
+        "naga/",
+        "naga (SPIR-V front end and validator) on the specialised float-G-buffer kernel (same BRDF; naga 30 reads no texel buffers)",
+    ),
     ("driver/", "Driver statistics (VK_KHR_pipeline_executable_properties)"),
     ("callgrind/", "Executed CPU instructions (Ir) per BRDF evaluation of lavapipe's JIT code, under callgrind"),
 ];
@@ -96,7 +102,8 @@ impl InspectReport {
             if columns.is_empty() && !with_notes {
                 continue;
             }
-            let (columns, constant) = fold_constant(&columns, |c| self.rows.iter().map(|r| r.stats.get(*c).copied()).collect());
+            let (columns, constant) =
+                fold_constant(&columns, |c| self.rows.iter().map(|r| r.stats.get(*c).copied()).collect());
             let mut headers = vec!["model".to_string()];
             headers.extend(columns.iter().map(|c| c[prefix.len()..].to_string()));
             if with_notes {
@@ -153,13 +160,21 @@ Each instruction of the kernel compiled with line information, attributed to the
     /// One line saying what was inspected.
     pub fn summary(&self) -> String {
         let device = self.provenance["device"]["name"].as_str().unwrap_or("?");
-        format!("{device}; shade kernel, {} lights; SPIR-V {}; tools: {}", self.lights, self.kernels, self.tools.iter().map(|(k, v)| format!("{k} = {v}")).collect::<Vec<_>>().join(", "))
+        format!(
+            "{device}; shade kernel, {} lights; SPIR-V {}; tools: {}",
+            self.lights,
+            self.kernels,
+            self.tools.iter().map(|(k, v)| format!("{k} = {v}")).collect::<Vec<_>>().join(", ")
+        )
     }
 }
 
 /// The columns whose value differs between rows (kept), and those equal on every one of three or more rows
 /// with that value (folded: a column that never changes says nothing per row). `values` gives a column's.
-pub fn fold_constant<'a, C: Copy>(columns: &'a [C], values: impl Fn(&C) -> Vec<Option<f64>>) -> (Vec<C>, Vec<(C, f64)>) {
+pub fn fold_constant<'a, C: Copy>(
+    columns: &'a [C],
+    values: impl Fn(&C) -> Vec<Option<f64>>,
+) -> (Vec<C>, Vec<(C, f64)>) {
     let (mut kept, mut folded) = (Vec::new(), Vec::new());
     for c in columns {
         let v = values(c);
@@ -174,7 +189,11 @@ pub fn fold_constant<'a, C: Copy>(columns: &'a [C], values: impl Fn(&C) -> Vec<O
 /// The line under a table that lists its folded columns, or nothing.
 pub fn constant_note<'a>(folded: impl Iterator<Item = (&'a str, f64)>) -> String {
     let items: Vec<String> = folded.map(|(name, v)| format!("{name} {}", format_value(v))).collect();
-    if items.is_empty() { String::new() } else { format!("\nThe same on every kernel (not listed per row): {}.\n", items.join(", ")) }
+    if items.is_empty() {
+        String::new()
+    } else {
+        format!("\nThe same on every kernel (not listed per row): {}.\n", items.join(", "))
+    }
 }
 
 #[cfg(test)]

@@ -3,8 +3,8 @@
 //! applies the same guards, so it is the limit the tool defines), 0 where no light arrives, and for invalid
 //! input (NaN, Inf) any finite non-negative value: the kernel must not pass the poison on.
 
-use crate::brdf::terms::{Param, ParamKind, ParamValue, PARAMS};
 use crate::brdf::Sample;
+use crate::brdf::terms::{PARAMS, Param, ParamKind, ParamValue};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
@@ -80,7 +80,9 @@ pub fn hard_cases() -> Vec<HardCase> {
     add("L = V", sample(0.6, 0.6, 0.0, 0.5), None, Twin);
     add("N = H exactly", mirror(0.6, 0.5), None, Twin);
     add("N = H at grazing, NoV = NoL = 1e-4", mirror(1e-4, 0.5), None, Twin);
-    for (label, r) in [("0", 0.0f32), ("1e-4", 1e-4), ("1e-2", 1e-2), ("fp16 smallest normal 6.1e-5", 6.103_515_6e-5), ("1", 1.0)] {
+    for (label, r) in
+        [("0", 0.0f32), ("1e-4", 1e-4), ("1e-2", 1e-2), ("fp16 smallest normal 6.1e-5", 6.103_515_6e-5), ("1", 1.0)]
+    {
         add(&format!("roughness {label}, N = H"), mirror(0.6, r), None, Twin);
         add(&format!("roughness {label}, off the peak"), sample(0.6, 0.8, PI / 2.0, r), None, Twin);
     }
@@ -109,7 +111,12 @@ pub fn hard_cases() -> Vec<HardCase> {
     add("zero light vector", Sample { l: [0.0; 3], ..mirror(0.6, 0.5) }, None, Twin);
     for (label, scale) in [("0.5", 0.5f32), ("2", 2.0), ("1e-30", 1e-30), ("1e30", 1e30)] {
         let s = sample(0.6, 0.8, PI / 2.0, 0.5);
-        add(&format!("vectors of length {label}"), Sample { n: s.n.map(|x| x * scale), v: s.v.map(|x| x * scale), l: s.l.map(|x| x * scale), ..s }, None, Twin);
+        add(
+            &format!("vectors of length {label}"),
+            Sample { n: s.n.map(|x| x * scale), v: s.v.map(|x| x * scale), l: s.l.map(|x| x * scale), ..s },
+            None,
+            Twin,
+        );
     }
     add("F0 = 0", Sample { f0: [0.0; 3], ..sample(0.6, 0.8, PI / 2.0, 0.5) }, None, Twin);
     add("F0 = 1", Sample { f0: [1.0; 3], ..sample(0.6, 0.8, PI / 2.0, 0.5) }, None, Twin);
@@ -136,7 +143,32 @@ mod tests {
         let n = names.len();
         names.dedup();
         assert_eq!(n, names.len());
-        for needle in ["NoV = 0", "NoV = 1e-7", "NoL = 1e-4", "just below", "back-facing", "L = -V", "L = V", "N = H exactly", "roughness 0,", "roughness 1e-4", "roughness 1e-2", "fp16 smallest normal", "gamma 1 - 1e-6", "gamma 2,", "Blinn exponent", "Beckmann exp", "denormal", "zero normal", "length 0.5", "length 2", "F0 = 0", "F0 = 1", "NaN", "Inf"] {
+        for needle in [
+            "NoV = 0",
+            "NoV = 1e-7",
+            "NoL = 1e-4",
+            "just below",
+            "back-facing",
+            "L = -V",
+            "L = V",
+            "N = H exactly",
+            "roughness 0,",
+            "roughness 1e-4",
+            "roughness 1e-2",
+            "fp16 smallest normal",
+            "gamma 1 - 1e-6",
+            "gamma 2,",
+            "Blinn exponent",
+            "Beckmann exp",
+            "denormal",
+            "zero normal",
+            "length 0.5",
+            "length 2",
+            "F0 = 0",
+            "F0 = 1",
+            "NaN",
+            "Inf",
+        ] {
             assert!(cases.iter().any(|c| c.name.contains(needle)), "no case for {needle}");
         }
         let m = mirror(0.6, 0.5);

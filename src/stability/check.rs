@@ -2,7 +2,7 @@
 
 use super::catalogue::{Expect, HardCase};
 use super::failures::{self, Failures};
-use super::{grid, tolerance, base_tolerance, CaseResult, SpecStability, Worst};
+use super::{CaseResult, SpecStability, Worst, base_tolerance, grid, tolerance};
 use crate::accuracy::FLOOR;
 use crate::brdf::{ModelSpec, Sample};
 use crate::gpu::Gpu;
@@ -75,7 +75,9 @@ impl Checks<'_> {
         let within = |range: Option<(f64, f64)>, x: f64| range.is_none_or(|(lo, hi)| (lo..=hi).contains(&x));
         let n = crate::brdf::guards::unit(s.n);
         within(self.roughness, f64::from(s.roughness))
-            && (self.nov.is_none() && self.nol.is_none() || within(self.nov, n.dot(crate::brdf::guards::unit(s.v))) && within(self.nol, n.dot(crate::brdf::guards::unit(s.l))))
+            && (self.nov.is_none() && self.nol.is_none()
+                || within(self.nov, n.dot(crate::brdf::guards::unit(s.v)))
+                    && within(self.nol, n.dot(crate::brdf::guards::unit(s.l))))
     }
 
     /// Whether any range narrows the inputs checked.
@@ -85,7 +87,11 @@ impl Checks<'_> {
 
     /// The ranges as the report says them.
     pub fn domain_text(&self) -> String {
-        [("roughness", self.roughness), ("NoV", self.nov), ("NoL", self.nol)].iter().filter_map(|(n, r)| r.map(|(lo, hi)| format!("{n} in [{lo}, {hi}]"))).collect::<Vec<_>>().join(", ")
+        [("roughness", self.roughness), ("NoV", self.nov), ("NoL", self.nol)]
+            .iter()
+            .filter_map(|(n, r)| r.map(|(lo, hi)| format!("{n} in [{lo}, {hi}]")))
+            .collect::<Vec<_>>()
+            .join(", ")
     }
 }
 
@@ -101,7 +107,8 @@ fn run_cases(gpu: &Gpu, model: &Model, cases: &[HardCase]) -> Result<Vec<[f32; 3
         }
     }
     for (m, idx) in &groups {
-        let got = kernels::eval(gpu, m, &idx.iter().map(|&i| cases[i].sample).collect::<Vec<_>>(), RunLimits::default())?;
+        let got =
+            kernels::eval(gpu, m, &idx.iter().map(|&i| cases[i].sample).collect::<Vec<_>>(), RunLimits::default())?;
         for (k, &i) in idx.iter().enumerate() {
             out[i] = got[k];
         }
@@ -121,14 +128,23 @@ fn deviation(spec: &ModelSpec, s: &Sample, got: &[f32; 3], expected: [f64; 3], s
 
 /// The channel where got and expected differ most, as a `Worst`.
 fn worst_at(deviation: f64, got: &[f32; 3], expected: [f64; 3], input: String) -> Worst {
-    let c = (0..3).max_by(|&a, &b| (got[a] as f64 - expected[a]).abs().total_cmp(&(got[b] as f64 - expected[b]).abs())).unwrap();
+    let c = (0..3)
+        .max_by(|&a, &b| (got[a] as f64 - expected[a]).abs().total_cmp(&(got[b] as f64 - expected[b]).abs()))
+        .unwrap();
     Worst { deviation, got: got[c], expected: expected[c], input }
 }
 
 /// Each case's verdict: against the twin or reference (within tolerance) for valid input, finite and
 /// non-negative for invalid input; without either, a valid case fails only on a NaN, Inf or negative value.
 /// None for a valid case outside the roughness domain (not run as far as the report goes).
-fn judge_cases(model: &Model, checks: &Checks, cases: &[HardCase], out: &[[f32; 3]], tally: &mut Tally, worst: &mut Worst) -> Vec<Option<CaseResult>> {
+fn judge_cases(
+    model: &Model,
+    checks: &Checks,
+    cases: &[HardCase],
+    out: &[[f32; 3]],
+    tally: &mut Tally,
+    worst: &mut Worst,
+) -> Vec<Option<CaseResult>> {
     cases
         .iter()
         .zip(out)
@@ -202,10 +218,18 @@ struct Steps {
     examples: Vec<String>,
 }
 
-fn scan_steps(grid: &[Sample], out: &[[f32; 3]], twin: Option<&[[f64; 3]]>, deviations: &[f64], in_domain: &[bool]) -> Steps {
+fn scan_steps(
+    grid: &[Sample],
+    out: &[[f32; 3]],
+    twin: Option<&[[f64; 3]]>,
+    deviations: &[f64],
+    in_domain: &[bool],
+) -> Steps {
     let mut steps = Steps { discontinuities: 0, model_jumps: 0, examples: Vec::new() };
     let Some(twin) = twin else { return steps };
-    let radiance = |vals: &dyn Fn(usize) -> f64, idx: &[usize]| idx.iter().map(|&i| vals(i) * (grid[i].l[2] as f64).max(0.0)).collect::<Vec<f64>>();
+    let radiance = |vals: &dyn Fn(usize) -> f64, idx: &[usize]| {
+        idx.iter().map(|&i| vals(i) * (grid[i].l[2] as f64).max(0.0)).collect::<Vec<f64>>()
+    };
     let mut scan = |idx: Vec<usize>, axis: &str| {
         let idx: Vec<usize> = idx.into_iter().filter(|&i| in_domain[i]).collect();
         let g = radiance(&|i| out[i][0] as f64, &idx);
@@ -217,7 +241,13 @@ fn scan_steps(grid: &[Sample], out: &[[f32; 3]], twin: Option<&[[f64; 3]]>, devi
         for j in grid::jumps(&g).into_iter().filter(|j| !model.contains(j) && off(*j)) {
             steps.discontinuities += 1;
             if steps.examples.len() < 5 {
-                steps.examples.push(format!("along {axis} between {} and {}: {:.4e} -> {:.4e}", super::failures::describe(&grid[idx[j]]), super::failures::describe(&grid[idx[j + 1]]), g[j], g[j + 1]));
+                steps.examples.push(format!(
+                    "along {axis} between {} and {}: {:.4e} -> {:.4e}",
+                    super::failures::describe(&grid[idx[j]]),
+                    super::failures::describe(&grid[idx[j + 1]]),
+                    g[j],
+                    g[j + 1]
+                ));
             }
         }
     };
@@ -259,7 +289,14 @@ fn reciprocity_error(forward: &[[f32; 3]], backward: &[[f32; 3]]) -> (Option<f64
 
 /// Checks one model: catalogue, grid, discontinuities, reciprocity and where it fails (energy is added by
 /// `run`).
-pub fn check_model(gpu: &Gpu, model: &Model, checks: &Checks, cases: &[HardCase], grid: &[Sample], reciprocity: &[Sample]) -> Result<SpecStability> {
+pub fn check_model(
+    gpu: &Gpu,
+    model: &Model,
+    checks: &Checks,
+    cases: &[HardCase],
+    grid: &[Sample],
+    reciprocity: &[Sample],
+) -> Result<SpecStability> {
     let case_out = run_cases(gpu, model, cases)?;
     let mut all: Vec<Sample> = grid.to_vec();
     all.extend_from_slice(reciprocity);
@@ -274,7 +311,11 @@ pub fn check_model(gpu: &Gpu, model: &Model, checks: &Checks, cases: &[HardCase]
     let spec = checks.expected(model, None);
     let twin: Option<Vec<[f64; 3]>> = spec.map(|s| grid.par_iter().map(|x| s.eval(x)).collect());
     let deviations: Vec<f64> = match (&spec, &twin) {
-        (Some(s), Some(t)) => grid_deviations(s, grid, grid_out, t).into_iter().zip(&in_domain).map(|(d, &inside)| if inside { d } else { 0.0 }).collect(),
+        (Some(s), Some(t)) => grid_deviations(s, grid, grid_out, t)
+            .into_iter()
+            .zip(&in_domain)
+            .map(|(d, &inside)| if inside { d } else { 0.0 })
+            .collect(),
         _ => vec![0.0; grid.len()],
     };
     let cells = bad_cells(grid_out, &in_domain, &mut tally);
@@ -289,7 +330,12 @@ pub fn check_model(gpu: &Gpu, model: &Model, checks: &Checks, cases: &[HardCase]
     let failures = locate_failures(gpu, model, cases, &case_out, &judged, grid, grid_out, &in_domain)?;
     if worst.input.is_empty() {
         if let Some(f) = failures.first() {
-            worst = Worst { deviation: f64::INFINITY, got: f.got.into_iter().find(|x| !x.is_finite() || *x < 0.0).unwrap_or(f.got[0]), expected: f64::NAN, input: format!("{}: {}", f.at, f.inputs) };
+            worst = Worst {
+                deviation: f64::INFINITY,
+                got: f.got.into_iter().find(|x| !x.is_finite() || *x < 0.0).unwrap_or(f.got[0]),
+                expected: f64::NAN,
+                input: format!("{}: {}", f.at, f.inputs),
+            };
         }
     }
     let results: Vec<CaseResult> = judged.iter().flatten().cloned().collect();
@@ -335,11 +381,23 @@ fn expected_from(model: &Model, checks: &Checks) -> Option<String> {
 
 /// The valid inputs in the domain with a NaN, Inf or negative result, and the input guards that remove them.
 #[allow(clippy::too_many_arguments)]
-fn locate_failures(gpu: &Gpu, model: &Model, cases: &[HardCase], case_out: &[[f32; 3]], judged: &[Option<CaseResult>], grid: &[Sample], grid_out: &[[f32; 3]], in_domain: &[bool]) -> Result<Failures> {
-    let case_models: Vec<(Model, &str, Sample)> = cases.iter().map(|c| (case_model(model, c), c.name.as_str(), c.sample)).collect();
+fn locate_failures(
+    gpu: &Gpu,
+    model: &Model,
+    cases: &[HardCase],
+    case_out: &[[f32; 3]],
+    judged: &[Option<CaseResult>],
+    grid: &[Sample],
+    grid_out: &[[f32; 3]],
+    in_domain: &[bool],
+) -> Result<Failures> {
+    let case_models: Vec<(Model, &str, Sample)> =
+        cases.iter().map(|c| (case_model(model, c), c.name.as_str(), c.sample)).collect();
     // Invalid-input cases and those outside the domain are not failures of a valid input.
     let counted = |i: usize| cases[i].expect == Expect::Twin && judged[i].is_some();
-    let case_out: Vec<[f32; 3]> = case_out.iter().enumerate().map(|(i, g)| if counted(i) { *g } else { [0.0; 3] }).collect();
-    let grid_out: Vec<[f32; 3]> = grid_out.iter().zip(in_domain).map(|(g, &inside)| if inside { *g } else { [0.0; 3] }).collect();
+    let case_out: Vec<[f32; 3]> =
+        case_out.iter().enumerate().map(|(i, g)| if counted(i) { *g } else { [0.0; 3] }).collect();
+    let grid_out: Vec<[f32; 3]> =
+        grid_out.iter().zip(in_domain).map(|(g, &inside)| if inside { *g } else { [0.0; 3] }).collect();
     failures::locate(gpu, &case_models, &case_out, model, grid, &grid_out)
 }

@@ -4,12 +4,12 @@
 //! as E(NoV) curves per roughness.
 
 use super::SpecStability;
-use crate::brdf::{ModelSpec, F};
+use crate::brdf::{F, ModelSpec};
 use crate::export::png;
 use crate::gpu::Gpu;
 use crate::kernels::{self, AlbedoCell};
 use crate::model::Model;
-use anyhow::{anyhow, Result};
+use anyhow::{Result, anyhow};
 use indicatif::ProgressBar;
 use plotters::prelude::*;
 use rayon::prelude::*;
@@ -69,7 +69,10 @@ pub fn white(spec: &ModelSpec) -> ModelSpec {
 }
 
 pub fn cells() -> Vec<AlbedoCell> {
-    ROUGHNESS.iter().flat_map(|&roughness| NOV.iter().map(move |&nov| AlbedoCell { nov, roughness, f0: [1.0; 3] })).collect()
+    ROUGHNESS
+        .iter()
+        .flat_map(|&roughness| NOV.iter().map(move |&nov| AlbedoCell { nov, roughness, f0: [1.0; 3] }))
+        .collect()
 }
 
 /// The model whose albedo is E: a spec with F = 1; a `.brdf` file as it is, given F0 = 1 (so F = 1 where its
@@ -107,9 +110,15 @@ pub fn energy_of(gpu: &Gpu, model: &Model) -> Result<Energy> {
     }
     let (mut cpu_check, mut cpu_check_nonfinite) = (None, 0);
     if let Some(white) = white.twin() {
-        let checked: Vec<(usize, usize)> = (0..ROUGHNESS.len()).filter(|&r| [0.1, 0.5, 1.0].contains(&ROUGHNESS[r])).flat_map(|r| (0..NOV.len()).map(move |v| (r, v))).collect();
+        let checked: Vec<(usize, usize)> = (0..ROUGHNESS.len())
+            .filter(|&r| [0.1, 0.5, 1.0].contains(&ROUGHNESS[r]))
+            .flat_map(|r| (0..NOV.len()).map(move |v| (r, v)))
+            .collect();
         let cells = cells();
-        let cpu: Vec<f64> = checked.par_iter().map(|&(r, v)| crate::accuracy::albedo_twin(white, &cells[r * NOV.len() + v])[0]).collect();
+        let cpu: Vec<f64> = checked
+            .par_iter()
+            .map(|&(r, v)| crate::accuracy::albedo_twin(white, &cells[r * NOV.len() + v])[0])
+            .collect();
         let mut worst = 0.0f64;
         for (&(r, v), c) in checked.iter().zip(&cpu) {
             let g = e[r][v] as f64;
@@ -118,7 +127,17 @@ pub fn energy_of(gpu: &Gpu, model: &Model) -> Result<Energy> {
         cpu_check = Some(worst);
     }
     let gains_energy = max_e.is_some_and(|m| m > 1.0 + error_bound);
-    Ok(Energy { e, error_bound, max_e, max_at, nonfinite, gains_energy, hemispherical_at_r1: hemi, cpu_check, cpu_check_nonfinite })
+    Ok(Energy {
+        e,
+        error_bound,
+        max_e,
+        max_at,
+        nonfinite,
+        gains_energy,
+        hemispherical_at_r1: hemi,
+        cpu_check,
+        cpu_check_nonfinite,
+    })
 }
 
 /// Computes energy once per distinct white model and attaches it to every result.
@@ -178,9 +197,16 @@ pub fn furnace_png(path: &Path, entries: &[(String, &Energy)]) -> Result<()> {
     png::render(path, width, height, |root| {
         let err = |e: &dyn std::fmt::Display| anyhow!("furnace: {e}");
         let text = |s: &str, x: i32, y: i32, size: i32| Text::new(s.to_string(), (x, y), (png::FONT, size).into_font());
-        root.draw(&text("White furnace: E(NoV) with F = 1 (white = lossless, grey = loss, red = gain, magenta = non-finite)", 10, 10, 16)).map_err(|e| err(&e))?;
+        root.draw(&text(
+            "White furnace: E(NoV) with F = 1 (white = lossless, grey = loss, red = gain, magenta = non-finite)",
+            10,
+            10,
+            16,
+        ))
+        .map_err(|e| err(&e))?;
         for (j, r) in ROUGHNESS.iter().enumerate() {
-            root.draw(&text(&format!("r = {r}"), label_w + j as i32 * cell + 8, header - 24, 16)).map_err(|e| err(&e))?;
+            root.draw(&text(&format!("r = {r}"), label_w + j as i32 * cell + 8, header - 24, 16))
+                .map_err(|e| err(&e))?;
         }
         for (i, (label, energy)) in entries.iter().enumerate() {
             let y0 = header + i as i32 * cell;
@@ -190,10 +216,14 @@ pub fn furnace_png(path: &Path, entries: &[(String, &Energy)]) -> Result<()> {
                 let radius = (cell / 2 - 4) as f64;
                 for py in 0..cell {
                     for px in 0..cell {
-                        let (dx, dy) = ((px as f64 + 0.5 - cell as f64 / 2.0) / radius, (py as f64 + 0.5 - cell as f64 / 2.0) / radius);
+                        let (dx, dy) = (
+                            (px as f64 + 0.5 - cell as f64 / 2.0) / radius,
+                            (py as f64 + 0.5 - cell as f64 / 2.0) / radius,
+                        );
                         let d2 = dx * dx + dy * dy;
                         if d2 < 1.0 {
-                            root.draw_pixel((x0 + px, y0 + py), &furnace_colour(interpolate(row, (1.0 - d2).sqrt()))).map_err(|e| err(&e))?;
+                            root.draw_pixel((x0 + px, y0 + py), &furnace_colour(interpolate(row, (1.0 - d2).sqrt())))
+                                .map_err(|e| err(&e))?;
                         }
                     }
                 }
@@ -209,7 +239,12 @@ pub fn albedo_chart(path: &Path, entries: &[(String, &Energy)]) -> Result<()> {
         .iter()
         .enumerate()
         .map(|(ri, r)| {
-            let series = entries.iter().map(|(label, e)| (label.clone(), NOV.iter().zip(&e.e[ri]).map(|(&v, &x)| (v as f64, (x as f64).min(4.0))).collect())).collect();
+            let series = entries
+                .iter()
+                .map(|(label, e)| {
+                    (label.clone(), NOV.iter().zip(&e.e[ri]).map(|(&v, &x)| (v as f64, (x as f64).min(4.0))).collect())
+                })
+                .collect();
             (format!("r = {r}"), series)
         })
         .collect();

@@ -3,8 +3,8 @@
 //! could (`guards::INPUT_GUARDS`), removes it. For a `.brdf` file, whose formula brdfprof cannot guard, this
 //! is what `--unguarded`'s "what each guard saves" is for a built-in spec.
 
-use crate::brdf::guards::{apply_all_input_guards, unit, INPUT_GUARDS};
 use crate::brdf::Sample;
+use crate::brdf::guards::{INPUT_GUARDS, apply_all_input_guards, unit};
 use crate::gpu::Gpu;
 use crate::kernels::{self, RunLimits};
 use crate::model::Model;
@@ -98,15 +98,27 @@ pub fn result_text(g: &[f32; 3]) -> String {
 
 /// One model's failing inputs at each hard case (`case_models[i]` is the model case i ran) and grid point,
 /// each run again under every input guard alone and all of them together.
-pub fn locate(gpu: &Gpu, case_models: &[(Model, &str, Sample)], case_out: &[[f32; 3]], model: &Model, grid: &[Sample], grid_out: &[[f32; 3]]) -> Result<Failures> {
+pub fn locate(
+    gpu: &Gpu,
+    case_models: &[(Model, &str, Sample)],
+    case_out: &[[f32; 3]],
+    model: &Model,
+    grid: &[Sample],
+    grid_out: &[[f32; 3]],
+) -> Result<Failures> {
     let min_roughness = model.precision().min_roughness();
     let failing_cases: Vec<usize> = (0..case_out.len()).filter(|&i| bad(&case_out[i])).collect();
     let failing_grid: Vec<usize> = (0..grid_out.len()).filter(|&i| bad(&grid_out[i])).collect();
     // (model, sample) per (failing input, guard), None where the guard means no call: batched per model.
     let variants = |s: &Sample| -> Vec<Option<Sample>> {
-        INPUT_GUARDS.iter().map(|g| (g.apply)(s, min_roughness)).chain(std::iter::once(apply_all_input_guards(s, min_roughness))).collect()
+        INPUT_GUARDS
+            .iter()
+            .map(|g| (g.apply)(s, min_roughness))
+            .chain(std::iter::once(apply_all_input_guards(s, min_roughness)))
+            .collect()
     };
-    let names: Vec<String> = INPUT_GUARDS.iter().map(|g| g.name.to_string()).chain(std::iter::once(ALL_GUARDS.to_string())).collect();
+    let names: Vec<String> =
+        INPUT_GUARDS.iter().map(|g| g.name.to_string()).chain(std::iter::once(ALL_GUARDS.to_string())).collect();
     let mut jobs: Vec<(Model, Vec<Sample>)> = Vec::new();
     let mut queue = |m: &Model, s: Sample| -> (usize, usize) {
         let k = match jobs.iter().position(|(j, _)| j == m) {
@@ -131,7 +143,8 @@ pub fn locate(gpu: &Gpu, case_models: &[(Model, &str, Sample)], case_out: &[[f32
         results.push(kernels::eval(gpu, m, samples, RunLimits::default())?);
     }
     // Removed: no call at all, or a finite non-negative result.
-    let removed: Vec<Vec<bool>> = plan.iter().map(|p| p.iter().map(|at| at.is_none_or(|(k, j)| !bad(&results[k][j]))).collect()).collect();
+    let removed: Vec<Vec<bool>> =
+        plan.iter().map(|p| p.iter().map(|at| at.is_none_or(|(k, j)| !bad(&results[k][j]))).collect()).collect();
     let failure = |at: &str, s: &Sample, got: &[f32; 3], removed: &[bool]| Failure {
         at: at.to_string(),
         input: *s,
@@ -140,13 +153,26 @@ pub fn locate(gpu: &Gpu, case_models: &[(Model, &str, Sample)], case_out: &[[f32
         result: result_text(got),
         removed_by: names.iter().zip(removed).filter(|(_, r)| **r).map(|(n, _)| n.clone()).collect(),
     };
-    let cases = failing_cases.iter().zip(&removed).map(|(&i, r)| failure(case_models[i].1, &case_models[i].2, &case_out[i], r)).collect();
+    let cases = failing_cases
+        .iter()
+        .zip(&removed)
+        .map(|(&i, r)| failure(case_models[i].1, &case_models[i].2, &case_out[i], r))
+        .collect();
     let grid_removed = &removed[failing_cases.len()..];
     Ok(Failures {
         cases,
         grid_points: failing_grid.len(),
-        grid_examples: distinct(failing_grid.iter().zip(grid_removed).map(|(&i, r)| failure("grid", &grid[i], &grid_out[i], r))).into_iter().take(GRID_EXAMPLES).collect(),
-        grid_removed_by: names.iter().enumerate().map(|(g, n)| GridRemoval { guard: n.clone(), removes: grid_removed.iter().filter(|r| r[g]).count() }).collect(),
+        grid_examples: distinct(
+            failing_grid.iter().zip(grid_removed).map(|(&i, r)| failure("grid", &grid[i], &grid_out[i], r)),
+        )
+        .into_iter()
+        .take(GRID_EXAMPLES)
+        .collect(),
+        grid_removed_by: names
+            .iter()
+            .enumerate()
+            .map(|(g, n)| GridRemoval { guard: n.clone(), removes: grid_removed.iter().filter(|r| r[g]).count() })
+            .collect(),
     })
 }
 
@@ -177,18 +203,30 @@ impl Failures {
     /// inputs, a term parameter's cases for a model that reads none, share one), then the grid.
     pub fn lines(&self) -> Vec<(usize, String)> {
         let mut out = Vec::new();
-        let same = |a: &Failure, b: &Failure| a.inputs == b.inputs && a.removed_by == b.removed_by && a.result == b.result;
+        let same =
+            |a: &Failure, b: &Failure| a.inputs == b.inputs && a.removed_by == b.removed_by && a.result == b.result;
         for (i, f) in self.cases.iter().enumerate() {
             if self.cases[..i].iter().any(|o| same(o, f)) {
                 continue;
             }
             let names: Vec<String> = self.cases.iter().filter(|o| same(o, f)).map(|o| format!("`{}`", o.at)).collect();
-            let which = if names.len() == 1 { format!("hard case {}", names[0]) } else { format!("hard cases {}", names.join(", ")) };
+            let which = if names.len() == 1 {
+                format!("hard case {}", names[0])
+            } else {
+                format!("hard cases {}", names.join(", "))
+            };
             out.push((0, format!("{which}: {} gives {}; {}", f.inputs, f.result, removed_text(f))));
         }
         if self.grid_points > 0 {
             let by: Vec<String> = self.grid_removed_by.iter().map(|g| format!("`{}` {}", g.guard, g.removes)).collect();
-            out.push((0, format!("grid: {} points; removed by each input guard alone (and by all at once): {}", self.grid_points, by.join(", "))));
+            out.push((
+                0,
+                format!(
+                    "grid: {} points; removed by each input guard alone (and by all at once): {}",
+                    self.grid_points,
+                    by.join(", ")
+                ),
+            ));
             for f in &self.grid_examples {
                 out.push((1, format!("{} gives {}; {}", f.inputs, f.result, removed_text(f))));
             }

@@ -9,12 +9,12 @@ pub mod energy;
 pub mod failures;
 pub mod grid;
 
-pub use check::{check_model, Checks};
+pub use check::{Checks, check_model};
 
 use crate::accuracy::FLOOR;
-use crate::brdf::guards::{unit, GuardSet, SWITCHES};
+use crate::brdf::guards::{GuardSet, SWITCHES, unit};
 use crate::brdf::spec::with_each_param_sample;
-use crate::brdf::{samples, ModelSpec, Precision, Sample, D, F, Vis};
+use crate::brdf::{D, F, ModelSpec, Precision, Sample, Vis, samples};
 use crate::gpu::Gpu;
 
 use crate::model::Model;
@@ -198,7 +198,13 @@ pub struct SpecStability {
 
 /// Bad cells as [roughness index, NoV index, count] triples of the non-empty cells, row by row.
 fn cell_triples(cells: &[Vec<u32>]) -> Vec<[u32; 3]> {
-    cells.iter().enumerate().flat_map(|(r, row)| row.iter().enumerate().filter(|(_, n)| **n > 0).map(move |(v, n)| [r as u32, v as u32, *n])).collect()
+    cells
+        .iter()
+        .enumerate()
+        .flat_map(|(r, row)| {
+            row.iter().enumerate().filter(|(_, n)| **n > 0).map(move |(v, n)| [r as u32, v as u32, *n])
+        })
+        .collect()
 }
 
 fn sparse_cells<S: serde::Serializer>(cells: &Option<Vec<Vec<u32>>>, s: S) -> Result<S::Ok, S::Error> {
@@ -294,7 +300,14 @@ pub fn with_guard_variants(models: Vec<Model>) -> Vec<Model> {
         out.extend(variants);
     }
     let mut seen = Vec::new();
-    out.retain(|m| if seen.contains(m) { false } else { seen.push(m.clone()); true });
+    out.retain(|m| {
+        if seen.contains(m) {
+            false
+        } else {
+            seen.push(m.clone());
+            true
+        }
+    });
     out
 }
 
@@ -317,8 +330,14 @@ fn guard_savings(models: &[Model], specs: &[SpecStability], cases: &[HardCase]) 
     for (i, guarded) in models.iter().enumerate() {
         let Some(g) = guarded.twin().filter(|s| s.guards == GuardSet::ALL) else { continue };
         for (j, without) in models.iter().enumerate() {
-            let Some(w) = without.twin().filter(|w| w.guards != GuardSet::ALL && ModelSpec { guards: GuardSet::ALL, ..**w } == *g) else { continue };
-            let saved = (0..cases.len()).filter(|&k| specs[j].case_deviation[k] > 1.0 && specs[i].case_deviation[k] <= 1.0);
+            let Some(w) = without
+                .twin()
+                .filter(|w| w.guards != GuardSet::ALL && ModelSpec { guards: GuardSet::ALL, ..**w } == *g)
+            else {
+                continue;
+            };
+            let saved =
+                (0..cases.len()).filter(|&k| specs[j].case_deviation[k] > 1.0 && specs[i].case_deviation[k] <= 1.0);
             out.push(GuardSaving {
                 spec: specs[i].spec.clone(),
                 off: w.guards.text(),
@@ -386,7 +405,13 @@ pub fn run(gpu: &Gpu, options: &StabilityOptions, progress: &ProgressBar) -> Res
         energy::attach(gpu, &options.models, &mut specs, progress)?;
     }
     let guard_savings = guard_savings(&options.models, &specs, &cases);
-    Ok(StabilityReport { provenance: crate::export::json::Provenance::new(&gpu.info), specs, grid_points: grid.len(), cases, guard_savings })
+    Ok(StabilityReport {
+        provenance: crate::export::json::Provenance::new(&gpu.info),
+        specs,
+        grid_points: grid.len(),
+        cases,
+        guard_savings,
+    })
 }
 
 /// The "cases out of tolerance" cell, as the Markdown and the HTML page both write it: without a twin or
@@ -423,19 +448,24 @@ fn worst_cell(w: &Worst) -> String {
 /// The max E, hemispherical albedo and E-vs-CPU cells, NaN/Inf cells counted (never a gain, never "inf").
 fn energy_cells(e: &energy::Energy) -> (String, String, String) {
     use crate::export::markdown::sig;
-    let nonfinite = if e.nonfinite > 0 { format!(" ({} of {} cells NaN/Inf)", e.nonfinite, e.cells()) } else { String::new() };
+    let nonfinite =
+        if e.nonfinite > 0 { format!(" ({} of {} cells NaN/Inf)", e.nonfinite, e.cells()) } else { String::new() };
     let max_e = match e.max_e {
-        Some(m) => format!("{}{} (±{:.0e}){nonfinite}", sig(m, 3), if e.gains_energy { " gain" } else { "" }, e.error_bound),
+        Some(m) => {
+            format!("{}{} (±{:.0e}){nonfinite}", sig(m, 3), if e.gains_energy { " gain" } else { "" }, e.error_bound)
+        }
         None => format!("-{nonfinite}"),
     };
     let hemi = if e.hemispherical_at_r1.is_finite() { sig(e.hemispherical_at_r1, 3) } else { "- (NaN/Inf)".into() };
-    let cpu_nonfinite = if e.cpu_check_nonfinite > 0 { format!(" ({} NaN/Inf)", e.cpu_check_nonfinite) } else { String::new() };
+    let cpu_nonfinite =
+        if e.cpu_check_nonfinite > 0 { format!(" ({} NaN/Inf)", e.cpu_check_nonfinite) } else { String::new() };
     (max_e, hemi, format!("{}{cpu_nonfinite}", e.cpu_check.map_or("- (no twin)".into(), |c| format!("{c:.1e}"))))
 }
 
 /// Reciprocity as a table cell, with the values it had to leave out.
 fn reciprocity_cell(s: &SpecStability) -> String {
-    let left_out = if s.reciprocity_nonfinite > 0 { format!(" ({} NaN/Inf)", s.reciprocity_nonfinite) } else { String::new() };
+    let left_out =
+        if s.reciprocity_nonfinite > 0 { format!(" ({} NaN/Inf)", s.reciprocity_nonfinite) } else { String::new() };
     match s.reciprocity {
         Some(r) => format!("{r:.1e}{left_out}"),
         None => format!("-{left_out}"),
@@ -467,9 +497,24 @@ impl StabilityReport {
             self.grid_points
         );
         if !self.provenance.front_ends.is_empty() {
-            out += &format!("{}\n\n", crate::export::markdown::front_ends_line(&self.provenance.front_ends).trim_start());
+            out +=
+                &format!("{}\n\n", crate::export::markdown::front_ends_line(&self.provenance.front_ends).trim_start());
         }
-        let mut t = Table::new(["spec", "NaN", "Inf", "neg", "cases out of tol.", "grid out of tol.", "worst (x tol.)", "jumps", "reciprocity", "max E", "hemi r=1", "E vs CPU", "verdict"]);
+        let mut t = Table::new([
+            "spec",
+            "NaN",
+            "Inf",
+            "neg",
+            "cases out of tol.",
+            "grid out of tol.",
+            "worst (x tol.)",
+            "jumps",
+            "reciprocity",
+            "max E",
+            "hemi r=1",
+            "E vs CPU",
+            "verdict",
+        ]);
         for s in &self.specs {
             let (max_e, hemi, cpu) = s.energy.as_ref().map_or(("-".into(), "-".into(), "-".into()), energy_cells);
             t.row([
@@ -499,11 +544,17 @@ impl StabilityReport {
     /// The hard-case table: how many specs each case puts out of tolerance, and the worst.
     fn cases_markdown(&self) -> String {
         use crate::export::markdown::Table;
-        let mut out = String::from("\n## Hard cases\n\nSpecs out of tolerance per case (fp32 / fp16; without a twin or reference: with a NaN, Inf or negative value), with the worst one.\n\n");
+        let mut out = String::from(
+            "\n## Hard cases\n\nSpecs out of tolerance per case (fp32 / fp16; without a twin or reference: with a NaN, Inf or negative value), with the worst one.\n\n",
+        );
         let mut c = Table::new(["case", "expected", "fp32 out", "fp16 out", "worst spec (x tol.)"]);
         for (i, case) in self.cases.iter().enumerate() {
             let count = |p: &str| self.specs.iter().filter(|s| s.precision == p && s.case_deviation[i] > 1.0).count();
-            let worst = self.specs.iter().max_by(|a, b| a.case_deviation[i].total_cmp(&b.case_deviation[i])).filter(|s| s.case_deviation[i] > 1.0);
+            let worst = self
+                .specs
+                .iter()
+                .max_by(|a, b| a.case_deviation[i].total_cmp(&b.case_deviation[i]))
+                .filter(|s| s.case_deviation[i] > 1.0);
             c.row([
                 case.name.clone(),
                 match case.expect {
@@ -524,7 +575,8 @@ impl StabilityReport {
         let mut out = String::new();
         let failing = self.failing();
         if !failing.is_empty() {
-            let guards: Vec<String> = crate::brdf::guards::INPUT_GUARDS.iter().map(|g| format!("`{}` ({})", g.name, g.does)).collect();
+            let guards: Vec<String> =
+                crate::brdf::guards::INPUT_GUARDS.iter().map(|g| format!("`{}` ({})", g.name, g.does)).collect();
             out += &format!(
                 "\n## Failing specs: where they fail\n\nEvery valid hard case with a NaN, Inf or negative result, the grid points with one (the first {} listed), \
                  and which of brdfprof's guards, applied to the inputs as an engine's caller could, removes each: {}; `{}`: all of them at once.\n\n",
@@ -533,8 +585,14 @@ impl StabilityReport {
                 failures::ALL_GUARDS
             );
             for s in failing {
-                let worst = if s.expected_from.is_some() && s.worst.deviation.is_finite() { format!("; worst deviation {:.2e} x tolerance at {}", s.worst.deviation, s.worst.input) } else { String::new() };
-                out += &s.failures.markdown(&s.label, &format!("{} NaN, {} Inf, {} negative{worst}", s.nan, s.inf, s.negative));
+                let worst = if s.expected_from.is_some() && s.worst.deviation.is_finite() {
+                    format!("; worst deviation {:.2e} x tolerance at {}", s.worst.deviation, s.worst.input)
+                } else {
+                    String::new()
+                };
+                out += &s
+                    .failures
+                    .markdown(&s.label, &format!("{} NaN, {} Inf, {} negative{worst}", s.nan, s.inf, s.negative));
             }
         }
         out
@@ -548,7 +606,12 @@ impl StabilityReport {
                 (Some(e), false) => Some(format!("checked against the {e}'s f64 values")),
                 _ => None,
             };
-            let domain = s.domain.as_ref().map(|d| format!("{d}: {} valid hard cases and {} grid points outside it not counted", s.cases_outside_domain, s.grid_outside_domain));
+            let domain = s.domain.as_ref().map(|d| {
+                format!(
+                    "{d}: {} valid hard cases and {} grid points outside it not counted",
+                    s.cases_outside_domain, s.grid_outside_domain
+                )
+            });
             let said: Vec<String> = against.into_iter().chain(domain).collect();
             if !said.is_empty() {
                 lines.push(format!("- `{}`: {}\n", s.label, said.join("; ")));
@@ -562,12 +625,31 @@ impl StabilityReport {
         if self.guard_savings.is_empty() {
             return String::new();
         }
-        let mut t = crate::export::markdown::Table::new(["spec", "guards", "NaN", "Inf", "neg", "grid out of tol. (more)", "hard cases out of tolerance only without them"]);
+        let mut t = crate::export::markdown::Table::new([
+            "spec",
+            "guards",
+            "NaN",
+            "Inf",
+            "neg",
+            "grid out of tol. (more)",
+            "hard cases out of tolerance only without them",
+        ]);
         for g in &self.guard_savings {
             let cases = if g.cases.is_empty() { "-".to_string() } else { g.cases.join("; ") };
-            t.row([g.spec.clone(), describe_guards(&g.off), g.nan.to_string(), g.inf.to_string(), g.negative.to_string(), g.grid_out_of_tolerance.to_string(), cases]);
+            t.row([
+                g.spec.clone(),
+                describe_guards(&g.off),
+                g.nan.to_string(),
+                g.inf.to_string(),
+                g.negative.to_string(),
+                g.grid_out_of_tolerance.to_string(),
+                cases,
+            ]);
         }
-        format!("\n## What each guard saves\n\nEach spec with all its guards against the same spec with all of them off (`off`), with each one off alone (`off:NAME`: what only that guard saves) and with each one on alone (`off:` all the others: what it saves by itself) (docs/guards.md): the results on valid inputs without them, and the hard cases they keep within tolerance.\n\n{}", t.markdown())
+        format!(
+            "\n## What each guard saves\n\nEach spec with all its guards against the same spec with all of them off (`off`), with each one off alone (`off:NAME`: what only that guard saves) and with each one on alone (`off:` all the others: what it saves by itself) (docs/guards.md): the results on valid inputs without them, and the hard cases they keep within tolerance.\n\n{}",
+            t.markdown()
+        )
     }
 
     /// A heat map per failing spec over (NoV, roughness): bad values per grid cell, one panel each.
@@ -579,7 +661,8 @@ impl StabilityReport {
         }
         // Every failing spec whose grid failed gets a panel (one that failed only in hard cases has no map).
         let failing: Vec<&SpecStability> = all.iter().copied().filter(|s| s.bad_cells.is_some()).collect();
-        let title = format!("Failing specs ({}): NaN, Inf or negative results per (NoV, roughness) grid cell", failing.len());
+        let title =
+            format!("Failing specs ({}): NaN, Inf or negative results per (NoV, roughness) grid cell", failing.len());
         let columns = 6usize.min(failing.len());
         // The title fits the figure's width: about 0.55 em per character.
         let title_size = (300.0 * columns as f64 / (0.55 * title.len() as f64)).min(20.0) as u32;
@@ -614,7 +697,11 @@ impl StabilityReport {
                     .draw_series(cells.iter().enumerate().flat_map(|(r, row)| {
                         row.iter().enumerate().map(move |(v, &n)| {
                             let t = n as f64 / max;
-                            let colour = if n == 0 { RGBColor(235, 235, 235) } else { RGBColor(255, (200.0 * (1.0 - t)) as u8, (60.0 * (1.0 - t)) as u8) };
+                            let colour = if n == 0 {
+                                RGBColor(235, 235, 235)
+                            } else {
+                                RGBColor(255, (200.0 * (1.0 - t)) as u8, (60.0 * (1.0 - t)) as u8)
+                            };
                             Rectangle::new([(v, r), (v + 1, r + 1)], colour.filled())
                         })
                     }))
@@ -640,15 +727,23 @@ impl StabilityReport {
             let white = energy::white(&spec);
             if !seen.contains(&white) {
                 seen.push(white);
-                let label = format!("{}/{}{}", spec.d.name(), spec.vis.name(), if spec.precision == Precision::F16 { " f16" } else { "" });
+                let label = format!(
+                    "{}/{}{}",
+                    spec.d.name(),
+                    spec.vis.name(),
+                    if spec.precision == Precision::F16 { " f16" } else { "" }
+                );
                 entries.push((label, white, s.energy.as_ref().unwrap()));
             }
         }
         if entries.len() > 24 {
-            let presets: Vec<ModelSpec> = crate::brdf::PRESETS.iter().flat_map(|p| {
-                let s = ModelSpec::preset(p.name).unwrap();
-                Precision::ALL.map(|precision| energy::white(&ModelSpec { precision, ..s }))
-            }).collect();
+            let presets: Vec<ModelSpec> = crate::brdf::PRESETS
+                .iter()
+                .flat_map(|p| {
+                    let s = ModelSpec::preset(p.name).unwrap();
+                    Precision::ALL.map(|precision| energy::white(&ModelSpec { precision, ..s }))
+                })
+                .collect();
             entries.retain(|(_, w, _)| presets.contains(w));
         }
         entries.into_iter().map(|(label, _, e)| (label, e)).chain(files).collect()

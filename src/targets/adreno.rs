@@ -13,21 +13,51 @@
 //! registers) is beside it to say how much latency other waves could hide.
 
 use super::cost;
-use crate::schema::cost::TargetCost;
-use super::mesa_noop::{MESA_25_UNVALIDATED, MESA_BACKPORTS, MESA_DEBIAN};
 use super::mesa_noop::shim::{Shim, ShimFamily};
+use super::mesa_noop::{MESA_25_UNVALIDATED, MESA_BACKPORTS, MESA_DEBIAN};
 use crate::schema::InspectReport;
+use crate::schema::cost::TargetCost;
 
 /// The statistics shown beside cycles/eval (Turnip's names).
-const SHOWN: [&str; 6] = ["Instruction Count", "NOPs Count", "Estimated cycles stalled on SS", "Estimated cycles stalled on SY", "Registers used", "Max Waves Per Core"];
+const SHOWN: [&str; 6] = [
+    "Instruction Count",
+    "NOPs Count",
+    "Estimated cycles stalled on SS",
+    "Estimated cycles stalled on SY",
+    "Registers used",
+    "Max Waves Per Core",
+];
 
 const fn family(name: &'static str, gpu_id: &'static str, products: &'static str, detail: &'static str) -> ShimFamily {
-    ShimFamily { name, gpu_id, architecture: "Adreno 6xx", products, detail, default: true, build: &MESA_DEBIAN, without_validation: None }
+    ShimFamily {
+        name,
+        gpu_id,
+        architecture: "Adreno 6xx",
+        products,
+        detail,
+        default: true,
+        build: &MESA_DEBIAN,
+        without_validation: None,
+    }
 }
 
 /// An a7xx GPU: Mesa 22.3's Turnip has none; bookworm-backports' Mesa 25.0 compiles for them.
-const fn family_a7xx(name: &'static str, gpu_id: &'static str, products: &'static str, detail: &'static str) -> ShimFamily {
-    ShimFamily { name, gpu_id, architecture: "Adreno 7xx", products, detail, default: true, build: &MESA_BACKPORTS, without_validation: Some(MESA_25_UNVALIDATED) }
+const fn family_a7xx(
+    name: &'static str,
+    gpu_id: &'static str,
+    products: &'static str,
+    detail: &'static str,
+) -> ShimFamily {
+    ShimFamily {
+        name,
+        gpu_id,
+        architecture: "Adreno 7xx",
+        products,
+        detail,
+        default: true,
+        build: &MESA_BACKPORTS,
+        without_validation: Some(MESA_25_UNVALIDATED),
+    }
 }
 
 pub static ADRENO: Shim = Shim {
@@ -58,14 +88,19 @@ pub static ADRENO: Shim = Shim {
 /// One wave's issue cycles per fibre and light (the module's rule).
 fn cycles_per_eval(stats: &std::collections::BTreeMap<String, f64>, lights: u32) -> Option<f64> {
     let instructions = cost::driver_stat(stats, "Instruction Count")?;
-    let stalls = cost::driver_stat(stats, "Estimated cycles stalled on SS").unwrap_or(0.0) + cost::driver_stat(stats, "Estimated cycles stalled on SY").unwrap_or(0.0);
+    let stalls = cost::driver_stat(stats, "Estimated cycles stalled on SS").unwrap_or(0.0)
+        + cost::driver_stat(stats, "Estimated cycles stalled on SY").unwrap_or(0.0);
     let fibres = stats.get(crate::schema::driver::SUBGROUP_SIZE).copied().filter(|s| *s > 0.0)?;
     Some((instructions + stalls) / (fibres * f64::from(lights)))
 }
 
 fn cost_table(shim: &Shim, family: &ShimFamily, report: &InspectReport) -> Option<TargetCost> {
     let rule = "cycles/eval = (Instruction Count, NOPs included + Estimated cycles stalled on SS + on SY) / (subgroupSize x lights per kernel): one wave's issue slots and ir3's own stall estimates (ir3.c collect_info), one instruction per wave per cycle, no latency hidden by other waves (Max Waves Per Core beside it)";
-    cost::table(report, shim.header(family, report, rule.into(), "wave issue cycles per fibre", &SHOWN), cycles_per_eval)
+    cost::table(
+        report,
+        shim.header(family, report, rule.into(), "wave issue cycles per fibre", &SHOWN),
+        cycles_per_eval,
+    )
 }
 
 #[cfg(test)]
@@ -89,7 +124,8 @@ mod tests {
         };
         let mut report = crate::schema::tests::empty_report("Turnip Adreno (TM) 660");
         report.provenance["target"] = "adreno:a660".into();
-        report.rows = vec![row("ggx", 1000.0, 20.0, 4.0, 64.0), row(crate::model::BASELINE_LABEL, 300.0, 0.0, 20.0, 128.0)];
+        report.rows =
+            vec![row("ggx", 1000.0, 20.0, 4.0, 64.0), row(crate::model::BASELINE_LABEL, 300.0, 0.0, 20.0, 128.0)];
         let t = super::super::Vendor::cost(&ADRENO, &report).unwrap();
         let lights = f64::from(t.lights_per_kernel);
         assert_eq!(t.target.as_deref(), Some("adreno:a660"));

@@ -10,15 +10,30 @@
 //! subgroupSize (ANV reports the dispatch width there).
 
 use super::cost;
-use crate::schema::cost::TargetCost;
 use super::mesa_noop::shim::{Shim, ShimFamily};
 use crate::schema::InspectReport;
+use crate::schema::cost::TargetCost;
 
 /// The statistics shown beside cycles/eval (ANV's names).
 const SHOWN: [&str; 5] = ["Instruction Count", "SEND Count", "Cycle Count", "Spill Count", "Fill Count"];
 
-const fn family(name: &'static str, gpu_id: &'static str, architecture: &'static str, products: &'static str, detail: &'static str) -> ShimFamily {
-    ShimFamily { name, gpu_id, architecture, products, detail, default: true, build: &super::mesa_noop::MESA_DEBIAN, without_validation: None }
+const fn family(
+    name: &'static str,
+    gpu_id: &'static str,
+    architecture: &'static str,
+    products: &'static str,
+    detail: &'static str,
+) -> ShimFamily {
+    ShimFamily {
+        name,
+        gpu_id,
+        architecture,
+        products,
+        detail,
+        default: true,
+        build: &super::mesa_noop::MESA_DEBIAN,
+        without_validation: None,
+    }
 }
 
 pub static ANV: Shim = Shim {
@@ -67,7 +82,11 @@ mod tests {
         let row = |model: &str, cycles: f64, simd: f64| Row {
             model: model.into(),
             spec: None,
-            stats: [("driver/Compute Shader/Cycle Count".to_string(), cycles), (crate::schema::driver::SUBGROUP_SIZE.to_string(), simd)].into(),
+            stats: [
+                ("driver/Compute Shader/Cycle Count".to_string(), cycles),
+                (crate::schema::driver::SUBGROUP_SIZE.to_string(), simd),
+            ]
+            .into(),
             notes: Default::default(),
         };
         let mut report = crate::schema::tests::empty_report("Intel(R) Xe Graphics (TGL GT2)");

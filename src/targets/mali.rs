@@ -18,13 +18,13 @@
 //! varying 16, texture 4, load/store 1 ("Mali G78 peak performance"), the bound their max, read by the same rule.
 
 use super::cost;
-use crate::schema::cost::TargetCost;
-use super::mesa_noop::{MESA_25_UNVALIDATED, MESA_BACKPORTS, MESA_DEBIAN};
 use super::mesa_noop::shim::{Shim, ShimFamily};
+use super::mesa_noop::{MESA_25_UNVALIDATED, MESA_BACKPORTS, MESA_DEBIAN};
 use crate::gpu::{CompilerLog, DriverStat};
-use crate::schema::InspectReport;
 use crate::model::BASELINE_LABEL;
-use anyhow::{anyhow, bail, Result};
+use crate::schema::InspectReport;
+use crate::schema::cost::TargetCost;
+use anyhow::{Result, anyhow, bail};
 
 /// The prefix of the compiler's statistics lines (`fprintf(stderr, "SHADER-DB: %s\n", ...)`).
 const LINE_PREFIX: &str = "SHADER-DB: ";
@@ -64,8 +64,10 @@ const PIPES: [(&str, &str); 7] = [
 ];
 
 /// The statistics shown beside cycles/eval.
-const SHOWN_BIFROST: [&str; 7] = ["Instructions", "Tuples", "Clauses", "Arithmetic cycles", "Load-store cycles", "Bound cycles", "Threads"];
-const SHOWN_VALHALL: [&str; 7] = ["Instructions", "FMA cycles", "CVT cycles", "SFU cycles", "Load-store cycles", "Bound cycles", "Threads"];
+const SHOWN_BIFROST: [&str; 7] =
+    ["Instructions", "Tuples", "Clauses", "Arithmetic cycles", "Load-store cycles", "Bound cycles", "Threads"];
+const SHOWN_VALHALL: [&str; 7] =
+    ["Instructions", "FMA cycles", "CVT cycles", "SFU cycles", "Load-store cycles", "Bound cycles", "Threads"];
 
 /// Why PanVK 22.3 (Bifrost) runs unvalidated; Mesa 25.0's PanVK (Vulkan 1.1) for `MESA_25_UNVALIDATED`'s reason.
 const PANVK_22_UNVALIDATED: &str = "PanVK 22.3 is a Vulkan 1.0 driver, and brdfprof's kernels are SPIR-V 1.3 (Vulkan 1.1), which the layer refuses on a 1.0 device; the driver compiles them (Mesa's SPIR-V front end reads any version), so its figures stand, unvalidated";
@@ -86,9 +88,36 @@ pub static MALI: Shim = Shim {
     // thread per core where v7 runs two (bi_print_stats: two only on v7 with <= 32 work registers), so it is
     // listed and they are not (docs/targets/mali.md).
     families: &[
-        ShimFamily { name: "g52", gpu_id: "0x7212", architecture: "Bifrost (v7)", products: "Mali-G52 (Rockchip RK3566/RK3568, Amlogic S922X)", detail: "PAN_GPU_ID=0x7212, Bifrost v7", default: true, build: &MESA_DEBIAN, without_validation: Some(PANVK_22_UNVALIDATED) },
-        ShimFamily { name: "g72", gpu_id: "0x6221", architecture: "Bifrost (v6)", products: "Mali-G72 (Exynos 9810, Kirin 970, Helio P60)", detail: "PAN_GPU_ID=0x6221, Bifrost v6", default: true, build: &MESA_DEBIAN, without_validation: Some(PANVK_22_UNVALIDATED) },
-        ShimFamily { name: "g610", gpu_id: "0xa867", architecture: "Valhall (v10)", products: "Mali-G610 (Rockchip RK3588, MediaTek Dimensity 1080)", detail: "PAN_GPU_ID=0xa867, Valhall v10, Mesa 25.0", default: true, build: &MESA_BACKPORTS, without_validation: Some(MESA_25_UNVALIDATED) },
+        ShimFamily {
+            name: "g52",
+            gpu_id: "0x7212",
+            architecture: "Bifrost (v7)",
+            products: "Mali-G52 (Rockchip RK3566/RK3568, Amlogic S922X)",
+            detail: "PAN_GPU_ID=0x7212, Bifrost v7",
+            default: true,
+            build: &MESA_DEBIAN,
+            without_validation: Some(PANVK_22_UNVALIDATED),
+        },
+        ShimFamily {
+            name: "g72",
+            gpu_id: "0x6221",
+            architecture: "Bifrost (v6)",
+            products: "Mali-G72 (Exynos 9810, Kirin 970, Helio P60)",
+            detail: "PAN_GPU_ID=0x6221, Bifrost v6",
+            default: true,
+            build: &MESA_DEBIAN,
+            without_validation: Some(PANVK_22_UNVALIDATED),
+        },
+        ShimFamily {
+            name: "g610",
+            gpu_id: "0xa867",
+            architecture: "Valhall (v10)",
+            products: "Mali-G610 (Rockchip RK3588, MediaTek Dimensity 1080)",
+            detail: "PAN_GPU_ID=0xa867, Valhall v10, Mesa 25.0",
+            default: true,
+            build: &MESA_BACKPORTS,
+            without_validation: Some(MESA_25_UNVALIDATED),
+        },
     ],
     cost: cost_table,
     noise: &[],
@@ -98,23 +127,39 @@ pub static MALI: Shim = Shim {
 /// One pipeline's stderr: its compute shader's `SHADER-DB:` line as statistics, the other lines passed on.
 pub fn read_shaderdb(log: &str) -> Result<(Vec<DriverStat>, Vec<String>)> {
     let (lines, rest): (Vec<&str>, Vec<&str>) = log.lines().partition(|l| l.starts_with(LINE_PREFIX));
-    let compute: Vec<&str> = lines.iter().filter_map(|l| l[LINE_PREFIX.len()..].strip_prefix("MESA_SHADER_COMPUTE shader: ")).collect();
+    let compute: Vec<&str> =
+        lines.iter().filter_map(|l| l[LINE_PREFIX.len()..].strip_prefix("MESA_SHADER_COMPUTE shader: ")).collect();
     let line = match compute.as_slice() {
         [one] => *one,
-        [] => bail!("the Bifrost compiler printed no `SHADER-DB: MESA_SHADER_COMPUTE` line (is BIFROST_MESA_DEBUG=shaderdb reaching the driver?)"),
+        [] => bail!(
+            "the Bifrost compiler printed no `SHADER-DB: MESA_SHADER_COMPUTE` line (is BIFROST_MESA_DEBUG=shaderdb reaching the driver?)"
+        ),
         many => bail!("the Bifrost compiler printed {} compute-shader statistics lines for one pipeline", many.len()),
     };
     let mut stats = Vec::new();
-    let mut stat = |name: &str, value: f64| stats.push(DriverStat { executable: crate::gpu::LOGGED_EXECUTABLE.into(), name: name.into(), description: format!("Bifrost compiler (bi_print_stats; va_print_stats for Valhall): {name}"), value });
+    let mut stat = |name: &str, value: f64| {
+        stats.push(DriverStat {
+            executable: crate::gpu::LOGGED_EXECUTABLE.into(),
+            name: name.into(),
+            description: format!("Bifrost compiler (bi_print_stats; va_print_stats for Valhall): {name}"),
+            value,
+        })
+    };
     for field in line.split(", ") {
-        let (number, word) = field.trim().split_once(' ').ok_or_else(|| anyhow!("unreadable field `{field}` in `{line}`"))?;
+        let (number, word) =
+            field.trim().split_once(' ').ok_or_else(|| anyhow!("unreadable field `{field}` in `{line}`"))?;
         if word == "spills:fills" {
-            let (spills, fills) = number.split_once(':').ok_or_else(|| anyhow!("unreadable spills:fills `{number}` in `{line}`"))?;
+            let (spills, fills) =
+                number.split_once(':').ok_or_else(|| anyhow!("unreadable spills:fills `{number}` in `{line}`"))?;
             stat("Spills", spills.parse()?);
             stat("Fills", fills.parse()?);
             continue;
         }
-        let name = FIELDS.iter().find(|(w, _)| *w == word).map(|(_, n)| *n).ok_or_else(|| anyhow!("unknown field `{word}` in `{line}`"))?;
+        let name = FIELDS
+            .iter()
+            .find(|(w, _)| *w == word)
+            .map(|(_, n)| *n)
+            .ok_or_else(|| anyhow!("unknown field `{word}` in `{line}`"))?;
         stat(name, number.parse().map_err(|e| anyhow!("`{number}` in `{line}`: {e}"))?);
     }
     Ok((stats, rest.into_iter().map(str::to_string).collect()))
@@ -123,16 +168,28 @@ pub fn read_shaderdb(log: &str) -> Result<(Vec<DriverStat>, Vec<String>)> {
 fn cost_table(shim: &Shim, family: &ShimFamily, report: &InspectReport) -> Option<TargetCost> {
     let valhall = family.architecture.starts_with("Valhall");
     let (rule, shown) = if valhall {
-        ("cycles/eval = Valhall's bound (max of its FMA, CVT, SFU, varying, texture and load/store cycles per thread, va_print_stats) / lights per kernel; net = max over pipes of (kernel - memory-only kernel) / lights, the binding pipe named", &SHOWN_VALHALL)
+        (
+            "cycles/eval = Valhall's bound (max of its FMA, CVT, SFU, varying, texture and load/store cycles per thread, va_print_stats) / lights per kernel; net = max over pipes of (kernel - memory-only kernel) / lights, the binding pipe named",
+            &SHOWN_VALHALL,
+        )
     } else {
-        ("cycles/eval = Bifrost's bound (max of its arithmetic, texture, varying and load/store cycles per thread, bi_print_stats) / lights per kernel; net = max over pipes of (kernel - memory-only kernel) / lights, the binding pipe named", &SHOWN_BIFROST)
+        (
+            "cycles/eval = Bifrost's bound (max of its arithmetic, texture, varying and load/store cycles per thread, bi_print_stats) / lights per kernel; net = max over pipes of (kernel - memory-only kernel) / lights, the binding pipe named",
+            &SHOWN_BIFROST,
+        )
     };
     let unit = if valhall { "Valhall cycles per thread" } else { "Bifrost cycles per thread" };
-    let mut t = cost::table(report, shim.header(family, report, rule.into(), unit, shown), |stats, lights| cost::driver_stat(stats, "Bound cycles").map(|c| c / f64::from(lights)))?;
+    let mut t = cost::table(report, shim.header(family, report, rule.into(), unit, shown), |stats, lights| {
+        cost::driver_stat(stats, "Bound cycles").map(|c| c / f64::from(lights))
+    })?;
     // The pipes the compiler reported for a kernel (its architecture's), by PIPES' index.
     let pipes = |model: &str| -> Option<Vec<(usize, f64)>> {
         let row = report.rows.iter().find(|r| r.model == model)?;
-        let found: Vec<(usize, f64)> = PIPES.iter().enumerate().filter_map(|(k, (name, _))| cost::driver_stat(&row.stats, name).map(|v| (k, v))).collect();
+        let found: Vec<(usize, f64)> = PIPES
+            .iter()
+            .enumerate()
+            .filter_map(|(k, (name, _))| cost::driver_stat(&row.stats, name).map(|v| (k, v)))
+            .collect();
         (!found.is_empty()).then_some(found)
     };
     let base = pipes(BASELINE_LABEL);
@@ -143,7 +200,10 @@ fn cost_table(shim: &Shim, family: &ShimFamily, report: &InspectReport) -> Optio
             continue;
         };
         let added = mine.iter().filter_map(|&(k, m)| base.iter().find(|(b, _)| *b == k).map(|&(_, b)| (k, m - b)));
-        let Some((k, net)) = added.fold(None, |best: Option<(usize, f64)>, (k, v)| if best.is_none_or(|(_, b)| v > b) { Some((k, v)) } else { best }) else {
+        let Some((k, net)) = added.fold(
+            None,
+            |best: Option<(usize, f64)>, (k, v)| if best.is_none_or(|(_, b)| v > b) { Some((k, v)) } else { best },
+        ) else {
             r.net_cycles_per_eval = None;
             continue;
         };
@@ -164,17 +224,27 @@ mod tests {
     fn reads_the_compute_line_and_passes_the_rest_on() {
         let (stats, rest) = read_shaderdb(&format!("drm-shim: hello\n{GGX}\n")).unwrap();
         let get = |n: &str| stats.iter().find(|s| s.name == n).map(|s| s.value);
-        assert_eq!((get("Instructions"), get("Arithmetic cycles"), get("Load-store cycles"), get("Bound cycles")), (Some(174.0), Some(5.75), Some(8.0), Some(8.0)));
+        assert_eq!(
+            (get("Instructions"), get("Arithmetic cycles"), get("Load-store cycles"), get("Bound cycles")),
+            (Some(174.0), Some(5.75), Some(8.0), Some(8.0))
+        );
         assert_eq!((get("Spills"), get("Fills"), get("Preloads")), (Some(1.0), Some(2.0), Some(3.0)));
         assert_eq!(rest, vec!["drm-shim: hello".to_string()]);
         assert!(read_shaderdb("nothing here").unwrap_err().to_string().contains("no `SHADER-DB"));
         assert!(read_shaderdb(&format!("{GGX}\n{GGX}")).unwrap_err().to_string().contains("2 compute-shader"));
-        assert!(read_shaderdb(&GGX.replace("tuples", "tupels")).unwrap_err().to_string().contains("unknown field `tupels`"));
+        assert!(
+            read_shaderdb(&GGX.replace("tuples", "tupels")).unwrap_err().to_string().contains("unknown field `tupels`")
+        );
     }
 
     /// A row with the compiler's statistics `stats` (name, value).
     fn pipe_row(model: &str, stats: &[(&str, f64)]) -> Row {
-        Row { model: model.into(), spec: None, stats: stats.iter().map(|(k, v)| (format!("driver/Compute Shader/{k}"), *v)).collect(), notes: Default::default() }
+        Row {
+            model: model.into(),
+            spec: None,
+            stats: stats.iter().map(|(k, v)| (format!("driver/Compute Shader/{k}"), *v)).collect(),
+            notes: Default::default(),
+        }
     }
 
     /// The cost table of `rows` as `target`'s child would report them.
@@ -191,9 +261,29 @@ mod tests {
     fn reads_valhalls_line_and_prices_its_fma_pipe() {
         let (stats, _) = read_shaderdb(VALHALL).unwrap();
         let get = |n: &str| stats.iter().find(|s| s.name == n).map(|s| s.value);
-        assert_eq!((get("FMA cycles"), get("SFU cycles"), get("Texture cycles"), get("Load-store cycles"), get("Bound cycles")), (Some(7.921875), Some(3.5), Some(0.25), Some(18.0), Some(18.0)));
+        assert_eq!(
+            (
+                get("FMA cycles"),
+                get("SFU cycles"),
+                get("Texture cycles"),
+                get("Load-store cycles"),
+                get("Bound cycles")
+            ),
+            (Some(7.921875), Some(3.5), Some(0.25), Some(18.0), Some(18.0))
+        );
         let row = |model: &str, fma: f64, sfu: f64| {
-            pipe_row(model, &[("FMA cycles", fma), ("CVT cycles", 1.0), ("SFU cycles", sfu), ("Texture cycles", 0.0), ("Varying cycles", 0.0), ("Load-store cycles", 18.0), ("Bound cycles", 18.0)])
+            pipe_row(
+                model,
+                &[
+                    ("FMA cycles", fma),
+                    ("CVT cycles", 1.0),
+                    ("SFU cycles", sfu),
+                    ("Texture cycles", 0.0),
+                    ("Varying cycles", 0.0),
+                    ("Load-store cycles", 18.0),
+                    ("Bound cycles", 18.0),
+                ],
+            )
         };
         let t = cost_of("mali:g610", "Mali-G610 (Panfrost)", vec![row("ggx", 7.9, 3.5), row(BASELINE_LABEL, 1.5, 1.0)]);
         let lights = f64::from(t.lights_per_kernel);
@@ -205,7 +295,16 @@ mod tests {
     #[test]
     fn net_is_the_bound_of_the_added_work_per_pipe() {
         let row = |model: &str, arith: f64, ldst: f64| {
-            pipe_row(model, &[("Arithmetic cycles", arith), ("Texture cycles", 0.0), ("Varying cycles", 0.0), ("Load-store cycles", ldst), ("Bound cycles", arith.max(ldst))])
+            pipe_row(
+                model,
+                &[
+                    ("Arithmetic cycles", arith),
+                    ("Texture cycles", 0.0),
+                    ("Varying cycles", 0.0),
+                    ("Load-store cycles", ldst),
+                    ("Bound cycles", arith.max(ldst)),
+                ],
+            )
         };
         let t = cost_of("mali:g52", "Mali-G52 (Panfrost)", vec![row("ggx", 5.75, 8.0), row(BASELINE_LABEL, 1.5, 8.0)]);
         let lights = f64::from(t.lights_per_kernel);

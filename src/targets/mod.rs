@@ -21,11 +21,11 @@ pub mod radv;
 pub mod translated;
 
 use crate::gpu::Gpu;
-use crate::schema::InspectReport;
 use crate::model::Model;
-use crate::shaders::Shaders;
-use anyhow::{anyhow, bail, Result};
+use crate::schema::InspectReport;
 use crate::schema::cost::TargetCost;
+use crate::shaders::Shaders;
+use anyhow::{Result, anyhow, bail};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
@@ -127,7 +127,8 @@ pub trait Vendor: Sync {
 }
 
 /// Every vendor: the one list (a new compiler lands here and in its own file or folder).
-pub static VENDORS: [&dyn Vendor; 6] = [&radv::RADV, &nvidia::NVIDIA, &intel::INTEL, &adreno::ADRENO, &mali::MALI, &anv::ANV];
+pub static VENDORS: [&dyn Vendor; 6] =
+    [&radv::RADV, &nvidia::NVIDIA, &intel::INTEL, &adreno::ADRENO, &mali::MALI, &anv::ANV];
 
 /// One family of one vendor.
 #[derive(Clone, Copy)]
@@ -186,7 +187,14 @@ pub fn prefixes() -> String {
 pub fn parse(device: &str) -> Result<Option<Vec<Target>>> {
     let Some((vendor, rest)) = vendor_of(device) else { return Ok(None) };
     let families = vendor.families();
-    let known = || format!("{} (or `{}:{ALL}` for {})", families.iter().map(|f| f.name).collect::<Vec<_>>().join(", "), vendor.prefix(), families.iter().filter(|f| f.default).map(|f| f.name).collect::<Vec<_>>().join(", "));
+    let known = || {
+        format!(
+            "{} (or `{}:{ALL}` for {})",
+            families.iter().map(|f| f.name).collect::<Vec<_>>().join(", "),
+            vendor.prefix(),
+            families.iter().filter(|f| f.default).map(|f| f.name).collect::<Vec<_>>().join(", ")
+        )
+    };
     if rest.trim().is_empty() {
         bail!("`{device}`: give a family after `{}:`; known: {}", vendor.prefix(), known());
     }
@@ -195,7 +203,12 @@ pub fn parse(device: &str) -> Result<Option<Vec<Target>>> {
         let found: Vec<usize> = if name.eq_ignore_ascii_case(ALL) {
             (0..families.len()).filter(|&k| families[k].default).collect()
         } else {
-            vec![families.iter().position(|f| f.name.eq_ignore_ascii_case(name)).ok_or_else(|| anyhow!("unknown {} family `{name}`; known: {}", vendor.name(), known()))?]
+            vec![
+                families
+                    .iter()
+                    .position(|f| f.name.eq_ignore_ascii_case(name))
+                    .ok_or_else(|| anyhow!("unknown {} family `{name}`; known: {}", vendor.name(), known()))?,
+            ]
         };
         for family in found {
             let t = Target { vendor, family };
@@ -209,7 +222,10 @@ pub fn parse(device: &str) -> Result<Option<Vec<Target>>> {
 
 /// `compile(vendor, its families)` for every vendor among `targets`, each vendor's families at once; results in
 /// `targets` order.
-fn vendor_by_vendor(targets: &[Target], mut compile: impl FnMut(&dyn Vendor, &[usize]) -> Result<Vec<Run>>) -> Result<Vec<Run>> {
+fn vendor_by_vendor(
+    targets: &[Target],
+    mut compile: impl FnMut(&dyn Vendor, &[usize]) -> Result<Vec<Run>>,
+) -> Result<Vec<Run>> {
     let mut runs: Vec<Option<Run>> = targets.iter().map(|_| None).collect();
     for vendor in VENDORS {
         let mine: Vec<usize> = (0..targets.len()).filter(|&k| targets[k].vendor.prefix() == vendor.prefix()).collect();
@@ -229,7 +245,10 @@ fn vendor_by_vendor(targets: &[Target], mut compile: impl FnMut(&dyn Vendor, &[u
 pub fn compile_all(targets: &[Target], request: &Request) -> Result<Vec<Run>> {
     let mut runs = vendor_by_vendor(targets, |vendor, families| {
         if vendor.needs_verification() && request.verify_on.is_none() {
-            bail!("{}: its costs are of a translation that must first run against a Vulkan device, and none was opened", vendor.prefix());
+            bail!(
+                "{}: its costs are of a translation that must first run against a Vulkan device, and none was opened",
+                vendor.prefix()
+            );
         }
         vendor.compile(families, request)
     })?;
@@ -250,7 +269,12 @@ pub const HARNESS_NOTE: &str = "harness";
 /// kernel carries (the G-buffer and light loads, the R11G11B10F store), whose cost differs between targets.
 pub fn harness_note(cost: &TargetCost) -> Option<String> {
     let base = cost.row(crate::model::BASELINE_LABEL)?.cycles_per_eval;
-    let shares: Vec<String> = cost.rows.iter().filter(|r| r.model != crate::model::BASELINE_LABEL && r.cycles_per_eval > 0.0).map(|r| format!("{} {:.0}%", r.model, 100.0 * base / r.cycles_per_eval)).collect();
+    let shares: Vec<String> = cost
+        .rows
+        .iter()
+        .filter(|r| r.model != crate::model::BASELINE_LABEL && r.cycles_per_eval > 0.0)
+        .map(|r| format!("{} {:.0}%", r.model, 100.0 * base / r.cycles_per_eval))
+        .collect();
     (!shares.is_empty()).then(|| format!("Harness share on {} (the memory-only kernel's cycles/eval as a share of each kernel's: the G-buffer and light loads and the R11G11B10F store every kernel carries): {}.", cost.label(), shares.join(", ")))
 }
 
@@ -287,6 +311,9 @@ pub fn device_slug(device: &crate::gpu::DeviceInfo) -> String {
 
 /// File-name form of a kernel label.
 pub fn file_slug(label: &str) -> String {
-    let s: String = label.chars().map(|c| if c.is_ascii_alphanumeric() || c == '.' { c.to_ascii_lowercase() } else { '-' }).collect();
+    let s: String = label
+        .chars()
+        .map(|c| if c.is_ascii_alphanumeric() || c == '.' { c.to_ascii_lowercase() } else { '-' })
+        .collect();
     s.trim_matches('-').to_string()
 }

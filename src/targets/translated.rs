@@ -5,7 +5,10 @@
 //! cost per source line. What differs is a `Translator`: the vendor's table of families (with the rates its
 //! parser charges), its compiler and its listing parser.
 
-use super::cost::{self, schedule::{self, Schedule}};
+use super::cost::{
+    self,
+    schedule::{self, Schedule},
+};
 use super::{Family, RawKernel, Request, Run, Target, Vendor};
 use crate::gpu::{DriverStat, Gpu};
 use crate::kernel_stats::{compiled_report, kernels_of, static_row};
@@ -13,7 +16,7 @@ use crate::model::Model;
 use crate::schema::cost::TargetCost;
 use crate::schema::{InspectReport, Row};
 use crate::translate::Dialect;
-use anyhow::{anyhow, Result};
+use anyhow::{Result, anyhow};
 use std::collections::BTreeMap;
 use std::marker::PhantomData;
 use std::path::Path;
@@ -70,7 +73,13 @@ pub trait Translator: Sync + 'static {
     fn isa_listing(family: &Self::Family, label: &str, binary: &Self::Binary, tools: &Self::Tools) -> Result<String>;
     /// A model's line-annotated `source` compiled for `family`, its line costs, and the instruction sequences
     /// of that compile and of the costed one (`costed`, the checked translation).
-    fn line_compile(model: &Model, source: &str, costed: &str, family: &Self::Family, precise: bool) -> Result<LineCompile>;
+    fn line_compile(
+        model: &Model,
+        source: &str,
+        costed: &str,
+        family: &Self::Family,
+        precise: bool,
+    ) -> Result<LineCompile>;
 }
 
 /// A translating vendor's compile-only targets.
@@ -93,24 +102,42 @@ impl<C: Translator> Translated<C> {
     /// per family, in order), after each translation agreed with its Vulkan kernel.
     fn inspect(&self, families: &[&C::Family], req: &Request) -> Result<Vec<InspectReport>> {
         let tools = C::tools()?;
-        let gpu = req.verify_on.ok_or_else(|| anyhow!("{}: no Vulkan device to check the translation against", C::PREFIX))?;
+        let gpu =
+            req.verify_on.ok_or_else(|| anyhow!("{}: no Vulkan device to check the translation against", C::PREFIX))?;
         let checked = checked_translations(req, gpu, C::DIALECT)?;
-        let statics = kernels_of(req.models).into_iter().map(|m| static_row(req.shaders, m, req.lights)).collect::<Result<Vec<_>>>()?;
+        let statics = kernels_of(req.models)
+            .into_iter()
+            .map(|m| static_row(req.shaders, m, req.lights))
+            .collect::<Result<Vec<_>>>()?;
         let mut reports = self.compile_checked(families, statics, &checked, tools, req)?;
-        add_lines(&mut reports, families, req, &checked, C::DIALECT, |m, source, costed, family| C::line_compile(m, source, costed, family, req.precise))?;
+        add_lines(&mut reports, families, req, &checked, C::DIALECT, |m, source, costed, family| {
+            C::line_compile(m, source, costed, family, req.precise)
+        })?;
         Ok(reports)
     }
 
     /// Every checked translation compiled for each family, its statistics added to its row (`statics`, in the
     /// same order), as one report per family.
-    fn compile_checked(&self, families: &[&C::Family], statics: Vec<Row>, checked: &[Checked], tools: &C::Tools, req: &Request) -> Result<Vec<InspectReport>> {
-        let jobs: Vec<(usize, usize)> = (0..families.len()).flat_map(|f| (0..checked.len()).map(move |k| (f, k))).collect();
+    fn compile_checked(
+        &self,
+        families: &[&C::Family],
+        statics: Vec<Row>,
+        checked: &[Checked],
+        tools: &C::Tools,
+        req: &Request,
+    ) -> Result<Vec<InspectReport>> {
+        let jobs: Vec<(usize, usize)> =
+            (0..families.len()).flat_map(|f| (0..checked.len()).map(move |k| (f, k))).collect();
         // Compiles are independent (NVRTC's API is thread-safe; ocloc is a process): one job per core.
         use rayon::prelude::*;
         let (sources, precise): (Vec<&str>, bool) = (checked.iter().map(|c| c.source.as_str()).collect(), req.precise);
-        let compiled: Vec<Result<C::Binary>> = jobs.par_iter().map(|&(f, k)| C::compile(sources[k], families[f], precise)).collect();
+        let compiled: Vec<Result<C::Binary>> =
+            jobs.par_iter().map(|&(f, k)| C::compile(sources[k], families[f], precise)).collect();
         // A family without what a kernel needs leaves it out with the reason; any other failure stops.
-        let compiled: Vec<std::result::Result<C::Binary, String>> = compiled.into_iter().map(|r| r.map(Ok).or_else(|e| C::unsupported(&e).map(Err).ok_or(e))).collect::<Result<_>>()?;
+        let compiled: Vec<std::result::Result<C::Binary, String>> = compiled
+            .into_iter()
+            .map(|r| r.map(Ok).or_else(|e| C::unsupported(&e).map(Err).ok_or(e)))
+            .collect::<Result<_>>()?;
         let mut reports = Vec::new();
         for (f, family) in families.iter().enumerate() {
             let mut rows = statics.clone();
@@ -133,7 +160,12 @@ impl<C: Translator> Translated<C> {
             let compilation = C::compilation(family, device_name::<C>(family), tools, req.precise);
             let mut report = translated_report(self, compilation, rows, req);
             if !left_out.is_empty() {
-                let note = format!("not compiled for {}:{}: {}", C::PREFIX, C::family(family).name, left_out.iter().map(|(m, why)| format!("{m} ({why})")).collect::<Vec<_>>().join("; "));
+                let note = format!(
+                    "not compiled for {}:{}: {}",
+                    C::PREFIX,
+                    C::family(family).name,
+                    left_out.iter().map(|(m, why)| format!("{m} ({why})")).collect::<Vec<_>>().join("; ")
+                );
                 crate::messages::warning(&note);
                 report.section_notes.insert("driver/".into(), note);
             }
@@ -143,7 +175,16 @@ impl<C: Translator> Translated<C> {
     }
 
     fn runs(reports: Vec<InspectReport>, families: &[usize]) -> Vec<Run> {
-        reports.into_iter().zip(families).map(|(report, &family)| Run { target: Target { vendor: C::vendor(), family }, report, isa_files: Vec::new(), note: None }).collect()
+        reports
+            .into_iter()
+            .zip(families)
+            .map(|(report, &family)| Run {
+                target: Target { vendor: C::vendor(), family },
+                report,
+                isa_files: Vec::new(),
+                note: None,
+            })
+            .collect()
     }
 
     fn chosen(families: &[usize]) -> Vec<&'static C::Family> {
@@ -152,13 +193,23 @@ impl<C: Translator> Translated<C> {
 }
 
 /// Writes a kernel's translation and its compiler's listing to DIR/<prefix>-<family>/<kernel>.<extension>.
-fn write_isa<C: Translator>(dir: &Path, family: &C::Family, label: &str, source: &str, binary: &C::Binary, tools: &C::Tools) -> Result<()> {
+fn write_isa<C: Translator>(
+    dir: &Path,
+    family: &C::Family,
+    label: &str,
+    source: &str,
+    binary: &C::Binary,
+    tools: &C::Tools,
+) -> Result<()> {
     let dir = dir.join(format!("{}-{}", C::PREFIX, C::family(family).name));
     std::fs::create_dir_all(&dir).map_err(|e| anyhow!("--isa: cannot create {}: {e}", dir.display()))?;
     let stem = super::file_slug(label);
     let (translation, listing) = C::ISA_EXTENSIONS;
     crate::io::write_output(&dir.join(format!("{stem}.{translation}")), source.as_bytes())?;
-    crate::io::write_output(&dir.join(format!("{stem}.{listing}")), C::isa_listing(family, label, binary, tools)?.as_bytes())
+    crate::io::write_output(
+        &dir.join(format!("{stem}.{listing}")),
+        C::isa_listing(family, label, binary, tools)?.as_bytes(),
+    )
 }
 
 impl<C: Translator> Vendor for Translated<C> {
@@ -245,8 +296,18 @@ fn checked_translations(req: &Request, gpu: &Gpu, dialect: Dialect) -> Result<Ve
         .map(|m| {
             let agreements = crate::translate::verify::check_cached(gpu, m, req.lights, req.shaders)?;
             let source = crate::translate::prepare::shade_kernel(m, req.lights, req.shaders)?.source(dialect);
-            let agreement = agreements.iter().map(|a| format!("{}{}", a.summary(), a.note().map_or_else(String::new, |n| format!(": {n}")))).collect::<Vec<_>>().join("; ");
-            Ok(Checked { source, agreement: format!("translation checked on the host against {} and the translation's f64 evaluation: {agreement}", gpu.info.name) })
+            let agreement = agreements
+                .iter()
+                .map(|a| format!("{}{}", a.summary(), a.note().map_or_else(String::new, |n| format!(": {n}"))))
+                .collect::<Vec<_>>()
+                .join("; ");
+            Ok(Checked {
+                source,
+                agreement: format!(
+                    "translation checked on the host against {} and the translation's f64 evaluation: {agreement}",
+                    gpu.info.name
+                ),
+            })
         })
         .collect()
 }
@@ -288,8 +349,15 @@ fn raw_translations(vendor: &dyn Vendor, kernels: &[RawKernel], dialect: Dialect
     let mut rows = Vec::new();
     let mut checked = Vec::new();
     for k in kernels {
-        let t = k.translation.as_ref().ok_or_else(|| anyhow!("{}: {} compiles the kernel's translation, and none was checked", k.label, vendor.prefix()))?;
-        rows.push(Row { model: k.label.clone(), spec: Some(k.model.canonical()), stats: BTreeMap::new(), notes: [("translation".to_string(), t.agreement.clone())].into() });
+        let t = k.translation.as_ref().ok_or_else(|| {
+            anyhow!("{}: {} compiles the kernel's translation, and none was checked", k.label, vendor.prefix())
+        })?;
+        rows.push(Row {
+            model: k.label.clone(),
+            spec: Some(k.model.canonical()),
+            stats: BTreeMap::new(),
+            notes: [("translation".to_string(), t.agreement.clone())].into(),
+        });
         checked.push(Checked { source: t.translation.source(dialect), agreement: t.agreement.clone() });
     }
     Ok((rows, checked))
@@ -300,17 +368,29 @@ fn raw_translations(vendor: &dyn Vendor, kernels: &[RawKernel], dialect: Dialect
 /// same instruction sequence, else a note says they differ. `lines` compiles a model's line-annotated `dialect`
 /// source (with its checked translation, `checked`, in the order of `kernels_of`) for a family and returns its
 /// lines with both compiles' instruction sequences (the costed one's first).
-fn add_lines<F>(reports: &mut [InspectReport], families: &[&F], req: &Request, checked: &[Checked], dialect: Dialect, mut lines: impl FnMut(&Model, &str, &str, &F) -> Result<LineCompile>) -> Result<()> {
+fn add_lines<F>(
+    reports: &mut [InspectReport],
+    families: &[&F],
+    req: &Request,
+    checked: &[Checked],
+    dialect: Dialect,
+    mut lines: impl FnMut(&Model, &str, &str, &F) -> Result<LineCompile>,
+) -> Result<()> {
     if !req.lines {
         return Ok(());
     }
     for (report, family) in reports.iter_mut().zip(families) {
         let mut per_model = Vec::new();
         for (m, checked) in req.models.iter().zip(checked) {
-            let source = crate::translate::prepare::shade_kernel_with_lines(Some(m), req.lights, req.shaders)?.source_with_lines(dialect);
+            let source = crate::translate::prepare::shade_kernel_with_lines(Some(m), req.lights, req.shaders)?
+                .source_with_lines(dialect);
             let LineCompile { mut lines, costed, annotated } = lines(m, &source, &checked.source, family)?;
             if costed != annotated {
-                lines.note = format!("the line-annotated compile is not the costed code ({} instructions against {}, not in the same sequence): its lines describe that compile", annotated.len(), costed.len());
+                lines.note = format!(
+                    "the line-annotated compile is not the costed code ({} instructions against {}, not in the same sequence): its lines describe that compile",
+                    annotated.len(),
+                    costed.len()
+                );
             }
             if let Model::File(f) = m {
                 // An HLSL or WGSL shader's lines are those of the GLSL its front end wrote: their text is the file

@@ -5,12 +5,13 @@
 use super::{BindingKind, Dialect, Translation};
 use crate::brdf::Sample;
 use crate::kernels::EvalExtras;
-use anyhow::{anyhow, bail, Context, Result};
+use anyhow::{Context, Result, anyhow, bail};
 
 /// The host compiler and its flags: precise maths (no -ffast-math), no FMA contraction beyond what the
 /// source writes.
 pub const HOST_COMPILER: &str = "g++";
-pub const HOST_FLAGS: [&str; 6] = ["-std=c++17", "-O2", "-fPIC", "-shared", "-ffp-contract=off", "-fno-strict-aliasing"];
+pub const HOST_FLAGS: [&str; 6] =
+    ["-std=c++17", "-O2", "-fPIC", "-shared", "-ffp-contract=off", "-fno-strict-aliasing"];
 
 /// What a host build depends on besides the source, for cache keys: the compiler's version line and the flags
 /// (another g++ may round the maths libraries differently).
@@ -18,8 +19,12 @@ pub fn build_identity() -> String {
     static IDENTITY: std::sync::OnceLock<String> = std::sync::OnceLock::new();
     IDENTITY
         .get_or_init(|| {
-            let out = crate::launch::output_quick(crate::cleanup::command(HOST_COMPILER).arg("--version"), "g++ --version");
-            let version = out.ok().and_then(|o| String::from_utf8_lossy(&o.stdout).lines().next().map(str::to_string)).unwrap_or_else(|| format!("{HOST_COMPILER} (version unknown)"));
+            let out =
+                crate::launch::output_quick(crate::cleanup::command(HOST_COMPILER).arg("--version"), "g++ --version");
+            let version = out
+                .ok()
+                .and_then(|o| String::from_utf8_lossy(&o.stdout).lines().next().map(str::to_string))
+                .unwrap_or_else(|| format!("{HOST_COMPILER} (version unknown)"));
             format!("{version} {}", HOST_FLAGS.join(" "))
         })
         .clone()
@@ -56,9 +61,21 @@ impl HostKernel {
         std::fs::write(&src, source).with_context(|| format!("cannot write {}", src.display()))?;
         let mut cmd = crate::cleanup::command(HOST_COMPILER);
         // g++'s own temporaries (cc*.s) go into the build's directory, removed with it even on a signal.
-        cmd.args(HOST_FLAGS).args(defines.iter().map(|d| format!("-D{d}"))).arg("-o").arg(&lib).arg(&src).env("TMPDIR", dir.path());
-        let out = crate::launch::output(&mut cmd, "the host build of the translation (g++)")
-            .map_err(|e| if e.downcast_ref::<std::io::Error>().is_some() { anyhow!("cannot run {HOST_COMPILER} ({e}): install g++ (Debian: apt-get install g++), or run `make setup`") } else { e })?;
+        cmd.args(HOST_FLAGS)
+            .args(defines.iter().map(|d| format!("-D{d}")))
+            .arg("-o")
+            .arg(&lib)
+            .arg(&src)
+            .env("TMPDIR", dir.path());
+        let out = crate::launch::output(&mut cmd, "the host build of the translation (g++)").map_err(|e| {
+            if e.downcast_ref::<std::io::Error>().is_some() {
+                anyhow!(
+                    "cannot run {HOST_COMPILER} ({e}): install g++ (Debian: apt-get install g++), or run `make setup`"
+                )
+            } else {
+                e
+            }
+        })?;
         if !out.status.success() {
             let log = String::from_utf8_lossy(&out.stderr);
             let head: Vec<&str> = log.lines().take(20).collect();
@@ -67,7 +84,12 @@ impl HostKernel {
         if !lib.is_file() {
             bail!("{HOST_COMPILER} exited 0 but wrote no {}", lib.display());
         }
-        Ok(HostKernel { library: lib, _dir: dir, bindings: t.bindings.iter().map(|b| b.kind.clone()).collect(), local_size: t.local_size })
+        Ok(HostKernel {
+            library: lib,
+            _dir: dir,
+            bindings: t.bindings.iter().map(|b| b.kind.clone()).collect(),
+            local_size: t.local_size,
+        })
     }
 
     /// Runs `groups` workgroups over `buffers` (one per binding, in the translation's binding order, push

@@ -49,7 +49,13 @@ pub fn judge(x: f32, r: Bounded, extra: f64) -> Judgement {
         return Judgement::Measured(0.0);
     }
     let beyond = (x - r.value).abs() - rounding;
-    Judgement::Measured(if !(beyond > 0.0) && beyond.is_finite() { 0.0 } else if beyond.is_finite() && r.bound > 0.0 { beyond / r.bound } else { f64::INFINITY })
+    Judgement::Measured(if !(beyond > 0.0) && beyond.is_finite() {
+        0.0
+    } else if beyond.is_finite() && r.bound > 0.0 {
+        beyond / r.bound
+    } else {
+        f64::INFINITY
+    })
 }
 
 /// The rounding R11G11B10F's conversion may add to a value of magnitude up to `m` (one step of its 6-bit,
@@ -117,7 +123,13 @@ pub fn tally(xs: &[f32], refs: &[Bounded], extra: impl Fn(usize) -> f64, per_ite
                 }
                 if m > t.worst || (m.is_nan() && !t.worst.is_nan()) {
                     t.worst = m;
-                    t.worst_at = format!("value {i} (item {}, channel {}): {x} against {} +- {:.2e}", i / per_item, i % per_item, r.value, r.bound + extra(i));
+                    t.worst_at = format!(
+                        "value {i} (item {}, channel {}): {x} against {} +- {:.2e}",
+                        i / per_item,
+                        i % per_item,
+                        r.value,
+                        r.bound + extra(i)
+                    );
                 }
             }
             Judgement::Unbounded | Judgement::Undefined => t.unbounded += 1,

@@ -6,7 +6,7 @@
 use super::{Dialect, Translation};
 use crate::brdf::Sample;
 use crate::kernels::EvalExtras;
-use anyhow::{bail, Context as _, Result};
+use anyhow::{Context as _, Result, bail};
 
 /// The platform `--device opencl` takes unless BRDFPROF_OPENCL_DEVICE names another (a substring of the
 /// platform or device name).
@@ -34,10 +34,22 @@ pub struct ClKernel {
 
 impl ClKernel {
     pub fn build(t: &Translation, precise: bool) -> Result<Self> {
-        let wanted = std::env::var("BRDFPROF_OPENCL_DEVICE").ok().filter(|s| !s.is_empty()).unwrap_or_else(|| DEFAULT_PLATFORM.into());
-        let dir = crate::cleanup::TempDir::new().context("cannot create a temporary directory for the OpenCL kernel")?;
-        std::fs::write(dir.path().join("kernel.cl"), t.source(Dialect::OpenCl)).context("cannot write the OpenCL source")?;
-        Ok(ClKernel { dir, options: format!("{} -DBRDFPROF_EXECUTED", build_options(precise)), wanted: wanted.clone(), local_size: t.local_size, bindings: t.bindings.len(), device: std::sync::Mutex::new(wanted) })
+        let wanted = std::env::var("BRDFPROF_OPENCL_DEVICE")
+            .ok()
+            .filter(|s| !s.is_empty())
+            .unwrap_or_else(|| DEFAULT_PLATFORM.into());
+        let dir =
+            crate::cleanup::TempDir::new().context("cannot create a temporary directory for the OpenCL kernel")?;
+        std::fs::write(dir.path().join("kernel.cl"), t.source(Dialect::OpenCl))
+            .context("cannot write the OpenCL source")?;
+        Ok(ClKernel {
+            dir,
+            options: format!("{} -DBRDFPROF_EXECUTED", build_options(precise)),
+            wanted: wanted.clone(),
+            local_size: t.local_size,
+            bindings: t.bindings.len(),
+            device: std::sync::Mutex::new(wanted),
+        })
     }
 
     /// The device of the last run (before one: the platform asked for).
@@ -51,8 +63,18 @@ impl ClKernel {
         if buffers.len() != self.bindings {
             bail!("the OpenCL kernel takes {} bindings, {} given", self.bindings, buffers.len());
         }
-        let engine = super::runner::Engine::OpenCl { source: self.dir.path().join("kernel.cl"), options: self.options.clone(), wanted: self.wanted.clone() };
-        let ran = super::runner::run(engine, self.local_size, buffers, groups, "the OpenCL C translation (built and run on OpenCL)")?;
+        let engine = super::runner::Engine::OpenCl {
+            source: self.dir.path().join("kernel.cl"),
+            options: self.options.clone(),
+            wanted: self.wanted.clone(),
+        };
+        let ran = super::runner::run(
+            engine,
+            self.local_size,
+            buffers,
+            groups,
+            "the OpenCL C translation (built and run on OpenCL)",
+        )?;
         *self.device.lock().unwrap_or_else(|e| e.into_inner()) = ran.device;
         Ok(())
     }

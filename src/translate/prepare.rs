@@ -18,14 +18,14 @@
 //! translation cannot express is located in the plainly prepared module (`PLAIN_PASSES`), whose functions
 //! are the source's.
 
-use super::{translate, TexelFormat, TranslateError, TranslateOptions, Translation};
+use super::{TexelFormat, TranslateError, TranslateOptions, Translation, translate};
 use crate::gpu::SpecConstants;
-use crate::spirv;
+use crate::kernels::shade::{self, GBufferFormat};
 use crate::model::file_model::FileModel;
 use crate::model::{KernelKind, Model};
-use crate::kernels::shade::{self, GBufferFormat};
 use crate::shaders::Shaders;
-use anyhow::{anyhow, Result};
+use crate::spirv;
+use anyhow::{Result, anyhow};
 
 /// spirv-opt passes after specialisation: inlining, SSA form, unrolling, dead code (bindings kept).
 pub const INLINE_PASSES: [&str; 10] = [
@@ -46,7 +46,8 @@ pub const INLINE_PASSES: [&str; 10] = [
 
 /// spirv-opt passes after flattening: value numbering (an instruction identical to a dominating one replaced
 /// by it), dead code.
-pub const CSE_PASSES: [&str; 3] = ["--preserve-bindings", "--redundancy-elimination", "--eliminate-dead-code-aggressive"];
+pub const CSE_PASSES: [&str; 3] =
+    ["--preserve-bindings", "--redundancy-elimination", "--eliminate-dead-code-aggressive"];
 
 /// The plain preparation (SSA form and unrolling only, every function kept): where a translation error is
 /// located, and what the flattened translation is tested against.
@@ -81,13 +82,22 @@ pub fn prepared_as(words: &[u32], constants: &SpecConstants, how: Preparation) -
 /// The translation of a model's kernel. A construct the translation cannot express is located in the plainly
 /// prepared module (its functions the source's); for a `.brdf` model in a line-annotated compile of the file,
 /// and named at the file's own line.
-fn translated(model: Option<&Model>, kind: KernelKind, (words, constants): (&[u32], &SpecConstants), options: &TranslateOptions, how: Preparation, shaders: &Shaders) -> Result<Translation> {
+fn translated(
+    model: Option<&Model>,
+    kind: KernelKind,
+    (words, constants): (&[u32], &SpecConstants),
+    options: &TranslateOptions,
+    how: Preparation,
+    shaders: &Shaders,
+) -> Result<Translation> {
     let label = model.map_or_else(|| crate::model::BASELINE_LABEL.to_string(), Model::label);
     let e = match translate(&prepared_as(words, constants, how)?, options) {
         Ok(t) => return Ok(t),
         Err(e) => e,
     };
-    let plain = |words: &[u32]| -> Result<TranslateError> { Ok(translate(&prepared_as(words, constants, Preparation::Plain)?, options).err().unwrap_or_else(|| e.clone())) };
+    let plain = |words: &[u32]| -> Result<TranslateError> {
+        Ok(translate(&prepared_as(words, constants, Preparation::Plain)?, options).err().unwrap_or_else(|| e.clone()))
+    };
     match model.and_then(Model::file) {
         Some(f) => Err(anyhow!("{}", locate(f, &plain(&f.kernel_with_lines(kind, shaders)?.words)?))),
         None => Err(anyhow!("{label}: {}", plain(words)?)),
@@ -102,7 +112,14 @@ pub fn eval_kernel(model: &Model, shaders: &Shaders) -> Result<Translation> {
 /// `eval_kernel` prepared as `how`.
 pub fn eval_kernel_as(model: &Model, shaders: &Shaders, how: Preparation) -> Result<Translation> {
     let k = model.kernel(KernelKind::Eval, shaders)?;
-    translated(Some(model), KernelKind::Eval, (&k.spirv.words, &k.constants), &TranslateOptions::default(), how, shaders)
+    translated(
+        Some(model),
+        KernelKind::Eval,
+        (&k.spirv.words, &k.constants),
+        &TranslateOptions::default(),
+        how,
+        shaders,
+    )
 }
 
 /// The profiling kernel over the packed G-buffer (glsl/shade.comp) for `model` (None: the memory-only
@@ -137,9 +154,15 @@ pub fn shade_kernel_with_lines(model: Option<&Model>, lights: u32, shaders: &Sha
 fn locate(f: &FileModel, e: &TranslateError) -> String {
     let prefix = f.file.renamed_shader().prefix.clone();
     let function = e.function.as_deref().map(|f| f.strip_prefix(prefix.as_str()).unwrap_or(f).to_string());
-    let construct = format!("the C translation cannot express {}{}", e.construct, function.map_or(String::new(), |f| format!(" (in function `{f}`)")));
+    let construct = format!(
+        "the C translation cannot express {}{}",
+        e.construct,
+        function.map_or(String::new(), |f| format!(" (in function `{f}`)"))
+    );
     match &e.location {
-        Some(l) if l.file == f.file.path.display().to_string() || l.file.ends_with(".brdf") => format!("{}:{}: {construct}", f.path, l.line),
+        Some(l) if l.file == f.file.path.display().to_string() || l.file.ends_with(".brdf") => {
+            format!("{}:{}: {construct}", f.path, l.line)
+        }
         Some(l) => format!("{}: {construct} (at {}:{} of brdfprof's kernel)", f.path, l.file, l.line),
         None => format!("{}: {construct}", f.path),
     }

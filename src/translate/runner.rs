@@ -6,16 +6,16 @@
 //! removed with it (and by the signal handler).
 
 use crate::cleanup;
-use anyhow::{anyhow, bail, Context, Result};
+use anyhow::{Context, Result, anyhow, bail};
 use opencl3::command_queue::CommandQueue;
 use opencl3::context::Context as ClContext;
-use opencl3::device::{Device, CL_DEVICE_TYPE_ALL};
+use opencl3::device::{CL_DEVICE_TYPE_ALL, Device};
 use opencl3::kernel::{ExecuteKernel, Kernel};
-use opencl3::memory::{Buffer, ClMem, CL_MEM_COPY_HOST_PTR, CL_MEM_READ_WRITE};
+use opencl3::memory::{Buffer, CL_MEM_COPY_HOST_PTR, CL_MEM_READ_WRITE, ClMem};
 use opencl3::program::Program;
 use opencl3::types::CL_BLOCKING;
-use std::ffi::c_void;
 use serde::{Deserialize, Serialize};
+use std::ffi::c_void;
 use std::path::{Path, PathBuf};
 
 /// The hidden subcommand of the child.
@@ -66,19 +66,28 @@ fn executable() -> Result<PathBuf> {
     let sibling = own.parent().and_then(Path::parent).map(|d| d.join("brdfprof"));
     match sibling {
         Some(s) if s.is_file() => Ok(s),
-        _ => bail!("cannot find the brdfprof executable to run a translated kernel in (looked beside {})", own.display()),
+        _ => {
+            bail!("cannot find the brdfprof executable to run a translated kernel in (looked beside {})", own.display())
+        }
     }
 }
 
 /// Runs `engine` over `buffers` (copied back in place) in a child, `what` naming the kernel in messages.
-pub fn run(engine: Engine, local_size: [u32; 3], buffers: &mut [&mut [u8]], groups: [u32; 3], what: &str) -> Result<Ran> {
+pub fn run(
+    engine: Engine,
+    local_size: [u32; 3],
+    buffers: &mut [&mut [u8]],
+    groups: [u32; 3],
+    what: &str,
+) -> Result<Ran> {
     let dir = cleanup::TempDir::new().context("cannot create a temporary directory for a translated kernel's run")?;
     for (k, b) in buffers.iter().enumerate() {
         let path = dir.path().join(format!("in-{k}.bin"));
         std::fs::write(&path, &**b).with_context(|| format!("cannot write {}", path.display()))?;
     }
     let request = Request { engine, local_size, groups, buffers: buffers.iter().map(|b| b.len()).collect() };
-    std::fs::write(dir.path().join("request.json"), serde_json::to_vec(&request)?).context("cannot write a translated kernel's request")?;
+    std::fs::write(dir.path().join("request.json"), serde_json::to_vec(&request)?)
+        .context("cannot write a translated kernel's request")?;
     let mut cmd = cleanup::command(&executable()?.to_string_lossy());
     // PoCL's kernel cache too: it leaves empty `tempfile_*` behind in it on every build, which would pile up
     // in the user's ~/.cache/pocl; in the run's directory they go with it.
@@ -89,10 +98,15 @@ pub fn run(engine: Engine, local_size: [u32; 3], buffers: &mut [&mut [u8]], grou
         bail!(failure(what, &out));
     }
     let stdout = String::from_utf8_lossy(&out.stdout);
-    let reply: Reply = stdout.lines().rev().find_map(|l| serde_json::from_str(l).ok()).ok_or_else(|| anyhow!("{what}: the child process answered no report"))?;
+    let reply: Reply = stdout
+        .lines()
+        .rev()
+        .find_map(|l| serde_json::from_str(l).ok())
+        .ok_or_else(|| anyhow!("{what}: the child process answered no report"))?;
     for (k, b) in buffers.iter_mut().enumerate() {
         let path = dir.path().join(format!("out-{k}.bin"));
-        let bytes = crate::io::read_bounded(&path, b.len() as u64).with_context(|| format!("{what}: the child's buffer {k}"))?;
+        let bytes = crate::io::read_bounded(&path, b.len() as u64)
+            .with_context(|| format!("{what}: the child's buffer {k}"))?;
         if bytes.len() != b.len() {
             bail!("{what}: the child wrote {} bytes of buffer {k}, {} expected", bytes.len(), b.len());
         }
@@ -112,7 +126,14 @@ fn failure(what: &str, out: &std::process::Output) -> String {
         );
     }
     let said: Vec<&str> = stderr.lines().filter(|l| !l.trim().is_empty()).collect();
-    let tail = said.iter().rev().take(20).rev().map(|l| l.strip_prefix("brdfprof: error: ").unwrap_or(l)).collect::<Vec<_>>().join("\n");
+    let tail = said
+        .iter()
+        .rev()
+        .take(20)
+        .rev()
+        .map(|l| l.strip_prefix("brdfprof: error: ").unwrap_or(l))
+        .collect::<Vec<_>>()
+        .join("\n");
     format!("{what}: {}", if tail.is_empty() { format!("the child process failed ({})", out.status) } else { tail })
 }
 
@@ -132,7 +153,9 @@ fn signal_name(signal: i32) -> String {
 /// The child: reads `DIR/request.json` and the buffers, runs the engine, writes `out-K.bin` and its reply.
 pub fn child_main(dir: &str) -> Result<()> {
     let dir = Path::new(dir);
-    let request: Request = serde_json::from_slice(&crate::io::read_bounded(&dir.join("request.json"), 1 << 20).context("cannot read the request")?)?;
+    let request: Request = serde_json::from_slice(
+        &crate::io::read_bounded(&dir.join("request.json"), 1 << 20).context("cannot read the request")?,
+    )?;
     let mut owned = Vec::new();
     for (k, &len) in request.buffers.iter().enumerate() {
         let bytes = crate::io::read_bounded(&dir.join(format!("in-{k}.bin")), len as u64)?;
@@ -143,9 +166,15 @@ pub fn child_main(dir: &str) -> Result<()> {
     }
     let mut buffers: Vec<&mut [u8]> = owned.iter_mut().map(Vec::as_mut_slice).collect();
     let reply = match &request.engine {
-        Engine::Host { library } => Reply { flags: run_host(library, &mut buffers, request.groups)?, device: "host".into() },
+        Engine::Host { library } => {
+            Reply { flags: run_host(library, &mut buffers, request.groups)?, device: "host".into() }
+        }
         Engine::OpenCl { source, options, wanted } => {
-            let text = String::from_utf8_lossy(&crate::io::read_bounded(source, crate::io::MAX_INPUT_BYTES).context("cannot read the OpenCL source")?).into_owned();
+            let text = String::from_utf8_lossy(
+                &crate::io::read_bounded(source, crate::io::MAX_INPUT_BYTES)
+                    .context("cannot read the OpenCL source")?,
+            )
+            .into_owned();
             let device = run_opencl(&text, options, wanted, request.local_size, &mut buffers, request.groups)?;
             Reply { flags: 0, device }
         }
@@ -158,7 +187,9 @@ pub fn child_main(dir: &str) -> Result<()> {
 }
 
 fn no_runtime(e: impl std::fmt::Display) -> anyhow::Error {
-    anyhow!("no OpenCL runtime ({e}): install PoCL and the ICD loader (Debian: apt-get install pocl-opencl-icd ocl-icd-libopencl1), or run `make setup`")
+    anyhow!(
+        "no OpenCL runtime ({e}): install PoCL and the ICD loader (Debian: apt-get install pocl-opencl-icd ocl-icd-libopencl1), or run `make setup`"
+    )
 }
 
 /// The OpenCL device: the first one whose platform or name contains `wanted`.
@@ -176,25 +207,48 @@ fn device(wanted: &str) -> Result<(Device, String)> {
             seen.push(format!("{dname} ({pname})"));
         }
     }
-    bail!("no OpenCL device matches `{wanted}` (devices: {}); install PoCL (apt-get install pocl-opencl-icd) or set BRDFPROF_OPENCL_DEVICE", if seen.is_empty() { "none".into() } else { seen.join(", ") })
+    bail!(
+        "no OpenCL device matches `{wanted}` (devices: {}); install PoCL (apt-get install pocl-opencl-icd) or set BRDFPROF_OPENCL_DEVICE",
+        if seen.is_empty() { "none".into() } else { seen.join(", ") }
+    )
 }
 
 /// The child's half of `opencl::ClKernel::run`: builds `source` on the device `wanted` names and runs it over
 /// `buffers`; returns the device's name.
-fn run_opencl(source: &str, options: &str, wanted: &str, local_size: [u32; 3], buffers: &mut [&mut [u8]], groups: [u32; 3]) -> Result<String> {
+fn run_opencl(
+    source: &str,
+    options: &str,
+    wanted: &str,
+    local_size: [u32; 3],
+    buffers: &mut [&mut [u8]],
+    groups: [u32; 3],
+) -> Result<String> {
     let (dev, name) = device(wanted)?;
     let context = ClContext::from_device(&dev).map_err(|e| anyhow!("{name}: cannot create an OpenCL context ({e})"))?;
     #[allow(deprecated)]
-    let queue = CommandQueue::create_default(&context, 0).map_err(|e| anyhow!("{name}: cannot create a queue ({e})"))?;
-    let program = Program::create_and_build_from_source(&context, source, options)
-        .map_err(|log| anyhow!("{name} cannot build the OpenCL C translation (a translator defect):\n{}", log.lines().take(20).collect::<Vec<_>>().join("\n")))?;
-    let kernel = Kernel::create(&program, "brdfprof_kernel").map_err(|e| anyhow!("{name}: no brdfprof_kernel ({e})"))?;
+    let queue =
+        CommandQueue::create_default(&context, 0).map_err(|e| anyhow!("{name}: cannot create a queue ({e})"))?;
+    let program = Program::create_and_build_from_source(&context, source, options).map_err(|log| {
+        anyhow!(
+            "{name} cannot build the OpenCL C translation (a translator defect):\n{}",
+            log.lines().take(20).collect::<Vec<_>>().join("\n")
+        )
+    })?;
+    let kernel =
+        Kernel::create(&program, "brdfprof_kernel").map_err(|e| anyhow!("{name}: no brdfprof_kernel ({e})"))?;
     // SAFETY: each buffer is created from (and read back into) a live host slice of its own size; the
     // kernel's arguments are these buffers in its parameter order.
     unsafe {
         let device_buffers = buffers
             .iter_mut()
-            .map(|b| Buffer::<u8>::create(&context, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, b.len().max(1), b.as_mut_ptr() as *mut c_void))
+            .map(|b| {
+                Buffer::<u8>::create(
+                    &context,
+                    CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR,
+                    b.len().max(1),
+                    b.as_mut_ptr() as *mut c_void,
+                )
+            })
             .collect::<Result<Vec<_>, _>>()
             .map_err(|e| anyhow!("{name}: cannot create buffers ({e})"))?;
         let mut exec = ExecuteKernel::new(&kernel);
@@ -203,9 +257,14 @@ fn run_opencl(source: &str, options: &str, wanted: &str, local_size: [u32; 3], b
         }
         let global: Vec<usize> = (0..3).map(|k| (groups[k] * local_size[k]) as usize).collect();
         let local: Vec<usize> = local_size.iter().map(|&l| l as usize).collect();
-        exec.set_global_work_sizes(&global).set_local_work_sizes(&local).enqueue_nd_range(&queue).map_err(|e| anyhow!("{name}: cannot run the kernel ({e})"))?;
+        exec.set_global_work_sizes(&global)
+            .set_local_work_sizes(&local)
+            .enqueue_nd_range(&queue)
+            .map_err(|e| anyhow!("{name}: cannot run the kernel ({e})"))?;
         for (b, host) in device_buffers.iter().zip(buffers.iter_mut()) {
-            queue.enqueue_read_buffer(b, CL_BLOCKING, 0, host, &[]).map_err(|e| anyhow!("{name}: cannot read a buffer back ({e})"))?;
+            queue
+                .enqueue_read_buffer(b, CL_BLOCKING, 0, host, &[])
+                .map_err(|e| anyhow!("{name}: cannot read a buffer back ({e})"))?;
         }
         queue.finish().context("clFinish")?;
     }
@@ -218,13 +277,15 @@ type RunFn = unsafe extern "C" fn(*const *mut u8, u32, u32, u32) -> u32;
 fn run_host(library: &std::path::Path, buffers: &mut [&mut [u8]], groups: [u32; 3]) -> Result<u32> {
     // SAFETY: the library is the one `HostKernel::compile` built from the translation; loading runs no
     // constructors of ours (the prelude defines none).
-    let lib = unsafe { libloading::Library::new(library) }.with_context(|| format!("cannot load {}", library.display()))?;
+    let lib =
+        unsafe { libloading::Library::new(library) }.with_context(|| format!("cannot load {}", library.display()))?;
     let pointers: Vec<*mut u8> = buffers.iter_mut().map(|b| b.as_mut_ptr()).collect();
     // SAFETY: `brdfprof_host_run` is the wrapper `entry::host_wrapper` writes, with this signature; every
     // pointer is a live buffer of the size the kernel's own bounds (its push-constant count) allow. A fault
     // ends this child process only.
     unsafe {
-        let run: libloading::Symbol<RunFn> = lib.get(b"brdfprof_host_run\0").context("the host build has no brdfprof_host_run")?;
+        let run: libloading::Symbol<RunFn> =
+            lib.get(b"brdfprof_host_run\0").context("the host build has no brdfprof_host_run")?;
         Ok(run(pointers.as_ptr(), groups[0], groups[1], groups[2]))
     }
 }

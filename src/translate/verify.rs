@@ -30,7 +30,7 @@ use crate::profile::gbuffer::{self, GBuffer};
 use crate::profile::protocol::Timed;
 use crate::profile::workload::{self, Variant, Workload};
 use crate::shaders::Shaders;
-use anyhow::{bail, Result};
+use anyhow::{Result, bail};
 use serde::{Deserialize, Serialize};
 
 /// Samples of the eval comparison.
@@ -86,7 +86,13 @@ impl Agreement {
     pub fn summary(&self) -> String {
         format!(
             "{}: Vulkan at {:.2} and the fp32 translation at {:.2} of the Vulkan precision bound (relative bound median {:.1e}, largest {:.1e}; {} of {} values unbounded)",
-            self.kernel, self.worst, self.translation_worst, self.bound_median, self.bound_max, self.unbounded, self.values
+            self.kernel,
+            self.worst,
+            self.translation_worst,
+            self.bound_median,
+            self.bound_max,
+            self.unbounded,
+            self.values
         )
     }
 
@@ -115,13 +121,21 @@ const SMOD_AS_SREM: &str = "BRDFPROF_SMOD_AS_SREM";
 
 /// Whether a disagreement (`worst` over `tolerance`) of a kernel that takes OpSMod vanishes when the host
 /// computes it as srem (`compare` run with `SMOD_AS_SREM`): then it is the device's, not the translation's.
-pub fn srem_explains(t: &super::Translation, worst: f64, tolerance: f64, compare: impl Fn(&[&str]) -> Result<f64>) -> Result<bool> {
+pub fn srem_explains(
+    t: &super::Translation,
+    worst: f64,
+    tolerance: f64,
+    compare: impl Fn(&[&str]) -> Result<f64>,
+) -> Result<bool> {
     Ok(!(worst <= tolerance) && t.body().contains("m_smod(") && compare(&[SMOD_AS_SREM])? <= tolerance)
 }
 
 /// The warning for a kernel whose disagreement `srem_explains` (once per kernel and command).
 pub fn warn_srem(label: &str, kernel: &str, device: &str, worst: f64) {
-    crate::messages::warning_once(format!("{label} ({kernel} kernel): {}; its cost is reported for the SPIR-V semantics", srem_note(device, worst)));
+    crate::messages::warning_once(format!(
+        "{label} ({kernel} kernel): {}; its cost is reported for the SPIR-V semantics",
+        srem_note(device, worst)
+    ));
 }
 
 /// What a disagreement that vanishes with `SMOD_AS_SREM` means.
@@ -148,7 +162,11 @@ pub fn worst_relative(host: &[[f32; 3]], device: &[[f32; 3]], scale: impl Fn(usi
     for (i, (h, d)) in host.iter().zip(device).enumerate() {
         for c in 0..3 {
             // Equal values (the same infinity included) and two NaNs agree; a NaN against a number does not.
-            let e = if h[c] == d[c] || (h[c].is_nan() && d[c].is_nan()) { 0.0 } else { (f64::from(h[c]) - f64::from(d[c])).abs() / scale(i, c) };
+            let e = if h[c] == d[c] || (h[c].is_nan() && d[c].is_nan()) {
+                0.0
+            } else {
+                (f64::from(h[c]) - f64::from(d[c])).abs() / scale(i, c)
+            };
             worst = if e.is_nan() { f64::INFINITY } else { worst.max(e) };
         }
     }
@@ -158,7 +176,8 @@ pub fn worst_relative(host: &[[f32; 3]], device: &[[f32; 3]], scale: impl Fn(usi
 /// `worst_relative` over each device value's brightest channel (at least 1e-3): the measure for kernels that
 /// write radiance, whose dim channels carry no precision of their own.
 pub fn worst_relative_to_brightest(host: &[[f32; 3]], device: &[[f32; 3]]) -> f64 {
-    let brightest: Vec<f64> = device.iter().map(|p| p.iter().fold(1e-3f64, |a, &b| a.max(f64::from(b).abs()))).collect();
+    let brightest: Vec<f64> =
+        device.iter().map(|p| p.iter().fold(1e-3f64, |a, &b| a.max(f64::from(b).abs()))).collect();
     worst_relative(host, device, |i, _| brightest[i])
 }
 
@@ -169,7 +188,14 @@ pub fn check_inputs(model: &Model) -> (Model, Vec<Sample>, Vec<f32>, usize) {
     use rand::{Rng, SeedableRng};
     let samples = well_conditioned_in(EVAL_SAMPLES, 0x7e57, CHECK_COSINES, CHECK_COSINES, 0.0..1.0);
     let Some(file) = model.file() else { return (model.clone(), samples, Vec::new(), 0) };
-    let params: Vec<_> = file.file.params.iter().zip(&file.bindings).filter(|(_, b)| matches!(b, crate::model::file_model::Binding::Value(_))).map(|(p, _)| p).collect();
+    let params: Vec<_> = file
+        .file
+        .params
+        .iter()
+        .zip(&file.bindings)
+        .filter(|(_, b)| matches!(b, crate::model::file_model::Binding::Value(_)))
+        .map(|(p, _)| p)
+        .collect();
     let names: Vec<&str> = params.iter().map(|p| p.name.as_str()).collect();
     let (with_rows, floats) = file.with_rows(&names);
     let mut rng = rand_pcg::Pcg64::seed_from_u64(0x7e58);
@@ -177,9 +203,13 @@ pub fn check_inputs(model: &Model) -> (Model, Vec<Sample>, Vec<f32>, usize) {
     for _ in &samples {
         for p in &params {
             match p.kind {
-                crate::model::brdf_file::FileParamKind::Float { min, max, .. } => rows.push(if max > min { rng.random_range(min..=max) } else { min } as f32),
+                crate::model::brdf_file::FileParamKind::Float { min, max, .. } => {
+                    rows.push(if max > min { rng.random_range(min..=max) } else { min } as f32)
+                }
                 crate::model::brdf_file::FileParamKind::Bool { .. } => rows.push(rng.random_range(0..2u32) as f32),
-                crate::model::brdf_file::FileParamKind::Color { .. } => rows.extend((0..3).map(|_| rng.random::<f32>())),
+                crate::model::brdf_file::FileParamKind::Color { .. } => {
+                    rows.extend((0..3).map(|_| rng.random::<f32>()))
+                }
             }
         }
     }
@@ -197,7 +227,11 @@ fn reference_as_f(model: &Model, values: Vec<[Bounded; 3]>, samples: &[Sample]) 
         let value = b.value / nol;
         Bounded { value, bound: b.bound / nol.abs() + value.abs() * f64::from(f32::EPSILON) }
     };
-    values.into_iter().zip(samples).map(|(g, s)| g.map(|b| if b.value == 0.0 && b.bound == 0.0 { b } else { divide(b, unit(s.n).dot(unit(s.l))) })).collect()
+    values
+        .into_iter()
+        .zip(samples)
+        .map(|(g, s)| g.map(|b| if b.value == 0.0 && b.bound == 0.0 { b } else { divide(b, unit(s.n).dot(unit(s.l))) }))
+        .collect()
 }
 
 fn flat<T: Copy>(v: &[[T; 3]]) -> Vec<T> {
@@ -210,7 +244,11 @@ pub fn eval_agreement(gpu: &Gpu, model: &Model, shaders: &Shaders) -> Result<Agr
     let extras = EvalExtras { tangents: None, rows: &rows, row_floats };
     let translation = prepare::eval_kernel(&checked, shaders)?;
     let on_device = flat(&kernels::eval_from(gpu, &checked, shaders, &samples, &extras, RunLimits::default())?);
-    let on_host = flat(&kernels::as_f(&checked, host::eval(&host::HostKernel::compile(&translation)?, &samples, &extras)?, &samples));
+    let on_host = flat(&kernels::as_f(
+        &checked,
+        host::eval(&host::HostKernel::compile(&translation)?, &samples, &extras)?,
+        &samples,
+    ));
     let reference = |defines: &[&str]| -> Result<Vec<Bounded>> {
         let r = host::eval_reference(&host::HostKernel::compile_reference(&translation, defines)?, &samples, &extras)?;
         Ok(flat(&reference_as_f(&checked, r, &samples)))
@@ -218,7 +256,9 @@ pub fn eval_agreement(gpu: &Gpu, model: &Model, shaders: &Shaders) -> Result<Agr
     let r = reference(&[])?;
     let device = judge::tally(&on_device, &r, |_| 0.0, 3);
     let host = judge::tally(&on_host, &r, |_| 0.0, 3);
-    let srem = srem_explains(&translation, device.worst, TOLERANCE, |d| Ok(judge::tally(&on_device, &reference(d)?, |_| 0.0, 3).worst))?;
+    let srem = srem_explains(&translation, device.worst, TOLERANCE, |d| {
+        Ok(judge::tally(&on_device, &reference(d)?, |_| 0.0, 3).worst)
+    })?;
     Ok(Agreement::of("eval", &device, &host, gpu, srem))
 }
 
@@ -231,9 +271,17 @@ pub fn check_gbuffer(width: u32, height: u32) -> GBuffer {
     let mut words = Vec::with_capacity((width * height * 4) as usize);
     for y in 0..height {
         for x in 0..width {
-            let n = glam::Vec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0)).normalize_or(glam::Vec3::Z);
+            let n =
+                glam::Vec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0))
+                    .normalize_or(glam::Vec3::Z);
             let base = glam::Vec3::new(rng.random(), rng.random(), rng.random());
-            let s = gbuffer::Surface { normal: n, view: camera.view(x, y).normalize(), roughness: rng.random(), metallic: rng.random(), base };
+            let s = gbuffer::Surface {
+                normal: n,
+                view: camera.view(x, y).normalize(),
+                roughness: rng.random(),
+                metallic: rng.random(),
+                base,
+            };
             words.extend(gbuffer::pack(&s));
         }
     }
@@ -267,7 +315,8 @@ pub fn shade_agreement(gpu: &Gpu, model: Option<&Model>, lights: u32, shaders: &
     gpu.submit(|cmd| variant.record(cmd, 0))?;
     let on_device = flat(&work.radiance()?);
     let translation = prepare::shade_kernel(model, lights, shaders)?;
-    let packed: Vec<u32> = bytemuck::pod_collect_to_vec(&shade_on_host(&host::HostKernel::compile(&translation)?, &g, &light_data, 4)?);
+    let packed: Vec<u32> =
+        bytemuck::pod_collect_to_vec(&shade_on_host(&host::HostKernel::compile(&translation)?, &g, &light_data, 4)?);
     let on_host = flat(&packed.into_iter().map(gbuffer::unpack_r11g11b10).collect::<Vec<_>>());
     let reference = |defines: &[&str]| -> Result<Vec<Bounded>> {
         let bytes = shade_on_host(&host::HostKernel::compile_reference(&translation, defines)?, &g, &light_data, 64)?;
@@ -275,7 +324,9 @@ pub fn shade_agreement(gpu: &Gpu, model: Option<&Model>, lights: u32, shaders: &
     };
     let r = reference(&[])?;
     let n = on_device.len();
-    let step = |r: &[Bounded]| -> Vec<f64> { r.iter().enumerate().map(|(i, b)| judge::r11g11b10_step(*b, if i % 3 == 2 { 5 } else { 6 })).collect() };
+    let step = |r: &[Bounded]| -> Vec<f64> {
+        r.iter().enumerate().map(|(i, b)| judge::r11g11b10_step(*b, if i % 3 == 2 { 5 } else { 6 })).collect()
+    };
     let steps = step(&r);
     let device = judge::tally(&on_device, &r[..n], |i| steps[i], 3);
     let host = judge::tally(&on_host[..n], &r[..n], |i| steps[i], 3);
@@ -305,7 +356,8 @@ pub fn verdict(model: Option<&Model>, agreements: &[Agreement]) -> Result<()> {
         if !(a.translation_worst <= a.tolerance) {
             bail!(
                 "{label}: the fp32 C translation of the {} kernel, run on the host, is {:.3e} times the Vulkan precision bound away from its own f64 evaluation: brdfprof's translation or its bound is wrong (a translator defect); its cost is not reported. Please report it with the model",
-                a.kernel, a.translation_worst
+                a.kernel,
+                a.translation_worst
             );
         }
         if a.srem {
@@ -315,7 +367,10 @@ pub fn verdict(model: Option<&Model>, agreements: &[Agreement]) -> Result<()> {
         if !(a.worst <= a.tolerance) {
             bail!(
                 "{label}: the Vulkan {} kernel on {} is {:.3e} times the Vulkan precision bound of its operations away from their f64 evaluation, where the fp32 C translation is within it ({}): the translation does not compute what the Vulkan kernel computes (a translator defect); its cost is not reported. Please report it with the model",
-                a.kernel, a.device, a.worst, a.worst_at
+                a.kernel,
+                a.device,
+                a.worst,
+                a.worst_at
             );
         }
     }
@@ -339,7 +394,10 @@ pub fn check_cached(gpu: &Gpu, model: Option<&Model>, lights: u32, shaders: &Sha
     let mut key = crate::cache::KeyBuilder::new("agreement")
         .part("brdfprof", env!("CARGO_PKG_VERSION"))
         .part("schema", AGREEMENT_SCHEMA)
-        .part("device", format!("{} {} {} {}", gpu.info.name, gpu.info.driver_name, gpu.info.driver_info, gpu.info.driver_version))
+        .part(
+            "device",
+            format!("{} {} {} {}", gpu.info.name, gpu.info.driver_name, gpu.info.driver_info, gpu.info.driver_version),
+        )
         .part("setup", format!("{EVAL_SAMPLES} {SHADE_SIZE:?} {CHECK_COSINES:?} {lights} {}", host::build_identity()))
         .part("shade-spirv", bytemuck::cast_slice::<u32, u8>(&shade.spirv.words))
         .part("shade-constants", format!("{:?}", shade.constants))
@@ -359,7 +417,14 @@ pub fn check_cached(gpu: &Gpu, model: Option<&Model>, lights: u32, shaders: &Sha
     let label = model.map_or_else(|| crate::model::BASELINE_LABEL.to_string(), Model::label);
     let what = format!("the check of {label}'s translation");
     let valid = |bytes: &[u8]| serde_json::from_slice::<Vec<Agreement>>(bytes).map(|_| ()).map_err(anyhow::Error::from);
-    let bytes = crate::cache::get_or_build(crate::cache::Store::open_default().as_ref(), "agreement", &key, &what, valid, || Ok(serde_json::to_vec(&measure(gpu, model, lights, shaders)?)?))?;
+    let bytes = crate::cache::get_or_build(
+        crate::cache::Store::open_default().as_ref(),
+        "agreement",
+        &key,
+        &what,
+        valid,
+        || Ok(serde_json::to_vec(&measure(gpu, model, lights, shaders)?)?),
+    )?;
     // The verdict on every use, cached or not: the same warning or refusal each time.
     let out: Vec<Agreement> = serde_json::from_slice(&bytes)?;
     verdict(model, &out)?;

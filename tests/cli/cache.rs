@@ -3,7 +3,7 @@
 //! replaced with a warning naming it, so that a result is the same as without the cache. `brdfprof cache
 //! show|clear` lists and removes brdfprof's entries only.
 
-use crate::common::{self, brdfprof, Run};
+use crate::common::{self, Run, brdfprof};
 use brdfprof::brdf::samples;
 use rand::{Rng, SeedableRng};
 use std::path::{Path, PathBuf};
@@ -16,7 +16,10 @@ fn write_csv(path: &Path, n: usize) {
     let mut text = String::from("nx,ny,nz,vx,vy,vz,lx,ly,lz,roughness,f0r,f0g,f0b\n");
     for s in samples::well_conditioned(n, 21, 0.05, 0.2..1.0) {
         let [n, v, l, f] = [s.n, s.v, s.l, s.f0];
-        text += &format!("{},{},{},{},{},{},{},{},{},{},{},{},{}\n", n[0], n[1], n[2], v[0], v[1], v[2], l[0], l[1], l[2], s.roughness, f[0], f[1], f[2]);
+        text += &format!(
+            "{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
+            n[0], n[1], n[2], v[0], v[1], v[2], l[0], l[1], l[2], s.roughness, f[0], f[1], f[2]
+        );
     }
     std::fs::write(path, text).unwrap();
 }
@@ -24,7 +27,11 @@ fn write_csv(path: &Path, n: usize) {
 /// `brdfprof ARGS` in `dir` with the disk cache at `cache` ("" turns it off).
 fn run_cached(dir: &Path, cache: &str, args: &[&str]) -> Run {
     let out = brdfprof().args(args).env("BRDFPROF_CACHE_DIR", cache).current_dir(dir).output().unwrap();
-    Run { code: out.status.code(), stdout: String::from_utf8_lossy(&out.stdout).into_owned(), stderr: String::from_utf8_lossy(&out.stderr).into_owned() }
+    Run {
+        code: out.status.code(),
+        stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
+        stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
+    }
 }
 
 fn entries(cache: &Path) -> Vec<PathBuf> {
@@ -43,13 +50,23 @@ fn an_edited_include_is_not_served_from_the_cache() {
     let glsl = d.join("glsl");
     brdfprof::shaders::write_glsl_tree(&glsl).unwrap();
     let model = format!("{},roughness=@roughness,f0=@f0", example("ggx"));
-    let check = |extra: &[&str]| run_cached(d, cache.to_str().unwrap(), &[&["check", "--glsl", "glsl", "--model", &model, "--no-callgrind", "--rounds", "0"], extra].concat());
+    let check = |extra: &[&str]| {
+        run_cached(
+            d,
+            cache.to_str().unwrap(),
+            &[&["check", "--glsl", "glsl", "--model", &model, "--no-callgrind", "--rounds", "0"], extra].concat(),
+        )
+    };
     check(&["--save-baseline", "b.json"]).ok();
     let brdf = glsl.join("brdf.glsl");
     let source = std::fs::read_to_string(&brdf).unwrap();
     let call = "return BRDF_FILE_FUNCTION(L, V, N, X, cross(N, X));";
     assert!(source.contains(call), "brdf.glsl returns the file's BRDF as `{call}`");
-    std::fs::write(&brdf, source.replace(call, "return BRDF_FILE_FUNCTION(L, V, N, X, cross(N, X)) * pow(max(dot(N, L), 1e-4), 1e-7);")).unwrap();
+    std::fs::write(
+        &brdf,
+        source.replace(call, "return BRDF_FILE_FUNCTION(L, V, N, X, cross(N, X)) * pow(max(dot(N, L), 1e-4), 1e-7);"),
+    )
+    .unwrap();
     let r = check(&["--baseline", "b.json"]);
     assert_eq!(r.code, Some(1), "the edit is a regression with the cache on\n{}\n{}", r.stdout, r.stderr);
     assert!(r.stdout.contains("glsl.Pow") && r.stdout.contains("REGRESSION"), "{}", r.stdout);
@@ -64,7 +81,8 @@ fn a_changed_float_in_an_entry_is_detected_and_replaced() {
     write_csv(&d.join("in.csv"), 50);
     let cache = d.join("cache");
     let ggx = example("ggx");
-    let eval = |cache: &str, out: &str| run_cached(d, cache, &["eval", "--model", &ggx, "--input", "in.csv", "--output", out]);
+    let eval =
+        |cache: &str, out: &str| run_cached(d, cache, &["eval", "--model", &ggx, "--input", "in.csv", "--output", out]);
     eval("", "reference.csv").ok();
     eval(cache.to_str().unwrap(), "first.csv").ok();
     let all = entries(&cache);
@@ -75,7 +93,11 @@ fn a_changed_float_in_an_entry_is_detected_and_replaced() {
     bytes[at..at + 4].copy_from_slice(&6.283f32.to_le_bytes());
     std::fs::write(&entry, &bytes).unwrap();
     let r = eval(cache.to_str().unwrap(), "after.csv").ok();
-    assert!(r.stderr.contains(&format!("warning: the cache entry {} ", entry.display())) && r.stderr.contains("damaged"), "{}", r.stderr);
+    assert!(
+        r.stderr.contains(&format!("warning: the cache entry {} ", entry.display())) && r.stderr.contains("damaged"),
+        "{}",
+        r.stderr
+    );
     let reference = std::fs::read_to_string(d.join("reference.csv")).unwrap();
     assert_eq!(std::fs::read_to_string(d.join("after.csv")).unwrap(), reference, "the same rows as without the cache");
     assert_eq!(std::fs::read_to_string(d.join("first.csv")).unwrap(), reference);
@@ -84,7 +106,12 @@ fn a_changed_float_in_an_entry_is_detected_and_replaced() {
     assert!(!r.stderr.contains("damaged"), "the replaced entry verifies: {}", r.stderr);
     // An entry that is no longer SPIR-V at all (it failed every later run, and segfaulted under validation).
     std::fs::write(&entry, b"\x03\x02\x23\x07 not SPIR-V any more").unwrap();
-    let r = run_cached(d, cache.to_str().unwrap(), &["eval", "--model", &ggx, "--input", "in.csv", "--output", "garbage.csv", "--validate"]).ok();
+    let r = run_cached(
+        d,
+        cache.to_str().unwrap(),
+        &["eval", "--model", &ggx, "--input", "in.csv", "--output", "garbage.csv", "--validate"],
+    )
+    .ok();
     assert!(r.stderr.contains(&entry.display().to_string()), "{}", r.stderr);
     assert_eq!(std::fs::read_to_string(d.join("garbage.csv")).unwrap(), reference);
 }
@@ -98,7 +125,9 @@ fn random_damage_to_entries_never_changes_a_result() {
     write_csv(&d.join("in.csv"), 20);
     let cache = d.join("cache");
     let (ggx, blinn) = (example("ggx"), example("blinn"));
-    let eval = |model: &str, cache: &str, out: &str| run_cached(d, cache, &["eval", "--model", model, "--input", "in.csv", "--output", out]).ok();
+    let eval = |model: &str, cache: &str, out: &str| {
+        run_cached(d, cache, &["eval", "--model", model, "--input", "in.csv", "--output", out]).ok()
+    };
     eval(&ggx, "", "reference.csv");
     let reference = std::fs::read_to_string(d.join("reference.csv")).unwrap();
     eval(&blinn, cache.to_str().unwrap(), "blinn.csv");
@@ -133,7 +162,11 @@ fn random_damage_to_entries_never_changes_a_result() {
         };
         std::fs::write(&entry, &bytes).unwrap();
         let r = eval(&ggx, cache.to_str().unwrap(), "out.csv");
-        assert_eq!(std::fs::read_to_string(d.join("out.csv")).unwrap(), reference, "round {round} ({what}): a different result");
+        assert_eq!(
+            std::fs::read_to_string(d.join("out.csv")).unwrap(),
+            reference,
+            "round {round} ({what}): a different result"
+        );
         assert!(r.stderr.contains("damaged"), "round {round} ({what}): not reported\n{}", r.stderr);
     }
 }
@@ -150,7 +183,11 @@ fn cache_show_and_clear_touch_only_brdfprofs_entries() {
     let size = std::fs::metadata(&entries(&cache)[0]).unwrap().len();
     let show = run_cached(d, c, &["cache", "show"]).ok();
     assert!(show.stdout.contains(&format!("directory: {c} (BRDFPROF_CACHE_DIR)")), "{}", show.stdout);
-    assert!(show.stdout.contains("entries: 1 (spv: 1)") && show.stdout.contains(&format!("total size: {size} bytes")), "{}", show.stdout);
+    assert!(
+        show.stdout.contains("entries: 1 (spv: 1)") && show.stdout.contains(&format!("total size: {size} bytes")),
+        "{}",
+        show.stdout
+    );
     let clear = run_cached(d, c, &["cache", "clear"]).ok();
     assert!(clear.stdout.contains(&format!("removed 1 cache entry ({size} bytes)")), "{}", clear.stdout);
     assert_eq!(entries(&cache), [cache.join("notes.txt")], "only brdfprof's entry went");

@@ -11,27 +11,40 @@ use std::path::Path;
 pub fn inspect_json(dir: &Path, name: &str, devices: &[&str], extra: &[&str], section: &str) -> serde_json::Value {
     let json = dir.join(format!("{name}.json"));
     let md = dir.join(format!("{name}.md"));
-    let mut args = vec!["inspect", "--no-callgrind", "--json", json.to_str().unwrap(), "--markdown", md.to_str().unwrap()];
+    let mut args =
+        vec!["inspect", "--no-callgrind", "--json", json.to_str().unwrap(), "--markdown", md.to_str().unwrap()];
     for d in devices {
         args.extend(["--device", d]);
     }
     args.extend(extra);
-    let out = common::brdfprof().args(&args).env("BRDFPROF_CACHE_DIR", dir.join(format!("cache-{name}"))).output().unwrap();
-    let out = common::Run { code: out.status.code(), stdout: String::from_utf8_lossy(&out.stdout).into_owned(), stderr: String::from_utf8_lossy(&out.stderr).into_owned() }.ok();
+    let out =
+        common::brdfprof().args(&args).env("BRDFPROF_CACHE_DIR", dir.join(format!("cache-{name}"))).output().unwrap();
+    let out = common::Run {
+        code: out.status.code(),
+        stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
+        stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
+    }
+    .ok();
     assert!(out.stdout.contains(section), "{}", out.stdout);
     serde_json::from_str(&std::fs::read_to_string(json).unwrap()).unwrap()
 }
 
 /// The row's `driver/COMPILER/NAME` statistic.
 pub fn stat(row: &serde_json::Value, compiler: &str, name: &str) -> f64 {
-    row["stats"][format!("driver/{compiler}/{name}")].as_f64().unwrap_or_else(|| panic!("{} has no {name}: {row}", row["model"]))
+    row["stats"][format!("driver/{compiler}/{name}")]
+        .as_f64()
+        .unwrap_or_else(|| panic!("{} has no {name}: {row}", row["model"]))
 }
 
 /// Every preset and each example `.brdf` file (parameters bound to the kernel inputs).
 pub fn every_preset_and_example() -> Vec<String> {
     let mut models: Vec<String> = brdfprof::brdf::spec::PRESETS.iter().map(|p| p.name.to_string()).collect();
     let dir = common::repo_root().join("examples/brdf");
-    let mut files: Vec<_> = std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().path()).filter(|p| p.extension().is_some_and(|x| x == "brdf")).collect();
+    let mut files: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x == "brdf"))
+        .collect();
     files.sort();
     models.extend(files.iter().map(|p| format!("{},roughness=@roughness,f0=@f0", p.display())));
     models

@@ -20,8 +20,13 @@ fn classes(target: &str, row: &serde_json::Value) -> Vec<f64> {
     let s = stats(row);
     let get = |k: String| s.get(&k).copied().unwrap_or_else(|| panic!("{target} {}: no {k}", row["model"]));
     match target {
-        "radv:navi21" => brdfprof::targets::radv::aco_perfinfo::Class::ALL.iter().map(|c| get(format!("driver/Compute Shader/{}", brdfprof::targets::radv::aco_perfinfo::count_name(*c)))).collect(),
-        "nvidia:sm_89" => brdfprof::targets::nvidia::Class::ALL.iter().map(|c| get(format!("driver/SASS/{}", c.name()))).collect(),
+        "radv:navi21" => brdfprof::targets::radv::aco_perfinfo::Class::ALL
+            .iter()
+            .map(|c| get(format!("driver/Compute Shader/{}", brdfprof::targets::radv::aco_perfinfo::count_name(*c))))
+            .collect(),
+        "nvidia:sm_89" => {
+            brdfprof::targets::nvidia::Class::ALL.iter().map(|c| get(format!("driver/SASS/{}", c.name()))).collect()
+        }
         _ => brdfprof::targets::intel::Class::ALL.iter().map(|c| get(format!("driver/IGC/{}", c.name()))).collect(),
     }
 }
@@ -30,7 +35,9 @@ fn classes(target: &str, row: &serde_json::Value) -> Vec<f64> {
 fn terms(target: &str, row: &serde_json::Value) -> Vec<(String, f64)> {
     let s = stats(row);
     let (schedule, lanes) = match target {
-        "radv:navi21" => (brdfprof::targets::radv::schedule(&s, AMD.iter().find(|f| f.family == "navi21").unwrap()).unwrap(), 64.0),
+        "radv:navi21" => {
+            (brdfprof::targets::radv::schedule(&s, AMD.iter().find(|f| f.family == "navi21").unwrap()).unwrap(), 64.0)
+        }
         "nvidia:sm_89" => (Schedule::of(&s).unwrap(), 32.0),
         _ => (Schedule::of(&s).unwrap(), s["driver/IGC/SIMD Width"]),
     };
@@ -41,7 +48,8 @@ fn terms(target: &str, row: &serde_json::Value) -> Vec<(String, f64)> {
 fn one_operation_more_moves_every_vendors_cost_the_way_its_code_does() {
     let dir = tempfile::tempdir().unwrap();
     let fixtures = crate::common::repo_root().join("tests/fixtures/brdf/pairs");
-    let files = ["base", "plus-sqrt", "plus-division", "pow5", "mul5"].map(|n| fixtures.join(format!("{n}.brdf")).to_str().unwrap().to_string());
+    let files = ["base", "plus-sqrt", "plus-division", "pow5", "mul5"]
+        .map(|n| fixtures.join(format!("{n}.brdf")).to_str().unwrap().to_string());
     let mut extra = Vec::new();
     for f in &files {
         extra.extend(["--model", f.as_str()]);
@@ -51,7 +59,11 @@ fn one_operation_more_moves_every_vendors_cost_the_way_its_code_does() {
     let mut moved = 0;
     for (target, report) in targets.iter().zip(all["reports"].as_array().unwrap()) {
         let row = |m: &str| report["rows"].as_array().unwrap().iter().find(|r| r["model"] == m).unwrap().clone();
-        let net = |m: &str| report["cost"]["rows"].as_array().unwrap().iter().find(|r| r["model"] == m).unwrap()["net_cycles_per_eval"].as_f64().unwrap();
+        let net = |m: &str| {
+            report["cost"]["rows"].as_array().unwrap().iter().find(|r| r["model"] == m).unwrap()["net_cycles_per_eval"]
+                .as_f64()
+                .unwrap()
+        };
         for (a, b) in PAIRS {
             let (ca, cb) = (classes(target, &row(a)), classes(target, &row(b)));
             let (ta, tb) = (terms(target, &row(a)), terms(target, &row(b)));
@@ -72,7 +84,8 @@ fn one_operation_more_moves_every_vendors_cost_the_way_its_code_does() {
         }
         // The sqrt and the division each reach the compiler's code: more of the instructions that compute them.
         for b in ["plus-sqrt", "plus-division"] {
-            let added: f64 = classes(target, &row(b)).iter().zip(classes(target, &row("base"))).map(|(y, x)| y - x).sum();
+            let added: f64 =
+                classes(target, &row(b)).iter().zip(classes(target, &row("base"))).map(|(y, x)| y - x).sum();
             assert!(added >= 8.0, "{target} {b}: {added} instructions more than base for 8 lights");
         }
     }

@@ -7,7 +7,11 @@ use crate::common::{self, run_in};
 fn an_empty_or_blank_device_is_refused_by_every_gpu_command() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    std::fs::write(d.join("in.csv"), "nx,ny,nz,vx,vy,vz,lx,ly,lz,roughness,f0r,f0g,f0b\n0,0,1,0,0.6,0.8,0.6,0,0.8,0.5,0.04,0.04,0.04\n").unwrap();
+    std::fs::write(
+        d.join("in.csv"),
+        "nx,ny,nz,vx,vy,vz,lx,ly,lz,roughness,f0r,f0g,f0b\n0,0,1,0,0.6,0.8,0.6,0,0.8,0.5,0.04,0.04,0.04\n",
+    )
+    .unwrap();
     let baseline = common::repo_root().join("results/baseline-llvmpipe.json");
     let scene = common::repo_root().join("scenes/sphere-grid.json");
     let (baseline, scene) = (baseline.to_str().unwrap(), scene.to_str().unwrap());
@@ -23,7 +27,8 @@ fn an_empty_or_blank_device_is_refused_by_every_gpu_command() {
     ];
     for args in commands {
         for device in ["--device=", "--device= ", "--device=\t"] {
-            let run = run_in(d, &[args, &[device]].concat()).fails(2, &format!("invalid value '{}' for '--device <DEVICE>': empty", &device[9..]));
+            let run = run_in(d, &[args, &[device]].concat())
+                .fails(2, &format!("invalid value '{}' for '--device <DEVICE>': empty", &device[9..]));
             assert!(run.stdout.is_empty(), "{args:?} {device:?} printed: {}", run.stdout);
         }
     }
@@ -37,7 +42,11 @@ fn an_empty_or_blank_device_is_refused_by_every_gpu_command() {
 fn mesa_variables_in_the_environment_cannot_crash_it() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    std::fs::write(d.join("in.csv"), "nx,ny,nz,vx,vy,vz,lx,ly,lz,roughness,f0r,f0g,f0b\n0,0,1,0,0.6,0.8,0.6,0,0.8,0.5,0.04,0.04,0.04\n").unwrap();
+    std::fs::write(
+        d.join("in.csv"),
+        "nx,ny,nz,vx,vy,vz,lx,ly,lz,roughness,f0r,f0g,f0b\n0,0,1,0,0.6,0.8,0.6,0,0.8,0.5,0.04,0.04,0.04\n",
+    )
+    .unwrap();
     let run = |var: &str, value: &str, args: &[&str]| {
         let out = common::brdfprof().args(args).env(var, value).current_dir(d).output().unwrap();
         let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
@@ -47,13 +56,21 @@ fn mesa_variables_in_the_environment_cannot_crash_it() {
     for value in ["garbage", "", " navi21", "-1"] {
         let (code, stderr) = run("RADV_FORCE_FAMILY", value, &["devices"]);
         assert_eq!(code, Some(0), "{stderr}");
-        assert!(stderr.contains(&format!("warning: RADV_FORCE_FAMILY=`{value}` is not a GPU family Mesa's RADV knows")), "{stderr}");
-        let (code, stderr) = run("RADV_FORCE_FAMILY", value, &["eval", "--model", "ggx", "--input", "in.csv", "--output", "out.csv"]);
+        assert!(
+            stderr.contains(&format!("warning: RADV_FORCE_FAMILY=`{value}` is not a GPU family Mesa's RADV knows")),
+            "{stderr}"
+        );
+        let (code, stderr) =
+            run("RADV_FORCE_FAMILY", value, &["eval", "--model", "ggx", "--input", "in.csv", "--output", "out.csv"]);
         assert_eq!(code, Some(0), "{stderr}");
     }
     // A family brdfprof lists is used as the user meant it (its null device listed, compiling only).
     let out = common::brdfprof().args(["devices"]).env("RADV_FORCE_FAMILY", "navi21").output().unwrap();
-    assert!(out.status.success() && String::from_utf8_lossy(&out.stdout).contains("NAVI21"), "{}", String::from_utf8_lossy(&out.stdout));
+    assert!(
+        out.status.success() && String::from_utf8_lossy(&out.stdout).contains("NAVI21"),
+        "{}",
+        String::from_utf8_lossy(&out.stdout)
+    );
     for var in ["MESA_SHADER_CACHE_DISABLE", "LP_NUM_THREADS"] {
         for value in ["garbage", "", "-1", "99999999999"] {
             run(var, value, &["eval", "--model", "ggx", "--input", "in.csv", "--output", "out.csv"]);

@@ -14,7 +14,20 @@ fn json(path: &std::path::Path) -> serde_json::Value {
 fn a_preset_against_itself_differs_by_nothing() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("same.json");
-    common::run(&["diff", "--model", "filament-high", "--model", "filament-high", "--samples", "3000", "--tolerance", "0", "--json", out.to_str().unwrap()]).ok();
+    common::run(&[
+        "diff",
+        "--model",
+        "filament-high",
+        "--model",
+        "filament-high",
+        "--samples",
+        "3000",
+        "--tolerance",
+        "0",
+        "--json",
+        out.to_str().unwrap(),
+    ])
+    .ok();
     let j = json(&out);
     assert_eq!(j["kind"], "diff");
     for c in j["difference"]["channels"].as_array().unwrap() {
@@ -30,7 +43,23 @@ fn ggx_against_filament_high_differs_as_the_twins_do() {
     let dir = tempfile::tempdir().unwrap();
     let (out, csv, png) = (dir.path().join("d.json"), dir.path().join("d.csv"), dir.path().join("d.png"));
     let (n, seed) = (4000, 5);
-    let args = ["diff", "--model", "ggx", "--model", "filament-high", "--samples", "4000", "--seed", "5", "--json", out.to_str().unwrap(), "--csv", csv.to_str().unwrap(), "--png", png.to_str().unwrap()];
+    let args = [
+        "diff",
+        "--model",
+        "ggx",
+        "--model",
+        "filament-high",
+        "--samples",
+        "4000",
+        "--seed",
+        "5",
+        "--json",
+        out.to_str().unwrap(),
+        "--csv",
+        csv.to_str().unwrap(),
+        "--png",
+        png.to_str().unwrap(),
+    ];
     common::run(&args).ok();
     // The known difference: the two presets' f64 twins on the same samples, B against A.
     let samples = diff::default_samples(n, seed);
@@ -41,28 +70,82 @@ fn ggx_against_filament_high_differs_as_the_twins_do() {
         let max = rel.iter().copied().fold(0.0, f64::max);
         let rms = (rel.iter().map(|e| e * e).sum::<f64>() / n as f64).sqrt();
         assert!(max > 0.05, "the presets differ (Vis and f90): {max}");
-        assert!((got["max_rel"].as_f64().unwrap() - max).abs() <= 1e-4 * max, "channel {c}: max rel {} vs the twins' {max}", got["max_rel"]);
-        assert!((got["rms_rel"].as_f64().unwrap() - rms).abs() <= 1e-4 * rms, "channel {c}: RMS rel {} vs the twins' {rms}", got["rms_rel"]);
+        assert!(
+            (got["max_rel"].as_f64().unwrap() - max).abs() <= 1e-4 * max,
+            "channel {c}: max rel {} vs the twins' {max}",
+            got["max_rel"]
+        );
+        assert!(
+            (got["rms_rel"].as_f64().unwrap() - rms).abs() <= 1e-4 * rms,
+            "channel {c}: RMS rel {} vs the twins' {rms}",
+            got["rms_rel"]
+        );
     }
     assert_eq!(std::fs::read_to_string(&csv).unwrap().lines().count(), n + 1);
     let picture = image::open(&png).unwrap();
     assert!(picture.width() > 1000 && picture.height() > 400, "{}x{}", picture.width(), picture.height());
     let max_rel = j["difference"]["max_rel"].as_f64().unwrap();
     let below = format!("{}", max_rel * 0.5);
-    common::run(&["diff", "--model", "ggx", "--model", "filament-high", "--samples", "4000", "--seed", "5", "--tolerance", &below]).fails(1, "");
+    common::run(&[
+        "diff",
+        "--model",
+        "ggx",
+        "--model",
+        "filament-high",
+        "--samples",
+        "4000",
+        "--seed",
+        "5",
+        "--tolerance",
+        &below,
+    ])
+    .fails(1, "");
     let above = format!("{}", max_rel * 2.0);
-    common::run(&["diff", "--model", "ggx", "--model", "filament-high", "--samples", "4000", "--seed", "5", "--tolerance", &above]).ok();
+    common::run(&[
+        "diff",
+        "--model",
+        "ggx",
+        "--model",
+        "filament-high",
+        "--samples",
+        "4000",
+        "--seed",
+        "5",
+        "--tolerance",
+        &above,
+    ])
+    .ok();
 }
 
 #[test]
 fn labels_name_the_sides_and_leave_the_specs_alone() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("named.json");
-    common::run(&["diff", "--model", "ggx,name=base", "--model", "examples/brdf/ggx.brdf", "--samples", "500", "--json", out.to_str().unwrap()]).ok();
+    common::run(&[
+        "diff",
+        "--model",
+        "ggx,name=base",
+        "--model",
+        "examples/brdf/ggx.brdf",
+        "--samples",
+        "500",
+        "--json",
+        out.to_str().unwrap(),
+    ])
+    .ok();
     let j = json(&out);
-    assert_eq!((j["a"]["name"].as_str(), j["b"]["name"].as_str()), (Some("base"), Some("ggx.brdf")), "the label, and a file's name (not its path; ggx.brdf keeps its extension, as its stem is a preset's)");
-    assert_eq!(j["a"]["canonical"].as_str().unwrap(), ModelSpec::parse("ggx").unwrap().canonical(), "a label is not part of the canonical spec");
-    common::run(&["diff", "--model", "ggx,name=x", "--model", "blinn,name=x"]).fails(2, "--model ggx,name=x and --model blinn,name=x: both are labelled `x`");
+    assert_eq!(
+        (j["a"]["name"].as_str(), j["b"]["name"].as_str()),
+        (Some("base"), Some("ggx.brdf")),
+        "the label, and a file's name (not its path; ggx.brdf keeps its extension, as its stem is a preset's)"
+    );
+    assert_eq!(
+        j["a"]["canonical"].as_str().unwrap(),
+        ModelSpec::parse("ggx").unwrap().canonical(),
+        "a label is not part of the canonical spec"
+    );
+    common::run(&["diff", "--model", "ggx,name=x", "--model", "blinn,name=x"])
+        .fails(2, "--model ggx,name=x and --model blinn,name=x: both are labelled `x`");
     common::run(&["diff", "--model", "ggx,name=a/b", "--model", "blinn"]).fails(2, "name=a/b");
 }
 
@@ -71,13 +154,38 @@ fn diff_reads_an_input_csv_and_names_its_lines() {
     let dir = tempfile::tempdir().unwrap();
     let (input, out) = (dir.path().join("in.csv"), dir.path().join("d.json"));
     std::fs::write(&input, "nx,ny,nz,vx,vy,vz,lx,ly,lz,roughness,f0r,f0g,f0b\n0,0,1,0,0.6,0.8,0.6,0,0.8,0.5,0.04,0.04,0.04\n0,0,1,0,0.8,0.6,0.3,0,0.9,0.2,0.9,0.5,0.1\n").unwrap();
-    common::run(&["diff", "--model", "ggx", "--model", "blinn", "--input", input.to_str().unwrap(), "--json", out.to_str().unwrap(), "--worst", "2"]).ok();
+    common::run(&[
+        "diff",
+        "--model",
+        "ggx",
+        "--model",
+        "blinn",
+        "--input",
+        input.to_str().unwrap(),
+        "--json",
+        out.to_str().unwrap(),
+        "--worst",
+        "2",
+    ])
+    .ok();
     let j = json(&out);
     assert_eq!(j["rows"].as_u64(), Some(2));
     let lines: Vec<u64> = j["worst"].as_array().unwrap().iter().map(|w| w["line"].as_u64().unwrap()).collect();
-    assert_eq!({ let mut l = lines.clone(); l.sort(); l }, [2, 3]);
-    std::fs::write(&input, "nx,ny,nz,vx,vy,vz,lx,ly,lz,roughness,f0r,f0g,f0b\n0,0,1,0,0.6,x,0.6,0,0.8,0.5,0.04,0.04,0.04\n").unwrap();
-    common::run(&["diff", "--model", "ggx", "--model", "blinn", "--input", input.to_str().unwrap()]).fails(2, "in.csv:2: column 6");
+    assert_eq!(
+        {
+            let mut l = lines.clone();
+            l.sort();
+            l
+        },
+        [2, 3]
+    );
+    std::fs::write(
+        &input,
+        "nx,ny,nz,vx,vy,vz,lx,ly,lz,roughness,f0r,f0g,f0b\n0,0,1,0,0.6,x,0.6,0,0.8,0.5,0.04,0.04,0.04\n",
+    )
+    .unwrap();
+    common::run(&["diff", "--model", "ggx", "--model", "blinn", "--input", input.to_str().unwrap()])
+        .fails(2, "in.csv:2: column 6");
 }
 
 #[test]
@@ -87,7 +195,18 @@ fn diff_refuses_bad_arguments() {
     common::run(&["diff", "--model", "ggx", "--model", "blinn", "--samples", "0"]).fails(2, "--samples 0");
     let dir = tempfile::tempdir().unwrap();
     let p = dir.path().join("x.out");
-    common::run(&["diff", "--model", "ggx", "--model", "blinn", "--csv", p.to_str().unwrap(), "--json", p.to_str().unwrap()]).fails(2, "is also given to --csv");
+    common::run(&[
+        "diff",
+        "--model",
+        "ggx",
+        "--model",
+        "blinn",
+        "--csv",
+        p.to_str().unwrap(),
+        "--json",
+        p.to_str().unwrap(),
+    ])
+    .fails(2, "is also given to --csv");
     assert!(!p.exists());
 }
 
@@ -104,24 +223,43 @@ fn diff_against_a_reference_measures_every_model_in_one_table() {
     let reference = "d=ggx,vis=smith-ggx-correlated,f=schlick";
     let (out, csv, html) = (dir.path().join("set.json"), dir.path().join("set.csv"), dir.path().join("set.html"));
     let run = |models: &[&str], extra: &[&str]| {
-        let mut args = vec!["diff", "--reference", reference, "--samples", "3000", "--tolerance", "1e-3", "--json", out.to_str().unwrap()];
+        let mut args = vec![
+            "diff",
+            "--reference",
+            reference,
+            "--samples",
+            "3000",
+            "--tolerance",
+            "1e-3",
+            "--json",
+            out.to_str().unwrap(),
+        ];
         for m in models {
             args.extend(["--model", m]);
         }
         args.extend(extra);
         common::run(&args)
     };
-    let r = run(&[reference, "ggx", &file, &file_f], &["--csv", csv.to_str().unwrap(), "--html", html.to_str().unwrap()]);
+    let r =
+        run(&[reference, "ggx", &file, &file_f], &["--csv", csv.to_str().unwrap(), "--html", html.to_str().unwrap()]);
     assert_eq!(r.code, Some(1), "ggx is beyond 1e-3 of the correlated Smith: {}", r.stderr);
     let j = json(&out);
     assert_eq!(j["kind"], diff::SET_KIND);
     let diffs = j["diffs"].as_array().unwrap();
     assert_eq!(diffs.len(), 4);
     let max_rel = |k: usize| diffs[k]["difference"]["max_rel"].as_f64().unwrap();
-    assert!(diffs.iter().all(|d| d["a"]["name"].as_str().unwrap().ends_with("(f64)")), "A is the reference's f64 values");
+    assert!(
+        diffs.iter().all(|d| d["a"]["name"].as_str().unwrap().ends_with("(f64)")),
+        "A is the reference's f64 values"
+    );
     assert!(max_rel(0) < 1e-4, "the reference's kernel against its own f64 values: {}", max_rel(0));
     assert!(max_rel(1) > 1e-2, "ggx's SmithJointApprox against the correlated Smith: {}", max_rel(1));
-    assert!(max_rel(2) < 1e-3 && max_rel(3) < 1e-3, "the engine files within their domain: {} {}", max_rel(2), max_rel(3));
+    assert!(
+        max_rel(2) < 1e-3 && max_rel(3) < 1e-3,
+        "the engine files within their domain: {} {}",
+        max_rel(2),
+        max_rel(3)
+    );
     // The CSV's columns recompute the table: the reference's values (f64 rounded to f32, which moves a
     // relative difference by at most 2^-24) and each model's.
     let text = std::fs::read_to_string(&csv).unwrap();
@@ -138,7 +276,11 @@ fn diff_against_a_reference_measures_every_model_in_one_table() {
         }
     }
     for (m, w) in worst.iter().enumerate() {
-        assert!((w - max_rel(m)).abs() <= 1e-7 + 1e-6 * max_rel(m), "model {m}: CSV {w} against the report's {}", max_rel(m));
+        assert!(
+            (w - max_rel(m)).abs() <= 1e-7 + 1e-6 * max_rel(m),
+            "model {m}: CSV {w} against the report's {}",
+            max_rel(m)
+        );
     }
     let page = std::fs::read_to_string(&html).unwrap();
     assert!(page.contains("4 models against") && page.contains("diffset0/ggx"), "the page's one table");

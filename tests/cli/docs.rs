@@ -28,7 +28,11 @@ fn without_comments(text: &str) -> String {
 fn layout_paths(readme: &str) -> Vec<String> {
     let section = readme.split("\n## Layout\n").nth(1).expect("README has a `## Layout` section");
     let block = section.split("```").nth(1).expect("README's Layout has a code block");
-    block.lines().filter(|l| !l.is_empty() && !l.starts_with(' ')).map(|l| l.split_whitespace().next().unwrap().to_string()).collect()
+    block
+        .lines()
+        .filter(|l| !l.is_empty() && !l.starts_with(' '))
+        .map(|l| l.split_whitespace().next().unwrap().to_string())
+        .collect()
 }
 
 /// Top-level names `.gitignore` ignores (its anchored one-name patterns: `/target`, `/gpu-run/`).
@@ -56,11 +60,18 @@ fn entries(dir: &Path) -> Vec<(String, bool)> {
 fn readme_is_short_and_its_test_command_is_what_ci_runs() {
     let readme = read("README.md");
     let lines = readme.lines().count();
-    assert!(lines <= README_MAX_LINES, "README.md has {lines} lines, more than {README_MAX_LINES}: move detail to docs/");
+    assert!(
+        lines <= README_MAX_LINES,
+        "README.md has {lines} lines, more than {README_MAX_LINES}: move detail to docs/"
+    );
     let ci = read(".ci/run");
-    let command = ci.lines().map(str::trim).rfind(|l| !l.is_empty() && !l.starts_with('#')).expect(".ci/run runs a command");
+    let command =
+        ci.lines().map(str::trim).rfind(|l| !l.is_empty() && !l.starts_with('#')).expect(".ci/run runs a command");
     let first_screen: String = readme.lines().take(40).collect::<Vec<_>>().join("\n");
-    assert!(first_screen.contains(&format!("\n{command} ")), "README's first screen must show `{command}`, what .ci/run runs");
+    assert!(
+        first_screen.contains(&format!("\n{command} ")),
+        "README's first screen must show `{command}`, what .ci/run runs"
+    );
     assert!(first_screen.contains("\nmake run "), "README's first screen must show `make run`");
 }
 
@@ -90,13 +101,24 @@ fn readme_layout_names_every_top_level_folder_src_and_crates_entry_and_only_real
 
 /// GitHub's anchor of a heading: lower case, punctuation dropped, spaces to hyphens.
 fn anchor(heading: &str) -> String {
-    heading.trim().to_lowercase().chars().filter(|c| c.is_alphanumeric() || matches!(c, ' ' | '-' | '_')).map(|c| if c == ' ' { '-' } else { c }).collect()
+    heading
+        .trim()
+        .to_lowercase()
+        .chars()
+        .filter(|c| c.is_alphanumeric() || matches!(c, ' ' | '-' | '_'))
+        .map(|c| if c == ' ' { '-' } else { c })
+        .collect()
 }
 
 /// The relative link targets of a Markdown text (`](target)`), outside HTML comments.
 fn relative_links(text: &str) -> Vec<String> {
     let text = without_comments(text);
-    text.split("](").skip(1).filter_map(|s| s.split(')').next()).filter(|t| !t.contains("://") && !t.starts_with("mailto:")).map(str::to_string).collect()
+    text.split("](")
+        .skip(1)
+        .filter_map(|s| s.split(')').next())
+        .filter(|t| !t.contains("://") && !t.starts_with("mailto:"))
+        .map(str::to_string)
+        .collect()
 }
 
 /// The Markdown pages under `folder` and its folders (docs/targets/: one page per compile-only vendor), as paths
@@ -124,7 +146,8 @@ fn every_docs_page_is_linked_from_readme_and_every_relative_link_leads_somewhere
         pages.push(page);
     }
     pages.push("glsl/README.md".to_string());
-    let linked: BTreeSet<String> = relative_links(&read("README.md")).iter().map(|t| t.split('#').next().unwrap().to_string()).collect();
+    let linked: BTreeSet<String> =
+        relative_links(&read("README.md")).iter().map(|t| t.split('#').next().unwrap().to_string()).collect();
     let unlinked: Vec<&String> = docs.iter().filter(|d| !linked.contains(*d)).collect();
     assert!(unlinked.is_empty(), "docs pages README does not link: {unlinked:?}");
     let mut broken = Vec::new();
@@ -138,7 +161,12 @@ fn every_docs_page_is_linked_from_readme_and_every_relative_link_leads_somewhere
                 broken.push(format!("{page}: {target} (no {path})"));
             } else if !fragment.is_empty() && path.ends_with(".md") {
                 let text = std::fs::read_to_string(&full).unwrap();
-                if !text.lines().filter_map(|l| l.strip_prefix('#')).map(|l| anchor(l.trim_start_matches('#'))).any(|a| a == fragment) {
+                if !text
+                    .lines()
+                    .filter_map(|l| l.strip_prefix('#'))
+                    .map(|l| anchor(l.trim_start_matches('#')))
+                    .any(|a| a == fragment)
+                {
                     broken.push(format!("{page}: {target} (no heading #{fragment} in {path})"));
                 }
             }
@@ -166,12 +194,19 @@ fn every_environment_variable_brdfprof_reads_is_documented() {
     for dir in common::source_dirs() {
         walk(&dir, &mut files);
     }
-    let macros: String = files.iter().filter(|f| f.extension().is_some_and(|x| x == "h")).map(|f| std::fs::read_to_string(f).unwrap()).collect();
+    let macros: String = files
+        .iter()
+        .filter(|f| f.extension().is_some_and(|x| x == "h"))
+        .map(|f| std::fs::read_to_string(f).unwrap())
+        .collect();
     let mut missing = BTreeSet::new();
     for f in files.iter().filter(|f| f.extension().is_some_and(|x| x == "rs")) {
         let text = std::fs::read_to_string(f).unwrap();
         for (i, _) in text.match_indices("\"BRDFPROF_") {
-            let name: String = text[i + 1..].chars().take_while(|c| c.is_ascii_uppercase() || c.is_ascii_digit() || *c == '_').collect();
+            let name: String = text[i + 1..]
+                .chars()
+                .take_while(|c| c.is_ascii_uppercase() || c.is_ascii_digit() || *c == '_')
+                .collect();
             if !macros.contains(&name) && !table.contains(&format!("| `{name}")) {
                 missing.insert(name);
             }

@@ -41,8 +41,19 @@ fn only_the_columns_the_model_reads_are_required() {
     let d = dir.path();
     let geometry = "0,0,1,0,0.6,0.8,0.6,0,0.8";
     let rows = ["0.5", "0.3"];
-    std::fs::write(d.join("full.csv"), format!("{HEADER}\n{}", rows.iter().map(|r| format!("{geometry},{r},0.04,0.04,0.04\n")).collect::<String>())).unwrap();
-    std::fs::write(d.join("no-f0.csv"), format!("nx,ny,nz,vx,vy,vz,lx,ly,lz,roughness\n{}", rows.iter().map(|r| format!("{geometry},{r}\n")).collect::<String>())).unwrap();
+    std::fs::write(
+        d.join("full.csv"),
+        format!("{HEADER}\n{}", rows.iter().map(|r| format!("{geometry},{r},0.04,0.04,0.04\n")).collect::<String>()),
+    )
+    .unwrap();
+    std::fs::write(
+        d.join("no-f0.csv"),
+        format!(
+            "nx,ny,nz,vx,vy,vz,lx,ly,lz,roughness\n{}",
+            rows.iter().map(|r| format!("{geometry},{r}\n")).collect::<String>()
+        ),
+    )
+    .unwrap();
     std::fs::write(d.join("geometry.csv"), format!("nx,ny,nz,vx,vy,vz,lx,ly,lz\n{geometry}\n{geometry}\n")).unwrap();
     let read = |name: &str| std::fs::read_to_string(d.join(name)).unwrap();
     let copper = "d=ggx,vis=smith-ggx-correlated,f=conductor,metal=copper";
@@ -50,12 +61,15 @@ fn only_the_columns_the_model_reads_are_required() {
     run_in(d, &["eval", "--model", copper, "--input", "no-f0.csv", "--output", "b.csv"]).ok();
     assert_eq!(read("a.csv"), read("b.csv"), "F0 is not read by a conductor");
     assert_ne!(read("a.csv").lines().nth(1), read("a.csv").lines().nth(2), "roughness is read: the rows differ");
-    run_in(d, &["eval", "--model", "ggx", "--input", "no-f0.csv", "--output", "c.csv"]).fails(2, "header lacks column(s) f0r, f0g, f0b");
-    run_in(d, &["eval", "--model", copper, "--input", "geometry.csv", "--output", "c.csv"]).fails(2, "header lacks column(s) roughness");
+    run_in(d, &["eval", "--model", "ggx", "--input", "no-f0.csv", "--output", "c.csv"])
+        .fails(2, "header lacks column(s) f0r, f0g, f0b");
+    run_in(d, &["eval", "--model", copper, "--input", "geometry.csv", "--output", "c.csv"])
+        .fails(2, "header lacks column(s) roughness");
     let file = crate::common::repo_root().join("tests/fixtures/brdf/quality-switch.brdf").display().to_string();
     run_in(d, &["eval", "--model", &file, "--input", "full.csv", "--output", "e.csv"]).ok();
     run_in(d, &["eval", "--model", &file, "--input", "geometry.csv", "--output", "f.csv"]).ok();
     assert_eq!(read("e.csv"), read("f.csv"), "a file with no binding reads no material column");
     let bound = format!("{}/examples/brdf/ggx.brdf,roughness=@roughness", crate::common::repo_root().display());
-    run_in(d, &["eval", "--model", &bound, "--input", "geometry.csv", "--output", "g.csv"]).fails(2, "header lacks column(s) roughness");
+    run_in(d, &["eval", "--model", &bound, "--input", "geometry.csv", "--output", "g.csv"])
+        .fails(2, "header lacks column(s) roughness");
 }

@@ -9,7 +9,7 @@ use brdfprof::brdf::samples;
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 use std::os::unix::process::ExitStatusExt;
-use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::{Path, PathBuf};
 use std::process::Stdio;
 use std::time::{Duration, Instant};
@@ -20,7 +20,22 @@ const MUTANTS: usize = 1000;
 const END_TO_END: usize = 10;
 
 /// Numbers a mutation puts in place of one in the file.
-const NUMBERS: [&str; 14] = ["1e39", "-1", "NaN", "nan", "inf", "-inf", "+inf", "1e308", "-1e308", "99999999999999999999", "4294967296", "-0", "1e-45", "0"];
+const NUMBERS: [&str; 14] = [
+    "1e39",
+    "-1",
+    "NaN",
+    "nan",
+    "inf",
+    "-inf",
+    "+inf",
+    "1e308",
+    "-1e308",
+    "99999999999999999999",
+    "4294967296",
+    "-0",
+    "1e-45",
+    "0",
+];
 /// Bytes that mean something to one of the formats, or to none.
 const SPECIAL: [u8; 14] = [b',', b'"', b'\n', b'\r', 0, 0xff, 0xc3, b'{', b'}', b'[', b']', b':', b'-', b'\\'];
 
@@ -29,7 +44,19 @@ fn eval_csv() -> Vec<u8> {
     for (i, s) in samples::well_conditioned(12, 5, 0.05, 0.2..1.0).iter().enumerate() {
         text += &format!(
             "{i},{},{},{},{},{},{},{},{},{},{},{},{},{},1,0,0\n",
-            s.l[2], s.l[1], s.l[0], s.roughness, s.f0[2], s.f0[1], s.f0[0], s.n[2], s.n[1], s.n[0], s.v[2], s.v[1], s.v[0]
+            s.l[2],
+            s.l[1],
+            s.l[0],
+            s.roughness,
+            s.f0[2],
+            s.f0[1],
+            s.f0[0],
+            s.n[2],
+            s.n[1],
+            s.n[0],
+            s.v[2],
+            s.v[1],
+            s.v[0]
         );
     }
     text.into_bytes()
@@ -52,7 +79,9 @@ fn numbers(bytes: &[u8]) -> Vec<(usize, usize)> {
         if bytes[i].is_ascii_digit() {
             let start = if i > 0 && bytes[i - 1] == b'-' { i - 1 } else { i };
             let mut end = i;
-            while end < bytes.len() && (bytes[end].is_ascii_digit() || matches!(bytes[end], b'.' | b'e' | b'E' | b'+' | b'-')) {
+            while end < bytes.len()
+                && (bytes[end].is_ascii_digit() || matches!(bytes[end], b'.' | b'e' | b'E' | b'+' | b'-'))
+            {
                 end += 1;
             }
             out.push((start, end));
@@ -75,7 +104,8 @@ fn mutate(rng: &mut Pcg64, good: &[u8]) -> Vec<u8> {
                 b[i] ^= 1 << rng.random_range(0..8);
             }
             1 => {
-                let byte = if rng.random_bool(0.5) { SPECIAL[rng.random_range(0..SPECIAL.len())] } else { rng.random() };
+                let byte =
+                    if rng.random_bool(0.5) { SPECIAL[rng.random_range(0..SPECIAL.len())] } else { rng.random() };
                 let i = at(rng, &b);
                 b.insert(i, byte);
             }
@@ -117,7 +147,9 @@ fn mutate(rng: &mut Pcg64, good: &[u8]) -> Vec<u8> {
 
 fn random_bytes(rng: &mut Pcg64) -> Vec<u8> {
     let n = rng.random_range(0..256);
-    (0..n).map(|_| if rng.random_bool(0.3) { SPECIAL[rng.random_range(0..SPECIAL.len())] } else { rng.random() }).collect()
+    (0..n)
+        .map(|_| if rng.random_bool(0.3) { SPECIAL[rng.random_range(0..SPECIAL.len())] } else { rng.random() })
+        .collect()
 }
 
 /// Runs `parse` on `input`; it must not panic, and an error must name `name`.
@@ -126,7 +158,11 @@ fn survives(kind: &str, input: &[u8], name: &str, parse: impl FnOnce() -> anyhow
         Ok(Ok(())) => {}
         Ok(Err(e)) => {
             let msg = format!("{e:#}");
-            assert!(!msg.trim().is_empty() && msg.contains(name), "{kind}: error `{msg}` does not name {name}; input: {:?}", String::from_utf8_lossy(input));
+            assert!(
+                !msg.trim().is_empty() && msg.contains(name),
+                "{kind}: error `{msg}` does not name {name}; input: {:?}",
+                String::from_utf8_lossy(input)
+            );
         }
         Err(_) => panic!("{kind}: the parser panicked on {:?}", String::from_utf8_lossy(input)),
     }
@@ -141,7 +177,15 @@ fn parsers_survive_random_and_mutated_input() {
     let (csv, scene, baseline) = (eval_csv(), scene_file(), baseline_file());
     // The unmutated inputs are valid: mutants start from something every parser accepts.
     assert!(brdfprof::io::parse_samples_csv(&csv, "good.csv").is_ok());
-    assert!(brdfprof::scene::Scene::parse(std::str::from_utf8(&scene).unwrap(), "good.json", PathBuf::new(), PathBuf::from("good.json")).is_ok());
+    assert!(
+        brdfprof::scene::Scene::parse(
+            std::str::from_utf8(&scene).unwrap(),
+            "good.json",
+            PathBuf::new(),
+            PathBuf::from("good.json")
+        )
+        .is_ok()
+    );
     std::fs::write(&baseline_path, &baseline).unwrap();
     assert!(brdfprof::check::load(&baseline_path).is_ok());
     let (mut accepted, mut total) = ([0usize; 3], 0);
@@ -154,11 +198,14 @@ fn parsers_survive_random_and_mutated_input() {
         let input = pick(&mut rng, &scene);
         survives("scene", &input, "fuzz.json", || {
             let text = String::from_utf8_lossy(&input);
-            brdfprof::scene::Scene::parse(&text, "fuzz.json", PathBuf::new(), PathBuf::from("fuzz.json")).map(|_| accepted[1] += 1)
+            brdfprof::scene::Scene::parse(&text, "fuzz.json", PathBuf::new(), PathBuf::from("fuzz.json"))
+                .map(|_| accepted[1] += 1)
         });
         let input = pick(&mut rng, &baseline);
         std::fs::write(&baseline_path, &input).unwrap();
-        survives("baseline", &input, &baseline_name, || brdfprof::check::load(&baseline_path).map(|_| accepted[2] += 1));
+        survives("baseline", &input, &baseline_name, || {
+            brdfprof::check::load(&baseline_path).map(|_| accepted[2] += 1)
+        });
         total += 1;
     }
     println!("accepted of {total} each: eval CSV {}, scene {}, baseline {}", accepted[0], accepted[1], accepted[2]);
@@ -173,7 +220,13 @@ struct Outcome {
 /// Runs brdfprof with `args` in `dir`, killing it (and failing) after 60 s; it must exit 0, 1 or 2.
 fn run_bounded(dir: &Path, args: &[&str], input: &[u8]) -> Outcome {
     let stderr_path = dir.join("stderr.txt");
-    let mut child = brdfprof().args(args).current_dir(dir).stdout(Stdio::null()).stderr(std::fs::File::create(&stderr_path).unwrap()).spawn().unwrap();
+    let mut child = brdfprof()
+        .args(args)
+        .current_dir(dir)
+        .stdout(Stdio::null())
+        .stderr(std::fs::File::create(&stderr_path).unwrap())
+        .spawn()
+        .unwrap();
     let start = Instant::now();
     let status = loop {
         if let Some(s) = child.try_wait().unwrap() {
@@ -188,7 +241,12 @@ fn run_bounded(dir: &Path, args: &[&str], input: &[u8]) -> Outcome {
     };
     let stderr = std::fs::read_to_string(&stderr_path).unwrap_or_default();
     std::fs::remove_file(&stderr_path).unwrap();
-    assert!(status.signal().is_none(), "{args:?} died of signal {:?}; stderr: {stderr}; input: {:?}", status.signal(), String::from_utf8_lossy(input));
+    assert!(
+        status.signal().is_none(),
+        "{args:?} died of signal {:?}; stderr: {stderr}; input: {:?}",
+        status.signal(),
+        String::from_utf8_lossy(input)
+    );
     let code = status.code().unwrap();
     assert!(matches!(code, 0..=2), "{args:?} exited {code}; stderr: {stderr}");
     if code != 0 {
@@ -213,7 +271,14 @@ fn commands_survive_mutated_files() {
         std::fs::write(d.join("fuzz.csv"), &input).unwrap();
         let out = d.join("out.csv");
         let run = run_bounded(d, &["eval", "--model", "ggx", "--input", "fuzz.csv", "--output", "out.csv"], &input);
-        assert_eq!(out.exists(), run.code == 0, "eval exit {} with output {}: {}", run.code, if out.exists() { "written" } else { "missing" }, run.stderr);
+        assert_eq!(
+            out.exists(),
+            run.code == 0,
+            "eval exit {} with output {}: {}",
+            run.code,
+            if out.exists() { "written" } else { "missing" },
+            run.stderr
+        );
         if run.code == 2 {
             assert!(run.stderr.contains("fuzz.csv"), "{}", run.stderr);
         }
@@ -222,9 +287,14 @@ fn commands_survive_mutated_files() {
 
         let input = mutate(&mut rng, &baseline);
         std::fs::write(d.join("fuzz-baseline.json"), &input).unwrap();
-        codes.push(("check", run_bounded(d, &["check", "--baseline", "fuzz-baseline.json", "--rounds", "0", "--no-callgrind"], &input).code));
+        codes.push((
+            "check",
+            run_bounded(d, &["check", "--baseline", "fuzz-baseline.json", "--rounds", "0", "--no-callgrind"], &input)
+                .code,
+        ));
     }
-    let mut left: Vec<String> = std::fs::read_dir(d).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    let mut left: Vec<String> =
+        std::fs::read_dir(d).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
     left.sort();
     assert_eq!(left, ["fuzz-baseline.json", "fuzz.csv", "fuzz.json"], "the commands wrote only their named outputs");
     println!("exit codes: {codes:?}");

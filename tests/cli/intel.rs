@@ -36,12 +36,27 @@ fn every_preset_and_example_file_gets_igc_statistics_on_all_five_families() {
         for row in rows {
             assert!([8.0, 16.0, 32.0].contains(&igc(row, "SIMD Width")), "{} {}", family.name, row["model"]);
             assert!([128.0, 256.0].contains(&igc(row, "Register Count")), "{} {}", family.name, row["model"]);
-            for stat in ["Instruction Count", "Binary Size", "Issue Cycles", Class::Fma.name(), Class::Send.name(), Class::Control.name()] {
+            for stat in [
+                "Instruction Count",
+                "Binary Size",
+                "Issue Cycles",
+                Class::Fma.name(),
+                Class::Send.name(),
+                Class::Control.name(),
+            ] {
                 assert!(igc(row, stat) > 0.0, "{} {}: {stat} is 0", family.name, row["model"]);
             }
             let classes: f64 = Class::ALL.iter().map(|c| igc(row, c.name())).sum();
-            assert_eq!(classes, igc(row, "Instruction Count"), "{} {}: the classes partition the listing", family.name, row["model"]);
-            let note = row["notes"]["translation"].as_str().unwrap_or_else(|| panic!("{} {}: no translation check", family.name, row["model"]));
+            assert_eq!(
+                classes,
+                igc(row, "Instruction Count"),
+                "{} {}: the classes partition the listing",
+                family.name,
+                row["model"]
+            );
+            let note = row["notes"]["translation"]
+                .as_str()
+                .unwrap_or_else(|| panic!("{} {}: no translation check", family.name, row["model"]));
             assert!(note.contains("translation checked on the host against"), "{note}");
         }
         // A BRDF costs more than the memory-only kernel; cycles/eval = max(busiest pipe, latency / resident
@@ -49,8 +64,18 @@ fn every_preset_and_example_file_gets_igc_statistics_on_all_five_families() {
         for c in r["cost"]["rows"].as_array().unwrap() {
             let stat = |k: &str| c["stats"][k].as_f64().unwrap();
             let per_thread = stat("busiest pipe (cycles/wave)").max(stat("latency / waves"));
-            assert!((c["cycles_per_eval"].as_f64().unwrap() - per_thread / (stat("SIMD Width") * 8.0)).abs() < 1e-9, "{} {}: {c}", family.name, c["model"]);
-            assert!(stat("busiest pipe (cycles/wave)") <= stat("Issue Cycles"), "{} {}: a pipe busier than the serial sum", family.name, c["model"]);
+            assert!(
+                (c["cycles_per_eval"].as_f64().unwrap() - per_thread / (stat("SIMD Width") * 8.0)).abs() < 1e-9,
+                "{} {}: {c}",
+                family.name,
+                c["model"]
+            );
+            assert!(
+                stat("busiest pipe (cycles/wave)") <= stat("Issue Cycles"),
+                "{} {}: a pipe busier than the serial sum",
+                family.name,
+                c["model"]
+            );
             if c["model"] != "baseline" {
                 assert!(c["net_cycles_per_eval"].as_f64().unwrap() > 0.0, "{} {}", family.name, c["model"]);
             }
@@ -72,7 +97,12 @@ fn the_statistics_are_deterministic_and_the_precise_forms_cost_more() {
     let precise = inspect_json(dir.path(), "precise", &["intel:gen12lp"], &["--model", "blinn", "--precise-math"]);
     assert!(!precise["provenance"]["compiler"]["options"].as_str().unwrap().contains("-cl-mad-enable"));
     let net = |r: &serde_json::Value| r["cost"]["rows"][0]["net_cycles_per_eval"].as_f64().unwrap();
-    assert!(net(&precise) > 1.2 * net(&fast), "IEEE pow, division and square root cost more: {} vs {}", net(&precise), net(&fast));
+    assert!(
+        net(&precise) > 1.2 * net(&fast),
+        "IEEE pow, division and square root cost more: {} vs {}",
+        net(&precise),
+        net(&fast)
+    );
 }
 
 #[test]
@@ -93,15 +123,26 @@ fn commands_that_execute_refuse_an_intel_target_and_unknown_families_are_named()
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("o");
     let out = out.to_str().unwrap();
-    for args in [vec!["profile", "--device", "intel:gen12lp", "--json", out], vec!["stability", "--device", "intel:gen9", "--out", out]] {
+    for args in [
+        vec!["profile", "--device", "intel:gen12lp", "--json", out],
+        vec!["stability", "--device", "intel:gen9", "--out", out],
+    ] {
         let r = common::brdfprof().args(&args).current_dir(common::repo_root()).output().unwrap();
         assert_eq!(r.status.code(), Some(2), "{args:?}");
-        assert!(String::from_utf8_lossy(&r.stderr).contains("compiles only"), "{args:?}: {}", String::from_utf8_lossy(&r.stderr));
+        assert!(
+            String::from_utf8_lossy(&r.stderr).contains("compiles only"),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&r.stderr)
+        );
     }
     run(&["inspect", "--device", "intel:gen8"]).fails(2, "unknown Intel family `gen8`");
     let listed = run(&["devices", "--targets"]).ok();
     for f in &FAMILIES {
-        assert!(listed.stdout.lines().any(|l| l.starts_with(&format!("| intel:{} ", f.name)) && l.contains(f.architecture)), "{}", listed.stdout);
+        assert!(
+            listed.stdout.lines().any(|l| l.starts_with(&format!("| intel:{} ", f.name)) && l.contains(f.architecture)),
+            "{}",
+            listed.stdout
+        );
     }
 }
 
@@ -129,7 +170,21 @@ fn inspect_charts_the_cost_across_devices() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let out = |n: &str| d.join(n).display().to_string();
-    let r = run(&["inspect", "--no-callgrind", "--device", "nvidia:sm_89", "--device", "intel:gen12lp", "--json", &out("i.json"), "--markdown", &out("i.md"), "--chart", &out("c.png")]).ok();
+    let r = run(&[
+        "inspect",
+        "--no-callgrind",
+        "--device",
+        "nvidia:sm_89",
+        "--device",
+        "intel:gen12lp",
+        "--json",
+        &out("i.json"),
+        "--markdown",
+        &out("i.md"),
+        "--chart",
+        &out("c.png"),
+    ])
+    .ok();
     assert!(r.stdout.contains("Chart: "), "{}", r.stdout);
     let img = image::open(d.join("c.png")).unwrap().to_rgb8();
     assert!(img.width() >= 800 && img.height() >= 600, "{}x{}", img.width(), img.height());
@@ -139,6 +194,18 @@ fn inspect_charts_the_cost_across_devices() {
         assert!(n > 2_000, "device {device}'s colour covers {n} pixels: its bars are missing");
     }
     assert!(!d.join("x.png").exists());
-    run(&["inspect", "--no-callgrind", "--device", "intel:gen12lp", "--json", &out("j.json"), "--markdown", &out("j.md"), "--chart", &out("x.png")]).fails(2, "give several --device");
+    run(&[
+        "inspect",
+        "--no-callgrind",
+        "--device",
+        "intel:gen12lp",
+        "--json",
+        &out("j.json"),
+        "--markdown",
+        &out("j.md"),
+        "--chart",
+        &out("x.png"),
+    ])
+    .fails(2, "give several --device");
     assert!(!d.join("x.png").exists());
 }

@@ -7,11 +7,13 @@ fn a_profile_larger_than_one_allocation_is_refused_up_front() {
     let started = std::time::Instant::now();
     // In a fresh directory: the checkout's committed results/ would refuse the default --json first.
     let dir = tempfile::tempdir().unwrap();
-    let r = common::run_in(dir.path(), &["profile", "--size", "100000x100000", "--budget", "5"]).fails(2, "--size 100000x100000: the packed G-buffer is 160000000000 bytes");
+    let r = common::run_in(dir.path(), &["profile", "--size", "100000x100000", "--budget", "5"])
+        .fails(2, "--size 100000x100000: the packed G-buffer is 160000000000 bytes");
     assert!(r.stderr.contains("maxMemoryAllocationSize") && r.stderr.contains("at most"), "{}", r.stderr);
     // Refused before the 160 GB picture is built (which aborted the process before this check existed).
     assert!(started.elapsed().as_secs() < 30, "refused up front");
-    common::run_in(dir.path(), &["profile", "--size", "20000x20000", "--gbuffer", "float", "--budget", "5"]).fails(2, "the float G-buffer is 19200000000 bytes");
+    common::run_in(dir.path(), &["profile", "--size", "20000x20000", "--gbuffer", "float", "--budget", "5"])
+        .fails(2, "the float G-buffer is 19200000000 bytes");
 }
 
 /// Bytes `BRDFPROF_MEMORY_LIMIT` gives the run below: less than a 16384^2 scene needs on any machine.
@@ -20,7 +22,9 @@ const SHORT_MEMORY: u64 = 16 << 30;
 #[test]
 fn a_scene_larger_than_memory_is_refused_before_it_is_built() {
     let dir = tempfile::tempdir().unwrap();
-    let mut scene: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(common::repo_root().join("scenes/sphere-grid.json")).unwrap()).unwrap();
+    let mut scene: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(common::repo_root().join("scenes/sphere-grid.json")).unwrap())
+            .unwrap();
     // 16384^2 needs about 68 GB (252 bytes a pixel).
     scene["gbuffer"]["procedural"]["size"] = serde_json::json!([16384, 16384]);
     let path = dir.path().join("big.json");
@@ -51,19 +55,26 @@ fn a_scene_larger_than_memory_is_refused_before_it_is_built() {
         let e = refused(&render(None));
         assert!(e.contains("(MemAvailable)"), "{e}");
     } else {
-        eprintln!("NOT CHECKED here: the refusal against MemAvailable itself ({available} bytes available, enough to build the scene); checked against BRDFPROF_MEMORY_LIMIT above");
+        eprintln!(
+            "NOT CHECKED here: the refusal against MemAvailable itself ({available} bytes available, enough to build the scene); checked against BRDFPROF_MEMORY_LIMIT above"
+        );
     }
 }
 
 #[test]
 fn a_scene_with_more_lights_than_compile_in_seconds_is_refused() {
     let dir = tempfile::tempdir().unwrap();
-    let mut scene: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(common::repo_root().join("scenes/sphere-grid.json")).unwrap()).unwrap();
+    let mut scene: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(common::repo_root().join("scenes/sphere-grid.json")).unwrap())
+            .unwrap();
     let n = brdfprof::scene::format::MAX_LIGHTS + 1;
-    scene["lights"] = serde_json::Value::Array((0..n).map(|i| serde_json::json!({"type": "point", "position": [i as f64 * 0.01, 3.0, 1.0]})).collect());
+    scene["lights"] = serde_json::Value::Array(
+        (0..n).map(|i| serde_json::json!({"type": "point", "position": [i as f64 * 0.01, 3.0, 1.0]})).collect(),
+    );
     let path = dir.path().join("many.json");
     std::fs::write(&path, scene.to_string()).unwrap();
-    common::run(&["scene", path.to_str().unwrap()]).fails(2, &format!("many.json: lights: at most {} lights ({n} given)", n - 1));
+    common::run(&["scene", path.to_str().unwrap()])
+        .fails(2, &format!("many.json: lights: at most {} lights ({n} given)", n - 1));
 }
 
 const CSV: &str = "nx,ny,nz,vx,vy,vz,lx,ly,lz,roughness,f0r,f0g,f0b\n0,0,1,0,0.6,0.8,0.6,0,0.8,0.5,0.04,0.04,0.04\n";
@@ -93,8 +104,15 @@ fn a_compile_past_the_limit_stops_naming_the_model_and_the_limit() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{stderr}");
     assert!(started.elapsed().as_secs() < 30, "stopped at the limit: {:?}", started.elapsed());
-    assert!(stderr.contains("brdfprof: still compiling huge.brdf:eval_f32") && stderr.contains("(the limit is 6 s)"), "progress after 5 s:\n{stderr}");
-    assert!(stderr.contains("brdfprof: error: huge.brdf:eval_f32") && stderr.contains("longer than the compile limit of 6 s"), "{stderr}");
+    assert!(
+        stderr.contains("brdfprof: still compiling huge.brdf:eval_f32") && stderr.contains("(the limit is 6 s)"),
+        "progress after 5 s:\n{stderr}"
+    );
+    assert!(
+        stderr.contains("brdfprof: error: huge.brdf:eval_f32")
+            && stderr.contains("longer than the compile limit of 6 s"),
+        "{stderr}"
+    );
     assert!(!d.join("out.csv").exists(), "nothing written");
     assert_eq!(std::fs::read_dir(&tmp).unwrap().count(), 0, "no temporary left");
 }
@@ -105,7 +123,10 @@ fn bad_limits_are_refused_naming_the_flag_or_variable() {
     let out = common::brdfprof().args(["devices"]).env("BRDFPROF_COMPILE_TIMEOUT", "soon").output().unwrap();
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("BRDFPROF_COMPILE_TIMEOUT=`soon`: give seconds"));
-    for (var, value, needle) in [("BRDFPROF_FENCE_TIMEOUT", "-1", "BRDFPROF_FENCE_TIMEOUT=`-1`: give seconds"), ("BRDFPROF_MEMORY_LIMIT", "lots", "BRDFPROF_MEMORY_LIMIT=lots: give a whole number of bytes")] {
+    for (var, value, needle) in [
+        ("BRDFPROF_FENCE_TIMEOUT", "-1", "BRDFPROF_FENCE_TIMEOUT=`-1`: give seconds"),
+        ("BRDFPROF_MEMORY_LIMIT", "lots", "BRDFPROF_MEMORY_LIMIT=lots: give a whole number of bytes"),
+    ] {
         let out = common::brdfprof().args(["devices"]).env(var, value).output().unwrap();
         assert_eq!(out.status.code(), Some(2), "{var}");
         assert!(String::from_utf8_lossy(&out.stderr).contains(needle), "{}", String::from_utf8_lossy(&out.stderr));
@@ -119,14 +140,30 @@ fn bad_limits_are_refused_naming_the_flag_or_variable() {
 fn a_fence_that_does_not_signal_in_time_stops_the_command() {
     let dir = tempfile::tempdir().unwrap();
     let out = common::brdfprof()
-        .args(["profile", "--model", "ggx", "--size", "64x64", "--min-rounds", "2", "--max-rounds", "2", "--json", "st/p.json"])
+        .args([
+            "profile",
+            "--model",
+            "ggx",
+            "--size",
+            "64x64",
+            "--min-rounds",
+            "2",
+            "--max-rounds",
+            "2",
+            "--json",
+            "st/p.json",
+        ])
         .env("BRDFPROF_FENCE_TIMEOUT", "0.000001")
         .current_dir(dir.path())
         .output()
         .unwrap();
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{stderr}");
-    assert!(stderr.contains("did not finish a submission within 0.000001 s (BRDFPROF_FENCE_TIMEOUT") && stderr.contains("may be hung"), "{stderr}");
+    assert!(
+        stderr.contains("did not finish a submission within 0.000001 s (BRDFPROF_FENCE_TIMEOUT")
+            && stderr.contains("may be hung"),
+        "{stderr}"
+    );
     assert!(!dir.path().join("st").exists(), "nothing written");
 }
 
@@ -134,7 +171,9 @@ fn a_fence_that_does_not_signal_in_time_stops_the_command() {
 /// of one literal and 258-byte back-references: a valid image of any size in a few MB.
 fn zero_png(width: u32, height: u32, grey16: bool) -> Vec<u8> {
     fn crc32(bytes: &[u8]) -> u32 {
-        let table: Vec<u32> = (0..256u32).map(|n| (0..8).fold(n, |c, _| if c & 1 != 0 { 0xEDB8_8320 ^ (c >> 1) } else { c >> 1 })).collect();
+        let table: Vec<u32> = (0..256u32)
+            .map(|n| (0..8).fold(n, |c, _| if c & 1 != 0 { 0xEDB8_8320 ^ (c >> 1) } else { c >> 1 }))
+            .collect();
         !bytes.iter().fold(!0u32, |c, &b| table[((c ^ u32::from(b)) & 0xff) as usize] ^ (c >> 8))
     }
     struct Bits {
@@ -216,14 +255,19 @@ fn a_16384_square_image_scene_is_refused_before_it_is_decoded() {
     std::fs::write(d.join("big.json"), scene.to_string()).unwrap();
     let limited = |args: &[&str]| {
         let started = std::time::Instant::now();
-        let out = common::brdfprof().args(args).env("BRDFPROF_MEMORY_LIMIT", "2000000000").current_dir(d).output().unwrap();
+        let out =
+            common::brdfprof().args(args).env("BRDFPROF_MEMORY_LIMIT", "2000000000").current_dir(d).output().unwrap();
         let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
         assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
         assert!(started.elapsed().as_secs() < 30, "{args:?} refused up front: {:?}", started.elapsed());
         stderr
     };
     let e = limited(&["scene", "big.json"]);
-    assert!(e.contains("big.json: gbuffer.images: decoding its 2 images of 16384x16384") && e.contains("2000000000 are available (BRDFPROF_MEMORY_LIMIT)"), "{e}");
+    assert!(
+        e.contains("big.json: gbuffer.images: decoding its 2 images of 16384x16384")
+            && e.contains("2000000000 are available (BRDFPROF_MEMORY_LIMIT)"),
+        "{e}"
+    );
     let e = limited(&["render", "--scene", "big.json", "--out", "pictures"]);
     assert!(e.contains("gbuffer.images: decoding its 2 images"), "{e}");
     assert!(!d.join("pictures").exists(), "nothing written");
@@ -234,7 +278,9 @@ fn a_16384_square_image_scene_is_refused_before_it_is_decoded() {
 #[test]
 fn a_scene_beyond_one_device_allocation_is_refused_before_it_is_built() {
     let dir = tempfile::tempdir().unwrap();
-    let mut scene: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(common::repo_root().join("scenes/sphere-grid.json")).unwrap()).unwrap();
+    let mut scene: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(common::repo_root().join("scenes/sphere-grid.json")).unwrap())
+            .unwrap();
     scene["gbuffer"]["procedural"]["size"] = serde_json::json!([7000, 7000]);
     std::fs::write(dir.path().join("wide.json"), scene.to_string()).unwrap();
     let started = std::time::Instant::now();
@@ -256,7 +302,23 @@ fn a_compile_only_child_past_the_limit_stops_naming_the_model() {
     text += "vec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) { return vec3(f0(dot(N, L))); }\n::end shader\n";
     std::fs::write(dir.path().join("tree.brdf"), text).unwrap();
     let started = std::time::Instant::now();
-    let r = common::run_in(dir.path(), &["inspect", "--no-callgrind", "--device", "radv:navi21", "--model", "tree.brdf", "--compile-timeout", "3", "--json", "i.json", "--markdown", "i.md"]);
+    let r = common::run_in(
+        dir.path(),
+        &[
+            "inspect",
+            "--no-callgrind",
+            "--device",
+            "radv:navi21",
+            "--model",
+            "tree.brdf",
+            "--compile-timeout",
+            "3",
+            "--json",
+            "i.json",
+            "--markdown",
+            "i.md",
+        ],
+    );
     assert_eq!(r.code, Some(2), "{}", r.stderr);
     assert!(r.stderr.contains("tree") && r.stderr.contains("longer than the compile limit of 3 s"), "{}", r.stderr);
     assert!(started.elapsed().as_secs() < 30 && !dir.path().join("i.json").exists());

@@ -9,7 +9,11 @@ use std::path::Path;
 
 /// The shim targets: every family of each shim driver.
 fn shim_targets() -> Vec<String> {
-    targets::VENDORS.iter().filter(|v| v.noop().is_some() && v.prefix() != "radv").flat_map(|v| v.families().into_iter().map(move |f| format!("{}:{}", v.prefix(), f.name))).collect()
+    targets::VENDORS
+        .iter()
+        .filter(|v| v.noop().is_some() && v.prefix() != "radv")
+        .flat_map(|v| v.families().into_iter().map(move |f| format!("{}:{}", v.prefix(), f.name)))
+        .collect()
 }
 
 fn inspect(dir: &Path, name: &str, devices: &[String], extra: &[&str]) -> serde_json::Value {
@@ -33,7 +37,10 @@ fn every_shim_target_reports_its_compilers_statistics_and_cost_identically_on_a_
         assert_eq!(report["cost"], again["cost"], "{device}: the cost table changed between runs");
         let cost = &report["cost"];
         assert_eq!(cost["target"], device.as_str(), "{device}: no cost table");
-        assert!(cost["model"].as_str().unwrap().starts_with("cycles/eval = "), "{device}: the rule text is in the report");
+        assert!(
+            cost["model"].as_str().unwrap().starts_with("cycles/eval = "),
+            "{device}: the rule text is in the report"
+        );
         let rows = cost["rows"].as_array().unwrap();
         assert_eq!(rows.len(), models.len() + 1, "{device}: every model and the memory-only kernel");
         for r in rows {
@@ -48,7 +55,11 @@ fn every_shim_target_reports_its_compilers_statistics_and_cost_identically_on_a_
             for (key, value) in row["stats"].as_object().unwrap().iter().filter(|(k, _)| k.starts_with("driver/")) {
                 assert_eq!(&row_again["stats"][key], value, "{device} {} {key} changed between runs", row["model"]);
             }
-            assert!(row["stats"]["driver/instructions"].as_f64().unwrap() > 0.0, "{device} {}: no instruction count", row["model"]);
+            assert!(
+                row["stats"]["driver/instructions"].as_f64().unwrap() > 0.0,
+                "{device} {}: no instruction count",
+                row["model"]
+            );
         }
     }
 }
@@ -56,7 +67,11 @@ fn every_shim_target_reports_its_compilers_statistics_and_cost_identically_on_a_
 #[test]
 fn the_corpus_of_brdf_files_compiles_on_each_shim_driver() {
     let corpus = common::repo_root().join("tests/fixtures/brdf/corpus");
-    let mut files: Vec<_> = std::fs::read_dir(&corpus).unwrap().map(|e| e.unwrap().path()).filter(|p| p.extension().is_some_and(|x| x == "brdf")).collect();
+    let mut files: Vec<_> = std::fs::read_dir(&corpus)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x == "brdf"))
+        .collect();
     files.sort();
     assert_eq!(files.len(), 40, "the corpus has 40 files");
     let models: Vec<String> = files.iter().map(|p| p.display().to_string()).collect();
@@ -69,7 +84,11 @@ fn the_corpus_of_brdf_files_compiles_on_each_shim_driver() {
         // Each file by its stem (and ggx, which inspect adds as the reference, and the memory-only kernel).
         for f in &files {
             let stem = f.file_stem().unwrap().to_str().unwrap();
-            assert!(rows.iter().any(|r| r["model"] == stem), "{device}: no row for {stem}: {}", report["section_notes"]);
+            assert!(
+                rows.iter().any(|r| r["model"] == stem),
+                "{device}: no row for {stem}: {}",
+                report["section_notes"]
+            );
         }
         assert!(rows.iter().all(|r| r["cycles_per_eval"].as_f64().unwrap() > 0.0), "{device}");
     }
@@ -105,9 +124,26 @@ fn without_a_mesa_build_every_shim_target_exits_2_naming_make_mesa() {
     let d = dir.path();
     let empty = d.join("empty");
     std::fs::create_dir(&empty).unwrap();
-    for (device, icd) in [("adreno:a660", "freedreno_devenv_icd"), ("mali:g52", "panfrost_devenv_icd"), ("anv:tgl", "intel_devenv_icd"), ("adreno:a740", "freedreno_devenv_icd"), ("mali:g610", "panfrost_devenv_icd")] {
+    for (device, icd) in [
+        ("adreno:a660", "freedreno_devenv_icd"),
+        ("mali:g52", "panfrost_devenv_icd"),
+        ("anv:tgl", "intel_devenv_icd"),
+        ("adreno:a740", "freedreno_devenv_icd"),
+        ("mali:g610", "panfrost_devenv_icd"),
+    ] {
         let out = common::brdfprof()
-            .args(["inspect", "--no-callgrind", "--model", "ggx", "--device", device, "--json", "r.json", "--markdown", "r.md"])
+            .args([
+                "inspect",
+                "--no-callgrind",
+                "--model",
+                "ggx",
+                "--device",
+                device,
+                "--json",
+                "r.json",
+                "--markdown",
+                "r.md",
+            ])
             .current_dir(d)
             .env(targets::mesa_noop::MESA_DEBIAN.var, &empty)
             .env(targets::mesa_noop::MESA_BACKPORTS.var, &empty)
@@ -115,22 +151,42 @@ fn without_a_mesa_build_every_shim_target_exits_2_naming_make_mesa() {
             .unwrap();
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(2), "{device}: {stderr}");
-        assert!(stderr.contains("is not built") && stderr.contains("`make mesa`") && stderr.contains(icd), "{device}: {stderr}");
+        assert!(
+            stderr.contains("is not built") && stderr.contains("`make mesa`") && stderr.contains(icd),
+            "{device}: {stderr}"
+        );
         assert!(!stderr.contains("make setup"), "{device}: `make setup` builds no Mesa: {stderr}");
     }
     assert!(!d.join("r.json").exists() && !d.join("r.md").exists());
     // devices --targets says so too.
-    let out = common::brdfprof().args(["devices", "--targets"]).env(targets::mesa_noop::MESA_DEBIAN.var, &empty).env(targets::mesa_noop::MESA_BACKPORTS.var, &empty).output().unwrap();
+    let out = common::brdfprof()
+        .args(["devices", "--targets"])
+        .env(targets::mesa_noop::MESA_DEBIAN.var, &empty)
+        .env(targets::mesa_noop::MESA_BACKPORTS.var, &empty)
+        .output()
+        .unwrap();
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(stdout.contains("is not built") && stdout.contains("`make mesa`"), "{stdout}");
     // The Makefile has that target, running the script; `make run` does not need it, `make test` does.
     let makefile = std::fs::read_to_string(common::repo_root().join("Makefile")).unwrap();
-    let rule = |target: &str| makefile.lines().find(|l| l.starts_with(&format!("{target}:"))).unwrap_or_else(|| panic!("no `{target}:` rule in the Makefile")).to_string();
+    let rule = |target: &str| {
+        makefile
+            .lines()
+            .find(|l| l.starts_with(&format!("{target}:")))
+            .unwrap_or_else(|| panic!("no `{target}:` rule in the Makefile"))
+            .to_string()
+    };
     assert!(rule("mesa").contains("setup") && makefile.contains("sh scripts/mesa-noop.sh"), "{makefile}");
     assert!(rule("test").split_whitespace().any(|w| w == "mesa"), "{}", rule("test"));
-    assert!(!rule("run").contains("mesa") && !rule("build").contains("mesa") && !rule("setup").contains("mesa"), "{makefile}");
+    assert!(
+        !rule("run").contains("mesa") && !rule("build").contains("mesa") && !rule("setup").contains("mesa"),
+        "{makefile}"
+    );
     let setup = std::fs::read_to_string(common::repo_root().join("scripts/setup.sh")).unwrap();
-    assert!(!setup.lines().any(|l| !l.trim_start().starts_with('#') && l.contains("mesa-noop.sh")), "scripts/setup.sh runs scripts/mesa-noop.sh");
+    assert!(
+        !setup.lines().any(|l| !l.trim_start().starts_with('#') && l.contains("mesa-noop.sh")),
+        "scripts/setup.sh runs scripts/mesa-noop.sh"
+    );
 }
 
 #[test]
@@ -138,19 +194,60 @@ fn a_missing_or_broken_build_exits_2_naming_make_mesa() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let inspect_with = |build: &Path, device: &str| {
-        let out = common::brdfprof().args(["inspect", "--no-callgrind", "--model", "ggx", "--device", device, "--json", "r.json", "--markdown", "r.md"]).current_dir(d).env(targets::mesa_noop::BUILD_DIR_VAR, build).output().unwrap();
+        let out = common::brdfprof()
+            .args([
+                "inspect",
+                "--no-callgrind",
+                "--model",
+                "ggx",
+                "--device",
+                device,
+                "--json",
+                "r.json",
+                "--markdown",
+                "r.md",
+            ])
+            .current_dir(d)
+            .env(targets::mesa_noop::BUILD_DIR_VAR, build)
+            .output()
+            .unwrap();
         (out.status.code(), String::from_utf8_lossy(&out.stderr).into_owned())
     };
     // No build at all.
     let (code, stderr) = inspect_with(&d.join("nothing"), "adreno:a660");
     assert_eq!(code, Some(2), "{stderr}");
-    assert!(stderr.contains("is not built") && stderr.contains("make mesa") && stderr.contains("freedreno_devenv_icd"), "{stderr}");
+    assert!(
+        stderr.contains("is not built") && stderr.contains("make mesa") && stderr.contains("freedreno_devenv_icd"),
+        "{stderr}"
+    );
     // bookworm-backports' build (Adreno 7xx, Valhall) missing: the families on it say so, naming its variable.
     for device in ["adreno:a740", "mali:g610"] {
-        let out = common::brdfprof().args(["inspect", "--no-callgrind", "--model", "ggx", "--device", device, "--json", "r.json", "--markdown", "r.md"]).current_dir(d).env(targets::mesa_noop::MESA_BACKPORTS.var, d.join("nothing")).output().unwrap();
+        let out = common::brdfprof()
+            .args([
+                "inspect",
+                "--no-callgrind",
+                "--model",
+                "ggx",
+                "--device",
+                device,
+                "--json",
+                "r.json",
+                "--markdown",
+                "r.md",
+            ])
+            .current_dir(d)
+            .env(targets::mesa_noop::MESA_BACKPORTS.var, d.join("nothing"))
+            .output()
+            .unwrap();
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(2), "{stderr}");
-        assert!(stderr.contains("is not built") && stderr.contains("make mesa") && stderr.contains("BRDFPROF_MESA25_DIR") && stderr.contains("Mesa 25.0"), "{stderr}");
+        assert!(
+            stderr.contains("is not built")
+                && stderr.contains("make mesa")
+                && stderr.contains("BRDFPROF_MESA25_DIR")
+                && stderr.contains("Mesa 25.0"),
+            "{stderr}"
+        );
     }
     // The driver and its ICD file present, the shim absent.
     let real = targets::mesa_noop::build_dir();
@@ -171,7 +268,11 @@ fn a_missing_or_broken_build_exits_2_naming_make_mesa() {
     assert!(stderr.contains("anv:tgl") && stderr.contains("make mesa"), "{stderr}");
     assert!(!d.join("r.json").exists() && !d.join("r.md").exists());
     // devices --targets says which vendor is not ready and why.
-    let out = common::brdfprof().args(["devices", "--targets"]).env(targets::mesa_noop::BUILD_DIR_VAR, d.join("nothing")).output().unwrap();
+    let out = common::brdfprof()
+        .args(["devices", "--targets"])
+        .env(targets::mesa_noop::BUILD_DIR_VAR, d.join("nothing"))
+        .output()
+        .unwrap();
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(stdout.contains("is not built"), "{stdout}");
 }
@@ -184,7 +285,20 @@ fn a_childs_report_is_cached_and_a_changed_driver_environment_compiles_afresh() 
     let inspect_with = |name: &str, env: &[(&str, &str)]| -> serde_json::Value {
         let json = d.join(format!("{name}.json"));
         let mut cmd = common::brdfprof();
-        cmd.args(["inspect", "--no-callgrind", "--model", "ggx", "--device", "adreno:a660", "--device", "mali:g52", "--json", json.to_str().unwrap(), "--markdown", d.join(format!("{name}.md")).to_str().unwrap()]);
+        cmd.args([
+            "inspect",
+            "--no-callgrind",
+            "--model",
+            "ggx",
+            "--device",
+            "adreno:a660",
+            "--device",
+            "mali:g52",
+            "--json",
+            json.to_str().unwrap(),
+            "--markdown",
+            d.join(format!("{name}.md")).to_str().unwrap(),
+        ]);
         let out = cmd.env("BRDFPROF_CACHE_DIR", &cache).envs(env.iter().copied()).output().unwrap();
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(0), "{stderr}");
@@ -192,7 +306,8 @@ fn a_childs_report_is_cached_and_a_changed_driver_environment_compiles_afresh() 
         value["stderr"] = stderr.into_owned().into();
         value
     };
-    let entry = |run: &serde_json::Value, i: usize| run["reports"][i]["provenance"]["cache_entry"].as_str().map(str::to_string);
+    let entry =
+        |run: &serde_json::Value, i: usize| run["reports"][i]["provenance"]["cache_entry"].as_str().map(str::to_string);
     let first = inspect_with("first", &[]);
     let second = inspect_with("second", &[]);
     for i in 0..2 {
@@ -219,10 +334,16 @@ fn a_childs_report_is_cached_and_a_changed_driver_environment_compiles_afresh() 
 fn a_noop_device_is_never_asked_to_run() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    std::fs::write(d.join("in.csv"), "nx,ny,nz,vx,vy,vz,lx,ly,lz,roughness,f0r,f0g,f0b\n0,0,1,0,0.6,0.8,0.6,0,0.8,0.5,0.04,0.04,0.04\n").unwrap();
+    std::fs::write(
+        d.join("in.csv"),
+        "nx,ny,nz,vx,vy,vz,lx,ly,lz,roughness,f0r,f0g,f0b\n0,0,1,0,0.6,0.8,0.6,0,0.8,0.5,0.04,0.04,0.04\n",
+    )
+    .unwrap();
     for device in shim_targets() {
-        run_in(d, &["profile", "--model", "ggx", "--size", "8x8", "--device", &device]).fails(2, "compiles only and cannot run kernels");
-        run_in(d, &["eval", "--model", "ggx", "--input", "in.csv", "--output", "out.csv", "--device", &device]).fails(2, "compiles only and cannot run kernels");
+        run_in(d, &["profile", "--model", "ggx", "--size", "8x8", "--device", &device])
+            .fails(2, "compiles only and cannot run kernels");
+        run_in(d, &["eval", "--model", "ggx", "--input", "in.csv", "--output", "out.csv", "--device", &device])
+            .fails(2, "compiles only and cannot run kernels");
     }
     assert_eq!(std::fs::read_dir(d).unwrap().count(), 1, "nothing but the input in the directory");
 }
@@ -232,7 +353,18 @@ fn a_shim_child_that_crashes_after_its_report_still_gives_the_report() {
     let dir = tempfile::tempdir().unwrap();
     let json = dir.path().join("r.json");
     let out = common::brdfprof()
-        .args(["inspect", "--no-callgrind", "--model", "ggx", "--device", "anv:tgl", "--json", json.to_str().unwrap(), "--markdown", dir.path().join("r.md").to_str().unwrap()])
+        .args([
+            "inspect",
+            "--no-callgrind",
+            "--model",
+            "ggx",
+            "--device",
+            "anv:tgl",
+            "--json",
+            json.to_str().unwrap(),
+            "--markdown",
+            dir.path().join("r.md").to_str().unwrap(),
+        ])
         .env(targets::mesa_noop::CRASH_AFTER_REPLY, "1")
         .output()
         .unwrap();
@@ -249,11 +381,51 @@ fn scene_kernels_and_the_sweep_reach_the_shim_compilers() {
     let d = dir.path();
     let scene = common::repo_root().join("scenes/sphere-grid.json");
     let json = d.join("scene.json");
-    let out = run_in(d, &["profile", "--scene", scene.to_str().unwrap(), "--budget", "2", "--cost-device", "adreno:a660", "--cost-device", "mali:g52", "--cost-device", "anv:tgl", "--json", json.to_str().unwrap()]).ok();
+    let out = run_in(
+        d,
+        &[
+            "profile",
+            "--scene",
+            scene.to_str().unwrap(),
+            "--budget",
+            "2",
+            "--cost-device",
+            "adreno:a660",
+            "--cost-device",
+            "mali:g52",
+            "--cost-device",
+            "anv:tgl",
+            "--json",
+            json.to_str().unwrap(),
+        ],
+    )
+    .ok();
     for t in ["adreno:a660 cycles/pixel", "mali:g52 cycles/pixel", "anv:tgl cycles/pixel"] {
         assert!(out.stdout.contains(t), "{}", out.stdout);
     }
-    let sweep = run_in(d, &["sweep", "--model", "ggx", "--model", "blinn", "--model", "burley", "--size", "16x16", "--min-rounds", "2", "--max-rounds", "2", "--out", "out", "--cost-device", "mali:g52"]).ok();
+    let sweep = run_in(
+        d,
+        &[
+            "sweep",
+            "--model",
+            "ggx",
+            "--model",
+            "blinn",
+            "--model",
+            "burley",
+            "--size",
+            "16x16",
+            "--min-rounds",
+            "2",
+            "--max-rounds",
+            "2",
+            "--out",
+            "out",
+            "--cost-device",
+            "mali:g52",
+        ],
+    )
+    .ok();
     assert!(sweep.stdout.contains("cost on g52 (Bifrost (v7))"), "{}", sweep.stdout);
 }
 
@@ -272,18 +444,40 @@ fn devices_targets_lists_every_shim_family_and_its_compiler() {
 fn setup_builds_every_file_each_shim_driver_loads() {
     let script = std::fs::read_to_string(common::repo_root().join("scripts/mesa-noop.sh")).unwrap();
     // A variable of the script (NAME="..."), with `$shim_products` expanded.
-    let var = |name: &str| -> String { script.split(&format!("\n{name}=\"")).nth(1).unwrap_or_else(|| panic!("no {name}=")).split('"').next().unwrap().to_string() };
+    let var = |name: &str| -> String {
+        script
+            .split(&format!("\n{name}=\""))
+            .nth(1)
+            .unwrap_or_else(|| panic!("no {name}="))
+            .split('"')
+            .next()
+            .unwrap()
+            .to_string()
+    };
     let products = |name: &str| -> Vec<String> {
-        let mut p: Vec<String> = var(name).replace("$shim_products", &var("shim_products")).split_whitespace().map(str::to_string).collect();
+        let mut p: Vec<String> =
+            var(name).replace("$shim_products", &var("shim_products")).split_whitespace().map(str::to_string).collect();
         p.sort();
         p.dedup();
         p
     };
     let shims = [&targets::adreno::ADRENO, &targets::mali::MALI, &targets::anv::ANV];
-    for (build, list) in [(&targets::mesa_noop::MESA_DEBIAN, "products"), (&targets::mesa_noop::MESA_BACKPORTS, "products25")] {
-        let mut loaded: Vec<String> = shims.iter().filter(|s| s.families.iter().any(|f| std::ptr::eq(f.build, build))).flat_map(|s| [s.icd, s.library, s.shim]).map(str::to_string).collect();
+    for (build, list) in
+        [(&targets::mesa_noop::MESA_DEBIAN, "products"), (&targets::mesa_noop::MESA_BACKPORTS, "products25")]
+    {
+        let mut loaded: Vec<String> = shims
+            .iter()
+            .filter(|s| s.families.iter().any(|f| std::ptr::eq(f.build, build)))
+            .flat_map(|s| [s.icd, s.library, s.shim])
+            .map(str::to_string)
+            .collect();
         loaded.sort();
-        assert_eq!(products(list), loaded, "scripts/mesa-noop.sh's {list} and the files of the Shims' families on {} differ", build.what);
+        assert_eq!(
+            products(list),
+            loaded,
+            "scripts/mesa-noop.sh's {list} and the files of the Shims' families on {} differ",
+            build.what
+        );
         assert!(script.contains(&format!("\"$root/{}\"", build.link)), "the script links {}", build.link);
     }
     // Every shim driver is in VENDORS.

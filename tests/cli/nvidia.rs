@@ -33,10 +33,19 @@ fn every_preset_and_example_file_gets_sass_statistics_on_all_five_families() {
         let rows = r["rows"].as_array().unwrap();
         assert_eq!(rows.len(), models.len() + 1, "every model and the memory-only kernel");
         for row in rows {
-            for stat in ["Instruction Count", "Register Count", "Binary Size", "Issue Cycles", "Warps per SM", "FP32 (FMA, MUL, ADD, compare)"] {
+            for stat in [
+                "Instruction Count",
+                "Register Count",
+                "Binary Size",
+                "Issue Cycles",
+                "Warps per SM",
+                "FP32 (FMA, MUL, ADD, compare)",
+            ] {
                 assert!(sass(row, stat) > 0.0, "{} {}: {stat} is 0", family.name, row["model"]);
             }
-            let note = row["notes"]["translation"].as_str().unwrap_or_else(|| panic!("{} {}: no translation check", family.name, row["model"]));
+            let note = row["notes"]["translation"]
+                .as_str()
+                .unwrap_or_else(|| panic!("{} {}: no translation check", family.name, row["model"]));
             assert!(note.contains("translation checked on the host against"), "{note}");
         }
         // A BRDF costs more than the memory-only kernel; cycles/eval = max(busiest pipe, latency / resident
@@ -44,8 +53,18 @@ fn every_preset_and_example_file_gets_sass_statistics_on_all_five_families() {
         for c in r["cost"]["rows"].as_array().unwrap() {
             let stat = |k: &str| c["stats"][k].as_f64().unwrap();
             let per_warp = stat("busiest pipe (cycles/wave)").max(stat("latency / waves"));
-            assert!((c["cycles_per_eval"].as_f64().unwrap() - per_warp / (32.0 * 8.0)).abs() < 1e-9, "{} {}: {c}", family.name, c["model"]);
-            assert!(stat("busiest pipe (cycles/wave)") <= stat("Issue Cycles"), "{} {}: a pipe busier than the serial sum", family.name, c["model"]);
+            assert!(
+                (c["cycles_per_eval"].as_f64().unwrap() - per_warp / (32.0 * 8.0)).abs() < 1e-9,
+                "{} {}: {c}",
+                family.name,
+                c["model"]
+            );
+            assert!(
+                stat("busiest pipe (cycles/wave)") <= stat("Issue Cycles"),
+                "{} {}: a pipe busier than the serial sum",
+                family.name,
+                c["model"]
+            );
             if c["model"] != "baseline" {
                 assert!(c["net_cycles_per_eval"].as_f64().unwrap() > 0.0, "{} {}", family.name, c["model"]);
             }
@@ -68,7 +87,12 @@ fn the_statistics_are_deterministic_and_the_exact_defaults_cost_more() {
     let precise = inspect_json(dir.path(), "precise", &["nvidia:sm_89"], &["--model", "blinn", "--precise-math"]);
     assert!(!precise["provenance"]["compiler"]["options"].as_str().unwrap().contains("-use_fast_math"));
     let net = |r: &serde_json::Value| r["cost"]["rows"][0]["net_cycles_per_eval"].as_f64().unwrap();
-    assert!(net(&precise) > 1.2 * net(&fast), "IEEE division, square root and pow cost more: {} vs {}", net(&precise), net(&fast));
+    assert!(
+        net(&precise) > 1.2 * net(&fast),
+        "IEEE division, square root and pow cost more: {} vs {}",
+        net(&precise),
+        net(&fast)
+    );
 }
 
 #[test]
@@ -89,10 +113,21 @@ fn fp16_kernels_compare_and_clamp_in_half_precision_where_the_family_has_the_ins
     let dir = tempfile::tempdir().unwrap();
     let isa = dir.path().join("isa");
     // sm_75 has no f16 min/max (the f32 fallback), sm_89 has (PTX min.f16, SASS HMNMX2); both compare in f16.
-    inspect_json(dir.path(), "f16", &["nvidia:sm_75,sm_89"], &["--model", "ggx,precision=f16", "--isa", isa.to_str().unwrap()]);
-    let sass = |family: &str| std::fs::read_to_string(isa.join(format!("nvidia-{family}")).join("ggx-precision-f16.sass")).unwrap();
+    inspect_json(
+        dir.path(),
+        "f16",
+        &["nvidia:sm_75,sm_89"],
+        &["--model", "ggx,precision=f16", "--isa", isa.to_str().unwrap()],
+    );
+    let sass = |family: &str| {
+        std::fs::read_to_string(isa.join(format!("nvidia-{family}")).join("ggx-precision-f16.sass")).unwrap()
+    };
     let (turing, ada) = (sass("sm_75"), sass("sm_89"));
-    assert!(turing.contains("HFMA2") && turing.contains("HSETP2") && !turing.contains("HMNMX2"), "sm_75 SASS:\n{}", &turing[..turing.len().min(2000)]);
+    assert!(
+        turing.contains("HFMA2") && turing.contains("HSETP2") && !turing.contains("HMNMX2"),
+        "sm_75 SASS:\n{}",
+        &turing[..turing.len().min(2000)]
+    );
     assert!(ada.contains("HMNMX2") && ada.contains("HSETP2"), "sm_89 SASS:\n{}", &ada[..ada.len().min(2000)]);
 }
 
@@ -109,12 +144,23 @@ fn commands_that_execute_refuse_an_nvidia_target_and_unknown_families_are_named(
         let mut cmd = common::brdfprof();
         let r = cmd.args(&args).current_dir(common::repo_root()).output().unwrap();
         assert_eq!(r.status.code(), Some(2), "{args:?}");
-        assert!(String::from_utf8_lossy(&r.stderr).contains("compiles only"), "{args:?}: {}", String::from_utf8_lossy(&r.stderr));
+        assert!(
+            String::from_utf8_lossy(&r.stderr).contains("compiles only"),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&r.stderr)
+        );
     }
     run(&["inspect", "--device", "nvidia:sm_87"]).fails(2, "unknown NVIDIA family `sm_87`");
     let listed = run(&["devices", "--targets"]).ok();
     for f in &FAMILIES {
-        assert!(listed.stdout.lines().any(|l| l.starts_with(&format!("| nvidia:{} ", f.name)) && l.contains(f.architecture)), "{}", listed.stdout);
+        assert!(
+            listed
+                .stdout
+                .lines()
+                .any(|l| l.starts_with(&format!("| nvidia:{} ", f.name)) && l.contains(f.architecture)),
+            "{}",
+            listed.stdout
+        );
     }
 }
 
@@ -145,10 +191,34 @@ fn a_construct_the_translation_lacks_is_refused_at_the_files_line() {
     )
     .unwrap();
     let json = dir.path().join("x.json");
-    let r = run(&["inspect", "--no-callgrind", "--device", "nvidia:sm_89", "--model", file.to_str().unwrap(), "--json", json.to_str().unwrap(), "--markdown", dir.path().join("x.md").to_str().unwrap()]);
+    let r = run(&[
+        "inspect",
+        "--no-callgrind",
+        "--device",
+        "nvidia:sm_89",
+        "--model",
+        file.to_str().unwrap(),
+        "--json",
+        json.to_str().unwrap(),
+        "--markdown",
+        dir.path().join("x.md").to_str().unwrap(),
+    ]);
     r.fails(2, &format!("{}:8: the C translation cannot express the GLSL.std.450 function Determinant (GLSL's determinant) (in function `frame_volume`)", file.display()));
     // The same file runs on Vulkan: the refusal is the translation's, not the file's.
     let csv = dir.path().join("in.csv");
-    std::fs::write(&csv, "nx,ny,nz,vx,vy,vz,lx,ly,lz,roughness,f0r,f0g,f0b\n0,0,1,0,0.6,0.8,0,-0.6,0.8,0.5,0.04,0.04,0.04\n").unwrap();
-    run(&["eval", "--model", file.to_str().unwrap(), "--input", csv.to_str().unwrap(), "--output", dir.path().join("out.csv").to_str().unwrap()]).ok();
+    std::fs::write(
+        &csv,
+        "nx,ny,nz,vx,vy,vz,lx,ly,lz,roughness,f0r,f0g,f0b\n0,0,1,0,0.6,0.8,0,-0.6,0.8,0.5,0.04,0.04,0.04\n",
+    )
+    .unwrap();
+    run(&[
+        "eval",
+        "--model",
+        file.to_str().unwrap(),
+        "--input",
+        csv.to_str().unwrap(),
+        "--output",
+        dir.path().join("out.csv").to_str().unwrap(),
+    ])
+    .ok();
 }

@@ -51,9 +51,15 @@ fn every_output_flag_is_checked_first() {
         ([&eval[..], &["--output", "a-dir"]].concat(), "--output a-dir: is a directory"),
         ([&eval[..], &["--output", "a-file/out.csv"]].concat(), "--output a-file/out.csv: a-file is not a directory"),
         ([&eval[..], &["--output", "new/"]].concat(), "--output new/: names a directory"),
-        (vec!["profile", "--model", "ggx", "--size", "8x8", "--json", "a-file/p.json"], "--json a-file/p.json: a-file is not a directory"),
+        (
+            vec!["profile", "--model", "ggx", "--size", "8x8", "--json", "a-file/p.json"],
+            "--json a-file/p.json: a-file is not a directory",
+        ),
         (vec!["profile", "--scene", scene, "--json", "a-dir"], "--json a-dir: is a directory"),
-        (vec!["sweep", "--model", "ggx", "--size", "8x8", "--out", "a-file"], "--out a-file: exists and is not a directory"),
+        (
+            vec!["sweep", "--model", "ggx", "--size", "8x8", "--out", "a-file"],
+            "--out a-file: exists and is not a directory",
+        ),
         (vec!["stability", "--model", "ggx", "--out", "a-file/sub"], "--out a-file/sub: a-file is not a directory"),
         ([&inspect[..], &["--json", "a-dir"]].concat(), "--json a-dir: is a directory"),
         ([&inspect[..], &["--json", "i.json", "--markdown", "a-dir"]].concat(), "--markdown a-dir: is a directory"),
@@ -68,7 +74,8 @@ fn every_output_flag_is_checked_first() {
     }
     // The defaults' directory is checked too: `results` is a file here.
     std::fs::write(d.join("results"), "x").unwrap();
-    run_in(d, &inspect).fails(2, "--json (default results/inspect-<device>.json) results: exists and is not a directory");
+    run_in(d, &inspect)
+        .fails(2, "--json (default results/inspect-<device>.json) results: exists and is not a directory");
 }
 
 /// An output that is the input (by any path) is refused before anything runs: `eval --input X --output X`
@@ -80,12 +87,14 @@ fn an_output_that_is_an_input_is_refused() {
     std::fs::write(d.join("in.csv"), CSV).unwrap();
     std::os::unix::fs::symlink("in.csv", d.join("link.csv")).unwrap();
     for out in ["in.csv", "./in.csv", "link.csv"] {
-        run_in(d, &["eval", "--model", "ggx", "--input", "in.csv", "--output", out]).fails(2, &format!("--output {out}: is the same file as --input in.csv"));
+        run_in(d, &["eval", "--model", "ggx", "--input", "in.csv", "--output", out])
+            .fails(2, &format!("--output {out}: is the same file as --input in.csv"));
         assert_eq!(std::fs::read_to_string(d.join("in.csv")).unwrap(), CSV, "the input is untouched");
     }
     let ggx = common::repo_root().join("examples/brdf/ggx.brdf");
     std::fs::copy(&ggx, d.join("m.brdf")).unwrap();
-    run_in(d, &["eval", "--model", "m.brdf", "--input", "in.csv", "--output", "m.brdf"]).fails(2, "--output m.brdf: is the same file as --model m.brdf");
+    run_in(d, &["eval", "--model", "m.brdf", "--input", "in.csv", "--output", "m.brdf"])
+        .fails(2, "--output m.brdf: is the same file as --model m.brdf");
     assert_eq!(std::fs::read(d.join("m.brdf")).unwrap(), std::fs::read(&ggx).unwrap());
 }
 
@@ -97,15 +106,46 @@ fn a_command_that_fails_midway_leaves_none_of_its_outputs() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let report = common::repo_root().join("results/radv/profile-llvmpipe.json");
-    run_in(d, &["compare", report.to_str().unwrap(), "--json", "out/c.json", "--markdown", "out/c.md", "--chart", "/dev/full"]).fails(2, "/dev/full");
+    run_in(
+        d,
+        &[
+            "compare",
+            report.to_str().unwrap(),
+            "--json",
+            "out/c.json",
+            "--markdown",
+            "out/c.md",
+            "--chart",
+            "/dev/full",
+        ],
+    )
+    .fails(2, "/dev/full");
     assert!(!d.join("out").exists(), "left: {:?}", files(d));
-    run_in(d, &["compare", report.to_str().unwrap(), "--json", "out/c.json", "--markdown", "out/c.md", "--chart", "out/c.png"]).ok();
+    run_in(
+        d,
+        &[
+            "compare",
+            report.to_str().unwrap(),
+            "--json",
+            "out/c.json",
+            "--markdown",
+            "out/c.md",
+            "--chart",
+            "out/c.png",
+        ],
+    )
+    .ok();
     assert_eq!(files(d), ["out/c.json", "out/c.md", "out/c.png"]);
 }
 
 /// `git` in `dir`, which must succeed.
 fn git(dir: &Path, args: &[&str]) {
-    let s = std::process::Command::new("git").args(["-c", "user.name=t", "-c", "user.email=t@t"]).args(args).current_dir(dir).output().expect("git runs");
+    let s = std::process::Command::new("git")
+        .args(["-c", "user.name=t", "-c", "user.email=t@t"])
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("git runs");
     assert!(s.status.success(), "git {args:?}: {}", String::from_utf8_lossy(&s.stderr));
 }
 
@@ -115,7 +155,9 @@ fn a_default_output_never_overwrites_a_file_git_tracks() {
     let d = dir.path();
     git(d, &["init", "-q"]);
     std::fs::create_dir(d.join("results")).unwrap();
-    for f in ["profile-somegpu.json", "sweep-somegpu.md", "stability-somegpu.json", "compare.json", "inspect-somegpu.md"] {
+    for f in
+        ["profile-somegpu.json", "sweep-somegpu.md", "stability-somegpu.json", "compare.json", "inspect-somegpu.md"]
+    {
         std::fs::write(d.join("results").join(f), "committed\n").unwrap();
     }
     git(d, &["add", "results"]);
@@ -128,7 +170,13 @@ fn a_default_output_never_overwrites_a_file_git_tracks() {
         (&["compare", "a.json"][..], "--json", "compare.json"),
     ] {
         let r = run_in(d, args).fails(2, "a file git tracks");
-        assert!(r.stderr.contains(flag) && r.stderr.contains(&format!("results/{file}")) && r.stderr.contains(&format!("{flag} PATH")), "{args:?}: {}", r.stderr);
+        assert!(
+            r.stderr.contains(flag)
+                && r.stderr.contains(&format!("results/{file}"))
+                && r.stderr.contains(&format!("{flag} PATH")),
+            "{args:?}: {}",
+            r.stderr
+        );
     }
     for f in std::fs::read_dir(d.join("results")).unwrap() {
         assert_eq!(std::fs::read_to_string(f.unwrap().path()).unwrap(), "committed\n", "nothing overwritten");
@@ -137,7 +185,9 @@ fn a_default_output_never_overwrites_a_file_git_tracks() {
     // Issue 31 item 9: a compile-only target's default is its own name, so another device's tracked report
     // does not refuse it (inspect-somegpu.md is tracked; inspect-nvidia-sm_89.md is not).
     run_in(d, &["inspect", "--no-callgrind", "--device", "nvidia:sm_89", "--model", "ggx"]).ok();
-    assert!(d.join("results/inspect-nvidia-sm_89.md").is_file() && d.join("results/inspect-nvidia-sm_89.json").is_file());
+    assert!(
+        d.join("results/inspect-nvidia-sm_89.md").is_file() && d.join("results/inspect-nvidia-sm_89.json").is_file()
+    );
     std::fs::remove_file(d.join("results/inspect-nvidia-sm_89.md")).unwrap();
     std::fs::remove_file(d.join("results/inspect-nvidia-sm_89.json")).unwrap();
     // Not tracked (outside any repository, or untracked in one): the defaults stand.
@@ -146,10 +196,17 @@ fn a_default_output_never_overwrites_a_file_git_tracks() {
     assert!(brdfprof::io::tracked_by_git(&d.join("results"), "profile-other.json").is_empty(), "an untracked file");
     let plain = tempfile::tempdir().unwrap();
     std::fs::write(plain.path().join("compare.json"), "").unwrap();
-    assert!(brdfprof::io::tracked_by_git(plain.path(), "*").is_empty() || git_above(plain.path()), "outside a repository");
+    assert!(
+        brdfprof::io::tracked_by_git(plain.path(), "*").is_empty() || git_above(plain.path()),
+        "outside a repository"
+    );
 }
 
 /// Whether `dir` is inside some git repository (a temp dir under a checkout would be).
 fn git_above(dir: &Path) -> bool {
-    std::process::Command::new("git").args(["rev-parse", "--git-dir"]).current_dir(dir).output().is_ok_and(|o| o.status.success())
+    std::process::Command::new("git")
+        .args(["rev-parse", "--git-dir"])
+        .current_dir(dir)
+        .output()
+        .is_ok_and(|o| o.status.success())
 }

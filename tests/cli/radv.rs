@@ -67,9 +67,14 @@ fn aco_schedule_is_acos_own_without_branches(family: &str, rows: &[serde_json::V
     let target = TARGETS.iter().find(|t| t.family == family).unwrap();
     for row in rows {
         let model = row["model"].as_str().unwrap();
-        let schedule = brdfprof::targets::radv::schedule(&serde_json::from_value(row["stats"].clone()).unwrap(), target).expect("perfinfo statistics");
+        let schedule =
+            brdfprof::targets::radv::schedule(&serde_json::from_value(row["stats"].clone()).unwrap(), target)
+                .expect("perfinfo statistics");
         let branch_free = stat(row, "Branches") == 0.0;
-        assert!(branch_free || !family.starts_with("navi"), "{family} {model}: RDNA compiles the built-in kernels without branches");
+        assert!(
+            branch_free || !family.starts_with("navi"),
+            "{family} {model}: RDNA compiles the built-in kernels without branches"
+        );
         let same = |ours: f64, aco: f64, what: &str| match branch_free {
             true => assert_eq!(ours, aco, "{family} {model}: {what}"),
             false => assert!(ours >= aco, "{family} {model}: {what} {ours} against ACO's weighted {aco}"),
@@ -82,7 +87,10 @@ fn aco_schedule_is_acos_own_without_branches(family: &str, rows: &[serde_json::V
         let cost = costs.iter().find(|c| c["model"] == model).unwrap();
         let it = stat(row, "Inverse Throughput");
         let ours = cost["cycles_per_eval"].as_f64().unwrap() * 64.0 * 8.0;
-        assert!(if branch_free { (ours - it).abs() <= 0.5 } else { ours >= it - 0.5 }, "{family} {model}: {ours} against ACO's Inverse Throughput {it}");
+        assert!(
+            if branch_free { (ours - it).abs() <= 0.5 } else { ours >= it - 0.5 },
+            "{family} {model}: {ours} against ACO's Inverse Throughput {it}"
+        );
     }
 }
 
@@ -90,14 +98,16 @@ fn aco_schedule_is_acos_own_without_branches(family: &str, rows: &[serde_json::V
 fn isa_writes_acos_disassembly_per_kernel_and_family() {
     let dir = tempfile::tempdir().unwrap();
     let isa = dir.path().join("isa");
-    let report = inspect_json(dir.path(), "one", &["radv:vangogh"], &["--model", "ggx", "--isa", isa.to_str().unwrap()]);
+    let report =
+        inspect_json(dir.path(), "one", &["radv:vangogh"], &["--model", "ggx", "--isa", isa.to_str().unwrap()]);
     assert!(report["cost"].is_object(), "a single device's JSON is that device's report");
     for kernel in ["ggx", "baseline"] {
         let text = std::fs::read_to_string(isa.join("vangogh").join(format!("{kernel}.assembly.txt"))).unwrap();
         assert!(text.contains("s_endpgm") && text.contains("v_"), "{kernel}: {}", &text[..text.len().min(400)]);
     }
     // --isa without a compile-only device is refused before anything runs.
-    run_in(dir.path(), &["inspect", "--no-callgrind", "--isa", "x"]).fails(2, "--isa x: the listings are a compile-only target's");
+    run_in(dir.path(), &["inspect", "--no-callgrind", "--isa", "x"])
+        .fails(2, "--isa x: the listings are a compile-only target's");
     assert!(!dir.path().join("x").exists());
 }
 
@@ -105,7 +115,11 @@ fn isa_writes_acos_disassembly_per_kernel_and_family() {
 fn commands_that_execute_refuse_a_compile_only_device() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    std::fs::write(d.join("in.csv"), "nx,ny,nz,vx,vy,vz,lx,ly,lz,roughness,f0r,f0g,f0b\n0,0,1,0,0.6,0.8,0.6,0,0.8,0.5,0.04,0.04,0.04\n").unwrap();
+    std::fs::write(
+        d.join("in.csv"),
+        "nx,ny,nz,vx,vy,vz,lx,ly,lz,roughness,f0r,f0g,f0b\n0,0,1,0,0.6,0.8,0.6,0,0.8,0.5,0.04,0.04,0.04\n",
+    )
+    .unwrap();
     let scene = common::repo_root().join("scenes/sphere-grid.json");
     let commands: [&[&str]; 5] = [
         &["eval", "--model", "ggx", "--input", "in.csv", "--output", "out.csv"],
@@ -133,7 +147,8 @@ fn default_device(env: Option<(&str, &str)>) -> (String, String) {
     }
     let out = cmd.output().unwrap();
     let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
-    let line = stdout.lines().find(|l| l.contains("(default)")).unwrap_or_else(|| panic!("no default device:\n{stdout}"));
+    let line =
+        stdout.lines().find(|l| l.contains("(default)")).unwrap_or_else(|| panic!("no default device:\n{stdout}"));
     (line.split('|').nth(2).unwrap().trim().to_string(), stdout)
 }
 
@@ -144,14 +159,28 @@ fn radv_force_family_in_the_users_environment_changes_no_default() {
     assert_eq!(plain, forced, "{listing}");
     assert!(!forced.starts_with("Null hardware"));
     // The null device is listed, marked, and refused by a command that executes even when chosen by index.
-    let null = listing.lines().find(|l| l.contains("Null hardware (RADV NAVI21)")).unwrap_or_else(|| panic!("{listing}"));
+    let null =
+        listing.lines().find(|l| l.contains("Null hardware (RADV NAVI21)")).unwrap_or_else(|| panic!("{listing}"));
     assert!(null.contains("(compiles only)"), "{null}");
     let index = null.trim_start_matches('|').split_whitespace().next().unwrap().to_string();
     let dir = tempfile::tempdir().unwrap();
     let json = dir.path().join("p.json");
     let profile = |device: Option<&str>| {
         let mut cmd = common::brdfprof();
-        cmd.args(["profile", "--model", "ggx", "--size", "16x16", "--min-rounds", "2", "--max-rounds", "2", "--json", json.to_str().unwrap()]).env("RADV_FORCE_FAMILY", "navi21");
+        cmd.args([
+            "profile",
+            "--model",
+            "ggx",
+            "--size",
+            "16x16",
+            "--min-rounds",
+            "2",
+            "--max-rounds",
+            "2",
+            "--json",
+            json.to_str().unwrap(),
+        ])
+        .env("RADV_FORCE_FAMILY", "navi21");
         if let Some(d) = device {
             cmd.args(["--device", d]);
         }
@@ -170,7 +199,11 @@ fn radv_force_family_in_the_users_environment_changes_no_default() {
 fn devices_targets_lists_every_family_of_the_table() {
     let out = run(&["devices", "--targets"]).ok();
     for t in &TARGETS {
-        let line = out.stdout.lines().find(|l| l.starts_with(&format!("| radv:{} ", t.family))).unwrap_or_else(|| panic!("{}", out.stdout));
+        let line = out
+            .stdout
+            .lines()
+            .find(|l| l.starts_with(&format!("| radv:{} ", t.family)))
+            .unwrap_or_else(|| panic!("{}", out.stdout));
         assert!(line.contains(t.architecture) && line.contains(&format!("wave{} ", t.wave_size)), "{line}");
     }
 }
@@ -180,7 +213,18 @@ fn a_child_that_crashes_after_its_report_still_gives_the_report_and_exit_0() {
     let dir = tempfile::tempdir().unwrap();
     let json = dir.path().join("r.json");
     let out = common::brdfprof()
-        .args(["inspect", "--no-callgrind", "--model", "ggx", "--device", "radv:navi21", "--json", json.to_str().unwrap(), "--markdown", dir.path().join("r.md").to_str().unwrap()])
+        .args([
+            "inspect",
+            "--no-callgrind",
+            "--model",
+            "ggx",
+            "--device",
+            "radv:navi21",
+            "--json",
+            json.to_str().unwrap(),
+            "--markdown",
+            dir.path().join("r.md").to_str().unwrap(),
+        ])
         .env(brdfprof::targets::mesa_noop::CRASH_AFTER_REPLY, "1")
         .output()
         .unwrap();
@@ -196,14 +240,46 @@ fn a_child_that_crashes_after_its_report_still_gives_the_report_and_exit_0() {
 fn sweep_cost_device_draws_the_frontier_again_with_acos_cycles() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let base = ["sweep", "--model", "ggx", "--model", "blinn", "--model", "ggx,vis=smith-ggx-correlated,f=dielectric", "--size", "16x16", "--min-rounds", "2", "--max-rounds", "2", "--out", "out"];
+    let base = [
+        "sweep",
+        "--model",
+        "ggx",
+        "--model",
+        "blinn",
+        "--model",
+        "ggx,vis=smith-ggx-correlated,f=dielectric",
+        "--size",
+        "16x16",
+        "--min-rounds",
+        "2",
+        "--max-rounds",
+        "2",
+        "--out",
+        "out",
+    ];
     run_in(d, &[&base[..], &["--cost-device", "0"]].concat()).fails(2, "--cost-device 0: give a compile-only target");
     run_in(d, &[&base[..], &["--cost-device", "radv:navi31"]].concat()).fails(2, "unknown AMD family `navi31`");
     assert!(!d.join("out").exists());
-    let out = run_in(d, &[&base[..], &["--cost-device", "radv:navi21", "--cost-device", "radv:vega10", "--cost-device", "nvidia:sm_89"]].concat()).ok();
+    let out = run_in(
+        d,
+        &[
+            &base[..],
+            &["--cost-device", "radv:navi21", "--cost-device", "radv:vega10", "--cost-device", "nvidia:sm_89"],
+        ]
+        .concat(),
+    )
+    .ok();
     assert!(out.stdout.contains("# brdfprof sweep: cost on navi21 (RDNA 2)"), "{}", out.stdout);
-    let file = |suffix: &str| std::fs::read_dir(d.join("out")).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).find(|n| n.ends_with(suffix)).unwrap();
-    let read = |name: &str| -> serde_json::Value { serde_json::from_str(&std::fs::read_to_string(d.join("out").join(name)).unwrap()).unwrap() };
+    let file = |suffix: &str| {
+        std::fs::read_dir(d.join("out"))
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .find(|n| n.ends_with(suffix))
+            .unwrap()
+    };
+    let read = |name: &str| -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(d.join("out").join(name)).unwrap()).unwrap()
+    };
     // The frontiers of the three targets at once: every spec on some target's frontier, with the targets
     // whose frontier it is on as the per-target files say; the exact model on all of them.
     let frontiers = read(&file("-frontiers.json"));
@@ -220,14 +296,21 @@ fn sweep_cost_device_draws_the_frontier_again_with_acos_cycles() {
     assert!(out.stdout.contains("On every target's frontier:"), "{}", out.stdout);
     for family in ["navi21", "vega10"] {
         let stem = file(&format!("-aco-{family}.json"));
-        let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(d.join("out").join(&stem)).unwrap()).unwrap();
+        let report: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(d.join("out").join(&stem)).unwrap()).unwrap();
         let rows = report["rows"].as_array().unwrap();
         assert_eq!(rows.len(), 3);
         assert_eq!(rows[0]["cost_vs_fastest"].as_f64(), Some(1.0), "sorted by cost, relative to the cheapest");
-        assert!(rows.iter().all(|r| r["cycles_per_eval"].as_f64().unwrap() > 0.0 && r["accuracy"]["vs_exact"]["rms"].is_number()));
+        assert!(
+            rows.iter()
+                .all(|r| r["cycles_per_eval"].as_f64().unwrap() > 0.0 && r["accuracy"]["vs_exact"]["rms"].is_number())
+        );
         assert!(rows.iter().any(|r| r["pareto"] == true));
         // The exact model (most accurate) is on every frontier.
-        assert!(rows.iter().any(|r| r["spec"].as_str().unwrap().contains("dielectric") && r["pareto"] == true), "{rows:?}");
+        assert!(
+            rows.iter().any(|r| r["spec"].as_str().unwrap().contains("dielectric") && r["pareto"] == true),
+            "{rows:?}"
+        );
         assert!(d.join("out").join(stem.replace(".json", ".png")).exists());
     }
 }
@@ -239,5 +322,8 @@ fn a_family_without_fp16_leaves_out_the_fp16_models_and_says_why() {
     let models: Vec<&str> = report["rows"].as_array().unwrap().iter().map(|r| r["model"].as_str().unwrap()).collect();
     assert_eq!(models, ["ggx", "baseline"]);
     let note = report["section_notes"]["driver/"].as_str().unwrap();
-    assert!(note.contains("not compiled for radv:tahiti: ggx,precision=f16") && note.contains("shaderFloat16"), "{note}");
+    assert!(
+        note.contains("not compiled for radv:tahiti: ggx,precision=f16") && note.contains("shaderFloat16"),
+        "{note}"
+    );
 }

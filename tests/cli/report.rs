@@ -7,24 +7,40 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 /// The reports of a default profile, sweep, stability and `inspect --device radv:all`, as committed.
-const INPUTS: [&str; 4] = ["results/profile-llvmpipe.json", "results/sweep-llvmpipe.json", "results/stability-llvmpipe.json", "results/radv/inspect-radv-all.json"];
+const INPUTS: [&str; 4] = [
+    "results/profile-llvmpipe.json",
+    "results/sweep-llvmpipe.json",
+    "results/stability-llvmpipe.json",
+    "results/radv/inspect-radv-all.json",
+];
 
 fn chromium() -> PathBuf {
     let found = ["/usr/bin/chromium", "/usr/bin/chromium-browser"].into_iter().map(PathBuf::from).find(|p| p.exists());
-    found.expect("Chromium is not installed: run `make setup` (Debian package chromium); the report is tested in a real browser")
+    found.expect(
+        "Chromium is not installed: run `make setup` (Debian package chromium); the report is tested in a real browser",
+    )
 }
 
 /// Runs headless Chromium on `page` with `extra` arguments; returns (stdout, the console lines of stderr).
 fn headless(page: &Path, profile: &Path, extra: &[&str]) -> (String, Vec<String>) {
     let out = Command::new(chromium())
-        .args(["--headless", "--no-sandbox", "--disable-gpu", "--no-first-run", "--enable-logging=stderr", "--v=0", "--virtual-time-budget=3000"])
+        .args([
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--no-first-run",
+            "--enable-logging=stderr",
+            "--v=0",
+            "--virtual-time-budget=3000",
+        ])
         .arg(format!("--user-data-dir={}", profile.display()))
         .args(extra)
         .arg(format!("file://{}", page.display()))
         .output()
         .expect("chromium runs");
     assert!(out.status.success(), "chromium failed: {}", String::from_utf8_lossy(&out.stderr));
-    let console = String::from_utf8_lossy(&out.stderr).lines().filter(|l| l.contains("CONSOLE")).map(str::to_owned).collect();
+    let console =
+        String::from_utf8_lossy(&out.stderr).lines().filter(|l| l.contains("CONSOLE")).map(str::to_owned).collect();
     (String::from_utf8_lossy(&out.stdout).into_owned(), console)
 }
 
@@ -32,7 +48,9 @@ fn headless(page: &Path, profile: &Path, extra: &[&str]) -> (String, Vec<String>
 fn shown(dom: &str, row: &str, col: &str) -> f64 {
     let start = dom.find(&format!("<tr data-row=\"{row}\">")).unwrap_or_else(|| panic!("no row {row} in the DOM"));
     let tr = &dom[start..start + dom[start..].find("</tr>").unwrap()];
-    let at = tr.find(&format!("data-col=\"{col}\" data-v=\"")).unwrap_or_else(|| panic!("no {col} figure in row {row}: {tr}"));
+    let at = tr
+        .find(&format!("data-col=\"{col}\" data-v=\""))
+        .unwrap_or_else(|| panic!("no {col} figure in row {row}: {tr}"));
     let v = &tr[at + col.len() + 20..];
     v[..v.find('"').unwrap()].parse().unwrap()
 }
@@ -75,7 +93,11 @@ fn a_report_of_profile_sweep_inspect_and_stability_opens_in_chromium_with_the_js
     }
 
     let shot = dir.path().join("shot.png");
-    headless(&page, &dir.path().join("profile"), &[&format!("--screenshot={}", shot.display()), "--window-size=1280,900"]);
+    headless(
+        &page,
+        &dir.path().join("profile"),
+        &[&format!("--screenshot={}", shot.display()), "--window-size=1280,900"],
+    );
     let img = image::open(&shot).unwrap().to_rgb8();
     let colours: std::collections::HashSet<[u8; 3]> = img.pixels().map(|p| p.0).collect();
     assert!(colours.len() > 64, "the screenshot has {} colours: blank", colours.len());
@@ -87,9 +109,24 @@ fn a_report_of_profile_sweep_inspect_and_stability_opens_in_chromium_with_the_js
 #[test]
 fn a_diff_report_shows_the_jsons_numbers_in_chromium() {
     let dir = tempfile::tempdir().unwrap();
-    let (d, from_diff, from_report) = (dir.path().join("d.json"), dir.path().join("diff.html"), dir.path().join("report.html"));
+    let (d, from_diff, from_report) =
+        (dir.path().join("d.json"), dir.path().join("diff.html"), dir.path().join("report.html"));
     let path = |p: &Path| p.display().to_string();
-    let r = common::run(&["diff", "--model", "ggx,name=base", "--model", "filament-high", "--samples", "2000", "--worst", "5", "--json", &path(&d), "--html", &path(&from_diff)]);
+    let r = common::run(&[
+        "diff",
+        "--model",
+        "ggx,name=base",
+        "--model",
+        "filament-high",
+        "--samples",
+        "2000",
+        "--worst",
+        "5",
+        "--json",
+        &path(&d),
+        "--html",
+        &path(&from_diff),
+    ]);
     assert!(r.code == Some(0), "{}", r.stderr);
     common::run(&["report", &path(&d), "--out", &path(&from_report)]).ok();
     let j: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&d).unwrap()).unwrap();
@@ -97,7 +134,10 @@ fn a_diff_report_shows_the_jsons_numbers_in_chromium() {
         let (dom, console) = headless(page, &dir.path().join(format!("profile{k}")), &["--dump-dom"]);
         assert!(console.is_empty(), "console messages:\n{}", console.join("\n"));
         assert!(dom.contains("data-ready=\"1\""), "the page's script did not finish");
-        assert!(dom.contains("B = <code>filament-high</code> against A = <code>base</code>"), "the models by their labels");
+        assert!(
+            dom.contains("B = <code>filament-high</code> against A = <code>base</code>"),
+            "the models by their labels"
+        );
         for c in j["difference"]["channels"].as_array().unwrap() {
             let key = format!("diff0/{}", c["channel"].as_str().unwrap());
             for col in ["max_rel", "rms_rel", "max_abs", "rms_abs"] {
@@ -108,12 +148,20 @@ fn a_diff_report_shows_the_jsons_numbers_in_chromium() {
         assert_eq!(worst.len(), 5);
         for (w, row) in worst.iter().enumerate() {
             assert_eq!(shown(&dom, &format!("diff0/worst{w}"), "rel"), row["rel"].as_f64().unwrap(), "worst row {w}");
-            assert_eq!(shown(&dom, &format!("diff0/worst{w}"), "index"), row["index"].as_f64().unwrap(), "worst row {w}");
+            assert_eq!(
+                shown(&dom, &format!("diff0/worst{w}"), "index"),
+                row["index"].as_f64().unwrap(),
+                "worst row {w}"
+            );
         }
         for (b, count) in j["histogram"]["counts"].as_array().unwrap().iter().enumerate() {
             assert_eq!(shown(&dom, &format!("diff0/bin{b}"), "rows"), count.as_f64().unwrap(), "bin {b}");
         }
-        assert!(dom.contains("src=\"data:image/png;base64,") && dom.contains("alt=\"B = filament-high against A = base: lit spheres"), "the picture of B against A");
+        assert!(
+            dom.contains("src=\"data:image/png;base64,")
+                && dom.contains("alt=\"B = filament-high against A = base: lit spheres"),
+            "the picture of B against A"
+        );
     }
 }
 
@@ -122,7 +170,11 @@ fn a_diff_report_shows_the_jsons_numbers_in_chromium() {
 fn a_console_error_is_seen() {
     let dir = tempfile::tempdir().unwrap();
     let page = dir.path().join("bad.html");
-    std::fs::write(&page, "<!doctype html><html><body><script>console.error('brdfprof-test-error');</script></body></html>").unwrap();
+    std::fs::write(
+        &page,
+        "<!doctype html><html><body><script>console.error('brdfprof-test-error');</script></body></html>",
+    )
+    .unwrap();
     let (_, console) = headless(&page, &dir.path().join("profile"), &["--dump-dom"]);
     assert!(console.iter().any(|l| l.contains("brdfprof-test-error")), "console lines: {console:?}");
 }
@@ -148,9 +200,35 @@ fn the_report_opens_on_a_one_screen_summary_with_one_card_per_model() {
     let engine = |name: &str| path(&common::repo_root().join("tests/fixtures/brdf/engine").join(name));
     let (set, page) = (d.join("set.json"), d.join("report.html"));
     let reference = "d=ggx,vis=smith-ggx-correlated,f=schlick";
-    let r = common::run(&["diff", "--reference", reference, "--model", "filament-high", "--model", "ggx", "--model", &engine("engine-ggx.brdf"), "--model", &engine("unclamped-ggx.brdf"), "--samples", "1000", "--json", &path(&set)]);
+    let r = common::run(&[
+        "diff",
+        "--reference",
+        reference,
+        "--model",
+        "filament-high",
+        "--model",
+        "ggx",
+        "--model",
+        &engine("engine-ggx.brdf"),
+        "--model",
+        &engine("unclamped-ggx.brdf"),
+        "--samples",
+        "1000",
+        "--json",
+        &path(&set),
+    ]);
     assert_eq!(r.code, Some(0), "{}", r.stderr);
-    let st = common::run(&["stability", "--unguarded", "--no-energy", "--model", "ggx", "--model", &engine("unclamped-ggx.brdf"), "--out", &path(d)]);
+    let st = common::run(&[
+        "stability",
+        "--unguarded",
+        "--no-energy",
+        "--model",
+        "ggx",
+        "--model",
+        &engine("unclamped-ggx.brdf"),
+        "--out",
+        &path(d),
+    ]);
     assert_eq!(st.code, Some(1), "the unclamped file fails: {}", st.stderr);
     let stability = common::device_file(d, "stability-", ".json");
     let profile = common::repo_root().join(INPUTS[0]);
@@ -163,9 +241,15 @@ fn the_report_opens_on_a_one_screen_summary_with_one_card_per_model() {
     let bottom = attr_of(&dom, "<section id=\"summary\"", "data-bottom");
     assert!(bottom <= 900.0, "the summary ends at {bottom} px: below the first screen of 900");
     let provenance = dom.find("<section id=\"provenance\"").unwrap();
-    assert!(dom[provenance..].contains("<details>") && provenance > dom.find("<section id=\"diff\"").unwrap(), "provenance folded, last");
+    assert!(
+        dom[provenance..].contains("<details>") && provenance > dom.find("<section id=\"diff\"").unwrap(),
+        "provenance folded, last"
+    );
 
-    let rows: Vec<&str> = dom.match_indices("<tr data-row=\"summary/").map(|(i, _)| &dom[i + 22..i + 22 + dom[i + 22..].find('"').unwrap()]).collect();
+    let rows: Vec<&str> = dom
+        .match_indices("<tr data-row=\"summary/")
+        .map(|(i, _)| &dom[i + 22..i + 22 + dom[i + 22..].find('"').unwrap()])
+        .collect();
     let mut unique = rows.clone();
     unique.sort();
     unique.dedup();
@@ -173,7 +257,10 @@ fn the_report_opens_on_a_one_screen_summary_with_one_card_per_model() {
     for model in ["ggx", "blinn", "filament-high", "engine-ggx", "unclamped-ggx"] {
         assert!(rows.contains(&model), "{model} has no summary row: {rows:?}");
     }
-    let cards: Vec<&str> = dom.match_indices("<div class=\"model\" data-model=\"").map(|(i, m)| &dom[i + m.len()..i + m.len() + dom[i + m.len()..].find('"').unwrap()]).collect();
+    let cards: Vec<&str> = dom
+        .match_indices("<div class=\"model\" data-model=\"")
+        .map(|(i, m)| &dom[i + m.len()..i + m.len() + dom[i + m.len()..].find('"').unwrap()])
+        .collect();
     let mut distinct = cards.clone();
     distinct.sort();
     distinct.dedup();

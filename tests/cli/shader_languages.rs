@@ -28,7 +28,9 @@ fn twin() -> String {
 /// The flags that find both fixtures' includes and imports.
 fn includes() -> Vec<String> {
     let engine = format!("/Engine={}", ue("Engine"));
-    ["--include-dir", &ue("Shaders"), "--include-dir", &bevy("shaders"), "--include-map", &engine].map(String::from).to_vec()
+    ["--include-dir", &ue("Shaders"), "--include-dir", &bevy("shaders"), "--include-map", &engine]
+        .map(String::from)
+        .to_vec()
 }
 
 /// `brdfprof ARGS` plus the include flags, in `dir`.
@@ -48,7 +50,10 @@ fn write_rows(path: &Path, n: usize) {
         let v: Vec<f64> = (0..13).map(|_| next()).collect();
         let d = |k: usize| [2.0 * v[k] - 1.0, 2.0 * v[k + 1] - 1.0, 2.0 * v[k + 2] - 0.6];
         let (nn, vv, ll) = (d(0), d(3), d(6));
-        s += &format!("{},{},{},{},{},{},{},{},{},{},{},{},{}\n", nn[0], nn[1], nn[2], vv[0], vv[1], vv[2], ll[0], ll[1], ll[2], v[9], v[10], v[11], v[12]);
+        s += &format!(
+            "{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
+            nn[0], nn[1], nn[2], vv[0], vv[1], vv[2], ll[0], ll[1], ll[2], v[9], v[10], v[11], v[12]
+        );
     }
     std::fs::write(path, s).unwrap();
 }
@@ -74,7 +79,11 @@ fn hlsl_and_wgsl_evaluate_bit_for_bit_as_their_glsl_twin() {
     std::fs::write(d.join("geometry.csv"), geometry).unwrap();
     let plain = root().join("examples/brdf/ggx.brdf").display().to_string();
     run_with_includes(d, &["eval", "--model", &plain, "--input", "geometry.csv", "--output", "plain-twin.csv"]).ok();
-    run_with_includes(d, &["eval", "--model", &ue("ue-ggx-constant.hlsl"), "--input", "geometry.csv", "--output", "plain.csv"]).ok();
+    run_with_includes(
+        d,
+        &["eval", "--model", &ue("ue-ggx-constant.hlsl"), "--input", "geometry.csv", "--output", "plain.csv"],
+    )
+    .ok();
     assert!(std::fs::read(d.join("plain.csv")).unwrap() == std::fs::read(d.join("plain-twin.csv")).unwrap());
 }
 
@@ -85,7 +94,12 @@ fn engine_entries_in_hlsl_and_wgsl_need_no_glue() {
     write_rows(&d.join("in.csv"), 2000);
     run_with_includes(d, &["eval", "--model", &ue("ue-ggx.brdf"), "--input", "in.csv", "--output", "f.csv"]).ok();
     let f = common::csv_values(&d.join("f.csv"));
-    let rows: Vec<Vec<f64>> = std::fs::read_to_string(d.join("in.csv")).unwrap().lines().skip(1).map(|l| l.split(',').map(|x| x.parse().unwrap()).collect()).collect();
+    let rows: Vec<Vec<f64>> = std::fs::read_to_string(d.join("in.csv"))
+        .unwrap()
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+        .collect();
     let nol = |r: &Vec<f64>| {
         let unit = |a: &[f64]| {
             let n = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
@@ -96,10 +110,20 @@ fn engine_entries_in_hlsl_and_wgsl_need_no_glue() {
     };
     // AccumulateDirectLight(..., @scratch, @out) in HLSL, SpecularLight by `entry=`, add_direct_light(..., @out)
     // in WGSL: f_s N.L, divided by N.L on the host in f64.
-    for (model, out) in [(ue("ue-light.brdf"), "a.csv"), (format!("{},entry=SpecularLight", ue("ue-light.brdf")), "b.csv"), (bevy("bevy-light.brdf"), "c.csv")] {
+    for (model, out) in [
+        (ue("ue-light.brdf"), "a.csv"),
+        (format!("{},entry=SpecularLight", ue("ue-light.brdf")), "b.csv"),
+        (bevy("bevy-light.brdf"), "c.csv"),
+    ] {
         run_with_includes(d, &["eval", "--model", &model, "--input", "in.csv", "--output", out]).ok();
         let g = common::csv_values(&d.join(out));
-        let worst = f.iter().zip(&g).zip(&rows).filter(|(_, r)| nol(r) >= 0.05).flat_map(|((x, y), _)| (0..3).map(move |c| common::rel_err(y[c], x[c]))).fold(0.0, f64::max);
+        let worst = f
+            .iter()
+            .zip(&g)
+            .zip(&rows)
+            .filter(|(_, r)| nol(r) >= 0.05)
+            .flat_map(|((x, y), _)| (0..3).map(move |c| common::rel_err(y[c], x[c])))
+            .fold(0.0, f64::max);
         assert!(worst < 1e-5, "{model}: worst relative difference {worst:e} from the f form");
     }
 }
@@ -110,16 +134,50 @@ fn diff_against_the_ggx_preset_is_zero_and_names_the_front_end() {
     let d = dir.path();
     for (model, front) in [(ue("ue-ggx.brdf"), "HLSL front end"), (bevy("bevy-ggx.brdf"), "naga_oil 0.23.0")] {
         run_with_includes(d, &["diff", "--model", "ggx", "--model", &model, "--json", "d.json"]).ok();
-        let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(d.join("d.json")).unwrap()).unwrap();
-        assert_eq!(report["difference"]["max_rel"].as_f64(), Some(0.0), "{model} against ggx: {}", report["difference"]);
+        let report: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(d.join("d.json")).unwrap()).unwrap();
+        assert_eq!(
+            report["difference"]["max_rel"].as_f64(),
+            Some(0.0),
+            "{model} against ggx: {}",
+            report["difference"]
+        );
         assert!(report["b"]["front_end"].as_str().unwrap().contains(front), "{}", report["b"]);
     }
     // `--define FULL_VISIBILITY` reaches the imported module's #ifdef: the exact height-correlated Smith term.
     let exact = "d=ggx,vis=smith-ggx-correlated,f=schlick";
-    run_with_includes(d, &["diff", "--model", exact, "--model", &bevy("bevy-ggx.brdf"), "--define", "FULL_VISIBILITY", "--json", "e.json"]).ok();
+    run_with_includes(
+        d,
+        &[
+            "diff",
+            "--model",
+            exact,
+            "--model",
+            &bevy("bevy-ggx.brdf"),
+            "--define",
+            "FULL_VISIBILITY",
+            "--json",
+            "e.json",
+        ],
+    )
+    .ok();
     let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(d.join("e.json")).unwrap()).unwrap();
     assert_eq!(report["difference"]["max_rel"].as_f64(), Some(0.0), "{}", report["difference"]);
-    run_with_includes(d, &["diff", "--model", "ggx", "--model", &bevy("bevy-ggx.brdf"), "--define", "FULL_VISIBILITY", "--json", "f.json"]).ok();
+    run_with_includes(
+        d,
+        &[
+            "diff",
+            "--model",
+            "ggx",
+            "--model",
+            &bevy("bevy-ggx.brdf"),
+            "--define",
+            "FULL_VISIBILITY",
+            "--json",
+            "f.json",
+        ],
+    )
+    .ok();
     let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(d.join("f.json")).unwrap()).unwrap();
     assert!(report["difference"]["max_rel"].as_f64().unwrap() > 0.01, "the define changes the maths");
 }
@@ -134,7 +192,12 @@ fn an_hlsl_define_selects_its_branch() {
     run_in(d, &["eval", "--model", "q.hlsl", "--define", "QUALITY=2", "--input", "in.csv", "--output", "b.csv"]).ok();
     run_in(d, &["eval", "--model", "q.hlsl,define=QUALITY=3", "--input", "in.csv", "--output", "c.csv"]).ok();
     assert!(common::csv_values(&d.join("a.csv")).iter().all(|v| *v == [1.0; 3]));
-    assert!(common::csv_values(&d.join("b.csv")).iter().chain(&common::csv_values(&d.join("c.csv"))).all(|v| *v == [2.0; 3]));
+    assert!(
+        common::csv_values(&d.join("b.csv"))
+            .iter()
+            .chain(&common::csv_values(&d.join("c.csv")))
+            .all(|v| *v == [2.0; 3])
+    );
 }
 
 #[test]
@@ -144,9 +207,20 @@ fn a_loop_in_an_included_header_is_warned_about_at_its_own_line() {
     write_rows(&d.join("in.csv"), 2);
     std::fs::create_dir(d.join("inc")).unwrap();
     std::fs::write(d.join("inc/sum.ush"), "#pragma once\nfloat Sum()\n{\n\tfloat s = 0;\n\t[loop] for (int i = 0; i < 100000; i++) { s += 1e-5; }\n\treturn s;\n}\n").unwrap();
-    std::fs::write(d.join("m.usf"), "#include \"sum.ush\"\nfloat3 BRDF(float3 L, float3 V, float3 N, float3 X, float3 Y) { return Sum(); }\n").unwrap();
-    let out = run_in(d, &["eval", "--model", "m.usf", "--include-dir", "inc", "--input", "in.csv", "--output", "o.csv"]).ok();
-    assert!(out.stderr.contains("inc/sum.ush:5: a `for` loop of 100000 iterations: lavapipe ends every loop after 65535 iterations"), "{}", out.stderr);
+    std::fs::write(
+        d.join("m.usf"),
+        "#include \"sum.ush\"\nfloat3 BRDF(float3 L, float3 V, float3 N, float3 X, float3 Y) { return Sum(); }\n",
+    )
+    .unwrap();
+    let out =
+        run_in(d, &["eval", "--model", "m.usf", "--include-dir", "inc", "--input", "in.csv", "--output", "o.csv"]).ok();
+    assert!(
+        out.stderr.contains(
+            "inc/sum.ush:5: a `for` loop of 100000 iterations: lavapipe ends every loop after 65535 iterations"
+        ),
+        "{}",
+        out.stderr
+    );
 }
 
 #[test]
@@ -154,38 +228,81 @@ fn profile_stability_sweep_and_report_take_them_and_state_the_front_end() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let (hlsl, wgsl) = (ue("ue-ggx.brdf"), bevy("bevy-ggx.brdf"));
-    run_with_includes(d, &["profile", "--model", &hlsl, "--model", &wgsl, "--size", "64x64", "--budget", "3", "--json", "p.json"]).ok();
+    run_with_includes(
+        d,
+        &["profile", "--model", &hlsl, "--model", &wgsl, "--size", "64x64", "--budget", "3", "--json", "p.json"],
+    )
+    .ok();
     let p: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(d.join("p.json")).unwrap()).unwrap();
     let labels: Vec<&str> = p["rows"].as_array().unwrap().iter().map(|r| r["model"].as_str().unwrap()).collect();
     assert!(labels.contains(&"ue-ggx") && labels.contains(&"bevy-ggx"), "{labels:?}");
     let fronts = p["provenance"]["front_ends"].as_object().unwrap();
-    assert!(fronts[&hlsl].as_str().unwrap().starts_with("HLSL: glslang") && fronts[&wgsl].as_str().unwrap().starts_with("WGSL: naga_oil"), "{fronts:?}");
+    assert!(
+        fronts[&hlsl].as_str().unwrap().starts_with("HLSL: glslang")
+            && fronts[&wgsl].as_str().unwrap().starts_with("WGSL: naga_oil"),
+        "{fronts:?}"
+    );
     let st = d.join("st");
     let light = ue("ue-light.brdf");
-    let out = run_with_includes(d, &["stability", "--model", &hlsl, "--model", &wgsl, "--model", &light, "--out", st.to_str().unwrap()]).ok();
+    let out = run_with_includes(
+        d,
+        &["stability", "--model", &hlsl, "--model", &wgsl, "--model", &light, "--out", st.to_str().unwrap()],
+    )
+    .ok();
     assert!(out.stdout.contains("Front ends: "), "{}", out.stdout);
     // ue-light.brdf declares its reference and its engine's roughness domain, which stability honours.
-    assert!(out.stdout.contains("- `ue-light`: checked against the reference `ggx`'s f64 values; roughness in [0.045, 1]"), "{}", out.stdout);
+    assert!(
+        out.stdout.contains("- `ue-light`: checked against the reference `ggx`'s f64 values; roughness in [0.045, 1]"),
+        "{}",
+        out.stdout
+    );
     let sw = d.join("sw");
-    run_with_includes(d, &["sweep", "--model", &hlsl, "--model", &wgsl, "--size", "64x64", "--budget", "3", "--out", sw.to_str().unwrap()]).ok();
+    run_with_includes(
+        d,
+        &[
+            "sweep",
+            "--model",
+            &hlsl,
+            "--model",
+            &wgsl,
+            "--size",
+            "64x64",
+            "--budget",
+            "3",
+            "--out",
+            sw.to_str().unwrap(),
+        ],
+    )
+    .ok();
     let stability = common::device_file(&st, "stability-", ".json");
     run_in(d, &["report", "p.json", stability.to_str().unwrap(), "--out", "r.html"]).ok();
     let html = std::fs::read_to_string(d.join("r.html")).unwrap();
-    assert!(html.contains("front ends") && html.contains("naga_oil 0.23.0"), "the page's provenance names the front ends");
+    assert!(
+        html.contains("front ends") && html.contains("naga_oil 0.23.0"),
+        "the page's provenance names the front ends"
+    );
 }
 
 /// `driver/` statistics of a report's row for `model`, without the hashes (of the SPIR-V, which differs).
 fn driver_stats(report: &serde_json::Value, model: &str) -> Vec<(String, serde_json::Value)> {
     let rows = report["rows"].as_array().unwrap();
     let row = rows.iter().find(|r| r["model"] == model).unwrap_or_else(|| panic!("no {model}"));
-    row["stats"].as_object().unwrap().iter().filter(|(k, _)| k.starts_with("driver/") && !k.to_lowercase().contains("hash")).map(|(k, v)| (k.clone(), v.clone())).collect()
+    row["stats"]
+        .as_object()
+        .unwrap()
+        .iter()
+        .filter(|(k, _)| k.starts_with("driver/") && !k.to_lowercase().contains("hash"))
+        .map(|(k, v)| (k.clone(), v.clone()))
+        .collect()
 }
 
 #[test]
 fn every_compile_only_target_counts_them_as_their_glsl_twin() {
     let dir = tempfile::tempdir().unwrap();
     let targets = ["radv:navi21", "nvidia:sm_89", "intel:gen12lp", "adreno:a660", "mali:g52", "anv:tgl"];
-    let mut extra: Vec<String> = ["--model", &twin(), "--model", &ue("ue-ggx.brdf"), "--model", &bevy("bevy-ggx.brdf")].map(String::from).to_vec();
+    let mut extra: Vec<String> = ["--model", &twin(), "--model", &ue("ue-ggx.brdf"), "--model", &bevy("bevy-ggx.brdf")]
+        .map(String::from)
+        .to_vec();
     extra.extend(includes());
     let extra: Vec<&str> = extra.iter().map(String::as_str).collect();
     let all = crate::compile_only::inspect_json(dir.path(), "langs", &targets, &extra, "ACO statistics");
@@ -193,13 +310,25 @@ fn every_compile_only_target_counts_them_as_their_glsl_twin() {
     assert_eq!(reports.len(), targets.len());
     for (target, report) in targets.iter().zip(reports) {
         let twin_stats = driver_stats(report, "ggx.brdf,roughness=@roughness,f0=@f0");
-        assert!(twin_stats.iter().any(|(k, v)| (k.ends_with("/Instructions") || k.ends_with("/Instruction Count")) && v.as_f64() > Some(0.0)), "{target}: {twin_stats:?}");
-        assert_eq!(driver_stats(report, "ue-ggx"), twin_stats, "{target}: the HLSL model's statistics are its GLSL twin's");
+        assert!(
+            twin_stats
+                .iter()
+                .any(|(k, v)| (k.ends_with("/Instructions") || k.ends_with("/Instruction Count"))
+                    && v.as_f64() > Some(0.0)),
+            "{target}: {twin_stats:?}"
+        );
+        assert_eq!(
+            driver_stats(report, "ue-ggx"),
+            twin_stats,
+            "{target}: the HLSL model's statistics are its GLSL twin's"
+        );
         let wgsl = driver_stats(report, "bevy-ggx");
         if *target == "intel:gen12lp" {
             // IGC on the C translation of naga's SPIR-V, whose `||` and `var`s are shaped otherwise than glslang's:
             // measured 2054 instructions against the twin's 1994 (docs/wgsl.md).
-            let count = |s: &[(String, serde_json::Value)]| s.iter().find(|(k, _)| k.ends_with("/Instruction Count")).and_then(|(_, v)| v.as_f64()).unwrap();
+            let count = |s: &[(String, serde_json::Value)]| {
+                s.iter().find(|(k, _)| k.ends_with("/Instruction Count")).and_then(|(_, v)| v.as_f64()).unwrap()
+            };
             let (w, t) = (count(&wgsl), count(&twin_stats));
             assert!(w > 0.0 && (w - t).abs() <= 0.05 * t, "{target}: {w} against {t}");
         } else {
@@ -244,12 +373,31 @@ fn errors_in_hlsl_and_wgsl_exit_2_at_file_line_and_column() {
     let cases: Vec<(String, Vec<&str>, String)> = vec![
         (hlsl("syntax.brdf"), vec![], format!("{}:6:12: 'expression' : Expected", hlsl("broken.ush"))),
         (hlsl("undeclared.hlsl"), vec![], format!("{}:5:21: 'Gloss' : unknown variable", hlsl("undeclared.hlsl"))),
-        (hlsl("missing.brdf"), vec![], format!("{}:5:10: cannot find include `Nowhere.ush` (searched: ", hlsl("missing.brdf"))),
+        (
+            hlsl("missing.brdf"),
+            vec![],
+            format!("{}:5:10: cannot find include `Nowhere.ush` (searched: ", hlsl("missing.brdf")),
+        ),
         (hlsl("cycle.brdf"), vec![], format!("{}:3:10: include cycle: ", hlsl("cycle-b.ush"))),
-        (wgsl("syntax.brdf"), vec!["--include-dir", &modules], format!("{}:6:5: expected `;`, found \"return\"", wgsl("modules/broken.wgsl"))),
+        (
+            wgsl("syntax.brdf"),
+            vec!["--include-dir", &modules],
+            format!("{}:6:5: expected `;`, found \"return\"", wgsl("modules/broken.wgsl")),
+        ),
         (wgsl("own-syntax.wgsl"), vec![], format!("{}:4:33: ", wgsl("own-syntax.wgsl"))),
-        (wgsl("missing.brdf"), vec!["--include-dir", &modules], format!("{}:7:22: required import 'errtest::nowhere' not found", wgsl("missing.brdf"))),
-        (wgsl("cycle.brdf"), vec!["--include-dir", &modules], format!("{}:2:9: import cycle: errtest::loop_a -> errtest::loop_b -> errtest::loop_a", wgsl("modules/loop_b.wgsl"))),
+        (
+            wgsl("missing.brdf"),
+            vec!["--include-dir", &modules],
+            format!("{}:7:22: required import 'errtest::nowhere' not found", wgsl("missing.brdf")),
+        ),
+        (
+            wgsl("cycle.brdf"),
+            vec!["--include-dir", &modules],
+            format!(
+                "{}:2:9: import cycle: errtest::loop_a -> errtest::loop_b -> errtest::loop_a",
+                wgsl("modules/loop_b.wgsl")
+            ),
+        ),
     ];
     for (model, extra, needle) in &cases {
         let mut args = vec!["eval", "--model", model.as_str(), "--input", "in.csv", "--output", "x.csv"];
@@ -265,15 +413,54 @@ fn errors_in_hlsl_and_wgsl_exit_2_at_file_line_and_column() {
     assert!(missing.contains("#include \"Nowhere.ush\"\n") && missing.contains("#define ENGINE_VERSION 5"));
     std::fs::write(d.join("dead.brdf"), missing.replace("#include \"Nowhere.ush\"\n", "\n")).unwrap();
     run_in(d, &["eval", "--model", "dead.brdf", "--input", "in.csv", "--output", "dead.csv"]).ok();
-    std::fs::write(d.join("live.brdf"), missing.replace("#include \"Nowhere.ush\"\n", "\n").replace("ENGINE_VERSION 5", "ENGINE_VERSION 3")).unwrap();
-    let live = run_in(d, &["eval", "--model", "live.brdf", "--input", "in.csv", "--output", "x.csv"]).fails(2, "live.brdf:7:10: cannot find include `Ancient.ush` (searched: .)");
+    std::fs::write(
+        d.join("live.brdf"),
+        missing.replace("#include \"Nowhere.ush\"\n", "\n").replace("ENGINE_VERSION 5", "ENGINE_VERSION 3"),
+    )
+    .unwrap();
+    let live = run_in(d, &["eval", "--model", "live.brdf", "--input", "in.csv", "--output", "x.csv"])
+        .fails(2, "live.brdf:7:10: cannot find include `Ancient.ush` (searched: .)");
     assert!(!live.stderr.contains("missing #endif"), "glslang stops at the include's #error: {}", live.stderr);
     // Without the map, the virtual path is named with what would find it.
-    run_in(d, &["eval", "--model", &ue("ue-ggx.brdf"), "--include-dir", &ue("Shaders"), "--input", "in.csv", "--output", "x.csv"])
-        .fails(2, &format!("{}:7:10: cannot find include `/Engine/Private/Common.ush` (searched: ", ue("Shaders/SpecularTerms.ush")))
-        .fails(2, "a virtual path needs --include-map /Engine=DIR");
-    run_in(d, &["eval", "--model", "ggx", "--include-dir", ".", "--input", "in.csv", "--output", "x.csv"]).fails(2, "--include-dir .: it is for a shader file's model");
-    run_in(d, &["eval", "--model", &ue("ue-ggx.brdf"), "--include-dir", "no-such-dir", "--input", "in.csv", "--output", "x.csv"]).fails(2, "no-such-dir is not a directory");
+    run_in(
+        d,
+        &[
+            "eval",
+            "--model",
+            &ue("ue-ggx.brdf"),
+            "--include-dir",
+            &ue("Shaders"),
+            "--input",
+            "in.csv",
+            "--output",
+            "x.csv",
+        ],
+    )
+    .fails(
+        2,
+        &format!(
+            "{}:7:10: cannot find include `/Engine/Private/Common.ush` (searched: ",
+            ue("Shaders/SpecularTerms.ush")
+        ),
+    )
+    .fails(2, "a virtual path needs --include-map /Engine=DIR");
+    run_in(d, &["eval", "--model", "ggx", "--include-dir", ".", "--input", "in.csv", "--output", "x.csv"])
+        .fails(2, "--include-dir .: it is for a shader file's model");
+    run_in(
+        d,
+        &[
+            "eval",
+            "--model",
+            &ue("ue-ggx.brdf"),
+            "--include-dir",
+            "no-such-dir",
+            "--input",
+            "in.csv",
+            "--output",
+            "x.csv",
+        ],
+    )
+    .fails(2, "no-such-dir is not a directory");
 }
 
 /// `write(dir, [(path, text)])`: the files of a test, folders made as needed.
@@ -300,8 +487,12 @@ fn hlsl_fmod_and_float_remainder_keep_the_sign_of_the_dividend() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     write_lights(&d.join("in.csv"), &[[-0.6, 0.0, 0.8], [0.6, 0.0, 0.8]]);
-    let hlsl = format!("{HLSL_BRDF}\n{{\n\tfloat a = L.x * 3.0;\n\tint i = (int)round(L.x * 10.0);\n\treturn float3(fmod(a, 1.0), a % 1.0, (float)(i % 4));\n}}\n");
-    let wgsl = format!("{WGSL_BRDF} {{\n    let a = L.x * 3.0;\n    let i = i32(round(L.x * 10.0));\n    return vec3<f32>(a % 1.0, a % 1.0, f32(i % 4));\n}}\n");
+    let hlsl = format!(
+        "{HLSL_BRDF}\n{{\n\tfloat a = L.x * 3.0;\n\tint i = (int)round(L.x * 10.0);\n\treturn float3(fmod(a, 1.0), a % 1.0, (float)(i % 4));\n}}\n"
+    );
+    let wgsl = format!(
+        "{WGSL_BRDF} {{\n    let a = L.x * 3.0;\n    let i = i32(round(L.x * 10.0));\n    return vec3<f32>(a % 1.0, a % 1.0, f32(i % 4));\n}}\n"
+    );
     write(d, &[("m.hlsl", &hlsl), ("m.wgsl", &wgsl)]);
     for m in ["m.hlsl", "m.wgsl"] {
         run_in(d, &["eval", "--model", m, "--input", "in.csv", "--output", "o.csv"]).ok();
@@ -319,10 +510,23 @@ fn an_include_or_an_if_inside_a_comment_is_none() {
     write_lights(&d.join("in.csv"), &[[0.0, 0.6, 0.8]]);
     // The commented-out include of a `#pragma once` header must not use up its one inclusion, a commented-out
     // header's own `*/` must not end the comment, and a commented `#if` opens nothing.
-    let model = format!("analytic\n::begin shader hlsl\n/* previously:\n#include \"a.ush\"\n#include \"old.ush\"\n#if 0\n*/\n#include \"a.ush\" /* the header\n   of A */\n{HLSL_BRDF} {{ return A() * dot(N, L); }}\n::end shader\n");
-    write(d, &[("m.brdf", &model), ("a.ush", "#pragma once\nfloat A() { return 2; }\n"), ("old.ush", "/* old header */\nfloat Old() { return 1; }\n")]);
+    let model = format!(
+        "analytic\n::begin shader hlsl\n/* previously:\n#include \"a.ush\"\n#include \"old.ush\"\n#if 0\n*/\n#include \"a.ush\" /* the header\n   of A */\n{HLSL_BRDF} {{ return A() * dot(N, L); }}\n::end shader\n"
+    );
+    write(
+        d,
+        &[
+            ("m.brdf", &model),
+            ("a.ush", "#pragma once\nfloat A() { return 2; }\n"),
+            ("old.ush", "/* old header */\nfloat Old() { return 1; }\n"),
+        ],
+    );
     run_in(d, &["eval", "--model", "m.brdf", "--input", "in.csv", "--output", "o.csv"]).ok();
-    assert!(common::csv_values(&d.join("o.csv")).iter().all(|v| (v[0] - 1.6).abs() < 1e-6), "{:?}", common::csv_values(&d.join("o.csv")));
+    assert!(
+        common::csv_values(&d.join("o.csv")).iter().all(|v| (v[0] - 1.6).abs() < 1e-6),
+        "{:?}",
+        common::csv_values(&d.join("o.csv"))
+    );
 }
 
 #[test]
@@ -330,15 +534,36 @@ fn pragma_once_holds_across_spellings_of_one_path_and_angle_includes_search_the_
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     write_lights(&d.join("in.csv"), &[[0.0, 0.6, 0.8]]);
-    let includes = ["a.ush", "./a.ush", "sub/../a.ush", "<b.ush>", "b.ush", "/Eng/Private/c.ush", "/Eng/Private/../Private/c.ush"];
-    let lines: String = includes.iter().map(|i| if i.starts_with('<') { format!("#include {i}\n") } else { format!("#include \"{i}\"\n") }).collect();
-    let model = format!("analytic\n::begin shader hlsl\n{lines}{HLSL_BRDF} {{ return A() + B() + C(); }}\n::end shader\n");
-    let angle = format!("analytic\n::begin shader hlsl\n#include <a.ush>\n{HLSL_BRDF} {{ return A(); }}\n::end shader\n");
-    write(d, &[("m.brdf", &model), ("n.brdf", &angle), ("a.ush", "#pragma once\nfloat A() { return 1; }\n"), ("sub/x.ush", ""), ("inc/b.ush", "#pragma once\nfloat B() { return 2; }\n"), ("eng/Private/c.ush", "#pragma once\nfloat C() { return 4; }\n")]);
+    let includes =
+        ["a.ush", "./a.ush", "sub/../a.ush", "<b.ush>", "b.ush", "/Eng/Private/c.ush", "/Eng/Private/../Private/c.ush"];
+    let lines: String = includes
+        .iter()
+        .map(|i| if i.starts_with('<') { format!("#include {i}\n") } else { format!("#include \"{i}\"\n") })
+        .collect();
+    let model =
+        format!("analytic\n::begin shader hlsl\n{lines}{HLSL_BRDF} {{ return A() + B() + C(); }}\n::end shader\n");
+    let angle =
+        format!("analytic\n::begin shader hlsl\n#include <a.ush>\n{HLSL_BRDF} {{ return A(); }}\n::end shader\n");
+    write(
+        d,
+        &[
+            ("m.brdf", &model),
+            ("n.brdf", &angle),
+            ("a.ush", "#pragma once\nfloat A() { return 1; }\n"),
+            ("sub/x.ush", ""),
+            ("inc/b.ush", "#pragma once\nfloat B() { return 2; }\n"),
+            ("eng/Private/c.ush", "#pragma once\nfloat C() { return 4; }\n"),
+        ],
+    );
     let flags = ["--include-dir", "inc", "--include-map", "/Eng=eng", "--input", "in.csv"];
-    let args = |m: &'static str| ["eval", "--model", m, "--output", "o.csv"].into_iter().chain(flags).collect::<Vec<_>>();
+    let args =
+        |m: &'static str| ["eval", "--model", m, "--output", "o.csv"].into_iter().chain(flags).collect::<Vec<_>>();
     run_in(d, &args("m.brdf")).ok();
-    assert!(common::csv_values(&d.join("o.csv")).iter().all(|v| *v == [7.0; 3]), "{:?}", common::csv_values(&d.join("o.csv")));
+    assert!(
+        common::csv_values(&d.join("o.csv")).iter().all(|v| *v == [7.0; 3]),
+        "{:?}",
+        common::csv_values(&d.join("o.csv"))
+    );
     // `<a.ush>` is not looked for beside the model.
     run_in(d, &args("n.brdf")).fails(2, "n.brdf:3:10: cannot find include `a.ush` (searched: inc)");
 }
@@ -348,8 +573,16 @@ fn an_include_guard_with_an_else_of_its_own_is_no_guard() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     write_lights(&d.join("in.csv"), &[[0.0, 0.6, 0.8]]);
-    let model = format!("analytic\n::begin shader hlsl\n#include \"g.ush\"\n#include \"g.ush\"\n{HLSL_BRDF} {{ return A() + A2(); }}\n::end shader\n");
-    write(d, &[("m.brdf", &model), ("g.ush", "#ifndef A_H\n#define A_H\nfloat A() { return 1; }\n#else\nfloat A2() { return 2; }\n#endif\n")]);
+    let model = format!(
+        "analytic\n::begin shader hlsl\n#include \"g.ush\"\n#include \"g.ush\"\n{HLSL_BRDF} {{ return A() + A2(); }}\n::end shader\n"
+    );
+    write(
+        d,
+        &[
+            ("m.brdf", &model),
+            ("g.ush", "#ifndef A_H\n#define A_H\nfloat A() { return 1; }\n#else\nfloat A2() { return 2; }\n#endif\n"),
+        ],
+    );
     run_in(d, &["eval", "--model", "m.brdf", "--input", "in.csv", "--output", "o.csv"]).ok();
     assert!(common::csv_values(&d.join("o.csv")).iter().all(|v| *v == [3.0; 3]));
 }
@@ -359,13 +592,26 @@ fn a_line_directive_in_an_hlsl_header_is_dropped_with_a_warning() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     write_lights(&d.join("in.csv"), &[[0.0, 0.6, 0.8]]);
-    let model = format!("analytic\n::begin shader hlsl\n#include \"lined.ush\"\n{HLSL_BRDF} {{ return H(); }}\n::end shader\n");
-    write(d, &[("m.brdf", &model), ("lined.ush", "#pragma once\n#line 500\nfloat H() { return 1; }\n"), ("bad.ush", "#pragma once\n#line 500\nfloat H() { return nope; }\n")]);
+    let model =
+        format!("analytic\n::begin shader hlsl\n#include \"lined.ush\"\n{HLSL_BRDF} {{ return H(); }}\n::end shader\n");
+    write(
+        d,
+        &[
+            ("m.brdf", &model),
+            ("lined.ush", "#pragma once\n#line 500\nfloat H() { return 1; }\n"),
+            ("bad.ush", "#pragma once\n#line 500\nfloat H() { return nope; }\n"),
+        ],
+    );
     let out = run_in(d, &["eval", "--model", "m.brdf", "--input", "in.csv", "--output", "o.csv"]).ok();
-    assert!(out.stderr.contains("lined.ush:2: `#line 500` is dropped: brdfprof numbers the file's lines itself"), "{}", out.stderr);
+    assert!(
+        out.stderr.contains("lined.ush:2: `#line 500` is dropped: brdfprof numbers the file's lines itself"),
+        "{}",
+        out.stderr
+    );
     // An error after it is at the header's own line.
     std::fs::write(d.join("m.brdf"), model.replace("lined.ush", "bad.ush")).unwrap();
-    run_in(d, &["eval", "--model", "m.brdf", "--input", "in.csv", "--output", "x.csv"]).fails(2, "bad.ush:3:20: 'nope' : unknown variable");
+    run_in(d, &["eval", "--model", "m.brdf", "--input", "in.csv", "--output", "x.csv"])
+        .fails(2, "bad.ush:3:20: 'nope' : unknown variable");
 }
 
 #[test]
@@ -376,13 +622,34 @@ fn generated_hlsl_lines_are_named_and_resources_and_keywords_are_refused_at_thei
     // An unknown name in an entry's argument: the `entry` line, named, not a column of the generated glue.
     let light = std::fs::read_to_string(ue("ue-light.brdf")).unwrap();
     let line = light.lines().position(|l| l.starts_with("entry SpecularLight(")).unwrap() + 1;
-    std::fs::write(d.join("light.brdf"), light.replace("entry SpecularLight(N, V, L, Roughness,", "entry SpecularLight(N, V, L, Rough,")).unwrap();
-    run_with_includes(d, &["eval", "--model", "light.brdf", "--input", "in.csv", "--output", "x.csv"]).fails(2, &format!("light.brdf:{line}:1: entry `SpecularLight`: 'Rough' : unknown variable"));
-    let param = |name: &str| format!("analytic\n::begin parameters\nfloat {name} 0 1 0.5\n::end parameters\n::begin shader hlsl\n{HLSL_BRDF} {{ return {name} * dot(N, L); }}\n::end shader\n");
-    write(d, &[("kw.brdf", &param("texture")), ("g.hlsl", &format!("/* Gloss: how glossy */\nfloat Gloss;\n{HLSL_BRDF} {{ return Gloss * dot(N, L); }}\n"))]);
-    run_in(d, &["eval", "--model", "kw.brdf", "--input", "in.csv", "--output", "x.csv"]).fails(2, "kw.brdf:3: parameter `texture`: a keyword of HLSL");
+    std::fs::write(
+        d.join("light.brdf"),
+        light.replace("entry SpecularLight(N, V, L, Roughness,", "entry SpecularLight(N, V, L, Rough,"),
+    )
+    .unwrap();
+    run_with_includes(d, &["eval", "--model", "light.brdf", "--input", "in.csv", "--output", "x.csv"])
+        .fails(2, &format!("light.brdf:{line}:1: entry `SpecularLight`: 'Rough' : unknown variable"));
+    let param = |name: &str| {
+        format!(
+            "analytic\n::begin parameters\nfloat {name} 0 1 0.5\n::end parameters\n::begin shader hlsl\n{HLSL_BRDF} {{ return {name} * dot(N, L); }}\n::end shader\n"
+        )
+    };
+    write(
+        d,
+        &[
+            ("kw.brdf", &param("texture")),
+            (
+                "g.hlsl",
+                &format!("/* Gloss: how glossy */\nfloat Gloss;\n{HLSL_BRDF} {{ return Gloss * dot(N, L); }}\n"),
+            ),
+        ],
+    );
+    run_in(d, &["eval", "--model", "kw.brdf", "--input", "in.csv", "--output", "x.csv"])
+        .fails(2, "kw.brdf:3: parameter `texture`: a keyword of HLSL");
     // A global without `static` is a uniform of HLSL's $Global constant buffer: its declaration, not a comment.
-    run_in(d, &["eval", "--model", "g.hlsl", "--input", "in.csv", "--output", "x.csv"]).fails(2, "g.hlsl:2:7: `Gloss` is a global without `static`").fails(2, "declare it `static`");
+    run_in(d, &["eval", "--model", "g.hlsl", "--input", "in.csv", "--output", "x.csv"])
+        .fails(2, "g.hlsl:2:7: `Gloss` is a global without `static`")
+        .fails(2, "declare it `static`");
     assert!(!d.join("x.csv").exists());
 }
 
@@ -392,10 +659,27 @@ fn wgsl_loops_are_warned_about_in_imported_modules_and_nested_comments_hide_thei
     let d = dir.path();
     write_lights(&d.join("in.csv"), &[[0.0, 0.6, 0.8]]);
     let sum = "#define_import_path loopy::sum\nfn total() -> f32 {\n    var s = 0.0;\n    for (var i: i32 = 0; i < 100000; i++) { s += 1e-5; }\n    return s;\n}\nfn unused() -> f32 {\n    var s = 0.0;\n    loop { s += 1.0; if s > 3.0 { break; } }\n    return s;\n}\n";
-    let lexed = format!("/* outer /* inner */ for (;;) {{}} */\nconst K = 0x1.8p1f;\n{WGSL_BRDF} {{ return vec3<f32>(K) * dot(N, L); }}\n");
-    write(d, &[("mods/sum.wgsl", sum), ("m.wgsl", &format!("#import loopy::sum::total\n{WGSL_BRDF} {{ return vec3<f32>(total()); }}\n")), ("lex.wgsl", &lexed)]);
-    let out = run_in(d, &["eval", "--model", "m.wgsl", "--include-dir", "mods", "--input", "in.csv", "--output", "o.csv"]).ok();
-    assert!(out.stderr.contains("mods/sum.wgsl:4: a `for` loop of 100000 iterations: lavapipe ends every loop after 65535 iterations"), "{}", out.stderr);
+    let lexed = format!(
+        "/* outer /* inner */ for (;;) {{}} */\nconst K = 0x1.8p1f;\n{WGSL_BRDF} {{ return vec3<f32>(K) * dot(N, L); }}\n"
+    );
+    write(
+        d,
+        &[
+            ("mods/sum.wgsl", sum),
+            ("m.wgsl", &format!("#import loopy::sum::total\n{WGSL_BRDF} {{ return vec3<f32>(total()); }}\n")),
+            ("lex.wgsl", &lexed),
+        ],
+    );
+    let out =
+        run_in(d, &["eval", "--model", "m.wgsl", "--include-dir", "mods", "--input", "in.csv", "--output", "o.csv"])
+            .ok();
+    assert!(
+        out.stderr.contains(
+            "mods/sum.wgsl:4: a `for` loop of 100000 iterations: lavapipe ends every loop after 65535 iterations"
+        ),
+        "{}",
+        out.stderr
+    );
     assert!(!out.stderr.contains("sum.wgsl:9"), "a function the composition leaves out: {}", out.stderr);
     let out = run_in(d, &["eval", "--model", "lex.wgsl", "--input", "in.csv", "--output", "o.csv"]).ok();
     assert!(!out.stderr.contains("loop"), "a `for` in a nested comment: {}", out.stderr);
@@ -406,7 +690,13 @@ fn a_wgsl_brdf_of_another_signature_is_refused_at_its_fn_in_wgsl() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     write_lights(&d.join("in.csv"), &[[0.0, 0.6, 0.8]]);
-    write(d, &[("n3.wgsl", "// the BRDF\n  fn BRDF(L: vec3<f32>, V: vec3<f32>, N: vec3<f32>, X: vec3<f32>, Y: vec3<f32>) -> f32 { return 1.0; }\n")]);
+    write(
+        d,
+        &[(
+            "n3.wgsl",
+            "// the BRDF\n  fn BRDF(L: vec3<f32>, V: vec3<f32>, N: vec3<f32>, X: vec3<f32>, Y: vec3<f32>) -> f32 { return 1.0; }\n",
+        )],
+    );
     run_in(d, &["eval", "--model", "n3.wgsl", "--input", "in.csv", "--output", "x.csv"])
         .fails(2, &format!("n3.wgsl:2:3: `BRDF` must be defined as `{WGSL_BRDF}`"))
         .fails(2, "-> f32`");
@@ -419,15 +709,22 @@ fn a_quoted_wgsl_import_is_found_beside_the_importing_module() {
     write_lights(&d.join("in.csv"), &[[0.0, 0.6, 0.8]]);
     // m.wgsl imports "mods/a.wgsl" (beside it), which imports "b.wgsl" beside itself, as an HLSL include is found;
     // n.wgsl, named bare, finds the module `named::c` declared beside it.
-    write(d, &[
-        ("m.wgsl", &format!("#import \"mods/a.wgsl\"::a\n{WGSL_BRDF} {{ return vec3<f32>(a()); }}\n")),
-        ("mods/a.wgsl", "#import \"b.wgsl\"::b\nfn a() -> f32 { return b() + 1.0; }\n"),
-        ("mods/b.wgsl", "fn b() -> f32 { return 2.0; }\n"),
-        ("n.wgsl", &format!("#import named::c::c\n{WGSL_BRDF} {{ return vec3<f32>(c()); }}\n")),
-        ("c.wgsl", "#define_import_path named::c\nfn c() -> f32 { return 5.0; }\n"),
-    ]);
+    write(
+        d,
+        &[
+            ("m.wgsl", &format!("#import \"mods/a.wgsl\"::a\n{WGSL_BRDF} {{ return vec3<f32>(a()); }}\n")),
+            ("mods/a.wgsl", "#import \"b.wgsl\"::b\nfn a() -> f32 { return b() + 1.0; }\n"),
+            ("mods/b.wgsl", "fn b() -> f32 { return 2.0; }\n"),
+            ("n.wgsl", &format!("#import named::c::c\n{WGSL_BRDF} {{ return vec3<f32>(c()); }}\n")),
+            ("c.wgsl", "#define_import_path named::c\nfn c() -> f32 { return 5.0; }\n"),
+        ],
+    );
     run_in(d, &["eval", "--model", "m.wgsl", "--input", "in.csv", "--output", "o.csv"]).ok();
-    assert!(common::csv_values(&d.join("o.csv")).iter().all(|v| *v == [3.0; 3]), "{:?}", common::csv_values(&d.join("o.csv")));
+    assert!(
+        common::csv_values(&d.join("o.csv")).iter().all(|v| *v == [3.0; 3]),
+        "{:?}",
+        common::csv_values(&d.join("o.csv"))
+    );
     run_in(d, &["eval", "--model", "n.wgsl", "--input", "in.csv", "--output", "o.csv"]).ok();
     assert!(common::csv_values(&d.join("o.csv")).iter().all(|v| *v == [5.0; 3]));
 }
@@ -438,23 +735,57 @@ fn a_global_initialiser_reading_a_bound_parameter_sees_its_value_in_glsl_and_hls
     let d = dir.path();
     write_rows(&d.join("in.csv"), 50);
     let params = "analytic\n::begin parameters\nfloat k 0 1 0.5\n::end parameters\n";
-    write(d, &[
-        ("twin.brdf", &format!("{params}::begin shader\nvec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) {{ return vec3(k * k * 2.0 + dot(N, L)); }}\n::end shader\n")),
-        ("glsl.brdf", &format!("{params}::begin shader\nfloat k2 = k * k, k4 = k2 * 2.0;\nfloat twice(float x) {{ return x * 2.0; }}\nfloat k3 = twice(k2);\nvec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) {{ return vec3((k4 + k3) * 0.5 + dot(N, L)); }}\n::end shader\n")),
-        ("hlsl.brdf", &format!("{params}::begin shader hlsl\nstatic float k2 = k * k;\n{HLSL_BRDF} {{ return k2 * 2.0 + dot(N, L); }}\n::end shader\n")),
-    ]);
+    write(
+        d,
+        &[
+            (
+                "twin.brdf",
+                &format!(
+                    "{params}::begin shader\nvec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) {{ return vec3(k * k * 2.0 + dot(N, L)); }}\n::end shader\n"
+                ),
+            ),
+            (
+                "glsl.brdf",
+                &format!(
+                    "{params}::begin shader\nfloat k2 = k * k, k4 = k2 * 2.0;\nfloat twice(float x) {{ return x * 2.0; }}\nfloat k3 = twice(k2);\nvec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) {{ return vec3((k4 + k3) * 0.5 + dot(N, L)); }}\n::end shader\n"
+                ),
+            ),
+            (
+                "hlsl.brdf",
+                &format!(
+                    "{params}::begin shader hlsl\nstatic float k2 = k * k;\n{HLSL_BRDF} {{ return k2 * 2.0 + dot(N, L); }}\n::end shader\n"
+                ),
+            ),
+        ],
+    );
     // Bound to an input (set per call), and per CSV row (a column named `k`).
     let rows = std::fs::read_to_string(d.join("in.csv")).unwrap();
-    let with_k: String = rows.lines().enumerate().map(|(i, l)| if i == 0 { "nx,ny,nz,vx,vy,vz,lx,ly,lz,k\n".to_string() } else { format!("{},{}\n", l.split(',').take(9).collect::<Vec<_>>().join(","), (i % 7) as f64 / 7.0) }).collect();
+    let with_k: String = rows
+        .lines()
+        .enumerate()
+        .map(|(i, l)| {
+            if i == 0 {
+                "nx,ny,nz,vx,vy,vz,lx,ly,lz,k\n".to_string()
+            } else {
+                format!("{},{}\n", l.split(',').take(9).collect::<Vec<_>>().join(","), (i % 7) as f64 / 7.0)
+            }
+        })
+        .collect();
     std::fs::write(d.join("k.csv"), with_k).unwrap();
     for (binding, input) in [(",k=@roughness", "in.csv"), ("", "k.csv")] {
-        let eval = |m: &str, out: &str| run_in(d, &["eval", "--model", &format!("{m}{binding}"), "--input", input, "--output", out]).ok();
+        let eval = |m: &str, out: &str| {
+            run_in(d, &["eval", "--model", &format!("{m}{binding}"), "--input", input, "--output", out]).ok()
+        };
         eval("twin.brdf", "twin.csv");
         let twin = common::csv_values(&d.join("twin.csv"));
         assert!(twin.windows(2).any(|w| w[0][0] != w[1][0]));
         for m in ["glsl.brdf", "hlsl.brdf"] {
             eval(m, "o.csv");
-            let worst = twin.iter().zip(common::csv_values(&d.join("o.csv"))).map(|(a, b)| common::rel_err(b[0], a[0])).fold(0.0, f64::max);
+            let worst = twin
+                .iter()
+                .zip(common::csv_values(&d.join("o.csv")))
+                .map(|(a, b)| common::rel_err(b[0], a[0]))
+                .fold(0.0, f64::max);
             assert!(worst < 1e-6, "{m}{binding} on {input}: worst relative difference {worst:e} from the twin");
         }
     }
@@ -465,16 +796,58 @@ fn reserved_define_names_are_refused_and_help_and_messages_name_every_model_file
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     write_lights(&d.join("in.csv"), &[[0.0, 0.6, 0.8]]);
-    run_in(d, &["eval", "--model", &ue("ue-ggx-constant.hlsl"), "--define", "brdfprof_stub=x", "--input", "in.csv", "--output", "x.csv"])
-        .fails(2, "`define=brdfprof_stub`: names starting with `brdfprof_` (in any case) are brdfprof's own");
-    run_in(d, &["eval", "--model", &bevy("bevy-ggx.brdf"), "--define", "BRDFPROF_ONCE_1", "--input", "in.csv", "--output", "x.csv"]).fails(2, "are brdfprof's own");
+    run_in(
+        d,
+        &[
+            "eval",
+            "--model",
+            &ue("ue-ggx-constant.hlsl"),
+            "--define",
+            "brdfprof_stub=x",
+            "--input",
+            "in.csv",
+            "--output",
+            "x.csv",
+        ],
+    )
+    .fails(2, "`define=brdfprof_stub`: names starting with `brdfprof_` (in any case) are brdfprof's own");
+    run_in(
+        d,
+        &[
+            "eval",
+            "--model",
+            &bevy("bevy-ggx.brdf"),
+            "--define",
+            "BRDFPROF_ONCE_1",
+            "--input",
+            "in.csv",
+            "--output",
+            "x.csv",
+        ],
+    )
+    .fails(2, "are brdfprof's own");
     // A name of brdfprof's own in the shader itself, at its line and column, in either language.
-    write(d, &[
-        ("s.hlsl", &format!("float Brdfprof_Stub() {{ return 1; }}\n{HLSL_BRDF} {{ return Brdfprof_Stub() * dot(N, L); }}\n")),
-        ("s.wgsl", &format!("/* brdfprof_note */\n  fn brdfprof_stub() -> f32 {{ return 1.0; }}\n{WGSL_BRDF} {{ return vec3<f32>(brdfprof_stub()); }}\n")),
-    ]);
-    run_in(d, &["eval", "--model", "s.hlsl", "--input", "in.csv", "--output", "x.csv"]).fails(2, "s.hlsl:1:7: `Brdfprof_Stub`: names starting with `brdfprof_` (in any case) are brdfprof's own");
-    run_in(d, &["eval", "--model", "s.wgsl", "--input", "in.csv", "--output", "x.csv"]).fails(2, "s.wgsl:2:6: `brdfprof_stub`: names starting with `brdfprof_`");
+    write(
+        d,
+        &[
+            (
+                "s.hlsl",
+                &format!(
+                    "float Brdfprof_Stub() {{ return 1; }}\n{HLSL_BRDF} {{ return Brdfprof_Stub() * dot(N, L); }}\n"
+                ),
+            ),
+            (
+                "s.wgsl",
+                &format!(
+                    "/* brdfprof_note */\n  fn brdfprof_stub() -> f32 {{ return 1.0; }}\n{WGSL_BRDF} {{ return vec3<f32>(brdfprof_stub()); }}\n"
+                ),
+            ),
+        ],
+    );
+    run_in(d, &["eval", "--model", "s.hlsl", "--input", "in.csv", "--output", "x.csv"])
+        .fails(2, "s.hlsl:1:7: `Brdfprof_Stub`: names starting with `brdfprof_` (in any case) are brdfprof's own");
+    run_in(d, &["eval", "--model", "s.wgsl", "--input", "in.csv", "--output", "x.csv"])
+        .fails(2, "s.wgsl:2:6: `brdfprof_stub`: names starting with `brdfprof_`");
     let help = run_in(d, &["eval", "--help"]).ok().stdout;
     assert!(help.contains(".hlsl") && help.contains(".wgsl") && !help.contains("every .brdf file"), "{help}");
 }
@@ -487,8 +860,25 @@ fn reserved_define_names_are_refused_and_help_and_messages_name_every_model_file
 fn wgsl_enable_f16_computes_in_half_precision_within_its_rounding() {
     let dir = tempfile::tempdir().unwrap();
     let half = |n: &str| root().join("tests/fixtures/wgsl/half").join(n).display().to_string();
-    run_in(dir.path(), &["diff", "--model", &half("d-ggx-f32.wgsl"), "--model", &half("d-ggx-f16.wgsl"), "--samples", "2000", "--json", "d.json", "--tolerance", "0.05"]).ok();
-    let d: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.path().join("d.json")).unwrap()).unwrap();
+    run_in(
+        dir.path(),
+        &[
+            "diff",
+            "--model",
+            &half("d-ggx-f32.wgsl"),
+            "--model",
+            &half("d-ggx-f16.wgsl"),
+            "--samples",
+            "2000",
+            "--json",
+            "d.json",
+            "--tolerance",
+            "0.05",
+        ],
+    )
+    .ok();
+    let d: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("d.json")).unwrap()).unwrap();
     for c in d["difference"]["channels"].as_array().unwrap() {
         let max = c["max_rel"].as_f64().unwrap();
         assert!(max > 1e-4 && max <= 0.05, "channel {}: max relative difference {max}", c["channel"]);
@@ -496,7 +886,22 @@ fn wgsl_enable_f16_computes_in_half_precision_within_its_rounding() {
     }
     // A GPU without shaderFloat16 (GCN 1 in Mesa 22.3) leaves the half model out with the reason, as it does a
     // built-in precision=f16 spec, instead of crashing its compiler.
-    let out = run_in(dir.path(), &["inspect", "--no-callgrind", "--device", "radv:tahiti", "--model", &half("d-ggx-f16.wgsl"), "--json", "t.json", "--markdown", "t.md"]).ok();
+    let out = run_in(
+        dir.path(),
+        &[
+            "inspect",
+            "--no-callgrind",
+            "--device",
+            "radv:tahiti",
+            "--model",
+            &half("d-ggx-f16.wgsl"),
+            "--json",
+            "t.json",
+            "--markdown",
+            "t.md",
+        ],
+    )
+    .ok();
     let md = std::fs::read_to_string(dir.path().join("t.md")).unwrap();
     assert!(md.contains("d-ggx-f16.wgsl") && md.contains("has no shaderFloat16"), "{}\n{md}", out.stderr);
 }

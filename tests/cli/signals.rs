@@ -58,8 +58,12 @@ fn callgrind_children(tmp: &Path) -> Vec<u32> {
     for entry in std::fs::read_dir("/proc").unwrap().flatten() {
         let Ok(pid) = entry.file_name().to_string_lossy().parse::<u32>() else { continue };
         let read = |f: &str| std::fs::read(entry.path().join(f)).unwrap_or_default();
-        let has = |bytes: Vec<u8>, needle: &str| bytes.split(|&b| b == 0).any(|s| String::from_utf8_lossy(s).contains(needle));
-        if has(read("cmdline"), "__callgrind-child") && read("environ").split(|&b| b == 0).any(|s| s.starts_with(marker.as_bytes())) {
+        let has = |bytes: Vec<u8>, needle: &str| {
+            bytes.split(|&b| b == 0).any(|s| String::from_utf8_lossy(s).contains(needle))
+        };
+        if has(read("cmdline"), "__callgrind-child")
+            && read("environ").split(|&b| b == 0).any(|s| s.starts_with(marker.as_bytes()))
+        {
             pids.push(pid);
         }
     }
@@ -121,13 +125,23 @@ fn evals_and_interrupted_runs_leave_no_temporary_and_no_picture() {
     let dir = tempfile::tempdir().unwrap();
     let (d, tmp) = (dir.path(), dir.path().join("tmp"));
     std::fs::create_dir(&tmp).unwrap();
-    std::fs::write(d.join("in.csv"), "nx,ny,nz,vx,vy,vz,lx,ly,lz,roughness,f0r,f0g,f0b\n0,0,1,0,0.6,0.8,0.6,0,0.8,0.5,0.04,0.04,0.04\n").unwrap();
+    std::fs::write(
+        d.join("in.csv"),
+        "nx,ny,nz,vx,vy,vz,lx,ly,lz,roughness,f0r,f0g,f0b\n0,0,1,0,0.6,0.8,0.6,0,0.8,0.5,0.04,0.04,0.04\n",
+    )
+    .unwrap();
     let ggx = common::repo_root().join("examples/brdf/ggx.brdf");
     let model = format!("{},roughness=@roughness,f0=@f0", ggx.display());
     for i in 0..20 {
         // Every other run compiles (the disk cache off), the others take the cached kernel.
         let cache = if i % 2 == 0 { String::new() } else { d.join("cache").display().to_string() };
-        let out = brdfprof().args(["eval", "--model", &model, "--input", "in.csv", "--output", "out.csv"]).env("TMPDIR", &tmp).env("BRDFPROF_CACHE_DIR", cache).current_dir(d).output().unwrap();
+        let out = brdfprof()
+            .args(["eval", "--model", &model, "--input", "in.csv", "--output", "out.csv"])
+            .env("TMPDIR", &tmp)
+            .env("BRDFPROF_CACHE_DIR", cache)
+            .current_dir(d)
+            .output()
+            .unwrap();
         assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     }
     assert!(files_under(&tmp).is_empty(), "left in TMPDIR after 20 evals: {:?}", files_under(&tmp));
@@ -151,7 +165,10 @@ fn evals_and_interrupted_runs_leave_no_temporary_and_no_picture() {
 #[test]
 fn sigterm_during_check_kills_valgrind_and_removes_its_files() {
     let baseline = common::repo_root().join("results/baseline-llvmpipe.json");
-    let (run, code) = interrupt(&["check", "--baseline", baseline.to_str().unwrap(), "--model", "ggx", "--rounds", "0"], libc::SIGTERM);
+    let (run, code) = interrupt(
+        &["check", "--baseline", baseline.to_str().unwrap(), "--model", "ggx", "--rounds", "0"],
+        libc::SIGTERM,
+    );
     assert_cleaned_up(&run, code);
 }
 

@@ -13,7 +13,9 @@ const TARGETS: [&str; 2] = ["nvidia:sm_89", "intel:gen12lp"];
 fn fixture() -> (std::path::PathBuf, u64) {
     let path = common::repo_root().join("tests/fixtures/brdf/lines/costly-line.brdf");
     let text = std::fs::read_to_string(&path).unwrap();
-    let line = text.lines().position(|l| l.contains("// the costly line")).expect("the fixture marks its costly line") as u64 + 1;
+    let line = text.lines().position(|l| l.contains("// the costly line")).expect("the fixture marks its costly line")
+        as u64
+        + 1;
     (path, line)
 }
 
@@ -33,37 +35,70 @@ fn the_planted_line_comes_first_on_every_target_that_names_lines() {
             // The line-annotated compile is the costed code: the same instruction sequence, no note.
             assert_eq!(k.get("note"), None, "{what}: {}", k["note"]);
             let lines = k["lines"].as_array().unwrap();
-            let counted: u64 = lines.iter().map(|l| l["instructions"].as_u64().unwrap()).sum::<u64>() + k["unattributed"].as_u64().unwrap();
+            let counted: u64 = lines.iter().map(|l| l["instructions"].as_u64().unwrap()).sum::<u64>()
+                + k["unattributed"].as_u64().unwrap();
             assert_eq!(counted, k["instructions"].as_u64().unwrap(), "{what}: every instruction counted once");
-            assert!(k["unattributed"].as_u64().unwrap() * 20 < k["instructions"].as_u64().unwrap(), "{what}: most instructions name a source line: {}", k["unattributed"]);
+            assert!(
+                k["unattributed"].as_u64().unwrap() * 20 < k["instructions"].as_u64().unwrap(),
+                "{what}: most instructions name a source line: {}",
+                k["unattributed"]
+            );
             // The lines share the binding pipe's cycles: never more than the kernel's, most of them.
             let pipe = k["binding_pipe"].as_str().unwrap();
             let on_pipe: f64 = lines.iter().map(|l| l["binding"].as_f64().unwrap()).sum();
             let row = report["cost"]["rows"].as_array().unwrap().iter().find(|r| r["model"] == k["model"]).unwrap();
-            let term = row["terms"].as_array().unwrap().iter().find(|t| t[0] == pipe).unwrap_or_else(|| panic!("{what}: no term {pipe}"))[1].as_f64().unwrap();
-            assert!(on_pipe <= term + 1e-9 && on_pipe >= 0.9 * term, "{what}: lines {on_pipe} of the kernel's {pipe} {term}");
-            assert!(lines.windows(2).all(|w| w[0]["binding"].as_f64() >= w[1]["binding"].as_f64()), "{what}: ranked by the binding pipe");
+            let term = row["terms"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .find(|t| t[0] == pipe)
+                .unwrap_or_else(|| panic!("{what}: no term {pipe}"))[1]
+                .as_f64()
+                .unwrap();
+            assert!(
+                on_pipe <= term + 1e-9 && on_pipe >= 0.9 * term,
+                "{what}: lines {on_pipe} of the kernel's {pipe} {term}"
+            );
+            assert!(
+                lines.windows(2).all(|w| w[0]["binding"].as_f64() >= w[1]["binding"].as_f64()),
+                "{what}: ranked by the binding pipe"
+            );
             if k["model"] == "ggx" {
-                assert!(lines.iter().all(|l| l["file"].as_str().unwrap().starts_with("glsl/")), "{what}: the built-in kernel's lines are glsl/'s");
+                assert!(
+                    lines.iter().all(|l| l["file"].as_str().unwrap().starts_with("glsl/")),
+                    "{what}: the built-in kernel's lines are glsl/'s"
+                );
                 continue;
             }
             let first = &lines[0];
-            assert!(first["file"].as_str().unwrap().ends_with("costly-line.brdf") && first["line"].as_u64() == Some(planted), "{what}: the first line is {first}, not the planted line {planted}");
+            assert!(
+                first["file"].as_str().unwrap().ends_with("costly-line.brdf")
+                    && first["line"].as_u64() == Some(planted),
+                "{what}: the first line is {first}, not the planted line {planted}"
+            );
             assert!(first["text"].as_str().unwrap().contains("pow("), "{what}: {first}");
-            assert!(first["binding"].as_f64().unwrap() > lines[1]["binding"].as_f64().unwrap(), "{what}: {first} ahead of {}", lines[1]);
+            assert!(
+                first["binding"].as_f64().unwrap() > lines[1]["binding"].as_f64().unwrap(),
+                "{what}: {first} ahead of {}",
+                lines[1]
+            );
         }
     }
     let page = dir.path().join("lines.html");
     common::run(&["report", dir.path().join("lines.json").to_str().unwrap(), "--out", page.to_str().unwrap()]).ok();
     let html = std::fs::read_to_string(&page).unwrap();
-    assert!(html.contains("Cost per source line") && html.contains(&format!("costly-line.brdf:{planted}")), "the HTML report has the lines");
+    assert!(
+        html.contains("Cost per source line") && html.contains(&format!("costly-line.brdf:{planted}")),
+        "the HTML report has the lines"
+    );
 }
 
 #[test]
 fn lines_need_a_target_whose_compiler_names_them() {
     let (path, _) = fixture();
     for device in ["radv:navi21", "lavapipe"] {
-        common::run(&["inspect", "--no-callgrind", "--lines", "--device", device, "--model", path.to_str().unwrap()]).fails(2, "--lines");
+        common::run(&["inspect", "--no-callgrind", "--lines", "--device", device, "--model", path.to_str().unwrap()])
+            .fails(2, "--lines");
     }
 }
 
@@ -75,10 +110,24 @@ fn an_hlsl_models_lines_are_its_front_ends_glsl_with_their_text() {
     let ue = common::repo_root().join("tests/fixtures/hlsl/ue");
     let at = |p: &str| ue.join(p).display().to_string();
     let engine = format!("/Engine={}", at("Engine"));
-    let all = inspect_json(dir.path(), "hlsl", &["nvidia:sm_89"], &["--lines", "--model", &at("ue-ggx.brdf"), "--include-dir", &at("Shaders"), "--include-map", &engine], "Cost per source line");
+    let all = inspect_json(
+        dir.path(),
+        "hlsl",
+        &["nvidia:sm_89"],
+        &["--lines", "--model", &at("ue-ggx.brdf"), "--include-dir", &at("Shaders"), "--include-map", &engine],
+        "Cost per source line",
+    );
     // One device: the JSON is its report.
     let k = all["lines"].as_array().unwrap().iter().find(|k| k["model"] == "ue-ggx").unwrap().clone();
-    let own: Vec<&serde_json::Value> = k["lines"].as_array().unwrap().iter().filter(|l| l["file"].as_str().unwrap().ends_with("ue-ggx.brdf (its HLSL as GLSL)")).collect();
+    let own: Vec<&serde_json::Value> = k["lines"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|l| l["file"].as_str().unwrap().ends_with("ue-ggx.brdf (its HLSL as GLSL)"))
+        .collect();
     assert!(!own.is_empty(), "{k}");
-    assert!(own.iter().all(|l| !l["text"].as_str().unwrap().is_empty()), "every front-end line has its GLSL text: {own:?}");
+    assert!(
+        own.iter().all(|l| !l["text"].as_str().unwrap().is_empty()),
+        "every front-end line has its GLSL text: {own:?}"
+    );
 }

@@ -9,7 +9,7 @@ use crate::common;
 use brdfprof::kernels;
 use brdfprof::model::Model;
 use brdfprof::targets::{intel, nvidia};
-use brdfprof::translate::{prepare, Dialect};
+use brdfprof::translate::{Dialect, prepare};
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -120,14 +120,35 @@ fn models() -> Vec<(String, Model)> {
 /// ACO's listing of every model's profiling kernel on navi21, by label (`inspect --isa`).
 fn aco_listings(dir: &Path, models: &[(String, Model)]) -> BTreeMap<String, String> {
     let isa = dir.join("isa");
-    let mut args: Vec<String> = ["inspect", "--no-callgrind", "--device", "radv:navi21", "--isa", isa.to_str().unwrap(), "--json", dir.join("aco.json").to_str().unwrap()].map(String::from).to_vec();
+    let mut args: Vec<String> = [
+        "inspect",
+        "--no-callgrind",
+        "--device",
+        "radv:navi21",
+        "--isa",
+        isa.to_str().unwrap(),
+        "--json",
+        dir.join("aco.json").to_str().unwrap(),
+    ]
+    .map(String::from)
+    .to_vec();
     for (spec, _) in models {
         args.extend(["--model".to_string(), spec.clone()]);
     }
     let refs: Vec<&str> = args.iter().map(String::as_str).collect();
     common::run_in(dir, &refs).ok();
     let labels = models.iter().map(|(_, m)| m.label()).chain([brdfprof::model::BASELINE_LABEL.to_string()]);
-    labels.map(|l| (l.clone(), std::fs::read_to_string(isa.join("navi21").join(format!("{}.assembly.txt", brdfprof::targets::file_slug(&l)))).unwrap_or_default())).collect()
+    labels
+        .map(|l| {
+            (
+                l.clone(),
+                std::fs::read_to_string(
+                    isa.join("navi21").join(format!("{}.assembly.txt", brdfprof::targets::file_slug(&l))),
+                )
+                .unwrap_or_default(),
+            )
+        })
+        .collect()
 }
 
 #[test]
@@ -154,7 +175,17 @@ fn every_kernel_does_the_same_transcendental_work_on_amd_nvidia_and_intel() {
             Err(e) => panic!("{name}: {e:#}"),
         };
         let count = |c: &Counts, op: &str| c.get(op).copied().unwrap_or(0.0);
-        let row: Vec<String> = OPS.iter().map(|op| format!("{op} {}/{}/{}", count(&a, op), count(&n, op), i.as_ref().map_or("-".into(), |i| count(i, op).to_string()))).collect();
+        let row: Vec<String> = OPS
+            .iter()
+            .map(|op| {
+                format!(
+                    "{op} {}/{}/{}",
+                    count(&a, op),
+                    count(&n, op),
+                    i.as_ref().map_or("-".into(), |i| count(i, op).to_string())
+                )
+            })
+            .collect();
         table.push(format!("{name:60} {}", row.join("  ")));
         for op in OPS {
             for (compiler, c) in [("sm_89", Some(&n)), ("gen12lp", i.as_ref())] {
@@ -163,23 +194,49 @@ fn every_kernel_does_the_same_transcendental_work_on_amd_nvidia_and_intel() {
                 if more == 0.0 {
                     continue;
                 }
-                match EXCEPTIONS.iter().position(|x| x.compiler == compiler && x.op == op && name.contains(x.kernels) && x.more == more) {
+                match EXCEPTIONS
+                    .iter()
+                    .position(|x| x.compiler == compiler && x.op == op && name.contains(x.kernels) && x.more == more)
+                {
                     Some(k) => used[k] += 1,
-                    None => unexplained.push(format!("{name}: {op} navi21 {}, {compiler} {}", count(&a, op), count(c, op))),
+                    None => {
+                        unexplained.push(format!("{name}: {op} navi21 {}, {compiler} {}", count(&a, op), count(c, op)))
+                    }
                 }
             }
         }
     }
     // The comparison can fail: burley's kernel prepared without flattening (SSA form and unrolling only)
     // computes the GTR normaliser once per light on sm_89, where ACO computes it once.
-    let plain = prepare::shade_kernel_as(Some(&Model::parse("burley").unwrap()), 8, kernels::embedded(), prepare::Preparation::Plain).unwrap();
+    let plain = prepare::shade_kernel_as(
+        Some(&Model::parse("burley").unwrap()),
+        8,
+        kernels::embedded(),
+        prepare::Preparation::Plain,
+    )
+    .unwrap();
     let unflattened = sass_counts(&nvidia::compile(&plain.source(Dialect::Cuda), sm_89, false).unwrap().listing);
     let aco_burley = aco_counts(&aco["burley"]);
-    println!("burley unflattened on sm_89: {} EX2, {} RCP; navi21: {} v_exp, {} v_rcp", unflattened["exp"], unflattened["rcp"], aco_burley["exp"], aco_burley["rcp"]);
+    println!(
+        "burley unflattened on sm_89: {} EX2, {} RCP; navi21: {} v_exp, {} v_rcp",
+        unflattened["exp"], unflattened["rcp"], aco_burley["exp"], aco_burley["rcp"]
+    );
     assert!(unflattened["exp"] > aco_burley["exp"] && unflattened["rcp"] > aco_burley["rcp"]);
     println!("navi21/sm_89/gen12lp per kernel (8 lights):\n{}", table.join("\n"));
-    assert!(unexplained.is_empty(), "{} transcendental counts differ with no listed reason:\n{}", unexplained.len(), unexplained.join("\n"));
+    assert!(
+        unexplained.is_empty(),
+        "{} transcendental counts differ with no listed reason:\n{}",
+        unexplained.len(),
+        unexplained.join("\n")
+    );
     for (x, n) in EXCEPTIONS.iter().zip(&used) {
-        assert!(*n > 0, "the exception for {} {} on {} ({}) no longer applies: remove it", x.kernels, x.op, x.compiler, x.why);
+        assert!(
+            *n > 0,
+            "the exception for {} {} on {} ({}) no longer applies: remove it",
+            x.kernels,
+            x.op,
+            x.compiler,
+            x.why
+        );
     }
 }

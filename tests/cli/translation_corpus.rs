@@ -15,8 +15,20 @@ fn judged(note: &str) -> Vec<(&'static str, f64, f64, usize, usize)> {
         let part = &note[at..];
         let after = |what: &str| part.split(what).nth(1).unwrap_or("");
         let number = |what: &str| after(what).split(' ').next().and_then(|x| x.parse::<f64>().ok()).unwrap_or(f64::NAN);
-        let counts: Vec<usize> = after("; ").split(" values unbounded").next().unwrap_or("").split(" of ").filter_map(|x| x.trim().parse().ok()).collect();
-        out.push((kernel, number("Vulkan at "), number("fp32 translation at "), counts.first().copied().unwrap_or(usize::MAX), counts.get(1).copied().unwrap_or(0)));
+        let counts: Vec<usize> = after("; ")
+            .split(" values unbounded")
+            .next()
+            .unwrap_or("")
+            .split(" of ")
+            .filter_map(|x| x.trim().parse().ok())
+            .collect();
+        out.push((
+            kernel,
+            number("Vulkan at "),
+            number("fp32 translation at "),
+            counts.first().copied().unwrap_or(usize::MAX),
+            counts.get(1).copied().unwrap_or(0),
+        ));
     }
     out
 }
@@ -25,14 +37,20 @@ fn judged(note: &str) -> Vec<(&'static str, f64, f64, usize, usize)> {
 fn every_corpus_file_is_priced_on_sm_89_and_gen12lp_against_its_f64_evaluation() {
     let dir = tempfile::tempdir().unwrap();
     let corpus = common::repo_root().join("tests/fixtures/brdf/corpus");
-    let mut files: Vec<String> = std::fs::read_dir(&corpus).unwrap().map(|e| e.unwrap().path()).filter(|p| p.extension().is_some_and(|x| x == "brdf")).map(|p| p.display().to_string()).collect();
+    let mut files: Vec<String> = std::fs::read_dir(&corpus)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x == "brdf"))
+        .map(|p| p.display().to_string())
+        .collect();
     files.sort();
     assert_eq!(files.len(), 40);
     let mut extra: Vec<&str> = Vec::new();
     for f in &files {
         extra.extend(["--model", f.as_str()]);
     }
-    let report = compile_only::inspect_json(dir.path(), "corpus", &["nvidia:sm_89", "intel:gen12lp"], &extra, "IGC statistics");
+    let report =
+        compile_only::inspect_json(dir.path(), "corpus", &["nvidia:sm_89", "intel:gen12lp"], &extra, "IGC statistics");
     let reports = report["reports"].as_array().unwrap();
     assert_eq!(reports.len(), 2);
     for r in reports {
@@ -49,12 +67,18 @@ fn every_corpus_file_is_priced_on_sm_89_and_gen12lp_against_its_f64_evaluation()
         assert!(harness.starts_with("Harness share on") && harness.contains("ggx-kelemen "), "{target}: {harness}");
         assert!(costs.iter().all(|c| c["cycles_per_eval"].as_f64().unwrap() > 0.0), "{target}");
         for row in r["rows"].as_array().unwrap() {
-            let note = row["notes"]["translation"].as_str().unwrap_or_else(|| panic!("{target} {}: no translation check", row["model"]));
+            let note = row["notes"]["translation"]
+                .as_str()
+                .unwrap_or_else(|| panic!("{target} {}: no translation check", row["model"]));
             let kernels = judged(note);
             assert_eq!(kernels.len(), if row["model"] == "baseline" { 1 } else { 2 }, "{note}");
             for (kernel, vulkan, translation, unbounded, values) in kernels {
                 assert!(vulkan <= 1.0 && translation <= 1.0, "{target} {} {kernel}: {note}", row["model"]);
-                assert!(values > 0 && 2 * unbounded < values, "{target} {} {kernel}: {unbounded} of {values} values unbounded", row["model"]);
+                assert!(
+                    values > 0 && 2 * unbounded < values,
+                    "{target} {} {kernel}: {unbounded} of {values} values unbounded",
+                    row["model"]
+                );
             }
         }
     }

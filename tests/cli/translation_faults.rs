@@ -9,7 +9,13 @@ use std::path::{Path, PathBuf};
 /// A .brdf file with `body` as BRDF's body (one line per statement), under `dir`.
 fn brdf(dir: &Path, name: &str, body: &str) -> PathBuf {
     let path = dir.join(format!("{name}.brdf"));
-    std::fs::write(&path, format!("analytic\n::begin shader\nvec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) {{\n{body}\n}}\n::end shader\n")).unwrap();
+    std::fs::write(
+        &path,
+        format!(
+            "analytic\n::begin shader\nvec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) {{\n{body}\n}}\n::end shader\n"
+        ),
+    )
+    .unwrap();
     path
 }
 
@@ -22,7 +28,15 @@ fn inputs(dir: &Path) -> PathBuf {
 
 fn eval_rows(dir: &Path, model: &Path, csv: &Path, device: Option<&str>) -> String {
     let out = dir.join(format!("out-{}.csv", device.unwrap_or("vulkan")));
-    let mut args = vec!["eval", "--model", model.to_str().unwrap(), "--input", csv.to_str().unwrap(), "--output", out.to_str().unwrap()];
+    let mut args = vec![
+        "eval",
+        "--model",
+        model.to_str().unwrap(),
+        "--input",
+        csv.to_str().unwrap(),
+        "--output",
+        out.to_str().unwrap(),
+    ];
     if let Some(d) = device {
         args.extend(["--device", d]);
     }
@@ -41,7 +55,11 @@ fn inspect(dir: &Path, devices: &[&str], model: &Path, env: &[(&str, &Path)]) ->
         cmd.env(k, v);
     }
     let out = cmd.output().unwrap();
-    common::Run { code: out.status.code(), stdout: String::from_utf8_lossy(&out.stdout).into_owned(), stderr: String::from_utf8_lossy(&out.stderr).into_owned() }
+    common::Run {
+        code: out.status.code(),
+        stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
+        stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
+    }
 }
 
 /// Item 1: an index past an array's end, and past a vector's, is clamped as lavapipe clamps it: OpenCL and
@@ -66,7 +84,11 @@ fn an_out_of_bounds_index_is_clamped_as_on_vulkan_and_never_faults() {
 #[test]
 fn an_endless_loop_on_opencl_stops_at_the_loop_limit() {
     let dir = tempfile::tempdir().unwrap();
-    let model = brdf(dir.path(), "spin", "    float x = 1.0 + abs(L.x) * 1e-30;\n    while (true) { x = x * 1.0000001; if (x > 1e30) break; }\n    return vec3(x * 1e-30);");
+    let model = brdf(
+        dir.path(),
+        "spin",
+        "    float x = 1.0 + abs(L.x) * 1e-30;\n    while (true) { x = x * 1.0000001; if (x > 1e30) break; }\n    return vec3(x * 1e-30);",
+    );
     let started = std::time::Instant::now();
     eval_rows(dir.path(), &model, &inputs(dir.path()), Some("opencl"));
     assert!(started.elapsed() < std::time::Duration::from_secs(60), "{:?}", started.elapsed());
@@ -84,7 +106,20 @@ fn a_host_compiler_that_hangs_stops_at_the_compile_limit() {
     let cache = dir.path().join("cache");
     let started = std::time::Instant::now();
     let out = common::brdfprof()
-        .args(["inspect", "--no-callgrind", "--compile-timeout", "3", "--device", "nvidia:sm_89", "--model", model.to_str().unwrap(), "--json", "i.json", "--markdown", "i.md"])
+        .args([
+            "inspect",
+            "--no-callgrind",
+            "--compile-timeout",
+            "3",
+            "--device",
+            "nvidia:sm_89",
+            "--model",
+            model.to_str().unwrap(),
+            "--json",
+            "i.json",
+            "--markdown",
+            "i.md",
+        ])
         .current_dir(dir.path())
         .env("PATH", path)
         .env("BRDFPROF_CACHE_DIR", &cache)
@@ -92,7 +127,12 @@ fn a_host_compiler_that_hangs_stops_at_the_compile_limit() {
         .unwrap();
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{stderr}");
-    assert!(stderr.contains("the host build of the translation (g++): the compilation took longer than the compile limit of 3 s"), "{stderr}");
+    assert!(
+        stderr.contains(
+            "the host build of the translation (g++): the compilation took longer than the compile limit of 3 s"
+        ),
+        "{stderr}"
+    );
     assert!(started.elapsed() < std::time::Duration::from_secs(45), "{:?}", started.elapsed());
 }
 
@@ -115,9 +155,18 @@ fn a_long_constant_array_translates() {
 #[test]
 fn fp64_is_left_out_of_the_intel_families_without_it() {
     let dir = tempfile::tempdir().unwrap();
-    let model = brdf(dir.path(), "wide", "    double d = double(dot(N, L)) * double(dot(N, V));\n    return vec3(float(sqrt(d + 1.0lf)));");
+    let model = brdf(
+        dir.path(),
+        "wide",
+        "    double d = double(dot(N, L)) * double(dot(N, V));\n    return vec3(float(sqrt(d + 1.0lf)));",
+    );
     let r = inspect(dir.path(), &["intel:gen9", "intel:gen12lp"], &model, &[]).ok();
-    assert!(r.stderr.contains("not compiled for intel:gen12lp: wide (tgllp has no fp64 (cl_khr_fp64); ocloc:") && r.stderr.contains("requires cl_khr_fp64"), "{}", r.stderr);
+    assert!(
+        r.stderr.contains("not compiled for intel:gen12lp: wide (tgllp has no fp64 (cl_khr_fp64); ocloc:")
+            && r.stderr.contains("requires cl_khr_fp64"),
+        "{}",
+        r.stderr
+    );
     let md = std::fs::read_to_string(dir.path().join("i.md")).unwrap();
     let across = md.split("### Cost per BRDF evaluation across devices").nth(1).unwrap();
     let row: Vec<&str> = across.lines().find(|l| l.starts_with("| wide ")).unwrap().split('|').map(str::trim).collect();
@@ -129,11 +178,21 @@ fn fp64_is_left_out_of_the_intel_families_without_it() {
 #[test]
 fn smod_on_negatives_is_named_as_lavapipes_deviation_on_every_path() {
     let dir = tempfile::tempdir().unwrap();
-    let model = brdf(dir.path(), "smod", "    int k = int(floor(L.x * 10.0)) - 7;\n    int r = k % 3;\n    return vec3(float(r + 3) * 0.1);");
+    let model = brdf(
+        dir.path(),
+        "smod",
+        "    int k = int(floor(L.x * 10.0)) - 7;\n    int r = k % 3;\n    return vec3(float(r + 3) * 0.1);",
+    );
     let cache = dir.path().join("cache");
     let r = inspect(dir.path(), &["nvidia:sm_89"], &model, &[("BRDFPROF_CACHE_DIR", &cache)]).ok();
     let said = "computes it with the dividend's sign (srem: -7 % 3 = -1) where SPIR-V's OpSMod and the translation take the divisor's (2)";
-    assert!(r.stderr.contains(&format!("smod (eval kernel): the kernel takes integer `%` (SPIR-V OpSMod) of a negative value: llvmpipe")) && r.stderr.contains(said), "{}", r.stderr);
+    assert!(
+        r.stderr.contains(&format!(
+            "smod (eval kernel): the kernel takes integer `%` (SPIR-V OpSMod) of a negative value: llvmpipe"
+        )) && r.stderr.contains(said),
+        "{}",
+        r.stderr
+    );
     // The same verdict from the cache, and from a scene whose clamped radiance alone might hide it.
     let again = inspect(dir.path(), &["nvidia:sm_89"], &model, &[("BRDFPROF_CACHE_DIR", &cache)]).ok();
     assert!(again.stderr.contains(said), "{}", again.stderr);
@@ -148,13 +207,45 @@ fn smod_on_negatives_is_named_as_lavapipes_deviation_on_every_path() {
         ),
     )
     .unwrap();
-    let s = run(&["profile", "--scene", scene.to_str().unwrap(), "--cost-device", "nvidia:sm_89", "--budget", "2", "--json", dir.path().join("s.json").to_str().unwrap()]).ok();
+    let s = run(&[
+        "profile",
+        "--scene",
+        scene.to_str().unwrap(),
+        "--cost-device",
+        "nvidia:sm_89",
+        "--budget",
+        "2",
+        "--json",
+        dir.path().join("s.json").to_str().unwrap(),
+    ])
+    .ok();
     assert!(s.stderr.contains("smod (eval kernel)") && s.stderr.contains(said), "{}", s.stderr);
     // eval on OpenCL runs the Vulkan kernel too and says where the two executions part (-7 % 3 at line 2).
     let csv = dir.path().join("neg.csv");
-    std::fs::write(&csv, "nx,ny,nz,vx,vy,vz,lx,ly,lz\n0,0,1,0.3,0.2,0.93,0.0,-0.3,0.95\n0,0,1,0.3,0.2,0.93,0.9,0.0,0.43\n").unwrap();
-    let e = run(&["eval", "--model", m, "--device", "opencl", "--input", csv.to_str().unwrap(), "--output", dir.path().join("o.csv").to_str().unwrap()]).ok();
-    assert!(e.stderr.contains("1 of 2 rows differ between") && e.stderr.contains("first: line 2") && e.stderr.contains("which lavapipe computes as srem"), "{}", e.stderr);
+    std::fs::write(
+        &csv,
+        "nx,ny,nz,vx,vy,vz,lx,ly,lz\n0,0,1,0.3,0.2,0.93,0.0,-0.3,0.95\n0,0,1,0.3,0.2,0.93,0.9,0.0,0.43\n",
+    )
+    .unwrap();
+    let e = run(&[
+        "eval",
+        "--model",
+        m,
+        "--device",
+        "opencl",
+        "--input",
+        csv.to_str().unwrap(),
+        "--output",
+        dir.path().join("o.csv").to_str().unwrap(),
+    ])
+    .ok();
+    assert!(
+        e.stderr.contains("1 of 2 rows differ between")
+            && e.stderr.contains("first: line 2")
+            && e.stderr.contains("which lavapipe computes as srem"),
+        "{}",
+        e.stderr
+    );
 }
 
 fn script(path: &Path, text: &str) {
@@ -170,7 +261,13 @@ fn nvidia_with(dir: &Path, fake: &str) -> PathBuf {
     std::fs::create_dir_all(root.join("nvidia/cu13/bin")).unwrap();
     std::os::unix::fs::symlink(real.join("lib"), root.join("nvidia/cu13/lib")).unwrap();
     let nvdisasm = real.join("bin/nvdisasm");
-    script(&root.join("nvidia/cu13/bin/nvdisasm"), &format!("#!/bin/sh\nif [ \"$1\" = --version ]; then echo 'Build fake_nvdisasm'; exit 0; fi\nREAL={}\n{fake}\n", nvdisasm.display()));
+    script(
+        &root.join("nvidia/cu13/bin/nvdisasm"),
+        &format!(
+            "#!/bin/sh\nif [ \"$1\" = --version ]; then echo 'Build fake_nvdisasm'; exit 0; fi\nREAL={}\n{fake}\n",
+            nvdisasm.display()
+        ),
+    );
     root
 }
 
@@ -182,14 +279,23 @@ fn a_disassembler_listing_that_is_not_the_kernel_is_refused() {
     let model = brdf(dir.path(), "plain", "    return vec3(dot(N, L) * 0.1);");
     for (case, fake, said) in [
         ("empty", "exit 0", "its listing of the cubin is not the kernel's code (no EXIT in 0 instruction lines)"),
-        ("one", "echo '        /*0000*/                   EXIT ;'", "1 instructions listed up to byte 16, where the code section holds"),
+        (
+            "one",
+            "echo '        /*0000*/                   EXIT ;'",
+            "1 instructions listed up to byte 16, where the code section holds",
+        ),
         ("cut", "\"$REAL\" \"$@\" | head -n 40", "its listing of the cubin is not the kernel's code"),
         ("endless", "yes '        /*0000*/                   EXIT ;'", "the tool printed more than 256 MiB"),
     ] {
         let d = dir.path().join(case);
         std::fs::create_dir(&d).unwrap();
         let nv = nvidia_with(&d, fake);
-        let r = inspect(&d, &["nvidia:sm_89"], &model, &[("BRDFPROF_NVIDIA_DIR", &nv), ("BRDFPROF_CACHE_DIR", &d.join("cache"))]);
+        let r = inspect(
+            &d,
+            &["nvidia:sm_89"],
+            &model,
+            &[("BRDFPROF_NVIDIA_DIR", &nv), ("BRDFPROF_CACHE_DIR", &d.join("cache"))],
+        );
         let r = r.fails(2, said);
         assert!(r.stderr.contains("nvdisasm"), "{case}: {}", r.stderr);
         assert!(!d.join("i.json").exists(), "{case}");
@@ -205,7 +311,20 @@ fn a_version_query_that_hangs_stops_at_the_compile_limit() {
     script(&nv.join("nvidia/cu13/bin/nvdisasm"), "#!/bin/sh\nsleep 60\n");
     let started = std::time::Instant::now();
     let out = common::brdfprof()
-        .args(["inspect", "--no-callgrind", "--compile-timeout", "2", "--device", "nvidia:sm_89", "--model", model.to_str().unwrap(), "--json", "i.json", "--markdown", "i.md"])
+        .args([
+            "inspect",
+            "--no-callgrind",
+            "--compile-timeout",
+            "2",
+            "--device",
+            "nvidia:sm_89",
+            "--model",
+            model.to_str().unwrap(),
+            "--json",
+            "i.json",
+            "--markdown",
+            "i.md",
+        ])
         .current_dir(dir.path())
         .env("BRDFPROF_NVIDIA_DIR", &nv)
         .output()
@@ -222,7 +341,11 @@ fn an_ocloc_that_writes_nothing_or_a_cut_listing_is_named() {
     let dir = tempfile::tempdir().unwrap();
     let model = brdf(dir.path(), "plain", "    return vec3(dot(N, L) * 0.1);");
     for (case, fake, said) in [
-        ("silent", "#!/bin/sh\nif [ \"$1\" = query ]; then exec ocloc \"$@\"; fi\nexit 0\n", "`ocloc compile` for tgllp exited 0 but wrote no device binary"),
+        (
+            "silent",
+            "#!/bin/sh\nif [ \"$1\" = query ]; then exec ocloc \"$@\"; fi\nexit 0\n",
+            "`ocloc compile` for tgllp exited 0 but wrote no device binary",
+        ),
         (
             "cut",
             "#!/bin/sh\nocloc \"$@\" || exit $?\nif [ \"$1\" = disasm ]; then d=$(echo \"$@\" | sed 's/.*-dump //'); head -n 3 \"$d/brdfprof_kernel_KernelHeap.asm\" > \"$d/x\"; mv \"$d/x\" \"$d/brdfprof_kernel_KernelHeap.asm\"; fi\n",
@@ -233,7 +356,12 @@ fn an_ocloc_that_writes_nothing_or_a_cut_listing_is_named() {
         std::fs::create_dir(&d).unwrap();
         let fake_path = d.join("ocloc");
         script(&fake_path, fake);
-        let r = inspect(&d, &["intel:gen12lp"], &model, &[("BRDFPROF_OCLOC", &fake_path), ("BRDFPROF_CACHE_DIR", &d.join("cache"))]);
+        let r = inspect(
+            &d,
+            &["intel:gen12lp"],
+            &model,
+            &[("BRDFPROF_OCLOC", &fake_path), ("BRDFPROF_CACHE_DIR", &d.join("cache"))],
+        );
         r.fails(2, said);
     }
     // Issue 33 item 10: a directory named as ocloc is called one.
@@ -247,14 +375,28 @@ fn diff_claims_no_tolerance_for_nan_and_refuses_an_empty_input() {
     let dir = tempfile::tempdir().unwrap();
     let model = brdf(dir.path(), "nan", "    return vec3(sqrt(-1.0 - abs(L.x)));");
     let m = model.to_str().unwrap();
-    let r = run(&["diff", "--model", m, "--model", m, "--samples", "50", "--tolerance", "0", "--json", dir.path().join("d.json").to_str().unwrap()]);
+    let r = run(&[
+        "diff",
+        "--model",
+        m,
+        "--model",
+        m,
+        "--samples",
+        "50",
+        "--tolerance",
+        "0",
+        "--json",
+        dir.path().join("d.json").to_str().unwrap(),
+    ]);
     assert_eq!(r.code, Some(1), "{}", r.stderr);
     assert!(r.stdout.contains("NOT within --tolerance 0: 150 values are NaN on both sides"), "{}", r.stdout);
-    let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.path().join("d.json")).unwrap()).unwrap();
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("d.json")).unwrap()).unwrap();
     assert_eq!(json["within_tolerance"], false);
     let empty = dir.path().join("empty.csv");
     std::fs::write(&empty, "nx,ny,nz,vx,vy,vz,lx,ly,lz,roughness,f0r,f0g,f0b\n").unwrap();
-    run(&["diff", "--model", "ggx", "--model", "blinn", "--input", empty.to_str().unwrap()]).fails(2, "the file has a header but no rows");
+    run(&["diff", "--model", "ggx", "--model", "blinn", "--input", empty.to_str().unwrap()])
+        .fails(2, "the file has a header but no rows");
 }
 
 /// Item 8: every saved report names its kind; a scene profile is refused by --html and by `report` by name.
@@ -263,12 +405,14 @@ fn saved_reports_name_their_kind_and_scene_profiles_are_refused_by_the_html_repo
     let dir = tempfile::tempdir().unwrap();
     let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/sphere-grid.json");
     let json = dir.path().join("scene.json");
-    run(&["profile", "--scene", scene.to_str().unwrap(), "--html", dir.path().join("s.html").to_str().unwrap()]).fails(2, "the HTML report does not draw scene profiles");
+    run(&["profile", "--scene", scene.to_str().unwrap(), "--html", dir.path().join("s.html").to_str().unwrap()])
+        .fails(2, "the HTML report does not draw scene profiles");
     assert!(!dir.path().join("s.html").exists());
     run(&["profile", "--scene", scene.to_str().unwrap(), "--budget", "2", "--json", json.to_str().unwrap()]).ok();
     let saved: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
     assert_eq!(saved["kind"], "scene-profile");
-    run(&["report", json.to_str().unwrap(), "--out", dir.path().join("r.html").to_str().unwrap()]).fails(2, "a `scene-profile` report, which the HTML report does not draw");
+    run(&["report", json.to_str().unwrap(), "--out", dir.path().join("r.html").to_str().unwrap()])
+        .fails(2, "a `scene-profile` report, which the HTML report does not draw");
     let profile = dir.path().join("p.json");
     run(&["profile", "--model", "ggx", "--size", "64x64", "--budget", "2", "--json", profile.to_str().unwrap()]).ok();
     let saved: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&profile).unwrap()).unwrap();
@@ -285,25 +429,47 @@ fn minor_refusals_and_notes_name_their_cause() {
     let m = model.to_str().unwrap();
     let csv = inputs(dir.path());
     let out = dir.path().join("o.csv");
-    let eval = |define: &str| run(&["eval", "--model", m, "--define", define, "--input", csv.to_str().unwrap(), "--output", out.to_str().unwrap()]);
+    let eval = |define: &str| {
+        run(&[
+            "eval",
+            "--model",
+            m,
+            "--define",
+            define,
+            "--input",
+            csv.to_str().unwrap(),
+            "--output",
+            out.to_str().unwrap(),
+        ])
+    };
     eval("L=1").fails(2, "`L` is a name of the entry `vec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y)`");
     eval("Q=1\\").fails(2, "the value ends with a backslash");
     run(&["report", "/dev/zero", "--out", dir.path().join("z.html").to_str().unwrap()]).fails(2, "not a regular file");
     let r = inspect(dir.path(), &["nvidia:sm_89"], &model, &[]).ok();
-    let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.path().join("i.json")).unwrap()).unwrap();
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("i.json")).unwrap()).unwrap();
     assert_eq!(json["kind"], "inspect");
     let md = std::fs::read_to_string(dir.path().join("i.md")).unwrap();
-    assert!(md.contains("flat: net cost not above zero: the kernel adds nothing to the memory-only kernel"), "{}\n{md}", r.stderr);
+    assert!(
+        md.contains("flat: net cost not above zero: the kernel adds nothing to the memory-only kernel"),
+        "{}\n{md}",
+        r.stderr
+    );
     let i = dir.path().join("i.json");
     let copy = dir.path().join("copy.json");
     std::fs::copy(&i, &copy).unwrap();
-    run(&["report", i.to_str().unwrap(), copy.to_str().unwrap(), "--out", dir.path().join("r.html").to_str().unwrap()]).fails(2, "is the same report as");
+    run(&["report", i.to_str().unwrap(), copy.to_str().unwrap(), "--out", dir.path().join("r.html").to_str().unwrap()])
+        .fails(2, "is the same report as");
     // Issue 31 item 4a: a file's parameters left at their values are compiled in, and the report says so.
     let tinted = dir.path().join("tinted.brdf");
     std::fs::write(&tinted, "analytic\n::begin parameters\nfloat gain 0 2 0.7\n::end parameters\n::begin shader\nvec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) { return vec3(gain * dot(N, L)); }\n::end shader\n").unwrap();
     let r = inspect(dir.path(), &["nvidia:sm_89"], &tinted, &[]).ok();
     let said = "parameters compiled in as constants, so the figures are for these values (the compiler may fold them): gain=0.7";
-    assert!(r.stderr.contains(said) && std::fs::read_to_string(dir.path().join("i.md")).unwrap().contains(said), "{}", r.stderr);
+    assert!(
+        r.stderr.contains(said) && std::fs::read_to_string(dir.path().join("i.md")).unwrap().contains(said),
+        "{}",
+        r.stderr
+    );
 }
 
 /// Issue 31 item 11: matrix operations as engine code applies a tangent frame translate, and agree with Vulkan.
@@ -316,8 +482,13 @@ fn matrix_operations_translate_and_agree_with_vulkan() {
         "    mat3 tbn = mat3(X, Y, N);\n    vec3 l = transpose(tbn) * L;\n    mat3 m2 = tbn * tbn;\n    mat3 m3 = m2 * 0.5 + tbn;\n    mat3 m4 = m3 - outerProduct(L, V);\n    return abs(vec3(l.z, m4[1][1], (V * m4).x)) * 0.3;",
     );
     let csv = inputs(dir.path());
-    let values = |text: String| -> Vec<f64> { text.lines().skip(1).flat_map(|l| l.split(',').map(|v| v.parse::<f64>().unwrap()).collect::<Vec<_>>()).collect() };
-    let (vulkan, opencl) = (values(eval_rows(dir.path(), &model, &csv, None)), values(eval_rows(dir.path(), &model, &csv, Some("opencl"))));
+    let values = |text: String| -> Vec<f64> {
+        text.lines().skip(1).flat_map(|l| l.split(',').map(|v| v.parse::<f64>().unwrap()).collect::<Vec<_>>()).collect()
+    };
+    let (vulkan, opencl) = (
+        values(eval_rows(dir.path(), &model, &csv, None)),
+        values(eval_rows(dir.path(), &model, &csv, Some("opencl"))),
+    );
     assert_eq!(vulkan.len(), opencl.len());
     for (a, b) in vulkan.iter().zip(&opencl) {
         assert!((a - b).abs() <= 1e-5 * a.abs().max(1e-3), "{vulkan:?} against {opencl:?}");
@@ -332,11 +503,30 @@ fn sweep_cost_tables_hold_every_model_by_its_label() {
     let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/brdf/blinn.brdf");
     let spec = format!("{},name=mine", file.display());
     let out = dir.path().join("sw");
-    let r = run(&["sweep", "--model", "ggx", "--model", &spec, "--cost-device", "radv:navi21", "--budget", "3", "--out", out.to_str().unwrap()]).ok();
+    let r = run(&[
+        "sweep",
+        "--model",
+        "ggx",
+        "--model",
+        &spec,
+        "--cost-device",
+        "radv:navi21",
+        "--budget",
+        "3",
+        "--out",
+        out.to_str().unwrap(),
+    ])
+    .ok();
     assert!(!r.stderr.contains("not compiled for"), "{}", r.stderr);
-    let md = std::fs::read_to_string(out.join("sweep-llvmpipe-aco-navi21.md")).or_else(|_| {
-        let f = std::fs::read_dir(&out).unwrap().map(|e| e.unwrap().path()).find(|p| p.to_string_lossy().ends_with("-aco-navi21.md")).unwrap();
-        std::fs::read_to_string(f)
-    }).unwrap();
+    let md = std::fs::read_to_string(out.join("sweep-llvmpipe-aco-navi21.md"))
+        .or_else(|_| {
+            let f = std::fs::read_dir(&out)
+                .unwrap()
+                .map(|e| e.unwrap().path())
+                .find(|p| p.to_string_lossy().ends_with("-aco-navi21.md"))
+                .unwrap();
+            std::fs::read_to_string(f)
+        })
+        .unwrap();
     assert!(md.lines().any(|l| l.starts_with("| mine ")) && md.lines().any(|l| l.starts_with("| ggx ")), "{md}");
 }

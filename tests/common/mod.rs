@@ -3,7 +3,7 @@
 #![allow(dead_code)]
 
 use brdfprof::brdf::spec::with_each_param_sample;
-use brdfprof::brdf::{ModelSpec, D, F, Vis};
+use brdfprof::brdf::{D, F, ModelSpec, Vis};
 use brdfprof::gpu::{Gpu, GpuOptions};
 use brdfprof::model::Model;
 use std::path::{Path, PathBuf};
@@ -43,7 +43,11 @@ pub struct Run {
 
 impl Run {
     fn of(out: Output) -> Run {
-        Run { code: out.status.code(), stdout: String::from_utf8_lossy(&out.stdout).into_owned(), stderr: String::from_utf8_lossy(&out.stderr).into_owned() }
+        Run {
+            code: out.status.code(),
+            stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
+            stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
+        }
     }
 
     /// Asserts exit 0 and no validation message; returns self.
@@ -82,7 +86,9 @@ pub fn device_file(dir: &Path, prefix: &str, suffix: &str) -> PathBuf {
         .map(|e| e.unwrap().path())
         .filter(|p| {
             let name = p.file_name().unwrap().to_string_lossy();
-            name.starts_with(prefix) && name.ends_with(suffix) && !name[prefix.len()..name.len() - suffix.len()].contains('-')
+            name.starts_with(prefix)
+                && name.ends_with(suffix)
+                && !name[prefix.len()..name.len() - suffix.len()].contains('-')
         })
         .collect();
     assert_eq!(matches.len(), 1, "one {prefix}<device>{suffix} in {}: {matches:?}", dir.display());
@@ -97,7 +103,8 @@ pub fn repo_root() -> PathBuf {
 pub fn source_dirs() -> Vec<PathBuf> {
     let root = repo_root();
     let mut dirs = vec![root.join("src")];
-    let mut crates: Vec<PathBuf> = std::fs::read_dir(root.join("crates")).unwrap().map(|e| e.unwrap().path().join("src")).collect();
+    let mut crates: Vec<PathBuf> =
+        std::fs::read_dir(root.join("crates")).unwrap().map(|e| e.unwrap().path().join("src")).collect();
     crates.sort();
     dirs.extend(crates);
     dirs
@@ -142,8 +149,13 @@ pub fn uniform(seed: u64) -> impl FnMut() -> f64 {
 
 /// The first three columns of every row of a CSV `eval` wrote (its header skipped): the outputs.
 pub fn csv_values(path: &Path) -> Vec<[f64; 3]> {
-    std::fs::read_to_string(path).unwrap().lines().skip(1).map(|l| {
-        let v: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
-        [v[0], v[1], v[2]]
-    }).collect()
+    std::fs::read_to_string(path)
+        .unwrap()
+        .lines()
+        .skip(1)
+        .map(|l| {
+            let v: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
+            [v[0], v[1], v[2]]
+        })
+        .collect()
 }

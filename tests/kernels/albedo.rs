@@ -6,7 +6,7 @@
 
 use crate::common;
 use brdfprof::accuracy::{albedo_exact, albedo_twin};
-use brdfprof::brdf::{ModelSpec, D, F, Vis};
+use brdfprof::brdf::{D, F, ModelSpec, Vis};
 use brdfprof::kernels::{self, AlbedoCell};
 
 fn cells() -> Vec<AlbedoCell> {
@@ -32,7 +32,15 @@ fn gpu_albedo_matches_cpu_integration_for_every_d_and_vis() {
                 let err = (g.e[0] - cpu).abs() / cpu.max(1.0);
                 worst = worst.max(err);
                 if err > 0.005 {
-                    failures.push(format!("{} at NoV {} r {}: GPU {:.5} (bound {:.1e}) CPU {:.5}", spec.canonical(), cell.nov, cell.roughness, g.e[0], g.error, cpu));
+                    failures.push(format!(
+                        "{} at NoV {} r {}: GPU {:.5} (bound {:.1e}) CPU {:.5}",
+                        spec.canonical(),
+                        cell.nov,
+                        cell.roughness,
+                        g.e[0],
+                        g.error,
+                        cpu
+                    ));
                 }
             }
         }
@@ -55,7 +63,13 @@ fn fp16_albedo_matches_where_fp16_can() {
             for (cell, g) in cells.iter().zip(kernels::albedo(&gpu, &common::model(spec), &cells).unwrap()) {
                 let cpu = albedo_twin(&spec, cell)[0];
                 if !g.e[0].is_finite() || (g.e[0] - cpu).abs() / cpu.max(1.0) > 0.005 {
-                    failures.push(format!("{} at NoV {} r {}: GPU {} CPU {cpu:.5}", spec.name(), cell.nov, cell.roughness, g.e[0]));
+                    failures.push(format!(
+                        "{} at NoV {} r {}: GPU {} CPU {cpu:.5}",
+                        spec.name(),
+                        cell.nov,
+                        cell.roughness,
+                        g.e[0]
+                    ));
                 }
             }
         }

@@ -3,9 +3,9 @@
 //! documented rule, and glslang's errors come back at the file's own lines.
 
 use crate::common;
-use brdfprof::brdf::{samples, Sample, THESIS_MODELS};
+use brdfprof::brdf::{Sample, THESIS_MODELS, samples};
 use brdfprof::kernels::{self, AlbedoCell, EvalExtras, RunLimits};
-use brdfprof::model::file_model::{tangent_frame, TANGENT_PARALLEL};
+use brdfprof::model::file_model::{TANGENT_PARALLEL, tangent_frame};
 use brdfprof::model::{KernelKind, Model};
 use glam::DVec3;
 use std::path::{Path, PathBuf};
@@ -30,7 +30,9 @@ fn example_files_match_their_presets_on_100000_samples() {
         let mut worst = common::Worst::default();
         for ((g, b), sample) in got.iter().zip(&builtin).zip(&s) {
             for c in 0..3 {
-                worst.update(common::rel_err(g[c] as f64, b[c] as f64), || format!("{sample:?} channel {c}: file {} built-in {}", g[c], b[c]));
+                worst.update(common::rel_err(g[c] as f64, b[c] as f64), || {
+                    format!("{sample:?} channel {c}: file {} built-in {}", g[c], b[c])
+                });
             }
         }
         println!("{name:14} max rel diff to the built-in over {per_model} samples: {:.2e}", worst.err);
@@ -42,13 +44,21 @@ fn example_files_match_their_presets_on_100000_samples() {
 #[test]
 fn example_files_albedo_matches_their_presets() {
     let gpu = common::gpu();
-    let cells: Vec<AlbedoCell> = [0.1f32, 0.5, 1.0].iter().flat_map(|&nov| [0.2f32, 0.6, 1.0].map(|roughness| AlbedoCell { nov, roughness, f0: [0.04, 0.5, 1.0] })).collect();
+    let cells: Vec<AlbedoCell> = [0.1f32, 0.5, 1.0]
+        .iter()
+        .flat_map(|&nov| [0.2f32, 0.6, 1.0].map(|roughness| AlbedoCell { nov, roughness, f0: [0.04, 0.5, 1.0] }))
+        .collect();
     for name in THESIS_MODELS {
         let file = kernels::albedo(&gpu, &bound(name), &cells).unwrap();
         let builtin = kernels::albedo(&gpu, &Model::parse(name).unwrap(), &cells).unwrap();
         for ((f, b), cell) in file.iter().zip(&builtin).zip(&cells) {
             for c in 0..3 {
-                assert!((f.e[c] - b.e[c]).abs() <= 1e-4, "{name}: {cell:?} channel {c}: file E {} built-in E {}", f.e[c], b.e[c]);
+                assert!(
+                    (f.e[c] - b.e[c]).abs() <= 1e-4,
+                    "{name}: {cell:?} channel {c}: file E {} built-in E {}",
+                    f.e[c],
+                    b.e[c]
+                );
             }
         }
     }
@@ -61,8 +71,17 @@ fn foreign(language: &str) -> Model {
     let root = common::repo_root().join("tests/fixtures");
     let ue = root.join("hlsl/ue");
     let text = match language {
-        "hlsl" => format!("{},include={},include-map=/Engine={}", ue.join("ue-ggx.brdf").display(), ue.join("Shaders").display(), ue.join("Engine").display()),
-        _ => format!("{},include={}", root.join("wgsl/bevy/bevy-ggx.brdf").display(), root.join("wgsl/bevy/shaders").display()),
+        "hlsl" => format!(
+            "{},include={},include-map=/Engine={}",
+            ue.join("ue-ggx.brdf").display(),
+            ue.join("Shaders").display(),
+            ue.join("Engine").display()
+        ),
+        _ => format!(
+            "{},include={}",
+            root.join("wgsl/bevy/bevy-ggx.brdf").display(),
+            root.join("wgsl/bevy/shaders").display()
+        ),
     };
     Model::parse(&text).unwrap()
 }
@@ -72,7 +91,10 @@ fn hlsl_and_wgsl_files_compute_their_glsl_twins_bits_and_albedo() {
     let gpu = common::gpu();
     let s = samples::well_conditioned(100_000, 30, 0.05, 0.0..1.0);
     let twin = kernels::eval(&gpu, &bound("ggx"), &s, RunLimits::default()).unwrap();
-    let cells: Vec<AlbedoCell> = [0.1f32, 0.5, 1.0].iter().flat_map(|&nov| [0.2f32, 0.6, 1.0].map(|roughness| AlbedoCell { nov, roughness, f0: [0.04, 0.5, 1.0] })).collect();
+    let cells: Vec<AlbedoCell> = [0.1f32, 0.5, 1.0]
+        .iter()
+        .flat_map(|&nov| [0.2f32, 0.6, 1.0].map(|roughness| AlbedoCell { nov, roughness, f0: [0.04, 0.5, 1.0] }))
+        .collect();
     let twin_albedo = kernels::albedo(&gpu, &bound("ggx"), &cells).unwrap();
     for language in ["hlsl", "wgsl"] {
         let model = foreign(language);
@@ -102,7 +124,9 @@ fn tangent_frame_follows_its_documented_rule() {
     let y_model = x_model.with_params(&["bitangent=1".into()]).unwrap();
     let mut s: Vec<Sample> = samples::well_conditioned(2_000, 7, 0.05, 0.2..1.0);
     // Normals everywhere on the sphere, the poles (Duff's basis switches sign at z = 0) included.
-    for (i, n) in [[0.0, 0.0, 1.0], [0.0, 0.0, -1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.3, -0.2, -0.93]].iter().enumerate() {
+    for (i, n) in
+        [[0.0, 0.0, 1.0], [0.0, 0.0, -1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.3, -0.2, -0.93]].iter().enumerate()
+    {
         s[i].n = *n;
     }
     for (i, x) in s.iter_mut().enumerate().skip(5) {
@@ -110,23 +134,40 @@ fn tangent_frame_follows_its_documented_rule() {
         x.n = [t.cos() * (t * 0.3).sin(), t.sin() * (t * 0.3).sin(), (t * 0.3).cos()];
     }
     // Given tangents: generic, parallel to N (falls back to the basis) and zero (no tangent).
-    let tangents: Vec<[f32; 3]> = s.iter().enumerate().map(|(i, x)| match i % 3 {
-        0 => [0.6, -0.3, 0.2],
-        1 => x.n.map(|c| 2.0 * c),
-        _ => [0.0; 3],
-    }).collect();
+    let tangents: Vec<[f32; 3]> = s
+        .iter()
+        .enumerate()
+        .map(|(i, x)| match i % 3 {
+            0 => [0.6, -0.3, 0.2],
+            1 => x.n.map(|c| 2.0 * c),
+            _ => [0.0; 3],
+        })
+        .collect();
     for (model, bitangent) in [(&x_model, false), (&y_model, true)] {
         for given in [None, Some(tangents.as_slice())] {
-            let got = kernels::eval_with(&gpu, model, &s, &EvalExtras { tangents: given, ..Default::default() }, RunLimits::default()).unwrap();
+            let got = kernels::eval_with(
+                &gpu,
+                model,
+                &s,
+                &EvalExtras { tangents: given, ..Default::default() },
+                RunLimits::default(),
+            )
+            .unwrap();
             for (i, (g, x)) in got.iter().zip(&s).enumerate() {
                 let n = DVec3::from(x.n.map(f64::from)).normalize();
                 let t = given.map_or(DVec3::ZERO, |t| DVec3::from(t[i].map(f64::from)));
                 let xf = tangent_frame(n, t);
                 let want = if bitangent { n.cross(xf) } else { xf };
                 for c in 0..3 {
-                    assert!((g[c] as f64 - want[c]).abs() <= 2e-5, "sample {i} (N {n:?}, t {t:?}, Y {bitangent}): GPU {g:?}, rule {want:?}");
+                    assert!(
+                        (g[c] as f64 - want[c]).abs() <= 2e-5,
+                        "sample {i} (N {n:?}, t {t:?}, Y {bitangent}): GPU {g:?}, rule {want:?}"
+                    );
                 }
-                assert!(xf.dot(n).abs() < 1e-12 && (xf.length() - 1.0).abs() < 1e-12, "X is a unit vector orthogonal to N");
+                assert!(
+                    xf.dot(n).abs() < 1e-12 && (xf.length() - 1.0).abs() < 1e-12,
+                    "X is a unit vector orthogonal to N"
+                );
             }
         }
     }
@@ -136,7 +177,10 @@ fn tangent_frame_follows_its_documented_rule() {
 #[test]
 fn the_parallel_threshold_is_the_same_on_both_sides() {
     let glsl = std::fs::read_to_string(common::repo_root().join("glsl/brdf.glsl")).unwrap();
-    let line = glsl.lines().find(|l| l.contains("const float FILE_TANGENT_PARALLEL")).expect("brdf.glsl defines FILE_TANGENT_PARALLEL");
+    let line = glsl
+        .lines()
+        .find(|l| l.contains("const float FILE_TANGENT_PARALLEL"))
+        .expect("brdf.glsl defines FILE_TANGENT_PARALLEL");
     let value: f64 = line.split('=').nth(1).unwrap().trim().trim_end_matches(';').parse().unwrap();
     assert_eq!(value, TANGENT_PARALLEL);
 }
@@ -155,7 +199,14 @@ fn glslang_errors_name_the_file_line() {
 #[test]
 fn every_kernel_kind_a_file_can_run_compiles() {
     let model = bound("burley");
-    for kind in [KernelKind::Eval, KernelKind::Shade, KernelKind::ShadeFloat, KernelKind::Albedo, KernelKind::Scene, KernelKind::SceneAlbedo] {
+    for kind in [
+        KernelKind::Eval,
+        KernelKind::Shade,
+        KernelKind::ShadeFloat,
+        KernelKind::Albedo,
+        KernelKind::Scene,
+        KernelKind::SceneAlbedo,
+    ] {
         let k = model.kernel(kind, kernels::embedded()).unwrap_or_else(|e| panic!("{kind:?}: {e:#}"));
         assert!(k.spirv.words.len() > 100, "{kind:?}");
     }
@@ -178,7 +229,11 @@ fn lavapipe_ends_every_loop_at_the_stated_limit() {
     for (n, expected) in [(1000u64, 1000u64), (100_000, brdfprof::model::brdf_file::LAVAPIPE_LOOP_LIMIT)] {
         let model = Model::parse(&format!("{},n={n}", path.display())).unwrap();
         let got = kernels::eval(&gpu, &model, &s, RunLimits::default()).unwrap();
-        assert!(got.iter().all(|v| v[0] as u64 == expected), "a loop of {n} iterations counted {:?} on lavapipe", got[0]);
+        assert!(
+            got.iter().all(|v| v[0] as u64 == expected),
+            "a loop of {n} iterations counted {:?} on lavapipe",
+            got[0]
+        );
     }
     common::assert_no_validation_messages(&gpu);
 }
@@ -207,7 +262,11 @@ fn messages_about(path: &Path) -> String {
 #[test]
 fn bad_files_give_the_expected_messages() {
     let dir = Path::new("tests/fixtures/brdf/messages");
-    let mut files: Vec<PathBuf> = std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().path()).filter(|p| p.extension().is_some_and(|e| e == "brdf")).collect();
+    let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "brdf"))
+        .collect();
     files.sort();
     assert!(files.len() >= 20, "{} fixtures", files.len());
     let bless = std::env::var_os("BLESS").is_some();
@@ -219,7 +278,8 @@ fn bad_files_give_the_expected_messages() {
             std::fs::write(&expected_path, &got).unwrap();
             continue;
         }
-        let expected = std::fs::read_to_string(&expected_path).unwrap_or_else(|_| panic!("{} has no {}", f.display(), expected_path.display()));
+        let expected = std::fs::read_to_string(&expected_path)
+            .unwrap_or_else(|_| panic!("{} has no {}", f.display(), expected_path.display()));
         if got != expected {
             wrong.push(format!("{}:\n--- expected\n{expected}--- got\n{got}", f.display()));
         }

@@ -3,7 +3,7 @@
 //! unchunked result at every element (including each chunk boundary) and with the f64 twin.
 
 use crate::common;
-use brdfprof::brdf::{samples, ModelSpec};
+use brdfprof::brdf::{ModelSpec, samples};
 use brdfprof::gpu::ChunkPlan;
 use brdfprof::kernels::{self, RunLimits};
 
@@ -16,13 +16,20 @@ fn eval_past_max_storage_buffer_range() {
     assert!(n * 64 > 128 << 20 || n * 64 > range);
     let base = samples::well_conditioned(50_000, 5, 0.05, 0.2..1.0);
     let samples: Vec<_> = (0..n).map(|i| base[(i * 7919) % base.len()]).collect();
-    assert!(ChunkPlan::new(&gpu.info, n as u64, &[64, 16], None).chunks.len() > 1, "the input must need several bindings");
+    assert!(
+        ChunkPlan::new(&gpu.info, n as u64, &[64, 16], None).chunks.len() > 1,
+        "the input must need several bindings"
+    );
     let spec = ModelSpec::preset("cook-torrance").unwrap();
     let big = kernels::eval(&gpu, &common::model(spec), &samples, RunLimits::default()).unwrap();
     let small = kernels::eval(&gpu, &common::model(spec), &base, RunLimits::default()).unwrap();
     assert_eq!(big.len(), n);
     for (i, got) in big.iter().enumerate() {
-        assert_eq!(*got, small[(i * 7919) % base.len()], "element {i} differs from the same sample evaluated unchunked");
+        assert_eq!(
+            *got,
+            small[(i * 7919) % base.len()],
+            "element {i} differs from the same sample evaluated unchunked"
+        );
     }
     for (s, g) in base.iter().zip(&small).step_by(97) {
         let want = spec.eval(s);

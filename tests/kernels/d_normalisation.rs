@@ -35,7 +35,18 @@ fn every_d_integrates_to_one_as_projected_area() {
         for r in [0.1, 0.2, 0.35, 0.5, 0.75, 1.0] {
             let a = spec.alpha(r);
             let nodes = nodes(a);
-            let inputs: Vec<TermInput> = nodes.iter().map(|&(th, _)| TermInput { nov: 1.0, nol: 1.0, noh: th.cos() as f32, voh: 1.0, sin2h: th.sin().powi(2) as f32, roughness: r as f32, f0: [1.0; 3] }).collect();
+            let inputs: Vec<TermInput> = nodes
+                .iter()
+                .map(|&(th, _)| TermInput {
+                    nov: 1.0,
+                    nol: 1.0,
+                    noh: th.cos() as f32,
+                    voh: 1.0,
+                    sin2h: th.sin().powi(2) as f32,
+                    roughness: r as f32,
+                    f0: [1.0; 3],
+                })
+                .collect();
             let gpu_d = kernels::terms(&gpu, &common::model(spec), &inputs).unwrap();
             let (mut on_gpu, mut twin) = (0.0, 0.0);
             for (&(th, w), out) in nodes.iter().zip(&gpu_d) {

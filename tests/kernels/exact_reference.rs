@@ -5,8 +5,8 @@
 
 use crate::common;
 use brdfprof::brdf::exact::{self, lambda_beckmann, lambda_numeric};
-use brdfprof::brdf::terms::{self, f_conductor, f_dielectric, Lobe, Params};
-use brdfprof::brdf::{Metal, D};
+use brdfprof::brdf::terms::{self, Lobe, Params, f_conductor, f_dielectric};
+use brdfprof::brdf::{D, Metal};
 
 #[test]
 fn smith_g1_tends_to_one_at_normal_incidence() {
@@ -20,7 +20,11 @@ fn smith_g1_tends_to_one_at_normal_incidence() {
             }
             // and falls to 0 at grazing (a grazing lobe, like sheen's, masks less there)
             let g1 = 1.0 / (1.0 + exact::lambda(d, 1e-4, a, p));
-            assert!(g1 < 0.05 || d.row().lobe == Lobe::Grazing && g1 < 0.5, "{} r {r}: G1 at grazing = {g1}", spec.name());
+            assert!(
+                g1 < 0.05 || d.row().lobe == Lobe::Grazing && g1 < 0.5,
+                "{} r {r}: G1 at grazing = {g1}",
+                spec.name()
+            );
         }
     }
 }
@@ -36,7 +40,11 @@ fn separable_g2_never_exceeds_height_correlated() {
                     let (lv, ll) = (exact::lambda(d, nov, a, p), exact::lambda(d, nol, a, p));
                     let separable = 1.0 / ((1.0 + lv) * (1.0 + ll));
                     let correlated = 1.0 / (1.0 + lv + ll);
-                    assert!(separable <= correlated + 1e-12, "{} r {r} NoV {nov} NoL {nol}: {separable} > {correlated}", spec.name());
+                    assert!(
+                        separable <= correlated + 1e-12,
+                        "{} r {r} NoV {nov} NoL {nol}: {separable} > {correlated}",
+                        spec.name()
+                    );
                 }
             }
         }
@@ -53,7 +61,11 @@ fn closed_form_lambdas_equal_their_integrated_definition() {
             for cos in [0.01, 0.05, 0.2, 0.5, 0.8, 0.95] {
                 let Some(closed) = (spec.d.row().lambda)(cos, a, &spec.params) else { continue };
                 let numeric = lambda_numeric(|c| spec.d.at(c, a, &spec.params), cos, a);
-                assert!((numeric - closed).abs() <= 1e-6 * (1.0 + closed), "{} r {r} cos {cos}: integrated {numeric}, closed form {closed}", spec.name());
+                assert!(
+                    (numeric - closed).abs() <= 1e-6 * (1.0 + closed),
+                    "{} r {r} cos {cos}: integrated {numeric}, closed form {closed}",
+                    spec.name()
+                );
             }
         }
     }
@@ -65,7 +77,11 @@ fn closed_form_lambdas_equal_their_integrated_definition() {
 fn fresnel_is_f0_at_normal_incidence_and_one_at_grazing() {
     for f0 in [0.0, 0.02, 0.04, 0.08, 0.2, 0.5, 0.9] {
         assert!((f_dielectric(f0, 1.0) - f0).abs() < 1e-12, "dielectric F(1) for F0 {f0}");
-        assert!(f_dielectric(f0, 1e-9) > 0.999999 || f0 == 0.0, "dielectric F(0) for F0 {f0}: {}", f_dielectric(f0, 1e-9));
+        assert!(
+            f_dielectric(f0, 1e-9) > 0.999999 || f0 == 0.0,
+            "dielectric F(0) for F0 {f0}: {}",
+            f_dielectric(f0, 1e-9)
+        );
         assert!((terms::f_schlick(f0, 1.0) - f0).abs() < 1e-15 && (terms::f_schlick(f0, 0.0) - 1.0).abs() < 1e-15);
     }
     for &metal in Metal::ALL {
@@ -83,12 +99,27 @@ fn fresnel_is_f0_at_normal_incidence_and_one_at_grazing() {
 #[derive(Clone, Copy)]
 struct C(f64, f64);
 impl C {
-    fn add(self, o: C) -> C { C(self.0 + o.0, self.1 + o.1) }
-    fn sub(self, o: C) -> C { C(self.0 - o.0, self.1 - o.1) }
-    fn mul(self, o: C) -> C { C(self.0 * o.0 - self.1 * o.1, self.0 * o.1 + self.1 * o.0) }
-    fn div(self, o: C) -> C { let d = o.0 * o.0 + o.1 * o.1; C((self.0 * o.0 + self.1 * o.1) / d, (self.1 * o.0 - self.0 * o.1) / d) }
-    fn sqrt(self) -> C { let r = (self.0 * self.0 + self.1 * self.1).sqrt(); let re = ((r + self.0) / 2.0).sqrt(); C(re, (self.1).signum() * ((r - self.0) / 2.0).sqrt()) }
-    fn norm2(self) -> f64 { self.0 * self.0 + self.1 * self.1 }
+    fn add(self, o: C) -> C {
+        C(self.0 + o.0, self.1 + o.1)
+    }
+    fn sub(self, o: C) -> C {
+        C(self.0 - o.0, self.1 - o.1)
+    }
+    fn mul(self, o: C) -> C {
+        C(self.0 * o.0 - self.1 * o.1, self.0 * o.1 + self.1 * o.0)
+    }
+    fn div(self, o: C) -> C {
+        let d = o.0 * o.0 + o.1 * o.1;
+        C((self.0 * o.0 + self.1 * o.1) / d, (self.1 * o.0 - self.0 * o.1) / d)
+    }
+    fn sqrt(self) -> C {
+        let r = (self.0 * self.0 + self.1 * self.1).sqrt();
+        let re = ((r + self.0) / 2.0).sqrt();
+        C(re, (self.1).signum() * ((r - self.0) / 2.0).sqrt())
+    }
+    fn norm2(self) -> f64 {
+        self.0 * self.0 + self.1 * self.1
+    }
 }
 
 /// Born & Wolf: r_s = (cos_i - eta cos_t)/(cos_i + eta cos_t), r_p = (eta cos_i - cos_t)/(eta cos_i + cos_t),
@@ -112,7 +143,11 @@ fn conductor_fresnel_matches_complex_amplitudes_and_published_reflectance() {
             let ours = f_conductor(metal, cos);
             for c in 0..3 {
                 let textbook = fresnel_complex(n[c], k[c], cos);
-                assert!((ours[c] - textbook).abs() < 1e-9, "{metal:?} channel {c} cos {cos}: {} vs {textbook}", ours[c]);
+                assert!(
+                    (ours[c] - textbook).abs() < 1e-9,
+                    "{metal:?} channel {c} cos {cos}: {} vs {textbook}",
+                    ours[c]
+                );
             }
         }
     }
@@ -128,7 +163,12 @@ fn conductor_fresnel_matches_complex_amplitudes_and_published_reflectance() {
     for (metal, f0, tolerance) in published {
         let ours = f_conductor(metal, 1.0);
         for c in 0..3 {
-            assert!((ours[c] - f0[c]).abs() <= tolerance, "{metal:?} channel {c}: F0 {} vs published {}", ours[c], f0[c]);
+            assert!(
+                (ours[c] - f0[c]).abs() <= tolerance,
+                "{metal:?} channel {c}: F0 {} vs published {}",
+                ours[c],
+                f0[c]
+            );
         }
     }
 }

@@ -17,7 +17,10 @@ fn is_ident(c: char) -> bool {
 
 /// Index just past a raw string starting at `i` (`r"`, `r#"`, ...), or None when `i` starts none.
 fn raw_string_end(s: &[char], i: usize) -> Option<usize> {
-    if s[i] != 'r' || (i > 0 && is_ident(s[i - 1]) && s[i - 1] != 'b') || (i > 1 && s[i - 1] == 'b' && is_ident(s[i - 2])) {
+    if s[i] != 'r'
+        || (i > 0 && is_ident(s[i - 1]) && s[i - 1] != 'b')
+        || (i > 1 && s[i - 1] == 'b' && is_ident(s[i - 2]))
+    {
         return None;
     }
     let hashes = s[i + 1..].iter().take_while(|c| **c == '#').count();
@@ -26,7 +29,10 @@ fn raw_string_end(s: &[char], i: usize) -> Option<usize> {
     }
     let mut j = i + 2 + hashes;
     while j < s.len() {
-        if s[j] == '"' && s[j + 1..].iter().take(hashes).filter(|c| **c == '#').count() == hashes && j + hashes < s.len() {
+        if s[j] == '"'
+            && s[j + 1..].iter().take(hashes).filter(|c| **c == '#').count() == hashes
+            && j + hashes < s.len()
+        {
             return Some(j + 1 + hashes);
         }
         j += 1;
@@ -110,7 +116,8 @@ fn functions(text: &str) -> Vec<(String, usize, usize)> {
     let mut out = Vec::new();
     let mut i = 0;
     while i + 2 < code.len() {
-        let keyword = code[i] == 'f' && code[i + 1] == 'n' && (i == 0 || !is_ident(code[i - 1])) && !is_ident(code[i + 2]);
+        let keyword =
+            code[i] == 'f' && code[i + 1] == 'n' && (i == 0 || !is_ident(code[i - 1])) && !is_ident(code[i + 2]);
         if !keyword {
             i += 1;
             continue;

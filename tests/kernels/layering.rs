@@ -8,8 +8,31 @@ use std::path::{Path, PathBuf};
 
 /// Top-level modules of src/, lowest first: a module may use only those before it. Written once, here.
 const LAYERS: &[&str] = &[
-    "host", "stats", "io", "cache", "shaders", "model", "kernels", "spirv", "accuracy",
-    "export", "schema", "kernel_stats", "profile", "translate", "targets", "inspect", "compare", "devices", "check", "sweep", "sweep_cost", "stability", "scene", "diff", "report_page",
+    "host",
+    "stats",
+    "io",
+    "cache",
+    "shaders",
+    "model",
+    "kernels",
+    "spirv",
+    "accuracy",
+    "export",
+    "schema",
+    "kernel_stats",
+    "profile",
+    "translate",
+    "targets",
+    "inspect",
+    "compare",
+    "devices",
+    "check",
+    "sweep",
+    "sweep_cost",
+    "stability",
+    "scene",
+    "diff",
+    "report_page",
 ];
 
 pub fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
@@ -36,7 +59,8 @@ fn names_after(text: &str, prefix: &str) -> BTreeSet<String> {
             // `use crate::{a, b}` / `use super::{a, b}`
             if let Some(group) = rest.strip_prefix('{') {
                 for part in group.split('}').next().unwrap_or("").split(',') {
-                    let n: String = part.trim().chars().take_while(|c| c.is_ascii_alphanumeric() || *c == '_').collect();
+                    let n: String =
+                        part.trim().chars().take_while(|c| c.is_ascii_alphanumeric() || *c == '_').collect();
                     if !n.is_empty() {
                         out.insert(n);
                     }
@@ -51,7 +75,10 @@ fn sources() -> Vec<(PathBuf, String)> {
     let src = common::repo_root().join("src");
     let mut files = Vec::new();
     rust_files(&src, &mut files);
-    files.into_iter().map(|f| (f.strip_prefix(&src).unwrap().to_path_buf(), std::fs::read_to_string(&f).unwrap())).collect()
+    files
+        .into_iter()
+        .map(|f| (f.strip_prefix(&src).unwrap().to_path_buf(), std::fs::read_to_string(&f).unwrap()))
+        .collect()
 }
 
 #[test]
@@ -62,10 +89,14 @@ fn no_module_uses_one_above_it() {
         if ["main", "lib", "cli"].contains(&top.as_str()) {
             continue;
         }
-        let own = LAYERS.iter().position(|l| *l == top).unwrap_or_else(|| panic!("src/{}: module `{top}` is not in LAYERS (tests/kernels/layering.rs)", rel.display()));
+        let own = LAYERS.iter().position(|l| *l == top).unwrap_or_else(|| {
+            panic!("src/{}: module `{top}` is not in LAYERS (tests/kernels/layering.rs)", rel.display())
+        });
         for used in names_after(&text, "crate::") {
             match LAYERS.iter().position(|l| *l == used) {
-                Some(i) if i > own => bad.push(format!("src/{} ({top}) uses crate::{used}, a layer above it", rel.display())),
+                Some(i) if i > own => {
+                    bad.push(format!("src/{} ({top}) uses crate::{used}, a layer above it", rel.display()))
+                }
                 _ => {}
             }
         }
@@ -104,13 +135,18 @@ fn no_two_files_of_a_folder_use_each_other() {
 #[test]
 fn leaf_crates_keep_their_dependencies() {
     const HEAVY: &[&str] = &["ash", "naga", "naga_oil", "plotters", "brdfprof"];
-    const ALLOWED: &[(&str, &[&str])] = &[("brdf", &[]), ("process", &[]), ("spirv-c", &[]), ("vulkan", &["ash", "brdfprof-process"])];
+    const ALLOWED: &[(&str, &[&str])] =
+        &[("brdf", &[]), ("process", &[]), ("spirv-c", &[]), ("vulkan", &["ash", "brdfprof-process"])];
     let root = common::repo_root().join("crates");
     let mut found = BTreeSet::new();
     for e in std::fs::read_dir(&root).unwrap() {
         let dir = e.unwrap().path();
         let name = dir.file_name().unwrap().to_string_lossy().to_string();
-        let allowed = ALLOWED.iter().find(|(n, _)| *n == name).unwrap_or_else(|| panic!("crates/{name} is not in ALLOWED (tests/kernels/layering.rs)")).1;
+        let allowed = ALLOWED
+            .iter()
+            .find(|(n, _)| *n == name)
+            .unwrap_or_else(|| panic!("crates/{name} is not in ALLOWED (tests/kernels/layering.rs)"))
+            .1;
         found.insert(name.clone());
         let manifest = std::fs::read_to_string(dir.join("Cargo.toml")).unwrap();
         let deps = manifest.split("[dependencies]").nth(1).unwrap_or("").split("\n[").next().unwrap_or("");

@@ -4,7 +4,7 @@
 
 use crate::common::{self, Worst};
 use brdfprof::brdf::spec::with_each_param_sample;
-use brdfprof::brdf::{samples, ModelSpec, PRESETS};
+use brdfprof::brdf::{ModelSpec, PRESETS, samples};
 use brdfprof::kernels::{self, RunLimits};
 
 fn check(gpu: &brdfprof::gpu::Gpu, spec: &ModelSpec, count: usize, seed: u64) -> Worst {
@@ -14,7 +14,9 @@ fn check(gpu: &brdfprof::gpu::Gpu, spec: &ModelSpec, count: usize, seed: u64) ->
     for (s, g) in samples.iter().zip(&got) {
         let reference = spec.eval(s);
         for c in 0..3 {
-            worst.update(common::rel_err(g[c] as f64, reference[c]), || format!("{s:?} channel {c}: gpu {} f64 {}", g[c], reference[c]));
+            worst.update(common::rel_err(g[c] as f64, reference[c]), || {
+                format!("{s:?} channel {c}: gpu {} f64 {}", g[c], reference[c])
+            });
         }
     }
     worst
@@ -46,7 +48,10 @@ fn every_preset_parameter_value_and_a_limit() {
     let gtr2 = common::model(ModelSpec::parse("d=gtr,vis=implicit,f=none,gamma=2").unwrap());
     let ggx = common::model(ModelSpec::parse("d=ggx,vis=implicit,f=none").unwrap());
     let s = samples::well_conditioned(20_000, 9, 0.05, 0.2..1.0);
-    let (a, b) = (kernels::eval(&gpu, &gtr2, &s, RunLimits::default()).unwrap(), kernels::eval(&gpu, &ggx, &s, RunLimits::default()).unwrap());
+    let (a, b) = (
+        kernels::eval(&gpu, &gtr2, &s, RunLimits::default()).unwrap(),
+        kernels::eval(&gpu, &ggx, &s, RunLimits::default()).unwrap(),
+    );
     for (x, y) in a.iter().zip(&b) {
         assert!(common::rel_err(x[0] as f64, y[0] as f64) < 1e-3, "GTR(2) {} vs GGX {}", x[0], y[0]);
     }
@@ -58,7 +63,8 @@ fn every_preset_without_its_guards_matches_its_unguarded_twin() {
     use brdfprof::brdf::guards::{GuardSet, SWITCHES};
     let gpu = common::gpu();
     // All guards off, and each one off alone: the twin follows the same switches (`spec::cosines_with`).
-    let sets: Vec<GuardSet> = std::iter::once(GuardSet::NONE).chain(SWITCHES.iter().map(|s| GuardSet(GuardSet::ALL.0 & !s.bit))).collect();
+    let sets: Vec<GuardSet> =
+        std::iter::once(GuardSet::NONE).chain(SWITCHES.iter().map(|s| GuardSet(GuardSet::ALL.0 & !s.bit))).collect();
     for preset in PRESETS {
         for &guards in &sets {
             let spec = ModelSpec { guards, ..ModelSpec::preset(preset.name).unwrap() };
@@ -68,11 +74,18 @@ fn every_preset_without_its_guards_matches_its_unguarded_twin() {
     }
     // Off the well-conditioned set the switches change the result, on the GPU as in the twin: a back-facing
     // light gives 0 with the lit mask and not without it; F0 = 2 is clamped to 1 only with the F0 clamp.
-    let back = brdfprof::brdf::Sample { n: [0.0, 0.0, 1.0], v: [0.0, 0.6, 0.8], l: [0.6, 0.0, -0.8], roughness: 0.5, f0: [0.04; 3] };
+    let back = brdfprof::brdf::Sample {
+        n: [0.0, 0.0, 1.0],
+        v: [0.0, 0.6, 0.8],
+        l: [0.6, 0.0, -0.8],
+        roughness: 0.5,
+        f0: [0.04; 3],
+    };
     let bright = brdfprof::brdf::Sample { l: [0.6, 0.0, 0.8], f0: [2.0; 3], ..back };
     for (text, sample) in [("ggx,guards=off:lit-mask", back), ("ggx,guards=off:f0-clamp", bright)] {
         let spec = ModelSpec::parse(text).unwrap();
-        let [on, off] = [ModelSpec::preset("ggx").unwrap(), spec].map(|s| kernels::eval(&gpu, &common::model(s), &[sample], RunLimits::default()).unwrap()[0][0] as f64);
+        let [on, off] = [ModelSpec::preset("ggx").unwrap(), spec]
+            .map(|s| kernels::eval(&gpu, &common::model(s), &[sample], RunLimits::default()).unwrap()[0][0] as f64);
         assert!(on != off, "{text}: guarded {on}, unguarded {off}");
         let twin = spec.eval(&sample)[0];
         assert!(common::rel_err(off, twin) <= 1e-3 || (off.is_nan() && twin.is_nan()), "{text}: gpu {off} twin {twin}");

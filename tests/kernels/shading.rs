@@ -6,9 +6,9 @@
 use crate::common;
 use brdfprof::brdf::THESIS_MODELS;
 use brdfprof::model::Model;
-use brdfprof::profile::gbuffer::{self, Camera, GBufferFormat, Surface, LIGHT_FLOATS, R11G11B10_REL_ERROR};
+use brdfprof::profile::gbuffer::{self, Camera, GBufferFormat, LIGHT_FLOATS, R11G11B10_REL_ERROR, Surface};
 use brdfprof::profile::protocol::Timed;
-use brdfprof::profile::workload::{light_blocks, Variant, Workload};
+use brdfprof::profile::workload::{Variant, Workload, light_blocks};
 use glam::DVec3;
 
 const W: u32 = 96;
@@ -44,7 +44,11 @@ fn both_gbuffer_layouts_shade_their_values_and_agree_within_the_packing() {
     let gpu = common::gpu();
     let camera = Camera::new(W, H);
     for light_count in [8, 21] {
-        assert_eq!(light_blocks(light_count).len() > 1, light_count > 8, "21 lights take three blocks, the last partial");
+        assert_eq!(
+            light_blocks(light_count).len() > 1,
+            light_count > 8,
+            "21 lights take three blocks, the last partial"
+        );
         let lights = gbuffer::lights(light_count);
         let blocks = light_blocks(light_count).len() as f64;
         for name in THESIS_MODELS {
@@ -69,10 +73,20 @@ fn both_gbuffer_layouts_shade_their_values_and_agree_within_the_packing() {
                         let e_packed = (f64::from(packed[i][c]) - want_packed[c]).abs() / scale;
                         worst_float = worst_float.max(e_float);
                         worst_packed = worst_packed.max(e_packed);
-                        assert!(e_float <= 2e-3, "{name}, {light_count} lights, float, pixel ({x}, {y}) channel {c}: {} vs twin {}", float[i][c], want_float[c]);
+                        assert!(
+                            e_float <= 2e-3,
+                            "{name}, {light_count} lights, float, pixel ({x}, {y}) channel {c}: {} vs twin {}",
+                            float[i][c],
+                            want_float[c]
+                        );
                         // Each block's sum is rounded to R11G11B10F once, and read back by the next.
                         let bound = f64::from(R11G11B10_REL_ERROR) * blocks + 2e-3;
-                        assert!(e_packed <= bound, "{name}, {light_count} lights, packed, pixel ({x}, {y}) channel {c}: {} vs twin of the stored values {} (bound {bound})", packed[i][c], want_packed[c]);
+                        assert!(
+                            e_packed <= bound,
+                            "{name}, {light_count} lights, packed, pixel ({x}, {y}) channel {c}: {} vs twin of the stored values {} (bound {bound})",
+                            packed[i][c],
+                            want_packed[c]
+                        );
                         picture_diff.push((f64::from(packed[i][c]) - f64::from(float[i][c])).abs() / scale);
                     }
                 }
@@ -80,10 +94,15 @@ fn both_gbuffer_layouts_shade_their_values_and_agree_within_the_packing() {
             picture_diff.sort_by(f64::total_cmp);
             let median = picture_diff[picture_diff.len() / 2];
             let p99 = picture_diff[picture_diff.len() * 99 / 100];
-            eprintln!("{name}, {light_count} lights: worst float {worst_float:.2e}, worst packed {worst_packed:.2e}; packed vs float median {median:.2e}, p99 {p99:.2e}");
+            eprintln!(
+                "{name}, {light_count} lights: worst float {worst_float:.2e}, worst packed {worst_packed:.2e}; packed vs float median {median:.2e}, p99 {p99:.2e}"
+            );
             // The two pictures differ by the packing: R11G11B10F rounding, 8-bit roughness and base colour,
             // 16-bit octahedral normals.
-            assert!(median <= f64::from(R11G11B10_REL_ERROR) / 2.0 && p99 <= 0.1, "{name}, {light_count} lights: packed and float pictures differ by median {median}, p99 {p99}");
+            assert!(
+                median <= f64::from(R11G11B10_REL_ERROR) / 2.0 && p99 <= 0.1,
+                "{name}, {light_count} lights: packed and float pictures differ by median {median}, p99 {p99}"
+            );
         }
     }
     common::assert_no_validation_messages(&gpu);

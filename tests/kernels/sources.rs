@@ -41,7 +41,10 @@ fn generated_glsl_is_what_the_rust_tables_generate() {
     let dir = common::repo_root().join("glsl/generated");
     for (name, text) in brdfprof::kernels::generated_glsl() {
         let committed = std::fs::read_to_string(dir.join(name)).unwrap_or_default();
-        assert!(committed == text, "glsl/generated/{name} is stale against the Rust tables: run `make spv` and commit glsl/ and spv/");
+        assert!(
+            committed == text,
+            "glsl/generated/{name} is stale against the Rust tables: run `make spv` and commit glsl/ and spv/"
+        );
     }
 }
 
@@ -68,10 +71,16 @@ fn every_term_has_its_glsl_function_with_the_tables_citation() {
         .collect();
     let mut problems = Vec::new();
     for (name, citation) in rows {
-        let reference = citation.split('[').nth(1).and_then(|r| r.split(']').next()).unwrap_or_else(|| panic!("{name}: citation without [reference]: {citation}"));
+        let reference = citation
+            .split('[')
+            .nth(1)
+            .and_then(|r| r.split(']').next())
+            .unwrap_or_else(|| panic!("{name}: citation without [reference]: {citation}"));
         match comment_above(&glsl, name) {
             None => problems.push(format!("{name}: no GLSL function `{name}(` in glsl/brdf.glsl")),
-            Some(c) if !c.contains(reference) => problems.push(format!("{name}: the comment above it does not cite [{reference}]: {c}")),
+            Some(c) if !c.contains(reference) => {
+                problems.push(format!("{name}: the comment above it does not cite [{reference}]: {c}"))
+            }
             Some(_) => {}
         }
     }

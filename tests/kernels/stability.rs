@@ -5,7 +5,7 @@
 //! the CLI exits 1 and says so where it fails. The guards are the same constants in GLSL and Rust.
 
 use crate::common;
-use brdfprof::brdf::{guards, samples, ModelSpec, Precision, PRESETS};
+use brdfprof::brdf::{ModelSpec, PRESETS, Precision, guards, samples};
 use brdfprof::kernels::{self, RunLimits};
 use brdfprof::stability::{self, catalogue, grid};
 
@@ -15,25 +15,39 @@ fn every_fp32_spec_is_stable_over_catalogue_and_grid() {
     let cases = catalogue::hard_cases();
     let grid = grid::samples();
     let reciprocity = samples::well_conditioned(5_000, 4, 1e-3, 0.0..1.0);
-    let specs: Vec<ModelSpec> = stability::default_specs().into_iter().filter(|s| s.precision == Precision::F32).collect();
+    let specs: Vec<ModelSpec> =
+        stability::default_specs().into_iter().filter(|s| s.precision == Precision::F32).collect();
     assert!(specs.len() >= 80, "every D x Vis and every Fresnel");
     let mut problems = Vec::new();
     for spec in &specs {
-        let r = stability::check_model(&gpu, &common::model(*spec), &Default::default(), &cases, &grid, &reciprocity).unwrap();
+        let r = stability::check_model(&gpu, &common::model(*spec), &Default::default(), &cases, &grid, &reciprocity)
+            .unwrap();
         if r.fails() {
-            problems.push(format!("{}: {} NaN, {} Inf, {} negative (worst at {})", r.spec, r.nan, r.inf, r.negative, r.worst.input));
+            problems.push(format!(
+                "{}: {} NaN, {} Inf, {} negative (worst at {})",
+                r.spec, r.nan, r.inf, r.negative, r.worst.input
+            ));
         }
         for c in &r.cases_out_of_tolerance {
-            problems.push(format!("{}: case `{}` got {:?}, expected {:?} ({:.2} x tolerance)", r.spec, c.case, c.got, c.expected, c.deviation));
+            problems.push(format!(
+                "{}: case `{}` got {:?}, expected {:?} ({:.2} x tolerance)",
+                r.spec, c.case, c.got, c.expected, c.deviation
+            ));
         }
         if r.grid_out_of_tolerance > 0 || r.discontinuities > 0 {
-            problems.push(format!("{}: {} grid points out of tolerance, {} steps; worst {:.2} x tolerance at {}", r.spec, r.grid_out_of_tolerance, r.discontinuities, r.worst.deviation, r.worst.input));
+            problems.push(format!(
+                "{}: {} grid points out of tolerance, {} steps; worst {:.2} x tolerance at {}",
+                r.spec, r.grid_out_of_tolerance, r.discontinuities, r.worst.deviation, r.worst.input
+            ));
         }
         if r.invalid_input_poisoned > 0 {
             problems.push(format!("{}: NaN/Inf input came out non-finite or negative", r.spec));
         }
         if r.reciprocity.is_none_or(|x| x > 1e-4) || r.reciprocity_nonfinite > 0 {
-            problems.push(format!("{}: f(v,l) and f(l,v) differ by {:?} ({} NaN/Inf)", r.spec, r.reciprocity, r.reciprocity_nonfinite));
+            problems.push(format!(
+                "{}: f(v,l) and f(l,v) differ by {:?} ({} NaN/Inf)",
+                r.spec, r.reciprocity, r.reciprocity_nonfinite
+            ));
         }
     }
     assert!(problems.is_empty(), "{} problems:\n{}", problems.len(), problems.join("\n"));
@@ -96,7 +110,9 @@ fn cli_exits_1_and_reports_failing_fp16_and_0_when_stable() {
     assert!(md.contains("| ggx ") && md.contains("| ok "));
     assert!(image::open(common::device_file(dir.path(), "furnace-", ".png")).is_ok());
     assert!(image::open(common::device_file(dir.path(), "albedo-", ".png")).is_ok());
-    let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(common::device_file(dir.path(), "stability-", ".json")).unwrap()).unwrap();
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(common::device_file(dir.path(), "stability-", ".json")).unwrap())
+            .unwrap();
     let burley = json["specs"].as_array().unwrap().iter().find(|s| s["spec"] == "burley").unwrap();
     assert!(burley["energy"]["gains_energy"].as_bool().unwrap(), "Burley's GTR with GGX's Smith G gains energy");
 
@@ -105,7 +121,10 @@ fn cli_exits_1_and_reports_failing_fp16_and_0_when_stable() {
     assert!(String::from_utf8_lossy(&failing.stderr).contains("1 spec(s) give NaN, Inf or negative values"));
     let md = std::fs::read_to_string(common::device_file(dir.path(), "stability-", ".md")).unwrap();
     assert!(md.contains("| ggx,precision=f16") && md.contains("FAIL"));
-    let failures = std::fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().path()).find(|p| p.to_string_lossy().ends_with("-failures.png"));
+    let failures = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .find(|p| p.to_string_lossy().ends_with("-failures.png"));
     assert!(failures.is_some_and(|p| image::open(p).is_ok()), "a heat map for the failing spec");
 }
 
@@ -114,7 +133,8 @@ fn guards_are_the_same_constants_in_glsl_and_rust() {
     let glsl = std::fs::read_to_string(common::repo_root().join("glsl/generated/brdf_table.glsl")).unwrap();
     let constant = |name: &str, occurrence: usize| -> f64 {
         let needle = format!("const float {name} = ");
-        let start = glsl.match_indices(&needle).nth(occurrence).unwrap_or_else(|| panic!("{name} in brdf.glsl")).0 + needle.len();
+        let start = glsl.match_indices(&needle).nth(occurrence).unwrap_or_else(|| panic!("{name} in brdf.glsl")).0
+            + needle.len();
         glsl[start..].split(';').next().unwrap().trim().parse().unwrap()
     };
     // MIN_ROUGHNESS appears twice: the fp16 branch first, then fp32.
@@ -133,10 +153,16 @@ fn guards_are_the_same_constants_in_glsl_and_rust() {
 #[test]
 fn stability_says_what_each_guard_saves() {
     let gpu = common::gpu();
-    let presets: Vec<brdfprof::model::Model> = PRESETS.iter().take(2).map(|p| common::model(ModelSpec::preset(p.name).unwrap())).collect();
+    let presets: Vec<brdfprof::model::Model> =
+        PRESETS.iter().take(2).map(|p| common::model(ModelSpec::preset(p.name).unwrap())).collect();
     let models = stability::with_guard_variants(presets.clone());
-    assert_eq!(models.len(), presets.len() * (2 + 2 * guards::SWITCHES.len()), "each preset, off, each off alone, each on alone");
-    let options = stability::StabilityOptions { models, energy: false, reference: None, roughness: None, nov: None, nol: None };
+    assert_eq!(
+        models.len(),
+        presets.len() * (2 + 2 * guards::SWITCHES.len()),
+        "each preset, off, each off alone, each on alone"
+    );
+    let options =
+        stability::StabilityOptions { models, energy: false, reference: None, roughness: None, nov: None, nol: None };
     let report = stability::run(&gpu, &options, &indicatif::ProgressBar::hidden()).unwrap();
     common::assert_no_validation_messages(&gpu);
     assert_eq!(report.guard_savings.len(), presets.len() * (1 + 2 * guards::SWITCHES.len()));
@@ -154,12 +180,20 @@ fn stability_says_what_each_guard_saves() {
         for g in &mine {
             let set = guards::GuardSet::parse(&g.off).unwrap();
             if set.0 & safe_h.bit != 0 {
-                assert!(!g.cases.contains(&no_half_vector), "{} {}: L = -V out of tolerance with the safe half vector on", p.name(), g.off);
+                assert!(
+                    !g.cases.contains(&no_half_vector),
+                    "{} {}: L = -V out of tolerance with the safe half vector on",
+                    p.name(),
+                    g.off
+                );
             }
         }
     }
     let md = report.markdown();
-    assert!(md.contains("## What each guard saves") && md.contains("only safe-h") && md.contains("all but lit-mask"), "{md}");
+    assert!(
+        md.contains("## What each guard saves") && md.contains("only safe-h") && md.contains("all but lit-mask"),
+        "{md}"
+    );
 }
 
 /// Issue 32: a `.brdf` file's failures named where they happen. unclamped-ggx.brdf (written for the tests, no
@@ -172,32 +206,59 @@ fn stability_names_a_files_failing_inputs_and_the_guard_that_removes_them() {
     let dir = tempfile::tempdir().unwrap();
     let file = common::repo_root().join("tests/fixtures/brdf/engine/unclamped-ggx.brdf");
     let run = |extra: &[&str]| -> (Option<i32>, String, serde_json::Value) {
-        let out = common::brdfprof().args(["stability", "--validate", "--no-energy", "--model"]).arg(&file).arg("--out").arg(dir.path()).args(extra).output().unwrap();
+        let out = common::brdfprof()
+            .args(["stability", "--validate", "--no-energy", "--model"])
+            .arg(&file)
+            .arg("--out")
+            .arg(dir.path())
+            .args(extra)
+            .output()
+            .unwrap();
         let md = std::fs::read_to_string(common::device_file(dir.path(), "stability-", ".md")).unwrap();
-        let json = serde_json::from_str(&std::fs::read_to_string(common::device_file(dir.path(), "stability-", ".json")).unwrap()).unwrap();
+        let json = serde_json::from_str(
+            &std::fs::read_to_string(common::device_file(dir.path(), "stability-", ".json")).unwrap(),
+        )
+        .unwrap();
         (out.status.code(), md, json)
     };
     let html = dir.path().join("report.html");
     let (code, md, json) = run(&["--html", html.to_str().unwrap()]);
     assert_eq!(code, Some(1), "{md}");
     let page = std::fs::read_to_string(&html).unwrap();
-    assert!(page.contains("Where the failing specs fail") && page.contains("removed by `roughness-floor`") && page.contains("(no twin)"), "the page says what the Markdown says");
+    assert!(
+        page.contains("Where the failing specs fail")
+            && page.contains("removed by `roughness-floor`")
+            && page.contains("(no twin)"),
+        "the page says what the Markdown says"
+    );
     let spec = &json["specs"][0];
     let failures = &spec["failures"];
     let cases = failures["cases"].as_array().unwrap();
-    let peak = cases.iter().find(|c| c["at"] == "roughness 0, N = H").unwrap_or_else(|| panic!("the 0/0 case is named: {failures}"));
+    let peak = cases
+        .iter()
+        .find(|c| c["at"] == "roughness 0, N = H")
+        .unwrap_or_else(|| panic!("the 0/0 case is named: {failures}"));
     assert_eq!(peak["input"]["roughness"].as_f64(), Some(0.0));
     assert!(peak["got"].as_array().unwrap().iter().all(|x| x.is_null()), "NaN, written as null: {peak}");
     let removed: Vec<&str> = peak["removed_by"].as_array().unwrap().iter().map(|x| x.as_str().unwrap()).collect();
     assert_eq!(removed, ["roughness-floor", "all"], "only the roughness floor removes a 0/0 at roughness 0");
     for c in cases {
-        assert!((c["input"]["roughness"].as_f64().unwrap()) < guards::MIN_ROUGHNESS_F32, "a failure above the floor: {c}");
+        assert!(
+            (c["input"]["roughness"].as_f64().unwrap()) < guards::MIN_ROUGHNESS_F32,
+            "a failure above the floor: {c}"
+        );
     }
     let grid_points = failures["grid_points"].as_u64().unwrap();
     assert!(grid_points > 0);
-    let floor = failures["grid_removed_by"].as_array().unwrap().iter().find(|g| g["guard"] == "roughness-floor").unwrap();
+    let floor =
+        failures["grid_removed_by"].as_array().unwrap().iter().find(|g| g["guard"] == "roughness-floor").unwrap();
     assert_eq!(floor["removes"].as_u64(), Some(grid_points), "{failures}");
-    assert!(md.contains("hard cases `roughness 0, N = H`") && md.contains("roughness 0, F0") && md.contains("removed by `roughness-floor`"), "{md}");
+    assert!(
+        md.contains("hard cases `roughness 0, N = H`")
+            && md.contains("roughness 0, F0")
+            && md.contains("removed by `roughness-floor`"),
+        "{md}"
+    );
     assert!(spec["jumps_checked"] == false && md.contains("- (no reference)"), "no jumps counted without a reference");
 
     let (code, md, json) = run(&["--roughness", "0.05..1", "--reference", "d=ggx,vis=smith-ggx-correlated,f=schlick"]);
@@ -206,8 +267,12 @@ fn stability_names_a_files_failing_inputs_and_the_guard_that_removes_them() {
     assert!(spec["cases_outside_domain"].as_u64().unwrap() > 0 && spec["grid_outside_domain"].as_u64().unwrap() > 0);
     assert_eq!(spec["expected_from"], "reference `d=ggx,vis=smith-ggx-correlated,f=schlick`");
     assert_eq!(spec["jumps_checked"], true);
-    let out: Vec<&str> = spec["cases_out_of_tolerance"].as_array().unwrap().iter().map(|c| c["case"].as_str().unwrap()).collect();
-    assert!(!out.contains(&"L = V") && !out.contains(&"N = H exactly"), "the same maths within tolerance of its reference where both are well conditioned: {out:?}");
+    let out: Vec<&str> =
+        spec["cases_out_of_tolerance"].as_array().unwrap().iter().map(|c| c["case"].as_str().unwrap()).collect();
+    assert!(
+        !out.contains(&"L = V") && !out.contains(&"N = H exactly"),
+        "the same maths within tolerance of its reference where both are well conditioned: {out:?}"
+    );
     assert!(md.contains("checked against the reference") && md.contains("not counted"), "{md}");
 
     // The same domain and reference declared in the file, with grazing N.V left out too: no flag needed.
@@ -216,11 +281,24 @@ fn stability_names_a_files_failing_inputs_and_the_guard_that_removes_them() {
     let with = text.replacen("bind roughness=@roughness f0=@f0", "bind roughness=@roughness f0=@f0\ndomain roughness 0.05 1\ndomain nov 0.1 1\nreference d=ggx,vis=smith-ggx-correlated,f=schlick", 1);
     assert_ne!(with, text);
     std::fs::write(&declared, with).unwrap();
-    let out = common::brdfprof().args(["stability", "--validate", "--no-energy", "--model"]).arg(&declared).arg("--out").arg(dir.path()).output().unwrap();
-    let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(common::device_file(dir.path(), "stability-", ".json")).unwrap()).unwrap();
+    let out = common::brdfprof()
+        .args(["stability", "--validate", "--no-energy", "--model"])
+        .arg(&declared)
+        .arg("--out")
+        .arg(dir.path())
+        .output()
+        .unwrap();
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(common::device_file(dir.path(), "stability-", ".json")).unwrap())
+            .unwrap();
     let decl = &json["specs"][0];
     assert_eq!(out.status.code(), Some(0), "{decl}");
     assert_eq!(decl["expected_from"], spec["expected_from"], "the file's own reference");
     assert_eq!(decl["domain"], "roughness in [0.05, 1], NoV in [0.1, 1]");
-    assert!(decl["grid_outside_domain"].as_u64() > spec["grid_outside_domain"].as_u64(), "grazing N.V left out as well: {} against {}", decl["grid_outside_domain"], spec["grid_outside_domain"]);
+    assert!(
+        decl["grid_outside_domain"].as_u64() > spec["grid_outside_domain"].as_u64(),
+        "grazing N.V left out as well: {} against {}",
+        decl["grid_outside_domain"],
+        spec["grid_outside_domain"]
+    );
 }

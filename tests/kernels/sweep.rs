@@ -10,7 +10,8 @@ fn small_sweep_is_consistent() {
     let dir = tempfile::tempdir().unwrap();
     let models = ["ggx", "cook-torrance", "d=ggx,vis=smith-ggx-correlated,f=dielectric", "ggx,precision=f16"];
     let mut cmd = common::brdfprof();
-    cmd.args(["sweep", "--validate", "--size", "128x128", "--budget", "4", "--min-rounds", "9", "--out"]).arg(dir.path());
+    cmd.args(["sweep", "--validate", "--size", "128x128", "--budget", "4", "--min-rounds", "9", "--out"])
+        .arg(dir.path());
     for m in models {
         cmd.args(["--model", m]);
     }
@@ -36,12 +37,18 @@ fn small_sweep_is_consistent() {
             c2 <= c && e2 <= e && (c2 < c || e2 < e)
         });
         assert_eq!(r["pareto"].as_bool().unwrap(), !dominated, "Pareto flag of {}", r["spec"]);
-        let tied = rows.iter().enumerate().any(|(j, o)| j != i && get(o, "lo") <= get(r, "hi") && get(r, "lo") <= get(o, "hi"));
+        let tied = rows
+            .iter()
+            .enumerate()
+            .any(|(j, o)| j != i && get(o, "lo") <= get(r, "hi") && get(r, "lo") <= get(o, "hi"));
         assert_eq!(r["tied"].as_bool().unwrap(), tied);
         if i > 0 {
             let prev = &rows[i - 1];
             let key = |r: &Value| (r["rank"].as_u64().unwrap(), get(r, "median"));
-            assert!(key(prev).0 < key(r).0 || key(prev).0 == key(r).0 && key(prev).1 <= key(r).1, "rows sorted by rank, then cost");
+            assert!(
+                key(prev).0 < key(r).0 || key(prev).0 == key(r).0 && key(prev).1 <= key(r).1,
+                "rows sorted by rank, then cost"
+            );
         }
     }
     let row = |name: &str| rows.iter().find(|r| r["spec"] == name).unwrap();
@@ -62,7 +69,10 @@ fn cut_file(domain: &str) -> String {
 fn sweep_json(dir: &std::path::Path, extra: &[&str]) -> Value {
     let out = dir.join(format!("out{}", std::fs::read_dir(dir).unwrap().count()));
     let mut cmd = common::brdfprof();
-    cmd.current_dir(dir).args(["sweep", "--validate", "--size", "16x16", "--budget", "20", "--min-rounds", "3", "--out"]).arg(&out).args(extra);
+    cmd.current_dir(dir)
+        .args(["sweep", "--validate", "--size", "16x16", "--budget", "20", "--min-rounds", "3", "--out"])
+        .arg(&out)
+        .args(extra);
     let r = cmd.output().unwrap();
     assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
     serde_json::from_str(&std::fs::read_to_string(common::device_file(&out, "sweep-", ".json")).unwrap()).unwrap()
@@ -72,27 +82,42 @@ fn sweep_json(dir: &std::path::Path, extra: &[&str]) -> Value {
 fn sweep_samples_its_domain_and_measures_every_model_against_a_chosen_reference() {
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("cut.brdf"), cut_file("")).unwrap();
-    std::fs::write(dir.path().join("cut-declared.brdf"), cut_file("domain roughness 0.3 1\ndomain nov 0.5 1\n")).unwrap();
+    std::fs::write(dir.path().join("cut-declared.brdf"), cut_file("domain roughness 0.3 1\ndomain nov 0.5 1\n"))
+        .unwrap();
     let correlated = "d=ggx,vis=smith-ggx-correlated,f=schlick";
     let models = ["--model", "cut.brdf", "--model", "ggx", "--model", correlated];
-    let row = |s: &Value, name: &str| s["rows"].as_array().unwrap().iter().find(|r| r["spec"].as_str().unwrap().starts_with(name)).unwrap().clone();
+    let row = |s: &Value, name: &str| {
+        s["rows"].as_array().unwrap().iter().find(|r| r["spec"].as_str().unwrap().starts_with(name)).unwrap().clone()
+    };
     let nonfinite = |r: &Value| r["accuracy"]["vs_exact"]["nonfinite"].as_u64().unwrap();
     let rms = |r: &Value| r["accuracy"]["vs_exact"]["rms"].as_f64().unwrap();
 
     let plain = sweep_json(dir.path(), &models);
     assert!(nonfinite(&row(&plain, "cut")) > 0, "the default set reaches below the file's cut");
     assert!(row(&plain, "ggx")["accuracy"]["reference"].is_null(), "a spec against its own exact model by default");
-    assert!(rms(&row(&plain, correlated)) > 1e-3, "the physical Fresnel counts Schlick's error: {}", rms(&row(&plain, correlated)));
+    assert!(
+        rms(&row(&plain, correlated)) > 1e-3,
+        "the physical Fresnel counts Schlick's error: {}",
+        rms(&row(&plain, correlated))
+    );
 
     let mut args = models.to_vec();
     args.extend(["--roughness", "0.3..1", "--nov", "0.5..1", "--reference", correlated, "--exact-fresnel", "own"]);
     let chosen = sweep_json(dir.path(), &args);
     assert_eq!(nonfinite(&row(&chosen, "cut")), 0, "every sample within --roughness and --nov");
-    assert!(chosen["sample_set"].as_str().unwrap().contains("roughness [0.3, 1], NoV [0.5, 1]"), "{}", chosen["sample_set"]);
+    assert!(
+        chosen["sample_set"].as_str().unwrap().contains("roughness [0.3, 1], NoV [0.5, 1]"),
+        "{}",
+        chosen["sample_set"]
+    );
     for r in chosen["rows"].as_array().unwrap() {
         assert_eq!(r["accuracy"]["reference"], correlated, "--reference applies to every model: {}", r["spec"]);
     }
-    assert!(rms(&row(&chosen, correlated)) < 1e-5, "against itself with its own Fresnel only rounding is left: {}", rms(&row(&chosen, correlated)));
+    assert!(
+        rms(&row(&chosen, correlated)) < 1e-5,
+        "against itself with its own Fresnel only rounding is left: {}",
+        rms(&row(&chosen, correlated))
+    );
     assert!(rms(&row(&chosen, "ggx")) > 1e-3, "ggx's joint visibility approximation still shows");
     assert!(chosen["against"].as_str().unwrap().contains("own Fresnel"), "{}", chosen["against"]);
 
@@ -101,5 +126,8 @@ fn sweep_samples_its_domain_and_measures_every_model_against_a_chosen_reference(
     assert!(declared["sample_set"].as_str().unwrap().contains("declared domain"), "{}", declared["sample_set"]);
     let mut crossed = vec!["--model", "cut-declared.brdf", "--model", "ggx", "--roughness", "0.2..0.3"];
     crossed.extend(["--nov", "0.5..1"]);
-    assert!(nonfinite(&row(&sweep_json(dir.path(), &crossed), "cut-declared")) > 0, "--roughness overrides the declaration");
+    assert!(
+        nonfinite(&row(&sweep_json(dir.path(), &crossed), "cut-declared")) > 0,
+        "--roughness overrides the declaration"
+    );
 }

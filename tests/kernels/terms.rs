@@ -4,7 +4,7 @@
 use crate::common::{self, Worst};
 use brdfprof::brdf::guards::guard_cosine;
 use brdfprof::brdf::spec::with_each_param_sample;
-use brdfprof::brdf::{Cosines, ModelSpec, D, F, Vis};
+use brdfprof::brdf::{Cosines, D, F, ModelSpec, Vis};
 use brdfprof::kernels::{self, TermInput};
 use rand::{Rng, SeedableRng};
 
@@ -27,7 +27,13 @@ fn inputs(count: usize, seed: u64) -> Vec<TermInput> {
 }
 
 fn cosines(t: &TermInput) -> Cosines {
-    Cosines { nov: guard_cosine(t.nov as f64), nol: guard_cosine(t.nol as f64), noh: guard_cosine(t.noh as f64), voh: guard_cosine(t.voh as f64), sin2h: t.sin2h as f64 }
+    Cosines {
+        nov: guard_cosine(t.nov as f64),
+        nol: guard_cosine(t.nol as f64),
+        noh: guard_cosine(t.noh as f64),
+        voh: guard_cosine(t.voh as f64),
+        sin2h: t.sin2h as f64,
+    }
 }
 
 #[test]
@@ -51,7 +57,12 @@ fn every_term_matches_its_f64_twin() {
     };
     // Every row of every table, with each sample of the parameters the term reads.
     for spec in common::every_d() {
-        check(spec, &|o, t| vec![(o.d as f64, { let c = cosines(t); spec.d.eval(c.noh, c.sin2h, spec.alpha(t.roughness as f64), &spec.params) })]);
+        check(spec, &|o, t| {
+            vec![(o.d as f64, {
+                let c = cosines(t);
+                spec.d.eval(c.noh, c.sin2h, spec.alpha(t.roughness as f64), &spec.params)
+            })]
+        });
     }
     for &vis in Vis::ALL {
         let spec = ModelSpec::new(D::ALL[0], vis, F::ALL[0]);

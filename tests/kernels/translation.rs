@@ -47,7 +47,10 @@ fn compare(model: &Model, samples: &[Sample], host: &[[f32; 3]], device: &[[f32;
                 o.over += 1;
                 let explained = exact.is_some_and(|x| (hv - dv).abs() <= 2.0 * (dv - x[c]).abs());
                 if !explained {
-                    o.unexplained.push(format!("{model} sample {i} channel {c}: host {hv} device {dv} exact {:?} ({s:?})", exact.map(|x| x[c])));
+                    o.unexplained.push(format!(
+                        "{model} sample {i} channel {c}: host {hv} device {dv} exact {:?} ({s:?})",
+                        exact.map(|x| x[c])
+                    ));
                 }
             }
         }
@@ -67,7 +70,11 @@ fn run(gpu: &brdfprof::gpu::Gpu, model: &Model, samples: &[Sample]) -> Outcome {
 /// after a preset is that preset written out: its twin is the preset's).
 fn examples() -> Vec<Model> {
     let dir = common::repo_root().join("examples/brdf");
-    let mut files: Vec<_> = std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().path()).filter(|p| p.extension().is_some_and(|x| x == "brdf")).collect();
+    let mut files: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x == "brdf"))
+        .collect();
     files.sort();
     assert!(!files.is_empty(), "no examples in {}", dir.display());
     files.iter().map(|p| Model::parse(&format!("{},roughness=@roughness,f0=@f0", p.display())).unwrap()).collect()
@@ -97,11 +104,23 @@ fn the_host_translation_agrees_with_vulkan_on_every_preset_and_example_file() {
                 o.unexplained = compare(&preset, &samples, &on_host, &on_device).unexplained;
             }
         }
-        report.push(format!("{:60} worst {:.2e} ({} of {} values beyond {AGREEMENT:.0e}) at {}", model.label(), o.worst, o.over, 3 * samples.len(), o.at));
+        report.push(format!(
+            "{:60} worst {:.2e} ({} of {} values beyond {AGREEMENT:.0e}) at {}",
+            model.label(),
+            o.worst,
+            o.over,
+            3 * samples.len(),
+            o.at
+        ));
         unexplained.extend(o.unexplained);
     }
     println!("{}", report.join("\n"));
-    assert!(unexplained.is_empty(), "{} values beyond {AGREEMENT:.0e} that the kernel's own rounding does not explain:\n{}", unexplained.len(), unexplained.iter().take(10).cloned().collect::<Vec<_>>().join("\n"));
+    assert!(
+        unexplained.is_empty(),
+        "{} values beyond {AGREEMENT:.0e} that the kernel's own rounding does not explain:\n{}",
+        unexplained.len(),
+        unexplained.iter().take(10).cloned().collect::<Vec<_>>().join("\n")
+    );
     common::assert_no_validation_messages(&gpu);
 }
 
@@ -135,9 +154,17 @@ fn the_translated_profiling_kernel_shades_as_the_vulkan_one_and_the_check_catche
     models.extend(brdfprof::brdf::THESIS_MODELS.iter().map(|m| Some(Model::parse(m).unwrap())));
     models.extend(examples().into_iter().map(Some));
     for m in &models {
-        let agreements = verify::check(&gpu, m.as_ref(), lights, kernels::embedded()).unwrap_or_else(|e| panic!("{e:#}"));
+        let agreements =
+            verify::check(&gpu, m.as_ref(), lights, kernels::embedded()).unwrap_or_else(|e| panic!("{e:#}"));
         for a in &agreements {
-            println!("{:40} {}: worst {:.2e} over {} values (tolerance {:.1e})", m.as_ref().map_or("baseline".into(), Model::label), a.kernel, a.worst, a.values, a.tolerance);
+            println!(
+                "{:40} {}: worst {:.2e} over {} values (tolerance {:.1e})",
+                m.as_ref().map_or("baseline".into(), Model::label),
+                a.kernel,
+                a.worst,
+                a.values,
+                a.tolerance
+            );
         }
         assert_eq!(agreements.len(), if m.is_some() { 2 } else { 1 });
     }
@@ -146,14 +173,22 @@ fn the_translated_profiling_kernel_shades_as_the_vulkan_one_and_the_check_catche
     let outside = |translated: &str, on_device: &str| -> f64 {
         let samples = well_conditioned(verify::EVAL_SAMPLES, 3, 0.05, 0.2..1.0);
         let t = prepare::eval_kernel(&Model::parse(translated).unwrap(), kernels::embedded()).unwrap();
-        let reference = host::eval_reference(&host::HostKernel::compile_reference(&t, &[]).unwrap(), &samples, &EvalExtras::default()).unwrap();
+        let reference = host::eval_reference(
+            &host::HostKernel::compile_reference(&t, &[]).unwrap(),
+            &samples,
+            &EvalExtras::default(),
+        )
+        .unwrap();
         let device = kernels::eval(&gpu, &Model::parse(on_device).unwrap(), &samples, RunLimits::default()).unwrap();
         let flat = |v: Vec<[f32; 3]>| v.into_iter().flatten().collect::<Vec<f32>>();
         judge::tally(&flat(device), &reference.into_iter().flatten().collect::<Vec<_>>(), |_| 0.0, 3).worst
     };
     let (other, nearby) = (outside("ggx", "blinn"), outside("burley,gamma=1.515", "burley"));
     println!("blinn against ggx's reference: {other:.2e} x the bound; burley against gamma 1.515's: {nearby:.2e}");
-    assert!(other > 1e3 && nearby > 2.0, "ggx's reference against blinn's kernel: {other:.2e}, gamma 1.5 against 1.515: {nearby:.2e}");
+    assert!(
+        other > 1e3 && nearby > 2.0,
+        "ggx's reference against blinn's kernel: {other:.2e}, gamma 1.5 against 1.515: {nearby:.2e}"
+    );
     common::assert_no_validation_messages(&gpu);
 }
 
@@ -170,18 +205,49 @@ fn flattening_and_cse_change_no_value() {
     for model in &models {
         let (checked, samples, rows, row_floats) = verify::check_inputs(model);
         let extras = EvalExtras { tangents: None, rows: &rows, row_floats };
-        let run = |how| bits(host::eval(&host::HostKernel::compile(&prepare::eval_kernel_as(&checked, kernels::embedded(), how).unwrap()).unwrap(), &samples, &extras).unwrap());
-        assert!(run(Plain) == run(Flattened), "{model}: the flattened eval kernel's values differ from the plain one's");
+        let run = |how| {
+            bits(
+                host::eval(
+                    &host::HostKernel::compile(&prepare::eval_kernel_as(&checked, kernels::embedded(), how).unwrap())
+                        .unwrap(),
+                    &samples,
+                    &extras,
+                )
+                .unwrap(),
+            )
+        };
+        assert!(
+            run(Plain) == run(Flattened),
+            "{model}: the flattened eval kernel's values differ from the plain one's"
+        );
     }
     let (w, h) = verify::SHADE_SIZE;
     let g = verify::check_gbuffer(w, h);
     let lights = brdfprof::profile::gbuffer::lights(8);
-    let shade_models: Vec<Option<Model>> = std::iter::once(None).chain(brdfprof::brdf::THESIS_MODELS.iter().map(|m| Some(Model::parse(m).unwrap()))).collect();
+    let shade_models: Vec<Option<Model>> = std::iter::once(None)
+        .chain(brdfprof::brdf::THESIS_MODELS.iter().map(|m| Some(Model::parse(m).unwrap())))
+        .collect();
     for m in &shade_models {
-        let run = |how| verify::shade_on_host(&host::HostKernel::compile(&prepare::shade_kernel_as(m.as_ref(), 8, kernels::embedded(), how).unwrap()).unwrap(), &g, &lights, 4).unwrap();
-        assert!(run(Plain) == run(Flattened), "{m:?}: the flattened profiling kernel's pixels differ from the plain one's");
+        let run = |how| {
+            verify::shade_on_host(
+                &host::HostKernel::compile(&prepare::shade_kernel_as(m.as_ref(), 8, kernels::embedded(), how).unwrap())
+                    .unwrap(),
+                &g,
+                &lights,
+                4,
+            )
+            .unwrap()
+        };
+        assert!(
+            run(Plain) == run(Flattened),
+            "{m:?}: the flattened profiling kernel's pixels differ from the plain one's"
+        );
     }
-    println!("{} eval kernels and {} profiling kernels: the same bits flattened and plain", models.len(), shade_models.len());
+    println!(
+        "{} eval kernels and {} profiling kernels: the same bits flattened and plain",
+        models.len(),
+        shade_models.len()
+    );
 }
 
 /// A `.brdf` file's check varies what the model reads: every parameter not bound to an input is read per row,
@@ -198,9 +264,15 @@ fn the_check_varies_a_files_parameters_and_directions() {
     let gammas: Vec<f32> = rows.chunks_exact(floats).map(|r| r[offset]).collect();
     let (lo, hi) = gammas.iter().fold((f32::MAX, f32::MIN), |(a, b), &g| (a.min(g), b.max(g)));
     assert!(floats == 5 && lo < 1.05 && hi > 2.95, "{floats} floats per row; gamma over [{lo}, {hi}]");
-    assert!(checked.file().unwrap().bindings.iter().all(|b| !matches!(b, brdfprof::model::file_model::Binding::Value(_))), "every parameter read per row");
+    assert!(
+        checked.file().unwrap().bindings.iter().all(|b| !matches!(b, brdfprof::model::file_model::Binding::Value(_))),
+        "every parameter read per row"
+    );
     let cos = |s: &Sample| s.n.iter().zip(&s.l).map(|(a, b)| a * b).sum::<f32>();
-    assert!(samples.iter().any(|s| cos(s) < 0.0) && samples.iter().any(|s| cos(s).abs() < 0.01), "back-facing and grazing light");
+    assert!(
+        samples.iter().any(|s| cos(s) < 0.0) && samples.iter().any(|s| cos(s).abs() < 0.01),
+        "back-facing and grazing light"
+    );
 }
 
 #[test]
@@ -218,18 +290,34 @@ fn the_opencl_translation_on_pocl_agrees_with_vulkan_on_every_preset_and_example
         let on_device = kernels::eval(&gpu, model, &samples, RunLimits::default()).unwrap();
         // The native_ forms the Intel figures are compiled with are PoCL's own approximations: within the
         // runtime check's tolerance.
-        let fast = opencl::eval(&opencl::ClKernel::build(&t, false).unwrap(), &samples, &EvalExtras::default()).unwrap();
+        let fast =
+            opencl::eval(&opencl::ClKernel::build(&t, false).unwrap(), &samples, &EvalExtras::default()).unwrap();
         let fast_worst = verify::worst_relative(&fast, &on_device, |i, c| f64::from(on_device[i][c]).abs().max(1e-3));
         assert!(fast_worst <= 1e-4, "{model}: the native_ build differs by {fast_worst:.2e}");
-        let judge = if model.twin().is_some() { model.clone() } else { twin_of_example(model).unwrap_or_else(|| model.clone()) };
+        let judge = if model.twin().is_some() {
+            model.clone()
+        } else {
+            twin_of_example(model).unwrap_or_else(|| model.clone())
+        };
         let o = compare(&judge, &samples, &on_cl, &on_device);
-        report.push(format!("{:60} worst {:.2e} ({} of {} beyond {AGREEMENT:.0e}; native_ build {fast_worst:.2e}) on {}", model.label(), o.worst, o.over, 3 * samples.len(), k.device()));
+        report.push(format!(
+            "{:60} worst {:.2e} ({} of {} beyond {AGREEMENT:.0e}; native_ build {fast_worst:.2e}) on {}",
+            model.label(),
+            o.worst,
+            o.over,
+            3 * samples.len(),
+            k.device()
+        ));
         unexplained.extend(o.unexplained);
     }
     println!("{}", report.join("\n"));
-    assert!(unexplained.is_empty(), "{} values beyond {AGREEMENT:.0e}:\n{}", unexplained.len(), unexplained.iter().take(10).cloned().collect::<Vec<_>>().join("\n"));
+    assert!(
+        unexplained.is_empty(),
+        "{} values beyond {AGREEMENT:.0e}:\n{}",
+        unexplained.len(),
+        unexplained.iter().take(10).cloned().collect::<Vec<_>>().join("\n")
+    );
 }
-
 
 /// Issue 33 item 1: a translated kernel runs in a child process, so a fault in it (here a library that
 /// writes through a null pointer, built by the real g++) is an error that names the signal, and this process
@@ -241,9 +329,20 @@ fn a_kernel_that_faults_ends_its_child_with_a_message_not_brdfprof() {
     let src = dir.path().join("fault.cpp");
     std::fs::write(&src, "extern \"C\" unsigned brdfprof_host_run(unsigned char* const* b, unsigned x, unsigned y, unsigned z) { volatile int* p = nullptr; *p = (int)x; return 0; }\n").unwrap();
     let library = dir.path().join("fault.so");
-    let built = std::process::Command::new("g++").args(["-shared", "-fPIC", "-O0", "-o"]).arg(&library).arg(&src).status().unwrap();
+    let built = std::process::Command::new("g++")
+        .args(["-shared", "-fPIC", "-O0", "-o"])
+        .arg(&library)
+        .arg(&src)
+        .status()
+        .unwrap();
     assert!(built.success());
     let mut buffer = vec![0u8; 16];
-    let e = runner::run(runner::Engine::Host { library }, [1, 1, 1], &mut [&mut buffer], [1, 1, 1], "a faulting kernel").unwrap_err().to_string();
-    assert!(e.starts_with("a faulting kernel: the kernel crashed the child process that ran it (signal 11, SIGSEGV)"), "{e}");
+    let e =
+        runner::run(runner::Engine::Host { library }, [1, 1, 1], &mut [&mut buffer], [1, 1, 1], "a faulting kernel")
+            .unwrap_err()
+            .to_string();
+    assert!(
+        e.starts_with("a faulting kernel: the kernel crashed the child process that ran it (signal 11, SIGSEGV)"),
+        "{e}"
+    );
 }

@@ -9,7 +9,11 @@ use std::path::Path;
 
 fn run(args: &[&str]) -> (i32, String, String) {
     let out = common::brdfprof().args(args).output().unwrap();
-    (out.status.code().unwrap_or(-1), String::from_utf8_lossy(&out.stdout).into_owned(), String::from_utf8_lossy(&out.stderr).into_owned())
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
 }
 
 const SMALL: &str = r#"{
@@ -39,7 +43,10 @@ fn write(dir: &Path, name: &str, text: &str) -> String {
 fn explain_and_check() {
     let (code, out, _) = run(&["scene", "--explain"]);
     assert_eq!(code, 0);
-    assert!(out.contains("\"effects\"") && out.contains("representative point") && out.contains("\"sphere-grid\""), "{out}");
+    assert!(
+        out.contains("\"effects\"") && out.contains("representative point") && out.contains("\"sphere-grid\""),
+        "{out}"
+    );
     let dir = tempfile::tempdir().unwrap();
     let f = write(dir.path(), "s.json", SMALL);
     let (code, out, err) = run(&["scene", &f]);
@@ -71,7 +78,18 @@ fn profile_scene_prints_what_is_compiled_in_and_effect_costs() {
     let dir = tempfile::tempdir().unwrap();
     let f = write(dir.path(), "s.json", SMALL);
     let json = dir.path().join("p.json");
-    let (code, out, err) = run(&["profile", "--validate", "--scene", &f, "--budget", "5", "--min-rounds", "6", "--json", json.to_str().unwrap()]);
+    let (code, out, err) = run(&[
+        "profile",
+        "--validate",
+        "--scene",
+        &f,
+        "--budget",
+        "5",
+        "--min-rounds",
+        "6",
+        "--json",
+        json.to_str().unwrap(),
+    ]);
     assert_eq!(code, 0, "{err}");
     assert!(!err.contains("validation ["), "{err}");
     assert!(out.contains("Compiled in") && out.contains("| ggx ") && out.contains("| blinn "), "{out}");
@@ -83,7 +101,10 @@ fn profile_scene_prints_what_is_compiled_in_and_effect_costs() {
     assert_eq!(effects.len(), 4);
     for e in effects {
         let x = &e["extra_ns_per_pixel"];
-        assert!(x["lo"].as_f64().unwrap() <= x["median"].as_f64().unwrap() && x["median"].as_f64().unwrap() <= x["hi"].as_f64().unwrap());
+        assert!(
+            x["lo"].as_f64().unwrap() <= x["median"].as_f64().unwrap()
+                && x["median"].as_f64().unwrap() <= x["hi"].as_f64().unwrap()
+        );
     }
     // Anisotropy (two lobes' worth of work on the brushed statue's pixels, per light) costs something measurable.
     let aniso = effects.iter().find(|e| e["effect"] == "anisotropy").unwrap();
@@ -101,7 +122,20 @@ fn profile_scene_cost_devices_compile_every_variant_on_each_vendor() {
     let json = dir.path().join("p.json");
     let targets = ["radv:navi21", "nvidia:sm_89", "intel:gen12lp"];
     let isa = dir.path().join("isa");
-    let mut args = vec!["profile", "--validate", "--scene", &f, "--budget", "3", "--min-rounds", "2", "--json", json.to_str().unwrap(), "--isa", isa.to_str().unwrap()];
+    let mut args = vec![
+        "profile",
+        "--validate",
+        "--scene",
+        &f,
+        "--budget",
+        "3",
+        "--min-rounds",
+        "2",
+        "--json",
+        json.to_str().unwrap(),
+        "--isa",
+        isa.to_str().unwrap(),
+    ];
     for t in targets {
         args.extend(["--cost-device", t]);
     }
@@ -115,12 +149,17 @@ fn profile_scene_cost_devices_compile_every_variant_on_each_vendor() {
         let name = r["target"].as_str().unwrap();
         assert!(out.contains(&format!("{name} cycles/pixel")), "{out}");
         let kernels = r["kernels"].as_array().unwrap();
-        assert_eq!(kernels.iter().map(|k| k["model"].as_str().unwrap()).collect::<Vec<_>>(), ["ggx", "blinn"], "{name}");
+        assert_eq!(
+            kernels.iter().map(|k| k["model"].as_str().unwrap()).collect::<Vec<_>>(),
+            ["ggx", "blinn"],
+            "{name}"
+        );
         for k in kernels {
             // Cycles per pixel is the vendor's cost rule over one light (max of the busiest pipe and latency over
             // resident waves, per lane): the kernel's light loops are in it.
             let (c, s) = (k["cycles_per_pixel"].as_f64().unwrap(), &k["stats"]);
-            let per_wave = s["busiest pipe (cycles/wave)"].as_f64().unwrap().max(s["latency / waves"].as_f64().unwrap());
+            let per_wave =
+                s["busiest pipe (cycles/wave)"].as_f64().unwrap().max(s["latency / waves"].as_f64().unwrap());
             let expected = match name.split(':').next().unwrap() {
                 "radv" => per_wave / 64.0,
                 "nvidia" => per_wave / 32.0,
@@ -128,8 +167,18 @@ fn profile_scene_cost_devices_compile_every_variant_on_each_vendor() {
             };
             assert!(c > 0.0 && (c - expected).abs() <= 1e-9 * expected, "{name} {}: {c} vs {expected}", k["model"]);
         }
-        let pairs = |v: &Value| v.as_array().unwrap().iter().map(|e| (e["model"].as_str().unwrap().to_string(), e["effect"].as_str().unwrap().to_string())).collect::<Vec<_>>();
-        assert_eq!(pairs(&r["effects"]), pairs(&report["effects"]), "{name}: the effects the profile measured, in its order");
+        let pairs = |v: &Value| {
+            v.as_array()
+                .unwrap()
+                .iter()
+                .map(|e| (e["model"].as_str().unwrap().to_string(), e["effect"].as_str().unwrap().to_string()))
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(
+            pairs(&r["effects"]),
+            pairs(&report["effects"]),
+            "{name}: the effects the profile measured, in its order"
+        );
         let effects = r["effects"].as_array().unwrap();
         // Anisotropy (a second lobe per light) and the clear coat (a second specular lobe) add instructions on
         // every compiler: compiling them out must save modelled cycles.
@@ -146,36 +195,85 @@ fn profile_scene_cost_devices_compile_every_variant_on_each_vendor() {
         let notes = r["translation"].as_object().unwrap();
         assert_eq!(notes.len(), 6, "{name}: every variant's translation was checked: {notes:?}");
         for (label, note) in notes {
-            let worst: f64 = note.as_str().unwrap().split("worst relative difference ").nth(1).unwrap().split_whitespace().next().unwrap().parse().unwrap();
+            let worst: f64 = note
+                .as_str()
+                .unwrap()
+                .split("worst relative difference ")
+                .nth(1)
+                .unwrap()
+                .split_whitespace()
+                .next()
+                .unwrap()
+                .parse()
+                .unwrap();
             assert!(worst <= 1e-3, "{name} {label}: {note}");
-            assert!(note.as_str().unwrap().contains("pixels (") && !note.as_str().unwrap().contains("(0 lit)"), "{label}: {note}");
+            assert!(
+                note.as_str().unwrap().contains("pixels (") && !note.as_str().unwrap().contains("(0 lit)"),
+                "{label}: {note}"
+            );
         }
     }
     // --isa: each variant's compiler output per target, as `inspect --isa` writes it.
-    for (file, marker) in [("navi21/ggx-without-clear-coat.assembly.txt", "s_endpgm"), ("nvidia-sm_89/ggx-without-clear-coat.sass", "EXIT"), ("intel-gen12lp/blinn-without-diffuse.asm", "EOT"), ("intel-gen12lp/blinn.cl", "__kernel")] {
+    for (file, marker) in [
+        ("navi21/ggx-without-clear-coat.assembly.txt", "s_endpgm"),
+        ("nvidia-sm_89/ggx-without-clear-coat.sass", "EXIT"),
+        ("intel-gen12lp/blinn-without-diffuse.asm", "EOT"),
+        ("intel-gen12lp/blinn.cl", "__kernel"),
+    ] {
         let text = std::fs::read_to_string(isa.join(file)).unwrap_or_else(|e| panic!("{file}: {e}"));
         assert!(text.contains(marker), "{file} has no {marker}");
     }
     // An fp16 model's translation agrees within fp16's tolerance (the maths libraries differ by its ulps); a
     // family without fp16 (tahiti) leaves that kernel out with a note, and the others are still reported.
-    let f16 = write(dir.path(), "f16.json", &SMALL.replace(r#""model": "blinn""#, r#""model": "burley,precision=f16""#));
-    let (code, out, err) = run(&["profile", "--scene", &f16, "--budget", "2", "--min-rounds", "2", "--json", json.to_str().unwrap(), "--cost-device", "nvidia:sm_89", "--cost-device", "radv:tahiti"]);
+    let f16 =
+        write(dir.path(), "f16.json", &SMALL.replace(r#""model": "blinn""#, r#""model": "burley,precision=f16""#));
+    let (code, out, err) = run(&[
+        "profile",
+        "--scene",
+        &f16,
+        "--budget",
+        "2",
+        "--min-rounds",
+        "2",
+        "--json",
+        json.to_str().unwrap(),
+        "--cost-device",
+        "nvidia:sm_89",
+        "--cost-device",
+        "radv:tahiti",
+    ]);
     assert_eq!(code, 0, "{err}");
     assert!(!err.contains("note: cache"), "the agreements' cache entries are valid: {err}");
     let report: Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
     let notes = report["targets"][0]["translation"].as_object().unwrap();
-    assert!(notes.iter().any(|(label, note)| label.starts_with("burley,precision=f16") && note.as_str().unwrap().contains("(tolerance 5e-2)")), "{notes:?}");
+    assert!(
+        notes.iter().any(|(label, note)| label.starts_with("burley,precision=f16")
+            && note.as_str().unwrap().contains("(tolerance 5e-2)")),
+        "{notes:?}"
+    );
     let tahiti = &report["targets"][1];
-    assert_eq!(tahiti["kernels"].as_array().unwrap().iter().map(|k| k["model"].as_str().unwrap()).collect::<Vec<_>>(), ["ggx"]);
-    assert!(tahiti["notes"][0].as_str().unwrap().contains("not compiled for radv:tahiti: burley,precision=f16"), "{tahiti}");
-    assert!(out.contains("| burley,precision=f16 ") && out.contains(" - "), "a kernel tahiti left out is `-` in its column:\n{out}");
+    assert_eq!(
+        tahiti["kernels"].as_array().unwrap().iter().map(|k| k["model"].as_str().unwrap()).collect::<Vec<_>>(),
+        ["ggx"]
+    );
+    assert!(
+        tahiti["notes"][0].as_str().unwrap().contains("not compiled for radv:tahiti: burley,precision=f16"),
+        "{tahiti}"
+    );
+    assert!(
+        out.contains("| burley,precision=f16 ") && out.contains(" - "),
+        "a kernel tahiti left out is `-` in its column:\n{out}"
+    );
     // The cost devices are compile-only targets, and only a scene profile takes them.
     let (code, _, err) = run(&["profile", "--scene", &f, "--cost-device", "llvmpipe"]);
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("--cost-device llvmpipe") && err.contains("compile-only target"), "{err}");
     let (code, _, err) = run(&["profile", "--cost-device", "radv:navi21"]);
     assert_eq!(code, 2, "{err}");
-    assert!(err.contains("--cost-device and --isa apply to --scene") && err.contains("inspect --device radv:navi21"), "{err}");
+    assert!(
+        err.contains("--cost-device and --isa apply to --scene") && err.contains("inspect --device radv:navi21"),
+        "{err}"
+    );
     let (code, _, err) = run(&["profile", "--scene", &f, "--isa", isa.to_str().unwrap()]);
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("--isa") && err.contains("give --cost-device too"), "{err}");
@@ -185,10 +283,16 @@ fn profile_scene_cost_devices_compile_every_variant_on_each_vendor() {
 fn bad_scenes_exit_2_naming_the_problem() {
     let dir = tempfile::tempdir().unwrap();
     let cases = [
-        (SMALL.replace(r#""roughness": 0.35"#, r#""roughness": "x""#), "materials[0].roughness: invalid type: string \"x\", expected f32"),
+        (
+            SMALL.replace(r#""roughness": 0.35"#, r#""roughness": "x""#),
+            "materials[0].roughness: invalid type: string \"x\", expected f32",
+        ),
         (SMALL.replace(r#""radius": 0.4"#, r#""radius": -1"#), "lights[3].radius"),
         (SMALL.replace(r#""model": "blinn""#, r#""model": "blin""#), "materials[2].model: unknown model `blin`"),
-        (SMALL.replace(r#""floor": "floor"}}"#, r#""floor": "flor"}}"#), "gbuffer.procedural.floor: no material named `flor`"),
+        (
+            SMALL.replace(r#""floor": "floor"}}"#, r#""floor": "flor"}}"#),
+            "gbuffer.procedural.floor: no material named `flor`",
+        ),
         (SMALL.replace(r#""size": [96, 54]"#, r#""size": [96]"#), "gbuffer.procedural.size"),
     ];
     for (i, (text, expected)) in cases.iter().enumerate() {
@@ -222,7 +326,13 @@ fn a_brdf_file_as_a_material_model_renders_as_its_preset() {
         .replace("[96, 54]", "[192, 108]")
         .replace(r#""models": ["ggx", "burley"]"#, r#""models": ["mine.brdf,roughness=@roughness,f0=@f0"]"#);
     let f = write(dir.path(), "s.json", &scene);
-    let builtin = write(dir.path(), "b.json", &scene.replace("mine.brdf,roughness=@roughness,f0=@f0", "ggx").replace(r#""name": "file""#, r#""name": "builtin""#));
+    let builtin = write(
+        dir.path(),
+        "b.json",
+        &scene
+            .replace("mine.brdf,roughness=@roughness,f0=@f0", "ggx")
+            .replace(r#""name": "file""#, r#""name": "builtin""#),
+    );
     let out = dir.path().join("out");
     for (scene, sub) in [(&f, "file"), (&builtin, "builtin")] {
         let (code, _, err) = run(&["render", "--scene", scene, "--out", out.join(sub).to_str().unwrap()]);
@@ -230,15 +340,26 @@ fn a_brdf_file_as_a_material_model_renders_as_its_preset() {
         assert!(!err.contains("validation ["), "{err}");
     }
     let png = |sub: &str, prefix: &str| {
-        let path = std::fs::read_dir(out.join(sub)).unwrap().map(|e| e.unwrap().path()).find(|p| p.file_name().unwrap().to_string_lossy().starts_with(prefix)).unwrap();
+        let path = std::fs::read_dir(out.join(sub))
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .find(|p| p.file_name().unwrap().to_string_lossy().starts_with(prefix))
+            .unwrap();
         image::open(path).unwrap().to_rgb8()
     };
     // The file by its label (its stem with its bindings), not its path: mine-roughness---roughness-f0---f0.png.
     let (a, b) = (png("file", "mine-roughness"), png("builtin", "ggx."));
     assert_eq!(a.dimensions(), b.dimensions());
     // Below the title, which names the model.
-    let below = |img: &image::RgbImage| img.enumerate_pixels().filter(|(_, y, _)| *y >= 20).map(|(_, _, p)| *p).collect::<Vec<_>>();
-    let worst = below(&a).iter().zip(below(&b).iter()).flat_map(|(p, q)| (0..3).map(move |c| (p[c] as i32 - q[c] as i32).abs())).max().unwrap();
+    let below = |img: &image::RgbImage| {
+        img.enumerate_pixels().filter(|(_, y, _)| *y >= 20).map(|(_, _, p)| *p).collect::<Vec<_>>()
+    };
+    let worst = below(&a)
+        .iter()
+        .zip(below(&b).iter())
+        .flat_map(|(p, q)| (0..3).map(move |c| (p[c] as i32 - q[c] as i32).abs()))
+        .max()
+        .unwrap();
     assert!(worst <= 1, "the file's picture differs from the preset's by {worst}/255");
 }
 
@@ -261,13 +382,22 @@ fn an_engine_entry_returning_f_nol_renders_as_its_twin_returning_f() {
         let (code, _, err) = run(&["render", "--scene", &f, "--out", out.to_str().unwrap()]);
         assert_eq!(code, 0, "{err}");
         assert!(!err.contains("validation ["), "{err}");
-        let path = std::fs::read_dir(&out).unwrap().map(|e| e.unwrap().path()).find(|p| p.file_name().unwrap().to_string_lossy().starts_with(file) && p.extension().is_some_and(|x| x == "png")).unwrap();
+        let path = std::fs::read_dir(&out)
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .find(|p| {
+                p.file_name().unwrap().to_string_lossy().starts_with(file) && p.extension().is_some_and(|x| x == "png")
+            })
+            .unwrap();
         pictures.push(image::open(path).unwrap().to_rgb8());
     }
-    let below = |img: &image::RgbImage| img.enumerate_pixels().filter(|(_, y, _)| *y >= 20).map(|(_, _, p)| *p).collect::<Vec<_>>();
+    let below = |img: &image::RgbImage| {
+        img.enumerate_pixels().filter(|(_, y, _)| *y >= 20).map(|(_, _, p)| *p).collect::<Vec<_>>()
+    };
     let (a, b) = (below(&pictures[0]), below(&pictures[1]));
     assert_eq!(a.len(), b.len());
-    let worst = a.iter().zip(&b).flat_map(|(p, q)| (0..3).map(move |c| (p[c] as i32 - q[c] as i32).abs())).max().unwrap();
+    let worst =
+        a.iter().zip(&b).flat_map(|(p, q)| (0..3).map(move |c| (p[c] as i32 - q[c] as i32).abs())).max().unwrap();
     assert!(worst <= 1, "the engine form's picture differs from the f form's by {worst}/255");
     assert!(a.iter().any(|p| p[0] > 10), "a lit picture");
 }
@@ -311,11 +441,17 @@ fn hlsl_and_wgsl_materials_render_as_their_glsl_twin() {
         let (code, _, err) = run(&["render", "--scene", &f, "--out", out.to_str().unwrap()]);
         assert_eq!(code, 0, "{err}");
         assert!(!err.contains("validation ["), "{err}");
-        let path = std::fs::read_dir(&out).unwrap().map(|e| e.unwrap().path()).find(|p| p.file_name().unwrap().to_string_lossy().starts_with(prefix)).unwrap_or_else(|| panic!("no {prefix}* in {}", out.display()));
+        let path = std::fs::read_dir(&out)
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .find(|p| p.file_name().unwrap().to_string_lossy().starts_with(prefix))
+            .unwrap_or_else(|| panic!("no {prefix}* in {}", out.display()));
         pictures.push(image::open(path).unwrap().to_rgb8());
     }
     // Below the title, which names the model: the same pixels.
-    let below = |img: &image::RgbImage| img.enumerate_pixels().filter(|(_, y, _)| *y >= 20).map(|(_, _, p)| *p).collect::<Vec<_>>();
+    let below = |img: &image::RgbImage| {
+        img.enumerate_pixels().filter(|(_, y, _)| *y >= 20).map(|(_, _, p)| *p).collect::<Vec<_>>()
+    };
     let twin = below(&pictures[0]);
     assert!(twin.iter().any(|p| p[0] > 10), "a lit picture");
     for (k, name) in [(1, "HLSL"), (2, "WGSL")] {

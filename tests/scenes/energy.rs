@@ -4,7 +4,7 @@
 //! of 1 at every view angle. The furnace kernel without effects agrees with albedo.comp.
 
 use crate::common;
-use brdfprof::brdf::{ModelSpec, F};
+use brdfprof::brdf::{F, ModelSpec};
 use brdfprof::kernels::{self, AlbedoCell};
 use brdfprof::model::Model;
 use brdfprof::scene::effects::{self, FurnaceCell};
@@ -14,7 +14,16 @@ const NOV: [f32; 7] = [0.05, 0.1, 0.3, 0.5, 0.7, 0.9, 1.0];
 
 fn cells(roughness: f32) -> Vec<FurnaceCell> {
     NOV.iter()
-        .map(|&nov| FurnaceCell { nov, roughness, f0: [1.0; 3], diffuse_colour: [0.0; 3], anisotropy: 0.0, coat: 0.0, coat_roughness: 1.0, diffuse: 0 })
+        .map(|&nov| FurnaceCell {
+            nov,
+            roughness,
+            f0: [1.0; 3],
+            diffuse_colour: [0.0; 3],
+            anisotropy: 0.0,
+            coat: 0.0,
+            coat_roughness: 1.0,
+            diffuse: 0,
+        })
         .collect()
 }
 
@@ -25,9 +34,14 @@ fn energy_compensation_makes_ggx_at_r1_lossless_within_2_percent() {
         let spec = Model::parse(name).unwrap();
         let table = effects::e_table(&gpu, &spec).unwrap();
         let off = effects::scene_albedo(&gpu, &spec, Switches::default(), None, &cells(1.0)).unwrap();
-        let on = effects::scene_albedo(&gpu, &spec, Switches { energy: 1, ..Default::default() }, Some(&table), &cells(1.0)).unwrap();
+        let on =
+            effects::scene_albedo(&gpu, &spec, Switches { energy: 1, ..Default::default() }, Some(&table), &cells(1.0))
+                .unwrap();
         for ((nov, a), b) in NOV.iter().zip(&off).zip(&on) {
-            println!("{name} r = 1, NoV {nov}: E {:.4} -> compensated {:.4} (integration error {:.1e})", a.e[0], b.e[0], b.error);
+            println!(
+                "{name} r = 1, NoV {nov}: E {:.4} -> compensated {:.4} (integration error {:.1e})",
+                a.e[0], b.e[0], b.error
+            );
             assert!(a.e[0] < 0.97, "{name}: GGX at r = 1 should lose energy without compensation (E = {})", a.e[0]);
             assert!((b.e[0] - 1.0).abs() <= 0.02, "{name} at NoV {nov}: compensated E = {}", b.e[0]);
         }
@@ -42,7 +56,8 @@ fn furnace_kernel_without_effects_agrees_with_albedo_comp() {
     let white = common::model(ModelSpec { f: F::None, ..spec });
     for r in [0.3f32, 1.0] {
         let scene = effects::scene_albedo(&gpu, &white, Switches::default(), None, &cells(r)).unwrap();
-        let plain = kernels::albedo(&gpu, &white, &NOV.map(|nov| AlbedoCell { nov, roughness: r, f0: [1.0; 3] })).unwrap();
+        let plain =
+            kernels::albedo(&gpu, &white, &NOV.map(|nov| AlbedoCell { nov, roughness: r, f0: [1.0; 3] })).unwrap();
         for ((a, b), nov) in scene.iter().zip(&plain).zip(NOV) {
             assert!((a.e[0] - b.e[0]).abs() < 1e-5, "r {r} NoV {nov}: scene furnace {} albedo.comp {}", a.e[0], b.e[0]);
         }

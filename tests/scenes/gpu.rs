@@ -6,14 +6,14 @@
 use crate::common;
 use brdfprof::brdf::guards::unit;
 use brdfprof::brdf::{Sample, THESIS_MODELS};
-use brdfprof::model::Model;
-use glam::DVec3;
 use brdfprof::kernels::{self, RunLimits};
+use brdfprof::model::Model;
+use brdfprof::scene::Scene;
 use brdfprof::scene::gbuffer::{self, BACKGROUND};
 use brdfprof::scene::plan::{self, ScenePlan};
 use brdfprof::scene::run;
 use brdfprof::scene::terms::{self, Surface};
-use brdfprof::scene::Scene;
+use glam::DVec3;
 use std::path::PathBuf;
 
 fn scene(text: &str) -> Scene {
@@ -114,7 +114,8 @@ fn twin(s: &Scene, g: &gbuffer::GBuffer, p: &ScenePlan, tables: &[Option<terms::
     let metallic = px.metallic as f64;
     let base = DVec3::from(px.base_colour.map(f64::from));
     let f0 = base.map(|b| 0.04 * (1.0 - metallic) + b * metallic);
-    let (coat, coat_roughness) = m.effects.clear_coat.map_or((0.0, 1.0), |c| (c.strength.0 as f64, c.roughness.0 as f64));
+    let (coat, coat_roughness) =
+        m.effects.clear_coat.map_or((0.0, 1.0), |c| (c.strength.0 as f64, c.roughness.0 as f64));
     let roughness = px.roughness as f64;
     let energy_on = kp.switches.energy == 1 || (kp.switches.energy == 2 && m.effects.energy_compensation);
     let energy = match (&tables[k], energy_on) {
@@ -135,7 +136,13 @@ fn twin(s: &Scene, g: &gbuffer::GBuffer, p: &ScenePlan, tables: &[Option<terms::
         diffuse: m.effects.diffuse.id(),
         energy,
     };
-    terms::shade_pixel(kp.model.twin().unwrap(), kp.switches, &surface, DVec3::from(px.position.map(f64::from)), &p.lights)
+    terms::shade_pixel(
+        kp.model.twin().unwrap(),
+        kp.switches,
+        &surface,
+        DVec3::from(px.position.map(f64::from)),
+        &p.lights,
+    )
 }
 
 #[test]
@@ -146,7 +153,11 @@ fn scene_kernel_with_every_light_and_effect_matches_its_f64_twin() {
     let p = plan::plan(&s, &g, None);
     assert_eq!(p.kernels.len(), 2, "ggx and burley materials: two kernels");
     let ggx = &p.kernels[0];
-    assert!(ggx.switches.anisotropy && ggx.switches.clear_coat && ggx.switches.energy == 2 && ggx.switches.diffuse == 3, "{:?}", ggx.switches);
+    assert!(
+        ggx.switches.anisotropy && ggx.switches.clear_coat && ggx.switches.energy == 2 && ggx.switches.diffuse == 3,
+        "{:?}",
+        ggx.switches
+    );
     assert_eq!((p.counts.directional, p.counts.point, p.counts.spot, p.counts.sphere), (1, 2, 1, 1));
     let tables = run::e_tables(&gpu, &p).unwrap();
     let out = run::shade(&gpu, &s, &g, &p, &tables, RunLimits::default()).unwrap();
@@ -158,7 +169,12 @@ fn scene_kernel_with_every_light_and_effect_matches_its_f64_twin() {
             for c in 0..3 {
                 let got = out[i as usize][c] as f64;
                 let err = (got - r[c]).abs() / r[c].abs().max(1e-3 * scale);
-                worst.update(err, || format!("pixel {i} ({}) channel {c}: GPU {got} f64 {}", s.file.materials[g.pixels[i as usize].material as usize].name, r[c]));
+                worst.update(err, || {
+                    format!(
+                        "pixel {i} ({}) channel {c}: GPU {got} f64 {}",
+                        s.file.materials[g.pixels[i as usize].material as usize].name, r[c]
+                    )
+                });
             }
         }
         println!("{}: {} pixels, max rel err {:.2e}", kp.model.name(), kp.pixels.len(), worst.err);

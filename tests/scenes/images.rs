@@ -4,8 +4,8 @@
 //! follow from the camera) and in 16-bit PNG with a depth range; material indices in an 8-bit PNG (255 =
 //! background). A missing image names the file.
 
-use brdfprof::scene::gbuffer::{self, srgb_to_linear, BACKGROUND};
 use brdfprof::scene::Scene;
+use brdfprof::scene::gbuffer::{self, BACKGROUND, srgb_to_linear};
 use image::{ImageBuffer, Luma, Rgb};
 use rand::{Rng, SeedableRng};
 use std::path::Path;
@@ -26,11 +26,14 @@ fn truth() -> Truth {
     let mut rng = rand_pcg::Pcg64::seed_from_u64(3);
     let n = (W * H) as usize;
     let normal = (0..n)
-        .map(|_| loop {
-            let v: [f32; 3] = [rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0)];
-            let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-            if l > 0.2 && l <= 1.0 {
-                break v.map(|x| x / l);
+        .map(|_| {
+            loop {
+                let v: [f32; 3] =
+                    [rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0)];
+                let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+                if l > 0.2 && l <= 1.0 {
+                    break v.map(|x| x / l);
+                }
             }
         })
         .collect();
@@ -46,14 +49,51 @@ fn truth() -> Truth {
 
 fn write_planes(dir: &Path, t: &Truth) {
     let enc = |x: f32, max: f32| (((x + 1.0) * 0.5) * max).round();
-    ImageBuffer::<Rgb<u8>, _>::from_raw(W, H, t.normal.iter().flat_map(|n| n.map(|x| enc(x, 255.0) as u8)).collect::<Vec<_>>()).unwrap().save(dir.join("n8.png")).unwrap();
-    ImageBuffer::<Rgb<u16>, _>::from_raw(W, H, t.normal.iter().flat_map(|n| n.map(|x| enc(x, 65535.0) as u16)).collect::<Vec<_>>()).unwrap().save(dir.join("n16.png")).unwrap();
-    ImageBuffer::<Rgb<f32>, _>::from_raw(W, H, t.normal.iter().flat_map(|n| *n).collect::<Vec<_>>()).unwrap().save(dir.join("n.exr")).unwrap();
-    ImageBuffer::<Luma<u16>, _>::from_raw(W, H, t.roughness.iter().map(|r| (r * 65535.0).round() as u16).collect::<Vec<_>>()).unwrap().save(dir.join("r16.png")).unwrap();
-    ImageBuffer::<Rgb<u8>, _>::from_raw(W, H, t.base_code.iter().flatten().copied().collect::<Vec<_>>()).unwrap().save(dir.join("base.png")).unwrap();
+    ImageBuffer::<Rgb<u8>, _>::from_raw(
+        W,
+        H,
+        t.normal.iter().flat_map(|n| n.map(|x| enc(x, 255.0) as u8)).collect::<Vec<_>>(),
+    )
+    .unwrap()
+    .save(dir.join("n8.png"))
+    .unwrap();
+    ImageBuffer::<Rgb<u16>, _>::from_raw(
+        W,
+        H,
+        t.normal.iter().flat_map(|n| n.map(|x| enc(x, 65535.0) as u16)).collect::<Vec<_>>(),
+    )
+    .unwrap()
+    .save(dir.join("n16.png"))
+    .unwrap();
+    ImageBuffer::<Rgb<f32>, _>::from_raw(W, H, t.normal.iter().flat_map(|n| *n).collect::<Vec<_>>())
+        .unwrap()
+        .save(dir.join("n.exr"))
+        .unwrap();
+    ImageBuffer::<Luma<u16>, _>::from_raw(
+        W,
+        H,
+        t.roughness.iter().map(|r| (r * 65535.0).round() as u16).collect::<Vec<_>>(),
+    )
+    .unwrap()
+    .save(dir.join("r16.png"))
+    .unwrap();
+    ImageBuffer::<Rgb<u8>, _>::from_raw(W, H, t.base_code.iter().flatten().copied().collect::<Vec<_>>())
+        .unwrap()
+        .save(dir.join("base.png"))
+        .unwrap();
     ImageBuffer::<Luma<u8>, _>::from_raw(W, H, t.metallic_code.clone()).unwrap().save(dir.join("metal.png")).unwrap();
-    ImageBuffer::<Rgb<f32>, _>::from_raw(W, H, t.depth.iter().flat_map(|d| [*d, 0.0, 0.0]).collect::<Vec<_>>()).unwrap().save(dir.join("depth.exr")).unwrap();
-    ImageBuffer::<Luma<u16>, _>::from_raw(W, H, t.depth.iter().map(|d| ((d - 0.5) / 49.5 * 65535.0).round() as u16).collect::<Vec<_>>()).unwrap().save(dir.join("depth16.png")).unwrap();
+    ImageBuffer::<Rgb<f32>, _>::from_raw(W, H, t.depth.iter().flat_map(|d| [*d, 0.0, 0.0]).collect::<Vec<_>>())
+        .unwrap()
+        .save(dir.join("depth.exr"))
+        .unwrap();
+    ImageBuffer::<Luma<u16>, _>::from_raw(
+        W,
+        H,
+        t.depth.iter().map(|d| ((d - 0.5) / 49.5 * 65535.0).round() as u16).collect::<Vec<_>>(),
+    )
+    .unwrap()
+    .save(dir.join("depth16.png"))
+    .unwrap();
     ImageBuffer::<Luma<u8>, _>::from_raw(W, H, t.material.clone()).unwrap().save(dir.join("mat.png")).unwrap();
 }
 
@@ -101,14 +141,26 @@ fn image_gbuffers_round_trip_within_quantisation() {
                 for c in 0..3 {
                     worst_n = worst_n.max((p.normal[c] - t.normal[i][c]).abs() / step);
                 }
-                assert!((p.roughness - t.roughness[i]).abs() <= 0.5 / 65535.0 + 1e-6, "roughness {} vs {}", p.roughness, t.roughness[i]);
+                assert!(
+                    (p.roughness - t.roughness[i]).abs() <= 0.5 / 65535.0 + 1e-6,
+                    "roughness {} vs {}",
+                    p.roughness,
+                    t.roughness[i]
+                );
                 assert!((p.metallic - t.metallic_code[i] as f32 / 255.0).abs() <= 1e-6);
                 for c in 0..3 {
                     let code = t.base_code[i][c] as f32 / 255.0;
-                    assert!((p.base_colour[c] - srgb_to_linear(code)).abs() <= 1e-6, "base colour {c}: {} vs {}", p.base_colour[c], srgb_to_linear(code));
+                    assert!(
+                        (p.base_colour[c] - srgb_to_linear(code)).abs() <= 1e-6,
+                        "base colour {c}: {} vs {}",
+                        p.base_colour[c],
+                        srgb_to_linear(code)
+                    );
                 }
             }
-            println!("{normal} / {depth}: normal error {worst_n:.2} steps; position error (beyond depth quantisation) {worst_p:.1e} relative");
+            println!(
+                "{normal} / {depth}: normal error {worst_n:.2} steps; position error (beyond depth quantisation) {worst_p:.1e} relative"
+            );
             assert!(worst_n <= 3.0, "{normal}: normals off by {worst_n} quantisation steps");
             assert!(worst_p <= 1e-5, "{normal} {depth}: positions off by {worst_p}");
         }
@@ -127,11 +179,16 @@ fn a_missing_image_names_the_file() {
     let e = gbuffer::build(&scene).unwrap_err().to_string();
     assert!(e.contains(&dir.path().join("metal.png").display().to_string()), "{e}");
     // A PNG depth without a range, and a size mismatch, are errors naming the file too.
-    std::fs::write(&path, scene_json("n8.png", r#""depth": "depth16.png""#).replace(r#", "metallic": "metal.png""#, "")).unwrap();
+    std::fs::write(
+        &path,
+        scene_json("n8.png", r#""depth": "depth16.png""#).replace(r#", "metallic": "metal.png""#, ""),
+    )
+    .unwrap();
     let e = gbuffer::build(&Scene::load(&path).unwrap()).unwrap_err().to_string();
     assert!(e.contains("depth16.png") && e.contains("depth_range"), "{e}");
     ImageBuffer::<Luma<u8>, _>::from_raw(3, 3, vec![0u8; 9]).unwrap().save(dir.path().join("mat.png")).unwrap();
-    std::fs::write(&path, scene_json("n8.png", r#""depth": "depth.exr""#).replace(r#", "metallic": "metal.png""#, "")).unwrap();
+    std::fs::write(&path, scene_json("n8.png", r#""depth": "depth.exr""#).replace(r#", "metallic": "metal.png""#, ""))
+        .unwrap();
     let e = gbuffer::build(&Scene::load(&path).unwrap()).unwrap_err().to_string();
     assert!(e.contains("mat.png is 3x3"), "{e}");
 }

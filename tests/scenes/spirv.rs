@@ -6,10 +6,10 @@
 use crate::common;
 use brdfprof::kernels;
 use brdfprof::model::KernelKind;
+use brdfprof::scene::Scene;
 use brdfprof::scene::gbuffer;
 use brdfprof::scene::plan::{self, Effect};
 use brdfprof::scene::spirv;
-use brdfprof::scene::Scene;
 
 /// Functions that only an effect uses.
 fn functions_of(effect: Effect) -> &'static [&'static str] {
@@ -26,14 +26,17 @@ fn effects_no_material_uses_are_absent_from_the_kernel() {
     let scene = Scene::load(&common::repo_root().join("scenes/sphere-grid.json")).unwrap();
     let mut file = scene.file.clone();
     file.gbuffer = match file.gbuffer {
-        brdfprof::scene::format::GBufferSource::Procedural(brdfprof::scene::format::Procedural::SphereGrid { rows, columns, floor, .. }) => {
-            brdfprof::scene::format::GBufferSource::Procedural(brdfprof::scene::format::Procedural::SphereGrid {
-                size: brdfprof::scene::format::Size([64, 28]),
-                rows,
-                columns,
-                floor,
-            })
-        }
+        brdfprof::scene::format::GBufferSource::Procedural(brdfprof::scene::format::Procedural::SphereGrid {
+            rows,
+            columns,
+            floor,
+            ..
+        }) => brdfprof::scene::format::GBufferSource::Procedural(brdfprof::scene::format::Procedural::SphereGrid {
+            size: brdfprof::scene::format::Size([64, 28]),
+            rows,
+            columns,
+            floor,
+        }),
         _ => panic!("sphere-grid.json is a sphere grid"),
     };
     let scene = Scene { file, ..scene };
@@ -44,14 +47,21 @@ fn effects_no_material_uses_are_absent_from_the_kernel() {
     let kernel = p.kernels[0].model.kernel(KernelKind::Scene, kernels::embedded()).unwrap();
     let (source, model_constants) = (&kernel.spirv, kernel.constants);
     let as_planned = spirv::specialise(source, &p.constants(model_constants.clone(), switches)).unwrap();
-    println!("as planned ({switches:?}): {} instructions, functions {:?}", as_planned.instructions, as_planned.functions);
+    println!(
+        "as planned ({switches:?}): {} instructions, functions {:?}",
+        as_planned.instructions, as_planned.functions
+    );
     for effect in Effect::ALL {
         let names = functions_of(effect);
         if effect.is_on(&switches) {
             continue;
         }
         for f in names {
-            assert!(!as_planned.functions.iter().any(|x| x == f), "{} is off in the scene, but {f} is in the kernel", effect.name());
+            assert!(
+                !as_planned.functions.iter().any(|x| x == f),
+                "{} is off in the scene, but {f} is in the kernel",
+                effect.name()
+            );
         }
         // Switched on, the same kernel carries the effect: the check above can fail.
         let mut on = switches;
@@ -62,19 +72,35 @@ fn effects_no_material_uses_are_absent_from_the_kernel() {
             Effect::ClearCoat => on.clear_coat = true,
         }
         let with = spirv::specialise(source, &p.constants(model_constants.clone(), on)).unwrap();
-        println!("{} on: {} instructions (+{})", effect.name(), with.instructions, with.instructions as i64 - as_planned.instructions as i64);
-        assert!(names.iter().any(|f| with.functions.iter().any(|x| x == f)), "{} on, but none of {names:?} in the kernel", effect.name());
+        println!(
+            "{} on: {} instructions (+{})",
+            effect.name(),
+            with.instructions,
+            with.instructions as i64 - as_planned.instructions as i64
+        );
+        assert!(
+            names.iter().any(|f| with.functions.iter().any(|x| x == f)),
+            "{} on, but none of {names:?} in the kernel",
+            effect.name()
+        );
         assert!(with.instructions > as_planned.instructions, "{} adds no instructions", effect.name());
     }
     // The scene's diffuse lobe is on (Lambert on some materials, none on the metal: chosen per pixel).
     assert_eq!(switches.diffuse, 3);
     let off = spirv::specialise(source, &p.constants(model_constants.clone(), Effect::Diffuse.off(switches))).unwrap();
-    assert!(!off.functions.iter().any(|x| x == "diffuse_lobe") && as_planned.functions.iter().any(|x| x == "diffuse_lobe"));
+    assert!(
+        !off.functions.iter().any(|x| x == "diffuse_lobe") && as_planned.functions.iter().any(|x| x == "diffuse_lobe")
+    );
     assert!(off.instructions < as_planned.instructions);
     // Light types: the scene has no spot or sphere light; one of each adds instructions.
     assert_eq!((p.counts.spot, p.counts.sphere), (0, 0));
     let mut more = p.clone();
     more.counts.spot = 1;
     let spot = spirv::specialise(source, &more.constants(model_constants, switches)).unwrap();
-    assert!(spot.instructions > as_planned.instructions, "a spot light adds nothing: {} vs {}", spot.instructions, as_planned.instructions);
+    assert!(
+        spot.instructions > as_planned.instructions,
+        "a spot light adds nothing: {} vs {}",
+        spot.instructions,
+        as_planned.instructions
+    );
 }

@@ -3,8 +3,8 @@
 //! error <= 1e-3 in fp32 (relative to max(|ref|, 1e-3)).
 
 use crate::common;
-use brdfprof::brdf::guards::safe_normalize;
 use brdfprof::brdf::ModelSpec;
+use brdfprof::brdf::guards::safe_normalize;
 use brdfprof::scene::effects::{self, TERM_IN};
 use brdfprof::scene::terms::{self, ETable};
 use common::Worst;
@@ -90,12 +90,30 @@ fn every_scene_term_matches_its_f64_twin() {
     let raw: Vec<[f32; TERM_IN]> = inputs.iter().map(|i| i.raw).collect();
     let out = effects::scene_terms(&gpu, &common::model(spec), &table, &raw).unwrap();
     let names = [
-        "D_GgxAnisotropic", "Vis_SmithGgxCorrelatedAnisotropic", "Fd_Lambert", "Fd_Burley",
-        "clear_coat_fresnel", "clear_coat_lobe", "spot_cone", "sphere_normalisation",
-        "energy_compensation.r", "energy_compensation.g", "energy_compensation.b", "inverse_square",
-        "sphere_representative_point.x", "sphere_representative_point.y", "sphere_representative_point.z", "e_lookup",
-        "specular_anisotropic.r", "specular_anisotropic.g", "specular_anisotropic.b", "-",
-        "anisotropic_alphas.at", "anisotropic_alphas.ab", "-", "-",
+        "D_GgxAnisotropic",
+        "Vis_SmithGgxCorrelatedAnisotropic",
+        "Fd_Lambert",
+        "Fd_Burley",
+        "clear_coat_fresnel",
+        "clear_coat_lobe",
+        "spot_cone",
+        "sphere_normalisation",
+        "energy_compensation.r",
+        "energy_compensation.g",
+        "energy_compensation.b",
+        "inverse_square",
+        "sphere_representative_point.x",
+        "sphere_representative_point.y",
+        "sphere_representative_point.z",
+        "e_lookup",
+        "specular_anisotropic.r",
+        "specular_anisotropic.g",
+        "specular_anisotropic.b",
+        "-",
+        "anisotropic_alphas.at",
+        "anisotropic_alphas.ab",
+        "-",
+        "-",
     ];
     let mut worst: Vec<Worst> = vec![Worst::default(); 24];
     for (x, o) in raw.iter().zip(&out) {
@@ -107,19 +125,38 @@ fn every_scene_term_matches_its_f64_twin() {
         let (at, ab) = terms::anisotropic_alphas(f(x, 19), f(x, 39), spec.min_roughness());
         let reference = [
             terms::d_ggx_anisotropic(f(x, 0), f(x, 1), f(x, 2), f(x, 3), f(x, 4)),
-            terms::vis_smith_ggx_correlated_anisotropic(f(x, 5), f(x, 6), f(x, 7), f(x, 8), f(x, 9), f(x, 10), f(x, 3), f(x, 4)),
+            terms::vis_smith_ggx_correlated_anisotropic(
+                f(x, 5),
+                f(x, 6),
+                f(x, 7),
+                f(x, 8),
+                f(x, 9),
+                f(x, 10),
+                f(x, 3),
+                f(x, 4),
+            ),
             terms::fd_lambert(),
             terms::fd_burley(f(x, 7), f(x, 10), f(x, 11), f(x, 12)),
             terms::clear_coat_fresnel(f(x, 11), f(x, 13)),
             terms::clear_coat_lobe(n, v, l, f(x, 43), f(x, 13), spec.min_roughness()),
             terms::spot_cone(f(x, 14), f(x, 15), f(x, 16)),
             terms::sphere_normalisation(f(x, 19), f(x, 17), f(x, 18)),
-            e[0], e[1], e[2],
+            e[0],
+            e[1],
+            e[2],
             terms::inverse_square(f(x, 27)),
-            rep[0], rep[1], rep[2],
+            rep[0],
+            rep[1],
+            rep[2],
             table.lookup(f(x, 32), f(x, 33)),
-            spa[0], spa[1], spa[2], 0.0,
-            at, ab, 0.0, 0.0,
+            spa[0],
+            spa[1],
+            spa[2],
+            0.0,
+            at,
+            ab,
+            0.0,
+            0.0,
         ];
         for k in 0..24 {
             let err = common::rel_err(o[k] as f64, reference[k]);

@@ -8,7 +8,6 @@ use crate::common;
 use std::path::{Path, PathBuf};
 use std::process::Output;
 
-
 fn baseline() -> PathBuf {
     common::repo_root().join("results/baseline-llvmpipe.json")
 }
@@ -46,10 +45,24 @@ fn this_build_passes_the_committed_baseline() {
     let _serial = crate::serial();
     let dir = tempfile::tempdir().unwrap();
     let saved = dir.path().join("saved.json");
-    let out = check(&["--baseline", baseline().to_str().unwrap(), "--save-baseline", saved.to_str().unwrap(), "--threshold", CI_TIMING_THRESHOLD], None);
+    let out = check(
+        &[
+            "--baseline",
+            baseline().to_str().unwrap(),
+            "--save-baseline",
+            saved.to_str().unwrap(),
+            "--threshold",
+            CI_TIMING_THRESHOLD,
+        ],
+        None,
+    );
     let (stdout, stderr) = text(&out);
     eprintln!("{stdout}");
-    assert_eq!(out.status.code(), Some(0), "the build regressed against results/baseline-llvmpipe.json (after a deliberate change: `make baseline`):\n{stdout}\n{stderr}");
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "the build regressed against results/baseline-llvmpipe.json (after a deliberate change: `make baseline`):\n{stdout}\n{stderr}"
+    );
     assert!(!stderr.contains("validation ["), "validation messages: {stderr}");
     assert_eq!(verdict(&stdout), ["no regression"]);
     // SPIR-V counts are machine-independent: always compared, and unchanged.
@@ -59,7 +72,9 @@ fn this_build_passes_the_committed_baseline() {
     let saved_json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&saved).unwrap()).unwrap();
     let committed: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(baseline()).unwrap()).unwrap();
     assert_eq!(saved_json["format"], committed["format"]);
-    for (new, old) in saved_json["inspect"]["rows"].as_array().unwrap().iter().zip(committed["inspect"]["rows"].as_array().unwrap()) {
+    for (new, old) in
+        saved_json["inspect"]["rows"].as_array().unwrap().iter().zip(committed["inspect"]["rows"].as_array().unwrap())
+    {
         for (key, value) in old["stats"].as_object().unwrap().iter().filter(|(k, _)| k.starts_with("spirv")) {
             assert_eq!(&new["stats"][key], value, "{} {key}", old["model"]);
         }

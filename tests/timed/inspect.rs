@@ -22,10 +22,16 @@ fn inspect(dir: &Path, name: &str, extra: &[&str]) -> Value {
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success(), "inspect failed: {stderr}");
     assert!(!stderr.contains("validation ["), "validation messages: {stderr}");
-    for title in ["SPIR-V instructions, glslang", "spirv-opt -O", "naga", "Driver statistics", "Executed CPU instructions"] {
+    for title in
+        ["SPIR-V instructions, glslang", "spirv-opt -O", "naga", "Driver statistics", "Executed CPU instructions"]
+    {
         assert!(stdout.contains(title), "no `{title}` section on stdout:\n{stdout}");
     }
-    assert_eq!(std::fs::read_to_string(&md).unwrap(), stdout[..stdout.find("JSON: ").unwrap()], "Markdown file differs from stdout");
+    assert_eq!(
+        std::fs::read_to_string(&md).unwrap(),
+        stdout[..stdout.find("JSON: ").unwrap()],
+        "Markdown file differs from stdout"
+    );
     serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap()
 }
 
@@ -42,7 +48,8 @@ fn executed_instruction_counts_are_identical_across_runs() {
     let b = inspect(dir.path(), "b", &[]);
     let kernels = |r: &Value| r["callgrind"]["kernels"].clone();
     assert_eq!(kernels(&a), kernels(&b), "callgrind counts differ between two runs of the same build");
-    let labels: Vec<&str> = a["callgrind"]["kernels"].as_array().unwrap().iter().map(|k| k["label"].as_str().unwrap()).collect();
+    let labels: Vec<&str> =
+        a["callgrind"]["kernels"].as_array().unwrap().iter().map(|k| k["label"].as_str().unwrap()).collect();
     assert_eq!(labels, ["ggx", "baseline"]);
     let ir = |r: &Value, m: &str| row(r, m)["stats"]["callgrind/ir-per-eval"].as_f64().unwrap();
     // The BRDF costs instructions on top of the memory-only kernel; net = gross - baseline.

@@ -9,9 +9,9 @@
 #[path = "../common/mod.rs"]
 mod common;
 
-mod mesa_gate;
 mod check_gate;
 mod inspect;
+mod mesa_gate;
 mod profile;
 mod translated_gate;
 

@@ -48,7 +48,12 @@ fn profile(json: &std::path::Path) -> (Run, Duration) {
         .filter(|r| !r["spec"].is_null())
         .map(|r| {
             let v = &r["vs_reference"];
-            (r["model"].as_str().unwrap().to_string(), v["median"].as_f64().unwrap(), v["lo"].as_f64().unwrap(), v["hi"].as_f64().unwrap())
+            (
+                r["model"].as_str().unwrap().to_string(),
+                v["median"].as_f64().unwrap(),
+                v["lo"].as_f64().unwrap(),
+                v["hi"].as_f64().unwrap(),
+            )
         })
         .collect();
     (Run { ratios }, elapsed)
@@ -77,7 +82,13 @@ fn default_profile_is_fast_resolved_and_repeatable() {
             // on lavapipe, 1.49-1.56x) resolve in one run and overlap in the next, and their point estimates
             // may then cross without either run being wrong.
             if separated_a && separated_b {
-                assert_eq!(x.1 < y.1, bx.1 < by.1, "{} and {} swapped order between runs: {x:?} {y:?} vs {bx:?} {by:?}", x.0, y.0);
+                assert_eq!(
+                    x.1 < y.1,
+                    bx.1 < by.1,
+                    "{} and {} swapped order between runs: {x:?} {y:?} vs {bx:?} {by:?}",
+                    x.0,
+                    y.0
+                );
             }
         }
     }
@@ -105,16 +116,33 @@ fn protocol_keeps_the_faster_instance_and_reports_the_spread() {
     }
 
     let gpu = common::gpu();
-    let work = Workload::upload(&gpu, &gbuffer::synthetic(256, 256, gbuffer::GBufferFormat::Packed), &gbuffer::lights(8), None).unwrap();
+    let work = Workload::upload(
+        &gpu,
+        &gbuffer::synthetic(256, 256, gbuffer::GBufferFormat::Packed),
+        &gbuffer::lights(8),
+        None,
+    )
+    .unwrap();
     let ggx = brdfprof::model::Model::reference();
     let variants = [Uneven(Variant::new(&gpu, &work, Some(&ggx), brdfprof::kernels::embedded(), 1).unwrap())];
-    let options = ProtocolOptions { min_rounds: 9, max_rounds: 9, reps: 3, budget: std::time::Duration::from_secs(60), started: std::time::Instant::now(), seed: 3 };
+    let options = ProtocolOptions {
+        min_rounds: 9,
+        max_rounds: 9,
+        reps: 3,
+        budget: std::time::Duration::from_secs(60),
+        started: std::time::Instant::now(),
+        seed: 3,
+    };
     let raw = protocol::measure(&gpu, &variants, &options, |_| false, |_| {}).unwrap();
     let spread = raw.instance_spread(0);
     assert!(spread > 1.5 && spread < 2.6, "twice the work should be about twice the time: {spread}");
     for (round, kept) in raw.ns[0].iter().enumerate() {
         let medians = &raw.instance_ns[0][round];
-        assert_eq!(brdfprof::stats::median(kept), medians[0].min(medians[1]), "round {round} keeps the faster instance");
+        assert_eq!(
+            brdfprof::stats::median(kept),
+            medians[0].min(medians[1]),
+            "round {round} keeps the faster instance"
+        );
     }
     common::assert_no_validation_messages(&gpu);
 }
@@ -140,7 +168,12 @@ fn an_engine_entry_costs_what_its_twin_returning_f_costs() {
     assert!(out.status.success() && !stderr.contains("validation ["), "{stderr}");
     let report: Value = serde_json::from_str(&std::fs::read_to_string(json).unwrap()).unwrap();
     let ci = |name: &str| {
-        let row = report["rows"].as_array().unwrap().iter().find(|r| r["model"] == name).unwrap_or_else(|| panic!("no row {name}"));
+        let row = report["rows"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|r| r["model"] == name)
+            .unwrap_or_else(|| panic!("no row {name}"));
         let r = &row["net_vs_reference"];
         (r["lo"].as_f64().unwrap(), r["median"].as_f64().unwrap(), r["hi"].as_f64().unwrap())
     };
@@ -149,5 +182,8 @@ fn an_engine_entry_costs_what_its_twin_returning_f_costs() {
     // differently (the engine form measured 2-6% cheaper here, 6% on a loaded machine), and a glue division
     // costs more (it moved Godot's function by 13-15% of ggx).
     let overlap = a.0 <= b.2 && b.0 <= a.2;
-    assert!(overlap || (a.1 / b.1 - 1.0).abs() <= 0.10, "net cost vs ggx: engine form {a:?}, f form {b:?}: the CIs do not overlap and the medians differ by more than 10%");
+    assert!(
+        overlap || (a.1 / b.1 - 1.0).abs() <= 0.10,
+        "net cost vs ggx: engine form {a:?}, f form {b:?}: the CIs do not overlap and the medians differ by more than 10%"
+    );
 }

@@ -34,14 +34,18 @@ impl Gate {
             cmd.arg("--glsl").arg(dir);
         }
         let out = cmd.output().unwrap();
-        let (stdout, stderr) = (String::from_utf8_lossy(&out.stdout).into_owned(), String::from_utf8_lossy(&out.stderr).into_owned());
+        let (stdout, stderr) =
+            (String::from_utf8_lossy(&out.stdout).into_owned(), String::from_utf8_lossy(&out.stderr).into_owned());
         assert!(!stderr.contains("validation ["), "{}: validation messages: {stderr}", self.device);
         (out.status.code(), stdout, stderr)
     }
 }
 
 fn group_line<'a>(stdout: &'a str, group: &str) -> &'a str {
-    stdout.lines().find(|l| l.starts_with(&format!("| {group} "))).unwrap_or_else(|| panic!("no {group} row:\n{stdout}"))
+    stdout
+        .lines()
+        .find(|l| l.starts_with(&format!("| {group} ")))
+        .unwrap_or_else(|| panic!("no {group} row:\n{stdout}"))
 }
 
 #[test]
@@ -50,7 +54,13 @@ fn this_build_passes_the_committed_translated_baselines() {
     for g in &GATES {
         let (code, stdout, stderr) = g.check(&g.baseline(), None);
         eprintln!("{stdout}");
-        assert_eq!(code, Some(0), "{} regressed against {} (after a deliberate change: `make baseline`):\n{stdout}\n{stderr}", g.device, g.baseline().display());
+        assert_eq!(
+            code,
+            Some(0),
+            "{} regressed against {} (after a deliberate change: `make baseline`):\n{stdout}\n{stderr}",
+            g.device,
+            g.baseline().display()
+        );
         let b: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(g.baseline()).unwrap()).unwrap();
         assert_eq!(b["inspect"]["provenance"]["target"], g.device);
         let driver = group_line(&stdout, "driver");
@@ -68,10 +78,19 @@ fn an_extra_pow_in_d_ggx_fails_each_translated_gate_naming_only_ggx() {
         let (code, stdout, stderr) = g.check(&g.baseline(), Some(&glsl));
         eprintln!("{stdout}");
         assert_eq!(code, Some(1), "{}: expected a regression:\n{stdout}\n{stderr}", g.device);
-        let regressions: Vec<&str> = stdout.split("## Verdict").nth(1).unwrap().lines().filter(|l| l.starts_with("- ")).collect();
-        assert!(!regressions.is_empty() && regressions.iter().all(|l| l.starts_with("- ggx ")), "{}: only ggx runs D_Ggx: {regressions:?}", g.device);
+        let regressions: Vec<&str> =
+            stdout.split("## Verdict").nth(1).unwrap().lines().filter(|l| l.starts_with("- ")).collect();
+        assert!(
+            !regressions.is_empty() && regressions.iter().all(|l| l.starts_with("- ggx ")),
+            "{}: only ggx runs D_Ggx: {regressions:?}",
+            g.device
+        );
         for stat in ["driver/instructions", "driver/issue-cycles"] {
-            assert!(regressions.iter().any(|l| l.starts_with(&format!("- ggx {stat}: "))), "{}: {stat} did not regress: {regressions:?}", g.device);
+            assert!(
+                regressions.iter().any(|l| l.starts_with(&format!("- ggx {stat}: "))),
+                "{}: {stat} did not regress: {regressions:?}",
+                g.device
+            );
         }
     }
 }
@@ -90,7 +109,11 @@ fn a_baseline_from_another_compiler_is_not_comparable() {
         std::fs::write(&path, serde_json::to_string(&b).unwrap()).unwrap();
         let (code, stdout, stderr) = g.check(&path, None);
         assert_eq!(code, Some(0), "{stdout}\n{stderr}");
-        assert!(group_line(&stdout, "driver").contains(&format!("not comparable: compiler: baseline `{}`", g.other_compiler)), "{stdout}");
+        assert!(
+            group_line(&stdout, "driver")
+                .contains(&format!("not comparable: compiler: baseline `{}`", g.other_compiler)),
+            "{stdout}"
+        );
         assert!(group_line(&stdout, "spirv").contains("| compared"), "{stdout}");
     }
 }

@@ -7,10 +7,10 @@
 //! hemisphere of microfacet normals m, the azimuth done in closed form and theta_m by double-exponential
 //! quadrature split at the lobe's scale and at the kink where <o, m> starts to clip.
 
+use super::Sample;
 use super::guards::MIN_ROUGHNESS_F32;
 use super::spec::ModelSpec;
-use super::terms::{Cosines, Lobe, Params, D};
-use super::Sample;
+use super::terms::{Cosines, D, Lobe, Params};
 use std::f64::consts::{FRAC_PI_2, PI};
 
 pub use super::terms::{lambda_beckmann_exact as lambda_beckmann, lambda_ggx};
@@ -184,7 +184,14 @@ pub fn from_cosines(spec: &ModelSpec, lambda: &Lambda, c: &Cosines, a: f64, f0: 
 }
 
 /// `from_cosines` with the Fresnel `fresnel` chooses.
-pub fn from_cosines_with(spec: &ModelSpec, fresnel: ExactFresnel, lambda: &Lambda, c: &Cosines, a: f64, f0: [f64; 3]) -> [f64; 3] {
+pub fn from_cosines_with(
+    spec: &ModelSpec,
+    fresnel: ExactFresnel,
+    lambda: &Lambda,
+    c: &Cosines,
+    a: f64,
+    f0: [f64; 3],
+) -> [f64; 3] {
     let g2 = 1.0 / (1.0 + lambda.at(c.nov) + lambda.at(c.nol));
     let dv = spec.d.eval(c.noh, c.sin2h, a, &spec.params) * g2 / (4.0 * c.nol * c.nov);
     fresnel.term(spec).eval(f0, c.voh, &spec.params).map(|f| dv * f)
@@ -210,7 +217,7 @@ pub fn eval_with(spec: &ModelSpec, fresnel: ExactFresnel, s: &Sample) -> [f64; 3
 mod tests {
     use super::*;
 
-    use crate::spec::{with_each_param_sample, ModelSpec};
+    use crate::spec::{ModelSpec, with_each_param_sample};
     use crate::{F, Vis};
 
     /// Every D with each sample of the parameters it reads.
@@ -226,7 +233,11 @@ mod tests {
                 for cos in [0.02, 0.1, 0.3, 0.6, 0.9, 0.999] {
                     let closed = lambda(spec.d, cos, a, &spec.params);
                     let numeric = lambda_numeric(|c| spec.d.at(c, a, &spec.params), cos, a);
-                    assert!((numeric - closed).abs() <= 1e-6 * (1.0 + closed), "{} a={a} cos={cos}: {numeric} vs {closed}", spec.name());
+                    assert!(
+                        (numeric - closed).abs() <= 1e-6 * (1.0 + closed),
+                        "{} a={a} cos={cos}: {numeric} vs {closed}",
+                        spec.name()
+                    );
                 }
             }
         }
@@ -239,7 +250,12 @@ mod tests {
                 let table = Lambda::new(spec.d, a, &spec.params);
                 for cos in [0.03, 0.2, 0.5, 0.8, 0.97] {
                     let direct = lambda_numeric(|c| spec.d.at(c, a, &spec.params), cos, a);
-                    assert!((table.at(cos) - direct).abs() <= 2e-4 * (1.0 + direct), "{} a={a} cos={cos}: {} vs {direct}", spec.name(), table.at(cos));
+                    assert!(
+                        (table.at(cos) - direct).abs() <= 2e-4 * (1.0 + direct),
+                        "{} a={a} cos={cos}: {} vs {direct}",
+                        spec.name(),
+                        table.at(cos)
+                    );
                 }
             }
         }

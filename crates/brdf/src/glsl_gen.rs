@@ -5,8 +5,8 @@
 //! this module generates. A term missing its GLSL function is a glslang error, and no `switch` has a term as
 //! its `default`: an id outside the table gives NaN.
 
-use super::guards::{GuardSet, GLSL_GUARDS, GUARDS_CONSTANT_ID, MIN_ROUGHNESS_F16, MIN_ROUGHNESS_F32, SWITCHES};
-use super::terms::{Metal, ParamKind, PARAMS, D, F, Vis};
+use super::guards::{GLSL_GUARDS, GUARDS_CONSTANT_ID, GuardSet, MIN_ROUGHNESS_F16, MIN_ROUGHNESS_F32, SWITCHES};
+use super::terms::{D, F, Metal, PARAMS, ParamKind, Vis};
 
 /// The term table's files under glsl/generated/ and their contents (`kernels::generated_glsl` adds the
 /// kernel constants').
@@ -29,7 +29,14 @@ pub fn float(x: f64) -> String {
     if s.contains(['.', 'e']) { s } else { format!("{s}.0") }
 }
 
-fn ids<T: Copy>(out: &mut String, title: &str, prefix: &str, all: &[T], name: impl Fn(T) -> &'static str, id: impl Fn(T) -> u32) {
+fn ids<T: Copy>(
+    out: &mut String,
+    title: &str,
+    prefix: &str,
+    all: &[T],
+    name: impl Fn(T) -> &'static str,
+    id: impl Fn(T) -> u32,
+) {
     *out += &format!("// {title} ids\n");
     for &t in all {
         *out += &format!("#define {} {}\n", id_macro(prefix, name(t)), id(t));
@@ -37,7 +44,9 @@ fn ids<T: Copy>(out: &mut String, title: &str, prefix: &str, all: &[T], name: im
 }
 
 fn table() -> String {
-    let mut out = format!("{HEADER}#ifndef BRDF_TABLE_GLSL\n#define BRDF_TABLE_GLSL\n\n// ---- Selectors and term parameters (specialisation constants) ----\n");
+    let mut out = format!(
+        "{HEADER}#ifndef BRDF_TABLE_GLSL\n#define BRDF_TABLE_GLSL\n\n// ---- Selectors and term parameters (specialisation constants) ----\n"
+    );
     out += "layout(constant_id = 0) const int D_TERM = 0;\nlayout(constant_id = 1) const int VIS_TERM = 0;\nlayout(constant_id = 2) const int F_TERM = 0;\n";
     for p in &PARAMS {
         let decl = match p.kind {
@@ -52,12 +61,21 @@ fn table() -> String {
     ids(&mut out, "F", "F", F::ALL, F::name, F::id);
     ids(&mut out, "Metal", "METAL", Metal::ALL, Metal::name, Metal::id);
     out += "\n// ---- Guards (crates/brdf/src/guards.rs; docs/limits.md \"Guards\") ----\n#ifdef BRDF_F16\n";
-    out += &format!("const float MIN_ROUGHNESS = {}; // Filament MIN_PERCEPTUAL_ROUGHNESS for mediump: a2 stays a normal fp16\n#else\n", float(MIN_ROUGHNESS_F16));
-    out += &format!("const float MIN_ROUGHNESS = {}; // Filament MIN_PERCEPTUAL_ROUGHNESS (highp)\n#endif\n", float(MIN_ROUGHNESS_F32));
+    out += &format!(
+        "const float MIN_ROUGHNESS = {}; // Filament MIN_PERCEPTUAL_ROUGHNESS for mediump: a2 stays a normal fp16\n#else\n",
+        float(MIN_ROUGHNESS_F16)
+    );
+    out += &format!(
+        "const float MIN_ROUGHNESS = {}; // Filament MIN_PERCEPTUAL_ROUGHNESS (highp)\n#endif\n",
+        float(MIN_ROUGHNESS_F32)
+    );
     for g in &GLSL_GUARDS {
         out += &format!("const float {} = {}; // {}\n", g.name, float(g.value), g.why);
     }
-    out += &format!("\n// Switchable guards (guards= in a spec; docs/guards.md): the bits of GUARDS, all on by default.\nlayout(constant_id = {GUARDS_CONSTANT_ID}) const int GUARDS = {};\n", GuardSet::ALL.0);
+    out += &format!(
+        "\n// Switchable guards (guards= in a spec; docs/guards.md): the bits of GUARDS, all on by default.\nlayout(constant_id = {GUARDS_CONSTANT_ID}) const int GUARDS = {};\n",
+        GuardSet::ALL.0
+    );
     for g in &SWITCHES {
         out += &format!("#define {} {} // {}; off: {}\n", g.glsl, g.bit, g.guarded, g.unguarded);
     }
@@ -69,13 +87,29 @@ fn table() -> String {
     let v3 = |v: [f64; 3]| format!("vec3({}, {}, {})", float(v[0]), float(v[1]), float(v[2]));
     for &m in Metal::ALL {
         let (n, k) = m.nk();
-        out += &format!("    case {}: n = {}; k = {}; return; // {}\n", id_macro("METAL", m.name()), v3(n), v3(k), m.citation());
+        out += &format!(
+            "    case {}: n = {}; k = {}; return; // {}\n",
+            id_macro("METAL", m.name()),
+            v3(n),
+            v3(k),
+            m.citation()
+        );
     }
     out += "    }\n    n = vec3(not_a_term());\n    k = vec3(not_a_term());\n}\n\n#endif\n";
     out
 }
 
-fn switch<T: Copy>(out: &mut String, signature: &str, selector: &str, prefix: &str, args: &str, all: &[T], name: impl Fn(T) -> &'static str, glsl: impl Fn(T) -> &'static str, nan: &str) {
+fn switch<T: Copy>(
+    out: &mut String,
+    signature: &str,
+    selector: &str,
+    prefix: &str,
+    args: &str,
+    all: &[T],
+    name: impl Fn(T) -> &'static str,
+    glsl: impl Fn(T) -> &'static str,
+    nan: &str,
+) {
     *out += &format!("{signature} {{\n    switch ({selector}) {{\n");
     for &t in all {
         *out += &format!("    case {}: return {}({args});\n", id_macro(prefix, name(t)), glsl(t));
@@ -84,10 +118,42 @@ fn switch<T: Copy>(out: &mut String, signature: &str, selector: &str, prefix: &s
 }
 
 fn dispatch() -> String {
-    let mut out = format!("{HEADER}// The term dispatch: one `case` per row of the Rust tables, each calling the term's GLSL function.\n\n");
-    switch(&mut out, "real D_term(real NoH, real sin2h, real a)", "D_TERM", "D", "NoH, sin2h, a", D::ALL, D::name, D::glsl_name, "real(not_a_term())");
-    switch(&mut out, "real Vis_term(real NoV, real NoL, real NoH, real VoH, real a)", "VIS_TERM", "VIS", "NoV, NoL, NoH, VoH, a", Vis::ALL, Vis::name, Vis::glsl_name, "real(not_a_term())");
-    switch(&mut out, "real3 F_term(real3 f0, real VoH)", "F_TERM", "F", "f0, VoH", F::ALL, F::name, F::glsl_name, "real3(not_a_term())");
+    let mut out = format!(
+        "{HEADER}// The term dispatch: one `case` per row of the Rust tables, each calling the term's GLSL function.\n\n"
+    );
+    switch(
+        &mut out,
+        "real D_term(real NoH, real sin2h, real a)",
+        "D_TERM",
+        "D",
+        "NoH, sin2h, a",
+        D::ALL,
+        D::name,
+        D::glsl_name,
+        "real(not_a_term())",
+    );
+    switch(
+        &mut out,
+        "real Vis_term(real NoV, real NoL, real NoH, real VoH, real a)",
+        "VIS_TERM",
+        "VIS",
+        "NoV, NoL, NoH, VoH, a",
+        Vis::ALL,
+        Vis::name,
+        Vis::glsl_name,
+        "real(not_a_term())",
+    );
+    switch(
+        &mut out,
+        "real3 F_term(real3 f0, real VoH)",
+        "F_TERM",
+        "F",
+        "f0, VoH",
+        F::ALL,
+        F::name,
+        F::glsl_name,
+        "real3(not_a_term())",
+    );
     out
 }
 

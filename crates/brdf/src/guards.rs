@@ -28,9 +28,21 @@ pub struct Guard {
 
 /// The guards the GLSL declares (MIN_ROUGHNESS, which depends on the precision, is written apart).
 pub const GLSL_GUARDS: [Guard; 4] = [
-    Guard { name: "MIN_COSINE", value: MIN_COSINE, why: "Filament MIN_N_DOT_V; NoV, NoL, NoH, VoH floor once a light is visible" },
-    Guard { name: "MIN_VECTOR", value: MIN_VECTOR, why: "FLT_MIN: a vector whose largest component is below it counts as zero" },
-    Guard { name: "GTR_SERIES_BAND", value: GTR_SERIES_BAND, why: "|a2-1| below which the GTR normaliser uses its series (0/0 at a2 = 1)" },
+    Guard {
+        name: "MIN_COSINE",
+        value: MIN_COSINE,
+        why: "Filament MIN_N_DOT_V; NoV, NoL, NoH, VoH floor once a light is visible",
+    },
+    Guard {
+        name: "MIN_VECTOR",
+        value: MIN_VECTOR,
+        why: "FLT_MIN: a vector whose largest component is below it counts as zero",
+    },
+    Guard {
+        name: "GTR_SERIES_BAND",
+        value: GTR_SERIES_BAND,
+        why: "|a2-1| below which the GTR normaliser uses its series (0/0 at a2 = 1)",
+    },
     Guard { name: "F0_MAX", value: F0_MAX, why: "dielectric F0 cap: the IOR (1+sqrt F0)/(1-sqrt F0) is infinite at 1" },
 ];
 
@@ -71,11 +83,41 @@ pub struct Switch {
 /// GTR_SERIES_BAND (inside terms: without them the terms are 0/0 on valid inputs) and the normalisation of the
 /// inputs N, V, L (the eval kernel's contract: unnormalised vectors) stay.
 pub const SWITCHES: [Switch; 5] = [
-    Switch { name: "safe-h", bit: 1, glsl: "GUARD_SAFE_H", guarded: "H = safe_normalize(V + L): scaled first, 0 for V = -L", unguarded: "H = normalize(V + L)" },
-    Switch { name: "sin2h", bit: 2, glsl: "GUARD_SIN2H", guarded: "1 - NoH^2 as |N x H|^2, no cancellation at the peak", unguarded: "1 - NoH * NoH" },
-    Switch { name: "cosine-floor", bit: 4, glsl: "GUARD_COSINE_FLOOR", guarded: "NoV, NoL, NoH, VoH clamped into [MIN_COSINE, 1]", unguarded: "clamped into [0, 1] (saturate)" },
-    Switch { name: "f0-clamp", bit: 8, glsl: "GUARD_F0_CLAMP", guarded: "F0 clamped into [0, 1]", unguarded: "F0 as given" },
-    Switch { name: "lit-mask", bit: 16, glsl: "GUARD_LIT_MASK", guarded: "f_s = 0 unless NoV > 0 and NoL > 0", unguarded: "f_s of the saturated cosines, whatever it is" },
+    Switch {
+        name: "safe-h",
+        bit: 1,
+        glsl: "GUARD_SAFE_H",
+        guarded: "H = safe_normalize(V + L): scaled first, 0 for V = -L",
+        unguarded: "H = normalize(V + L)",
+    },
+    Switch {
+        name: "sin2h",
+        bit: 2,
+        glsl: "GUARD_SIN2H",
+        guarded: "1 - NoH^2 as |N x H|^2, no cancellation at the peak",
+        unguarded: "1 - NoH * NoH",
+    },
+    Switch {
+        name: "cosine-floor",
+        bit: 4,
+        glsl: "GUARD_COSINE_FLOOR",
+        guarded: "NoV, NoL, NoH, VoH clamped into [MIN_COSINE, 1]",
+        unguarded: "clamped into [0, 1] (saturate)",
+    },
+    Switch {
+        name: "f0-clamp",
+        bit: 8,
+        glsl: "GUARD_F0_CLAMP",
+        guarded: "F0 clamped into [0, 1]",
+        unguarded: "F0 as given",
+    },
+    Switch {
+        name: "lit-mask",
+        bit: 16,
+        glsl: "GUARD_LIT_MASK",
+        guarded: "f_s = 0 unless NoV > 0 and NoL > 0",
+        unguarded: "f_s of the saturated cosines, whatever it is",
+    },
 ];
 
 /// The GUARDS specialisation constant's id (3..16 belong to the term parameters; 15 is the last of them).
@@ -124,7 +166,10 @@ impl GuardSet {
         match self {
             GuardSet::ALL => "on".into(),
             GuardSet::NONE => "off".into(),
-            _ => format!("off:{}", SWITCHES.iter().filter(|s| self.0 & s.bit == 0).map(|s| s.name).collect::<Vec<_>>().join("+")),
+            _ => format!(
+                "off:{}",
+                SWITCHES.iter().filter(|s| self.0 & s.bit == 0).map(|s| s.name).collect::<Vec<_>>().join("+")
+            ),
         }
     }
 
@@ -147,9 +192,21 @@ pub struct InputGuard {
 
 /// The input guards, in the order `stability` lists them.
 pub const INPUT_GUARDS: [InputGuard; 5] = [
-    InputGuard { name: "roughness-floor", does: "roughness clamped into [MIN_ROUGHNESS, 1] (0.045 fp32, 0.089 fp16)", apply: floor_roughness },
-    InputGuard { name: "cosine-floor", does: "V and L less than MIN_COSINE = 1e-4 above the horizon turned up to it", apply: floor_cosines },
-    InputGuard { name: "safe-h", does: "not called where V + L of the unit vectors is 0 (largest component below FLT_MIN in f32): no half vector", apply: skip_without_half_vector },
+    InputGuard {
+        name: "roughness-floor",
+        does: "roughness clamped into [MIN_ROUGHNESS, 1] (0.045 fp32, 0.089 fp16)",
+        apply: floor_roughness,
+    },
+    InputGuard {
+        name: "cosine-floor",
+        does: "V and L less than MIN_COSINE = 1e-4 above the horizon turned up to it",
+        apply: floor_cosines,
+    },
+    InputGuard {
+        name: "safe-h",
+        does: "not called where V + L of the unit vectors is 0 (largest component below FLT_MIN in f32): no half vector",
+        apply: skip_without_half_vector,
+    },
     InputGuard { name: "lit-mask", does: "not called unless NoV > 0 and NoL > 0", apply: skip_unlit },
     InputGuard { name: "f0-clamp", does: "F0 clamped into [0, 1]", apply: clamp_f0 },
 ];
@@ -202,17 +259,30 @@ mod tests {
     #[test]
     fn each_input_guard_is_a_kernel_guard_or_the_roughness_floor() {
         for g in &INPUT_GUARDS {
-            assert!(g.name == "roughness-floor" || SWITCHES.iter().any(|s| s.name == g.name), "{} names no kernel guard", g.name);
+            assert!(
+                g.name == "roughness-floor" || SWITCHES.iter().any(|s| s.name == g.name),
+                "{} names no kernel guard",
+                g.name
+            );
         }
     }
 
     #[test]
     fn input_guards_do_what_they_say() {
-        let s = Sample { n: [0.0, 0.0, 2.0], v: [1.0, 0.0, 0.0], l: [-1.0, 0.0, 0.0], roughness: 0.0, f0: [1.5, -0.1, 0.5] };
+        let s = Sample {
+            n: [0.0, 0.0, 2.0],
+            v: [1.0, 0.0, 0.0],
+            l: [-1.0, 0.0, 0.0],
+            roughness: 0.0,
+            f0: [1.5, -0.1, 0.5],
+        };
         let by = |name: &str| INPUT_GUARDS.iter().find(|g| g.name == name).unwrap().apply;
         assert_eq!(by("roughness-floor")(&s, MIN_ROUGHNESS_F32).unwrap().roughness, MIN_ROUGHNESS_F32 as f32);
         let up = by("cosine-floor")(&s, MIN_ROUGHNESS_F32).unwrap();
-        assert!((f64::from(up.v[2]) - MIN_COSINE).abs() < 1e-9 && (f64::from(up.l[2]) - MIN_COSINE).abs() < 1e-9, "{up:?}");
+        assert!(
+            (f64::from(up.v[2]) - MIN_COSINE).abs() < 1e-9 && (f64::from(up.l[2]) - MIN_COSINE).abs() < 1e-9,
+            "{up:?}"
+        );
         assert!(by("safe-h")(&s, 0.0).is_none(), "V = -L has no half vector");
         assert!(by("safe-h")(&up, 0.0).is_some());
         assert!(by("lit-mask")(&s, 0.0).is_none() && by("lit-mask")(&up, 0.0).is_some());

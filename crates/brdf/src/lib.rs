@@ -7,8 +7,8 @@ pub mod samples;
 pub mod spec;
 pub mod terms;
 
-pub use spec::{ModelSpec, Precision, PRESETS, THESIS_MODELS};
-pub use terms::{Cosines, Metal, D, F, Vis};
+pub use spec::{ModelSpec, PRESETS, Precision, THESIS_MODELS};
+pub use terms::{Cosines, D, F, Metal, Vis};
 
 /// One BRDF query as the kernels receive it: world-space vectors (normalised by the kernel), perceptual
 /// roughness and an RGB F0, all in f32.

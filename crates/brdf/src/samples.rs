@@ -59,7 +59,13 @@ pub fn well_conditioned(count: usize, seed: u64, min_cos: f64, roughness: std::o
 
 /// `well_conditioned` with NoV uniform in [nov.0, nov.1] and NoL in [nol.0, nol.1] (an engine's domain); the
 /// same draws, so that [min_cos, 1] gives `well_conditioned`'s samples exactly.
-pub fn well_conditioned_in(count: usize, seed: u64, nov: (f64, f64), nol: (f64, f64), roughness: std::ops::Range<f64>) -> Vec<Sample> {
+pub fn well_conditioned_in(
+    count: usize,
+    seed: u64,
+    nov: (f64, f64),
+    nol: (f64, f64),
+    roughness: std::ops::Range<f64>,
+) -> Vec<Sample> {
     let mut rng = Pcg64::seed_from_u64(seed);
     (0..count)
         .map(|_| {
@@ -87,7 +93,13 @@ pub fn stratified(per_axis: usize, seed: u64, min_cos: f64, roughness: std::ops:
 }
 
 /// `stratified` with NoV, NoL and roughness each in its own range (a degenerate range gives its one value).
-pub fn stratified_in(per_axis: usize, seed: u64, nov_range: (f64, f64), nol_range: (f64, f64), roughness: (f64, f64)) -> Vec<Sample> {
+pub fn stratified_in(
+    per_axis: usize,
+    seed: u64,
+    nov_range: (f64, f64),
+    nol_range: (f64, f64),
+    roughness: (f64, f64),
+) -> Vec<Sample> {
     let mut rng = Pcg64::seed_from_u64(seed);
     let k = per_axis as f64;
     let mut out = Vec::with_capacity(per_axis.pow(4));

@@ -3,9 +3,9 @@
 //! overrides (`burley,gamma=2`, `ggx,precision=f16`). Every key is checked once: a parameter no term of the
 //! spec reads, or a key given twice, is an error.
 
-use super::guards::{self, GuardSet, MIN_ROUGHNESS_F16, MIN_ROUGHNESS_F32};
-use super::terms::{Cosines, Exact, Metal, Param, ParamKind, ParamValue, Params, D, F, Vis};
 use super::Sample;
+use super::guards::{self, GuardSet, MIN_ROUGHNESS_F16, MIN_ROUGHNESS_F32};
+use super::terms::{Cosines, D, Exact, F, Metal, Param, ParamKind, ParamValue, Params, Vis};
 use glam::DVec3;
 use std::fmt;
 
@@ -57,13 +57,55 @@ pub struct Preset {
 }
 
 pub const PRESETS: &[Preset] = &[
-    Preset { name: "ggx", d: D::Ggx, vis: Vis::SmithGgxJointApprox, f: F::Schlick, source: "thesis 4.1: UE5 Default Lit (GGX, SmithJointApprox, Schlick)" },
-    Preset { name: "blinn", d: D::Blinn, vis: Vis::SchlickBeckmann, f: F::Schlick, source: "thesis 4.2: normalised Blinn-Phong, Smith-Schlick with k = a sqrt(2/pi)" },
-    Preset { name: "cook-torrance", d: D::Beckmann, vis: Vis::VCavity, f: F::Schlick, source: "thesis 4.3: Beckmann, Cook-Torrance V-cavity" },
-    Preset { name: "burley", d: D::Gtr, vis: Vis::SmithGgxSeparable, f: F::Schlick, source: "thesis 4.4: GTR (gamma 1.5), separable Smith GGX" },
-    Preset { name: "ue-default-lit", d: D::Ggx, vis: Vis::SmithGgxJointApprox, f: F::SchlickUe, source: "UE5 Default Lit with its f90 = saturate(50 F0.g) Schlick" },
-    Preset { name: "filament-high", d: D::Ggx, vis: Vis::SmithGgxCorrelated, f: F::SchlickFilament, source: "Filament high quality: GGX, exact correlated Smith, Schlick with f90" },
-    Preset { name: "filament-low", d: D::Ggx, vis: Vis::Hammon, f: F::Schlick, source: "Filament low quality: GGX, V_SmithGGXCorrelated_Fast (Hammon), Schlick f90 = 1" },
+    Preset {
+        name: "ggx",
+        d: D::Ggx,
+        vis: Vis::SmithGgxJointApprox,
+        f: F::Schlick,
+        source: "thesis 4.1: UE5 Default Lit (GGX, SmithJointApprox, Schlick)",
+    },
+    Preset {
+        name: "blinn",
+        d: D::Blinn,
+        vis: Vis::SchlickBeckmann,
+        f: F::Schlick,
+        source: "thesis 4.2: normalised Blinn-Phong, Smith-Schlick with k = a sqrt(2/pi)",
+    },
+    Preset {
+        name: "cook-torrance",
+        d: D::Beckmann,
+        vis: Vis::VCavity,
+        f: F::Schlick,
+        source: "thesis 4.3: Beckmann, Cook-Torrance V-cavity",
+    },
+    Preset {
+        name: "burley",
+        d: D::Gtr,
+        vis: Vis::SmithGgxSeparable,
+        f: F::Schlick,
+        source: "thesis 4.4: GTR (gamma 1.5), separable Smith GGX",
+    },
+    Preset {
+        name: "ue-default-lit",
+        d: D::Ggx,
+        vis: Vis::SmithGgxJointApprox,
+        f: F::SchlickUe,
+        source: "UE5 Default Lit with its f90 = saturate(50 F0.g) Schlick",
+    },
+    Preset {
+        name: "filament-high",
+        d: D::Ggx,
+        vis: Vis::SmithGgxCorrelated,
+        f: F::SchlickFilament,
+        source: "Filament high quality: GGX, exact correlated Smith, Schlick with f90",
+    },
+    Preset {
+        name: "filament-low",
+        d: D::Ggx,
+        vis: Vis::Hammon,
+        f: F::Schlick,
+        source: "Filament low quality: GGX, V_SmithGGXCorrelated_Fast (Hammon), Schlick f90 = 1",
+    },
 ];
 
 /// The four models of the thesis, in its order.
@@ -132,7 +174,8 @@ impl ModelSpec {
         let mut seen: Vec<&str> = Vec::new();
         let mut given: Vec<(Param, ParamValue)> = Vec::new();
         for item in items {
-            let (key, value) = item.split_once('=').ok_or_else(|| format!("`{item}` in model spec `{text}` is not key=value"))?;
+            let (key, value) =
+                item.split_once('=').ok_or_else(|| format!("`{item}` in model spec `{text}` is not key=value"))?;
             let (key, value) = (key.trim(), value.trim());
             if seen.contains(&key) {
                 return Err(format!("`{key}` is given twice in model spec `{text}`"));
@@ -142,7 +185,10 @@ impl ModelSpec {
                 "d" => spec.d = D::from_name(value).ok_or_else(|| unknown("d", value, &D::names()))?,
                 "vis" => spec.vis = Vis::from_name(value).ok_or_else(|| unknown("vis", value, &Vis::names()))?,
                 "f" => spec.f = parse_f(value, &mut given)?,
-                "precision" => spec.precision = Precision::from_name(value).ok_or_else(|| unknown("precision", value, &["f32", "f16"]))?,
+                "precision" => {
+                    spec.precision =
+                        Precision::from_name(value).ok_or_else(|| unknown("precision", value, &["f32", "f16"]))?
+                }
                 "guards" => spec.guards = GuardSet::parse(value)?,
                 _ => {
                     let p = Param::from_name(key).ok_or_else(|| {
@@ -159,7 +205,13 @@ impl ModelSpec {
         let reads = spec.reads();
         for (p, value) in given {
             if !reads.contains(&p) {
-                return Err(format!("`{}` is read by no term of model spec `{text}` (d={}, vis={}, f={})", p.name(), spec.d.name(), spec.vis.name(), spec.f.name()));
+                return Err(format!(
+                    "`{}` is read by no term of model spec `{text}` (d={}, vis={}, f={})",
+                    p.name(),
+                    spec.d.name(),
+                    spec.vis.name(),
+                    spec.f.name()
+                ));
             }
             spec.params.set(p, value);
         }
@@ -173,7 +225,10 @@ impl ModelSpec {
         }
         let overridden: Vec<&str> = params.iter().filter_map(|p| p.split_once('=').map(|(k, _)| k.trim())).collect();
         let canonical = self.canonical();
-        let kept: Vec<&str> = canonical.split(',').filter(|item| !item.split_once('=').is_some_and(|(k, _)| overridden.contains(&k))).collect();
+        let kept: Vec<&str> = canonical
+            .split(',')
+            .filter(|item| !item.split_once('=').is_some_and(|(k, _)| overridden.contains(&k)))
+            .collect();
         ModelSpec::parse(&format!("{},{}", kept.join(","), params.join(",")))
     }
 
@@ -214,7 +269,11 @@ impl ModelSpec {
 
     /// The Fresnel with its metal where it reads one (`conductor-gold`), for labels.
     pub fn f_label(&self) -> String {
-        if self.f.row().reads.contains(&Param::Metal) { format!("{}-{}", self.f.name(), self.params.metal().name()) } else { self.f.name().to_string() }
+        if self.f.row().reads.contains(&Param::Metal) {
+            format!("{}-{}", self.f.name(), self.params.metal().name())
+        } else {
+            self.f.name().to_string()
+        }
     }
 
     /// The exact Fresnel this spec's F stands for, as a spec term: the metal's conductor Fresnel, or the
@@ -244,7 +303,13 @@ impl ModelSpec {
 
     /// The f64 twin of `specular_brdf`: f_s for unnormalised vectors, 0 unless NoL > 0 and NoV > 0.
     pub fn eval(&self, s: &Sample) -> [f64; 3] {
-        self.eval_unit(guards::unit(s.n), guards::unit(s.v), guards::unit(s.l), f64::from(s.roughness), s.f0.map(f64::from))
+        self.eval_unit(
+            guards::unit(s.n),
+            guards::unit(s.v),
+            guards::unit(s.l),
+            f64::from(s.roughness),
+            s.f0.map(f64::from),
+        )
     }
 
     /// `eval` for inputs already in f64.
@@ -375,10 +440,24 @@ mod tests {
             assert_eq!(ModelSpec::parse(&g.canonical()).unwrap(), g, "{text}");
         }
         assert_eq!(ModelSpec::parse("ggx,guards=on").unwrap(), ModelSpec::parse("ggx").unwrap());
-        assert_eq!(ModelSpec::parse("ggx,guards=off:safe-h+sin2h+cosine-floor+f0-clamp+lit-mask").unwrap().guards, GuardSet::NONE);
+        assert_eq!(
+            ModelSpec::parse("ggx,guards=off:safe-h+sin2h+cosine-floor+f0-clamp+lit-mask").unwrap().guards,
+            GuardSet::NONE
+        );
         assert_eq!(ModelSpec::parse("d=beckmann,vis=smith-beckmann-walter,f=conductor,metal=copper").unwrap(), c);
-        assert_eq!(ModelSpec::parse("burley").unwrap().with_params(&["gamma=2.5".into()]).unwrap().params.number(Param::Gamma), 2.5);
-        assert_eq!(ModelSpec::parse("burley,gamma=2").unwrap().with_params(&["gamma=2.5".into()]).unwrap().params.number(Param::Gamma), 2.5);
+        assert_eq!(
+            ModelSpec::parse("burley").unwrap().with_params(&["gamma=2.5".into()]).unwrap().params.number(Param::Gamma),
+            2.5
+        );
+        assert_eq!(
+            ModelSpec::parse("burley,gamma=2")
+                .unwrap()
+                .with_params(&["gamma=2.5".into()])
+                .unwrap()
+                .params
+                .number(Param::Gamma),
+            2.5
+        );
     }
 
     #[test]

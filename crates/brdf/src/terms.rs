@@ -92,7 +92,15 @@ pub const PARAMS: [ParamDef; 2] = [
         // g = 1 is the normaliser's limit form (a2-1)/ln(a2); 1 +- 1e-6 straddle it; 2 is GGX; 3 the range end.
         hard_values: &[1.0, 1.0 - 1e-6, 1.0 + 1e-6, 2.0, 3.0],
     },
-    ParamDef { param: Param::Metal, name: "metal", glsl: "METAL", constant_id: 4, kind: ParamKind::Metal, about: "metal of the conductor Fresnel terms", hard_values: &[] },
+    ParamDef {
+        param: Param::Metal,
+        name: "metal",
+        glsl: "METAL",
+        constant_id: 4,
+        kind: ParamKind::Metal,
+        about: "metal of the conductor Fresnel terms",
+        hard_values: &[],
+    },
 ];
 
 impl Param {
@@ -170,7 +178,10 @@ impl Params {
             ParamKind::Number { min, max, why, .. } => {
                 let x: f64 = value.parse().map_err(|_| format!("{} `{value}` is not a number", p.name()))?;
                 if !(x.is_finite() && (min..=max).contains(&x)) {
-                    return Err(format!("{} {value} is outside [{min}, {max}], the range brdfprof's kernels are stable in: {why}", p.name()));
+                    return Err(format!(
+                        "{} {value} is outside [{min}, {max}], the range brdfprof's kernels are stable in: {why}",
+                        p.name()
+                    ));
                 }
                 Ok(ParamValue::Number(x))
             }

@@ -22,7 +22,8 @@ struct Registry {
     created_dirs: Vec<PathBuf>,
 }
 
-static REGISTRY: Mutex<Registry> = Mutex::new(Registry { children: Vec::new(), paths: Vec::new(), created_dirs: Vec::new() });
+static REGISTRY: Mutex<Registry> =
+    Mutex::new(Registry { children: Vec::new(), paths: Vec::new(), created_dirs: Vec::new() });
 static INTERRUPTED: AtomicBool = AtomicBool::new(false);
 
 /// The registry, even if a panicking thread poisoned it (it holds plain lists; nothing is half-updated).
@@ -87,7 +88,11 @@ pub fn stop(code: i32, message: &str) -> ! {
     for d in dirs.iter().rev() {
         let _ = std::fs::remove_dir(d);
     }
-    crate::messages::line(&format!("{message}; stopped {} child process(es) and removed {} temporary path(s)", children.len(), paths.len()));
+    crate::messages::line(&format!(
+        "{message}; stopped {} child process(es) and removed {} temporary path(s)",
+        children.len(),
+        paths.len()
+    ));
     // _exit, not exit: other threads may be inside the Vulkan driver, whose exit-time teardown must not run
     // under them. Nothing buffered is lost that matters for a stopped run.
     // SAFETY: _exit ends the process at once; it has no preconditions.

@@ -20,7 +20,7 @@
 //!   (`Gpu::submit`, with this module's `Watch`), and past it stops the command as `bounded` does. That wait
 //!   includes the dispatch's own run, seconds at most for brdfprof's largest first submissions.
 
-use anyhow::{anyhow, bail, Result};
+use anyhow::{Result, anyhow, bail};
 use std::process::{Command, Output, Stdio};
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
@@ -87,7 +87,10 @@ fn seconds(d: Duration) -> String {
 
 /// The message of a compilation that went past the limit.
 pub fn over_limit(what: &str, limit: Duration) -> String {
-    format!("{what}: the compilation took longer than the compile limit of {} (set it with --compile-timeout SECONDS or {ENV})", seconds(limit))
+    format!(
+        "{what}: the compilation took longer than the compile limit of {} (set it with --compile-timeout SECONDS or {ENV})",
+        seconds(limit)
+    )
 }
 
 /// Says, from `PROGRESS_AFTER` on, what has been compiling for how long: for a compiler whose end is waited
@@ -107,7 +110,12 @@ impl<'a> Watch<'a> {
     pub fn tick(&mut self, limit: Duration) {
         let elapsed = self.started.elapsed();
         if elapsed >= self.next {
-            crate::messages::progress(format!("still compiling {} after {} (the limit is {})", self.what, seconds(Duration::from_secs(elapsed.as_secs())), seconds(limit)));
+            crate::messages::progress(format!(
+                "still compiling {} after {} (the limit is {})",
+                self.what,
+                seconds(Duration::from_secs(elapsed.as_secs())),
+                seconds(limit)
+            ));
             self.next += PROGRESS_EVERY;
         }
     }
@@ -144,18 +152,22 @@ pub fn output_quick(cmd: &mut Command, what: &str) -> Result<Output> {
 }
 
 fn over_output(what: &str) -> String {
-    format!("{what}: the tool printed more than {} MiB, far more than it prints for any kernel: not its promised output", MAX_OUTPUT_BYTES >> 20)
+    format!(
+        "{what}: the tool printed more than {} MiB, far more than it prints for any kernel: not its promised output",
+        MAX_OUTPUT_BYTES >> 20
+    )
 }
 
 fn run(cmd: &mut Command, input: Option<Vec<u8>>, what: &str, limit: Duration) -> Result<Output> {
     use std::io::{Read, Write};
-    use std::sync::atomic::{AtomicBool, Ordering};
     use std::sync::Arc;
+    use std::sync::atomic::{AtomicBool, Ordering};
     let stdin = if input.is_some() { Stdio::piped() } else { Stdio::null() };
     let mut child = cmd.stdin(stdin).stdout(Stdio::piped()).stderr(Stdio::piped()).spawn()?;
     let _guard = crate::cleanup::ChildGuard::new(&child);
     // Written on a thread so that a large output cannot deadlock against the input.
-    let writer = child.stdin.take().zip(input).map(|(mut pipe, bytes)| std::thread::spawn(move || pipe.write_all(&bytes)));
+    let writer =
+        child.stdin.take().zip(input).map(|(mut pipe, bytes)| std::thread::spawn(move || pipe.write_all(&bytes)));
     // Readers drain the pipes while this thread watches the clock (a full pipe would stall the child).
     let overflow = Arc::new(AtomicBool::new(false));
     let read_all = |pipe: Option<Box<dyn Read + Send>>| {
@@ -217,7 +229,9 @@ pub fn bounded<T: Send>(what: &str, work: impl FnOnce() -> T + Send) -> T {
         loop {
             match rx.recv_timeout(Duration::from_millis(50)) {
                 Ok(value) => return value,
-                Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => panic!("{what}: the compiling thread ended without a result"),
+                Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => {
+                    panic!("{what}: the compiling thread ended without a result")
+                }
                 Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {}
             }
             if progress.elapsed() >= limit {
@@ -244,17 +258,26 @@ mod tests {
     #[test]
     fn a_process_past_the_limit_is_killed_and_named() {
         let started = Instant::now();
-        let e = output_within(Command::new("sleep").arg("30"), "sleep 30", Duration::from_millis(300)).unwrap_err().to_string();
+        let e = output_within(Command::new("sleep").arg("30"), "sleep 30", Duration::from_millis(300))
+            .unwrap_err()
+            .to_string();
         assert!(e.starts_with("sleep 30: the compilation took longer than the compile limit of 0.3 s"), "{e}");
         assert!(started.elapsed() < Duration::from_secs(5), "killed at the limit");
-        let out = output_within(Command::new("sh").args(["-c", "echo out; echo err >&2"]), "sh", Duration::from_secs(30)).unwrap();
-        assert_eq!((out.stdout.as_slice(), out.stderr.as_slice(), out.status.success()), (&b"out\n"[..], &b"err\n"[..], true));
+        let out =
+            output_within(Command::new("sh").args(["-c", "echo out; echo err >&2"]), "sh", Duration::from_secs(30))
+                .unwrap();
+        assert_eq!(
+            (out.stdout.as_slice(), out.stderr.as_slice(), out.status.success()),
+            (&b"out\n"[..], &b"err\n"[..], true)
+        );
     }
 
     #[test]
     fn a_tool_that_prints_without_end_is_killed() {
         let started = Instant::now();
-        let e = output_within(&mut Command::new("yes"), "yes as a disassembler", Duration::from_secs(60)).unwrap_err().to_string();
+        let e = output_within(&mut Command::new("yes"), "yes as a disassembler", Duration::from_secs(60))
+            .unwrap_err()
+            .to_string();
         assert!(e.starts_with("yes as a disassembler: the tool printed more than 256 MiB"), "{e}");
         assert!(started.elapsed() < Duration::from_secs(50), "stopped at the byte bound, not the time limit");
     }

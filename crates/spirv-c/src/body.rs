@@ -80,7 +80,11 @@ impl<'m> FunctionWriter<'m> {
     }
 
     pub fn err(&self, construct: impl Into<String>) -> TranslateError {
-        TranslateError { construct: construct.into(), function: Some(self.m.name(self.id).unwrap_or("?").to_string()), location: self.location.clone() }
+        TranslateError {
+            construct: construct.into(),
+            function: Some(self.m.name(self.id).unwrap_or("?").to_string()),
+            location: self.location.clone(),
+        }
     }
 
     /// The C function: signature, declarations, body.
@@ -153,7 +157,10 @@ impl<'m> FunctionWriter<'m> {
         if self.m.constants.contains_key(&id) {
             let ty = self.m.type_of(id).unwrap_or(0);
             let e = super::constants::expr(self.m, id).map_err(|e| self.err(e.construct))?;
-            if !matches!(self.m.ty(ty), Type::Vector { .. } | Type::Matrix { .. } | Type::Array { .. } | Type::Struct { .. }) {
+            if !matches!(
+                self.m.ty(ty),
+                Type::Vector { .. } | Type::Matrix { .. } | Type::Array { .. } | Type::Struct { .. }
+            ) {
                 return Ok(e);
             }
             let name = format!("k{id}");
@@ -190,7 +197,9 @@ impl<'m> FunctionWriter<'m> {
                 }
                 self.location = Some(here);
             }
-            NoLine if self.line_directives && self.location.take().is_some() => writeln!(self.body, "#line 1 \"{}\"", super::TRANSLATION_FILE).unwrap(),
+            NoLine if self.line_directives && self.location.take().is_some() => {
+                writeln!(self.body, "#line 1 \"{}\"", super::TRANSLATION_FILE).unwrap()
+            }
             NoLine | Nop | SelectionMerge | LoopMerge | Phi => {}
             Variable => self.variable(inst)?,
             Load => self.load(inst)?,
@@ -221,7 +230,11 @@ impl<'m> FunctionWriter<'m> {
             FunctionCall => self.call(inst)?,
             SampledImage | Image => {
                 let source = Self::id(inst, 0);
-                let val = self.vals.get(&source).cloned().ok_or_else(|| self.err("an image that does not come from a binding"))?;
+                let val = self
+                    .vals
+                    .get(&source)
+                    .cloned()
+                    .ok_or_else(|| self.err("an image that does not come from a binding"))?;
                 self.vals.insert(inst.result_id.unwrap_or(0), val);
             }
             ImageFetch | ImageRead => self.image_read(inst)?,
@@ -247,7 +260,11 @@ impl<'m> FunctionWriter<'m> {
         for (result, pairs) in &phis {
             let ty = self.m.c_type(self.m.result_types.get(result).copied().unwrap_or(0))?;
             self.declare(*result, &ty);
-            let value = pairs.iter().find(|(_, b)| *b == from).map(|(v, _)| *v).ok_or_else(|| self.err(format!("an OpPhi without a value for block {from}")))?;
+            let value = pairs
+                .iter()
+                .find(|(_, b)| *b == from)
+                .map(|(v, _)| *v)
+                .ok_or_else(|| self.err(format!("an OpPhi without a value for block {from}")))?;
             let value = self.v(value)?;
             if many {
                 if self.phi_temps.insert(*result) {
@@ -327,8 +344,12 @@ impl<'m> FunctionWriter<'m> {
             return Ok(v.clone());
         }
         match self.env.globals.get(&id) {
-            Some(GlobalRep::Local { field, pointee }) => Ok(Val::Local { ptr: format!("(&env->{field})"), pointee: *pointee }),
-            Some(GlobalRep::Buffer { pointee, .. }) => Ok(Val::Buffer { var: id, off: "0u".into(), pointee: *pointee, matrix_stride: None }),
+            Some(GlobalRep::Local { field, pointee }) => {
+                Ok(Val::Local { ptr: format!("(&env->{field})"), pointee: *pointee })
+            }
+            Some(GlobalRep::Buffer { pointee, .. }) => {
+                Ok(Val::Buffer { var: id, off: "0u".into(), pointee: *pointee, matrix_stride: None })
+            }
             Some(GlobalRep::Image { .. }) => Ok(Val::Image { var: id }),
             None => Err(self.err(format!("a pointer (%{id}) the translation does not know"))),
         }
@@ -395,7 +416,12 @@ impl<'m> FunctionWriter<'m> {
         Ok(())
     }
 
-    fn local_chain(&mut self, mut lvalue: String, mut ty: Word, indices: &[Word]) -> Result<(String, Word), TranslateError> {
+    fn local_chain(
+        &mut self,
+        mut lvalue: String,
+        mut ty: Word,
+        indices: &[Word],
+    ) -> Result<(String, Word), TranslateError> {
         for &i in indices {
             match self.m.ty(ty).clone() {
                 Type::Struct { members } => {
@@ -435,12 +461,22 @@ impl<'m> FunctionWriter<'m> {
     }
 
     /// Byte offset of a chain into a buffer, from Offset, ArrayStride and MatrixStride.
-    fn buffer_chain(&mut self, mut off: String, mut ty: Word, mut stride: Option<u32>, indices: &[Word]) -> Result<(String, Word, Option<u32>), TranslateError> {
+    fn buffer_chain(
+        &mut self,
+        mut off: String,
+        mut ty: Word,
+        mut stride: Option<u32>,
+        indices: &[Word],
+    ) -> Result<(String, Word, Option<u32>), TranslateError> {
         for &i in indices {
             match self.m.ty(ty).clone() {
                 Type::Struct { members } => {
                     let k = self.constant_index(i)?;
-                    let o = self.m.member_decoration(ty, k, Decoration::Offset).and_then(|a| a.first().copied()).ok_or_else(|| self.err("a buffer struct member without an Offset"))?;
+                    let o = self
+                        .m
+                        .member_decoration(ty, k, Decoration::Offset)
+                        .and_then(|a| a.first().copied())
+                        .ok_or_else(|| self.err("a buffer struct member without an Offset"))?;
                     if self.m.member_decoration(ty, k, Decoration::RowMajor).is_some() {
                         return Err(self.err("a row_major matrix in a buffer"));
                     }
@@ -449,7 +485,11 @@ impl<'m> FunctionWriter<'m> {
                     ty = members[k as usize];
                 }
                 Type::Array { elem, .. } | Type::RuntimeArray { elem } => {
-                    let s = self.m.decoration(ty, Decoration::ArrayStride).and_then(|a| a.first().copied()).ok_or_else(|| self.err("a buffer array without an ArrayStride"))?;
+                    let s = self
+                        .m
+                        .decoration(ty, Decoration::ArrayStride)
+                        .and_then(|a| a.first().copied())
+                        .ok_or_else(|| self.err("a buffer array without an ArrayStride"))?;
                     off = format!("({off} + (u32)({}) * {s}u)", self.v(i)?);
                     ty = elem;
                 }
@@ -474,14 +514,24 @@ impl<'m> FunctionWriter<'m> {
     /// read-only storage buffer, `ld` otherwise.
     fn binding(&self, var: Word) -> Result<(String, bool, &'static str), TranslateError> {
         match self.env.globals.get(&var) {
-            Some(GlobalRep::Buffer { field, constant: true, .. }) => Ok((format!("BRDFPROF_CONSTANT_REF(env, {field})"), true, "ldc")),
-            Some(GlobalRep::Buffer { field, readonly, .. }) | Some(GlobalRep::Image { field, readonly, .. }) => Ok((format!("env->{field}"), *readonly, if *readonly { "ldro" } else { "ld" })),
+            Some(GlobalRep::Buffer { field, constant: true, .. }) => {
+                Ok((format!("BRDFPROF_CONSTANT_REF(env, {field})"), true, "ldc"))
+            }
+            Some(GlobalRep::Buffer { field, readonly, .. }) | Some(GlobalRep::Image { field, readonly, .. }) => {
+                Ok((format!("env->{field}"), *readonly, if *readonly { "ldro" } else { "ld" }))
+            }
             _ => Err(self.err("a buffer access to something that is not a binding")),
         }
     }
 
     /// A value of type `ty` read from `var` at byte offset `off`, member by member.
-    fn buffer_load(&mut self, var: Word, off: &str, ty: Word, matrix_stride: Option<u32>) -> Result<String, TranslateError> {
+    fn buffer_load(
+        &mut self,
+        var: Word,
+        off: &str,
+        ty: Word,
+        matrix_stride: Option<u32>,
+    ) -> Result<String, TranslateError> {
         let (field, _, ld) = self.binding(var)?;
         match self.m.ty(ty).clone() {
             Type::Bool => Ok(format!("({ld}_u32({field}, {off}) != 0u)")),
@@ -499,26 +549,47 @@ impl<'m> FunctionWriter<'m> {
                     self.decls.push(format!("{c} {tmp}[4];"));
                     writeln!(self.body, "  {ld}4_{suffix}({field}, {off}, {tmp});").unwrap();
                     let cast = if s == Scalar::I32 { "(i32)" } else { "" };
-                    return Ok(format!("mk_{}({})", self.m.c_type(ty)?, (0..4).map(|k| format!("{cast}{tmp}[{k}]")).collect::<Vec<_>>().join(", ")));
+                    return Ok(format!(
+                        "mk_{}({})",
+                        self.m.c_type(ty)?,
+                        (0..4).map(|k| format!("{cast}{tmp}[{k}]")).collect::<Vec<_>>().join(", ")
+                    ));
                 }
-                let parts: Vec<String> = (0..n).map(|k| self.buffer_load(var, &format!("({off} + {}u)", k * s.size()), elem, None)).collect::<Result<_, _>>()?;
+                let parts: Vec<String> = (0..n)
+                    .map(|k| self.buffer_load(var, &format!("({off} + {}u)", k * s.size()), elem, None))
+                    .collect::<Result<_, _>>()?;
                 Ok(format!("mk_{}({})", self.m.c_type(ty)?, parts.join(", ")))
             }
             Type::Matrix { column, columns } => {
                 let s = matrix_stride.ok_or_else(|| self.err("a buffer matrix without a MatrixStride"))?;
-                let parts: Vec<String> = (0..columns).map(|k| self.buffer_load(var, &format!("({off} + {}u)", k * s), column, None)).collect::<Result<_, _>>()?;
+                let parts: Vec<String> = (0..columns)
+                    .map(|k| self.buffer_load(var, &format!("({off} + {}u)", k * s), column, None))
+                    .collect::<Result<_, _>>()?;
                 Ok(format!("mk_{}({})", self.m.c_type(ty)?, parts.join(", ")))
             }
             Type::Array { elem, len } if len <= 64 => {
-                let s = self.m.decoration(ty, Decoration::ArrayStride).and_then(|a| a.first().copied()).ok_or_else(|| self.err("a buffer array without an ArrayStride"))?;
-                let parts: Vec<String> = (0..len).map(|k| self.buffer_load(var, &format!("({off} + {}u)", k * s), elem, None)).collect::<Result<_, _>>()?;
+                let s = self
+                    .m
+                    .decoration(ty, Decoration::ArrayStride)
+                    .and_then(|a| a.first().copied())
+                    .ok_or_else(|| self.err("a buffer array without an ArrayStride"))?;
+                let parts: Vec<String> = (0..len)
+                    .map(|k| self.buffer_load(var, &format!("({off} + {}u)", k * s), elem, None))
+                    .collect::<Result<_, _>>()?;
                 Ok(format!("mk_{}({})", self.m.c_type(ty)?, parts.join(", ")))
             }
             Type::Struct { members } => {
                 let mut parts = Vec::new();
                 for (k, m) in members.iter().enumerate() {
-                    let o = self.m.member_decoration(ty, k as u32, Decoration::Offset).and_then(|a| a.first().copied()).ok_or_else(|| self.err("a buffer struct member without an Offset"))?;
-                    let stride = self.m.member_decoration(ty, k as u32, Decoration::MatrixStride).and_then(|a| a.first().copied());
+                    let o = self
+                        .m
+                        .member_decoration(ty, k as u32, Decoration::Offset)
+                        .and_then(|a| a.first().copied())
+                        .ok_or_else(|| self.err("a buffer struct member without an Offset"))?;
+                    let stride = self
+                        .m
+                        .member_decoration(ty, k as u32, Decoration::MatrixStride)
+                        .and_then(|a| a.first().copied());
                     parts.push(self.buffer_load(var, &format!("({off} + {o}u)"), *m, stride)?);
                 }
                 Ok(format!("mk_{}({})", self.m.c_type(ty)?, parts.join(", ")))
@@ -528,7 +599,14 @@ impl<'m> FunctionWriter<'m> {
     }
 
     /// Statements writing `value` (a C expression of type `ty`) to `var` at byte offset `off`.
-    fn buffer_store(&mut self, var: Word, off: &str, ty: Word, matrix_stride: Option<u32>, value: &str) -> Result<String, TranslateError> {
+    fn buffer_store(
+        &mut self,
+        var: Word,
+        off: &str,
+        ty: Word,
+        matrix_stride: Option<u32>,
+        value: &str,
+    ) -> Result<String, TranslateError> {
         let (field, readonly, _) = self.binding(var)?;
         if readonly {
             return Err(self.err("a store to a read-only binding"));
@@ -553,14 +631,29 @@ impl<'m> FunctionWriter<'m> {
                 (0..columns).map(|k| (column, format!("c[{k}]"), k * s, None)).collect()
             }
             Type::Array { elem, len } => {
-                let s = self.m.decoration(ty, Decoration::ArrayStride).and_then(|a| a.first().copied()).ok_or_else(|| self.err("a buffer array without an ArrayStride"))?;
+                let s = self
+                    .m
+                    .decoration(ty, Decoration::ArrayStride)
+                    .and_then(|a| a.first().copied())
+                    .ok_or_else(|| self.err("a buffer array without an ArrayStride"))?;
                 (0..len).map(|k| (elem, format!("c[{k}]"), k * s, None)).collect()
             }
             Type::Struct { members } => {
                 let mut out = Vec::new();
                 for (k, m) in members.iter().enumerate() {
-                    let o = self.m.member_decoration(ty, k as u32, Decoration::Offset).and_then(|a| a.first().copied()).ok_or_else(|| self.err("a buffer struct member without an Offset"))?;
-                    out.push((*m, format!("m{k}"), o, self.m.member_decoration(ty, k as u32, Decoration::MatrixStride).and_then(|a| a.first().copied())));
+                    let o = self
+                        .m
+                        .member_decoration(ty, k as u32, Decoration::Offset)
+                        .and_then(|a| a.first().copied())
+                        .ok_or_else(|| self.err("a buffer struct member without an Offset"))?;
+                    out.push((
+                        *m,
+                        format!("m{k}"),
+                        o,
+                        self.m
+                            .member_decoration(ty, k as u32, Decoration::MatrixStride)
+                            .and_then(|a| a.first().copied()),
+                    ));
                 }
                 out
             }
@@ -586,7 +679,15 @@ impl<'m> FunctionWriter<'m> {
         let tmp = format!("t{}", inst.result_id.unwrap_or(0));
         self.decls.push(format!("{} {tmp}[4];", scalar.c_name()));
         writeln!(self.body, "  tex_ld_{}(env->{field}, (u32)({coord}), {tmp});", format.suffix()).unwrap();
-        let fill = |k: u32| if k < n { format!("{tmp}[{k}]") } else if k == 3 { one(scalar) } else { zero(scalar) };
+        let fill = |k: u32| {
+            if k < n {
+                format!("{tmp}[{k}]")
+            } else if k == 3 {
+                one(scalar)
+            } else {
+                zero(scalar)
+            }
+        };
         let parts: Vec<String> = (0..self.m.components(ty)).map(fill).collect();
         self.assign(inst, format!("mk_{}({})", self.m.c_type(ty)?, parts.join(", ")))
     }
@@ -604,8 +705,11 @@ impl<'m> FunctionWriter<'m> {
         let coord = self.v(Self::id(inst, 1))?;
         let texel = self.v(Self::id(inst, 2))?;
         let n = self.m.components(self.m.type_of(Self::id(inst, 2)).unwrap_or(0));
-        let parts: Vec<String> = (0..format.texel().1).map(|k| if k < n { format!("{texel}.c[{k}]") } else { zero(format.texel().0) }).collect();
-        writeln!(self.body, "  tex_st_{}(env->{field}, (u32)({coord}), {});", format.suffix(), parts.join(", ")).unwrap();
+        let parts: Vec<String> = (0..format.texel().1)
+            .map(|k| if k < n { format!("{texel}.c[{k}]") } else { zero(format.texel().0) })
+            .collect();
+        writeln!(self.body, "  tex_st_{}(env->{field}, (u32)({coord}), {});", format.suffix(), parts.join(", "))
+            .unwrap();
         Ok(())
     }
 }
@@ -656,6 +760,10 @@ pub(super) const LINED_FN: &str = "BRDFPROF_LINED_FN";
 /// directories and would otherwise resolve it there), with forward slashes and no quotes.
 fn absolute_source(file: &str) -> String {
     let path = std::path::Path::new(file);
-    let path = if path.is_relative() { std::env::current_dir().map(|d| d.join(path)).unwrap_or_else(|_| path.to_path_buf()) } else { path.to_path_buf() };
+    let path = if path.is_relative() {
+        std::env::current_dir().map(|d| d.join(path)).unwrap_or_else(|_| path.to_path_buf())
+    } else {
+        path.to_path_buf()
+    };
     path.to_string_lossy().replace('\\', "/").replace('"', "")
 }

@@ -1,9 +1,9 @@
 //! Module-level constants as C expressions: literals that convert back to the same bits, composites through
 //! their `mk_` constructors, and the OpSpecConstantOp forms spirv-opt leaves unfolded after freezing.
 
+use super::TranslateError;
 use super::ctypes::Scalar;
 use super::module::{Constant, ModuleInfo};
-use super::TranslateError;
 use rspirv::spirv::{Op, Word};
 
 /// A C literal of the scalar `bits` of type `s` that the C compiler reads back exactly.
@@ -34,7 +34,9 @@ pub fn expr(m: &ModuleInfo, id: Word) -> Result<String, TranslateError> {
     match m.constants.get(&id) {
         Some(Constant::Scalar { ty, bits }) => Ok(literal(m.scalar(*ty)?, *bits)),
         Some(Constant::Bool { value, .. }) => Ok(value.to_string()),
-        Some(Constant::Composite { parts, .. }) if parts.len() as u32 > super::ctypes::MAX_CONSTRUCTOR_MEMBERS => Ok(format!("k_{id}()")),
+        Some(Constant::Composite { parts, .. }) if parts.len() as u32 > super::ctypes::MAX_CONSTRUCTOR_MEMBERS => {
+            Ok(format!("k_{id}()"))
+        }
         Some(Constant::Composite { ty, parts }) => {
             let parts = parts.iter().map(|p| expr(m, *p)).collect::<Result<Vec<_>, _>>()?;
             Ok(format!("mk_{}({})", m.c_type(*ty)?, parts.join(", ")))
@@ -108,7 +110,12 @@ pub fn large_composites(m: &ModuleInfo) -> Result<String, TranslateError> {
     Ok(out)
 }
 
-fn define_large(m: &ModuleInfo, id: Word, done: &mut std::collections::HashSet<Word>, out: &mut String) -> Result<(), TranslateError> {
+fn define_large(
+    m: &ModuleInfo,
+    id: Word,
+    done: &mut std::collections::HashSet<Word>,
+    out: &mut String,
+) -> Result<(), TranslateError> {
     let Some(Constant::Composite { ty, parts }) = m.constants.get(&id) else { return Ok(()) };
     if !done.insert(id) {
         return Ok(());
@@ -120,7 +127,12 @@ fn define_large(m: &ModuleInfo, id: Word, done: &mut std::collections::HashSet<W
         return Ok(());
     }
     let c = m.c_type(*ty)?;
-    let sets = m.members(*ty).iter().zip(parts).map(|((_, accessor), p)| Ok(format!(" r.{accessor} = {};", expr(m, *p)?))).collect::<Result<String, TranslateError>>()?;
+    let sets = m
+        .members(*ty)
+        .iter()
+        .zip(parts)
+        .map(|((_, accessor), p)| Ok(format!(" r.{accessor} = {};", expr(m, *p)?)))
+        .collect::<Result<String, TranslateError>>()?;
     out.push_str(&format!("BRDFPROF_FN {c} k_{id}(void) {{ {c} r;{sets} return r; }}\n"));
     Ok(())
 }

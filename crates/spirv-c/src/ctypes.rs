@@ -3,8 +3,8 @@
 //! or columns in `c[]` (so a component index may be dynamic, as SPIR-V allows), an array `c[N]`, a struct its
 //! members `m0, m1, ...`. Each composite gets `mk_T(...)` (its constructor) and `z_T()` (its zero value).
 
-use super::module::{ModuleInfo, Type};
 use super::TranslateError;
+use super::module::{ModuleInfo, Type};
 use rspirv::spirv::Word;
 use std::fmt::Write;
 
@@ -70,7 +70,11 @@ impl ModuleInfo {
             Type::Float { width: 16 } => Ok(Scalar::F16),
             Type::Float { width: 32 } => Ok(Scalar::F32),
             Type::Float { width: 64 } => Ok(Scalar::F64),
-            Type::Int { width, signed } => Err(TranslateError::new(format!("{width}-bit {} integers (OpTypeInt {width} {})", if *signed { "signed" } else { "unsigned" }, *signed as u8))),
+            Type::Int { width, signed } => Err(TranslateError::new(format!(
+                "{width}-bit {} integers (OpTypeInt {width} {})",
+                if *signed { "signed" } else { "unsigned" },
+                *signed as u8
+            ))),
             Type::Float { width } => Err(TranslateError::new(format!("{width}-bit floats (OpTypeFloat {width})"))),
             other => Err(TranslateError::new(format!("a {other:?} where a scalar was expected"))),
         }
@@ -93,7 +97,9 @@ impl ModuleInfo {
             },
             Type::Pointer { pointee, .. } => format!("{}*", self.c_type(*pointee)?),
             Type::RuntimeArray { .. } => return Err(TranslateError::new("a runtime array outside a buffer".into())),
-            Type::Image { .. } | Type::SampledImage { .. } | Type::Sampler => return Err(TranslateError::new("an image or sampler value outside its binding".into())),
+            Type::Image { .. } | Type::SampledImage { .. } | Type::Sampler => {
+                return Err(TranslateError::new("an image or sampler value outside its binding".into()));
+            }
             Type::Function { .. } => return Err(TranslateError::new("a function type as a value".into())),
         })
     }
@@ -166,13 +172,21 @@ impl ModuleInfo {
             let elem = self.c_type(members.first().map_or(0, |m| m.0))?;
             writeln!(out, "typedef struct {{ {elem} c[{}]; }} {name};", members.len()).unwrap();
         } else {
-            let fields = members.iter().map(|(t, a)| Ok(format!("{} {a};", self.c_type(*t)?))).collect::<Result<Vec<_>, TranslateError>>()?;
+            let fields = members
+                .iter()
+                .map(|(t, a)| Ok(format!("{} {a};", self.c_type(*t)?)))
+                .collect::<Result<Vec<_>, TranslateError>>()?;
             writeln!(out, "typedef struct {{ {} }} {name};", fields.join(" ")).unwrap();
         }
         if members.len() as u32 <= MAX_CONSTRUCTOR_MEMBERS {
-            let params = members.iter().enumerate().map(|(k, (t, _))| Ok(format!("{} a{k}", self.c_type(*t)?))).collect::<Result<Vec<_>, TranslateError>>()?;
+            let params = members
+                .iter()
+                .enumerate()
+                .map(|(k, (t, _))| Ok(format!("{} a{k}", self.c_type(*t)?)))
+                .collect::<Result<Vec<_>, TranslateError>>()?;
             let sets: String = members.iter().enumerate().map(|(k, (_, a))| format!(" r.{a} = a{k};")).collect();
-            writeln!(out, "BRDFPROF_FN {name} mk_{name}({}) {{ {name} r;{sets} return r; }}", params.join(", ")).unwrap();
+            writeln!(out, "BRDFPROF_FN {name} mk_{name}({}) {{ {name} r;{sets} return r; }}", params.join(", "))
+                .unwrap();
         }
         if array && members.len() as u32 > MAX_CONSTRUCTOR_MEMBERS {
             let z = self.zero(members[0].0)?;

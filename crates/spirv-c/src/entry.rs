@@ -58,24 +58,42 @@ impl EnvLayout {
     pub fn of(m: &ModuleInfo, options: &TranslateOptions) -> Result<Self, TranslateError> {
         let mut layout = EnvLayout::default();
         for (&id, g) in &m.globals {
-            let slot = (m.decoration(id, Decoration::DescriptorSet).and_then(|a| a.first().copied()).unwrap_or(0), m.decoration(id, Decoration::Binding).and_then(|a| a.first().copied()).unwrap_or(0));
+            let slot = (
+                m.decoration(id, Decoration::DescriptorSet).and_then(|a| a.first().copied()).unwrap_or(0),
+                m.decoration(id, Decoration::Binding).and_then(|a| a.first().copied()).unwrap_or(0),
+            );
             let field = format!("b{}_{}", slot.0, slot.1);
             let (rep, kind) = match g.class {
                 StorageClass::StorageBuffer | StorageClass::Uniform => {
-                    let ssbo = g.class == StorageClass::StorageBuffer || m.decoration(g.pointee, Decoration::BufferBlock).is_some();
+                    let ssbo = g.class == StorageClass::StorageBuffer
+                        || m.decoration(g.pointee, Decoration::BufferBlock).is_some();
                     let readonly = !ssbo || buffer_is_readonly(m, id, g.pointee);
                     let kind = if ssbo { BindingKind::StorageBuffer { readonly } } else { BindingKind::UniformBuffer };
-                    (GlobalRep::Buffer { field: field.clone(), readonly, pointee: g.pointee, constant: !ssbo }, Some((slot, kind, field)))
+                    (
+                        GlobalRep::Buffer { field: field.clone(), readonly, pointee: g.pointee, constant: !ssbo },
+                        Some((slot, kind, field)),
+                    )
                 }
-                StorageClass::PushConstant => (GlobalRep::Buffer { field: "push".into(), readonly: true, pointee: g.pointee, constant: true }, Some(((u32::MAX, 0), BindingKind::PushConstant, "push".to_string()))),
+                StorageClass::PushConstant => (
+                    GlobalRep::Buffer { field: "push".into(), readonly: true, pointee: g.pointee, constant: true },
+                    Some(((u32::MAX, 0), BindingKind::PushConstant, "push".to_string())),
+                ),
                 StorageClass::UniformConstant => {
                     let (format, storage) = texel_binding(m, g.pointee, slot, options)?;
                     let rep = GlobalRep::Image { field: field.clone(), format, readonly: !storage };
                     (rep, Some((slot, BindingKind::TexelBuffer { format, storage }, field)))
                 }
                 StorageClass::Input => {
-                    let b = m.builtin(id).ok_or_else(|| unsupported("an input variable that is not a built-in".into()))?;
-                    if !matches!(b, BuiltIn::GlobalInvocationId | BuiltIn::LocalInvocationId | BuiltIn::WorkgroupId | BuiltIn::NumWorkgroups | BuiltIn::LocalInvocationIndex) {
+                    let b =
+                        m.builtin(id).ok_or_else(|| unsupported("an input variable that is not a built-in".into()))?;
+                    if !matches!(
+                        b,
+                        BuiltIn::GlobalInvocationId
+                            | BuiltIn::LocalInvocationId
+                            | BuiltIn::WorkgroupId
+                            | BuiltIn::NumWorkgroups
+                            | BuiltIn::LocalInvocationIndex
+                    ) {
                         return Err(unsupported(format!("the built-in {b:?}")));
                     }
                     let field = format!("in{id}");
@@ -87,7 +105,11 @@ impl EnvLayout {
                     layout.privates.push((field.clone(), g.pointee, g.initializer));
                     (GlobalRep::Local { field, pointee: g.pointee }, None)
                 }
-                other => return Err(unsupported(format!("a global variable in {other:?} memory (shared memory, atomics or outputs)"))),
+                other => {
+                    return Err(unsupported(format!(
+                        "a global variable in {other:?} memory (shared memory, atomics or outputs)"
+                    )));
+                }
             };
             layout.globals.insert(id, rep);
             if let Some((slot, kind, field)) = kind {
@@ -107,15 +129,24 @@ impl EnvLayout {
                 GlobalRep::Buffer { field, pointee, .. } if *field == b.field => Some(*pointee),
                 _ => None,
             });
-            let bytes = ty.and_then(|t| block_size(m, t)).ok_or_else(|| unsupported(format!("a uniform or push-constant block ({}) whose size its layout does not give", b.field)))?;
+            let bytes = ty.and_then(|t| block_size(m, t)).ok_or_else(|| {
+                unsupported(format!(
+                    "a uniform or push-constant block ({}) whose size its layout does not give",
+                    b.field
+                ))
+            })?;
             writeln!(s, "BRDFPROF_CONSTANT_BLOCK({}, {bytes})", b.field).unwrap();
         }
         s += "typedef struct {\n";
         for b in &self.bindings {
             match &b.kind {
                 k if k.is_constant() => writeln!(s, "  BRDFPROF_CONSTANT_FIELD({})", b.field).unwrap(),
-                BindingKind::TexelBuffer { format: TexelFormat::R11g11b10f, storage: true } => writeln!(s, "  BRDFPROF_SURFACE_FIELD({})", b.field).unwrap(),
-                k => writeln!(s, "  GLOBAL {}u8* {};", if binding_readonly(k) { "const " } else { "" }, b.field).unwrap(),
+                BindingKind::TexelBuffer { format: TexelFormat::R11g11b10f, storage: true } => {
+                    writeln!(s, "  BRDFPROF_SURFACE_FIELD({})", b.field).unwrap()
+                }
+                k => {
+                    writeln!(s, "  GLOBAL {}u8* {};", if binding_readonly(k) { "const " } else { "" }, b.field).unwrap()
+                }
             }
         }
         for (field, _, ty) in &self.inputs {
@@ -130,7 +161,13 @@ impl EnvLayout {
 
     /// Statements that fill `env` (a local `Env`) given the dialect's invocation ids `gid[k]`, `lid[k]`,
     /// `wg[k]`, `nwg[k]`, then call the entry point.
-    fn fill(&self, m: &ModuleInfo, dialect: Dialect, ids: &dyn Fn(&str, u32) -> String, local_size: [u32; 3]) -> Result<String, TranslateError> {
+    fn fill(
+        &self,
+        m: &ModuleInfo,
+        dialect: Dialect,
+        ids: &dyn Fn(&str, u32) -> String,
+        local_size: [u32; 3],
+    ) -> Result<String, TranslateError> {
         let mut s = String::from("  BRDFPROF_INVOCATION_BEGIN();\n");
         // CUDA's constant blocks are module `__constant__` arrays, not `Env` fields.
         for b in self.bindings.iter().filter(|b| !(dialect == Dialect::Cuda && b.kind.is_constant())) {
@@ -142,9 +179,17 @@ impl EnvLayout {
                 BuiltIn::LocalInvocationId => (0..3).map(|k| ids("lid", k)).collect(),
                 BuiltIn::WorkgroupId => (0..3).map(|k| ids("wg", k)).collect(),
                 BuiltIn::NumWorkgroups => (0..3).map(|k| ids("nwg", k)).collect(),
-                _ => vec![format!("({} + {}u * ({} + {}u * {}))", ids("lid", 0), local_size[0], ids("lid", 1), local_size[1], ids("lid", 2))],
+                _ => vec![format!(
+                    "({} + {}u * ({} + {}u * {}))",
+                    ids("lid", 0),
+                    local_size[0],
+                    ids("lid", 1),
+                    local_size[1],
+                    ids("lid", 2)
+                )],
             };
-            let value = if parts.len() > 1 { format!("mk_{}({})", m.c_type(*ty)?, parts.join(", ")) } else { parts[0].clone() };
+            let value =
+                if parts.len() > 1 { format!("mk_{}({})", m.c_type(*ty)?, parts.join(", ")) } else { parts[0].clone() };
             writeln!(s, "  env.{field} = {value};").unwrap();
         }
         for (field, ty, init) in &self.privates {
@@ -172,7 +217,11 @@ impl EnvLayout {
                         _ => format!("(u32)gridDim.{c}"),
                     }
                 };
-                format!("extern \"C\" __global__ void __launch_bounds__({threads}) brdfprof_kernel({}) {{\n  Env env;\n{}}}\n", self.params(dialect), self.fill(m, dialect, &ids, local_size)?)
+                format!(
+                    "extern \"C\" __global__ void __launch_bounds__({threads}) brdfprof_kernel({}) {{\n  Env env;\n{}}}\n",
+                    self.params(dialect),
+                    self.fill(m, dialect, &ids, local_size)?
+                )
             }
             Dialect::OpenCl => {
                 let ids = |name: &str, k: u32| match name {
@@ -182,7 +231,11 @@ impl EnvLayout {
                     _ => format!("(u32)get_num_groups({k})"),
                 };
                 let [x, y, z] = local_size;
-                format!("__kernel __attribute__((reqd_work_group_size({x}, {y}, {z}))) void brdfprof_kernel({}) {{\n  Env env;\n{}}}\n", self.params(dialect), self.fill(m, dialect, &ids, local_size)?)
+                format!(
+                    "__kernel __attribute__((reqd_work_group_size({x}, {y}, {z}))) void brdfprof_kernel({}) {{\n  Env env;\n{}}}\n",
+                    self.params(dialect),
+                    self.fill(m, dialect, &ids, local_size)?
+                )
             }
             Dialect::Host => self.host_wrapper(m, local_size)?,
         })
@@ -196,8 +249,12 @@ impl EnvLayout {
             let (ro, f) = (binding_readonly(&b.kind), &b.field);
             Some(match (dialect, &b.kind) {
                 (Dialect::Cuda, k) if k.is_constant() => return None,
-                (Dialect::Cuda, BindingKind::TexelBuffer { format: TexelFormat::R11g11b10f, storage: true }) => format!("unsigned long long {f}"),
-                (Dialect::Cuda, _) => format!("{}u8*{} {f}", if ro { "const " } else { "" }, if ro { " __restrict__" } else { "" }),
+                (Dialect::Cuda, BindingKind::TexelBuffer { format: TexelFormat::R11g11b10f, storage: true }) => {
+                    format!("unsigned long long {f}")
+                }
+                (Dialect::Cuda, _) => {
+                    format!("{}u8*{} {f}", if ro { "const " } else { "" }, if ro { " __restrict__" } else { "" })
+                }
                 (_, k) if k.is_constant() => format!("__constant u8* {f}"),
                 _ => format!("__global {}u8* {f}", if ro { "const " } else { "" }),
             })
@@ -217,12 +274,18 @@ impl EnvLayout {
                 _ => format!("n{c}"),
             }
         };
-        let mut s = String::from("extern \"C\" u32 brdfprof_host_run(u8* const* bindings, u32 nx, u32 ny, u32 nz) {\n  u32 flags = 0u;\n");
+        let mut s = String::from(
+            "extern \"C\" u32 brdfprof_host_run(u8* const* bindings, u32 nx, u32 ny, u32 nz) {\n  u32 flags = 0u;\n",
+        );
         for (k, b) in self.bindings.iter().enumerate() {
             writeln!(s, "  u8* {} = bindings[{k}];", b.field).unwrap();
         }
         let [x, y, z] = local_size;
-        writeln!(s, "  for (u32 wz = 0u; wz < nz; ++wz) for (u32 wy = 0u; wy < ny; ++wy) for (u32 wx = 0u; wx < nx; ++wx)").unwrap();
+        writeln!(
+            s,
+            "  for (u32 wz = 0u; wz < nz; ++wz) for (u32 wy = 0u; wy < ny; ++wy) for (u32 wx = 0u; wx < nx; ++wx)"
+        )
+        .unwrap();
         writeln!(s, "  for (u32 lz = 0u; lz < {z}u; ++lz) for (u32 ly = 0u; ly < {y}u; ++ly) for (u32 lx = 0u; lx < {x}u; ++lx) {{\n  Env env;").unwrap();
         s += &self.fill(m, Dialect::Host, &ids, local_size)?;
         s += "  flags |= env.flags;\n  }\n  return flags;\n}\n";
@@ -271,18 +334,29 @@ fn buffer_is_readonly(m: &ModuleInfo, var: Word, block: Word) -> bool {
         return true;
     }
     match m.ty(block) {
-        Type::Struct { members } => (0..members.len() as u32).all(|k| m.member_decoration(block, k, Decoration::NonWritable).is_some()),
+        Type::Struct { members } => {
+            (0..members.len() as u32).all(|k| m.member_decoration(block, k, Decoration::NonWritable).is_some())
+        }
         _ => false,
     }
 }
 
 /// The texel format and access of an image binding: a storage texel buffer's format from its type, a sampled
 /// one's from the options (Vulkan gives it in the buffer view, not in the shader).
-fn texel_binding(m: &ModuleInfo, ty: Word, slot: (u32, u32), options: &TranslateOptions) -> Result<(TexelFormat, bool), TranslateError> {
+fn texel_binding(
+    m: &ModuleInfo,
+    ty: Word,
+    slot: (u32, u32),
+    options: &TranslateOptions,
+) -> Result<(TexelFormat, bool), TranslateError> {
     let image = match m.ty(ty) {
         Type::SampledImage { image } => *image,
         Type::Image { .. } => ty,
-        _ => return Err(unsupported("a uniform-constant variable that is not an image (a sampler or an opaque type)".into())),
+        _ => {
+            return Err(unsupported(
+                "a uniform-constant variable that is not an image (a sampler or an opaque type)".into(),
+            ));
+        }
     };
     let Type::Image { dim, format, storage, .. } = m.ty(image).clone() else {
         return Err(unsupported("a sampled image of something that is not an image".into()));
@@ -292,7 +366,12 @@ fn texel_binding(m: &ModuleInfo, ty: Word, slot: (u32, u32), options: &Translate
     }
     let format = match (format, options.texel_formats.get(&slot)) {
         (_, Some(f)) => *f,
-        (rspirv::spirv::ImageFormat::Unknown, None) => return Err(unsupported(format!("a texel buffer at set {} binding {} whose view format the caller did not give", slot.0, slot.1))),
+        (rspirv::spirv::ImageFormat::Unknown, None) => {
+            return Err(unsupported(format!(
+                "a texel buffer at set {} binding {} whose view format the caller did not give",
+                slot.0, slot.1
+            )));
+        }
         (f, None) => TexelFormat::from_spirv(f).ok_or_else(|| unsupported(format!("the texel format {f:?}")))?,
     };
     Ok((format, storage))

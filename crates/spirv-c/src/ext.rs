@@ -4,10 +4,10 @@
 //! options of the target decide, as a Vulkan driver's do). Half-precision arguments are computed in f32
 //! between exact conversions, as NVIDIA and Intel evaluate fp16 transcendentals.
 
+use super::TranslateError;
 use super::body::FunctionWriter;
 use super::ctypes::Scalar;
 use super::ops::{as_f32, comp, fbin};
-use super::TranslateError;
 use rspirv::dr::Instruction;
 use rspirv::spirv::{GlslStd450Op as G, Word};
 use std::fmt::Write;
@@ -62,7 +62,11 @@ fn less(s: Scalar, a: &str, b: &str) -> String {
 /// `min` or `max` (`what`) of `a` and `b` in scalar kind `s`: GLSL.std.450's FMin/FMax, the other operand where
 /// one is NaN; halves with the prelude's native `h_min`/`h_max`.
 fn min_max(s: Scalar, what: &str, a: &str, b: &str) -> String {
-    if s == Scalar::F16 { format!("h_{what}({a}, {b})") } else { float_call(s, &format!("m_f{what}"), &[a.to_string(), b.to_string()]) }
+    if s == Scalar::F16 {
+        format!("h_{what}({a}, {b})")
+    } else {
+        float_call(s, &format!("m_f{what}"), &[a.to_string(), b.to_string()])
+    }
 }
 
 /// A float literal in scalar kind `s`.
@@ -87,8 +91,22 @@ impl FunctionWriter<'_> {
         if !self.m.glsl_std_450.contains(&Self::id(inst, 0)) {
             return Err(self.err("an extended instruction outside GLSL.std.450"));
         }
-        let op = G::from_u32(Self::lit(inst, 1)).ok_or_else(|| self.err(format!("the GLSL.std.450 instruction {}", Self::lit(inst, 1))))?;
-        if matches!(op, G::Determinant | G::MatrixInverse | G::Modf | G::ModfStruct | G::Frexp | G::FrexpStruct | G::InterpolateAtCentroid | G::InterpolateAtSample | G::InterpolateAtOffset | G::PackDouble2x32 | G::UnpackDouble2x32) {
+        let op = G::from_u32(Self::lit(inst, 1))
+            .ok_or_else(|| self.err(format!("the GLSL.std.450 instruction {}", Self::lit(inst, 1))))?;
+        if matches!(
+            op,
+            G::Determinant
+                | G::MatrixInverse
+                | G::Modf
+                | G::ModfStruct
+                | G::Frexp
+                | G::FrexpStruct
+                | G::InterpolateAtCentroid
+                | G::InterpolateAtSample
+                | G::InterpolateAtOffset
+                | G::PackDouble2x32
+                | G::UnpackDouble2x32
+        ) {
             let name = format!("{op:?}");
             return Err(self.err(format!("the GLSL.std.450 function {name} (GLSL's {})", name.to_ascii_lowercase())));
         }
@@ -121,7 +139,14 @@ impl FunctionWriter<'_> {
         let int = |x: &str| format!("(i32)({x})");
         let uint = |x: &str| format!("(u32)({x})");
         Ok(match op {
-            G::FSign => format!("({} ? {} : ({} ? {} : {}))", less(s, &lit(s, 0.0), &a[0]), lit(s, 1.0), less(s, &a[0], &lit(s, 0.0)), lit(s, -1.0), lit(s, 0.0)),
+            G::FSign => format!(
+                "({} ? {} : ({} ? {} : {}))",
+                less(s, &lit(s, 0.0), &a[0]),
+                lit(s, 1.0),
+                less(s, &a[0], &lit(s, 0.0)),
+                lit(s, -1.0),
+                lit(s, 0.0)
+            ),
             G::Fract => fbin(s, "-", &a[0], &float_call(s, "m_floor", &a[..1])),
             G::Radians => fbin(s, "*", &a[0], &lit(s, std::f32::consts::PI / 180.0)),
             G::Degrees => fbin(s, "*", &a[0], &lit(s, 180.0 / std::f32::consts::PI)),
@@ -133,7 +158,9 @@ impl FunctionWriter<'_> {
             G::Step => format!("({} ? {} : {})", less(s, &a[1], &a[0]), lit(s, 0.0), lit(s, 1.0)),
             G::SmoothStep => float_call(s, "m_smoothstep", &a[..3]),
             // GLSL 4.50 8.3: mix(x, y, a) = x (1 - a) + y a.
-            G::FMix => fbin(s, "+", &fbin(s, "*", &a[0], &fbin(s, "-", &lit(s, 1.0), &a[2])), &fbin(s, "*", &a[1], &a[2])),
+            G::FMix => {
+                fbin(s, "+", &fbin(s, "*", &a[0], &fbin(s, "-", &lit(s, 1.0), &a[2])), &fbin(s, "*", &a[1], &a[2]))
+            }
             G::Fma if s == Scalar::F16 => format!("h_fma({}, {}, {})", a[0], a[1], a[2]),
             G::Fma => float_call(s, "m_fma", &a[..3]),
             G::Ldexp => float_call(s, "m_ldexp", &[a[0].clone(), int(&a[1])]),
@@ -153,14 +180,26 @@ impl FunctionWriter<'_> {
     }
 
     /// The geometric functions of GLSL 4.50 8.5 (not componentwise).
-    fn geometric(&mut self, op: G, s: Scalar, a: &[String], n: u32, ty: Word, arg_ty: Word) -> Result<Option<String>, TranslateError> {
+    fn geometric(
+        &mut self,
+        op: G,
+        s: Scalar,
+        a: &[String],
+        n: u32,
+        ty: Word,
+        arg_ty: Word,
+    ) -> Result<Option<String>, TranslateError> {
         let scalar_ty = s.c_name();
         let e = match op {
             G::Length if n == 1 => float_call(s, "m_fabs", &a[..1]),
             G::Length => float_call(s, "m_sqrt", &[self.dot(s, &a[0], &a[0], n)]),
             G::Distance => {
                 let diff = (0..n).map(|k| fbin(s, "-", &comp(&a[0], n, k), &comp(&a[1], n, k))).collect::<Vec<_>>();
-                let d = if n == 1 { diff[0].clone() } else { self.temp(&self.m.c_type(arg_ty)?, self.build(arg_ty, diff)?) };
+                let d = if n == 1 {
+                    diff[0].clone()
+                } else {
+                    self.temp(&self.m.c_type(arg_ty)?, self.build(arg_ty, diff)?)
+                };
                 if n == 1 { float_call(s, "m_fabs", &[d]) } else { float_call(s, "m_sqrt", &[self.dot(s, &d, &d, n)]) }
             }
             G::Normalize if n == 1 => format!("({} < {} ? {} : {})", a[0], lit(s, 0.0), lit(s, -1.0), lit(s, 1.0)),
@@ -169,27 +208,66 @@ impl FunctionWriter<'_> {
                 self.build(ty, (0..n).map(|k| fbin(s, "*", &comp(&a[0], n, k), &r)).collect())?
             }
             G::Cross => {
-                let c = |i: u32, j: u32| fbin(s, "-", &fbin(s, "*", &comp(&a[0], 3, i), &comp(&a[1], 3, j)), &fbin(s, "*", &comp(&a[1], 3, i), &comp(&a[0], 3, j)));
+                let c = |i: u32, j: u32| {
+                    fbin(
+                        s,
+                        "-",
+                        &fbin(s, "*", &comp(&a[0], 3, i), &comp(&a[1], 3, j)),
+                        &fbin(s, "*", &comp(&a[1], 3, i), &comp(&a[0], 3, j)),
+                    )
+                };
                 self.build(ty, vec![c(1, 2), c(2, 0), c(0, 1)])?
             }
             G::FaceForward => {
                 let d = self.dot(s, &a[2], &a[1], n);
-                let neg = self.build(ty, (0..n).map(|k| if s == Scalar::F16 { format!("h_neg({})", comp(&a[0], n, k)) } else { format!("(-{})", comp(&a[0], n, k)) }).collect())?;
+                let neg = self.build(
+                    ty,
+                    (0..n)
+                        .map(|k| {
+                            if s == Scalar::F16 {
+                                format!("h_neg({})", comp(&a[0], n, k))
+                            } else {
+                                format!("(-{})", comp(&a[0], n, k))
+                            }
+                        })
+                        .collect(),
+                )?;
                 format!("({} < {} ? {} : {neg})", as_f32(s, &d), "0.0f", a[0])
             }
             G::Reflect => {
                 // I - 2 dot(N, I) N
                 let d = self.temp(scalar_ty, self.dot(s, &a[1], &a[0], n));
                 let twice = fbin(s, "*", &lit(s, 2.0), &d);
-                self.build(ty, (0..n).map(|k| fbin(s, "-", &comp(&a[0], n, k), &fbin(s, "*", &twice, &comp(&a[1], n, k)))).collect())?
+                self.build(
+                    ty,
+                    (0..n)
+                        .map(|k| fbin(s, "-", &comp(&a[0], n, k), &fbin(s, "*", &twice, &comp(&a[1], n, k))))
+                        .collect(),
+                )?
             }
             G::Refract => {
                 // k = 1 - eta^2 (1 - dot(N, I)^2); k < 0: 0, else eta I - (eta dot(N, I) + sqrt(k)) N
                 let d = self.temp(scalar_ty, self.dot(s, &a[1], &a[0], n));
                 let eta = &a[2];
-                let k = self.temp(scalar_ty, fbin(s, "-", &lit(s, 1.0), &fbin(s, "*", &fbin(s, "*", eta, eta), &fbin(s, "-", &lit(s, 1.0), &fbin(s, "*", &d, &d)))));
-                let f = self.temp(scalar_ty, fbin(s, "+", &fbin(s, "*", eta, &d), &float_call(s, "m_sqrt", &[k.clone()])));
-                let r = self.build(ty, (0..n).map(|c| fbin(s, "-", &fbin(s, "*", eta, &comp(&a[0], n, c)), &fbin(s, "*", &f, &comp(&a[1], n, c)))).collect())?;
+                let k = self.temp(
+                    scalar_ty,
+                    fbin(
+                        s,
+                        "-",
+                        &lit(s, 1.0),
+                        &fbin(s, "*", &fbin(s, "*", eta, eta), &fbin(s, "-", &lit(s, 1.0), &fbin(s, "*", &d, &d))),
+                    ),
+                );
+                let f =
+                    self.temp(scalar_ty, fbin(s, "+", &fbin(s, "*", eta, &d), &float_call(s, "m_sqrt", &[k.clone()])));
+                let r = self.build(
+                    ty,
+                    (0..n)
+                        .map(|c| {
+                            fbin(s, "-", &fbin(s, "*", eta, &comp(&a[0], n, c)), &fbin(s, "*", &f, &comp(&a[1], n, c)))
+                        })
+                        .collect(),
+                )?;
                 format!("({} < 0.0f ? {} : {r})", as_f32(s, &k), self.m.zero(ty)?)
             }
             _ => return Ok(None),
@@ -202,18 +280,74 @@ impl FunctionWriter<'_> {
         let p = a.first().cloned().unwrap_or_default();
         let clamp = |x: String, lo: &str, hi: &str| format!("m_fmin(m_fmax({x}, {lo}), {hi})");
         let e = match op {
-            G::UnpackUnorm4x8 => self.build(ty, (0..4).map(|k| format!("m_fdiv((float)(({p} >> {}u) & 255u), 255.0f)", 8 * k)).collect())?,
-            G::UnpackSnorm4x8 => self.build(ty, (0..4).map(|k| clamp(format!("m_fdiv((float)((i32)({p} << {}u) >> 24), 127.0f)", 24 - 8 * k), "-1.0f", "1.0f")).collect())?,
-            G::UnpackUnorm2x16 => self.build(ty, (0..2).map(|k| format!("m_fdiv((float)(({p} >> {}u) & 65535u), 65535.0f)", 16 * k)).collect())?,
-            G::UnpackSnorm2x16 => self.build(ty, (0..2).map(|k| clamp(format!("m_fdiv((float)((i32)({p} << {}u) >> 16), 32767.0f)", 16 - 16 * k), "-1.0f", "1.0f")).collect())?,
-            G::UnpackHalf2x16 => self.build(ty, (0..2).map(|k| format!("h_to_f32(h_from_bits(({p} >> {}u) & 65535u))", 16 * k)).collect())?,
-            G::PackUnorm4x8 => (0..4).map(|k| format!("((u32)m_rint({} * 255.0f) << {}u)", clamp(comp(&p, n, k), "0.0f", "1.0f"), 8 * k)).collect::<Vec<_>>().join(" | "),
-            G::PackSnorm4x8 => (0..4).map(|k| format!("(((u32)(i32)m_rint({} * 127.0f) & 255u) << {}u)", clamp(comp(&p, n, k), "-1.0f", "1.0f"), 8 * k)).collect::<Vec<_>>().join(" | "),
-            G::PackUnorm2x16 => (0..2).map(|k| format!("((u32)m_rint({} * 65535.0f) << {}u)", clamp(comp(&p, n, k), "0.0f", "1.0f"), 16 * k)).collect::<Vec<_>>().join(" | "),
-            G::PackSnorm2x16 => (0..2).map(|k| format!("(((u32)(i32)m_rint({} * 32767.0f) & 65535u) << {}u)", clamp(comp(&p, n, k), "-1.0f", "1.0f"), 16 * k)).collect::<Vec<_>>().join(" | "),
-            G::PackHalf2x16 => (0..2).map(|k| format!("((u32)h_bits(h_from_f32({})) << {}u)", comp(&p, n, k), 16 * k)).collect::<Vec<_>>().join(" | "),
+            G::UnpackUnorm4x8 => self
+                .build(ty, (0..4).map(|k| format!("m_fdiv((float)(({p} >> {}u) & 255u), 255.0f)", 8 * k)).collect())?,
+            G::UnpackSnorm4x8 => self.build(
+                ty,
+                (0..4)
+                    .map(|k| {
+                        clamp(format!("m_fdiv((float)((i32)({p} << {}u) >> 24), 127.0f)", 24 - 8 * k), "-1.0f", "1.0f")
+                    })
+                    .collect(),
+            )?,
+            G::UnpackUnorm2x16 => self.build(
+                ty,
+                (0..2).map(|k| format!("m_fdiv((float)(({p} >> {}u) & 65535u), 65535.0f)", 16 * k)).collect(),
+            )?,
+            G::UnpackSnorm2x16 => self.build(
+                ty,
+                (0..2)
+                    .map(|k| {
+                        clamp(
+                            format!("m_fdiv((float)((i32)({p} << {}u) >> 16), 32767.0f)", 16 - 16 * k),
+                            "-1.0f",
+                            "1.0f",
+                        )
+                    })
+                    .collect(),
+            )?,
+            G::UnpackHalf2x16 => self
+                .build(ty, (0..2).map(|k| format!("h_to_f32(h_from_bits(({p} >> {}u) & 65535u))", 16 * k)).collect())?,
+            G::PackUnorm4x8 => (0..4)
+                .map(|k| format!("((u32)m_rint({} * 255.0f) << {}u)", clamp(comp(&p, n, k), "0.0f", "1.0f"), 8 * k))
+                .collect::<Vec<_>>()
+                .join(" | "),
+            G::PackSnorm4x8 => (0..4)
+                .map(|k| {
+                    format!(
+                        "(((u32)(i32)m_rint({} * 127.0f) & 255u) << {}u)",
+                        clamp(comp(&p, n, k), "-1.0f", "1.0f"),
+                        8 * k
+                    )
+                })
+                .collect::<Vec<_>>()
+                .join(" | "),
+            G::PackUnorm2x16 => (0..2)
+                .map(|k| format!("((u32)m_rint({} * 65535.0f) << {}u)", clamp(comp(&p, n, k), "0.0f", "1.0f"), 16 * k))
+                .collect::<Vec<_>>()
+                .join(" | "),
+            G::PackSnorm2x16 => (0..2)
+                .map(|k| {
+                    format!(
+                        "(((u32)(i32)m_rint({} * 32767.0f) & 65535u) << {}u)",
+                        clamp(comp(&p, n, k), "-1.0f", "1.0f"),
+                        16 * k
+                    )
+                })
+                .collect::<Vec<_>>()
+                .join(" | "),
+            G::PackHalf2x16 => (0..2)
+                .map(|k| format!("((u32)h_bits(h_from_f32({})) << {}u)", comp(&p, n, k), 16 * k))
+                .collect::<Vec<_>>()
+                .join(" | "),
             _ => return Ok(None),
         };
-        Ok(Some(if matches!(op, G::PackUnorm4x8 | G::PackSnorm4x8 | G::PackUnorm2x16 | G::PackSnorm2x16 | G::PackHalf2x16) { format!("({e})") } else { e }))
+        Ok(Some(
+            if matches!(op, G::PackUnorm4x8 | G::PackSnorm4x8 | G::PackUnorm2x16 | G::PackSnorm2x16 | G::PackHalf2x16) {
+                format!("({e})")
+            } else {
+                e
+            },
+        ))
     }
 }

@@ -24,8 +24,14 @@ pub const SIDE_LIMIT: usize = 8;
 /// contains it).
 pub fn flatten(words: &[u32]) -> anyhow::Result<Vec<u32>> {
     use rspirv::binary::Assemble;
-    let mut module = rspirv::dr::load_words(words).map_err(|e| anyhow::anyhow!("rspirv cannot parse the module: {e}"))?;
-    let glsl: Vec<Word> = module.ext_inst_imports.iter().filter(|i| matches!(i.operands.first(), Some(Operand::LiteralString(s)) if s == "GLSL.std.450")).filter_map(|i| i.result_id).collect();
+    let mut module =
+        rspirv::dr::load_words(words).map_err(|e| anyhow::anyhow!("rspirv cannot parse the module: {e}"))?;
+    let glsl: Vec<Word> = module
+        .ext_inst_imports
+        .iter()
+        .filter(|i| matches!(i.operands.first(), Some(Operand::LiteralString(s)) if s == "GLSL.std.450"))
+        .filter_map(|i| i.result_id)
+        .collect();
     let mut functions = std::mem::take(&mut module.functions);
     for f in &mut functions {
         while let Some(site) = find_site(f, &module, &glsl) {
@@ -64,7 +70,9 @@ fn successors(b: &Block) -> Vec<Word> {
     match t.class.opcode {
         Op::Branch => vec![id(t, 0)],
         Op::BranchConditional => vec![id(t, 1), id(t, 2)],
-        Op::Switch => t.operands.iter().skip(1).filter_map(|o| if let Operand::IdRef(v) = o { Some(*v) } else { None }).collect(),
+        Op::Switch => {
+            t.operands.iter().skip(1).filter_map(|o| if let Operand::IdRef(v) = o { Some(*v) } else { None }).collect()
+        }
         _ => Vec::new(),
     }
 }
@@ -78,15 +86,84 @@ fn predecessors(f: &Function, block: Word) -> usize {
 fn speculatable(i: &Instruction, glsl: &[Word]) -> bool {
     use Op::*;
     match i.class.opcode {
-        Line | NoLine | FAdd | FSub | FMul | FDiv | FRem | FMod | FNegate | IAdd | ISub | IMul | SNegate | Dot | VectorTimesScalar | MatrixTimesScalar
-        | VectorTimesMatrix | MatrixTimesVector | MatrixTimesMatrix | OuterProduct | Transpose | ConvertSToF | ConvertUToF | FConvert | UConvert
-        | SConvert | Bitcast | QuantizeToF16 | CompositeConstruct | CompositeExtract | CompositeInsert | VectorShuffle | VectorExtractDynamic
-        | VectorInsertDynamic | CopyObject | Select | IEqual | INotEqual | UGreaterThan | SGreaterThan | UGreaterThanEqual | SGreaterThanEqual
-        | ULessThan | SLessThan | ULessThanEqual | SLessThanEqual | FOrdEqual | FUnordEqual | FOrdNotEqual | FUnordNotEqual | FOrdLessThan
-        | FUnordLessThan | FOrdGreaterThan | FUnordGreaterThan | FOrdLessThanEqual | FUnordLessThanEqual | FOrdGreaterThanEqual
-        | FUnordGreaterThanEqual | IsNan | IsInf | LogicalEqual | LogicalNotEqual | LogicalOr | LogicalAnd | LogicalNot | ShiftRightLogical
-        | ShiftRightArithmetic | ShiftLeftLogical | BitwiseOr | BitwiseXor | BitwiseAnd | Not | Any | All => true,
-        ExtInst => glsl.contains(&id(i, 0)) && !matches!(i.operands.get(1), Some(Operand::LiteralExtInstInteger(op)) if pointer_argument(*op)),
+        Line
+        | NoLine
+        | FAdd
+        | FSub
+        | FMul
+        | FDiv
+        | FRem
+        | FMod
+        | FNegate
+        | IAdd
+        | ISub
+        | IMul
+        | SNegate
+        | Dot
+        | VectorTimesScalar
+        | MatrixTimesScalar
+        | VectorTimesMatrix
+        | MatrixTimesVector
+        | MatrixTimesMatrix
+        | OuterProduct
+        | Transpose
+        | ConvertSToF
+        | ConvertUToF
+        | FConvert
+        | UConvert
+        | SConvert
+        | Bitcast
+        | QuantizeToF16
+        | CompositeConstruct
+        | CompositeExtract
+        | CompositeInsert
+        | VectorShuffle
+        | VectorExtractDynamic
+        | VectorInsertDynamic
+        | CopyObject
+        | Select
+        | IEqual
+        | INotEqual
+        | UGreaterThan
+        | SGreaterThan
+        | UGreaterThanEqual
+        | SGreaterThanEqual
+        | ULessThan
+        | SLessThan
+        | ULessThanEqual
+        | SLessThanEqual
+        | FOrdEqual
+        | FUnordEqual
+        | FOrdNotEqual
+        | FUnordNotEqual
+        | FOrdLessThan
+        | FUnordLessThan
+        | FOrdGreaterThan
+        | FUnordGreaterThan
+        | FOrdLessThanEqual
+        | FUnordLessThanEqual
+        | FOrdGreaterThanEqual
+        | FUnordGreaterThanEqual
+        | IsNan
+        | IsInf
+        | LogicalEqual
+        | LogicalNotEqual
+        | LogicalOr
+        | LogicalAnd
+        | LogicalNot
+        | ShiftRightLogical
+        | ShiftRightArithmetic
+        | ShiftLeftLogical
+        | BitwiseOr
+        | BitwiseXor
+        | BitwiseAnd
+        | Not
+        | Any
+        | All => true,
+        ExtInst => {
+            glsl.contains(&id(i, 0))
+                && !matches!(i.operands.get(1), Some(Operand::LiteralExtInstInteger(op)) if pointer_argument(*op))
+        }
         _ => false,
     }
 }
@@ -94,7 +171,9 @@ fn speculatable(i: &Instruction, glsl: &[Word]) -> bool {
 /// GLSL.std.450 functions that write through a pointer or read an interpolant.
 fn pointer_argument(op: u32) -> bool {
     use GlslStd450Op as G;
-    [G::Modf, G::Frexp, G::InterpolateAtCentroid, G::InterpolateAtSample, G::InterpolateAtOffset].iter().any(|g| *g as u32 == op)
+    [G::Modf, G::Frexp, G::InterpolateAtCentroid, G::InterpolateAtSample, G::InterpolateAtOffset]
+        .iter()
+        .any(|g| *g as u32 == op)
 }
 
 /// The side block `target` of a selection with header `header` merging at `merge`: its index when it is one
@@ -141,7 +220,13 @@ fn site_at(f: &Function, module: &Module, glsl: &[Word], h: usize) -> Option<Sit
             n => bool_vectors.push((n, bool_vector(module, n)?)),
         }
     }
-    Some(Site { header: h, condition: id(branch, 0), merge, sides: sides.map(|s| s.map(|k| label(&f.blocks[k]))), bool_vectors })
+    Some(Site {
+        header: h,
+        condition: id(branch, 0),
+        merge,
+        sides: sides.map(|s| s.map(|k| label(&f.blocks[k]))),
+        bool_vectors,
+    })
 }
 
 /// How OpSelect takes a value of type `ty` in SPIR-V 1.0: 0 with a scalar condition (scalars), n with a
@@ -165,7 +250,11 @@ fn bool_vector(module: &Module, n: u32) -> Option<Word> {
     module
         .types_global_values
         .iter()
-        .find(|i| i.class.opcode == Op::TypeVector && id(i, 0) == bool_ty && matches!(i.operands.get(1), Some(Operand::LiteralBit32(k)) if *k == n))
+        .find(|i| {
+            i.class.opcode == Op::TypeVector
+                && id(i, 0) == bool_ty
+                && matches!(i.operands.get(1), Some(Operand::LiteralBit32(k)) if *k == n)
+        })
         .and_then(|i| i.result_id)
 }
 
@@ -190,7 +279,12 @@ fn apply(f: &mut Function, module: &mut Module, site: Site) {
     for (n, ty) in &site.bool_vectors {
         let v = fresh(module);
         splats.push((*n, v));
-        moved.push(Instruction::new(Op::CompositeConstruct, Some(*ty), Some(v), vec![Operand::IdRef(site.condition); *n as usize]));
+        moved.push(Instruction::new(
+            Op::CompositeConstruct,
+            Some(*ty),
+            Some(v),
+            vec![Operand::IdRef(site.condition); *n as usize],
+        ));
     }
     let h = f.blocks.iter().position(|b| label(b) == header_label).expect("the header");
     let ins = &mut f.blocks[h].instructions;
@@ -201,11 +295,22 @@ fn apply(f: &mut Function, module: &mut Module, site: Site) {
     let (on_true, on_false) = (edge(0), edge(1));
     let m = f.blocks.iter().position(|b| label(b) == site.merge).expect("the merge block");
     for phi in f.blocks[m].instructions.iter_mut().filter(|i| i.class.opcode == Op::Phi) {
-        let value = |from: Word| phi.operands.chunks(2).find(|p| p.get(1) == Some(&Operand::IdRef(from))).and_then(|p| if let Operand::IdRef(v) = p[0] { Some(v) } else { None }).unwrap_or(0);
+        let value = |from: Word| {
+            phi.operands
+                .chunks(2)
+                .find(|p| p.get(1) == Some(&Operand::IdRef(from)))
+                .and_then(|p| if let Operand::IdRef(v) = p[0] { Some(v) } else { None })
+                .unwrap_or(0)
+        };
         let (t, e) = (value(on_true), value(on_false));
         let n = select_type(module, phi.result_type.unwrap_or(0)).unwrap_or(0);
         let condition = splats.iter().find(|(w, _)| *w == n).map_or(site.condition, |(_, v)| *v);
-        *phi = Instruction::new(Op::Select, phi.result_type, phi.result_id, vec![Operand::IdRef(condition), Operand::IdRef(t), Operand::IdRef(e)]);
+        *phi = Instruction::new(
+            Op::Select,
+            phi.result_type,
+            phi.result_id,
+            vec![Operand::IdRef(condition), Operand::IdRef(t), Operand::IdRef(e)],
+        );
     }
     join(f, header_label, site.merge);
 }
@@ -213,7 +318,10 @@ fn apply(f: &mut Function, module: &mut Module, site: Site) {
 /// Appends block `merge` to block `header` (which now branches only to it) when no merge or continue
 /// instruction names it; its successors' phis then name `header` as the edge they come from.
 fn join(f: &mut Function, header: Word, merge: Word) {
-    let named = f.blocks.iter().flat_map(|b| &b.instructions).any(|i| matches!(i.class.opcode, Op::SelectionMerge | Op::LoopMerge) && i.operands.iter().any(|o| *o == Operand::IdRef(merge)));
+    let named = f.blocks.iter().flat_map(|b| &b.instructions).any(|i| {
+        matches!(i.class.opcode, Op::SelectionMerge | Op::LoopMerge)
+            && i.operands.iter().any(|o| *o == Operand::IdRef(merge))
+    });
     if named || predecessors(f, merge) != 1 {
         return;
     }

@@ -29,13 +29,29 @@ pub enum Type {
 #[derive(Clone, Debug)]
 pub enum Constant {
     /// An integer or float, as its bits (32- or 64-bit literal).
-    Scalar { ty: Word, bits: u64 },
-    Bool { ty: Word, value: bool },
-    Composite { ty: Word, parts: Vec<Word> },
+    Scalar {
+        ty: Word,
+        bits: u64,
+    },
+    Bool {
+        ty: Word,
+        value: bool,
+    },
+    Composite {
+        ty: Word,
+        parts: Vec<Word>,
+    },
     /// OpConstantNull and OpUndef (read as zero).
-    Zero { ty: Word },
+    Zero {
+        ty: Word,
+    },
     /// An OpSpecConstantOp spirv-opt left unfolded: the operation and its operand ids.
-    Op { ty: Word, op: Op, operands: Vec<Word>, literals: Vec<u32> },
+    Op {
+        ty: Word,
+        op: Op,
+        operands: Vec<Word>,
+        literals: Vec<u32>,
+    },
 }
 
 /// A global OpVariable.
@@ -92,7 +108,8 @@ fn unsupported(construct: String) -> TranslateError {
 
 impl ModuleInfo {
     pub fn read(words: &[u32]) -> Result<Self, TranslateError> {
-        let module = rspirv::dr::load_words(words).map_err(|e| unsupported(format!("a SPIR-V module rspirv cannot parse ({e})")))?;
+        let module = rspirv::dr::load_words(words)
+            .map_err(|e| unsupported(format!("a SPIR-V module rspirv cannot parse ({e})")))?;
         let mut info = ModuleInfo {
             types: HashMap::new(),
             type_order: Vec::new(),
@@ -127,20 +144,27 @@ impl ModuleInfo {
         for i in &module.ext_inst_imports {
             match i.operands.first() {
                 Some(Operand::LiteralString(s)) if s == "GLSL.std.450" => self.glsl_std_450.extend(i.result_id),
-                Some(Operand::LiteralString(s)) => return Err(unsupported(format!("the extended instruction set `{s}`"))),
+                Some(Operand::LiteralString(s)) => {
+                    return Err(unsupported(format!("the extended instruction set `{s}`")));
+                }
                 _ => {}
             }
         }
         let entries: Vec<&Instruction> = module.entry_points.iter().collect();
         let [entry] = entries.as_slice() else {
-            return Err(unsupported(format!("a module with {} entry points (one compute entry point is translated)", entries.len())));
+            return Err(unsupported(format!(
+                "a module with {} entry points (one compute entry point is translated)",
+                entries.len()
+            )));
         };
         if !matches!(entry.operands.first(), Some(Operand::ExecutionModel(rspirv::spirv::ExecutionModel::GLCompute))) {
             return Err(unsupported("an entry point that is not a compute shader".into()));
         }
         self.entry = id_at(entry, 1);
         for m in &module.execution_modes {
-            if let [Operand::IdRef(_), Operand::ExecutionMode(ExecutionMode::LocalSize), x, y, z] = m.operands.as_slice() {
+            if let [Operand::IdRef(_), Operand::ExecutionMode(ExecutionMode::LocalSize), x, y, z] =
+                m.operands.as_slice()
+            {
                 self.local_size = [literal(Some(x)), literal(Some(y)), literal(Some(z))];
             }
         }
@@ -153,7 +177,9 @@ impl ModuleInfo {
             }
         }
         for s in &module.debug_string_source {
-            if let (Op::String, Some(id), Some(Operand::LiteralString(text))) = (s.class.opcode, s.result_id, s.operands.first()) {
+            if let (Op::String, Some(id), Some(Operand::LiteralString(text))) =
+                (s.class.opcode, s.result_id, s.operands.first())
+            {
                 self.strings.insert(id, text.clone());
             }
         }
@@ -165,7 +191,11 @@ impl ModuleInfo {
 
     fn read_annotation(&mut self, a: &Instruction) {
         let literals = |ops: &[Operand]| ops.iter().map(|o| literal(Some(o))).collect::<Vec<u32>>();
-        let builtin = |ops: &[Operand]| ops.iter().filter_map(|o| if let Operand::BuiltIn(b) = o { Some(*b as u32) } else { None }).collect::<Vec<u32>>();
+        let builtin = |ops: &[Operand]| {
+            ops.iter()
+                .filter_map(|o| if let Operand::BuiltIn(b) = o { Some(*b as u32) } else { None })
+                .collect::<Vec<u32>>()
+        };
         match (a.class.opcode, a.operands.as_slice()) {
             (Op::Decorate, [Operand::IdRef(id), Operand::Decoration(d), rest @ ..]) => {
                 let args = if *d == Decoration::BuiltIn { builtin(rest) } else { literals(rest) };
@@ -206,7 +236,10 @@ impl ModuleInfo {
                     ty,
                     op: *inner,
                     operands: ids(&inst.operands[1..]),
-                    literals: inst.operands[1..].iter().filter_map(|o| if let Operand::LiteralBit32(v) = o { Some(*v) } else { None }).collect(),
+                    literals: inst.operands[1..]
+                        .iter()
+                        .filter_map(|o| if let Operand::LiteralBit32(v) = o { Some(*v) } else { None })
+                        .collect(),
                 },
                 _ => return Err(unsupported("an OpSpecConstantOp without its operation".into())),
             },
@@ -219,7 +252,18 @@ impl ModuleInfo {
                     Some(Type::Pointer { pointee, .. }) => *pointee,
                     _ => 0,
                 };
-                self.globals.insert(id, Global { ty, class, pointee, initializer: inst.operands.get(1).and_then(|o| if let Operand::IdRef(i) = o { Some(*i) } else { None }) });
+                self.globals.insert(
+                    id,
+                    Global {
+                        ty,
+                        class,
+                        pointee,
+                        initializer: inst
+                            .operands
+                            .get(1)
+                            .and_then(|o| if let Operand::IdRef(i) = o { Some(*i) } else { None }),
+                    },
+                );
                 return Ok(());
             }
             Op::Line | Op::NoLine => return Ok(()),
@@ -300,7 +344,13 @@ impl ModuleInfo {
     /// The type of any value: a constant, a global, a function result or parameter.
     pub fn type_of(&self, id: Word) -> Option<Word> {
         match self.constants.get(&id) {
-            Some(Constant::Scalar { ty, .. } | Constant::Bool { ty, .. } | Constant::Composite { ty, .. } | Constant::Zero { ty } | Constant::Op { ty, .. }) => return Some(*ty),
+            Some(
+                Constant::Scalar { ty, .. }
+                | Constant::Bool { ty, .. }
+                | Constant::Composite { ty, .. }
+                | Constant::Zero { ty }
+                | Constant::Op { ty, .. },
+            ) => return Some(*ty),
             None => {}
         }
         self.globals.get(&id).map(|g| g.ty).or_else(|| self.result_types.get(&id).copied())

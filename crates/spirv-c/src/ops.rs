@@ -3,11 +3,11 @@
 //! undefined (signed overflow, a shift by the width or more, a division by zero) goes through unsigned forms or
 //! the prelude's `m_` functions, which give SPIR-V's wrapping results.
 
+use super::TranslateError;
 use super::body::FunctionWriter;
 use super::constants::convert_float;
 use super::ctypes::Scalar;
 use super::module::Type;
-use super::TranslateError;
 use rspirv::dr::{Instruction, Operand};
 use rspirv::spirv::{Op, Word};
 use std::fmt::Write;
@@ -97,10 +97,24 @@ impl FunctionWriter<'_> {
         let ty = inst.result_type.unwrap_or(0);
         match op {
             FAdd | FSub | FMul | FDiv | FRem | FMod | FNegate => self.float_arith(inst),
-            IAdd | ISub | IMul | UDiv | SDiv | UMod | SRem | SMod | ShiftLeftLogical | ShiftRightLogical | ShiftRightArithmetic | BitwiseAnd | BitwiseOr | BitwiseXor | Not | SNegate => self.int_arith(inst),
-            ConvertFToS | ConvertFToU | ConvertSToF | ConvertUToF | FConvert | UConvert | SConvert | Bitcast | QuantizeToF16 => self.conversion(inst),
-            FOrdEqual | FUnordEqual | FOrdNotEqual | FUnordNotEqual | FOrdLessThan | FUnordLessThan | FOrdGreaterThan | FUnordGreaterThan | FOrdLessThanEqual | FUnordLessThanEqual | FOrdGreaterThanEqual | FUnordGreaterThanEqual => self.float_compare(inst),
-            IEqual | INotEqual | SLessThan | SLessThanEqual | SGreaterThan | SGreaterThanEqual | ULessThan | ULessThanEqual | UGreaterThan | UGreaterThanEqual => self.int_compare(inst),
+            IAdd | ISub | IMul | UDiv | SDiv | UMod | SRem | SMod | ShiftLeftLogical | ShiftRightLogical
+            | ShiftRightArithmetic | BitwiseAnd | BitwiseOr | BitwiseXor | Not | SNegate => self.int_arith(inst),
+            ConvertFToS | ConvertFToU | ConvertSToF | ConvertUToF | FConvert | UConvert | SConvert | Bitcast
+            | QuantizeToF16 => self.conversion(inst),
+            FOrdEqual
+            | FUnordEqual
+            | FOrdNotEqual
+            | FUnordNotEqual
+            | FOrdLessThan
+            | FUnordLessThan
+            | FOrdGreaterThan
+            | FUnordGreaterThan
+            | FOrdLessThanEqual
+            | FUnordLessThanEqual
+            | FOrdGreaterThanEqual
+            | FUnordGreaterThanEqual => self.float_compare(inst),
+            IEqual | INotEqual | SLessThan | SLessThanEqual | SGreaterThan | SGreaterThanEqual | ULessThan
+            | ULessThanEqual | UGreaterThan | UGreaterThanEqual => self.int_compare(inst),
             LogicalAnd => self.each(inst, |o| format!("({} && {})", o[0], o[1])),
             LogicalOr => self.each(inst, |o| format!("({} || {})", o[0], o[1])),
             LogicalEqual => self.each(inst, |o| format!("({} == {})", o[0], o[1])),
@@ -121,7 +135,10 @@ impl FunctionWriter<'_> {
             CompositeConstruct => self.construct(inst),
             CompositeExtract => {
                 let base = self.v(Self::id(inst, 0))?;
-                let path = self.member_path(self.ty_of(Self::id(inst, 0)), &(1..inst.operands.len()).map(|k| Self::lit(inst, k)).collect::<Vec<_>>())?;
+                let path = self.member_path(
+                    self.ty_of(Self::id(inst, 0)),
+                    &(1..inst.operands.len()).map(|k| Self::lit(inst, k)).collect::<Vec<_>>(),
+                )?;
                 Ok(format!("{base}{path}"))
             }
             VectorExtractDynamic => {
@@ -145,7 +162,8 @@ impl FunctionWriter<'_> {
                 let n = self.m.components(ty);
                 self.build(ty, (0..n).map(|k| fbin(s, "*", &comp(&v, n, k), &scalar)).collect())
             }
-            MatrixTimesScalar | MatrixTimesVector | VectorTimesMatrix | MatrixTimesMatrix | OuterProduct | Transpose => self.matrix(inst),
+            MatrixTimesScalar | MatrixTimesVector | VectorTimesMatrix | MatrixTimesMatrix | OuterProduct
+            | Transpose => self.matrix(inst),
             other => Err(self.err(format!("the instruction Op{other:?}"))),
         }
     }
@@ -205,7 +223,9 @@ impl FunctionWriter<'_> {
         let to = self.scalar_kind(inst.result_type.unwrap_or(0))?;
         let from = self.scalar_kind(self.ty_of(Self::id(inst, 0)))?;
         let op = inst.class.opcode;
-        if op == Op::Bitcast && self.m.components(inst.result_type.unwrap_or(0)) != self.m.components(self.ty_of(Self::id(inst, 0))) {
+        if op == Op::Bitcast
+            && self.m.components(inst.result_type.unwrap_or(0)) != self.m.components(self.ty_of(Self::id(inst, 0)))
+        {
             return Err(self.err("an OpBitcast between vectors of different lengths"));
         }
         let err = self.err(format!("an Op{op:?} from {from:?} to {to:?}"));
@@ -229,7 +249,8 @@ impl FunctionWriter<'_> {
         let ty = inst.result_type.unwrap_or(0);
         let n = self.m.components(ty);
         let v = self.v(Self::id(inst, 0))?;
-        let parts = (0..n).map(|k| convert(&comp(&v, n, k)).ok_or_else(|| err.clone())).collect::<Result<Vec<_>, _>>()?;
+        let parts =
+            (0..n).map(|k| convert(&comp(&v, n, k)).ok_or_else(|| err.clone())).collect::<Result<Vec<_>, _>>()?;
         self.build(ty, parts)
     }
 
@@ -330,10 +351,18 @@ impl FunctionWriter<'_> {
         let id = inst.result_id.unwrap_or(0);
         let (copy, member, value) = if inst.class.opcode == Op::CompositeInsert {
             let path: Vec<u32> = (2..inst.operands.len()).map(|k| Self::lit(inst, k)).collect();
-            (self.v(Self::id(inst, 1))?, self.member_path(self.ty_of(Self::id(inst, 1)), &path)?, self.v(Self::id(inst, 0))?)
+            (
+                self.v(Self::id(inst, 1))?,
+                self.member_path(self.ty_of(Self::id(inst, 1)), &path)?,
+                self.v(Self::id(inst, 0))?,
+            )
         } else {
             let n = self.m.components(self.ty_of(Self::id(inst, 0)));
-            (self.v(Self::id(inst, 0))?, format!(".c[{}]", self.index(Self::id(inst, 2), n)?), self.v(Self::id(inst, 1))?)
+            (
+                self.v(Self::id(inst, 0))?,
+                format!(".c[{}]", self.index(Self::id(inst, 2), n)?),
+                self.v(Self::id(inst, 1))?,
+            )
         };
         self.assign(inst, copy)?;
         writeln!(self.body, "  _{id}{member} = {value};").unwrap();
@@ -381,11 +410,33 @@ impl FunctionWriter<'_> {
         };
         let (cols, rows) = shape(ty);
         let columns: Vec<String> = match inst.class.opcode {
-            Op::MatrixTimesScalar => (0..cols).map(|c| column(&|r| fbin(s, "*", &at(&ea, c, r), &eb), rows)).collect::<Result<_, _>>()?,
-            Op::MatrixTimesVector => return self.build(ty, (0..ar).map(|r| sum((0..ac).map(|c| fbin(s, "*", &at(&ea, c, r), &comp(&eb, ac, c))).collect())).collect()),
-            Op::VectorTimesMatrix => return self.build(ty, (0..bc).map(|c| sum((0..ar).map(|r| fbin(s, "*", &comp(&ea, ar, r), &at(&eb, c, r))).collect())).collect()),
-            Op::MatrixTimesMatrix => (0..cols).map(|c| column(&|r| sum((0..ac).map(|k| fbin(s, "*", &at(&ea, k, r), &at(&eb, c, k))).collect()), rows)).collect::<Result<_, _>>()?,
-            Op::OuterProduct => (0..cols).map(|c| column(&|r| fbin(s, "*", &comp(&ea, ar, r), &comp(&eb, cols, c)), rows)).collect::<Result<_, _>>()?,
+            Op::MatrixTimesScalar => {
+                (0..cols).map(|c| column(&|r| fbin(s, "*", &at(&ea, c, r), &eb), rows)).collect::<Result<_, _>>()?
+            }
+            Op::MatrixTimesVector => {
+                return self.build(
+                    ty,
+                    (0..ar)
+                        .map(|r| sum((0..ac).map(|c| fbin(s, "*", &at(&ea, c, r), &comp(&eb, ac, c))).collect()))
+                        .collect(),
+                );
+            }
+            Op::VectorTimesMatrix => {
+                return self.build(
+                    ty,
+                    (0..bc)
+                        .map(|c| sum((0..ar).map(|r| fbin(s, "*", &comp(&ea, ar, r), &at(&eb, c, r))).collect()))
+                        .collect(),
+                );
+            }
+            Op::MatrixTimesMatrix => (0..cols)
+                .map(|c| {
+                    column(&|r| sum((0..ac).map(|k| fbin(s, "*", &at(&ea, k, r), &at(&eb, c, k))).collect()), rows)
+                })
+                .collect::<Result<_, _>>()?,
+            Op::OuterProduct => (0..cols)
+                .map(|c| column(&|r| fbin(s, "*", &comp(&ea, ar, r), &comp(&eb, cols, c)), rows))
+                .collect::<Result<_, _>>()?,
             _ => (0..cols).map(|c| column(&|r| at(&ea, r, c), rows)).collect::<Result<_, _>>()?,
         };
         Ok(format!("mk_{}({})", self.m.c_type(ty)?, columns.join(", ")))

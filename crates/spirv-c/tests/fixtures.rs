@@ -4,7 +4,7 @@
 //! it: `NAME.out` (the inlined module), `NAME.flat.out` (after `flatten`), `NAME.plain.out`, or `NAME.err`
 //! where the writer must refuse the module. `BLESS=1` rewrites the expected files; review their diff.
 
-use brdfprof_spirv_c::{flatten::flatten, translate, Dialect, TexelFormat, TranslateOptions, Translation};
+use brdfprof_spirv_c::{Dialect, TexelFormat, TranslateOptions, Translation, flatten::flatten, translate};
 use std::path::{Path, PathBuf};
 
 fn fixtures() -> PathBuf {
@@ -58,8 +58,18 @@ fn expect(path: &Path, got: &str, mismatches: &mut Vec<String>) {
     }
     let want = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e} (BLESS=1 writes it)", path.display()));
     if want != got {
-        let line = want.lines().zip(got.lines()).position(|(a, b)| a != b).unwrap_or_else(|| want.lines().count().min(got.lines().count()));
-        mismatches.push(format!("{}: differs from line {} on: expected {:?}, got {:?}", path.display(), line + 1, want.lines().nth(line), got.lines().nth(line)));
+        let line = want
+            .lines()
+            .zip(got.lines())
+            .position(|(a, b)| a != b)
+            .unwrap_or_else(|| want.lines().count().min(got.lines().count()));
+        mismatches.push(format!(
+            "{}: differs from line {} on: expected {:?}, got {:?}",
+            path.display(),
+            line + 1,
+            want.lines().nth(line),
+            got.lines().nth(line)
+        ));
     }
 }
 
@@ -73,7 +83,10 @@ fn outcome(result: Result<Translation, brdfprof_spirv_c::TranslateError>) -> (&'
 #[test]
 fn each_fixture_translates_to_its_expected_text() {
     let dir = fixtures();
-    let mut names: Vec<String> = std::fs::read_dir(&dir).unwrap().filter_map(|e| e.unwrap().file_name().to_str()?.strip_suffix(".comp").map(String::from)).collect();
+    let mut names: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .filter_map(|e| e.unwrap().file_name().to_str()?.strip_suffix(".comp").map(String::from))
+        .collect();
     names.sort();
     assert!(names.len() >= 4, "fixtures missing from {}", dir.display());
     let mut mismatches = Vec::new();
@@ -95,7 +108,11 @@ fn each_fixture_translates_to_its_expected_text() {
             Err(e) => expect(&dir.join(format!("{name}.flat.err")), &format!("{e}\n"), &mut mismatches),
         }
     }
-    assert!(mismatches.is_empty(), "translations that changed (BLESS=1 rewrites them; review the diff):\n{}", mismatches.join("\n"));
+    assert!(
+        mismatches.is_empty(),
+        "translations that changed (BLESS=1 rewrites them; review the diff):\n{}",
+        mismatches.join("\n")
+    );
 }
 
 /// The expected files are only those a fixture produces, so that a renamed or removed fixture leaves no
@@ -118,7 +135,8 @@ fn refusal_does_not_depend_on_the_preparation() {
     for e in std::fs::read_dir(&dir).unwrap() {
         let file = e.unwrap().file_name().to_string_lossy().to_string();
         if let Some(name) = file.strip_suffix(".comp") {
-            let kinds: Vec<bool> = ["", ".plain", ".flat"].iter().map(|s| dir.join(format!("{name}{s}.err")).exists()).collect();
+            let kinds: Vec<bool> =
+                ["", ".plain", ".flat"].iter().map(|s| dir.join(format!("{name}{s}.err")).exists()).collect();
             assert!(kinds.iter().all(|k| *k == kinds[0]), "{name}: refused in some preparations only: {kinds:?}");
         }
     }

@@ -52,22 +52,35 @@ impl Kernel<'_> {
     pub fn executables(&self) -> Result<Option<Vec<PipelineExecutable>>> {
         let beside = self.gpu.compiler_log.is_some_and(|l| l.beside_properties);
         if let (Some(stats), false) = (&self.logged_stats, beside) {
-            return Ok(Some(vec![PipelineExecutable { name: LOGGED_EXECUTABLE.into(), subgroup_size: 0, stats: stats.clone(), representations: Vec::new() }]));
+            return Ok(Some(vec![PipelineExecutable {
+                name: LOGGED_EXECUTABLE.into(),
+                subgroup_size: 0,
+                stats: stats.clone(),
+                representations: Vec::new(),
+            }]));
         }
         let Some(ext) = &self.gpu.executable_properties else { return Ok(None) };
         let info = vk::PipelineInfoKHR::default().pipeline(self.pipeline);
         // SAFETY: the pipeline was created on this device with CAPTURE_STATISTICS (Kernel::new sets it whenever
         // the extension is enabled) and lives through these calls.
-        let executables = unsafe { ext.get_pipeline_executable_properties(&info) }.context("vkGetPipelineExecutablePropertiesKHR")?;
+        let executables =
+            unsafe { ext.get_pipeline_executable_properties(&info) }.context("vkGetPipelineExecutablePropertiesKHR")?;
         let mut out = Vec::new();
         for (index, exe) in executables.iter().enumerate() {
             let name = text(exe.name_as_c_str());
-            let exe_info = vk::PipelineExecutableInfoKHR::default().pipeline(self.pipeline).executable_index(index as u32);
+            let exe_info =
+                vk::PipelineExecutableInfoKHR::default().pipeline(self.pipeline).executable_index(index as u32);
             // SAFETY: as above; index < the executable count the driver returned.
-            let stats = unsafe { ext.get_pipeline_executable_statistics(&exe_info) }.context("vkGetPipelineExecutableStatisticsKHR")?;
+            let stats = unsafe { ext.get_pipeline_executable_statistics(&exe_info) }
+                .context("vkGetPipelineExecutableStatisticsKHR")?;
             let stats = stats
                 .iter()
-                .map(|s| DriverStat { executable: name.clone(), name: text(s.name_as_c_str()), description: text(s.description_as_c_str()), value: value(s) })
+                .map(|s| DriverStat {
+                    executable: name.clone(),
+                    name: text(s.name_as_c_str()),
+                    description: text(s.description_as_c_str()),
+                    value: value(s),
+                })
                 .collect();
             let representations = if self.captures_ir { self.representations(ext, &exe_info)? } else { Vec::new() };
             out.push(PipelineExecutable { name, subgroup_size: exe.subgroup_size, stats, representations });
@@ -80,27 +93,37 @@ impl Kernel<'_> {
     }
 
     /// The textual internal representations of one executable (the two-call idiom: sizes, then data).
-    fn representations(&self, ext: &ash::khr::pipeline_executable_properties::Device, exe: &vk::PipelineExecutableInfoKHR) -> Result<Vec<(String, String)>> {
+    fn representations(
+        &self,
+        ext: &ash::khr::pipeline_executable_properties::Device,
+        exe: &vk::PipelineExecutableInfoKHR,
+    ) -> Result<Vec<(String, String)>> {
         let fp = ext.fp();
         let device = self.gpu.device.handle();
         let mut count = 0u32;
         // SAFETY: first call with a null array asks for the count.
-        unsafe { (fp.get_pipeline_executable_internal_representations_khr)(device, exe, &mut count, std::ptr::null_mut()) }
-            .result()
-            .context("vkGetPipelineExecutableInternalRepresentationsKHR")?;
+        unsafe {
+            (fp.get_pipeline_executable_internal_representations_khr)(device, exe, &mut count, std::ptr::null_mut())
+        }
+        .result()
+        .context("vkGetPipelineExecutableInternalRepresentationsKHR")?;
         let mut reps = vec![vk::PipelineExecutableInternalRepresentationKHR::default(); count as usize];
         // SAFETY: second call fills `count` entries with their sizes (p_data null).
-        unsafe { (fp.get_pipeline_executable_internal_representations_khr)(device, exe, &mut count, reps.as_mut_ptr()) }
-            .result()
-            .context("vkGetPipelineExecutableInternalRepresentationsKHR")?;
+        unsafe {
+            (fp.get_pipeline_executable_internal_representations_khr)(device, exe, &mut count, reps.as_mut_ptr())
+        }
+        .result()
+        .context("vkGetPipelineExecutableInternalRepresentationsKHR")?;
         let mut buffers: Vec<Vec<u8>> = reps.iter().map(|r| vec![0u8; r.data_size]).collect();
         for (r, b) in reps.iter_mut().zip(&mut buffers) {
             r.p_data = b.as_mut_ptr().cast();
         }
         // SAFETY: third call writes into the buffers, each as large as the driver asked for; they outlive it.
-        unsafe { (fp.get_pipeline_executable_internal_representations_khr)(device, exe, &mut count, reps.as_mut_ptr()) }
-            .result()
-            .context("vkGetPipelineExecutableInternalRepresentationsKHR")?;
+        unsafe {
+            (fp.get_pipeline_executable_internal_representations_khr)(device, exe, &mut count, reps.as_mut_ptr())
+        }
+        .result()
+        .context("vkGetPipelineExecutableInternalRepresentationsKHR")?;
         Ok(reps
             .iter()
             .zip(buffers)

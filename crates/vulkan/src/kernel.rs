@@ -2,7 +2,7 @@
 //! keeps every binding inside maxStorageBufferRange and every dispatch inside maxComputeWorkGroupCount.
 
 use super::{Buffer, Commands, DeviceInfo, Gpu};
-use anyhow::{anyhow, bail, Context, Result};
+use anyhow::{Context, Result, anyhow, bail};
 use ash::vk;
 
 /// Specialisation constants, in the order they are added.
@@ -122,16 +122,35 @@ impl<'g> Kernel<'g> {
     /// A pipeline for the SPIR-V `words` (named `name` in errors), specialised, with the buffers of `bindings`
     /// (binding 0, 1, ...) and `push_bytes` of push constants. With `capture_ir` the driver keeps its internal
     /// representations (`PipelineExecutable::representations`).
-    pub fn new(gpu: &'g Gpu, name: &str, words: &[u32], spec: &SpecConstants, bindings: &[Binding], push_bytes: u32) -> Result<Self> {
+    pub fn new(
+        gpu: &'g Gpu,
+        name: &str,
+        words: &[u32],
+        spec: &SpecConstants,
+        bindings: &[Binding],
+        push_bytes: u32,
+    ) -> Result<Self> {
         Self::with_capture(gpu, name, words, spec, bindings, push_bytes, false)
     }
 
-    pub fn with_capture(gpu: &'g Gpu, name: &str, words: &[u32], spec: &SpecConstants, bindings: &[Binding], push_bytes: u32, capture_ir: bool) -> Result<Self> {
+    pub fn with_capture(
+        gpu: &'g Gpu,
+        name: &str,
+        words: &[u32],
+        spec: &SpecConstants,
+        bindings: &[Binding],
+        push_bytes: u32,
+        capture_ir: bool,
+    ) -> Result<Self> {
         for b in bindings {
             if let Some(format) = b.texel_format() {
                 let storage = matches!(b, Binding::TexelStorage(_));
                 if !gpu.texel_buffer_support(format, storage) {
-                    bail!("{name}: {} cannot use {format:?} as a {} texel buffer", gpu.info.name, if storage { "storage" } else { "uniform" });
+                    bail!(
+                        "{name}: {} cannot use {format:?} as a {} texel buffer",
+                        gpu.info.name,
+                        if storage { "storage" } else { "uniform" }
+                    );
                 }
             }
         }
@@ -157,10 +176,13 @@ impl<'g> Kernel<'g> {
         // SAFETY: every create info and what it points to outlives its call; handles are destroyed in Drop.
         unsafe {
             let module = device.create_shader_module(&vk::ShaderModuleCreateInfo::default().code(words), None)?;
-            let set_layout = device
-                .create_descriptor_set_layout(&vk::DescriptorSetLayoutCreateInfo::default().bindings(&binding_info), None)?;
+            let set_layout = device.create_descriptor_set_layout(
+                &vk::DescriptorSetLayoutCreateInfo::default().bindings(&binding_info),
+                None,
+            )?;
             let set_layouts = [set_layout];
-            let ranges = [vk::PushConstantRange { stage_flags: vk::ShaderStageFlags::COMPUTE, offset: 0, size: push_bytes }];
+            let ranges =
+                [vk::PushConstantRange { stage_flags: vk::ShaderStageFlags::COMPUTE, offset: 0, size: push_bytes }];
             let mut layout_info = vk::PipelineLayoutCreateInfo::default().set_layouts(&set_layouts);
             if push_bytes > 0 {
                 layout_info = layout_info.push_constant_ranges(&ranges);
@@ -179,7 +201,8 @@ impl<'g> Kernel<'g> {
             for b in bindings {
                 match sizes.iter_mut().find(|s| s.ty == b.descriptor_type()) {
                     Some(s) => s.descriptor_count += SETS_PER_KERNEL,
-                    None => sizes.push(vk::DescriptorPoolSize { ty: b.descriptor_type(), descriptor_count: SETS_PER_KERNEL }),
+                    None => sizes
+                        .push(vk::DescriptorPoolSize { ty: b.descriptor_type(), descriptor_count: SETS_PER_KERNEL }),
                 }
             }
             let pool = device.create_descriptor_pool(
@@ -187,7 +210,21 @@ impl<'g> Kernel<'g> {
                 None,
             )?;
             let captures_ir = capture_ir && gpu.executable_properties.is_some();
-            Ok(Kernel { gpu, name: name.into(), pipeline, layout, set_layout, pool, bindings: bindings.to_vec(), views: Default::default(), push_bytes, workgroup: WORKGROUP, captures_ir, logged_stats, dispatched: Default::default() })
+            Ok(Kernel {
+                gpu,
+                name: name.into(),
+                pipeline,
+                layout,
+                set_layout,
+                pool,
+                bindings: bindings.to_vec(),
+                views: Default::default(),
+                push_bytes,
+                workgroup: WORKGROUP,
+                captures_ir,
+                logged_stats,
+                dispatched: Default::default(),
+            })
         }
     }
 
@@ -204,8 +241,12 @@ impl<'g> Kernel<'g> {
                 .device
                 .allocate_descriptor_sets(&alloc)
                 .with_context(|| format!("{}: more than {SETS_PER_KERNEL} chunks bound at once", self.name))?[0];
-            let infos: Vec<[vk::DescriptorBufferInfo; 1]> =
-                windows.iter().map(|(b, offset, range)| [vk::DescriptorBufferInfo { buffer: b.buffer, offset: *offset, range: *range }]).collect();
+            let infos: Vec<[vk::DescriptorBufferInfo; 1]> = windows
+                .iter()
+                .map(|(b, offset, range)| {
+                    [vk::DescriptorBufferInfo { buffer: b.buffer, offset: *offset, range: *range }]
+                })
+                .collect();
             let mut views = self.views.borrow_mut();
             let texel_views: Vec<Option<[vk::BufferView; 1]>> = windows
                 .iter()
@@ -213,7 +254,11 @@ impl<'g> Kernel<'g> {
                 .map(|((b, offset, range), kind)| {
                     kind.texel_format()
                         .map(|format| {
-                            let info = vk::BufferViewCreateInfo::default().buffer(b.buffer).format(format).offset(*offset).range(*range);
+                            let info = vk::BufferViewCreateInfo::default()
+                                .buffer(b.buffer)
+                                .format(format)
+                                .offset(*offset)
+                                .range(*range);
                             let view = self.gpu.device.create_buffer_view(&info, None)?;
                             views.push(view);
                             Ok::<_, vk::Result>([view])
@@ -226,7 +271,10 @@ impl<'g> Kernel<'g> {
                 .zip(&texel_views)
                 .enumerate()
                 .map(|(i, (info, view))| {
-                    let w = vk::WriteDescriptorSet::default().dst_set(set).dst_binding(i as u32).descriptor_type(self.bindings[i].descriptor_type());
+                    let w = vk::WriteDescriptorSet::default()
+                        .dst_set(set)
+                        .dst_binding(i as u32)
+                        .descriptor_type(self.bindings[i].descriptor_type());
                     match view {
                         Some(v) => w.texel_buffer_view(v),
                         None => w.buffer_info(info),
@@ -258,9 +306,17 @@ impl<'g> Kernel<'g> {
     /// As `dispatch`, with the offsets of the dynamic uniform buffers (in binding order).
     pub fn dispatch_at(&self, cmd: &Commands, set: Bindings, offsets: &[u32], push: &[u8], invocations: u64) {
         assert_eq!(push.len() as u32, self.push_bytes, "{}: wrong push-constant size", self.name);
-        assert_eq!(offsets.len(), self.bindings.iter().filter(|b| **b == Binding::UniformDynamic).count(), "{}: wrong number of dynamic offsets", self.name);
+        assert_eq!(
+            offsets.len(),
+            self.bindings.iter().filter(|b| **b == Binding::UniformDynamic).count(),
+            "{}: wrong number of dynamic offsets",
+            self.name
+        );
         let groups = invocations.div_ceil(self.workgroup as u64) as u32;
-        assert!(groups <= self.gpu.info.max_compute_work_group_count[0], "dispatch past maxComputeWorkGroupCount: chunk it");
+        assert!(
+            groups <= self.gpu.info.max_compute_work_group_count[0],
+            "dispatch past maxComputeWorkGroupCount: chunk it"
+        );
         if !self.dispatched.replace(true) {
             cmd.first_dispatches.borrow_mut().push(self.name.clone());
         }
@@ -283,27 +339,53 @@ impl<'g> Kernel<'g> {
 /// runs under the compile limit on a worker thread (`compile_limit::bounded`).
 /// `create_pipeline`, with the statistics the driver printed on stderr meanwhile where it reports them there
 /// (`GpuOptions::compiler_log`).
-fn create_logged_pipeline(gpu: &Gpu, name: &str, module: vk::ShaderModule, layout: vk::PipelineLayout, map: &[vk::SpecializationMapEntry], data: &[u8], flags: vk::PipelineCreateFlags) -> Result<(vk::Pipeline, Option<Vec<super::DriverStat>>)> {
-    let Some(read) = gpu.compiler_log else { return Ok((create_pipeline(gpu, name, module, layout, map, data, flags)?, None)) };
-    let (pipeline, log) = super::stderr_capture::capture(|| create_pipeline(gpu, name, module, layout, map, data, flags))?;
+fn create_logged_pipeline(
+    gpu: &Gpu,
+    name: &str,
+    module: vk::ShaderModule,
+    layout: vk::PipelineLayout,
+    map: &[vk::SpecializationMapEntry],
+    data: &[u8],
+    flags: vk::PipelineCreateFlags,
+) -> Result<(vk::Pipeline, Option<Vec<super::DriverStat>>)> {
+    let Some(read) = gpu.compiler_log else {
+        return Ok((create_pipeline(gpu, name, module, layout, map, data, flags)?, None));
+    };
+    let (pipeline, log) =
+        super::stderr_capture::capture(|| create_pipeline(gpu, name, module, layout, map, data, flags))?;
     let pipeline = pipeline?;
-    let read = (read.read)(&log).with_context(|| format!("{name}: the statistics {} printed while compiling it", gpu.info.name));
+    let read = (read.read)(&log)
+        .with_context(|| format!("{name}: the statistics {} printed while compiling it", gpu.info.name));
     // SAFETY: the pipeline was just created on this device and nothing uses it.
     let (stats, rest) = read.inspect_err(|_| unsafe { gpu.device.destroy_pipeline(pipeline, None) })?;
     super::stderr_capture::pass_on(&rest);
     Ok((pipeline, Some(stats)))
 }
 
-fn create_pipeline(gpu: &Gpu, name: &str, module: vk::ShaderModule, layout: vk::PipelineLayout, map: &[vk::SpecializationMapEntry], data: &[u8], flags: vk::PipelineCreateFlags) -> Result<vk::Pipeline> {
+fn create_pipeline(
+    gpu: &Gpu,
+    name: &str,
+    module: vk::ShaderModule,
+    layout: vk::PipelineLayout,
+    map: &[vk::SpecializationMapEntry],
+    data: &[u8],
+    flags: vk::PipelineCreateFlags,
+) -> Result<vk::Pipeline> {
     let device = &gpu.device;
     let what = format!("{name} (pipeline creation on {})", gpu.info.name);
     let created = brdfprof_process::launch::bounded(&what, || {
         let spec_info = vk::SpecializationInfo::default().map_entries(map).data(data);
-        let stage = vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::COMPUTE).module(module).name(c"main").specialization_info(&spec_info);
+        let stage = vk::PipelineShaderStageCreateInfo::default()
+            .stage(vk::ShaderStageFlags::COMPUTE)
+            .module(module)
+            .name(c"main")
+            .specialization_info(&spec_info);
         let info = vk::ComputePipelineCreateInfo::default().stage(stage).layout(layout).flags(flags);
         // SAFETY: the module and layout belong to this device; the create info and what it points to live
         // through the call.
-        unsafe { device.create_compute_pipelines(vk::PipelineCache::null(), &[info], None) }.map(|p| p[0]).map_err(|(_, e)| e)
+        unsafe { device.create_compute_pipelines(vk::PipelineCache::null(), &[info], None) }
+            .map(|p| p[0])
+            .map_err(|(_, e)| e)
     });
     created.map_err(|e| anyhow!("creating the {name} pipeline: {e}"))
 }

@@ -7,15 +7,15 @@ mod memory;
 mod stderr_capture;
 mod timing;
 
-pub use driver_stats::{DriverStat, PipelineExecutable, LOGGED_EXECUTABLE};
+pub use driver_stats::{DriverStat, LOGGED_EXECUTABLE, PipelineExecutable};
 pub use kernel::{Binding, Bindings, ChunkPlan, Kernel, SpecConstants, TexelFormat, WORKGROUP};
 pub use memory::{Buffer, MemoryKind};
 pub use timing::Timestamps;
 
-use anyhow::{anyhow, bail, Context, Result};
+use anyhow::{Context, Result, anyhow, bail};
 use ash::vk;
 use serde::{Deserialize, Deserializer, Serialize};
-use std::ffi::{c_void, CStr};
+use std::ffi::{CStr, c_void};
 use std::sync::{Arc, Mutex};
 
 const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
@@ -29,7 +29,11 @@ pub const FENCE_TIMEOUT_ENV: &str = "BRDFPROF_FENCE_TIMEOUT";
 
 /// The fence timeout in force: `FENCE_TIMEOUT_ENV` when it holds seconds (more than 0), else the default.
 pub fn fence_timeout() -> std::time::Duration {
-    std::env::var(FENCE_TIMEOUT_ENV).ok().and_then(|t| t.trim().parse::<f64>().ok()).filter(|s| s.is_finite() && *s > 0.0 && *s <= 86_400.0).map_or(DEFAULT_FENCE_TIMEOUT, std::time::Duration::from_secs_f64)
+    std::env::var(FENCE_TIMEOUT_ENV)
+        .ok()
+        .and_then(|t| t.trim().parse::<f64>().ok())
+        .filter(|s| s.is_finite() && *s > 0.0 && *s <= 86_400.0)
+        .map_or(DEFAULT_FENCE_TIMEOUT, std::time::Duration::from_secs_f64)
 }
 
 /// How to open a device.
@@ -104,7 +108,10 @@ impl DeviceInfo {
     pub fn mesa_llvm(&self) -> (Option<String>, Option<String>) {
         let find = |key: &str| {
             let text = format!("{} {}", self.driver_info, self.name);
-            text.split(key).nth(1).and_then(|rest| rest.split([' ', ')', ',']).find(|w| !w.is_empty())).map(str::to_string)
+            text.split(key)
+                .nth(1)
+                .and_then(|rest| rest.split([' ', ')', ',']).find(|w| !w.is_empty()))
+                .map(str::to_string)
         };
         (find("Mesa "), find("LLVM "))
     }
@@ -117,7 +124,9 @@ impl DeviceInfo {
     /// (RADV_FORCE_FAMILY), whose timestampPeriod is not even finite, and every device of a process that runs a
     /// Mesa driver on a noop kernel shim (`mark_compile_only_process`), whose submissions execute nothing.
     pub fn compile_only(&self) -> bool {
-        self.name.starts_with("Null hardware") || !self.timestamp_period.is_finite() || COMPILE_ONLY_PROCESS.load(std::sync::atomic::Ordering::Relaxed)
+        self.name.starts_with("Null hardware")
+            || !self.timestamp_period.is_finite()
+            || COMPILE_ONLY_PROCESS.load(std::sync::atomic::Ordering::Relaxed)
     }
 }
 
@@ -203,9 +212,11 @@ fn describe(instance: &ash::Instance, index: usize, pd: vk::PhysicalDevice) -> D
         let props = instance.get_physical_device_properties(pd);
         let mut driver = vk::PhysicalDeviceDriverProperties::default();
         // Vulkan 1.1's guaranteed minimum, for a Vulkan 1.0 device (PanVK 22.3), which cannot state it.
-        let mut maint3 = vk::PhysicalDeviceMaintenance3Properties { max_memory_allocation_size: 1 << 30, ..Default::default() };
+        let mut maint3 =
+            vk::PhysicalDeviceMaintenance3Properties { max_memory_allocation_size: 1 << 30, ..Default::default() };
         let mut f16 = vk::PhysicalDeviceShaderFloat16Int8Features::default();
-        let features = if vk::api_version_minor(props.api_version) >= 1 || vk::api_version_major(props.api_version) > 1 {
+        let features = if vk::api_version_minor(props.api_version) >= 1 || vk::api_version_major(props.api_version) > 1
+        {
             let mut props2 = vk::PhysicalDeviceProperties2::default().push_next(&mut driver).push_next(&mut maint3);
             instance.get_physical_device_properties2(pd, &mut props2);
             let mut features2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut f16);
@@ -220,7 +231,8 @@ fn describe(instance: &ash::Instance, index: usize, pd: vk::PhysicalDevice) -> D
         let extensions = instance.enumerate_device_extension_properties(pd).unwrap_or_default();
         let has_ext = |name: &CStr| extensions.iter().any(|e| e.extension_name_as_c_str() == Ok(name));
         let l = props.limits;
-        let text = |r: std::result::Result<&CStr, _>| r.map(|s: &CStr| s.to_string_lossy().into_owned()).unwrap_or_default();
+        let text =
+            |r: std::result::Result<&CStr, _>| r.map(|s: &CStr| s.to_string_lossy().into_owned()).unwrap_or_default();
         DeviceInfo {
             index,
             name: text(props.device_name_as_c_str()),
@@ -265,9 +277,7 @@ unsafe extern "system" fn on_validation_message(
 }
 
 fn create_instance(entry: &ash::Entry, validation: bool) -> Result<ash::Instance> {
-    let app = vk::ApplicationInfo::default()
-        .application_name(c"brdfprof")
-        .api_version(vk::API_VERSION_1_2);
+    let app = vk::ApplicationInfo::default().application_name(c"brdfprof").api_version(vk::API_VERSION_1_2);
     let mut layers = Vec::new();
     let mut extensions = Vec::new();
     if validation {
@@ -315,14 +325,20 @@ pub fn select_device(infos: &[DeviceInfo], wanted: Option<&str>) -> Result<usize
     if infos.is_empty() {
         return Err(no_device_error());
     }
-    let listing = || infos.iter().map(|d| format!("  {}: {} ({})", d.index, d.name, d.device_type)).collect::<Vec<_>>().join("\n");
+    let listing = || {
+        infos.iter().map(|d| format!("  {}: {} ({})", d.index, d.name, d.device_type)).collect::<Vec<_>>().join("\n")
+    };
     if let Some(w) = wanted {
         // Every name contains the empty string: a blank choice would silently pick device 0.
         if w.trim().is_empty() {
             bail!("device `{w}`: empty; give an index or a name substring (see `brdfprof devices`)");
         }
         if let Ok(i) = w.parse::<usize>() {
-            return if i < infos.len() { Ok(i) } else { bail!("no device with index {i}; devices are:\n{}", listing()) };
+            return if i < infos.len() {
+                Ok(i)
+            } else {
+                bail!("no device with index {i}; devices are:\n{}", listing())
+            };
         }
         let needle = w.to_lowercase();
         return infos
@@ -333,11 +349,18 @@ pub fn select_device(infos: &[DeviceInfo], wanted: Option<&str>) -> Result<usize
     let runs = |d: &&DeviceInfo| !d.compile_only();
     let gpu = infos.iter().filter(runs).find(|d| d.device_type == "discrete-gpu" || d.device_type == "integrated-gpu");
     let chosen = gpu.or_else(|| infos.iter().filter(runs).find(|d| d.is_cpu())).or_else(|| infos.iter().find(runs));
-    chosen.map(|d| d.index).ok_or_else(|| anyhow!("every Vulkan device here compiles only (RADV's null device); none can run kernels"))
+    chosen
+        .map(|d| d.index)
+        .ok_or_else(|| anyhow!("every Vulkan device here compiles only (RADV's null device); none can run kernels"))
 }
 
 /// The logical device: one compute queue, fp16 arithmetic and pipeline executable properties where available.
-fn create_device(instance: &ash::Instance, physical: vk::PhysicalDevice, family: u32, info: &DeviceInfo) -> Result<ash::Device> {
+fn create_device(
+    instance: &ash::Instance,
+    physical: vk::PhysicalDevice,
+    family: u32,
+    info: &DeviceInfo,
+) -> Result<ash::Device> {
     let priorities = [1.0f32];
     let queues = [vk::DeviceQueueCreateInfo::default().queue_family_index(family).queue_priorities(&priorities)];
     let mut extensions = Vec::new();
@@ -349,11 +372,15 @@ fn create_device(instance: &ash::Instance, physical: vk::PhysicalDevice, family:
         unsafe { instance.get_physical_device_properties(physical) }.api_version,
     ) >= 2;
     let mut f16 = vk::PhysicalDeviceShaderFloat16Int8Features::default().shader_float16(info.shader_float16);
-    let mut exec = vk::PhysicalDevicePipelineExecutablePropertiesFeaturesKHR::default().pipeline_executable_info(info.pipeline_executable_properties);
+    let mut exec = vk::PhysicalDevicePipelineExecutablePropertiesFeaturesKHR::default()
+        .pipeline_executable_info(info.pipeline_executable_properties);
     // fp64 where the device has it: a .brdf shader may compute in double (validation refuses the Float64
     // capability on a device that did not enable it).
     let features = vk::PhysicalDeviceFeatures::default().shader_float64(info.shader_float64);
-    let mut create = vk::DeviceCreateInfo::default().queue_create_infos(&queues).enabled_extension_names(&extensions).enabled_features(&features);
+    let mut create = vk::DeviceCreateInfo::default()
+        .queue_create_infos(&queues)
+        .enabled_extension_names(&extensions)
+        .enabled_features(&features);
     if api_1_2 && info.shader_float16 {
         create = create.push_next(&mut f16);
     }
@@ -438,7 +465,11 @@ impl Gpu {
     pub(crate) fn texel_buffer_support(&self, format: vk::Format, storage: bool) -> bool {
         // SAFETY: the physical device belongs to this instance.
         let props = unsafe { self.instance.get_physical_device_format_properties(self.physical, format) };
-        let wanted = if storage { vk::FormatFeatureFlags::STORAGE_TEXEL_BUFFER } else { vk::FormatFeatureFlags::UNIFORM_TEXEL_BUFFER };
+        let wanted = if storage {
+            vk::FormatFeatureFlags::STORAGE_TEXEL_BUFFER
+        } else {
+            vk::FormatFeatureFlags::UNIFORM_TEXEL_BUFFER
+        };
         props.buffer_features.contains(wanted)
     }
 
@@ -485,7 +516,9 @@ impl Gpu {
             let fence = self.device.create_fence(&vk::FenceCreateInfo::default(), None)?;
             let cmds = [cmd];
             let submit = vk::SubmitInfo::default().command_buffers(&cmds);
-            let result = self.device.queue_submit(self.queue, &[submit], fence).and_then(|_| if compiling.is_empty() { self.wait(fence) } else { self.wait_compiling(fence, &compiling) });
+            let result = self.device.queue_submit(self.queue, &[submit], fence).and_then(|_| {
+                if compiling.is_empty() { self.wait(fence) } else { self.wait_compiling(fence, &compiling) }
+            });
             self.device.destroy_fence(fence, None);
             self.device.free_command_buffers(self.command_pool, &cmds);
             result.context("queue submission failed")?;
@@ -526,7 +559,10 @@ impl Gpu {
                 other => return other,
             }
             if watch.elapsed() >= limit {
-                brdfprof_process::cleanup::stop(2, &format!("brdfprof: error: {}", brdfprof_process::launch::over_limit(&what, limit)));
+                brdfprof_process::cleanup::stop(
+                    2,
+                    &format!("brdfprof: error: {}", brdfprof_process::launch::over_limit(&what, limit)),
+                );
             }
             watch.tick(limit);
         }
@@ -537,7 +573,9 @@ impl Gpu {
     pub fn barrier(&self, cmd: &Commands) {
         let barrier = vk::MemoryBarrier::default()
             .src_access_mask(vk::AccessFlags::SHADER_WRITE | vk::AccessFlags::TRANSFER_WRITE)
-            .dst_access_mask(vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE | vk::AccessFlags::TRANSFER_READ);
+            .dst_access_mask(
+                vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE | vk::AccessFlags::TRANSFER_READ,
+            );
         // SAFETY: cmd is recording.
         unsafe {
             self.device.cmd_pipeline_barrier(

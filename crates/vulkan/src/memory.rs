@@ -2,7 +2,7 @@
 //! staging buffer when it is not host-visible), host-visible and mapped otherwise.
 
 use super::Gpu;
-use anyhow::{anyhow, Context, Result};
+use anyhow::{Context, Result, anyhow};
 use ash::vk;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -25,10 +25,16 @@ pub struct Buffer<'g> {
 const STAGING_BYTES: u64 = 64 << 20;
 
 impl Gpu {
-    fn memory_type(&self, bits: u32, required: vk::MemoryPropertyFlags, preferred: vk::MemoryPropertyFlags) -> Option<u32> {
+    fn memory_type(
+        &self,
+        bits: u32,
+        required: vk::MemoryPropertyFlags,
+        preferred: vk::MemoryPropertyFlags,
+    ) -> Option<u32> {
         let props = &self.memory_properties;
         let types = &props.memory_types[..props.memory_type_count as usize];
-        let candidates = || types.iter().enumerate().filter(|(i, t)| bits & (1 << i) != 0 && t.property_flags.contains(required));
+        let candidates =
+            || types.iter().enumerate().filter(|(i, t)| bits & (1 << i) != 0 && t.property_flags.contains(required));
         candidates()
             .find(|(_, t)| t.property_flags.contains(preferred))
             .or_else(|| candidates().next())
@@ -50,7 +56,8 @@ impl<'g> Buffer<'g> {
             | vk::BufferUsageFlags::UNIFORM_BUFFER
             | vk::BufferUsageFlags::UNIFORM_TEXEL_BUFFER
             | vk::BufferUsageFlags::STORAGE_TEXEL_BUFFER
-            | vk::BufferUsageFlags::TRANSFER_SRC | vk::BufferUsageFlags::TRANSFER_DST;
+            | vk::BufferUsageFlags::TRANSFER_SRC
+            | vk::BufferUsageFlags::TRANSFER_DST;
         let info = vk::BufferCreateInfo::default().size(size).usage(usage).sharing_mode(vk::SharingMode::EXCLUSIVE);
         let device = &gpu.device;
         // SAFETY: all handles come from `device`; memory is bound once, before any use.
@@ -59,7 +66,9 @@ impl<'g> Buffer<'g> {
             let req = device.get_buffer_memory_requirements(buffer);
             let host = vk::MemoryPropertyFlags::HOST_VISIBLE | vk::MemoryPropertyFlags::HOST_COHERENT;
             let index = match kind {
-                MemoryKind::Device => gpu.memory_type(req.memory_type_bits, vk::MemoryPropertyFlags::DEVICE_LOCAL, host),
+                MemoryKind::Device => {
+                    gpu.memory_type(req.memory_type_bits, vk::MemoryPropertyFlags::DEVICE_LOCAL, host)
+                }
                 MemoryKind::Host => gpu.memory_type(req.memory_type_bits, host, vk::MemoryPropertyFlags::HOST_CACHED),
             }
             .or_else(|| gpu.memory_type(req.memory_type_bits, vk::MemoryPropertyFlags::empty(), host))
@@ -97,9 +106,15 @@ impl<'g> Buffer<'g> {
         let staging = Buffer::new(self.gpu, STAGING_BYTES.min(data.len() as u64), MemoryKind::Host)?;
         for (i, chunk) in data.chunks(STAGING_BYTES as usize).enumerate() {
             staging.write(0, chunk)?;
-            let region = vk::BufferCopy { src_offset: 0, dst_offset: offset + i as u64 * STAGING_BYTES, size: chunk.len() as u64 };
+            let region = vk::BufferCopy {
+                src_offset: 0,
+                dst_offset: offset + i as u64 * STAGING_BYTES,
+                size: chunk.len() as u64,
+            };
             // SAFETY: both buffers are live and the region lies within them.
-            self.gpu.submit(|cmd| unsafe { self.gpu.device.cmd_copy_buffer(cmd.raw, staging.buffer, self.buffer, &[region]) })?;
+            self.gpu.submit(|cmd| unsafe {
+                self.gpu.device.cmd_copy_buffer(cmd.raw, staging.buffer, self.buffer, &[region])
+            })?;
         }
         Ok(())
     }
@@ -118,7 +133,9 @@ impl<'g> Buffer<'g> {
             let n = STAGING_BYTES.min(len - done);
             let region = vk::BufferCopy { src_offset: offset + done, dst_offset: 0, size: n };
             // SAFETY: both buffers are live and the region lies within them.
-            self.gpu.submit(|cmd| unsafe { self.gpu.device.cmd_copy_buffer(cmd.raw, self.buffer, staging.buffer, &[region]) })?;
+            self.gpu.submit(|cmd| unsafe {
+                self.gpu.device.cmd_copy_buffer(cmd.raw, self.buffer, staging.buffer, &[region])
+            })?;
             out.extend_from_slice(&staging.read(0, n)?);
             done += n;
         }

@@ -2,7 +2,7 @@
 //! prints its statistics there (`SHADER-DB: ...`) and nowhere else. Lines that are not the driver's statistics
 //! go back to the real stderr afterwards, so nothing the user should see is lost.
 
-use anyhow::{bail, Context, Result};
+use anyhow::{Context, Result, bail};
 use std::io::{Read, Seek, Write};
 use std::os::fd::{AsRawFd, FromRawFd};
 
@@ -39,7 +39,9 @@ pub fn capture<T>(work: impl FnOnce() -> T) -> Result<(T, String)> {
     }
     let mut text = String::new();
     file.rewind().context("reading the captured stderr")?;
-    file.take(brdfprof_process::launch::MAX_OUTPUT_BYTES as u64).read_to_string(&mut text).context("reading the captured stderr")?;
+    file.take(brdfprof_process::launch::MAX_OUTPUT_BYTES as u64)
+        .read_to_string(&mut text)
+        .context("reading the captured stderr")?;
     Ok((value, text))
 }
 

@@ -3,7 +3,7 @@
 //! Ticks are masked to timestampValidBits and scaled by timestampPeriod.
 
 use super::{Commands, Gpu};
-use anyhow::{bail, Result};
+use anyhow::{Result, bail};
 use ash::vk;
 
 pub struct Timestamps<'g> {
@@ -32,7 +32,9 @@ impl<'g> Timestamps<'g> {
     pub fn write(&self, cmd: &Commands, index: u32) {
         assert!(index < self.capacity);
         // SAFETY: cmd is recording; the query was reset in this command buffer.
-        unsafe { self.gpu.device.cmd_write_timestamp(cmd.raw, vk::PipelineStageFlags::BOTTOM_OF_PIPE, self.pool, index) };
+        unsafe {
+            self.gpu.device.cmd_write_timestamp(cmd.raw, vk::PipelineStageFlags::BOTTOM_OF_PIPE, self.pool, index)
+        };
     }
 
     /// Nanoseconds between query pairs (start, end), read after the submission completed.
@@ -41,13 +43,21 @@ impl<'g> Timestamps<'g> {
         let mut ticks = vec![0u64; count as usize];
         // SAFETY: the queries were written by a completed submission.
         unsafe {
-            self.gpu.device.get_query_pool_results(self.pool, 0, &mut ticks, vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT)
+            self.gpu.device.get_query_pool_results(
+                self.pool,
+                0,
+                &mut ticks,
+                vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT,
+            )
         }?;
         let bits = self.gpu.info.timestamp_valid_bits;
         let mask = if bits >= 64 { u64::MAX } else { (1u64 << bits) - 1 };
         let period = self.gpu.info.timestamp_period as f64;
         // Wrapping subtraction under the mask handles a counter that wrapped between the two reads.
-        Ok(pairs.iter().map(|&(a, b)| ((ticks[b as usize] & mask).wrapping_sub(ticks[a as usize] & mask) & mask) as f64 * period).collect())
+        Ok(pairs
+            .iter()
+            .map(|&(a, b)| ((ticks[b as usize] & mask).wrapping_sub(ticks[a as usize] & mask) & mask) as f64 * period)
+            .collect())
     }
 }
 

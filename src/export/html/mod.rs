@@ -42,7 +42,12 @@ pub fn base64(bytes: &[u8]) -> String {
 /// An 8-bit RGB image as a PNG data: URI.
 pub fn png_data_uri(width: u32, height: u32, rgb: &[u8]) -> Result<String> {
     use image::ImageEncoder;
-    anyhow::ensure!(rgb.len() == width as usize * height as usize * 3, "image of {width}x{height} needs {} bytes, got {}", width * height * 3, rgb.len());
+    anyhow::ensure!(
+        rgb.len() == width as usize * height as usize * 3,
+        "image of {width}x{height} needs {} bytes, got {}",
+        width * height * 3,
+        rgb.len()
+    );
     let mut png = Vec::new();
     image::codecs::png::PngEncoder::new(&mut png).write_image(rgb, width, height, image::ExtendedColorType::Rgb8)?;
     Ok(format!("data:image/png;base64,{}", base64(&png)))
@@ -50,12 +55,19 @@ pub fn png_data_uri(width: u32, height: u32, rgb: &[u8]) -> Result<String> {
 
 /// `<img>` of a data: URI, drawn `scale` times its size with square pixels.
 pub fn img(uri: &str, width: u32, height: u32, scale: u32, alt: &str) -> String {
-    format!("<img class=\"px\" src=\"{uri}\" width=\"{}\" height=\"{}\" alt=\"{}\" title=\"{}\">", width * scale, height * scale, esc(alt), esc(alt))
+    format!(
+        "<img class=\"px\" src=\"{uri}\" width=\"{}\" height=\"{}\" alt=\"{}\" title=\"{}\">",
+        width * scale,
+        height * scale,
+        esc(alt),
+        esc(alt)
+    )
 }
 
 /// Ten distinguishable colours (the same order as `chart::palette`).
 pub fn colour(i: usize) -> &'static str {
-    const P: [&str; 10] = ["#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#17becf"];
+    const P: [&str; 10] =
+        ["#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#17becf"];
     P[i % P.len()]
 }
 
@@ -106,7 +118,12 @@ impl HtmlTable {
             for ((col, _), c) in self.columns.iter().zip(cells) {
                 match c.value {
                     Some(v) => {
-                        let _ = write!(s, "<td data-col=\"{}\" data-v=\"{v:e}\" class=\"n\">{}</td>", esc(col), esc(&c.text));
+                        let _ = write!(
+                            s,
+                            "<td data-col=\"{}\" data-v=\"{v:e}\" class=\"n\">{}</td>",
+                            esc(col),
+                            esc(&c.text)
+                        );
                     }
                     None => {
                         let _ = write!(s, "<td data-col=\"{}\">{}</td>", esc(col), esc(&c.text));
@@ -147,7 +164,11 @@ impl Axis {
 
     /// Where `v` falls from 0 (lo) to 1 (hi).
     pub fn frac(&self, v: f64) -> f64 {
-        if self.log { (v.log10() - self.lo.log10()) / (self.hi.log10() - self.lo.log10()) } else { (v - self.lo) / (self.hi - self.lo) }
+        if self.log {
+            (v.log10() - self.lo.log10()) / (self.hi.log10() - self.lo.log10())
+        } else {
+            (v - self.lo) / (self.hi - self.lo)
+        }
     }
 
     /// Tick values: decades (and 2x, 5x when there are few) on a log axis, 1/2/5 steps on a linear one.
@@ -207,14 +228,38 @@ fn frame(s: &mut String, x: &Axis, y: &Axis, x_label: &str, y_label: &str, size:
     let _ = write!(s, "<rect x=\"{l}\" y=\"{t}\" width=\"{}\" height=\"{}\" class=\"frame\"/>", W - l - r, H - t - b);
     for v in x.ticks() {
         let px = l + x.frac(v) * (W - l - r);
-        let _ = write!(s, "<line x1=\"{px:.1}\" y1=\"{t}\" x2=\"{px:.1}\" y2=\"{}\" class=\"grid\"/><text x=\"{px:.1}\" y=\"{}\" class=\"tick\" text-anchor=\"middle\">{}</text>", H - b, H - b + 16.0, tick_label(v));
+        let _ = write!(
+            s,
+            "<line x1=\"{px:.1}\" y1=\"{t}\" x2=\"{px:.1}\" y2=\"{}\" class=\"grid\"/><text x=\"{px:.1}\" y=\"{}\" class=\"tick\" text-anchor=\"middle\">{}</text>",
+            H - b,
+            H - b + 16.0,
+            tick_label(v)
+        );
     }
     for v in y.ticks() {
         let py = H - b - y.frac(v) * (H - t - b);
-        let _ = write!(s, "<line x1=\"{l}\" y1=\"{py:.1}\" x2=\"{}\" y2=\"{py:.1}\" class=\"grid\"/><text x=\"{}\" y=\"{:.1}\" class=\"tick\" text-anchor=\"end\">{}</text>", W - r, l - 6.0, py + 4.0, tick_label(v));
+        let _ = write!(
+            s,
+            "<line x1=\"{l}\" y1=\"{py:.1}\" x2=\"{}\" y2=\"{py:.1}\" class=\"grid\"/><text x=\"{}\" y=\"{:.1}\" class=\"tick\" text-anchor=\"end\">{}</text>",
+            W - r,
+            l - 6.0,
+            py + 4.0,
+            tick_label(v)
+        );
     }
-    let _ = write!(s, "<text x=\"{}\" y=\"{}\" text-anchor=\"middle\" class=\"axis\">{}</text>", (l + W - r) / 2.0, H - 10.0, esc(x_label));
-    let _ = write!(s, "<text transform=\"translate(16 {}) rotate(-90)\" text-anchor=\"middle\" class=\"axis\">{}</text>", (t + H - b) / 2.0, esc(y_label));
+    let _ = write!(
+        s,
+        "<text x=\"{}\" y=\"{}\" text-anchor=\"middle\" class=\"axis\">{}</text>",
+        (l + W - r) / 2.0,
+        H - 10.0,
+        esc(x_label)
+    );
+    let _ = write!(
+        s,
+        "<text transform=\"translate(16 {}) rotate(-90)\" text-anchor=\"middle\" class=\"axis\">{}</text>",
+        (t + H - b) / 2.0,
+        esc(y_label)
+    );
 }
 
 /// A scatter chart; each point shows its tip on hover (an SVG `<title>`, and the page's tooltip line).
@@ -224,13 +269,21 @@ pub fn scatter_svg(points: &[Point], x: Axis, y: Axis, x_label: &str, y_label: &
     let Size { w: W, h: H } = size;
     let mut s = format!("<svg class=\"chart\" viewBox=\"0 0 {W} {H}\" width=\"{W}\" height=\"{H}\" role=\"img\">");
     frame(&mut s, &x, &y, x_label, y_label, size);
-    for p in points.iter().filter(|p| p.x.is_finite() && p.y.is_finite() && (!x.log || p.x > 0.0) && (!y.log || p.y > 0.0)) {
+    for p in
+        points.iter().filter(|p| p.x.is_finite() && p.y.is_finite() && (!x.log || p.x > 0.0) && (!y.log || p.y > 0.0))
+    {
         let px = l + x.frac(p.x) * (W - l - r);
         let py = H - b - y.frac(p.y) * (H - t - b);
         let class = if p.emphasis { "pt em" } else { "pt" };
-        let _ = write!(s, "<circle cx=\"{px:.1}\" cy=\"{py:.1}\" r=\"5\" class=\"{class}\" data-tip=\"{}\"><title>{}</title></circle>", esc(&p.tip), esc(&p.tip));
+        let _ = write!(
+            s,
+            "<circle cx=\"{px:.1}\" cy=\"{py:.1}\" r=\"5\" class=\"{class}\" data-tip=\"{}\"><title>{}</title></circle>",
+            esc(&p.tip),
+            esc(&p.tip)
+        );
         if p.emphasis {
-            let _ = write!(s, "<text x=\"{:.1}\" y=\"{:.1}\" class=\"lbl\">{}</text>", px + 7.0, py - 5.0, esc(&p.label));
+            let _ =
+                write!(s, "<text x=\"{:.1}\" y=\"{:.1}\" class=\"lbl\">{}</text>", px + 7.0, py - 5.0, esc(&p.label));
         }
     }
     s + "</svg>"
@@ -246,7 +299,15 @@ pub struct Curve {
 fn legend(s: &mut String, labels: &[&str], x0: f64, y0: f64) {
     for (i, label) in labels.iter().enumerate() {
         let y = y0 + 16.0 * i as f64;
-        let _ = write!(s, "<line x1=\"{x0}\" y1=\"{y}\" x2=\"{}\" y2=\"{y}\" stroke=\"{}\" stroke-width=\"2.5\"/><text x=\"{}\" y=\"{}\" class=\"tick\">{}</text>", x0 + 18.0, colour(i), x0 + 22.0, y + 4.0, esc(label));
+        let _ = write!(
+            s,
+            "<line x1=\"{x0}\" y1=\"{y}\" x2=\"{}\" y2=\"{y}\" stroke=\"{}\" stroke-width=\"2.5\"/><text x=\"{}\" y=\"{}\" class=\"tick\">{}</text>",
+            x0 + 18.0,
+            colour(i),
+            x0 + 22.0,
+            y + 4.0,
+            esc(label)
+        );
     }
 }
 
@@ -262,9 +323,22 @@ pub fn lines_svg(curves: &[Curve], x: Axis, y: Axis, x_label: &str, y_label: &st
             .points
             .iter()
             .filter(|(a, v)| a.is_finite() && v.is_finite() && (!y.log || *v > 0.0))
-            .map(|(a, v)| format!("{:.1},{:.1}", l + x.frac(*a) * (W - l - r), H - b - y.frac(*v).clamp(-0.02, 1.02) * (H - t - b)))
+            .map(|(a, v)| {
+                format!(
+                    "{:.1},{:.1}",
+                    l + x.frac(*a) * (W - l - r),
+                    H - b - y.frac(*v).clamp(-0.02, 1.02) * (H - t - b)
+                )
+            })
             .collect();
-        let _ = write!(s, "<polyline fill=\"none\" stroke=\"{}\" stroke-width=\"2\" points=\"{}\" data-tip=\"{}\"><title>{}</title></polyline>", colour(i), pts.join(" "), esc(&c.label), esc(&c.label));
+        let _ = write!(
+            s,
+            "<polyline fill=\"none\" stroke=\"{}\" stroke-width=\"2\" points=\"{}\" data-tip=\"{}\"><title>{}</title></polyline>",
+            colour(i),
+            pts.join(" "),
+            esc(&c.label),
+            esc(&c.label)
+        );
     }
     legend(&mut s, &curves.iter().map(|c| c.label.as_str()).collect::<Vec<_>>(), l + 10.0, t + 14.0);
     s + "</svg>"
@@ -276,13 +350,22 @@ pub fn lines_svg(curves: &[Curve], x: Axis, y: Axis, x_label: &str, y_label: &st
 /// labelled direction (e.g. the light).
 pub fn polar_svg(title: &str, curves: &[Curve], marks: &[(f64, &str)], log_decades: Option<f64>) -> String {
     let (w, h, cx, cy, rim) = (300.0, 180.0, 150.0, 160.0, 135.0);
-    let mut s = format!("<svg class=\"polar\" viewBox=\"0 0 {w} {h}\" width=\"{w}\" height=\"{h}\" role=\"img\"><text x=\"6\" y=\"14\" class=\"tick\">{}</text>", esc(title));
+    let mut s = format!(
+        "<svg class=\"polar\" viewBox=\"0 0 {w} {h}\" width=\"{w}\" height=\"{h}\" role=\"img\"><text x=\"6\" y=\"14\" class=\"tick\">{}</text>",
+        esc(title)
+    );
     for k in 1..=4 {
         let rr = rim * k as f64 / 4.0;
-        let _ = write!(s, "<path d=\"M {:.1} {cy} A {rr:.1} {rr:.1} 0 0 1 {:.1} {cy}\" class=\"grid\" fill=\"none\"/>", cx - rr, cx + rr);
+        let _ = write!(
+            s,
+            "<path d=\"M {:.1} {cy} A {rr:.1} {rr:.1} 0 0 1 {:.1} {cy}\" class=\"grid\" fill=\"none\"/>",
+            cx - rr,
+            cx + rr
+        );
     }
     let _ = write!(s, "<line x1=\"{}\" y1=\"{cy}\" x2=\"{}\" y2=\"{cy}\" class=\"grid\"/>", cx - rim, cx + rim);
-    let peak = curves.iter().flat_map(|c| c.points.iter().map(|p| p.1)).filter(|r| r.is_finite()).fold(0.0f64, f64::max);
+    let peak =
+        curves.iter().flat_map(|c| c.points.iter().map(|p| p.1)).filter(|r| r.is_finite()).fold(0.0f64, f64::max);
     let scale = |r: f64| -> f64 {
         if !(peak > 0.0 && r.is_finite() && r > 0.0) {
             return 0.0;
@@ -293,12 +376,28 @@ pub fn polar_svg(title: &str, curves: &[Curve], marks: &[(f64, &str)], log_decad
         }
     };
     for (i, c) in curves.iter().enumerate() {
-        let pts: Vec<String> = c.points.iter().map(|&(a, r)| format!("{:.1},{:.1}", cx + rim * scale(r) * a.sin(), cy - rim * scale(r) * a.cos())).collect();
-        let _ = write!(s, "<polyline fill=\"none\" stroke=\"{}\" stroke-width=\"1.8\" points=\"{}\" data-tip=\"{}\"><title>{}</title></polyline>", colour(i), pts.join(" "), esc(&c.label), esc(&c.label));
+        let pts: Vec<String> = c
+            .points
+            .iter()
+            .map(|&(a, r)| format!("{:.1},{:.1}", cx + rim * scale(r) * a.sin(), cy - rim * scale(r) * a.cos()))
+            .collect();
+        let _ = write!(
+            s,
+            "<polyline fill=\"none\" stroke=\"{}\" stroke-width=\"1.8\" points=\"{}\" data-tip=\"{}\"><title>{}</title></polyline>",
+            colour(i),
+            pts.join(" "),
+            esc(&c.label),
+            esc(&c.label)
+        );
     }
     for (a, label) in marks {
         let (x, y) = (cx + rim * 1.05 * a.sin(), cy - rim * 1.05 * a.cos());
-        let _ = write!(s, "<line x1=\"{cx}\" y1=\"{cy}\" x2=\"{x:.1}\" y2=\"{y:.1}\" stroke=\"#000\" stroke-dasharray=\"3 2\"/><text x=\"{x:.1}\" y=\"{:.1}\" class=\"tick\">{}</text>", y - 2.0, esc(label));
+        let _ = write!(
+            s,
+            "<line x1=\"{cx}\" y1=\"{cy}\" x2=\"{x:.1}\" y2=\"{y:.1}\" stroke=\"#000\" stroke-dasharray=\"3 2\"/><text x=\"{x:.1}\" y=\"{:.1}\" class=\"tick\">{}</text>",
+            y - 2.0,
+            esc(label)
+        );
     }
     s + "</svg>"
 }
@@ -329,14 +428,18 @@ impl Page {
     }
 
     pub fn render(&self) -> String {
-        let mut s = format!("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><meta name=\"viewport\" content=\"width=device-width, initial-scale=1\"><title>{}</title><style>{CSS}</style></head><body>\n", esc(&self.title));
+        let mut s = format!(
+            "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><meta name=\"viewport\" content=\"width=device-width, initial-scale=1\"><title>{}</title><style>{CSS}</style></head><body>\n",
+            esc(&self.title)
+        );
         let _ = write!(s, "<header><h1>{}</h1><nav>", esc(&self.title));
         for sec in &self.sections {
             let _ = write!(s, "<a href=\"#{}\">{}</a> ", esc(&sec.id), esc(&sec.title));
         }
         s += "</nav></header><div id=\"tip\"></div><main>\n";
         for sec in &self.sections {
-            let _ = write!(s, "<section id=\"{}\"><h2>{}</h2>\n{}\n</section>\n", esc(&sec.id), esc(&sec.title), sec.body);
+            let _ =
+                write!(s, "<section id=\"{}\"><h2>{}</h2>\n{}\n</section>\n", esc(&sec.id), esc(&sec.title), sec.body);
         }
         s + "</main><script>" + SCRIPT + "</script></body></html>\n"
     }
@@ -348,7 +451,15 @@ mod tests {
 
     #[test]
     fn base64_matches_rfc4648_vectors() {
-        for (input, want) in [("", ""), ("f", "Zg=="), ("fo", "Zm8="), ("foo", "Zm9v"), ("foob", "Zm9vYg=="), ("fooba", "Zm9vYmE="), ("foobar", "Zm9vYmFy")] {
+        for (input, want) in [
+            ("", ""),
+            ("f", "Zg=="),
+            ("fo", "Zm8="),
+            ("foo", "Zm9v"),
+            ("foob", "Zm9vYg=="),
+            ("fooba", "Zm9vYmE="),
+            ("foobar", "Zm9vYmFy"),
+        ] {
             assert_eq!(base64(input.as_bytes()), want, "{input}");
         }
     }

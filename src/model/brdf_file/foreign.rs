@@ -6,13 +6,22 @@
 //! name its files and lines.
 
 use super::*;
-use crate::model::front::{self, cross, hlsl, includes::Expanded, wgsl, Glue, GlueArg};
+use crate::model::front::{self, Glue, GlueArg, cross, hlsl, includes::Expanded, wgsl};
 
 /// The shader's GLSL, numbered from 1, for the steps after this one; sets the file's loops, whether it
 /// defines `BRDF`, each entry's glue function and the front end.
 pub(super) fn translate(file: &mut BrdfFile) -> Result<Vec<(usize, String)>> {
     if let Some(p) = file.params.iter().find(|p| p.name.starts_with(front::GENERATED_PREFIX)) {
-        bail!(at(&file.path, p.line, format!("`{}`: names starting with `{}` are brdfprof's own in an {} shader", p.name, front::GENERATED_PREFIX, file.language.name())));
+        bail!(at(
+            &file.path,
+            p.line,
+            format!(
+                "`{}`: names starting with `{}` are brdfprof's own in an {} shader",
+                p.name,
+                front::GENERATED_PREFIX,
+                file.language.name()
+            )
+        ));
     }
     check_reserved_names(file)?;
     let (spirv, source) = match file.language {
@@ -40,13 +49,33 @@ pub(super) fn translate(file: &mut BrdfFile) -> Result<Vec<(usize, String)>> {
 /// the shader (its stub, the entries' glue, the include guards), where the user's would clash with them.
 /// `#include` and `#import` lines name files, not identifiers.
 fn check_reserved_names(file: &BrdfFile) -> Result<()> {
-    let code: Vec<(usize, String)> = file.source.iter().map(|(n, l)| (*n, if l.trim_start().starts_with("#include") || l.trim_start().starts_with("#import") { String::new() } else { l.clone() })).collect();
-    let tokens = if file.language == Language::Wgsl { tokenize_wgsl(&file.path, &code)? } else { tokenize(&file.path, &code)? };
-    let reserved = |t: &&Token| t.kind == Kind::Ident && t.text.to_ascii_lowercase().starts_with(front::GENERATED_PREFIX);
+    let code: Vec<(usize, String)> = file
+        .source
+        .iter()
+        .map(|(n, l)| {
+            (
+                *n,
+                if l.trim_start().starts_with("#include") || l.trim_start().starts_with("#import") {
+                    String::new()
+                } else {
+                    l.clone()
+                },
+            )
+        })
+        .collect();
+    let tokens =
+        if file.language == Language::Wgsl { tokenize_wgsl(&file.path, &code)? } else { tokenize(&file.path, &code)? };
+    let reserved =
+        |t: &&Token| t.kind == Kind::Ident && t.text.to_ascii_lowercase().starts_with(front::GENERATED_PREFIX);
     let Some(t) = tokens.iter().find(reserved) else { return Ok(()) };
     let (n, text) = &code[t.line];
     let column = text[..t.start].chars().count() + 1;
-    bail!("{}:{n}:{column}: `{}`: names starting with `{}` (in any case) are brdfprof's own (the stub, glue and include guards it writes into the shader); give it another name", file.path.display(), t.text, front::GENERATED_PREFIX)
+    bail!(
+        "{}:{n}:{column}: `{}`: names starting with `{}` (in any case) are brdfprof's own (the stub, glue and include guards it writes into the shader); give it another name",
+        file.path.display(),
+        t.text,
+        front::GENERATED_PREFIX
+    )
 }
 
 /// The shader's source lines with their files and lines (HLSL: with its includes), where a name is looked for.
@@ -58,7 +87,10 @@ fn locate(source: &Source, name: &str) -> Option<String> {
     let code = front::includes::code_lines(&source.iter().map(|(_, n, text)| (*n, text.clone())).collect::<Vec<_>>());
     source.iter().zip(code).find_map(|((f, n, _), code)| {
         let text = code.text;
-        let i = text.match_indices(name).map(|(i, _)| i).find(|&i| !text[..i].ends_with(ident) && !text[i + name.len()..].starts_with(ident))?;
+        let i = text
+            .match_indices(name)
+            .map(|(i, _)| i)
+            .find(|&i| !text[..i].ends_with(ident) && !text[i + name.len()..].starts_with(ident))?;
         Some(format!("{f}:{n}:{}", text[..i].chars().count() + 1))
     })
 }
@@ -69,7 +101,14 @@ fn check_param_names(file: &BrdfFile, glsl: &str) -> Result<()> {
     for p in &file.params {
         let escaped = format!("_{}", p.name);
         if glsl.lines().any(|l| cross::plain_declaration(l).is_some_and(|(_, n)| n == escaped)) {
-            bail!(at(&file.path, p.line, format!("parameter `{}`: the name of a GLSL built-in, which the translation into GLSL renames (`{escaped}`); give the parameter another name", p.name)));
+            bail!(at(
+                &file.path,
+                p.line,
+                format!(
+                    "parameter `{}`: the name of a GLSL built-in, which the translation into GLSL renames (`{escaped}`); give the parameter another name",
+                    p.name
+                )
+            ));
         }
     }
     Ok(())
@@ -106,7 +145,14 @@ fn hlsl_spirv(file: &mut BrdfFile) -> Result<(Vec<u32>, Source)> {
     let mut x = Expanded::new(&file.path);
     for p in &file.params {
         if hlsl::is_keyword(&p.name) {
-            bail!(at(&file.path, p.line, format!("parameter `{}`: a keyword of HLSL (glslang's HLSL front end reads it as one), so no variable of the shader can be named so; give the parameter another name", p.name)));
+            bail!(at(
+                &file.path,
+                p.line,
+                format!(
+                    "parameter `{}`: a keyword of HLSL (glslang's HLSL front end reads it as one), so no variable of the shader can be named so; give the parameter another name",
+                    p.name
+                )
+            ));
         }
         x.push_generated(hlsl::param_decl(&p.name, p.glsl_type()), p.line, format!("parameter `{}`", p.name));
     }
@@ -119,7 +165,11 @@ fn hlsl_spirv(file: &mut BrdfFile) -> Result<(Vec<u32>, Source)> {
     for (g, e) in glues.iter().zip(&file.entries) {
         x.push_generated(hlsl::glue(g), e.line, format!("entry `{}`", e.name));
     }
-    x.push_generated(hlsl::stub(&stub_calls(file, &glues)), file.shader_begin, format!("the shader's `BRDF` as brdfprof calls it, `{}`", globals::HLSL_SIGNATURE.text));
+    x.push_generated(
+        hlsl::stub(&stub_calls(file, &glues)),
+        file.shader_begin,
+        format!("the shader's `BRDF` as brdfprof calls it, `{}`", globals::HLSL_SIGNATURE.text),
+    );
     let spirv = hlsl::compile(&x, &file.defines, &file.path)?.map_err(|m| anyhow!("{m}"))?;
     let source = x.lines.iter().zip(&x.origins).map(|(l, &(f, n))| (x.files[f].clone(), n, l.clone())).collect();
     Ok((spirv, source))
@@ -170,11 +220,18 @@ fn wgsl_spirv(file: &mut BrdfFile) -> Result<(Vec<u32>, Source)> {
     for (g, e) in glues.iter().zip(&file.entries) {
         top.push(&wgsl::glue(g), e.line, &format!("entry `{}`", e.name));
     }
-    top.push(&wgsl::stub(&stub_calls(file, &glues)), file.shader_begin, &format!("the shader's `BRDF` as brdfprof calls it, `{WGSL_BRDF}`"));
+    top.push(
+        &wgsl::stub(&stub_calls(file, &glues)),
+        file.shader_begin,
+        &format!("the shader's `BRDF` as brdfprof calls it, `{WGSL_BRDF}`"),
+    );
     let composed = wgsl::compose(&file.path, &top, &file.defines, &file.includes)?;
     file.loops = wgsl_loops_of(file, &top, &composed)?;
     let model = file.path.display().to_string();
-    Ok((wgsl::emit_spirv(&composed.module, &file.path)?, file.source.iter().map(|(n, l)| (model.clone(), *n, l.clone())).collect()))
+    Ok((
+        wgsl::emit_spirv(&composed.module, &file.path)?,
+        file.source.iter().map(|(n, l)| (model.clone(), *n, l.clone())).collect(),
+    ))
 }
 
 const WGSL_BRDF: &str = "fn BRDF(L: vec3<f32>, V: vec3<f32>, N: vec3<f32>, X: vec3<f32>, Y: vec3<f32>) -> vec3<f32>";
@@ -185,23 +242,41 @@ const WGSL_BRDF: &str = "fn BRDF(L: vec3<f32>, V: vec3<f32>, N: vec3<f32>, X: ve
 fn check_wgsl_brdf(file: &BrdfFile, top: &wgsl::Top, bare: &naga::Module) -> Result<bool> {
     let vec3 = Some("vec3<f32>".to_string());
     let found = wgsl::signature(bare, "BRDF");
-    if found.as_ref().is_some_and(|(params, result)| params.len() == 5 && params.iter().all(|(_, t)| *t == vec3) && *result == vec3) {
+    if found
+        .as_ref()
+        .is_some_and(|(params, result)| params.len() == 5 && params.iter().all(|(_, t)| *t == vec3) && *result == vec3)
+    {
         return Ok(true);
     }
     if !file.entries.is_empty() {
         return Ok(false);
     }
     let Some((params, result)) = found else {
-        bail!(at(&file.path, file.shader_begin, format!("the shader defines no function `BRDF` at global scope (brdfprof calls `{WGSL_BRDF}`)")));
+        bail!(at(
+            &file.path,
+            file.shader_begin,
+            format!("the shader defines no function `BRDF` at global scope (brdfprof calls `{WGSL_BRDF}`)")
+        ));
     };
     let shown = |t: &Option<String>| t.clone().unwrap_or_else(|| "?".into());
     let params: Vec<String> = params.iter().map(|(n, t)| format!("{n}: {}", shown(t))).collect();
-    let actual = format!("fn BRDF({}){}", params.join(", "), result.as_ref().map_or(String::new(), |r| format!(" -> {r}")));
-    let lines: Vec<(usize, String)> = wgsl::preprocessed(&top.text, &file.defines, &file.path).lines().enumerate().map(|(i, l)| (i + 1, l.to_string())).collect();
+    let actual =
+        format!("fn BRDF({}){}", params.join(", "), result.as_ref().map_or(String::new(), |r| format!(" -> {r}")));
+    let lines: Vec<(usize, String)> = wgsl::preprocessed(&top.text, &file.defines, &file.path)
+        .lines()
+        .enumerate()
+        .map(|(i, l)| (i + 1, l.to_string()))
+        .collect();
     let tokens = tokenize_wgsl(&file.path, &lines)?;
-    let at_fn = tokens.windows(2).find(|w| w[0].text == "fn" && w[1].text == "BRDF").map(|w| (lines[w[0].line].0, lines[w[0].line].1[..w[0].start].chars().count() + 1));
+    let at_fn = tokens
+        .windows(2)
+        .find(|w| w[0].text == "fn" && w[1].text == "BRDF")
+        .map(|w| (lines[w[0].line].0, lines[w[0].line].1[..w[0].start].chars().count() + 1));
     let (line, column) = at_fn.unwrap_or((file.shader_begin, 1));
-    bail!("{}:{line}:{column}: `BRDF` must be defined as `{WGSL_BRDF}`; the shader's is `{actual}`", file.path.display())
+    bail!(
+        "{}:{line}:{column}: `BRDF` must be defined as `{WGSL_BRDF}`; the shader's is `{actual}`",
+        file.path.display()
+    )
 }
 
 /// The WGSL shader's loops and those of the modules it imports, each at its own file and line, read from
@@ -211,8 +286,14 @@ fn wgsl_loops_of(file: &BrdfFile, top: &wgsl::Top, composed: &wgsl::Composed) ->
     let model = file.path.display().to_string();
     let kept = wgsl::function_names(&composed.module);
     let mut out = Vec::new();
-    for (k, (shown, text)) in std::iter::once((&model, &top.text)).chain(composed.files.iter().map(|(f, t)| (f, t))).enumerate() {
-        let lines: Vec<(usize, String)> = wgsl::preprocessed(text, &file.defines, &file.path).lines().enumerate().map(|(i, l)| (i + 1, l.to_string())).collect();
+    for (k, (shown, text)) in
+        std::iter::once((&model, &top.text)).chain(composed.files.iter().map(|(f, t)| (f, t))).enumerate()
+    {
+        let lines: Vec<(usize, String)> = wgsl::preprocessed(text, &file.defines, &file.path)
+            .lines()
+            .enumerate()
+            .map(|(i, l)| (i + 1, l.to_string()))
+            .collect();
         let tokens = tokenize_wgsl(Path::new(shown), &lines)?;
         for (l, function) in wgsl_loops(&lines, &tokens) {
             if k == 0 || function.is_some_and(|f| kept.contains(&f)) {
@@ -229,7 +310,8 @@ fn wgsl_glues(file: &BrdfFile, top: &wgsl::Top, bare: &naga::Module) -> Result<V
     let mut glues = Vec::new();
     for (k, e) in file.entries.iter().enumerate() {
         globals::check_special_args(&file.path, e, "WGSL")?;
-        let types = if e.args.iter().any(|a| a.starts_with('@')) { wgsl_types(file, top, bare, e)? } else { Vec::new() };
+        let types =
+            if e.args.iter().any(|a| a.starts_with('@')) { wgsl_types(file, top, bare, e)? } else { Vec::new() };
         glues.push(glue(k, e, &types));
     }
     Ok(glues)
@@ -239,14 +321,33 @@ fn wgsl_glues(file: &BrdfFile, top: &wgsl::Top, bare: &naga::Module) -> Result<V
 fn wgsl_types(file: &BrdfFile, top: &wgsl::Top, bare: &naga::Module, e: &Entry) -> Result<Vec<Option<String>>> {
     let fail = |m: String| anyhow!(at(&file.path, e.line, m));
     let found = wgsl::parameter_types(&file.path, top, bare, &file.defines, &file.includes, &e.name)?;
-    let types = found.ok_or_else(|| fail(format!("entry `{}`: neither the shader nor a module it imports defines a function `{}`", e.name, e.name)))?;
+    let types = found.ok_or_else(|| {
+        fail(format!("entry `{}`: neither the shader nor a module it imports defines a function `{}`", e.name, e.name))
+    })?;
     if types.len() != e.args.len() {
-        return Err(fail(format!("entry `{}` takes {} arguments and the declaration gives {}", e.name, types.len(), e.args.len())));
+        return Err(fail(format!(
+            "entry `{}` takes {} arguments and the declaration gives {}",
+            e.name,
+            types.len(),
+            e.args.len()
+        )));
     }
     for (k, (a, t)) in e.args.iter().zip(&types).enumerate().filter(|(_, (a, _))| a.starts_with('@')) {
         match t.as_deref() {
-            None => return Err(fail(format!("entry `{}`: parameter {} of `{a}` has a type brdfprof cannot declare (an array or a runtime-sized type)", e.name, k + 1))),
-            Some(t) if a == globals::OUT_ARG && t != "vec3<f32>" => return Err(fail(format!("entry `{}`: the `{a}` parameter {} is `{t}`; the value is a vec3<f32>", e.name, k + 1))),
+            None => {
+                return Err(fail(format!(
+                    "entry `{}`: parameter {} of `{a}` has a type brdfprof cannot declare (an array or a runtime-sized type)",
+                    e.name,
+                    k + 1
+                )));
+            }
+            Some(t) if a == globals::OUT_ARG && t != "vec3<f32>" => {
+                return Err(fail(format!(
+                    "entry `{}`: the `{a}` parameter {} is `{t}`; the value is a vec3<f32>",
+                    e.name,
+                    k + 1
+                )));
+            }
             _ => {}
         }
     }

@@ -2,7 +2,7 @@
 //! `#` lines of the shader stay for the preprocessor.
 
 use super::*;
-use anyhow::{anyhow, bail, Result};
+use anyhow::{Result, anyhow, bail};
 use std::path::Path;
 
 /// The lines of `text`, ended by `\n`, `\r\n` or a lone `\r` (classic Mac OS line ends, which some editors
@@ -61,7 +61,8 @@ pub(super) struct Open {
 /// selects its branches with `#if` and names its constants with `#define`).
 /// `#pragma` is not among them: glslang's preprocessor passes pragmas through into the text brdfprof reads for
 /// the file's globals, and none changes the SPIR-V of a compute kernel (`dropped_hash_line`).
-pub(super) const PREPROCESSOR_DIRECTIVES: [&str; 10] = ["define", "undef", "if", "ifdef", "ifndef", "elif", "else", "endif", "error", "extension"];
+pub(super) const PREPROCESSOR_DIRECTIVES: [&str; 10] =
+    ["define", "undef", "if", "ifdef", "ifndef", "elif", "else", "endif", "error", "extension"];
 
 /// The directive name of a `#` line (`#  if X` -> `if`).
 pub(super) fn directive_of(line: &str) -> &str {
@@ -72,7 +73,13 @@ pub(super) fn directive_of(line: &str) -> &str {
 /// composed alone, so nothing could be found), any other line is dropped (`dropped_hash_line`).
 pub(super) fn keeps_directive(path: &Path, n: usize, line: &str) -> Result<bool> {
     match directive_of(line) {
-        "include" => bail!(at(path, n, format!("`{line}`: a .brdf shader is composed alone, so it cannot include files; paste the included code into the file"))),
+        "include" => bail!(at(
+            path,
+            n,
+            format!(
+                "`{line}`: a .brdf shader is composed alone, so it cannot include files; paste the included code into the file"
+            )
+        )),
         d => Ok(PREPROCESSOR_DIRECTIVES.contains(&d)),
     }
 }
@@ -83,7 +90,9 @@ pub(super) fn dropped_hash_line(path: &Path, n: usize, line: &str) -> String {
     let why = match directive_of(line) {
         "version" => "the kernel the file is composed into sets `#version 450`",
         "line" => "brdfprof numbers the file's lines itself, so messages name the file's own lines",
-        "pragma" => "no pragma changes the compute kernel brdfprof compiles (glslang ignores `optimize` and `debug` for SPIR-V, `STDGL invariant` applies to vertex outputs, and a .brdf shader is one file, so `once` guards nothing)",
+        "pragma" => {
+            "no pragma changes the compute kernel brdfprof compiles (glslang ignores `optimize` and `debug` for SPIR-V, `STDGL invariant` applies to vertex outputs, and a .brdf shader is one file, so `once` guards nothing)"
+        }
         _ => "a `#` line that is no preprocessor directive is a BRDF Explorer comment",
     };
     at(path, n, format!("`{line}` is dropped: {why}"))
@@ -130,7 +139,14 @@ pub(super) fn read_sections<'a>(file: &mut BrdfFile, lines: impl Iterator<Item =
             "::begin" => {
                 let name = tokens.next().ok_or_else(|| anyhow!(at(&path, n, "`::begin` names no section")))?;
                 if let Some(o) = &open {
-                    bail!(at(&path, n, format!("`::begin {name}` inside section `{}` (begun at line {}): sections do not nest", o.name, o.line)));
+                    bail!(at(
+                        &path,
+                        n,
+                        format!(
+                            "`::begin {name}` inside section `{}` (begun at line {}): sections do not nest",
+                            o.name, o.line
+                        )
+                    ));
                 }
                 match name {
                     "shader" => {
@@ -138,11 +154,24 @@ pub(super) fn read_sections<'a>(file: &mut BrdfFile, lines: impl Iterator<Item =
                             bail!(at(&path, n, format!("a second shader section (the first begins at line {first})")));
                         }
                         let word = tokens.next();
-                        file.language = Language::of_section(word).ok_or_else(|| anyhow!(at(&path, n, format!("`::begin shader {}`: the shader's language is glsl (the default), hlsl or wgsl", word.unwrap_or("")))))?;
+                        file.language = Language::of_section(word).ok_or_else(|| {
+                            anyhow!(at(
+                                &path,
+                                n,
+                                format!(
+                                    "`::begin shader {}`: the shader's language is glsl (the default), hlsl or wgsl",
+                                    word.unwrap_or("")
+                                )
+                            ))
+                        })?;
                         shader_begin = Some(n);
                     }
                     "parameters" | "isFunc" | DIRECTIVES_SECTION => {}
-                    other => file.warnings.push(at(&path, n, format!("don't know what to do with section `{other}`: its content is ignored"))),
+                    other => file.warnings.push(at(
+                        &path,
+                        n,
+                        format!("don't know what to do with section `{other}`: its content is ignored"),
+                    )),
                 }
                 open = Some(Open { name: name.to_string(), line: n });
             }
@@ -151,7 +180,11 @@ pub(super) fn read_sections<'a>(file: &mut BrdfFile, lines: impl Iterator<Item =
                 match &open {
                     None => bail!(at(&path, n, format!("`::end {name}` outside any section"))),
                     Some(o) if o.name != name => {
-                        bail!(at(&path, n, format!("`::end {name}` does not close section `{}` (begun at line {})", o.name, o.line)))
+                        bail!(at(
+                            &path,
+                            n,
+                            format!("`::end {name}` does not close section `{}` (begun at line {})", o.name, o.line)
+                        ))
                     }
                     Some(_) => open = None,
                 }
@@ -161,7 +194,11 @@ pub(super) fn read_sections<'a>(file: &mut BrdfFile, lines: impl Iterator<Item =
                 Some("parameters") => {
                     let param = parse_param(&path, n, trimmed, &mut file.warnings)?;
                     if let Some(first) = declared.insert(param.name.clone(), param.line) {
-                        bail!(at(&path, n, format!("parameter `{}` is declared twice (first at line {first})", param.name)));
+                        bail!(at(
+                            &path,
+                            n,
+                            format!("parameter `{}` is declared twice (first at line {first})", param.name)
+                        ));
                     }
                     file.params.push(param);
                 }
@@ -185,7 +222,9 @@ pub(super) fn parse_param(path: &Path, n: usize, line: &str, warnings: &mut Vec<
         "float" => ("float NAME MIN MAX DEFAULT", 4),
         "bool" => ("bool NAME DEFAULT", 2),
         "color" => ("color NAME R G B", 4),
-        other => bail!(at(path, n, format!("unknown parameter type `{other}`: BRDF Explorer knows float, bool and color"))),
+        other => {
+            bail!(at(path, n, format!("unknown parameter type `{other}`: BRDF Explorer knows float, bool and color")))
+        }
     };
     if tokens.len() < needed + 1 {
         bail!(at(path, n, format!("`{line}`: too few values, expected `{form}`")));
@@ -193,17 +232,33 @@ pub(super) fn parse_param(path: &Path, n: usize, line: &str, warnings: &mut Vec<
     let name = tokens[1];
     check_identifier(path, n, name, warnings)?;
     let number = |what: &str, s: &str| -> Result<f64> {
-        let x = s.parse::<f64>().ok().filter(|x| x.is_finite()).ok_or_else(|| anyhow!(at(path, n, format!("{what} of `{name}`: `{s}` is not a finite number"))))?;
+        let x = s
+            .parse::<f64>()
+            .ok()
+            .filter(|x| x.is_finite())
+            .ok_or_else(|| anyhow!(at(path, n, format!("{what} of `{name}`: `{s}` is not a finite number"))))?;
         if x.abs() > f64::from(f32::MAX) && what != "MIN" && what != "MAX" {
-            bail!(at(path, n, format!("{what} of `{name}`: `{s}` is beyond fp32's range (at most {:e} in magnitude), in which the kernels compute", f32::MAX)));
+            bail!(at(
+                path,
+                n,
+                format!(
+                    "{what} of `{name}`: `{s}` is beyond fp32's range (at most {:e} in magnitude), in which the kernels compute",
+                    f32::MAX
+                )
+            ));
         }
         Ok(x)
     };
     let kind = match tokens[0] {
         "float" => {
-            let (min, max, default) = (number("MIN", tokens[2])?, number("MAX", tokens[3])?, number("DEFAULT", tokens[4])?);
+            let (min, max, default) =
+                (number("MIN", tokens[2])?, number("MAX", tokens[3])?, number("DEFAULT", tokens[4])?);
             if !(min <= default && default <= max) {
-                warnings.push(at(path, n, format!("`{name}`'s default {default} is outside its slider range [{min}, {max}]")));
+                warnings.push(at(
+                    path,
+                    n,
+                    format!("`{name}`'s default {default} is outside its slider range [{min}, {max}]"),
+                ));
             }
             FileParamKind::Float { min, max, default }
         }
@@ -213,33 +268,169 @@ pub(super) fn parse_param(path: &Path, n: usize, line: &str, warnings: &mut Vec<
             "1" => FileParamKind::Bool { default: true },
             other => bail!(at(path, n, format!("DEFAULT of bool `{name}`: `{other}` is not 0 or 1"))),
         },
-        _ => FileParamKind::Color { default: [number("R", tokens[2])?, number("G", tokens[3])?, number("B", tokens[4])?] },
+        _ => FileParamKind::Color {
+            default: [number("R", tokens[2])?, number("G", tokens[3])?, number("B", tokens[4])?],
+        },
     };
     let rest = &tokens[needed + 1..];
     if rest.first().is_some_and(|t| !t.starts_with('#')) {
-        warnings.push(at(path, n, format!("`{}` after `{name}` is ignored (BRDF Explorer ignores it too)", rest.join(" "))));
+        warnings.push(at(
+            path,
+            n,
+            format!("`{}` after `{name}` is ignored (BRDF Explorer ignores it too)", rest.join(" ")),
+        ));
     }
     Ok(FileParam { name: name.to_string(), kind, line: n })
 }
 
 /// GLSL keywords and reserved words (GLSL 4.60, with Vulkan's), which cannot name a parameter.
 pub(super) const GLSL_KEYWORDS: &[&str] = &[
-    "active", "asm", "atomic_uint", "attribute", "bool", "break", "buffer", "bvec2", "bvec3", "bvec4", "case", "cast", "centroid", "class",
-    "coherent", "common", "const", "continue", "default", "discard", "dmat2", "dmat2x2", "dmat2x3", "dmat2x4", "dmat3", "dmat3x2",
-    "dmat3x3", "dmat3x4", "dmat4", "dmat4x2", "dmat4x3", "dmat4x4", "do", "double", "dvec2", "dvec3", "dvec4", "else", "enum", "extern",
-    "external", "false", "filter", "fixed", "flat", "float", "for", "fvec2", "fvec3", "fvec4", "goto", "half", "highp", "hvec2", "hvec3",
-    "hvec4", "if", "in", "inline", "inout", "input", "int", "interface", "invariant", "isampler2D", "isampler3D", "ivec2", "ivec3", "ivec4",
-    "layout", "long", "lowp", "mat2", "mat2x2", "mat2x3", "mat2x4", "mat3", "mat3x2", "mat3x3", "mat3x4", "mat4", "mat4x2", "mat4x3",
-    "mat4x4", "mediump", "namespace", "noinline", "noperspective", "out", "output", "partition", "patch", "precise", "precision", "public",
-    "readonly", "resource", "restrict", "return", "sample", "sampler", "sampler1D", "sampler2D", "sampler3D", "samplerCube",
-    "sampler2DShadow", "shared", "short", "sizeof", "smooth", "static", "struct", "subpassInput", "subroutine", "superp", "switch",
-    "template", "texture2D", "texture3D", "textureCube", "this", "true", "typedef", "uint", "uniform", "union", "unsigned", "usampler2D",
-    "using", "uvec2", "uvec3", "uvec4", "varying", "vec2", "vec3", "vec4", "void", "volatile", "while", "writeonly",
+    "active",
+    "asm",
+    "atomic_uint",
+    "attribute",
+    "bool",
+    "break",
+    "buffer",
+    "bvec2",
+    "bvec3",
+    "bvec4",
+    "case",
+    "cast",
+    "centroid",
+    "class",
+    "coherent",
+    "common",
+    "const",
+    "continue",
+    "default",
+    "discard",
+    "dmat2",
+    "dmat2x2",
+    "dmat2x3",
+    "dmat2x4",
+    "dmat3",
+    "dmat3x2",
+    "dmat3x3",
+    "dmat3x4",
+    "dmat4",
+    "dmat4x2",
+    "dmat4x3",
+    "dmat4x4",
+    "do",
+    "double",
+    "dvec2",
+    "dvec3",
+    "dvec4",
+    "else",
+    "enum",
+    "extern",
+    "external",
+    "false",
+    "filter",
+    "fixed",
+    "flat",
+    "float",
+    "for",
+    "fvec2",
+    "fvec3",
+    "fvec4",
+    "goto",
+    "half",
+    "highp",
+    "hvec2",
+    "hvec3",
+    "hvec4",
+    "if",
+    "in",
+    "inline",
+    "inout",
+    "input",
+    "int",
+    "interface",
+    "invariant",
+    "isampler2D",
+    "isampler3D",
+    "ivec2",
+    "ivec3",
+    "ivec4",
+    "layout",
+    "long",
+    "lowp",
+    "mat2",
+    "mat2x2",
+    "mat2x3",
+    "mat2x4",
+    "mat3",
+    "mat3x2",
+    "mat3x3",
+    "mat3x4",
+    "mat4",
+    "mat4x2",
+    "mat4x3",
+    "mat4x4",
+    "mediump",
+    "namespace",
+    "noinline",
+    "noperspective",
+    "out",
+    "output",
+    "partition",
+    "patch",
+    "precise",
+    "precision",
+    "public",
+    "readonly",
+    "resource",
+    "restrict",
+    "return",
+    "sample",
+    "sampler",
+    "sampler1D",
+    "sampler2D",
+    "sampler3D",
+    "samplerCube",
+    "sampler2DShadow",
+    "shared",
+    "short",
+    "sizeof",
+    "smooth",
+    "static",
+    "struct",
+    "subpassInput",
+    "subroutine",
+    "superp",
+    "switch",
+    "template",
+    "texture2D",
+    "texture3D",
+    "textureCube",
+    "this",
+    "true",
+    "typedef",
+    "uint",
+    "uniform",
+    "union",
+    "unsigned",
+    "usampler2D",
+    "using",
+    "uvec2",
+    "uvec3",
+    "uvec4",
+    "varying",
+    "vec2",
+    "vec3",
+    "vec4",
+    "void",
+    "volatile",
+    "while",
+    "writeonly",
 ];
 
 pub fn is_identifier(s: &str) -> bool {
     let mut chars = s.chars();
-    chars.next().is_some_and(|c| c == '_' || c.is_ascii_alphabetic()) && chars.all(|c| c == '_' || c.is_ascii_alphanumeric())
+    chars.next().is_some_and(|c| c == '_' || c.is_ascii_alphabetic())
+        && chars.all(|c| c == '_' || c.is_ascii_alphanumeric())
 }
 
 /// A parameter name must be a GLSL identifier that GLSL does not reserve.
@@ -275,9 +466,17 @@ pub(super) fn parse_directive(file: &mut BrdfFile, n: usize, line: &str) -> Resu
         }
         "bind" => {
             for item in rest.split_whitespace() {
-                let (name, value) = item.split_once('=').ok_or_else(|| anyhow!(at(&path, n, format!("`{item}`: expected NAME=@INPUT"))))?;
+                let (name, value) = item
+                    .split_once('=')
+                    .ok_or_else(|| anyhow!(at(&path, n, format!("`{item}`: expected NAME=@INPUT"))))?;
                 if !value.starts_with('@') {
-                    bail!(at(&path, n, format!("`{item}`: `bind` binds a parameter to an input (NAME=@roughness, ...); a value belongs in the parameters section")));
+                    bail!(at(
+                        &path,
+                        n,
+                        format!(
+                            "`{item}`: `bind` binds a parameter to an input (NAME=@roughness, ...); a value belongs in the parameters section"
+                        )
+                    ));
                 }
                 if let Some((_, _, first)) = file.binds.iter().find(|(b, _, _)| b == name) {
                     bail!(at(&path, n, format!("`{name}` is bound twice (first at line {first})")));
@@ -291,12 +490,18 @@ pub(super) fn parse_directive(file: &mut BrdfFile, n: usize, line: &str) -> Resu
         "domain" => {
             let form = "`domain roughness|nov|nol MIN MAX`";
             let words: Vec<&str> = rest.split_whitespace().collect();
-            let [input, min, max] = words.as_slice() else { bail!(at(&path, n, format!("`domain {rest}`: expected {form}"))) };
+            let [input, min, max] = words.as_slice() else {
+                bail!(at(&path, n, format!("`domain {rest}`: expected {form}")))
+            };
             let (slot, top) = match *input {
                 "roughness" => (&mut file.roughness_domain, f64::INFINITY),
                 "nov" => (&mut file.nov_domain, 1.0),
                 "nol" => (&mut file.nol_domain, 1.0),
-                _ => bail!(at(&path, n, format!("`domain {input}`: the domains declared are roughness, nov and nol ({form})"))),
+                _ => bail!(at(
+                    &path,
+                    n,
+                    format!("`domain {input}`: the domains declared are roughness, nov and nol ({form})")
+                )),
             };
             let number = |t: &str| t.parse::<f64>().ok().filter(|x| x.is_finite() && *x >= 0.0 && *x <= top);
             let (Some(lo), Some(hi)) = (number(min), number(max)) else {
@@ -315,10 +520,22 @@ pub(super) fn parse_directive(file: &mut BrdfFile, n: usize, line: &str) -> Resu
             if let Some((_, first)) = &file.reference {
                 bail!(at(&path, n, format!("the reference is declared twice (first at line {first})")));
             }
-            crate::brdf::ModelSpec::parse(rest).map_err(|e| anyhow!(at(&path, n, format!("`reference {rest}`: {e} (a reference is a built-in spec: a preset or d=..,vis=..,f=..)"))))?;
+            crate::brdf::ModelSpec::parse(rest).map_err(|e| {
+                anyhow!(at(
+                    &path,
+                    n,
+                    format!("`reference {rest}`: {e} (a reference is a built-in spec: a preset or d=..,vis=..,f=..)")
+                ))
+            })?;
             file.reference = Some((rest.trim().to_string(), n));
         }
-        other => bail!(at(&path, n, format!("unknown directive `{other}` in the `{DIRECTIVES_SECTION}` section (known: entry, bind, domain, reference)"))),
+        other => bail!(at(
+            &path,
+            n,
+            format!(
+                "unknown directive `{other}` in the `{DIRECTIVES_SECTION}` section (known: entry, bind, domain, reference)"
+            )
+        )),
     }
     Ok(())
 }
@@ -353,7 +570,8 @@ fn parse_entry(path: &Path, n: usize, text: &str) -> Result<Entry> {
             _ => {}
         }
     }
-    let close = close.ok_or_else(|| anyhow!(at(path, n, format!("`entry {text}`: the argument list has no closing `)`"))))?;
+    let close =
+        close.ok_or_else(|| anyhow!(at(path, n, format!("`entry {text}`: the argument list has no closing `)`"))))?;
     let last = text[start..close].trim();
     if !(args.is_empty() && last.is_empty()) {
         args.push(last.to_string());
@@ -363,7 +581,9 @@ fn parse_entry(path: &Path, n: usize, text: &str) -> Result<Entry> {
     }
     let returns = match text[close + 1..].split_whitespace().collect::<Vec<_>>().as_slice() {
         [] => Returns::F,
-        ["returns", r] => Returns::parse(r).ok_or_else(|| anyhow!(at(path, n, format!("`returns {r}`: expected f or f_nol"))))?,
+        ["returns", r] => {
+            Returns::parse(r).ok_or_else(|| anyhow!(at(path, n, format!("`returns {r}`: expected f or f_nol"))))?
+        }
         _ => bail!(at(path, n, format!("`entry {text}`: expected {form}"))),
     };
     Ok(Entry { name: name.to_string(), args, param_types: Vec::new(), returns, line: n, glue: None })

@@ -2,7 +2,7 @@
 //! global named like a parameter).
 
 use super::*;
-use anyhow::{bail, Result};
+use anyhow::{Result, bail};
 use std::collections::HashSet;
 use std::path::Path;
 
@@ -10,15 +10,24 @@ use std::path::Path;
 /// qualifier on a global is dropped (renamed_shader) with a warning.
 pub(super) fn check_shader(file: &mut BrdfFile, begin: usize, tokens: &[Token], scan: &Scan) -> Result<()> {
     if let Some(t) = tokens.iter().find(|t| t.kind == Kind::Ident && t.text == "layout") {
-        bail!(at(&file.path, file.shader[t.line].0, "`layout(...)` is not supported in a .brdf shader: the kernel the file is composed into sets its own layout (work-group size, bindings); declare values in the parameters section"));
+        bail!(at(
+            &file.path,
+            file.shader[t.line].0,
+            "`layout(...)` is not supported in a .brdf shader: the kernel the file is composed into sets its own layout (work-group size, bindings); declare values in the parameters section"
+        ));
     }
     if file.language == Language::Glsl {
         file.loops = loops(&file.shader, tokens);
     }
-    let params: std::collections::HashMap<&str, usize> = file.params.iter().map(|p| (p.name.as_str(), p.line)).collect();
+    let params: std::collections::HashMap<&str, usize> =
+        file.params.iter().map(|p| (p.name.as_str(), p.line)).collect();
     for g in &scan.globals {
         if let Some(line) = params.get(g.name.as_str()) {
-            bail!(at(&file.path, g.line, format!("`{}` is both a parameter (line {line}) and a global of the shader", g.name)));
+            bail!(at(
+                &file.path,
+                g.line,
+                format!("`{}` is both a parameter (line {line}) and a global of the shader", g.name)
+            ));
         }
     }
     for &(line, ref name) in &scan.uniforms {
@@ -47,8 +56,16 @@ pub(super) fn check_shader(file: &mut BrdfFile, begin: usize, tokens: &[Token], 
 /// The function an HLSL or WGSL front end wrote for entry `e` (its arguments already checked in the shader's
 /// own language) must be in its GLSL: `vec3 glue(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y)`.
 fn check_glue(lines: &Lines, e: &Entry, glue: &str, globals: &[Global]) -> Result<Vec<String>> {
-    let view = Entry { name: glue.to_string(), args: ["L", "V", "N", "X", "Y"].map(String::from).to_vec(), param_types: Vec::new(), returns: e.returns, line: e.line, glue: None };
-    check_entry(lines, &view, globals, &GLSL_SIGNATURE).map_err(|err| anyhow::anyhow!("{err:#} (the front end's call of `{}`)", e.name))
+    let view = Entry {
+        name: glue.to_string(),
+        args: ["L", "V", "N", "X", "Y"].map(String::from).to_vec(),
+        param_types: Vec::new(),
+        returns: e.returns,
+        line: e.line,
+        glue: None,
+    };
+    check_entry(lines, &view, globals, &GLSL_SIGNATURE)
+        .map_err(|err| anyhow::anyhow!("{err:#} (the front end's call of `{}`)", e.name))
 }
 
 /// Where the scanned lines are: the model file's own lines (GLSL), or lines of an expanded text whose
@@ -93,26 +110,54 @@ pub(super) const SCRATCH_ARG: &str = "@scratch";
 pub(super) fn check_entry(lines: &Lines, entry: &Entry, globals: &[Global], sig: &Signature) -> Result<Vec<String>> {
     let vec3 = sig.vec3[0];
     let defined = globals.iter().find_map(|g| match &g.kind {
-        GlobalKind::Function { defined: true, returns, params } if g.name == entry.name => Some((lines.cite(g.line), returns, params)),
+        GlobalKind::Function { defined: true, returns, params } if g.name == entry.name => {
+            Some((lines.cite(g.line), returns, params))
+        }
         _ => None,
     });
     let fail = |m: String| Err(anyhow::anyhow!(at(lines.path, entry.line, m)));
-    let Some((line, returns, params)) = defined else { return fail(format!("entry `{}`: the shader defines no function `{}` at global scope", entry.name, entry.name)) };
+    let Some((line, returns, params)) = defined else {
+        return fail(format!(
+            "entry `{}`: the shader defines no function `{}` at global scope",
+            entry.name, entry.name
+        ));
+    };
     if params.len() != entry.args.len() {
-        return fail(format!("entry `{}` takes {} arguments ({line}) and the declaration gives {}", entry.name, params.len(), entry.args.len()));
+        return fail(format!(
+            "entry `{}` takes {} arguments ({line}) and the declaration gives {}",
+            entry.name,
+            params.len(),
+            entry.args.len()
+        ));
     }
     let outs = check_special_args(lines.path, entry, sig.language)?;
     if outs == 0 && !sig.vec3.contains(&returns.as_str()) {
-        return fail(format!("entry `{}` returns `{returns}` ({line}); an entry returns {vec3} (f_s, or f_s N.L with `returns f_nol`), or writes it to an `{OUT_ARG}` argument", entry.name));
+        return fail(format!(
+            "entry `{}` returns `{returns}` ({line}); an entry returns {vec3} (f_s, or f_s N.L with `returns f_nol`), or writes it to an `{OUT_ARG}` argument",
+            entry.name
+        ));
     }
-    let types: Vec<String> = params.iter().map(|p| p.iter().find(|t| !QUALIFIERS.contains(&t.as_str())).cloned().unwrap_or_default()).collect();
+    let types: Vec<String> = params
+        .iter()
+        .map(|p| p.iter().find(|t| !QUALIFIERS.contains(&t.as_str())).cloned().unwrap_or_default())
+        .collect();
     for (k, (arg, p)) in entry.args.iter().zip(params).enumerate() {
         let writable = p.iter().any(|t| t == "out" || t == "inout");
         if arg.starts_with('@') && !writable {
-            return fail(format!("entry `{}`: argument {} is `{arg}` but parameter {} ({line}) is not `out` or `inout`", entry.name, k + 1, k + 1));
+            return fail(format!(
+                "entry `{}`: argument {} is `{arg}` but parameter {} ({line}) is not `out` or `inout`",
+                entry.name,
+                k + 1,
+                k + 1
+            ));
         }
         if arg == OUT_ARG && !sig.vec3.contains(&types[k].as_str()) {
-            return fail(format!("entry `{}`: the `{OUT_ARG}` parameter {} ({line}) is `{}`; the value is a {vec3}", entry.name, k + 1, types[k]));
+            return fail(format!(
+                "entry `{}`: the `{OUT_ARG}` parameter {} ({line}) is `{}`; the value is a {vec3}",
+                entry.name,
+                k + 1,
+                types[k]
+            ));
         }
     }
     Ok(types)
@@ -122,7 +167,10 @@ pub(super) fn check_entry(lines: &Lines, entry: &Entry, globals: &[Global], sig:
 pub(super) fn check_special_args(path: &Path, entry: &Entry, language: &str) -> Result<usize> {
     let fail = |m: String| Err(anyhow::anyhow!(at(path, entry.line, m)));
     if let Some(a) = entry.args.iter().find(|a| a.starts_with('@') && ![OUT_ARG, SCRATCH_ARG].contains(&a.as_str())) {
-        return fail(format!("entry `{}`: `{a}`: an argument is a {language} expression, `{OUT_ARG}` (the argument the function writes its value to) or `{SCRATCH_ARG}` (one whose value is discarded)", entry.name));
+        return fail(format!(
+            "entry `{}`: `{a}`: an argument is a {language} expression, `{OUT_ARG}` (the argument the function writes its value to) or `{SCRATCH_ARG}` (one whose value is discarded)",
+            entry.name
+        ));
     }
     let outs = entry.args.iter().filter(|a| *a == OUT_ARG).count();
     if outs > 1 {
@@ -139,16 +187,23 @@ pub(super) struct Signature {
     pub(super) text: &'static str,
 }
 
-pub(super) const GLSL_SIGNATURE: Signature = Signature { language: "GLSL", vec3: &["vec3"], text: "vec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y)" };
+pub(super) const GLSL_SIGNATURE: Signature =
+    Signature { language: "GLSL", vec3: &["vec3"], text: "vec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y)" };
 /// HLSL's, `half3` included (32-bit: glslang's and DXC's default).
-pub(super) const HLSL_SIGNATURE: Signature = Signature { language: "HLSL", vec3: &["float3", "half3"], text: "float3 BRDF(float3 L, float3 V, float3 N, float3 X, float3 Y)" };
+pub(super) const HLSL_SIGNATURE: Signature = Signature {
+    language: "HLSL",
+    vec3: &["float3", "half3"],
+    text: "float3 BRDF(float3 L, float3 V, float3 N, float3 X, float3 Y)",
+};
 
 /// `BRDF` must be defined at global scope with BRDF Explorer's signature (`sig`).
 pub(super) fn check_brdf(lines: &Lines, begin: usize, globals: &[Global], sig: &Signature) -> Result<()> {
     let brdfs: Vec<&Global> = globals.iter().filter(|g| g.name == "BRDF").collect();
     let is_vec3 = |t: &String| sig.vec3.contains(&t.as_str());
     let fits = |g: &Global| match &g.kind {
-        GlobalKind::Function { defined, returns, params } => *defined && is_vec3(returns) && params.len() == 5 && params.iter().all(|p| p.iter().any(is_vec3)),
+        GlobalKind::Function { defined, returns, params } => {
+            *defined && is_vec3(returns) && params.len() == 5 && params.iter().all(|p| p.iter().any(is_vec3))
+        }
         _ => false,
     };
     let signature = sig.text;
@@ -158,15 +213,25 @@ pub(super) fn check_brdf(lines: &Lines, begin: usize, globals: &[Global], sig: &
     let defined = |g: &&&Global| matches!(g.kind, GlobalKind::Function { defined: true, .. });
     match (brdfs.iter().find(defined), brdfs.first()) {
         (Some(g), _) => bail!(lines.at(g.line, format!("`BRDF` must be defined as `{signature}`"))),
-        (None, Some(g)) => bail!(lines.at(g.line, format!("`BRDF` is declared but not defined (BRDF Explorer calls `{signature}`)"))),
-        (None, None) => bail!(at(lines.path, begin, format!("the shader defines no function `BRDF` at global scope (BRDF Explorer calls `{signature}`)"))),
+        (None, Some(g)) => {
+            bail!(lines.at(g.line, format!("`BRDF` is declared but not defined (BRDF Explorer calls `{signature}`)")))
+        }
+        (None, None) => bail!(at(
+            lines.path,
+            begin,
+            format!("the shader defines no function `BRDF` at global scope (BRDF Explorer calls `{signature}`)")
+        )),
     }
 }
 
 #[derive(Clone, Debug, PartialEq)]
 pub(super) enum GlobalKind {
     /// A function definition (`defined`) or prototype: the token before its name, and each parameter's tokens.
-    Function { defined: bool, returns: String, params: Vec<Vec<String>> },
+    Function {
+        defined: bool,
+        returns: String,
+        params: Vec<Vec<String>>,
+    },
     Variable,
     Struct,
 }
@@ -189,8 +254,29 @@ pub(super) struct Scan {
 
 /// Qualifiers that may precede a global's type.
 pub(super) const QUALIFIERS: &[&str] = &[
-    "const", "uniform", "in", "out", "inout", "buffer", "shared", "highp", "mediump", "lowp", "precise", "invariant", "flat", "smooth",
-    "noperspective", "centroid", "sample", "patch", "coherent", "volatile", "restrict", "readonly", "writeonly",
+    "const",
+    "uniform",
+    "in",
+    "out",
+    "inout",
+    "buffer",
+    "shared",
+    "highp",
+    "mediump",
+    "lowp",
+    "precise",
+    "invariant",
+    "flat",
+    "smooth",
+    "noperspective",
+    "centroid",
+    "sample",
+    "patch",
+    "coherent",
+    "volatile",
+    "restrict",
+    "readonly",
+    "writeonly",
 ];
 
 pub(super) fn scan_globals(path: &Path, lines: &[(usize, String)], tokens: &[Token]) -> Result<Scan> {
@@ -207,7 +293,12 @@ pub(super) fn scan_globals(path: &Path, lines: &[(usize, String)], tokens: &[Tok
 
 /// The end (exclusive) of the global-scope item starting at `start` (a declaration up to its `;`, or a
 /// function definition up to its body's `}`), and the body's braces (function or struct), if any.
-pub(super) fn item_end(path: &Path, lines: &[(usize, String)], tokens: &[Token], start: usize) -> Result<(usize, Option<(usize, usize)>)> {
+pub(super) fn item_end(
+    path: &Path,
+    lines: &[(usize, String)],
+    tokens: &[Token],
+    start: usize,
+) -> Result<(usize, Option<(usize, usize)>)> {
     let mut nest = 0;
     let mut body = None;
     let mut j = start;
@@ -225,8 +316,14 @@ pub(super) fn item_end(path: &Path, lines: &[(usize, String)], tokens: &[Token],
             } else if header.iter().any(|t| t.text == "struct") {
                 body = Some((j, close));
                 j = close;
-            } else if header.last().is_some_and(|t| t.kind == Kind::Ident) && header.iter().any(|t| ["uniform", "buffer", "in", "out"].contains(&t.text.as_str())) {
-                bail!(at(path, lines[t.line].0, "interface blocks are not supported in a .brdf shader: declare values in the parameters section"));
+            } else if header.last().is_some_and(|t| t.kind == Kind::Ident)
+                && header.iter().any(|t| ["uniform", "buffer", "in", "out"].contains(&t.text.as_str()))
+            {
+                bail!(at(
+                    path,
+                    lines[t.line].0,
+                    "interface blocks are not supported in a .brdf shader: declare values in the parameters section"
+                ));
             } else {
                 nest += 1; // an initializer list
             }
@@ -247,9 +344,16 @@ pub(super) fn item_end(path: &Path, lines: &[(usize, String)], tokens: &[Token],
 
 /// Records what one global-scope item declares. `first` is its first token's index; `body` its braces,
 /// relative to the item.
-pub(super) fn declare(scan: &mut Scan, lines: &[(usize, String)], item: &[Token], first: usize, body: Option<(usize, usize)>) {
+pub(super) fn declare(
+    scan: &mut Scan,
+    lines: &[(usize, String)],
+    item: &[Token],
+    first: usize,
+    body: Option<(usize, usize)>,
+) {
     let line_of = |t: &Token| lines[t.line].0;
-    let mut push = |t: &Token, kind: GlobalKind| scan.globals.push(Global { name: t.text.clone(), line: line_of(t), kind });
+    let mut push =
+        |t: &Token, kind: GlobalKind| scan.globals.push(Global { name: t.text.clone(), line: line_of(t), kind });
     if item.first().is_some_and(|t| t.text == "precision") {
         return;
     }
@@ -271,7 +375,10 @@ pub(super) fn declare(scan: &mut Scan, lines: &[(usize, String)], item: &[Token]
         if typed && header[k - 1].kind == Kind::Ident && !header[..k].iter().any(|t| t.is("=")) {
             let close = matching(header, k).min(header.len());
             let params = split_params(&header[k + 1..close]);
-            push(&header[k - 1], GlobalKind::Function { defined: body.is_some(), returns: header[k - 2].text.clone(), params });
+            push(
+                &header[k - 1],
+                GlobalKind::Function { defined: body.is_some(), returns: header[k - 2].text.clone(), params },
+            );
             return;
         }
     }
@@ -282,7 +389,11 @@ pub(super) fn declare(scan: &mut Scan, lines: &[(usize, String)], item: &[Token]
         if header[p].text == "uniform" {
             uniform = Some(p);
         }
-        p = if header[p].text == "layout" && header.get(p + 1).is_some_and(|t| t.is("(")) { matching(header, p + 1) + 1 } else { p + 1 };
+        p = if header[p].text == "layout" && header.get(p + 1).is_some_and(|t| t.is("(")) {
+            matching(header, p + 1) + 1
+        } else {
+            p + 1
+        };
     }
     if p >= header.len() || header[p].kind != Kind::Ident {
         return;
@@ -298,7 +409,8 @@ pub(super) fn declare(scan: &mut Scan, lines: &[(usize, String)], item: &[Token]
         scan.uniforms.push((line_of(name), name.text.clone()));
         scan.uniform_tokens.push(first + u);
     }
-    let mut push = |t: &Token| scan.globals.push(Global { name: t.text.clone(), line: line_of(t), kind: GlobalKind::Variable });
+    let mut push =
+        |t: &Token| scan.globals.push(Global { name: t.text.clone(), line: line_of(t), kind: GlobalKind::Variable });
     push(name);
     let mut nest = 0;
     for k in p + 1..header.len() {
@@ -351,7 +463,8 @@ pub(super) fn struct_members(tokens: &[Token]) -> HashSet<usize> {
         for k in open + 1..close {
             let (prev, next) = (&tokens[k - 1], tokens.get(k + 1));
             let declarator = prev.kind == Kind::Ident || prev.is(",") || prev.is("]");
-            if tokens[k].kind == Kind::Ident && declarator && next.is_some_and(|n| n.is(";") || n.is(",") || n.is("[")) {
+            if tokens[k].kind == Kind::Ident && declarator && next.is_some_and(|n| n.is(";") || n.is(",") || n.is("["))
+            {
                 members.insert(k);
             }
         }

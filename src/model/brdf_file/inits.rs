@@ -37,23 +37,43 @@ pub(super) fn initialisers(file: &BrdfFile, tokens: &[Token]) -> Result<Vec<Init
         i = end;
     }
     // The renamed names (parameters and globals) a token is, where the renaming renames it.
-    let renamed = |k: usize| tokens[k].kind == Kind::Ident && file.renamed.lookup.contains(&tokens[k].text) && !(k > 0 && tokens[k - 1].is(".")) && !members.contains(&k);
-    let mentions = |r: &std::ops::Range<usize>| -> BTreeSet<String> { r.clone().filter(|&k| renamed(k)).map(|k| tokens[k].text.clone()).collect() };
-    let direct: Vec<(&str, BTreeSet<String>)> = items.iter().map(|n| match n { Named::Initialiser(g, r) | Named::Function(g, r) => (g.as_str(), mentions(r)) }).collect();
+    let renamed = |k: usize| {
+        tokens[k].kind == Kind::Ident
+            && file.renamed.lookup.contains(&tokens[k].text)
+            && !(k > 0 && tokens[k - 1].is("."))
+            && !members.contains(&k)
+    };
+    let mentions = |r: &std::ops::Range<usize>| -> BTreeSet<String> {
+        r.clone().filter(|&k| renamed(k)).map(|k| tokens[k].text.clone()).collect()
+    };
+    let direct: Vec<(&str, BTreeSet<String>)> = items
+        .iter()
+        .map(|n| match n {
+            Named::Initialiser(g, r) | Named::Function(g, r) => (g.as_str(), mentions(r)),
+        })
+        .collect();
     let reads = transitive_reads(&direct, &params);
     let rename = |k: usize| if renamed(k) { file.glsl_name(&tokens[k].text) } else { tokens[k].text.clone() };
     Ok(items
         .iter()
         .filter_map(|n| match n {
-            Named::Initialiser(g, r) => Some(Initialiser { name: g.clone(), reads: reads.get(g.as_str()).cloned().unwrap_or_default(), assignment: format!("{} = {};", file.glsl_name(g), spaced(tokens, r.clone(), rename)) }),
+            Named::Initialiser(g, r) => Some(Initialiser {
+                name: g.clone(),
+                reads: reads.get(g.as_str()).cloned().unwrap_or_default(),
+                assignment: format!("{} = {};", file.glsl_name(g), spaced(tokens, r.clone(), rename)),
+            }),
             Named::Function(..) => None,
         })
         .collect())
 }
 
 /// The parameters each name reads through what it mentions (`direct`), to a fixed point.
-fn transitive_reads<'a>(direct: &[(&'a str, BTreeSet<String>)], params: &HashSet<&str>) -> HashMap<&'a str, BTreeSet<String>> {
-    let mut reads: HashMap<&str, BTreeSet<String>> = direct.iter().map(|(g, m)| (*g, m.iter().filter(|n| params.contains(n.as_str())).cloned().collect())).collect();
+fn transitive_reads<'a>(
+    direct: &[(&'a str, BTreeSet<String>)],
+    params: &HashSet<&str>,
+) -> HashMap<&'a str, BTreeSet<String>> {
+    let mut reads: HashMap<&str, BTreeSet<String>> =
+        direct.iter().map(|(g, m)| (*g, m.iter().filter(|n| params.contains(n.as_str())).cloned().collect())).collect();
     loop {
         let mut changed = false;
         for (g, m) in direct {
@@ -99,7 +119,11 @@ fn named_by(tokens: &[Token], start: usize, end: usize, body: Option<(usize, usi
         if item[p].text == "const" {
             return; // a constant's initialiser is a constant expression
         }
-        p = if item[p].text == "layout" && item.get(p + 1).is_some_and(|t| t.is("(")) { matching(item, p + 1) + 1 } else { p + 1 };
+        p = if item[p].text == "layout" && item.get(p + 1).is_some_and(|t| t.is("(")) {
+            matching(item, p + 1) + 1
+        } else {
+            p + 1
+        };
     }
     p += 1; // the type
     while p < item.len() {

@@ -45,7 +45,9 @@ pub(super) fn wgsl_loops(lines: &[(usize, String)], tokens: &[Token]) -> Vec<(Lo
         match t.text.as_str() {
             "{" if t.kind == Kind::Punct => depth += 1,
             "}" if t.kind == Kind::Punct => depth = depth.saturating_sub(1),
-            "fn" if depth == 0 && t.kind == Kind::Ident => function = tokens.get(i + 1).filter(|n| n.kind == Kind::Ident).map(|n| n.text.clone()),
+            "fn" if depth == 0 && t.kind == Kind::Ident => {
+                function = tokens.get(i + 1).filter(|n| n.kind == Kind::Ident).map(|n| n.text.clone())
+            }
             "for" | "while" | "loop" if t.kind == Kind::Ident => {
                 let keyword = match t.text.as_str() {
                     "for" => "for",
@@ -73,7 +75,13 @@ pub(super) fn literal(tokens: &[Token], at: &mut usize) -> Option<f64> {
     let x = match t.text.strip_prefix("0x").or_else(|| t.text.strip_prefix("0X")) {
         // A hex digit `f` is no suffix.
         Some(h) => u64::from_str_radix(h.trim_end_matches(['u', 'U', 'i']), 16).ok()? as f64,
-        None => t.text.trim_end_matches("lf").trim_end_matches("LF").trim_end_matches(['u', 'U', 'f', 'F', 'h', 'i']).parse::<f64>().ok()?,
+        None => t
+            .text
+            .trim_end_matches("lf")
+            .trim_end_matches("LF")
+            .trim_end_matches(['u', 'U', 'f', 'F', 'h', 'i'])
+            .parse::<f64>()
+            .ok()?,
     };
     Some(if negative { -x } else { x })
 }
@@ -108,7 +116,11 @@ pub(super) fn trip_count(tokens: &[Token]) -> Option<u64> {
         return None;
     }
     at += 1;
-    let step = match (tokens.get(at).map(|t| t.text.as_str()), tokens.get(at + 1).map(|t| t.text.as_str()), tokens.get(at + 2).map(|t| t.text.as_str())) {
+    let step = match (
+        tokens.get(at).map(|t| t.text.as_str()),
+        tokens.get(at + 1).map(|t| t.text.as_str()),
+        tokens.get(at + 2).map(|t| t.text.as_str()),
+    ) {
         (Some(v), Some("+"), Some("+")) | (Some("+"), Some("+"), Some(v)) if v == var => 1.0,
         (Some(v), Some("-"), Some("-")) | (Some("-"), Some("-"), Some(v)) if v == var => -1.0,
         (Some(v), Some(sign @ ("+" | "-")), Some("=")) if v == var => {

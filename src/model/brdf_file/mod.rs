@@ -47,9 +47,9 @@ mod inits;
 mod loops;
 mod preprocess;
 mod rename;
-mod tokens;
 #[cfg(test)]
 mod tests;
+mod tokens;
 
 use format::*;
 use globals::*;
@@ -64,7 +64,7 @@ pub use loops::LAVAPIPE_LOOP_LIMIT;
 
 pub use crate::model::front::{Includes, Language};
 
-use anyhow::{anyhow, bail, Result};
+use anyhow::{Result, anyhow, bail};
 use sha2::{Digest, Sha256};
 use std::collections::HashSet;
 use std::fmt::Display;
@@ -264,7 +264,8 @@ fn read_brdf(path: &Path, bytes: &[u8]) -> Result<BrdfFile> {
     check_kind(path, lines.next().unwrap_or(""))?;
     let mut file = empty(path, bytes, Language::Glsl);
     let shader_begin = read_sections(&mut file, lines)?;
-    file.shader_begin = shader_begin.ok_or_else(|| anyhow!(at(path, 1, "no shader section (`::begin shader` ... `::end shader`)")))?;
+    file.shader_begin =
+        shader_begin.ok_or_else(|| anyhow!(at(path, 1, "no shader section (`::begin shader` ... `::end shader`)")))?;
     file.format_warnings = std::mem::take(&mut file.warnings);
     Ok(file)
 }
@@ -317,7 +318,10 @@ impl BrdfFile {
     /// precision (`float16_t`, `f16vec*`, `f16mat*`: WGSL's `enable f16`, GLSL's explicit 16-bit types), which a
     /// device without shaderFloat16 cannot run.
     pub fn uses_float16(&self) -> bool {
-        self.shader.iter().any(|(_, line)| line.split(|c: char| !(c.is_ascii_alphanumeric() || c == '_')).any(|w| w == "float16_t" || w.starts_with("f16vec") || w.starts_with("f16mat")))
+        self.shader.iter().any(|(_, line)| {
+            line.split(|c: char| !(c.is_ascii_alphanumeric() || c == '_'))
+                .any(|w| w == "float16_t" || w.starts_with("f16vec") || w.starts_with("f16mat"))
+        })
     }
 
     /// The same file with its shader preprocessed under `defines` (`NAME`, `VALUE`; an empty value defines
@@ -340,10 +344,18 @@ impl BrdfFile {
     fn set_defines(&mut self, defines: &[(String, String)]) -> Result<()> {
         for (name, _) in defines {
             if name.to_ascii_lowercase().starts_with(crate::model::front::GENERATED_PREFIX) {
-                bail!("{}: `define={name}`: names starting with `{}` (in any case) are brdfprof's own (the functions and guards it writes into the shader); give the macro another name", self.path.display(), crate::model::front::GENERATED_PREFIX);
+                bail!(
+                    "{}: `define={name}`: names starting with `{}` (in any case) are brdfprof's own (the functions and guards it writes into the shader); give the macro another name",
+                    self.path.display(),
+                    crate::model::front::GENERATED_PREFIX
+                );
             }
             if let Some(p) = self.params.iter().find(|p| &p.name == name) {
-                bail!("{}: `define={name}`: `{name}` is the file's parameter (line {}); a macro of that name would replace it in the shader", self.path.display(), p.line);
+                bail!(
+                    "{}: `define={name}`: `{name}` is the file's parameter (line {}); a macro of that name would replace it in the shader",
+                    self.path.display(),
+                    p.line
+                );
             }
         }
         self.defines = defines.to_vec();
@@ -398,7 +410,9 @@ impl FileParam {
         match self.kind {
             FileParamKind::Float { default, .. } => glsl_float(default),
             FileParamKind::Bool { default } => default.to_string(),
-            FileParamKind::Color { default: [r, g, b] } => format!("vec3({}, {}, {})", glsl_float(r), glsl_float(g), glsl_float(b)),
+            FileParamKind::Color { default: [r, g, b] } => {
+                format!("vec3({}, {}, {})", glsl_float(r), glsl_float(g), glsl_float(b))
+            }
         }
     }
 }

@@ -1,14 +1,18 @@
 //! glslang's preprocessor on the shader section, line for line with the file.
 
 use super::*;
-use anyhow::{anyhow, bail, Result};
+use anyhow::{Result, anyhow, bail};
 use std::path::Path;
 
 /// glslang's preprocessor on the shader's lines under `defines`, numbered as in the file: the result is line
 /// for line with `source` (glslang keeps a blank line for each directive and a macro's continuation lines).
 /// Without directives and defines the source is returned as it is (no glslang run, and the text keeps its
 /// spacing). A preprocessor error (`#error`, an unterminated `#if`) names the file's line.
-pub(super) fn preprocess(path: &Path, source: &[(usize, String)], defines: &[(String, String)]) -> Result<Vec<(usize, String)>> {
+pub(super) fn preprocess(
+    path: &Path,
+    source: &[(usize, String)],
+    defines: &[(String, String)],
+) -> Result<Vec<(usize, String)>> {
     let directive = |l: &str| l.trim_start().starts_with('#');
     if defines.is_empty() && !source.iter().any(|(_, l)| directive(l)) {
         return Ok(source.to_vec());
@@ -19,8 +23,13 @@ pub(super) fn preprocess(path: &Path, source: &[(usize, String)], defines: &[(St
         text += l;
         text.push('\n');
     }
-    let flags: Vec<String> = defines.iter().map(|(n, v)| if v.is_empty() { n.clone() } else { format!("{n}={v}") }).collect();
-    let out = match crate::shaders::glslang_preprocess(&text, &flags, &format!("{} (glslang's preprocessor)", path.display()))? {
+    let flags: Vec<String> =
+        defines.iter().map(|(n, v)| if v.is_empty() { n.clone() } else { format!("{n}={v}") }).collect();
+    let out = match crate::shaders::glslang_preprocess(
+        &text,
+        &flags,
+        &format!("{} (glslang's preprocessor)", path.display()),
+    )? {
         Ok(out) => out,
         Err(log) => bail!("{}", preprocessor_errors(path, source, &log)),
     };
@@ -74,19 +83,31 @@ pub(super) fn number_preprocessed(path: &Path, source: &[(usize, String)], out: 
 
 /// Preprocessed `out` lines (after any header), one per line of `source` from line `next` on, renumbered
 /// where a `#line` directive says: `source`'s lines with their preprocessed text.
-pub(super) fn number_lines<'a>(path: &Path, source: &[(usize, String)], out: impl Iterator<Item = &'a str>, mut next: usize) -> Result<Vec<(usize, String)>> {
+pub(super) fn number_lines<'a>(
+    path: &Path,
+    source: &[(usize, String)],
+    out: impl Iterator<Item = &'a str>,
+    mut next: usize,
+) -> Result<Vec<(usize, String)>> {
     let mut shader: Vec<(usize, String)> = source.iter().map(|(n, _)| (*n, String::new())).collect();
     let first = source.first().map_or(1, |l| l.0);
     for line in out {
         if let Some(n) = line.trim().strip_prefix("#line ") {
-            next = n.split_whitespace().next().and_then(|d| d.parse().ok()).ok_or_else(|| anyhow!("{}: glslang's preprocessor wrote `{line}`", path.display()))?;
+            next = n
+                .split_whitespace()
+                .next()
+                .and_then(|d| d.parse().ok())
+                .ok_or_else(|| anyhow!("{}: glslang's preprocessor wrote `{line}`", path.display()))?;
             continue;
         }
         let slot = next.checked_sub(first).and_then(|k| shader.get_mut(k));
         match slot {
             Some(slot) => slot.1 = line.to_string(),
             None if line.trim().is_empty() => {}
-            None => bail!("{}: glslang's preprocessor wrote line {next} beyond the shader section: `{line}`", path.display()),
+            None => bail!(
+                "{}: glslang's preprocessor wrote line {next} beyond the shader section: `{line}`",
+                path.display()
+            ),
         }
         next += 1;
     }

@@ -11,7 +11,8 @@ impl BrdfFile {
     /// GLSL reserves) appears.
     pub(super) fn choose_prefix(&self) -> String {
         let runs: Vec<&str> = self.shader.iter().flat_map(|(_, l)| identifier_runs(l)).collect();
-        let underscore = runs.iter().copied().chain(self.params.iter().map(|p| p.name.as_str())).any(|s| s.starts_with('_'));
+        let underscore =
+            runs.iter().copied().chain(self.params.iter().map(|p| p.name.as_str())).any(|s| s.starts_with('_'));
         let base = (0..)
             .map(|k| if k == 0 { "brdf_f".to_string() } else { format!("brdf_f{k}") })
             .find(|base| !runs.iter().any(|r| r.starts_with(base.as_str())))
@@ -64,7 +65,10 @@ impl BrdfFile {
 
     /// `const TYPE NAME = DEFAULT;` for each parameter, under its GLSL name: the simplest composition.
     pub fn default_constants(&self) -> String {
-        self.params.iter().map(|p| format!("const {} {} = {};\n", p.glsl_type(), self.glsl_name(&p.name), p.default_glsl())).collect()
+        self.params
+            .iter()
+            .map(|p| format!("const {} {} = {};\n", p.glsl_type(), self.glsl_name(&p.name), p.default_glsl()))
+            .collect()
     }
 
     /// The name the composed source's `#line` directive gives the file: its path, with the characters a
@@ -84,7 +88,12 @@ impl BrdfFile {
     pub fn entry_glue(&self, entry: &Entry) -> (String, String) {
         let name = format!("{}0entry", self.prefix);
         if let Some(glue) = &entry.glue {
-            let text = format!("#line {} \"{}\"\nvec3 {name}(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) {{ return {}(L, V, N, X, Y); }}\n", entry.line, self.directive_name(), self.glsl_name(glue));
+            let text = format!(
+                "#line {} \"{}\"\nvec3 {name}(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) {{ return {}(L, V, N, X, Y); }}\n",
+                entry.line,
+                self.directive_name(),
+                self.glsl_name(glue)
+            );
             return (name, text);
         }
         let mut locals = String::new();
@@ -111,7 +120,11 @@ impl BrdfFile {
             Some(out) => format!("{locals}{call}; return {out};"),
             None => format!("{locals}return {call};"),
         };
-        let text = format!("#line {} \"{}\"\nvec3 {name}(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) {{ {body} }}\n", entry.line, self.directive_name());
+        let text = format!(
+            "#line {} \"{}\"\nvec3 {name}(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) {{ {body} }}\n",
+            entry.line,
+            self.directive_name()
+        );
         (name, text)
     }
 
@@ -123,7 +136,11 @@ impl BrdfFile {
         let mut out = arg.to_string();
         for (i, t) in tokens.iter().enumerate().rev() {
             let after_dot = i > 0 && tokens[i - 1].is(".");
-            if t.kind == Kind::Ident && !after_dot && !["L", "V", "N", "X", "Y"].contains(&t.text.as_str()) && self.renamed.lookup.contains(&t.text) {
+            if t.kind == Kind::Ident
+                && !after_dot
+                && !["L", "V", "N", "X", "Y"].contains(&t.text.as_str())
+                && self.renamed.lookup.contains(&t.text)
+            {
                 out.replace_range(t.start..t.end, &self.glsl_name(&t.text));
             }
         }
@@ -145,11 +162,15 @@ impl BrdfFile {
     /// "compilation terminated", link errors that follow a failed compile) are dropped.
     pub fn remap_log(&self, renamed: &RenamedShader, log: &str, line_of: impl Fn(usize) -> Option<usize>) -> String {
         // A translated shader's lines are its GLSL's, named so.
-        let shown = if self.language == Language::Glsl { self.path.display().to_string() } else { self.directive_name() };
+        let shown =
+            if self.language == Language::Glsl { self.path.display().to_string() } else { self.directive_name() };
         let ours = [self.path.display().to_string(), self.directive_name()];
         let mut out = String::new();
         for line in log.lines().map(str::trim) {
-            let Some((severity, rest)) = line.split_once(": ").filter(|(s, _)| ["ERROR", "WARNING", "NOTE", "UNIMPLEMENTED", "INTERNAL ERROR"].contains(s)) else {
+            let Some((severity, rest)) = line
+                .split_once(": ")
+                .filter(|(s, _)| ["ERROR", "WARNING", "NOTE", "UNIMPLEMENTED", "INTERNAL ERROR"].contains(s))
+            else {
                 continue;
             };
             let Some((source, n, message)) = split_location(rest) else {
@@ -211,7 +232,8 @@ impl RenamedShader {
         let mut out = String::with_capacity(text.len());
         let mut rest = text;
         while let Some(start) = rest.find(|c: char| c == '_' || c.is_ascii_alphanumeric()) {
-            let len = rest[start..].find(|c: char| !(c == '_' || c.is_ascii_alphanumeric())).unwrap_or(rest.len() - start);
+            let len =
+                rest[start..].find(|c: char| !(c == '_' || c.is_ascii_alphanumeric())).unwrap_or(rest.len() - start);
             let word = &rest[start..start + len];
             out += &rest[..start];
             match word.strip_prefix(self.prefix.as_str()).filter(|w| self.lookup.contains(*w)) {

@@ -1,5 +1,5 @@
 use super::*;
-use crate::shaders::{glslang, GlslangError};
+use crate::shaders::{GlslangError, glslang};
 
 const PATH: &str = "dir/t.brdf";
 
@@ -56,13 +56,33 @@ fn errors_name_file_and_line() {
     }
     fails_at("analytic\n::begin parameters\nfloat n 0 1 0\n::end parameters\n", 1, "no shader section");
     fails_at(&file("", "\nfloat f() { return 1.0; }\n"), 4, "defines no function `BRDF`");
-    fails_at(&file("", "// vec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) { }\nvec3 f() { return BRDF(); }\n"), 4, "defines no function `BRDF`");
-    fails_at(&file("", "\nvec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y);\n"), 6, "`BRDF` is declared but not defined");
-    fails_at(&file("", "\nfloat BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) { return 1.0; }\n"), 6, "`BRDF` must be defined as `vec3 BRDF(vec3 L");
+    fails_at(
+        &file("", "// vec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) { }\nvec3 f() { return BRDF(); }\n"),
+        4,
+        "defines no function `BRDF`",
+    );
+    fails_at(
+        &file("", "\nvec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y);\n"),
+        6,
+        "`BRDF` is declared but not defined",
+    );
+    fails_at(
+        &file("", "\nfloat BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) { return 1.0; }\n"),
+        6,
+        "`BRDF` must be defined as `vec3 BRDF(vec3 L",
+    );
     fails_at(&file("", "\n\nvec3 BRDF(vec3 L, vec3 V) { return L; }\n"), 7, "must be defined as");
     fails_at(&file("", &format!("{BRDF}/* never\nclosed\n")), 6, "`/*` comment is never closed");
-    fails_at(&file("float m 0 1 0\n", &format!("{BRDF}\nconst float m = 1.0;\n")), 8, "`m` is both a parameter (line 3) and a global");
-    fails_at(&format!("{}::begin shader\n{BRDF}::end shader\n", file("", BRDF)), 7, "a second shader section (the first begins at line 4)");
+    fails_at(
+        &file("float m 0 1 0\n", &format!("{BRDF}\nconst float m = 1.0;\n")),
+        8,
+        "`m` is both a parameter (line 3) and a global",
+    );
+    fails_at(
+        &format!("{}::begin shader\n{BRDF}::end shader\n", file("", BRDF)),
+        7,
+        "a second shader section (the first begins at line 4)",
+    );
     fails_at(&file("", &format!("{BRDF}uniform Block {{ float k; }};\n")), 6, "interface blocks are not supported");
     let e = format!("{:#}", load(Path::new("/nonexistent/x.brdf")).unwrap_err());
     assert!(e.starts_with("cannot read /nonexistent/x.brdf"), "{e}");
@@ -87,7 +107,10 @@ fn parameters_of_each_type_with_defaults_and_warnings() {
     );
     assert_eq!(
         f.warnings,
-        ["dir/t.brdf:7: `k`'s default 2 is outside its slider range [0, 1]", "dir/t.brdf:7: `extra words` after `k` is ignored (BRDF Explorer ignores it too)"]
+        [
+            "dir/t.brdf:7: `k`'s default 2 is outside its slider range [0, 1]",
+            "dir/t.brdf:7: `extra words` after `k` is ignored (BRDF Explorer ignores it too)"
+        ]
     );
     assert_eq!(f.name, "t");
     assert_eq!(
@@ -98,14 +121,25 @@ fn parameters_of_each_type_with_defaults_and_warnings() {
 
 #[test]
 fn sections_warnings_is_func_and_hash() {
-    let text = format!("analytic extra\nstray text\n::begin notes\nanything\n::end notes\n::begin isFunc\nvec3 sampleBRDF() {{ }}\n::end isFunc\n::begin shader\n{BRDF}::end shader\n");
+    let text = format!(
+        "analytic extra\nstray text\n::begin notes\nanything\n::end notes\n::begin isFunc\nvec3 sampleBRDF() {{ }}\n::end isFunc\n::begin shader\n{BRDF}::end shader\n"
+    );
     let f = ok(&text);
     assert!(f.has_is_func);
-    assert_eq!(f.warnings, ["dir/t.brdf:2: text outside any section is ignored", "dir/t.brdf:3: don't know what to do with section `notes`: its content is ignored"]);
+    assert_eq!(
+        f.warnings,
+        [
+            "dir/t.brdf:2: text outside any section is ignored",
+            "dir/t.brdf:3: don't know what to do with section `notes`: its content is ignored"
+        ]
+    );
     // sha256 of the text, as `sha256sum` gives it.
     assert_eq!(ok(&file("", BRDF)).hash, hex(&Sha256::digest(file("", BRDF).as_bytes())));
     assert_eq!(hex(&Sha256::digest(b"abc")), "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
-    assert!(!ok(&format!("analytic\n::begin isFunc\n# only a comment\n::end isFunc\n::begin shader\n{BRDF}::end shader\n")).has_is_func);
+    assert!(
+        !ok(&format!("analytic\n::begin isFunc\n# only a comment\n::end isFunc\n::begin shader\n{BRDF}::end shader\n"))
+            .has_is_func
+    );
     // CRLF line ends and a byte order mark.
     let crlf = format!("\u{feff}{}", file("float n 0 1 0.5\n", BRDF).replace('\n', "\r\n"));
     let f = ok(&crlf);
@@ -115,21 +149,39 @@ fn sections_warnings_is_func_and_hash() {
 
 #[test]
 fn comments_blank_and_hash_lines_keep_numbering() {
-    let f = ok("analytic\n::begin shader\n\n#version 450\n  # indented\n// a comment\n/* a\n # in a comment\nb */\nvec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) { return vec3(1.0); }\n::end shader\n");
+    let f = ok(
+        "analytic\n::begin shader\n\n#version 450\n  # indented\n// a comment\n/* a\n # in a comment\nb */\nvec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) { return vec3(1.0); }\n::end shader\n",
+    );
     let numbers: Vec<usize> = f.shader.iter().map(|(n, _)| *n).collect();
     assert_eq!(numbers, (3..=10).collect::<Vec<_>>());
     assert_eq!(f.shader[1], (4, String::new()));
     assert_eq!(f.shader[2], (5, String::new()));
     assert_eq!(f.shader[5], (8, String::new()));
-    assert_eq!(f.shader[3], (6, "// a comment".to_string()), "no directive is kept, so no preprocessor runs and the text is as written");
+    assert_eq!(
+        f.shader[3],
+        (6, "// a comment".to_string()),
+        "no directive is kept, so no preprocessor runs and the text is as written"
+    );
     let r = f.renamed_shader();
     assert_eq!(r.lines.iter().map(|l| l.0).collect::<Vec<_>>(), numbers);
     assert_eq!(r.lines[7].1, "vec3 brdf_f_BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) { return vec3(1.0); }");
     assert_eq!(f.line_directive(), "#line 3 \"dir/t.brdf\"");
     let dropped: Vec<&String> = f.warnings.iter().filter(|w| w.contains("is dropped")).collect();
     assert_eq!(dropped.len(), 3, "every dropped `#` line is named: {dropped:?}");
-    assert!(dropped[0].contains(":4") && dropped[0].contains("`#version 450`") && dropped[0].contains("sets `#version 450`"), "{}", dropped[0]);
-    assert!(dropped[1].contains(":5") && dropped[1].contains("`# indented`") && dropped[1].contains("BRDF Explorer comment"), "{}", dropped[1]);
+    assert!(
+        dropped[0].contains(":4")
+            && dropped[0].contains("`#version 450`")
+            && dropped[0].contains("sets `#version 450`"),
+        "{}",
+        dropped[0]
+    );
+    assert!(
+        dropped[1].contains(":5")
+            && dropped[1].contains("`# indented`")
+            && dropped[1].contains("BRDF Explorer comment"),
+        "{}",
+        dropped[1]
+    );
 }
 
 /// An engine-style quality switch, in the style of Filament's `surface_brdf.fs` (written for this test): the
@@ -147,7 +199,11 @@ fn the_preprocessor_selects_the_branch_the_defines_select() {
     assert_eq!(line(&f, 12), "");
     assert!(line(&f, 14).replace(' ', "").contains("return1.0-u"), "{}", line(&f, 14));
     let high = f.with_defines(&[("QUALITY".into(), "1".into())]).unwrap();
-    assert!(line(&high, 12).replace(' ', "").contains("pow(1.0-u,5.0)*1.0"), "the high branch with F90 expanded: {}", line(&high, 12));
+    assert!(
+        line(&high, 12).replace(' ', "").contains("pow(1.0-u,5.0)*1.0"),
+        "the high branch with F90 expanded: {}",
+        line(&high, 12)
+    );
     assert_eq!(line(&high, 14), "");
     assert!(high.renamed_shader().text().contains("brdf_f_f5"), "the selected branch's function is renamed");
     assert_eq!(high.renamed_shader().renamed.iter().filter(|n| *n == "f5").count(), 1);
@@ -208,7 +264,10 @@ fn renames_globals_and_parameters_everywhere_but_members() {
     let f = ok(DIALECT);
     let r = f.renamed_shader();
     assert_eq!(r.prefix, "brdf_f_");
-    assert_eq!(r.renamed, ["m", "n", "useF", "tint", "PI", "sqr", "Lobe", "reflect", "spike", "lobe", "clamp01", "BRDF"]);
+    assert_eq!(
+        r.renamed,
+        ["m", "n", "useF", "tint", "PI", "sqr", "Lobe", "reflect", "spike", "lobe", "clamp01", "BRDF"]
+    );
     let text = r.text();
     for expected in [
         "const float brdf_f_PI = 3.14159265358979;",
@@ -228,7 +287,10 @@ fn renames_globals_and_parameters_everywhere_but_members() {
     assert_eq!(r.lines.len(), f.shader.len());
     assert_eq!(r.lines[1], (12, String::new()), "the `#` comment line is dropped");
     assert_eq!(f.glsl_name("BRDF"), "brdf_f_BRDF");
-    assert_eq!(r.original_names("'brdf_f_sqr' : no matching overloaded function found for brdf_f_Lobe, brdf_f_x"), "'sqr' : no matching overloaded function found for Lobe, brdf_f_x");
+    assert_eq!(
+        r.original_names("'brdf_f_sqr' : no matching overloaded function found for brdf_f_Lobe, brdf_f_x"),
+        "'sqr' : no matching overloaded function found for Lobe, brdf_f_x"
+    );
 }
 
 #[test]
@@ -239,7 +301,11 @@ fn prefix_avoids_names_the_file_uses_and_double_underscores() {
     let f = ok(&file("bool _x 0\n", "vec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) { return _x ? L : V; }\n"));
     let r = f.renamed_shader();
     assert_eq!(r.prefix, "brdf_f");
-    assert!(r.text().contains("vec3 brdf_fBRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) { return brdf_f_x ? L : V; }"), "{}", r.text());
+    assert!(
+        r.text().contains("vec3 brdf_fBRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) { return brdf_f_x ? L : V; }"),
+        "{}",
+        r.text()
+    );
 }
 
 #[test]
@@ -260,8 +326,21 @@ fn global_declarations() {
     let tokens = tokenize(Path::new(PATH), &lines).unwrap();
     let scan = scan_globals(Path::new(PATH), &lines, &tokens).unwrap();
     let names: Vec<(&str, usize)> = scan.globals.iter().map(|g| (g.name.as_str(), g.line)).collect();
-    assert_eq!(names, [("A", 1), ("B", 1), ("C", 1), ("g", 2), ("h", 3), ("S", 4), ("s1", 4), ("s2", 4), ("W", 5), ("j", 7)]);
-    assert_eq!(scan.globals[3].kind, GlobalKind::Function { defined: false, returns: "vec3".into(), params: vec![vec!["vec3".into(), "a".into()], vec!["float".into(), "b".into(), "[".into(), "2".into(), "]".into()]] });
+    assert_eq!(
+        names,
+        [("A", 1), ("B", 1), ("C", 1), ("g", 2), ("h", 3), ("S", 4), ("s1", 4), ("s2", 4), ("W", 5), ("j", 7)]
+    );
+    assert_eq!(
+        scan.globals[3].kind,
+        GlobalKind::Function {
+            defined: false,
+            returns: "vec3".into(),
+            params: vec![
+                vec!["vec3".into(), "a".into()],
+                vec!["float".into(), "b".into(), "[".into(), "2".into(), "]".into()]
+            ]
+        }
+    );
     assert_eq!(scan.globals[4].kind, GlobalKind::Function { defined: true, returns: "float".into(), params: vec![] });
 }
 
@@ -270,7 +349,9 @@ fn compile(source: &str) -> std::result::Result<(), String> {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("composed.comp");
     std::fs::write(&path, source).unwrap();
-    glslang(&path, &[], &[], "a test kernel").map(|_| ()).map_err(|e| e.downcast_ref::<GlslangError>().map_or_else(|| format!("{e:#}"), |g| g.log.clone()))
+    glslang(&path, &[], &[], "a test kernel")
+        .map(|_| ())
+        .map_err(|e| e.downcast_ref::<GlslangError>().map_or_else(|| format!("{e:#}"), |g| g.log.clone()))
 }
 
 /// A tiny compute kernel around the file: its parameters as constants at their defaults, the renamed shader
@@ -328,7 +409,10 @@ vec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) { return vec3(a(1.0) + b(1.0, 
 fn glslang_refuses_a_built_in_redefined_without_the_rename() {
     let shader = "vec3 reflect(vec3 I, vec3 N) { return 2*dot(I,N)*N - I; }\nvec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) { return reflect(L, N); }\n";
     let f = ok(&file("", shader));
-    let raw = format!("#version 450\nlayout(local_size_x = 1) in;\n{}void main() {{ }}\n", f.shader.iter().map(|(_, l)| format!("{l}\n")).collect::<String>());
+    let raw = format!(
+        "#version 450\nlayout(local_size_x = 1) in;\n{}void main() {{ }}\n",
+        f.shader.iter().map(|(_, l)| format!("{l}\n")).collect::<String>()
+    );
     let log = compile(&raw).expect_err("glslang accepts a redefined reflect");
     assert!(log.contains("overloaded functions must have the same parameter precision qualifiers"), "{log}");
     compile(&compose(&f, false).0).unwrap();
@@ -352,7 +436,10 @@ fn remap_log_names_the_file_line() {
     assert_eq!(f.remap_log(&r, &log, line_of), "dir/t.brdf:11: 'sqr' : no matching overloaded function found\n");
     // Messages about other sources are kept; warnings say so; counts and the rest are dropped.
     let log = "composed.comp\nWARNING: dir/t.brdf:8: 'brdf_f_k' : something odd \nERROR: composed.comp:30: 'x' : undeclared identifier \nERROR: C:\\a b\\c:1.comp:3: '' : compilation terminated \nERROR: 2 compilation errors.  No code generated.\n\nERROR: Linking compute stage: Missing entry point: Each stage requires one entry point\n";
-    assert_eq!(f.remap_log(&r, log, |_| None), "dir/t.brdf:8: warning: 'k' : something odd\nERROR: composed.comp:30: 'x' : undeclared identifier\n");
+    assert_eq!(
+        f.remap_log(&r, log, |_| None),
+        "dir/t.brdf:8: warning: 'k' : something odd\nERROR: composed.comp:30: 'x' : undeclared identifier\n"
+    );
     assert_eq!(split_location("C:\\a b\\c:1.comp:3: msg"), Some(("C:\\a b\\c:1.comp", 3, "msg")));
 }
 
@@ -364,7 +451,14 @@ fn example_files_parse_and_compile() {
         let f = load(&dir.join(format!("{name}.brdf"))).unwrap();
         assert_eq!((f.name.as_str(), f.params.len()), (name, params));
         assert!(f.warnings.is_empty(), "{:?}", f.warnings);
-        assert_eq!(f.params[0], FileParam { name: "roughness".into(), kind: FileParamKind::Float { min: 0.0, max: 1.0, default: 0.5 }, line: f.params[0].line });
+        assert_eq!(
+            f.params[0],
+            FileParam {
+                name: "roughness".into(),
+                kind: FileParamKind::Float { min: 0.0, max: 1.0, default: 0.5 },
+                line: f.params[0].line
+            }
+        );
         assert_eq!(f.params[1].kind, FileParamKind::Color { default: [0.04; 3] });
         let r = f.renamed_shader();
         for host in ["PI", "pow5", "safe_normalize", "guard_cosine", "MIN_COSINE", "F_Schlick"] {
@@ -381,7 +475,8 @@ fn cr_only_line_ends_parse_as_lines() {
     let f = ok(&text);
     assert_eq!((f.params.len(), f.params[0].line), (1, 3));
     assert!(f.shader.iter().any(|(n, l)| *n == 6 && l.starts_with("vec3 BRDF")), "{:?}", f.shader);
-    let mixed = "analytic\r\n::begin shader\r\rvec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) { return L; }\n::end shader\n";
+    let mixed =
+        "analytic\r\n::begin shader\r\rvec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) { return L; }\n::end shader\n";
     assert_eq!(ok(mixed).shader.iter().find(|(_, l)| !l.is_empty()).unwrap().0, 4);
 }
 
@@ -419,7 +514,16 @@ vec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) { return vec3(f(1.0)); }
     let got: Vec<(usize, &str, Option<u64>)> = f.loops.iter().map(|l| (l.line, l.keyword, l.trip_count)).collect();
     assert_eq!(
         got,
-        [(7, "for", Some(100000)), (8, "for", Some(4)), (9, "for", Some(5)), (10, "for", None), (11, "for", None), (12, "for", None), (13, "while", None), (14, "do", None)]
+        [
+            (7, "for", Some(100000)),
+            (8, "for", Some(4)),
+            (9, "for", Some(5)),
+            (10, "for", None),
+            (11, "for", None),
+            (12, "for", None),
+            (13, "while", None),
+            (14, "do", None)
+        ]
     );
     assert!(ok(&file("", BRDF)).loops.is_empty());
     assert_eq!(iterations(5.0, "<", 5.0, 1.0), Some(0));
@@ -452,28 +556,54 @@ fn renaming_is_linear_in_the_number_of_functions() {
     let (small, _) = of(10_000);
     let (large, f) = of(40_000);
     assert!(f.renamed_shader().text().contains("float brdf_f_f39999(float x)"));
-    assert!(large / small < 11.0, "10,000 functions: {small:.3} s, 40,000: {large:.3} s (linear: about 4x; quadratic: 16x)");
+    assert!(
+        large / small < 11.0,
+        "10,000 functions: {small:.3} s, 40,000: {large:.3} s (linear: about 4x; quadratic: 16x)"
+    );
 }
 
 #[test]
 fn wgsl_tokens_nest_their_comments_and_wgsl_loop_headers_are_counted() {
     let lines = |t: &str| t.lines().enumerate().map(|(i, l)| (i + 1, l.to_string())).collect::<Vec<_>>();
-    let text = lines("/* a /* b */ for (;;) {} */ x\nfn f() -> f32 {\n  for (var i: i32 = 0; i < 100000; i++) {}\n  loop { break; }\n  while (true) {}\n  for (var j = 0x1Fu; j > 0u; j--) {}\n  return 0x1.8p-1f;\n}\n");
+    let text = lines(
+        "/* a /* b */ for (;;) {} */ x\nfn f() -> f32 {\n  for (var i: i32 = 0; i < 100000; i++) {}\n  loop { break; }\n  while (true) {}\n  for (var j = 0x1Fu; j > 0u; j--) {}\n  return 0x1.8p-1f;\n}\n",
+    );
     let tokens = tokenize_wgsl(Path::new("m.wgsl"), &text).unwrap();
     assert_eq!(tokens[0].text, "x");
     assert!(tokens.iter().any(|t| t.text == "0x1.8p-1f"), "a hex float with a signed exponent is one number");
-    let got: Vec<(usize, &str, Option<u64>, Option<String>)> = wgsl_loops(&text, &tokens).into_iter().map(|(l, f)| (l.line, l.keyword, l.trip_count, f)).collect();
+    let got: Vec<(usize, &str, Option<u64>, Option<String>)> =
+        wgsl_loops(&text, &tokens).into_iter().map(|(l, f)| (l.line, l.keyword, l.trip_count, f)).collect();
     let f = Some("f".to_string());
-    assert_eq!(got, [(3, "for", Some(100000), f.clone()), (4, "loop", None, f.clone()), (5, "while", None, f.clone()), (6, "for", Some(31), f)]);
+    assert_eq!(
+        got,
+        [
+            (3, "for", Some(100000), f.clone()),
+            (4, "loop", None, f.clone()),
+            (5, "while", None, f.clone()),
+            (6, "for", Some(31), f)
+        ]
+    );
     // GLSL's block comments do not nest: `*/` ends the first.
-    assert_eq!(tokenize(Path::new("m.glsl"), &lines("/* a /* b */ c */")).unwrap().iter().map(|t| t.text.as_str()).collect::<String>(), "c*/");
+    assert_eq!(
+        tokenize(Path::new("m.glsl"), &lines("/* a /* b */ c */"))
+            .unwrap()
+            .iter()
+            .map(|t| t.text.as_str())
+            .collect::<String>(),
+        "c*/"
+    );
 }
 
 #[test]
 fn global_initialisers_know_the_parameters_they_read_through_globals_and_functions() {
     let shader = "float a = k * 2.0, b[2] = float[2](a, 1.0);\nconst float c = 3.0;\nfloat d = c * 2.0;\nfloat twice(float x) { return x * r; }\nstruct S { float k; };\nfloat e = twice(d);\nfloat g;\nfloat h = g + 1.0;\n";
     let f = ok(&file("float k 0 1 0.5\nfloat r 0 1 0.5\n", &format!("{shader}{BRDF}")));
-    let got: Vec<(&str, Vec<&str>, &str)> = f.renamed_shader().initialisers.iter().map(|i| (i.name.as_str(), i.reads.iter().map(String::as_str).collect(), i.assignment.as_str())).collect();
+    let got: Vec<(&str, Vec<&str>, &str)> = f
+        .renamed_shader()
+        .initialisers
+        .iter()
+        .map(|i| (i.name.as_str(), i.reads.iter().map(String::as_str).collect(), i.assignment.as_str()))
+        .collect();
     assert_eq!(
         got,
         [

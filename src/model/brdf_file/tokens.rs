@@ -1,7 +1,7 @@
 //! GLSL tokens of the shader, each with its line and columns.
 
 use super::*;
-use anyhow::{bail, Result};
+use anyhow::{Result, bail};
 use std::path::Path;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -116,7 +116,8 @@ pub(super) fn number_end(b: &[u8], mut i: usize) -> usize {
 
 /// Identifier-like runs of `text` (comments included): what the prefix must not start.
 pub(super) fn identifier_runs(text: &str) -> impl Iterator<Item = &str> {
-    text.split(|c: char| !(c == '_' || c.is_ascii_alphanumeric())).filter(|s| s.chars().next().is_some_and(|c| !c.is_ascii_digit()))
+    text.split(|c: char| !(c == '_' || c.is_ascii_alphanumeric()))
+        .filter(|s| s.chars().next().is_some_and(|c| !c.is_ascii_digit()))
 }
 
 /// Index of the token closing the bracket opened at `open` (or the end, when it is never closed).

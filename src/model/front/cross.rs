@@ -6,7 +6,7 @@
 //! of `main`) becomes a global initialiser again, as GLSL allows.
 
 use super::STUB;
-use anyhow::{anyhow, bail, Context, Result};
+use anyhow::{Context, Result, anyhow, bail};
 use std::path::Path;
 use std::sync::OnceLock;
 
@@ -17,13 +17,16 @@ pub const FLAGS: [&str; 4] = ["--version", "450", "--vulkan-semantics", "--force
 pub fn to_glsl(words: &[u32], model: &Path) -> Result<String> {
     let dir = crate::cleanup::TempDir::new().context("cannot create a temporary directory for spirv-cross")?;
     let path = dir.path().join("shader.spv");
-    std::fs::write(&path, words.iter().flat_map(|w| w.to_le_bytes()).collect::<Vec<u8>>()).with_context(|| format!("cannot write {}", path.display()))?;
+    std::fs::write(&path, words.iter().flat_map(|w| w.to_le_bytes()).collect::<Vec<u8>>())
+        .with_context(|| format!("cannot write {}", path.display()))?;
     let mut cmd = crate::cleanup::command("spirv-cross");
     cmd.arg(&path).args(FLAGS);
     let what = format!("{} (spirv-cross)", model.display());
     let out = match crate::launch::output(&mut cmd, &what) {
         Ok(o) => o,
-        Err(e) if e.downcast_ref::<std::io::Error>().is_some() => bail!("cannot run spirv-cross ({e}): install spirv-cross, or run `make setup`"),
+        Err(e) if e.downcast_ref::<std::io::Error>().is_some() => {
+            bail!("cannot run spirv-cross ({e}): install spirv-cross, or run `make setup`")
+        }
         Err(e) => return Err(e),
     };
     if !out.status.success() {
@@ -68,8 +71,13 @@ impl Resource {
     /// The message without the model's name (for a caller that locates the resource in the source).
     pub fn message(&self) -> String {
         match self.members.first().filter(|_| self.name == HLSL_GLOBALS) {
-            Some(m) => format!("`{m}` is a global without `static`, which HLSL makes a uniform of its implicit constant buffer $Global (a resource): a model is a function of its inputs and parameters; declare it `static` (a private global of the shader) or make it a parameter of the file"),
-            None => format!("the shader uses the resource `{}` (a constant buffer, structured buffer or texture): a model is a function of its inputs and parameters; declare each value it reads as a parameter", self.name),
+            Some(m) => format!(
+                "`{m}` is a global without `static`, which HLSL makes a uniform of its implicit constant buffer $Global (a resource): a model is a function of its inputs and parameters; declare it `static` (a private global of the shader) or make it a parameter of the file"
+            ),
+            None => format!(
+                "the shader uses the resource `{}` (a constant buffer, structured buffer or texture): a model is a function of its inputs and parameters; declare each value it reads as a parameter",
+                self.name
+            ),
         }
     }
 
@@ -99,7 +107,12 @@ fn block_members(lines: &[&str]) -> Vec<String> {
     if lines.get(1) != Some(&"{") {
         return Vec::new();
     }
-    lines[2..].iter().take_while(|l| !l.starts_with('}')).map(|l| declared_name(l).to_string()).filter(|n| !n.is_empty()).collect()
+    lines[2..]
+        .iter()
+        .take_while(|l| !l.starts_with('}'))
+        .map(|l| declared_name(l).to_string())
+        .filter(|n| !n.is_empty())
+        .collect()
 }
 
 /// What `view` collects: the kept lines, the globals the stub's prologue initialises, and where the first
@@ -129,7 +142,11 @@ pub fn view(glsl: &str, params: &[&str], model: &Path) -> Result<Vec<String>> {
         if l.starts_with("#version") || l.starts_with("layout(local_size") {
             i += 1;
         } else if l.starts_with("layout(") || l.starts_with("uniform ") || l.starts_with("buffer ") {
-            bail!(Resource { name: resource_name(l).to_string(), members: block_members(&lines[i..]), model: model.display().to_string() });
+            bail!(Resource {
+                name: resource_name(l).to_string(),
+                members: block_members(&lines[i..]),
+                model: model.display().to_string()
+            });
         } else if l.starts_with("struct ") {
             let end = block_end(&lines, i, "};");
             v.lines.extend(lines[i..end].iter().map(|s| s.to_string()));
@@ -172,15 +189,23 @@ fn function(v: &mut View, f: &[&str], model: &Path) -> Result<()> {
 /// `main` is the stub itself and has none): `NAME = EXPR;` joins NAME's declaration, `TYPE T = EXPR;` (a
 /// temporary) becomes a global; anything else is refused.
 fn prologue(v: &mut View, body: &[&str], model: &Path) -> Result<()> {
-    let Some(call) = body.iter().position(|s| s.trim().trim_start_matches('_').starts_with(&format!("{STUB}("))) else { return Ok(()) };
+    let Some(call) = body.iter().position(|s| s.trim().trim_start_matches('_').starts_with(&format!("{STUB}("))) else {
+        return Ok(());
+    };
     for s in body[..call].iter().map(|s| s.trim()) {
         let (lhs, rhs) = s.split_once(" = ").ok_or_else(|| anyhow!("{}: spirv-cross's translation sets a global with `{s}`, which brdfprof cannot make an initialiser; initialise the global with a constant expression", model.display()))?;
         if lhs.contains(' ') {
             v.initialised.push(s.to_string());
             continue;
         }
-        let decl = v.lines.iter().position(|l| plain_declaration(l).is_some_and(|(_, n)| n == lhs) && !l.contains(" = "));
-        let Some(decl) = decl else { bail!("{}: spirv-cross's translation sets `{lhs}` (`{s}`), which it does not declare as a global", model.display()) };
+        let decl =
+            v.lines.iter().position(|l| plain_declaration(l).is_some_and(|(_, n)| n == lhs) && !l.contains(" = "));
+        let Some(decl) = decl else {
+            bail!(
+                "{}: spirv-cross's translation sets `{lhs}` (`{s}`), which it does not declare as a global",
+                model.display()
+            )
+        };
         let line = v.lines.remove(decl);
         let ty = line.rsplit_once(' ').map_or("", |(t, _)| t).to_string();
         if let Some(f) = v.first_function.as_mut().filter(|f| **f > decl) {
@@ -196,9 +221,20 @@ fn prologue(v: &mut View, body: &[&str], model: &Path) -> Result<()> {
 pub fn describe() -> String {
     static V: OnceLock<String> = OnceLock::new();
     V.get_or_init(|| {
-        let revision = crate::shaders::first_line_of(crate::cleanup::command("spirv-cross").arg("--revision")).unwrap_or_default();
-        let package = || crate::shaders::first_line_of(crate::cleanup::command("dpkg-query").args(["-W", "-f=${Version}", "spirv-cross"]));
-        let version = if revision.chars().any(|c| c.is_ascii_digit()) { revision } else { package().map_or(revision, |p| format!("{p} (Debian)")) };
+        let revision =
+            crate::shaders::first_line_of(crate::cleanup::command("spirv-cross").arg("--revision")).unwrap_or_default();
+        let package = || {
+            crate::shaders::first_line_of(crate::cleanup::command("dpkg-query").args([
+                "-W",
+                "-f=${Version}",
+                "spirv-cross",
+            ]))
+        };
+        let version = if revision.chars().any(|c| c.is_ascii_digit()) {
+            revision
+        } else {
+            package().map_or(revision, |p| format!("{p} (Debian)"))
+        };
         format!("SPIR-V to GLSL by spirv-cross {} ({})", version.trim(), FLAGS.join(" "))
     })
     .clone()
@@ -214,17 +250,25 @@ mod tests {
     fn the_view_keeps_the_shader_and_moves_run_time_initialisers() {
         let v = view(GLSL, &["roughness"], Path::new("m.hlsl")).unwrap();
         let text = v.join("\n");
-        assert_eq!(text, "\nstruct S\n{\n    float a;\n};\n\nconst float K[2] = float[](1.0, 2.0);\n\nvec3 _12 = normalize(vec3(1.0));\nvec3 LUMA = _12 * 2.0;\nvec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y)\n{\n    return L * roughness * LUMA;\n}\n\n");
+        assert_eq!(
+            text,
+            "\nstruct S\n{\n    float a;\n};\n\nconst float K[2] = float[](1.0, 2.0);\n\nvec3 _12 = normalize(vec3(1.0));\nvec3 LUMA = _12 * 2.0;\nvec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y)\n{\n    return L * roughness * LUMA;\n}\n\n"
+        );
         let bad = GLSL.replace("    LUMA = _12 * 2.0;\n", "    LUMA.x = 1.0;\n");
         assert!(format!("{:#}", view(&bad, &[], Path::new("m.hlsl")).unwrap_err()).contains("`LUMA.x = 1.0;`"));
-        let resource = GLSL.replace("vec3 LUMA;\n", "layout(set = 0, binding = 0, std140) uniform Mat\n{\n    float k;\n} mat;\n");
+        let resource =
+            GLSL.replace("vec3 LUMA;\n", "layout(set = 0, binding = 0, std140) uniform Mat\n{\n    float k;\n} mat;\n");
         let r = view(&resource, &[], Path::new("m.hlsl")).unwrap_err().downcast::<Resource>().unwrap();
         assert_eq!((r.name.as_str(), r.members.as_slice(), r.declared()), ("Mat", ["k".to_string()].as_slice(), "Mat"));
-        let globals = GLSL.replace("vec3 LUMA;\n", "layout(set = 0, binding = 0, std140) uniform _Global\n{\n    float Gloss;\n    vec3 Tint;\n} _31;\n");
+        let globals = GLSL.replace(
+            "vec3 LUMA;\n",
+            "layout(set = 0, binding = 0, std140) uniform _Global\n{\n    float Gloss;\n    vec3 Tint;\n} _31;\n",
+        );
         let r = view(&globals, &[], Path::new("m.hlsl")).unwrap_err().downcast::<Resource>().unwrap();
         assert_eq!(r.declared(), "Gloss");
         assert!(r.message().starts_with("`Gloss` is a global without `static`"), "{}", r.message());
-        let relaxed = GLSL.replace("float roughness;", "mediump float roughness;").replace("vec3 LUMA;", "mediump vec3 LUMA;");
+        let relaxed =
+            GLSL.replace("float roughness;", "mediump float roughness;").replace("vec3 LUMA;", "mediump vec3 LUMA;");
         let v = view(&relaxed, &["roughness"], Path::new("m.hlsl")).unwrap().join("\n");
         assert!(!v.contains("roughness;") && v.contains("mediump vec3 LUMA = _12 * 2.0;"), "{v}");
         assert_eq!(plain_declaration("mediump float _length;"), Some(("float", "_length")));

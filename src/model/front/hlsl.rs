@@ -7,7 +7,7 @@
 
 use super::includes::Expanded;
 use super::{Glue, GlueArg, STUB};
-use anyhow::{bail, Context, Result};
+use anyhow::{Context, Result, bail};
 use std::collections::HashMap;
 use std::path::Path;
 
@@ -28,23 +28,135 @@ pub fn param_decl(name: &str, glsl_type: &str) -> String {
 /// set, glslang/HLSL/hlslScanContext.cpp), besides the numeric vector and matrix types (`is_keyword`): no
 /// variable can take one of these names.
 const KEYWORDS: &[&str] = &[
-    "static", "const", "unorm", "snorm", "extern", "uniform", "volatile", "precise", "shared", "groupshared", "linear", "centroid",
-    "nointerpolation", "noperspective", "sample", "row_major", "column_major", "packoffset", "in", "out", "inout", "layout",
-    "globallycoherent", "inline", "point", "line", "triangle", "lineadj", "triangleadj", "PointStream", "LineStream", "TriangleStream",
-    "InputPatch", "OutputPatch", "Buffer", "vector", "matrix", "void", "string", "uint64_t", "dword", "sampler", "sampler1D",
-    "sampler2D", "sampler3D", "samplerCUBE", "sampler_state", "SamplerState", "SamplerComparisonState", "texture", "Texture1D",
-    "Texture1DArray", "Texture2D", "Texture2DArray", "Texture3D", "TextureCube", "TextureCubeArray", "Texture2DMS", "Texture2DMSArray",
-    "RWTexture1D", "RWTexture1DArray", "RWTexture2D", "RWTexture2DArray", "RWTexture3D", "RWBuffer", "SubpassInput", "SubpassInputMS",
-    "AppendStructuredBuffer", "ByteAddressBuffer", "ConsumeStructuredBuffer", "RWByteAddressBuffer", "RWStructuredBuffer",
-    "StructuredBuffer", "TextureBuffer", "class", "struct", "cbuffer", "ConstantBuffer", "tbuffer", "typedef", "this", "namespace",
-    "true", "false", "for", "do", "while", "break", "continue", "if", "else", "discard", "return", "switch", "case", "default",
-    "auto", "catch", "char", "const_cast", "enum", "explicit", "friend", "goto", "long", "mutable", "new", "operator", "private",
-    "protected", "public", "reinterpret_cast", "short", "signed", "sizeof", "static_cast", "template", "throw", "try", "typename",
-    "union", "unsigned", "using", "virtual",
+    "static",
+    "const",
+    "unorm",
+    "snorm",
+    "extern",
+    "uniform",
+    "volatile",
+    "precise",
+    "shared",
+    "groupshared",
+    "linear",
+    "centroid",
+    "nointerpolation",
+    "noperspective",
+    "sample",
+    "row_major",
+    "column_major",
+    "packoffset",
+    "in",
+    "out",
+    "inout",
+    "layout",
+    "globallycoherent",
+    "inline",
+    "point",
+    "line",
+    "triangle",
+    "lineadj",
+    "triangleadj",
+    "PointStream",
+    "LineStream",
+    "TriangleStream",
+    "InputPatch",
+    "OutputPatch",
+    "Buffer",
+    "vector",
+    "matrix",
+    "void",
+    "string",
+    "uint64_t",
+    "dword",
+    "sampler",
+    "sampler1D",
+    "sampler2D",
+    "sampler3D",
+    "samplerCUBE",
+    "sampler_state",
+    "SamplerState",
+    "SamplerComparisonState",
+    "texture",
+    "Texture1D",
+    "Texture1DArray",
+    "Texture2D",
+    "Texture2DArray",
+    "Texture3D",
+    "TextureCube",
+    "TextureCubeArray",
+    "Texture2DMS",
+    "Texture2DMSArray",
+    "RWTexture1D",
+    "RWTexture1DArray",
+    "RWTexture2D",
+    "RWTexture2DArray",
+    "RWTexture3D",
+    "RWBuffer",
+    "SubpassInput",
+    "SubpassInputMS",
+    "AppendStructuredBuffer",
+    "ByteAddressBuffer",
+    "ConsumeStructuredBuffer",
+    "RWByteAddressBuffer",
+    "RWStructuredBuffer",
+    "StructuredBuffer",
+    "TextureBuffer",
+    "class",
+    "struct",
+    "cbuffer",
+    "ConstantBuffer",
+    "tbuffer",
+    "typedef",
+    "this",
+    "namespace",
+    "true",
+    "false",
+    "for",
+    "do",
+    "while",
+    "break",
+    "continue",
+    "if",
+    "else",
+    "discard",
+    "return",
+    "switch",
+    "case",
+    "default",
+    "auto",
+    "catch",
+    "char",
+    "const_cast",
+    "enum",
+    "explicit",
+    "friend",
+    "goto",
+    "long",
+    "mutable",
+    "new",
+    "operator",
+    "private",
+    "protected",
+    "public",
+    "reinterpret_cast",
+    "short",
+    "signed",
+    "sizeof",
+    "static_cast",
+    "template",
+    "throw",
+    "try",
+    "typename",
+    "union",
+    "unsigned",
+    "using",
+    "virtual",
 ];
 
 /// The scalar types whose vectors (`float3`) and matrices (`half2x4`) are keywords too.
-const NUMERIC: [&str; 11] = ["bool", "int", "uint", "half", "float", "double", "min16float", "min10float", "min16int", "min12int", "min16uint"];
+const NUMERIC: [&str; 11] =
+    ["bool", "int", "uint", "half", "float", "double", "min16float", "min10float", "min16int", "min12int", "min16uint"];
 
 /// Whether glslang's HLSL front end reads `name` as a keyword (or reserves it): `texture`, `sample`, `float3`.
 pub fn is_keyword(name: &str) -> bool {
@@ -55,7 +167,8 @@ pub fn is_keyword(name: &str) -> bool {
 /// Whether `(T)0` makes a zero of HLSL type `ty` (a scalar, vector or matrix of a numeric type).
 fn is_numeric(ty: &str) -> bool {
     let base = ty.trim_end_matches(|c: char| c.is_ascii_digit() || c == 'x');
-    ["float", "half", "double", "int", "uint", "bool", "min16float", "min10float", "min16int", "min12int", "min16uint"].contains(&base)
+    ["float", "half", "double", "int", "uint", "bool", "min16float", "min10float", "min16int", "min12int", "min16uint"]
+        .contains(&base)
 }
 
 /// A glue function, on one line: `float3 NAME(float3 L, ...) { return CALLEE(ARGS); }`, with a local for each
@@ -98,7 +211,12 @@ fn define_flags(defines: &[(String, String)]) -> Vec<String> {
 
 /// Runs glslangValidator on `x`'s text written to a temporary `shader.hlsl`, with `args` then the defines:
 /// Ok(Ok(stdout, the output file's bytes)) or Ok(Err(its log)) when it refuses the shader.
-fn run(x: &Expanded, defines: &[(String, String)], args: &[&str], what: &str) -> Result<std::result::Result<(String, Option<Vec<u8>>), String>> {
+fn run(
+    x: &Expanded,
+    defines: &[(String, String)],
+    args: &[&str],
+    what: &str,
+) -> Result<std::result::Result<(String, Option<Vec<u8>>), String>> {
     let dir = crate::cleanup::TempDir::new().context("cannot create a temporary directory for glslang")?;
     let source = dir.path().join("shader.hlsl");
     std::fs::write(&source, x.text()).with_context(|| format!("cannot write {}", source.display()))?;
@@ -110,26 +228,40 @@ fn run(x: &Expanded, defines: &[(String, String)], args: &[&str], what: &str) ->
     }
     let result = match crate::launch::output(&mut cmd, what) {
         Ok(r) => r,
-        Err(e) if e.downcast_ref::<std::io::Error>().is_some() => bail!("cannot run glslangValidator ({e}): install glslang-tools, or run `make setup`"),
+        Err(e) if e.downcast_ref::<std::io::Error>().is_some() => {
+            bail!("cannot run glslangValidator ({e}): install glslang-tools, or run `make setup`")
+        }
         Err(e) => return Err(e),
     };
     let stdout = String::from_utf8_lossy(&result.stdout).into_owned();
     if !result.status.success() {
         return Ok(Err(stdout + &String::from_utf8_lossy(&result.stderr)));
     }
-    let spirv = if args.contains(&"-V") { Some(crate::io::read_bounded(&out, crate::launch::MAX_OUTPUT_BYTES as u64).context("glslang's SPIR-V")?) } else { None };
+    let spirv = if args.contains(&"-V") {
+        Some(crate::io::read_bounded(&out, crate::launch::MAX_OUTPUT_BYTES as u64).context("glslang's SPIR-V")?)
+    } else {
+        None
+    };
     Ok(Ok((stdout, spirv)))
 }
 
 /// glslang's preprocessor (`-E`) on the expanded text under `defines`: Ok(the preprocessed text, line for line
 /// with `x` but for its `#line` directives) or Err(the messages at the user's files' lines).
-pub fn preprocess(x: &Expanded, defines: &[(String, String)], model: &Path) -> Result<std::result::Result<String, String>> {
+pub fn preprocess(
+    x: &Expanded,
+    defines: &[(String, String)],
+    model: &Path,
+) -> Result<std::result::Result<String, String>> {
     let what = format!("{} (glslang's HLSL preprocessor)", model.display());
     Ok(run(x, defines, &["-D", "-E", "-S", "comp"], &what)?.map(|(out, _)| out).map_err(|log| messages(&log, x)))
 }
 
 /// The shader compiled to SPIR-V (`FLAGS`, the stub as entry), or Err(the messages at the user's files' lines).
-pub fn compile(x: &Expanded, defines: &[(String, String)], model: &Path) -> Result<std::result::Result<Vec<u32>, String>> {
+pub fn compile(
+    x: &Expanded,
+    defines: &[(String, String)],
+    model: &Path,
+) -> Result<std::result::Result<Vec<u32>, String>> {
     let what = format!("{} (glslang's HLSL front end)", model.display());
     Ok(match run(x, defines, &FLAGS, &what)? {
         Ok((_, Some(bytes))) => {
@@ -170,10 +302,13 @@ pub fn c_remainders(words: &mut [u32]) -> usize {
 /// `SOURCE:LINE: message` -> (LINE, message), at the first `:digits: `.
 fn located(rest: &str) -> Option<(usize, &str)> {
     let b = rest.as_bytes();
-    rest.match_indices(':').find_map(|(i, _)| {
-        let digits = b[i + 1..].iter().take_while(|c| c.is_ascii_digit()).count();
-        (digits > 0 && b.get(i + 1 + digits) == Some(&b':')).then(|| (rest[i + 1..i + 1 + digits].parse().ok(), rest[i + 2 + digits..].trim()))
-    }).and_then(|(n, m)| Some((n?, m)))
+    rest.match_indices(':')
+        .find_map(|(i, _)| {
+            let digits = b[i + 1..].iter().take_while(|c| c.is_ascii_digit()).count();
+            (digits > 0 && b.get(i + 1 + digits) == Some(&b':'))
+                .then(|| (rest[i + 1..i + 1 + digits].parse().ok(), rest[i + 2 + digits..].trim()))
+        })
+        .and_then(|(n, m)| Some((n?, m)))
 }
 
 /// glslang's `FILE(LINE): error at column C, HLSL parsing failed.` lines: LINE -> C.
@@ -195,7 +330,9 @@ fn parse_columns(log: &str) -> HashMap<usize, usize> {
 pub fn token_column(line: &str, message: &str) -> Option<usize> {
     let quoted = message.strip_prefix('\'').and_then(|m| m.split('\'').next()).filter(|t| !t.is_empty())?;
     let ident = |c: char| c.is_ascii_alphanumeric() || c == '_';
-    let whole = |i: usize| !(quoted.starts_with(ident) && (line[..i].ends_with(ident) || line[i + quoted.len()..].starts_with(ident)));
+    let whole = |i: usize| {
+        !(quoted.starts_with(ident) && (line[..i].ends_with(ident) || line[i + quoted.len()..].starts_with(ident)))
+    };
     let i = line.match_indices(quoted).map(|(i, _)| i).find(|&i| whole(i))?;
     Some(line[..i].chars().count() + 1)
 }
@@ -244,8 +381,12 @@ pub fn messages(log: &str, x: &Expanded) -> String {
 
 /// The front end, with glslang's version, as reports state it.
 pub fn describe() -> String {
-    let v = crate::shaders::glslang_version().map_or_else(|| "(version unknown)".into(), |v| v.trim_start_matches("Glslang Version:").trim().to_string());
-    format!("glslang {v}'s HLSL front end (glslangValidator {}; `half` is 32-bit float, as DXC without -enable-16bit-types)", FLAGS.join(" "))
+    let v = crate::shaders::glslang_version()
+        .map_or_else(|| "(version unknown)".into(), |v| v.trim_start_matches("Glslang Version:").trim().to_string());
+    format!(
+        "glslang {v}'s HLSL front end (glslangValidator {}; `half` is 32-bit float, as DXC without -enable-16bit-types)",
+        FLAGS.join(" ")
+    )
 }
 
 #[cfg(test)]
@@ -254,9 +395,19 @@ mod tests {
 
     #[test]
     fn glue_and_stub_text() {
-        let g = Glue { name: "brdfprof_entry0".into(), callee: "Light".into(), args: vec![GlueArg::Expr("N".into()), GlueArg::Scratch("Surface".into()), GlueArg::Out("float3".into())] };
-        assert_eq!(glue(&g), "float3 brdfprof_entry0(float3 L, float3 V, float3 N, float3 X, float3 Y) { Surface brdfprof_arg1; float3 brdfprof_arg2 = (float3)0; Light(N, brdfprof_arg1, brdfprof_arg2); return brdfprof_arg2; }");
-        assert_eq!(stub(&["BRDF".into()]), "[numthreads(1, 1, 1)] void brdfprof_stub() { float3 v = (float3)0; v += BRDF(v, v, v, v, v); }");
+        let g = Glue {
+            name: "brdfprof_entry0".into(),
+            callee: "Light".into(),
+            args: vec![GlueArg::Expr("N".into()), GlueArg::Scratch("Surface".into()), GlueArg::Out("float3".into())],
+        };
+        assert_eq!(
+            glue(&g),
+            "float3 brdfprof_entry0(float3 L, float3 V, float3 N, float3 X, float3 Y) { Surface brdfprof_arg1; float3 brdfprof_arg2 = (float3)0; Light(N, brdfprof_arg1, brdfprof_arg2); return brdfprof_arg2; }"
+        );
+        assert_eq!(
+            stub(&["BRDF".into()]),
+            "[numthreads(1, 1, 1)] void brdfprof_stub() { float3 v = (float3)0; v += BRDF(v, v, v, v, v); }"
+        );
         assert_eq!(param_decl("f0", "vec3"), "static float3 f0;");
     }
 
@@ -271,7 +422,13 @@ mod tests {
         assert_eq!(c_remainders(&mut words), 2);
         let ops: Vec<u32> = words[5..].chunks(5).map(|c| c[0] & 0xffff).collect();
         assert_eq!(ops, [Op::FRem, Op::SRem, Op::UMod, Op::FAdd].map(|o| o as u32));
-        assert!(is_keyword("texture") && is_keyword("sample") && is_keyword("half3x4") && is_keyword("min16float2") && is_keyword("template"));
+        assert!(
+            is_keyword("texture")
+                && is_keyword("sample")
+                && is_keyword("half3x4")
+                && is_keyword("min16float2")
+                && is_keyword("template")
+        );
         assert!(!is_keyword("Roughness") && !is_keyword("float5") && !is_keyword("half3x5") && !is_keyword("floatx"));
     }
 
@@ -279,7 +436,11 @@ mod tests {
     fn columns_come_from_the_parse_failure_or_the_quoted_token() {
         assert_eq!(token_column("  return x + foo;", "'foo' : unknown variable"), Some(14));
         assert_eq!(token_column("  return food + foo;", "'foo' : unknown variable"), Some(17));
-        assert_eq!(column("\treturn x * Gloss;", "'Gloss' : unknown variable", Some(19)), 13, "the token, not where parsing stopped");
+        assert_eq!(
+            column("\treturn x * Gloss;", "'Gloss' : unknown variable", Some(19)),
+            13,
+            "the token, not where parsing stopped"
+        );
         assert_eq!(column("   }", "';' : Expected", None), 4);
         assert_eq!(column("  x +* 2;", "'expression' : Expected", Some(6)), 6);
         assert_eq!(parse_columns("x.hlsl(2): error at column 13, HLSL parsing failed."), HashMap::from([(2, 13)]));

@@ -19,7 +19,7 @@
 //!   that does not exist).
 
 use super::Includes;
-use anyhow::{anyhow, bail, Result};
+use anyhow::{Result, anyhow, bail};
 use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
 
@@ -74,8 +74,17 @@ impl Expanded {
     /// Appends the model's section `lines` (numbered as in its file), each `#include` resolved from `dir` (the
     /// model file's directory) and `includes`.
     pub fn include_section(&mut self, dir: &Path, lines: &[(usize, String)], includes: &Includes) -> Result<()> {
-        let model = Source { dir: dir.to_path_buf(), code: code_lines(lines), lines: lines.to_vec(), once: false, guard: None };
-        let mut x = Expander { includes, sources: vec![model], by_path: HashMap::new(), stack: vec![0], done: HashSet::new(), undefined: HashSet::new(), out: std::mem::take(self) };
+        let model =
+            Source { dir: dir.to_path_buf(), code: code_lines(lines), lines: lines.to_vec(), once: false, guard: None };
+        let mut x = Expander {
+            includes,
+            sources: vec![model],
+            by_path: HashMap::new(),
+            stack: vec![0],
+            done: HashSet::new(),
+            undefined: HashSet::new(),
+            out: std::mem::take(self),
+        };
         let result = x.expand(0, 0);
         *self = x.out;
         result
@@ -160,7 +169,15 @@ impl Expander<'_> {
     fn include(&mut self, from: usize, n: usize, text: &str, rest: &str, depth: usize) -> Result<()> {
         let column = text.find(['"', '<']).map_or(1, |c| c + 1);
         let Some((name, quoted)) = include_name(rest) else {
-            return Ok(self.error_line(from, n, column, format!("`{}`: brdfprof resolves #include itself and reads only \"NAME\" or <NAME>, not a macro", text.trim())));
+            return Ok(self.error_line(
+                from,
+                n,
+                column,
+                format!(
+                    "`{}`: brdfprof resolves #include itself and reads only \"NAME\" or <NAME>, not a macro",
+                    text.trim()
+                ),
+            ));
         };
         let Some((path, shown)) = self.resolve(from, name, quoted) else {
             let message = self.not_found(from, name, quoted);
@@ -215,18 +232,28 @@ impl Expander<'_> {
         let hint = if self.includes.mapped(name).is_some() {
             String::new()
         } else if name.starts_with('/') {
-            format!("; a virtual path needs --include-map {}=DIR", name.split('/').take(2).collect::<Vec<_>>().join("/"))
+            format!(
+                "; a virtual path needs --include-map {}=DIR",
+                name.split('/').take(2).collect::<Vec<_>>().join("/")
+            )
         } else {
             "; add the directory with --include-dir DIR".to_string()
         };
-        format!("cannot find include `{name}`{}{hint}", self.includes.searched(name, quoted.then(|| self.sources[from].dir.as_path())))
+        format!(
+            "cannot find include `{name}`{}{hint}",
+            self.includes.searched(name, quoted.then(|| self.sources[from].dir.as_path()))
+        )
     }
 
     /// The message of a cycle that reaches source `idx` again through `#include "name"`.
     fn cycle(&self, idx: usize, name: &str) -> String {
         let from = self.stack.iter().position(|&s| s == idx).unwrap_or(0);
         let chain: Vec<&str> = self.stack[from..].iter().map(|&s| self.shown(s)).collect();
-        format!("include cycle: {} includes `{name}` again ({}), which has neither `#pragma once` nor an include guard", chain.last().copied().unwrap_or("?"), chain.iter().chain([&self.shown(idx)]).copied().collect::<Vec<_>>().join(" -> "))
+        format!(
+            "include cycle: {} includes `{name}` again ({}), which has neither `#pragma once` nor an include guard",
+            chain.last().copied().unwrap_or("?"),
+            chain.iter().chain([&self.shown(idx)]).copied().collect::<Vec<_>>().join(" -> ")
+        )
     }
 
     fn shown(&self, idx: usize) -> &str {
@@ -243,8 +270,17 @@ impl Expander<'_> {
         }
         let fail = |e: anyhow::Error| anyhow!("{}:{}:{}: {e:#}", self.out.files[at.0], at.1, at.2);
         let bytes = crate::io::read_input(path).map_err(fail)?;
-        let text = String::from_utf8(bytes).map_err(|e| fail(anyhow!("{} is not UTF-8 text (byte {})", path.display(), e.utf8_error().valid_up_to())))?;
-        let lines: Vec<(usize, String)> = text.strip_prefix('\u{feff}').unwrap_or(&text).split('\n').map(|l| l.strip_suffix('\r').unwrap_or(l).to_string()).enumerate().map(|(i, l)| (i + 1, l)).collect();
+        let text = String::from_utf8(bytes).map_err(|e| {
+            fail(anyhow!("{} is not UTF-8 text (byte {})", path.display(), e.utf8_error().valid_up_to()))
+        })?;
+        let lines: Vec<(usize, String)> = text
+            .strip_prefix('\u{feff}')
+            .unwrap_or(&text)
+            .split('\n')
+            .map(|l| l.strip_suffix('\r').unwrap_or(l).to_string())
+            .enumerate()
+            .map(|(i, l)| (i + 1, l))
+            .collect();
         let code = code_lines(&lines);
         let once = code.iter().any(|c| directive(&c.text).is_some_and(|(d, r)| d == "pragma" && r.trim() == "once"));
         let guard = guard_macro(&code);
@@ -316,10 +352,13 @@ pub fn guard_macro(code: &[Code]) -> Option<String> {
     let (first, second, last) = (code.first()?, code.get(1)?, code.last()?);
     let name = match directive(first)? {
         ("ifndef", r) => r.trim().to_string(),
-        ("if", r) => r.trim().strip_prefix("!defined")?.trim().trim_start_matches('(').trim_end_matches(')').trim().to_string(),
+        ("if", r) => {
+            r.trim().strip_prefix("!defined")?.trim().trim_start_matches('(').trim_end_matches(')').trim().to_string()
+        }
         _ => return None,
     };
-    let defines = directive(second).is_some_and(|(d, r)| d == "define" && r.split_whitespace().next() == Some(name.as_str()));
+    let defines =
+        directive(second).is_some_and(|(d, r)| d == "define" && r.split_whitespace().next() == Some(name.as_str()));
     if !defines || directive(last).map(|(d, _)| d) != Some("endif") {
         return None;
     }
@@ -355,14 +394,29 @@ mod tests {
     #[test]
     fn include_guards_are_recognised_only_around_the_whole_file() {
         let guard = |text: &str| guard_macro(&code_lines(&lines(text)));
-        assert_eq!(guard("// licence\n/* more\n */\n#ifndef A_H\n#define A_H\nfloat a;\n#endif // A_H\n"), Some("A_H".into()));
+        assert_eq!(
+            guard("// licence\n/* more\n */\n#ifndef A_H\n#define A_H\nfloat a;\n#endif // A_H\n"),
+            Some("A_H".into())
+        );
         assert_eq!(guard("#if !defined(B)\n#define B 1\n#endif\n"), Some("B".into()));
         assert_eq!(guard("#ifndef A\n#define A\n#endif\nfloat b;\n"), None, "code after the guard");
         assert_eq!(guard("#ifndef A\n#define A\n#endif\n#ifndef C\n#endif\n"), None, "two blocks");
         assert_eq!(guard("#ifndef A\n#define B\n#endif\n"), None);
-        assert_eq!(guard("#ifndef A\n#define A\nfloat a;\n#else\nfloat b;\n#endif\n"), None, "a second inclusion is not empty");
-        assert_eq!(guard("#ifndef A\n#define A\n#if Q\n#else\n#endif\n#endif\n"), Some("A".into()), "an #else of an inner #if");
-        assert_eq!(guard("/*\n#endif */\n#ifndef A\n#define A\n/* #else */\n#endif\n"), Some("A".into()), "directives in comments are none");
+        assert_eq!(
+            guard("#ifndef A\n#define A\nfloat a;\n#else\nfloat b;\n#endif\n"),
+            None,
+            "a second inclusion is not empty"
+        );
+        assert_eq!(
+            guard("#ifndef A\n#define A\n#if Q\n#else\n#endif\n#endif\n"),
+            Some("A".into()),
+            "an #else of an inner #if"
+        );
+        assert_eq!(
+            guard("/*\n#endif */\n#ifndef A\n#define A\n/* #else */\n#endif\n"),
+            Some("A".into()),
+            "directives in comments are none"
+        );
     }
 
     #[test]
@@ -371,7 +425,11 @@ mod tests {
         let d = dir.path();
         std::fs::create_dir_all(d.join("engine/Private")).unwrap();
         std::fs::write(d.join("engine/Private/Common.ush"), "#pragma once\nstatic const float PI = 3.14;\n").unwrap();
-        std::fs::write(d.join("brdf.ush"), "#pragma once\n#include \"/Engine/Private/Common.ush\"\nfloat D() { return PI; }\n").unwrap();
+        std::fs::write(
+            d.join("brdf.ush"),
+            "#pragma once\n#include \"/Engine/Private/Common.ush\"\nfloat D() { return PI; }\n",
+        )
+        .unwrap();
         let inc = Includes { dirs: vec![], maps: vec![("/Engine".into(), d.join("engine"))] };
         let x = expand(d, "#include \"brdf.ush\"\n#include \"brdf.ush\"\nfloat3 BRDF();\n", &inc);
         let text = x.text();
@@ -389,14 +447,28 @@ mod tests {
         let d = dir.path();
         std::fs::write(d.join("a.ush"), "#pragma once\nfloat a;\n").unwrap();
         std::fs::write(d.join("old.ush"), "/* old */\nfloat old;\n").unwrap();
-        let x = expand(d, "/*\n#include \"a.ush\"\n#include \"old.ush\"\n#if 0\n*/\n#include \"a.ush\" /* the header\n of a */\n#line 90\nfloat b;\n", &Includes::default());
+        let x = expand(
+            d,
+            "/*\n#include \"a.ush\"\n#include \"old.ush\"\n#if 0\n*/\n#include \"a.ush\" /* the header\n of a */\n#line 90\nfloat b;\n",
+            &Includes::default(),
+        );
         let text = x.text();
         assert_eq!(text.matches("float a;").count(), 1, "{text}");
         assert!(!text.contains("float old;") && !text.contains("#line") && x.notes.is_empty(), "{text}");
         let after = x.lines.iter().position(|l| l == "#endif").unwrap() + 1;
-        assert_eq!((x.lines[after].as_str(), x.lines[after + 1].as_str()), ("/*", " of a */"), "the comment the #include line opens goes on");
+        assert_eq!(
+            (x.lines[after].as_str(), x.lines[after + 1].as_str()),
+            ("/*", " of a */"),
+            "the comment the #include line opens goes on"
+        );
         assert_eq!(x.dropped, [(0, 8, "#line 90".to_string())]);
-        assert_eq!(code_lines(&lines("x = \"//\"; // c\n/* a */ #include \"b\"")), [Code { text: "x = \"//\"; ".into(), opens_comment: false }, Code { text: "        #include \"b\"".into(), opens_comment: false }]);
+        assert_eq!(
+            code_lines(&lines("x = \"//\"; // c\n/* a */ #include \"b\"")),
+            [
+                Code { text: "x = \"//\"; ".into(), opens_comment: false },
+                Code { text: "        #include \"b\"".into(), opens_comment: false }
+            ]
+        );
     }
 
     #[test]
@@ -406,12 +478,27 @@ mod tests {
         std::fs::write(d.join("a.ush"), "#pragma once\nfloat a;\n").unwrap();
         std::fs::write(d.join("loop1.ush"), "float l1;\n#include \"loop2.ush\"\n").unwrap();
         std::fs::write(d.join("loop2.ush"), "float l2;\n  #include \"loop1.ush\"\n").unwrap();
-        let x = expand(d, "#if Q\n#include \"a.ush\"\n#endif\n#include \"a.ush\"\n#if 0\n#include \"gone.ush\"\n#endif\n#include \"loop1.ush\"\n", &Includes::default());
-        assert_eq!(x.lines.iter().filter(|l| l.as_str() == "float a;").count(), 2, "inside an #if it is expanded again, guarded");
-        let notes: Vec<&(usize, String)> = { let mut k: Vec<_> = x.notes.iter().collect(); k.sort(); k.into_iter().map(|(_, n)| n).collect() };
+        let x = expand(
+            d,
+            "#if Q\n#include \"a.ush\"\n#endif\n#include \"a.ush\"\n#if 0\n#include \"gone.ush\"\n#endif\n#include \"loop1.ush\"\n",
+            &Includes::default(),
+        );
+        assert_eq!(
+            x.lines.iter().filter(|l| l.as_str() == "float a;").count(),
+            2,
+            "inside an #if it is expanded again, guarded"
+        );
+        let notes: Vec<&(usize, String)> = {
+            let mut k: Vec<_> = x.notes.iter().collect();
+            k.sort();
+            k.into_iter().map(|(_, n)| n).collect()
+        };
         assert!(notes[0].1.starts_with("cannot find include `gone.ush` (searched: "), "{notes:?}");
         assert_eq!(notes[0].0, 10);
-        assert!(notes[1].1.starts_with("include cycle: ") && notes[1].1.contains("loop1.ush -> ") && notes[1].0 == 12, "{notes:?}");
+        assert!(
+            notes[1].1.starts_with("include cycle: ") && notes[1].1.contains("loop1.ush -> ") && notes[1].0 == 12,
+            "{notes:?}"
+        );
         let at = *x.notes.keys().max().unwrap();
         assert_eq!(x.origin(at).map(|(f, l)| (f.ends_with("loop2.ush"), l)), Some((true, 2)));
     }

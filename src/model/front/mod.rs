@@ -74,7 +74,8 @@ impl Includes {
     /// The longest mapped prefix `name` lies under (`/Engine` for `/Engine/Private/BRDF.ush`), with the rest of
     /// the name after it.
     pub fn mapped<'a>(&self, name: &'a str) -> Option<(&(String, PathBuf), &'a str)> {
-        let under = |v: &str| name == v || (name.starts_with(v) && (v.ends_with('/') || name[v.len()..].starts_with('/')));
+        let under =
+            |v: &str| name == v || (name.starts_with(v) && (v.ends_with('/') || name[v.len()..].starts_with('/')));
         let map = self.maps.iter().filter(|(v, _)| under(v)).max_by_key(|(v, _)| v.len())?;
         Some((map, name[map.0.len()..].trim_start_matches('/')))
     }
@@ -96,9 +97,14 @@ impl Includes {
     /// P, which does not exist`, or ` (searched: DIR, ...)`.
     pub fn searched(&self, name: &str, beside: Option<&Path>) -> String {
         if let Some(((v, dir), rest)) = self.mapped(name) {
-            return format!(": --include-map {v}={} maps it to {}, which does not exist", dir.display(), dir.join(rest).display());
+            return format!(
+                ": --include-map {v}={} maps it to {}, which does not exist",
+                dir.display(),
+                dir.join(rest).display()
+            );
         }
-        let dirs: Vec<String> = beside.map(shown_dir).into_iter().chain(self.dirs.iter().map(|d| shown_dir(d))).collect();
+        let dirs: Vec<String> =
+            beside.map(shown_dir).into_iter().chain(self.dirs.iter().map(|d| shown_dir(d))).collect();
         format!(" (searched: {})", if dirs.is_empty() { "no directory".to_string() } else { dirs.join(", ") })
     }
 }
@@ -180,7 +186,14 @@ mod tests {
 
     #[test]
     fn the_longest_virtual_prefix_maps_a_name() {
-        let inc = Includes { dirs: vec![], maps: vec![("/Engine".into(), "a".into()), ("/Engine/Private".into(), "b".into()), ("/Eng".into(), "c".into())] };
+        let inc = Includes {
+            dirs: vec![],
+            maps: vec![
+                ("/Engine".into(), "a".into()),
+                ("/Engine/Private".into(), "b".into()),
+                ("/Eng".into(), "c".into()),
+            ],
+        };
         let ((v, d), rest) = inc.mapped("/Engine/Private/BRDF.ush").unwrap();
         assert_eq!((v.as_str(), d.to_str().unwrap(), rest), ("/Engine/Private", "b", "BRDF.ush"));
         assert_eq!(inc.mapped("/Engine/Public/X.ush").unwrap().1, "Public/X.ush");

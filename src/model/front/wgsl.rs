@@ -6,8 +6,11 @@
 //! place); lines brdfprof appends to the shader (parameters, glue, stub) name what they came from.
 
 use super::{Glue, GlueArg, Includes, STUB};
-use anyhow::{anyhow, bail, Context, Result};
-use naga_oil::compose::{ComposableModuleDescriptor, Composer, ComposerError, NagaModuleDescriptor, ShaderDefValue, ShaderLanguage, ShaderType};
+use anyhow::{Context, Result, anyhow, bail};
+use naga_oil::compose::{
+    ComposableModuleDescriptor, Composer, ComposerError, NagaModuleDescriptor, ShaderDefValue, ShaderLanguage,
+    ShaderType,
+};
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
 
@@ -84,7 +87,10 @@ pub fn glue(g: &Glue) -> String {
         Some(o) => format!("{locals}{call}; return {o};"),
         None => format!("{locals}return {call};"),
     };
-    format!("fn {}(L: vec3<f32>, V: vec3<f32>, N: vec3<f32>, X: vec3<f32>, Y: vec3<f32>) -> vec3<f32> {{ {body} }}", g.name)
+    format!(
+        "fn {}(L: vec3<f32>, V: vec3<f32>, N: vec3<f32>, X: vec3<f32>, Y: vec3<f32>) -> vec3<f32> {{ {body} }}",
+        g.name
+    )
 }
 
 /// The compute entry that calls each of `calls`, on one line.
@@ -119,8 +125,13 @@ pub fn shader_defs(defines: &[(String, String)], model: &Path) -> Result<HashMap
 /// one, whose files are named without `./`), sorted.
 fn wgsl_files(dir: &Path, depth: usize, out: &mut Vec<PathBuf>) {
     let Ok(entries) = std::fs::read_dir(if dir.as_os_str().is_empty() { Path::new(".") } else { dir }) else { return };
-    let named = |p: PathBuf| if dir.as_os_str().is_empty() { p.strip_prefix(".").map(Path::to_path_buf).unwrap_or(p) } else { p };
-    let mut paths: Vec<PathBuf> = entries.filter_map(|e| e.ok().map(|e| named(e.path()))).filter(|p| !p.file_name().is_some_and(|n| n.to_string_lossy().starts_with('.'))).collect();
+    let named = |p: PathBuf| {
+        if dir.as_os_str().is_empty() { p.strip_prefix(".").map(Path::to_path_buf).unwrap_or(p) } else { p }
+    };
+    let mut paths: Vec<PathBuf> = entries
+        .filter_map(|e| e.ok().map(|e| named(e.path())))
+        .filter(|p| !p.file_name().is_some_and(|n| n.to_string_lossy().starts_with('.')))
+        .collect();
     paths.sort();
     for p in paths {
         if out.len() >= MAX_FILES {
@@ -135,7 +146,8 @@ fn wgsl_files(dir: &Path, depth: usize, out: &mut Vec<PathBuf>) {
 }
 
 fn read_text(path: &Path) -> Result<String> {
-    String::from_utf8(crate::io::read_input(path)?).map_err(|e| anyhow!("{} is not UTF-8 text (byte {})", path.display(), e.utf8_error().valid_up_to()))
+    String::from_utf8(crate::io::read_input(path)?)
+        .map_err(|e| anyhow!("{} is not UTF-8 text (byte {})", path.display(), e.utf8_error().valid_up_to()))
 }
 
 /// The modules the include directories (recursively) and the model's own directory declare with
@@ -174,7 +186,10 @@ fn resolve(import: &str, dir: &Path, includes: &Includes, index: &BTreeMap<Strin
 /// The 1-based line and column where `text` imports `import` (its `#import` line), else 1:1.
 fn import_at(text: &str, import: &str) -> (usize, usize) {
     let key = import.trim_matches('"').rsplit("::").last().unwrap_or(import);
-    text.lines().enumerate().find(|(_, l)| l.trim_start().starts_with("#import") && l.contains(key)).map_or((1, 1), |(i, l)| (i + 1, l.find(key).unwrap_or(0) + 1))
+    text.lines()
+        .enumerate()
+        .find(|(_, l)| l.trim_start().starts_with("#import") && l.contains(key))
+        .map_or((1, 1), |(i, l)| (i + 1, l.find(key).unwrap_or(0) + 1))
 }
 
 /// naga_oil composition state: the composer and the modules added or being added.
@@ -210,7 +225,13 @@ impl Modules<'_> {
             self.add_imports_of(&source, &file, &super::dir_of(&path))?;
             self.stack.pop();
             let as_name = import.starts_with('"').then(|| import.clone());
-            let desc = ComposableModuleDescriptor { source: &source, file_path: &file, language: ShaderLanguage::Wgsl, as_name, ..Default::default() };
+            let desc = ComposableModuleDescriptor {
+                source: &source,
+                file_path: &file,
+                language: ShaderLanguage::Wgsl,
+                as_name,
+                ..Default::default()
+            };
             if let Err(e) = self.composer.add_composable_module(desc) {
                 bail!("{}", located(&e, &self.composer, None));
             }
@@ -227,12 +248,20 @@ fn located(e: &ComposerError, composer: &Composer, top: Option<(&str, &Top)>) ->
     let report = e.emit_to_string(composer);
     let message = report.lines().find_map(|l| l.strip_prefix("error: ")).unwrap_or("").trim().to_string();
     let notes: Vec<&str> = report.lines().filter_map(|l| l.trim().strip_prefix("= ")).collect();
-    let labels: Vec<&str> = report.lines().filter_map(|l| l.split_once('^').map(|(_, r)| r.trim_start_matches('^').trim())).filter(|l| !l.is_empty()).collect();
+    let labels: Vec<&str> = report
+        .lines()
+        .filter_map(|l| l.split_once('^').map(|(_, r)| r.trim_start_matches('^').trim()))
+        .filter(|l| !l.is_empty())
+        .collect();
     let Some(at) = report.lines().find_map(|l| l.split_once("┌─ ").map(|(_, r)| r.trim().to_string())) else {
         return report.trim().to_string();
     };
     let mut parts = at.rsplitn(3, ':');
-    let (col, line, file) = (parts.next().unwrap_or("1"), parts.next().and_then(|l| l.parse::<usize>().ok()).unwrap_or(1), parts.next().unwrap_or(""));
+    let (col, line, file) = (
+        parts.next().unwrap_or("1"),
+        parts.next().and_then(|l| l.parse::<usize>().ok()).unwrap_or(1),
+        parts.next().unwrap_or(""),
+    );
     let mut detail: Vec<&str> = labels.into_iter().chain(notes).filter(|d| *d != message).collect();
     detail.dedup();
     let tail = if detail.is_empty() { String::new() } else { format!(" ({})", detail.join("; ")) };
@@ -255,9 +284,22 @@ pub fn compose(model: &Path, top: &Top, defines: &[(String, String)], includes: 
     let model_dir = super::dir_of(model);
     let shader_defs = shader_defs(defines, model)?;
     let shown = model.display().to_string();
-    let mut m = Modules { composer: Composer::default().with_capabilities(SHADER_CAPABILITIES), includes, index: module_index(&model_dir, includes), added: Vec::new(), stack: Vec::new(), files: Vec::new() };
+    let mut m = Modules {
+        composer: Composer::default().with_capabilities(SHADER_CAPABILITIES),
+        includes,
+        index: module_index(&model_dir, includes),
+        added: Vec::new(),
+        stack: Vec::new(),
+        files: Vec::new(),
+    };
     m.add_imports_of(&top.text, &shown, &model_dir)?;
-    let desc = NagaModuleDescriptor { source: &top.text, file_path: &shown, shader_type: ShaderType::Wgsl, shader_defs, additional_imports: &[] };
+    let desc = NagaModuleDescriptor {
+        source: &top.text,
+        file_path: &shown,
+        shader_type: ShaderType::Wgsl,
+        shader_defs,
+        additional_imports: &[],
+    };
     let module = m.composer.make_naga_module(desc).map_err(|e| {
         let hint = match e.inner {
             naga_oil::compose::ComposerErrorInner::ImportNotFound(..) => format!("; brdfprof looks for a module's `#define_import_path` in the .wgsl files of {}, and for a quoted import as for an HLSL include (beside the importing file, in the include directories, under a mapped prefix)", searched(&model_dir, includes)),
@@ -270,7 +312,9 @@ pub fn compose(model: &Path, top: &Top, defines: &[(String, String)], includes: 
 
 /// What naga may accept in a user's WGSL: its defaults (multisampled shading, cube array textures) and `enable f16` (the kernels run where the device has
 /// shaderFloat16, as for a GLSL model's fp16, `Model::check_support`).
-const SHADER_CAPABILITIES: naga::valid::Capabilities = naga::valid::Capabilities::SHADER_FLOAT16.union(naga::valid::Capabilities::MULTISAMPLED_SHADING).union(naga::valid::Capabilities::CUBE_ARRAY_TEXTURES);
+const SHADER_CAPABILITIES: naga::valid::Capabilities = naga::valid::Capabilities::SHADER_FLOAT16
+    .union(naga::valid::Capabilities::MULTISAMPLED_SHADING)
+    .union(naga::valid::Capabilities::CUBE_ARRAY_TEXTURES);
 
 /// The directories searched for modules, as a message lists them.
 fn searched(model_dir: &Path, includes: &Includes) -> String {
@@ -283,7 +327,9 @@ fn searched(model_dir: &Path, includes: &Includes) -> String {
 /// line for line (the text itself where it does not preprocess, which composing it has reported).
 pub fn preprocessed(text: &str, defines: &[(String, String)], model: &Path) -> String {
     let defs = shader_defs(defines, model).unwrap_or_default();
-    naga_oil::compose::preprocess::Preprocessor::default().preprocess(text, &defs).map_or_else(|_| text.to_string(), |p| p.preprocessed_source)
+    naga_oil::compose::preprocess::Preprocessor::default()
+        .preprocess(text, &defs)
+        .map_or_else(|_| text.to_string(), |p| p.preprocessed_source)
 }
 
 /// The module's SPIR-V for its stub entry: naga's validation, `override`s at their defaults, and naga's SPIR-V
@@ -292,11 +338,20 @@ pub fn preprocessed(text: &str, defines: &[(String, String)], model: &Path) -> S
 pub fn emit_spirv(module: &naga::Module, model: &Path) -> Result<Vec<u32>> {
     use naga::valid::{ValidationFlags, Validator};
     let what = model.display();
-    let info = Validator::new(ValidationFlags::all(), SHADER_CAPABILITIES).validate(module).map_err(|e| anyhow!("{what}: naga's validation: {}", e.emit_to_string("")))?;
-    let (module, info) = naga::back::pipeline_constants::process_overrides(module, &info, None, &Default::default()).map_err(|e| anyhow!("{what}: the overrides at their defaults: {e}"))?;
-    let options = naga::back::spv::Options { flags: naga::back::spv::WriterFlags::DEBUG, force_loop_bounding: false, ..Default::default() };
-    let pipeline = naga::back::spv::PipelineOptions { shader_stage: naga::ShaderStage::Compute, entry_point: STUB.to_string() };
-    naga::back::spv::write_vec(&module, &info, &options, Some(&pipeline)).with_context(|| format!("{what}: naga's SPIR-V writer"))
+    let info = Validator::new(ValidationFlags::all(), SHADER_CAPABILITIES)
+        .validate(module)
+        .map_err(|e| anyhow!("{what}: naga's validation: {}", e.emit_to_string("")))?;
+    let (module, info) = naga::back::pipeline_constants::process_overrides(module, &info, None, &Default::default())
+        .map_err(|e| anyhow!("{what}: the overrides at their defaults: {e}"))?;
+    let options = naga::back::spv::Options {
+        flags: naga::back::spv::WriterFlags::DEBUG,
+        force_loop_bounding: false,
+        ..Default::default()
+    };
+    let pipeline =
+        naga::back::spv::PipelineOptions { shader_stage: naga::ShaderStage::Compute, entry_point: STUB.to_string() };
+    naga::back::spv::write_vec(&module, &info, &options, Some(&pipeline))
+        .with_context(|| format!("{what}: naga's SPIR-V writer"))
 }
 
 /// A naga type as WGSL writes it (scalars, vectors, matrices, structs by their undecorated name).
@@ -334,7 +389,11 @@ pub type Signature = (Vec<(String, Option<String>)>, Option<String>);
 /// such function.
 pub fn signature(module: &naga::Module, callee: &str) -> Option<Signature> {
     let name = callee.rsplit("::").next().unwrap_or(callee);
-    let f = module.functions.iter().map(|(_, f)| f).find(|f| f.name.as_deref().map(undecorated).as_deref() == Some(name))?;
+    let f = module
+        .functions
+        .iter()
+        .map(|(_, f)| f)
+        .find(|f| f.name.as_deref().map(undecorated).as_deref() == Some(name))?;
     let params = f.arguments.iter().map(|a| (a.name.clone().unwrap_or_default(), type_text(module, a.ty))).collect();
     Some((params, f.result.as_ref().and_then(|r| type_text(module, r.ty))))
 }
@@ -347,7 +406,14 @@ pub fn function_names(module: &naga::Module) -> std::collections::HashSet<String
 /// The parameter types of `callee` (as `signature`), a function of the shader composed as `bare` or of a
 /// module the shader `top` imports: naga_oil keeps only the imported functions a shader calls, so each
 /// imported module is composed on its own to find it there.
-pub fn parameter_types(model: &Path, top: &Top, bare: &naga::Module, defines: &[(String, String)], includes: &Includes, callee: &str) -> Result<Option<Vec<Option<String>>>> {
+pub fn parameter_types(
+    model: &Path,
+    top: &Top,
+    bare: &naga::Module,
+    defines: &[(String, String)],
+    includes: &Includes,
+    callee: &str,
+) -> Result<Option<Vec<Option<String>>>> {
     let types = |m: &naga::Module| signature(m, callee).map(|(p, _)| p.into_iter().map(|(_, t)| t).collect());
     if let Some(t) = types(bare) {
         return Ok(Some(t));
@@ -356,7 +422,8 @@ pub fn parameter_types(model: &Path, top: &Top, bare: &naga::Module, defines: &[
     let index = module_index(&model_dir, includes);
     for import in declared_imports(&top.text) {
         let Some(path) = resolve(&import, &model_dir, includes, &index) else { continue };
-        let lines: Vec<(usize, String)> = read_text(&path)?.lines().enumerate().map(|(i, l)| (i + 1, l.to_string())).collect();
+        let lines: Vec<(usize, String)> =
+            read_text(&path)?.lines().enumerate().map(|(i, l)| (i + 1, l.to_string())).collect();
         if let Some(t) = types(&compose(&path, &Top::new(&lines), defines, includes)?.module) {
             return Ok(Some(t));
         }
@@ -393,21 +460,46 @@ mod tests {
     /// The version Cargo.lock pins for `package`.
     fn locked(package: &str) -> String {
         let lock = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/Cargo.lock")).unwrap();
-        let entry = lock.split("[[package]]").find(|e| e.lines().any(|l| l.trim() == format!("name = \"{package}\""))).unwrap();
+        let entry =
+            lock.split("[[package]]").find(|e| e.lines().any(|l| l.trim() == format!("name = \"{package}\""))).unwrap();
         entry.lines().find_map(|l| l.trim().strip_prefix("version = \"")).unwrap().trim_end_matches('"').to_string()
     }
 
     #[test]
     fn generated_text() {
-        let g = Glue { name: "brdfprof_entry0".into(), callee: "lighting::direct".into(), args: vec![GlueArg::Expr("N".into()), GlueArg::Out("vec3<f32>".into())] };
-        assert_eq!(glue(&g), "fn brdfprof_entry0(L: vec3<f32>, V: vec3<f32>, N: vec3<f32>, X: vec3<f32>, Y: vec3<f32>) -> vec3<f32> { var brdfprof_arg1: vec3<f32> = vec3<f32>(); lighting::direct(N, &brdfprof_arg1); return brdfprof_arg1; }");
+        let g = Glue {
+            name: "brdfprof_entry0".into(),
+            callee: "lighting::direct".into(),
+            args: vec![GlueArg::Expr("N".into()), GlueArg::Out("vec3<f32>".into())],
+        };
+        assert_eq!(
+            glue(&g),
+            "fn brdfprof_entry0(L: vec3<f32>, V: vec3<f32>, N: vec3<f32>, X: vec3<f32>, Y: vec3<f32>) -> vec3<f32> { var brdfprof_arg1: vec3<f32> = vec3<f32>(); lighting::direct(N, &brdfprof_arg1); return brdfprof_arg1; }"
+        );
         assert_eq!(param_decl("f0", "vec3"), "var<private> f0: vec3<f32>;");
         let top = Top::new(&[(3, "fn BRDF(L: vec3<f32>) {}".into()), (5, "x".into())]);
         assert_eq!((top.text.as_str(), top.lines), ("\n\nfn BRDF(L: vec3<f32>) {}\n\nx\n", 5));
-        let defs = shader_defs(&[("A".into(), "".into()), ("B".into(), "-2".into()), ("C".into(), "3u".into())], Path::new("m")).unwrap();
-        assert_eq!((defs["A"], defs["B"], defs["C"]), (ShaderDefValue::Bool(true), ShaderDefValue::Int(-2), ShaderDefValue::UInt(3)));
-        assert!(format!("{:#}", shader_defs(&[("A".into(), "0.5".into())], Path::new("m")).unwrap_err()).contains("define A=0.5"));
-        assert!(describe().starts_with(&format!("naga_oil {} (", locked("naga_oil"))) && describe().contains(&format!("naga {} (", locked("naga"))), "describe() names the versions Cargo.lock pins");
-        assert_eq!(declared_imports("#import a::b::{x, y}\n  #import a::c::f\n#import \"p/q.wgsl\" f, g\n// #import no\n"), ["a::b", "a::c::f", "\"p/q.wgsl\""]);
+        let defs = shader_defs(
+            &[("A".into(), "".into()), ("B".into(), "-2".into()), ("C".into(), "3u".into())],
+            Path::new("m"),
+        )
+        .unwrap();
+        assert_eq!(
+            (defs["A"], defs["B"], defs["C"]),
+            (ShaderDefValue::Bool(true), ShaderDefValue::Int(-2), ShaderDefValue::UInt(3))
+        );
+        assert!(
+            format!("{:#}", shader_defs(&[("A".into(), "0.5".into())], Path::new("m")).unwrap_err())
+                .contains("define A=0.5")
+        );
+        assert!(
+            describe().starts_with(&format!("naga_oil {} (", locked("naga_oil")))
+                && describe().contains(&format!("naga {} (", locked("naga"))),
+            "describe() names the versions Cargo.lock pins"
+        );
+        assert_eq!(
+            declared_imports("#import a::b::{x, y}\n  #import a::c::f\n#import \"p/q.wgsl\" f, g\n// #import no\n"),
+            ["a::b", "a::c::f", "\"p/q.wgsl\""]
+        );
     }
 }

@@ -31,7 +31,15 @@ pub fn per_line(model: &str, instructions: &[Attributed], binding_pipe: &str) ->
             unattributed += 1;
             continue;
         };
-        let entry = by_line.entry((file.clone(), *line)).or_insert_with(|| LineCost { file: file.clone(), line: *line, instructions: 0, pipes: BTreeMap::new(), binding: 0.0, schedule: 0.0, text: String::new() });
+        let entry = by_line.entry((file.clone(), *line)).or_insert_with(|| LineCost {
+            file: file.clone(),
+            line: *line,
+            instructions: 0,
+            pipes: BTreeMap::new(),
+            binding: 0.0,
+            schedule: 0.0,
+            text: String::new(),
+        });
         entry.instructions += 1;
         entry.schedule += i.schedule;
         if i.issue > 0.0 {
@@ -43,19 +51,36 @@ pub fn per_line(model: &str, instructions: &[Attributed], binding_pipe: &str) ->
         entry.binding = entry.pipes.get(binding_pipe).copied().unwrap_or(0.0);
     }
     let mut lines: Vec<LineCost> = by_line.into_values().collect();
-    lines.sort_by(|a, b| b.binding.total_cmp(&a.binding).then(b.schedule.total_cmp(&a.schedule)).then(a.file.cmp(&b.file)).then(a.line.cmp(&b.line)));
+    lines.sort_by(|a, b| {
+        b.binding
+            .total_cmp(&a.binding)
+            .then(b.schedule.total_cmp(&a.schedule))
+            .then(a.file.cmp(&b.file))
+            .then(a.line.cmp(&b.line))
+    });
     for l in &mut lines {
         l.text = source_text(&l.file, l.line);
         l.file = short(&l.file);
     }
-    KernelLines { model: model.into(), binding_pipe: binding_pipe.into(), lines, unattributed, instructions: instructions.len() as u32, note: String::new() }
+    KernelLines {
+        model: model.into(),
+        binding_pipe: binding_pipe.into(),
+        lines,
+        unattributed,
+        instructions: instructions.len() as u32,
+        note: String::new(),
+    }
 }
 
 /// Line `line` of `file` trimmed, or empty where it cannot be read.
 fn source_text(file: &str, line: u32) -> String {
     let path = std::path::Path::new(file);
-    let embedded = || file.rsplit_once("glsl/").and_then(|(_, rel)| crate::shaders::embedded_glsl(rel)).map(str::to_string);
-    let text = crate::io::read_bounded(path, 64 << 20).ok().map(|b| String::from_utf8_lossy(&b).into_owned()).or_else(embedded);
+    let embedded =
+        || file.rsplit_once("glsl/").and_then(|(_, rel)| crate::shaders::embedded_glsl(rel)).map(str::to_string);
+    let text = crate::io::read_bounded(path, 64 << 20)
+        .ok()
+        .map(|b| String::from_utf8_lossy(&b).into_owned())
+        .or_else(embedded);
     text.and_then(|t| t.lines().nth(line.saturating_sub(1) as usize).map(|l| l.trim().to_string())).unwrap_or_default()
 }
 /// A file name as reports give it: glsl/'s (compiled from a temporary copy) by their name in the tree, a user's
@@ -78,7 +103,13 @@ mod tests {
 
     #[test]
     fn lines_sum_their_instructions_and_rank_by_the_binding_pipe() {
-        let is = [at("a.brdf", 3, "FMA", 1.0, 2.0), at("a.brdf", 5, "MUFU", 8.0, 20.0), at("a.brdf", 3, "FMA", 1.0, 1.0), at("a.brdf", 4, "FMA", 1.5, 0.0), Attributed { source: None, pipes: vec![], schedule: 1.0, issue: 0.25 }];
+        let is = [
+            at("a.brdf", 3, "FMA", 1.0, 2.0),
+            at("a.brdf", 5, "MUFU", 8.0, 20.0),
+            at("a.brdf", 3, "FMA", 1.0, 1.0),
+            at("a.brdf", 4, "FMA", 1.5, 0.0),
+            Attributed { source: None, pipes: vec![], schedule: 1.0, issue: 0.25 },
+        ];
         let k = per_line("ggx", &is, "FMA");
         assert_eq!(k.lines.iter().map(|l| l.line).collect::<Vec<_>>(), [3, 4, 5]);
         assert_eq!((k.lines[0].instructions, k.lines[0].binding, k.lines[0].schedule), (2, 2.0, 3.0));

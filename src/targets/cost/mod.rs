@@ -8,9 +8,9 @@ pub mod schedule;
 
 use crate::kernels::shade::steady_block;
 use crate::model::BASELINE_LABEL;
-use crate::schema::cost::{CostRow, TargetCost};
 use crate::schema::InspectReport;
-use schedule::{Schedule, LATENCY, RESIDENT_WAVES};
+use crate::schema::cost::{CostRow, TargetCost};
+use schedule::{LATENCY, RESIDENT_WAVES, Schedule};
 
 /// A row's statistics by key.
 type Stats = std::collections::BTreeMap<String, f64>;
@@ -18,19 +18,34 @@ type Stats = std::collections::BTreeMap<String, f64>;
 /// The value of driver statistic `name` of any executable, summed (a compute pipeline has one).
 pub fn driver_stat(stats: &std::collections::BTreeMap<String, f64>, name: &str) -> Option<f64> {
     let suffix = format!("/{name}");
-    let v: Vec<f64> = stats.iter().filter(|(k, _)| k.starts_with("driver/") && k.ends_with(&suffix) && k.matches('/').count() == 2).map(|(_, v)| *v).collect();
+    let v: Vec<f64> = stats
+        .iter()
+        .filter(|(k, _)| k.starts_with("driver/") && k.ends_with(&suffix) && k.matches('/').count() == 2)
+        .map(|(_, v)| *v)
+        .collect();
     (!v.is_empty()).then(|| v.iter().sum())
 }
 
 /// A cost table of `report` from a per-kernel rule: `cycles(stats, lights per kernel)` (None: the kernel has no
 /// figure, e.g. the driver reported none) and the statistics `columns` shown beside it.
-pub fn table(report: &InspectReport, header: TargetCost, cycles: impl Fn(&std::collections::BTreeMap<String, f64>, u32) -> Option<f64>) -> Option<TargetCost> {
+pub fn table(
+    report: &InspectReport,
+    header: TargetCost,
+    cycles: impl Fn(&std::collections::BTreeMap<String, f64>, u32) -> Option<f64>,
+) -> Option<TargetCost> {
     let lights = steady_block(report.lights).0;
     let mut t = TargetCost { lights_per_kernel: lights, rows: Vec::new(), ..header };
     for r in &report.rows {
         let Some(c) = cycles(&r.stats, lights) else { continue };
         let stats = t.columns.iter().map(|name| (name.clone(), driver_stat(&r.stats, name).unwrap_or(0.0))).collect();
-        t.rows.push(CostRow { model: r.model.clone(), stats, cycles_per_eval: c, net_cycles_per_eval: None, bound: None, terms: Vec::new() });
+        t.rows.push(CostRow {
+            model: r.model.clone(),
+            stats,
+            cycles_per_eval: c,
+            net_cycles_per_eval: None,
+            bound: None,
+            terms: Vec::new(),
+        });
     }
     if t.rows.is_empty() {
         return None;
@@ -51,7 +66,11 @@ pub const HIDDEN_LATENCY: &str = "latency / waves";
 /// schedule latency / resident waves) over the figures `schedule_of(stats)` gives with the lanes of one wave,
 /// divided by those lanes and the lights per kernel; net = the largest term the kernel adds to the memory-only
 /// kernel's (per evaluation: kernels may differ in width), that term named in `bound`.
-pub fn schedule_table(report: &InspectReport, mut header: TargetCost, schedule_of: impl Fn(&Stats) -> Option<(Schedule, f64)>) -> Option<TargetCost> {
+pub fn schedule_table(
+    report: &InspectReport,
+    mut header: TargetCost,
+    schedule_of: impl Fn(&Stats) -> Option<(Schedule, f64)>,
+) -> Option<TargetCost> {
     let lights = f64::from(steady_block(report.lights).0);
     let per_eval = |stats: &Stats| schedule_of(stats).map(|(s, lanes)| (s.scaled(1.0 / (lanes * lights)), s));
     let figures = |model: &str| report.rows.iter().find(|r| r.model == model).and_then(|r| per_eval(&r.stats));

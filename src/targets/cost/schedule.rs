@@ -61,7 +61,11 @@ impl Schedule {
 
     /// Every figure in another unit: pipes and latency times `factor` (per evaluation: 1 / (lanes x lights)).
     pub fn scaled(&self, factor: f64) -> Schedule {
-        Schedule { pipes: self.pipes.iter().map(|(n, v)| (n.clone(), v * factor)).collect(), latency: self.latency.map(|l| l * factor), resident_waves: self.resident_waves }
+        Schedule {
+            pipes: self.pipes.iter().map(|(n, v)| (n.clone(), v * factor)).collect(),
+            latency: self.latency.map(|l| l * factor),
+            resident_waves: self.resident_waves,
+        }
     }
 
     /// Latency over resident waves, where both are known.
@@ -117,7 +121,13 @@ mod tests {
 
     #[test]
     fn the_busiest_pipe_binds_unless_latency_is_not_hidden() {
-        let s = Schedule::of(&stats(&[("Pipe: FMA", 100.0), ("Pipe: MUFU", 40.0), (LATENCY, 800.0), (RESIDENT_WAVES, 16.0)])).unwrap();
+        let s = Schedule::of(&stats(&[
+            ("Pipe: FMA", 100.0),
+            ("Pipe: MUFU", 40.0),
+            (LATENCY, 800.0),
+            (RESIDENT_WAVES, 16.0),
+        ]))
+        .unwrap();
         assert_eq!(s.throughput(), ("FMA".to_string(), 100.0));
         assert_eq!(s.cycles(), ("FMA".to_string(), 100.0));
         let few = Schedule { resident_waves: Some(4.0), ..s.clone() };
@@ -127,7 +137,11 @@ mod tests {
 
     #[test]
     fn net_is_the_largest_added_term() {
-        let s = |fma: f64, mufu: f64, lat: f64| Schedule { pipes: vec![("FMA".into(), fma), ("MUFU".into(), mufu)], latency: Some(lat), resident_waves: Some(10.0) };
+        let s = |fma: f64, mufu: f64, lat: f64| Schedule {
+            pipes: vec![("FMA".into(), fma), ("MUFU".into(), mufu)],
+            latency: Some(lat),
+            resident_waves: Some(10.0),
+        };
         // The base binds on latency (50), the kernel on MUFU (70): the difference of the bounds (20) would
         // hide most of what it adds; the added MUFU work (70) is larger than the FMA work (50).
         let (name, v) = s(60.0, 70.0, 400.0).net(&s(10.0, 0.0, 500.0));

@@ -53,7 +53,10 @@ fn registers(operand: &str, exec: u32, grf: u32, length: Option<u32>, dst: bool)
     let o = operand.trim_start_matches(['-', '~']).trim_start_matches("(abs)");
     let (name, rest) = o.split_at(o.find(|c: char| !c.is_ascii_alphabetic()).unwrap_or(o.len()));
     let number: u32 = rest.split(|c: char| !c.is_ascii_digit()).next().and_then(|n| n.parse().ok()).unwrap_or(0);
-    let sub: u32 = rest.split_once('.').and_then(|(_, s)| s.split(|c: char| !c.is_ascii_digit()).next()?.parse().ok()).unwrap_or(0);
+    let sub: u32 = rest
+        .split_once('.')
+        .and_then(|(_, s)| s.split(|c: char| !c.is_ascii_digit()).next()?.parse().ok())
+        .unwrap_or(0);
     let ty = o.rsplit_once(':').map_or("ud", |(_, t)| t);
     let size = type_bytes(ty);
     match name {
@@ -90,7 +93,8 @@ fn region_bytes(operand: &str, exec: u32, size: u32, dst: bool) -> u32 {
 fn send_lengths(comment: &str) -> (Option<u32>, Option<u32>, Option<u32>) {
     let number = |s: &str| s.trim().trim_end_matches('h').parse::<u32>().ok().map(|n| n.max(1));
     let field = |key: &str| comment.split(|c| c == ',' || c == ';').find_map(|f| f.trim().strip_prefix(key));
-    let (src0, src1) = field("wr:").and_then(|w| w.split_once('+')).map_or((None, None), |(a, b)| (number(a), number(b)));
+    let (src0, src1) =
+        field("wr:").and_then(|w| w.split_once('+')).map_or((None, None), |(a, b)| (number(a), number(b)));
     (src0, src1, field("rd:").and_then(number))
 }
 
@@ -105,7 +109,9 @@ pub fn instruction(line: &str, grf: u32) -> Option<Instruction> {
     let mut words = code.split_whitespace().peekable();
     let mut reads = Vec::new();
     if let Some(predicate) = words.next_if(|w| w.starts_with('(')) {
-        if let Some(f) = predicate.trim_matches(['(', ')']).split('&').find(|p| p.trim_start_matches('~').starts_with('f')) {
+        if let Some(f) =
+            predicate.trim_matches(['(', ')']).split('&').find(|p| p.trim_start_matches('~').starts_with('f'))
+        {
             reads.extend(registers(f.trim_start_matches('~'), 1, grf, None, false));
         }
     }
@@ -114,17 +120,28 @@ pub fn instruction(line: &str, grf: u32) -> Option<Instruction> {
     if mnemonic.is_empty() || !mnemonic.chars().all(|c| c.is_ascii_alphanumeric()) {
         return None;
     }
-    let exec_size = words.next_if(|w| w.starts_with('(') && w.contains('|')).and_then(|w| w.trim_start_matches('(').split('|').next()?.parse().ok()).unwrap_or(1);
+    let exec_size = words
+        .next_if(|w| w.starts_with('(') && w.contains('|'))
+        .and_then(|w| w.trim_start_matches('(').split('|').next()?.parse().ok())
+        .unwrap_or(1);
     let mut writes = Vec::new();
     if let Some(cond) = words.next_if(|w| w.starts_with('(') && w.contains(")f")) {
         writes.extend(registers(cond.split_once(')').map_or("", |(_, f)| f), exec_size, grf, None, true));
     }
-    let operands: Vec<&str> = words.filter(|w| w.starts_with(['r', 'a', 'f', 'n', 'c', 's', 't', '-', '~', '(']) && !w.starts_with("0x")).collect();
+    let operands: Vec<&str> = words
+        .filter(|w| w.starts_with(['r', 'a', 'f', 'n', 'c', 's', 't', '-', '~', '(']) && !w.starts_with("0x"))
+        .collect();
     let is_send = mnemonic.starts_with("send");
     let (src0, src1, dst_len) = if is_send { send_lengths(comment) } else { (None, None, None) };
     let mut dst_type = String::new();
     for (k, o) in operands.iter().enumerate() {
-        if k == 0 && !["if", "else", "endif", "while", "jmpi", "goto", "join", "break", "cont", "call", "ret", "halt", "brd", "brc", "nop"].contains(&mnemonic) {
+        if k == 0
+            && ![
+                "if", "else", "endif", "while", "jmpi", "goto", "join", "break", "cont", "call", "ret", "halt", "brd",
+                "brc", "nop",
+            ]
+            .contains(&mnemonic)
+        {
             writes.extend(registers(o, exec_size, grf, dst_len.filter(|_| is_send), true));
             dst_type = o.rsplit_once(':').map_or(String::new(), |(_, t)| t.to_string());
         } else if k > 0 {
@@ -210,20 +227,30 @@ mod tests {
 
     #[test]
     fn operands_give_the_registers_read_and_written() {
-        let i = instruction("(W&f0.0)  sel (16|M0)   (lt)f1.0   r39.0<1>:f    r4.1<0;1,0>:f     1.0:f   {Compacted}", 32).unwrap();
+        let i =
+            instruction("(W&f0.0)  sel (16|M0)   (lt)f1.0   r39.0<1>:f    r4.1<0;1,0>:f     1.0:f   {Compacted}", 32)
+                .unwrap();
         assert_eq!((i.mnemonic.as_str(), i.exec_size, i.dst_type.as_str()), ("sel", 16, "f"));
         assert_eq!(i.reads, vec![Reg::Flag(0), Reg::Grf(4)]);
         assert_eq!(i.writes, vec![Reg::Flag(2), Reg::Grf(39), Reg::Grf(40)]);
-        let m = instruction("        mad (16|M0)   acc0.0<1>:f   acc0.0<8;1>:f     r28.0<8;1>:f      r28.0<1>:f       {@6}", 32).unwrap();
+        let m = instruction(
+            "        mad (16|M0)   acc0.0<1>:f   acc0.0<8;1>:f     r28.0<8;1>:f      r28.0<1>:f       {@6}",
+            32,
+        )
+        .unwrap();
         assert_eq!(m.writes, vec![Reg::Acc(0)]);
         assert_eq!(m.reads, vec![Reg::Acc(0), Reg::Grf(28), Reg::Grf(29), Reg::Grf(28), Reg::Grf(29)]);
         let s = instruction("        send.dc1 (16|M0)         r10      r2      null    0x0            0x04605800           {@2,$0} // wr:2+0, rd:6; untyped surface read with xyz", 32).unwrap();
         assert_eq!(s.writes, (10..16).map(Reg::Grf).collect::<Vec<_>>());
         assert_eq!(s.reads, vec![Reg::Grf(2), Reg::Grf(3)]);
-        let p = instruction("        math.pow (16|M0)         r8.0<1>:f     r2.0<1;1,0>:f     r4.0<1;1,0>:f  {F@1}", 32).unwrap();
+        let p =
+            instruction("        math.pow (16|M0)         r8.0<1>:f     r2.0<1;1,0>:f     r4.0<1;1,0>:f  {F@1}", 32)
+                .unwrap();
         assert_eq!((p.mnemonic.as_str(), p.function.as_str()), ("math", "pow"));
         assert!(instruction("L640:", 32).is_none() && instruction("// a comment", 32).is_none());
-        let c = instruction("(f0.0)  if (32|M0)                           L944                  L992                ", 32).unwrap();
+        let c =
+            instruction("(f0.0)  if (32|M0)                           L944                  L992                ", 32)
+                .unwrap();
         assert_eq!((c.reads.clone(), c.writes.clone()), (vec![Reg::Flag(0)], vec![]));
     }
 
@@ -236,7 +263,13 @@ mod tests {
                      add (16|M0)  r22.0<1>:f  r20.0<8;8,1>:f  r30.0<8;8,1>:f\n",
             32,
         );
-        let timing = |i: &Instruction| Ok(if i.mnemonic == "send" { Timing { latency: 320.0, pipe: None } } else { Timing { latency: 10.0, pipe: Some((0, 2.0)) } });
+        let timing = |i: &Instruction| {
+            Ok(if i.mnemonic == "send" {
+                Timing { latency: 320.0, pipe: None }
+            } else {
+                Timing { latency: 10.0, pipe: Some((0, 2.0)) }
+            })
+        };
         // send at 0; the first mul waits for r10 (320); the second for the pipe (322); add for r30 (332).
         assert_eq!(schedule_latency(&is, timing).unwrap(), 333.0);
         assert_eq!(issue_times(&is, timing).unwrap(), [0.0, 320.0, 322.0, 332.0, 333.0]);
@@ -245,7 +278,8 @@ mod tests {
     #[test]
     fn igcs_file_and_line_comments_name_the_instructions_after_them() {
         let listing = "(W)     mov (8|M0)  r59.0<1>:ud  r0.0<1;1,0>:ud  // $1\n// File: /tmp/a.brdf\n// Line 20\n        shl (16|M0)  r64.0<1>:d  r64.0<8;8,1>:d  2:w  // $18\n// Line 11\n        math.exp (16|M0)  r60.0<1>:f  r108.0<8;8,1>:f  {$1}  // $28\n";
-        let got: Vec<(String, Option<(String, u32)>)> = sourced_instructions(listing, 32).into_iter().map(|(i, s)| (i.mnemonic, s)).collect();
+        let got: Vec<(String, Option<(String, u32)>)> =
+            sourced_instructions(listing, 32).into_iter().map(|(i, s)| (i.mnemonic, s)).collect();
         let a = |n| Some(("/tmp/a.brdf".to_string(), n));
         assert_eq!(got, [("mov".to_string(), None), ("shl".to_string(), a(20)), ("math".to_string(), a(11))]);
     }

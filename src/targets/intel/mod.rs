@@ -15,7 +15,7 @@ use super::translated::{Compilation, LineCompile, Translated, Translator};
 use crate::gpu::DriverStat;
 use crate::model::Model;
 use crate::translate::Dialect;
-use anyhow::{anyhow, bail, Result};
+use anyhow::{Result, anyhow, bail};
 use std::collections::BTreeMap;
 
 /// One Intel GPU generation, as ocloc names a device of it.
@@ -54,11 +54,61 @@ pub enum Pipes {
 }
 
 pub const FAMILIES: [Family; 5] = [
-    Family { name: "gen9", device: "skl", architecture: "Gen9", products: "HD/UHD Graphics 5xx-6xx (Skylake to Comet Lake)", column: 0, grf_bytes: 32, threads: 7, pipes: Pipes::TwoFpus, legacy_latency: true },
-    Family { name: "gen11", device: "icllp", architecture: "Gen11", products: "Iris Plus / UHD (Ice Lake)", column: 1, grf_bytes: 32, threads: 7, pipes: Pipes::TwoFpus, legacy_latency: true },
-    Family { name: "gen12lp", device: "tgllp", architecture: "Xe-LP (Gen12LP)", products: "Iris Xe / UHD (Tiger Lake to Raptor Lake), Iris Xe MAX", column: 2, grf_bytes: 32, threads: 7, pipes: Pipes::OneAlu, legacy_latency: false },
-    Family { name: "xe-hpg", device: "dg2", architecture: "Xe-HPG", products: "Arc A-series (Alchemist, ACM-G10)", column: 3, grf_bytes: 32, threads: 8, pipes: Pipes::ThreePipes, legacy_latency: false },
-    Family { name: "xe-hpc", device: "pvc", architecture: "Xe-HPC", products: "Data Center GPU Max (Ponte Vecchio)", column: 4, grf_bytes: 64, threads: 8, pipes: Pipes::ThreePipes, legacy_latency: false },
+    Family {
+        name: "gen9",
+        device: "skl",
+        architecture: "Gen9",
+        products: "HD/UHD Graphics 5xx-6xx (Skylake to Comet Lake)",
+        column: 0,
+        grf_bytes: 32,
+        threads: 7,
+        pipes: Pipes::TwoFpus,
+        legacy_latency: true,
+    },
+    Family {
+        name: "gen11",
+        device: "icllp",
+        architecture: "Gen11",
+        products: "Iris Plus / UHD (Ice Lake)",
+        column: 1,
+        grf_bytes: 32,
+        threads: 7,
+        pipes: Pipes::TwoFpus,
+        legacy_latency: true,
+    },
+    Family {
+        name: "gen12lp",
+        device: "tgllp",
+        architecture: "Xe-LP (Gen12LP)",
+        products: "Iris Xe / UHD (Tiger Lake to Raptor Lake), Iris Xe MAX",
+        column: 2,
+        grf_bytes: 32,
+        threads: 7,
+        pipes: Pipes::OneAlu,
+        legacy_latency: false,
+    },
+    Family {
+        name: "xe-hpg",
+        device: "dg2",
+        architecture: "Xe-HPG",
+        products: "Arc A-series (Alchemist, ACM-G10)",
+        column: 3,
+        grf_bytes: 32,
+        threads: 8,
+        pipes: Pipes::ThreePipes,
+        legacy_latency: false,
+    },
+    Family {
+        name: "xe-hpc",
+        device: "pvc",
+        architecture: "Xe-HPC",
+        products: "Data Center GPU Max (Ponte Vecchio)",
+        column: 4,
+        grf_bytes: 64,
+        threads: 8,
+        pipes: Pipes::ThreePipes,
+        legacy_latency: false,
+    },
 ];
 
 /// The families of `THROUGHPUT`'s columns.
@@ -120,10 +170,13 @@ impl Class {
 /// The report class of a Gen ISA mnemonic (before its first `.`).
 pub fn classify(mnemonic: &str) -> Class {
     match mnemonic {
-        "add" | "add3" | "mul" | "mad" | "mac" | "mach" | "macl" | "madm" | "lrp" | "dp2" | "dp3" | "dp4" | "dph" | "dp4a" | "line" | "pln" | "avg" | "frc" | "rndd" | "rnde" | "rndu" | "rndz" | "sad2" | "sada2" | "addc" | "subb" => Class::Fma,
+        "add" | "add3" | "mul" | "mad" | "mac" | "mach" | "macl" | "madm" | "lrp" | "dp2" | "dp3" | "dp4" | "dph"
+        | "dp4a" | "line" | "pln" | "avg" | "frc" | "rndd" | "rnde" | "rndu" | "rndz" | "sad2" | "sada2" | "addc"
+        | "subb" => Class::Fma,
         "math" => Class::ExtendedMath,
         "send" | "sendc" | "sends" | "sendsc" => Class::Send,
-        "if" | "else" | "endif" | "while" | "break" | "cont" | "goto" | "join" | "jmpi" | "call" | "calla" | "ret" | "halt" | "brd" | "brc" | "wait" | "sync" | "nop" | "illegal" => Class::Control,
+        "if" | "else" | "endif" | "while" | "break" | "cont" | "goto" | "join" | "jmpi" | "call" | "calla" | "ret"
+        | "halt" | "brd" | "brc" | "wait" | "sync" | "nop" | "illegal" => Class::Control,
         "mov" | "movi" | "smov" => Class::Move,
         _ => Class::Alu,
     }
@@ -151,7 +204,12 @@ fn pipe_of(i: &gen_isa::Instruction, family: &Family) -> Pipe {
         _ if family.pipes != Pipes::ThreePipes => Pipe::Alu,
         // Mesa's inferred_exec_pipe: 64-bit types and dword integer multiplies on the long pipe, float
         // destinations on the float pipe, the rest on the integer pipe.
-        _ if ["df", "q", "uq"].contains(&i.dst_type.as_str()) || (["mul", "mad", "mach"].contains(&i.mnemonic.as_str()) && ["d", "ud"].contains(&i.dst_type.as_str())) => Pipe::Long,
+        _ if ["df", "q", "uq"].contains(&i.dst_type.as_str())
+            || (["mul", "mad", "mach"].contains(&i.mnemonic.as_str())
+                && ["d", "ud"].contains(&i.dst_type.as_str())) =>
+        {
+            Pipe::Long
+        }
         _ if ["f", "hf", "bf"].contains(&i.dst_type.as_str()) => Pipe::Float,
         _ => Pipe::Int,
     }
@@ -258,7 +316,9 @@ pub fn check_listing(listing: &str, code_bytes: Option<usize>) -> std::result::R
     }
     let listed: u64 = lines.iter().map(|l| instruction_bytes(l)).sum();
     match code_bytes {
-        Some(code) if listed != code as u64 => Err(format!("{} instructions of {listed} bytes, where the kernel's code holds {code} bytes", lines.len())),
+        Some(code) if listed != code as u64 => {
+            Err(format!("{} instructions of {listed} bytes, where the kernel's code holds {code} bytes", lines.len()))
+        }
         _ => Ok(()),
     }
 }
@@ -338,14 +398,31 @@ const LEGACY_MATH_TWO_SOURCE: f64 = 30.0;
 impl IsaStats {
     pub fn of(binary: &ocloc::Binary, family: &Family) -> Result<Self> {
         let tokens = patch_tokens(&binary.tokens);
-        let env = tokens.get(&EXECUTION_ENVIRONMENT).filter(|w| w.len() > GRF_WORD).ok_or_else(|| anyhow!("ocloc's patch tokens carry no execution environment (SIMD width, GRF count)"))?;
+        let env = tokens
+            .get(&EXECUTION_ENVIRONMENT)
+            .filter(|w| w.len() > GRF_WORD)
+            .ok_or_else(|| anyhow!("ocloc's patch tokens carry no execution environment (SIMD width, GRF count)"))?;
         let scratch = |t: u32| tokens.get(&t).and_then(|w| w.get(1).copied()).unwrap_or(0);
-        let mut s = IsaStats { simd: env[SIMD_WORD], grf: env[GRF_WORD], scratch_bytes: scratch(MEDIA_VFE_STATE) + scratch(MEDIA_VFE_STATE_SLOT1), binary_bytes: kernel_bytes(&binary.tokens).unwrap_or(binary.bytes) as u32, ..Default::default() };
+        let mut s = IsaStats {
+            simd: env[SIMD_WORD],
+            grf: env[GRF_WORD],
+            scratch_bytes: scratch(MEDIA_VFE_STATE) + scratch(MEDIA_VFE_STATE_SLOT1),
+            binary_bytes: kernel_bytes(&binary.tokens).unwrap_or(binary.bytes) as u32,
+            ..Default::default()
+        };
         s.count(&binary.listing, family.grf_bytes);
         if s.instructions == 0 || ![8, 16, 32].contains(&s.simd) {
-            bail!("IGA's listing has {} instructions and the binary says SIMD{}: not a kernel brdfprof can count", s.instructions, s.simd);
+            bail!(
+                "IGA's listing has {} instructions and the binary says SIMD{}: not a kernel brdfprof can count",
+                s.instructions,
+                s.simd
+            );
         }
-        check_listing(&binary.listing, kernel_bytes(&binary.tokens)).map_err(|why| anyhow!("ocloc disasm's listing is not the kernel's code ({why}); reinstall Intel's compiler with `make setup`"))?;
+        check_listing(&binary.listing, kernel_bytes(&binary.tokens)).map_err(|why| {
+            anyhow!(
+                "ocloc disasm's listing is not the kernel's code ({why}); reinstall Intel's compiler with `make setup`"
+            )
+        })?;
         Ok(s)
     }
 
@@ -402,7 +479,12 @@ impl IsaStats {
     /// The statistics as driver statistics of the executable "IGC" (names lined up with `schema::driver`'s
     /// aliases, so that the gate reads registers, instructions, spills and code size as for any driver).
     pub fn driver_stats(&self, family: &Family) -> Result<Vec<DriverStat>> {
-        let stat = |name: &str, value: f64| DriverStat { executable: "IGC".into(), name: name.into(), description: String::new(), value };
+        let stat = |name: &str, value: f64| DriverStat {
+            executable: "IGC".into(),
+            name: name.into(),
+            description: String::new(),
+            value,
+        };
         let mut out = vec![
             stat("SIMD Width", f64::from(self.simd)),
             stat("Register Count", f64::from(self.grf)),
@@ -461,10 +543,15 @@ pub fn compile_as(source: &str, family: &Family, precise: bool, lines: bool) -> 
         let binary: ocloc::Binary = serde_json::from_slice(bytes)?;
         IsaStats::of(&binary, family).map(|_| ())
     };
-    let bytes = crate::cache::get_or_build(crate::cache::Store::open_default().as_ref(), "igc", &key, &what, valid, || {
-        let binary = if lines { tools.compile_with_lines(source, family.device, &options, &what)? } else { tools.compile(source, family.device, &options, &what)? };
-        Ok(serde_json::to_vec(&binary)?)
-    })?;
+    let bytes =
+        crate::cache::get_or_build(crate::cache::Store::open_default().as_ref(), "igc", &key, &what, valid, || {
+            let binary = if lines {
+                tools.compile_with_lines(source, family.device, &options, &what)?
+            } else {
+                tools.compile(source, family.device, &options, &what)?
+            };
+            Ok(serde_json::to_vec(&binary)?)
+        })?;
     Ok(serde_json::from_slice(&bytes)?)
 }
 
@@ -473,15 +560,25 @@ pub fn compile_as(source: &str, family: &Family, precise: bool, lines: bool) -> 
 /// `IsaStats::schedule_latency`'s schedule), summed per line; the translation's own lines and IGC's prologue
 /// name none. Lines are ranked on the pipe that binds the kernel.
 pub fn line_costs(model: &str, binary: &ocloc::Binary, family: &Family) -> Result<crate::schema::lines::KernelLines> {
-    use super::cost::lines::{per_line, Attributed};
+    use super::cost::lines::{Attributed, per_line};
     let stats = IsaStats::of(binary, family)?;
-    let listing = binary.lines_listings.get(&stats.simd).ok_or_else(|| anyhow!("IGC's shader dump has no SIMD{} listing (it has {:?})", stats.simd, binary.lines_listings.keys().collect::<Vec<_>>()))?;
+    let listing = binary.lines_listings.get(&stats.simd).ok_or_else(|| {
+        anyhow!(
+            "IGC's shader dump has no SIMD{} listing (it has {:?})",
+            stats.simd,
+            binary.lines_listings.keys().collect::<Vec<_>>()
+        )
+    })?;
     let sourced = gen_isa::sourced_instructions(listing, family.grf_bytes);
     if sourced.is_empty() {
         bail!("IGC's listing with line information has no instructions");
     }
     let instructions: Vec<gen_isa::Instruction> = sourced.iter().map(|(i, _)| i.clone()).collect();
-    let binding = stats.pipes(family)?.into_iter().fold(("-".to_string(), f64::NEG_INFINITY), |b, p| if p.1 > b.1 { p } else { b }).0;
+    let binding = stats
+        .pipes(family)?
+        .into_iter()
+        .fold(("-".to_string(), f64::NEG_INFINITY), |b, p| if p.1 > b.1 { p } else { b })
+        .0;
     let times = gen_isa::issue_times(&instructions, |i| {
         let pipe = occupancy(i, family)?.map(|(p, c)| (p as usize, c));
         Ok(gen_isa::Timing { latency: latency(i, family), pipe })
@@ -493,7 +590,12 @@ pub fn line_costs(model: &str, binary: &ocloc::Binary, family: &Family) -> Resul
         let schedule = times[k] - previous;
         previous = times[k];
         let pipes = pipe_cycles(&i, family)?.into_iter().map(|(p, c)| (p.name(family.pipes).to_string(), c)).collect();
-        attributed.push(Attributed { source: super::translated::user_source(source.as_slice()), pipes, schedule, issue: 0.0 });
+        attributed.push(Attributed {
+            source: super::translated::user_source(source.as_slice()),
+            pipes,
+            schedule,
+            issue: 0.0,
+        });
     }
     Ok(per_line(model, &attributed, &binding))
 }
@@ -515,7 +617,8 @@ impl Translator for Intel {
     const COMPILER: &'static str = "IGC";
     const UNIT: &'static str = "EU cycles";
     const RULE: &'static str = "a thread's pipes at THROUGHPUT's lanes per clock (Intel's documents; extended math: IGC's scheduling model), its latency in IGC's instruction order at IGC's scheduler latencies, threads per EU from the registers; / (SIMD width x lights per kernel); Issue Cycles: the old serial sum";
-    const SHOWN: &'static [&'static str] = &["SIMD Width", "Register Count", "Spill Count", "Instruction Count", "Extended math", "Issue Cycles"];
+    const SHOWN: &'static [&'static str] =
+        &["SIMD Width", "Register Count", "Spill Count", "Instruction Count", "Extended math", "Issue Cycles"];
     const ISA_EXTENSIONS: (&'static str, &'static str) = ("cl", "asm");
 
     fn families() -> &'static [Family] {
@@ -523,7 +626,13 @@ impl Translator for Intel {
     }
 
     fn family(f: &Family) -> super::Family {
-        super::Family { name: f.name, architecture: f.architecture, products: f.products, detail: format!("ocloc -device {}", f.device), default: true }
+        super::Family {
+            name: f.name,
+            architecture: f.architecture,
+            products: f.products,
+            detail: format!("ocloc -device {}", f.device),
+            default: true,
+        }
     }
 
     fn tools() -> Result<&'static ocloc::Tools> {
@@ -562,24 +671,40 @@ impl Translator for Intel {
             target: format!("intel:{}", family.name),
             device: serde_json::json!({"name": device, "driver_name": "IGC (ocloc)", "driver_info": format!("{} (-device {}; {options})", tools.version, family.device), "driver_version": tools.version}),
             compiler: serde_json::json!({"name": tools.version, "options": options, "device": family.device, "translation": "brdfprof's SPIR-V to OpenCL C translation"}),
-            driver_note: format!("Intel's OpenCL compiler (IGC, {}) on the kernels' OpenCL C translation, same maths; -device {}; options: {options}", tools.version, family.device),
+            driver_note: format!(
+                "Intel's OpenCL compiler (IGC, {}) on the kernels' OpenCL C translation, same maths; -device {}; options: {options}",
+                tools.version, family.device
+            ),
             tool: ("ocloc".to_string(), tools.version.clone()),
         }
     }
 
     fn isa_listing(family: &Family, label: &str, binary: &ocloc::Binary, tools: &ocloc::Tools) -> Result<String> {
         let stats = IsaStats::of(binary, family)?;
-        let header = format!("// {label}: Gen ISA for {} (ocloc -device {}) by {}, listed by IGA\n// SIMD{}, {} GRF, {} bytes scratch per thread\n", family.name, family.device, tools.version, stats.simd, stats.grf, stats.scratch_bytes);
+        let header = format!(
+            "// {label}: Gen ISA for {} (ocloc -device {}) by {}, listed by IGA\n// SIMD{}, {} GRF, {} bytes scratch per thread\n",
+            family.name, family.device, tools.version, stats.simd, stats.grf, stats.scratch_bytes
+        );
         Ok(format!("{header}{}", binary.listing))
     }
 
     fn line_compile(m: &Model, source: &str, costed: &str, family: &Family, precise: bool) -> Result<LineCompile> {
         let binary = compile_as(source, family, precise, true)?;
         let lines = line_costs(&m.label(), &binary, family)?;
-        let shape = |i: gen_isa::Instruction| format!("{}.{} ({}) :{}", i.mnemonic, i.function, i.exec_size, i.dst_type);
-        let costed = gen_isa::instructions(&compile(costed, family, precise)?.listing, family.grf_bytes).into_iter().map(shape).collect();
+        let shape =
+            |i: gen_isa::Instruction| format!("{}.{} ({}) :{}", i.mnemonic, i.function, i.exec_size, i.dst_type);
+        let costed = gen_isa::instructions(&compile(costed, family, precise)?.listing, family.grf_bytes)
+            .into_iter()
+            .map(shape)
+            .collect();
         let simd = IsaStats::of(&binary, family)?.simd;
-        let annotated = gen_isa::sourced_instructions(binary.lines_listings.get(&simd).map_or("", String::as_str), family.grf_bytes).into_iter().map(|(i, _)| shape(i)).collect();
+        let annotated = gen_isa::sourced_instructions(
+            binary.lines_listings.get(&simd).map_or("", String::as_str),
+            family.grf_bytes,
+        )
+        .into_iter()
+        .map(|(i, _)| shape(i))
+        .collect();
         Ok(LineCompile { lines, costed, annotated })
     }
 }
@@ -590,14 +715,30 @@ mod tests {
 
     #[test]
     fn iga_lines_give_mnemonic_width_type_and_row() {
-        let i = gen_isa::instruction("        math.inv (32|M0)         r6.0<1>:f     r2.0<1;1,0>:f                    {F@1}", 32).unwrap();
+        let i = gen_isa::instruction(
+            "        math.inv (32|M0)         r6.0<1>:f     r2.0<1;1,0>:f                    {F@1}",
+            32,
+        )
+        .unwrap();
         assert_eq!((i.mnemonic.as_str(), i.exec_size, classify(&i.mnemonic)), ("math", 32, Class::ExtendedMath));
         assert_eq!(row_of(classify(&i.mnemonic), &i.dst_type, &i.function), Some(EM));
-        let h = gen_isa::instruction("        mad (16|M0)              r5.0<1>:hf    r1.0<1;0>:hf   r2.0<1;0>:hf   r3.0<1;0>:hf", 32).unwrap();
+        let h = gen_isa::instruction(
+            "        mad (16|M0)              r5.0<1>:hf    r1.0<1;0>:hf   r2.0<1;0>:hf   r3.0<1;0>:hf",
+            32,
+        )
+        .unwrap();
         assert_eq!(row_of(classify(&h.mnemonic), &h.dst_type, &h.function), Some(FP16));
-        let p = gen_isa::instruction("        math.pow (16|M0)         r8.0<1>:f     r2.0<1;1,0>:f     r4.0<1;1,0>:f  {F@1}", 32).unwrap();
+        let p = gen_isa::instruction(
+            "        math.pow (16|M0)         r8.0<1>:f     r2.0<1;1,0>:f     r4.0<1;1,0>:f  {F@1}",
+            32,
+        )
+        .unwrap();
         assert_eq!(row_of(classify(&p.mnemonic), &p.dst_type, &p.function), Some(EM_TWO_SOURCE));
-        let s = gen_isa::instruction("        sync.nop                             null                             {Compacted,$6.dst}", 32).unwrap();
+        let s = gen_isa::instruction(
+            "        sync.nop                             null                             {Compacted,$6.dst}",
+            32,
+        )
+        .unwrap();
         assert_eq!((s.mnemonic.as_str(), s.exec_size), ("sync", 1));
     }
 
@@ -605,7 +746,11 @@ mod tests {
     fn pipes_follow_the_family() {
         let family = |n: &str| FAMILIES.iter().find(|f| f.name == n).unwrap();
         let i = |l: &str| gen_isa::instruction(l, 32).unwrap();
-        let (fmul, imul, iadd) = (i("mul (16|M0) r5.0<1>:f r1.0<8;8,1>:f r2.0<8;8,1>:f"), i("mul (16|M0) r5.0<1>:d r1.0<8;8,1>:d r2.0<8;8,1>:d"), i("add (16|M0) r5.0<1>:d r1.0<8;8,1>:d r2.0<8;8,1>:d"));
+        let (fmul, imul, iadd) = (
+            i("mul (16|M0) r5.0<1>:f r1.0<8;8,1>:f r2.0<8;8,1>:f"),
+            i("mul (16|M0) r5.0<1>:d r1.0<8;8,1>:d r2.0<8;8,1>:d"),
+            i("add (16|M0) r5.0<1>:d r1.0<8;8,1>:d r2.0<8;8,1>:d"),
+        );
         assert_eq!([&fmul, &imul, &iadd].map(|x| pipe_of(x, family("xe-hpg"))), [Pipe::Float, Pipe::Long, Pipe::Int]);
         assert_eq!([&fmul, &imul, &iadd].map(|x| pipe_of(x, family("gen12lp"))), [Pipe::Alu; 3]);
         // Xe latencies: an FPU result at SIMD16 10 + 1; a SIMD16 math 17 + 4; the legacy table 14 and 22.
@@ -644,8 +789,18 @@ mod throughput_fixture {
             .filter(|l| !l.starts_with('#') && !l.trim().is_empty())
             .map(|l| {
                 let f: Vec<&str> = l.split('\t').collect();
-                assert!(f.len() == 7 && !f[6].trim().is_empty(), "a fixture line needs row, family, lanes, basis, source, figures and note: {l}");
-                Entry { row: f[0].into(), family: f[1].into(), lanes: f[2].parse().unwrap(), basis: f[3].into(), source: f[4].into(), figures: f[5].into() }
+                assert!(
+                    f.len() == 7 && !f[6].trim().is_empty(),
+                    "a fixture line needs row, family, lanes, basis, source, figures and note: {l}"
+                );
+                Entry {
+                    row: f[0].into(),
+                    family: f[1].into(),
+                    lanes: f[2].parse().unwrap(),
+                    basis: f[3].into(),
+                    source: f[4].into(),
+                    figures: f[5].into(),
+                }
             })
             .collect()
     }
@@ -682,14 +837,28 @@ mod throughput_fixture {
         let header = include_str!("../../../tests/fixtures/intel-throughput.tsv");
         for e in &rows {
             let what = format!("{} on {}", e.row, e.family);
-            assert!(["stated", "derived"].contains(&e.basis.as_str()), "{what}: basis `{}` (a rate is the source's figure or computed from it)", e.basis);
-            assert!(header.contains(&format!("# [{}]", e.source)), "{what}: source `{}` is not cited in the header", e.source);
+            assert!(
+                ["stated", "derived"].contains(&e.basis.as_str()),
+                "{what}: basis `{}` (a rate is the source's figure or computed from it)",
+                e.basis
+            );
+            assert!(
+                header.contains(&format!("# [{}]", e.source)),
+                "{what}: source `{}` is not cited in the header",
+                e.source
+            );
             assert_eq!(evaluate(&e.figures), e.lanes, "{what}: the figures `{}` do not give the rate", e.figures);
             if e.basis == "stated" {
-                assert!(e.figures.chars().all(|c| c.is_ascii_digit()), "{what}: a stated rate is the figure itself, not `{}`", e.figures);
+                assert!(
+                    e.figures.chars().all(|c| c.is_ascii_digit()),
+                    "{what}: a stated rate is the figure itself, not `{}`",
+                    e.figures
+                );
             }
-            let column = COLUMNS.iter().position(|c| *c == e.family).unwrap_or_else(|| panic!("unknown family {}", e.family));
-            let rate = THROUGHPUT.iter().find(|r| r.row == e.row).unwrap_or_else(|| panic!("the code has no row `{}`", e.row));
+            let column =
+                COLUMNS.iter().position(|c| *c == e.family).unwrap_or_else(|| panic!("unknown family {}", e.family));
+            let rate =
+                THROUGHPUT.iter().find(|r| r.row == e.row).unwrap_or_else(|| panic!("the code has no row `{}`", e.row));
             assert_eq!(rate.lanes_per_clock[column], e.lanes, "{what}");
         }
         assert_eq!(rows.len(), THROUGHPUT.len() * COLUMNS.len(), "every rate of every family is in the fixture once");
@@ -721,7 +890,13 @@ mod throughput_fixture {
         // The pipes on gen9: the mads on either FPU (2 x 2 FPU-cycles each), the math on FPU1 (8 + 16):
         // FPU1 binds at 24; on gen12lp the ALU has 4, extended math 16.
         let pipes = |f: &str| s.pipes(family(f)).unwrap().into_iter().collect::<BTreeMap<String, f64>>();
-        assert_eq!((pipes("gen9")["FPU0 + FPU1 (FP, integer, extended math)"], pipes("gen9")["FPU1 (extended math)"]), ((8.0 + 24.0) / 2.0, 24.0));
-        assert_eq!((pipes("gen12lp")["ALU (FP, integer)"], pipes("gen12lp")["extended math"], pipes("gen12lp")["send"]), (4.0, 16.0, 1.0));
+        assert_eq!(
+            (pipes("gen9")["FPU0 + FPU1 (FP, integer, extended math)"], pipes("gen9")["FPU1 (extended math)"]),
+            ((8.0 + 24.0) / 2.0, 24.0)
+        );
+        assert_eq!(
+            (pipes("gen12lp")["ALU (FP, integer)"], pipes("gen12lp")["extended math"], pipes("gen12lp")["send"]),
+            (4.0, 16.0, 1.0)
+        );
     }
 }

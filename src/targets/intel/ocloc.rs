@@ -3,7 +3,7 @@
 //! which lists the ISA through IGA, `libiga64.so`, and the binary's patch tokens). Every run is under the
 //! compile limit (`launch::output`).
 
-use anyhow::{anyhow, bail, Context, Result};
+use anyhow::{Context, Result, anyhow, bail};
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
@@ -36,7 +36,10 @@ pub fn iga_dir() -> PathBuf {
 }
 
 fn not_installed(why: &str) -> String {
-    format!("Intel compiler not installed: run `make setup` (it installs Debian's intel-opencl-icd, whose ocloc runs IGC with no Intel GPU, and links IGA's libiga64.so into {}); {why}", iga_dir().display())
+    format!(
+        "Intel compiler not installed: run `make setup` (it installs Debian's intel-opencl-icd, whose ocloc runs IGC with no Intel GPU, and links IGA's libiga64.so into {}); {why}",
+        iga_dir().display()
+    )
 }
 
 /// IGC's library as ocloc loads it: its resolved name and size stand for its version (Debian ships no
@@ -55,20 +58,27 @@ fn igc_identity() -> String {
 fn load() -> std::result::Result<Tools, String> {
     let ocloc = ocloc_path();
     if ocloc.is_dir() {
-        return Err(not_installed(&format!("{} is a directory, not the ocloc executable (BRDFPROF_OCLOC names the program itself)", ocloc.display())));
+        return Err(not_installed(&format!(
+            "{} is a directory, not the ocloc executable (BRDFPROF_OCLOC names the program itself)",
+            ocloc.display()
+        )));
     }
     if !ocloc.is_file() {
         return Err(not_installed(&format!("{} is missing", ocloc.display())));
     }
     let iga_dir = iga_dir();
     if !iga_dir.join("libiga64.so").exists() {
-        return Err(not_installed(&format!("{} is missing (ocloc cannot disassemble without it)", iga_dir.join("libiga64.so").display())));
+        return Err(not_installed(&format!(
+            "{} is missing (ocloc cannot disassemble without it)",
+            iga_dir.join("libiga64.so").display()
+        )));
     }
     // `ocloc query OCL_DRIVER_VERSION` writes the version to a file of that name in its working directory.
     let dir = crate::cleanup::TempDir::new().map_err(|e| not_installed(&format!("no temporary directory: {e}")))?;
     let mut cmd = crate::cleanup::command(ocloc.to_str().unwrap_or("ocloc"));
     cmd.args(["query", "OCL_DRIVER_VERSION"]).current_dir(dir.path());
-    let out = crate::launch::output(&mut cmd, "ocloc's version query").map_err(|e| not_installed(&format!("cannot run {}: {e:#}", ocloc.display())))?;
+    let out = crate::launch::output(&mut cmd, "ocloc's version query")
+        .map_err(|e| not_installed(&format!("cannot run {}: {e:#}", ocloc.display())))?;
     let driver = std::fs::read_to_string(dir.path().join("OCL_DRIVER_VERSION")).unwrap_or_default();
     let driver = driver.trim_matches(|c: char| c.is_whitespace() || c == '\0');
     if !out.status.success() || driver.is_empty() {
@@ -119,14 +129,21 @@ impl std::fmt::Display for Unsupported {
 impl std::error::Error for Unsupported {}
 
 impl Tools {
-    fn run(&self, args: &[&std::ffi::OsStr], cwd: &Path, what: &str, dump: Option<&Path>) -> Result<std::process::Output> {
+    fn run(
+        &self,
+        args: &[&std::ffi::OsStr],
+        cwd: &Path,
+        what: &str,
+        dump: Option<&Path>,
+    ) -> Result<std::process::Output> {
         let mut cmd = crate::cleanup::command(self.ocloc.to_str().unwrap_or("ocloc"));
         cmd.args(args).current_dir(cwd).env("LD_LIBRARY_PATH", &self.iga_dir);
         if let Some(dir) = dump {
             // IGC's debug knobs (read from the environment): its shader dumps, into `dir`.
             cmd.env("IGC_ShaderDumpEnable", "1").env("IGC_DumpToCustomDir", dir);
         }
-        let out = crate::launch::output(&mut cmd, what).with_context(|| format!("cannot run {}", self.ocloc.display()))?;
+        let out =
+            crate::launch::output(&mut cmd, what).with_context(|| format!("cannot run {}", self.ocloc.display()))?;
         Ok(out)
     }
 
@@ -149,25 +166,50 @@ impl Tools {
         std::fs::write(&src, source).with_context(|| format!("cannot write {}", src.display()))?;
         let out_dir = dir.path().join("out");
         let os = |s: &str| std::ffi::OsString::from(s);
-        let args = [os("compile"), os("-file"), src.clone().into_os_string(), os("-device"), os(device), os("-options"), os(options), os("-q"), os("-out_dir"), out_dir.clone().into_os_string()];
+        let args = [
+            os("compile"),
+            os("-file"),
+            src.clone().into_os_string(),
+            os("-device"),
+            os(device),
+            os("-options"),
+            os(options),
+            os("-q"),
+            os("-out_dir"),
+            out_dir.clone().into_os_string(),
+        ];
         let dump_dir = dir.path().join("igc-dump");
         let dump_into = lines.then_some(dump_dir.as_path());
         let out = self.run(&args.iter().map(|a| a.as_os_str()).collect::<Vec<_>>(), dir.path(), what, dump_into)?;
         let log = format!("{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
         // The shader dump's own notice is not the compiler's.
-        let log: String = log.lines().filter(|l| !l.starts_with("ShaderDumpEnable Warning")).collect::<Vec<_>>().join("\n");
+        let log: String =
+            log.lines().filter(|l| !l.starts_with("ShaderDumpEnable Warning")).collect::<Vec<_>>().join("\n");
         if !out.status.success() {
             // -q hides the compiler's messages: the failure is compiled again without it, for the reason.
-            let loud: Vec<&std::ffi::OsStr> = args.iter().filter(|a| a.as_os_str() != "-q").map(|a| a.as_os_str()).collect();
+            let loud: Vec<&std::ffi::OsStr> =
+                args.iter().filter(|a| a.as_os_str() != "-q").map(|a| a.as_os_str()).collect();
             let again = self.run(&loud, dir.path(), what, None)?;
             let log = format!("{}{}", String::from_utf8_lossy(&again.stdout), String::from_utf8_lossy(&again.stderr));
             let errors: Vec<&str> = log.lines().filter(|l| l.contains("error:")).take(5).collect();
             if let Some(e) = errors.iter().find(|l| l.contains("cl_khr_fp64")) {
-                return Err(Unsupported { reason: format!("{device} has no fp64 (cl_khr_fp64); ocloc: {}", e.trim()) }.into());
+                return Err(
+                    Unsupported { reason: format!("{device} has no fp64 (cl_khr_fp64); ocloc: {}", e.trim()) }.into()
+                );
             }
-            bail!("ocloc cannot compile the OpenCL C translation for {device} (a translator defect):\n{}", if errors.is_empty() { log.lines().take(20).collect::<Vec<_>>().join("\n") } else { errors.join("\n") });
+            bail!(
+                "ocloc cannot compile the OpenCL C translation for {device} (a translator defect):\n{}",
+                if errors.is_empty() { log.lines().take(20).collect::<Vec<_>>().join("\n") } else { errors.join("\n") }
+            );
         }
-        let no_binary = |why: String| anyhow!("{}: `ocloc compile` for {device} exited 0 but wrote no device binary ({why}) in {}: {}", self.ocloc.display(), out_dir.display(), if log.trim().is_empty() { "it printed nothing" } else { log.trim() });
+        let no_binary = |why: String| {
+            anyhow!(
+                "{}: `ocloc compile` for {device} exited 0 but wrote no device binary ({why}) in {}: {}",
+                self.ocloc.display(),
+                out_dir.display(),
+                if log.trim().is_empty() { "it printed nothing" } else { log.trim() }
+            )
+        };
         let bin = std::fs::read_dir(&out_dir)
             .map_err(|e| no_binary(e.to_string()))?
             .filter_map(|e| e.ok().map(|e| e.path()))
@@ -175,16 +217,41 @@ impl Tools {
             .ok_or_else(|| no_binary("no .bin file".into()))?;
         let bytes = std::fs::metadata(&bin).map_err(|e| no_binary(e.to_string()))?.len() as usize;
         let dump = dir.path().join("disasm");
-        let args = [os("disasm"), os("-file"), bin.into_os_string(), os("-device"), os(device), os("-dump"), dump.clone().into_os_string()];
-        let out = self.run(&args.iter().map(|a| a.as_os_str()).collect::<Vec<_>>(), dir.path(), &format!("{what}: its ISA (ocloc disasm)"), None)?;
-        let read = |name: &str| crate::io::read_bounded(&dump.join(name), crate::launch::MAX_OUTPUT_BYTES as u64).map(|b| String::from_utf8_lossy(&b).into_owned());
+        let args = [
+            os("disasm"),
+            os("-file"),
+            bin.into_os_string(),
+            os("-device"),
+            os(device),
+            os("-dump"),
+            dump.clone().into_os_string(),
+        ];
+        let out = self.run(
+            &args.iter().map(|a| a.as_os_str()).collect::<Vec<_>>(),
+            dir.path(),
+            &format!("{what}: its ISA (ocloc disasm)"),
+            None,
+        )?;
+        let read = |name: &str| {
+            crate::io::read_bounded(&dump.join(name), crate::launch::MAX_OUTPUT_BYTES as u64)
+                .map(|b| String::from_utf8_lossy(&b).into_owned())
+        };
         let listing = read("brdfprof_kernel_KernelHeap.asm").map_err(|e| {
-            anyhow!("{}: `ocloc disasm` for {device} wrote no ISA listing ({e}; it needs {} to load IGA): {}", self.ocloc.display(), self.iga_dir.join("libiga64.so").display(), String::from_utf8_lossy(&out.stderr).trim())
+            anyhow!(
+                "{}: `ocloc disasm` for {device} wrote no ISA listing ({e}; it needs {} to load IGA): {}",
+                self.ocloc.display(),
+                self.iga_dir.join("libiga64.so").display(),
+                String::from_utf8_lossy(&out.stderr).trim()
+            )
         })?;
-        let tokens = read("PTM.txt").map_err(|e| anyhow!("{}: `ocloc disasm` for {device} wrote no patch tokens ({e})", self.ocloc.display()))?;
-        let mut binary = Binary { listing, tokens, bytes, log: log.trim().to_string(), lines_listings: Default::default() };
+        let tokens = read("PTM.txt").map_err(|e| {
+            anyhow!("{}: `ocloc disasm` for {device} wrote no patch tokens ({e})", self.ocloc.display())
+        })?;
+        let mut binary =
+            Binary { listing, tokens, bytes, log: log.trim().to_string(), lines_listings: Default::default() };
         if lines {
-            binary.lines_listings = dumped_listings(&dump_dir).with_context(|| format!("{what}: IGC's shader dump in {}", dump_dir.display()))?;
+            binary.lines_listings = dumped_listings(&dump_dir)
+                .with_context(|| format!("{what}: IGC's shader dump in {}", dump_dir.display()))?;
         }
         Ok(binary)
     }
@@ -196,7 +263,11 @@ fn dumped_listings(dir: &Path) -> Result<std::collections::BTreeMap<u32, String>
     for entry in std::fs::read_dir(dir).with_context(|| format!("cannot read {}", dir.display()))? {
         let path = entry?.path();
         let Some(name) = path.file_name().and_then(|n| n.to_str()) else { continue };
-        let width = name.split_once("_simd").and_then(|(_, rest)| rest.split_once("_entry_")).filter(|_| name.ends_with(".asm")).and_then(|(w, _)| w.parse::<u32>().ok());
+        let width = name
+            .split_once("_simd")
+            .and_then(|(_, rest)| rest.split_once("_entry_"))
+            .filter(|_| name.ends_with(".asm"))
+            .and_then(|(w, _)| w.parse::<u32>().ok());
         if let Some(w) = width {
             let bytes = crate::io::read_bounded(&path, crate::launch::MAX_OUTPUT_BYTES as u64)?;
             out.insert(w, String::from_utf8_lossy(&bytes).into_owned());

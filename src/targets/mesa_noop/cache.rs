@@ -16,11 +16,11 @@
 //! A request that writes files (`--isa`) or asks the child to crash (the containment test) is never cached
 //! (`mesa_noop::compile` decides).
 
-use crate::targets::RawKernel;
 use crate::cache::{Key, KeyBuilder};
-use crate::kernels::shade::{kernel_hash, GBufferFormat};
+use crate::kernels::shade::{GBufferFormat, kernel_hash};
 use crate::model::Model;
 use crate::shaders::Shaders;
+use crate::targets::RawKernel;
 use anyhow::Result;
 use std::path::{Path, PathBuf};
 
@@ -29,8 +29,27 @@ pub const KIND: &str = "noop_report";
 
 /// Prefixes of the variables a Mesa driver, the Vulkan loader or the dynamic linker may read.
 const DRIVER_PREFIXES: [&str; 21] = [
-    "MESA_", "RADV_", "ACO_", "TU_", "IR3_", "FD_", "PAN_", "PANVK_", "BIFROST_", "MIDGARD_", "INTEL_", "ANV_", "BRW_", "NIR_", "GALLIUM_", "LP_", "VK_", "LD_", "XDG_DATA",
-    "XDG_CONFIG", "HOME",
+    "MESA_",
+    "RADV_",
+    "ACO_",
+    "TU_",
+    "IR3_",
+    "FD_",
+    "PAN_",
+    "PANVK_",
+    "BIFROST_",
+    "MIDGARD_",
+    "INTEL_",
+    "ANV_",
+    "BRW_",
+    "NIR_",
+    "GALLIUM_",
+    "LP_",
+    "VK_",
+    "LD_",
+    "XDG_DATA",
+    "XDG_CONFIG",
+    "HOME",
 ];
 
 /// The Vulkan loader's system folders (where no variable names the files), under which `vulkan/icd.d` holds
@@ -45,7 +64,8 @@ fn vulkan_dirs(kind: &str, environment: &std::collections::BTreeMap<String, Stri
 
 /// Every JSON manifest under `dirs`, sorted.
 fn manifests(dirs: &[PathBuf]) -> Vec<PathBuf> {
-    let mut all: Vec<PathBuf> = dirs.iter().flat_map(|d| std::fs::read_dir(d).into_iter().flatten().flatten().map(|e| e.path())).collect();
+    let mut all: Vec<PathBuf> =
+        dirs.iter().flat_map(|d| std::fs::read_dir(d).into_iter().flatten().flatten().map(|e| e.path())).collect();
     all.sort();
     all
 }
@@ -61,7 +81,13 @@ fn layer_files(environment: &std::collections::BTreeMap<String, String>) -> Vec<
 
 /// The part of a child's key that every family of one request shares: brdfprof's executable, spirv-opt's
 /// version, the light count, whether validation runs, and every kernel's SPIR-V (computed once per request).
-pub fn request_digest(models: &[Model], raw: &[RawKernel], lights: u32, validate: bool, shaders: &Shaders) -> Result<String> {
+pub fn request_digest(
+    models: &[Model],
+    raw: &[RawKernel],
+    lights: u32,
+    validate: bool,
+    shaders: &Shaders,
+) -> Result<String> {
     let exe = std::env::current_exe()?;
     let mut key = KeyBuilder::new(KIND)
         .part("brdfprof", env!("CARGO_PKG_VERSION"))
@@ -114,7 +140,11 @@ pub fn key(request_digest: &str, target: &str, driver_environment: &[(String, St
 fn identity(path: &Path) -> String {
     match std::fs::metadata(path) {
         Ok(m) => {
-            let mtime = m.modified().ok().and_then(|t| t.duration_since(std::time::UNIX_EPOCH).ok()).map_or(0, |d| d.as_nanos());
+            let mtime = m
+                .modified()
+                .ok()
+                .and_then(|t| t.duration_since(std::time::UNIX_EPOCH).ok())
+                .map_or(0, |d| d.as_nanos());
             format!("{} {} {mtime}", path.display(), m.len())
         }
         Err(_) => format!("{} absent", path.display()),
@@ -124,7 +154,8 @@ fn identity(path: &Path) -> String {
 /// The ICD files the child's loader reads (the variables' list, else the system directories), the library
 /// each names, and the preloaded files.
 fn driver_files(environment: &std::collections::BTreeMap<String, String>) -> Vec<PathBuf> {
-    let named = ["VK_DRIVER_FILES", "VK_ICD_FILENAMES"].iter().find_map(|v| environment.get(*v).filter(|s| !s.is_empty()));
+    let named =
+        ["VK_DRIVER_FILES", "VK_ICD_FILENAMES"].iter().find_map(|v| environment.get(*v).filter(|s| !s.is_empty()));
     let icds: Vec<PathBuf> = match named {
         Some(list) => std::env::split_paths(list).collect(),
         None => manifests(&vulkan_dirs("icd.d", environment)),
@@ -178,7 +209,11 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let icd = dir.path().join("x_icd.json");
         std::fs::write(&icd, r#"{"file_format_version": "1.0.0", "ICD": {"library_path": "./lib/libvulkan_x.so", "api_version": "1.3"}}"#).unwrap();
-        let env = [("VK_ICD_FILENAMES".to_string(), icd.display().to_string()), ("LD_PRELOAD".to_string(), "/s/shim.so".to_string())].into();
+        let env = [
+            ("VK_ICD_FILENAMES".to_string(), icd.display().to_string()),
+            ("LD_PRELOAD".to_string(), "/s/shim.so".to_string()),
+        ]
+        .into();
         let files = driver_files(&env);
         assert_eq!(files, vec![dir.path().join("./lib/libvulkan_x.so"), icd, PathBuf::from("/s/shim.so")]);
     }

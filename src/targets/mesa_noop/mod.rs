@@ -19,15 +19,15 @@
 pub mod cache;
 pub mod shim;
 
-use crate::schema::InspectReport;
+use super::{Request, Run, Target, Vendor};
 use crate::cleanup;
 use crate::gpu::{CompilerLog, Gpu, GpuOptions, Kernel};
-use crate::model::Model;
-use crate::kernels::shade::{self, shade_kernel, steady_block, GBufferFormat};
+use crate::kernels::shade::{self, GBufferFormat, shade_kernel, steady_block};
 use crate::model::BASELINE_LABEL;
+use crate::model::Model;
+use crate::schema::InspectReport;
 use crate::shaders::Shaders;
-use super::{Request, Run, Target, Vendor};
-use anyhow::{anyhow, bail, Context, Result};
+use anyhow::{Context, Result, anyhow, bail};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -114,31 +114,51 @@ pub struct NoopReply {
 
 /// The driver of a `--device` prefix.
 fn driver_of(prefix: &str) -> Result<&'static dyn NoopDriver> {
-    super::VENDORS.iter().find_map(|v| v.noop().filter(|d| d.prefix() == prefix)).ok_or_else(|| anyhow!("`{prefix}` is not a driver brdfprof runs on a compile-only device"))
+    super::VENDORS
+        .iter()
+        .find_map(|v| v.noop().filter(|d| d.prefix() == prefix))
+        .ok_or_else(|| anyhow!("`{prefix}` is not a driver brdfprof runs on a compile-only device"))
 }
 
 /// The child: compiles every kernel on the compile-only device its environment offers and reports.
 pub fn child_main(request_json: &str) -> Result<()> {
     let req: NoopRequest = serde_json::from_str(request_json).context("bad compile-only child request")?;
     let driver = driver_of(&req.driver)?;
-    let family = driver.families().iter().position(|f| f.name == req.family).ok_or_else(|| anyhow!("unknown {} family `{}`", driver.name(), req.family))?;
+    let family = driver
+        .families()
+        .iter()
+        .position(|f| f.name == req.family)
+        .ok_or_else(|| anyhow!("unknown {} family `{}`", driver.name(), req.family))?;
     let target = Target { vendor: driver, family }.name();
     let environment = driver.environment(family)?;
     let set = |k: &str, v: &str| std::env::var(k).ok().as_deref() == Some(v);
     if !set(TARGET_VAR, &target) || !environment.iter().all(|(k, v)| set(k, v)) {
         let vars = environment.iter().map(|(k, v)| format!("{k}={v}")).collect::<Vec<_>>().join(" ");
-        bail!("`brdfprof {CHILD_COMMAND}` runs with {TARGET_VAR}={target} {vars}; `brdfprof inspect --device {target}` runs it so");
+        bail!(
+            "`brdfprof {CHILD_COMMAND}` runs with {TARGET_VAR}={target} {vars}; `brdfprof inspect --device {target}` runs it so"
+        );
     }
     crate::gpu::mark_compile_only_process();
-    let models = req.models.iter().map(|s| Model::parse(s).map_err(|e| anyhow!("{s}: {e:#}"))).collect::<Result<Vec<_>>>()?;
+    let models =
+        req.models.iter().map(|s| Model::parse(s).map_err(|e| anyhow!("{s}: {e:#}"))).collect::<Result<Vec<_>>>()?;
     let shaders = match &req.glsl {
         Some(dir) => Shaders::from_glsl(dir)?,
         None => Shaders::embedded(),
     };
     let wanted = driver.device(family);
     let unvalidated = driver.without_validation(family).filter(|_| req.validate);
-    let options = GpuOptions { device: Some(wanted.clone().unwrap_or_else(|| "0".into())), validation: req.validate && unvalidated.is_none(), compiler_log: driver.compiler_log() };
-    let gpu = Gpu::new(&options).map_err(|e| anyhow!("{target}: the driver offered no compile-only device{} ({e:#}). {}", wanted.map_or_else(String::new, |w| format!(" `{w}`")), driver.install_hint()))?;
+    let options = GpuOptions {
+        device: Some(wanted.clone().unwrap_or_else(|| "0".into())),
+        validation: req.validate && unvalidated.is_none(),
+        compiler_log: driver.compiler_log(),
+    };
+    let gpu = Gpu::new(&options).map_err(|e| {
+        anyhow!(
+            "{target}: the driver offered no compile-only device{} ({e:#}). {}",
+            wanted.map_or_else(String::new, |w| format!(" `{w}`")),
+            driver.install_hint()
+        )
+    })?;
     if !gpu.reports_statistics() {
         bail!("{target}: {} reports no compiler statistics (no VK_KHR_pipeline_executable_properties)", gpu.info.name);
     }
@@ -146,10 +166,18 @@ pub fn child_main(request_json: &str) -> Result<()> {
     // PanVK 25 has the extension but its statistics and no listing come through the compiler's log.
     let listings = gpu.has_executable_properties() && driver.compiler_log().is_none_or(|l| l.beside_properties);
     let isa_dir = req.isa_dir.as_ref().filter(|_| listings).map(|d| d.join(driver.isa_folder(family)));
-    let (mut report, isa_files) = if req.raw.is_empty() { models_report(&gpu, &shaders, &req, &target, models, isa_dir.as_deref())? } else { raw_report(&gpu, &shaders, &req, &target, isa_dir.as_deref())? };
+    let (mut report, isa_files) = if req.raw.is_empty() {
+        models_report(&gpu, &shaders, &req, &target, models, isa_dir.as_deref())?
+    } else {
+        raw_report(&gpu, &shaders, &req, &target, isa_dir.as_deref())?
+    };
     report.provenance["target"] = serde_json::Value::String(target.clone());
     if req.isa_dir.is_some() && !listings {
-        let why = if !gpu.has_executable_properties() { "has no VK_KHR_pipeline_executable_properties to return one" } else { "reports its compiler's statistics on stderr, not through pipeline executable properties" };
+        let why = if !gpu.has_executable_properties() {
+            "has no VK_KHR_pipeline_executable_properties to return one"
+        } else {
+            "reports its compiler's statistics on stderr, not through pipeline executable properties"
+        };
         add_driver_note(&mut report, format!("--isa: no listing for {target}: {} {why}", gpu.info.name));
     }
     if let Some(why) = unvalidated {
@@ -169,8 +197,16 @@ fn add_driver_note(report: &mut InspectReport, note: String) {
 /// The models' kernels and the memory-only one, as `inspect` reports them; a model this family cannot compile
 /// (fp16 arithmetic where the device has no shaderFloat16) is left out and named in the driver section's
 /// notes, so that one family does not stop a report of many.
-fn models_report(gpu: &Gpu, shaders: &Shaders, req: &NoopRequest, target: &str, models: Vec<Model>, isa_dir: Option<&Path>) -> Result<(InspectReport, Vec<PathBuf>)> {
-    let (models, skipped): (Vec<Model>, Vec<Model>) = models.into_iter().partition(|m| m.check_support(&gpu.info).is_ok());
+fn models_report(
+    gpu: &Gpu,
+    shaders: &Shaders,
+    req: &NoopRequest,
+    target: &str,
+    models: Vec<Model>,
+    isa_dir: Option<&Path>,
+) -> Result<(InspectReport, Vec<PathBuf>)> {
+    let (models, skipped): (Vec<Model>, Vec<Model>) =
+        models.into_iter().partition(|m| m.check_support(&gpu.info).is_ok());
     // The listings first: Turnip keeps each compiled kernel in its in-memory pipeline cache, and a capture
     // compiled after the same kernel without one would come back from there without its IR3 assembly.
     let mut isa_files = Vec::new();
@@ -184,7 +220,11 @@ fn models_report(gpu: &Gpu, shaders: &Shaders, req: &NoopRequest, target: &str, 
     let mut report = crate::kernel_stats::device_report(gpu, shaders, &models, req.lights, None)?;
     report.cost = super::cost_of(&report);
     if !skipped.is_empty() {
-        let why = skipped.iter().map(|m| format!("{} ({:#})", m.name(), m.check_support(&gpu.info).unwrap_err())).collect::<Vec<_>>().join("; ");
+        let why = skipped
+            .iter()
+            .map(|m| format!("{} ({:#})", m.name(), m.check_support(&gpu.info).unwrap_err()))
+            .collect::<Vec<_>>()
+            .join("; ");
         report.section_notes.insert("driver/".into(), format!("not compiled for {target}: {why}"));
     }
     Ok((report, isa_files))
@@ -209,7 +249,13 @@ fn reply(reply: NoopReply) -> Result<()> {
 /// The request's raw kernels compiled on the compile-only device, one row each with the compiler's statistics, as one report
 /// (with the request's lights per kernel, which the cost divides by); a kernel the family cannot compile is left
 /// out and named in the driver section's notes.
-fn raw_report(gpu: &Gpu, shaders: &Shaders, req: &NoopRequest, target: &str, isa_dir: Option<&Path>) -> Result<(InspectReport, Vec<PathBuf>)> {
+fn raw_report(
+    gpu: &Gpu,
+    shaders: &Shaders,
+    req: &NoopRequest,
+    target: &str,
+    isa_dir: Option<&Path>,
+) -> Result<(InspectReport, Vec<PathBuf>)> {
     let mut rows = Vec::new();
     let mut skipped = Vec::new();
     let mut isa_files = Vec::new();
@@ -219,11 +265,26 @@ fn raw_report(gpu: &Gpu, shaders: &Shaders, req: &NoopRequest, target: &str, isa
             skipped.push(format!("{} ({e:#})", r.label));
             continue;
         }
-        let bytes = crate::io::read_bounded(&r.path, crate::launch::MAX_OUTPUT_BYTES as u64).with_context(|| format!("the {target} child cannot read {}", r.path.display()))?;
+        let bytes = crate::io::read_bounded(&r.path, crate::launch::MAX_OUTPUT_BYTES as u64)
+            .with_context(|| format!("the {target} child cannot read {}", r.path.display()))?;
         let words: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes);
-        let kernel = Kernel::with_capture(gpu, &r.label, &words, &Default::default(), &crate::gpu::Binding::storage(r.storage_buffers), r.push_bytes, isa_dir.is_some())?;
-        let mut row = crate::schema::Row { model: r.label.clone(), spec: None, stats: Default::default(), notes: Default::default() };
-        let executables = kernel.executables()?.ok_or_else(|| anyhow!("{} reports no pipeline statistics", gpu.info.name))?;
+        let kernel = Kernel::with_capture(
+            gpu,
+            &r.label,
+            &words,
+            &Default::default(),
+            &crate::gpu::Binding::storage(r.storage_buffers),
+            r.push_bytes,
+            isa_dir.is_some(),
+        )?;
+        let mut row = crate::schema::Row {
+            model: r.label.clone(),
+            spec: None,
+            stats: Default::default(),
+            notes: Default::default(),
+        };
+        let executables =
+            kernel.executables()?.ok_or_else(|| anyhow!("{} reports no pipeline statistics", gpu.info.name))?;
         if let Some(dir) = isa_dir {
             isa_files.extend(write_representations(gpu, &executables, &r.label, dir)?);
         }
@@ -231,8 +292,15 @@ fn raw_report(gpu: &Gpu, shaders: &Shaders, req: &NoopRequest, target: &str, isa
         rows.push(row);
     }
     let provenance = serde_json::to_value(crate::export::json::Provenance::new(&gpu.info))?;
-    let notes = if skipped.is_empty() { Default::default() } else { [("driver/".to_string(), format!("not compiled for {target}: {}", skipped.join("; ")))].into() };
-    Ok((crate::kernel_stats::compiled_report(rows, provenance, req.lights, shaders, Default::default(), notes), isa_files))
+    let notes = if skipped.is_empty() {
+        Default::default()
+    } else {
+        [("driver/".to_string(), format!("not compiled for {target}: {}", skipped.join("; ")))].into()
+    };
+    Ok((
+        crate::kernel_stats::compiled_report(rows, provenance, req.lights, shaders, Default::default(), notes),
+        isa_files,
+    ))
 }
 
 /// Set in a child's environment, it dies of SIGSEGV after printing its report, as Mesa 22.3's teardown of
@@ -246,23 +314,47 @@ fn write_isa(gpu: &Gpu, shaders: &Shaders, model: Option<&Model>, lights: u32, d
     let label = model.map_or_else(|| BASELINE_LABEL.to_string(), Model::label);
     let (per_dispatch, accumulate) = steady_block(lights);
     let k = shade_kernel(model, GBufferFormat::Packed, per_dispatch, accumulate, shaders)?;
-    let kernel = Kernel::with_capture(gpu, &k.spirv.name, &k.spirv.words, &k.constants, &shade::bindings(GBufferFormat::Packed), shade::PUSH_BYTES, true)?;
+    let kernel = Kernel::with_capture(
+        gpu,
+        &k.spirv.name,
+        &k.spirv.words,
+        &k.constants,
+        &shade::bindings(GBufferFormat::Packed),
+        shade::PUSH_BYTES,
+        true,
+    )?;
     write_representations(gpu, &kernel.executables()?.unwrap_or_default(), &label, dir)
 }
 
 /// Each text representation of each executable to DIR/<kernel>.<representation>.txt.
-fn write_representations(gpu: &Gpu, executables: &[crate::gpu::PipelineExecutable], label: &str, dir: &Path) -> Result<Vec<PathBuf>> {
+fn write_representations(
+    gpu: &Gpu,
+    executables: &[crate::gpu::PipelineExecutable],
+    label: &str,
+    dir: &Path,
+) -> Result<Vec<PathBuf>> {
     std::fs::create_dir_all(dir).with_context(|| format!("--isa: cannot create {}", dir.display()))?;
     let mut files = Vec::new();
     for exe in executables {
         for (name, text) in &exe.representations {
             let path = dir.join(format!("{}.{}.txt", super::file_slug(label), super::file_slug(name)));
-            crate::io::write_output(&path, format!("; {label}: {} of {}, {}\n{text}", name, exe.name, gpu.info.name).as_bytes())?;
+            crate::io::write_output(
+                &path,
+                format!("; {label}: {} of {}, {}\n{text}", name, exe.name, gpu.info.name).as_bytes(),
+            )?;
             files.push(path);
         }
     }
     if files.is_empty() {
-        bail!("{}: the driver returned no internal representation for {label}{}", gpu.info.name, if !gpu.has_executable_properties() { " (it has no VK_KHR_pipeline_executable_properties: --isa has nothing to write for it)" } else { "" });
+        bail!(
+            "{}: the driver returned no internal representation for {label}{}",
+            gpu.info.name,
+            if !gpu.has_executable_properties() {
+                " (it has no VK_KHR_pipeline_executable_properties: --isa has nothing to write for it)"
+            } else {
+                ""
+            }
+        );
     }
     Ok(files)
 }
@@ -295,7 +387,13 @@ struct CachedChild {
 
 /// Runs the child for one target and reads its report, or takes both from the kernel cache when nothing that
 /// reaches the driver changed (`cache`); the child's messages reach the user either way.
-fn run(driver: &'static dyn NoopDriver, family: usize, models: &[Model], raw: &[super::RawKernel], request: &Job) -> Result<ChildRun> {
+fn run(
+    driver: &'static dyn NoopDriver,
+    family: usize,
+    models: &[Model],
+    raw: &[super::RawKernel],
+    request: &Job,
+) -> Result<ChildRun> {
     let name = Target { vendor: driver, family }.name();
     // The driver's environment first: a driver that is not built stops here, naming what to run.
     let environment = driver.environment(family)?;
@@ -325,25 +423,41 @@ fn run(driver: &'static dyn NoopDriver, family: usize, models: &[Model], raw: &[
     let mut cached: CachedChild = serde_json::from_slice(&bytes)?;
     cached.messages.iter().for_each(|m| crate::messages::line(m));
     if let (false, Some(store)) = (built, &store) {
-        cached.report.provenance["cache_entry"] = serde_json::Value::String(store.path(cache::KIND, &key).display().to_string());
+        cached.report.provenance["cache_entry"] =
+            serde_json::Value::String(store.path(cache::KIND, &key).display().to_string());
     }
     Ok(ChildRun { report: cached.report, isa_files: Vec::new(), teardown_note })
 }
 
 /// Runs the child for one target: its report, and the lines of its stderr meant for the user.
-fn spawn(driver: &'static dyn NoopDriver, family: usize, models: &[Model], raw: &[super::RawKernel], request: &Job, environment: Vec<(String, String)>) -> Result<(ChildRun, Vec<String>)> {
+fn spawn(
+    driver: &'static dyn NoopDriver,
+    family: usize,
+    models: &[Model],
+    raw: &[super::RawKernel],
+    request: &Job,
+    environment: Vec<(String, String)>,
+) -> Result<(ChildRun, Vec<String>)> {
     let target = Target { vendor: driver, family };
     let name = target.name();
     // The child writes its ISA files into its own TMPDIR; they become outputs of this process (staged with
     // its others) only once the child has succeeded.
-    let mut cmd = cleanup::command(&std::env::current_exe().context("cannot find brdfprof's own executable")?.to_string_lossy());
+    let mut cmd =
+        cleanup::command(&std::env::current_exe().context("cannot find brdfprof's own executable")?.to_string_lossy());
     let tmp = cleanup::child_tmpdir(&mut cmd)?;
     let child_isa = request.isa_dir.map(|_| tmp.path().join("isa"));
     let mut raw_files = Vec::new();
     for (k, r) in raw.iter().enumerate() {
         let path = tmp.path().join(format!("raw-{k}.spv"));
-        std::fs::write(&path, bytemuck::cast_slice::<u32, u8>(&r.spirv)).with_context(|| format!("cannot write {}", path.display()))?;
-        raw_files.push(RawSpirv { label: r.label.clone(), model: r.model.name(), path, storage_buffers: r.storage_buffers, push_bytes: r.push_bytes });
+        std::fs::write(&path, bytemuck::cast_slice::<u32, u8>(&r.spirv))
+            .with_context(|| format!("cannot write {}", path.display()))?;
+        raw_files.push(RawSpirv {
+            label: r.label.clone(),
+            model: r.model.name(),
+            path,
+            storage_buffers: r.storage_buffers,
+            push_bytes: r.push_bytes,
+        });
     }
     let req = NoopRequest {
         driver: driver.prefix().to_string(),
@@ -355,7 +469,10 @@ fn spawn(driver: &'static dyn NoopDriver, family: usize, models: &[Model], raw: 
         isa_dir: child_isa.clone(),
         raw: raw_files,
     };
-    cmd.arg(CHILD_COMMAND).arg(serde_json::to_string(&req)?).env(TARGET_VAR, &name).envs(environment)
+    cmd.arg(CHILD_COMMAND)
+        .arg(serde_json::to_string(&req)?)
+        .env(TARGET_VAR, &name)
+        .envs(environment)
         // The compiler's output, not a binary an earlier process cached, and no stale statistics.
         .env("MESA_SHADER_CACHE_DISABLE", "true");
     // The child compiles each kernel under the compile limit itself; the whole child gets one limit per
@@ -364,14 +481,19 @@ fn spawn(driver: &'static dyn NoopDriver, family: usize, models: &[Model], raw: 
     let kernels = (models.len() as u32 + 1 + raw.len() as u32) * if request.isa_dir.is_some() { 2 } else { 1 };
     let limit = crate::launch::limit() * kernels + std::time::Duration::from_secs(10);
     let what = format!("the kernels for {name} ({}, in a child process)", driver.compiler());
-    let output = crate::launch::output_within(&mut cmd, &what, limit).with_context(|| format!("cannot run brdfprof's {name} child"))?;
+    let output = crate::launch::output_within(&mut cmd, &what, limit)
+        .with_context(|| format!("cannot run brdfprof's {name} child"))?;
     let stdout = String::from_utf8_lossy(&output.stdout);
     let stderr = String::from_utf8_lossy(&output.stderr);
     let reply: Option<NoopReply> = stdout.lines().rev().find_map(|l| serde_json::from_str(l).ok());
     // Validation messages and warnings of the child reach the user as they are, but for the banner Mesa prints
     // for every driver it does not consider conformant (RADV's null device, PanVK) and the shims' notices.
     // (A failed child's last lines are in the error below.)
-    let messages: Vec<String> = stderr.lines().filter(|l| reply.is_some() && !is_banner(l) && !driver.is_noise(l)).map(str::to_string).collect();
+    let messages: Vec<String> = stderr
+        .lines()
+        .filter(|l| reply.is_some() && !is_banner(l) && !driver.is_noise(l))
+        .map(str::to_string)
+        .collect();
     let teardown_note = match (&reply, output.status.success()) {
         (Some(_), true) => None,
         (Some(_), false) if output.status.code().is_none() => Some(format!(
@@ -380,7 +502,12 @@ fn spawn(driver: &'static dyn NoopDriver, family: usize, models: &[Model], raw: 
         )),
         _ => {
             let tail: Vec<&str> = stderr.lines().rev().take(15).collect::<Vec<_>>().into_iter().rev().collect();
-            bail!("{name}: the compile-only child failed ({}):\n{}\n{}", output.status, tail.join("\n"), driver.install_hint());
+            bail!(
+                "{name}: the compile-only child failed ({}):\n{}\n{}",
+                output.status,
+                tail.join("\n"),
+                driver.install_hint()
+            );
         }
     };
     let reply = reply.expect("checked above");
@@ -401,8 +528,11 @@ fn is_banner(line: &str) -> bool {
 
 /// Writes a file the child wrote under `from` as this process' output under `to`.
 fn publish(file: &Path, from: &Path, to: &Path) -> Result<PathBuf> {
-    let rel = file.strip_prefix(from).map_err(|_| anyhow!("the compile-only child wrote {} outside its ISA directory", file.display()))?;
-    let bytes = crate::io::read_bounded(file, crate::launch::MAX_OUTPUT_BYTES as u64).with_context(|| format!("cannot read the compile-only child's {}", file.display()))?;
+    let rel = file
+        .strip_prefix(from)
+        .map_err(|_| anyhow!("the compile-only child wrote {} outside its ISA directory", file.display()))?;
+    let bytes = crate::io::read_bounded(file, crate::launch::MAX_OUTPUT_BYTES as u64)
+        .with_context(|| format!("cannot read the compile-only child's {}", file.display()))?;
     let path = to.join(rel);
     crate::io::write_output(&path, &bytes)?;
     Ok(path)
@@ -419,24 +549,34 @@ pub fn compile(prefix: &str, families: &[usize], raw: &[super::RawKernel], reque
         true => None,
         false => Some(cache::request_digest(models, raw, request.lights, request.validate, request.shaders)?),
     };
-    let request = &Job { lights: request.lights, shaders: request.shaders, validate: request.validate, isa_dir: request.isa_dir, cache_digest };
+    let request = &Job {
+        lights: request.lights,
+        shaders: request.shaders,
+        validate: request.validate,
+        isa_dir: request.isa_dir,
+        cache_digest,
+    };
     let workers = std::thread::available_parallelism().map_or(1, |n| n.get()).min(families.len()).max(1);
     let next = std::sync::atomic::AtomicUsize::new(0);
-    let results: std::sync::Mutex<Vec<Option<Result<ChildRun>>>> = std::sync::Mutex::new((0..families.len()).map(|_| None).collect());
+    let results: std::sync::Mutex<Vec<Option<Result<ChildRun>>>> =
+        std::sync::Mutex::new((0..families.len()).map(|_| None).collect());
     // Each worker spawns and waits for its own children (PR_SET_PDEATHSIG follows the spawning thread).
     std::thread::scope(|s| {
         for _ in 0..workers {
-            s.spawn(|| loop {
-                let i = next.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
-                if i >= families.len() {
-                    break;
+            s.spawn(|| {
+                loop {
+                    let i = next.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
+                    if i >= families.len() {
+                        break;
+                    }
+                    let r = run(driver, families[i], models, raw, request);
+                    results.lock().unwrap_or_else(|e| e.into_inner())[i] = Some(r);
                 }
-                let r = run(driver, families[i], models, raw, request);
-                results.lock().unwrap_or_else(|e| e.into_inner())[i] = Some(r);
             });
         }
     });
-    let runs = results.into_inner().unwrap_or_else(|e| e.into_inner()).into_iter().map(|r| r.expect("every target ran"));
+    let runs =
+        results.into_inner().unwrap_or_else(|e| e.into_inner()).into_iter().map(|r| r.expect("every target ran"));
     runs.zip(families)
         .map(|(run, &family)| {
             let run = run?;
@@ -445,7 +585,12 @@ pub fn compile(prefix: &str, families: &[usize], raw: &[super::RawKernel], reque
                 add_driver_note(&mut report, note.clone());
             }
             report.cost = driver.cost(&report);
-            Ok(Run { target: Target { vendor: driver, family }, report, isa_files: run.isa_files, note: run.teardown_note })
+            Ok(Run {
+                target: Target { vendor: driver, family },
+                report,
+                isa_files: run.isa_files,
+                note: run.teardown_note,
+            })
         })
         .collect()
 }
@@ -468,7 +613,10 @@ pub fn fingerprint(report: &InspectReport) -> std::collections::BTreeMap<String,
 pub fn driver_version(report: &InspectReport) -> String {
     let p = &report.provenance;
     let nonempty = |v: &serde_json::Value| v.as_str().filter(|s| !s.is_empty()).map(str::to_string);
-    nonempty(&p["mesa_version"]).or_else(|| nonempty(&p["device"]["driver_info"])).or_else(|| nonempty(&p["device"]["driver_version"])).unwrap_or_else(|| "?".into())
+    nonempty(&p["mesa_version"])
+        .or_else(|| nonempty(&p["device"]["driver_info"]))
+        .or_else(|| nonempty(&p["device"]["driver_version"]))
+        .unwrap_or_else(|| "?".into())
 }
 
 /// A Mesa build `make mesa` makes (scripts/mesa-noop.sh), which some families' drivers load.
@@ -539,11 +687,22 @@ pub const BUILD_DIR_VAR: &str = "BRDFPROF_MESA_DIR";
 /// The environment of a driver on a noop drm-shim: the loader sees only `icd` (the driver's devenv ICD file,
 /// which names `library` in the build), `shim` answers the kernel's ioctls, and `extra` selects the GPU. Each
 /// file must be in the build, or the error names it and `make mesa`.
-pub fn shim_environment(driver: &str, build: &MesaBuild, icd: &str, library: &str, shim: &str, extra: &[(&str, String)]) -> Result<Vec<(String, String)>> {
+pub fn shim_environment(
+    driver: &str,
+    build: &MesaBuild,
+    icd: &str,
+    library: &str,
+    shim: &str,
+    extra: &[(&str, String)],
+) -> Result<Vec<(String, String)>> {
     let icd = build.file(driver, icd)?;
     build.file(driver, library)?;
     let shim = build.file(driver, shim)?;
-    let mut env = vec![("VK_ICD_FILENAMES".to_string(), icd.display().to_string()), ("VK_DRIVER_FILES".to_string(), icd.display().to_string()), ("LD_PRELOAD".to_string(), shim.display().to_string())];
+    let mut env = vec![
+        ("VK_ICD_FILENAMES".to_string(), icd.display().to_string()),
+        ("VK_DRIVER_FILES".to_string(), icd.display().to_string()),
+        ("LD_PRELOAD".to_string(), shim.display().to_string()),
+    ];
     env.extend(extra.iter().map(|(k, v)| (k.to_string(), v.clone())));
     Ok(env)
 }

@@ -2,11 +2,11 @@
 //! variable that picks the GPU, the families, and the driver's cost rule. `adreno.rs`, `mali.rs` and `anv.rs`
 //! are one `Shim` each; the child process, its environment checks and crash handling are `mesa_noop`'s.
 
-use crate::schema::cost::TargetCost;
 use super::NoopDriver;
-use crate::targets::{mesa_noop, Family, Request, Run, Vendor};
 use crate::gpu::CompilerLog;
 use crate::schema::InspectReport;
+use crate::schema::cost::TargetCost;
+use crate::targets::{Family, Request, Run, Vendor, mesa_noop};
 use anyhow::Result;
 use std::collections::BTreeMap;
 
@@ -57,13 +57,24 @@ pub struct Shim {
 
 impl Shim {
     /// The cost table's header for a report of `family`: the rule text, unit and columns are the driver's.
-    pub fn header(&self, family: &ShimFamily, report: &InspectReport, model: String, unit: &str, columns: &[&str]) -> TargetCost {
+    pub fn header(
+        &self,
+        family: &ShimFamily,
+        report: &InspectReport,
+        model: String,
+        unit: &str,
+        columns: &[&str],
+    ) -> TargetCost {
         TargetCost {
             device: report.provenance["device"]["name"].as_str().unwrap_or("?").to_string(),
             target: Some(format!("{}:{}", self.prefix, family.name)),
             family: Some(family.name.to_string()),
             architecture: Some(family.architecture.to_string()),
-            compiler: format!("{} (Mesa {}, on the noop drm-shim)", self.compiler, mesa_noop::driver_version(report).trim_start_matches("Mesa ")),
+            compiler: format!(
+                "{} (Mesa {}, on the noop drm-shim)",
+                self.compiler,
+                mesa_noop::driver_version(report).trim_start_matches("Mesa ")
+            ),
             model,
             unit: unit.to_string(),
             lights_per_kernel: 0,
@@ -87,7 +98,16 @@ impl Vendor for Shim {
     }
 
     fn families(&self) -> Vec<Family> {
-        self.families.iter().map(|f| Family { name: f.name, architecture: f.architecture, products: f.products, detail: f.detail.to_string(), default: f.default }).collect()
+        self.families
+            .iter()
+            .map(|f| Family {
+                name: f.name,
+                architecture: f.architecture,
+                products: f.products,
+                detail: f.detail.to_string(),
+                default: f.default,
+            })
+            .collect()
     }
 
     fn status(&self) -> Result<String> {
@@ -100,16 +120,31 @@ impl Vendor for Shim {
                 continue;
             }
             seen.push(f.build);
-            let names = self.families.iter().filter(|g| std::ptr::eq(g.build, f.build)).map(|g| g.name).collect::<Vec<_>>().join(", ");
+            let names = self
+                .families
+                .iter()
+                .filter(|g| std::ptr::eq(g.build, f.build))
+                .map(|g| g.name)
+                .collect::<Vec<_>>()
+                .join(", ");
             match self.environment(k) {
                 Ok(_) => ready.push(format!("{} ({names})", f.build.dir().display())),
                 Err(e) => missing.push((names, e)),
             }
         }
         if ready.is_empty() {
-            return Err(missing.into_iter().next().map(|(_, e)| e).unwrap_or_else(|| anyhow::anyhow!("{}: no family", self.prefix)));
+            return Err(missing
+                .into_iter()
+                .next()
+                .map(|(_, e)| e)
+                .unwrap_or_else(|| anyhow::anyhow!("{}: no family", self.prefix)));
         }
-        let mut text = format!("Mesa's {} ({} compiler) on its noop drm-shim, built by make mesa in {}", self.driver, self.compiler, ready.join(" and "));
+        let mut text = format!(
+            "Mesa's {} ({} compiler) on its noop drm-shim, built by make mesa in {}",
+            self.driver,
+            self.compiler,
+            ready.join(" and ")
+        );
         for (names, e) in missing {
             text += &format!("; not built for {names}: {e:#}");
         }
@@ -124,7 +159,12 @@ impl Vendor for Shim {
         mesa_noop::compile(self.prefix, families, &[], request)
     }
 
-    fn compile_raw(&self, families: &[usize], kernels: &[crate::targets::RawKernel], request: &Request) -> Result<Vec<Run>> {
+    fn compile_raw(
+        &self,
+        families: &[usize],
+        kernels: &[crate::targets::RawKernel],
+        request: &Request,
+    ) -> Result<Vec<Run>> {
         if kernels.is_empty() {
             anyhow::bail!("{}: no raw kernel to compile", self.prefix);
         }
@@ -158,11 +198,21 @@ impl NoopDriver for Shim {
         let mut extra: Vec<(&str, String)> = vec![(self.gpu_var, self.families[family].gpu_id.to_string())];
         extra.extend(self.extra_env.iter().map(|(k, v)| (*k, v.to_string())));
         let f = &self.families[family];
-        mesa_noop::shim_environment(&format!("{}:{} (Mesa's {})", self.prefix, f.name, self.driver), f.build, self.icd, self.library, self.shim, &extra)
+        mesa_noop::shim_environment(
+            &format!("{}:{} (Mesa's {})", self.prefix, f.name, self.driver),
+            f.build,
+            self.icd,
+            self.library,
+            self.shim,
+            &extra,
+        )
     }
 
     fn install_hint(&self) -> String {
-        format!("`make mesa` builds Mesa's drivers and their noop shims (once per machine, ~20 min); `brdfprof devices --targets` says whether {}: is ready", self.prefix)
+        format!(
+            "`make mesa` builds Mesa's drivers and their noop shims (once per machine, ~20 min); `brdfprof devices --targets` says whether {}: is ready",
+            self.prefix
+        )
     }
 
     fn compiler_log(&self) -> Option<CompilerLog> {

@@ -14,7 +14,7 @@ use super::translated::{Compilation, LineCompile, Translated, Translator};
 use crate::gpu::DriverStat;
 use crate::model::Model;
 use crate::translate::Dialect;
-use anyhow::{bail, Result};
+use anyhow::{Result, bail};
 use std::collections::BTreeMap;
 
 /// One NVIDIA GPU generation, as a compute capability.
@@ -32,11 +32,46 @@ pub struct Family {
 }
 
 pub const FAMILIES: [Family; 5] = [
-    Family { name: "sm_75", compute_capability: (7, 5), architecture: "Turing", products: "GeForce RTX 20 / GTX 16 series, T4", column: 0, max_warps: 32 },
-    Family { name: "sm_86", compute_capability: (8, 6), architecture: "Ampere (GA10x)", products: "GeForce RTX 30 series, RTX A6000", column: 1, max_warps: 48 },
-    Family { name: "sm_89", compute_capability: (8, 9), architecture: "Ada Lovelace", products: "GeForce RTX 40 series, L4, L40", column: 2, max_warps: 48 },
-    Family { name: "sm_90", compute_capability: (9, 0), architecture: "Hopper", products: "H100, H200", column: 3, max_warps: 64 },
-    Family { name: "sm_120", compute_capability: (12, 0), architecture: "Blackwell (GB20x)", products: "GeForce RTX 50 series, RTX PRO 6000", column: 4, max_warps: 48 },
+    Family {
+        name: "sm_75",
+        compute_capability: (7, 5),
+        architecture: "Turing",
+        products: "GeForce RTX 20 / GTX 16 series, T4",
+        column: 0,
+        max_warps: 32,
+    },
+    Family {
+        name: "sm_86",
+        compute_capability: (8, 6),
+        architecture: "Ampere (GA10x)",
+        products: "GeForce RTX 30 series, RTX A6000",
+        column: 1,
+        max_warps: 48,
+    },
+    Family {
+        name: "sm_89",
+        compute_capability: (8, 9),
+        architecture: "Ada Lovelace",
+        products: "GeForce RTX 40 series, L4, L40",
+        column: 2,
+        max_warps: 48,
+    },
+    Family {
+        name: "sm_90",
+        compute_capability: (9, 0),
+        architecture: "Hopper",
+        products: "H100, H200",
+        column: 3,
+        max_warps: 64,
+    },
+    Family {
+        name: "sm_120",
+        compute_capability: (12, 0),
+        architecture: "Blackwell (GB20x)",
+        products: "GeForce RTX 50 series, RTX PRO 6000",
+        column: 4,
+        max_warps: 48,
+    },
 ];
 
 /// The compute capabilities of `THROUGHPUT`'s columns.
@@ -114,7 +149,17 @@ pub enum Class {
 }
 
 impl Class {
-    pub const ALL: [Class; 9] = [Class::Fp32, Class::Fp16, Class::Fp64, Class::Mufu, Class::Integer, Class::Conversion, Class::Memory, Class::Control, Class::Move];
+    pub const ALL: [Class; 9] = [
+        Class::Fp32,
+        Class::Fp16,
+        Class::Fp64,
+        Class::Mufu,
+        Class::Integer,
+        Class::Conversion,
+        Class::Memory,
+        Class::Control,
+        Class::Move,
+    ];
 
     pub fn name(self) -> &'static str {
         match self {
@@ -156,7 +201,8 @@ pub enum Pipe {
 }
 
 impl Pipe {
-    pub const ALL: [Pipe; 9] = [Pipe::Fma, Pipe::Fp16, Pipe::Fp64, Pipe::Alu, Pipe::Xu, Pipe::Lsu, Pipe::Adu, Pipe::Cbu, Pipe::Uniform];
+    pub const ALL: [Pipe; 9] =
+        [Pipe::Fma, Pipe::Fp16, Pipe::Fp64, Pipe::Alu, Pipe::Xu, Pipe::Lsu, Pipe::Adu, Pipe::Cbu, Pipe::Uniform];
 
     pub fn name(self) -> &'static str {
         match self {
@@ -184,9 +230,13 @@ impl Pipe {
 pub fn classify(opcode: &str) -> (Class, Option<&'static str>, Option<Pipe>) {
     let mnemonic = opcode.split('.').next().unwrap_or(opcode);
     match mnemonic {
-        "FADD" | "FMUL" | "FFMA" | "FADD32I" | "FMUL32I" | "FFMA32I" | "FSWZADD" => (Class::Fp32, Some(FP32), Some(Pipe::Fma)),
+        "FADD" | "FMUL" | "FFMA" | "FADD32I" | "FMUL32I" | "FFMA32I" | "FSWZADD" => {
+            (Class::Fp32, Some(FP32), Some(Pipe::Fma))
+        }
         "FMNMX" | "FSETP" | "FSET" | "FSEL" | "FCHK" => (Class::Fp32, Some(CMP), Some(Pipe::Alu)),
-        "HADD2" | "HMUL2" | "HFMA2" | "HADD2_32I" | "HMUL2_32I" | "HFMA2_32I" => (Class::Fp16, Some(FP16), Some(Pipe::Fp16)),
+        "HADD2" | "HMUL2" | "HFMA2" | "HADD2_32I" | "HMUL2_32I" | "HFMA2_32I" => {
+            (Class::Fp16, Some(FP16), Some(Pipe::Fp16))
+        }
         "HSETP2" | "HSET2" | "HMNMX2" => (Class::Fp16, Some(CMP), Some(Pipe::Fp16)),
         "DADD" | "DMUL" | "DFMA" => (Class::Fp64, Some(FP64), Some(Pipe::Fp64)),
         "DSETP" | "DMNMX" => (Class::Fp64, Some(CMP), Some(Pipe::Fp64)),
@@ -204,8 +254,11 @@ pub fn classify(opcode: &str) -> (Class, Option<&'static str>, Option<Pipe>) {
         "F2F" | "I2F" | "FRND" | "I2I" | "I2IP" => (Class::Conversion, Some(CVT), Some(Pipe::Xu)),
         "LDC" | "ULDC" | "LDCU" => (Class::Memory, None, Some(Pipe::Adu)),
         "S2R" | "S2UR" | "CS2R" => (Class::Move, None, Some(Pipe::Lsu)),
-        op if ["LD", "ST", "ATOM", "RED", "TEX", "TLD", "SULD", "SUST"].iter().any(|p| op.starts_with(p)) => (Class::Memory, None, Some(Pipe::Lsu)),
-        "BRA" | "BRX" | "JMP" | "JMX" | "EXIT" | "RET" | "CALL" | "BSSY" | "BSYNC" | "BREAK" | "BMOV" | "BPT" | "WARPSYNC" | "BAR" | "YIELD" | "KILL" | "NANOSLEEP" => (Class::Control, None, Some(Pipe::Cbu)),
+        op if ["LD", "ST", "ATOM", "RED", "TEX", "TLD", "SULD", "SUST"].iter().any(|p| op.starts_with(p)) => {
+            (Class::Memory, None, Some(Pipe::Lsu))
+        }
+        "BRA" | "BRX" | "JMP" | "JMX" | "EXIT" | "RET" | "CALL" | "BSSY" | "BSYNC" | "BREAK" | "BMOV" | "BPT"
+        | "WARPSYNC" | "BAR" | "YIELD" | "KILL" | "NANOSLEEP" => (Class::Control, None, Some(Pipe::Cbu)),
         // The uniform datapath's own instructions (UIADD3, ULOP3, UMOV, ...) and bit operations the table
         // has no row for: the issue rate.
         op if op.starts_with('U') => (Class::Integer, None, Some(Pipe::Uniform)),
@@ -249,7 +302,11 @@ impl SassStats {
     /// with a branch to itself and NOPs after it), NOPs left out of the counts (not of the schedule).
     pub fn of(listing: &str, ptxas_log: &str, cubin_bytes: usize) -> Result<Self> {
         let instructions = sass::instructions(listing)?;
-        let mut s = SassStats { cubin_bytes: cubin_bytes as u32, schedule_latency: sass::schedule_latency(&instructions), ..Default::default() };
+        let mut s = SassStats {
+            cubin_bytes: cubin_bytes as u32,
+            schedule_latency: sass::schedule_latency(&instructions),
+            ..Default::default()
+        };
         for i in instructions.iter().filter(|i| i.mnemonic() != "NOP") {
             let (class, row, pipe) = classify(&i.opcode);
             s.instructions += 1;
@@ -315,7 +372,12 @@ impl SassStats {
     /// of `schema::driver`, so that the gate reads registers, instructions, spills and code size as for any
     /// driver).
     pub fn driver_stats(&self, family: &Family) -> Result<Vec<DriverStat>> {
-        let stat = |name: &str, value: f64| DriverStat { executable: "SASS".into(), name: name.into(), description: String::new(), value };
+        let stat = |name: &str, value: f64| DriverStat {
+            executable: "SASS".into(),
+            name: name.into(),
+            description: String::new(),
+            value,
+        };
         let mut out = vec![
             stat("Instruction Count", f64::from(self.instructions)),
             stat("Register Count", f64::from(self.registers)),
@@ -377,7 +439,10 @@ pub fn compile_as(source: &str, family: &Family, precise: bool, lines: bool) -> 
         .part("brdfprof", env!("CARGO_PKG_VERSION"))
         .part("nvrtc", &tools.version)
         .part("nvdisasm", &tools.nvdisasm_version)
-        .part("nvdisasm options", format!("{}{}", nvrtc::DISASSEMBLE_OPTIONS.join(" "), if lines { nvrtc::LINE_INFO } else { "" }))
+        .part(
+            "nvdisasm options",
+            format!("{}{}", nvrtc::DISASSEMBLE_OPTIONS.join(" "), if lines { nvrtc::LINE_INFO } else { "" }),
+        )
         .part("options", options.join(" "))
         .part("source", source)
         .finish();
@@ -389,11 +454,12 @@ pub fn compile_as(source: &str, family: &Family, precise: bool, lines: bool) -> 
         }
         Ok(())
     };
-    let bytes = crate::cache::get_or_build(crate::cache::Store::open_default().as_ref(), "sass", &key, &what, valid, || {
-        let compiled = crate::launch::bounded(&what, || tools.compile(source, "brdfprof_kernel.cu", &options))?;
-        let listing = tools.disassemble(&compiled.cubin, lines)?;
-        Ok(serde_json::to_vec(&Sass { listing, log: compiled.log, cubin_bytes: compiled.cubin.len() })?)
-    })?;
+    let bytes =
+        crate::cache::get_or_build(crate::cache::Store::open_default().as_ref(), "sass", &key, &what, valid, || {
+            let compiled = crate::launch::bounded(&what, || tools.compile(source, "brdfprof_kernel.cu", &options))?;
+            let listing = tools.disassemble(&compiled.cubin, lines)?;
+            Ok(serde_json::to_vec(&Sass { listing, log: compiled.log, cubin_bytes: compiled.cubin.len() })?)
+        })?;
     Ok(serde_json::from_slice(&bytes)?)
 }
 
@@ -401,10 +467,14 @@ pub fn compile_as(source: &str, family: &Family, precise: bool, lines: bool) -> 
 /// instruction on its pipe at its row's rate and its issue slot, its schedule cycles (the scoreboard wait before
 /// it and its stall), summed per line; the translation's own lines and NVRTC's prologue name none.
 pub fn line_costs(model: &str, sass: &Sass, family: &Family) -> Result<crate::schema::lines::KernelLines> {
-    use super::cost::lines::{per_line, Attributed};
+    use super::cost::lines::{Attributed, per_line};
     let instructions = sass::instructions(&sass.listing)?;
     let stats = SassStats::of(&sass.listing, &sass.log, sass.cubin_bytes)?;
-    let binding = stats.pipes(family)?.into_iter().fold(("-".to_string(), f64::NEG_INFINITY), |b, p| if p.1 > b.1 { p } else { b }).0;
+    let binding = stats
+        .pipes(family)?
+        .into_iter()
+        .fold(("-".to_string(), f64::NEG_INFINITY), |b, p| if p.1 > b.1 { p } else { b })
+        .0;
     let times = sass::issue_times(&instructions);
     let mut attributed = Vec::new();
     let mut previous_end = 0.0;
@@ -440,7 +510,8 @@ impl Translator for Nvidia {
     const COMPILER: &'static str = "ptxas";
     const UNIT: &'static str = "SM cycles";
     const RULE: &'static str = "a warp's pipes at the CUDA guide's throughputs (Nsight Compute's pipe assignment), its latency by ptxas' stall counts and scoreboards, warps per SM from the registers; / (32 x lights per kernel); Issue Cycles: the old serial sum";
-    const SHOWN: &'static [&'static str] = &["Instruction Count", "Register Count", "Spill Count", "MUFU (special functions)", "Issue Cycles"];
+    const SHOWN: &'static [&'static str] =
+        &["Instruction Count", "Register Count", "Spill Count", "MUFU (special functions)", "Issue Cycles"];
     const ISA_EXTENSIONS: (&'static str, &'static str) = ("cu", "sass");
 
     fn families() -> &'static [Family] {
@@ -448,7 +519,13 @@ impl Translator for Nvidia {
     }
 
     fn family(f: &Family) -> super::Family {
-        super::Family { name: f.name, architecture: f.architecture, products: f.products, detail: format!("compute capability {}.{}", f.compute_capability.0, f.compute_capability.1), default: true }
+        super::Family {
+            name: f.name,
+            architecture: f.architecture,
+            products: f.products,
+            detail: format!("compute capability {}.{}", f.compute_capability.0, f.compute_capability.1),
+            default: true,
+        }
     }
 
     fn tools() -> Result<&'static nvrtc::Tools> {
@@ -481,7 +558,10 @@ impl Translator for Nvidia {
             target: format!("nvidia:{}", family.name),
             device: serde_json::json!({"name": device, "driver_name": "NVRTC", "driver_info": format!("{} ({options})", tools.version), "driver_version": tools.version}),
             compiler: serde_json::json!({"name": tools.version, "options": options, "translation": "brdfprof's SPIR-V to CUDA C++ translation"}),
-            driver_note: format!("NVIDIA's CUDA compiler ({}, ptxas) on the kernels' CUDA C++ translation, same maths; options: {options}", tools.version),
+            driver_note: format!(
+                "NVIDIA's CUDA compiler ({}, ptxas) on the kernels' CUDA C++ translation, same maths; options: {options}",
+                tools.version
+            ),
             tool: ("nvrtc".to_string(), tools.version.clone()),
         }
     }
@@ -492,8 +572,14 @@ impl Translator for Nvidia {
 
     fn line_compile(m: &Model, source: &str, costed: &str, family: &Family, precise: bool) -> Result<LineCompile> {
         let sass = compile_as(source, family, precise, true)?;
-        let opcodes = |listing: &str| -> Result<Vec<String>> { Ok(sass::instructions(listing)?.into_iter().map(|i| i.opcode).collect()) };
-        Ok(LineCompile { lines: line_costs(&m.label(), &sass, family)?, costed: opcodes(&compile(costed, family, precise)?.listing)?, annotated: opcodes(&sass.listing)? })
+        let opcodes = |listing: &str| -> Result<Vec<String>> {
+            Ok(sass::instructions(listing)?.into_iter().map(|i| i.opcode).collect())
+        };
+        Ok(LineCompile {
+            lines: line_costs(&m.label(), &sass, family)?,
+            costed: opcodes(&compile(costed, family, precise)?.listing)?,
+            annotated: opcodes(&sass.listing)?,
+        })
     }
 }
 
@@ -504,15 +590,27 @@ mod tests {
     #[test]
     fn every_rate_is_the_fixtures() {
         let text = include_str!("../../../tests/fixtures/nvidia-throughput.tsv");
-        let rows: Vec<Vec<&str>> = text.lines().filter(|l| !l.starts_with('#') && !l.trim().is_empty() && !l.starts_with("ratio")).map(|l| l.split('\t').collect()).collect();
+        let rows: Vec<Vec<&str>> = text
+            .lines()
+            .filter(|l| !l.starts_with('#') && !l.trim().is_empty() && !l.starts_with("ratio"))
+            .map(|l| l.split('\t').collect())
+            .collect();
         for r in &rows {
-            let rate = THROUGHPUT.iter().find(|t| t.row == r[0]).unwrap_or_else(|| panic!("the code has no row `{}`", r[0]));
+            let rate =
+                THROUGHPUT.iter().find(|t| t.row == r[0]).unwrap_or_else(|| panic!("the code has no row `{}`", r[0]));
             let figures: Vec<u32> = r[1..].iter().map(|v| v.parse().unwrap()).collect();
             assert_eq!(rate.per_clock.to_vec(), figures, "{}", r[0]);
         }
         assert_eq!(rows.len(), THROUGHPUT.len(), "every row of the code is in the fixture once");
         // FP64 is FP32 over Table 30's ratio.
-        let ratio: Vec<u32> = text.lines().find(|l| l.starts_with("ratio")).unwrap().split('\t').skip(1).map(|v| v.parse().unwrap()).collect();
+        let ratio: Vec<u32> = text
+            .lines()
+            .find(|l| l.starts_with("ratio"))
+            .unwrap()
+            .split('\t')
+            .skip(1)
+            .map(|v| v.parse().unwrap())
+            .collect();
         for (k, r) in ratio.iter().enumerate() {
             assert_eq!(rate(FP32, &FAMILIES[k]).unwrap() / r, rate(FP64, &FAMILIES[k]).unwrap(), "{}", COLUMNS[k]);
         }
@@ -534,7 +632,10 @@ mod tests {
         s.by_row.insert((None, None), 1);
         let pipes = |n: &str| s.pipes(sm(n)).unwrap().into_iter().collect::<BTreeMap<String, f64>>();
         // sm_89: FFMA 32/128 each, MUFU 32/16, F2I 32/16; every instruction 32/128 on the issue slot.
-        assert_eq!((pipes("sm_89")["FMA"], pipes("sm_89")["XU (MUFU, conversions)"], pipes("sm_89")["issue"]), (1.0, 6.0, 2.0));
+        assert_eq!(
+            (pipes("sm_89")["FMA"], pipes("sm_89")["XU (MUFU, conversions)"], pipes("sm_89")["issue"]),
+            (1.0, 6.0, 2.0)
+        );
         // sm_120: F2I at 2 per clock; sm_75: FP32 at 64.
         assert_eq!((pipes("sm_120")["XU (MUFU, conversions)"], pipes("sm_75")["FMA"]), (4.0 + 16.0, 2.0));
         // The serial sum adds them all: 1 + 4 + 2 + 0.25 on sm_89.

@@ -2,8 +2,8 @@
 //! CUDA C++ to a cubin for one compute capability, with ptxas' resource report in its log, and nvdisasm's
 //! SASS listing of the cubin. No NVIDIA GPU or driver is involved.
 
-use anyhow::{anyhow, bail, Context, Result};
-use std::ffi::{c_char, c_int, c_void, CStr, CString};
+use anyhow::{Context, Result, anyhow, bail};
+use std::ffi::{CStr, CString, c_char, c_int, c_void};
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
@@ -12,7 +12,14 @@ type NvrtcResult = c_int;
 
 /// The NVRTC C API (nvrtc.h) brdfprof calls.
 struct Api {
-    create: unsafe extern "C" fn(*mut Program, *const c_char, *const c_char, c_int, *const *const c_char, *const *const c_char) -> NvrtcResult,
+    create: unsafe extern "C" fn(
+        *mut Program,
+        *const c_char,
+        *const c_char,
+        c_int,
+        *const *const c_char,
+        *const *const c_char,
+    ) -> NvrtcResult,
     compile: unsafe extern "C" fn(Program, c_int, *const *const c_char) -> NvrtcResult,
     log_size: unsafe extern "C" fn(Program, *mut usize) -> NvrtcResult,
     log: unsafe extern "C" fn(Program, *mut c_char) -> NvrtcResult,
@@ -60,11 +67,14 @@ fn load() -> std::result::Result<Tools, String> {
         return Err(not_installed(&format!("{} or {} is missing", lib_path.display(), nvdisasm.display())));
     }
     // SAFETY: NVRTC's library, loaded for its documented C API; its initialisers are NVIDIA's.
-    let lib = unsafe { libloading::Library::new(&lib_path) }.map_err(|e| not_installed(&format!("cannot load {}: {e}", lib_path.display())))?;
+    let lib = unsafe { libloading::Library::new(&lib_path) }
+        .map_err(|e| not_installed(&format!("cannot load {}: {e}", lib_path.display())))?;
     // SAFETY: each symbol is looked up with the signature nvrtc.h gives it.
     let api = unsafe {
         let sym = |name: &[u8]| -> std::result::Result<*const c_void, String> {
-            lib.get::<*const c_void>(name).map(|s| *s).map_err(|e| not_installed(&format!("{}: {e}", String::from_utf8_lossy(&name[..name.len() - 1]))))
+            lib.get::<*const c_void>(name)
+                .map(|s| *s)
+                .map_err(|e| not_installed(&format!("{}: {e}", String::from_utf8_lossy(&name[..name.len() - 1]))))
         };
         Api {
             create: std::mem::transmute::<*const c_void, _>(sym(b"nvrtcCreateProgram\0")?),
@@ -79,7 +89,8 @@ fn load() -> std::result::Result<Tools, String> {
     };
     // SAFETY: nvrtcVersion(int*, int*), as nvrtc.h declares it.
     let version = unsafe {
-        let f: libloading::Symbol<unsafe extern "C" fn(*mut c_int, *mut c_int) -> NvrtcResult> = lib.get(b"nvrtcVersion\0").map_err(|e| not_installed(&e.to_string()))?;
+        let f: libloading::Symbol<unsafe extern "C" fn(*mut c_int, *mut c_int) -> NvrtcResult> =
+            lib.get(b"nvrtcVersion\0").map_err(|e| not_installed(&e.to_string()))?;
         let (mut major, mut minor) = (0, 0);
         f(&mut major, &mut minor);
         format!("NVRTC {major}.{minor}")
@@ -87,10 +98,20 @@ fn load() -> std::result::Result<Tools, String> {
     // Its last line names the build ("Build cuda_13.5.r13.5/compiler.37..."): the cache keys on it.
     let mut cmd = crate::cleanup::command(&nvdisasm.to_string_lossy());
     cmd.arg("--version");
-    let out = crate::launch::output_quick(&mut cmd, &format!("{} --version", nvdisasm.display())).map_err(|e| not_installed(&format!("{e:#}")))?;
-    let nvdisasm_version = String::from_utf8_lossy(&out.stdout).lines().last().map(str::to_string).filter(|l| out.status.success() && l.starts_with("Build ")).ok_or_else(|| {
-        not_installed(&format!("{} --version printed no build line ({}): not NVIDIA's nvdisasm", nvdisasm.display(), out.status))
-    })?;
+    let out = crate::launch::output_quick(&mut cmd, &format!("{} --version", nvdisasm.display()))
+        .map_err(|e| not_installed(&format!("{e:#}")))?;
+    let nvdisasm_version = String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .last()
+        .map(str::to_string)
+        .filter(|l| out.status.success() && l.starts_with("Build "))
+        .ok_or_else(|| {
+            not_installed(&format!(
+                "{} --version printed no build line ({}): not NVIDIA's nvdisasm",
+                nvdisasm.display(),
+                out.status
+            ))
+        })?;
     Ok(Tools { _lib: lib, api, nvdisasm, version, nvdisasm_version })
 }
 
@@ -117,7 +138,11 @@ impl Tools {
     pub fn compile(&self, source: &str, name: &str, options: &[String]) -> Result<Compiled> {
         let src = CString::new(source).context("the CUDA source holds a NUL byte")?;
         let cname = CString::new(name).context("a kernel name with a NUL byte")?;
-        let opts: Vec<CString> = options.iter().map(|o| CString::new(o.as_str())).collect::<Result<_, _>>().context("an NVRTC option with a NUL byte")?;
+        let opts: Vec<CString> = options
+            .iter()
+            .map(|o| CString::new(o.as_str()))
+            .collect::<Result<_, _>>()
+            .context("an NVRTC option with a NUL byte")?;
         let ptrs: Vec<*const c_char> = opts.iter().map(|o| o.as_ptr()).collect();
         let mut prog: Program = std::ptr::null_mut();
         // SAFETY: the NVRTC API as documented: a program created from NUL-terminated strings, compiled,
@@ -141,7 +166,11 @@ impl Tools {
             }
             (self.api.destroy)(&mut prog);
             if compiled != 0 {
-                bail!("NVRTC cannot compile the translation ({}; a translator defect):\n{}", self.error(compiled), log.lines().take(20).collect::<Vec<_>>().join("\n"));
+                bail!(
+                    "NVRTC cannot compile the translation ({}; a translator defect):\n{}",
+                    self.error(compiled),
+                    log.lines().take(20).collect::<Vec<_>>().join("\n")
+                );
             }
             Ok(Compiled { cubin, log })
         }
@@ -155,12 +184,23 @@ impl Tools {
         std::fs::write(&path, cubin).with_context(|| format!("cannot write {}", path.display()))?;
         let mut cmd = crate::cleanup::command(self.nvdisasm.to_str().unwrap_or("nvdisasm"));
         cmd.args(DISASSEMBLE_OPTIONS).args(line_info.then_some(LINE_INFO)).arg(&path);
-        let out = crate::launch::output(&mut cmd, "a cubin's SASS (nvdisasm)").with_context(|| format!("cannot run {}", self.nvdisasm.display()))?;
+        let out = crate::launch::output(&mut cmd, "a cubin's SASS (nvdisasm)")
+            .with_context(|| format!("cannot run {}", self.nvdisasm.display()))?;
         if !out.status.success() {
-            bail!("{} failed ({}): {}", self.nvdisasm.display(), out.status, String::from_utf8_lossy(&out.stderr).trim());
+            bail!(
+                "{} failed ({}): {}",
+                self.nvdisasm.display(),
+                out.status,
+                String::from_utf8_lossy(&out.stderr).trim()
+            );
         }
         let listing = String::from_utf8_lossy(&out.stdout).into_owned();
-        check_listing(&listing, cubin).map_err(|why| anyhow!("{}: its listing of the cubin is not the kernel's code ({why}); reinstall it with `make setup`", self.nvdisasm.display()))?;
+        check_listing(&listing, cubin).map_err(|why| {
+            anyhow!(
+                "{}: its listing of the cubin is not the kernel's code ({why}); reinstall it with `make setup`",
+                self.nvdisasm.display()
+            )
+        })?;
         Ok(listing)
     }
 }
@@ -183,7 +223,8 @@ pub fn code_bytes(cubin: &[u8]) -> Option<u64> {
     if cubin.get(0..5)? != b"\x7fELF\x02" {
         return None;
     }
-    let (shoff, shentsize, shnum, shstrndx) = (u64_at(0x28)? as usize, u16_at(0x3a)? as usize, u16_at(0x3c)? as usize, u16_at(0x3e)? as usize);
+    let (shoff, shentsize, shnum, shstrndx) =
+        (u64_at(0x28)? as usize, u16_at(0x3a)? as usize, u16_at(0x3c)? as usize, u16_at(0x3e)? as usize);
     let section = |k: usize| shoff.checked_add(k.checked_mul(shentsize)?);
     let names = u64_at(section(shstrndx)? + 0x18)? as usize;
     let mut total = None;
@@ -214,7 +255,10 @@ pub fn check_listing(listing: &str, cubin: &[u8]) -> std::result::Result<(), Str
     let covered = addresses.iter().max().map_or(0, |a| a + SASS_INSTRUCTION_BYTES);
     // Sections list from address 0 each, so the count, not the last address, must match their sum.
     if (addresses.len() as u64) * SASS_INSTRUCTION_BYTES != code {
-        return Err(format!("{} instructions listed up to byte {covered}, where the code section holds {code} bytes", addresses.len()));
+        return Err(format!(
+            "{} instructions listed up to byte {covered}, where the code section holds {code} bytes",
+            addresses.len()
+        ));
     }
     Ok(())
 }

@@ -12,7 +12,7 @@
 //! no NVIDIA document gives, so `VARIABLE_LATENCY` states the figures brdfprof assumes and where each comes
 //! from (memory: one figure for every vendor, so that memory cannot make two vendors differ).
 
-use anyhow::{anyhow, bail, Result};
+use anyhow::{Result, anyhow, bail};
 
 /// One instruction: its full opcode (`F2F.F32.F16`, `MUFU.EX2`, without its predicate) and its control bits.
 #[derive(Clone, Debug, PartialEq)]
@@ -128,20 +128,42 @@ pub struct VariableLatency {
 }
 
 /// Global and local memory loads.
-pub const MEMORY: VariableLatency = VariableLatency { what: "global/local memory load", cycles: 320.0, source: "ACO's vector-memory figure (Mesa's aco_statistics.cpp), used for every vendor's memory loads" };
+pub const MEMORY: VariableLatency = VariableLatency {
+    what: "global/local memory load",
+    cycles: 320.0,
+    source: "ACO's vector-memory figure (Mesa's aco_statistics.cpp), used for every vendor's memory loads",
+};
 /// Constant and uniform loads.
-pub const CONSTANT: VariableLatency = VariableLatency { what: "constant/uniform load", cycles: 30.0, source: "ACO's scalar-memory figure for a likely cache hit (aco_statistics.cpp), used for every vendor's constant loads" };
+pub const CONSTANT: VariableLatency = VariableLatency {
+    what: "constant/uniform load",
+    cycles: 30.0,
+    source: "ACO's scalar-memory figure for a likely cache hit (aco_statistics.cpp), used for every vendor's constant loads",
+};
 /// The special-function unit and the other variable-latency instructions (conversions, S2R, shuffles).
-pub const SFU: VariableLatency = VariableLatency { what: "MUFU, conversions, S2R, shuffles", cycles: 21.0, source: "Accel-Sim's tuned SM75/SM86/SM89 configurations (-ptx_opcode_latency_sfu 21)" };
+pub const SFU: VariableLatency = VariableLatency {
+    what: "MUFU, conversions, S2R, shuffles",
+    cycles: 21.0,
+    source: "Accel-Sim's tuned SM75/SM86/SM89 configurations (-ptx_opcode_latency_sfu 21)",
+};
 /// A read scoreboard (the sources have been read, so their registers may be written again).
-pub const SOURCES_READ: VariableLatency = VariableLatency { what: "sources read (read scoreboard)", cycles: 4.0, source: "assumed: the FP32 pipe latency (Accel-Sim's SM86 sp latency 4)" };
+pub const SOURCES_READ: VariableLatency = VariableLatency {
+    what: "sources read (read scoreboard)",
+    cycles: 4.0,
+    source: "assumed: the FP32 pipe latency (Accel-Sim's SM86 sp latency 4)",
+};
 
 /// The variable latency of `instruction`'s result.
 pub fn variable_latency(instruction: &Instruction) -> &'static VariableLatency {
     let m = instruction.mnemonic();
     if ["LDC", "ULDC", "LDCU"].contains(&m) {
         &CONSTANT
-    } else if m.starts_with("LD") || m.starts_with("ATOM") || m.starts_with("RED") || m.starts_with("TEX") || m.starts_with("TLD") || m.starts_with("SULD") {
+    } else if m.starts_with("LD")
+        || m.starts_with("ATOM")
+        || m.starts_with("RED")
+        || m.starts_with("TEX")
+        || m.starts_with("TLD")
+        || m.starts_with("SULD")
+    {
         &MEMORY
     } else {
         &SFU
@@ -189,7 +211,10 @@ mod tests {
     fn decodes_the_control_bits() {
         // IMAD.MOV.U32 R1, RZ, RZ, c[0x0][0x28]: stall 2, yield, no scoreboards.
         let c = Control::decode(0x000fe400078e00ff);
-        assert_eq!((c.stall, c.yield_hint, c.write_barrier, c.read_barrier, c.wait_mask, c.reuse), (2, true, None, None, 0, 0));
+        assert_eq!(
+            (c.stall, c.yield_hint, c.write_barrier, c.read_barrier, c.wait_mask, c.reuse),
+            (2, true, None, None, 0, 0)
+        );
         // Write scoreboard 0, wait on scoreboards 0 and 2, stall 4.
         let high = (4u64 << 41) | (0u64 << 46) | (7u64 << 49) | (0b101u64 << 52);
         let c = Control::decode(high);
@@ -212,7 +237,10 @@ mod tests {
     #[test]
     fn plays_the_schedule_through_with_the_waits() {
         let is = instructions(LISTING).unwrap();
-        assert_eq!(is.iter().map(|i| i.opcode.as_str()).collect::<Vec<_>>(), ["MOV", "LDG.E", "MUFU.RCP", "FADD", "EXIT"]);
+        assert_eq!(
+            is.iter().map(|i| i.opcode.as_str()).collect::<Vec<_>>(),
+            ["MOV", "LDG.E", "MUFU.RCP", "FADD", "EXIT"]
+        );
         assert_eq!(is[1].control.write_barrier, Some(2));
         assert_eq!(is[2].control.write_barrier, Some(0));
         assert_eq!(is[3].control.wait_mask, 0b101);

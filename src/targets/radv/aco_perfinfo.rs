@@ -10,7 +10,7 @@
 //! (tested).
 
 use crate::gpu::DriverStat;
-use anyhow::{bail, Result};
+use anyhow::{Result, bail};
 
 /// An instruction class of ACO's (`instr_class` in aco_opcodes.py), as far as its cost model distinguishes
 /// them (`get_perf_info`).
@@ -90,21 +90,129 @@ impl Class {
 /// are salu, SMEM smem, VOP* valu32, MUBUF/MTBUF/MIMG/FLAT/GLOBAL/SCRATCH vmem, DS ds; these are the
 /// exceptions the cost model prices differently).
 const CLASSES: &[(Class, &[&str])] = &[
-    (Class::ValuTranscendental32, &["v_cos_f16", "v_cos_f32", "v_exp_f16", "v_exp_f32", "v_exp_legacy_f32", "v_log_clamp_f32", "v_log_f16", "v_log_f32", "v_log_legacy_f32", "v_rcp_clamp_f32", "v_rcp_f16", "v_rcp_f32", "v_rcp_iflag_f32", "v_rcp_legacy_f32", "v_rsq_clamp_f32", "v_rsq_f16", "v_rsq_f32", "v_rsq_legacy_f32", "v_sin_f16", "v_sin_f32", "v_sqrt_f16", "v_sqrt_f32"]),
+    (
+        Class::ValuTranscendental32,
+        &[
+            "v_cos_f16",
+            "v_cos_f32",
+            "v_exp_f16",
+            "v_exp_f32",
+            "v_exp_legacy_f32",
+            "v_log_clamp_f32",
+            "v_log_f16",
+            "v_log_f32",
+            "v_log_legacy_f32",
+            "v_rcp_clamp_f32",
+            "v_rcp_f16",
+            "v_rcp_f32",
+            "v_rcp_iflag_f32",
+            "v_rcp_legacy_f32",
+            "v_rsq_clamp_f32",
+            "v_rsq_f16",
+            "v_rsq_f32",
+            "v_rsq_legacy_f32",
+            "v_sin_f16",
+            "v_sin_f32",
+            "v_sqrt_f16",
+            "v_sqrt_f32",
+        ],
+    ),
     (Class::ValuQuarterRate32, &["v_mul_hi_i32", "v_mul_hi_u32", "v_mul_lo_i32", "v_mul_lo_u32"]),
     (Class::ValuFma, &["v_fma_f32", "v_fma_legacy_f16", "v_fma_legacy_f32"]),
-    (Class::Valu64, &["v_ashr_i64", "v_ashrrev_i64", "v_lshl_b64", "v_lshlrev_b64", "v_lshr_b64", "v_lshrrev_b64", "v_mad_i64_i32", "v_mad_u64_u32"]),
+    (
+        Class::Valu64,
+        &[
+            "v_ashr_i64",
+            "v_ashrrev_i64",
+            "v_lshl_b64",
+            "v_lshlrev_b64",
+            "v_lshr_b64",
+            "v_lshrrev_b64",
+            "v_mad_i64_i32",
+            "v_mad_u64_u32",
+        ],
+    ),
     (Class::ValuDoubleAdd, &["v_add_f64"]),
-    (Class::ValuDoubleConvert, &["v_cvt_f32_f64", "v_cvt_f64_f32", "v_cvt_f64_i32", "v_cvt_f64_u32", "v_cvt_i32_f64", "v_cvt_u32_f64"]),
+    (
+        Class::ValuDoubleConvert,
+        &["v_cvt_f32_f64", "v_cvt_f64_f32", "v_cvt_f64_i32", "v_cvt_f64_u32", "v_cvt_i32_f64", "v_cvt_u32_f64"],
+    ),
     (Class::ValuDoubleTranscendental, &["v_rcp_clamp_f64", "v_rcp_f64", "v_rsq_clamp_f64", "v_rsq_f64", "v_sqrt_f64"]),
-    (Class::ValuDouble, &["v_ceil_f64", "v_floor_f64", "v_fract_f64", "v_frexp_exp_i32_f64", "v_frexp_mant_f64", "v_rndne_f64", "v_trunc_f64", "v_div_fmas_f64", "v_div_scale_f64", "v_fma_f64", "v_ldexp_f64", "v_max_f64", "v_min_f64", "v_mul_f64", "v_trig_preop_f64"]),
-    (Class::Branch, &["s_branch", "s_cbranch_scc0", "s_cbranch_scc1", "s_cbranch_vccz", "s_cbranch_vccnz", "s_cbranch_execz", "s_cbranch_execnz", "s_cbranch_cdbgsys", "s_cbranch_cdbguser", "s_cbranch_cdbgsys_or_user", "s_cbranch_cdbgsys_and_user", "s_trap", "s_setpc_b64", "s_swappc_b64", "s_rfe_b64", "s_cbranch_join", "s_cbranch_g_fork", "s_rfe_restore_b64", "s_call_b64", "s_cbranch_i_fork", "s_subvector_loop_begin", "s_subvector_loop_end"]),
+    (
+        Class::ValuDouble,
+        &[
+            "v_ceil_f64",
+            "v_floor_f64",
+            "v_fract_f64",
+            "v_frexp_exp_i32_f64",
+            "v_frexp_mant_f64",
+            "v_rndne_f64",
+            "v_trunc_f64",
+            "v_div_fmas_f64",
+            "v_div_scale_f64",
+            "v_fma_f64",
+            "v_ldexp_f64",
+            "v_max_f64",
+            "v_min_f64",
+            "v_mul_f64",
+            "v_trig_preop_f64",
+        ],
+    ),
+    (
+        Class::Branch,
+        &[
+            "s_branch",
+            "s_cbranch_scc0",
+            "s_cbranch_scc1",
+            "s_cbranch_vccz",
+            "s_cbranch_vccnz",
+            "s_cbranch_execz",
+            "s_cbranch_execnz",
+            "s_cbranch_cdbgsys",
+            "s_cbranch_cdbguser",
+            "s_cbranch_cdbgsys_or_user",
+            "s_cbranch_cdbgsys_and_user",
+            "s_trap",
+            "s_setpc_b64",
+            "s_swappc_b64",
+            "s_rfe_b64",
+            "s_cbranch_join",
+            "s_cbranch_g_fork",
+            "s_rfe_restore_b64",
+            "s_call_b64",
+            "s_cbranch_i_fork",
+            "s_subvector_loop_begin",
+            "s_subvector_loop_end",
+        ],
+    ),
     (Class::Sendmsg, &["s_sendmsg", "s_sendmsghalt"]),
-    (Class::Other, &["s_waitcnt", "s_waitcnt_vscnt", "s_waitcnt_vmcnt", "s_waitcnt_expcnt", "s_waitcnt_lgkmcnt", "s_barrier", "exp"]),
+    (
+        Class::Other,
+        &[
+            "s_waitcnt",
+            "s_waitcnt_vscnt",
+            "s_waitcnt_vmcnt",
+            "s_waitcnt_expcnt",
+            "s_waitcnt_lgkmcnt",
+            "s_barrier",
+            "exp",
+        ],
+    ),
 ];
 
 /// SMEM opcodes: every scalar memory access (`Format.SMEM`).
-const SMEM_PREFIXES: [&str; 10] = ["s_load_", "s_buffer_", "s_store_", "s_scratch_", "s_atomic_", "s_dcache_", "s_memtime", "s_memrealtime", "s_atc_probe", "s_gl1_inv"];
+const SMEM_PREFIXES: [&str; 10] = [
+    "s_load_",
+    "s_buffer_",
+    "s_store_",
+    "s_scratch_",
+    "s_atomic_",
+    "s_dcache_",
+    "s_memtime",
+    "s_memrealtime",
+    "s_atc_probe",
+    "s_gl1_inv",
+];
 /// Vector memory encodings (MUBUF, MTBUF, MIMG, FLAT, GLOBAL, SCRATCH).
 const VMEM_PREFIXES: [&str; 6] = ["buffer_", "tbuffer_", "image_", "flat_", "global_", "scratch_"];
 
@@ -141,7 +249,15 @@ pub enum Resource {
 }
 
 impl Resource {
-    pub const ALL: [Resource; 7] = [Resource::Valu, Resource::ValuComplex, Resource::Scalar, Resource::BranchSendmsg, Resource::VMem, Resource::Lds, Resource::ExportGds];
+    pub const ALL: [Resource; 7] = [
+        Resource::Valu,
+        Resource::ValuComplex,
+        Resource::Scalar,
+        Resource::BranchSendmsg,
+        Resource::VMem,
+        Resource::Lds,
+        Resource::ExportGds,
+    ];
 
     /// The pipe's name in reports, and ACO's perfinfo name of its usage.
     pub fn name(self) -> &'static str {
@@ -187,7 +303,9 @@ pub fn usage(class: Class, arch: Arch) -> Vec<(Resource, f64)> {
             Class::Valu64 => vec![(Valu, 2.0), (ValuComplex, 2.0)],
             Class::ValuQuarterRate32 => vec![(Valu, 4.0), (ValuComplex, 4.0)],
             Class::ValuTranscendental32 => vec![(Valu, 1.0), (ValuComplex, 4.0)],
-            Class::ValuDouble | Class::ValuDoubleAdd | Class::ValuDoubleConvert | Class::ValuDoubleTranscendental => vec![(Valu, 16.0), (ValuComplex, 16.0)],
+            Class::ValuDouble | Class::ValuDoubleAdd | Class::ValuDoubleConvert | Class::ValuDoubleTranscendental => {
+                vec![(Valu, 16.0), (ValuComplex, 16.0)]
+            }
             Class::Salu | Class::SMem => vec![(Scalar, 1.0)],
             Class::Branch | Class::Sendmsg => vec![(BranchSendmsg, 1.0)],
             Class::Ds => vec![(Lds, 1.0)],
@@ -235,7 +353,9 @@ pub fn split(log: &str) -> (Vec<Program>, Vec<String>) {
             if let Some((clk, mnemonic)) = instruction(line) {
                 current.as_mut().expect("just set").instructions.push((clk, mnemonic));
             }
-        } else if let (true, Some((name, value))) = (inside, line.split_once(": ").and_then(|(n, v)| Some((n, v.trim().parse::<f64>().ok()?)))) {
+        } else if let (true, Some((name, value))) =
+            (inside, line.split_once(": ").and_then(|(n, v)| Some((n, v.trim().parse::<f64>().ok()?))))
+        {
             current.as_mut().expect("inside").totals.push((name.to_string(), value));
             if name == LAST_TOTAL {
                 programs.extend(current.take());
@@ -250,15 +370,35 @@ pub fn split(log: &str) -> (Vec<Program>, Vec<String>) {
 /// Whether a line is one perfinfo prints (a program or its totals), for the programs ACO compiles outside a
 /// kernel's pipeline creation (RADV's internal shaders when its device opens), which are not the user's.
 pub fn is_printed_line(line: &str) -> bool {
-    line == "After RA:" || is_listing_line(line) || line.split_once(": ").is_some_and(|(n, v)| TOTALS.contains(&n) && v.trim().parse::<f64>().is_ok())
+    line == "After RA:"
+        || is_listing_line(line)
+        || line.split_once(": ").is_some_and(|(n, v)| TOTALS.contains(&n) && v.trim().parse::<f64>().is_ok())
 }
 
 /// The totals perfinfo prints after a program (Mesa 22.3's `collect_preasm_stats`).
-const TOTALS: [&str; 12] = ["num_waves", "salu_smem_usage", "branch_sendmsg_usage", "valu_usage", "valu_complex_usage", "lds_usage", "export_gds_usage", "vmem_usage", "latency", "parallelism", "max_utilization", LAST_TOTAL];
+const TOTALS: [&str; 12] = [
+    "num_waves",
+    "salu_smem_usage",
+    "branch_sendmsg_usage",
+    "valu_usage",
+    "valu_complex_usage",
+    "lds_usage",
+    "export_gds_usage",
+    "vmem_usage",
+    "latency",
+    "parallelism",
+    "max_utilization",
+    LAST_TOTAL,
+];
 
 /// A line of the printed program before its totals: stage, block headers, instructions, blank lines.
 fn is_listing_line(line: &str) -> bool {
-    line.is_empty() || line.starts_with("ACO shader stage:") || line.starts_with("BB") || line.starts_with("/*") || line.starts_with('\t') || line.starts_with('[')
+    line.is_empty()
+        || line.starts_with("ACO shader stage:")
+        || line.starts_with("BB")
+        || line.starts_with("/*")
+        || line.starts_with('\t')
+        || line.starts_with('[')
 }
 
 /// `\t(  2 clk)   v0 = v_lshl_add_u32 ...`: the clocks and the mnemonic (the word after ` = `, or the first).
@@ -289,7 +429,12 @@ pub fn read(log: &str) -> Result<(Vec<DriverStat>, Vec<String>)> {
         [] => bail!("ACO printed no perfinfo program (is ACO_DEBUG=perfinfo reaching RADV?)"),
         many => bail!("ACO printed {} perfinfo programs for one pipeline", many.len()),
     };
-    let stat = |name: String, value: f64| DriverStat { executable: crate::gpu::LOGGED_EXECUTABLE.into(), description: format!("ACO_DEBUG=perfinfo: {name}"), name, value };
+    let stat = |name: String, value: f64| DriverStat {
+        executable: crate::gpu::LOGGED_EXECUTABLE.into(),
+        description: format!("ACO_DEBUG=perfinfo: {name}"),
+        name,
+        value,
+    };
     let mut stats = vec![stat(CLOCKS.into(), program.instructions.iter().map(|(c, _)| c).sum())];
     for c in Class::ALL {
         stats.push(stat(count_name(c), program.instructions.iter().filter(|(_, m)| class(m) == c).count() as f64));
@@ -326,7 +471,15 @@ max_utilization: 1.000000\nwave64_per_cycle: 0.023088\n\nradv: a driver message\
         let (stats, _) = read(LOG).unwrap();
         let get = |n: &str| stats.iter().find(|s| s.name == n).map(|s| s.value);
         assert_eq!((get(CLOCKS), get(WAVES)), (Some(677.0), Some(16.0)));
-        assert_eq!((get(&count_name(Class::ValuTranscendental32)), get(&count_name(Class::Valu32)), get(&count_name(Class::SMem)), get(&count_name(Class::Other))), (Some(1.0), Some(1.0), Some(1.0), Some(2.0)));
+        assert_eq!(
+            (
+                get(&count_name(Class::ValuTranscendental32)),
+                get(&count_name(Class::Valu32)),
+                get(&count_name(Class::SMem)),
+                get(&count_name(Class::Other))
+            ),
+            (Some(1.0), Some(1.0), Some(1.0), Some(2.0))
+        );
         assert_eq!(get("perfinfo: weighted valu_complex_usage"), Some(8.0));
         assert!(read(&format!("{LOG}{LOG}")).unwrap_err().to_string().contains("2 perfinfo programs"));
         assert!(read("radv: nothing\n").unwrap_err().to_string().contains("no perfinfo program"));
@@ -336,11 +489,40 @@ max_utilization: 1.000000\nwave64_per_cycle: 0.023088\n\nradv: a driver message\
 
     #[test]
     fn classes_and_costs_are_acos() {
-        assert_eq!([class("v_rcp_f32"), class("v_fma_f32"), class("v_add_f32"), class("s_load_dwordx4"), class("s_buffer_load_dword"), class("buffer_store_format_xyz"), class("global_load_dword"), class("s_cbranch_execz"), class("s_waitcnt"), class("s_mov_b32"), class("exp")],
-            [Class::ValuTranscendental32, Class::ValuFma, Class::Valu32, Class::SMem, Class::SMem, Class::VMem, Class::VMem, Class::Branch, Class::Other, Class::Salu, Class::Export]);
+        assert_eq!(
+            [
+                class("v_rcp_f32"),
+                class("v_fma_f32"),
+                class("v_add_f32"),
+                class("s_load_dwordx4"),
+                class("s_buffer_load_dword"),
+                class("buffer_store_format_xyz"),
+                class("global_load_dword"),
+                class("s_cbranch_execz"),
+                class("s_waitcnt"),
+                class("s_mov_b32"),
+                class("exp")
+            ],
+            [
+                Class::ValuTranscendental32,
+                Class::ValuFma,
+                Class::Valu32,
+                Class::SMem,
+                Class::SMem,
+                Class::VMem,
+                Class::VMem,
+                Class::Branch,
+                Class::Other,
+                Class::Salu,
+                Class::Export
+            ]
+        );
         let rdna = Arch { gfx10: true, fast_fma: true };
         assert_eq!(usage(Class::ValuTranscendental32, rdna), vec![(Resource::Valu, 1.0), (Resource::ValuComplex, 4.0)]);
         let polaris = Arch { gfx10: false, fast_fma: false };
-        assert_eq!((usage(Class::ValuFma, polaris), usage(Class::ValuFma, Arch { fast_fma: true, ..polaris })), (vec![(Resource::Valu, 16.0)], vec![(Resource::Valu, 4.0)]));
+        assert_eq!(
+            (usage(Class::ValuFma, polaris), usage(Class::ValuFma, Arch { fast_fma: true, ..polaris })),
+            (vec![(Resource::Valu, 16.0)], vec![(Resource::Valu, 4.0)])
+        );
     }
 }

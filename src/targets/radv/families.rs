@@ -23,7 +23,13 @@ pub struct Family {
     pub default: bool,
 }
 
-const fn t(family: &'static str, gfx: &'static str, architecture: &'static str, products: &'static str, default: bool) -> Family {
+const fn t(
+    family: &'static str,
+    gfx: &'static str,
+    architecture: &'static str,
+    products: &'static str,
+    default: bool,
+) -> Family {
     Family { family, gfx, architecture, products, wave_size: 64, default }
 }
 
@@ -61,7 +67,10 @@ impl Family {
 
 /// A family by its name (case-insensitive).
 pub fn lookup(family: &str) -> Result<&'static Family> {
-    FAMILIES.iter().find(|t| t.family.eq_ignore_ascii_case(family.trim())).ok_or_else(|| anyhow::anyhow!("unknown AMD family `{family}`"))
+    FAMILIES
+        .iter()
+        .find(|t| t.family.eq_ignore_ascii_case(family.trim()))
+        .ok_or_else(|| anyhow::anyhow!("unknown AMD family `{family}`"))
 }
 
 /// The compile-only devices' name as RADV gives it: "Null hardware (RADV NAVI21)".

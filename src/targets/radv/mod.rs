@@ -16,14 +16,14 @@ pub mod env;
 pub mod families;
 
 use super::cost;
-use crate::schema::cost::TargetCost;
+use super::cost::schedule::Schedule;
 use super::mesa_noop::{self, NoopDriver};
 use super::{Request, Run};
-use families::{family_of_device, null_device_name, Family, FAMILIES, FORCE_FAMILY_VAR};
 use crate::gpu::CompilerLog;
-use super::cost::schedule::Schedule;
 use crate::schema::InspectReport;
+use crate::schema::cost::TargetCost;
 use anyhow::Result;
+use families::{FAMILIES, FORCE_FAMILY_VAR, Family, family_of_device, null_device_name};
 use std::collections::BTreeMap;
 
 /// Invocations ACO's Inverse Throughput is normalised to.
@@ -39,7 +39,7 @@ const PERFINFO: &str = "perfinfo";
 /// instruction once at ACO's own resource costs for `family` (vector instructions twice for wave64 on
 /// GFX10+, as ACO dual-issues them for workgroups over 32 invocations), the clocks summed, ACO's num_waves.
 pub fn schedule(stats: &BTreeMap<String, f64>, family: &Family) -> Option<Schedule> {
-    use aco_perfinfo::{count_name, usage, Arch, Class, Resource, CLOCKS, WAVES};
+    use aco_perfinfo::{Arch, CLOCKS, Class, Resource, WAVES, count_name, usage};
     let arch = Arch { gfx10: family.gfx_major() >= 10, fast_fma: family.fast_fma() };
     let dual = if arch.gfx10 && family.wave_size == 64 { 2.0 } else { 1.0 };
     let mut busy: BTreeMap<Resource, f64> = Resource::ALL.iter().map(|r| (*r, 0.0)).collect();
@@ -77,7 +77,16 @@ impl super::Vendor for Radv {
     }
 
     fn families(&self) -> Vec<super::Family> {
-        FAMILIES.iter().map(|f| super::Family { name: f.family, architecture: f.architecture, products: f.products, detail: format!("{}, wave{}", f.gfx, f.wave_size), default: f.default }).collect()
+        FAMILIES
+            .iter()
+            .map(|f| super::Family {
+                name: f.family,
+                architecture: f.architecture,
+                products: f.products,
+                detail: format!("{}, wave{}", f.gfx, f.wave_size),
+                default: f.default,
+            })
+            .collect()
     }
 
     fn status(&self) -> Result<String> {
@@ -118,10 +127,20 @@ impl super::Vendor for Radv {
         let perfinfo = family.filter(|f| report.rows.iter().any(|r| schedule(&r.stats, f).is_some()));
         match perfinfo {
             Some(f) => {
-                let rule = format!("{}; ACO's resource costs and per-instruction clocks (ACO_DEBUG=perfinfo) with every instruction once, ACO's num_waves; / (64 x lights per kernel); ACO's own Latency and Inverse Throughput (its branch weights) beside", super::cost::schedule::RULE);
+                let rule = format!(
+                    "{}; ACO's resource costs and per-instruction clocks (ACO_DEBUG=perfinfo) with every instruction once, ACO's num_waves; / (64 x lights per kernel); ACO's own Latency and Inverse Throughput (its branch weights) beside",
+                    super::cost::schedule::RULE
+                );
                 cost::schedule_table(report, header(rule), |stats| Some((schedule(stats, f)?, THROUGHPUT_INVOCATIONS)))
             }
-            None => cost::table(report, header("cycles/eval = Inverse Throughput / (64 x lights per kernel)".into()), |stats, lights| cost::driver_stat(stats, "Inverse Throughput").map(|it| it / (THROUGHPUT_INVOCATIONS * f64::from(lights)))),
+            None => cost::table(
+                report,
+                header("cycles/eval = Inverse Throughput / (64 x lights per kernel)".into()),
+                |stats, lights| {
+                    cost::driver_stat(stats, "Inverse Throughput")
+                        .map(|it| it / (THROUGHPUT_INVOCATIONS * f64::from(lights)))
+                },
+            ),
         }
     }
 
@@ -181,7 +200,7 @@ impl NoopDriver for Radv {
 
 #[cfg(test)]
 mod tests {
-    use super::super::{parse, Vendor};
+    use super::super::{Vendor, parse};
     use super::*;
     use crate::schema::Row;
 
@@ -192,7 +211,11 @@ mod tests {
         assert_eq!(parse("radv:navi21").unwrap().unwrap()[0].info().name, "navi21");
         assert_eq!(parse("RADV:Vangogh").unwrap().unwrap()[0].info().architecture, "RDNA 2 Steam Deck APU");
         let all = parse("radv:all").unwrap().unwrap();
-        assert!(all.len() >= 6 && all.iter().any(|t| t.info().name == "vega10") && all.iter().any(|t| t.info().name == "gfx1100"));
+        assert!(
+            all.len() >= 6
+                && all.iter().any(|t| t.info().name == "vega10")
+                && all.iter().any(|t| t.info().name == "gfx1100")
+        );
         assert_eq!(parse("radv:navi21,navi21,vega10").unwrap().unwrap().len(), 2);
         let e = parse("radv:navi31").unwrap_err().to_string();
         assert!(e.contains("unknown AMD family `navi31`") && e.contains("tahiti") && e.contains("gfx1100"), "{e}");
@@ -204,7 +227,11 @@ mod tests {
         let row = |model: &str, it: f64| Row {
             model: model.into(),
             spec: None,
-            stats: [("driver/Compute Shader/Inverse Throughput".to_string(), it), ("driver/Compute Shader/VGPRs".to_string(), 40.0)].into(),
+            stats: [
+                ("driver/Compute Shader/Inverse Throughput".to_string(), it),
+                ("driver/Compute Shader/VGPRs".to_string(), 40.0),
+            ]
+            .into(),
             notes: BTreeMap::new(),
         };
         let mut report = crate::schema::tests::empty_report("Null hardware (RADV NAVI21)");
