@@ -47,7 +47,7 @@ enum Command {
     /// Measures the counts and a short timing run and compares them with a saved baseline: exit 0 no
     /// regression, 1 regression, 2 could not measure.
     Check(cli::check::CheckArgs),
-    /// Merge saved profile and inspect JSON reports (other machines, GPUs, compile-only AMD targets) into one
+    /// Merge saved profile and inspect JSON reports (other machines, GPUs, compile-only targets) into one
     /// cost table across devices with rank correlations, its JSON and a PNG chart; refuses reports whose
     /// kernels differ.
     Compare(cli::compare::CompareArgs),

@@ -181,7 +181,7 @@ pub struct TimingArgs {
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// Independently compiled pipelines per kernel, all timed every round (the faster counts): guards against
-    /// one JIT compilation landing badly placed, seen to double a kernel's time on lavapipe.
+    /// one JIT compilation landing badly placed (docs/measurement.md, the lavapipe hazards).
     #[arg(long, default_value_t = 2)]
     pub instances: usize,
     /// Keep Mesa's on-disk shader cache (timed runs switch it off by default; see `fresh_compilation`).

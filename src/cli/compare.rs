@@ -1,5 +1,5 @@
 //! `brdfprof compare FILE.json ...`: saved `profile` and `inspect` reports (from different machines, a CI
-//! matrix of GPUs, compile-only AMD targets) merged into one cost table, its JSON and a PNG chart.
+//! matrix of GPUs, compile-only targets) merged into one cost table, its JSON and a PNG chart.
 
 use super::check_output;
 use anyhow::Result;

@@ -16,8 +16,7 @@ pub struct ProfileArgs {
     pub model: ModelArgs,
     #[command(flatten)]
     pub timing: TimingArgs,
-    /// G-buffer size, WIDTHxHEIGHT (default 960x540: a quarter of 1080p gives the same ratios on lavapipe as
-    /// 1080p and four times the rounds per second, docs/measurement.md).
+    /// G-buffer size, WIDTHxHEIGHT (default 960x540, a quarter of 1080p; why: docs/measurement.md).
     #[arg(long)]
     pub size: Option<String>,
     /// Timed dispatches of each kernel per round.

@@ -18,8 +18,7 @@ pub struct SweepArgs {
     pub model: ModelArgs,
     #[command(flatten)]
     pub timing: TimingArgs,
-    /// G-buffer size, WIDTHxHEIGHT: 256x256 gives the same cost ratios as 512x512 on lavapipe (within 2.3%,
-    /// inside the CIs) and four times the rounds.
+    /// G-buffer size, WIDTHxHEIGHT (why this default: docs/results-lavapipe.md, the sweep).
     #[arg(long, default_value = "256x256")]
     pub size: String,
     #[arg(long, default_value_t = 1)]
