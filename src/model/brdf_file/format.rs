@@ -57,8 +57,8 @@ pub(super) struct Open {
     pub(super) line: usize,
 }
 
-/// The directives of a `.brdf` shader that glslang's preprocessor runs, as in any GLSL (issue 19: engine code
-/// selects its branches with `#if` and names its constants with `#define`).
+/// The directives of a `.brdf` shader that glslang's preprocessor runs, as in any GLSL (engine code selects its
+/// branches with `#if` and names its constants with `#define`).
 /// `#pragma` is not among them: glslang's preprocessor passes pragmas through into the text brdfprof reads for
 /// the file's globals, and none changes the SPIR-V of a compute kernel (`dropped_hash_line`).
 pub(super) const PREPROCESSOR_DIRECTIVES: [&str; 10] =
