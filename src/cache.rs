@@ -388,7 +388,7 @@ mod tests {
         );
     }
 
-    /// Issue 31 item 6: an entry that is a symbolic link (here to an endless file) is damaged, not read; an
+    /// An entry that is a symbolic link (here to an endless file) is damaged, not read; an
     /// entry longer than its header says is read no further than that.
     #[test]
     fn a_linked_or_overlong_entry_is_bad_and_read_within_its_length() {

@@ -42,7 +42,7 @@ pub fn eval(args: &EvalArgs) -> Result<ExitCode> {
         kernels::EvalExtras { tangents: input.tangents.as_deref(), rows: &rows.values, row_floats: rows.floats };
     let (device, values) = if args.device.device.as_deref() == Some(OPENCL_DEVICE) {
         let (device, values, smod) = on_opencl(&model, &input.samples, &extras)?;
-        // Two executions of one source: where they disagree, the user is told (issue 31 item 2).
+        // Two executions of one source: where they disagree, the user is told.
         let vulkan = DeviceArgs { device: None, validate: args.device.validate };
         let (gpu, on_vulkan) = on_device(&vulkan, |gpu, _| {
             kernels::eval_with(gpu, &model, &input.samples, &extras, kernels::RunLimits::default())

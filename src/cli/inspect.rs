@@ -73,39 +73,7 @@ pub fn inspect(args: &InspectArgs) -> Result<ExitCode> {
     }
     let validate = DeviceArgs { device: None, validate: args.validate }.validation();
     let plan = devices::plan(&args.devices)?;
-    if args.lines && !plan.iter().any(|p| matches!(p, devices::Planned::Target(t) if brdfprof::targets::names_lines(t)))
-    {
-        bail!(
-            "--lines: only the nvidia: and intel: targets' compilers name each instruction's source line; give one (e.g. --device nvidia:sm_89 --device intel:gen12lp)"
-        );
-    }
-    // A compile-only target's default name is known now (`devices::slug`); a local device's only once it is open.
-    let default_name = match plan.as_slice() {
-        [devices::Planned::Target(t)] => format!("inspect-{}", t.slug()),
-        [_] => "inspect-<device>".to_string(),
-        _ => "inspect-devices".to_string(),
-    };
-    check_output("--json", args.json.as_deref(), "results", &format!("{default_name}.json"))?;
-    check_output("--markdown", args.markdown.as_deref(), "results", &format!("{default_name}.md"))?;
-    args.html.check()?;
-    if let Some(chart) = &args.chart {
-        if plan.len() < 2 {
-            bail!(
-                "--chart {}: the chart compares devices; give several --device (e.g. --device radv:all --device nvidia:all)",
-                chart.display()
-            );
-        }
-        io::check_output_path("--chart", chart)?;
-    }
-    if let Some(dir) = &args.isa {
-        if !plan.iter().any(|p| matches!(p, devices::Planned::Target(_))) {
-            bail!(
-                "--isa {}: the listings are a compile-only target's; give one, e.g. --device radv:navi21 or nvidia:sm_89 (see `brdfprof devices --targets`)",
-                dir.display()
-            );
-        }
-        io::check_output_dir("--isa", dir)?;
-    }
+    check_outputs(args, &plan)?;
     let models = if args.sweep_specs {
         brdfprof::sweep::default_specs().into_iter().map(brdfprof::model::Model::spec).collect()
     } else {
@@ -152,4 +120,42 @@ pub fn inspect(args: &InspectArgs) -> Result<ExitCode> {
         args.chart.as_ref().map_or(String::new(), |c| format!("\nChart: {}", c.display()))
     );
     Ok(ExitCode::SUCCESS)
+}
+
+/// Refuses, before anything runs, options that `plan`'s devices cannot serve and outputs that cannot be written.
+fn check_outputs(args: &InspectArgs, plan: &[devices::Planned]) -> Result<()> {
+    if args.lines && !plan.iter().any(|p| matches!(p, devices::Planned::Target(t) if brdfprof::targets::names_lines(t)))
+    {
+        bail!(
+            "--lines: only the nvidia: and intel: targets' compilers name each instruction's source line; give one (e.g. --device nvidia:sm_89 --device intel:gen12lp)"
+        );
+    }
+    // A compile-only target's default name is known now (`devices::slug`); a local device's only once it is open.
+    let default_name = match plan {
+        [devices::Planned::Target(t)] => format!("inspect-{}", t.slug()),
+        [_] => "inspect-<device>".to_string(),
+        _ => "inspect-devices".to_string(),
+    };
+    check_output("--json", args.json.as_deref(), "results", &format!("{default_name}.json"))?;
+    check_output("--markdown", args.markdown.as_deref(), "results", &format!("{default_name}.md"))?;
+    args.html.check()?;
+    if let Some(chart) = &args.chart {
+        if plan.len() < 2 {
+            bail!(
+                "--chart {}: the chart compares devices; give several --device (e.g. --device radv:all --device nvidia:all)",
+                chart.display()
+            );
+        }
+        io::check_output_path("--chart", chart)?;
+    }
+    if let Some(dir) = &args.isa {
+        if !plan.iter().any(|p| matches!(p, devices::Planned::Target(_))) {
+            bail!(
+                "--isa {}: the listings are a compile-only target's; give one, e.g. --device radv:navi21 or nvidia:sm_89 (see `brdfprof devices --targets`)",
+                dir.display()
+            );
+        }
+        io::check_output_dir("--isa", dir)?;
+    }
+    Ok(())
 }

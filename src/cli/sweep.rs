@@ -7,7 +7,7 @@ use anyhow::Result;
 use brdfprof::model::Model;
 use brdfprof::sweep;
 use clap::Args;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 #[derive(Args)]
@@ -132,9 +132,23 @@ pub fn sweep(args: &SweepArgs) -> Result<ExitCode> {
     let mut files = result.write(&out, &slug)?;
     files.extend(args.html.write(&[just_measured(&out.join(format!("sweep-{slug}.json")), &result)?], Some(&gpu))?);
     print!("{}", result.markdown());
+    let missing = write_cost_tables(&result, &costs, &out, &slug, &mut files)?;
+    println!("\n{}", written(&files));
+    Ok(if missing { ExitCode::from(1) } else { ExitCode::SUCCESS })
+}
+
+/// Each target's cost table of the swept specs beside `result`'s files in `out` (added to `files`), printed,
+/// and the frontiers across targets where there are several. True when some spec has no figure on some target.
+fn write_cost_tables(
+    result: &sweep::SweepReport,
+    costs: &[brdfprof::targets::Run],
+    out: &Path,
+    slug: &str,
+    files: &mut Vec<PathBuf>,
+) -> Result<bool> {
     let mut missing = false;
     let mut swept_all = Vec::new();
-    for run in &costs {
+    for run in costs {
         let name = run.target.name();
         let table = run
             .report
@@ -143,7 +157,7 @@ pub fn sweep(args: &SweepArgs) -> Result<ExitCode> {
             .ok_or_else(|| anyhow::anyhow!("{name}: the compiler reported no statistics the cost model reads"))?;
         let note =
             run.report.section_notes.get("driver/").map(String::as_str).filter(|n| n.starts_with("not compiled"));
-        let swept = brdfprof::sweep_cost::build(&result, &name, &table, note)?;
+        let swept = brdfprof::sweep_cost::build(result, &name, &table, note)?;
         if let Some(skipped) = &swept.skipped {
             // Every model asked for is in every table, or the command says which is not, and exits 1.
             brdfprof::messages::warning(format!("{skipped}: those specs have no {name} figure"));
@@ -159,6 +173,5 @@ pub fn sweep(args: &SweepArgs) -> Result<ExitCode> {
         files.extend(frontiers.write(&out.join(format!("sweep-{slug}-frontiers")))?);
         print!("\n{}", frontiers.markdown());
     }
-    println!("\n{}", written(&files));
-    Ok(if missing { ExitCode::from(1) } else { ExitCode::SUCCESS })
+    Ok(missing)
 }

@@ -209,22 +209,7 @@ fn scatter_panel(
             series.label(name.clone()).legend(move |(x, y)| Circle::new((x + 15, y), 7, colour.filled()));
         }
     }
-    // Labels (highlighted points) and numbers (the rest), placed greedily from the top down.
-    let mut placed: Vec<(i32, i32, i32, i32)> = Vec::new();
-    let mut order: Vec<&&Point> = pts.iter().collect();
-    order.sort_by(|a, b| b.highlight.cmp(&a.highlight).then(b.y.total_cmp(&a.y)));
-    for p in order {
-        let text = if p.highlight {
-            p.label.clone()
-        } else {
-            numbers.iter().find(|(_, q)| std::ptr::eq(*q, *p)).map_or(String::new(), |(n, _)| n.to_string())
-        };
-        let at = chart.backend_coord(&(p.x, p.y));
-        let (x, y) = place(&mut placed, at, CHAR_W * text.chars().count() as i32);
-        let base = area.get_base_pixel();
-        let font = (FONT, if p.highlight { 16 } else { 14 }).into_font().color(&palette(p.group).mix(0.95));
-        area.draw(&Text::new(text, (x - base.0, y - base.1), font)).map_err(|e| err(&e))?;
-    }
+    draw_labels(area, pts, numbers, |p| chart.backend_coord(&(p.x, p.y)))?;
     if main {
         chart
             .configure_series_labels()
@@ -234,6 +219,32 @@ fn scatter_panel(
             .border_style(BLACK)
             .draw()
             .map_err(|e| err(&e))?;
+    }
+    Ok(())
+}
+
+/// Labels (highlighted points) and numbers (the rest), placed greedily from the top down; `coord` is a point's
+/// pixel in the chart.
+fn draw_labels(
+    area: &Area,
+    pts: &[&Point],
+    numbers: &[(usize, &Point)],
+    coord: impl Fn(&Point) -> (i32, i32),
+) -> Result<()> {
+    let mut placed: Vec<(i32, i32, i32, i32)> = Vec::new();
+    let mut order: Vec<&&Point> = pts.iter().collect();
+    order.sort_by(|a, b| b.highlight.cmp(&a.highlight).then(b.y.total_cmp(&a.y)));
+    for p in order {
+        let text = if p.highlight {
+            p.label.clone()
+        } else {
+            numbers.iter().find(|(_, q)| std::ptr::eq(*q, *p)).map_or(String::new(), |(n, _)| n.to_string())
+        };
+        let at = coord(p);
+        let (x, y) = place(&mut placed, at, CHAR_W * text.chars().count() as i32);
+        let base = area.get_base_pixel();
+        let font = (FONT, if p.highlight { 16 } else { 14 }).into_font().color(&palette(p.group).mix(0.95));
+        area.draw(&Text::new(text, (x - base.0, y - base.1), font)).map_err(|e| anyhow!("chart: {e}"))?;
     }
     Ok(())
 }

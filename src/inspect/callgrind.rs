@@ -224,9 +224,14 @@ pub fn run(models: &[Model], lights: u32, shaders: &Shaders, options: &Callgrind
         .find_map(|l| serde_json::from_str(l).ok())
         .ok_or_else(|| anyhow!("the callgrind child printed no reply; its output:\n{stdout}"))?;
     let dumps = read_dumps(dir.path())?;
+    let kernels = kernel_irs(models, &reply.labels, &dumps)?;
+    Ok(CallgrindRun { kernels, evaluations: reply.evaluations, jit_cpu_features: reply.jit_cpu_features, valgrind })
+}
+
+/// Each kernel's Ir of JIT code: the dump labelled `labels[i]` is `models[i]`'s (the baseline's last).
+fn kernel_irs(models: &[Model], labels: &[String], dumps: &BTreeMap<String, u64>) -> Result<Vec<KernelIr>> {
     let names: Vec<String> = models.iter().map(Model::label).chain([super::BASELINE_LABEL.to_string()]).collect();
-    let kernels = reply
-        .labels
+    labels
         .iter()
         .zip(names)
         .map(|(dump_label, label)| {
@@ -239,8 +244,7 @@ pub fn run(models: &[Model], lights: u32, shaders: &Shaders, options: &Callgrind
             }
             Ok(KernelIr { label, jit_ir })
         })
-        .collect::<Result<Vec<_>>>()?;
-    Ok(CallgrindRun { kernels, evaluations: reply.evaluations, jit_cpu_features: reply.jit_cpu_features, valgrind })
+        .collect()
 }
 
 /// Every client-request dump in `dir`: its label -> Ir of the JIT code.

@@ -650,12 +650,7 @@ impl FileModel {
                         bail!("{}: `{}` is set per CSV row, which only eval reads", self.path, p.name);
                     }
                     s += &format!("{} {g};\n", p.glsl_type());
-                    let at = |k: usize| format!("inputs[(base) + {}][{}]", (offset + k) / 4, (offset + k) % 4);
-                    rows.push(match p.kind {
-                        FileParamKind::Float { .. } => format!("{g} = {};", at(0)),
-                        FileParamKind::Bool { .. } => format!("{g} = {} != 0.0;", at(0)),
-                        FileParamKind::Color { .. } => format!("{g} = vec3({}, {}, {});", at(0), at(1), at(2)),
-                    });
+                    rows.push(row_assignment(&g, &p.kind, *offset));
                     row_floats = row_floats.max(offset + p.columns().len());
                 }
             }
@@ -959,6 +954,17 @@ pub fn tangent_frame(n: DVec3, t: DVec3) -> DVec3 {
 /// |t - n (n.t)|^2 / |t|^2 below which a given tangent counts as parallel to N (sin^2 of 1e-3 rad): the
 /// documented basis is used instead. The same constant is in glsl/brdf.glsl (a test reads both).
 pub const TANGENT_PARALLEL: f64 = 1e-6;
+
+/// The GLSL statement setting parameter `g` (of `kind`) from its columns of a CSV row, at float `offset` in the
+/// row's `inputs[(base) + ..]` vec4s.
+fn row_assignment(g: &str, kind: &FileParamKind, offset: usize) -> String {
+    let at = |k: usize| format!("inputs[(base) + {}][{}]", (offset + k) / 4, (offset + k) % 4);
+    match kind {
+        FileParamKind::Float { .. } => format!("{g} = {};", at(0)),
+        FileParamKind::Bool { .. } => format!("{g} = {} != 0.0;", at(0)),
+        FileParamKind::Color { .. } => format!("{g} = vec3({}, {}, {});", at(0), at(1), at(2)),
+    }
+}
 
 #[cfg(test)]
 mod tests {

@@ -204,6 +204,21 @@ fn analyse_all(raw: &RawTimes, specs: &[Option<Model>], groups: &[Group]) -> Vec
     groups.iter().flat_map(|g| analyse(raw, specs, g)).collect()
 }
 
+/// The size of the profiled workload: `options`' G-buffer and light counts, split as `work` (any one) is.
+fn workload_size(options: &ProfileOptions, work: &Workload) -> WorkloadSize {
+    WorkloadSize {
+        width: options.width,
+        height: options.height,
+        pixels: work.pixel_count,
+        lights: options.lights.clone(),
+        gbuffer: options.format,
+        bytes_per_pixel: options.format.bytes_in(),
+        output_bytes_per_pixel: options.format.bytes_out(),
+        light_block: workload::LIGHT_BLOCK,
+        chunks: work.chunks(),
+    }
+}
+
 /// Runs the profile: for each light count, the models (the reference added when missing) and the baseline,
 /// all interleaved in the same rounds.
 pub fn run(gpu: &Gpu, options: &ProfileOptions, progress: &ProgressBar) -> Result<ProfileReport> {
@@ -260,17 +275,7 @@ pub fn run(gpu: &Gpu, options: &ProfileOptions, progress: &ProgressBar) -> Resul
     Ok(ProfileReport {
         provenance: Provenance::new(&gpu.info),
         reference: REFERENCE_MODEL.into(),
-        workload: WorkloadSize {
-            width: options.width,
-            height: options.height,
-            pixels: works[0].pixel_count,
-            lights: options.lights.clone(),
-            gbuffer: options.format,
-            bytes_per_pixel: options.format.bytes_in(),
-            output_bytes_per_pixel: options.format.bytes_out(),
-            light_block: workload::LIGHT_BLOCK,
-            chunks: works[0].chunks(),
-        },
+        workload: workload_size(options, &works[0]),
         rounds: raw.rounds(),
         reps_per_round: options.protocol.reps,
         instances: options.instances,

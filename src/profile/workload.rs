@@ -192,6 +192,24 @@ pub struct Variant<'g> {
 
 pub use crate::model::BASELINE_LABEL;
 
+/// One kernel per distinct (lights per dispatch, accumulate) among the light `blocks`: those kinds, and each
+/// block's index among them.
+fn kernel_kinds(blocks: &[(u32, u32)]) -> (Vec<(u32, bool)>, Vec<usize>) {
+    let mut kinds: Vec<(u32, bool)> = Vec::new();
+    let kind_of: Vec<usize> = blocks
+        .iter()
+        .enumerate()
+        .map(|(b, &(_, count))| {
+            let kind = (count, b > 0);
+            kinds.iter().position(|k| *k == kind).unwrap_or_else(|| {
+                kinds.push(kind);
+                kinds.len() - 1
+            })
+        })
+        .collect();
+    (kinds, kind_of)
+}
+
 impl<'g> Variant<'g> {
     /// The shading kernels for `model` (None: the memory-only baseline) from `shaders`, as `instances`
     /// independent pipelines.
@@ -206,19 +224,7 @@ impl<'g> Variant<'g> {
             m.check_support(&gpu.info)?;
         }
         let blocks = light_blocks(work.light_count);
-        // One kernel per distinct (lights per dispatch, accumulate) among the blocks.
-        let mut kinds: Vec<(u32, bool)> = Vec::new();
-        let kind_of: Vec<usize> = blocks
-            .iter()
-            .enumerate()
-            .map(|(b, &(_, count))| {
-                let kind = (count, b > 0);
-                kinds.iter().position(|k| *k == kind).unwrap_or_else(|| {
-                    kinds.push(kind);
-                    kinds.len() - 1
-                })
-            })
-            .collect();
+        let (kinds, kind_of) = kernel_kinds(&blocks);
         let compiled = kinds
             .iter()
             .map(|&(count, acc)| shade_kernel(model, work.format, count, acc, shaders).map(|k| (k.spirv, k.constants)))

@@ -65,56 +65,54 @@ fn stability_cell(s: &SpecStability) -> Cell {
     }
 }
 
+/// A profile's column: each model's cost against the reference at the first light count.
+fn profile_column(s: &mut Summary, p: &crate::profile::ProfileReport) {
+    let lights = p.rows.first().map(|r| r.lights);
+    let mut cells = Vec::new();
+    for r in p.rows.iter().filter(|r| Some(r.lights) == lights && r.spec.is_some()) {
+        let key = s.model(r.spec.as_deref().unwrap(), &r.model);
+        cells.push((key, estimate_cell(r.net_vs_reference.as_ref().or(Some(&r.vs_reference)))));
+    }
+    let net = if p.rows.iter().any(|r| r.net_vs_reference.is_some()) { "net cost" } else { "cost" };
+    s.column(format!("{net} vs {} ({}, {} lights)", p.reference, p.provenance.device.name, lights.unwrap_or(0)), cells);
+}
+
+/// One column per inspected device with a cost table: each model's modelled cost against the reference.
+fn inspect_columns(s: &mut Summary, reports: &[crate::schema::InspectReport]) {
+    for r in reports {
+        let Some(cost) = r.cost.clone().or_else(|| crate::targets::cost_of(r)) else { continue };
+        let specs: BTreeMap<&str, &str> =
+            r.rows.iter().filter_map(|x| x.spec.as_deref().map(|sp| (x.model.as_str(), sp))).collect();
+        let reference = cost
+            .rows
+            .iter()
+            .find(|c| c.model == crate::brdf::spec::REFERENCE_MODEL)
+            .and_then(|c| c.net_cycles_per_eval);
+        let mut cells = Vec::new();
+        for c in &cost.rows {
+            let (Some(spec), Some(net), Some(base)) = (specs.get(c.model.as_str()), c.net_cycles_per_eval, reference)
+            else {
+                continue;
+            };
+            let key = s.model(spec, &c.model);
+            cells.push((key, num_cell(Some(net / base))));
+        }
+        let device = r.provenance["device"]["name"].as_str().unwrap_or("?");
+        s.column(
+            format!("{} vs {} ({device}, modelled)", cost.column_name(), crate::brdf::spec::REFERENCE_MODEL),
+            cells,
+        );
+    }
+}
+
 /// Gathers the rows and columns: models from every report but stability first, then the specs stability
 /// failed (guard variants left out); a stability column fills in for the models it checked.
 fn gather(inputs: &[Input]) -> Summary {
     let mut s = Summary::default();
     for input in inputs {
         match &input.loaded {
-            Loaded::Profile(p) => {
-                let lights = p.rows.first().map(|r| r.lights);
-                let mut cells = Vec::new();
-                for r in p.rows.iter().filter(|r| Some(r.lights) == lights && r.spec.is_some()) {
-                    let key = s.model(r.spec.as_deref().unwrap(), &r.model);
-                    cells.push((key, estimate_cell(r.net_vs_reference.as_ref().or(Some(&r.vs_reference)))));
-                }
-                let net = if p.rows.iter().any(|r| r.net_vs_reference.is_some()) { "net cost" } else { "cost" };
-                s.column(
-                    format!("{net} vs {} ({}, {} lights)", p.reference, p.provenance.device.name, lights.unwrap_or(0)),
-                    cells,
-                );
-            }
-            Loaded::Inspect(reports, _) => {
-                for r in reports {
-                    let Some(cost) = r.cost.clone().or_else(|| crate::targets::cost_of(r)) else { continue };
-                    let specs: BTreeMap<&str, &str> =
-                        r.rows.iter().filter_map(|x| x.spec.as_deref().map(|sp| (x.model.as_str(), sp))).collect();
-                    let reference = cost
-                        .rows
-                        .iter()
-                        .find(|c| c.model == crate::brdf::spec::REFERENCE_MODEL)
-                        .and_then(|c| c.net_cycles_per_eval);
-                    let mut cells = Vec::new();
-                    for c in &cost.rows {
-                        let (Some(spec), Some(net), Some(base)) =
-                            (specs.get(c.model.as_str()), c.net_cycles_per_eval, reference)
-                        else {
-                            continue;
-                        };
-                        let key = s.model(spec, &c.model);
-                        cells.push((key, num_cell(Some(net / base))));
-                    }
-                    let device = r.provenance["device"]["name"].as_str().unwrap_or("?");
-                    s.column(
-                        format!(
-                            "{} vs {} ({device}, modelled)",
-                            cost.column_name(),
-                            crate::brdf::spec::REFERENCE_MODEL
-                        ),
-                        cells,
-                    );
-                }
-            }
+            Loaded::Profile(p) => profile_column(&mut s, p),
+            Loaded::Inspect(reports, _) => inspect_columns(&mut s, reports),
             Loaded::Sweep(w) => {
                 let cells = w
                     .rows

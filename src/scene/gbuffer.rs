@@ -635,23 +635,61 @@ fn decode_vector(plane: &Plane, i: usize) -> V3 {
     if plane.float { c.normalize_or_zero() } else { (2.0 * c - Vec3::ONE).normalize_or_zero() }
 }
 
+/// `plane`, or an error where its size is not the normal image's.
+fn same_size(plane: Plane, normal: &Plane) -> Result<Plane> {
+    let (w, h) = (normal.width, normal.height);
+    if (plane.width, plane.height) != (w, h) {
+        bail!(
+            "{} is {}x{}, but the normal image {} is {w}x{h}",
+            plane.path.display(),
+            plane.width,
+            plane.height,
+            normal.path.display()
+        );
+    }
+    Ok(plane)
+}
+
+/// Pixel `i`'s position: along its ray `dir` from the camera at `eye` to the depth image's distance (a PNG's
+/// scaled to `depth_range`), or else read from the position image.
+fn image_position(
+    depth: Option<&Plane>,
+    position: Option<&Plane>,
+    depth_range: Option<[f32; 2]>,
+    eye: [f32; 3],
+    dir: V3,
+    i: usize,
+) -> [f32; 3] {
+    match (depth, position) {
+        (Some(d), _) => {
+            let c = d.rgba[i][0];
+            let z = if d.float {
+                c
+            } else {
+                let [near, far] = depth_range.unwrap();
+                near + c * (far - near)
+            };
+            (Vec3::from(eye) + dir * z).to_array()
+        }
+        (_, Some(p)) => [p.rgba[i][0], p.rgba[i][1], p.rgba[i][2]],
+        _ => unreachable!("checked: depth or position"),
+    }
+}
+
+/// Pixel `i`'s base colour from the base colour image (an 8-bit one is sRGB), or the material's `default`.
+fn image_base_colour(base: Option<&Plane>, default: [f32; 3], i: usize) -> [f32; 3] {
+    base.map_or(default, |b| {
+        let c = b.rgba[i];
+        if b.float { [c[0], c[1], c[2]] } else { [srgb_to_linear(c[0]), srgb_to_linear(c[1]), srgb_to_linear(c[2])] }
+    })
+}
+
 fn load_images(scene: &Scene, files: &ImageFiles) -> Result<GBuffer> {
     let camera = scene.file.camera.expect("checked: image G-buffers have a camera");
     let open = |p: &PathBuf, what: &str, kind: PlaneKind| read_plane(&scene.dir.join(p), what, kind);
     let normal = open(&files.normal, "normal", PlaneKind::Vector)?;
     let (w, h) = (normal.width, normal.height);
-    let same = |plane: Plane| -> Result<Plane> {
-        if (plane.width, plane.height) != (w, h) {
-            bail!(
-                "{} is {}x{}, but the normal image {} is {w}x{h}",
-                plane.path.display(),
-                plane.width,
-                plane.height,
-                normal.path.display()
-            );
-        }
-        Ok(plane)
-    };
+    let same = |plane: Plane| same_size(plane, &normal);
     let optional = |p: &Option<PathBuf>, what: &str, kind: PlaneKind| {
         p.as_ref().map(|p| open(p, what, kind).and_then(same)).transpose()
     };
@@ -678,20 +716,7 @@ fn load_images(scene: &Scene, files: &ImageFiles) -> Result<GBuffer> {
             let (x, y) = (i as u32 % w, i as u32 / w);
             let mat = material.as_ref().map_or(0, |m| (m.rgba[i][0] * 255.0).round() as u32);
             let dir = rays.dir(x, y);
-            let pos = match (&depth, &position) {
-                (Some(d), _) => {
-                    let c = d.rgba[i][0];
-                    let z = if d.float {
-                        c
-                    } else {
-                        let [near, far] = files.depth_range.unwrap();
-                        near + c * (far - near)
-                    };
-                    (Vec3::from(camera.position) + dir * z).to_array()
-                }
-                (_, Some(p)) => [p.rgba[i][0], p.rgba[i][1], p.rgba[i][2]],
-                _ => unreachable!("checked: depth or position"),
-            };
+            let pos = image_position(depth.as_ref(), position.as_ref(), files.depth_range, camera.position, dir, i);
             if mat == 255 {
                 return Pixel {
                     position: pos,
@@ -704,14 +729,7 @@ fn load_images(scene: &Scene, files: &ImageFiles) -> Result<GBuffer> {
             let n = decode_vector(&normal, i);
             let t =
                 tangent.as_ref().map(|t| decode_vector(t, i)).filter(|t| *t != Vec3::ZERO && t.dot(n).abs() < 0.999);
-            let base_colour = base.as_ref().map_or(m.base_colour.0, |b| {
-                let c = b.rgba[i];
-                if b.float {
-                    [c[0], c[1], c[2]]
-                } else {
-                    [srgb_to_linear(c[0]), srgb_to_linear(c[1]), srgb_to_linear(c[2])]
-                }
-            });
+            let base_colour = image_base_colour(base.as_ref(), m.base_colour.0, i);
             Pixel {
                 position: pos,
                 normal: n.to_array(),

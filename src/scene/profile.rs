@@ -167,6 +167,23 @@ fn slot_of(slots: &[Slot], k: usize, without: Option<Effect>) -> usize {
     slots.iter().position(|s| s.kernel == k && s.without == without).expect("every kernel and effect has a slot")
 }
 
+/// The rows of the effects table: what each effect of each kernel costs, in time and in SPIR-V instructions
+/// (`instructions` per slot).
+fn effect_rows(p: &ScenePlan, a: &Analysis, slots: &[Slot], instructions: &[Option<usize>]) -> Vec<EffectRow> {
+    a.effects
+        .iter()
+        .map(|&(k, e, extra, frac)| EffectRow {
+            model: p.kernels[k].model.label(),
+            effect: e.name().into(),
+            extra_ns_per_pixel: extra,
+            extra_fraction: frac,
+            extra_spirv_instructions: instructions[slot_of(slots, k, None)]
+                .zip(instructions[slot_of(slots, k, Some(e))])
+                .map(|(a, b)| a as i64 - b as i64),
+        })
+        .collect()
+}
+
 /// Loads the G-buffer, plans, compiles and times the scene.
 pub fn run(
     gpu: &Gpu,
@@ -214,19 +231,7 @@ pub fn run(
             frame_share: a.kernels[k].1,
         })
         .collect();
-    let effects = a
-        .effects
-        .iter()
-        .map(|&(k, e, extra, frac)| EffectRow {
-            model: p.kernels[k].model.label(),
-            effect: e.name().into(),
-            extra_ns_per_pixel: extra,
-            extra_fraction: frac,
-            extra_spirv_instructions: instructions[slot_of(&slots, k, None)]
-                .zip(instructions[slot_of(&slots, k, Some(e))])
-                .map(|(a, b)| a as i64 - b as i64),
-        })
-        .collect();
+    let effects = effect_rows(&p, &a, &slots, &instructions);
     Ok(SceneProfileReport {
         provenance: Provenance::new(&gpu.info),
         scene: scene.name(),

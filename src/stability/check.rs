@@ -287,6 +287,41 @@ fn reciprocity_error(forward: &[[f32; 3]], backward: &[[f32; 3]]) -> (Option<f64
     (worst, nonfinite)
 }
 
+/// Each grid sample's deviation from the expected values (`spec`'s, `twin` on the grid), 0 outside the domain
+/// and where nothing is expected.
+fn domain_deviations(
+    spec: Option<&ModelSpec>,
+    twin: Option<&[[f64; 3]]>,
+    grid: &[Sample],
+    grid_out: &[[f32; 3]],
+    in_domain: &[bool],
+) -> Vec<f64> {
+    match (spec, twin) {
+        (Some(s), Some(t)) => grid_deviations(s, grid, grid_out, t)
+            .into_iter()
+            .zip(in_domain)
+            .map(|(d, &inside)| if inside { d } else { 0.0 })
+            .collect(),
+        _ => vec![0.0; grid.len()],
+    }
+}
+
+/// `worst`, or where no case or grid value deviated, the first failure found (its first non-finite or negative
+/// value).
+fn worst_or_first_failure(worst: Worst, failures: &Failures) -> Worst {
+    if worst.input.is_empty() {
+        if let Some(f) = failures.first() {
+            return Worst {
+                deviation: f64::INFINITY,
+                got: f.got.into_iter().find(|x| !x.is_finite() || *x < 0.0).unwrap_or(f.got[0]),
+                expected: f64::NAN,
+                input: format!("{}: {}", f.at, f.inputs),
+            };
+        }
+    }
+    worst
+}
+
 /// Checks one model: catalogue, grid, discontinuities, reciprocity and where it fails (energy is added by
 /// `run`).
 pub fn check_model(
@@ -310,14 +345,7 @@ pub fn check_model(
     let judged = judge_cases(model, checks, cases, &case_out, &mut tally, &mut worst);
     let spec = checks.expected(model, None);
     let twin: Option<Vec<[f64; 3]>> = spec.map(|s| grid.par_iter().map(|x| s.eval(x)).collect());
-    let deviations: Vec<f64> = match (&spec, &twin) {
-        (Some(s), Some(t)) => grid_deviations(s, grid, grid_out, t)
-            .into_iter()
-            .zip(&in_domain)
-            .map(|(d, &inside)| if inside { d } else { 0.0 })
-            .collect(),
-        _ => vec![0.0; grid.len()],
-    };
+    let deviations = domain_deviations(spec.as_ref(), twin.as_deref(), grid, grid_out, &in_domain);
     let cells = bad_cells(grid_out, &in_domain, &mut tally);
     if let (Some(t), Some((i, &d))) = (&twin, deviations.iter().enumerate().max_by(|a, b| a.1.total_cmp(b.1))) {
         if d > worst.deviation {
@@ -328,16 +356,7 @@ pub fn check_model(
     let any_bad = cells.iter().flatten().any(|&n| n > 0);
     let (reciprocity, reciprocity_nonfinite) = reciprocity_error(forward, backward);
     let failures = locate_failures(gpu, model, cases, &case_out, &judged, grid, grid_out, &in_domain)?;
-    if worst.input.is_empty() {
-        if let Some(f) = failures.first() {
-            worst = Worst {
-                deviation: f64::INFINITY,
-                got: f.got.into_iter().find(|x| !x.is_finite() || *x < 0.0).unwrap_or(f.got[0]),
-                expected: f64::NAN,
-                input: format!("{}: {}", f.at, f.inputs),
-            };
-        }
-    }
+    let worst = worst_or_first_failure(worst, &failures);
     let results: Vec<CaseResult> = judged.iter().flatten().cloned().collect();
     Ok(SpecStability {
         label: model.label(),

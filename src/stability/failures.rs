@@ -96,6 +96,28 @@ pub fn result_text(g: &[f32; 3]) -> String {
     triple(*g)
 }
 
+/// Sample `s` under each input guard alone, then under all of them; None where a guard means no call.
+fn guarded(s: &Sample, min_roughness: f64) -> Vec<Option<Sample>> {
+    INPUT_GUARDS
+        .iter()
+        .map(|g| (g.apply)(s, min_roughness))
+        .chain(std::iter::once(apply_all_input_guards(s, min_roughness)))
+        .collect()
+}
+
+/// Adds sample `s` to model `m`'s job (a new one for a model not in `jobs` yet); returns (job, index in it).
+fn queue_job(jobs: &mut Vec<(Model, Vec<Sample>)>, m: &Model, s: Sample) -> (usize, usize) {
+    let k = match jobs.iter().position(|(j, _)| j == m) {
+        Some(k) => k,
+        None => {
+            jobs.push((m.clone(), Vec::new()));
+            jobs.len() - 1
+        }
+    };
+    jobs[k].1.push(s);
+    (k, jobs[k].1.len() - 1)
+}
+
 /// One model's failing inputs at each hard case (`case_models[i]` is the model case i ran) and grid point,
 /// each run again under every input guard alone and all of them together.
 pub fn locate(
@@ -110,27 +132,11 @@ pub fn locate(
     let failing_cases: Vec<usize> = (0..case_out.len()).filter(|&i| bad(&case_out[i])).collect();
     let failing_grid: Vec<usize> = (0..grid_out.len()).filter(|&i| bad(&grid_out[i])).collect();
     // (model, sample) per (failing input, guard), None where the guard means no call: batched per model.
-    let variants = |s: &Sample| -> Vec<Option<Sample>> {
-        INPUT_GUARDS
-            .iter()
-            .map(|g| (g.apply)(s, min_roughness))
-            .chain(std::iter::once(apply_all_input_guards(s, min_roughness)))
-            .collect()
-    };
+    let variants = |s: &Sample| guarded(s, min_roughness);
     let names: Vec<String> =
         INPUT_GUARDS.iter().map(|g| g.name.to_string()).chain(std::iter::once(ALL_GUARDS.to_string())).collect();
     let mut jobs: Vec<(Model, Vec<Sample>)> = Vec::new();
-    let mut queue = |m: &Model, s: Sample| -> (usize, usize) {
-        let k = match jobs.iter().position(|(j, _)| j == m) {
-            Some(k) => k,
-            None => {
-                jobs.push((m.clone(), Vec::new()));
-                jobs.len() - 1
-            }
-        };
-        jobs[k].1.push(s);
-        (k, jobs[k].1.len() - 1)
-    };
+    let mut queue = |m: &Model, s: Sample| queue_job(&mut jobs, m, s);
     let mut plan: Vec<Vec<Option<(usize, usize)>>> = Vec::new();
     for &i in &failing_cases {
         plan.push(variants(&case_models[i].2).into_iter().map(|v| v.map(|s| queue(&case_models[i].0, s))).collect());

@@ -332,7 +332,7 @@ fn sweep_measures_a_file_against_a_reference() {
     let file = rows.iter().find(|r| r["spec"].as_str().unwrap().contains("ggx.brdf")).unwrap();
     let builtin = rows.iter().find(|r| r["spec"] == "ggx").unwrap();
     assert_eq!(file["accuracy"]["reference"], "ggx");
-    // Issue 19: the numerical error of a file is against the reference spec's own f64 formula (a transcription
+    // The numerical error of a file is against the reference spec's own f64 formula (a transcription
     // of ggx's formula matches it to fp32 rounding), its error against exact GGX is the preset's.
     let numerical = file["accuracy"]["numerical"]["max"].as_f64().unwrap();
     assert!(numerical < 1e-3, "the file against ggx's f64 formula: {numerical}");
@@ -368,8 +368,8 @@ fn a_file_gates_on_a_compile_only_amd_target() {
 
 const NAN_FILE: &str = "analytic\n::begin shader\nvec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) { return vec3(sqrt(dot(N, L) - 2.0)); }\n::end shader\n";
 
-/// Issue 21: stability of an all-NaN file reported reciprocity 0.0 (perfect), max E "inf gain" (JSON null)
-/// and NaN results as "(inf)". NaN is now counted and named wherever it is.
+/// Stability of an all-NaN file counts and names NaN wherever it is: not a reciprocity of 0.0 (perfect), not a
+/// max E of "inf gain" (JSON null), not NaN results as "(inf)".
 #[test]
 fn stability_counts_and_names_nan_instead_of_calling_it_perfect() {
     let dir = tempfile::tempdir().unwrap();
@@ -456,7 +456,8 @@ fn loops_are_warned_about_with_their_bounds() {
     );
 }
 
-/// The smaller items of issue 21 (11), each as the user meets it.
+/// Smaller checks of `.brdf` models, each as the user meets it: parameters as CSV columns, a key given twice,
+/// a path with commas, a recursion error's names, and defines.
 #[test]
 fn csv_columns_follow_the_parameters_declarations() {
     let dir = tempfile::tempdir().unwrap();

@@ -40,8 +40,8 @@ fn entries(cache: &Path) -> Vec<PathBuf> {
     e
 }
 
-/// Issue 21's reproduction: a baseline from a copy of glsl/, then a `pow` added to the file model's return
-/// in the copy's brdf.glsl. With the cache on, the gate must see the edit (it exited 0 on a cache hit).
+/// A baseline from a copy of glsl/, then a `pow` added to the file model's return in the copy's brdf.glsl.
+/// With the cache on, the gate must see the edit, not exit 0 on a cache hit.
 #[test]
 fn an_edited_include_is_not_served_from_the_cache() {
     let dir = tempfile::tempdir().unwrap();

@@ -35,9 +35,9 @@ fn an_empty_or_blank_device_is_refused_by_every_gpu_command() {
     assert_eq!(std::fs::read_dir(d).unwrap().count(), 1, "nothing but the input in the directory");
 }
 
-/// Issue 21: `RADV_FORCE_FAMILY=garbage` (or empty) in the user's environment aborted `devices` and `eval`
-/// (134, "radv: Unknown family"). Any value of it, and of the other Mesa variables brdfprof sets for its
-/// children, gives a working run (or exit 2 with a message), never a crash.
+/// `RADV_FORCE_FAMILY=garbage` (or empty) in the user's environment makes RADV abort (134, "radv: Unknown
+/// family"); it must not abort `devices` or `eval`. Any value of it, and of the other Mesa variables brdfprof
+/// sets for its children, gives a working run (or exit 2 with a message), never a crash.
 #[test]
 fn mesa_variables_in_the_environment_cannot_crash_it() {
     let dir = tempfile::tempdir().unwrap();

@@ -210,7 +210,7 @@ fn diff_refuses_bad_arguments() {
     assert!(!p.exists());
 }
 
-/// Issue 32: `diff --reference SPEC` measures any number of models against one reference's exact f64 values
+/// `diff --reference SPEC` measures any number of models against one reference's exact f64 values
 /// in one table. The reference's own kernel is within fp32 rounding of its f64 values; the engine-shaped GGX
 /// files (written for the tests) within 1e-3 inside their declared roughness domain; the thesis's ggx preset
 /// (another visibility term) is not, so --tolerance 1e-3 exits 1 with it and 0 without it. Each model's

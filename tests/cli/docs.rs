@@ -6,7 +6,7 @@ use crate::common;
 use std::collections::BTreeSet;
 use std::path::Path;
 
-/// The most lines README may have (issue 20: a README a newcomer reads to the end).
+/// The most lines README may have (a README a newcomer reads to the end).
 const README_MAX_LINES: usize = 250;
 
 fn read(rel: &str) -> String {

@@ -32,7 +32,7 @@ fn bad_bytes_and_twice_named_columns_name_where() {
     assert!(!dir.path().join("out.csv").exists());
 }
 
-/// Issue 19: eval requires only the material columns the model reads. A conductor's Fresnel reads no F0 and a
+/// Eval requires only the material columns the model reads. A conductor's Fresnel reads no F0 and a
 /// `.brdf` file with no binding reads neither roughness nor F0: their CSVs may leave those out, with the same
 /// output as with them; a model that reads a column still requires it, by name.
 #[test]

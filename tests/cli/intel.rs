@@ -163,7 +163,7 @@ fn a_missing_compiler_says_make_setup() {
     assert!(!dir.path().join("x.json").exists());
 }
 
-/// Issue 18 item 6: `inspect --chart` draws the cost table across devices as compare does: one colour per
+/// `inspect --chart` draws the cost table across devices as compare does: one colour per
 /// device (the chart's palette), its bars drawn; one device is refused with exit 2.
 #[test]
 fn inspect_charts_the_cost_across_devices() {

@@ -82,7 +82,7 @@ const CSV: &str = "nx,ny,nz,vx,vy,vz,lx,ly,lz,roughness,f0r,f0g,f0b\n0,0,1,0,0.6
 /// A `.brdf` whose kernel LLVM compiles for minutes (a million-element array).
 const HUGE_ARRAY: &str = "analytic\n::begin shader\nvec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y)\n{\n    float a[1000000];\n    for (int i = 0; i < 1000000; i++) a[i] = float(i) * dot(N, L);\n    float s = 0.0;\n    for (int i = 0; i < 1000000; i += 7) s += a[i];\n    return vec3(s);\n}\n::end shader\n";
 
-/// Issue 21: `float a[1000000]` compiled for minutes. Under --compile-timeout it says what it compiles once
+/// `float a[1000000]` compiles for minutes. Under --compile-timeout brdfprof says what it compiles once
 /// that takes seconds, then stops with exit 2 naming the model and the limit, writing nothing and leaving no
 /// temporary file.
 #[test]
@@ -232,7 +232,7 @@ fn zero_png(width: u32, height: u32, grey16: bool) -> Vec<u8> {
     png
 }
 
-/// Issue 21: a real 16384x16384 normal + depth PNG scene was OOM-killed at 24.4 GB in `render`. Its images'
+/// A 16384x16384 normal + depth PNG scene takes over 24 GB in `render`, enough to be OOM-killed. Its images'
 /// decoding is checked against the memory available from their headers, before a pixel is decoded;
 /// BRDFPROF_MEMORY_LIMIT makes the memory short here without filling the machine.
 #[test]

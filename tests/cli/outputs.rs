@@ -182,7 +182,7 @@ fn a_default_output_never_overwrites_a_file_git_tracks() {
         assert_eq!(std::fs::read_to_string(f.unwrap().path()).unwrap(), "committed\n", "nothing overwritten");
     }
     assert!(!d.join("i.json").exists());
-    // Issue 31 item 9: a compile-only target's default is its own name, so another device's tracked report
+    // A compile-only target's default is its own name, so another device's tracked report
     // does not refuse it (inspect-somegpu.md is tracked; inspect-nvidia-sm_89.md is not).
     run_in(d, &["inspect", "--no-callgrind", "--device", "nvidia:sm_89", "--model", "ggx"]).ok();
     assert!(

@@ -187,7 +187,7 @@ fn attr_of(dom: &str, open: &str, attr: &str) -> f64 {
     tag[at..at + tag[at..].find('"').unwrap()].parse().unwrap()
 }
 
-/// Issue 32: the page a team would show. A profile, a diff of four models against a reference and a stability
+/// The page a team would show. A profile, a diff of four models against a reference and a stability
 /// run with `--unguarded` (each guard variant a spec of its own): in Chromium at 1280x900 the summary (one row
 /// per model) is the first section and fits the first screen, provenance is folded at the end, each model has
 /// one card however many reports name it (guard variants none), the lobes of all models are overlaid, and

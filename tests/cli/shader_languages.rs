@@ -1,4 +1,4 @@
-//! Models written in HLSL and WGSL (issue 30; docs/hlsl.md, docs/wgsl.md): the UE-style HLSL fixture over three
+//! Models written in HLSL and WGSL (docs/hlsl.md, docs/wgsl.md): the UE-style HLSL fixture over three
 //! files (tests/fixtures/hlsl/ue: a wrapper, a BRDF header with `#pragma once` included twice, a common header
 //! reached through the virtual path /Engine/Private/Common.ush) and the Bevy-style WGSL fixture with `#import`
 //! and `#ifdef` (tests/fixtures/wgsl/bevy), both written for the project, against their GLSL twin
@@ -852,7 +852,7 @@ fn reserved_define_names_are_refused_and_help_and_messages_name_every_model_file
     assert!(help.contains(".hlsl") && help.contains(".wgsl") && !help.contains("every .brdf file"), "{help}");
 }
 
-/// `enable f16` (issue 30: naga's front end takes it): a WGSL GGX distribution in half precision evaluates within
+/// `enable f16` (naga's front end takes it): a WGSL GGX distribution in half precision evaluates within
 /// f16's error of its f32 twin, and not bit-identically (the halves are really computed in half precision). The
 /// bound: f16 rounds N.H by up to 2^-11; D's denominator 1 - (1 - a^2) N.H^2 at N.H near 1 and a = 0.25 is then
 /// off by about 1.9 x 2^-11 of its 0.0625, about 1.5%, squared about 3%; 5% allowed.

@@ -116,10 +116,10 @@ fn assert_cleaned_up(run: &Run, code: Option<i32>) {
     assert!(!run.cwd.path().join("results").exists(), "an interrupted run wrote reports");
 }
 
-/// Issue 21: every `.brdf` run left a `$TMPDIR/brdfprof-XXXXXX` (the GLSL tree, in a static never dropped), a
-/// killed child left its own, and SIGINT during `render` left the pictures written so far. Here 20 evals, an
-/// interrupted render and an interrupted callgrind run of a `.brdf` model (whose child composes its kernel in
-/// its own temporary directory) leave nothing in TMPDIR and no picture.
+/// Nothing is left behind: not a `.brdf` run's `$TMPDIR/brdfprof-XXXXXX` (its GLSL tree), not a killed child's
+/// own, not the pictures an interrupted `render` has written so far. Here 20 evals, an interrupted render and
+/// an interrupted callgrind run of a `.brdf` model (whose child composes its kernel in its own temporary
+/// directory) leave nothing in TMPDIR and no picture.
 #[test]
 fn evals_and_interrupted_runs_leave_no_temporary_and_no_picture() {
     let dir = tempfile::tempdir().unwrap();

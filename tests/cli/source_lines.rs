@@ -1,4 +1,4 @@
-//! Cost per source line (`inspect --lines`, issue 29 item 6): a `.brdf` file with one line planted to cost more
+//! Cost per source line (`inspect --lines`): a `.brdf` file with one line planted to cost more
 //! than any other (a loop of eight `pow`s of distinct bases, tests/fixtures/brdf/lines/costly-line.brdf) is compiled
 //! with line information by NVRTC (sm_89) and IGC (gen12lp); that line must come first, the lines must account
 //! for the kernel's instructions and its binding pipe, the line-annotated compile must be the costed one's code,

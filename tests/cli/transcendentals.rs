@@ -1,4 +1,4 @@
-//! The translation does no more transcendental work than the SPIR-V (issue 29 item 3): for every preset, each
+//! The translation does no more transcendental work than the SPIR-V: for every preset, each
 //! example `.brdf` file and every default sweep spec, the profiling kernel's transcendental instructions
 //! (exp, log, reciprocal, reciprocal square root, square root, sine, cosine) are counted in ACO's navi21
 //! disassembly (`inspect --isa`, the SPIR-V as RADV compiles it), in ptxas' sm_89 SASS (MUFU) and in IGC's

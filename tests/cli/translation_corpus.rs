@@ -1,4 +1,4 @@
-//! Issue 29 item 5: every BRDF Explorer-style file of tests/fixtures/brdf/corpus/ gets NVIDIA (sm_89) and Intel
+//! Every BRDF Explorer-style file of tests/fixtures/brdf/corpus/ gets NVIDIA (sm_89) and Intel
 //! (gen12lp) costs from `inspect`, its translation judged against its own f64 evaluation: the Vulkan kernel on
 //! the test device and the fp32 translation within the Vulkan precision bound of every value the rules bound,
 //! and most values bound (a check that judged nothing would pass anything).

@@ -1,4 +1,4 @@
-//! Issue 33: the translation paths never crash brdfprof or run unbounded, and a vendor tool's output is
+//! The translation paths never crash brdfprof or run unbounded, and a vendor tool's output is
 //! believed only when it is the whole kernel. Each shader here is written for the test; the tools are the real
 //! ones, or a script standing in front of the real one that damages its output as a broken install would.
 
@@ -62,7 +62,7 @@ fn inspect(dir: &Path, devices: &[&str], model: &Path, env: &[(&str, &Path)]) ->
     }
 }
 
-/// Item 1: an index past an array's end, and past a vector's, is clamped as lavapipe clamps it: OpenCL and
+/// An index past an array's end, and past a vector's, is clamped as lavapipe clamps it: OpenCL and
 /// Vulkan give the same values (before the fix: SIGSEGV in the host check, garbage on PoCL).
 #[test]
 fn an_out_of_bounds_index_is_clamped_as_on_vulkan_and_never_faults() {
@@ -80,7 +80,7 @@ fn an_out_of_bounds_index_is_clamped_as_on_vulkan_and_never_faults() {
     inspect(dir.path(), &["nvidia:sm_89", "intel:gen12lp"], &model, &[]).ok();
 }
 
-/// Item 2: an endless loop on PoCL ends at the host's loop limit instead of spinning.
+/// An endless loop on PoCL ends at the host's loop limit instead of spinning.
 #[test]
 fn an_endless_loop_on_opencl_stops_at_the_loop_limit() {
     let dir = tempfile::tempdir().unwrap();
@@ -94,7 +94,7 @@ fn an_endless_loop_on_opencl_stops_at_the_loop_limit() {
     assert!(started.elapsed() < std::time::Duration::from_secs(60), "{:?}", started.elapsed());
 }
 
-/// Item 3: the host build runs under the compile limit, its temporaries in the command's directory.
+/// The host build runs under the compile limit, its temporaries in the command's directory.
 #[test]
 fn a_host_compiler_that_hangs_stops_at_the_compile_limit() {
     let dir = tempfile::tempdir().unwrap();
@@ -136,7 +136,7 @@ fn a_host_compiler_that_hangs_stops_at_the_compile_limit() {
     assert!(started.elapsed() < std::time::Duration::from_secs(45), "{:?}", started.elapsed());
 }
 
-/// Item 5: a constant array longer than a constructor takes (80 > 64 elements) translates.
+/// A constant array longer than a constructor takes (80 > 64 elements) translates.
 #[test]
 fn a_long_constant_array_translates() {
     let dir = tempfile::tempdir().unwrap();
@@ -151,7 +151,7 @@ fn a_long_constant_array_translates() {
     inspect(dir.path(), &["nvidia:sm_89", "intel:gen12lp"], &model, &[]).ok();
 }
 
-/// Item 6: fp64 on a family without it leaves that family's row out with ocloc's reason, not the command.
+/// fp64 on a family without it leaves that family's row out with ocloc's reason, not the command.
 #[test]
 fn fp64_is_left_out_of_the_intel_families_without_it() {
     let dir = tempfile::tempdir().unwrap();
@@ -173,7 +173,7 @@ fn fp64_is_left_out_of_the_intel_families_without_it() {
     assert!(row[2] != "-" && row[5] == "-", "gen9 priced, gen12lp left out: {row:?}");
 }
 
-/// Item 7 (and issue 31 item 2): integer % of a negative value, where lavapipe computes srem and SPIR-V's
+/// Integer % of a negative value, where lavapipe computes srem and SPIR-V's
 /// OpSMod takes the divisor's sign: named as the device's deviation, by inspect and by a scene alike.
 #[test]
 fn smod_on_negatives_is_named_as_lavapipes_deviation_on_every_path() {
@@ -271,7 +271,7 @@ fn nvidia_with(dir: &Path, fake: &str) -> PathBuf {
     root
 }
 
-/// Item 4 and issue 31 items 1 and 4: a disassembler whose listing is not the kernel's (nothing, one EXIT,
+/// A disassembler whose listing is not the kernel's (nothing, one EXIT,
 /// a cut listing, endless output) is refused with exit 2 naming it.
 #[test]
 fn a_disassembler_listing_that_is_not_the_kernel_is_refused() {
@@ -335,7 +335,7 @@ fn a_version_query_that_hangs_stops_at_the_compile_limit() {
     assert!(started.elapsed() < std::time::Duration::from_secs(30));
 }
 
-/// Issue 31 items 1 and 8, issue 33 item 4: an ocloc that writes nothing, or whose listing is cut, is named.
+/// An ocloc that writes nothing, or whose listing is cut, is named.
 #[test]
 fn an_ocloc_that_writes_nothing_or_a_cut_listing_is_named() {
     let dir = tempfile::tempdir().unwrap();
@@ -364,12 +364,12 @@ fn an_ocloc_that_writes_nothing_or_a_cut_listing_is_named() {
         );
         r.fails(2, said);
     }
-    // Issue 33 item 10: a directory named as ocloc is called one.
+    // A directory named as ocloc is called one.
     let r = inspect(dir.path(), &["intel:gen12lp"], &model, &[("BRDFPROF_OCLOC", dir.path())]);
     r.fails(2, "is a directory, not the ocloc executable");
 }
 
-/// Item 9: NaN on both sides is not "within tolerance"; issue 31 item 3: an input without rows is refused.
+/// NaN on both sides is not "within tolerance", and an input without rows is refused.
 #[test]
 fn diff_claims_no_tolerance_for_nan_and_refuses_an_empty_input() {
     let dir = tempfile::tempdir().unwrap();
@@ -399,7 +399,7 @@ fn diff_claims_no_tolerance_for_nan_and_refuses_an_empty_input() {
         .fails(2, "the file has a header but no rows");
 }
 
-/// Item 8: every saved report names its kind; a scene profile is refused by --html and by `report` by name.
+/// Every saved report names its kind; a scene profile is refused by --html and by `report` by name.
 #[test]
 fn saved_reports_name_their_kind_and_scene_profiles_are_refused_by_the_html_report() {
     let dir = tempfile::tempdir().unwrap();
@@ -420,7 +420,7 @@ fn saved_reports_name_their_kind_and_scene_profiles_are_refused_by_the_html_repo
     run(&["report", profile.to_str().unwrap(), "--out", dir.path().join("p.html").to_str().unwrap()]).ok();
 }
 
-/// Item 10 and issue 31 item 5: defines that would rewrite BRDF's signature or continue a line, a report
+/// Defines that would rewrite BRDF's signature or continue a line, a report
 /// given twice, a device as a report, and a constant BRDF's net cost (not above zero), each named.
 #[test]
 fn minor_refusals_and_notes_name_their_cause() {
@@ -460,7 +460,7 @@ fn minor_refusals_and_notes_name_their_cause() {
     std::fs::copy(&i, &copy).unwrap();
     run(&["report", i.to_str().unwrap(), copy.to_str().unwrap(), "--out", dir.path().join("r.html").to_str().unwrap()])
         .fails(2, "is the same report as");
-    // Issue 31 item 4a: a file's parameters left at their values are compiled in, and the report says so.
+    // A file's parameters left at their values are compiled in, and the report says so.
     let tinted = dir.path().join("tinted.brdf");
     std::fs::write(&tinted, "analytic\n::begin parameters\nfloat gain 0 2 0.7\n::end parameters\n::begin shader\nvec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) { return vec3(gain * dot(N, L)); }\n::end shader\n").unwrap();
     let r = inspect(dir.path(), &["nvidia:sm_89"], &tinted, &[]).ok();
@@ -472,7 +472,7 @@ fn minor_refusals_and_notes_name_their_cause() {
     );
 }
 
-/// Issue 31 item 11: matrix operations as engine code applies a tangent frame translate, and agree with Vulkan.
+/// Matrix operations as engine code applies a tangent frame translate, and agree with Vulkan.
 #[test]
 fn matrix_operations_translate_and_agree_with_vulkan() {
     let dir = tempfile::tempdir().unwrap();
@@ -496,7 +496,7 @@ fn matrix_operations_translate_and_agree_with_vulkan() {
     inspect(dir.path(), &["nvidia:sm_89", "intel:gen12lp"], &model, &[]).ok();
 }
 
-/// Issue 31 item 4b: a .brdf model with `name=` is in the compile-only target's sweep table, by its label.
+/// A .brdf model with `name=` is in the compile-only target's sweep table, by its label.
 #[test]
 fn sweep_cost_tables_hold_every_model_by_its_label() {
     let dir = tempfile::tempdir().unwrap();

@@ -65,7 +65,7 @@ fn example_files_albedo_matches_their_presets() {
     common::assert_no_validation_messages(&gpu);
 }
 
-/// The HLSL and WGSL fixtures of issue 30 (tests/fixtures/hlsl/ue, tests/fixtures/wgsl/bevy), with the
+/// The HLSL and WGSL fixtures (tests/fixtures/hlsl/ue, tests/fixtures/wgsl/bevy), with the
 /// directories their includes and imports are in.
 fn foreign(language: &str) -> Model {
     let root = common::repo_root().join("tests/fixtures");

@@ -146,7 +146,7 @@ fn guards_are_the_same_constants_in_glsl_and_rust() {
     assert_eq!(constant("F0_MAX", 0), guards::F0_MAX);
 }
 
-/// Issue 19: which hard cases each guard saves. Presets run with all their guards, all off, each off alone
+/// Which hard cases each guard saves. Presets run with all their guards, all off, each off alone
 /// and each on alone (`with_guard_variants`): the guarded spec passes; without its guards `L = -V` is out of
 /// tolerance, and the reference (GGX) gives NaN or Inf, as measured (docs/guards.md); no guard set that keeps
 /// the safe half vector lets `L = -V` out of tolerance.
@@ -196,7 +196,7 @@ fn stability_says_what_each_guard_saves() {
     );
 }
 
-/// Issue 32: a `.brdf` file's failures named where they happen. unclamped-ggx.brdf (written for the tests, no
+/// A `.brdf` file's failures named where they happen. unclamped-ggx.brdf (written for the tests, no
 /// roughness floor) is 0/0 at roughness 0 on the peak: `stability` names each failing hard case with its input
 /// values and says the roughness floor, applied to the input, removes it; the grid's failures are counted with
 /// what each input guard removes. Within a roughness domain that leaves 0 out the file passes; against a

@@ -319,7 +319,7 @@ fn the_opencl_translation_on_pocl_agrees_with_vulkan_on_every_preset_and_example
     );
 }
 
-/// Issue 33 item 1: a translated kernel runs in a child process, so a fault in it (here a library that
+/// A translated kernel runs in a child process, so a fault in it (here a library that
 /// writes through a null pointer, built by the real g++) is an error that names the signal, and this process
 /// lives on.
 #[test]

@@ -418,7 +418,7 @@ fn copy_tree(from: &Path, to: &Path) {
 
 #[test]
 fn hlsl_and_wgsl_materials_render_as_their_glsl_twin() {
-    // The UE-style HLSL and Bevy-style WGSL fixtures of issue 30, copied beside the scene: their include
+    // The UE-style HLSL and Bevy-style WGSL fixtures, copied beside the scene: their include
     // directories, as the model's path, are relative to the scene file.
     let dir = tempfile::tempdir().unwrap();
     copy_tree(&common::repo_root().join("tests/fixtures/hlsl/ue"), &dir.path().join("ue"));

@@ -544,16 +544,7 @@ impl<'m> FunctionWriter<'m> {
                 // A vec4 of 32-bit words is 16-byte aligned in every buffer layout: one 128-bit load, as a
                 // driver issues it.
                 if n == 4 && matches!(s, Scalar::F32 | Scalar::U32 | Scalar::I32) {
-                    let (suffix, c) = if s == Scalar::F32 { ("f32", "float") } else { ("u32", "u32") };
-                    let tmp = format!("q{}_{}", self.decls.len(), self.body.len());
-                    self.decls.push(format!("{c} {tmp}[4];"));
-                    writeln!(self.body, "  {ld}4_{suffix}({field}, {off}, {tmp});").unwrap();
-                    let cast = if s == Scalar::I32 { "(i32)" } else { "" };
-                    return Ok(format!(
-                        "mk_{}({})",
-                        self.m.c_type(ty)?,
-                        (0..4).map(|k| format!("{cast}{tmp}[{k}]")).collect::<Vec<_>>().join(", ")
-                    ));
+                    return self.buffer_load_vec4(&field, ld, off, ty, s);
                 }
                 let parts: Vec<String> = (0..n)
                     .map(|k| self.buffer_load(var, &format!("({off} + {}u)", k * s.size()), elem, None))
@@ -596,6 +587,27 @@ impl<'m> FunctionWriter<'m> {
             }
             other => Err(self.err(format!("a buffer load of {other:?}"))),
         }
+    }
+
+    /// A vec4 of 32-bit words (`s` its scalar) read from `field` at byte offset `off` in one 128-bit load.
+    fn buffer_load_vec4(
+        &mut self,
+        field: &str,
+        ld: &str,
+        off: &str,
+        ty: Word,
+        s: Scalar,
+    ) -> Result<String, TranslateError> {
+        let (suffix, c) = if s == Scalar::F32 { ("f32", "float") } else { ("u32", "u32") };
+        let tmp = format!("q{}_{}", self.decls.len(), self.body.len());
+        self.decls.push(format!("{c} {tmp}[4];"));
+        writeln!(self.body, "  {ld}4_{suffix}({field}, {off}, {tmp});").unwrap();
+        let cast = if s == Scalar::I32 { "(i32)" } else { "" };
+        Ok(format!(
+            "mk_{}({})",
+            self.m.c_type(ty)?,
+            (0..4).map(|k| format!("{cast}{tmp}[{k}]")).collect::<Vec<_>>().join(", ")
+        ))
     }
 
     /// Statements writing `value` (a C expression of type `ty`) to `var` at byte offset `off`.

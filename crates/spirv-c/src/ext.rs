@@ -218,22 +218,7 @@ impl FunctionWriter<'_> {
                 };
                 self.build(ty, vec![c(1, 2), c(2, 0), c(0, 1)])?
             }
-            G::FaceForward => {
-                let d = self.dot(s, &a[2], &a[1], n);
-                let neg = self.build(
-                    ty,
-                    (0..n)
-                        .map(|k| {
-                            if s == Scalar::F16 {
-                                format!("h_neg({})", comp(&a[0], n, k))
-                            } else {
-                                format!("(-{})", comp(&a[0], n, k))
-                            }
-                        })
-                        .collect(),
-                )?;
-                format!("({} < {} ? {} : {neg})", as_f32(s, &d), "0.0f", a[0])
-            }
+            G::FaceForward => self.face_forward(s, a, n, ty)?,
             G::Reflect => {
                 // I - 2 dot(N, I) N
                 let d = self.temp(scalar_ty, self.dot(s, &a[1], &a[0], n));
@@ -245,40 +230,61 @@ impl FunctionWriter<'_> {
                         .collect(),
                 )?
             }
-            G::Refract => {
-                // k = 1 - eta^2 (1 - dot(N, I)^2); k < 0: 0, else eta I - (eta dot(N, I) + sqrt(k)) N
-                let d = self.temp(scalar_ty, self.dot(s, &a[1], &a[0], n));
-                let eta = &a[2];
-                let k = self.temp(
-                    scalar_ty,
-                    fbin(
-                        s,
-                        "-",
-                        &lit(s, 1.0),
-                        &fbin(s, "*", &fbin(s, "*", eta, eta), &fbin(s, "-", &lit(s, 1.0), &fbin(s, "*", &d, &d))),
-                    ),
-                );
-                let f =
-                    self.temp(scalar_ty, fbin(s, "+", &fbin(s, "*", eta, &d), &float_call(s, "m_sqrt", &[k.clone()])));
-                let r = self.build(
-                    ty,
-                    (0..n)
-                        .map(|c| {
-                            fbin(s, "-", &fbin(s, "*", eta, &comp(&a[0], n, c)), &fbin(s, "*", &f, &comp(&a[1], n, c)))
-                        })
-                        .collect(),
-                )?;
-                format!("({} < 0.0f ? {} : {r})", as_f32(s, &k), self.m.zero(ty)?)
-            }
+            G::Refract => self.refract(s, a, n, ty)?,
             _ => return Ok(None),
         };
         Ok(Some(e))
     }
 
+    /// faceForward(N, I, Nref): N where dot(Nref, I) < 0, else -N.
+    fn face_forward(&mut self, s: Scalar, a: &[String], n: u32, ty: Word) -> Result<String, TranslateError> {
+        let d = self.dot(s, &a[2], &a[1], n);
+        let neg = self.build(
+            ty,
+            (0..n)
+                .map(|k| {
+                    if s == Scalar::F16 {
+                        format!("h_neg({})", comp(&a[0], n, k))
+                    } else {
+                        format!("(-{})", comp(&a[0], n, k))
+                    }
+                })
+                .collect(),
+        )?;
+        Ok(format!("({} < {} ? {} : {neg})", as_f32(s, &d), "0.0f", a[0]))
+    }
+
+    /// refract(I, N, eta), from its definition in GLSL 4.50 8.5.
+    fn refract(&mut self, s: Scalar, a: &[String], n: u32, ty: Word) -> Result<String, TranslateError> {
+        // k = 1 - eta^2 (1 - dot(N, I)^2); k < 0: 0, else eta I - (eta dot(N, I) + sqrt(k)) N
+        let scalar_ty = s.c_name();
+        let d = self.temp(scalar_ty, self.dot(s, &a[1], &a[0], n));
+        let eta = &a[2];
+        let k = self.temp(
+            scalar_ty,
+            fbin(
+                s,
+                "-",
+                &lit(s, 1.0),
+                &fbin(s, "*", &fbin(s, "*", eta, eta), &fbin(s, "-", &lit(s, 1.0), &fbin(s, "*", &d, &d))),
+            ),
+        );
+        let f = self.temp(scalar_ty, fbin(s, "+", &fbin(s, "*", eta, &d), &float_call(s, "m_sqrt", &[k.clone()])));
+        let r = self.build(
+            ty,
+            (0..n)
+                .map(|c| fbin(s, "-", &fbin(s, "*", eta, &comp(&a[0], n, c)), &fbin(s, "*", &f, &comp(&a[1], n, c))))
+                .collect(),
+        )?;
+        Ok(format!("({} < 0.0f ? {} : {r})", as_f32(s, &k), self.m.zero(ty)?))
+    }
+
     /// The packing functions of GLSL 4.50 8.4, from their definitions.
     fn packing(&mut self, op: G, a: &[String], n: u32, ty: Word) -> Result<Option<String>, TranslateError> {
         let p = a.first().cloned().unwrap_or_default();
-        let clamp = |x: String, lo: &str, hi: &str| format!("m_fmin(m_fmax({x}, {lo}), {hi})");
+        if let Some(e) = pack(op, &p, n) {
+            return Ok(Some(e));
+        }
         let e = match op {
             G::UnpackUnorm4x8 => self
                 .build(ty, (0..4).map(|k| format!("m_fdiv((float)(({p} >> {}u) & 255u), 255.0f)", 8 * k)).collect())?,
@@ -308,46 +314,49 @@ impl FunctionWriter<'_> {
             )?,
             G::UnpackHalf2x16 => self
                 .build(ty, (0..2).map(|k| format!("h_to_f32(h_from_bits(({p} >> {}u) & 65535u))", 16 * k)).collect())?,
-            G::PackUnorm4x8 => (0..4)
-                .map(|k| format!("((u32)m_rint({} * 255.0f) << {}u)", clamp(comp(&p, n, k), "0.0f", "1.0f"), 8 * k))
-                .collect::<Vec<_>>()
-                .join(" | "),
-            G::PackSnorm4x8 => (0..4)
-                .map(|k| {
-                    format!(
-                        "(((u32)(i32)m_rint({} * 127.0f) & 255u) << {}u)",
-                        clamp(comp(&p, n, k), "-1.0f", "1.0f"),
-                        8 * k
-                    )
-                })
-                .collect::<Vec<_>>()
-                .join(" | "),
-            G::PackUnorm2x16 => (0..2)
-                .map(|k| format!("((u32)m_rint({} * 65535.0f) << {}u)", clamp(comp(&p, n, k), "0.0f", "1.0f"), 16 * k))
-                .collect::<Vec<_>>()
-                .join(" | "),
-            G::PackSnorm2x16 => (0..2)
-                .map(|k| {
-                    format!(
-                        "(((u32)(i32)m_rint({} * 32767.0f) & 65535u) << {}u)",
-                        clamp(comp(&p, n, k), "-1.0f", "1.0f"),
-                        16 * k
-                    )
-                })
-                .collect::<Vec<_>>()
-                .join(" | "),
-            G::PackHalf2x16 => (0..2)
-                .map(|k| format!("((u32)h_bits(h_from_f32({})) << {}u)", comp(&p, n, k), 16 * k))
-                .collect::<Vec<_>>()
-                .join(" | "),
             _ => return Ok(None),
         };
-        Ok(Some(
-            if matches!(op, G::PackUnorm4x8 | G::PackSnorm4x8 | G::PackUnorm2x16 | G::PackSnorm2x16 | G::PackHalf2x16) {
-                format!("({e})")
-            } else {
-                e
-            },
-        ))
+        Ok(Some(e))
     }
+}
+
+/// `x` clamped to `lo`..=`hi`.
+fn clamp(x: String, lo: &str, hi: &str) -> String {
+    format!("m_fmin(m_fmax({x}, {lo}), {hi})")
+}
+
+/// The pack functions of GLSL 4.50 8.4 (`op` one of them, or None), of the `n`-component vector `p`.
+fn pack(op: G, p: &str, n: u32) -> Option<String> {
+    let e = match op {
+        G::PackUnorm4x8 => (0..4)
+            .map(|k| format!("((u32)m_rint({} * 255.0f) << {}u)", clamp(comp(p, n, k), "0.0f", "1.0f"), 8 * k))
+            .collect::<Vec<_>>()
+            .join(" | "),
+        G::PackSnorm4x8 => (0..4)
+            .map(|k| {
+                format!("(((u32)(i32)m_rint({} * 127.0f) & 255u) << {}u)", clamp(comp(p, n, k), "-1.0f", "1.0f"), 8 * k)
+            })
+            .collect::<Vec<_>>()
+            .join(" | "),
+        G::PackUnorm2x16 => (0..2)
+            .map(|k| format!("((u32)m_rint({} * 65535.0f) << {}u)", clamp(comp(p, n, k), "0.0f", "1.0f"), 16 * k))
+            .collect::<Vec<_>>()
+            .join(" | "),
+        G::PackSnorm2x16 => (0..2)
+            .map(|k| {
+                format!(
+                    "(((u32)(i32)m_rint({} * 32767.0f) & 65535u) << {}u)",
+                    clamp(comp(p, n, k), "-1.0f", "1.0f"),
+                    16 * k
+                )
+            })
+            .collect::<Vec<_>>()
+            .join(" | "),
+        G::PackHalf2x16 => (0..2)
+            .map(|k| format!("((u32)h_bits(h_from_f32({})) << {}u)", comp(p, n, k), 16 * k))
+            .collect::<Vec<_>>()
+            .join(" | "),
+        _ => return None,
+    };
+    Some(format!("({e})"))
 }

@@ -81,86 +81,91 @@ fn predecessors(f: &Function, block: Word) -> usize {
     f.blocks.iter().map(|b| successors(b).iter().filter(|s| **s == block).count()).sum()
 }
 
+/// The opcodes `speculatable` takes as they are: pure arithmetic, conversions, composites, comparisons and
+/// logic, none of which touches memory, calls, traps or is undefined in C.
+const SPECULATABLE: &[Op] = &[
+    Op::Line,
+    Op::NoLine,
+    Op::FAdd,
+    Op::FSub,
+    Op::FMul,
+    Op::FDiv,
+    Op::FRem,
+    Op::FMod,
+    Op::FNegate,
+    Op::IAdd,
+    Op::ISub,
+    Op::IMul,
+    Op::SNegate,
+    Op::Dot,
+    Op::VectorTimesScalar,
+    Op::MatrixTimesScalar,
+    Op::VectorTimesMatrix,
+    Op::MatrixTimesVector,
+    Op::MatrixTimesMatrix,
+    Op::OuterProduct,
+    Op::Transpose,
+    Op::ConvertSToF,
+    Op::ConvertUToF,
+    Op::FConvert,
+    Op::UConvert,
+    Op::SConvert,
+    Op::Bitcast,
+    Op::QuantizeToF16,
+    Op::CompositeConstruct,
+    Op::CompositeExtract,
+    Op::CompositeInsert,
+    Op::VectorShuffle,
+    Op::VectorExtractDynamic,
+    Op::VectorInsertDynamic,
+    Op::CopyObject,
+    Op::Select,
+    Op::IEqual,
+    Op::INotEqual,
+    Op::UGreaterThan,
+    Op::SGreaterThan,
+    Op::UGreaterThanEqual,
+    Op::SGreaterThanEqual,
+    Op::ULessThan,
+    Op::SLessThan,
+    Op::ULessThanEqual,
+    Op::SLessThanEqual,
+    Op::FOrdEqual,
+    Op::FUnordEqual,
+    Op::FOrdNotEqual,
+    Op::FUnordNotEqual,
+    Op::FOrdLessThan,
+    Op::FUnordLessThan,
+    Op::FOrdGreaterThan,
+    Op::FUnordGreaterThan,
+    Op::FOrdLessThanEqual,
+    Op::FUnordLessThanEqual,
+    Op::FOrdGreaterThanEqual,
+    Op::FUnordGreaterThanEqual,
+    Op::IsNan,
+    Op::IsInf,
+    Op::LogicalEqual,
+    Op::LogicalNotEqual,
+    Op::LogicalOr,
+    Op::LogicalAnd,
+    Op::LogicalNot,
+    Op::ShiftRightLogical,
+    Op::ShiftRightArithmetic,
+    Op::ShiftLeftLogical,
+    Op::BitwiseOr,
+    Op::BitwiseXor,
+    Op::BitwiseAnd,
+    Op::Not,
+    Op::Any,
+    Op::All,
+];
+
 /// Whether `i` may be executed where its block was not taken: no memory, no call, no trap, no undefined
 /// behaviour in C.
 fn speculatable(i: &Instruction, glsl: &[Word]) -> bool {
-    use Op::*;
     match i.class.opcode {
-        Line
-        | NoLine
-        | FAdd
-        | FSub
-        | FMul
-        | FDiv
-        | FRem
-        | FMod
-        | FNegate
-        | IAdd
-        | ISub
-        | IMul
-        | SNegate
-        | Dot
-        | VectorTimesScalar
-        | MatrixTimesScalar
-        | VectorTimesMatrix
-        | MatrixTimesVector
-        | MatrixTimesMatrix
-        | OuterProduct
-        | Transpose
-        | ConvertSToF
-        | ConvertUToF
-        | FConvert
-        | UConvert
-        | SConvert
-        | Bitcast
-        | QuantizeToF16
-        | CompositeConstruct
-        | CompositeExtract
-        | CompositeInsert
-        | VectorShuffle
-        | VectorExtractDynamic
-        | VectorInsertDynamic
-        | CopyObject
-        | Select
-        | IEqual
-        | INotEqual
-        | UGreaterThan
-        | SGreaterThan
-        | UGreaterThanEqual
-        | SGreaterThanEqual
-        | ULessThan
-        | SLessThan
-        | ULessThanEqual
-        | SLessThanEqual
-        | FOrdEqual
-        | FUnordEqual
-        | FOrdNotEqual
-        | FUnordNotEqual
-        | FOrdLessThan
-        | FUnordLessThan
-        | FOrdGreaterThan
-        | FUnordGreaterThan
-        | FOrdLessThanEqual
-        | FUnordLessThanEqual
-        | FOrdGreaterThanEqual
-        | FUnordGreaterThanEqual
-        | IsNan
-        | IsInf
-        | LogicalEqual
-        | LogicalNotEqual
-        | LogicalOr
-        | LogicalAnd
-        | LogicalNot
-        | ShiftRightLogical
-        | ShiftRightArithmetic
-        | ShiftLeftLogical
-        | BitwiseOr
-        | BitwiseXor
-        | BitwiseAnd
-        | Not
-        | Any
-        | All => true,
-        ExtInst => {
+        op if SPECULATABLE.contains(&op) => true,
+        Op::ExtInst => {
             glsl.contains(&id(i, 0))
                 && !matches!(i.operands.get(1), Some(Operand::LiteralExtInstInteger(op)) if pointer_argument(*op))
         }

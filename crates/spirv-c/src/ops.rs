@@ -149,23 +149,27 @@ impl FunctionWriter<'_> {
             VectorShuffle => self.shuffle(inst),
             CopyObject | CopyLogical => self.v(Self::id(inst, 0)),
             Undef => self.m.zero(ty),
-            Dot => {
-                let (a, b) = (Self::id(inst, 0), Self::id(inst, 1));
-                let (ea, eb, n) = (self.v(a)?, self.v(b)?, self.m.components(self.ty_of(a)));
-                let s = self.scalar_kind(ty)?;
-                Ok(self.dot(s, &ea, &eb, n))
-            }
-            VectorTimesScalar => {
-                let s = self.scalar_kind(ty)?;
-                let scalar = self.v(Self::id(inst, 1))?;
-                let v = self.v(Self::id(inst, 0))?;
-                let n = self.m.components(ty);
-                self.build(ty, (0..n).map(|k| fbin(s, "*", &comp(&v, n, k), &scalar)).collect())
-            }
+            Dot | VectorTimesScalar => self.vector_product(inst),
             MatrixTimesScalar | MatrixTimesVector | VectorTimesMatrix | MatrixTimesMatrix | OuterProduct
             | Transpose => self.matrix(inst),
             other => Err(self.err(format!("the instruction Op{other:?}"))),
         }
+    }
+
+    /// OpDot and OpVectorTimesScalar.
+    fn vector_product(&mut self, inst: &Instruction) -> Result<String, TranslateError> {
+        let ty = inst.result_type.unwrap_or(0);
+        if inst.class.opcode == Op::Dot {
+            let (a, b) = (Self::id(inst, 0), Self::id(inst, 1));
+            let (ea, eb, n) = (self.v(a)?, self.v(b)?, self.m.components(self.ty_of(a)));
+            let s = self.scalar_kind(ty)?;
+            return Ok(self.dot(s, &ea, &eb, n));
+        }
+        let s = self.scalar_kind(ty)?;
+        let scalar = self.v(Self::id(inst, 1))?;
+        let v = self.v(Self::id(inst, 0))?;
+        let n = self.m.components(ty);
+        self.build(ty, (0..n).map(|k| fbin(s, "*", &comp(&v, n, k), &scalar)).collect())
     }
 
     pub fn dot(&self, s: Scalar, a: &str, b: &str, n: u32) -> String {

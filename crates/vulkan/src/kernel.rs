@@ -118,6 +118,50 @@ const SETS_PER_KERNEL: u32 = 256;
 /// local_size_x of every kernel in glsl/.
 pub const WORKGROUP: u32 = 64;
 
+/// An error naming the first texel buffer of `bindings` whose format `gpu` cannot use as such.
+fn check_texel_formats(gpu: &Gpu, name: &str, bindings: &[Binding]) -> Result<()> {
+    for b in bindings {
+        if let Some(format) = b.texel_format() {
+            let storage = matches!(b, Binding::TexelStorage(_));
+            if !gpu.texel_buffer_support(format, storage) {
+                bail!(
+                    "{name}: {} cannot use {format:?} as a {} texel buffer",
+                    gpu.info.name,
+                    if storage { "storage" } else { "uniform" }
+                );
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The descriptor set layout bindings of `bindings`: binding 0, 1, ..., one descriptor each, for compute.
+fn layout_bindings(bindings: &[Binding]) -> Vec<vk::DescriptorSetLayoutBinding<'static>> {
+    bindings
+        .iter()
+        .enumerate()
+        .map(|(b, kind)| {
+            vk::DescriptorSetLayoutBinding::default()
+                .binding(b as u32)
+                .descriptor_type(kind.descriptor_type())
+                .descriptor_count(1)
+                .stage_flags(vk::ShaderStageFlags::COMPUTE)
+        })
+        .collect()
+}
+
+/// The descriptor pool sizes for `SETS_PER_KERNEL` sets of `bindings`, one entry per descriptor type.
+fn pool_sizes(bindings: &[Binding]) -> Vec<vk::DescriptorPoolSize> {
+    let mut sizes: Vec<vk::DescriptorPoolSize> = Vec::new();
+    for b in bindings {
+        match sizes.iter_mut().find(|s| s.ty == b.descriptor_type()) {
+            Some(s) => s.descriptor_count += SETS_PER_KERNEL,
+            None => sizes.push(vk::DescriptorPoolSize { ty: b.descriptor_type(), descriptor_count: SETS_PER_KERNEL }),
+        }
+    }
+    sizes
+}
+
 impl<'g> Kernel<'g> {
     /// A pipeline for the SPIR-V `words` (named `name` in errors), specialised, with the buffers of `bindings`
     /// (binding 0, 1, ...) and `push_bytes` of push constants. With `capture_ir` the driver keeps its internal
@@ -142,30 +186,9 @@ impl<'g> Kernel<'g> {
         push_bytes: u32,
         capture_ir: bool,
     ) -> Result<Self> {
-        for b in bindings {
-            if let Some(format) = b.texel_format() {
-                let storage = matches!(b, Binding::TexelStorage(_));
-                if !gpu.texel_buffer_support(format, storage) {
-                    bail!(
-                        "{name}: {} cannot use {format:?} as a {} texel buffer",
-                        gpu.info.name,
-                        if storage { "storage" } else { "uniform" }
-                    );
-                }
-            }
-        }
+        check_texel_formats(gpu, name, bindings)?;
         let device = &gpu.device;
-        let binding_info: Vec<_> = bindings
-            .iter()
-            .enumerate()
-            .map(|(b, kind)| {
-                vk::DescriptorSetLayoutBinding::default()
-                    .binding(b as u32)
-                    .descriptor_type(kind.descriptor_type())
-                    .descriptor_count(1)
-                    .stage_flags(vk::ShaderStageFlags::COMPUTE)
-            })
-            .collect();
+        let binding_info = layout_bindings(bindings);
         let map: Vec<_> = spec
             .entries
             .iter()
@@ -197,14 +220,7 @@ impl<'g> Kernel<'g> {
             }
             let (pipeline, logged_stats) = create_logged_pipeline(gpu, name, module, layout, &map, &data, flags)?;
             device.destroy_shader_module(module, None);
-            let mut sizes: Vec<vk::DescriptorPoolSize> = Vec::new();
-            for b in bindings {
-                match sizes.iter_mut().find(|s| s.ty == b.descriptor_type()) {
-                    Some(s) => s.descriptor_count += SETS_PER_KERNEL,
-                    None => sizes
-                        .push(vk::DescriptorPoolSize { ty: b.descriptor_type(), descriptor_count: SETS_PER_KERNEL }),
-                }
-            }
+            let sizes = pool_sizes(bindings);
             let pool = device.create_descriptor_pool(
                 &vk::DescriptorPoolCreateInfo::default().max_sets(SETS_PER_KERNEL).pool_sizes(&sizes),
                 None,

@@ -57,8 +57,8 @@ pub(super) struct Open {
     pub(super) line: usize,
 }
 
-/// The directives of a `.brdf` shader that glslang's preprocessor runs, as in any GLSL (issue 19: engine code
-/// selects its branches with `#if` and names its constants with `#define`).
+/// The directives of a `.brdf` shader that glslang's preprocessor runs, as in any GLSL (engine code selects its
+/// branches with `#if` and names its constants with `#define`).
 /// `#pragma` is not among them: glslang's preprocessor passes pragmas through into the text brdfprof reads for
 /// the file's globals, and none changes the SPIR-V of a compute kernel (`dropped_hash_line`).
 pub(super) const PREPROCESSOR_DIRECTIVES: [&str; 10] =
@@ -136,45 +136,7 @@ pub(super) fn read_sections<'a>(file: &mut BrdfFile, lines: impl Iterator<Item =
         }
         let mut tokens = trimmed.split_whitespace();
         match tokens.next().unwrap_or("") {
-            "::begin" => {
-                let name = tokens.next().ok_or_else(|| anyhow!(at(&path, n, "`::begin` names no section")))?;
-                if let Some(o) = &open {
-                    bail!(at(
-                        &path,
-                        n,
-                        format!(
-                            "`::begin {name}` inside section `{}` (begun at line {}): sections do not nest",
-                            o.name, o.line
-                        )
-                    ));
-                }
-                match name {
-                    "shader" => {
-                        if let Some(first) = shader_begin {
-                            bail!(at(&path, n, format!("a second shader section (the first begins at line {first})")));
-                        }
-                        let word = tokens.next();
-                        file.language = Language::of_section(word).ok_or_else(|| {
-                            anyhow!(at(
-                                &path,
-                                n,
-                                format!(
-                                    "`::begin shader {}`: the shader's language is glsl (the default), hlsl or wgsl",
-                                    word.unwrap_or("")
-                                )
-                            ))
-                        })?;
-                        shader_begin = Some(n);
-                    }
-                    "parameters" | "isFunc" | DIRECTIVES_SECTION => {}
-                    other => file.warnings.push(at(
-                        &path,
-                        n,
-                        format!("don't know what to do with section `{other}`: its content is ignored"),
-                    )),
-                }
-                open = Some(Open { name: name.to_string(), line: n });
-            }
+            "::begin" => open = Some(begin_section(file, n, &mut tokens, open.as_ref(), &mut shader_begin)?),
             "::end" => {
                 let name = tokens.next().unwrap_or("");
                 match &open {
@@ -213,6 +175,52 @@ pub(super) fn read_sections<'a>(file: &mut BrdfFile, lines: impl Iterator<Item =
         bail!(at(&path, o.line, format!("section `{}` has no `::end {}`", o.name, o.name)));
     }
     Ok(shader_begin)
+}
+
+/// The section a `::begin` line opens (`tokens` after `::begin`), with the shader's language where it is the
+/// shader; an error where a section is open (`open`) or the shader section is a second one.
+fn begin_section<'t>(
+    file: &mut BrdfFile,
+    n: usize,
+    tokens: &mut impl Iterator<Item = &'t str>,
+    open: Option<&Open>,
+    shader_begin: &mut Option<usize>,
+) -> Result<Open> {
+    let path = file.path.clone();
+    let name = tokens.next().ok_or_else(|| anyhow!(at(&path, n, "`::begin` names no section")))?;
+    if let Some(o) = open {
+        bail!(at(
+            &path,
+            n,
+            format!("`::begin {name}` inside section `{}` (begun at line {}): sections do not nest", o.name, o.line)
+        ));
+    }
+    match name {
+        "shader" => {
+            if let Some(first) = *shader_begin {
+                bail!(at(&path, n, format!("a second shader section (the first begins at line {first})")));
+            }
+            let word = tokens.next();
+            file.language = Language::of_section(word).ok_or_else(|| {
+                anyhow!(at(
+                    &path,
+                    n,
+                    format!(
+                        "`::begin shader {}`: the shader's language is glsl (the default), hlsl or wgsl",
+                        word.unwrap_or("")
+                    )
+                ))
+            })?;
+            *shader_begin = Some(n);
+        }
+        "parameters" | "isFunc" | DIRECTIVES_SECTION => {}
+        other => file.warnings.push(at(
+            &path,
+            n,
+            format!("don't know what to do with section `{other}`: its content is ignored"),
+        )),
+    }
+    Ok(Open { name: name.to_string(), line: n })
 }
 
 /// One line of the parameters section.
@@ -464,58 +472,8 @@ pub(super) fn parse_directive(file: &mut BrdfFile, n: usize, line: &str) -> Resu
             }
             file.entries.push(entry);
         }
-        "bind" => {
-            for item in rest.split_whitespace() {
-                let (name, value) = item
-                    .split_once('=')
-                    .ok_or_else(|| anyhow!(at(&path, n, format!("`{item}`: expected NAME=@INPUT"))))?;
-                if !value.starts_with('@') {
-                    bail!(at(
-                        &path,
-                        n,
-                        format!(
-                            "`{item}`: `bind` binds a parameter to an input (NAME=@roughness, ...); a value belongs in the parameters section"
-                        )
-                    ));
-                }
-                if let Some((_, _, first)) = file.binds.iter().find(|(b, _, _)| b == name) {
-                    bail!(at(&path, n, format!("`{name}` is bound twice (first at line {first})")));
-                }
-                file.binds.push((name.to_string(), value.to_string(), n));
-            }
-            if rest.is_empty() {
-                bail!(at(&path, n, "`bind` names no parameter: `bind NAME=@INPUT ...`"));
-            }
-        }
-        "domain" => {
-            let form = "`domain roughness|nov|nol MIN MAX`";
-            let words: Vec<&str> = rest.split_whitespace().collect();
-            let [input, min, max] = words.as_slice() else {
-                bail!(at(&path, n, format!("`domain {rest}`: expected {form}")))
-            };
-            let (slot, top) = match *input {
-                "roughness" => (&mut file.roughness_domain, f64::INFINITY),
-                "nov" => (&mut file.nov_domain, 1.0),
-                "nol" => (&mut file.nol_domain, 1.0),
-                _ => bail!(at(
-                    &path,
-                    n,
-                    format!("`domain {input}`: the domains declared are roughness, nov and nol ({form})")
-                )),
-            };
-            let number = |t: &str| t.parse::<f64>().ok().filter(|x| x.is_finite() && *x >= 0.0 && *x <= top);
-            let (Some(lo), Some(hi)) = (number(min), number(max)) else {
-                let range = if top == 1.0 { "within [0, 1]" } else { "finite, 0 or more" };
-                bail!(at(&path, n, format!("`domain {rest}`: MIN and MAX are numbers {range}")))
-            };
-            if lo > hi {
-                bail!(at(&path, n, format!("`domain {rest}`: MIN {lo} is above MAX {hi}")));
-            }
-            if let Some((_, _, first)) = slot {
-                bail!(at(&path, n, format!("the {input} domain is declared twice (first at line {first})")));
-            }
-            *slot = Some((lo, hi, n));
-        }
+        "bind" => parse_bind(file, n, rest)?,
+        "domain" => parse_domain(file, n, rest)?,
         "reference" => {
             if let Some((_, first)) = &file.reference {
                 bail!(at(&path, n, format!("the reference is declared twice (first at line {first})")));
@@ -537,6 +495,59 @@ pub(super) fn parse_directive(file: &mut BrdfFile, n: usize, line: &str) -> Resu
             )
         )),
     }
+    Ok(())
+}
+
+/// `bind NAME=@INPUT ...`.
+fn parse_bind(file: &mut BrdfFile, n: usize, rest: &str) -> Result<()> {
+    let path = file.path.clone();
+    for item in rest.split_whitespace() {
+        let (name, value) =
+            item.split_once('=').ok_or_else(|| anyhow!(at(&path, n, format!("`{item}`: expected NAME=@INPUT"))))?;
+        if !value.starts_with('@') {
+            bail!(at(
+                &path,
+                n,
+                format!(
+                    "`{item}`: `bind` binds a parameter to an input (NAME=@roughness, ...); a value belongs in the parameters section"
+                )
+            ));
+        }
+        if let Some((_, _, first)) = file.binds.iter().find(|(b, _, _)| b == name) {
+            bail!(at(&path, n, format!("`{name}` is bound twice (first at line {first})")));
+        }
+        file.binds.push((name.to_string(), value.to_string(), n));
+    }
+    if rest.is_empty() {
+        bail!(at(&path, n, "`bind` names no parameter: `bind NAME=@INPUT ...`"));
+    }
+    Ok(())
+}
+
+/// `domain roughness|nov|nol MIN MAX`.
+fn parse_domain(file: &mut BrdfFile, n: usize, rest: &str) -> Result<()> {
+    let path = file.path.clone();
+    let form = "`domain roughness|nov|nol MIN MAX`";
+    let words: Vec<&str> = rest.split_whitespace().collect();
+    let [input, min, max] = words.as_slice() else { bail!(at(&path, n, format!("`domain {rest}`: expected {form}"))) };
+    let (slot, top) = match *input {
+        "roughness" => (&mut file.roughness_domain, f64::INFINITY),
+        "nov" => (&mut file.nov_domain, 1.0),
+        "nol" => (&mut file.nol_domain, 1.0),
+        _ => bail!(at(&path, n, format!("`domain {input}`: the domains declared are roughness, nov and nol ({form})"))),
+    };
+    let number = |t: &str| t.parse::<f64>().ok().filter(|x| x.is_finite() && *x >= 0.0 && *x <= top);
+    let (Some(lo), Some(hi)) = (number(min), number(max)) else {
+        let range = if top == 1.0 { "within [0, 1]" } else { "finite, 0 or more" };
+        bail!(at(&path, n, format!("`domain {rest}`: MIN and MAX are numbers {range}")))
+    };
+    if lo > hi {
+        bail!(at(&path, n, format!("`domain {rest}`: MIN {lo} is above MAX {hi}")));
+    }
+    if let Some((_, _, first)) = slot {
+        bail!(at(&path, n, format!("the {input} domain is declared twice (first at line {first})")));
+    }
+    *slot = Some((lo, hi, n));
     Ok(())
 }
 

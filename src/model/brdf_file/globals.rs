@@ -382,7 +382,13 @@ pub(super) fn declare(
             return;
         }
     }
-    // A variable: [qualifiers] TYPE [[..]] NAME [[..]] [= ...] {, NAME [[..]] [= ...]} ;
+    declare_variables(scan, lines, header, first);
+}
+
+/// Records the variables an item's `header` declares (and its uniforms, by token index from `first`):
+/// `[qualifiers] TYPE [[..]] NAME [[..]] [= ...] {, NAME [[..]] [= ...]} ;`
+fn declare_variables(scan: &mut Scan, lines: &[(usize, String)], header: &[Token], first: usize) {
+    let line_of = |t: &Token| lines[t.line].0;
     let mut p = 0;
     let mut uniform = None;
     while p < header.len() && (QUALIFIERS.contains(&header[p].text.as_str()) || header[p].text == "layout") {

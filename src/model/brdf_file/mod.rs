@@ -4,7 +4,7 @@
 //! The format: line 1 names the kind (`analytic`; brdfprof reads no other). After it, blank lines and lines
 //! whose trimmed text starts with `#` are skipped, as BRDF Explorer skips them; but in the shader a
 //! preprocessor directive (`#define`, `#if`, ...) is kept and the shader goes through glslang's preprocessor
-//! (`preprocess`, under the model's defines), because engine code relies on it (issue 19); any other `#` line
+//! (`preprocess`, under the model's defines), because engine code relies on it; any other `#` line
 //! there is dropped with a warning. `::begin NAME` / `::end NAME` enclose sections: `parameters` (`float NAME MIN
 //! MAX DEFAULT`, `bool NAME 0|1`, `color NAME R G B`), `shader` (GLSL defining
 //! `vec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y)`; BRDF Explorer declares each parameter before it as

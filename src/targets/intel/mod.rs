@@ -440,8 +440,8 @@ impl IsaStats {
         }
     }
 
-    /// EU cycles of one hardware thread if no two instructions overlapped (the old serial sum, kept as a
-    /// column): each instruction its execution size over its row's lanes per clock, at least one cycle;
+    /// EU cycles of one hardware thread if no two instructions overlapped (the serial sum, reported as a column
+    /// of its own): each instruction its execution size over its row's lanes per clock, at least one cycle;
     /// sends and control one issue cycle each.
     pub fn issue_cycles(&self, family: &Family) -> Result<f64> {
         let mut cycles = 0.0;

@@ -186,21 +186,7 @@ impl Tools {
         let log: String =
             log.lines().filter(|l| !l.starts_with("ShaderDumpEnable Warning")).collect::<Vec<_>>().join("\n");
         if !out.status.success() {
-            // -q hides the compiler's messages: the failure is compiled again without it, for the reason.
-            let loud: Vec<&std::ffi::OsStr> =
-                args.iter().filter(|a| a.as_os_str() != "-q").map(|a| a.as_os_str()).collect();
-            let again = self.run(&loud, dir.path(), what, None)?;
-            let log = format!("{}{}", String::from_utf8_lossy(&again.stdout), String::from_utf8_lossy(&again.stderr));
-            let errors: Vec<&str> = log.lines().filter(|l| l.contains("error:")).take(5).collect();
-            if let Some(e) = errors.iter().find(|l| l.contains("cl_khr_fp64")) {
-                return Err(
-                    Unsupported { reason: format!("{device} has no fp64 (cl_khr_fp64); ocloc: {}", e.trim()) }.into()
-                );
-            }
-            bail!(
-                "ocloc cannot compile the OpenCL C translation for {device} (a translator defect):\n{}",
-                if errors.is_empty() { log.lines().take(20).collect::<Vec<_>>().join("\n") } else { errors.join("\n") }
-            );
+            return Err(self.compile_error(&args, dir.path(), device, what));
         }
         let no_binary = |why: String| {
             anyhow!(
@@ -216,7 +202,40 @@ impl Tools {
             .find(|p| p.extension().is_some_and(|x| x == "bin") && p.is_file())
             .ok_or_else(|| no_binary("no .bin file".into()))?;
         let bytes = std::fs::metadata(&bin).map_err(|e| no_binary(e.to_string()))?.len() as usize;
-        let dump = dir.path().join("disasm");
+        let (listing, tokens) = self.disassemble(bin, dir.path(), device, what)?;
+        let mut binary =
+            Binary { listing, tokens, bytes, log: log.trim().to_string(), lines_listings: Default::default() };
+        if lines {
+            binary.lines_listings = dumped_listings(&dump_dir)
+                .with_context(|| format!("{what}: IGC's shader dump in {}", dump_dir.display()))?;
+        }
+        Ok(binary)
+    }
+
+    /// The error of an ocloc compile that failed: compiled again without -q, which hides the compiler's
+    /// messages, for the reason (the translation needs an fp64 `device` has not, or a translator defect).
+    fn compile_error(&self, args: &[std::ffi::OsString], dir: &Path, device: &str, what: &str) -> anyhow::Error {
+        let loud: Vec<&std::ffi::OsStr> =
+            args.iter().filter(|a| a.as_os_str() != "-q").map(|a| a.as_os_str()).collect();
+        let again = match self.run(&loud, dir, what, None) {
+            Ok(again) => again,
+            Err(e) => return e,
+        };
+        let log = format!("{}{}", String::from_utf8_lossy(&again.stdout), String::from_utf8_lossy(&again.stderr));
+        let errors: Vec<&str> = log.lines().filter(|l| l.contains("error:")).take(5).collect();
+        if let Some(e) = errors.iter().find(|l| l.contains("cl_khr_fp64")) {
+            return Unsupported { reason: format!("{device} has no fp64 (cl_khr_fp64); ocloc: {}", e.trim()) }.into();
+        }
+        anyhow!(
+            "ocloc cannot compile the OpenCL C translation for {device} (a translator defect):\n{}",
+            if errors.is_empty() { log.lines().take(20).collect::<Vec<_>>().join("\n") } else { errors.join("\n") }
+        )
+    }
+
+    /// The ISA listing and patch tokens of the device binary `bin` (`ocloc disasm` into `dir`).
+    fn disassemble(&self, bin: PathBuf, dir: &Path, device: &str, what: &str) -> Result<(String, String)> {
+        let os = |s: &str| std::ffi::OsString::from(s);
+        let dump = dir.join("disasm");
         let args = [
             os("disasm"),
             os("-file"),
@@ -228,7 +247,7 @@ impl Tools {
         ];
         let out = self.run(
             &args.iter().map(|a| a.as_os_str()).collect::<Vec<_>>(),
-            dir.path(),
+            dir,
             &format!("{what}: its ISA (ocloc disasm)"),
             None,
         )?;
@@ -247,13 +266,7 @@ impl Tools {
         let tokens = read("PTM.txt").map_err(|e| {
             anyhow!("{}: `ocloc disasm` for {device} wrote no patch tokens ({e})", self.ocloc.display())
         })?;
-        let mut binary =
-            Binary { listing, tokens, bytes, log: log.trim().to_string(), lines_listings: Default::default() };
-        if lines {
-            binary.lines_listings = dumped_listings(&dump_dir)
-                .with_context(|| format!("{what}: IGC's shader dump in {}", dump_dir.display()))?;
-        }
-        Ok(binary)
+        Ok((listing, tokens))
     }
 }
 

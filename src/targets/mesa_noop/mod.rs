@@ -429,6 +429,51 @@ fn run(
     Ok(ChildRun { report: cached.report, isa_files: Vec::new(), teardown_note })
 }
 
+/// Writes each raw SPIR-V kernel into `dir` for the child (`raw-K.spv`), as the child's request names it.
+fn write_raw_spirv(dir: &Path, raw: &[super::RawKernel]) -> Result<Vec<RawSpirv>> {
+    let mut raw_files = Vec::new();
+    for (k, r) in raw.iter().enumerate() {
+        let path = dir.join(format!("raw-{k}.spv"));
+        std::fs::write(&path, bytemuck::cast_slice::<u32, u8>(&r.spirv))
+            .with_context(|| format!("cannot write {}", path.display()))?;
+        raw_files.push(RawSpirv {
+            label: r.label.clone(),
+            model: r.model.name(),
+            path,
+            storage_buffers: r.storage_buffers,
+            push_bytes: r.push_bytes,
+        });
+    }
+    Ok(raw_files)
+}
+
+/// What the child's exit `status` means: nothing where it replied and succeeded, a note where it crashed after
+/// writing its complete report (in Mesa's teardown), else the error of a failed child with its last lines.
+fn teardown_note(
+    driver: &'static dyn NoopDriver,
+    name: &str,
+    replied: bool,
+    status: std::process::ExitStatus,
+    stderr: &str,
+) -> Result<Option<String>> {
+    Ok(match (replied, status.success()) {
+        (true, true) => None,
+        (true, false) if status.code().is_none() => Some(format!(
+            "the {name} child crashed after writing its complete report ({}); the crash is in Mesa's teardown of the compile-only device, not in the figures",
+            status
+        )),
+        _ => {
+            let tail: Vec<&str> = stderr.lines().rev().take(15).collect::<Vec<_>>().into_iter().rev().collect();
+            bail!(
+                "{name}: the compile-only child failed ({}):\n{}\n{}",
+                status,
+                tail.join("\n"),
+                driver.install_hint()
+            );
+        }
+    })
+}
+
 /// Runs the child for one target: its report, and the lines of its stderr meant for the user.
 fn spawn(
     driver: &'static dyn NoopDriver,
@@ -446,19 +491,7 @@ fn spawn(
         cleanup::command(&std::env::current_exe().context("cannot find brdfprof's own executable")?.to_string_lossy());
     let tmp = cleanup::child_tmpdir(&mut cmd)?;
     let child_isa = request.isa_dir.map(|_| tmp.path().join("isa"));
-    let mut raw_files = Vec::new();
-    for (k, r) in raw.iter().enumerate() {
-        let path = tmp.path().join(format!("raw-{k}.spv"));
-        std::fs::write(&path, bytemuck::cast_slice::<u32, u8>(&r.spirv))
-            .with_context(|| format!("cannot write {}", path.display()))?;
-        raw_files.push(RawSpirv {
-            label: r.label.clone(),
-            model: r.model.name(),
-            path,
-            storage_buffers: r.storage_buffers,
-            push_bytes: r.push_bytes,
-        });
-    }
+    let raw_files = write_raw_spirv(tmp.path(), raw)?;
     let req = NoopRequest {
         driver: driver.prefix().to_string(),
         family: target.info().name.to_string(),
@@ -494,22 +527,7 @@ fn spawn(
         .filter(|l| reply.is_some() && !is_banner(l) && !driver.is_noise(l))
         .map(str::to_string)
         .collect();
-    let teardown_note = match (&reply, output.status.success()) {
-        (Some(_), true) => None,
-        (Some(_), false) if output.status.code().is_none() => Some(format!(
-            "the {name} child crashed after writing its complete report ({}); the crash is in Mesa's teardown of the compile-only device, not in the figures",
-            output.status
-        )),
-        _ => {
-            let tail: Vec<&str> = stderr.lines().rev().take(15).collect::<Vec<_>>().into_iter().rev().collect();
-            bail!(
-                "{name}: the compile-only child failed ({}):\n{}\n{}",
-                output.status,
-                tail.join("\n"),
-                driver.install_hint()
-            );
-        }
-    };
+    let teardown_note = teardown_note(driver, &name, reply.is_some(), output.status, &stderr)?;
     let reply = reply.expect("checked above");
     if reply.target != name {
         bail!("the compile-only child answered for {} instead of {name}", reply.target);

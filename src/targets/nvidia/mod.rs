@@ -333,9 +333,9 @@ impl SassStats {
         Ok(32.0 * f64::from(results) / f64::from(per_clock.min(ISSUE_PER_CLOCK * results)))
     }
 
-    /// SM cycles one warp's instructions take at the table's rates if no two overlapped (the old serial sum,
-    /// kept as a column): the sum over rows of count x 32 / (results per clock), the issue rate for every
-    /// unlisted instruction.
+    /// SM cycles one warp's instructions take at the table's rates if no two overlapped (the serial sum,
+    /// reported as a column of its own): the sum over rows of count x 32 / (results per clock), the issue rate
+    /// for every unlisted instruction.
     pub fn issue_cycles(&self, family: &Family) -> Result<f64> {
         let mut cycles = 0.0;
         for ((row, _), n) in &self.by_row {
