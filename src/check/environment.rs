@@ -12,7 +12,7 @@ pub(super) const MESA: &str = "mesa";
 
 /// "vendor family F model M stepping S (model name)" from /proc/cpuinfo: the host CPU as the JIT sees it.
 pub fn host_cpu() -> String {
-    crate::host::HostCpu::detect().describe()
+    crate::host_cpu::HostCpu::detect().describe()
 }
 
 /// What each group's figures depend on.

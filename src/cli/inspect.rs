@@ -4,7 +4,7 @@ use super::args::{CountArgs, DeviceArgs, HtmlArg, ModelArgs, device_name};
 use super::{check_output, just_measured, on_device_with};
 use anyhow::{Result, bail};
 use brdfprof::brdf::THESIS_MODELS;
-use brdfprof::devices;
+use brdfprof::across_devices;
 use brdfprof::gpu::Gpu;
 use brdfprof::inspect::{self, InspectOptions};
 use brdfprof::{export::json, io};
@@ -72,7 +72,7 @@ pub fn inspect(args: &InspectArgs) -> Result<ExitCode> {
         bail!("--lights must be at least 1");
     }
     let validate = DeviceArgs { device: None, validate: args.validate }.validation();
-    let plan = devices::plan(&args.devices)?;
+    let plan = across_devices::plan(&args.devices)?;
     check_outputs(args, &plan)?;
     let models = if args.sweep_specs {
         brdfprof::sweep::default_specs().into_iter().map(brdfprof::model::Model::spec).collect()
@@ -87,7 +87,7 @@ pub fn inspect(args: &InspectArgs) -> Result<ExitCode> {
         let d = DeviceArgs { device: device.map(str::to_string), validate };
         on_device_with(&d, device.is_some(), |gpu, _| work(gpu)).map(|_| ())
     };
-    let run = devices::Run {
+    let run = across_devices::Run {
         options: &options,
         shaders: &shaders,
         validate,
@@ -95,7 +95,7 @@ pub fn inspect(args: &InspectArgs) -> Result<ExitCode> {
         precise: args.precise_math,
         lines: args.lines,
     };
-    let result = devices::inspect(&plan, &run, &local, profile.as_ref())?;
+    let result = across_devices::inspect(&plan, &run, &local, profile.as_ref())?;
     let stem = result.stem();
     let json = args.json.clone().unwrap_or_else(|| PathBuf::from(format!("results/{stem}.json")));
     let markdown = args.markdown.clone().unwrap_or_else(|| PathBuf::from(format!("results/{stem}.md")));
@@ -123,16 +123,16 @@ pub fn inspect(args: &InspectArgs) -> Result<ExitCode> {
 }
 
 /// Refuses, before anything runs, options that `plan`'s devices cannot serve and outputs that cannot be written.
-fn check_outputs(args: &InspectArgs, plan: &[devices::Planned]) -> Result<()> {
-    if args.lines && !plan.iter().any(|p| matches!(p, devices::Planned::Target(t) if brdfprof::targets::names_lines(t)))
+fn check_outputs(args: &InspectArgs, plan: &[across_devices::Planned]) -> Result<()> {
+    if args.lines && !plan.iter().any(|p| matches!(p, across_devices::Planned::Target(t) if brdfprof::targets::names_lines(t)))
     {
         bail!(
             "--lines: only the nvidia: and intel: targets' compilers name each instruction's source line; give one (e.g. --device nvidia:sm_89 --device intel:gen12lp)"
         );
     }
-    // A compile-only target's default name is known now (`devices::slug`); a local device's only once it is open.
+    // A compile-only target's default name is known now (`across_devices::slug`); a local device's only once it is open.
     let default_name = match plan {
-        [devices::Planned::Target(t)] => format!("inspect-{}", t.slug()),
+        [across_devices::Planned::Target(t)] => format!("inspect-{}", t.slug()),
         [_] => "inspect-<device>".to_string(),
         _ => "inspect-devices".to_string(),
     };
@@ -149,7 +149,7 @@ fn check_outputs(args: &InspectArgs, plan: &[devices::Planned]) -> Result<()> {
         io::check_output_path("--chart", chart)?;
     }
     if let Some(dir) = &args.isa {
-        if !plan.iter().any(|p| matches!(p, devices::Planned::Target(_))) {
+        if !plan.iter().any(|p| matches!(p, across_devices::Planned::Target(_))) {
             bail!(
                 "--isa {}: the listings are a compile-only target's; give one, e.g. --device radv:navi21 or nvidia:sm_89 (see `brdfprof devices --targets`)",
                 dir.display()

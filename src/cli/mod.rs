@@ -122,7 +122,7 @@ pub fn prepare(child: bool, compile_timeout: Option<Duration>) -> Result<()> {
     }
     brdfprof::launch::init(compile_timeout)?;
     check_env_seconds(brdfprof::gpu::FENCE_TIMEOUT_ENV)?;
-    brdfprof::host::memory_limit()?;
+    brdfprof::host_cpu::memory_limit()?;
     if !child {
         brdfprof::targets::radv::env::sanitise()?;
     }

@@ -28,7 +28,7 @@ pub struct Provenance {
     pub host_cpu: Option<String>,
     /// Family, model, stepping and vector features: lavapipe's costs are this CPU's (None: a report from
     /// before it was recorded).
-    pub cpu: Option<crate::host::HostCpu>,
+    pub cpu: Option<crate::host_cpu::HostCpu>,
     pub host_threads: usize,
     /// The command line that wrote the report (None: a report from before it was recorded).
     pub command: Option<Vec<String>>,
@@ -55,7 +55,7 @@ impl Provenance {
             llvm_version: llvm,
             env: driver_environment(),
             host_cpu,
-            cpu: Some(crate::host::HostCpu::detect()),
+            cpu: Some(crate::host_cpu::HostCpu::detect()),
             host_threads: std::thread::available_parallelism().map_or(1, |n| n.get()),
             command: Some(std::env::args().collect()),
             front_ends: crate::model::front::used(),

@@ -102,7 +102,7 @@ pub struct ChildReply {
     pub jit_cpu_features: Vec<String>,
 }
 
-pub use crate::host::cpu_features;
+pub use crate::host_cpu::cpu_features;
 
 /// The child: measures each kernel between client requests. Runs only under valgrind.
 pub fn child_main(request_json: &str) -> Result<()> {

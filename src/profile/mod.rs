@@ -9,7 +9,7 @@ pub mod workload;
 use crate::export::json::Provenance;
 use crate::export::markdown::{self, Table};
 use crate::gpu::Gpu;
-use crate::host::HostCpu;
+use crate::host_cpu::HostCpu;
 use crate::model::Model;
 use crate::shaders::Shaders;
 use crate::stats::{self, Estimate};

@@ -71,7 +71,7 @@ pub fn check_size(
             side(most)
         );
     }
-    if let Some((available, source)) = crate::host::memory_budget() {
+    if let Some((available, source)) = crate::host_cpu::memory_budget() {
         let need = pixels * host_bytes_per_pixel(format, light_counts as u64);
         if need > available {
             let most = available / host_bytes_per_pixel(format, light_counts as u64);

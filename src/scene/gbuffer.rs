@@ -334,9 +334,9 @@ pub fn closeup(scene: &Scene, material: u32, size: u32) -> GBuffer {
 /// radiance read back (1 vec4); on a CPU driver the device's copies are host memory too.
 const HOST_BYTES_PER_PIXEL: u64 = std::mem::size_of::<Pixel>() as u64 + 2 * (5 * 16) + 2 * 16;
 
-/// Refuses a G-buffer that would not fit in the memory available (`host::memory_budget`), before building it.
+/// Refuses a G-buffer that would not fit in the memory available (`host_cpu::memory_budget`), before building it.
 fn check_memory(file: &str, width: u32, height: u32) -> Result<()> {
-    let Some((available, source)) = crate::host::memory_budget() else { return Ok(()) };
+    let Some((available, source)) = crate::host_cpu::memory_budget() else { return Ok(()) };
     let need = width as u64 * height as u64 * HOST_BYTES_PER_PIXEL;
     if need > available {
         bail!(
@@ -357,7 +357,7 @@ fn decode_bytes_per_pixel(planes: &[PlaneHeader]) -> u64 {
 /// Refuses image planes whose decoding and scene run would not fit in the memory available, from their
 /// headers, before any pixel is decoded.
 fn check_image_memory(file: &str, planes: &[PlaneHeader]) -> Result<()> {
-    let Some((available, source)) = crate::host::memory_budget() else { return Ok(()) };
+    let Some((available, source)) = crate::host_cpu::memory_budget() else { return Ok(()) };
     let (w, h) = (planes[0].width as u64, planes[0].height as u64);
     let per_pixel = decode_bytes_per_pixel(planes) + HOST_BYTES_PER_PIXEL;
     let need = w * h * per_pixel;

@@ -333,7 +333,7 @@ fn translated_report(vendor: &dyn Vendor, c: Compilation, rows: Vec<Row>, req: &
         "device": c.device,
         "target": c.target,
         "compiler": c.compiler,
-        "host_cpu": crate::host::HostCpu::detect().describe(),
+        "host_cpu": crate::host_cpu::HostCpu::detect().describe(),
     });
     let mut notes = std::collections::BTreeMap::new();
     notes.insert("driver/".into(), c.driver_note);

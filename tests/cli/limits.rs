@@ -50,7 +50,7 @@ fn a_scene_larger_than_memory_is_refused_before_it_is_built() {
     assert!(e.contains(&format!("{SHORT_MEMORY} are available (BRDFPROF_MEMORY_LIMIT)")), "{e}");
     // With the machine's own MemAvailable, only where it is well short of the need (a machine with more would
     // build the scene): said loudly where it is not.
-    let available = brdfprof::host::available_memory().expect("Linux reports MemAvailable");
+    let available = brdfprof::host_cpu::available_memory().expect("Linux reports MemAvailable");
     if available < 60 << 30 {
         let e = refused(&render(None));
         assert!(e.contains("(MemAvailable)"), "{e}");

@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 
 /// Top-level modules of src/, lowest first: a module may use only those before it. Written once, here.
 const LAYERS: &[&str] = &[
-    "host",
+    "host_cpu",
     "stats",
     "io",
     "cache",
@@ -25,7 +25,7 @@ const LAYERS: &[&str] = &[
     "targets",
     "inspect",
     "compare",
-    "devices",
+    "across_devices",
     "check",
     "sweep",
     "sweep_cost",
