@@ -8,10 +8,10 @@ pub use brdfprof_process::{cleanup, launch, messages};
 pub use brdfprof_vulkan as gpu;
 
 pub mod accuracy;
+pub mod across_devices;
 pub mod cache;
 pub mod check;
 pub mod compare;
-pub mod across_devices;
 pub mod diff;
 pub mod export;
 pub mod host_cpu;

@@ -3,8 +3,8 @@
 use super::args::{CountArgs, DeviceArgs, HtmlArg, ModelArgs, device_name};
 use super::{check_output, just_measured, on_device_with};
 use anyhow::{Result, bail};
-use brdfprof::brdf::THESIS_MODELS;
 use brdfprof::across_devices;
+use brdfprof::brdf::THESIS_MODELS;
 use brdfprof::gpu::Gpu;
 use brdfprof::inspect::{self, InspectOptions};
 use brdfprof::{export::json, io};
@@ -124,7 +124,8 @@ pub fn inspect(args: &InspectArgs) -> Result<ExitCode> {
 
 /// Refuses, before anything runs, options that `plan`'s devices cannot serve and outputs that cannot be written.
 fn check_outputs(args: &InspectArgs, plan: &[across_devices::Planned]) -> Result<()> {
-    if args.lines && !plan.iter().any(|p| matches!(p, across_devices::Planned::Target(t) if brdfprof::targets::names_lines(t)))
+    if args.lines
+        && !plan.iter().any(|p| matches!(p, across_devices::Planned::Target(t) if brdfprof::targets::names_lines(t)))
     {
         bail!(
             "--lines: only the nvidia: and intel: targets' compilers name each instruction's source line; give one (e.g. --device nvidia:sm_89 --device intel:gen12lp)"

@@ -1,14 +1,51 @@
-//! What the tests of the compile-only targets (tests/cli/radv.rs, nvidia.rs, intel.rs) share: an inspect run
-//! with a cache of its own, a compiler statistic of a row, and the models every target must take (every
-//! preset and each example `.brdf` file).
+//! What the tests of the compile-only targets (tests/cli/radv.rs, nvidia.rs, intel.rs and the rest) share: an
+//! inspect run with the binary's kernel cache or a cache of its own, a compiler statistic of a row, and the
+//! models every target must take (every preset and each example `.brdf` file).
 
 use crate::common;
-use std::path::Path;
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
 
-/// `inspect --no-callgrind` on `devices` with `extra` arguments, writing NAME.json and NAME.md in `dir` with a
-/// cache of its own (every call compiles and checks afresh); its output must have `section` (the compiler's
-/// statistics heading). Returns the JSON.
+/// The kernel cache the tests of this binary share, as a developer's cache is shared by their runs: a kernel one
+/// test compiled and checked (its translation judged against its f64 evaluation included) is read by the next
+/// test that needs it. Emptied once per run, so every kernel is compiled afresh at least once in it.
+fn shared_cache() -> &'static Path {
+    static DIR: OnceLock<PathBuf> = OnceLock::new();
+    DIR.get_or_init(|| {
+        let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("cli-kernel-cache");
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        dir
+    })
+}
+
+/// `inspect --no-callgrind` on `devices` with `extra` arguments, writing NAME.json and NAME.md in `dir`, with the
+/// binary's shared kernel cache; its output must have `section` (the compiler's statistics heading). Returns the
+/// JSON.
 pub fn inspect_json(dir: &Path, name: &str, devices: &[&str], extra: &[&str], section: &str) -> serde_json::Value {
+    inspect_with_cache(dir, name, devices, extra, section, shared_cache())
+}
+
+/// `inspect_json` with a cache of its own: every kernel compiled and checked afresh (a rerun compared with a first
+/// run, so that a cache cannot make two runs agree).
+pub fn inspect_json_afresh(
+    dir: &Path,
+    name: &str,
+    devices: &[&str],
+    extra: &[&str],
+    section: &str,
+) -> serde_json::Value {
+    inspect_with_cache(dir, name, devices, extra, section, &dir.join(format!("cache-{name}")))
+}
+
+fn inspect_with_cache(
+    dir: &Path,
+    name: &str,
+    devices: &[&str],
+    extra: &[&str],
+    section: &str,
+    cache: &Path,
+) -> serde_json::Value {
     let json = dir.join(format!("{name}.json"));
     let md = dir.join(format!("{name}.md"));
     let mut args =
@@ -17,8 +54,7 @@ pub fn inspect_json(dir: &Path, name: &str, devices: &[&str], extra: &[&str], se
         args.extend(["--device", d]);
     }
     args.extend(extra);
-    let out =
-        common::brdfprof().args(&args).env("BRDFPROF_CACHE_DIR", dir.join(format!("cache-{name}"))).output().unwrap();
+    let out = common::brdfprof().args(&args).env("BRDFPROF_CACHE_DIR", cache).output().unwrap();
     let out = common::Run {
         code: out.status.code(),
         stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
