@@ -150,14 +150,15 @@ fn read_entry(path: &Path) -> std::result::Result<Option<Vec<u8>>, String> {
         }
         Ok(_) => {}
     }
-    let mut file = std::fs::File::open(path).map_err(|e| format!("cannot be read ({e})"))?;
+    let mut file = crate::io::open_regular(path).map_err(|e| format!("{e:#}"))?.0;
     let mut bytes = Vec::new();
     (&mut file).take(MAX_HEADER).read_to_end(&mut bytes).map_err(|e| format!("cannot be read ({e})"))?;
     let Some(end) = bytes.windows(2).position(|w| w == b"\n\n") else { return Ok(Some(bytes)) };
     let length = std::str::from_utf8(&bytes[..end])
         .ok()
         .and_then(|h| h.lines().find_map(|l| l.strip_prefix("length: ")?.parse::<u64>().ok()));
-    let Some(length) = length else { return Ok(Some(bytes)) };
+    // No length, or one past any entry's: the header alone, which `decode` refuses.
+    let Some(length) = length.filter(|&l| l <= MAX_PAYLOAD) else { return Ok(Some(bytes)) };
     let total = (end as u64).saturating_add(3).saturating_add(length);
     if (bytes.len() as u64) > total {
         bytes.truncate(total as usize);
@@ -167,8 +168,21 @@ fn read_entry(path: &Path) -> std::result::Result<Option<Vec<u8>>, String> {
     Ok(Some(bytes))
 }
 
-/// The payload of an entry for `kind` and (when given) `key`, or why it cannot be trusted.
-fn decode<'a>(bytes: &'a [u8], kind: &str, key: Option<&str>) -> std::result::Result<&'a [u8], String> {
+/// An entry's header, as `put` writes it.
+struct Header {
+    /// Bytes of the header and the blank line after it: where the payload starts.
+    payload_at: usize,
+    length: u64,
+    sha256: String,
+}
+
+/// The largest payload an entry may hold: more than anything brdfprof stores (a tool's output is bounded by
+/// `launch::MAX_OUTPUT_BYTES`), so a header saying more is damaged and nothing past it is read.
+const MAX_PAYLOAD: u64 = crate::launch::MAX_OUTPUT_BYTES as u64;
+
+/// The header at the start of `bytes` for an entry of `kind` (and `key`, when given), or why it cannot be
+/// trusted.
+fn decode_header(bytes: &[u8], kind: &str, key: Option<&str>) -> std::result::Result<Header, String> {
     let end =
         bytes.windows(2).position(|w| w == b"\n\n").ok_or("no header (not a brdfprof cache entry, or cut short)")?;
     let header = std::str::from_utf8(&bytes[..end]).map_err(|_| "the header is not text")?;
@@ -184,21 +198,75 @@ fn decode<'a>(bytes: &'a [u8], kind: &str, key: Option<&str>) -> std::result::Re
             .map(str::to_string)
             .ok_or(format!("no `{name}` line"))
     };
-    let (k, found_key, length, sum) = (field("kind")?, field("key")?, field("length")?, field("sha256")?);
+    let (k, found_key, length, sha256) = (field("kind")?, field("key")?, field("length")?, field("sha256")?);
     if k != kind {
         return Err(format!("an entry of kind `{k}` where `{kind}` belongs"));
     }
     if key.is_some_and(|key| key != found_key) {
         return Err(format!("the entry of key {}... under another key's name", &found_key[..found_key.len().min(12)]));
     }
-    let payload = &bytes[end + 2..];
-    if length.parse::<usize>().ok() != Some(payload.len()) {
-        return Err(format!("{} bytes of payload where the header says {length}", payload.len()));
+    let length = length.parse::<u64>().map_err(|_| format!("the length `{length}` is not a number of bytes"))?;
+    if length > MAX_PAYLOAD {
+        return Err(format!("the header says {length} bytes of payload, more than any entry holds ({MAX_PAYLOAD})"));
     }
-    if hex(&Sha256::digest(payload)) != sum {
+    Ok(Header { payload_at: end + 2, length, sha256 })
+}
+
+/// The payload of an entry for `kind` and (when given) `key`, or why it cannot be trusted.
+fn decode<'a>(bytes: &'a [u8], kind: &str, key: Option<&str>) -> std::result::Result<&'a [u8], String> {
+    let header = decode_header(bytes, kind, key)?;
+    let payload = &bytes[header.payload_at..];
+    if payload.len() as u64 != header.length {
+        return Err(format!("{} bytes of payload where the header says {}", payload.len(), header.length));
+    }
+    if hex(&Sha256::digest(payload)) != header.sha256 {
         return Err("its content does not match its checksum".into());
     }
     Ok(payload)
+}
+
+/// What `entries` finds in a file named like an entry, read in bounded memory: the header (at most
+/// `MAX_HEADER` bytes), then the payload streamed through the checksum in blocks, no further than the header's
+/// length, which is at most `MAX_PAYLOAD`. None: not brdfprof's; Some((legacy, damaged)).
+fn verify_entry(path: &Path, kind: &str, key: &str) -> Option<(bool, Option<String>)> {
+    use std::io::Read;
+    let mut file = crate::io::open_regular(path).ok()?.0;
+    let mut head = Vec::new();
+    (&mut file).take(MAX_HEADER).read_to_end(&mut head).ok()?;
+    if kind == "spv" && head.starts_with(&SPIRV_MAGIC) {
+        return Some((true, None));
+    }
+    // Named like an entry but not written by brdfprof: not ours (a header cut short still is).
+    if !(head.starts_with(MAGIC.as_bytes()) || MAGIC.as_bytes().starts_with(&head)) {
+        return None;
+    }
+    let header = match decode_header(&head, kind, Some(key)) {
+        Ok(h) => h,
+        Err(why) => return Some((false, Some(why))),
+    };
+    let mut hasher = Sha256::new();
+    hasher.update(&head[header.payload_at.min(head.len())..]);
+    let mut seen = (head.len() - header.payload_at.min(head.len())) as u64;
+    let mut block = vec![0u8; 1 << 16];
+    let mut rest = (&mut file).take((header.length + 1).saturating_sub(seen));
+    loop {
+        match rest.read(&mut block) {
+            Ok(0) => break,
+            Ok(n) => {
+                hasher.update(&block[..n]);
+                seen += n as u64;
+            }
+            Err(e) => return Some((false, Some(format!("cannot be read ({e})")))),
+        }
+    }
+    let damaged = if seen != header.length {
+        Some(format!("{seen} bytes of payload where the header says {}", header.length))
+    } else if hex(&hasher.finalize()) != header.sha256 {
+        Some("its content does not match its checksum".into())
+    } else {
+        None
+    };
+    Some((false, damaged))
 }
 
 impl Store {
@@ -281,14 +349,7 @@ impl Store {
                 continue;
             }
             let Some((key, kind)) = entry_name(&name) else { continue };
-            let content = std::fs::read(&path).unwrap_or_default();
-            let legacy = kind == "spv" && content.starts_with(&SPIRV_MAGIC);
-            // Named like an entry but not written by brdfprof: not ours (a header cut short still is).
-            let ours = content.starts_with(MAGIC.as_bytes()) || MAGIC.as_bytes().starts_with(&content);
-            if !legacy && !ours {
-                continue;
-            }
-            let damaged = if legacy { None } else { decode(&content, kind, Some(key)).err() };
+            let Some((legacy, damaged)) = verify_entry(&path, kind, key) else { continue };
             out.push(Entry { path, kind: kind.to_string(), bytes, damaged, legacy });
         }
         out.sort_by(|a, b| a.path.cmp(&b.path));

@@ -145,7 +145,8 @@ impl Shaders {
 /// `name`'s line in `dir/kernels.txt`: (source file, defines).
 pub fn kernel_entry(dir: &Path, name: &str) -> Result<(String, Vec<String>)> {
     let list = dir.join("kernels.txt");
-    let text = std::fs::read_to_string(&list).with_context(|| format!("cannot read {}", list.display()))?;
+    let text = String::from_utf8(crate::io::read_input(&list)?)
+        .map_err(|_| anyhow::anyhow!("cannot read {}: not UTF-8 text", list.display()))?;
     for line in text.lines().map(str::trim).filter(|l| !l.is_empty() && !l.starts_with('#')) {
         let mut fields = line.split_whitespace();
         if fields.next() == Some(name) {

@@ -13,7 +13,7 @@
 
 use crate::cleanup;
 use crate::gpu::{Gpu, GpuOptions};
-use crate::kernels::shade::GBufferFormat;
+use crate::kernels::shade::{GBufferFormat, kernel_hash};
 use crate::model::Model;
 use crate::profile::gbuffer;
 use crate::profile::protocol::Timed;
@@ -100,6 +100,9 @@ pub struct ChildReply {
     pub evaluations: u64,
     /// CPU features as the JIT sees them under valgrind (valgrind hides some, e.g. AVX-512).
     pub jit_cpu_features: Vec<String>,
+    /// Each model's kernel hash (`kernel_hash`, packed) as the child composed it from the files it read.
+    #[serde(default)]
+    pub kernels: Vec<String>,
 }
 
 pub use crate::host_cpu::cpu_features;
@@ -140,7 +143,9 @@ pub fn child_main(request_json: &str) -> Result<()> {
         labels.push(label.trim_end_matches('\0').to_string());
     }
     gpu.check_validation()?;
-    let reply = ChildReply { labels, evaluations: work.evaluations(), jit_cpu_features: cpu_features() };
+    let kernels =
+        models.iter().map(|m| kernel_hash(Some(m), GBufferFormat::Packed, &shaders)).collect::<Result<_>>()?;
+    let reply = ChildReply { labels, evaluations: work.evaluations(), jit_cpu_features: cpu_features(), kernels };
     println!("{}", serde_json::to_string(&reply)?);
     Ok(())
 }
@@ -223,6 +228,15 @@ pub fn run(models: &[Model], lights: u32, shaders: &Shaders, options: &Callgrind
         .rev()
         .find_map(|l| serde_json::from_str(l).ok())
         .ok_or_else(|| anyhow!("the callgrind child printed no reply; its output:\n{stdout}"))?;
+    // The child reads the model files again: a file edited during the run gave it another kernel.
+    for (model, theirs) in models.iter().zip(&reply.kernels) {
+        if *theirs != kernel_hash(Some(model), GBufferFormat::Packed, shaders)? {
+            bail!(
+                "{}: the callgrind child measured another kernel than brdfprof composed (the child read the model file again and it had changed: was it edited during the run?); run again",
+                model.file().map_or_else(|| model.label(), |f| f.path.clone())
+            );
+        }
+    }
     let dumps = read_dumps(dir.path())?;
     let kernels = kernel_irs(models, &reply.labels, &dumps)?;
     Ok(CallgrindRun { kernels, evaluations: reply.evaluations, jit_cpu_features: reply.jit_cpu_features, valgrind })

@@ -72,14 +72,7 @@ pub const MAX_REPORT_BYTES: u64 = 256 << 20;
 /// while it is read (or lies about its size) cannot exhaust memory.
 pub fn read_bounded(path: &Path, max: u64) -> Result<Vec<u8>> {
     use std::io::Read;
-    let file = std::fs::File::open(path).map_err(|e| anyhow!("cannot read {}: {e}", path.display()))?;
-    let meta = file.metadata().map_err(|e| anyhow!("cannot read {}: {e}", path.display()))?;
-    if meta.is_dir() {
-        bail!("cannot read {}: Is a directory", path.display());
-    }
-    if !meta.is_file() {
-        bail!("cannot read {}: not a regular file (a device, FIFO or socket)", path.display());
-    }
+    let (file, meta) = open_regular(path)?;
     if meta.len() > max {
         bail!(
             "cannot read {}: {} bytes, more than the {max} bytes brdfprof reads from such a file",
@@ -93,6 +86,33 @@ pub fn read_bounded(path: &Path, max: u64) -> Result<Vec<u8>> {
         bail!("cannot read {}: it grew past the {max} bytes brdfprof reads from such a file", path.display());
     }
     Ok(bytes)
+}
+
+/// Opens a file for reading that must be a regular one (after symbolic links). The open itself does not
+/// block: a FIFO with no writer would hold a plain open forever, so the file is opened with O_NONBLOCK (which
+/// changes nothing for a regular file's reads) and its type checked on the open descriptor, before anything is
+/// read; a device, FIFO, socket or directory is refused naming the path.
+pub fn open_regular(path: &Path) -> Result<(std::fs::File, std::fs::Metadata)> {
+    use std::os::unix::fs::{FileTypeExt, OpenOptionsExt};
+    let file = std::fs::OpenOptions::new()
+        .read(true)
+        .custom_flags(libc::O_NONBLOCK | libc::O_NOCTTY)
+        .open(path)
+        .map_err(|e| anyhow!("cannot read {}: {e}", path.display()))?;
+    let meta = file.metadata().map_err(|e| anyhow!("cannot read {}: {e}", path.display()))?;
+    let kind = meta.file_type();
+    let what = if kind.is_dir() {
+        "a directory"
+    } else if kind.is_fifo() {
+        "a FIFO"
+    } else if kind.is_socket() {
+        "a socket"
+    } else if kind.is_char_device() || kind.is_block_device() {
+        "a device"
+    } else {
+        return Ok((file, meta));
+    };
+    bail!("cannot read {}: not a regular file ({what})", path.display())
 }
 
 /// Symbolic links followed at most this many times (Linux's own limit, MAXSYMLINKS).

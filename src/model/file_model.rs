@@ -823,8 +823,11 @@ impl GlslTree {
                     .map(|(_, t)| t.to_string())
                     .ok_or_else(|| anyhow!("the embedded glsl/ has no {rel}"))
             }
-            GlslTree::Dir(root) => std::fs::read_to_string(root.join(rel))
-                .with_context(|| format!("cannot read {}", root.join(rel).display())),
+            GlslTree::Dir(root) => {
+                let path = root.join(rel);
+                String::from_utf8(crate::io::read_input(&path)?)
+                    .map_err(|_| anyhow!("cannot read {}: not UTF-8 text", path.display()))
+            }
         }
     }
 

@@ -81,7 +81,21 @@ fn picture(d: &DiffReport, gpu: Option<&Gpu>) -> Result<String> {
     let Some(gpu) = gpu else {
         return Ok("<p class=\"note\">Picture not drawn: the report was built without a device (--no-gpu).</p>".into());
     };
-    let (a, b) = (Model::parse(&d.a.canonical)?, Model::parse(&d.b.canonical)?);
+    // A model file gone or changed since the diff ran: the rest of the diff is still the saved result.
+    let models = Model::parse(&d.a.canonical).and_then(|a| Ok((a, Model::parse(&d.b.canonical)?)));
+    let (a, b) = match models {
+        Ok(ab) => ab,
+        Err(e) => {
+            crate::messages::warning(format!(
+                "report: the picture of {} against {}: not drawn: {e:#}",
+                d.b.name, d.a.name
+            ));
+            return Ok(format!(
+                "<p class=\"err\">Picture not drawn: a model cannot be read now ({}); the tables above are the saved diff's.</p>",
+                esc(&format!("{e:#}"))
+            ));
+        }
+    };
     let (w, h, px) = crate::diff::picture::pixels(gpu, &a, &b)?;
     let alt = format!("B = {} against A = {}: lit spheres, relative difference and lobes", d.b.name, d.a.name);
     Ok(format!(
@@ -157,7 +171,8 @@ fn diff_set_html(i: usize, d: &DiffSet, path: &str, gpu: Option<&Gpu>) -> Result
             .iter()
             .filter_map(|c| finite(c.rms_rel))
             .fold(None, |m: Option<f64>, r| Some(m.map_or(r, |m| m.max(r))));
-        let one_side: usize = x.difference.channels.iter().map(|c| c.mismatched_nonfinite).sum();
+        // Counts read from a saved report: summed so that a crafted one cannot wrap.
+        let one_side = x.difference.channels.iter().fold(0usize, |n, c| n.saturating_add(c.mismatched_nonfinite));
         let verdict = match d.tolerance {
             Some(t) if x.within_tolerance => format!("within {t}"),
             Some(t) => format!("beyond {t}"),

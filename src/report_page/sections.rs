@@ -506,7 +506,8 @@ fn heat_map(s: &SpecStability, triples: &[[u32; 3]]) -> Result<String> {
         let c = crate::export::raster::viridis((1.0 + n as f32).ln() / (1.0 + max).ln());
         rgb[k..k + 3].copy_from_slice(&c);
     }
-    let total: u32 = triples.iter().map(|t| t[2]).sum();
+    // Counts read from a saved report: summed wide, so a crafted one cannot wrap the caption's total.
+    let total: u64 = triples.iter().map(|t| u64::from(t[2])).sum();
     let uri = html::png_data_uri(w, h, &rgb)?;
     let caption = format!(
         "{}: {total} bad values (NaN, Inf, negative) in {} cells; NoV {}..{} right, roughness {}..{} up; most in a cell {max}",

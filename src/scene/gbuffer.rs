@@ -533,7 +533,11 @@ pub struct PlaneHeader {
 /// does not fit is refused without being decoded. Errors name the file.
 fn open_plane(path: &Path, what: &str, kind: PlaneKind) -> Result<(impl ImageDecoder, PlaneHeader, bool)> {
     let shown = path.display();
-    let reader = image::ImageReader::open(path).map_err(|e| anyhow!("cannot read image {shown}: {e}"))?;
+    let (file, _) = crate::io::open_regular(path).map_err(|e| anyhow!("image: {e:#}"))?;
+    let mut reader = image::ImageReader::new(std::io::BufReader::new(file));
+    if let Ok(format) = image::ImageFormat::from_path(path) {
+        reader.set_format(format);
+    }
     let mut reader = reader.with_guessed_format().map_err(|e| anyhow!("cannot read image {shown}: {e}"))?;
     let format = reader.format();
     // The size is checked here, from the header, instead of by the image crate's allocation limit (512 MiB,

@@ -81,7 +81,6 @@ pub static ADRENO: Shim = Shim {
         family_a7xx("a750", "750", "Snapdragon 8 Gen 3", "FD_GPU_ID=750, a7xx gen 3, Mesa 25.0"),
     ],
     cost: cost_table,
-    noise: &[],
     compiler_log: None,
 };
 

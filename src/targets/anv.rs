@@ -56,7 +56,6 @@ pub static ANV: Shim = Shim {
     ],
     cost: cost_table,
     // The shim's line for each ioctl query it does not emulate (Mesa 22.3's i915 shim: DG2's memory regions).
-    noise: &["Unknown drm_i915_query_item id="],
     compiler_log: None,
 };
 

@@ -120,7 +120,6 @@ pub static MALI: Shim = Shim {
         },
     ],
     cost: cost_table,
-    noise: &[],
     compiler_log: Some(CompilerLog { read: read_shaderdb, beside_properties: false }),
 };
 

@@ -503,7 +503,7 @@ fn model_files_errors_say_why() {
     std::os::unix::fs::symlink("loop.brdf", d.join("loop.brdf")).unwrap();
     std::os::unix::fs::symlink("gone.brdf", d.join("dangling.brdf")).unwrap();
     let eval = |model: &str| run_in(d, &["eval", "--model", model, "--input", "in.csv", "--output", "out.csv"]);
-    eval("dir.brdf").fails(2, "cannot read dir.brdf: Is a directory");
+    eval("dir.brdf").fails(2, "cannot read dir.brdf: not a regular file (a directory)");
     eval("loop.brdf").fails(2, "cannot read loop.brdf: Too many levels of symbolic links");
     eval("dangling.brdf")
         .fails(2, "cannot read dangling.brdf: it is a symbolic link to gone.brdf, which does not exist");

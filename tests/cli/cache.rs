@@ -194,3 +194,33 @@ fn cache_show_and_clear_touch_only_brdfprofs_entries() {
     assert!(run_cached(d, c, &["cache", "show"]).ok().stdout.contains("entries: 0"));
     assert!(run_cached(d, "", &["cache", "show"]).ok().stdout.contains("the disk cache is off"));
 }
+
+/// `cache show` reads an entry's header and streams its payload through the checksum: a 3 GB sparse file
+/// named like an entry (its header claiming all 3 GB, or 1 MB) is listed as damaged under a 512 MB address
+/// space limit, which reading it whole would exceed six times over.
+#[test]
+fn cache_show_reads_a_huge_sparse_entry_in_bounded_memory() {
+    let dir = tempfile::tempdir().unwrap();
+    let cache = dir.path().join("cache");
+    std::fs::create_dir(&cache).unwrap();
+    let size: u64 = 3 << 30;
+    for (name, claimed) in [("a", size - 200), ("b", 1 << 20)] {
+        let key = format!("{:064}", 0).replacen('0', name, 1);
+        let header = format!("brdfprof-cache 1\nkind: spv\nkey: {key}\nlength: {claimed}\nsha256: {:064}\n\n", 0);
+        let file = std::fs::File::create(cache.join(format!("{key}.spv"))).unwrap();
+        std::os::unix::fs::FileExt::write_all_at(&file, header.as_bytes(), 0).unwrap();
+        file.set_len(size).unwrap();
+    }
+    let started = std::time::Instant::now();
+    let out = std::process::Command::new("sh")
+        .args(["-c", "ulimit -v 524288 && exec \"$0\" cache show", env!("CARGO_BIN_EXE_brdfprof")])
+        .env("BRDFPROF_CACHE_DIR", &cache)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(0), "{stdout}{}", String::from_utf8_lossy(&out.stderr));
+    assert!(stdout.contains("entries: 2 (spv: 2)"), "{stdout}");
+    assert!(stdout.contains("more than any entry holds"), "the 3 GB claim is refused from the header: {stdout}");
+    assert!(stdout.contains("where the header says 1048576"), "the 1 MB claim is read 1 MB + 1 byte far: {stdout}");
+    assert!(started.elapsed().as_secs() < 20, "headers and at most a bounded payload read");
+}

@@ -323,3 +323,139 @@ fn a_compile_only_child_past_the_limit_stops_naming_the_model() {
     assert!(r.stderr.contains("tree") && r.stderr.contains("longer than the compile limit of 3 s"), "{}", r.stderr);
     assert!(started.elapsed().as_secs() < 30 && !dir.path().join("i.json").exists());
 }
+
+/// `brdfprof ARGS` in `dir`, killed after `limit`: a run that hangs fails the test instead of holding it.
+fn run_within(dir: &std::path::Path, args: &[&str], limit: std::time::Duration) -> (common::Run, std::time::Duration) {
+    let started = std::time::Instant::now();
+    let child = common::brdfprof()
+        .args(args)
+        .current_dir(dir)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let id = child.id();
+    let (done, wait) = std::sync::mpsc::channel::<()>();
+    let watchdog = std::thread::spawn(move || {
+        if wait.recv_timeout(limit).is_err() {
+            unsafe { libc::kill(id as i32, libc::SIGKILL) };
+        }
+    });
+    let out = child.wait_with_output().unwrap();
+    let _ = done.send(());
+    watchdog.join().unwrap();
+    let run = common::Run {
+        code: out.status.code(),
+        stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
+        stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
+    };
+    (run, started.elapsed())
+}
+
+/// Every input path a command reads (models in each language, an include, `--input`, and the JSON of report,
+/// compare, check, inspect --profile and scene) that is a FIFO with no writer is refused by name, exit 2,
+/// without blocking on it (docs/limits.md: input files).
+#[test]
+fn a_fifo_as_any_input_is_refused_without_waiting_for_a_writer() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("in.csv"), CSV).unwrap();
+    std::fs::write(d.join("main.hlsl"), "#include \"lib.hlsl\"\nfloat3 f(float3 n) { return n; }\n").unwrap();
+    for name in ["m.brdf", "m.hlsl", "m.wgsl", "lib.hlsl", "in.fifo", "r.json", "b.json", "p.json", "s.json"] {
+        assert!(std::process::Command::new("mkfifo").arg(d.join(name)).status().unwrap().success());
+    }
+    let cases: [&[&str]; 10] = [
+        &["eval", "--model", "m.brdf", "--input", "in.csv", "--output", "o.csv"],
+        &["eval", "--model", "m.hlsl", "--input", "in.csv", "--output", "o.csv"],
+        &["eval", "--model", "m.wgsl", "--input", "in.csv", "--output", "o.csv"],
+        &["eval", "--model", "main.hlsl", "--input", "in.csv", "--output", "o.csv"],
+        &["eval", "--model", "ggx", "--input", "in.fifo", "--output", "o.csv"],
+        &["report", "r.json", "--out", "o.html"],
+        &["compare", "r.json"],
+        &["check", "--baseline", "b.json", "--rounds", "0", "--no-callgrind"],
+        &["inspect", "--model", "ggx", "--profile", "p.json", "--json", "o.json"],
+        &["scene", "s.json"],
+    ];
+    for args in cases {
+        let fifo = args.iter().find(|a| a.ends_with(".fifo") || a.ends_with(".json") && !a.starts_with("o."));
+        let named = fifo.copied().unwrap_or_else(|| if args[2] == "main.hlsl" { "lib.hlsl" } else { args[2] });
+        let (r, took) = run_within(d, args, std::time::Duration::from_secs(30));
+        assert_eq!(r.code, Some(2), "{args:?} (killed after 30 s if None): {}", r.stderr);
+        assert!(r.stderr.contains(&format!("{named}: not a regular file (a FIFO)")), "{args:?}: {}", r.stderr);
+        assert!(took.as_secs() < 10, "{args:?}: refused after {took:?}");
+    }
+}
+
+/// A WGSL model whose `BRDF` returns one sum of `terms` products.
+fn wgsl_sum(terms: usize) -> String {
+    let sum = vec!["L.x * 0.001"; terms].join(" + ");
+    format!(
+        "fn BRDF(L: vec3<f32>, V: vec3<f32>, N: vec3<f32>, X: vec3<f32>, Y: vec3<f32>) -> vec3<f32> {{\n    let s = {sum};\n    return vec3<f32>(s);\n}}\n"
+    )
+}
+
+/// Generated shaders reach expressions of tens of thousands of terms: a 20,000-term sum (which overflowed the
+/// main thread's stack in naga's WGSL front end) evaluates; a statement past the front end's bound is refused
+/// at its line, never a signal.
+#[test]
+fn a_20000_term_wgsl_expression_evaluates_and_a_larger_one_is_refused_at_its_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("in.csv"), CSV).unwrap();
+    std::fs::write(d.join("long.wgsl"), wgsl_sum(20_000)).unwrap();
+    let r = common::run_in(d, &["eval", "--model", "long.wgsl", "--input", "in.csv", "--output", "o.csv"]).ok();
+    let value: f64 = std::fs::read_to_string(d.join("o.csv"))
+        .unwrap()
+        .lines()
+        .nth(1)
+        .unwrap()
+        .split(',')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    // 20,000 x 0.6 x 0.001 = 12, summed in fp32.
+    assert!((value - 12.0).abs() < 1e-2, "{value}: {}", r.stderr);
+    std::fs::write(d.join("huge.wgsl"), wgsl_sum(200_001)).unwrap();
+    common::run_in(d, &["eval", "--model", "huge.wgsl", "--input", "in.csv", "--output", "o.csv"])
+        .fails(2, "huge.wgsl:2: a statement of more than 200000 operators");
+}
+
+/// A WGSL model that imports nothing never walks `--include-dir`; one that imports a module walks each folder
+/// once, however many symbolic links lead back to it (a folder of six links to itself took 63 s before).
+#[test]
+fn include_folders_of_links_to_themselves_are_walked_once_and_only_for_imports() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("in.csv"), CSV).unwrap();
+    let mods = d.join("mods");
+    std::fs::create_dir(&mods).unwrap();
+    for k in 0..6 {
+        std::os::unix::fs::symlink(&mods, mods.join(format!("self{k}"))).unwrap();
+    }
+    std::fs::write(
+        mods.join("scale.wgsl"),
+        "#define_import_path my::scale\nfn half(x: f32) -> f32 { return 0.5 * x; }\n",
+    )
+    .unwrap();
+    std::fs::write(d.join("plain.wgsl"), wgsl_sum(1)).unwrap();
+    let importing = "#import my::scale::half\nfn BRDF(L: vec3<f32>, V: vec3<f32>, N: vec3<f32>, X: vec3<f32>, Y: vec3<f32>) -> vec3<f32> {\n    return vec3<f32>(half(L.x));\n}\n";
+    std::fs::write(d.join("imports.wgsl"), importing).unwrap();
+    for (model, expect) in [("plain.wgsl", 0.0006), ("imports.wgsl", 0.3)] {
+        let args = ["eval", "--model", model, "--include-dir", "mods", "--input", "in.csv", "--output", "o.csv"];
+        let (r, took) = run_within(d, &args, std::time::Duration::from_secs(60));
+        assert_eq!(r.code, Some(0), "{model}: {}", r.stderr);
+        assert!(took.as_secs() < 20, "{model}: {took:?}");
+        let value: f64 = std::fs::read_to_string(d.join("o.csv"))
+            .unwrap()
+            .lines()
+            .nth(1)
+            .unwrap()
+            .split(',')
+            .next()
+            .unwrap()
+            .parse()
+            .unwrap();
+        assert!((value - expect).abs() < 1e-6, "{model}: {value}");
+    }
+}

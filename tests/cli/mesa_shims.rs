@@ -487,3 +487,59 @@ fn setup_builds_every_file_each_shim_driver_loads() {
         assert!(targets::VENDORS.iter().any(|v| v.prefix() == s.prefix), "{}", s.prefix);
     }
 }
+
+/// A model file edited between the parent's key and the child's compile (the test hook holds the parent until
+/// the edit is made) never leaves the edited text's figures in the cache or in the report: the run exits 2
+/// naming the file, and a later run of the original text reports the figures of a cold run of it.
+#[test]
+fn a_model_file_edited_during_a_run_never_mixes_two_texts() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let cache = d.join("cache");
+    let model = d.join("m.brdf");
+    let original = std::fs::read_to_string(common::repo_root().join("examples/brdf/ggx.brdf")).unwrap();
+    // Another kernel: the BRDF's value doubled.
+    let edited = original.replacen("return D_GGX(", "return 2.0 * D_GGX(", 1);
+    assert_ne!(original, edited);
+    std::fs::write(&model, &original).unwrap();
+    let inspect = |name: &str, hold: Option<&Path>| {
+        let json = d.join(format!("{name}.json"));
+        let mut cmd = common::brdfprof();
+        cmd.args(["inspect", "--no-callgrind", "--model", model.to_str().unwrap(), "--device", "adreno:a660"])
+            .args(["--json", json.to_str().unwrap(), "--markdown", d.join(format!("{name}.md")).to_str().unwrap()])
+            .env("BRDFPROF_CACHE_DIR", &cache)
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped());
+        if let Some(h) = hold {
+            cmd.env(targets::mesa_noop::HOLD_BEFORE_CHILDREN, h);
+        }
+        (cmd.spawn().unwrap(), json)
+    };
+    let hold = d.join("hold");
+    let (child, _) = inspect("edited", Some(&hold));
+    let waiting = hold.with_extension("waiting");
+    let start = std::time::Instant::now();
+    while !waiting.exists() {
+        assert!(start.elapsed().as_secs() < 240, "the parent never reached its children");
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    std::fs::write(&model, &edited).unwrap();
+    std::fs::write(&hold, b"").unwrap();
+    let out = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("m.brdf: the adreno:a660 child compiled another kernel"), "{stderr}");
+    // The original text again, through the cache, then cold: the same figures.
+    std::fs::write(&model, &original).unwrap();
+    let rows = |name: &str| {
+        let (child, json) = inspect(name, None);
+        let out = child.wait_with_output().unwrap();
+        assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+        let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(json).unwrap()).unwrap();
+        v.get("reports").map_or(&v, |r| &r[0])["rows"].clone()
+    };
+    let warm = rows("after");
+    std::fs::remove_dir_all(&cache).unwrap();
+    let cold = rows("cold");
+    assert_eq!(warm, cold, "the cache held another text's figures under the original's key");
+}

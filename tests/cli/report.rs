@@ -165,6 +165,40 @@ fn a_diff_report_shows_the_jsons_numbers_in_chromium() {
     }
 }
 
+/// A diff whose `.brdf` model is gone since it ran is still drawn: its tables are the saved diff's, and the
+/// picture says why it is not drawn (exit 0, a warning naming the file).
+#[test]
+fn a_report_of_a_diff_whose_brdf_file_is_gone_says_why_its_picture_is_missing() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let model = d.join("mine.brdf");
+    std::fs::copy(common::repo_root().join("examples/brdf/ggx.brdf"), &model).unwrap();
+    let spec = format!("{},roughness=@roughness,f0=@f0", model.display());
+    common::run_in(d, &["diff", "--model", "ggx", "--model", &spec, "--samples", "200", "--json", "d.json"]).ok();
+    std::fs::remove_file(&model).unwrap();
+    let r = common::run_in(d, &["report", "d.json", "--out", "r.html"]).ok();
+    assert!(r.stderr.contains("not drawn") && r.stderr.contains("mine.brdf"), "{}", r.stderr);
+    let page = std::fs::read_to_string(d.join("r.html")).unwrap();
+    assert!(page.contains("Picture not drawn: a model cannot be read now"), "the card says why");
+    assert!(page.contains("diff0/r") && page.contains("mine.brdf"), "the saved tables are drawn");
+}
+
+/// Counts read from a saved stability report are summed without wrapping: two cells of u32::MAX bad values
+/// make a caption of 8589934590, not 4294967294.
+#[test]
+fn a_stability_reports_huge_counts_do_not_wrap_in_the_heat_map_caption() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let mut st = json("results/stability-llvmpipe.json");
+    // `bad_cells` as written: sparse [roughness index, NoV index, count] triples.
+    let spec = st["specs"].as_array_mut().unwrap().iter_mut().find(|s| s["bad_cells"].is_array());
+    spec.expect("a spec with a heat map")["bad_cells"] = serde_json::json!([[0, 0, u32::MAX], [1, 1, u32::MAX]]);
+    std::fs::write(d.join("st.json"), st.to_string()).unwrap();
+    common::run_in(d, &["report", "st.json", "--no-gpu", "--out", "r.html"]).ok();
+    let page = std::fs::read_to_string(d.join("r.html")).unwrap();
+    assert!(page.contains(&format!("{} bad values", 2 * u64::from(u32::MAX))), "the total, summed wide");
+}
+
 /// The console check can fail: a page that logs an error is caught.
 #[test]
 fn a_console_error_is_seen() {

@@ -53,6 +53,11 @@ fn stop(run: &mut Run, signal: libc::c_int) -> Option<i32> {
 /// Processes whose command line contains `__callgrind-child` and whose TMPDIR is in `tmp` (brdfprof gives each
 /// child a directory of its own there; a zombie has neither).
 fn callgrind_children(tmp: &Path) -> Vec<u32> {
+    processes_under(tmp, "__callgrind-child")
+}
+
+/// Processes whose command line contains `needle` and whose TMPDIR is in `tmp`.
+fn processes_under(tmp: &Path, needle: &str) -> Vec<u32> {
     let marker = format!("TMPDIR={}/", tmp.display());
     let mut pids = Vec::new();
     for entry in std::fs::read_dir("/proc").unwrap().flatten() {
@@ -61,8 +66,7 @@ fn callgrind_children(tmp: &Path) -> Vec<u32> {
         let has = |bytes: Vec<u8>, needle: &str| {
             bytes.split(|&b| b == 0).any(|s| String::from_utf8_lossy(s).contains(needle))
         };
-        if has(read("cmdline"), "__callgrind-child")
-            && read("environ").split(|&b| b == 0).any(|s| s.starts_with(marker.as_bytes()))
+        if has(read("cmdline"), needle) && read("environ").split(|&b| b == 0).any(|s| s.starts_with(marker.as_bytes()))
         {
             pids.push(pid);
         }
@@ -181,4 +185,19 @@ fn sigkill_takes_the_valgrind_child_along() {
     run.child.wait().unwrap();
     // No handler runs on SIGKILL, so files may remain (the TempDir removes them); the child must not.
     wait_for("end of the valgrind child", Duration::from_secs(10), || callgrind_children(&tmp).is_empty());
+}
+
+/// A tool's own children are killed with it: SIGTERM while g++ compiles the NVIDIA translation's host build
+/// leaves no cc1plus behind (it ran on for seconds when only g++ itself was killed).
+#[test]
+fn sigterm_during_the_translation_check_kills_the_compilers_children() {
+    let mut run = start(&["inspect", "--no-callgrind", "--device", "nvidia:sm_89", "--model", "ggx"]);
+    let tmp = run.tmp.path().to_path_buf();
+    wait_for("cc1plus under g++", Duration::from_secs(240), || !processes_under(&tmp, "cc1plus").is_empty());
+    let code = stop(&mut run, libc::SIGTERM);
+    let stderr = std::fs::read_to_string(&run.stderr).unwrap();
+    assert_eq!(code, Some(130), "{stderr}");
+    let left = processes_under(&tmp, "cc1plus");
+    assert!(left.is_empty(), "cc1plus still running after brdfprof exited: {left:?}\n{stderr}");
+    assert!(files_under(&tmp).is_empty(), "left in TMPDIR: {:?}", files_under(&tmp));
 }

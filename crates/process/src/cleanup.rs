@@ -104,8 +104,9 @@ fn kill_and_reap(pid: u32) {
     let Ok(pid) = libc::pid_t::try_from(pid) else { return };
     // SAFETY: plain system calls on a pid this process spawned and has not yet reaped (the guard is dropped
     // only after `wait`); a pid already reaped by the waiting thread makes waitpid return -1 (ECHILD).
+    kill_group(pid as u32);
+    // SAFETY: as in `kill_group`.
     unsafe {
-        libc::kill(pid, libc::SIGKILL);
         let start = Instant::now();
         while start.elapsed() < Duration::from_secs(2) {
             if libc::waitpid(pid, std::ptr::null_mut(), libc::WNOHANG) != 0 {
@@ -192,11 +193,31 @@ impl Drop for ChildGuard {
 }
 
 /// `Command::new(program)` whose child dies with brdfprof. PR_SET_PDEATHSIG fires when the spawning thread
-/// ends, so spawn from the thread that waits for the child (as every caller here does).
+/// ends, so spawn from the thread that waits for the child (as every caller here does). In brdfprof itself
+/// the child leads a process group of its own, which `kill_group` kills whole: what a tool starts (cc1plus
+/// and as under g++, ocloc's children, a brdfprof child's own tools) goes with it. In a brdfprof child
+/// process the tools stay in the child's group, so that killing the child's group reaches them too.
 pub fn command(program: &str) -> Command {
     let mut cmd = Command::new(program);
     die_with_parent(&mut cmd);
+    if !crate::messages::is_child_process() {
+        std::os::unix::process::CommandExt::process_group(&mut cmd, 0);
+    }
     cmd
+}
+
+/// SIGKILL to `pid`'s process group (which `command` made it lead) and to `pid` itself, whose group it may
+/// not lead (a command built without `command`).
+pub fn kill_group(pid: u32) {
+    let Ok(pid) = libc::pid_t::try_from(pid) else { return };
+    // SAFETY: plain system calls on a pid this process spawned and has not yet reaped; a group already gone
+    // makes kill return -1 (ESRCH).
+    unsafe {
+        if libc::getpgid(pid) == pid {
+            libc::kill(-pid, libc::SIGKILL);
+        }
+        libc::kill(pid, libc::SIGKILL);
+    }
 }
 
 #[cfg(target_os = "linux")]

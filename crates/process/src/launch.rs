@@ -191,12 +191,12 @@ fn run(cmd: &mut Command, input: Option<Vec<u8>>, what: &str, limit: Duration) -
             break status;
         }
         if progress.elapsed() >= limit {
-            let _ = child.kill();
+            crate::cleanup::kill_group(child.id());
             let _ = child.wait();
             bail!(over_limit(what, limit));
         }
         if overflow.load(Ordering::SeqCst) {
-            let _ = child.kill();
+            crate::cleanup::kill_group(child.id());
             let _ = child.wait();
             bail!(over_output(what));
         }

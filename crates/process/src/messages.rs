@@ -73,6 +73,11 @@ pub fn set_child_process() {
     CHILD.store(true, Ordering::SeqCst);
 }
 
+/// Whether this process is one of brdfprof's own children (`set_child_process`).
+pub fn is_child_process() -> bool {
+    CHILD.load(Ordering::SeqCst)
+}
+
 /// A warning about the user's input (a model file, a parameter): once per process, never in a child.
 pub fn input_warning(text: impl Display) {
     if !CHILD.load(Ordering::SeqCst) {

@@ -15,6 +15,11 @@ pub fn esc(text: &str) -> String {
             '>' => out.push_str("&gt;"),
             '"' => out.push_str("&quot;"),
             '\'' => out.push_str("&#39;"),
+            // Bidirectional controls (embeddings, overrides, isolates, marks) would reorder how a name reads
+            // (U+202E shows the rest of a file name reversed): shown as their code points instead.
+            '\u{200E}' | '\u{200F}' | '\u{061C}' | '\u{202A}'..='\u{202E}' | '\u{2066}'..='\u{2069}' => {
+                let _ = write!(out, "[U+{:04X}]", c as u32);
+            }
             c => out.push(c),
         }
     }
@@ -467,6 +472,17 @@ mod tests {
     #[test]
     fn escaping_covers_markup_and_quotes() {
         assert_eq!(esc("<a href=\"x\">&'</a>"), "&lt;a href=&quot;x&quot;&gt;&amp;&#39;&lt;/a&gt;");
+    }
+
+    #[test]
+    fn bidirectional_controls_are_shown_not_obeyed() {
+        // "evil\u{202E}fdp.brdf" would display as "evilfdp.brdf" reversed after the override.
+        assert_eq!(esc("evil\u{202E}fdp.brdf"), "evil[U+202E]fdp.brdf");
+        let controls = ['\u{200E}', '\u{200F}', '\u{061C}', '\u{202A}', '\u{202D}', '\u{2066}', '\u{2069}'];
+        for c in controls {
+            assert!(!esc(&format!("a{c}b")).contains(c), "{:04X}", c as u32);
+        }
+        assert_eq!(esc("héllo ✓ 光"), "héllo ✓ 光", "other characters pass");
     }
 
     #[test]

@@ -8,9 +8,27 @@
 use super::*;
 use crate::model::front::{self, Glue, GlueArg, cross, hlsl, includes::Expanded, wgsl};
 
+/// The stack the front ends run on. naga's WGSL front end recurses once per operand of an expression (a
+/// 20,000-term sum overflowed the main thread's 8 MiB and aborted the process); generated shaders (fitted
+/// polynomials, tabulated lobes) reach such sizes. Only the pages used are ever touched.
+const FRONT_END_STACK: usize = 1 << 30;
+
 /// The shader's GLSL, numbered from 1, for the steps after this one; sets the file's loops, whether it
-/// defines `BRDF`, each entry's glue function and the front end.
+/// defines `BRDF`, each entry's glue function and the front end. Runs on a thread of its own with
+/// `FRONT_END_STACK`.
 pub(super) fn translate(file: &mut BrdfFile) -> Result<Vec<(usize, String)>> {
+    std::thread::scope(|scope| {
+        std::thread::Builder::new()
+            .name("front end".into())
+            .stack_size(FRONT_END_STACK)
+            .spawn_scoped(scope, || translate_here(file))
+            .map_err(|e| anyhow!("cannot start the front end's thread: {e}"))?
+            .join()
+            .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
+    })
+}
+
+fn translate_here(file: &mut BrdfFile) -> Result<Vec<(usize, String)>> {
     if let Some(p) = file.params.iter().find(|p| p.name.starts_with(front::GENERATED_PREFIX)) {
         bail!(at(
             &file.path,
@@ -210,6 +228,7 @@ fn check_hlsl(file: &mut BrdfFile, x: &Expanded, pre: &str) -> Result<Vec<Glue>>
 /// and the stub, through naga_oil and naga (`front::wgsl`). The shader with its parameters alone is composed
 /// first: `BRDF`'s signature and the entries' parameter types are read from naga's module of it.
 fn wgsl_spirv(file: &mut BrdfFile) -> Result<(Vec<u32>, Source)> {
+    check_statement_sizes(file)?;
     let mut top = wgsl::Top::new(&file.source);
     for p in &file.params {
         top.push(&wgsl::param_decl(&p.name, p.glsl_type()), p.line, &format!("parameter `{}`", p.name));
@@ -232,6 +251,38 @@ fn wgsl_spirv(file: &mut BrdfFile) -> Result<(Vec<u32>, Source)> {
         wgsl::emit_spirv(&composed.module, &file.path)?,
         file.source.iter().map(|(n, l)| (model.clone(), *n, l.clone())).collect(),
     ))
+}
+
+/// The most operators (and opening brackets) one WGSL statement may hold: naga's front end recurses once per
+/// operand, so this bounds the stack it needs to well within `FRONT_END_STACK` (a 100,000-term sum parsed, and
+/// lavapipe compiled it in 68 s on the 2-core VM of docs/limits.md).
+const MAX_STATEMENT_OPERATORS: usize = 200_000;
+
+/// Refuses a statement of the WGSL section larger than `MAX_STATEMENT_OPERATORS` at the line it starts on.
+fn check_statement_sizes(file: &BrdfFile) -> Result<()> {
+    let (mut count, mut start) = (0usize, None);
+    for (n, line) in &file.source {
+        for c in line.split("//").next().unwrap_or("").chars() {
+            match c {
+                ';' | '{' | '}' => (count, start) = (0, None),
+                '+' | '-' | '*' | '/' | '%' | '&' | '|' | '^' | '<' | '>' | '(' | '[' | ',' => {
+                    count += 1;
+                    let first = *start.get_or_insert(*n);
+                    if count > MAX_STATEMENT_OPERATORS {
+                        bail!(at(
+                            &file.path,
+                            first,
+                            format!(
+                                "a statement of more than {MAX_STATEMENT_OPERATORS} operators: brdfprof's WGSL front end (naga) takes at most that many in one statement; split it"
+                            )
+                        ));
+                    }
+                }
+                _ => {}
+            }
+        }
+    }
+    Ok(())
 }
 
 const WGSL_BRDF: &str = "fn BRDF(L: vec3<f32>, V: vec3<f32>, N: vec3<f32>, X: vec3<f32>, Y: vec3<f32>) -> vec3<f32>";

@@ -85,12 +85,14 @@ impl Includes {
     /// The one lookup of a file a shader names, for HLSL's `#include` and WGSL's quoted `#import`: a name under
     /// a mapped virtual prefix under its DIR alone; any other in `beside` (the including file's directory, for
     /// `#include "NAME"` and a quoted import; None for `#include <NAME>`), then in each include directory in
-    /// order.
+    /// order. The first that exists and is not a directory is the one: a FIFO or device there is refused
+    /// by name when it is read, not passed over for another file.
     pub fn find(&self, name: &str, beside: Option<&Path>) -> Option<PathBuf> {
+        let found = |p: &PathBuf| p.metadata().is_ok_and(|m| !m.is_dir());
         if let Some(((_, dir), rest)) = self.mapped(name) {
-            return Some(dir.join(rest)).filter(|p| p.is_file());
+            return Some(dir.join(rest)).filter(found);
         }
-        beside.map(|d| d.join(name)).into_iter().chain(self.dirs.iter().map(|d| d.join(name))).find(|p| p.is_file())
+        beside.map(|d| d.join(name)).into_iter().chain(self.dirs.iter().map(|d| d.join(name))).find(found)
     }
 
     /// Where `find` looked for `name`, as a message goes on after the name: `: --include-map V=DIR maps it to

@@ -14,9 +14,14 @@ use naga_oil::compose::{
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
 
-/// Include directories are searched for modules this deep, and this many files at most.
+/// The search for modules under the include directories: this many folders deep, this many folders and `.wgsl`
+/// files at most (beyond either, the search stops with an error naming the folder), and the first
+/// `MODULE_HEAD` bytes of each file scanned for its `#define_import_path` (Bevy's modules declare it in their
+/// first lines), so a large file nothing imports is never read whole.
 const MAX_DEPTH: usize = 8;
+const MAX_DIRS: usize = 10_000;
 const MAX_FILES: usize = 20_000;
+const MODULE_HEAD: u64 = 1 << 20;
 
 /// The shader naga_oil composes: the model's section at its own line numbers (blank lines before it), then
 /// the lines brdfprof appends, each with the model file's line it stands for and what it is.
@@ -121,27 +126,53 @@ pub fn shader_defs(defines: &[(String, String)], model: &Path) -> Result<HashMap
         .collect()
 }
 
-/// Every `.wgsl` file under `dir` (to `MAX_DEPTH`, skipping hidden entries; the empty directory is the working
-/// one, whose files are named without `./`), sorted.
-fn wgsl_files(dir: &Path, depth: usize, out: &mut Vec<PathBuf>) {
-    let Ok(entries) = std::fs::read_dir(if dir.as_os_str().is_empty() { Path::new(".") } else { dir }) else { return };
-    let named = |p: PathBuf| {
-        if dir.as_os_str().is_empty() { p.strip_prefix(".").map(Path::to_path_buf).unwrap_or(p) } else { p }
-    };
-    let mut paths: Vec<PathBuf> = entries
-        .filter_map(|e| e.ok().map(|e| named(e.path())))
-        .filter(|p| !p.file_name().is_some_and(|n| n.to_string_lossy().starts_with('.')))
-        .collect();
-    paths.sort();
-    for p in paths {
-        if out.len() >= MAX_FILES {
-            return;
+/// A walk of include directories for `.wgsl` files: the folders entered (by device and inode, so a symbolic
+/// link back to a folder already entered, or a loop of them, is not walked again) and the files found.
+#[derive(Default)]
+struct Walk {
+    entered: std::collections::HashSet<(u64, u64)>,
+    files: Vec<PathBuf>,
+}
+
+impl Walk {
+    /// Every `.wgsl` file under `dir` (to `MAX_DEPTH`, skipping hidden entries; the empty directory is the
+    /// working one, whose files are named without `./`), in sorted order; Err past `MAX_DIRS` or `MAX_FILES`.
+    fn add(&mut self, dir: &Path, depth: usize, root: &Path) -> Result<()> {
+        use std::os::unix::fs::MetadataExt;
+        let at = if dir.as_os_str().is_empty() { Path::new(".") } else { dir };
+        let Ok(meta) = std::fs::metadata(at) else { return Ok(()) };
+        if !self.entered.insert((meta.dev(), meta.ino())) {
+            return Ok(());
         }
-        if p.is_dir() && depth < MAX_DEPTH {
-            wgsl_files(&p, depth + 1, out);
-        } else if p.extension().is_some_and(|e| e == "wgsl") && p.is_file() {
-            out.push(p);
+        if self.entered.len() > MAX_DIRS {
+            bail!(
+                "{}: the search for WGSL modules entered more than {MAX_DIRS} folders (at most {MAX_DEPTH} deep) under it; name a narrower include folder",
+                super::shown_dir(root)
+            );
         }
+        let Ok(entries) = std::fs::read_dir(at) else { return Ok(()) };
+        let named = |p: PathBuf| {
+            if dir.as_os_str().is_empty() { p.strip_prefix(".").map(Path::to_path_buf).unwrap_or(p) } else { p }
+        };
+        let mut paths: Vec<PathBuf> = entries
+            .filter_map(|e| e.ok().map(|e| named(e.path())))
+            .filter(|p| !p.file_name().is_some_and(|n| n.to_string_lossy().starts_with('.')))
+            .collect();
+        paths.sort();
+        for p in paths {
+            if p.extension().is_some_and(|e| e == "wgsl") && p.is_file() {
+                if self.files.len() >= MAX_FILES {
+                    bail!(
+                        "{}: more than {MAX_FILES} .wgsl files under it to search for modules; name a narrower include folder",
+                        super::shown_dir(root)
+                    );
+                }
+                self.files.push(p);
+            } else if depth < MAX_DEPTH && p.is_dir() {
+                self.add(&p, depth + 1, root)?;
+            }
+        }
+        Ok(())
     }
 }
 
@@ -150,37 +181,67 @@ fn read_text(path: &Path) -> Result<String> {
         .map_err(|e| anyhow!("{} is not UTF-8 text (byte {})", path.display(), e.utf8_error().valid_up_to()))
 }
 
+/// The module `path` declares with `#define_import_path`, from its first `MODULE_HEAD` bytes (whole lines).
+fn declared_module(path: &Path) -> Option<String> {
+    use std::io::Read;
+    let (file, _) = crate::io::open_regular(path).ok()?;
+    let mut head = Vec::new();
+    file.take(MODULE_HEAD).read_to_end(&mut head).ok()?;
+    if head.len() as u64 == MODULE_HEAD {
+        head.truncate(head.iter().rposition(|&b| b == b'\n').unwrap_or(0));
+    }
+    naga_oil::compose::get_preprocessor_data(&String::from_utf8_lossy(&head)).0
+}
+
 /// The modules the include directories (recursively) and the model's own directory declare with
-/// `#define_import_path NAME`: NAME -> its file, the first found in that order.
-fn module_index(model_dir: &Path, includes: &Includes) -> BTreeMap<String, PathBuf> {
-    let mut files = Vec::new();
-    for d in &includes.dirs {
-        wgsl_files(d, 0, &mut files);
+/// `#define_import_path NAME`: NAME -> its file, the first found in that order. Built when an import first
+/// names a module, so a shader that imports none (or only quoted paths) never walks a folder.
+struct ModuleIndex<'a> {
+    model_dir: PathBuf,
+    includes: &'a Includes,
+    built: std::cell::OnceCell<BTreeMap<String, PathBuf>>,
+}
+
+impl<'a> ModuleIndex<'a> {
+    fn new(model_dir: &Path, includes: &'a Includes) -> Self {
+        ModuleIndex { model_dir: model_dir.to_path_buf(), includes, built: Default::default() }
     }
-    wgsl_files(model_dir, MAX_DEPTH, &mut files);
-    let mut index = BTreeMap::new();
-    for f in files {
-        if let Some(name) = read_text(&f).ok().and_then(|t| naga_oil::compose::get_preprocessor_data(&t).0) {
-            index.entry(name).or_insert(f);
+
+    fn get(&self) -> Result<&BTreeMap<String, PathBuf>> {
+        if let Some(index) = self.built.get() {
+            return Ok(index);
         }
+        let mut walk = Walk::default();
+        for d in &self.includes.dirs {
+            walk.add(d, 0, d)?;
+        }
+        walk.add(&self.model_dir, MAX_DEPTH, &self.model_dir)?;
+        let mut index = BTreeMap::new();
+        for f in walk.files {
+            if let Some(name) = declared_module(&f) {
+                index.entry(name).or_insert(f);
+            }
+        }
+        Ok(self.built.get_or_init(|| index))
     }
-    index
 }
 
 /// The file an import names: a quoted path as a quoted HLSL include is found (`Includes::find`, beside the
 /// importing file `dir`), a module name through the index.
-fn resolve(import: &str, dir: &Path, includes: &Includes, index: &BTreeMap<String, PathBuf>) -> Option<PathBuf> {
+fn resolve(import: &str, dir: &Path, includes: &Includes, index: &ModuleIndex) -> Result<Option<PathBuf>> {
     let Some(path) = import.strip_prefix('"').and_then(|p| p.strip_suffix('"')) else {
         // `a::b::item` names item of module `a::b`: the longest prefix that is a module.
+        let index = index.get()?;
         let mut name = import;
         loop {
             if let Some(p) = index.get(name) {
-                return Some(p.clone());
+                return Ok(Some(p.clone()));
             }
-            name = name.rsplit_once("::")?.0;
+            let Some((prefix, _)) = name.rsplit_once("::") else { return Ok(None) };
+            name = prefix;
         }
     };
-    includes.find(path, Some(dir))
+    Ok(includes.find(path, Some(dir)))
 }
 
 /// The 1-based line and column where `text` imports `import` (its `#import` line), else 1:1.
@@ -196,7 +257,7 @@ fn import_at(text: &str, import: &str) -> (usize, usize) {
 struct Modules<'a> {
     composer: Composer,
     includes: &'a Includes,
-    index: BTreeMap<String, PathBuf>,
+    index: ModuleIndex<'a>,
     added: Vec<String>,
     stack: Vec<String>,
     /// Each module's file as messages name it, and its text, in the order added.
@@ -215,7 +276,7 @@ impl Modules<'_> {
                 let (line, col) = import_at(text, &import);
                 bail!("{shown}:{line}:{col}: import cycle: {} -> {import}", self.stack[k..].join(" -> "));
             }
-            let Some(path) = resolve(&import, dir, self.includes, &self.index) else { continue };
+            let Some(path) = resolve(&import, dir, self.includes, &self.index)? else { continue };
             let source = read_text(&path).map_err(|e| {
                 let (line, col) = import_at(text, &import);
                 anyhow!("{shown}:{line}:{col}: {e:#}")
@@ -287,7 +348,7 @@ pub fn compose(model: &Path, top: &Top, defines: &[(String, String)], includes: 
     let mut m = Modules {
         composer: Composer::default().with_capabilities(SHADER_CAPABILITIES),
         includes,
-        index: module_index(&model_dir, includes),
+        index: ModuleIndex::new(&model_dir, includes),
         added: Vec::new(),
         stack: Vec::new(),
         files: Vec::new(),
@@ -419,9 +480,9 @@ pub fn parameter_types(
         return Ok(Some(t));
     }
     let model_dir = super::dir_of(model);
-    let index = module_index(&model_dir, includes);
+    let index = ModuleIndex::new(&model_dir, includes);
     for import in declared_imports(&top.text) {
-        let Some(path) = resolve(&import, &model_dir, includes, &index) else { continue };
+        let Some(path) = resolve(&import, &model_dir, includes, &index)? else { continue };
         let lines: Vec<(usize, String)> =
             read_text(&path)?.lines().enumerate().map(|(i, l)| (i + 1, l.to_string())).collect();
         if let Some(t) = types(&compose(&path, &Top::new(&lines), defines, includes)?.module) {

@@ -22,7 +22,7 @@ pub mod shim;
 use super::{Request, Run, Target, Vendor};
 use crate::cleanup;
 use crate::gpu::{CompilerLog, Gpu, GpuOptions, Kernel};
-use crate::kernels::shade::{self, GBufferFormat, shade_kernel, steady_block};
+use crate::kernels::shade::{self, GBufferFormat, kernel_hash, shade_kernel, steady_block};
 use crate::model::BASELINE_LABEL;
 use crate::model::Model;
 use crate::schema::InspectReport;
@@ -367,6 +367,10 @@ struct Job<'a> {
     shaders: &'a Shaders,
     validate: bool,
     isa_dir: Option<&'a Path>,
+    /// Each kernel's row label and hash (`kernel_hash`, packed) as this process composed it, which the key
+    /// holds: a child reads the model files again, and a report of other kernels (a file edited during the
+    /// run) is refused, neither used nor cached.
+    kernels: Vec<(String, String)>,
 }
 
 /// One target's child: run, and its report read back.
@@ -524,7 +528,7 @@ fn spawn(
     // (A failed child's last lines are in the error below.)
     let messages: Vec<String> = stderr
         .lines()
-        .filter(|l| reply.is_some() && !is_banner(l) && !driver.is_noise(l))
+        .filter(|l| reply.is_some() && !is_banner(l) && !is_shim_notice(l) && !driver.is_noise(l))
         .map(str::to_string)
         .collect();
     let teardown_note = teardown_note(driver, &name, reply.is_some(), output.status, &stderr)?;
@@ -532,11 +536,49 @@ fn spawn(
     if reply.target != name {
         bail!("the compile-only child answered for {} instead of {name}", reply.target);
     }
+    check_kernels(&reply.report, &request.kernels, models, &name)?;
     let isa_files = match (&child_isa, request.isa_dir) {
         (Some(from), Some(to)) => reply.isa_files.iter().map(|f| publish(f, from, to)).collect::<Result<Vec<_>>>()?,
         _ => Vec::new(),
     };
     Ok((ChildRun { report: reply.report, isa_files, teardown_note }, messages))
+}
+
+/// Refuses a child's report whose kernels are not the ones this process composed (`Job::kernels`).
+fn check_kernels(report: &InspectReport, kernels: &[(String, String)], models: &[Model], target: &str) -> Result<()> {
+    for (label, hash) in kernels {
+        let row = report.rows.iter().find(|r| r.model == *label);
+        let theirs = row.and_then(|r| r.notes.get(crate::schema::HASH_NOTE));
+        if theirs.is_some_and(|h| h != hash) {
+            let file = models.iter().find(|m| m.label() == *label).and_then(Model::file).map(|f| f.path.clone());
+            bail!(
+                "{}: the {target} child compiled another kernel than brdfprof composed for `{label}` (its file was read again by the child and had changed: was it edited during the run?); nothing was cached, run again",
+                file.unwrap_or_else(|| label.clone())
+            );
+        }
+    }
+    Ok(())
+}
+
+/// Where a test makes the parent wait before it starts its children: set to a path P, the parent writes
+/// P.waiting and waits (at most 120 s) until P exists, so that a test can edit a model file between the
+/// parent's key and the child's compile.
+pub const HOLD_BEFORE_CHILDREN: &str = "BRDFPROF_TEST_NOOP_HOLD";
+
+fn hold_before_children() {
+    let Some(path) = std::env::var_os(HOLD_BEFORE_CHILDREN).map(PathBuf::from) else { return };
+    let _ = std::fs::write(path.with_extension("waiting"), b"");
+    let start = std::time::Instant::now();
+    while !path.exists() && start.elapsed() < std::time::Duration::from_secs(120) {
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+}
+
+/// A line the drm-shim prints for each ioctl or query its noop device does not answer (Mesa 25's Turnip:
+/// `Unknown DRM_IOCTL_MSM_GET_PARAM 16`; ANV: `Unknown drm_i915_query_item id=...`): the driver falls back on
+/// each, so they reach the user only in a failed child's error.
+fn is_shim_notice(line: &str) -> bool {
+    line.starts_with("Unknown DRM_IOCTL_") || line.starts_with("Unknown drm_")
 }
 
 /// The line Mesa prints on every start of a driver it calls non-conformant (RADV's null device, PanVK).
@@ -567,13 +609,19 @@ pub fn compile(prefix: &str, families: &[usize], raw: &[super::RawKernel], reque
         true => None,
         false => Some(cache::request_digest(models, raw, request.lights, request.validate, request.shaders)?),
     };
+    let mut kernels = Vec::new();
+    for model in models {
+        kernels.push((model.label(), kernel_hash(Some(model), GBufferFormat::Packed, request.shaders)?));
+    }
     let request = &Job {
         lights: request.lights,
         shaders: request.shaders,
         validate: request.validate,
         isa_dir: request.isa_dir,
         cache_digest,
+        kernels,
     };
+    hold_before_children();
     let workers = std::thread::available_parallelism().map_or(1, |n| n.get()).min(families.len()).max(1);
     let next = std::sync::atomic::AtomicUsize::new(0);
     let results: std::sync::Mutex<Vec<Option<Result<ChildRun>>>> =

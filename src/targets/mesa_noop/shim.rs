@@ -51,8 +51,6 @@ pub struct Shim {
     pub cost: fn(&Shim, &ShimFamily, &InspectReport) -> Option<TargetCost>,
     /// Statistics the compiler prints on stderr, for a driver without VK_KHR_pipeline_executable_properties.
     pub compiler_log: Option<CompilerLog>,
-    /// Prefixes of the stderr lines the shim prints about ioctls it does not emulate (not the user's concern).
-    pub noise: &'static [&'static str],
 }
 
 impl Shim {
@@ -221,9 +219,5 @@ impl NoopDriver for Shim {
 
     fn without_validation(&self, family: usize) -> Option<&'static str> {
         self.families[family].without_validation
-    }
-
-    fn is_noise(&self, line: &str) -> bool {
-        self.noise.iter().any(|p| line.starts_with(p))
     }
 }
