@@ -3,7 +3,8 @@
 # Khronos validation layer, glslang, SPIRV-Tools, spirv-cross (HLSL and WGSL models' SPIR-V back to GLSL,
 # docs/hlsl.md), vulkaninfo and valgrind; g++ (runs the kernels' C translation
 # on the CPU); Intel's OpenCL compiler (ocloc/IGC) and PoCL (OpenCL on the CPU) for the intel: targets; Chromium
-# (the HTML report is tested in it, headless); and,
+# (the HTML report is tested in it, headless); npm (Debian's nodejs), and from the npm registry Microsoft's SARIF
+# Multitool into .tools/sarif (about 100 MB; the tests validate `check --sarif` with it); and,
 # from PyPI, NVIDIA's NVRTC and nvdisasm for the nvidia: targets, into .tools/nvidia (about 150 MB).
 # As root with apt-get it installs what is missing; otherwise it says exactly what to install and fails.
 # Mesa's noop drivers (adreno:, mali:, anv:) are not built here: `make mesa` (scripts/mesa-noop.sh), ~20 min once.
@@ -26,6 +27,7 @@ command -v ocloc >/dev/null 2>&1 || missing="$missing intel-opencl-icd"
 have_file /etc/OpenCL/vendors/pocl.icd || missing="$missing pocl-opencl-icd"
 have_lib 'libOpenCL.so.1' || missing="$missing ocl-icd-libopencl1"
 have_file /usr/bin/chromium || missing="$missing chromium"
+command -v npm >/dev/null 2>&1 || missing="$missing npm"
 
 if [ -n "$missing" ]; then
     if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
@@ -39,7 +41,7 @@ if [ -n "$missing" ]; then
         echo "  install them as root on Debian/Ubuntu:  apt-get install$missing" >&2
         echo "  (other systems: the Vulkan loader, Mesa's lavapipe driver, the Khronos validation layer," >&2
         echo "   glslang, SPIRV-Tools, spirv-cross, vulkan-tools, valgrind, g++, Intel's compute runtime (ocloc), PoCL, the" >&2
-        echo "   OpenCL ICD loader and Chromium from your package manager)" >&2
+        echo "   OpenCL ICD loader, Chromium and npm from your package manager)" >&2
         exit 1
     fi
 fi
@@ -62,5 +64,18 @@ iga=$(ls /usr/lib/x86_64-linux-gnu/libiga64.so.1 /usr/lib/*/libiga64.so.1 2>/dev
 if [ -n "$iga" ]; then
     mkdir -p "$root/.tools/intel"
     ln -sf "$iga" "$root/.tools/intel/libiga64.so"
+fi
+# Microsoft's SARIF Multitool validates `check --sarif` in the tests: the pinned npm package, project-local.
+sarif="$root/.tools/sarif"
+multitool=$(cat "$root/scripts/sarif-multitool.txt")
+tool="$sarif/node_modules/@microsoft/sarif-multitool-linux/Sarif.Multitool"
+if [ ! -x "$tool" ] || [ "$(cat "$sarif/.package" 2>/dev/null)" != "$multitool" ]; then
+    echo "brdfprof setup: installing $multitool into $sarif" >&2
+    rm -rf "$sarif"
+    mkdir -p "$sarif"
+    npm install --silent --no-audit --no-fund --prefix "$sarif" "$multitool" >/dev/null
+    # npm may skip the package's install script, which only makes the binary executable.
+    chmod u+x "$tool"
+    echo "$multitool" > "$sarif/.package"
 fi
 echo "brdfprof setup: system packages present" >&2

@@ -77,6 +77,43 @@ pub struct Inspected {
 }
 
 impl Inspected {
+    /// Each model's headline figure per device or target, as benchmark-dashboard entries named
+    /// `inspect/<target or device>/<model>`: a compile-only target's modelled cycles per evaluation (its cost
+    /// rule), a device's callgrind instructions per evaluation where measured.
+    pub fn bench_entries(&self) -> Vec<crate::export::bench::Entry> {
+        use crate::export::bench::Entry;
+        let mut out = Vec::new();
+        for report in &self.reports {
+            let device = report.provenance["device"]["name"].as_str().unwrap_or("device");
+            match &report.cost {
+                Some(cost) => {
+                    let on = cost.target.clone().unwrap_or_else(|| crate::export::name_slug(device));
+                    out.extend(cost.rows.iter().filter(|r| r.model != crate::model::BASELINE_LABEL).map(|r| Entry {
+                        name: format!("inspect/{on}/{}", r.model),
+                        unit: format!("{}/eval", cost.unit),
+                        value: r.cycles_per_eval,
+                        range: None,
+                        extra: format!("modelled, not measured: {} ({})", cost.model, cost.compiler),
+                    }));
+                }
+                None => {
+                    out.extend(report.rows.iter().filter(|r| r.model != crate::model::BASELINE_LABEL).filter_map(|r| {
+                        Some(Entry {
+                            name: format!("inspect/{}/{}", crate::export::name_slug(device), r.model),
+                            unit: "instructions/eval (callgrind)".into(),
+                            value: *r.stats.get("callgrind/ir-per-eval")?,
+                            range: None,
+                            extra: format!(
+                                "CPU instructions per evaluation of lavapipe's JIT code under callgrind, on {device}"
+                            ),
+                        })
+                    }))
+                }
+            }
+        }
+        out
+    }
+
     /// The outputs' default file stem: `inspect-<device>` for one device, `inspect-devices` for several.
     pub fn stem(&self) -> String {
         match &self.multi {

@@ -2,6 +2,7 @@
 
 use super::baseline::Baseline;
 use super::environment::{JIT_FEATURES, MESA};
+use super::lines::LineChange;
 use super::thresholds::{ALPHA, GROUPS, MIN_TIMING_ROUNDS, TIMING_KEY, Thresholds, group_of, is_gated};
 use crate::inspect::timing::TimingRun;
 use crate::stats;
@@ -85,6 +86,18 @@ pub struct Comparison {
     pub only_new: Vec<String>,
     /// Notes that do not change the verdict (e.g. naga's verdict changed).
     pub notes: Vec<String>,
+    /// Each regressed model's source lines before and after, largest rise first, where both runs have
+    /// per-line cost (`lines::changes`), with the pipe they are counted on.
+    pub lines: Vec<ModelLines>,
+}
+
+/// One model's per-line changes.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ModelLines {
+    pub model: String,
+    /// The new kernel's binding pipe, whose cycles per wave the lines are counted in.
+    pub pipe: String,
+    pub changes: Vec<LineChange>,
 }
 
 /// Why two fingerprints differ, or None when they match.
@@ -216,7 +229,22 @@ pub fn compare(old: &Baseline, new: &Baseline, thresholds: &Thresholds, force: b
         _ => Vec::new(),
     };
     let timing_reference = new.timing.as_ref().map_or_else(String::new, |t| t.reference.clone());
-    Comparison { groups, changes, timing, timing_reference, only_old, only_new, notes }
+    let mut regressed: Vec<&str> = Vec::new();
+    let counted = changes.iter().filter(|c| c.is_regression()).map(|c| c.model.as_str());
+    for model in counted.chain(timing.iter().filter(|t| t.is_regression()).map(|t| t.model.as_str())) {
+        if !regressed.contains(&model) {
+            regressed.push(model);
+        }
+    }
+    let lines = regressed
+        .iter()
+        .filter_map(|&model| {
+            let changes = super::lines::changes(&old.inspect.lines, &new.inspect.lines, model)?;
+            let pipe = new.inspect.lines.iter().find(|k| k.model == model)?.binding_pipe.clone();
+            Some(ModelLines { model: model.to_string(), pipe, changes })
+        })
+        .collect();
+    Comparison { groups, changes, timing, timing_reference, only_old, only_new, notes, lines }
 }
 
 fn compare_timing(old: &TimingRun, new: &TimingRun, thresholds: &Thresholds) -> Vec<TimingChange> {

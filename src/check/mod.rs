@@ -14,11 +14,13 @@
 mod baseline;
 mod compare;
 mod environment;
+pub mod findings;
+pub mod lines;
 mod report;
 mod thresholds;
 
 pub use baseline::{Baseline, FORMAT, load};
-pub use compare::{Change, Comparison, GroupStatus, TimingChange, compare};
+pub use compare::{Change, Comparison, GroupStatus, ModelLines, TimingChange, compare};
 pub use environment::{environment, host_cpu};
 pub use thresholds::{
     ALPHA, DEFAULT_COUNT_THRESHOLD, DEFAULT_TIMING_THRESHOLD, GROUPS, MIN_TIMING_ROUNDS, TIMING_KEY, Thresholds,
@@ -51,11 +53,13 @@ pub struct CheckOptions {
     pub timing: TimingOptions,
 }
 
-/// The result of `check`: the report text and the exit status (0 no regression, 1 regression, 2 could not
-/// measure).
+/// The result of `check`: the report text, the exit status (0 no regression, 1 regression, 2 could not
+/// measure), the regressions as findings (SARIF, annotations) and what was measured on (target, compiler).
 pub struct Outcome {
     pub text: String,
     pub exit: u8,
+    pub findings: Vec<crate::export::sarif::Finding>,
+    pub measured_on: (String, String),
 }
 
 /// The models and lights a check measures: those asked for, else the baseline's, else the defaults.
@@ -152,7 +156,8 @@ pub fn run_target(
             isa_dir: None,
             precise: false,
             verify_on,
-            lines: false,
+            // Kept in the baseline so that a regression names the source lines whose cost rose.
+            lines: crate::targets::names_lines(&target),
         };
         let run = crate::targets::compile_all(&[target], &request)?.pop().expect("one run per target");
         let mut inspect = run.report;
@@ -177,12 +182,19 @@ fn run_measured(options: &CheckOptions, measure: impl FnOnce(Vec<Model>, u32) ->
     let old = options.baseline.as_deref().map(load).transpose()?;
     let (specs, lights) = plan(options, old.as_ref())?;
     let new = measure(specs, lights)?;
+    let measured_on = findings::measured_on(&new);
     let outcome = match (&old, &options.baseline) {
         (Some(old), Some(path)) => {
             let cmp = compare(old, &new, &options.thresholds, options.force);
-            Outcome { text: cmp.report(path, &new), exit: cmp.exit_code() }
+            let findings = findings::findings(&cmp, &new);
+            Outcome { text: cmp.report(path, &new), exit: cmp.exit_code(), findings, measured_on }
         }
-        _ => Outcome { text: format!("{}\n\n{}", new.inspect.summary(), new.inspect.markdown()), exit: 0 },
+        _ => Outcome {
+            text: format!("{}\n\n{}", new.inspect.summary(), new.inspect.markdown()),
+            exit: 0,
+            findings: Vec::new(),
+            measured_on,
+        },
     };
     if let Some(path) = &options.save {
         json::write_report(path, json::Kind::Baseline, &new)?;

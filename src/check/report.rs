@@ -7,6 +7,9 @@ use crate::export::markdown::{self, Table};
 use crate::schema::format_value;
 use std::path::Path;
 
+/// Lines shown per regressed model.
+pub const LINES_SHOWN: usize = 5;
+
 fn percent(rel: f64) -> String {
     if rel.is_infinite() {
         return if rel > 0.0 { "+inf".into() } else { "-inf".into() };
@@ -68,6 +71,7 @@ impl Comparison {
         out += &self.helped_hurt_section();
         out += &self.totals_section();
         out += &self.timing_section();
+        out += &self.lines_section();
         for note in self.notes.iter().chain(
             self.only_old
                 .iter()
@@ -229,6 +233,35 @@ impl Comparison {
             self.timing_reference,
             t.markdown()
         )
+    }
+
+    /// Each regressed model's lines whose cost rose most (`LINES_SHOWN`).
+    fn lines_section(&self) -> String {
+        let mut out = String::new();
+        for m in &self.lines {
+            let risen = super::lines::risen(&m.changes, LINES_SHOWN);
+            if risen.is_empty() {
+                continue;
+            }
+            let mut t = Table::new(["file:line", "before", "after", "change", "share of the rise", "source"]);
+            for c in risen {
+                t.row([
+                    format!("{}:{}", c.file, c.line),
+                    markdown::sig(c.before, 4),
+                    markdown::sig(c.after, 4),
+                    format!("+{}", markdown::sig(c.rise(), 4)),
+                    format!("{:.0}%", 100.0 * c.share),
+                    format!("`{}`", c.text.replace('|', "\\|").replace('`', "'")),
+                ]);
+            }
+            out += &format!(
+                "## {}: the lines whose cost rose most ({} cycles per wave; lines matched by their text, so an edit above a line does not move it)\n\n{}\n",
+                m.model,
+                m.pipe,
+                t.markdown()
+            );
+        }
+        out
     }
 
     fn verdict_section(&self) -> String {

@@ -324,6 +324,29 @@ impl CountArgs {
     }
 }
 
+/// `--bench-json FILE`, shared by profile, inspect and sweep.
+#[derive(Args, Clone, Default)]
+pub struct BenchArg {
+    /// Also write the figures as github-action-benchmark's `customSmallerIsBetter` list (name, unit, value,
+    /// range from the interval where there is one), for a benchmark dashboard's trend (docs/ci.md).
+    #[arg(long, value_name = "FILE")]
+    pub bench_json: Option<PathBuf>,
+}
+
+impl BenchArg {
+    /// Refuses a bad path before anything is measured.
+    pub fn check(&self) -> Result<()> {
+        self.bench_json.as_deref().map_or(Ok(()), |p| io::check_output_path("--bench-json", p))
+    }
+
+    pub fn write(&self, entries: &[brdfprof::export::bench::Entry]) -> Result<()> {
+        let Some(path) = &self.bench_json else { return Ok(()) };
+        brdfprof::export::bench::write(path, entries)?;
+        brdfprof::messages::progress(format!("benchmark JSON: {} ({} entries)", path.display(), entries.len()));
+        Ok(())
+    }
+}
+
 /// `--html FILE`: the flag's help, shared by the commands that take it.
 #[derive(Args, Clone, Default)]
 pub struct HtmlArg {

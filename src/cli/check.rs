@@ -44,11 +44,27 @@ pub struct CheckArgs {
     pub shader_cache: bool,
     #[command(flatten)]
     pub device: DeviceArgs,
+    /// Write the regressions as SARIF 2.1.0 (code scanning): one result per regressed model, at the lines of its
+    /// file whose cost rose most (per-line cost is kept in baselines of nvidia: and intel: targets), else at its
+    /// file; no regression writes a log with no results.
+    #[arg(long, value_name = "FILE")]
+    pub sarif: Option<PathBuf>,
+    /// Print workflow commands for the CI's own annotations: `github` (`::error file=...,line=...::...`, the
+    /// largest regressions first, at most 10, GitHub's limit per step).
+    #[arg(long, value_name = "FORMAT", value_parser = ["github"])]
+    pub annotations: Option<String>,
+    /// Append the Markdown report to FILE (GitHub's $GITHUB_STEP_SUMMARY; cut at its 1 MiB limit).
+    #[arg(long, value_name = "FILE")]
+    pub summary: Option<PathBuf>,
 }
 
 pub fn check(args: &CheckArgs) -> Result<ExitCode> {
-    if let Some(p) = &args.save_baseline {
-        io::check_output_path("--save-baseline", p)?;
+    for (flag, path) in
+        [("--save-baseline", &args.save_baseline), ("--sarif", &args.sarif), ("--summary", &args.summary)]
+    {
+        if let Some(p) = path {
+            io::check_output_path(flag, p)?;
+        }
     }
     fresh_compilation(args.shader_cache);
     let (width, height) = parse_size("--timing-size", &args.timing_size)?;
@@ -80,5 +96,29 @@ pub fn check(args: &CheckArgs) -> Result<ExitCode> {
         None => check::run(&options, &shaders, || args.device.open_with(true))?,
     };
     print!("{}", outcome.text);
+    write_ci_outputs(args, &outcome)?;
     Ok(ExitCode::from(outcome.exit))
+}
+
+/// The SARIF log, the annotations and the step summary of a check's outcome, where asked for.
+fn write_ci_outputs(args: &CheckArgs, outcome: &check::Outcome) -> Result<()> {
+    use brdfprof::export::{github, sarif};
+    if let Some(path) = &args.sarif {
+        let root = std::env::current_dir()?;
+        let (target, compiler) = &outcome.measured_on;
+        let properties = serde_json::json!({
+            "baseline": args.baseline.as_ref().map(|b| b.display().to_string()),
+            "target": target,
+            "compiler": compiler,
+        });
+        let log = sarif::log(env!("CARGO_PKG_VERSION"), &check::findings::RULES, &outcome.findings, &root, properties);
+        io::write_output(path, format!("{}\n", serde_json::to_string_pretty(&log)?).as_bytes())?;
+    }
+    if args.annotations.is_some() {
+        print!("{}", github::annotations(&outcome.findings));
+    }
+    if let Some(path) = &args.summary {
+        github::append_summary(path, &outcome.text)?;
+    }
+    Ok(())
 }

@@ -1,6 +1,6 @@
 //! `brdfprof inspect`: instruction counts of each model's shading kernel, on devices and compile-only targets.
 
-use super::args::{CountArgs, DeviceArgs, HtmlArg, ModelArgs, device_name};
+use super::args::{BenchArg, CountArgs, DeviceArgs, HtmlArg, ModelArgs, device_name};
 use super::{check_output, just_measured, on_device_with};
 use anyhow::{Result, bail};
 use brdfprof::across_devices;
@@ -64,6 +64,8 @@ pub struct InspectArgs {
     pub lines: bool,
     #[command(flatten)]
     pub html: HtmlArg,
+    #[command(flatten)]
+    pub bench: BenchArg,
 }
 
 pub fn inspect(args: &InspectArgs) -> Result<ExitCode> {
@@ -109,6 +111,7 @@ pub fn inspect(args: &InspectArgs) -> Result<ExitCode> {
         gpu.check_validation()?;
     }
     io::write_output(&markdown, result.markdown.as_bytes())?;
+    args.bench.write(&result.bench_entries())?;
     if let (Some(chart), Some(multi)) = (&args.chart, &result.multi) {
         multi.costs.chart(chart)?;
     }
@@ -140,6 +143,7 @@ fn check_outputs(args: &InspectArgs, plan: &[across_devices::Planned]) -> Result
     check_output("--json", args.json.as_deref(), "results", &format!("{default_name}.json"))?;
     check_output("--markdown", args.markdown.as_deref(), "results", &format!("{default_name}.md"))?;
     args.html.check()?;
+    args.bench.check()?;
     if let Some(chart) = &args.chart {
         if plan.len() < 2 {
             bail!(

@@ -1,7 +1,7 @@
 //! `brdfprof profile`: the cost per BRDF evaluation of models over a synthetic G-buffer, or with `--scene` of a
 //! scene's kernels and effects.
 
-use super::args::{DeviceArgs, HtmlArg, ModelArgs, TimingArgs, device_name};
+use super::args::{BenchArg, DeviceArgs, HtmlArg, ModelArgs, TimingArgs, device_name};
 use super::{check_output, cost_targets, fresh_compilation, just_measured, on_device};
 use anyhow::{Result, bail};
 use brdfprof::brdf::THESIS_MODELS;
@@ -48,6 +48,8 @@ pub struct ProfileArgs {
     #[command(flatten)]
     pub html: HtmlArg,
     #[command(flatten)]
+    pub bench: BenchArg,
+    #[command(flatten)]
     pub device: DeviceArgs,
 }
 
@@ -63,6 +65,7 @@ pub fn profile(args: &ProfileArgs) -> Result<ExitCode> {
     }
     check_output("--json", args.json.as_deref(), "results", "profile-<device>.json")?;
     args.html.check()?;
+    args.bench.check()?;
     fresh_compilation(args.timing.shader_cache);
     let size = args.size.as_deref().unwrap_or("960x540");
     let options =
@@ -73,6 +76,7 @@ pub fn profile(args: &ProfileArgs) -> Result<ExitCode> {
     });
     json::write_report(&path, json::Kind::Profile, &result)?;
     args.html.write(&[just_measured(&path, &result)?], Some(&gpu))?;
+    args.bench.write(&result.bench_entries("profile"))?;
     println!("{}\n", result.summary());
     print!("{}{}", result.table().markdown(), result.placement_notes());
     if let Some(t) = result.light_table() {

@@ -1,7 +1,7 @@
 //! `brdfprof sweep`: many model specs timed in one interleaved run and measured for accuracy; error against
 //! cost and the Pareto frontier, also with compile-only targets' modelled cost.
 
-use super::args::{DeviceArgs, HtmlArg, ModelArgs, TimingArgs, cosine_range, device_name, roughness_range};
+use super::args::{BenchArg, DeviceArgs, HtmlArg, ModelArgs, TimingArgs, cosine_range, device_name, roughness_range};
 use super::{cost_targets, fresh_compilation, just_measured, on_device, out_dir, written};
 use anyhow::Result;
 use brdfprof::model::Model;
@@ -62,6 +62,8 @@ pub struct SweepArgs {
     #[command(flatten)]
     pub html: HtmlArg,
     #[command(flatten)]
+    pub bench: BenchArg,
+    #[command(flatten)]
     pub device: DeviceArgs,
 }
 
@@ -74,6 +76,7 @@ fn exact_fresnel(text: &str) -> Result<brdfprof::brdf::exact::ExactFresnel, Stri
 pub fn sweep(args: &SweepArgs) -> Result<ExitCode> {
     let out = out_dir(args.out.as_deref(), &["sweep-*"])?;
     args.html.check()?;
+    args.bench.check()?;
     let cost_targets = cost_targets(&args.cost_devices)?;
     if let Some(d) = args.device.device.as_deref().filter(|d| brdfprof::targets::is_compile_only(d)) {
         return Err(super::compiles_only_error(d));
@@ -131,6 +134,7 @@ pub fn sweep(args: &SweepArgs) -> Result<ExitCode> {
     let slug = brdfprof::targets::device_slug(&gpu.info);
     let mut files = result.write(&out, &slug)?;
     files.extend(args.html.write(&[just_measured(&out.join(format!("sweep-{slug}.json")), &result)?], Some(&gpu))?);
+    args.bench.write(&result.profile.bench_entries("sweep"))?;
     print!("{}", result.markdown());
     let missing = write_cost_tables(&result, &costs, &out, &slug, &mut files)?;
     println!("\n{}", written(&files));

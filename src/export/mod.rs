@@ -1,12 +1,16 @@
 //! Every output format in one place: Markdown tables (markdown), saved JSON reports (json), self-contained
-//! HTML pages (html), PNG charts (png) and the pixel helpers pictures share (raster). What a command measured
+//! HTML pages (html), PNG charts (png) and the pixel helpers pictures share (raster), SARIF for code scanning
+//! (sarif), GitHub's workflow commands and step summary (github), benchmark-dashboard JSON (bench). What a command measured
 //! stays with the command; only how it is written out lives here.
 
+pub mod bench;
+pub mod github;
 pub mod html;
 pub mod json;
 pub mod markdown;
 pub mod png;
 pub mod raster;
+pub mod sarif;
 
 /// The file-name form of a device name: its first words, lower case ("llvmpipe (LLVM 15.0.6, 256 bits)" ->
 /// "llvmpipe").

@@ -127,6 +127,32 @@ fn unread_gbuffer() -> GBufferFormat {
 }
 
 impl ProfileReport {
+    /// Each model's ns/eval with its interval, as benchmark-dashboard entries named `<command>/<device>/<model>`.
+    pub fn bench_entries(&self, command: &str) -> Vec<crate::export::bench::Entry> {
+        let device = crate::export::name_slug(&self.provenance.device.name);
+        self.rows
+            .iter()
+            .map(|r| {
+                let e = &r.ns_per_eval;
+                crate::export::bench::Entry {
+                    name: format!("{command}/{device}/{}", r.model),
+                    unit: "ns/eval".into(),
+                    value: e.median,
+                    range: crate::export::bench::Entry::range_of(e.median, e.lo, e.hi),
+                    extra: format!(
+                        "median of {} rounds, interval [{}, {}] of coverage {:.3}, {} lights, on {}",
+                        e.n,
+                        crate::export::markdown::sig(e.lo, 4),
+                        crate::export::markdown::sig(e.hi, 4),
+                        e.coverage,
+                        r.lights,
+                        self.provenance.device.name
+                    ),
+                }
+            })
+            .collect()
+    }
+
     /// The rows of models (not the memory-only kernel), in report order.
     pub fn model_rows(&self) -> impl Iterator<Item = &Row> {
         self.rows.iter().filter(|r| r.spec.is_some())

@@ -12,6 +12,7 @@ mod common;
 
 mod brdf_models;
 mod cache;
+mod ci;
 mod compare;
 mod compile_only;
 mod cost_pairs;

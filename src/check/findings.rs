@@ -1,0 +1,130 @@
+//! A comparison's regressions as findings (`export::sarif::Finding`): one per regressed model, located at the
+//! lines of the model's own file whose cost rose most (at the file where no line is known), for SARIF and
+//! GitHub's annotations.
+
+use super::baseline::Baseline;
+use super::compare::Comparison;
+use super::report::LINES_SHOWN;
+use super::thresholds::TIMING_KEY;
+use crate::export::markdown::sig;
+use crate::export::sarif::{Finding, Place, Rule};
+use crate::model::Model;
+use serde_json::json;
+
+pub const COUNT_RULE: Rule = Rule {
+    id: "brdfprof/count-regression",
+    name: "Shader cost regression",
+    short: "A model's instruction counts or modelled cycles grew past the check's threshold.",
+    full: "brdfprof check compared the model's kernel with the saved baseline: a gated statistic (SPIR-V, driver or compiler statistics, modelled cycles per evaluation, callgrind) grew by more than its threshold (--threshold). The locations are the source lines whose cost on the kernel's binding pipe rose most.",
+};
+
+pub const TIMING_RULE: Rule = Rule {
+    id: "brdfprof/timing-regression",
+    name: "Shader timing regression",
+    short: "A model's measured cost relative to the reference model rose significantly past the threshold.",
+    full: "brdfprof check timed the model interleaved with the reference model: its per-round cost ratio rose past the noise threshold with a significant Mann-Whitney U test (alpha 0.05).",
+};
+
+/// Statistics a finding's message names (the largest relative changes).
+const MESSAGE_CHANGES: usize = 3;
+
+/// Every rule a finding may name, in SARIF's `rules` order.
+pub const RULES: [&Rule; 2] = [&COUNT_RULE, &TIMING_RULE];
+
+/// What the run was measured on: the compile-only target (`nvidia:sm_89`) or the device, and the compiler.
+pub fn measured_on(new: &Baseline) -> (String, String) {
+    let device = new.inspect.provenance["device"]["name"].as_str().unwrap_or("?").to_string();
+    match &new.inspect.cost {
+        Some(c) => (c.target.clone().unwrap_or(device), c.compiler.clone()),
+        None => (device, new.inspect.tools.iter().map(|(k, v)| format!("{k} {v}")).collect::<Vec<_>>().join(", ")),
+    }
+}
+
+/// The model file behind row `model` of `new`, where it is one.
+fn model_file(new: &Baseline, model: &str) -> Option<String> {
+    let spec = new.inspect.row(model)?.spec.as_deref()?;
+    Model::parse(spec).ok()?.file().map(|f| f.path.clone())
+}
+
+/// One finding per regressed model, the largest relative change first.
+pub fn findings(cmp: &Comparison, new: &Baseline) -> Vec<Finding> {
+    let (target, compiler) = measured_on(new);
+    let mut models: Vec<(String, f64)> = Vec::new();
+    let regressions = cmp.changes.iter().filter(|c| c.is_regression()).map(|c| (&c.model, c.rel));
+    for (model, rel) in regressions.chain(cmp.timing.iter().filter(|t| t.is_regression()).map(|t| (&t.model, t.change)))
+    {
+        match models.iter_mut().find(|(m, _)| m == model) {
+            Some((_, worst)) => *worst = worst.max(rel),
+            None => models.push((model.clone(), rel)),
+        }
+    }
+    models.sort_by(|a, b| b.1.total_cmp(&a.1));
+    models.iter().map(|(model, _)| finding(cmp, new, model, &target, &compiler)).collect()
+}
+
+fn finding(cmp: &Comparison, new: &Baseline, model: &str, target: &str, compiler: &str) -> Finding {
+    let mut regressed: Vec<_> = cmp.changes.iter().filter(|c| c.model == model && c.is_regression()).collect();
+    regressed.sort_by(|a, b| b.rel.total_cmp(&a.rel));
+    let counts: Vec<String> = regressed
+        .iter()
+        .map(|c| format!("{} {} -> {} ({:+.1}%)", c.key, sig(c.old, 4), sig(c.new, 4), 100.0 * c.rel))
+        .collect();
+    let timing: Vec<String> = cmp
+        .timing
+        .iter()
+        .filter(|t| t.model == model && t.is_regression())
+        .map(|t| {
+            format!("{TIMING_KEY} {} -> {} ({:+.1}%)", sig(t.old_median, 4), sig(t.new_median, 4), 100.0 * t.change)
+        })
+        .collect();
+    let rule = if counts.is_empty() { &TIMING_RULE } else { &COUNT_RULE };
+    let file = model_file(new, model);
+    let lines = cmp.lines.iter().find(|m| m.model == model);
+    // The model's own lines: glsl/'s are brdfprof's, not in the user's repository.
+    let places: Vec<Place> = lines
+        .map(|m| super::lines::risen(&m.changes, usize::MAX))
+        .unwrap_or_default()
+        .into_iter()
+        .filter(|c| file.as_deref().is_some_and(|f| same_file(f, &c.file)))
+        .take(LINES_SHOWN)
+        .map(|c| Place {
+            file: c.file.clone(),
+            line: Some(c.line),
+            text: c.text.clone(),
+            note: format!(
+                "+{} {} cycles per wave ({} -> {}), {:.0}% of the rise",
+                sig(c.rise(), 3),
+                lines.map_or("", |m| m.pipe.as_str()),
+                sig(c.before, 3),
+                sig(c.after, 3),
+                100.0 * c.share
+            ),
+        })
+        .collect();
+    let places = match (places.is_empty(), &file) {
+        (true, Some(f)) => vec![Place { file: f.clone(), line: None, text: String::new(), note: String::new() }],
+        _ => places,
+    };
+    let at = places
+        .first()
+        .and_then(|p| p.line.map(|l| format!("; the line whose cost rose most: {}:{l} ({})", p.file, p.note)));
+    // The message names the largest changes; the properties hold all of them.
+    let all: Vec<&String> = timing.iter().chain(&counts).collect();
+    let shown = all.iter().take(MESSAGE_CHANGES).map(|s| s.as_str()).collect::<Vec<_>>().join(", ");
+    let more = all.len().saturating_sub(MESSAGE_CHANGES);
+    let more = if more > 0 { format!(" and {more} more statistic(s)") } else { String::new() };
+    Finding {
+        rule,
+        message: format!("{model} on {target}: {shown}{more}{}", at.unwrap_or_default()),
+        places,
+        identity: format!("{target}\n{model}"),
+        properties: json!({ "model": model, "target": target, "compiler": compiler, "regressions": counts.iter().chain(&timing).collect::<Vec<_>>() }),
+    }
+}
+
+/// Whether a line's file (as per-line cost names it: relative to the working directory where below it) is
+/// the model file `model` (as the user gave it).
+fn same_file(model: &str, line_file: &str) -> bool {
+    let canon = |p: &str| std::fs::canonicalize(p).ok();
+    model == line_file || canon(model).is_some_and(|m| Some(m) == canon(line_file))
+}
