@@ -80,6 +80,21 @@ impl Checks<'_> {
                     && within(self.nol, n.dot(crate::brdf::guards::unit(s.l))))
     }
 
+    /// Why nothing is left to check where the ranges leave no hard case with an expected value and no grid
+    /// point (a range between grid values, or one the file's inputs never reach); None otherwise.
+    pub fn leaves_nothing(&self, cases: &[HardCase], grid: &[Sample]) -> Option<String> {
+        let cases_in = cases.iter().filter(|c| c.expect == Expect::Twin && self.in_domain(&c.sample)).count();
+        let grid_in = grid.iter().filter(|s| self.in_domain(s)).count();
+        (self.has_domain() && cases_in == 0 && grid_in == 0).then(|| {
+            format!(
+                "{}: none of the {} hard cases and {} grid points lies in it, so nothing would be checked; widen it",
+                self.domain_text(),
+                cases.iter().filter(|c| c.expect == Expect::Twin).count(),
+                grid.len()
+            )
+        })
+    }
+
     /// Whether any range narrows the inputs checked.
     pub fn has_domain(&self) -> bool {
         self.roughness.is_some() || self.nov.is_some() || self.nol.is_some()

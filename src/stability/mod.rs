@@ -399,6 +399,9 @@ pub fn run(gpu: &Gpu, options: &StabilityOptions, progress: &ProgressBar) -> Res
             nov: options.nov.or(nov),
             nol: options.nol.or(nol),
         };
+        if let Some(why) = checks.leaves_nothing(&cases, &grid) {
+            anyhow::bail!("{}: {why}", model.label());
+        }
         specs.push(check_model(gpu, model, &checks, &cases, &grid, &reciprocity)?);
     }
     if options.energy {

@@ -377,3 +377,21 @@ fn bad_out_and_scratch_arguments_exit_2_at_the_entry_line() {
     run_in(d, &["eval", "--model", "engine.brdf", "--input", "in.csv", "--output", "out.csv"])
         .fails(2, &format!(":{line}: entry `light_compute`: the `@out` parameter 9"));
 }
+
+/// A domain outside its quantity's range is refused at its line; a domain or range that leaves the stability
+/// suite nothing to check exits 2 saying so, never `ok`.
+#[test]
+fn a_domain_outside_its_range_or_leaving_nothing_to_check_exits_2() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let text = std::fs::read_to_string(engine()).unwrap();
+    let line = text.lines().position(|l| l.trim().starts_with("domain roughness")).expect("a roughness domain") + 1;
+    std::fs::write(d.join("beyond.brdf"), text.replacen("domain roughness 0.0525 1", "domain roughness 2 3", 1))
+        .unwrap();
+    run_in(d, &["stability", "--model", "beyond.brdf", "--out", "st"])
+        .fails(2, &format!("beyond.brdf:{line}: `domain roughness 2 3`: MIN and MAX are numbers within [0, 1]"));
+    // Between the grid's roughness values and the hard cases': nothing to check.
+    run_in(d, &["stability", "--model", "ggx", "--roughness", "0.333..0.333", "--out", "st"])
+        .fails(2, "ggx: roughness in [0.333, 0.333]: none of the");
+    assert!(!d.join("st").exists(), "no report");
+}

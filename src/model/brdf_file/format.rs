@@ -530,16 +530,16 @@ fn parse_domain(file: &mut BrdfFile, n: usize, rest: &str) -> Result<()> {
     let form = "`domain roughness|nov|nol MIN MAX`";
     let words: Vec<&str> = rest.split_whitespace().collect();
     let [input, min, max] = words.as_slice() else { bail!(at(&path, n, format!("`domain {rest}`: expected {form}"))) };
-    let (slot, top) = match *input {
-        "roughness" => (&mut file.roughness_domain, f64::INFINITY),
-        "nov" => (&mut file.nov_domain, 1.0),
-        "nol" => (&mut file.nol_domain, 1.0),
+    // Perceptual roughness and the cosines all lie in [0, 1]: a domain outside it holds no input brdfprof makes.
+    let slot = match *input {
+        "roughness" => &mut file.roughness_domain,
+        "nov" => &mut file.nov_domain,
+        "nol" => &mut file.nol_domain,
         _ => bail!(at(&path, n, format!("`domain {input}`: the domains declared are roughness, nov and nol ({form})"))),
     };
-    let number = |t: &str| t.parse::<f64>().ok().filter(|x| x.is_finite() && *x >= 0.0 && *x <= top);
+    let number = |t: &str| t.parse::<f64>().ok().filter(|x| (0.0..=1.0).contains(x));
     let (Some(lo), Some(hi)) = (number(min), number(max)) else {
-        let range = if top == 1.0 { "within [0, 1]" } else { "finite, 0 or more" };
-        bail!(at(&path, n, format!("`domain {rest}`: MIN and MAX are numbers {range}")))
+        bail!(at(&path, n, format!("`domain {rest}`: MIN and MAX are numbers within [0, 1] (the range of {input})")))
     };
     if lo > hi {
         bail!(at(&path, n, format!("`domain {rest}`: MIN {lo} is above MAX {hi}")));
