@@ -83,9 +83,10 @@ impl Side {
         }
     }
 
-    /// A reference's side: its f64 twin's values, not its kernel's.
+    /// A reference's side: its formula in f64 at the sampled roughness (`ModelSpec::eval_reference`: no
+    /// roughness floor), not its kernel's values.
     pub fn reference(model: &Model) -> Self {
-        Side { name: format!("{} (f64)", model.label()), canonical: model.canonical(), front_end: None }
+        Side { name: format!("{} (f64, no floor)", model.label()), canonical: model.canonical(), front_end: None }
     }
 }
 

@@ -171,12 +171,19 @@ fn diff_set(args: &DiffArgs, reference: &Model, models: &[Model]) -> Result<Exit
     }
     let twin = reference.twin().expect("a reference is a built-in spec");
     let outs = outputs(args, models)?;
-    let inputs = Inputs::read(args, models)?;
+    let mut inputs = Inputs::read(args, models)?;
+    inputs.drop_singular_rows();
+    if inputs.samples.is_empty() {
+        bail!(
+            "diff --reference: every row has roughness 0, where the reference's D is singular; no row is left to compare"
+        );
+    }
     let (gpu, values) = on_device(&args.device, |gpu, progress| {
         progress.set_message(format!("{} models on {} rows", models.len(), inputs.samples.len()));
         inputs.eval_all(gpu)
     })?;
-    let exact: Vec<[f64; 3]> = inputs.samples.iter().map(|s| twin.eval(s)).collect();
+    let exact: Vec<[f64; 3]> =
+        inputs.samples.iter().map(|s| twin.eval_reference(s).expect("singular rows dropped")).collect();
     let rounded: Vec<[f32; 3]> = exact.iter().map(|v| v.map(|x| x as f32)).collect();
     let diffs: Vec<DiffReport> = models
         .iter()
@@ -222,6 +229,30 @@ struct Inputs {
 }
 
 impl Inputs {
+    /// Leaves out the rows where a reference has no value (roughness 0: its D is a Dirac delta), counting them
+    /// in the label and on stderr.
+    fn drop_singular_rows(&mut self) {
+        let keep: Vec<bool> = self.samples.iter().map(|s| s.roughness > 0.0).collect();
+        let dropped = keep.iter().filter(|k| !**k).count();
+        if dropped == 0 {
+            return;
+        }
+        fn kept<T: Copy>(rows: &[T], keep: &[bool], per_row: usize) -> Vec<T> {
+            rows.chunks(per_row.max(1)).zip(keep).filter(|(_, k)| **k).flat_map(|(r, _)| r.iter().copied()).collect()
+        }
+        self.samples = kept(&self.samples, &keep, 1);
+        self.lines = self.lines.as_ref().map(|l| kept(l, &keep, 1));
+        self.tangents = self.tangents.as_ref().map(|t| kept(t, &keep, 1));
+        for (_, row) in &mut self.models {
+            if !row.values.is_empty() {
+                row.values = kept(&row.values, &keep, row.floats);
+            }
+        }
+        let why = format!("{dropped} rows with roughness 0 left out (the reference's D is singular there)");
+        brdfprof::messages::note(format!("diff: {why}"));
+        self.label += &format!("; {why}");
+    }
+
     fn read(args: &DiffArgs, models: &[Model]) -> Result<Self> {
         let Some(path) = &args.input else {
             let (domain, why) = domain_of(args, &models.iter().collect::<Vec<_>>())?;

@@ -249,7 +249,7 @@ fn diff_against_a_reference_measures_every_model_in_one_table() {
     assert_eq!(diffs.len(), 4);
     let max_rel = |k: usize| diffs[k]["difference"]["max_rel"].as_f64().unwrap();
     assert!(
-        diffs.iter().all(|d| d["a"]["name"].as_str().unwrap().ends_with("(f64)")),
+        diffs.iter().all(|d| d["a"]["name"].as_str().unwrap().ends_with("(f64, no floor)")),
         "A is the reference's f64 values"
     );
     assert!(max_rel(0) < 1e-4, "the reference's kernel against its own f64 values: {}", max_rel(0));
@@ -288,4 +288,36 @@ fn diff_against_a_reference_measures_every_model_in_one_table() {
     let r = run(&[reference, &file, &file_f], &[]);
     assert_eq!(r.code, Some(0), "{}", r.stderr);
     assert!(r.stdout.contains("| engine-ggx ") && r.stdout.contains("within"), "{}", r.stdout);
+}
+
+/// A reference is the formula at the sampled roughness, with no roughness floor: a floor-free fp32 file of the
+/// formula is within 1e-2 of it down to roughness 0.02 (with the fp32 floor of 0.045 in the reference, rows
+/// below it differed by most of their value); rows of roughness 0, where D is singular, are left out and
+/// counted.
+#[test]
+fn a_reference_has_no_roughness_floor_and_leaves_out_singular_rows() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let file = common::repo_root().join("tests/fixtures/brdf/reference/ggx-no-floor.brdf").display().to_string();
+    let args = ["diff", "--model", &file, "--roughness", "0.02..1", "--samples", "4000", "--json", "r.json"];
+    common::run_in(d, &args).ok();
+    let r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(d.join("r.json")).unwrap()).unwrap();
+    let max = r["diffs"][0]["difference"]["max_rel"].as_f64().unwrap();
+    assert!(max < 1e-2, "max rel {max} against the reference over roughness 0.02..1");
+    assert!(r["diffs"][0]["a"]["name"].as_str().unwrap().ends_with("(f64, no floor)"));
+    // Below the floor the reference differs from its own floored twin: the floor is the model's, not the reference's.
+    let ggx = ModelSpec::parse("d=ggx,vis=smith-ggx-correlated,f=schlick").unwrap();
+    let s = brdfprof::brdf::samples::well_conditioned_in(1, 3, (0.9, 1.0), (0.9, 1.0), 0.02..0.021)[0];
+    let (exact, floored) = (ggx.eval_reference(&s).unwrap(), ggx.eval(&s));
+    assert!((exact[0] / floored[0] - 1.0).abs() > 0.5, "{exact:?} against the floored twin {floored:?}");
+    // Rows of roughness 0 have no reference value: left out, counted, named.
+    let mut csv = String::from("nx,ny,nz,vx,vy,vz,lx,ly,lz,roughness,f0r,f0g,f0b\n");
+    for r in ["0", "0.5", "0", "0.3"] {
+        csv += &format!("0,0,1,0,0.6,0.8,0.6,0,0.8,{r},0.04,0.04,0.04\n");
+    }
+    std::fs::write(d.join("in.csv"), csv).unwrap();
+    let out = common::run_in(d, &["diff", "--model", &file, "--input", "in.csv", "--json", "z.json"]).ok();
+    assert!(out.stderr.contains("2 rows with roughness 0 left out"), "{}", out.stderr);
+    let z: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(d.join("z.json")).unwrap()).unwrap();
+    assert_eq!(z["rows"], 2);
 }

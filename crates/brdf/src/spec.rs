@@ -318,6 +318,22 @@ impl ModelSpec {
         self.eval_unit(unit(n), unit(v), unit(l), roughness, f0)
     }
 
+    /// The formula itself as a reference, at the sampled roughness: `eval` without the roughness floor (the
+    /// floor is a guard of fp32 kernels and engines, not of the mathematics; a reference that applied it would
+    /// blame a model for the rows below it). None at roughness 0, where D is singular (a Dirac delta): such a
+    /// row has no reference value.
+    pub fn eval_reference(&self, s: &Sample) -> Option<[f64; 3]> {
+        let r = f64::from(s.roughness).min(1.0);
+        if r.is_nan() || r <= 0.0 {
+            return None;
+        }
+        let (n, v, l) = (guards::unit(s.n), guards::unit(s.v), guards::unit(s.l));
+        Some(match cosines_with(n, v, l, s.f0.map(f64::from), self.guards) {
+            Some((c, f0)) => self.from_cosines(&c, r * r, f0),
+            None => [0.0; 3],
+        })
+    }
+
     /// The twin of `specular_brdf_unit`: N, V, L taken as given (the kernel's unit vectors, rounding and all).
     pub fn eval_unit(&self, n: DVec3, v: DVec3, l: DVec3, roughness: f64, f0: [f64; 3]) -> [f64; 3] {
         match cosines_with(n, v, l, f0, self.guards) {
