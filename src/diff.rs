@@ -5,6 +5,7 @@
 //! rounding. docs/diff.md documents the JSON report (`"kind": "diff"`).
 
 pub mod picture;
+pub mod signed;
 
 use crate::accuracy::rel_err;
 use crate::brdf::guards::unit;
@@ -145,6 +146,8 @@ impl DiffSet {
             "max rel",
             "RMS rel (worst channel)",
             "max abs",
+            "best-fit scale",
+            "B/A median",
             "rows within 1e-3",
             "non-finite (model / one side only)",
             "worst row",
@@ -177,6 +180,8 @@ impl DiffSet {
                 sig(d.difference.max_rel, 3),
                 sig(rms, 3),
                 sig(d.difference.max_abs, 3),
+                d.signed.best_fit_scale.map_or("-".into(), |s| sig(s, 3)),
+                d.signed.ratio_at(50.0).map_or("-".into(), |r| sig(r, 3)),
                 format!("{within} of {}", d.rows),
                 format!("{nonfinite} / {one_side}"),
                 worst,
@@ -288,6 +293,9 @@ pub struct DiffReport {
     pub twins: Option<Difference>,
     pub worst: Vec<WorstRow>,
     pub histogram: Histogram,
+    /// How B is wrong: B/A percentiles, the best-fit scale, the shares brighter and darker (`signed`).
+    #[serde(default)]
+    pub signed: signed::Signed,
     pub tolerance: Option<f64>,
     /// max_rel <= tolerance and no row finite on one side only (true without a tolerance).
     pub within_tolerance: bool,
@@ -449,6 +457,7 @@ impl DiffReport {
             twins: twin_values(e.a, e.b, e.samples).map(|(ta, tb)| self::difference(&ta, &tb)),
             worst: worst_rows(e.samples, e.lines, e.a_values, e.b_values, worst),
             histogram: histogram(&a, &b),
+            signed: signed::signed(&a, &b),
             difference,
             tolerance,
             within_tolerance,
@@ -487,6 +496,7 @@ impl DiffReport {
                 sig(tw.max_abs, 3)
             );
         }
+        out += &self.signed.markdown();
         out += &self.histogram_markdown();
         out += &self.worst_markdown();
         if let Some(tol) = self.tolerance {

@@ -143,6 +143,17 @@ fn diff_html(i: usize, d: &DiffReport, path: &str, gpu: Option<&Gpu>) -> Result<
     for (k, row) in d.worst.iter().enumerate() {
         w.row(format!("diff{i}/worst{k}"), worst_row(row));
     }
+    let sg = &d.signed;
+    let _ = write!(
+        s,
+        "<p>Signed, B against A: best-fit scale <span data-key=\"diff{i}/best_fit_scale\">{}</span>; B/A median {}, 5th to 95th percentile {} to {}; B brighter on {:.1}% of values, darker on {:.1}%.</p>",
+        sg.best_fit_scale.map_or("-".into(), |x| sig(x, 4)),
+        sg.ratio_at(50.0).map_or("-".into(), |x| sig(x, 3)),
+        sg.ratio_at(5.0).map_or("-".into(), |x| sig(x, 3)),
+        sg.ratio_at(95.0).map_or("-".into(), |x| sig(x, 3)),
+        100.0 * sg.brighter,
+        100.0 * sg.darker
+    );
     let _ = write!(
         s,
         "<h4>Rows where they differ most</h4>{}<h4>Rows by their largest relative difference</h4>{}",
@@ -152,9 +163,10 @@ fn diff_html(i: usize, d: &DiffReport, path: &str, gpu: Option<&Gpu>) -> Result<
     Ok(s + &picture(d, gpu)?)
 }
 
-const SET_COLUMNS: [(&str, &str); 5] = [
+const SET_COLUMNS: [(&str, &str); 6] = [
     ("model", "model"),
     ("max_rel", "max rel"),
+    ("scale", "best-fit scale"),
     ("rms_rel", "RMS rel (worst channel)"),
     ("one_side", "finite on one side"),
     ("verdict", "verdict"),
@@ -183,6 +195,7 @@ fn diff_set_html(i: usize, d: &DiffSet, path: &str, gpu: Option<&Gpu>) -> Result
             vec![
                 Cell::text(x.b.name.clone()),
                 num_cell(finite(x.difference.max_rel)),
+                num_cell(x.signed.best_fit_scale),
                 num_cell(rms),
                 Cell::num(one_side as f64, one_side.to_string()),
                 Cell::text(verdict),

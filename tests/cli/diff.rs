@@ -321,3 +321,24 @@ fn a_reference_has_no_roughness_floor_and_leaves_out_singular_rows() {
     let z: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(d.join("z.json")).unwrap()).unwrap();
     assert_eq!(z["rows"], 2);
 }
+
+/// Signed figures say how a model is wrong: a file that returns 4 times the reference's formula reads a
+/// best-fit scale and a B/A median near 4 and is brighter on every value, where the unsigned max rel says 3.
+#[test]
+fn a_model_four_times_the_reference_reads_a_best_fit_scale_of_four() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let exact = std::fs::read_to_string(common::repo_root().join("tests/fixtures/brdf/reference/ggx-no-floor.brdf"));
+    let four = exact.unwrap().replacen("return D * Vis *", "return 4.0 * D * Vis *", 1);
+    assert!(four.contains("4.0 * D"));
+    std::fs::write(d.join("four.brdf"), four).unwrap();
+    let r = common::run_in(d, &["diff", "--model", "four.brdf", "--roughness", "0.1..1", "--json", "f.json"]).ok();
+    let j: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(d.join("f.json")).unwrap()).unwrap();
+    let signed = &j["diffs"][0]["signed"];
+    let scale = signed["best_fit_scale"].as_f64().unwrap();
+    assert!((scale - 4.0).abs() < 0.01, "best-fit scale {scale}");
+    let median = signed["ratio_percentiles"].as_array().unwrap().iter().find(|p| p[0] == 50.0).unwrap()[1].as_f64();
+    assert!((median.unwrap() - 4.0).abs() < 0.01, "{signed}");
+    assert!(signed["brighter"].as_f64().unwrap() > 0.99, "{signed}");
+    assert!(r.stdout.contains("best-fit scale B ~ s A with s = 4.0"), "{}", r.stdout);
+}
