@@ -25,32 +25,36 @@ pub const HISTOGRAM_EDGES: [f64; 9] = [0.0, 1e-7, 1e-6, 1e-5, 1e-4, 1e-3, 1e-2, 
 /// The largest input `diff` evaluates (both models' outputs and the statistics stay within a few GB).
 pub const MAX_SAMPLES: usize = 20_000_000;
 
+pub use crate::brdf::f0::F0Set;
 pub use crate::brdf::samples::{DEFAULT_MIN_COS, SampleDomain};
 
-/// The default inputs: `count` well-conditioned samples (`SampleDomain::default()`, F0 uniform in [0, 1]^3),
-/// seeded.
+/// The default inputs: `count` well-conditioned samples (`SampleDomain::default()`, F0 of real materials,
+/// `F0Set::default()`), seeded.
 pub fn default_samples(count: usize, seed: u64) -> Vec<Sample> {
-    default_samples_in(count, seed, &SampleDomain::default())
+    default_samples_in(count, seed, &SampleDomain::default(), F0Set::default())
 }
 
-/// `default_samples` within `domain` (`--roughness`, `--nov`, `--nol`, a file's domains).
-pub fn default_samples_in(count: usize, seed: u64, domain: &SampleDomain) -> Vec<Sample> {
+/// `default_samples` within `domain` (`--roughness`, `--nov`, `--nol`, a file's domains), F0 from `f0`.
+pub fn default_samples_in(count: usize, seed: u64, domain: &SampleDomain, f0: F0Set) -> Vec<Sample> {
     let (lo, hi) = domain.roughness;
-    if lo == hi {
+    let mut s = if lo == hi {
         let mut s = samples::well_conditioned_in(count, seed, domain.nov, domain.nol, 0.0..1.0);
         s.iter_mut().for_each(|x| x.roughness = lo as f32);
-        return s;
-    }
-    samples::well_conditioned_in(count, seed, domain.nov, domain.nol, lo..hi)
+        s
+    } else {
+        samples::well_conditioned_in(count, seed, domain.nov, domain.nol, lo..hi)
+    };
+    f0.apply(&mut s, seed);
+    s
 }
 
 /// The words that say what the default inputs are.
 pub fn default_samples_label(count: usize, seed: u64) -> String {
-    default_samples_label_in(count, seed, &SampleDomain::default(), ["", "", ""])
+    default_samples_label_in(count, seed, &SampleDomain::default(), ["", "", ""], F0Set::default())
 }
 
 /// `default_samples_label` within `domain`, `why` saying where its roughness, NoV and NoL ranges come from.
-pub fn default_samples_label_in(count: usize, seed: u64, domain: &SampleDomain, why: [&str; 3]) -> String {
+pub fn default_samples_label_in(count: usize, seed: u64, domain: &SampleDomain, why: [&str; 3], f0: F0Set) -> String {
     let (r, v, l) = (domain.roughness, domain.nov, domain.nol);
     let cosines = if v == l && why[1] == why[2] {
         format!("NoV, NoL in [{}, {}]{}", v.0, v.1, why[1])
@@ -58,8 +62,11 @@ pub fn default_samples_label_in(count: usize, seed: u64, domain: &SampleDomain, 
         format!("NoV in [{}, {}]{}, NoL in [{}, {}]{}", v.0, v.1, why[1], l.0, l.1, why[2])
     };
     format!(
-        "{count} well-conditioned samples (seed {seed}; {cosines}, roughness in [{}, {}]{}, F0 in [0, 1]^3)",
-        r.0, r.1, why[0]
+        "{count} well-conditioned samples (seed {seed}; {cosines}, roughness in [{}, {}]{}, {})",
+        r.0,
+        r.1,
+        why[0],
+        f0.describe()
     )
 }
 

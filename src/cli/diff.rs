@@ -29,7 +29,7 @@ pub struct DiffArgs {
     /// well-conditioned samples (--samples, --seed).
     #[arg(long)]
     pub input: Option<PathBuf>,
-    /// Number of default samples (NoV, NoL in [0.05, 1], roughness in [0, 1], F0 in [0, 1]^3).
+    /// Number of default samples (NoV, NoL in [0.05, 1], roughness in [0, 1], F0 as --f0 says).
     #[arg(long, default_value_t = 10_000, conflicts_with = "input")]
     pub samples: usize,
     #[arg(long, default_value_t = 19, conflicts_with = "input")]
@@ -45,6 +45,11 @@ pub struct DiffArgs {
     /// N.L range of the default samples, as --nov (`domain nol`).
     #[arg(long, value_parser = cosine_range, conflicts_with = "input")]
     pub nol: Option<(f64, f64)>,
+    /// F0 of the default samples: `materials` (default: 13 real materials, one per sample, dielectrics from
+    /// their refractive index and metals of Real-Time Rendering 4th ed. Table 9.2; docs/diff.md), `uniform`
+    /// ([0, 1]^3), MIN..MAX (every channel) or R0..R1,G0..G1,B0..B1.
+    #[arg(long, value_parser = diff::F0Set::parse, default_value = "materials", conflicts_with = "input")]
+    pub f0: diff::F0Set,
     /// Rows listed where the models differ most.
     #[arg(long, default_value_t = 10)]
     pub worst: usize,
@@ -257,7 +262,7 @@ impl Inputs {
         let Some(path) = &args.input else {
             let (domain, why) = domain_of(args, &models.iter().collect::<Vec<_>>())?;
             return Ok(Inputs {
-                samples: diff::default_samples_in(args.samples, args.seed, &domain),
+                samples: diff::default_samples_in(args.samples, args.seed, &domain, args.f0),
                 tangents: None,
                 lines: None,
                 label: diff::default_samples_label_in(
@@ -265,6 +270,7 @@ impl Inputs {
                     args.seed,
                     &domain,
                     why.each_ref().map(String::as_str),
+                    args.f0,
                 ),
                 models: models.iter().map(|m| (m.clone(), RowValues::default())).collect(),
             });

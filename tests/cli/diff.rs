@@ -342,3 +342,35 @@ fn a_model_four_times_the_reference_reads_a_best_fit_scale_of_four() {
     assert!(signed["brighter"].as_f64().unwrap() > 0.99, "{signed}");
     assert!(r.stdout.contains("best-fit scale B ~ s A with s = 4.0"), "{}", r.stdout);
 }
+
+/// `--f0` chooses the default samples' F0: a range keeps every sample's F0 within it; the default draws real
+/// materials' F0 (never a reflectance like 0.0004 that no material has), and `uniform` the old cube.
+#[test]
+fn f0_sets_keep_the_samples_f0_where_they_say() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let f0_of = |extra: &[&str]| -> Vec<[f64; 3]> {
+        let args = [&["diff", "--model", "ggx", "--model", "blinn", "--samples", "2000", "--csv", "c.csv"][..], extra];
+        common::run_in(d, &args.concat()).ok();
+        let text = std::fs::read_to_string(d.join("c.csv")).unwrap();
+        let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+        let at = header.iter().position(|h| *h == "f0r").unwrap();
+        text.lines()
+            .skip(1)
+            .map(|l| {
+                let v: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
+                [v[at], v[at + 1], v[at + 2]]
+            })
+            .collect()
+    };
+    let ranged = f0_of(&["--f0", "0.02..0.08"]);
+    assert!(ranged.iter().flatten().all(|f| (0.02..=0.08).contains(f)), "F0 outside 0.02..0.08");
+    let materials: Vec<[f64; 3]> =
+        brdfprof::brdf::f0::materials().iter().map(|(_, f)| f.map(|x| x as f32 as f64)).collect();
+    let default = f0_of(&[]);
+    assert!(default.iter().all(|f| materials.iter().any(|m| (0..3).all(|c| (m[c] - f[c]).abs() < 1e-6))));
+    assert!(default.iter().flatten().all(|&f| f >= 0.02), "no reflectance below water's");
+    let uniform = f0_of(&["--f0", "uniform"]);
+    assert!(uniform.iter().flatten().any(|&f| f < 0.01) && uniform.iter().flatten().any(|&f| f > 0.99));
+    common::run_in(d, &["diff", "--model", "ggx", "--model", "blinn", "--f0", "0.5..0.1"]).fails(2, "--f0");
+}

@@ -1,6 +1,7 @@
 //! BRDF definitions: the term library with its f64 twins, the guards, model specs and presets.
 
 pub mod exact;
+pub mod f0;
 pub mod glsl_gen;
 pub mod guards;
 pub mod samples;
