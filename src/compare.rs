@@ -31,6 +31,11 @@ pub struct CostColumn {
     /// Model -> 95% CI of the net cost, where measured.
     #[serde(default)]
     pub net_ci: BTreeMap<String, (f64, f64)>,
+    /// A measured column's net ratios to the reference as its report gives them (the median over rounds of
+    /// each round's ratio, `profile::Row::net_vs_reference`), a model missing where the ratio is unresolved;
+    /// None for a modelled or counted column, whose ratio is that of its net figures.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub measured_ratios: Option<BTreeMap<String, f64>>,
     /// Model -> kernel hash.
     #[serde(default)]
     pub hashes: BTreeMap<String, String>,
@@ -160,6 +165,7 @@ pub fn inspect_columns(report: &InspectReport, source: &str) -> Vec<CostColumn> 
             gross: cost.rows.iter().map(|r| (r.model.clone(), r.cycles_per_eval)).collect(),
             net: cost.rows.iter().filter_map(|r| r.net_cycles_per_eval.map(|n| (r.model.clone(), n))).collect(),
             net_ci: BTreeMap::new(),
+            measured_ratios: None,
             hashes: hashes(report),
             lights: report.lights,
         });
@@ -181,6 +187,7 @@ pub fn inspect_columns(report: &InspectReport, source: &str) -> Vec<CostColumn> 
                 .filter_map(|r| r.stats.get("callgrind/net-ir-per-eval").map(|v| (r.model.clone(), *v)))
                 .collect(),
             net_ci: BTreeMap::new(),
+            measured_ratios: None,
             hashes: hashes(report),
             lights: report.lights,
         });
@@ -205,6 +212,7 @@ pub fn profile_columns(view: &ProfileReport, source: &str) -> Vec<CostColumn> {
             gross: BTreeMap::new(),
             net: BTreeMap::new(),
             net_ci: BTreeMap::new(),
+            measured_ratios: Some(BTreeMap::new()),
             hashes: view.kernel_sha256.clone(),
             lights: l,
         };
@@ -213,6 +221,9 @@ pub fn profile_columns(view: &ProfileReport, source: &str) -> Vec<CostColumn> {
             if let Some(n) = &r.net_ns_per_eval {
                 col.net.insert(r.model.clone(), n.median);
                 col.net_ci.insert(r.model.clone(), (n.lo, n.hi));
+            }
+            if let (Some(ratio), Some(map)) = (&r.net_vs_reference, col.measured_ratios.as_mut()) {
+                map.insert(r.model.clone(), ratio.median);
             }
         }
         out.push(col);
@@ -317,10 +328,23 @@ impl CostTable {
         self
     }
 
-    /// Net cost relative to ggx's net cost in the same column.
+    /// Net cost relative to ggx's net cost in the same column: one definition everywhere (docs/measurement.md):
+    /// a measured column's own per-round ratio (None where unresolved), else the ratio of the net figures.
     pub fn relative(&self, column: &CostColumn, model: &str) -> Option<f64> {
+        if let Some(ratios) = &column.measured_ratios {
+            return ratios.get(model).copied();
+        }
         let g = column.net.get(crate::brdf::spec::REFERENCE_MODEL)?;
         column.net.get(model).map(|n| n / g).filter(|r| r.is_finite() && *g > 0.0)
+    }
+
+    /// The "net vs ggx" cell: the ratio, "unresolved" for a measured model without one, else "-".
+    fn relative_cell(&self, column: &CostColumn, model: &str) -> String {
+        match self.relative(column, model) {
+            Some(r) => format!("{r:.2}"),
+            None if column.measured_ratios.is_some() && column.net.contains_key(model) => "unresolved".into(),
+            None => "-".into(),
+        }
     }
 
     pub fn markdown(&self) -> String {
@@ -340,7 +364,7 @@ impl CostTable {
                     (Some(v), None) => sig(*v, 4),
                     _ => "-".into(),
                 });
-                cells.push(self.relative(c, m).map_or("-".into(), |r| format!("{r:.2}")));
+                cells.push(self.relative_cell(c, m));
             }
             t.row(cells);
         }

@@ -78,7 +78,7 @@ pub fn profile(args: &ProfileArgs) -> Result<ExitCode> {
     args.html.write(&[just_measured(&path, &result)?], Some(&gpu))?;
     args.bench.write(&result.bench_entries("profile"))?;
     println!("{}\n", result.summary());
-    print!("{}{}", result.table().markdown(), result.placement_notes());
+    print!("{}{}{}", result.table().markdown(), result.interval_notes(), result.placement_notes());
     if let Some(t) = result.light_table() {
         println!("\nns/eval by light count (net of the baseline; the baseline gross):\n\n{}", t.markdown());
     }

@@ -70,6 +70,10 @@ pub struct Row {
     /// baseline / cost, per round: the share of this kernel's time that the memory-only kernel (loads,
     /// decode, light loop, stores) takes.
     pub harness_share: Option<Estimate>,
+    /// Why `net_vs_reference` is None for a model with a net cost: the reference's net interval contains 0,
+    /// so no ratio to it is resolved (`unresolved_net_ratios`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub net_ratio_unresolved: Option<String>,
     /// Median over rounds of slowest / fastest instance: how much JIT code placement alone moved this kernel.
     #[serde(skip_deserializing)]
     pub instance_spread: f64,
@@ -180,7 +184,7 @@ fn analyse(raw: &RawTimes, specs: &[Option<Model>], group: &Group) -> Vec<Row> {
     let (reference, baseline) = (group.reference, Some(group.baseline));
     let reference_t = per_round(raw, reference, e);
     let baseline_t = baseline.map(|b| per_round(raw, b, e));
-    group
+    let rows: Vec<Row> = group
         .variants
         .clone()
         .map(|i| {
@@ -212,10 +216,33 @@ fn analyse(raw: &RawTimes, specs: &[Option<Model>], group: &Group) -> Vec<Row> {
                 net_ns_per_eval: net,
                 net_vs_reference: net_ratio,
                 harness_share: share,
+                net_ratio_unresolved: None,
                 instance_spread: raw.instance_spread(i),
             }
         })
-        .collect()
+        .collect();
+    unresolved_net_ratios(rows, reference - group.variants.start)
+}
+
+/// Net ratios to the reference exist only where the reference's net cost is resolved: where its interval
+/// contains 0 (or lies below it) the memory-only kernel is as slow as the reference within the noise, and a
+/// ratio to that difference is noise over noise. Then every row's `net_vs_reference` is None, with the reason.
+fn unresolved_net_ratios(mut rows: Vec<Row>, reference: usize) -> Vec<Row> {
+    let Some(net) = rows.get(reference).and_then(|r| r.net_ns_per_eval) else { return rows };
+    if net.lo > 0.0 {
+        return rows;
+    }
+    let why = format!(
+        "unresolved: {}'s net ns/eval interval [{}, {}] contains 0 (or lies below it)",
+        rows[reference].model,
+        markdown::sig(net.lo, 3),
+        markdown::sig(net.hi, 3)
+    );
+    for r in rows.iter_mut().filter(|r| r.net_ns_per_eval.is_some()) {
+        r.net_vs_reference = None;
+        r.net_ratio_unresolved = Some(why.clone());
+    }
+    rows
 }
 
 /// True once every model's ratio is resolved to `target` (net ratios to twice that). The reference's and the
@@ -317,13 +344,14 @@ impl ProfileReport {
     pub fn table(&self) -> Table {
         let r = &self.reference;
         let several = self.workload.lights.len() > 1;
+        let ci = self.interval_label();
         let mut header = vec![
             "model".to_string(),
-            "ns/eval [95% CI]".into(),
+            format!("ns/eval [{ci}]"),
             "Meval/s".into(),
-            format!("vs {r} [95% CI]"),
-            "net ns/eval [95% CI]".into(),
-            format!("net vs {r} [95% CI]"),
+            format!("vs {r} [{ci}]"),
+            format!("net ns/eval [{ci}]"),
+            format!("net vs {r} [{ci}]"),
             "harness share".into(),
         ];
         if several {
@@ -337,7 +365,11 @@ impl ProfileReport {
                 markdown::sig(row.evals_per_second / 1e6, 3),
                 markdown::estimate(&row.vs_reference, 3),
                 row.net_ns_per_eval.as_ref().map_or("-".into(), |e| markdown::estimate(e, 3)),
-                row.net_vs_reference.as_ref().map_or("-".into(), |e| markdown::estimate(e, 3)),
+                match (&row.net_vs_reference, &row.net_ratio_unresolved) {
+                    (Some(e), _) => markdown::estimate(e, 3),
+                    (None, Some(_)) => "unresolved".into(),
+                    (None, None) => "-".into(),
+                },
                 row.harness_share.as_ref().map_or("-".into(), |e| format!("{:.0}%", 100.0 * e.median)),
             ];
             if several {
@@ -346,6 +378,34 @@ impl ProfileReport {
             t.row(cells);
         }
         t
+    }
+
+    /// What the intervals are, as a column header says it: "95% CI" where every interval reaches the
+    /// confidence level, else their real (smallest) coverage: a median's interval from n rounds by order
+    /// statistics needs n >= 6 for 95%; below, it is the sample's extremes, of coverage 1 - 2^(1-n).
+    pub fn interval_label(&self) -> String {
+        let coverage = self.rows.iter().map(|r| r.ns_per_eval.coverage).fold(f64::INFINITY, f64::min);
+        if coverage.is_finite() && coverage + 1e-9 < self.confidence_level {
+            format!("interval of coverage {coverage:.2}, not {:.0}%", 100.0 * self.confidence_level)
+        } else {
+            format!("{:.0}% CI", 100.0 * self.confidence_level)
+        }
+    }
+
+    /// Notes under the table: a net ratio that is unresolved, intervals short of their level.
+    pub fn interval_notes(&self) -> String {
+        let mut out = String::new();
+        if let Some(why) = self.rows.iter().find_map(|r| r.net_ratio_unresolved.as_ref()) {
+            out += &format!("note: net vs {}: {why}; no net ratio to it is given\n", self.reference);
+        }
+        let rounds = self.rows.first().map_or(0, |r| r.ns_per_eval.n);
+        if self.interval_label().starts_with("interval of coverage") {
+            out += &format!(
+                "note: {rounds} rounds are too few for a {:.0}% interval of a median (6 are needed); the intervals are the rounds' extremes; give a longer --budget\n",
+                100.0 * self.confidence_level
+            );
+        }
+        out
     }
 
     /// With several light counts: net ns/eval of each model (the baseline's gross) at each count, one column

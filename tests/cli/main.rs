@@ -33,6 +33,7 @@ mod report;
 mod shader_languages;
 mod signals;
 mod source_lines;
+mod swiftshader;
 mod transcendentals;
 mod translation_corpus;
 mod translation_faults;
