@@ -58,7 +58,15 @@ pub struct Checks<'a> {
     /// unit vectors.
     pub nov: Option<(f64, f64)>,
     pub nol: Option<(f64, f64)>,
+    /// The model returns f N.L: inputs with |N.L| below `F_NOL_ZERO` are left out (`in_domain`).
+    pub f_nol: bool,
 }
+
+/// Where a model returns f N.L (`returns f_nol`), its f is that value over N.L: at N.L = 0 the value is 0
+/// whatever f is, and the quotient measures rounding, not the model (deviations of 1e15 tolerances). Its
+/// inputs at N.L = 0, up to the rounding of unit vectors (|N.L| below this; the grid's next cosine is 1e-7),
+/// are left out of the checks and counted as outside its domain.
+pub const F_NOL_ZERO: f64 = 1e-9;
 
 impl Checks<'_> {
     /// The spec whose f64 values a case's results are checked against: the twin of the case's model, else
@@ -74,6 +82,9 @@ impl Checks<'_> {
     fn in_domain(&self, s: &Sample) -> bool {
         let within = |range: Option<(f64, f64)>, x: f64| range.is_none_or(|(lo, hi)| (lo..=hi).contains(&x));
         let n = crate::brdf::guards::unit(s.n);
+        if self.f_nol && n.dot(crate::brdf::guards::unit(s.l)).abs() < F_NOL_ZERO {
+            return false;
+        }
         within(self.roughness, f64::from(s.roughness))
             && (self.nov.is_none() && self.nol.is_none()
                 || within(self.nov, n.dot(crate::brdf::guards::unit(s.v)))
@@ -97,16 +108,21 @@ impl Checks<'_> {
 
     /// Whether any range narrows the inputs checked.
     pub fn has_domain(&self) -> bool {
-        self.roughness.is_some() || self.nov.is_some() || self.nol.is_some()
+        self.roughness.is_some() || self.nov.is_some() || self.nol.is_some() || self.f_nol
     }
 
     /// The ranges as the report says them.
     pub fn domain_text(&self) -> String {
-        [("roughness", self.roughness), ("NoV", self.nov), ("NoL", self.nol)]
+        let mut text = [("roughness", self.roughness), ("NoV", self.nov), ("NoL", self.nol)]
             .iter()
             .filter_map(|(n, r)| r.map(|(lo, hi)| format!("{n} in [{lo}, {hi}]")))
             .collect::<Vec<_>>()
-            .join(", ")
+            .join(", ");
+        if self.f_nol {
+            let and = if text.is_empty() { "" } else { ", " };
+            text += &format!("{and}NoL not 0 (the model returns f N.L, which is 0 at N.L = 0 whatever f is)");
+        }
+        text
     }
 }
 

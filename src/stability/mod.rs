@@ -398,6 +398,7 @@ pub fn run(gpu: &Gpu, options: &StabilityOptions, progress: &ProgressBar) -> Res
             roughness: options.roughness.or(model.roughness_domain()),
             nov: options.nov.or(nov),
             nol: options.nol.or(nol),
+            f_nol: model.file().is_some_and(|f| f.returns_f_nol()),
         };
         if let Some(why) = checks.leaves_nothing(&cases, &grid) {
             anyhow::bail!("{}: {why}", model.label());
