@@ -135,7 +135,7 @@ impl DiffSet {
     /// One table (a row per model: its largest and RMS relative difference over the channels, its
     /// non-finite values, its worst row), then each model's report.
     pub fn markdown(&self) -> String {
-        use crate::export::markdown::{Table, sig};
+        use crate::export::markdown::Table;
         let mut out = format!(
             "# {} models against {}\n\n{} rows of {} on {}; relative: rel_err(model, reference) = |model - reference| / max(|reference|, {}).\n\n",
             self.diffs.len(),
@@ -161,39 +161,7 @@ impl DiffSet {
             "verdict",
         ]);
         for d in &self.diffs {
-            let rms = d.difference.channels.iter().map(|c| c.rms_rel).fold(0.0, f64::max);
-            let within: usize =
-                d.histogram.counts.iter().zip(&d.histogram.edges).filter(|(_, e)| **e < 1e-3).map(|(n, _)| n).sum();
-            let nonfinite = d.difference.channels.iter().map(|c| c.b_nonfinite).sum::<usize>();
-            let one_side = d.difference.channels.iter().map(|c| c.mismatched_nonfinite).sum::<usize>();
-            let worst = d.worst.first().map_or("-".into(), |w| {
-                let (n, v, l) = (unit(w.sample.n), unit(w.sample.v), unit(w.sample.l));
-                format!(
-                    "{} ({}) at NoV {:.3}, NoL {:.3}, roughness {:.3}",
-                    sig(w.rel, 3),
-                    w.channel,
-                    n.dot(v),
-                    n.dot(l),
-                    w.sample.roughness
-                )
-            });
-            let verdict = match self.tolerance {
-                Some(_) if d.within_tolerance => "within",
-                Some(_) => "ABOVE",
-                None => "-",
-            };
-            t.row([
-                d.b.name.clone(),
-                sig(d.difference.max_rel, 3),
-                sig(rms, 3),
-                sig(d.difference.max_abs, 3),
-                d.signed.best_fit_scale.map_or("-".into(), |s| sig(s, 3)),
-                d.signed.ratio_at(50.0).map_or("-".into(), |r| sig(r, 3)),
-                format!("{within} of {}", d.rows),
-                format!("{nonfinite} / {one_side}"),
-                worst,
-                verdict.to_string(),
-            ]);
+            t.row(self.row(d));
         }
         out += &t.markdown();
         if let Some(tol) = self.tolerance {
@@ -206,6 +174,44 @@ impl DiffSet {
             out += &format!("\n{}", d.markdown().replacen("# ", "## ", 1));
         }
         out
+    }
+
+    /// One model's row of the table.
+    fn row(&self, d: &DiffReport) -> [String; 10] {
+        use crate::export::markdown::sig;
+        let rms = d.difference.channels.iter().map(|c| c.rms_rel).fold(0.0, f64::max);
+        let within: usize =
+            d.histogram.counts.iter().zip(&d.histogram.edges).filter(|(_, e)| **e < 1e-3).map(|(n, _)| n).sum();
+        let nonfinite = d.difference.channels.iter().map(|c| c.b_nonfinite).sum::<usize>();
+        let one_side = d.difference.channels.iter().map(|c| c.mismatched_nonfinite).sum::<usize>();
+        let worst = d.worst.first().map_or("-".into(), |w| {
+            let (n, v, l) = (unit(w.sample.n), unit(w.sample.v), unit(w.sample.l));
+            format!(
+                "{} ({}) at NoV {:.3}, NoL {:.3}, roughness {:.3}",
+                sig(w.rel, 3),
+                w.channel,
+                n.dot(v),
+                n.dot(l),
+                w.sample.roughness
+            )
+        });
+        let verdict = match self.tolerance {
+            Some(_) if d.within_tolerance => "within",
+            Some(_) => "ABOVE",
+            None => "-",
+        };
+        [
+            d.b.name.clone(),
+            sig(d.difference.max_rel, 3),
+            sig(rms, 3),
+            sig(d.difference.max_abs, 3),
+            d.signed.best_fit_scale.map_or("-".into(), |s| sig(s, 3)),
+            d.signed.ratio_at(50.0).map_or("-".into(), |r| sig(r, 3)),
+            format!("{within} of {}", d.rows),
+            format!("{nonfinite} / {one_side}"),
+            worst,
+            verdict.to_string(),
+        ]
     }
 }
 
