@@ -404,16 +404,7 @@ fn a_20000_term_wgsl_expression_evaluates_and_a_larger_one_is_refused_at_its_lin
     std::fs::write(d.join("in.csv"), CSV).unwrap();
     std::fs::write(d.join("long.wgsl"), wgsl_sum(20_000)).unwrap();
     let r = common::run_in(d, &["eval", "--model", "long.wgsl", "--input", "in.csv", "--output", "o.csv"]).ok();
-    let value: f64 = std::fs::read_to_string(d.join("o.csv"))
-        .unwrap()
-        .lines()
-        .nth(1)
-        .unwrap()
-        .split(',')
-        .next()
-        .unwrap()
-        .parse()
-        .unwrap();
+    let value = common::csv_values(&d.join("o.csv"))[0][0];
     // 20,000 x 0.6 x 0.001 = 12, summed in fp32.
     assert!((value - 12.0).abs() < 1e-2, "{value}: {}", r.stderr);
     std::fs::write(d.join("huge.wgsl"), wgsl_sum(200_001)).unwrap();
@@ -446,16 +437,7 @@ fn include_folders_of_links_to_themselves_are_walked_once_and_only_for_imports()
         let (r, took) = run_within(d, &args, std::time::Duration::from_secs(60));
         assert_eq!(r.code, Some(0), "{model}: {}", r.stderr);
         assert!(took.as_secs() < 20, "{model}: {took:?}");
-        let value: f64 = std::fs::read_to_string(d.join("o.csv"))
-            .unwrap()
-            .lines()
-            .nth(1)
-            .unwrap()
-            .split(',')
-            .next()
-            .unwrap()
-            .parse()
-            .unwrap();
+        let value = common::csv_values(&d.join("o.csv"))[0][0];
         assert!((value - expect).abs() < 1e-6, "{model}: {value}");
     }
 }
