@@ -563,8 +563,8 @@ impl FileModel {
     /// what it returns, then the parameters (`all`: every one; else those that differ from the defaults).
     fn text_with(&self, all: bool, includes: bool) -> String {
         let mut s = self.path.clone();
-        for (name, value) in &self.file.defines {
-            s += &if value.is_empty() { format!(",{DEFINE}={name}") } else { format!(",{DEFINE}={name}={value}") };
+        if includes {
+            s += &self.define_items().iter().map(|d| format!(",{DEFINE}={d}")).collect::<String>();
         }
         if includes {
             s += &self.file.includes.dirs.iter().map(|d| format!(",{INCLUDE}={}", d.display())).collect::<String>();
@@ -600,10 +600,16 @@ impl FileModel {
         self.text_with(false, true)
     }
 
-    /// `name` without the include directories and maps (which say where files are, not what the model
-    /// computes): what a label adds after the file's stem.
-    pub fn name_without_includes(&self) -> String {
+    /// `name` without the defines and the include directories and maps: what a default label adds after the
+    /// file's stem (`labels::distinguish` adds the defines that tell models given together apart).
+    pub fn name_for_label(&self) -> String {
         self.text_with(false, false)
+    }
+
+    /// Each define as `NAME` or `NAME=VALUE`.
+    pub fn define_items(&self) -> Vec<String> {
+        let item = |(n, v): &(String, String)| if v.is_empty() { n.clone() } else { format!("{n}={v}") };
+        self.file.defines.iter().map(item).collect()
     }
 
     /// The path with every parameter.

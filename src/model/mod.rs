@@ -9,6 +9,7 @@ pub mod brdf_file;
 pub mod csv_rows;
 pub mod file_model;
 pub mod front;
+pub mod labels;
 
 use crate::brdf::terms::{PARAMS, ParamValue};
 use crate::brdf::{ModelSpec, Precision};
@@ -17,6 +18,9 @@ use crate::shaders::{Shaders, Spirv};
 use anyhow::{Result, anyhow, bail};
 use std::fmt;
 use std::sync::Arc;
+
+pub use labels::check_labels;
+use labels::split_label;
 
 /// The kinds of kernel a model is compiled into (the GLSL kernels of glsl/, each including brdf.glsl).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -191,7 +195,7 @@ impl Model {
         match self {
             Model::Spec(s, _) => s.name(),
             Model::File(f) => {
-                let name = f.name_without_includes();
+                let name = f.name_for_label();
                 let path = std::path::Path::new(&f.path);
                 let part = |p: Option<&std::ffi::OsStr>| p.map_or(f.path.clone(), |n| n.to_string_lossy().into_owned());
                 // `ggx.brdf` keeps its extension: a stem that reads as a built-in model would take that one's rows.
@@ -361,6 +365,7 @@ pub fn models_from_args(models: &[String], params: &[String], default: &[&str]) 
             m.with_params(&mine).map_err(|e| anyhow!("--param: {e:#}"))
         })
         .collect::<Result<Vec<_>>>()
+        .map(labels::distinguish)
         .and_then(|models| check_labels(&models, "--model").map(|_| models))
 }
 
@@ -372,46 +377,6 @@ pub fn with_reference(models: &[Model]) -> Vec<Model> {
         all.insert(0, reference);
     }
     all
-}
-
-/// Splits a `name=LABEL` item off a model text; a label is a file-name-safe word.
-fn split_label(text: &str) -> Result<(String, Option<String>)> {
-    let (mut rest, mut label) = (Vec::new(), None);
-    for item in text.split(',') {
-        match item.trim().strip_prefix(LABEL_KEY).and_then(|r| r.trim_start().strip_prefix('=')) {
-            Some(_) if label.is_some() => bail!("`{text}`: {LABEL_KEY}= is given twice"),
-            Some(l) => label = Some(l.trim().to_string()),
-            None => rest.push(item),
-        }
-    }
-    if let Some(l) = &label {
-        let safe = |c: char| c.is_ascii_alphanumeric() || "-_.+".contains(c);
-        if l.is_empty() || l.len() > 64 || !l.chars().all(safe) || l.starts_with(['-', '.']) {
-            bail!(
-                "`{text}`: {LABEL_KEY}={l}: a label is 1 to 64 of A-Z a-z 0-9 - _ . + (not starting with - or .), as it names output files"
-            );
-        }
-        if l == BASELINE_LABEL {
-            bail!("`{text}`: {LABEL_KEY}={l} is the memory-only baseline kernel's label; give another name");
-        }
-    }
-    Ok((rest.join(","), label))
-}
-
-/// Fails when two different models of one run share a label (each names a row, a chart point and an output
-/// file); the same model given twice (`diff` of a preset with itself) is not ambiguous.
-pub fn check_labels(models: &[Model], flag: &str) -> Result<()> {
-    for (i, m) in models.iter().enumerate() {
-        if let Some(o) = models[..i].iter().find(|o| o.label() == m.label() && *o != m) {
-            bail!(
-                "{flag} {} and {flag} {}: both are labelled `{}`; give one of them its own {LABEL_KEY}=",
-                o.name(),
-                m.name(),
-                m.label()
-            );
-        }
-    }
-    Ok(())
 }
 
 #[cfg(test)]

@@ -609,5 +609,8 @@ fn the_preprocessor_selects_the_branch_the_defines_select() {
     )
     .ok();
     let report = std::fs::read_to_string(d.join("i.md")).unwrap();
-    assert!(report.contains("define=QUALITY_LEVEL=1"), "{report}\n{}", r.stderr);
+    assert!(report.contains("| quality-switch+QUALITY_LEVEL=1 |"), "{report}\n{}", r.stderr);
+    assert!(r.stderr.contains("share a default label; called `quality-switch+QUALITY_LEVEL=1`"), "{}", r.stderr);
+    let json = std::fs::read_to_string(d.join("i.json")).unwrap();
+    assert!(json.contains(",define=QUALITY_LEVEL=1"), "the full spec is kept in the JSON: {json}");
 }
