@@ -229,25 +229,39 @@ fn model_card(gpu: &Gpu, spec: &str, label: &str) -> Result<(String, Vec<[f32; 3
 /// Incidence angles (of `INCIDENCE`) of the overlay of every model's lobe.
 const OVERLAY_INCIDENCE: [usize; 2] = [1, 2];
 
-/// Every model's lobe in one plot per incidence angle (linear and log), a colour per model.
-fn overlay_svg(lobes: &[(String, Vec<[f32; 3]>)]) -> String {
+/// Every model's lobe at incidence `INCIDENCE[i]`; `per_peak` divides each by its own peak (shapes only).
+fn overlay_curves(lobes: &[(String, Vec<[f32; 3]>)], i: usize, per_peak: bool) -> Vec<Curve> {
     let n = SLICE.count();
+    lobes
+        .iter()
+        .map(|(label, v)| {
+            let values: Vec<f64> = v[i * n..(i + 1) * n].iter().map(|f| f64::from(f[0])).collect();
+            let peak = values.iter().copied().filter(|x| x.is_finite()).fold(0.0f64, f64::max);
+            let scale = if per_peak && peak > 0.0 { 1.0 / peak } else { 1.0 };
+            Curve {
+                label: label.clone(),
+                points: SLICE.zip(values).map(|(a, f)| ((a as f64).to_radians(), f * scale)).collect(),
+            }
+        })
+        .collect()
+}
+
+/// The linear and log plots of the overlay at each of `OVERLAY_INCIDENCE`.
+fn overlay_plots(lobes: &[(String, Vec<[f32; 3]>)], per_peak: bool) -> String {
     let mut plots = String::new();
     for i in OVERLAY_INCIDENCE {
-        let curves: Vec<Curve> = lobes
-            .iter()
-            .map(|(label, v)| Curve {
-                label: label.clone(),
-                points: SLICE
-                    .zip(&v[i * n..(i + 1) * n])
-                    .map(|(a, f)| ((a as f64).to_radians(), f64::from(f[0])))
-                    .collect(),
-            })
-            .collect();
+        let curves = overlay_curves(lobes, i, per_peak);
+        let rim =
+            curves.iter().flat_map(|c| c.points.iter().map(|p| p.1)).filter(|v| v.is_finite()).fold(0.0, f64::max);
         let t = INCIDENCE[i];
         let marks = [(-t.to_radians(), format!("L{t}"))];
         let marks: Vec<(f64, &str)> = marks.iter().map(|(a, l)| (*a, l.as_str())).collect();
-        plots += &html::polar_svg(&format!("light at {t} deg, linear"), &curves, &marks, None);
+        let scale = if per_peak {
+            "each to its peak".to_string()
+        } else {
+            format!("rim f_s = {}", crate::export::markdown::sig(rim, 3))
+        };
+        plots += &html::polar_svg(&format!("light at {t} deg, linear, {scale}"), &curves, &marks, None);
         plots += &html::polar_svg(
             &format!("light at {t} deg, log ({LOG_DECADES} decades)"),
             &curves,
@@ -255,14 +269,23 @@ fn overlay_svg(lobes: &[(String, Vec<[f32; 3]>)]) -> String {
             Some(LOG_DECADES),
         );
     }
+    plots
+}
+
+/// Every model's lobe in one plot per incidence angle (linear and log), a colour per model, on one common scale
+/// (a model 4x brighter than another draws 4x larger); each model scaled to its own peak, to compare shapes,
+/// folded below.
+fn overlay_svg(lobes: &[(String, Vec<[f32; 3]>)]) -> String {
     let legend: Vec<String> = lobes
         .iter()
         .enumerate()
         .map(|(k, (label, _))| format!("<span style=\"color:{}\">&#9632; {}</span>", html::colour(k), esc(label)))
         .collect();
     format!(
-        "<div class=\"model overlay\" data-model=\"overlay\"><h3>All models overlaid</h3><figure><div class=\"row\">{plots}</div><figcaption>{}</figcaption></figure></div>",
-        legend.join(" ")
+        "<div class=\"model overlay\" data-model=\"overlay\"><h3>All models overlaid</h3><p class=\"note\">One scale for all models: the rim is the largest f_s of any model at that incidence, so a model brighter or darker than another draws so.</p><figure data-scale=\"common\"><div class=\"row\">{}</div><figcaption>{}</figcaption></figure><details><summary>Each model scaled to its own peak (shapes only)</summary><figure data-scale=\"peak\"><div class=\"row\">{}</div></figure></details></div>",
+        overlay_plots(lobes, false),
+        legend.join(" "),
+        overlay_plots(lobes, true)
     )
 }
 
@@ -270,7 +293,7 @@ fn overlay_svg(lobes: &[(String, Vec<[f32; 3]>)]) -> String {
 /// says why in its place).
 pub fn section(gpu: &Gpu, models: &[(String, String)]) -> Result<String> {
     let mut s = format!(
-        "<p class=\"note\">Evaluated now on {} by the same kernels that were measured. Lobes: f_s in the plane of incidence, roughness {LOBE_ROUGHNESS}, F0 {}, light at each incidence angle on the left (dashed), view over the plane; each plot scaled to its peak. Spheres: f_s NoL pi, F0 ({}, {}, {}), one directional light, tone-mapped (ACES, sRGB); magenta where a value is NaN or Inf. Albedo: E(NoV) with F = 1.</p><div class=\"models\">",
+        "<p class=\"note\">Evaluated now on {} by the same kernels that were measured. Lobes: f_s in the plane of incidence, roughness {LOBE_ROUGHNESS}, F0 {}, light at each incidence angle on the left (dashed), view over the plane; each card's plots scaled to that model's peak, the overlay of all models to one common scale. Spheres: f_s NoL pi, F0 ({}, {}, {}), one directional light, tone-mapped (ACES, sRGB); magenta where a value is NaN or Inf. Albedo: E(NoV) with F = 1.</p><div class=\"models\">",
         esc(&gpu.info.name),
         LOBE_F0[0],
         SPHERE_F0[0],
@@ -308,4 +331,32 @@ pub fn section(gpu: &Gpu, models: &[(String, String)]) -> Result<String> {
         );
     }
     Ok(s + "</div>")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn peak(c: &Curve) -> f64 {
+        c.points.iter().map(|p| p.1).fold(0.0, f64::max)
+    }
+
+    #[test]
+    fn the_overlay_keeps_one_scale_and_folds_the_per_peak_view() {
+        let n = SLICE.count() * INCIDENCE.len();
+        let base: Vec<[f32; 3]> = (0..n).map(|k| [1.0 + (k % 7) as f32; 3]).collect();
+        let bright: Vec<[f32; 3]> = base.iter().map(|v| v.map(|c| 4.0 * c)).collect();
+        let lobes = vec![("a".to_string(), base), ("four-a".to_string(), bright)];
+        let i = OVERLAY_INCIDENCE[0];
+        let common = overlay_curves(&lobes, i, false);
+        assert_eq!(peak(&common[1]) / peak(&common[0]), 4.0, "a model 4x another draws 4x on the common scale");
+        let shapes = overlay_curves(&lobes, i, true);
+        assert!(shapes.iter().all(|c| peak(c) == 1.0), "each scaled to its own peak");
+        let html = overlay_svg(&lobes);
+        let (common_at, peak_at) =
+            (html.find("data-scale=\"common\"").unwrap(), html.find("data-scale=\"peak\"").unwrap());
+        let details = html.find("<details>").unwrap();
+        assert!(common_at < details && details < peak_at, "the per-peak view is the folded option");
+        assert!(html.contains("rim f_s = 28.0"), "the common scale's rim in values (4 x 7)");
+    }
 }
