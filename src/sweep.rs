@@ -88,6 +88,8 @@ pub struct AccuracyOptions {
     /// The sample set's ranges, and the words saying where each comes from (a flag, the files' domains).
     pub domain: SampleDomain,
     pub domain_why: [String; 3],
+    /// `--f0`: None keeps the set's dielectric F0.
+    pub f0: Option<crate::brdf::f0::F0Set>,
 }
 
 impl Default for AccuracyOptions {
@@ -97,6 +99,7 @@ impl Default for AccuracyOptions {
             exact_fresnel: ExactFresnel::Physical,
             domain: accuracy::STANDARD_DOMAIN,
             domain_why: Default::default(),
+            f0: None,
         }
     }
 }
@@ -113,7 +116,7 @@ impl AccuracyOptions {
             .filter(|(_, w)| !w.trim().is_empty())
             .map(|(axis, w)| format!("{axis}: {}", w.trim().trim_start_matches('(').trim_end_matches(')')))
             .collect();
-        let set = SampleSet::within(self.domain).describe();
+        let set = SampleSet::within(self.domain, self.f0).describe();
         if why.is_empty() { set } else { format!("{set}; {}", why.join("; ")) }
     }
 
@@ -262,7 +265,7 @@ fn measure_accuracy(
     options: &AccuracyOptions,
     progress: &ProgressBar,
 ) -> Result<Vec<Accuracy>> {
-    let set = SampleSet::within(options.domain);
+    let set = SampleSet::within(options.domain, options.f0);
     let references: Vec<Option<Model>> = models.iter().map(|m| options.reference_of(m)).collect();
     let mut checked: Vec<String> = Vec::new();
     for r in references.iter().flatten() {

@@ -5,6 +5,7 @@
 pub mod albedo;
 
 use crate::brdf::exact::{self, ExactFresnel, Lambda};
+use crate::brdf::f0::F0Set;
 use crate::brdf::samples::SampleDomain;
 use crate::brdf::{D, F, ModelSpec, Sample, samples};
 use crate::gpu::Gpu;
@@ -100,7 +101,12 @@ pub struct SampleSet {
     pub samples: Vec<Sample>,
     pub cells: Vec<AlbedoCell>,
     pub domain: SampleDomain,
+    /// Where the samples' F0 comes from (`sweep --f0`); None: the two dielectric triples of `stratified_in`.
+    pub f0: Option<F0Set>,
 }
+
+/// `stratified_in`'s F0, the sweep's default.
+const DIELECTRIC_PAIR: &str = "dielectric F0 (0.02, 0.04, 0.08) or (0.03, 0.05, 0.045)";
 
 pub const ALBEDO_NOV: [f32; 6] = [0.1, 0.3, 0.5, 0.7, 0.9, 1.0];
 pub const ALBEDO_ROUGHNESS: [f32; 5] = [0.1, 0.25, 0.5, 0.75, 1.0];
@@ -121,17 +127,22 @@ fn grid_within(grid: &[f32], range: (f64, f64)) -> Vec<f32> {
 
 impl SampleSet {
     pub fn standard() -> Self {
-        Self::within(STANDARD_DOMAIN)
+        Self::within(STANDARD_DOMAIN, None)
     }
 
-    /// The stratified set over `domain`; the albedo cells are the standard grid's within it.
-    pub fn within(domain: SampleDomain) -> Self {
+    /// The stratified set over `domain`, F0 from `f0` where given; the albedo cells are the standard grid's
+    /// within it.
+    pub fn within(domain: SampleDomain, f0: Option<F0Set>) -> Self {
         let noves = grid_within(&ALBEDO_NOV, domain.nov);
         let cells = grid_within(&ALBEDO_ROUGHNESS, domain.roughness)
             .into_iter()
             .flat_map(|roughness| noves.iter().map(move |&nov| AlbedoCell { nov, roughness, f0: [0.04; 3] }))
             .collect();
-        SampleSet { samples: samples::stratified_in(10, 2023, domain.nov, domain.nol, domain.roughness), cells, domain }
+        let mut samples = samples::stratified_in(10, 2023, domain.nov, domain.nol, domain.roughness);
+        if let Some(set) = f0 {
+            set.apply(&mut samples, 2023);
+        }
+        SampleSet { samples, cells, domain, f0 }
     }
 
     /// The words that say what the set is.
@@ -145,7 +156,7 @@ impl SampleSet {
         };
         format!(
             "10 strata each of roughness [{}, {}], NoV [{}, {}] and NoL [{}, {}], azimuth [0, pi]; {} samples, seed 2023; \
-             dielectric F0 (0.02, 0.04, 0.08) or (0.03, 0.05, 0.045); albedo cells NoV {{{}}} x r {{{}}}, F0 0.04",
+             {}; albedo cells NoV {{{}}} x r {{{}}}, F0 0.04",
             r.0,
             r.1,
             v.0,
@@ -153,6 +164,7 @@ impl SampleSet {
             l.0,
             l.1,
             self.samples.len(),
+            self.f0.map_or(DIELECTRIC_PAIR.to_string(), |f| f.describe()),
             distinct(|c| c.nov),
             distinct(|c| c.roughness)
         )
@@ -305,4 +317,19 @@ pub fn albedo_exact_with(spec: &ModelSpec, fresnel: ExactFresnel, cell: &AlbedoC
     let lambda = Lambda::new(spec.d, a, &spec.params);
     let f0 = cell.f0.map(f64::from);
     albedo::albedo_f64(&|c| exact::from_cosines_with(spec, fresnel, &lambda, c, a, f0), cell.nov as f64, a)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_sweep_set_keeps_every_f0_within_its_f0_set() {
+        let plain = SampleSet::standard();
+        let set = SampleSet::within(STANDARD_DOMAIN, Some(F0Set::parse("0.5..0.6").unwrap()));
+        assert!(set.samples.iter().all(|s| s.f0.iter().all(|&c| (0.5..=0.6).contains(&c))));
+        assert!(set.describe().contains("F0 in [0.5, 0.6]^3") && plain.describe().contains(DIELECTRIC_PAIR));
+        let same = |a: &Sample, b: &Sample| a.n == b.n && a.v == b.v && a.l == b.l && a.roughness == b.roughness;
+        assert!(plain.samples.iter().zip(&set.samples).all(|(a, b)| same(a, b)), "only F0 changes");
+    }
 }

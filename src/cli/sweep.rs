@@ -53,6 +53,12 @@ pub struct SweepArgs {
     /// N.L range of the sample set, as --nov (`domain nol`).
     #[arg(long, value_parser = cosine_range)]
     pub nol: Option<(f64, f64)>,
+    /// F0 of the sample set: MIN..MAX (every channel), R0..R1,G0..G1,B0..B1, `materials` (13 real materials,
+    /// as diff's) or `uniform` ([0, 1]^3); default: dielectric F0 (0.02, 0.04, 0.08) or (0.03, 0.05, 0.045).
+    /// With --exact-fresnel physical a Schlick spec's reference is the exact dielectric Fresnel at the sample's
+    /// F0, so a metal's F0 reads as a dielectric's; --exact-fresnel own leaves Fresnel out of the error.
+    #[arg(long, value_parser = brdfprof::diff::F0Set::parse)]
+    pub f0: Option<brdfprof::diff::F0Set>,
     /// Also draw the table, JSON and Pareto chart with a compile-only target's modelled cycles per evaluation
     /// as the cost (radv:FAMILY, nvidia:FAMILY, intel:FAMILY, PREFIX:all; repeatable; see `devices --targets`):
     /// sweep-<device>-<compiler>-<family>.* (aco, ptxas, igc); with several, sweep-<device>-frontiers.md/.json:
@@ -97,7 +103,8 @@ pub fn sweep(args: &SweepArgs) -> Result<ExitCode> {
         brdfprof::accuracy::STANDARD_DOMAIN,
         &models.iter().collect::<Vec<_>>(),
     )?;
-    let accuracy = sweep::AccuracyOptions { reference, exact_fresnel: args.exact_fresnel, domain, domain_why: why };
+    let accuracy =
+        sweep::AccuracyOptions { reference, exact_fresnel: args.exact_fresnel, domain, domain_why: why, f0: args.f0 };
     let options = sweep::SweepOptions {
         profile: args.timing.options(models, &args.size, args.reps, args.budget, args.target_ci)?,
         accuracy,

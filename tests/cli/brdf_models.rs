@@ -322,12 +322,16 @@ fn sweep_measures_a_file_against_a_reference() {
             "3",
             "--budget",
             "60",
+            "--f0",
+            "0.02..0.08",
             "--out",
             "sw",
         ],
     )
     .ok();
     let s = json(&common::device_file(&dir.path().join("sw"), "sweep-", ".json"));
+    let set = s["sample_set"].as_str().unwrap();
+    assert!(set.contains("F0 in [0.02, 0.08]^3") && !set.contains("dielectric F0"), "--f0 names the set: {set}");
     let rows = s["rows"].as_array().unwrap();
     let file = rows.iter().find(|r| r["spec"].as_str().unwrap().contains("ggx.brdf")).unwrap();
     let builtin = rows.iter().find(|r| r["spec"] == "ggx").unwrap();
