@@ -54,6 +54,15 @@ pub fn sig(x: f64, digits: usize) -> String {
     format!("{x:.decimals$}")
 }
 
+/// `sig`, in scientific form below 1e-3 and from 1e6 on (`5.17e-7`), so that a figure stays a few characters
+/// wide in a table cell.
+pub fn sig_compact(x: f64, digits: usize) -> String {
+    if x != 0.0 && x.is_finite() && !(1e-3..1e6).contains(&x.abs()) {
+        return format!("{x:.prec$e}", prec = digits.saturating_sub(1));
+    }
+    sig(x, digits)
+}
+
 /// "median [lo, hi]".
 pub fn estimate(e: &Estimate, digits: usize) -> String {
     format!("{} [{}, {}]", sig(e.median, digits), sig(e.lo, digits), sig(e.hi, digits))
@@ -77,6 +86,10 @@ mod tests {
         assert_eq!(sig(1234.5, 3), "1234");
         assert_eq!(sig(1.2345, 3), "1.23");
         assert_eq!(sig(0.0012345, 3), "0.00123");
+        assert_eq!(sig_compact(5.17e-7, 3), "5.17e-7");
+        assert_eq!(sig_compact(0.0012345, 3), "0.00123");
+        assert_eq!(sig_compact(2.5e7, 2), "2.5e7");
+        assert_eq!(sig_compact(0.0, 3), "0");
     }
 
     #[test]

@@ -1,5 +1,5 @@
 //! Every output format in one place: Markdown tables (markdown), saved JSON reports (json), self-contained
-//! HTML pages (html), PNG charts (png) and the pixel helpers pictures share (raster), SARIF for code scanning
+//! HTML pages (html), PNG charts (png), the label placement charts share (labels) and the pixel helpers pictures share (raster), SARIF for code scanning
 //! (sarif), GitHub's workflow commands and step summary (github), benchmark-dashboard JSON (bench). What a command measured
 //! stays with the command; only how it is written out lives here.
 
@@ -7,6 +7,7 @@ pub mod bench;
 pub mod github;
 pub mod html;
 pub mod json;
+pub mod labels;
 pub mod markdown;
 pub mod png;
 pub mod raster;

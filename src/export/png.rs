@@ -1,6 +1,7 @@
 //! PNG charts and images. Plotters draws into an RGB buffer (DejaVu Sans embedded, so no system fonts are
 //! needed); the `image` crate encodes it and `io::write_output` writes it.
 
+use crate::export::labels::{Placer, Rect};
 use anyhow::{Result, anyhow};
 use plotters::prelude::*;
 use plotters::style::FontStyle;
@@ -133,32 +134,6 @@ fn x_range(pts: &[&Point]) -> (f64, f64) {
     (lo - pad, hi + pad * 6.0)
 }
 
-/// Places a label at the first candidate offset from (px, py) whose box overlaps no placed box; returns its
-/// top-left corner.
-fn place(placed: &mut Vec<(i32, i32, i32, i32)>, (px, py): (i32, i32), width: i32) -> (i32, i32) {
-    let candidates = [
-        (10, -8),
-        (10, 10),
-        (10, -26),
-        (10, 28),
-        (-10 - width, -8),
-        (-10 - width, 10),
-        (10, -44),
-        (10, 46),
-        (-10 - width, -26),
-        (-10 - width, 28),
-    ];
-    let boxed = |(dx, dy): (i32, i32)| (px + dx, py + dy - TEXT_H / 2, px + dx + width, py + dy + TEXT_H / 2);
-    let free = |c: (i32, i32)| {
-        let b = boxed(c);
-        !placed.iter().any(|o| b.0 < o.2 && o.0 < b.2 && b.1 < o.3 && o.1 < b.3)
-    };
-    let c = candidates.iter().copied().find(|c| free(*c)).unwrap_or(candidates[0]);
-    let b = boxed(c);
-    placed.push(b);
-    (b.0, b.1)
-}
-
 type Area<'a> = DrawingArea<BitMapBackend<'a>, plotters::coord::Shift>;
 
 /// One panel: axes, the frontier (main panel), whiskers and points by group, and their labels or numbers.
@@ -223,15 +198,23 @@ fn scatter_panel(
     Ok(())
 }
 
-/// Labels (highlighted points) and numbers (the rest), placed greedily from the top down; `coord` is a point's
-/// pixel in the chart.
+/// Labels (highlighted points) and numbers (the rest), placed greedily from the top down by `labels::Placer`
+/// within the panel, so that none overlaps another or a point; one with no free place is left out (its point
+/// is still drawn, and listed in the key or the table). `coord` is a point's pixel in the chart.
 fn draw_labels(
     area: &Area,
     pts: &[&Point],
     numbers: &[(usize, &Point)],
     coord: impl Fn(&Point) -> (i32, i32),
 ) -> Result<()> {
-    let mut placed: Vec<(i32, i32, i32, i32)> = Vec::new();
+    let (xs, ys) = area.get_pixel_range();
+    let mut placer =
+        Placer::new(Rect { x0: xs.start as f64, y0: ys.start as f64, x1: xs.end as f64, y1: ys.end as f64 });
+    for p in pts {
+        let (x, y) = coord(p);
+        let r = 8.0;
+        placer.occupy(Rect { x0: x as f64 - r, y0: y as f64 - r, x1: x as f64 + r, y1: y as f64 + r });
+    }
     let mut order: Vec<&&Point> = pts.iter().collect();
     order.sort_by(|a, b| b.highlight.cmp(&a.highlight).then(b.y.total_cmp(&a.y)));
     for p in order {
@@ -240,11 +223,13 @@ fn draw_labels(
         } else {
             numbers.iter().find(|(_, q)| std::ptr::eq(*q, *p)).map_or(String::new(), |(n, _)| n.to_string())
         };
-        let at = coord(p);
-        let (x, y) = place(&mut placed, at, CHAR_W * text.chars().count() as i32);
+        let (x, y) = coord(p);
+        let width = (CHAR_W * text.chars().count() as i32) as f64;
+        let Some(b) = placer.place((x as f64, y as f64), width, TEXT_H as f64) else { continue };
         let base = area.get_base_pixel();
         let font = (FONT, if p.highlight { 16 } else { 14 }).into_font().color(&palette(p.group).mix(0.95));
-        area.draw(&Text::new(text, (x - base.0, y - base.1), font)).map_err(|e| anyhow!("chart: {e}"))?;
+        let at = (b.x0 as i32 - base.0, b.y0 as i32 - base.1);
+        area.draw(&Text::new(text, at, font)).map_err(|e| anyhow!("chart: {e}"))?;
     }
     Ok(())
 }

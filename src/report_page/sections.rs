@@ -33,7 +33,7 @@ pub fn estimate_cell(e: Option<&Estimate>) -> Cell {
 /// A number as a cell ("-" where absent; "NaN/Inf" where the report wrote null for a figure that exists).
 pub fn num_cell(x: Option<f64>) -> Cell {
     match x {
-        Some(x) => Cell::num(x, sig(x, DIGITS)),
+        Some(x) => Cell::num(x, crate::export::markdown::sig_compact(x, DIGITS)),
         None => Cell::text("-"),
     }
 }
@@ -345,9 +345,11 @@ fn err_text(e: &ErrorStats) -> String {
 }
 
 /// The sweep's error-against-cost chart: net ns/eval (gross where there is no net) against the RMS relative
-/// error against the exact reference, both log; the Pareto frontier emphasised.
+/// error against the exact reference, both log; the Pareto frontier labelled and joined. fp16 specs (and any
+/// spec costlier than every fp32 one) go to a narrow panel of their own beside it on the same error axis, so
+/// that they do not squeeze the fp32 specs into one band.
 pub fn sweep_chart(w: &SweepReport) -> String {
-    let points: Vec<Point> = w
+    let points: Vec<(Point, bool)> = w
         .rows
         .iter()
         .map(|r| {
@@ -363,28 +365,38 @@ pub fn sweep_chart(w: &SweepReport) -> String {
                 if r.net_ns_per_eval.is_some() { " net" } else { "" },
                 err_text(&r.accuracy.vs_exact)
             );
-            Point { x: cost.median, y: err, label: r.label.clone(), tip, emphasis: r.pareto }
+            let half = r.canonical.contains("precision=f16");
+            (Point { x: cost.median, y: err, label: r.label.clone(), tip, emphasis: r.pareto }, half)
         })
         .collect();
-    let drawable = |p: &&Point| p.x.is_finite() && p.x > 0.0 && p.y.is_finite() && p.y > 0.0;
-    let left_out = points.len() - points.iter().filter(drawable).count();
-    let (Some(x), Some(y)) = (
-        Axis::fit(points.iter().filter(drawable).map(|p| p.x), true),
-        Axis::fit(points.iter().filter(drawable).map(|p| p.y), true),
+    let drawable = |p: &Point| p.x.is_finite() && p.x > 0.0 && p.y.is_finite() && p.y > 0.0;
+    let left_out = points.iter().filter(|(p, _)| !drawable(p)).count();
+    let fp32_top = points.iter().filter(|(p, half)| !half && drawable(p)).map(|(p, _)| p.x).fold(0.0, f64::max);
+    let (main, side): (Vec<Point>, Vec<Point>) = {
+        let (m, s): (Vec<_>, Vec<_>) = points.into_iter().partition(|(p, half)| !half && p.x <= fp32_top);
+        (m.into_iter().map(|(p, _)| p).collect(), s.into_iter().map(|(p, _)| p).collect())
+    };
+    let xs = |pts: &[Point]| Axis::fit(pts.iter().filter(|p| drawable(p)).map(|p| p.x), true);
+    let (Some(y), Some(x)) = (
+        Axis::fit(main.iter().chain(&side).filter(|p| drawable(p)).map(|p| p.y), true),
+        xs(&main).or_else(|| xs(&side)),
     ) else {
         return "<p class=\"note\">No spec has a finite, positive cost and error to draw.</p>".into();
     };
-    let mut s = html::scatter_svg(
-        &points,
-        x,
-        y,
-        "net ns per evaluation (log)",
-        "RMS relative error vs exact (log)",
-        html::WIDE,
-    );
+    let (x_label, y_label) = ("net ns per evaluation (log)", "RMS relative error vs exact (log)");
+    let mut s = String::from("<div class=\"row\">");
+    s += &html::scatter_svg(&main, (x, y), x_label, y_label, html::WIDE, true);
+    let side_note = match xs(&side).filter(|_| !main.is_empty()) {
+        Some(sx) => {
+            s += &html::scatter_svg(&side, (sx, y), "fp16 specs: net ns/eval", y_label, html::SIDE, false);
+            format!(" The {} fp16 spec(s) have their own panel (their own cost axis, the same error axis).", side.len())
+        }
+        None => String::new(),
+    };
+    s += "</div>";
     let _ = write!(
         s,
-        "<p class=\"note\">Red: the Pareto frontier (no spec both cheaper and more accurate). Hover a point for its spec, cost and error.{}</p>",
+        "<p class=\"note\">Red, joined: the Pareto frontier (no spec both cheaper and more accurate), labelled where there is room; hover any point for its spec, cost and error (every spec is in the table).{side_note}{}</p>",
         if left_out > 0 {
             format!(" {left_out} spec(s) with an infinite, zero or NaN figure are not drawn.")
         } else {
@@ -518,7 +530,23 @@ fn heat_map(s: &SpecStability, triples: &[[u32; 3]]) -> Result<String> {
         ROUGHNESS[0],
         ROUGHNESS[ROUGHNESS.len() - 1]
     );
-    Ok(format!("<figure>{}<figcaption>{}</figcaption></figure>", html::img(&uri, w, h, 6, &caption), esc(s.label())))
+    let ticks = |grid: &[f64], at: &[f64]| -> Vec<(usize, String)> {
+        at.iter().filter_map(|v| grid.iter().position(|g| (g - v).abs() < 1e-6).map(|i| (i, v.to_string()))).collect()
+    };
+    let roughness: Vec<f64> = ROUGHNESS.iter().map(|&r| f64::from(r)).collect();
+    let (x, y) = (ticks(&COSINES, &[0.0, 0.1, 0.5, 0.9, 1.0]), ticks(&roughness, &[0.0, 0.1, 0.5, 1.0]));
+    // The colour is ln(1 + n) / ln(1 + most): its middle is n = sqrt(1 + most) - 1.
+    let middle = ((1.0 + max as f64).sqrt() - 1.0).round();
+    let axes = html::HeatAxes {
+        x: (&x, "NoV"),
+        y: (&y, "roughness"),
+        bar: (["0".into(), format!("{middle}"), format!("{max}")], "bad values per cell (log)"),
+    };
+    Ok(format!(
+        "<figure>{}<figcaption>{}</figcaption></figure>",
+        html::heat_svg(&uri, (w, h, 6), &axes, &caption),
+        esc(s.label())
+    ))
 }
 
 /// One stability report: the summary table (rows keyed `stability<i>/<spec>`) and a heat map per spec with

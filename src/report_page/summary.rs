@@ -5,11 +5,14 @@
 use super::sections::{estimate_cell, num_cell};
 use super::{Input, Loaded};
 use crate::brdf::guards::GuardSet;
-use crate::export::html::{Cell, HtmlTable};
+use crate::export::html::{Cell, HtmlTable, esc};
 use crate::io::finite;
 use crate::model::Model;
 use crate::stability::SpecStability;
 use std::collections::BTreeMap;
+
+/// The mark of a modelled (compile-only) column's header.
+const MODELLED: &str = "(m)";
 
 /// Most rows and figure columns shown (the sections below hold every figure).
 const MAX_ROWS: usize = 24;
@@ -27,6 +30,9 @@ pub fn is_guard_variant(spec: &str) -> bool {
 }
 
 struct Column {
+    /// The header: a few words (the device or report and what the figure is).
+    short: String,
+    /// What the figure is in full: the header's tooltip and the table's footnote.
     title: String,
     cells: BTreeMap<String, Cell>,
 }
@@ -47,9 +53,13 @@ impl Summary {
         key
     }
 
-    fn column(&mut self, title: String, cells: Vec<(String, Cell)>) {
+    /// A second column of one short name (one device in two reports) is numbered: `tahiti x ggx (m) #2`.
+    fn column(&mut self, short: String, title: String, cells: Vec<(String, Cell)>) {
         if !cells.is_empty() {
-            self.columns.push(Column { title, cells: cells.into_iter().collect() });
+            let same =
+                self.columns.iter().filter(|c| c.short == short || c.short.starts_with(&format!("{short} #"))).count();
+            let short = if same > 0 { format!("{short} #{}", same + 1) } else { short };
+            self.columns.push(Column { short, title, cells: cells.into_iter().collect() });
         }
     }
 }
@@ -74,7 +84,12 @@ fn profile_column(s: &mut Summary, p: &crate::profile::ProfileReport) {
         cells.push((key, estimate_cell(r.net_vs_reference.as_ref().or(Some(&r.vs_reference)))));
     }
     let net = if p.rows.iter().any(|r| r.net_vs_reference.is_some()) { "net cost" } else { "cost" };
-    s.column(format!("{net} vs {} ({}, {} lights)", p.reference, p.provenance.device.name, lights.unwrap_or(0)), cells);
+    let device = &p.provenance.device.name;
+    s.column(
+        format!("{} {net} x {}", crate::export::name_slug(device), p.reference),
+        format!("{net} vs {} ({device}, {} lights), measured", p.reference, lights.unwrap_or(0)),
+        cells,
+    );
 }
 
 /// One column per inspected device with a cost table: each model's modelled cost against the reference.
@@ -98,8 +113,11 @@ fn inspect_columns(s: &mut Summary, reports: &[crate::schema::InspectReport]) {
             cells.push((key, num_cell(Some(net / base))));
         }
         let device = r.provenance["device"]["name"].as_str().unwrap_or("?");
+        let reference = crate::brdf::spec::REFERENCE_MODEL;
+        let family = cost.column_name().split_whitespace().next().unwrap_or("?").to_string();
         s.column(
-            format!("{} vs {} ({device}, modelled)", cost.column_name(), crate::brdf::spec::REFERENCE_MODEL),
+            format!("{family} x {reference} {MODELLED}"),
+            format!("{} vs {reference} ({device}, modelled)", cost.column_name()),
             cells,
         );
     }
@@ -120,13 +138,14 @@ fn gather(inputs: &[Input]) -> Summary {
                     .filter(|r| r.pareto)
                     .map(|r| (s.model(&r.canonical, &r.label), num_cell(finite(r.accuracy.vs_exact.rms))))
                     .collect();
-                s.column("RMS rel. error vs exact (sweep)".into(), cells);
+                s.column("RMS err. (sweep)".into(), "RMS relative error vs exact (sweep)".into(), cells);
             }
             Loaded::Diff(d) => {
                 s.model(&d.a.canonical, &d.a.name);
                 let key = s.model(&d.b.canonical, &d.b.name);
                 s.column(
-                    format!("max rel. difference vs {}", d.a.name),
+                    format!("max diff. vs {}", d.a.name),
+                    format!("max relative difference vs {}", d.a.name),
                     vec![(key, num_cell(finite(d.difference.max_rel)))],
                 );
             }
@@ -136,7 +155,11 @@ fn gather(inputs: &[Input]) -> Summary {
                     .iter()
                     .map(|x| (s.model(&x.b.canonical, &x.b.name), num_cell(finite(x.difference.max_rel))))
                     .collect();
-                s.column(format!("max rel. difference vs {}", d.reference.name), cells);
+                s.column(
+                    format!("max diff. vs {}", d.reference.name),
+                    format!("max relative difference vs {}", d.reference.name),
+                    cells,
+                );
             }
             Loaded::Stability(_) | Loaded::Costs(_) => {}
         }
@@ -155,7 +178,11 @@ fn gather(inputs: &[Input]) -> Summary {
                 .filter(|(k, _)| known.contains(k))
                 .collect();
             let failing = st.specs.iter().filter(|x| x.fails()).count();
-            s.column(format!("stability ({} of {} specs fail)", failing, st.specs.len()), cells);
+            s.column(
+                "stability".into(),
+                format!("stability: NaN, Inf or negative values ({failing} of {} specs fail)", st.specs.len()),
+                cells,
+            );
         }
     }
     s
@@ -169,8 +196,17 @@ pub fn summary(inputs: &[Input]) -> Option<String> {
     }
     let keys: Vec<String> = (0..s.columns.len().min(MAX_COLUMNS)).map(|i| format!("c{i}")).collect();
     let mut header: Vec<(&str, &str)> = vec![("model", "model")];
-    header.extend(keys.iter().map(String::as_str).zip(s.columns.iter().map(|c| c.title.as_str())));
+    header.extend(keys.iter().map(String::as_str).zip(s.columns.iter().map(|c| c.short.as_str())));
     let mut t = HtmlTable::new(&header);
+    for (key, c) in keys.iter().zip(&s.columns) {
+        t.describe(key, c.title.clone());
+    }
+    let footnotes: Vec<String> = s
+        .columns
+        .iter()
+        .take(MAX_COLUMNS)
+        .map(|c| format!("<li><b>{}</b>: {}</li>", esc(&c.short), esc(&c.title)))
+        .collect();
     for (key, label) in s.models.iter().take(MAX_ROWS) {
         let mut cells = vec![Cell::text(label.clone())];
         cells.extend(
@@ -185,7 +221,8 @@ pub fn summary(inputs: &[Input]) -> Option<String> {
         ),
     };
     Some(format!(
-        "<p class=\"note\">One row per model across the reports given (each named once, by its label); a cost is a ratio to the reference model with its confidence interval where measured; modelled compile-only costs say so (<a href=\"#devices\">their rules</a>); accuracy is against the reference each report names; stability: NaN, Inf or negative values on valid inputs. Where each figure comes from: <a href=\"#provenance\">provenance</a>, at the end.</p>{}{more}",
-        t.html()
+        "<p class=\"note\">One row per model across the reports given (each named once, by its label); a cost is a ratio to the reference model with its confidence interval where measured; {MODELLED} marks a modelled compile-only cost (<a href=\"#devices\">their rules</a>); accuracy is against the reference each report names; stability: NaN, Inf or negative values on valid inputs. Where each figure comes from: <a href=\"#provenance\">provenance</a>, at the end.</p>{}{more}<details class=\"columns\"><summary>The columns</summary><ul class=\"note\">{}</ul></details>",
+        t.html(),
+        footnotes.join("")
     ))
 }

@@ -55,6 +55,43 @@ fn shown(dom: &str, row: &str, col: &str) -> f64 {
     v[..v.find('"').unwrap()].parse().unwrap()
 }
 
+/// The number in attribute `name` of the element that starts at `at`.
+fn attr_at(dom: &str, at: usize, name: &str) -> Option<f64> {
+    let tag = &dom[at..at + dom[at..].find('>').unwrap()];
+    let v = &tag[tag.find(&format!(" {name}=\""))? + name.len() + 3..];
+    v[..v.find('"').unwrap()].parse().ok()
+}
+
+/// What page.js measured in Chromium at 1400 px: no two text boxes of any chart, polar plot or heat map
+/// overlap; the summary table fits the page; every heat map carries its colour scale and value axes.
+fn readable_at_1400_px(dom: &str) {
+    let svgs: Vec<usize> = dom.match_indices("<svg ").map(|(i, _)| i).collect();
+    assert!(svgs.len() > 20, "{} pictures", svgs.len());
+    for &i in &svgs {
+        let overlaps = attr_at(dom, i, "data-overlaps").expect("page.js measured every picture");
+        let tag = &dom[i..i + dom[i..].find('>').unwrap()];
+        assert_eq!(overlaps, 0.0, "text boxes overlap in {tag}");
+    }
+    let labelled = svgs.iter().filter(|&&i| attr_at(dom, i, "data-texts").unwrap_or(0.0) > 0.0).count();
+    assert_eq!(labelled, svgs.len(), "every picture has text (titles, axes or labels) that was measured");
+    let page = attr_at(dom, dom.find("<body").unwrap(), "data-page-width").unwrap();
+    let summary = dom.find("<section id=\"summary\"").unwrap();
+    let table = summary + dom[summary..].find("<table").unwrap();
+    let width = attr_at(dom, table, "data-width").unwrap();
+    assert!(width <= page, "the summary table is {width} px wide on a {page} px page");
+    let heat: Vec<&str> = dom
+        .match_indices("<svg class=\"heatmap\"")
+        .map(|(i, _)| &dom[i..i + dom[i..].find("</svg>").unwrap()])
+        .collect();
+    assert!(!heat.is_empty(), "the stability report's heat maps");
+    for h in heat {
+        assert!(
+            h.contains("<linearGradient") && h.contains("bad values per cell") && h.contains(">roughness<"),
+            "a heat map without its scale"
+        );
+    }
+}
+
 fn json(path: &str) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(common::repo_root().join(path)).unwrap()).unwrap()
 }
@@ -70,10 +107,11 @@ fn a_report_of_profile_sweep_inspect_and_stability_opens_in_chromium_with_the_js
     let size = std::fs::metadata(&page).unwrap().len();
     assert!(size < 5 << 20, "the report is {size} bytes, over 5 MB");
 
-    let (dom, console) = headless(&page, &dir.path().join("profile"), &["--dump-dom"]);
+    let (dom, console) = headless(&page, &dir.path().join("profile"), &["--dump-dom", "--window-size=1400,900"]);
     assert!(console.is_empty(), "console messages:\n{}", console.join("\n"));
     assert!(dom.contains("data-ready=\"1\""), "the page's script did not finish");
     assert!(!dom.contains("src=\"http") && !dom.contains("href=\"http"), "the page loads nothing from the network");
+    readable_at_1400_px(&dom);
 
     let profile = json(INPUTS[0]);
     let rows = profile["rows"].as_array().unwrap();

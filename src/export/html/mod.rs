@@ -2,6 +2,7 @@
 //! data: URIs, with its CSS and script inline, so that it opens from file:// with no network. Knows nothing of
 //! BRDFs: `report_page` decides what goes in.
 
+use crate::export::labels::{Placer, Rect};
 use anyhow::Result;
 use std::fmt::Write;
 
@@ -69,6 +70,84 @@ pub fn img(uri: &str, width: u32, height: u32, scale: u32, alt: &str) -> String 
     )
 }
 
+/// A heat map's axes and colour scale: the ticks of each axis as (cell index, label), its name, and the
+/// viridis bar's labels at t = 0, 0.5 and 1 with its name.
+pub struct HeatAxes<'a> {
+    pub x: (&'a [(usize, String)], &'a str),
+    pub y: (&'a [(usize, String)], &'a str),
+    pub bar: ([String; 3], &'a str),
+}
+
+/// A `w` x `h` cell image (row 0 at the top, `scale` px per cell) in an SVG with its axes in values and a
+/// viridis colour bar: a colour-coded picture a reader can read without its caption.
+pub fn heat_svg(uri: &str, (w, h, scale): (u32, u32, u32), axes: &HeatAxes, alt: &str) -> String {
+    let (iw, ih) = (f64::from(w * scale), f64::from(h * scale));
+    let (l, t, b) = (46.0, 8.0, 34.0);
+    let bar_x = l + iw + 14.0;
+    let (sw, sh) = (bar_x + 60.0, t + ih + b);
+    let cell = f64::from(scale);
+    let mut s = format!(
+        "<svg class=\"heatmap\" viewBox=\"0 0 {sw} {sh}\" width=\"{sw}\" height=\"{sh}\" role=\"img\"><title>{}</title><image href=\"{uri}\" x=\"{l}\" y=\"{t}\" width=\"{iw}\" height=\"{ih}\" style=\"image-rendering:pixelated\" preserveAspectRatio=\"none\"/><rect x=\"{l}\" y=\"{t}\" width=\"{iw}\" height=\"{ih}\" class=\"frame\"/>",
+        esc(alt)
+    );
+    for (i, label) in axes.x.0 {
+        let x = l + (*i as f64 + 0.5) * cell;
+        let _ = write!(
+            s,
+            "<line x1=\"{x:.1}\" y1=\"{}\" x2=\"{x:.1}\" y2=\"{}\" stroke=\"#444\"/><text x=\"{x:.1}\" y=\"{}\" class=\"tick\" text-anchor=\"middle\">{}</text>",
+            t + ih,
+            t + ih + 3.0,
+            t + ih + 13.0,
+            esc(label)
+        );
+    }
+    for (i, label) in axes.y.0 {
+        // Row 0 of the data is drawn at the bottom.
+        let y = t + ih - (*i as f64 + 0.5) * cell;
+        let _ = write!(
+            s,
+            "<line x1=\"{}\" y1=\"{y:.1}\" x2=\"{l}\" y2=\"{y:.1}\" stroke=\"#444\"/><text x=\"{}\" y=\"{:.1}\" class=\"tick\" text-anchor=\"end\">{}</text>",
+            l - 3.0,
+            l - 5.0,
+            y + 3.5,
+            esc(label)
+        );
+    }
+    let _ = write!(
+        s,
+        "<text x=\"{:.1}\" y=\"{}\" class=\"tick\" text-anchor=\"middle\">{}</text><text transform=\"translate(10 {:.1}) rotate(-90)\" class=\"tick\" text-anchor=\"middle\">{}</text>",
+        l + iw / 2.0,
+        t + ih + 28.0,
+        esc(axes.x.1),
+        t + ih / 2.0,
+        esc(axes.y.1)
+    );
+    let stops: String = (0..=8)
+        .map(|k| {
+            let [r, g, b] = crate::export::raster::viridis(k as f32 / 8.0);
+            format!("<stop offset=\"{}\" stop-color=\"rgb({r},{g},{b})\"/>", 1.0 - k as f64 / 8.0)
+        })
+        .rev()
+        .collect();
+    let id = format!("v{:x}", uri.len() ^ (w as usize) << 8 ^ (h as usize) << 16 ^ alt.len() << 24);
+    let _ = write!(
+        s,
+        "<defs><linearGradient id=\"{id}\" x1=\"0\" y1=\"0\" x2=\"0\" y2=\"1\">{stops}</linearGradient></defs><rect x=\"{bar_x}\" y=\"{t}\" width=\"10\" height=\"{ih}\" fill=\"url(#{id})\" stroke=\"#999\"/>"
+    );
+    for (k, label) in axes.bar.0.iter().enumerate() {
+        let y = t + ih - ih * k as f64 / 2.0;
+        let _ = write!(s, "<text x=\"{}\" y=\"{:.1}\" class=\"tick\">{}</text>", bar_x + 13.0, y + 3.5, esc(label));
+    }
+    let _ = write!(
+        s,
+        "<text transform=\"translate({} {:.1}) rotate(-90)\" class=\"tick\" text-anchor=\"middle\">{}</text>",
+        bar_x + 52.0,
+        t + ih / 2.0,
+        esc(axes.bar.1)
+    );
+    s + "</svg>"
+}
+
 /// Ten distinguishable colours (the same order as `chart::palette`).
 pub fn colour(i: usize) -> &'static str {
     const P: [&str; 10] =
@@ -99,12 +178,22 @@ impl Cell {
 pub struct HtmlTable {
     pub columns: Vec<(String, String)>,
     pub rows: Vec<(String, Vec<Cell>)>,
+    /// A column's long description (its header's tooltip), by key.
+    pub descriptions: Vec<(String, String)>,
 }
 
 impl HtmlTable {
     /// `columns`: (key, header) pairs.
     pub fn new(columns: &[(&str, &str)]) -> Self {
-        HtmlTable { columns: columns.iter().map(|(k, h)| (k.to_string(), h.to_string())).collect(), rows: Vec::new() }
+        HtmlTable {
+            columns: columns.iter().map(|(k, h)| (k.to_string(), h.to_string())).collect(),
+            ..Default::default()
+        }
+    }
+
+    /// Gives column `key` a long description, shown when the pointer rests on its short header.
+    pub fn describe(&mut self, key: &str, text: impl Into<String>) {
+        self.descriptions.push((key.to_string(), text.into()));
     }
 
     pub fn row(&mut self, key: impl Into<String>, cells: Vec<Cell>) {
@@ -115,7 +204,11 @@ impl HtmlTable {
     pub fn html(&self) -> String {
         let mut s = String::from("<table class=\"sortable\"><thead><tr>");
         for (key, header) in &self.columns {
-            let _ = write!(s, "<th data-col=\"{}\" title=\"sort\">{}</th>", esc(key), esc(header));
+            let title = match self.descriptions.iter().find(|(k, _)| k == key) {
+                Some((_, d)) => format!("{d} (click to sort)"),
+                None => "sort".into(),
+            };
+            let _ = write!(s, "<th data-col=\"{}\" title=\"{}\">{}</th>", esc(key), esc(&title), esc(header));
         }
         s += "</tr></thead><tbody>\n";
         for (key, cells) in &self.rows {
@@ -223,6 +316,8 @@ pub struct Size {
 
 /// The full-width chart size.
 pub const WIDE: Size = Size { w: 760.0, h: 440.0 };
+/// A narrow panel beside a wide chart (sweep's fp16 specs).
+pub const SIDE: Size = Size { w: 300.0, h: 440.0 };
 /// A chart that fits beside others in a card.
 pub const SMALL: Size = Size { w: 320.0, h: 200.0 };
 
@@ -267,18 +362,42 @@ fn frame(s: &mut String, x: &Axis, y: &Axis, x_label: &str, y_label: &str, size:
     );
 }
 
-/// A scatter chart; each point shows its tip on hover (an SVG `<title>`, and the page's tooltip line).
+/// Label text in the page's CSS (`.lbl`): its size and a width per character no sans-serif face exceeds on
+/// average for labels (0.62 em), so that a placed box holds its text.
+const LABEL_PX: f64 = 10.5;
+const LABEL_CHAR_W: f64 = LABEL_PX * 0.62;
+
+/// A scatter chart; each point shows its tip on hover (an SVG `<title>`, and the page's tooltip line). The
+/// emphasised points are labelled where `labels::Placer` finds room (none overlapping another or a point) and,
+/// with `frontier`, joined by a line in order of x.
 #[allow(non_snake_case)] // W, H: the chart's width and height, as in the SVG
-pub fn scatter_svg(points: &[Point], x: Axis, y: Axis, x_label: &str, y_label: &str, size: Size) -> String {
+pub fn scatter_svg(
+    points: &[Point],
+    (x, y): (Axis, Axis),
+    x_label: &str,
+    y_label: &str,
+    size: Size,
+    frontier: bool,
+) -> String {
     let (l, r, t, b) = M;
     let Size { w: W, h: H } = size;
     let mut s = format!("<svg class=\"chart\" viewBox=\"0 0 {W} {H}\" width=\"{W}\" height=\"{H}\" role=\"img\">");
     frame(&mut s, &x, &y, x_label, y_label, size);
-    for p in
-        points.iter().filter(|p| p.x.is_finite() && p.y.is_finite() && (!x.log || p.x > 0.0) && (!y.log || p.y > 0.0))
-    {
-        let px = l + x.frac(p.x) * (W - l - r);
-        let py = H - b - y.frac(p.y) * (H - t - b);
+    let at = |p: &Point| (l + x.frac(p.x) * (W - l - r), H - b - y.frac(p.y) * (H - t - b));
+    let drawn: Vec<&Point> = points
+        .iter()
+        .filter(|p| p.x.is_finite() && p.y.is_finite() && (!x.log || p.x > 0.0) && (!y.log || p.y > 0.0))
+        .collect();
+    if frontier {
+        let mut front: Vec<(f64, f64)> = drawn.iter().filter(|p| p.emphasis).map(|p| at(p)).collect();
+        front.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let pts: Vec<String> = front.iter().map(|(x, y)| format!("{x:.1},{y:.1}")).collect();
+        let _ = write!(s, "<polyline class=\"front\" fill=\"none\" points=\"{}\"/>", pts.join(" "));
+    }
+    let mut placer = Placer::new(Rect { x0: l, y0: t, x1: W - r, y1: H - b });
+    for p in &drawn {
+        let (px, py) = at(p);
+        placer.occupy(Rect { x0: px - 5.0, y0: py - 5.0, x1: px + 5.0, y1: py + 5.0 });
         let class = if p.emphasis { "pt em" } else { "pt" };
         let _ = write!(
             s,
@@ -286,9 +405,24 @@ pub fn scatter_svg(points: &[Point], x: Axis, y: Axis, x_label: &str, y_label: &
             esc(&p.tip),
             esc(&p.tip)
         );
-        if p.emphasis {
-            let _ =
-                write!(s, "<text x=\"{:.1}\" y=\"{:.1}\" class=\"lbl\">{}</text>", px + 7.0, py - 5.0, esc(&p.label));
+    }
+    let mut labelled: Vec<&&Point> = drawn.iter().filter(|p| p.emphasis).collect();
+    labelled.sort_by(|a, b| b.y.total_cmp(&a.y));
+    for p in labelled {
+        let w = LABEL_CHAR_W * p.label.chars().count() as f64;
+        if let Some(bx) = placer.place(at(p), w, LABEL_PX * 1.3) {
+            if bx.far_from(at(p)) {
+                let ((x1, y1), (x2, y2)) = (at(p), bx.nearest(at(p)));
+                let _ =
+                    write!(s, "<line x1=\"{x1:.1}\" y1=\"{y1:.1}\" x2=\"{x2:.1}\" y2=\"{y2:.1}\" class=\"leader\"/>");
+            }
+            let _ = write!(
+                s,
+                "<text x=\"{:.1}\" y=\"{:.1}\" class=\"lbl\">{}</text>",
+                bx.x0,
+                bx.y1 - LABEL_PX * 0.3,
+                esc(&p.label)
+            );
         }
     }
     s + "</svg>"
@@ -354,7 +488,8 @@ pub fn lines_svg(curves: &[Curve], x: Axis, y: Axis, x_label: &str, y_label: &st
 /// radius is log10(r / peak) + decades over decades (values below the range at the centre). `marks` draws a
 /// labelled direction (e.g. the light).
 pub fn polar_svg(title: &str, curves: &[Curve], marks: &[(f64, &str)], log_decades: Option<f64>) -> String {
-    let (w, h, cx, cy, rim) = (300.0, 180.0, 150.0, 160.0, 135.0);
+    // The title has its own band above the rim, so the mark of a light at normal incidence never meets it.
+    let (w, h, cx, cy, rim) = (300.0, 196.0, 150.0, 176.0, 135.0);
     let mut s = format!(
         "<svg class=\"polar\" viewBox=\"0 0 {w} {h}\" width=\"{w}\" height=\"{h}\" role=\"img\"><text x=\"6\" y=\"14\" class=\"tick\">{}</text>",
         esc(title)

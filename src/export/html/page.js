@@ -43,5 +43,29 @@
     sec.setAttribute("data-top", String(Math.round(r.top + window.scrollY)));
     sec.setAttribute("data-bottom", String(Math.round(r.bottom + window.scrollY)));
   });
+  // Layout facts a reader would notice, recorded for tests: text boxes of one picture that overlap (by more
+  // than a pixel each way), and how wide each table is against the page.
+  function overlaps(a, b) {
+    return Math.min(a.right, b.right) - Math.max(a.left, b.left) > 1 &&
+      Math.min(a.bottom, b.bottom) - Math.max(a.top, b.top) > 1;
+  }
+  document.querySelectorAll("svg").forEach(function (svg) {
+    var boxes = [];
+    svg.querySelectorAll("text").forEach(function (t) {
+      var r = t.getBoundingClientRect();
+      if (r.width > 0 && r.height > 0) boxes.push([t.textContent, r]);
+    });
+    var pairs = [];
+    for (var i = 0; i < boxes.length; i++)
+      for (var j = i + 1; j < boxes.length; j++)
+        if (overlaps(boxes[i][1], boxes[j][1])) pairs.push(boxes[i][0] + " / " + boxes[j][0]);
+    svg.setAttribute("data-texts", String(boxes.length));
+    svg.setAttribute("data-overlaps", String(pairs.length));
+    if (pairs.length) svg.setAttribute("data-overlap-pairs", pairs.slice(0, 5).join(" | "));
+  });
+  document.querySelectorAll("table").forEach(function (t) {
+    t.setAttribute("data-width", String(Math.round(t.getBoundingClientRect().width)));
+  });
+  document.body.setAttribute("data-page-width", String(document.documentElement.clientWidth));
   document.body.setAttribute("data-ready", "1");
 })();
