@@ -406,76 +406,46 @@ impl CostTable {
         out
     }
 
-    /// A grouped bar chart: net cost relative to ggx, per model (groups) and device (colours).
+    /// The headline picture: net cost relative to ggx as a heat-map table, models by rows, devices by columns
+    /// grouped by vendor and compiler, each group saying whether its columns are measured, counted or modelled
+    /// (`export::heat_table`).
     pub fn chart(&self, path: &Path) -> Result<()> {
-        use plotters::prelude::*;
-        const LEGEND_WIDTH: i32 = 230;
         let models: Vec<&String> = self.models.iter().filter(|m| *m != BASELINE_LABEL).collect();
-        let values: Vec<Vec<Option<f64>>> =
-            models.iter().map(|m| self.columns.iter().map(|c| self.relative(c, m)).collect()).collect();
-        let max = values.iter().flatten().flatten().fold(1.0f64, |a, &b| a.max(b)) * 1.1;
-        let width = (300 + 60 * models.len() as u32 * self.columns.len().max(1) as u32 / 2).clamp(800, 2400)
-            + LEGEND_WIDTH as u32;
-        crate::export::png::render(path, width, 600, |root| {
-            let e = |e: DrawingAreaErrorKind<_>| anyhow!("{e}");
-            // The legend goes in a right margin of its own, so that it never hides a bar.
-            let mut chart = ChartBuilder::on(root)
-                .caption(
-                    "BRDF cost net of the memory-only kernel, relative to ggx, per device",
-                    (crate::export::png::FONT, 20),
-                )
-                .margin(15)
-                .margin_right(LEGEND_WIDTH)
-                .x_label_area_size(90)
-                .y_label_area_size(60)
-                .build_cartesian_2d(0f64..models.len() as f64, 0f64..max)
-                .map_err(e)?;
-            chart
-                .configure_mesh()
-                .disable_x_mesh()
-                .x_labels(0)
-                .y_desc("net cost / ggx's net cost")
-                .label_style((crate::export::png::FONT, 13))
-                .draw()
-                .map_err(e)?;
-            let n = self.columns.len().max(1) as f64;
-            for (j, c) in self.columns.iter().enumerate() {
-                let colour = crate::export::png::palette(j);
-                let bars: Vec<_> = values
-                    .iter()
-                    .enumerate()
-                    .filter_map(|(i, v)| v[j].map(|y| (i, y)))
-                    .map(|(i, y)| {
-                        let x0 = i as f64 + 0.1 + 0.8 * j as f64 / n;
-                        Rectangle::new([(x0, 0.0), (x0 + 0.8 / n, y.max(0.0))], colour.filled())
-                    })
-                    .collect();
-                chart.draw_series(bars).map_err(e)?;
-                let (lx, ly) = (width as i32 - LEGEND_WIDTH + 10, 50 + 18 * j as i32);
-                root.draw(&Rectangle::new([(lx, ly - 5), (lx + 12, ly + 7)], colour.filled())).map_err(e)?;
-                root.draw(&Text::new(c.name.clone(), (lx + 18, ly - 5), (crate::export::png::FONT, 13))).map_err(e)?;
+        let mut order: Vec<(usize, String, usize)> =
+            self.columns.iter().enumerate().map(|(j, c)| (c.vendor().0, c.vendor().1, j)).collect();
+        order.sort_by(|a, b| (a.0, &a.1).cmp(&(b.0, &b.1)).then(a.2.cmp(&b.2)));
+        let mut groups: Vec<(String, Vec<String>)> = Vec::new();
+        let mut picked = Vec::new();
+        for (_, vendor, j) in &order {
+            let c = &self.columns[*j];
+            let short = c.name.strip_suffix(" cycles/eval").unwrap_or(&c.name).to_string();
+            match groups.last_mut() {
+                Some((g, cols)) if g == vendor => cols.push(short),
+                _ => groups.push((vendor.clone(), vec![short])),
             }
-            chart
-                .draw_series(std::iter::once(PathElement::new(
-                    vec![(0.0, 1.0), (models.len() as f64, 1.0)],
-                    BLACK.mix(0.5),
-                )))
-                .map_err(e)?;
-            // Model names under their groups (long specs wrapped at commas).
-            for (i, m) in models.iter().enumerate() {
-                let (px, py) = chart.backend_coord(&(i as f64 + 0.5, 0.0));
-                for (k, part) in m.split_inclusive(',').enumerate() {
-                    let w = 7 * part.len() as i32;
-                    root.draw(&Text::new(
-                        part.to_string(),
-                        (px - w / 2, py + 8 + 16 * k as i32),
-                        (crate::export::png::FONT, 13),
-                    ))
-                    .map_err(e)?;
-                }
+            picked.push(*j);
+        }
+        // A group of one kind says it once; a mixed group (lavapipe's measured and counted) says it per column.
+        let mut at = 0;
+        for (g, cols) in groups.iter_mut() {
+            let kinds: Vec<&str> = picked[at..at + cols.len()].iter().map(|&j| self.columns[j].kind()).collect();
+            if kinds.iter().all(|k| *k == kinds[0]) {
+                *g = format!("{g}: {}", kinds[0]);
+            } else {
+                cols.iter_mut().zip(&kinds).for_each(|(c, k)| *c = format!("{c}, {k}"));
             }
-            Ok(())
-        })
+            at += cols.len();
+        }
+        let cells =
+            models.iter().map(|m| picked.iter().map(|&j| self.relative(&self.columns[j], m)).collect()).collect();
+        let table = crate::export::heat_table::HeatTable {
+            title: "BRDF cost net of the memory-only kernel, relative to ggx in each column".into(),
+            groups,
+            rows: models.iter().map(|m| m.to_string()).collect(),
+            cells,
+            scale_name: "net cost / ggx's".into(),
+        };
+        crate::export::heat_table::draw(path, &table)
     }
 }
 
@@ -543,6 +513,41 @@ pub fn refuse_repeated_reports(files: &[PathBuf], why: &str) -> Result<()> {
 }
 
 impl CostColumn {
+    /// Measured (a timed column), counted (callgrind's instructions) or modelled (a compile-only target).
+    pub fn kind(&self) -> &'static str {
+        if self.unit.starts_with("measured") {
+            "measured"
+        } else if self.name.starts_with("callgrind") {
+            "counted"
+        } else {
+            "modelled"
+        }
+    }
+
+    /// The column's vendor and compiler, for grouping, with its rank in the headline picture's order (CPU,
+    /// AMD, NVIDIA, Intel, Qualcomm, Arm, other); from the source's device name and the unit's compiler.
+    pub fn vendor(&self) -> (usize, String) {
+        let source = self.source.to_lowercase();
+        let has = |words: &[&str]| words.iter().any(|w| source.contains(w));
+        let compiler = self.unit.split_whitespace().next().unwrap_or("?");
+        let (rank, vendor) = if has(&["llvmpipe", "lavapipe", "swiftshader"]) && self.kind() != "modelled" {
+            return (0, "lavapipe".into());
+        } else if has(&["radv", "amd"]) {
+            (1, "AMD")
+        } else if has(&["nvidia", "nouveau", "nvk"]) {
+            (2, "NVIDIA")
+        } else if has(&["intel", "anv"]) {
+            (3, "Intel")
+        } else if has(&["adreno", "turnip", "freedreno"]) {
+            (4, "Qualcomm")
+        } else if has(&["mali", "panvk", "panfrost"]) {
+            (5, "Arm")
+        } else {
+            (6, "other")
+        };
+        (rank, format!("{vendor} ({compiler})"))
+    }
+
     /// Refuses figures no measurement gives: a cost that is not finite or not above 0, a net cost that is not
     /// finite or above the gross one (the memory-only kernel cannot cost less than nothing), a CI that does
     /// not hold its median.
@@ -597,4 +602,29 @@ pub fn from_files(files: &[PathBuf]) -> Result<CostTable> {
     }
     check_kernels(&columns)?;
     Ok(build(columns))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The committed three-vendor table: the headline picture's groups come out in vendor order, each of one
+    /// kind but lavapipe's.
+    #[test]
+    fn the_headline_columns_group_by_vendor_and_say_how_each_was_obtained() {
+        let text = std::fs::read_to_string("results/targets/inspect-thesis.json").unwrap();
+        let json: serde_json::Value = serde_json::from_str(&text).unwrap();
+        let columns: Vec<CostColumn> = serde_json::from_value(json["costs"]["columns"].clone()).unwrap();
+        let groups: Vec<(usize, String, &str)> =
+            columns.iter().map(|c| (c.vendor().0, c.vendor().1, c.kind())).collect();
+        let mut ranks: Vec<usize> = groups.iter().map(|g| g.0).collect();
+        ranks.dedup();
+        assert_eq!(ranks, [0, 1, 2, 3], "lavapipe, AMD, NVIDIA, Intel: {groups:?}");
+        let kind = |name: &str| groups.iter().zip(&columns).find(|(_, c)| c.name.starts_with(name)).unwrap().0.2;
+        assert_eq!(
+            (kind("llvmpipe"), kind("callgrind"), kind("navi21"), kind("sm_89")),
+            ("measured", "counted", "modelled", "modelled")
+        );
+        assert!(groups.iter().any(|g| g.1 == "AMD (ACO)") && groups.iter().any(|g| g.1 == "Intel (IGC)"), "{groups:?}");
+    }
 }

@@ -5,6 +5,7 @@
 
 pub mod bench;
 pub mod github;
+pub mod heat_table;
 pub mod html;
 pub mod json;
 pub mod labels;

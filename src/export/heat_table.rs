@@ -1,0 +1,231 @@
+//! A table of ratios drawn as a picture: rows (models) x columns (devices) grouped under headers (vendors),
+//! each cell its ratio printed on a diverging colour (blue cheaper than 1, white 1, red costlier; log2 scale
+//! clamped at 0.5x and 2x), a colour bar in values beside it. README's headline picture: one vendor's
+//! columns side by side, which columns are measured and which modelled in the group's header.
+//! Every text's box is measured with the font it is drawn in and laid out on a grid, and `layout` returns
+//! them, so a test checks that none overlaps another.
+
+use crate::export::labels::Rect;
+use crate::export::png::{FONT, render};
+use anyhow::{Result, anyhow};
+use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
+use std::path::Path;
+
+/// What the picture shows.
+pub struct HeatTable {
+    pub title: String,
+    /// (group header, the columns' names under it).
+    pub groups: Vec<(String, Vec<String>)>,
+    pub rows: Vec<String>,
+    /// Per row, per column in group order: the ratio, or None where there is none (`-`).
+    pub cells: Vec<Vec<Option<f64>>>,
+    /// What a ratio is, under the colour bar.
+    pub scale_name: String,
+}
+
+/// Pixel sizes: picture drawn at twice a screen's density, so it stays sharp when GitHub scales it to its
+/// README width (about 880 px).
+const CELL_W: i32 = 84;
+const CELL_H: i32 = 38;
+const NAME_W: i32 = 190;
+const GROUP_H: i32 = 40;
+const TITLE_H: i32 = 50;
+const BAR_W: i32 = 170;
+const MARGIN: i32 = 16;
+/// The colour bar's height: 2x at the top to 0.5x at the bottom.
+const BAR_H: i32 = 240;
+const CELL_FONT: u32 = 24;
+const HEAD_FONT: u32 = 20;
+
+/// Colour of a ratio: log2 clamped to [-1, 1], white at 0.
+pub fn colour(ratio: f64) -> RGBColor {
+    let t = ratio.log2().clamp(-1.0, 1.0);
+    let (to, k) = if t < 0.0 { ((33, 102, 172), -t) } else { ((178, 24, 43), t) };
+    let mix = |c: u8| (255.0 + (f64::from(c) - 255.0) * k).round() as u8;
+    RGBColor(mix(to.0), mix(to.1), mix(to.2))
+}
+
+/// A text to draw: its box (top-left, size), anchor point, size, rotation.
+#[derive(Clone, Debug)]
+pub struct Placed {
+    pub text: String,
+    pub at: (i32, i32),
+    pub size: u32,
+    pub vertical: bool,
+    pub bold: bool,
+    pub rect: Rect,
+}
+
+fn group_of(table: &HeatTable) -> Vec<(usize, usize)> {
+    let mut start = 0;
+    table
+        .groups
+        .iter()
+        .map(|(_, c)| {
+            let r = (start, c.len());
+            start += c.len();
+            r
+        })
+        .collect()
+}
+
+/// Where the picture's size and every text go; `measure` gives a text's width and height at a size.
+pub fn layout(table: &HeatTable, measure: &dyn Fn(&str, u32, bool) -> (i32, i32)) -> ((u32, u32), Vec<Placed>) {
+    let columns: usize = table.groups.iter().map(|g| g.1.len()).sum();
+    let gap = 8;
+    let x0 = MARGIN + NAME_W;
+    let col_x = |j: usize, group: usize| x0 + j as i32 * CELL_W + group as i32 * gap;
+    let header_h =
+        table.groups.iter().flat_map(|g| &g.1).map(|c| measure(c, HEAD_FONT, false).0).max().unwrap_or(0) + 16;
+    let grid_top = TITLE_H + GROUP_H + header_h;
+    let width = x0 + columns as i32 * CELL_W + (table.groups.len() as i32 - 1).max(0) * gap + BAR_W + MARGIN;
+    let height = grid_top + (table.rows.len() as i32 * CELL_H).max(BAR_H + 12) + MARGIN;
+    let mut out = Vec::new();
+    let mut put = |text: String, at: (i32, i32), size: u32, vertical: bool, bold: bool, centre: bool| {
+        let (w, h) = measure(&text, size, bold);
+        let (w, h) = if vertical { (h, w) } else { (w, h) };
+        let left = if centre { at.0 - w / 2 } else { at.0 };
+        let top = if vertical { at.1 - h } else { at.1 - h / 2 };
+        let rect = Rect { x0: left as f64, y0: top as f64, x1: (left + w) as f64, y1: (top + h) as f64 };
+        out.push(Placed { text, at, size, vertical, bold, rect });
+    };
+    put(table.title.clone(), (MARGIN, TITLE_H / 2), 26, false, true, false);
+    for (g, ((name, cols), (start, n))) in table.groups.iter().zip(group_of(table)).enumerate() {
+        let (left, right) = (col_x(start, g), col_x(start + n, g));
+        // A group header wider than its columns is cut to fit, with an ellipsis.
+        let mut text = name.clone();
+        while text.chars().count() > 1 && measure(&text, HEAD_FONT, true).0 > right - left - 4 {
+            text = format!("{}…", text.chars().take(text.chars().count().saturating_sub(2)).collect::<String>());
+        }
+        put(text, ((left + right) / 2, TITLE_H + GROUP_H / 2), HEAD_FONT, false, true, true);
+        for (k, c) in cols.iter().enumerate() {
+            let x = col_x(start + k, g) + CELL_W / 2;
+            put(c.clone(), (x, grid_top - 8), HEAD_FONT, true, false, true);
+        }
+    }
+    for (i, row) in table.rows.iter().enumerate() {
+        let y = grid_top + i as i32 * CELL_H + CELL_H / 2;
+        put(row.clone(), (MARGIN, y), CELL_FONT, false, false, false);
+        let mut j = 0;
+        for (g, (_, n)) in group_of(table).iter().enumerate() {
+            for k in 0..*n {
+                let text = table.cells[i].get(j + k).copied().flatten().map_or("-".into(), |r| format!("{r:.2}"));
+                put(text, (col_x(j + k, g) + CELL_W / 2, y), CELL_FONT, false, false, true);
+            }
+            j += n;
+        }
+    }
+    let bar_x = width - BAR_W - MARGIN + 40;
+    for (k, v) in [2.0, 1.41, 1.0, 0.71, 0.5].iter().enumerate() {
+        put(format!("{v}"), (bar_x + 34, grid_top + k as i32 * 60), HEAD_FONT, false, false, false);
+    }
+    put(table.scale_name.clone(), (bar_x + 100, grid_top + BAR_H), HEAD_FONT, true, false, true);
+    ((width as u32, height as u32), out)
+}
+
+/// The grid's top: below the title, the group headers and the tallest column header (whose bottoms sit 8 px
+/// above it).
+fn grid_top(table: &HeatTable, texts: &[Placed]) -> i32 {
+    let columns: Vec<&String> = table.groups.iter().flat_map(|g| &g.1).collect();
+    texts
+        .iter()
+        .filter(|t| t.vertical && columns.contains(&&t.text))
+        .map(|t| t.at.1 + 8)
+        .max()
+        .unwrap_or(TITLE_H + GROUP_H)
+}
+
+/// Draws the table to `path` as PNG.
+pub fn draw(path: &Path, table: &HeatTable) -> Result<()> {
+    let mut size = (0, 0);
+    let mut texts = Vec::new();
+    crate::export::png::pixels(1, 1, |root| {
+        let measure = |t: &str, s: u32, bold: bool| {
+            let font = if bold { (FONT, s).into_font().style(FontStyle::Bold) } else { (FONT, s).into_font() };
+            root.estimate_text_size(t, &TextStyle::from(font)).map_or((0, 0), |(w, h)| (w as i32, h as i32))
+        };
+        (size, texts) = layout(table, &measure);
+        Ok(())
+    })?;
+    let e = |e: DrawingAreaErrorKind<_>| anyhow!("{}: {e}", path.display());
+    render(path, size.0, size.1, |root| {
+        let gap = 8;
+        let x0 = MARGIN + NAME_W;
+        let grid_top = grid_top(table, &texts);
+        for (g, (start, n)) in group_of(table).into_iter().enumerate() {
+            let left = x0 + start as i32 * CELL_W + g as i32 * gap;
+            root.draw(&PathElement::new(
+                vec![(left, TITLE_H + GROUP_H - 4), (left + n as i32 * CELL_W, TITLE_H + GROUP_H - 4)],
+                BLACK.stroke_width(2),
+            ))
+            .map_err(e)?;
+            // A light grey behind the cells draws the grid lines between them (a ratio of 1 is white).
+            let bottom = grid_top + table.rows.len() as i32 * CELL_H;
+            root.draw(&Rectangle::new(
+                [(left - 2, grid_top - 2), (left + n as i32 * CELL_W, bottom)],
+                RGBColor(214, 214, 214).filled(),
+            ))
+            .map_err(e)?;
+            for i in 0..table.rows.len() {
+                for k in 0..n {
+                    let x = left + k as i32 * CELL_W;
+                    let y = grid_top + i as i32 * CELL_H;
+                    let fill = table.cells[i].get(start + k).copied().flatten().map_or(RGBColor(238, 238, 238), colour);
+                    root.draw(&Rectangle::new([(x, y), (x + CELL_W - 2, y + CELL_H - 2)], fill.filled())).map_err(e)?;
+                }
+            }
+        }
+        let bar_x = size.0 as i32 - BAR_W - MARGIN + 40;
+        for p in 0..BAR_H {
+            let ratio = 2f64.powf(1.0 - 2.0 * p as f64 / BAR_H as f64);
+            root.draw(&Rectangle::new([(bar_x, grid_top + p), (bar_x + 24, grid_top + p + 1)], colour(ratio).filled()))
+                .map_err(e)?;
+        }
+        for t in &texts {
+            let style =
+                if t.bold { (FONT, t.size).into_font().style(FontStyle::Bold) } else { (FONT, t.size).into_font() };
+            let style = if t.vertical { style.transform(FontTransform::Rotate270) } else { style };
+            let pos = (t.rect.x0 as i32, t.rect.y0 as i32);
+            let style = style.color(&BLACK).pos(Pos::new(HPos::Left, VPos::Top));
+            let at = if t.vertical { (pos.0, t.rect.y1 as i32) } else { pos };
+            root.draw(&Text::new(t.text.clone(), at, style)).map_err(e)?;
+        }
+        Ok(())
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn no_text_of_a_wide_table_overlaps_another_and_the_colours_diverge_at_one() {
+        let groups: Vec<(String, Vec<String>)> = [
+            ("lavapipe: measured, counted", 2),
+            ("AMD (ACO): modelled", 7),
+            ("NVIDIA (ptxas): modelled", 5),
+            ("Intel (IGC): modelled", 5),
+        ]
+        .iter()
+        .map(|(g, n)| (g.to_string(), (0..*n).map(|k| format!("polaris1{k} cycles/eval")).collect()))
+        .collect();
+        let rows: Vec<String> = ["ggx", "blinn", "cook-torrance", "burley"].iter().map(|s| s.to_string()).collect();
+        let cells = rows.iter().map(|_| (0..19).map(|k| (k != 3).then_some(0.5 + k as f64 / 10.0)).collect()).collect();
+        let table =
+            HeatTable { title: "net cost relative to ggx".into(), groups, rows, cells, scale_name: "x ggx".into() };
+        let dir = tempfile::tempdir().unwrap();
+        draw(&dir.path().join("t.png"), &table).unwrap();
+        let measure = |t: &str, s: u32, _: bool| ((t.chars().count() as u32 * s * 6 / 10) as i32, s as i32);
+        let ((w, h), texts) = layout(&table, &measure);
+        for (i, a) in texts.iter().enumerate() {
+            assert!(a.rect.x0 >= 0.0 && a.rect.x1 <= w as f64 && a.rect.y0 >= 0.0 && a.rect.y1 <= h as f64, "{a:?}");
+            for b in &texts[..i] {
+                assert!(!a.rect.overlaps(&b.rect), "{} over {}", a.text, b.text);
+            }
+        }
+        assert_eq!(colour(1.0), RGBColor(255, 255, 255));
+        let (cheap, dear) = (colour(0.5), colour(2.0));
+        assert!(cheap.2 > cheap.0 && dear.0 > dear.2, "blue below 1, red above");
+    }
+}
