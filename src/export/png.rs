@@ -227,6 +227,11 @@ fn draw_labels(
         let width = (CHAR_W * text.chars().count() as i32) as f64;
         let Some(b) = placer.place((x as f64, y as f64), width, TEXT_H as f64) else { continue };
         let base = area.get_base_pixel();
+        if b.far_from((x as f64, y as f64)) {
+            let (nx, ny) = b.nearest((x as f64, y as f64));
+            let leader = vec![(x - base.0, y - base.1), (nx as i32 - base.0, ny as i32 - base.1)];
+            area.draw(&PathElement::new(leader, palette(p.group).mix(0.6))).map_err(|e| anyhow!("chart: {e}"))?;
+        }
         let font = (FONT, if p.highlight { 16 } else { 14 }).into_font().color(&palette(p.group).mix(0.95));
         let at = (b.x0 as i32 - base.0, b.y0 as i32 - base.1);
         area.draw(&Text::new(text, at, font)).map_err(|e| anyhow!("chart: {e}"))?;
