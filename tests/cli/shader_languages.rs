@@ -905,3 +905,37 @@ fn wgsl_enable_f16_computes_in_half_precision_within_its_rounding() {
     let md = std::fs::read_to_string(dir.path().join("t.md")).unwrap();
     assert!(md.contains("d-ggx-f16.wgsl") && md.contains("has no shaderFloat16"), "{}\n{md}", out.stderr);
 }
+
+/// A parameter name the translation into GLSL would rename never silently loses its value, and storage a
+/// workgroup shares is refused: each exit 2 at the declaration's file and line (and column for storage).
+#[test]
+fn renamed_parameters_and_workgroup_storage_are_refused_at_their_lines() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write_rows(&d.join("in.csv"), 2);
+    let hlsl = |param: &str, body: &str| {
+        format!(
+            "analytic\n::begin parameters\nfloat {param} 0 1 0.5\n::end parameters\n::begin shader hlsl\n{body}float3 BRDF(float3 L, float3 V, float3 N, float3 X, float3 Y)\n{{\n\treturn {param}.xxx;\n}}\n::end shader\n"
+        )
+    };
+    let cases = [
+        ("double.brdf", hlsl("rough__ness", ""), "double.brdf:3: parameter `rough__ness`: the translation into GLSL would rename it (GLSL reserves names with two underscores in a row)"),
+        ("temp.brdf", hlsl("_12", ""), "temp.brdf:3: parameter `_12`: the translation into GLSL would rename it (spirv-cross names its own temporaries `_N`)"),
+        ("shared.brdf", hlsl("gloss", "groupshared float cache[4];\n"), "shared.brdf:6:1: `groupshared` storage is shared by a workgroup's invocations"),
+        (
+            "shared.wgsl",
+            "var<workgroup> total: atomic<u32>;\nfn BRDF(L: vec3<f32>, V: vec3<f32>, N: vec3<f32>, X: vec3<f32>, Y: vec3<f32>) -> vec3<f32> {\n    return vec3<f32>(f32(atomicAdd(&total, 1u)));\n}\n".to_string(),
+            "shared.wgsl:1:5: `workgroup` storage is shared by a workgroup's invocations",
+        ),
+    ];
+    for (name, text, needle) in &cases {
+        std::fs::write(d.join(name), text).unwrap();
+        run_in(d, &["eval", "--model", name, "--input", "in.csv", "--output", "x.csv"]).fails(2, needle);
+        assert!(!d.join("x.csv").exists(), "{name}");
+    }
+    // The same file with a name GLSL keeps evaluates to its parameter's value.
+    std::fs::write(d.join("plain.brdf"), hlsl("rough_ness", "")).unwrap();
+    run_in(d, &["eval", "--model", "plain.brdf,rough_ness=0.25", "--input", "in.csv", "--output", "p.csv"]).ok();
+    let text = std::fs::read_to_string(d.join("p.csv")).unwrap();
+    assert!(text.lines().skip(1).all(|l| l.split(',').rev().take(3).all(|v| v.trim() == "0.25")), "{text}");
+}

@@ -42,6 +42,7 @@ fn translate_here(file: &mut BrdfFile) -> Result<Vec<(usize, String)>> {
         ));
     }
     check_reserved_names(file)?;
+    check_param_spelling(file)?;
     let (spirv, source) = match file.language {
         Language::Hlsl => hlsl_spirv(file)?,
         _ => wgsl_spirv(file)?,
@@ -83,17 +84,63 @@ fn check_reserved_names(file: &BrdfFile) -> Result<()> {
         .collect();
     let tokens =
         if file.language == Language::Wgsl { tokenize_wgsl(&file.path, &code)? } else { tokenize(&file.path, &code)? };
+    let place = |t: &Token| {
+        let (n, text) = &code[t.line];
+        format!("{}:{n}:{}", file.path.display(), text[..t.start].chars().count() + 1)
+    };
     let reserved =
         |t: &&Token| t.kind == Kind::Ident && t.text.to_ascii_lowercase().starts_with(front::GENERATED_PREFIX);
-    let Some(t) = tokens.iter().find(reserved) else { return Ok(()) };
-    let (n, text) = &code[t.line];
-    let column = text[..t.start].chars().count() + 1;
-    bail!(
-        "{}:{n}:{column}: `{}`: names starting with `{}` (in any case) are brdfprof's own (the stub, glue and include guards it writes into the shader); give it another name",
-        file.path.display(),
-        t.text,
-        front::GENERATED_PREFIX
-    )
+    if let Some(t) = tokens.iter().find(reserved) {
+        bail!(
+            "{}: `{}`: names starting with `{}` (in any case) are brdfprof's own (the stub, glue and include guards it writes into the shader); give it another name",
+            place(t),
+            t.text,
+            front::GENERATED_PREFIX
+        )
+    }
+    // Storage one invocation shares with its workgroup: the kernels run the model once per invocation with no
+    // barrier, so such a variable would be read while others write it (and a translation loses its zeroing).
+    let shared = |(k, t): &(usize, &Token)| {
+        t.kind == Kind::Ident
+            && match file.language {
+                Language::Wgsl => t.text == "workgroup" && *k > 0 && tokens[*k - 1].text == "<",
+                _ => t.text == "groupshared",
+            }
+    };
+    if let Some((_, t)) = tokens.iter().enumerate().find(shared) {
+        bail!(
+            "{}: `{}` storage is shared by a workgroup's invocations, which brdfprof's kernels run as independent evaluations with no barrier; make it a local (function) variable",
+            place(t),
+            t.text
+        )
+    }
+    Ok(())
+}
+
+/// Refuses, at its declaration, a parameter name the translation into GLSL would rename, so that the value
+/// brdfprof binds could never reach it: GLSL reserves names with two underscores in a row and `gl_`, and
+/// spirv-cross names its own temporaries `_N`.
+fn check_param_spelling(file: &BrdfFile) -> Result<()> {
+    for p in &file.params {
+        let why = if p.name.contains("__") {
+            "GLSL reserves names with two underscores in a row"
+        } else if p.name.starts_with("gl_") {
+            "GLSL reserves names starting with `gl_`"
+        } else if p.name.strip_prefix('_').is_some_and(|d| !d.is_empty() && d.bytes().all(|b| b.is_ascii_digit())) {
+            "spirv-cross names its own temporaries `_N`"
+        } else {
+            continue;
+        };
+        bail!(at(
+            &file.path,
+            p.line,
+            format!(
+                "parameter `{}`: the translation into GLSL would rename it ({why}), so its value would never arrive; give the parameter another name",
+                p.name
+            )
+        ));
+    }
+    Ok(())
 }
 
 /// The shader's source lines with their files and lines (HLSL: with its includes), where a name is looked for.
