@@ -318,9 +318,11 @@ fn is_shader_option(item: &str) -> bool {
 }
 
 /// `include=DIR` and `include-map=VIRTUAL=DIR` items over `old`: a directory given again is not repeated, a
-/// virtual prefix mapped again takes the new directory. Each directory must exist.
+/// virtual prefix of `old` mapped again takes the new directory, and one prefix mapped to two directories by
+/// `items` themselves is refused, naming both (neither would be chosen silently). Each directory must exist.
 fn merge_includes(path: &str, old: &Includes, items: &[String]) -> Result<Includes> {
     let mut out = old.clone();
+    let mut mapped: Vec<(&str, &str, &String)> = Vec::new();
     for item in items {
         let (key, value) = item.split_once('=').map(|(k, v)| (k.trim(), v.trim())).unwrap_or((item, ""));
         let (virtual_prefix, dir) = match key {
@@ -332,6 +334,15 @@ fn merge_includes(path: &str, old: &Includes, items: &[String]) -> Result<Includ
         }
         if !Path::new(dir).is_dir() {
             bail!("{path}: `{item}`: {dir} is not a directory");
+        }
+        if let Some(v) = virtual_prefix {
+            let same = |p: &str| p.trim_end_matches('/') == v.trim_end_matches('/');
+            if let Some((_, first_dir, first)) = mapped.iter().find(|(p, d, _)| same(p) && *d != dir) {
+                bail!(
+                    "{path}: `{first}` and `{item}` map one prefix to two directories ({first_dir}, {dir}); give it once"
+                );
+            }
+            mapped.push((v, dir, item));
         }
         match virtual_prefix {
             Some(v) => match out.maps.iter_mut().find(|(m, _)| m == v) {

@@ -939,3 +939,43 @@ fn renamed_parameters_and_workgroup_storage_are_refused_at_their_lines() {
     let text = std::fs::read_to_string(d.join("p.csv")).unwrap();
     assert!(text.lines().skip(1).all(|l| l.split(',').rev().take(3).all(|v| v.trim() == "0.25")), "{text}");
 }
+
+/// Nothing chosen silently among two: one prefix mapped to two directories, one module name two files
+/// declare; and a mapped include stays under its directory. Each exit 2 naming both (or the map).
+#[test]
+fn two_candidates_for_one_include_or_module_are_refused_naming_both() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write_rows(&d.join("in.csv"), 2);
+    for sub in ["x", "y", "a", "b"] {
+        std::fs::create_dir_all(d.join(sub)).unwrap();
+    }
+    let entry = "float3 BRDF(float3 L, float3 V, float3 N, float3 X, float3 Y)\n{\n\treturn Gain().xxx;\n}\n";
+    std::fs::write(d.join("x/gain.ush"), "float Gain() { return 0.5; }\n").unwrap();
+    std::fs::write(d.join("y/gain.ush"), "float Gain() { return 2.0; }\n").unwrap();
+    std::fs::write(d.join("outside.ush"), "float Gain() { return 3.0; }\n").unwrap();
+    std::fs::write(d.join("m.hlsl"), format!("#include \"/Engine/gain.ush\"\n{entry}")).unwrap();
+    std::fs::write(d.join("up.hlsl"), format!("#include \"/Engine/../outside.ush\"\n{entry}")).unwrap();
+    let eval = |model: &str, maps: &[&str]| {
+        let mut args = vec!["eval", "--model", model, "--input", "in.csv", "--output", "x.csv"];
+        args.extend(maps.iter().flat_map(|m| ["--include-map", *m]));
+        run_in(d, &args)
+    };
+    eval("m.hlsl", &["/Engine=x"]).ok();
+    eval("m.hlsl", &["/Engine=x", "/Engine/=y"]).fails(2, "map one prefix to two directories (x, y); give it once");
+    eval("up.hlsl", &["/Engine=x"]).fails(2, "its `..` leaves the directory --include-map /Engine=x maps it under");
+    let module = |gain: &str| format!("#define_import_path dup::gain\nfn gain() -> f32 {{ return {gain}; }}\n");
+    std::fs::write(d.join("a/gain.wgsl"), module("0.5")).unwrap();
+    std::fs::write(d.join("b/gain.wgsl"), module("2.0")).unwrap();
+    let wgsl = "#import dup::gain::gain\nfn BRDF(L: vec3<f32>, V: vec3<f32>, N: vec3<f32>, X: vec3<f32>, Y: vec3<f32>) -> vec3<f32> {\n    return vec3<f32>(gain());\n}\n";
+    std::fs::write(d.join("w.wgsl"), wgsl).unwrap();
+    let run = |dirs: &[&str]| {
+        let mut args = vec!["eval", "--model", "w.wgsl", "--input", "in.csv", "--output", "x.csv"];
+        args.extend(dirs.iter().flat_map(|m| ["--include-dir", *m]));
+        run_in(d, &args)
+    };
+    run(&["a"]).ok();
+    let out =
+        run(&["a", "b"]).fails(2, "w.wgsl:1:9: `dup::gain` is declared by two modules, a/gain.wgsl and b/gain.wgsl");
+    assert!(!out.stderr.contains("panicked"), "{}", out.stderr);
+}

@@ -90,7 +90,7 @@ impl Includes {
     pub fn find(&self, name: &str, beside: Option<&Path>) -> Option<PathBuf> {
         let found = |p: &PathBuf| p.metadata().is_ok_and(|m| !m.is_dir());
         if let Some(((_, dir), rest)) = self.mapped(name) {
-            return Some(dir.join(rest)).filter(found);
+            return Some(dir.join(rest)).filter(|p| stays_under(rest) && found(p));
         }
         beside.map(|d| d.join(name)).into_iter().chain(self.dirs.iter().map(|d| d.join(name))).find(found)
     }
@@ -98,6 +98,9 @@ impl Includes {
     /// Where `find` looked for `name`, as a message goes on after the name: `: --include-map V=DIR maps it to
     /// P, which does not exist`, or ` (searched: DIR, ...)`.
     pub fn searched(&self, name: &str, beside: Option<&Path>) -> String {
+        if let Some(((v, dir), _)) = self.mapped(name).filter(|(_, rest)| !stays_under(rest)) {
+            return format!(": its `..` leaves the directory --include-map {v}={} maps it under", dir.display());
+        }
         if let Some(((v, dir), rest)) = self.mapped(name) {
             return format!(
                 ": --include-map {v}={} maps it to {}, which does not exist",
@@ -109,6 +112,23 @@ impl Includes {
             beside.map(shown_dir).into_iter().chain(self.dirs.iter().map(|d| shown_dir(d))).collect();
         format!(" (searched: {})", if dirs.is_empty() { "no directory".to_string() } else { dirs.join(", ") })
     }
+}
+
+/// Whether a path under a mapped prefix stays under its directory (its `..` never climbs above the start), as
+/// the map promises "under DIR alone".
+fn stays_under(rest: &str) -> bool {
+    let mut depth = 0i32;
+    for part in rest.split(['/', '\\']) {
+        match part {
+            ".." => depth -= 1,
+            "" | "." => {}
+            _ => depth += 1,
+        }
+        if depth < 0 {
+            return false;
+        }
+    }
+    true
 }
 
 /// The directory a shader file's own includes and imports are found beside: its parent, empty for a bare file

@@ -194,12 +194,13 @@ fn declared_module(path: &Path) -> Option<String> {
 }
 
 /// The modules the include directories (recursively) and the model's own directory declare with
-/// `#define_import_path NAME`: NAME -> its file, the first found in that order. Built when an import first
-/// names a module, so a shader that imports none (or only quoted paths) never walks a folder.
+/// `#define_import_path NAME`: NAME -> every file that declares it, in that order (an import of a name two
+/// files declare is refused, naming both). Built when an import first names a module, so a shader that
+/// imports none (or only quoted paths) never walks a folder.
 struct ModuleIndex<'a> {
     model_dir: PathBuf,
     includes: &'a Includes,
-    built: std::cell::OnceCell<BTreeMap<String, PathBuf>>,
+    built: std::cell::OnceCell<BTreeMap<String, Vec<PathBuf>>>,
 }
 
 impl<'a> ModuleIndex<'a> {
@@ -207,7 +208,7 @@ impl<'a> ModuleIndex<'a> {
         ModuleIndex { model_dir: model_dir.to_path_buf(), includes, built: Default::default() }
     }
 
-    fn get(&self) -> Result<&BTreeMap<String, PathBuf>> {
+    fn get(&self) -> Result<&BTreeMap<String, Vec<PathBuf>>> {
         if let Some(index) = self.built.get() {
             return Ok(index);
         }
@@ -216,10 +217,10 @@ impl<'a> ModuleIndex<'a> {
             walk.add(d, 0, d)?;
         }
         walk.add(&self.model_dir, MAX_DEPTH, &self.model_dir)?;
-        let mut index = BTreeMap::new();
+        let mut index: BTreeMap<String, Vec<PathBuf>> = BTreeMap::new();
         for f in walk.files {
             if let Some(name) = declared_module(&f) {
-                index.entry(name).or_insert(f);
+                index.entry(name).or_default().push(f);
             }
         }
         Ok(self.built.get_or_init(|| index))
@@ -234,8 +235,14 @@ fn resolve(import: &str, dir: &Path, includes: &Includes, index: &ModuleIndex) -
         let index = index.get()?;
         let mut name = import;
         loop {
-            if let Some(p) = index.get(name) {
-                return Ok(Some(p.clone()));
+            match index.get(name).map(Vec::as_slice) {
+                Some([one]) => return Ok(Some(one.clone())),
+                Some([a, b, ..]) => bail!(
+                    "`{name}` is declared by two modules, {} and {} (`#define_import_path {name}`); brdfprof will not pick one: keep one of them out of the include directories and the model's folder",
+                    a.display(),
+                    b.display()
+                ),
+                _ => {}
             }
             let Some((prefix, _)) = name.rsplit_once("::") else { return Ok(None) };
             name = prefix;
@@ -276,7 +283,11 @@ impl Modules<'_> {
                 let (line, col) = import_at(text, &import);
                 bail!("{shown}:{line}:{col}: import cycle: {} -> {import}", self.stack[k..].join(" -> "));
             }
-            let Some(path) = resolve(&import, dir, self.includes, &self.index)? else { continue };
+            let found = resolve(&import, dir, self.includes, &self.index).map_err(|e| {
+                let (line, col) = import_at(text, &import);
+                anyhow!("{shown}:{line}:{col}: {e:#}")
+            })?;
+            let Some(path) = found else { continue };
             let source = read_text(&path).map_err(|e| {
                 let (line, col) = import_at(text, &import);
                 anyhow!("{shown}:{line}:{col}: {e:#}")
