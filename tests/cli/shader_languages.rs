@@ -979,3 +979,41 @@ fn two_candidates_for_one_include_or_module_are_refused_naming_both() {
         run(&["a", "b"]).fails(2, "w.wgsl:1:9: `dup::gain` is declared by two modules, a/gain.wgsl and b/gain.wgsl");
     assert!(!out.stderr.contains("panicked"), "{}", out.stderr);
 }
+
+/// A Bevy-style module that needs shader defs: without them the error lists each def by name at its file,
+/// line and column with the --define to pass; with them the model evaluates to the branch they select.
+#[test]
+fn shader_defs_an_import_graph_needs_are_listed_by_name_where_missing() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write_rows(&d.join("in.csv"), 2);
+    std::fs::create_dir_all(d.join("mods")).unwrap();
+    std::fs::write(
+        d.join("mods/lights.wgsl"),
+        "#define_import_path test::lights\n\nconst MAX_LIGHTS: i32 = #{MAX_LIGHTS};\n\nfn gain() -> f32 {\n#if CASCADES == 4\n    return 0.5 * f32(MAX_LIGHTS) / 8.0;\n#else\n    return 1.0;\n#endif\n}\n",
+    )
+    .unwrap();
+    std::fs::write(
+        d.join("m.wgsl"),
+        "#import test::lights::gain\nfn BRDF(L: vec3<f32>, V: vec3<f32>, N: vec3<f32>, X: vec3<f32>, Y: vec3<f32>) -> vec3<f32> {\n    return vec3<f32>(gain());\n}\n",
+    )
+    .unwrap();
+    let eval = |defines: &[&str]| {
+        let mut args =
+            vec!["eval", "--model", "m.wgsl", "--include-dir", "mods", "--input", "in.csv", "--output", "x.csv"];
+        args.extend(defines.iter().flat_map(|v| ["--define", *v]));
+        run_in(d, &args)
+    };
+    let out = eval(&[]).fails(2, "shader defs the shader and its imports use that no define gives: ");
+    for needle in [
+        "MAX_LIGHTS (mods/lights.wgsl:3:27 `const MAX_LIGHTS",
+        "CASCADES (mods/lights.wgsl:6:5 `#if CASCADES == 4`)",
+        "--define MAX_LIGHTS=VALUE --define CASCADES=VALUE",
+    ] {
+        assert!(out.stderr.contains(needle), "{needle}: {}", out.stderr);
+    }
+    eval(&["MAX_LIGHTS=8"]).fails(2, "CASCADES (mods/lights.wgsl:6:5");
+    eval(&["MAX_LIGHTS=8", "CASCADES=4"]).ok();
+    let text = std::fs::read_to_string(d.join("x.csv")).unwrap();
+    assert!(text.lines().skip(1).all(|l| l.rsplit(',').next().unwrap().trim() == "0.5"), "{text}");
+}

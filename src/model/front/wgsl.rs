@@ -269,6 +269,8 @@ struct Modules<'a> {
     stack: Vec<String>,
     /// Each module's file as messages name it, and its text, in the order added.
     files: Vec<(String, String)>,
+    /// The shader defs given (`--define`, `define=`).
+    defs: HashMap<String, ShaderDefValue>,
 }
 
 impl Modules<'_> {
@@ -305,7 +307,9 @@ impl Modules<'_> {
                 ..Default::default()
             };
             if let Err(e) = self.composer.add_composable_module(desc) {
-                bail!("{}", located(&e, &self.composer, None));
+                let graph: Vec<(String, String)> =
+                    self.files.iter().cloned().chain([(file.clone(), source.clone())]).collect();
+                bail!("{}{}", located(&e, &self.composer, None), missing_defs_note(&graph, &self.defs));
             }
             self.added.push(import);
             self.files.push((file, source));
@@ -343,6 +347,51 @@ fn located(e: &ComposerError, composer: &Composer, top: Option<(&str, &Top)>) ->
     }
 }
 
+/// The shader defs `files` (name, text) use and `defs` lacks, each at its first use: `#if NAME ...` (naga_oil
+/// refuses an unknown def there) and `#{NAME}` (left in the text unsubstituted); `#ifdef`/`#ifndef` read an
+/// absent def as false, so they need none. As `NAME (FILE:LINE:COLUMN \`use\`)`.
+fn missing_defs(files: &[(String, String)], defs: &HashMap<String, ShaderDefValue>) -> Vec<String> {
+    let ident = |t: &str| t.chars().take_while(|c| c.is_ascii_alphanumeric() || *c == '_').collect::<String>();
+    let mut out: Vec<(String, String)> = Vec::new();
+    for (file, text) in files {
+        for (i, line) in text.lines().enumerate() {
+            let mut uses: Vec<(usize, String)> = Vec::new();
+            let trimmed = line.trim_start();
+            let directive = trimmed.strip_prefix("#else").map_or(trimmed, str::trim_start);
+            if let Some(rest) = directive.strip_prefix("#if").filter(|r| r.starts_with([' ', '\t'])) {
+                let name = ident(rest.trim_start());
+                let col = line.len() - rest.trim_start().len();
+                uses.push((col, name));
+            }
+            for (k, _) in line.match_indices("#{") {
+                uses.push((k + 2, ident(&line[k + 2..])));
+            }
+            for (col, name) in uses {
+                if !name.is_empty() && !defs.contains_key(&name) && !out.iter().any(|(n, _)| *n == name) {
+                    let at = format!("{file}:{}:{} `{}`", i + 1, line[..col].chars().count() + 1, line.trim());
+                    out.push((name, at));
+                }
+            }
+        }
+    }
+    out.into_iter().map(|(n, at)| format!("{n} ({at})")).collect()
+}
+
+/// A message's tail naming the shader defs the import graph uses and no define gives, with the flag to pass.
+fn missing_defs_note(files: &[(String, String)], defs: &HashMap<String, ShaderDefValue>) -> String {
+    let missing = missing_defs(files, defs);
+    if missing.is_empty() {
+        return String::new();
+    }
+    let flags: Vec<String> =
+        missing.iter().map(|m| format!("--define {}=VALUE", m.split(' ').next().unwrap_or(""))).collect();
+    format!(
+        "; shader defs the shader and its imports use that no define gives: {}; pass {}",
+        missing.join(", "),
+        flags.join(" ")
+    )
+}
+
 /// A composed shader: naga's module, and the files of the modules it imports (as messages name them, with
 /// their text).
 pub struct Composed {
@@ -363,6 +412,7 @@ pub fn compose(model: &Path, top: &Top, defines: &[(String, String)], includes: 
         added: Vec::new(),
         stack: Vec::new(),
         files: Vec::new(),
+        defs: shader_defs.clone(),
     };
     m.add_imports_of(&top.text, &shown, &model_dir)?;
     let desc = NagaModuleDescriptor {
@@ -377,7 +427,8 @@ pub fn compose(model: &Path, top: &Top, defines: &[(String, String)], includes: 
             naga_oil::compose::ComposerErrorInner::ImportNotFound(..) => format!("; brdfprof looks for a module's `#define_import_path` in the .wgsl files of {}, and for a quoted import as for an HLSL include (beside the importing file, in the include directories, under a mapped prefix)", searched(&model_dir, includes)),
             _ => String::new(),
         };
-        anyhow!("{}{hint}", located(&e, &m.composer, Some((&shown, top))))
+        let graph: Vec<(String, String)> = std::iter::once((shown.clone(), top.text.clone())).chain(m.files.clone()).collect();
+        anyhow!("{}{hint}{}", located(&e, &m.composer, Some((&shown, top))), missing_defs_note(&graph, &m.defs))
     })?;
     Ok(Composed { module, files: m.files })
 }
