@@ -1017,3 +1017,52 @@ fn shader_defs_an_import_graph_needs_are_listed_by_name_where_missing() {
     let text = std::fs::read_to_string(d.join("x.csv")).unwrap();
     assert!(text.lines().skip(1).all(|l| l.rsplit(',').next().unwrap().trim() == "0.5"), "{text}");
 }
+
+/// HLSL as engines write it, read as a compiler would: a return semantic on BRDF, a main file that includes
+/// itself after `#pragma once`, a shader global `_x` beside parameter `x`, a chain of 120 `#pragma once`
+/// headers (past glslang's `#ifdef` nesting limit had each been wrapped); and a NUL byte or an error after
+/// lone-CR line ends named at its own file, line and column.
+#[test]
+fn hlsl_read_as_a_compiler_reads_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write_rows(&d.join("in.csv"), 2);
+    let entry = |body: &str| {
+        format!("float3 BRDF(float3 L, float3 V, float3 N, float3 X, float3 Y){body}\n{{\n\treturn Gain().xxx;\n}}\n")
+    };
+    std::fs::write(d.join("gain.ush"), "#pragma once\nfloat Gain() { return 0.5; }\n").unwrap();
+    std::fs::write(d.join("sv.hlsl"), format!("#include \"gain.ush\"\n{}", entry(" : SV_Target"))).unwrap();
+    std::fs::write(
+        d.join("self.hlsl"),
+        format!("#pragma once\n#include \"self.hlsl\"\n#include \"gain.ush\"\n{}", entry("")),
+    )
+    .unwrap();
+    std::fs::write(
+        d.join("global.brdf"),
+        "analytic\n::begin parameters\nfloat x 0 1 0.5\n::end parameters\n::begin shader hlsl\nstatic float _x = 2.0;\nfloat Gain() { return x * _x * 0.5; }\nfloat3 BRDF(float3 L, float3 V, float3 N, float3 X, float3 Y)\n{\n\treturn Gain().xxx;\n}\n::end shader\n",
+    )
+    .unwrap();
+    for k in 0..120 {
+        let next =
+            if k + 1 < 120 { format!("#include \"h{}.ush\"\n", k + 1) } else { "#include \"gain.ush\"\n".into() };
+        std::fs::write(d.join(format!("h{k}.ush")), format!("#pragma once\n{next}float H{k}() {{ return 1.0; }}\n"))
+            .unwrap();
+    }
+    std::fs::write(d.join("deep.hlsl"), format!("#include \"h0.ush\"\n#include \"h1.ush\"\n{}", entry(""))).unwrap();
+    for model in ["sv.hlsl", "self.hlsl", "global.brdf,x=0.5", "deep.hlsl"] {
+        run_in(d, &["eval", "--model", model, "--input", "in.csv", "--output", "v.csv"]).ok();
+        let text = std::fs::read_to_string(d.join("v.csv")).unwrap();
+        assert!(text.lines().skip(1).all(|l| l.split(',').all(|v| v.trim() == "0.5")), "{model}: {text}");
+    }
+    std::fs::write(d.join("nul.ush"), b"float Gain() { return 0.5; }\n  \x00\n").unwrap();
+    std::fs::write(d.join("nul.hlsl"), format!("#include \"nul.ush\"\n{}", entry(""))).unwrap();
+    run_in(d, &["eval", "--model", "nul.hlsl", "--input", "in.csv", "--output", "x.csv"])
+        .fails(2, "nul.ush:2:3: a NUL byte (U+0000)");
+    std::fs::write(
+        d.join("cr.ush"),
+        "// old Mac line ends\rfloat Gain() { return 0.5; }\rfloat Bad() { return nowhere; }\r",
+    )
+    .unwrap();
+    std::fs::write(d.join("cr.hlsl"), format!("#include \"cr.ush\"\n{}", entry(""))).unwrap();
+    run_in(d, &["eval", "--model", "cr.hlsl", "--input", "in.csv", "--output", "x.csv"]).fails(2, "cr.ush:3:");
+}

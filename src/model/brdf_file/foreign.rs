@@ -165,7 +165,9 @@ fn locate(source: &Source, name: &str) -> Option<String> {
 fn check_param_names(file: &BrdfFile, glsl: &str) -> Result<()> {
     for p in &file.params {
         let escaped = format!("_{}", p.name);
-        if glsl.lines().any(|l| cross::plain_declaration(l).is_some_and(|(_, n)| n == escaped)) {
+        let declares = |name: &str| glsl.lines().any(|l| cross::plain_declaration(l).is_some_and(|(_, n)| n == name));
+        // Renamed only where its own name is gone: a shader global `_x` beside parameter `x` is no renaming.
+        if !declares(&p.name) && declares(&escaped) {
             bail!(at(
                 &file.path,
                 p.line,
@@ -221,7 +223,7 @@ fn hlsl_spirv(file: &mut BrdfFile) -> Result<(Vec<u32>, Source)> {
         }
         x.push_generated(hlsl::param_decl(&p.name, p.glsl_type()), p.line, format!("parameter `{}`", p.name));
     }
-    x.include_section(&front::dir_of(&file.path), &file.source, &file.includes)?;
+    x.include_section(&file.path, &file.source, &file.includes)?;
     for (f, n, text) in &x.dropped {
         file.warnings.push(dropped_hash_line(Path::new(&x.files[*f]), *n, text));
     }

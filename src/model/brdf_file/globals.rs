@@ -311,7 +311,10 @@ pub(super) fn item_end(
         } else if t.is("{") && nest == 0 {
             let close = matching(tokens, j);
             let header = &tokens[start..j];
-            if j > start && tokens[j - 1].is(")") {
+            // A function's body: after its `)`, or after an HLSL return semantic (`) : SV_Target {`).
+            let semantic =
+                j >= start + 3 && tokens[j - 1].kind == Kind::Ident && tokens[j - 2].is(":") && tokens[j - 3].is(")");
+            if j > start && (tokens[j - 1].is(")") || semantic) {
                 return Ok(((close + 1).min(tokens.len()), Some((j, close))));
             } else if header.iter().any(|t| t.text == "struct") {
                 body = Some((j, close));

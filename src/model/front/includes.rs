@@ -71,15 +71,19 @@ impl Expanded {
         self.origins.get(index).map(|&(f, l)| (self.files[f].as_str(), l))
     }
 
-    /// Appends the model's section `lines` (numbered as in its file), each `#include` resolved from `dir` (the
-    /// model file's directory) and `includes`.
-    pub fn include_section(&mut self, dir: &Path, lines: &[(usize, String)], includes: &Includes) -> Result<()> {
-        let model =
-            Source { dir: dir.to_path_buf(), code: code_lines(lines), lines: lines.to_vec(), once: false, guard: None };
+    /// Appends the model's section `lines` (numbered as in its file `path`), each `#include` resolved from the
+    /// file's directory and `includes`. The file itself is one of the files (an `#include` of it after its
+    /// `#pragma once` is empty, as a compiler's would be).
+    pub fn include_section(&mut self, path: &Path, lines: &[(usize, String)], includes: &Includes) -> Result<()> {
+        let code = code_lines(lines);
+        let once = code.iter().any(|c| directive(&c.text).is_some_and(|(d, r)| d == "pragma" && r.trim() == "once"));
+        let model = Source { dir: super::dir_of(path), code, lines: lines.to_vec(), once, guard: None };
+        let key = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf());
         let mut x = Expander {
             includes,
             sources: vec![model],
-            by_path: HashMap::new(),
+            by_path: HashMap::from([(key, 0)]),
+            wrapped: HashSet::new(),
             stack: vec![0],
             done: HashSet::new(),
             undefined: HashSet::new(),
@@ -112,6 +116,10 @@ struct Expander<'a> {
     done: HashSet<usize>,
     /// Macros some `#undef` names (a guard among them no longer proves a file empty).
     undefined: HashSet<String>,
+    /// `#pragma once` files written inside a guard of brdfprof's: needed only where an `#if` surrounds the
+    /// inclusion (brdfprof itself leaves out one included again outside every `#if`), so that a long chain of
+    /// headers never nests glslang's `#ifdef`s past its limit.
+    wrapped: HashSet<usize>,
     out: Expanded,
 }
 
@@ -198,8 +206,9 @@ impl Expander<'_> {
             return Ok(self.error_line(from, n, column, format!("#include nested deeper than {MAX_DEPTH} files")));
         }
         self.out.push("", from, n);
-        let once = self.sources[idx].once;
+        let once = self.sources[idx].once && (depth > 0 || self.wrapped.contains(&idx));
         if once {
+            self.wrapped.insert(idx);
             self.out.push(format!("#ifndef BRDFPROF_ONCE_{idx}"), from, n);
             self.out.push(format!("#define BRDFPROF_ONCE_{idx}"), from, n);
         }
@@ -273,14 +282,15 @@ impl Expander<'_> {
         let text = String::from_utf8(bytes).map_err(|e| {
             fail(anyhow!("{} is not UTF-8 text (byte {})", path.display(), e.utf8_error().valid_up_to()))
         })?;
-        let lines: Vec<(usize, String)> = text
-            .strip_prefix('\u{feff}')
-            .unwrap_or(&text)
-            .split('\n')
-            .map(|l| l.strip_suffix('\r').unwrap_or(l).to_string())
+        let lines: Vec<(usize, String)> = split_lines(text.strip_prefix('\u{feff}').unwrap_or(&text))
+            .into_iter()
             .enumerate()
             .map(|(i, l)| (i + 1, l))
             .collect();
+        if let Some((n, l)) = lines.iter().find(|(_, l)| l.contains('\0')) {
+            let column = l[..l.find('\0').unwrap_or(0)].chars().count() + 1;
+            bail!("{}:{n}:{column}: a NUL byte (U+0000), where glslang would end the text; remove it", path.display());
+        }
         let code = code_lines(&lines);
         let once = code.iter().any(|c| directive(&c.text).is_some_and(|(d, r)| d == "pragma" && r.trim() == "once"));
         let guard = guard_macro(&code);
@@ -289,6 +299,19 @@ impl Expander<'_> {
         self.by_path.insert(key, self.sources.len() - 1);
         Ok(self.sources.len() - 1)
     }
+}
+
+/// A file's lines, each ending at `\r\n`, `\n` or a lone `\r` (old Mac line ends), as a compiler counts them.
+pub fn split_lines(text: &str) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut rest = text;
+    while let Some(i) = rest.find(['\r', '\n']) {
+        out.push(rest[..i].to_string());
+        let skip = if rest[i..].starts_with("\r\n") { 2 } else { 1 };
+        rest = &rest[i + skip..];
+    }
+    out.push(rest.to_string());
+    out
 }
 
 /// `"NAME"` (quoted: true) or `<NAME>` after `#include`.
@@ -387,7 +410,7 @@ mod tests {
 
     fn expand(dir: &Path, text: &str, includes: &Includes) -> Expanded {
         let mut x = Expanded::new(&dir.join("m.hlsl"));
-        x.include_section(dir, &lines(text), includes).unwrap();
+        x.include_section(&dir.join("m.hlsl"), &lines(text), includes).unwrap();
         x
     }
 
@@ -435,7 +458,7 @@ mod tests {
         let text = x.text();
         assert_eq!(text.matches("float D()").count(), 1, "{text}");
         assert_eq!(text.matches("PI = 3.14").count(), 1, "{text}");
-        assert!(text.contains("#ifndef BRDFPROF_ONCE_1") && x.notes.is_empty(), "{text}");
+        assert!(!text.contains("BRDFPROF_ONCE") && x.notes.is_empty(), "outside every #if, no guard to nest: {text}");
         let at = x.lines.iter().position(|l| l.contains("PI = 3.14")).unwrap();
         assert_eq!(x.origin(at), Some((d.join("engine/Private/Common.ush").display().to_string().as_str(), 2)));
         assert_eq!(x.origin(x.lines.len() - 1), Some((d.join("m.hlsl").display().to_string().as_str(), 3)));
@@ -455,7 +478,8 @@ mod tests {
         let text = x.text();
         assert_eq!(text.matches("float a;").count(), 1, "{text}");
         assert!(!text.contains("float old;") && !text.contains("#line") && x.notes.is_empty(), "{text}");
-        let after = x.lines.iter().position(|l| l == "#endif").unwrap() + 1;
+        let after = x.lines.iter().rposition(|l| l == "/*").unwrap();
+        assert!(after > x.lines.iter().position(|l| l == "float a;").unwrap(), "after the included lines");
         assert_eq!(
             (x.lines[after].as_str(), x.lines[after + 1].as_str()),
             ("/*", " of a */"),
