@@ -193,11 +193,18 @@ fn inspect_charts_the_cost_across_devices() {
     .ok();
     assert!(r.stdout.contains("Chart: "), "{}", r.stdout);
     let img = image::open(d.join("c.png")).unwrap().to_rgb8();
-    assert!(img.width() >= 800 && img.height() >= 600, "{}x{}", img.width(), img.height());
-    for device in 0..2 {
-        let c = brdfprof::export::png::palette(device);
-        let n = img.pixels().filter(|p| p.0 == [c.0, c.1, c.2]).count();
-        assert!(n > 2_000, "device {device}'s colour covers {n} pixels: its bars are missing");
+    assert!(img.width() >= 400 && img.height() >= 300, "{}x{}", img.width(), img.height());
+    // Each device's cell of each model is filled with the colour of its ratio to ggx (the JSON's net figures).
+    let table: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(d.join("i.json")).unwrap()).unwrap();
+    let columns = table["costs"]["columns"].as_array().unwrap();
+    assert_eq!(columns.len(), 2);
+    for c in columns {
+        let net = |m: &str| c["net"][m].as_f64().unwrap();
+        for model in ["blinn", "cook-torrance", "burley"] {
+            let colour = brdfprof::export::heat_table::colour(net(model) / net("ggx"));
+            let n = img.pixels().filter(|p| p.0 == [colour.0, colour.1, colour.2]).count();
+            assert!(n > 1_000, "{} {model}: its cell's colour covers {n} pixels", c["name"]);
+        }
     }
     assert!(!d.join("x.png").exists());
     run(&[
