@@ -188,6 +188,22 @@ fn gather(inputs: &[Input]) -> Summary {
     s
 }
 
+/// Each model's label, numbered `label #k` where models of different specs share it.
+fn numbered_labels(models: &[(String, String)]) -> Vec<String> {
+    models
+        .iter()
+        .enumerate()
+        .map(|(i, (_, label))| {
+            let same: Vec<usize> = (0..models.len()).filter(|&j| models[j].1 == *label).collect();
+            if same.len() < 2 {
+                label.clone()
+            } else {
+                format!("{label} #{}", same.iter().position(|&j| j == i).unwrap_or(0) + 1)
+            }
+        })
+        .collect()
+}
+
 /// The summary section's body, or None when no report names a model.
 pub fn summary(inputs: &[Input]) -> Option<String> {
     let s = gather(inputs);
@@ -207,22 +223,44 @@ pub fn summary(inputs: &[Input]) -> Option<String> {
         .take(MAX_COLUMNS)
         .map(|c| format!("<li><b>{}</b>: {}</li>", esc(&c.short), esc(&c.title)))
         .collect();
-    for (key, label) in s.models.iter().take(MAX_ROWS) {
+    // Two different models under one label (from different reports) are told apart by a number, and said so.
+    let shown = numbered_labels(&s.models);
+    let shared: Vec<&str> =
+        s.models.iter().zip(&shown).filter(|((_, l), shown)| l != *shown).map(|(_, shown)| shown.as_str()).collect();
+    for ((key, _), label) in s.models.iter().zip(&shown).take(MAX_ROWS) {
         let mut cells = vec![Cell::text(label.clone())];
         cells.extend(
             s.columns.iter().take(MAX_COLUMNS).map(|c| c.cells.get(key).cloned().unwrap_or_else(|| Cell::text("-"))),
         );
         t.row(format!("summary/{label}"), cells);
     }
-    let more = match (s.models.len().saturating_sub(MAX_ROWS), s.columns.len().saturating_sub(MAX_COLUMNS)) {
+    let mut more = match (s.models.len().saturating_sub(MAX_ROWS), s.columns.len().saturating_sub(MAX_COLUMNS)) {
         (0, 0) => String::new(),
         (m, c) => format!(
             "<p class=\"note\">Not shown here: {m} more model(s), {c} more column(s); the sections below hold every figure.</p>"
         ),
     };
+    if !shared.is_empty() {
+        more += &format!(
+            "<p class=\"note\">Different models (canonical specs) carry one label in the reports given; numbered here: {}. Their specs are in provenance.</p>",
+            esc(&shared.join(", "))
+        );
+    }
     Some(format!(
         "<p class=\"note\">One row per model across the reports given (each named once, by its label); a cost is a ratio to the reference model with its confidence interval where measured; {MODELLED} marks a modelled compile-only cost (<a href=\"#devices\">their rules</a>); accuracy is against the reference each report names; stability: NaN, Inf or negative values on valid inputs. Where each figure comes from: <a href=\"#provenance\">provenance</a>, at the end.</p>{}{more}<details class=\"columns\"><summary>The columns</summary><ul class=\"note\">{}</ul></details>",
         t.html(),
         footnotes.join("")
     ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn two_models_under_one_label_are_numbered_and_others_keep_theirs() {
+        let models: Vec<(String, String)> =
+            [("a", "mine"), ("b", "ggx"), ("c", "mine")].iter().map(|(k, l)| (k.to_string(), l.to_string())).collect();
+        assert_eq!(numbered_labels(&models), ["mine #1", "ggx", "mine #2"]);
+    }
 }
