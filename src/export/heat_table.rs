@@ -70,16 +70,32 @@ fn group_of(table: &HeatTable) -> Vec<(usize, usize)> {
         .collect()
 }
 
-/// Where the picture's size and every text go; `measure` gives a text's width and height at a size.
-pub fn layout(table: &HeatTable, measure: &dyn Fn(&str, u32, bool) -> (i32, i32)) -> ((u32, u32), Vec<Placed>) {
+/// Where everything goes: the picture's size, the cells' top, each group's left edge, the colour bar's left
+/// edge, and every text.
+pub struct Layout {
+    pub size: (u32, u32),
+    pub grid_top: i32,
+    pub group_left: Vec<i32>,
+    pub bar_x: i32,
+    pub texts: Vec<Placed>,
+}
+
+/// Pixels between two groups of columns.
+const GAP: i32 = 8;
+
+fn font(size: u32, bold: bool) -> FontDesc<'static> {
+    if bold { (FONT, size).into_font().style(FontStyle::Bold) } else { (FONT, size).into_font() }
+}
+
+/// The layout of `table`; `measure` gives a text's width and height at a size (bold or not).
+pub fn layout(table: &HeatTable, measure: &dyn Fn(&str, u32, bool) -> (i32, i32)) -> Layout {
     let columns: usize = table.groups.iter().map(|g| g.1.len()).sum();
-    let gap = 8;
     let x0 = MARGIN + NAME_W;
-    let col_x = |j: usize, group: usize| x0 + j as i32 * CELL_W + group as i32 * gap;
+    let col_x = |j: usize, group: usize| x0 + j as i32 * CELL_W + group as i32 * GAP;
     let header_h =
         table.groups.iter().flat_map(|g| &g.1).map(|c| measure(c, HEAD_FONT, false).0).max().unwrap_or(0) + 16;
     let grid_top = TITLE_H + GROUP_H + header_h;
-    let width = x0 + columns as i32 * CELL_W + (table.groups.len() as i32 - 1).max(0) * gap + BAR_W + MARGIN;
+    let width = x0 + columns as i32 * CELL_W + (table.groups.len() as i32 - 1).max(0) * GAP + BAR_W + MARGIN;
     let height = grid_top + (table.rows.len() as i32 * CELL_H).max(BAR_H + 12) + MARGIN;
     let mut out = Vec::new();
     let mut put = |text: String, at: (i32, i32), size: u32, vertical: bool, bold: bool, centre: bool| {
@@ -117,44 +133,29 @@ pub fn layout(table: &HeatTable, measure: &dyn Fn(&str, u32, bool) -> (i32, i32)
         }
     }
     let bar_x = width - BAR_W - MARGIN + 40;
+    // The bar runs from 2x at its top to 0.5x at its bottom, log2-even: a label every quarter.
     for (k, v) in [2.0, 1.41, 1.0, 0.71, 0.5].iter().enumerate() {
-        put(format!("{v}"), (bar_x + 34, grid_top + k as i32 * 60), HEAD_FONT, false, false, false);
+        put(format!("{v}"), (bar_x + 34, grid_top + k as i32 * BAR_H / 4), HEAD_FONT, false, false, false);
     }
     put(table.scale_name.clone(), (bar_x + 100, grid_top + BAR_H), HEAD_FONT, true, false, true);
-    ((width as u32, height as u32), out)
-}
-
-/// The grid's top: below the title, the group headers and the tallest column header (whose bottoms sit 8 px
-/// above it).
-fn grid_top(table: &HeatTable, texts: &[Placed]) -> i32 {
-    let columns: Vec<&String> = table.groups.iter().flat_map(|g| &g.1).collect();
-    texts
-        .iter()
-        .filter(|t| t.vertical && columns.contains(&&t.text))
-        .map(|t| t.at.1 + 8)
-        .max()
-        .unwrap_or(TITLE_H + GROUP_H)
+    let group_left = group_of(table).iter().enumerate().map(|(g, (start, _))| col_x(*start, g)).collect();
+    Layout { size: (width as u32, height as u32), grid_top, group_left, bar_x, texts: out }
 }
 
 /// Draws the table to `path` as PNG.
 pub fn draw(path: &Path, table: &HeatTable) -> Result<()> {
-    let mut size = (0, 0);
-    let mut texts = Vec::new();
+    let mut laid = None;
     crate::export::png::pixels(1, 1, |root| {
         let measure = |t: &str, s: u32, bold: bool| {
-            let font = if bold { (FONT, s).into_font().style(FontStyle::Bold) } else { (FONT, s).into_font() };
-            root.estimate_text_size(t, &TextStyle::from(font)).map_or((0, 0), |(w, h)| (w as i32, h as i32))
+            root.estimate_text_size(t, &TextStyle::from(font(s, bold))).map_or((0, 0), |(w, h)| (w as i32, h as i32))
         };
-        (size, texts) = layout(table, &measure);
+        laid = Some(layout(table, &measure));
         Ok(())
     })?;
+    let Layout { size, grid_top, group_left, bar_x, texts } = laid.expect("the layout ran");
     let e = |e: DrawingAreaErrorKind<_>| anyhow!("{}: {e}", path.display());
     render(path, size.0, size.1, |root| {
-        let gap = 8;
-        let x0 = MARGIN + NAME_W;
-        let grid_top = grid_top(table, &texts);
-        for (g, (start, n)) in group_of(table).into_iter().enumerate() {
-            let left = x0 + start as i32 * CELL_W + g as i32 * gap;
+        for ((start, n), left) in group_of(table).into_iter().zip(group_left) {
             root.draw(&PathElement::new(
                 vec![(left, TITLE_H + GROUP_H - 4), (left + n as i32 * CELL_W, TITLE_H + GROUP_H - 4)],
                 BLACK.stroke_width(2),
@@ -176,19 +177,16 @@ pub fn draw(path: &Path, table: &HeatTable) -> Result<()> {
                 }
             }
         }
-        let bar_x = size.0 as i32 - BAR_W - MARGIN + 40;
         for p in 0..BAR_H {
             let ratio = 2f64.powf(1.0 - 2.0 * p as f64 / BAR_H as f64);
             root.draw(&Rectangle::new([(bar_x, grid_top + p), (bar_x + 24, grid_top + p + 1)], colour(ratio).filled()))
                 .map_err(e)?;
         }
         for t in &texts {
-            let style =
-                if t.bold { (FONT, t.size).into_font().style(FontStyle::Bold) } else { (FONT, t.size).into_font() };
+            let style = font(t.size, t.bold);
             let style = if t.vertical { style.transform(FontTransform::Rotate270) } else { style };
-            let pos = (t.rect.x0 as i32, t.rect.y0 as i32);
             let style = style.color(&BLACK).pos(Pos::new(HPos::Left, VPos::Top));
-            let at = if t.vertical { (pos.0, t.rect.y1 as i32) } else { pos };
+            let at = (t.rect.x0 as i32, if t.vertical { t.rect.y1 } else { t.rect.y0 } as i32);
             root.draw(&Text::new(t.text.clone(), at, style)).map_err(e)?;
         }
         Ok(())
@@ -217,7 +215,7 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         draw(&dir.path().join("t.png"), &table).unwrap();
         let measure = |t: &str, s: u32, _: bool| ((t.chars().count() as u32 * s * 6 / 10) as i32, s as i32);
-        let ((w, h), texts) = layout(&table, &measure);
+        let Layout { size: (w, h), texts, .. } = layout(&table, &measure);
         for (i, a) in texts.iter().enumerate() {
             assert!(a.rect.x0 >= 0.0 && a.rect.x1 <= w as f64 && a.rect.y0 >= 0.0 && a.rect.y1 <= h as f64, "{a:?}");
             for b in &texts[..i] {

@@ -570,14 +570,13 @@ impl FileModel {
         )
     }
 
-    /// The model text: the path, the defines, the include directories and maps (`includes`), the entry and
-    /// what it returns, then the parameters (`all`: every one; else those that differ from the defaults).
-    fn text_with(&self, all: bool, includes: bool) -> String {
+    /// The model text: the path, the shader options (`options`: the defines, the include directories and maps),
+    /// the entry and what it returns, then the parameters (`all`: every one; else those that differ from the
+    /// defaults).
+    fn text_with(&self, all: bool, options: bool) -> String {
         let mut s = self.path.clone();
-        if includes {
+        if options {
             s += &self.define_items().iter().map(|d| format!(",{DEFINE}={d}")).collect::<String>();
-        }
-        if includes {
             s += &self.file.includes.dirs.iter().map(|d| format!(",{INCLUDE}={}", d.display())).collect::<String>();
             s += &self
                 .file

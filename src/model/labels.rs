@@ -4,7 +4,6 @@
 use super::{BASELINE_LABEL, LABEL_KEY, Model, file_model::FileModel};
 use anyhow::{Result, bail};
 use std::path::Path;
-use std::sync::Arc;
 
 /// The characters of a label: it names output files.
 const LABEL_CHARS: &str = "A-Z a-z 0-9 - _ . + =";
@@ -76,7 +75,7 @@ pub fn distinguish(models: Vec<Model>) -> Vec<Model> {
         let taken = models.iter().any(|o| o.label() == label);
         if label != m.label() && valid(&label) && !taken {
             renamed.push(format!("`{label}` ({})", m.name()));
-            out[i] = Model::File(Arc::new(FileModel { label: Some(label), ..f.clone() }));
+            out[i] = m.clone().with_label(Some(label));
         }
     }
     if !renamed.is_empty() {

@@ -129,6 +129,7 @@ pub fn heat_svg(uri: &str, (w, h, scale): (u32, u32, u32), axes: &HeatAxes, alt:
         })
         .rev()
         .collect();
+    // Every bar's gradient is the same viridis, so two maps whose ids coincide still draw right.
     let id = format!("v{:x}", uri.len() ^ (w as usize) << 8 ^ (h as usize) << 16 ^ alt.len() << 24);
     let _ = write!(
         s,

@@ -349,8 +349,8 @@ fn located(e: &ComposerError, composer: &Composer, top: Option<(&str, &Top)>) ->
 
 /// The shader defs `files` (name, text) use and `defs` lacks, each at its first use: `#if NAME ...` (naga_oil
 /// refuses an unknown def there) and `#{NAME}` (left in the text unsubstituted); `#ifdef`/`#ifndef` read an
-/// absent def as false, so they need none. As `NAME (FILE:LINE:COLUMN \`use\`)`.
-fn missing_defs(files: &[(String, String)], defs: &HashMap<String, ShaderDefValue>) -> Vec<String> {
+/// absent def as false, so they need none. Each as (NAME, `FILE:LINE:COLUMN \`use\``).
+fn missing_defs(files: &[(String, String)], defs: &HashMap<String, ShaderDefValue>) -> Vec<(String, String)> {
     let ident = |t: &str| t.chars().take_while(|c| c.is_ascii_alphanumeric() || *c == '_').collect::<String>();
     let mut out: Vec<(String, String)> = Vec::new();
     for (file, text) in files {
@@ -374,7 +374,7 @@ fn missing_defs(files: &[(String, String)], defs: &HashMap<String, ShaderDefValu
             }
         }
     }
-    out.into_iter().map(|(n, at)| format!("{n} ({at})")).collect()
+    out
 }
 
 /// A message's tail naming the shader defs the import graph uses and no define gives, with the flag to pass.
@@ -383,11 +383,11 @@ fn missing_defs_note(files: &[(String, String)], defs: &HashMap<String, ShaderDe
     if missing.is_empty() {
         return String::new();
     }
-    let flags: Vec<String> =
-        missing.iter().map(|m| format!("--define {}=VALUE", m.split(' ').next().unwrap_or(""))).collect();
+    let uses: Vec<String> = missing.iter().map(|(n, at)| format!("{n} ({at})")).collect();
+    let flags: Vec<String> = missing.iter().map(|(n, _)| format!("--define {n}=VALUE")).collect();
     format!(
         "; shader defs the shader and its imports use that no define gives: {}; pass {}",
-        missing.join(", "),
+        uses.join(", "),
         flags.join(" ")
     )
 }
