@@ -6,7 +6,9 @@
 // indices in a loop [[unroll]]ed over the block (a rolled loop turns light loads into per-lane gathers), so the
 // unrolled code stays one block long at any light count. Light directions are unit vectors (normalised on the
 // host, as engines pass them). No early return and no bounds check (buffers are padded to whole workgroups).
-// BASELINE = 1 is the memory-only kernel: the same loads, decode, NoL and stores, no BRDF.
+// BASELINE = 1 is the memory-only kernel: the same loads, decode, NoL and stores, no BRDF. Every kernel keeps
+// every input it loads live behind a condition no compiler can decide (keep_inputs, always 0), so a BRDF that
+// ignores an input cannot drop loads or decode the memory-only kernel keeps: no kernel undercuts it.
 // The including kernel defines GBUFFER_PACKED (engine-style G-buffer, R11G11B10F output) or not (48-byte float
 // pixels, fp32 output).
 #extension GL_GOOGLE_include_directive : require
@@ -31,13 +33,14 @@ layout(std430, set = 0, binding = 1) buffer Radiance { vec4 radiance[]; };
 layout(std140, set = 0, binding = 2) uniform Lights { vec4 lights[2 * LIGHT_BLOCK]; };
 
 // first_pixel: the chunk's first pixel in the picture (the binding windows start there). width: the picture's
-// width. camera: sx = (x + 0.5) camera.x + camera.y and sy = (y + 0.5) camera.z + camera.w, the pinhole
+// width. keep_inputs: 0 (see above). camera: sx = (x + 0.5) camera.x + camera.y and sy = (y + 0.5) camera.z +
+// camera.w, the pinhole
 // camera's image-plane coordinates of pixel (x, y); V is normalize(-sx, -sy, 1) (the camera at the origin
 // looks down -z).
 layout(push_constant) uniform Push {
     uint first_pixel;
     uint width;
-    uint pad0;
+    uint keep_inputs;
     uint pad1;
     vec4 camera;
 } pc;
@@ -127,8 +130,7 @@ void main() {
         acc += fs * (NoL * colour);
 #endif
     }
-    // The baseline folds every input it would otherwise skip into the result, so no load is dead code.
-    if (BASELINE != 0) acc = acc * p.f0 + vec3(p.roughness) + p.V;
+    if (pc.keep_inputs != 0u) acc += p.f0 + vec3(p.roughness) + p.V;
     if (ACCUMULATE != 0) acc += load_radiance(i);
     store_radiance(i, acc);
 }

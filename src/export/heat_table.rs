@@ -76,6 +76,10 @@ pub struct Layout {
     pub size: (u32, u32),
     pub grid_top: i32,
     pub group_left: Vec<i32>,
+    /// Each group's cell width.
+    pub cell_w: Vec<i32>,
+    /// Where the groups' rules run under their headers.
+    pub rule_y: i32,
     pub bar_x: i32,
     pub texts: Vec<Placed>,
 }
@@ -87,15 +91,68 @@ fn font(size: u32, bold: bool) -> FontDesc<'static> {
     if bold { (FONT, size).into_font().style(FontStyle::Bold) } else { (FONT, size).into_font() }
 }
 
+/// A group header's words as lines no wider than `width` (a word wider than that on a line of its own).
+fn wrap(name: &str, width: i32, measure: &dyn Fn(&str, u32, bool) -> (i32, i32)) -> Vec<String> {
+    let mut lines: Vec<String> = Vec::new();
+    for word in name.split_whitespace() {
+        match lines.last_mut() {
+            Some(line) if measure(&format!("{line} {word}"), HEAD_FONT, true).0 <= width => {
+                line.push(' ');
+                line.push_str(word);
+            }
+            _ => lines.push(word.to_string()),
+        }
+    }
+    lines
+}
+
+/// The columns' geometry: each group's cell width and wrapped header, the header band's line and total
+/// heights, each group's left edge and the right edge of the last.
+struct Columns {
+    cell_w: Vec<i32>,
+    headers: Vec<Vec<String>>,
+    line_h: i32,
+    group_h: i32,
+    group_left: Vec<i32>,
+    right: i32,
+}
+
+fn columns(table: &HeatTable, measure: &dyn Fn(&str, u32, bool) -> (i32, i32)) -> Columns {
+    let x0 = MARGIN + NAME_W;
+    // A group's cells are wide enough for the longest word of its header; the header wraps at its width.
+    let cell_w: Vec<i32> = table
+        .groups
+        .iter()
+        .map(|(name, cols)| {
+            let word = name.split_whitespace().map(|w| measure(w, HEAD_FONT, true).0).max().unwrap_or(0);
+            CELL_W.max((word + 8 + cols.len() as i32 - 1) / cols.len().max(1) as i32)
+        })
+        .collect();
+    let headers: Vec<Vec<String>> = table
+        .groups
+        .iter()
+        .zip(&cell_w)
+        .map(|((name, cols), w)| wrap(name, cols.len() as i32 * w - 4, measure))
+        .collect();
+    let line_h = measure("Ag", HEAD_FONT, true).1.max(1) + 2;
+    let group_h = headers.iter().map(Vec::len).max().unwrap_or(1) as i32 * line_h + GROUP_H - line_h;
+    let mut group_left = Vec::new();
+    let mut x = x0;
+    for ((_, cols), w) in table.groups.iter().zip(&cell_w) {
+        group_left.push(x);
+        x += cols.len() as i32 * w + GAP;
+    }
+    Columns { cell_w, headers, line_h, group_h, group_left, right: x - GAP }
+}
+
 /// The layout of `table`; `measure` gives a text's width and height at a size (bold or not).
 pub fn layout(table: &HeatTable, measure: &dyn Fn(&str, u32, bool) -> (i32, i32)) -> Layout {
-    let columns: usize = table.groups.iter().map(|g| g.1.len()).sum();
-    let x0 = MARGIN + NAME_W;
-    let col_x = |j: usize, group: usize| x0 + j as i32 * CELL_W + group as i32 * GAP;
+    let Columns { cell_w, headers, line_h, group_h, group_left, right } = columns(table, measure);
+    let col_x = |g: usize, k: usize| group_left[g] + k as i32 * cell_w[g];
     let header_h =
         table.groups.iter().flat_map(|g| &g.1).map(|c| measure(c, HEAD_FONT, false).0).max().unwrap_or(0) + 16;
-    let grid_top = TITLE_H + GROUP_H + header_h;
-    let width = x0 + columns as i32 * CELL_W + (table.groups.len() as i32 - 1).max(0) * GAP + BAR_W + MARGIN;
+    let grid_top = TITLE_H + group_h + header_h;
+    let width = right + BAR_W + MARGIN;
     let height = grid_top + (table.rows.len() as i32 * CELL_H).max(BAR_H + 12) + MARGIN;
     let mut out = Vec::new();
     let mut put = |text: String, at: (i32, i32), size: u32, vertical: bool, bold: bool, centre: bool| {
@@ -107,17 +164,15 @@ pub fn layout(table: &HeatTable, measure: &dyn Fn(&str, u32, bool) -> (i32, i32)
         out.push(Placed { text, at, size, vertical, bold, rect });
     };
     put(table.title.clone(), (MARGIN, TITLE_H / 2), 26, false, true, false);
-    for (g, ((name, cols), (start, n))) in table.groups.iter().zip(group_of(table)).enumerate() {
-        let (left, right) = (col_x(start, g), col_x(start + n, g));
-        // A group header wider than its columns is cut to fit, with an ellipsis.
-        let mut text = name.clone();
-        while text.chars().count() > 1 && measure(&text, HEAD_FONT, true).0 > right - left - 4 {
-            text = format!("{}…", text.chars().take(text.chars().count().saturating_sub(2)).collect::<String>());
+    for (g, ((_, cols), lines)) in table.groups.iter().zip(&headers).enumerate() {
+        let centre = (col_x(g, 0) + col_x(g, cols.len())) / 2;
+        // The header's last line sits on the group's rule.
+        let first = TITLE_H + group_h - GROUP_H / 2 - (lines.len() as i32 - 1) * line_h;
+        for (l, line) in lines.iter().enumerate() {
+            put(line.clone(), (centre, first + l as i32 * line_h), HEAD_FONT, false, true, true);
         }
-        put(text, ((left + right) / 2, TITLE_H + GROUP_H / 2), HEAD_FONT, false, true, true);
         for (k, c) in cols.iter().enumerate() {
-            let x = col_x(start + k, g) + CELL_W / 2;
-            put(c.clone(), (x, grid_top - 8), HEAD_FONT, true, false, true);
+            put(c.clone(), (col_x(g, k) + cell_w[g] / 2, grid_top - 8), HEAD_FONT, true, false, true);
         }
     }
     for (i, row) in table.rows.iter().enumerate() {
@@ -127,7 +182,7 @@ pub fn layout(table: &HeatTable, measure: &dyn Fn(&str, u32, bool) -> (i32, i32)
         for (g, (_, n)) in group_of(table).iter().enumerate() {
             for k in 0..*n {
                 let text = table.cells[i].get(j + k).copied().flatten().map_or("-".into(), |r| format!("{r:.2}"));
-                put(text, (col_x(j + k, g) + CELL_W / 2, y), CELL_FONT, false, false, true);
+                put(text, (col_x(g, k) + cell_w[g] / 2, y), CELL_FONT, false, false, true);
             }
             j += n;
         }
@@ -138,8 +193,8 @@ pub fn layout(table: &HeatTable, measure: &dyn Fn(&str, u32, bool) -> (i32, i32)
         put(format!("{v}"), (bar_x + 34, grid_top + k as i32 * BAR_H / 4), HEAD_FONT, false, false, false);
     }
     put(table.scale_name.clone(), (bar_x + 100, grid_top + BAR_H), HEAD_FONT, true, false, true);
-    let group_left = group_of(table).iter().enumerate().map(|(g, (start, _))| col_x(*start, g)).collect();
-    Layout { size: (width as u32, height as u32), grid_top, group_left, bar_x, texts: out }
+    let rule_y = TITLE_H + group_h - 4;
+    Layout { size: (width as u32, height as u32), grid_top, group_left, cell_w, rule_y, bar_x, texts: out }
 }
 
 /// Draws the table to `path` as PNG.
@@ -152,28 +207,28 @@ pub fn draw(path: &Path, table: &HeatTable) -> Result<()> {
         laid = Some(layout(table, &measure));
         Ok(())
     })?;
-    let Layout { size, grid_top, group_left, bar_x, texts } = laid.expect("the layout ran");
+    let Layout { size, grid_top, group_left, cell_w, rule_y, bar_x, texts } = laid.expect("the layout ran");
     let e = |e: DrawingAreaErrorKind<_>| anyhow!("{}: {e}", path.display());
     render(path, size.0, size.1, |root| {
-        for ((start, n), left) in group_of(table).into_iter().zip(group_left) {
+        for (((start, n), left), cell_w) in group_of(table).into_iter().zip(group_left).zip(cell_w) {
             root.draw(&PathElement::new(
-                vec![(left, TITLE_H + GROUP_H - 4), (left + n as i32 * CELL_W, TITLE_H + GROUP_H - 4)],
+                vec![(left, rule_y), (left + n as i32 * cell_w, rule_y)],
                 BLACK.stroke_width(2),
             ))
             .map_err(e)?;
             // A light grey behind the cells draws the grid lines between them (a ratio of 1 is white).
             let bottom = grid_top + table.rows.len() as i32 * CELL_H;
             root.draw(&Rectangle::new(
-                [(left - 2, grid_top - 2), (left + n as i32 * CELL_W, bottom)],
+                [(left - 2, grid_top - 2), (left + n as i32 * cell_w, bottom)],
                 RGBColor(214, 214, 214).filled(),
             ))
             .map_err(e)?;
             for i in 0..table.rows.len() {
                 for k in 0..n {
-                    let x = left + k as i32 * CELL_W;
+                    let x = left + k as i32 * cell_w;
                     let y = grid_top + i as i32 * CELL_H;
                     let fill = table.cells[i].get(start + k).copied().flatten().map_or(RGBColor(238, 238, 238), colour);
-                    root.draw(&Rectangle::new([(x, y), (x + CELL_W - 2, y + CELL_H - 2)], fill.filled())).map_err(e)?;
+                    root.draw(&Rectangle::new([(x, y), (x + cell_w - 2, y + CELL_H - 2)], fill.filled())).map_err(e)?;
                 }
             }
         }

@@ -16,9 +16,14 @@ pub struct CostRow {
     pub cycles_per_eval: f64,
     /// The same minus the memory-only kernel's (None for that kernel).
     pub net_cycles_per_eval: Option<f64>,
-    /// The pipe that binds the net figure, where the vendor's rule is a bound over pipes (Mali's Bifrost).
+    /// The term (pipe, or latency over resident waves) that binds the kernel, where the vendor's rule is a
+    /// bound over terms.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub bound: Option<String>,
+    /// Per evaluation, each term's difference from the memory-only kernel's (the net's breakdown; the net
+    /// itself is the difference of the bounds, never above it).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub net_terms: Vec<(String, f64)>,
     /// The rule's terms per wave (`targets::cost::schedule`: each pipe's busy cycles, then latency / resident waves),
     /// where the vendor's rule has them.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
@@ -44,6 +49,10 @@ pub struct TargetCost {
     /// Statistic names of `CostRow::stats` (as the compiler names them).
     pub columns: Vec<String>,
     pub rows: Vec<CostRow>,
+    /// Models the target could not compile (fp16 arithmetic without shaderFloat16), each with why: named in
+    /// the table so that no column drops a model silently.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub absent: Vec<(String, String)>,
 }
 
 /// The note beside a net cost at or below zero.
@@ -65,8 +74,17 @@ impl TargetCost {
             .iter()
             .map(|(n, v)| if n == bind { format!("**{n} {}**", sig(*v, 4)) } else { format!("{n} {}", sig(*v, 4)) })
             .collect();
+        let added: Vec<String> = r.net_terms.iter().map(|(n, v)| format!("{n} {}", sig(*v, 4))).collect();
+        let breakdown = if added.is_empty() {
+            String::new()
+        } else {
+            format!(
+                " Per evaluation, each term's difference from the memory-only kernel's: {}; the net is the difference of the bounds, never above it.",
+                added.join(", ")
+            )
+        };
         format!(
-            "\n{}'s cycles per wave taken apart ({}): {}; the largest binds.\n",
+            "\n{}'s cycles per wave taken apart ({}): {}; the largest binds.{breakdown}\n",
             r.model,
             self.unit,
             parts.join(", ")
@@ -133,6 +151,9 @@ impl TargetCost {
         );
         out += &super::constant_note(constant.iter().map(|(c, v)| (c.as_str(), *v)));
         out += &self.terms_note();
+        for (model, why) in &self.absent {
+            out += &format!("\n{model}: not compiled for this target ({why}), so no figure.\n");
+        }
         for r in self.rows.iter().filter(|r| r.net_cycles_per_eval.is_some_and(|v| v <= 0.0)) {
             out += &format!("\n{}: {}\n", r.model, NEGATIVE_NET);
         }

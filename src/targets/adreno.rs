@@ -2,21 +2,26 @@
 //! 25.0) through Mesa's Turnip driver and its ir3 compiler, on the freedreno noop drm-shim (`FD_GPU_ID`). Turnip's ir3 is what Linux and some Android systems run on Adreno;
 //! stock phone drivers use Qualcomm's own compiler, so these are ir3's figures, not a phone driver's.
 //!
-//! ir3 states no cycle model, so brdfprof's rule is built from the statistics ir3 computes itself
-//! (`collect_info` in src/freedreno/ir3/ir3.c, Mesa 22.3 and 25.0 alike): "Instruction Count" counts every issue slot of one
-//! wave (each instruction `1 + repeat + nop`, so the NOPs it folds into `(nopN)` and plain `nop`s are already in
-//! it), and "Estimated cycles stalled on SS/SY" are its own estimates of the cycles a wave waits for SFU
-//! (transcendental) and memory results at the `(ss)`/`(sy)` sync bits. One wave's issue cycles are their sum; a
-//! wave holds `subgroupSize` fibres (64, or 128 where ir3 doubles the thread size), so
-//! `cycles/eval = (Instruction Count + SS stall + SY stall) / (subgroupSize x lights per kernel)`. It assumes
-//! one instruction issued per wave per cycle and no other wave hiding the stalls; "Max Waves Per Core" (from
-//! registers) is beside it to say how much latency other waves could hide.
+//! ir3 states no cycle model; brdfprof prices the statistics ir3 computes itself (`collect_info` in
+//! src/freedreno/ir3/ir3.c, Mesa 22.3 and 25.0 alike) under the one rule of `cost::schedule`:
+//! - **pipes** (cycles one wave keeps each busy, one issue per instruction and repeat): ALU = cat1 (moves and
+//!   conversions) + cat2 + cat3 (one- to three-source arithmetic); SFU = cat4 (transcendentals); texture = cat5;
+//!   load/store = cat6; control = cat0 without the NOPs (ir3 counts each NOP, folded `(nopN)` ones too, under
+//!   cat0) + cat7 (barriers). a6xx's and a7xx's base wave is 64 fibres (`threadsize_base = 64`,
+//!   ir3_compiler.c); a wave ir3 doubles to 128 fibres passes each ALU instruction twice.
+//! - **schedule latency**: one wave alone issues every slot, NOPs included (Instruction Count), and waits ir3's
+//!   own estimates at its `(ss)` (SFU results) and `(sy)` (memory results) sync bits.
+//! - **resident waves**: "Max Waves Per Core", ir3's figure from the registers the kernel uses.
+//!
+//! ir3 publishes no SFU, texture or load/store rate, so each of those instructions is one issue cycle of its
+//! pipe: a lower bound on those pipes, whose results' waits the schedule latency carries.
 
 use super::cost;
 use super::mesa_noop::shim::{Shim, ShimFamily};
 use super::mesa_noop::{MESA_25_UNVALIDATED, MESA_BACKPORTS, MESA_DEBIAN};
 use crate::schema::InspectReport;
 use crate::schema::cost::TargetCost;
+use cost::schedule::Schedule;
 
 /// The statistics shown beside cycles/eval (Turnip's names).
 const SHOWN: [&str; 6] = [
@@ -84,22 +89,42 @@ pub static ADRENO: Shim = Shim {
     compiler_log: None,
 };
 
-/// One wave's issue cycles per fibre and light (the module's rule).
-fn cycles_per_eval(stats: &std::collections::BTreeMap<String, f64>, lights: u32) -> Option<f64> {
-    let instructions = cost::driver_stat(stats, "Instruction Count")?;
-    let stalls = cost::driver_stat(stats, "Estimated cycles stalled on SS").unwrap_or(0.0)
-        + cost::driver_stat(stats, "Estimated cycles stalled on SY").unwrap_or(0.0);
+/// ir3's instruction categories by pipe (`instrs_per_cat`, statistics "catN instructions").
+const PIPES: [(&str, &[u8]); 5] =
+    [("ALU", &[1, 2, 3]), ("SFU", &[4]), ("texture", &[5]), ("load/store", &[6]), ("control", &[0, 7])];
+
+/// The rule's figures of one wave, and its fibres.
+fn schedule_of(stats: &Stats) -> Option<(Schedule, f64)> {
+    let stat = |name: &str| cost::driver_stat(stats, name);
     let fibres = stats.get(crate::schema::driver::SUBGROUP_SIZE).copied().filter(|s| *s > 0.0)?;
-    Some((instructions + stalls) / (fibres * f64::from(lights)))
+    let instructions = stat("Instruction Count")?;
+    let nops = stat("NOPs Count").unwrap_or(0.0);
+    let cat = |k: &u8| stat(&format!("cat{k} instructions"));
+    // ir3 older than its per-category statistics: no pipes to price.
+    (0..8).try_for_each(|k| cat(&k).map(|_| ()))?;
+    let passes = fibres / 64.0;
+    let pipes = PIPES
+        .iter()
+        .map(|(name, cats)| {
+            let issued: f64 = cats.iter().filter_map(cat).sum::<f64>() - if cats.contains(&0) { nops } else { 0.0 };
+            let per_issue = if *name == "ALU" { passes.max(1.0) } else { 1.0 };
+            (name.to_string(), issued.max(0.0) * per_issue)
+        })
+        .collect();
+    let stalls =
+        stat("Estimated cycles stalled on SS").unwrap_or(0.0) + stat("Estimated cycles stalled on SY").unwrap_or(0.0);
+    let schedule = Schedule { pipes, latency: Some(instructions + stalls), resident_waves: stat("Max Waves Per Core") };
+    Some((schedule, fibres))
 }
 
+type Stats = std::collections::BTreeMap<String, f64>;
+
 fn cost_table(shim: &Shim, family: &ShimFamily, report: &InspectReport) -> Option<TargetCost> {
-    let rule = "cycles/eval = (Instruction Count, NOPs included + Estimated cycles stalled on SS + on SY) / (subgroupSize x lights per kernel): one wave's issue slots and ir3's own stall estimates (ir3.c collect_info), one instruction per wave per cycle, no latency hidden by other waves (Max Waves Per Core beside it)";
-    cost::table(
-        report,
-        shim.header(family, report, rule.into(), "wave issue cycles per fibre", &SHOWN),
-        cycles_per_eval,
-    )
+    let rule = format!(
+        "{}; ir3's statistics: pipes ALU (cat1-3, twice at 128 fibres), SFU (cat4), texture (cat5), load/store (cat6), control (cat0 less NOPs, cat7), one issue each; latency = Instruction Count (NOPs included) + ir3's SS and SY stall estimates; waves = Max Waves Per Core; / (subgroupSize x lights per kernel)",
+        cost::schedule::RULE
+    );
+    cost::schedule_table(report, shim.header(family, report, rule, "SP cycles", &SHOWN), schedule_of)
 }
 
 #[cfg(test)]
@@ -108,29 +133,45 @@ mod tests {
     use crate::schema::Row;
 
     #[test]
-    fn issue_cycles_are_instructions_plus_stalls_per_fibre_and_light() {
-        let row = |model: &str, instructions: f64, ss: f64, sy: f64, fibres: f64| Row {
-            model: model.into(),
-            spec: None,
-            stats: [
-                ("driver/CS/Instruction Count".to_string(), instructions),
+    fn ir3s_categories_are_pipes_and_its_stalls_the_latency_waves_hide() {
+        // cat0 holds the NOPs; ALU is cat1-3.
+        let row = |model: &str, cats: [f64; 8], nops: f64, ss: f64, waves: f64, fibres: f64| {
+            let mut stats: std::collections::BTreeMap<String, f64> = [
+                ("driver/CS/Instruction Count".to_string(), cats.iter().sum()),
+                ("driver/CS/NOPs Count".to_string(), nops),
                 ("driver/CS/Estimated cycles stalled on SS".to_string(), ss),
-                ("driver/CS/Estimated cycles stalled on SY".to_string(), sy),
+                ("driver/CS/Estimated cycles stalled on SY".to_string(), 0.0),
+                ("driver/CS/Max Waves Per Core".to_string(), waves),
                 (crate::schema::driver::SUBGROUP_SIZE.to_string(), fibres),
             ]
-            .into(),
-            notes: Default::default(),
+            .into();
+            for (k, c) in cats.iter().enumerate() {
+                stats.insert(format!("driver/CS/cat{k} instructions"), *c);
+            }
+            Row { model: model.into(), spec: None, stats, notes: Default::default() }
         };
         let mut report = crate::schema::tests::empty_report("Turnip Adreno (TM) 660");
         report.provenance["target"] = "adreno:a660".into();
-        report.rows =
-            vec![row("ggx", 1000.0, 20.0, 4.0, 64.0), row(crate::model::BASELINE_LABEL, 300.0, 0.0, 20.0, 128.0)];
+        report.rows = vec![
+            // 900 ALU issues; latency 1000 + 100 + 300 stalls over 10 waves = 140: ALU binds.
+            row("ggx", [101.0, 10.0, 800.0, 90.0, 36.0, 1.0, 1.0, 0.0], 100.0, 300.0, 10.0, 64.0),
+            // One wave's 400 cycles over 2 waves (200) exceed its 100 ALU issues: latency binds.
+            row("chain", [201.0, 0.0, 100.0, 0.0, 0.0, 1.0, 1.0, 0.0], 200.0, 97.0, 2.0, 64.0),
+            // At 128 fibres each ALU instruction is two passes.
+            row(crate::model::BASELINE_LABEL, [1.0, 0.0, 100.0, 0.0, 0.0, 1.0, 1.0, 0.0], 0.0, 0.0, 16.0, 128.0),
+        ];
         let t = super::super::Vendor::cost(&ADRENO, &report).unwrap();
         let lights = f64::from(t.lights_per_kernel);
+        let r = |m: &str| t.row(m).unwrap();
         assert_eq!(t.target.as_deref(), Some("adreno:a660"));
-        assert_eq!(t.rows[0].cycles_per_eval, 1024.0 / (64.0 * lights));
-        assert_eq!(t.rows[1].cycles_per_eval, 320.0 / (128.0 * lights));
-        assert_eq!(t.rows[0].net_cycles_per_eval, Some(1024.0 / (64.0 * lights) - 320.0 / (128.0 * lights)));
+        assert_eq!((r("ggx").cycles_per_eval, r("ggx").bound.as_deref()), (900.0 / (64.0 * lights), Some("ALU")));
+        let chain = r("chain");
+        assert_eq!(chain.cycles_per_eval, 400.0 / 2.0 / (64.0 * lights));
+        assert_eq!(chain.bound.as_deref(), Some(crate::targets::cost::schedule::LATENCY_TERM));
+        let base = r(crate::model::BASELINE_LABEL).cycles_per_eval;
+        assert_eq!(base, 200.0 / (128.0 * lights));
+        assert_eq!(r("ggx").net_cycles_per_eval, Some(900.0 / (64.0 * lights) - base));
+        assert!(r("ggx").terms.iter().any(|(n, v)| n == "SFU" && *v == 36.0));
         // Another vendor's report is not Adreno's.
         report.provenance["target"] = "anv:tgl".into();
         assert!(super::super::Vendor::cost(&ADRENO, &report).is_none());

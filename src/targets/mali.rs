@@ -164,50 +164,73 @@ pub fn read_shaderdb(log: &str) -> Result<(Vec<DriverStat>, Vec<String>)> {
     Ok((stats, rest.into_iter().map(str::to_string).collect()))
 }
 
+/// The per-pipe cycles the compiler reported for a row (its architecture's), by PIPES' index.
+fn pipes_of(stats: &Stats) -> Vec<(usize, f64)> {
+    PIPES.iter().enumerate().filter_map(|(k, (name, _))| cost::driver_stat(stats, name).map(|v| (k, v))).collect()
+}
+
+type Stats = std::collections::BTreeMap<String, f64>;
+
+/// Evaluations one pass through the program stands for: the compiler counts a loop's body once, so where it
+/// kept a loop (the light loop, which shade.glsl asks to be unrolled and Bifrost keeps rolled) one pass is one
+/// light's evaluation, the body's trip count being the lights per kernel; an unrolled program holds them all.
+fn evaluations_per_pass(stats: &Stats, lights: u32) -> f64 {
+    if cost::driver_stat(stats, "Loops").unwrap_or(0.0) > 0.0 { 1.0 } else { f64::from(lights) }
+}
+
+/// Each pipe's cycles per evaluation, by pipe name.
+fn per_eval(stats: &Stats, lights: u32) -> Vec<(String, f64)> {
+    let passes = evaluations_per_pass(stats, lights);
+    pipes_of(stats).into_iter().map(|(k, v)| (PIPES[k].1.to_string(), v / passes)).collect()
+}
+
 fn cost_table(shim: &Shim, family: &ShimFamily, report: &InspectReport) -> Option<TargetCost> {
     let valhall = family.architecture.starts_with("Valhall");
     let (rule, shown) = if valhall {
         (
-            "cycles/eval = Valhall's bound (max of its FMA, CVT, SFU, varying, texture and load/store cycles per thread, va_print_stats) / lights per kernel; net = max over pipes of (kernel - memory-only kernel) / lights, the binding pipe named",
+            "cycles/eval = Valhall's bound (max of its FMA, CVT, SFU, varying, texture and load/store cycles per thread, va_print_stats) per evaluation; net = kernel - memory-only kernel, each pipe's difference beside it",
             &SHOWN_VALHALL,
         )
     } else {
         (
-            "cycles/eval = Bifrost's bound (max of its arithmetic, texture, varying and load/store cycles per thread, bi_print_stats) / lights per kernel; net = max over pipes of (kernel - memory-only kernel) / lights, the binding pipe named",
+            "cycles/eval = Bifrost's bound (max of its arithmetic, texture, varying and load/store cycles per thread, bi_print_stats) per evaluation; net = kernel - memory-only kernel, each pipe's difference beside it",
             &SHOWN_BIFROST,
         )
     };
+    let rule = format!(
+        "{rule}; per evaluation = / lights per kernel where the light loop is unrolled, / 1 where the compiler keeps a loop (Loops > 0: its body, one light, counted once; the per-pixel loads and store outside it are then charged to every light, an upper bound)"
+    );
     let unit = if valhall { "Valhall cycles per thread" } else { "Bifrost cycles per thread" };
-    let mut t = cost::table(report, shim.header(family, report, rule.into(), unit, shown), |stats, lights| {
-        cost::driver_stat(stats, "Bound cycles").map(|c| c / f64::from(lights))
+    let header = shim.header(family, report, rule, unit, shown);
+    // The bound is the busiest pipe (the compiler's "Bound cycles" where it names no pipe).
+    let mut t = cost::table(report, header, |stats, lights| {
+        let pipes = per_eval(stats, lights);
+        match pipes.iter().map(|p| p.1).reduce(f64::max) {
+            Some(busiest) => Some(busiest),
+            None => cost::driver_stat(stats, "Bound cycles").map(|c| c / evaluations_per_pass(stats, lights)),
+        }
     })?;
-    // The pipes the compiler reported for a kernel (its architecture's), by PIPES' index.
-    let pipes = |model: &str| -> Option<Vec<(usize, f64)>> {
-        let row = report.rows.iter().find(|r| r.model == model)?;
-        let found: Vec<(usize, f64)> = PIPES
+    let lights = t.lights_per_kernel;
+    let stats_of = |model: &str| report.rows.iter().find(|r| r.model == model).map(|r| &r.stats);
+    let base = stats_of(BASELINE_LABEL).map(|s| per_eval(s, lights));
+    for r in t.rows.iter_mut() {
+        let Some(mine) = stats_of(&r.model).map(|s| per_eval(s, lights)).filter(|p| !p.is_empty()) else { continue };
+        let binding = mine
             .iter()
-            .enumerate()
-            .filter_map(|(k, (name, _))| cost::driver_stat(&row.stats, name).map(|v| (k, v)))
+            .fold(None, |b: Option<&(String, f64)>, p| if b.is_none_or(|b| p.1 > b.1) { Some(p) } else { b });
+        r.bound = binding.map(|(n, _)| n.clone());
+        r.terms = stats_of(&r.model)
+            .map(pipes_of)
+            .unwrap_or_default()
+            .into_iter()
+            .map(|(k, v)| (PIPES[k].1.to_string(), v))
             .collect();
-        (!found.is_empty()).then_some(found)
-    };
-    let base = pipes(BASELINE_LABEL);
-    let lights = f64::from(t.lights_per_kernel);
-    for r in t.rows.iter_mut().filter(|r| r.model != BASELINE_LABEL) {
-        let (Some(base), Some(mine)) = (&base, pipes(&r.model)) else {
-            r.net_cycles_per_eval = None;
-            continue;
-        };
-        let added = mine.iter().filter_map(|&(k, m)| base.iter().find(|(b, _)| *b == k).map(|&(_, b)| (k, m - b)));
-        let Some((k, net)) = added.fold(
-            None,
-            |best: Option<(usize, f64)>, (k, v)| if best.is_none_or(|(_, b)| v > b) { Some((k, v)) } else { best },
-        ) else {
-            r.net_cycles_per_eval = None;
-            continue;
-        };
-        r.net_cycles_per_eval = Some(net / lights);
-        r.bound = Some(PIPES[k].1.to_string());
+        if let (Some(base), true) = (&base, r.model != BASELINE_LABEL) {
+            r.net_terms = mine
+                .iter()
+                .map(|(n, v)| (n.clone(), v - base.iter().find(|(b, _)| b == n).map_or(0.0, |b| b.1)))
+                .collect();
+        }
     }
     Some(t)
 }
@@ -284,16 +307,19 @@ mod tests {
                 ],
             )
         };
-        let t = cost_of("mali:g610", "Mali-G610 (Panfrost)", vec![row("ggx", 7.9, 3.5), row(BASELINE_LABEL, 1.5, 1.0)]);
+        let t =
+            cost_of("mali:g610", "Mali-G610 (Panfrost)", vec![row("ggx", 20.0, 3.5), row(BASELINE_LABEL, 1.5, 1.0)]);
         let lights = f64::from(t.lights_per_kernel);
-        assert_eq!(t.rows[0].net_cycles_per_eval, Some((7.9 - 1.5) / lights));
+        // FMA binds the kernel (20), load/store the memory-only one (18).
+        assert_eq!(t.rows[0].net_cycles_per_eval, Some((20.0 - 18.0) / lights));
         assert_eq!(t.rows[0].bound.as_deref(), Some("FMA"));
+        assert!(t.rows[0].net_terms.iter().any(|(n, v)| n == "FMA" && *v == (20.0 - 1.5) / lights));
         assert!(t.model.contains("va_print_stats") && t.columns.iter().any(|c| c == "FMA cycles"), "{}", t.model);
     }
 
     #[test]
-    fn net_is_the_bound_of_the_added_work_per_pipe() {
-        let row = |model: &str, arith: f64, ldst: f64| {
+    fn net_is_the_difference_of_the_bounds_and_a_kept_loop_is_one_evaluation_per_pass() {
+        let row = |model: &str, arith: f64, ldst: f64, loops: f64| {
             pipe_row(
                 model,
                 &[
@@ -302,15 +328,26 @@ mod tests {
                     ("Varying cycles", 0.0),
                     ("Load-store cycles", ldst),
                     ("Bound cycles", arith.max(ldst)),
+                    ("Loops", loops),
                 ],
             )
         };
-        let t = cost_of("mali:g52", "Mali-G52 (Panfrost)", vec![row("ggx", 5.75, 8.0), row(BASELINE_LABEL, 1.5, 8.0)]);
+        let t = cost_of(
+            "mali:g52",
+            "Mali-G52 (Panfrost)",
+            vec![row("ggx", 5.75, 8.0, 0.0), row("rolled", 12.0, 8.0, 1.0), row(BASELINE_LABEL, 1.5, 8.0, 0.0)],
+        );
         let lights = f64::from(t.lights_per_kernel);
         assert_eq!(t.rows[0].cycles_per_eval, 8.0 / lights);
-        // The bounds (8 and 8) would subtract to nothing; the arithmetic the BRDF adds is 4.25.
-        assert_eq!(t.rows[0].net_cycles_per_eval, Some(4.25 / lights));
-        assert_eq!(t.rows[0].bound.as_deref(), Some("arithmetic"));
+        // The bounds (8 and 8) subtract to nothing, the net never above that; the arithmetic it adds is the
+        // breakdown's.
+        assert_eq!(t.rows[0].net_cycles_per_eval, Some(0.0));
+        assert_eq!(t.rows[0].bound.as_deref(), Some("load/store"));
+        assert!(t.rows[0].net_terms.iter().any(|(n, v)| n == "arithmetic" && *v == 4.25 / lights));
+        // A kept loop's body is one light: one pass is one evaluation.
+        assert_eq!(t.rows[1].cycles_per_eval, 12.0);
+        assert_eq!(t.rows[1].net_cycles_per_eval, Some(12.0 - 8.0 / lights));
+        assert_eq!(t.rows[1].bound.as_deref(), Some("arithmetic"));
         assert!(t.markdown().contains("bound by"));
     }
 }

@@ -260,6 +260,7 @@ impl<C: Translator> Vendor for Translated<C> {
             lights_per_kernel: 0,
             columns: C::SHOWN.iter().map(|s| s.to_string()).collect(),
             rows: Vec::new(),
+            absent: Vec::new(),
         };
         cost::schedule_table(report, header, |stats| Some((Schedule::of(stats)?, C::lanes(stats)?)))
     }

@@ -82,11 +82,15 @@ fn one_operation_more_moves_every_vendors_cost_the_way_its_code_does() {
             assert!((delta <= 0.0 || grew) && (delta >= 0.0 || shrank), "{what}: terms {ta:?} -> {tb:?}");
             moved += usize::from(delta != 0.0);
         }
-        // The sqrt and the division each reach the compiler's code: more of the instructions that compute them.
+        // The sqrt and the division each reach the compiler's code: one class of instructions (those that
+        // compute them) grows by at least one per light, whatever the scheduler's waits do to another.
         for b in ["plus-sqrt", "plus-division"] {
-            let added: f64 =
-                classes(target, &row(b)).iter().zip(classes(target, &row("base"))).map(|(y, x)| y - x).sum();
-            assert!(added >= 8.0, "{target} {b}: {added} instructions more than base for 8 lights");
+            let added = classes(target, &row(b))
+                .iter()
+                .zip(classes(target, &row("base")))
+                .map(|(y, x)| y - x)
+                .fold(f64::NEG_INFINITY, f64::max);
+            assert!(added >= 8.0, "{target} {b}: no class has 8 instructions more than base for 8 lights");
         }
     }
     assert!(moved >= 3, "the one-operation pairs moved only {moved} costs of 9");

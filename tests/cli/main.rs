@@ -26,6 +26,7 @@ mod fuzz;
 mod intel;
 mod limits;
 mod mesa_shims;
+mod microkernels;
 mod nvidia;
 mod outputs;
 mod radv;

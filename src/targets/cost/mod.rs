@@ -45,6 +45,7 @@ pub fn table(
             net_cycles_per_eval: None,
             bound: None,
             terms: Vec::new(),
+            net_terms: Vec::new(),
         });
     }
     if t.rows.is_empty() {
@@ -64,8 +65,9 @@ pub const HIDDEN_LATENCY: &str = "latency / waves";
 
 /// A cost table under `schedule`'s rule (`schedule::RULE`): per kernel, cycles per wave = max(busiest pipe,
 /// schedule latency / resident waves) over the figures `schedule_of(stats)` gives with the lanes of one wave,
-/// divided by those lanes and the lights per kernel; net = the largest term the kernel adds to the memory-only
-/// kernel's (per evaluation: kernels may differ in width), that term named in `bound`.
+/// divided by those lanes and the lights per kernel; net = the kernel's cycles/eval minus the memory-only
+/// kernel's (per evaluation: kernels may differ in width), the term binding the kernel named in `bound` and
+/// each term's difference in `net_terms`.
 pub fn schedule_table(
     report: &InspectReport,
     mut header: TargetCost,
@@ -89,6 +91,7 @@ pub fn schedule_table(
         row.stats.insert(HIDDEN_LATENCY.into(), wave.hidden_latency().unwrap_or(f64::NAN));
         let (bound, net) = match &base {
             Some(b) if row.model != BASELINE_LABEL => {
+                row.net_terms = eval.added_terms(b);
                 let (name, v) = eval.net(b);
                 (name, Some(v))
             }

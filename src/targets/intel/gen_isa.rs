@@ -49,7 +49,7 @@ fn type_bytes(t: &str) -> u32 {
 /// The registers an operand covers: a general register's bytes from its sub-register over its region for
 /// `exec` channels (`grf` bytes a register), or `length` whole registers for a send's payload; accumulators,
 /// flags and others as one unit each (a SIMD32 flag two).
-fn registers(operand: &str, exec: u32, grf: u32, length: Option<u32>, dst: bool) -> Vec<Reg> {
+pub(super) fn registers(operand: &str, exec: u32, grf: u32, length: Option<u32>, dst: bool) -> Vec<Reg> {
     let o = operand.trim_start_matches(['-', '~']).trim_start_matches("(abs)");
     let (name, rest) = o.split_at(o.find(|c: char| !c.is_ascii_alphabetic()).unwrap_or(o.len()));
     let number: u32 = rest.split(|c: char| !c.is_ascii_digit()).next().and_then(|n| n.parse().ok()).unwrap_or(0);

@@ -6,6 +6,7 @@
 //! (`THROUGHPUT`, the one place those figures live). These are "Intel's OpenCL compiler (IGC), same maths" figures: Mesa's ANV, Intel's Vulkan driver on
 //! Linux, compiles SPIR-V with its own compiler (brw); Intel's Windows Vulkan driver uses IGC.
 
+pub mod brw;
 pub mod gen_isa;
 pub mod ocloc;
 
@@ -426,9 +427,20 @@ impl IsaStats {
         Ok(s)
     }
 
+    /// Another compiler's listing (brw's, `brw`) of SIMD width `simd` with `grf` registers, counted as IGC's.
+    pub fn of_listing(simd: u32, grf: u32, listing: Vec<gen_isa::Instruction>) -> Self {
+        let mut s = IsaStats { simd, grf, ..Default::default() };
+        s.count_instructions(listing);
+        s
+    }
+
     /// Counts IGA's listing: instructions by class, and their execution sizes by `THROUGHPUT` row.
     fn count(&mut self, listing: &str, grf_bytes: u32) {
-        self.listing = gen_isa::instructions(listing, grf_bytes);
+        self.count_instructions(gen_isa::instructions(listing, grf_bytes));
+    }
+
+    fn count_instructions(&mut self, listing: Vec<gen_isa::Instruction>) {
+        self.listing = listing;
         for i in &self.listing {
             let class = classify(&i.mnemonic);
             self.instructions += 1;
@@ -493,15 +505,24 @@ impl IsaStats {
             stat("Spill Count", f64::from(self.scratch_bytes)),
             stat("Scratch Memory Size", f64::from(self.scratch_bytes)),
             stat("Binary Size", f64::from(self.binary_bytes)),
-            stat("Issue Cycles", self.issue_cycles(family)?),
-            stat(LATENCY, self.schedule_latency(family)?),
-            stat(RESIDENT_WAVES, f64::from(self.resident_threads(family))),
         ];
         for c in Class::ALL {
             out.push(stat(c.name(), f64::from(self.by_class.get(&c).copied().unwrap_or(0))));
         }
+        out.extend(self.rule_stats(family)?.into_iter().map(|(n, v)| stat(&n, v)));
+        Ok(out)
+    }
+
+    /// The figures of the one rule (`cost::schedule`): each pipe's busy cycles, the schedule latency and the
+    /// resident threads, and the old serial sum beside them.
+    pub fn rule_stats(&self, family: &Family) -> Result<Vec<(String, f64)>> {
+        let mut out = vec![
+            ("Issue Cycles".to_string(), self.issue_cycles(family)?),
+            (LATENCY.to_string(), self.schedule_latency(family)?),
+            (RESIDENT_WAVES.to_string(), f64::from(self.resident_threads(family))),
+        ];
         for (pipe, cycles) in self.pipes(family)? {
-            out.push(stat(&format!("{PIPE_PREFIX}{pipe}"), cycles));
+            out.push((format!("{PIPE_PREFIX}{pipe}"), cycles));
         }
         Ok(out)
     }

@@ -219,6 +219,10 @@ fn models_report(
     }
     let mut report = crate::kernel_stats::device_report(gpu, shaders, &models, req.lights, None)?;
     report.cost = super::cost_of(&report);
+    if let Some(cost) = &mut report.cost {
+        cost.absent =
+            skipped.iter().map(|m| (m.name(), format!("{:#}", m.check_support(&gpu.info).unwrap_err()))).collect();
+    }
     if !skipped.is_empty() {
         let why = skipped
             .iter()

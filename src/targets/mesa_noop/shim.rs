@@ -78,6 +78,7 @@ impl Shim {
             lights_per_kernel: 0,
             columns: columns.iter().map(|c| c.to_string()).collect(),
             rows: Vec::new(),
+            absent: Vec::new(),
         }
     }
 }

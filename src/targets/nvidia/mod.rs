@@ -29,6 +29,8 @@ pub struct Family {
     column: usize,
     /// Resident warps per SM at most (Programming Guide, "Technical Specifications per Compute Capability").
     pub max_warps: u32,
+    /// Resident blocks (workgroups) per SM at most (the same table).
+    pub max_blocks: u32,
 }
 
 pub const FAMILIES: [Family; 5] = [
@@ -39,6 +41,7 @@ pub const FAMILIES: [Family; 5] = [
         products: "GeForce RTX 20 / GTX 16 series, T4",
         column: 0,
         max_warps: 32,
+        max_blocks: 16,
     },
     Family {
         name: "sm_86",
@@ -47,6 +50,7 @@ pub const FAMILIES: [Family; 5] = [
         products: "GeForce RTX 30 series, RTX A6000",
         column: 1,
         max_warps: 48,
+        max_blocks: 16,
     },
     Family {
         name: "sm_89",
@@ -55,6 +59,7 @@ pub const FAMILIES: [Family; 5] = [
         products: "GeForce RTX 40 series, L4, L40",
         column: 2,
         max_warps: 48,
+        max_blocks: 24,
     },
     Family {
         name: "sm_90",
@@ -63,6 +68,7 @@ pub const FAMILIES: [Family; 5] = [
         products: "H100, H200",
         column: 3,
         max_warps: 64,
+        max_blocks: 32,
     },
     Family {
         name: "sm_120",
@@ -71,6 +77,7 @@ pub const FAMILIES: [Family; 5] = [
         products: "GeForce RTX 50 series, RTX PRO 6000",
         column: 4,
         max_warps: 48,
+        max_blocks: 32,
     },
 ];
 
@@ -358,14 +365,17 @@ impl SassStats {
         Ok(out)
     }
 
-    /// Resident warps per SM the register count allows: 65,536 registers per SM allocated per warp in units
-    /// of 256 (occupancy calculator), two warps per 64-thread workgroup, at most the family's warps.
+    /// Resident warps per SM under every limit the kernels meet: 65,536 registers per SM allocated per warp
+    /// in units of 256 (occupancy calculator), whole 64-thread workgroups of two warps, the family's resident
+    /// warps and resident blocks per SM (Programming Guide, "Technical Specifications per Compute
+    /// Capability"); no shared memory is used, so its limit never binds.
     pub fn warps_per_sm(&self, family: &Family) -> u32 {
         const REGISTERS_PER_SM: u32 = 65_536;
         const ALLOCATION_UNIT: u32 = 256;
+        const WARPS_PER_BLOCK: u32 = 2;
         let per_warp = (self.registers.max(1) * 32).div_ceil(ALLOCATION_UNIT) * ALLOCATION_UNIT;
-        let warps = (REGISTERS_PER_SM / per_warp) / 2 * 2;
-        warps.min(family.max_warps)
+        let warps = (REGISTERS_PER_SM / per_warp) / WARPS_PER_BLOCK * WARPS_PER_BLOCK;
+        warps.min(family.max_warps).min(family.max_blocks * WARPS_PER_BLOCK)
     }
 
     /// The statistics as driver statistics of the executable "SASS" (their names line up with the aliases
@@ -586,6 +596,18 @@ impl Translator for Nvidia {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn resident_warps_meet_the_register_warp_and_block_limits() {
+        let family = |name: &str| FAMILIES.iter().find(|f| f.name == name).unwrap();
+        let with = |registers: u32| SassStats { registers, ..Default::default() };
+        // 32 registers allow 64 warps; Ampere GA10x holds 48 warps but only 16 blocks (32 warps of 64 threads).
+        assert_eq!(with(32).warps_per_sm(family("sm_86")), 32);
+        // Ada holds 24 blocks: its 48 warps.
+        assert_eq!(with(32).warps_per_sm(family("sm_89")), 48);
+        // 128 registers: 16 warps, whatever the other limits.
+        assert_eq!(with(128).warps_per_sm(family("sm_90")), 16);
+    }
 
     #[test]
     fn every_rate_is_the_fixtures() {

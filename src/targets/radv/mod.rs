@@ -121,6 +121,7 @@ impl super::Vendor for Radv {
             lights_per_kernel: 0,
             columns: SHOWN.iter().map(|s| s.to_string()).collect(),
             rows: Vec::new(),
+            absent: Vec::new(),
         };
         // ACO's per-instruction schedule where the report has it (the compile-only targets), else (a real
         // RADV GPU) its Inverse Throughput, branch weights and all.
