@@ -6,9 +6,10 @@
 // indices in a loop [[unroll]]ed over the block (a rolled loop turns light loads into per-lane gathers), so the
 // unrolled code stays one block long at any light count. Light directions are unit vectors (normalised on the
 // host, as engines pass them). No early return and no bounds check (buffers are padded to whole workgroups).
-// BASELINE = 1 is the memory-only kernel: the same loads, decode, NoL and stores, no BRDF. Every kernel keeps
-// every input it loads live behind a condition no compiler can decide (keep_inputs, always 0), so a BRDF that
-// ignores an input cannot drop loads or decode the memory-only kernel keeps: no kernel undercuts it.
+// BASELINE = 1 is the memory-only kernel: the same loads, decode, NoL and stores, no BRDF. Every kernel adds
+// every input it loads times a factor no compiler can know (keep_inputs, always 0; a product, not a branch, so
+// the kernels stay branch-free), so a BRDF that ignores an input cannot drop loads or decode the memory-only
+// kernel keeps: no kernel undercuts it.
 // The including kernel defines GBUFFER_PACKED (engine-style G-buffer, R11G11B10F output) or not (48-byte float
 // pixels, fp32 output).
 #extension GL_GOOGLE_include_directive : require
@@ -130,7 +131,7 @@ void main() {
         acc += fs * (NoL * colour);
 #endif
     }
-    if (pc.keep_inputs != 0u) acc += p.f0 + vec3(p.roughness) + p.V;
+    acc += float(pc.keep_inputs) * (p.f0 + vec3(p.roughness) + p.V);
     if (ACCUMULATE != 0) acc += load_radiance(i);
     store_radiance(i, acc);
 }

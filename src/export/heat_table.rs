@@ -118,7 +118,9 @@ struct Columns {
 }
 
 fn columns(table: &HeatTable, measure: &dyn Fn(&str, u32, bool) -> (i32, i32)) -> Columns {
-    let x0 = MARGIN + NAME_W;
+    // The row names' column is as wide as the longest name (a sweep spec can be long).
+    let names = table.rows.iter().map(|r| measure(r, CELL_FONT, false).0 + 16).max().unwrap_or(0);
+    let x0 = MARGIN + NAME_W.max(names);
     // A group's cells are wide enough for the longest word of its header; the header wraps at its width.
     let cell_w: Vec<i32> = table
         .groups

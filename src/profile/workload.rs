@@ -160,7 +160,7 @@ pub fn light_buffer(lights: &[f32]) -> Vec<f32> {
 /// The push constants of a dispatch over the chunk starting at pixel `first_pixel` of a picture `width`
 /// wide, with the camera's (scale x, offset x, scale y, offset y) (glsl/shade.glsl `Push`).
 pub fn push_constants(first_pixel: u64, width: u32, camera: [f32; 4]) -> Vec<u8> {
-    // keep_inputs = 0: the kernels keep their inputs live behind it, and never take that branch.
+    // keep_inputs = 0: the kernels add their inputs times it, so that no compiler drops them.
     let words: [u32; 8] = [
         first_pixel as u32,
         width,

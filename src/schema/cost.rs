@@ -56,7 +56,7 @@ pub struct TargetCost {
 }
 
 /// The note beside a net cost at or below zero.
-pub const NEGATIVE_NET: &str = "net cost not above zero: the kernel adds nothing to the memory-only kernel (on no pipe or term of the rule, where the rule has them): it compiled to as little or less (a constant BRDF, or one whose inputs the compiler found unused, lets it drop loads and work the memory-only kernel keeps); its net figures measure that, not a cost of the BRDF";
+pub const NEGATIVE_NET: &str = "net cost not above zero: the kernel's bound is not above the memory-only kernel's (a constant BRDF, or the BRDF's work hidden under a pipe both kernels bind on, such as Mali's load/store); its net figure measures that, and the breakdown by term says what the BRDF's code adds";
 
 impl TargetCost {
     /// The reference model's cycles taken apart (its terms per wave, the binding one named), where the rule

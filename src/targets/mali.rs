@@ -307,13 +307,19 @@ mod tests {
                 ],
             )
         };
-        let t =
-            cost_of("mali:g610", "Mali-G610 (Panfrost)", vec![row("ggx", 20.0, 3.5), row(BASELINE_LABEL, 1.5, 1.0)]);
+        let t = cost_of(
+            "mali:g610",
+            "Mali-G610 (Panfrost)",
+            vec![row("ggx", 20.0, 3.5), row("flat", 1.6, 1.0), row(BASELINE_LABEL, 1.5, 1.0)],
+        );
         let lights = f64::from(t.lights_per_kernel);
         // FMA binds the kernel (20), load/store the memory-only one (18).
         assert_eq!(t.rows[0].net_cycles_per_eval, Some((20.0 - 18.0) / lights));
         assert_eq!(t.rows[0].bound.as_deref(), Some("FMA"));
         assert!(t.rows[0].net_terms.iter().any(|(n, v)| n == "FMA" && *v == (20.0 - 1.5) / lights));
+        // Load/store binds both kernels: a net of 0, said so.
+        assert_eq!(t.rows[1].net_cycles_per_eval, Some(0.0));
+        assert!(t.markdown().contains("flat: net cost not above zero"), "{}", t.markdown());
         assert!(t.model.contains("va_print_stats") && t.columns.iter().any(|c| c == "FMA cycles"), "{}", t.model);
     }
 

@@ -449,10 +449,18 @@ fn minor_refusals_and_notes_name_their_cause() {
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.path().join("i.json")).unwrap()).unwrap();
     assert_eq!(json["kind"], "inspect");
-    let md = std::fs::read_to_string(dir.path().join("i.md")).unwrap();
+    // A constant BRDF cannot drop the loads the memory-only kernel keeps (glsl/shade.glsl's keep_inputs): it
+    // nets at or just above zero, far below ggx.
+    let net = |m: &str| {
+        json["cost"]["rows"].as_array().unwrap().iter().find(|r| r["model"] == m).unwrap()["net_cycles_per_eval"]
+            .as_f64()
+            .unwrap()
+    };
     assert!(
-        md.contains("flat: net cost not above zero: the kernel adds nothing to the memory-only kernel"),
-        "{}\n{md}",
+        (0.0..0.05 * net("ggx")).contains(&net("flat")),
+        "{} against ggx {}\n{}",
+        net("flat"),
+        net("ggx"),
         r.stderr
     );
     let i = dir.path().join("i.json");
