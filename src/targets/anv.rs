@@ -89,7 +89,7 @@ pub fn read_listing(log: &str) -> Result<(Vec<DriverStat>, Vec<String>)> {
     let platform = std::env::var(ANV.gpu_var).map_err(|_| anyhow!("{} is not set in the ANV child", ANV.gpu_var))?;
     let family = intel_family(&platform).ok_or_else(|| anyhow!("no Intel rates for ANV platform `{platform}`"))?;
     let (simd, listing) = super::intel::brw::last_program(log, family.grf_bytes)
-        .ok_or_else(|| anyhow!("brw printed no program listing (is INTEL_DEBUG=cs reaching ANV?)"))?;
+        .map_err(|e| anyhow!("brw's listing (INTEL_DEBUG=cs): {e:#}"))?;
     if listing.is_empty() || ![8, 16, 32].contains(&simd) {
         bail!("brw's listing has {} instructions at SIMD{simd}: not a program brdfprof can price", listing.len());
     }

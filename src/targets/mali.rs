@@ -18,10 +18,10 @@
 //! varying 16, texture 4, load/store 1 ("Mali G78 peak performance"), the bound their max, read by the same rule.
 
 use super::cost;
+use super::cost::schedule::Schedule;
 use super::mesa_noop::shim::{Shim, ShimFamily};
 use super::mesa_noop::{MESA_25_UNVALIDATED, MESA_BACKPORTS, MESA_DEBIAN};
 use crate::gpu::{CompilerLog, DriverStat};
-use crate::model::BASELINE_LABEL;
 use crate::schema::InspectReport;
 use crate::schema::cost::TargetCost;
 use anyhow::{Result, anyhow, bail};
@@ -63,11 +63,12 @@ const PIPES: [(&str, &str); 7] = [
     ("Load-store cycles", "load/store"),
 ];
 
-/// The statistics shown beside cycles/eval.
-const SHOWN_BIFROST: [&str; 7] =
-    ["Instructions", "Tuples", "Clauses", "Arithmetic cycles", "Load-store cycles", "Bound cycles", "Threads"];
-const SHOWN_VALHALL: [&str; 7] =
-    ["Instructions", "FMA cycles", "CVT cycles", "SFU cycles", "Load-store cycles", "Bound cycles", "Threads"];
+/// The statistics shown beside cycles/eval (the busiest pipe, the compiler's "Bound cycles", is the rule's own
+/// column).
+const SHOWN_BIFROST: [&str; 6] =
+    ["Instructions", "Tuples", "Clauses", "Arithmetic cycles", "Load-store cycles", "Threads"];
+const SHOWN_VALHALL: [&str; 6] =
+    ["Instructions", "FMA cycles", "CVT cycles", "SFU cycles", "Load-store cycles", "Threads"];
 
 /// Why PanVK 22.3 (Bifrost) runs unvalidated; Mesa 25.0's PanVK (Vulkan 1.1) for `MESA_25_UNVALIDATED`'s reason.
 const PANVK_22_UNVALIDATED: &str = "PanVK 22.3 is a Vulkan 1.0 driver, and brdfprof's kernels are SPIR-V 1.3 (Vulkan 1.1), which the layer refuses on a 1.0 device; the driver compiles them (Mesa's SPIR-V front end reads any version), so its figures stand, unvalidated";
@@ -164,11 +165,6 @@ pub fn read_shaderdb(log: &str) -> Result<(Vec<DriverStat>, Vec<String>)> {
     Ok((stats, rest.into_iter().map(str::to_string).collect()))
 }
 
-/// The per-pipe cycles the compiler reported for a row (its architecture's), by PIPES' index.
-fn pipes_of(stats: &Stats) -> Vec<(usize, f64)> {
-    PIPES.iter().enumerate().filter_map(|(k, (name, _))| cost::driver_stat(stats, name).map(|v| (k, v))).collect()
-}
-
 type Stats = std::collections::BTreeMap<String, f64>;
 
 /// Evaluations one pass through the program stands for: the compiler counts a loop's body once, so where it
@@ -178,10 +174,13 @@ fn evaluations_per_pass(stats: &Stats, lights: u32) -> f64 {
     if cost::driver_stat(stats, "Loops").unwrap_or(0.0) > 0.0 { 1.0 } else { f64::from(lights) }
 }
 
-/// Each pipe's cycles per evaluation, by pipe name.
-fn per_eval(stats: &Stats, lights: u32) -> Vec<(String, f64)> {
-    let passes = evaluations_per_pass(stats, lights);
-    pipes_of(stats).into_iter().map(|(k, v)| (PIPES[k].1.to_string(), v / passes)).collect()
+/// The pipes the compiler reported for a kernel (its architecture's), as a bound with no latency term, and the
+/// evaluations one pass stands for.
+fn pipes_of(stats: &Stats, lights: u32) -> Option<(Schedule, f64)> {
+    let pipes: Vec<(String, f64)> =
+        PIPES.iter().filter_map(|(stat, pipe)| cost::driver_stat(stats, stat).map(|v| (pipe.to_string(), v))).collect();
+    let schedule = Schedule { pipes, latency: None, resident_waves: None };
+    (!schedule.pipes.is_empty()).then(|| (schedule, evaluations_per_pass(stats, lights)))
 }
 
 fn cost_table(shim: &Shim, family: &ShimFamily, report: &InspectReport) -> Option<TargetCost> {
@@ -201,43 +200,13 @@ fn cost_table(shim: &Shim, family: &ShimFamily, report: &InspectReport) -> Optio
         "{rule}; per evaluation = / lights per kernel where the light loop is unrolled, / 1 where the compiler keeps a loop (Loops > 0: its body, one light, counted once; the per-pixel loads and store outside it are then charged to every light, an upper bound)"
     );
     let unit = if valhall { "Valhall cycles per thread" } else { "Bifrost cycles per thread" };
-    let header = shim.header(family, report, rule, unit, shown);
-    // The bound is the busiest pipe (the compiler's "Bound cycles" where it names no pipe).
-    let mut t = cost::table(report, header, |stats, lights| {
-        let pipes = per_eval(stats, lights);
-        match pipes.iter().map(|p| p.1).reduce(f64::max) {
-            Some(busiest) => Some(busiest),
-            None => cost::driver_stat(stats, "Bound cycles").map(|c| c / evaluations_per_pass(stats, lights)),
-        }
-    })?;
-    let lights = t.lights_per_kernel;
-    let stats_of = |model: &str| report.rows.iter().find(|r| r.model == model).map(|r| &r.stats);
-    let base = stats_of(BASELINE_LABEL).map(|s| per_eval(s, lights));
-    for r in t.rows.iter_mut() {
-        let Some(mine) = stats_of(&r.model).map(|s| per_eval(s, lights)).filter(|p| !p.is_empty()) else { continue };
-        let binding = mine
-            .iter()
-            .fold(None, |b: Option<&(String, f64)>, p| if b.is_none_or(|b| p.1 > b.1) { Some(p) } else { b });
-        r.bound = binding.map(|(n, _)| n.clone());
-        r.terms = stats_of(&r.model)
-            .map(pipes_of)
-            .unwrap_or_default()
-            .into_iter()
-            .map(|(k, v)| (PIPES[k].1.to_string(), v))
-            .collect();
-        if let (Some(base), true) = (&base, r.model != BASELINE_LABEL) {
-            r.net_terms = mine
-                .iter()
-                .map(|(n, v)| (n.clone(), v - base.iter().find(|(b, _)| b == n).map_or(0.0, |b| b.1)))
-                .collect();
-        }
-    }
-    Some(t)
+    cost::bound_table(report, shim.header(family, report, rule, unit, shown), pipes_of)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::model::BASELINE_LABEL;
     use crate::schema::Row;
 
     const GGX: &str = "SHADER-DB: MESA_SHADER_COMPUTE shader: 174 inst, 145 tuples, 23 clauses, 8.000000 cycles, 5.750000 arith, 0.000000 texture, 0.000000 vary, 8.000000 ldst, 121 quadwords, 2 threads, 3 preloads, 0 loops, 1:2 spills:fills";

@@ -65,19 +65,33 @@ pub const HIDDEN_LATENCY: &str = "latency / waves";
 
 /// A cost table under `schedule`'s rule (`schedule::RULE`): per kernel, cycles per wave = max(busiest pipe,
 /// schedule latency / resident waves) over the figures `schedule_of(stats)` gives with the lanes of one wave,
-/// divided by those lanes and the lights per kernel; net = the kernel's cycles/eval minus the memory-only
-/// kernel's (per evaluation: kernels may differ in width), the term binding the kernel named in `bound` and
-/// each term's difference in `net_terms`.
+/// divided by those lanes and the lights per kernel (`bound_table`).
 pub fn schedule_table(
     report: &InspectReport,
-    mut header: TargetCost,
+    header: TargetCost,
     schedule_of: impl Fn(&Stats) -> Option<(Schedule, f64)>,
 ) -> Option<TargetCost> {
-    let lights = f64::from(steady_block(report.lights).0);
-    let per_eval = |stats: &Stats| schedule_of(stats).map(|(s, lanes)| (s.scaled(1.0 / (lanes * lights)), s));
+    bound_table(report, header, |stats, lights| schedule_of(stats).map(|(s, lanes)| (s, lanes * f64::from(lights))))
+}
+
+/// A cost table of bounds over terms: `evaluations_of(stats, lights per kernel)` gives a kernel's figures and
+/// the BRDF evaluations they stand for (lanes x lights, or fewer where a loop's body is counted once); per
+/// evaluation, cycles = the largest term; net = the kernel's cycles/eval minus the memory-only kernel's
+/// (kernels may differ in width), the term binding the kernel named in `bound` and each term's difference in
+/// `net_terms`. The latency columns appear where some kernel has a schedule latency.
+pub fn bound_table(
+    report: &InspectReport,
+    mut header: TargetCost,
+    evaluations_of: impl Fn(&Stats, u32) -> Option<(Schedule, f64)>,
+) -> Option<TargetCost> {
+    let lights = steady_block(report.lights).0;
+    let per_eval = |stats: &Stats| evaluations_of(stats, lights).map(|(s, evals)| (s.scaled(1.0 / evals), s));
     let figures = |model: &str| report.rows.iter().find(|r| r.model == model).and_then(|r| per_eval(&r.stats));
     let base = figures(BASELINE_LABEL).map(|(e, _)| e);
-    for c in [BUSIEST_PIPE, LATENCY, RESIDENT_WAVES, HIDDEN_LATENCY] {
+    let latency = report.rows.iter().any(|r| per_eval(&r.stats).is_some_and(|(_, w)| w.latency.is_some()));
+    let added: &[&str] =
+        if latency { &[BUSIEST_PIPE, LATENCY, RESIDENT_WAVES, HIDDEN_LATENCY] } else { &[BUSIEST_PIPE] };
+    for c in added {
         if !header.columns.iter().any(|x| x == c) {
             header.columns.push(c.to_string());
         }
@@ -86,9 +100,11 @@ pub fn schedule_table(
     for row in &mut t.rows {
         let Some((eval, wave)) = figures(&row.model) else { continue };
         row.stats.insert(BUSIEST_PIPE.into(), wave.throughput().1);
-        row.stats.insert(LATENCY.into(), wave.latency.unwrap_or(f64::NAN));
-        row.stats.insert(RESIDENT_WAVES.into(), wave.resident_waves.unwrap_or(f64::NAN));
-        row.stats.insert(HIDDEN_LATENCY.into(), wave.hidden_latency().unwrap_or(f64::NAN));
+        if latency {
+            row.stats.insert(LATENCY.into(), wave.latency.unwrap_or(f64::NAN));
+            row.stats.insert(RESIDENT_WAVES.into(), wave.resident_waves.unwrap_or(f64::NAN));
+            row.stats.insert(HIDDEN_LATENCY.into(), wave.hidden_latency().unwrap_or(f64::NAN));
+        }
         let (bound, net) = match &base {
             Some(b) if row.model != BASELINE_LABEL => {
                 row.net_terms = eval.added_terms(b);

@@ -4,15 +4,16 @@
 //! compilers under one rule.
 
 use super::gen_isa::{Instruction, registers};
+use anyhow::{Result, anyhow, bail};
 
 /// The SIMD width and instructions of the last program in `log` (`SIMD16 shader: N instructions. ...` and the
-/// blocks after it); None where the log holds none.
-pub fn last_program(log: &str, grf: u32) -> Option<(u32, Vec<Instruction>)> {
-    let mut program: Option<(u32, Vec<String>)> = None;
+/// blocks after it), read strictly: every line of its blocks an instruction, as many as the header states.
+pub fn last_program(log: &str, grf: u32) -> Result<(u32, Vec<Instruction>)> {
+    let mut program: Option<(&str, Vec<String>)> = None;
     let mut inside = false;
     for line in log.lines() {
-        if let Some(width) = line.strip_prefix("SIMD").and_then(|r| r.split_once(" shader: ")).map(|(w, _)| w) {
-            program = Some((width.parse().ok()?, Vec::new()));
+        if line.starts_with("SIMD") && line.contains(" shader: ") {
+            program = Some((line, Vec::new()));
             inside = true;
             continue;
         }
@@ -32,8 +33,18 @@ pub fn last_program(log: &str, grf: u32) -> Option<(u32, Vec<Instruction>)> {
             lines.push(line.to_string());
         }
     }
-    let (width, lines) = program?;
-    Some((width, lines.iter().filter_map(|l| instruction(l, grf)).collect()))
+    let (header, lines) = program.ok_or_else(|| anyhow!("no `SIMDn shader:` program listing"))?;
+    let number = |text: &str| text.trim().parse::<u32>().map_err(|_| anyhow!("unreadable program header `{header}`"));
+    let (width, rest) = header.strip_prefix("SIMD").and_then(|r| r.split_once(" shader: ")).unwrap_or_default();
+    let (width, stated) = (number(width)?, number(rest.split_once(" instructions").unwrap_or_default().0)?);
+    let instructions = lines
+        .iter()
+        .map(|l| instruction(l, grf).ok_or_else(|| anyhow!("not an instruction brdfprof can read: `{}`", l.trim())))
+        .collect::<Result<Vec<_>>>()?;
+    if instructions.len() != stated as usize {
+        bail!("{} instructions read where the header `{header}` states {stated}", instructions.len());
+    }
+    Ok((width, instructions))
 }
 
 /// Joins a send's descriptor line to its instruction line.
@@ -219,6 +230,16 @@ NIR (from SPIR-V) for MESA_SHADER_COMPUTE shader:\n\tmul(16) g1<1>F g2<8,8,1>F g
         assert_eq!(is[0].reads, [Reg::Grf(2), Reg::Grf(3), Reg::Grf(111), Reg::Grf(112)]);
         assert_eq!(is[1].writes, (1..9).map(Reg::Grf).collect::<Vec<_>>());
         assert_eq!(is[3].reads, [Reg::Grf(105), Reg::Grf(106)]);
-        assert!(last_program("no program here", 32).is_none());
+        assert!(last_program("no program here", 32).is_err());
+        // Garbage among the instructions, or a count other than the header's, is refused.
+        assert!(
+            last_program(&log.replace("mul(16)         g20", "??? g20"), 32).unwrap_err().to_string().contains("???")
+        );
+        assert!(
+            last_program(&log.replace("4 instructions", "5 instructions"), 32)
+                .unwrap_err()
+                .to_string()
+                .contains("states 5")
+        );
     }
 }
