@@ -101,33 +101,41 @@ version25="25.0.7-2~bpo12+1"
 key25="$version25 $(printf '%s %s' "$options25" "$meson_pypi" | sha256sum | cut -c1-16)"
 dir25="$cache/mesa-noop-$(printf '%s' "$key25" | tr ' +:~' '----')"
 
-backports_build() {
+# backports_source DIR: bookworm-backports' Mesa source in DIR (its upstream tarball, checked against Debian's signed
+# index; meson from PyPI in DIR/meson); prints the source folder. Needs root and apt-get.
+backports_source() {
+    s_dir=$1
     [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1 || {
-        echo "brdfprof mesa: bookworm-backports' Mesa is not built in $dir25; run make mesa as root (it needs apt-get)" >&2; return 1; }
+        echo "brdfprof mesa: bookworm-backports' Mesa is not built in $s_dir; run make mesa as root (it needs apt-get)" >&2; return 1; }
     suite="$(. /etc/os-release && echo "${VERSION_CODENAME:-}")-backports"
     list=/etc/apt/sources.list.d/brdfprof-deb-src-backports.sources
     if ! LC_ALL=C apt-get source --print-uris "mesa=$version25" >/dev/null 2>&1; then
         # A deb-src entry for backports: source indexes only, nothing installed comes from it.
         printf 'Types: deb-src\nURIs: http://deb.debian.org/debian\nSuites: %s\nComponents: main\nSigned-By: /usr/share/keyrings/debian-archive-keyring.gpg\n' "$suite" > "$list"
-        LC_ALL=C apt-get update -qq || { rm -f "$list"; echo "brdfprof mesa: apt-get update failed with $suite's deb-src entry (removed)" >&2; return 1; }
+        LC_ALL=C apt-get update -qq >&2 || { rm -f "$list"; echo "brdfprof mesa: apt-get update failed with $suite's deb-src entry (removed)" >&2; return 1; }
     fi
     uris=$(LC_ALL=C apt-get source --print-uris -qq "mesa=$version25" 2>&1) || { echo "brdfprof mesa: no mesa=$version25 source package in $suite: $uris" >&2; return 1; }
     tools
-    rm -rf "$dir25"
-    mkdir -p "$dir25" || return 1
+    rm -rf "$s_dir"
+    mkdir -p "$s_dir" || return 1
     line=$(printf '%s\n' "$uris" | grep "\.orig\.tar\.[a-z0-9]*' " | grep -v "\.asc'" | head -n 1)
     tarball=$(printf '%s' "$line" | cut -d' ' -f2)
     sum=$(printf '%s' "$line" | sed -n 's/.*SHA256:\([0-9a-f]*\).*/\1/p')
     [ -n "$tarball" ] && [ -n "$sum" ] || { echo "brdfprof mesa: no upstream tarball for mesa=$version25 in apt's index" >&2; return 1; }
-    echo "brdfprof mesa: fetching $tarball (Debian's mesa $version25 source package, $suite) into $dir25" >&2
+    echo "brdfprof mesa: fetching $tarball (Debian's mesa $version25 source package, $suite) into $s_dir" >&2
     # --download-only fetches and checks each file it can; only the tarball is needed (see above).
-    (cd "$dir25" && LC_ALL=C apt-get source --download-only -qq "mesa=$version25" >/dev/null 2>&1) || true
-    echo "$sum  $dir25/$tarball" | sha256sum -c --quiet - || { echo "brdfprof mesa: $tarball is missing or does not match Debian's index" >&2; return 1; }
-    tar -xf "$dir25/$tarball" -C "$dir25" || return 1
-    src25=$(find "$dir25" -mindepth 1 -maxdepth 1 -type d -name 'mesa-*' | head -n 1)
-    [ -n "$src25" ] || { echo "brdfprof mesa: $tarball unpacked no mesa-* folder" >&2; return 1; }
+    (cd "$s_dir" && LC_ALL=C apt-get source --download-only -qq "mesa=$version25" >/dev/null 2>&1) || true
+    echo "$sum  $s_dir/$tarball" | sha256sum -c --quiet - >&2 || { echo "brdfprof mesa: $tarball is missing or does not match Debian's index" >&2; return 1; }
+    tar -xf "$s_dir/$tarball" -C "$s_dir" || return 1
+    s_src=$(find "$s_dir" -mindepth 1 -maxdepth 1 -type d -name 'mesa-*' | head -n 1)
+    [ -n "$s_src" ] || { echo "brdfprof mesa: $tarball unpacked no mesa-* folder" >&2; return 1; }
     # Mesa 25 needs meson >= 1.1 (Debian 12 has 1.0.1): PyPI's, pinned, in the build's own folder.
-    python3 -m pip install --quiet --disable-pip-version-check --root-user-action=ignore --no-deps --target "$dir25/meson" "$meson_pypi" || return 1
+    python3 -m pip install --quiet --disable-pip-version-check --root-user-action=ignore --no-deps --target "$s_dir/meson" "$meson_pypi" >&2 || return 1
+    printf '%s\n' "$s_src"
+}
+
+backports_build() {
+    src25=$(backports_source "$dir25") || return 1
     # Exported: ninja runs meson's own script again for generated files.
     export PYTHONPATH="$dir25/meson"
     build "Turnip and PanVK and their noop shims from Mesa $version25 (about 900 steps, ~12 min on 2 cores)" "$key25" "$dir25" "$options25" "$products25" \
@@ -141,4 +149,71 @@ fi
 if built "$key25" "$dir25" "$products25"; then
     ln -sfn "$dir25/build" "$root/.tools/mesa25"
     echo "brdfprof mesa: Mesa noop drivers present ($key25) in $dir25" >&2
+fi
+
+# NVK (Mesa's Vulkan driver for NVIDIA GPUs; its compiler is NAK) from the same Mesa 25.0 source, in a build of its
+# own (the one above keeps its key and its build). NAK and NIL are Rust: meson >= 1.3.2 with Rust (the PyPI meson
+# above), bindgen >= 0.65 and cbindgen >= 0.25 (Debian 12 has 0.60 and 0.24: cargo-installed, pinned versions,
+# into the cache), and Mesa's Rust subprojects, whose .wrap download URLs do not resolve here: cargo fetches the
+# same crate versions, and each .crate goes into subprojects/packagecache/ under its wrap's source_filename,
+# where meson checks the wrap's source_hash before building from it. Best effort, like the build above.
+options_nvk="-Dbuildtype=release -Dvulkan-drivers=nouveau -Dgallium-drivers= -Dtools=drm-shim \
+-Dplatforms= -Dglx=disabled -Degl=disabled -Dgbm=disabled -Dopengl=false -Dgles1=disabled -Dgles2=disabled \
+-Dllvm=disabled -Dvalgrind=disabled -Dlibunwind=disabled -Dzstd=enabled -Dvideo-codecs="
+# What brdfprof loads (src/targets/nak.rs names these files; a test ties them).
+products_nvk="src/nouveau/vulkan/libvulkan_nouveau.so src/nouveau/vulkan/nouveau_devenv_icd.x86_64.json
+src/nouveau/drm-shim/libnouveau_noop_drm_shim.so"
+rust_tools="bindgen-cli@0.73.2 cbindgen@0.29.4"
+keynvk="$version25 $(printf '%s %s %s' "$options_nvk" "$meson_pypi" "$rust_tools" | sha256sum | cut -c1-16)"
+dirnvk="$cache/mesa-nvk-$(printf '%s' "$keynvk" | tr ' +:~' '----')"
+
+# The crates of each wrap-file=... Rust subproject (rust_crates SRCDIR): cargo fetches them in a throwaway project.
+rust_crates() {
+    r_src=$1
+    r_home="$dirnvk/cargo-home"
+    mkdir -p "$r_src/subprojects/packagecache"
+    for wrap in "$r_src"/subprojects/*.wrap; do
+        url=$(sed -n 's/^source_url *= *//p' "$wrap")
+        case "$url" in *crates.io/api/v1/crates/*/download) ;; *) continue ;; esac
+        name=$(printf '%s' "$url" | sed 's|.*/crates/\([^/]*\)/\([^/]*\)/download|\1|')
+        ver=$(printf '%s' "$url" | sed 's|.*/crates/\([^/]*\)/\([^/]*\)/download|\2|')
+        file=$(sed -n 's/^source_filename *= *//p' "$wrap")
+        proj="$dirnvk/fetch-$name"
+        mkdir -p "$proj/src" && : > "$proj/src/lib.rs"
+        printf '[package]\nname = "fetch-%s"\nversion = "0.0.0"\nedition = "2021"\n[dependencies]\n%s = "=%s"\n' "$name" "$name" "$ver" > "$proj/Cargo.toml"
+        # Not every wrap is NVK's: one that cannot be fetched fails the build only if meson needs it.
+        CARGO_HOME="$r_home" cargo fetch -q --manifest-path "$proj/Cargo.toml" || { echo "brdfprof mesa: cargo could not fetch crate $name $ver" >&2; continue; }
+        crate=$(find "$r_home/registry/cache" -name "$name-$ver.crate" | head -n 1)
+        [ -n "$crate" ] || { echo "brdfprof mesa: cargo fetched no $name-$ver.crate" >&2; continue; }
+        cp "$crate" "$r_src/subprojects/packagecache/$file"
+        echo "brdfprof mesa: Rust subproject $name $ver from cargo (meson checks its hash)" >&2
+    done
+}
+
+nvk_build() {
+    command -v cargo >/dev/null 2>&1 && command -v rustc >/dev/null 2>&1 || { echo "brdfprof mesa: NVK needs rustc and cargo" >&2; return 1; }
+    srcnvk=$(backports_source "$dirnvk") || return 1
+    export DEBIAN_FRONTEND=noninteractive
+    apt-get install -y -qq libclang1-15 >/dev/null || return 1
+    tools_dir="$cache/rust-tools"
+    if ! "$tools_dir/bin/bindgen" --version >/dev/null 2>&1 || ! "$tools_dir/bin/cbindgen" --version >/dev/null 2>&1; then
+        echo "brdfprof mesa: installing $rust_tools with cargo (once per machine, ~7 min on 2 cores)" >&2
+        # shellcheck disable=SC2086
+        cargo install -q --locked $rust_tools --root "$tools_dir" || return 1
+    fi
+    rust_crates "$srcnvk" || return 1
+    # A native file names these tools: `build` puts /usr/bin first in PATH, where Debian's older ones may be.
+    printf "[binaries]\nrust = ['%s']\nbindgen = '%s'\ncbindgen = '%s'\n" "$(command -v rustc)" "$tools_dir/bin/bindgen" "$tools_dir/bin/cbindgen" > "$dirnvk/tools.ini"
+    export PYTHONPATH="$dirnvk/meson"
+    build "NVK and its noop shim from Mesa $version25 (about 870 steps, ~12 min on 2 cores)" "$keynvk" "$dirnvk" "$options_nvk --native-file $dirnvk/tools.ini" "$products_nvk" \
+        "python3 $dirnvk/meson/bin/meson" "$srcnvk"
+    rm -rf "$dirnvk"/cargo-home "$dirnvk"/fetch-*
+}
+
+if ! built "$keynvk" "$dirnvk" "$products_nvk"; then
+    ( nvk_build ) || echo "brdfprof mesa: warning: NVK from Mesa $version25 was not built; the nak: targets are unavailable (the other targets are not affected); make mesa tries again" >&2
+fi
+if built "$keynvk" "$dirnvk" "$products_nvk"; then
+    ln -sfn "$dirnvk/build" "$root/.tools/mesa25-nvk"
+    echo "brdfprof mesa: NVK noop driver present ($keynvk) in $dirnvk" >&2
 fi

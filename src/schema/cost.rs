@@ -99,9 +99,15 @@ impl TargetCost {
         }
     }
 
-    /// The column name in cross-device tables: "navi21 cycles/eval".
+    /// The column name in cross-device tables: "navi21 cycles/eval"; a family name two vendors share (sm_86:
+    /// ptxas' and NAK's) by its target, "nak:sm_86 cycles/eval".
     pub fn column_name(&self) -> String {
-        format!("{} cycles/eval", self.family.clone().unwrap_or_else(|| self.device.clone()))
+        let name = match (&self.family, &self.target) {
+            (Some(f), Some(t)) if crate::targets::shared_family_name(f) => t.clone(),
+            (Some(f), _) => f.clone(),
+            _ => self.device.clone(),
+        };
+        format!("{name} cycles/eval")
     }
 
     pub fn row(&self, model: &str) -> Option<&CostRow> {

@@ -87,6 +87,7 @@ pub static ADRENO: Shim = Shim {
     ],
     cost: cost_table,
     compiler_log: None,
+    representation_stats: None,
 };
 
 /// ir3's instruction categories by pipe (`instrs_per_cat`, statistics "catN instructions").

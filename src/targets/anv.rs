@@ -81,6 +81,7 @@ pub static ANV: Shim = Shim {
     ],
     cost: cost_table,
     compiler_log: Some(CompilerLog { read: read_listing, beside_properties: true }),
+    representation_stats: None,
 };
 
 /// One pipeline's stderr under INTEL_DEBUG=cs: its program's listing priced for the family the shim emulates

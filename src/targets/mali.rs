@@ -122,6 +122,7 @@ pub static MALI: Shim = Shim {
     ],
     cost: cost_table,
     compiler_log: Some(CompilerLog { read: read_shaderdb, beside_properties: false }),
+    representation_stats: None,
 };
 
 /// One pipeline's stderr: its compute shader's `SHADER-DB:` line as statistics, the other lines passed on.

@@ -1,7 +1,7 @@
 //! Compile-only targets: GPU families whose production compiler brdfprof runs without the GPU, one `Vendor`
 //! per `--device` prefix, each in its own file or folder (`radv`: Mesa RADV's ACO in a child process; `nvidia`:
 //! NVRTC and ptxas on the kernels' CUDA C++ translation; `intel`: IGC through ocloc on their OpenCL C
-//! translation; `adreno`, `mali`, `anv`: Mesa's Turnip, PanVK and ANV on Mesa's noop drm-shims), listed once in
+//! translation; `adreno`, `mali`, `anv`, `nak`: Mesa's Turnip, PanVK, ANV and NVK on Mesa's noop drm-shims), listed once in
 //! `VENDORS`. Two runtimes carry them: `mesa_noop`, the child process every Mesa driver runs in, and
 //! `translated`, the one `Vendor` of the translating vendors, each of them a `Translator`. A target is `--device PREFIX:FAMILY` (or `PREFIX:all`, or
 //! `PREFIX:a,b`); `devices --targets`, `inspect`, `check`, `sweep --cost-device`, `profile --scene --cost-device` and `compare` reach the vendors
@@ -16,6 +16,7 @@ pub mod cost;
 pub mod intel;
 pub mod mali;
 pub mod mesa_noop;
+pub mod nak;
 pub mod nvidia;
 pub mod radv;
 pub mod translated;
@@ -127,8 +128,13 @@ pub trait Vendor: Sync {
 }
 
 /// Every vendor: the one list (a new compiler lands here and in its own file or folder).
-pub static VENDORS: [&dyn Vendor; 6] =
-    [&radv::RADV, &nvidia::NVIDIA, &intel::INTEL, &adreno::ADRENO, &mali::MALI, &anv::ANV];
+pub static VENDORS: [&dyn Vendor; 7] =
+    [&radv::RADV, &nvidia::NVIDIA, &intel::INTEL, &adreno::ADRENO, &mali::MALI, &anv::ANV, &nak::NAK];
+
+/// Whether more than one vendor has a family of this name (`sm_86`: `nvidia:` and `nak:`).
+pub fn shared_family_name(name: &str) -> bool {
+    VENDORS.iter().filter(|v| v.families().iter().any(|f| f.name == name)).count() > 1
+}
 
 /// One family of one vendor.
 #[derive(Clone, Copy)]

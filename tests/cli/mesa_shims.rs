@@ -1,5 +1,5 @@
-//! Mesa's Turnip (adreno:), PanVK (mali:) and ANV (anv:) on Mesa's noop drm-shims, built by `make mesa`:
-//! the drivers' real compilers (ir3, Bifrost, brw) compile brdfprof's unchanged SPIR-V in child processes, and
+//! Mesa's Turnip (adreno:), PanVK (mali:), ANV (anv:) and NVK (nak:) on Mesa's noop drm-shims, built by
+//! `make mesa`: the drivers' real compilers (ir3, Bifrost, brw, NAK) compile brdfprof's unchanged SPIR-V in child processes, and
 //! their statistics and cost rules reach every compile-only command. Nothing here mocks a driver: a missing
 //! or broken build is a real directory without (or with a broken) driver.
 
@@ -139,6 +139,7 @@ fn without_a_mesa_build_every_shim_target_exits_2_naming_make_mesa() {
         ("anv:tgl", "intel_devenv_icd"),
         ("adreno:a740", "freedreno_devenv_icd"),
         ("mali:g610", "panfrost_devenv_icd"),
+        ("nak:sm_86", "nouveau_devenv_icd"),
     ] {
         let out = common::brdfprof()
             .args([
@@ -156,6 +157,7 @@ fn without_a_mesa_build_every_shim_target_exits_2_naming_make_mesa() {
             .current_dir(d)
             .env(targets::mesa_noop::MESA_DEBIAN.var, &empty)
             .env(targets::mesa_noop::MESA_BACKPORTS.var, &empty)
+            .env(targets::mesa_noop::MESA_NVK.var, &empty)
             .output()
             .unwrap();
         let stderr = String::from_utf8_lossy(&out.stderr);
@@ -172,6 +174,7 @@ fn without_a_mesa_build_every_shim_target_exits_2_naming_make_mesa() {
         .args(["devices", "--targets"])
         .env(targets::mesa_noop::MESA_DEBIAN.var, &empty)
         .env(targets::mesa_noop::MESA_BACKPORTS.var, &empty)
+        .env(targets::mesa_noop::MESA_NVK.var, &empty)
         .output()
         .unwrap();
     let stdout = String::from_utf8_lossy(&out.stdout);
@@ -444,7 +447,7 @@ fn devices_targets_lists_every_shim_family_and_its_compiler() {
     for device in shim_targets() {
         assert!(out.stdout.lines().any(|l| l.starts_with(&format!("| {device} "))), "{device}:\n{}", out.stdout);
     }
-    for compiler in ["Turnip (ir3 compiler)", "PanVK (Bifrost compiler)", "ANV (brw compiler)"] {
+    for compiler in ["Turnip (ir3 compiler)", "PanVK (Bifrost compiler)", "ANV (brw compiler)", "NVK (NAK compiler)"] {
         assert!(out.stdout.contains(compiler), "{compiler}:\n{}", out.stdout);
     }
 }
@@ -470,10 +473,12 @@ fn setup_builds_every_file_each_shim_driver_loads() {
         p.dedup();
         p
     };
-    let shims = [&targets::adreno::ADRENO, &targets::mali::MALI, &targets::anv::ANV];
-    for (build, list) in
-        [(&targets::mesa_noop::MESA_DEBIAN, "products"), (&targets::mesa_noop::MESA_BACKPORTS, "products25")]
-    {
+    let shims = [&targets::adreno::ADRENO, &targets::mali::MALI, &targets::anv::ANV, &targets::nak::NAK];
+    for (build, list) in [
+        (&targets::mesa_noop::MESA_DEBIAN, "products"),
+        (&targets::mesa_noop::MESA_BACKPORTS, "products25"),
+        (&targets::mesa_noop::MESA_NVK, "products_nvk"),
+    ] {
         let mut loaded: Vec<String> = shims
             .iter()
             .filter(|s| s.families.iter().any(|f| std::ptr::eq(f.build, build)))
@@ -549,4 +554,30 @@ fn a_model_file_edited_during_a_run_never_mixes_two_texts() {
     std::fs::remove_dir_all(&cache).unwrap();
     let cold = rows("cold");
     assert_eq!(warm, cold, "the cache held another text's figures under the original's key");
+}
+
+/// NVK's NAK prices its own assembly: every instruction NVK counts is read from the "NAK assembly" it returns
+/// (with its delays and scoreboards), the listing is written under --isa, and a model the family cannot compile
+/// (fp16 arithmetic before SM80, where NVK offers no shaderFloat16) is named under the cost table, not dropped.
+#[test]
+fn nak_reads_every_instruction_of_its_assembly_and_names_what_a_family_cannot_compile() {
+    let dir = tempfile::tempdir().unwrap();
+    let isa = dir.path().join("isa");
+    let devices = ["nak:sm_75", "nak:sm_86"].map(String::from);
+    let extra = ["--model", "ggx", "--model", "burley,precision=f16", "--isa", isa.to_str().unwrap()];
+    let out = inspect(dir.path(), "nak", &devices, &extra);
+    let reports = out["reports"].as_array().unwrap();
+    for (report, device) in reports.iter().zip(&devices) {
+        for row in report["rows"].as_array().unwrap() {
+            let stat = |name: &str| row["stats"][format!("driver/compute/{name}")].as_f64();
+            assert!(stat("Instruction count").unwrap() > 0.0, "{device} {}", row["model"]);
+            assert_eq!(stat("Assembly Instructions"), stat("Instruction count"), "{device} {}", row["model"]);
+        }
+        let listing = std::fs::read_to_string(isa.join(format!("{}/ggx.nak-assembly.txt", device.replace(':', "-"))))
+            .unwrap_or_else(|e| panic!("{device}: {e}"));
+        assert!(listing.contains("// delay=") && listing.contains("exit"), "{}", &listing[..listing.len().min(400)]);
+    }
+    let absent = |k: usize| reports[k]["cost"]["absent"].to_string();
+    assert!(absent(0).contains("precision=f16"), "sm_75 names the fp16 model it cannot compile: {}", absent(0));
+    assert!(!absent(1).contains("precision=f16"), "sm_86 compiles fp16: {}", absent(1));
 }

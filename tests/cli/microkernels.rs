@@ -1,5 +1,6 @@
 //! The cost rule's microkernel suite: kernels of tests/fixtures/brdf/micro/ whose cost follows from first
-//! principles (a dependent FMA chain and its independent twin, a branch and its select twin, a constant BRDF),
+//! principles (a dependent FMA chain and its independent twin, a branch and its select twin, a constant BRDF,
+//! packed fp16 and its fp32 twin, register pressure),
 //! priced by every vendor's compile-only target at 1 and 8 lights. Each assertion states the physics it checks
 //! and names the target and the family that broke it, in the spirit of llvm-mca's tests against measured
 //! tables: a change to a vendor's rule that breaks documented behaviour fails here.
@@ -7,11 +8,29 @@
 use crate::compile_only::inspect_json;
 use std::collections::BTreeMap;
 
-/// One target of each vendor and compiler: ACO, ptxas, IGC, ir3, Bifrost, brw.
-const TARGETS: [&str; 6] = ["radv:navi21", "nvidia:sm_89", "intel:gen12lp", "adreno:a660", "mali:g52", "anv:tgl"];
+/// One target of each vendor and compiler: ACO, ptxas, IGC, ir3, Bifrost, brw, NAK.
+const TARGETS: [&str; 7] =
+    ["radv:navi21", "nvidia:sm_89", "intel:gen12lp", "adreno:a660", "mali:g52", "anv:tgl", "nak:sm_86"];
 
-/// (target, model) -> (cycles/eval, net cycles/eval) of every cost table in an inspect report.
-type Costs = BTreeMap<(String, String), (f64, Option<f64>)>;
+/// The targets whose hardware runs two fp16 results where it runs one fp32 result, by their documents: RDNA's packed
+/// v_pk_fma_f16 (AMD's RDNA whitepaper, "packed math"), NVIDIA's HFMA2 (two results per instruction: the CUDA
+/// guide's FP16 row, at FP32's results per clock on 8.9 but half its issue slots), Intel Xe-LP's FP16 at 16 lanes
+/// per clock against FP32's 8 (`intel::THROUGHPUT`, tests/fixtures/intel-throughput.tsv), for IGC and brw alike.
+/// Not ir3 (no fp16 rate in ir3 or Qualcomm's public documents: the rule counts its instructions), not Bifrost on
+/// PanVK 22.3 (no fp16 at all) and not NAK 25.0 (its code adds an HADD2 per HFMA2: docs/targets/nak.md).
+const PACKED_FP16: [&str; 4] = ["radv:navi21", "nvidia:sm_89", "intel:gen12lp", "anv:tgl"];
+
+/// The targets whose resident waves fall with the registers a thread holds (AMD: VGPRs per SIMD; NVIDIA: the
+/// register file per SM; Adreno: ir3's Max Waves Per Core); Intel's EUs hold a fixed number of threads of 128
+/// registers each (more registers spill instead), and Bifrost's rule has no latency term.
+const OCCUPANCY_BY_REGISTERS: [&str; 4] = ["radv:navi21", "nvidia:sm_89", "adreno:a660", "nak:sm_86"];
+const FIXED_THREADS: [&str; 2] = ["intel:gen12lp", "anv:tgl"];
+
+/// A kernel's figures: cycles/eval, net cycles/eval, resident waves (where the rule has them).
+type Figures = (f64, Option<f64>, Option<f64>);
+
+/// (target, model) -> its figures, of every cost table in an inspect report.
+type Costs = BTreeMap<(String, String), Figures>;
 
 fn costs_at(dir: &std::path::Path, lights: u32) -> Costs {
     let micro = crate::common::repo_root().join("tests/fixtures/brdf/micro");
@@ -35,7 +54,11 @@ fn costs_at(dir: &std::path::Path, lights: u32) -> Costs {
         for row in cost["rows"].as_array().unwrap() {
             out.insert(
                 (target.to_string(), row["model"].as_str().unwrap().to_string()),
-                (row["cycles_per_eval"].as_f64().unwrap(), row["net_cycles_per_eval"].as_f64()),
+                (
+                    row["cycles_per_eval"].as_f64().unwrap(),
+                    row["net_cycles_per_eval"].as_f64(),
+                    row["stats"]["Resident Waves"].as_f64(),
+                ),
             );
         }
     }
@@ -61,7 +84,7 @@ fn microkernels_cost_what_each_vendors_documents_say_on_every_target() {
     for t in TARGETS {
         for (lights, costs) in &at {
             let base = get(costs, t, "baseline").0;
-            for ((target, model), (cycles, net)) in costs.iter().filter(|((target, _), _)| target == t) {
+            for ((target, model), (cycles, net, _)) in costs.iter().filter(|((target, _), _)| target == t) {
                 // The net is the difference of the bounds: never above the gross difference.
                 if let Some(net) = net {
                     check(
@@ -90,6 +113,21 @@ fn microkernels_cost_what_each_vendors_documents_say_on_every_target() {
             (n8 / n1 - 1.0).abs() <= 0.2,
             format!("{t} fma-dependent: net {n1} per evaluation at 1 light, {n8} at 8 (more than 20% apart)"),
         );
+    }
+    let one = &at[0].1;
+    // Packed fp16: the same 128 multiply-adds cost at most 3/4 of their fp32 twin's net (2x per the documents,
+    // less the conversions around them).
+    for t in PACKED_FP16 {
+        let (f16, f32) = (get(one, t, "fma-pair-f16").1.unwrap(), get(one, t, "fma-pair-f32").1.unwrap());
+        check(f16 <= 0.75 * f32, format!("{t} fp16 pair (1 light): net {f16} over 0.75x its fp32 twin {f32}"));
+    }
+    // 64 values live at once: fewer waves fit where registers bound them, the same where the thread count is
+    // fixed.
+    for t in OCCUPANCY_BY_REGISTERS.iter().chain(&FIXED_THREADS) {
+        let waves = |m: &str| get(one, t, m).2.unwrap_or_else(|| panic!("{t} {m}: no resident waves"));
+        let (pressed, free) = (waves("registers"), waves("fma-independent"));
+        let ok = if FIXED_THREADS.contains(t) { pressed == free } else { pressed < free };
+        check(ok, format!("{t} register pressure (1 light): {pressed} resident waves against {free} without it"));
     }
     assert!(failures.is_empty(), "the microkernels broke the cost rule:\n{}", failures.join("\n"));
 }

@@ -73,7 +73,7 @@ impl Kernel<'_> {
             // SAFETY: as above; index < the executable count the driver returned.
             let stats = unsafe { ext.get_pipeline_executable_statistics(&exe_info) }
                 .context("vkGetPipelineExecutableStatisticsKHR")?;
-            let stats = stats
+            let mut stats: Vec<DriverStat> = stats
                 .iter()
                 .map(|s| DriverStat {
                     executable: name.clone(),
@@ -82,7 +82,25 @@ impl Kernel<'_> {
                     value: value(s),
                 })
                 .collect();
-            let representations = if self.captures_ir { self.representations(ext, &exe_info)? } else { Vec::new() };
+            let mut representations = Vec::new();
+            if self.captures_ir || self.gpu.representation_stats.is_some() {
+                representations = self.representations(ext, &exe_info)?;
+            }
+            if let Some(reader) = self.gpu.representation_stats {
+                let (_, ir) = representations.iter().find(|(n, _)| n == reader.name).with_context(|| {
+                    format!("{}: the driver returned no internal representation `{}`", self.name, reader.name)
+                })?;
+                let read = (reader.read)(ir).with_context(|| format!("{}: its {}", self.name, reader.name))?;
+                stats.extend(read.into_iter().map(|(stat, value)| DriverStat {
+                    executable: name.clone(),
+                    description: format!("read from the driver's {}", reader.name),
+                    name: stat,
+                    value,
+                }));
+            }
+            if !self.captures_ir {
+                representations.clear();
+            }
             out.push(PipelineExecutable { name, subgroup_size: exe.subgroup_size, stats, representations });
         }
         // Logged statistics beside the extension's join the (one) compute executable's, under its name.

@@ -214,7 +214,7 @@ impl<'g> Kernel<'g> {
             let mut flags = vk::PipelineCreateFlags::empty();
             if gpu.executable_properties.is_some() {
                 flags |= vk::PipelineCreateFlags::CAPTURE_STATISTICS_KHR;
-                if capture_ir {
+                if capture_ir || gpu.representation_stats.is_some() {
                     flags |= vk::PipelineCreateFlags::CAPTURE_INTERNAL_REPRESENTATIONS_KHR;
                 }
             }

@@ -47,6 +47,18 @@ pub struct GpuOptions {
     /// (PanVK with BIFROST_MESA_DEBUG=shaderdb): what each pipeline creation writes there is captured and read
     /// into statistics by this function (`Kernel::executables`).
     pub compiler_log: Option<CompilerLog>,
+    /// Statistics read from one of the driver's internal representations (NVK's "NAK assembly"): every
+    /// pipeline is created to capture them, and `Kernel::executables` adds what this reads to its statistics.
+    pub representation_stats: Option<RepresentationStats>,
+}
+
+/// How to read statistics from an internal representation of a pipeline executable.
+#[derive(Clone, Copy, Debug)]
+pub struct RepresentationStats {
+    /// The representation's name as the driver gives it ("NAK assembly").
+    pub name: &'static str,
+    /// Its statistics, named as the executable's own are.
+    pub read: fn(&str) -> Result<Vec<(String, f64)>>,
 }
 
 /// How to read a driver's stderr output of one pipeline creation.
@@ -143,6 +155,7 @@ pub struct Gpu {
     pub(crate) device: ash::Device,
     pub(crate) executable_properties: Option<ash::khr::pipeline_executable_properties::Device>,
     pub(crate) compiler_log: Option<CompilerLog>,
+    pub(crate) representation_stats: Option<RepresentationStats>,
     queue: vk::Queue,
     command_pool: vk::CommandPool,
     memory_properties: vk::PhysicalDeviceMemoryProperties,
@@ -235,7 +248,8 @@ fn describe(instance: &ash::Instance, index: usize, pd: vk::PhysicalDevice) -> D
             |r: std::result::Result<&CStr, _>| r.map(|s: &CStr| s.to_string_lossy().into_owned()).unwrap_or_default();
         DeviceInfo {
             index,
-            name: text(props.device_name_as_c_str()),
+            // NVK on the noop shim names itself "NVK " (no chip name to append).
+            name: text(props.device_name_as_c_str()).trim().to_string(),
             device_type: device_type_name(props.device_type).into(),
             vendor_id: props.vendor_id,
             device_id: props.device_id,
@@ -453,6 +467,7 @@ impl Gpu {
             device,
             executable_properties,
             compiler_log: options.compiler_log,
+            representation_stats: options.representation_stats,
             queue,
             command_pool,
             memory_properties,

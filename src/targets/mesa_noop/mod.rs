@@ -21,7 +21,7 @@ pub mod shim;
 
 use super::{Request, Run, Target, Vendor};
 use crate::cleanup;
-use crate::gpu::{CompilerLog, Gpu, GpuOptions, Kernel};
+use crate::gpu::{CompilerLog, Gpu, GpuOptions, Kernel, RepresentationStats};
 use crate::kernels::shade::{self, GBufferFormat, kernel_hash, shade_kernel, steady_block};
 use crate::model::BASELINE_LABEL;
 use crate::model::Model;
@@ -60,6 +60,10 @@ pub trait NoopDriver: Vendor {
     }
     /// Statistics the compiler prints on stderr (drivers without VK_KHR_pipeline_executable_properties).
     fn compiler_log(&self) -> Option<CompilerLog> {
+        None
+    }
+    /// Statistics read from one of the driver's internal representations (every pipeline captures them).
+    fn representation_stats(&self) -> Option<RepresentationStats> {
         None
     }
 }
@@ -151,6 +155,7 @@ pub fn child_main(request_json: &str) -> Result<()> {
         device: Some(wanted.clone().unwrap_or_else(|| "0".into())),
         validation: req.validate && unvalidated.is_none(),
         compiler_log: driver.compiler_log(),
+        representation_stats: driver.representation_stats(),
     };
     let gpu = Gpu::new(&options).map_err(|e| {
         anyhow!(
@@ -218,6 +223,8 @@ fn models_report(
         }
     }
     let mut report = crate::kernel_stats::device_report(gpu, shaders, &models, req.lights, None)?;
+    // The target first: a driver's cost rule finds its family by it.
+    report.provenance["target"] = serde_json::Value::String(target.to_string());
     report.cost = super::cost_of(&report);
     if let Some(cost) = &mut report.cost {
         cost.absent =
@@ -654,7 +661,12 @@ pub fn compile(prefix: &str, families: &[usize], raw: &[super::RawKernel], reque
             if let Some(note) = &run.teardown_note {
                 add_driver_note(&mut report, note.clone());
             }
+            // The cost is the parent's rule; the models the child could not compile stay named under it.
+            let absent = report.cost.take().map(|c| c.absent).unwrap_or_default();
             report.cost = driver.cost(&report);
+            if let Some(cost) = &mut report.cost {
+                cost.absent = absent;
+            }
             Ok(Run {
                 target: Target { vendor: driver, family },
                 report,
@@ -710,7 +722,7 @@ pub static MESA_DEBIAN: MesaBuild = MesaBuild {
 };
 
 /// Why the validation layer does not run for Mesa 25.0's drivers.
-pub const MESA_25_UNVALIDATED: &str = "Debian 12's validation layer warns, on Mesa 25.0's Turnip and PanVK only, that the kernels' texel-buffer fetch (GLSL usamplerBuffer: an OpTypeSampledImage of Dim Buffer) should not be a sampled image; the same SPIR-V 1.3 kernels pass the layer on lavapipe, RADV and Mesa 22.3's drivers, so brdfprof compiles them unvalidated there and says so";
+pub const MESA_25_UNVALIDATED: &str = "Debian 12's validation layer warns, on Mesa 25.0's Turnip, PanVK and NVK only, that the kernels' texel-buffer fetch (GLSL usamplerBuffer: an OpTypeSampledImage of Dim Buffer) should not be a sampled image; the same SPIR-V 1.3 kernels pass the layer on lavapipe, RADV and Mesa 22.3's drivers, so brdfprof compiles them unvalidated there and says so";
 
 /// bookworm-backports' Mesa (25.0): Adreno 7xx and Mali Valhall.
 pub static MESA_BACKPORTS: MesaBuild = MesaBuild {
@@ -718,6 +730,15 @@ pub static MESA_BACKPORTS: MesaBuild = MesaBuild {
     var: "BRDFPROF_MESA25_DIR",
     what: "bookworm-backports' Mesa 25.0",
     drivers: "Turnip and PanVK from Debian's bookworm-backports source package of Mesa 25.0, ~12 minutes on 2 cores",
+};
+
+/// The same Mesa 25.0 source again, its NVK alone (NAK is Rust, so this build needs cargo-installed bindgen and
+/// cbindgen and Mesa's Rust subprojects): NVIDIA Turing and Ampere.
+pub static MESA_NVK: MesaBuild = MesaBuild {
+    link: ".tools/mesa25-nvk",
+    var: "BRDFPROF_MESA25_NVK_DIR",
+    what: "bookworm-backports' Mesa 25.0 (NVK)",
+    drivers: "NVK from Debian's bookworm-backports source package of Mesa 25.0, ~12 minutes on 2 cores after ~7 minutes of cargo install for bindgen and cbindgen",
 };
 
 impl MesaBuild {

@@ -1,9 +1,9 @@
 //! A Mesa Vulkan driver on Mesa's noop drm-shim, as data: the files of the build `make mesa` made, the
-//! variable that picks the GPU, the families, and the driver's cost rule. `adreno.rs`, `mali.rs` and `anv.rs`
-//! are one `Shim` each; the child process, its environment checks and crash handling are `mesa_noop`'s.
+//! variable that picks the GPU, the families, and the driver's cost rule. `adreno.rs`, `mali.rs`, `anv.rs` and
+//! `nak.rs` are one `Shim` each; the child process, its environment checks and crash handling are `mesa_noop`'s.
 
 use super::NoopDriver;
-use crate::gpu::CompilerLog;
+use crate::gpu::{CompilerLog, RepresentationStats};
 use crate::schema::InspectReport;
 use crate::schema::cost::TargetCost;
 use crate::targets::{Family, Request, Run, Vendor, mesa_noop};
@@ -51,6 +51,8 @@ pub struct Shim {
     pub cost: fn(&Shim, &ShimFamily, &InspectReport) -> Option<TargetCost>,
     /// Statistics the compiler prints on stderr, for a driver without VK_KHR_pipeline_executable_properties.
     pub compiler_log: Option<CompilerLog>,
+    /// Statistics read from one of the driver's internal representations (NAK's assembly).
+    pub representation_stats: Option<RepresentationStats>,
 }
 
 impl Shim {
@@ -216,6 +218,10 @@ impl NoopDriver for Shim {
 
     fn compiler_log(&self) -> Option<CompilerLog> {
         self.compiler_log
+    }
+
+    fn representation_stats(&self) -> Option<RepresentationStats> {
+        self.representation_stats
     }
 
     fn without_validation(&self, family: usize) -> Option<&'static str> {

@@ -308,22 +308,26 @@ impl SassStats {
     /// Counts the `-hex` listing: every instruction up to the kernel's last EXIT (nvdisasm pads the section
     /// with a branch to itself and NOPs after it), NOPs left out of the counts (not of the schedule).
     pub fn of(listing: &str, ptxas_log: &str, cubin_bytes: usize) -> Result<Self> {
-        let instructions = sass::instructions(listing)?;
-        let mut s = SassStats {
-            cubin_bytes: cubin_bytes as u32,
-            schedule_latency: sass::schedule_latency(&instructions),
-            ..Default::default()
-        };
+        let mut s = Self::of_instructions(&sass::instructions(listing)?);
+        s.cubin_bytes = cubin_bytes as u32;
+        s.registers = ptxas_figure(ptxas_log, "registers");
+        s.stack_bytes = ptxas_figure(ptxas_log, "bytes stack frame");
+        s.spill_bytes = ptxas_figure(ptxas_log, "bytes spill stores") + ptxas_figure(ptxas_log, "bytes spill loads");
+        Ok(s)
+    }
+
+    /// The counts and the schedule latency of one warp's instructions in issue order, whichever compiler
+    /// scheduled them (ptxas' SASS, NAK's assembly), NOPs left out of the counts (not of the schedule); no
+    /// registers, stack or code size.
+    pub fn of_instructions(instructions: &[sass::Instruction]) -> Self {
+        let mut s = SassStats { schedule_latency: sass::schedule_latency(instructions), ..Default::default() };
         for i in instructions.iter().filter(|i| i.mnemonic() != "NOP") {
             let (class, row, pipe) = classify(&i.opcode);
             s.instructions += 1;
             *s.by_class.entry(class).or_default() += 1;
             *s.by_row.entry((row, pipe)).or_default() += 1;
         }
-        s.registers = ptxas_figure(ptxas_log, "registers");
-        s.stack_bytes = ptxas_figure(ptxas_log, "bytes stack frame");
-        s.spill_bytes = ptxas_figure(ptxas_log, "bytes spill stores") + ptxas_figure(ptxas_log, "bytes spill loads");
-        Ok(s)
+        s
     }
 
     /// SM cycles per warp of each of `n` instructions of `row`: 32 x (results per instruction) / (results per
@@ -395,15 +399,25 @@ impl SassStats {
             stat("Scratch Memory Size", f64::from(self.stack_bytes)),
             stat("Binary Size", f64::from(self.cubin_bytes)),
             stat("Warps per SM", f64::from(self.warps_per_sm(family))),
-            stat("Issue Cycles", self.issue_cycles(family)?),
-            stat(LATENCY, self.schedule_latency),
             stat(RESIDENT_WAVES, f64::from(self.warps_per_sm(family))),
         ];
+        out.extend(self.rule_stats(family)?.into_iter().map(|(n, v)| stat(&n, v)));
+        Ok(out)
+    }
+
+    /// What the rule reads of the instructions alone, named as `cost::schedule` reads them: the classes, each
+    /// pipe's busy cycles, the schedule latency and the serial sum ("Issue Cycles"); not the resident warps,
+    /// which need the registers.
+    pub fn rule_stats(&self, family: &Family) -> Result<Vec<(String, f64)>> {
+        let mut out = vec![
+            ("Issue Cycles".to_string(), self.issue_cycles(family)?),
+            (LATENCY.to_string(), self.schedule_latency),
+        ];
         for c in Class::ALL {
-            out.push(stat(c.name(), f64::from(self.by_class.get(&c).copied().unwrap_or(0))));
+            out.push((c.name().to_string(), f64::from(self.by_class.get(&c).copied().unwrap_or(0))));
         }
         for (pipe, cycles) in self.pipes(family)? {
-            out.push(stat(&format!("{PIPE_PREFIX}{pipe}"), cycles));
+            out.push((format!("{PIPE_PREFIX}{pipe}"), cycles));
         }
         Ok(out)
     }
