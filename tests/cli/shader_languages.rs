@@ -1068,3 +1068,69 @@ fn hlsl_read_as_a_compiler_reads_it() {
     std::fs::write(d.join("cr.hlsl"), format!("#include \"cr.ush\"\n{}", entry(""))).unwrap();
     run_in(d, &["eval", "--model", "cr.hlsl", "--input", "in.csv", "--output", "x.csv"]).fails(2, "cr.ush:3:");
 }
+
+/// What the front ends refuse without a location of their own is named at the user's line and column, with the
+/// cause, and never by a temporary file, brdfprof's stub or a U+FFFD: HLSL recursion (a link error), a
+/// non-ASCII identifier (glslang reads bytes), a WGSL derivative (a validation error of the compute entry), an
+/// array sized by an override, parentheses past naga's parser depth, and a `//` inside an `entry` argument.
+#[test]
+fn front_end_errors_without_a_location_are_named_at_the_users_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write_rows(&d.join("in.csv"), 2);
+    let deep = format!("{}dot(N, L){}", "(".repeat(200), ")".repeat(200));
+    write(
+        d,
+        &[
+            (
+                "rec.hlsl",
+                "float helper(float x) { return x > 0 ? helper(x - 1) : 0; }\nfloat3 BRDF(float3 L, float3 V, float3 N, float3 X, float3 Y) { return helper(dot(N, L)).xxx; }\n",
+            ),
+            (
+                "ascii.brdf",
+                "analytic\n::begin shader\nvec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) {\n    float rauh_\u{e4} = dot(N, L);\n    return vec3(rauh_\u{e4});\n}\n::end shader\n",
+            ),
+            (
+                "ascii.hlsl",
+                "float3 BRDF(float3 L, float3 V, float3 N, float3 X, float3 Y) {\n    float rauh_\u{e4} = dot(N, L);\n    return rauh_\u{e4}.xxx;\n}\n",
+            ),
+            ("dpdx.wgsl", &format!("{WGSL_BRDF} {{\n    let a = dpdx(dot(N, L));\n    return vec3<f32>(a);\n}}\n")),
+            (
+                "override.wgsl",
+                &format!(
+                    "override COUNT: u32 = 4u;\n{WGSL_BRDF} {{\n    var a: array<f32, COUNT>;\n    a[0] = dot(N, L);\n    return vec3<f32>(a[0]);\n}}\n"
+                ),
+            ),
+            ("deep.wgsl", &format!("{WGSL_BRDF} {{\n    let a = {deep};\n    return vec3<f32>(a);\n}}\n")),
+            (
+                "entry.brdf",
+                "analytic\n::begin brdfprof\nentry light(N, L, V, 0.5 // roughness)\n::end brdfprof\n::begin shader\nvec3 light(vec3 n, vec3 l, vec3 v, float r) { return vec3(max(dot(n, l), 0.0) * r); }\n::end shader\n",
+            ),
+        ],
+    );
+    let cases = [
+        ("rec.hlsl", "rec.hlsl:1:7: recursion: `helper` calls `helper`"),
+        ("ascii.brdf", "ascii.brdf:4: '\u{e4}' : unexpected token (column 16: `\u{e4}`, U+00E4;"),
+        ("ascii.hlsl", "ascii.hlsl:2:16: '<bad token>' : unexpected token (`\u{e4}`, U+00E4:"),
+        ("dpdx.wgsl", "dpdx.wgsl:2:13: `dpdx` needs a fragment stage's derivatives"),
+        ("override.wgsl", "override.wgsl:3:12: `array<f32, COUNT>` is sized by the override `COUNT`"),
+        ("deep.wgsl", "deep.wgsl:2:216: an expression nested 201 parentheses deep"),
+        (
+            "entry.brdf",
+            "entry.brdf:3: `entry light(N, L, V, 0.5 // roughness)`: a `//` comment inside the argument list",
+        ),
+    ];
+    for (model, needle) in cases {
+        let out = run_in(d, &["eval", "--model", model, "--input", "in.csv", "--output", "x.csv"]).fails(2, needle);
+        for internal in ["/tmp/", "brdfprof_stub", "glsl/generated", "\u{fffd}"] {
+            assert!(!out.stderr.contains(internal), "{model}: names `{internal}`: {}", out.stderr);
+        }
+    }
+    // A comment after the closing parenthesis is the directive's own.
+    std::fs::write(
+        d.join("after.brdf"),
+        std::fs::read_to_string(d.join("entry.brdf")).unwrap().replace("0.5 // roughness)", "0.5) // roughness"),
+    )
+    .unwrap();
+    run_in(d, &["eval", "--model", "after.brdf", "--input", "in.csv", "--output", "after.csv"]).ok();
+}

@@ -581,6 +581,14 @@ fn parse_entry(path: &Path, n: usize, text: &str) -> Result<Entry> {
             _ => {}
         }
     }
+    // A line comment inside the arguments would reach the composed kernel's call and hide the rest of it.
+    if text.find("//").is_some_and(|p| close.is_none_or(|c| p < c)) {
+        bail!(at(
+            path,
+            n,
+            format!("`entry {text}`: a `//` comment inside the argument list; put it after the closing `)`")
+        ));
+    }
     let close =
         close.ok_or_else(|| anyhow!(at(path, n, format!("`entry {text}`: the argument list has no closing `)`"))))?;
     let last = text[start..close].trim();
@@ -590,7 +598,8 @@ fn parse_entry(path: &Path, n: usize, text: &str) -> Result<Entry> {
     if let Some(empty) = args.iter().position(|a| a.is_empty()) {
         bail!(at(path, n, format!("`entry {text}`: argument {} is empty", empty + 1)));
     }
-    let returns = match text[close + 1..].split_whitespace().collect::<Vec<_>>().as_slice() {
+    let tail = text[close + 1..].split("//").next().unwrap_or_default();
+    let returns = match tail.split_whitespace().collect::<Vec<_>>().as_slice() {
         [] => Returns::F,
         ["returns", r] => {
             Returns::parse(r).ok_or_else(|| anyhow!(at(path, n, format!("`returns {r}`: expected f or f_nol"))))?

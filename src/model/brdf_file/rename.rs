@@ -179,8 +179,11 @@ impl BrdfFile {
             if message.starts_with("'' : compilation terminated") {
                 continue;
             }
-            let message = renamed.original_names(message.trim_end());
+            let mut message = renamed.original_names(message.trim_end());
             let file_line = if ours.iter().any(|o| o == source) { Some(n) } else { line_of(n) };
+            if let Some(fl) = file_line {
+                message = self.non_ascii(fl, &message).unwrap_or(message);
+            }
             let kind = if severity == "ERROR" { String::new() } else { format!("{}: ", severity.to_lowercase()) };
             match file_line {
                 Some(fl) => out += &format!("{shown}:{fl}: {kind}{message}\n"),
@@ -192,6 +195,23 @@ impl BrdfFile {
 }
 
 impl BrdfFile {
+    /// A message quoting a byte glslang could not read (it reads bytes, and a non-ASCII character's first byte
+    /// comes back as U+FFFD) with the character the file has on that line, its code point and column, and why:
+    /// GLSL's tokens are ASCII (non-ASCII text belongs in comments).
+    fn non_ascii(&self, line: usize, message: &str) -> Option<String> {
+        if !message.contains('\u{FFFD}') {
+            return None;
+        }
+        let text = &self.source.iter().find(|(n, _)| *n == line)?.1;
+        let (i, c) = text.char_indices().find(|(_, c)| !c.is_ascii())?;
+        let column = text[..i].chars().count() + 1;
+        Some(format!(
+            "{} (column {column}: `{c}`, U+{:04X}; GLSL identifiers and tokens are ASCII letters, digits and _ only, non-ASCII text belongs in comments)",
+            message.replace('\u{FFFD}', &c.to_string()),
+            u32::from(c)
+        ))
+    }
+
     /// glslang's log when none of its messages is located in the file (errors of the link stage, such as
     /// recursion, which GLSL forbids): its messages and their continuation lines with the file's own names,
     /// without glslang's banner lines (the source's name, "SPIR-V is not generated ...").

@@ -366,7 +366,10 @@ pub fn messages(log: &str, x: &Expanded) -> String {
             (Some((c, m)), _) => (*c, m.clone()),
             // A line brdfprof wrote: named by what it stands for, at the start of the model file's line.
             (None, Some(what)) => (1, format!("{what}: {message}")),
-            (None, None) => (column(text, message, columns.get(&n).copied()), message.to_string()),
+            (None, None) => {
+                let column = column(text, message, columns.get(&n).copied());
+                (column, non_ascii(text, column, message))
+            }
         };
         out.push(format!("{}:{}:{column}: {message}", x.files[origin.0], origin.1));
         if x.notes.contains_key(&(n - 1)) {
@@ -374,9 +377,54 @@ pub fn messages(log: &str, x: &Expanded) -> String {
         }
     }
     if out.is_empty() {
-        return log.trim().to_string();
+        return unlocated(log, x);
     }
     out.join("\n")
+}
+
+/// A message at a non-ASCII character (glslang reads bytes: `'<bad token>'`) says which character and why.
+fn non_ascii(line: &str, column: usize, message: &str) -> String {
+    match line.chars().nth(column.saturating_sub(1)).filter(|c| !c.is_ascii()) {
+        Some(c) => format!(
+            "{} (`{c}`, U+{:04X}: glslang reads HLSL identifiers and tokens as ASCII letters, digits and _ only; non-ASCII text belongs in comments)",
+            message.replace('\u{FFFD}', &c.to_string()),
+            u32::from(c)
+        ),
+        None => message.to_string(),
+    }
+}
+
+/// glslang's log when it located no message (a link-stage error): recursion named at the user's function that
+/// recurses, else the log without the temporary file's name glslang prints first and its closing banner.
+fn unlocated(log: &str, x: &Expanded) -> String {
+    let call = log.lines().skip_while(|l| !l.contains("Recursion detected")).nth(1);
+    // "    f(f1; calling g(f1;": the caller's and the callee's mangled names.
+    let name = |s: &str| s.trim().split('(').next().unwrap_or_default().to_string();
+    if let Some((caller, callee)) = call.and_then(|c| c.split_once(" calling ")).map(|(a, b)| (name(a), name(b))) {
+        let message = format!(
+            "recursion: `{caller}` calls `{callee}`, which leads back to it (HLSL shaders, as SPIR-V for Vulkan, cannot recurse)"
+        );
+        return match definition(x, &caller) {
+            Some((file, line, column)) => format!("{file}:{line}:{column}: {message}"),
+            None => message,
+        };
+    }
+    let banner = |l: &str| l.trim_end().ends_with("shader.hlsl") || l.starts_with("SPIR-V is not generated");
+    log.lines().filter(|l| !banner(l)).collect::<Vec<_>>().join("\n").trim().to_string()
+}
+
+/// Where the user's text first names `function(`: (file, 1-based line, 1-based column), lines brdfprof wrote
+/// left out.
+fn definition(x: &Expanded, function: &str) -> Option<(String, usize, usize)> {
+    let ident = |c: char| c.is_ascii_alphanumeric() || c == '_';
+    x.lines.iter().enumerate().filter(|(i, _)| !x.generated.contains_key(i)).find_map(|(i, line)| {
+        let at = line
+            .match_indices(function)
+            .map(|(k, _)| k)
+            .find(|&k| !line[..k].ends_with(ident) && line[k + function.len()..].trim_start().starts_with('('))?;
+        let (file, n) = *x.origins.get(i)?;
+        Some((x.files[file].clone(), n, line[..at].chars().count() + 1))
+    })
 }
 
 /// The front end, with glslang's version, as reports state it.

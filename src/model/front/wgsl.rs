@@ -309,7 +309,7 @@ impl Modules<'_> {
             if let Err(e) = self.composer.add_composable_module(desc) {
                 let graph: Vec<(String, String)> =
                     self.files.iter().cloned().chain([(file.clone(), source.clone())]).collect();
-                bail!("{}{}", located(&e, &self.composer, None), missing_defs_note(&graph, &self.defs));
+                bail!("{}{}", located(&e, &self.composer, None, &graph), missing_defs_note(&graph, &self.defs));
             }
             self.added.push(import);
             self.files.push((file, source));
@@ -320,7 +320,7 @@ impl Modules<'_> {
 
 /// A naga_oil error as `FILE:LINE:COLUMN: message` (from its codespan report's `┌─ FILE:LINE:COLUMN` line),
 /// a generated line of `top` named by what it stands for.
-fn located(e: &ComposerError, composer: &Composer, top: Option<(&str, &Top)>) -> String {
+fn located(e: &ComposerError, composer: &Composer, top: Option<(&str, &Top)>, files: &[(String, String)]) -> String {
     let report = e.emit_to_string(composer);
     let message = report.lines().find_map(|l| l.strip_prefix("error: ")).unwrap_or("").trim().to_string();
     let notes: Vec<&str> = report.lines().filter_map(|l| l.trim().strip_prefix("= ")).collect();
@@ -330,7 +330,8 @@ fn located(e: &ComposerError, composer: &Composer, top: Option<(&str, &Top)>) ->
         .filter(|l| !l.is_empty())
         .collect();
     let Some(at) = report.lines().find_map(|l| l.split_once("┌─ ").map(|(_, r)| r.trim().to_string())) else {
-        return report.trim().to_string();
+        let user = |l: &usize, f: &str| top.is_none_or(|(shown, t)| f != shown || !t.generated.contains_key(l));
+        return cause(&report, files, user).unwrap_or_else(|| report.trim().to_string());
     };
     let mut parts = at.rsplitn(3, ':');
     let (col, line, file) = (
@@ -345,6 +346,96 @@ fn located(e: &ComposerError, composer: &Composer, top: Option<(&str, &Top)>) ->
         Some((origin, what)) => format!("{file}:{origin}:1: {what}: {message}{tail}"),
         None => format!("{file}:{line}:{col}: {message}{tail}"),
     }
+}
+
+/// Builtins a compute kernel has no derivatives for: the derivatives and implicit-derivative sampling.
+const DERIVATIVES: [&str; 12] = [
+    "dpdx",
+    "dpdy",
+    "fwidth",
+    "dpdxCoarse",
+    "dpdxFine",
+    "dpdyCoarse",
+    "dpdyFine",
+    "fwidthCoarse",
+    "fwidthFine",
+    "textureSample",
+    "textureSampleBias",
+    "textureSampleCompare",
+];
+
+/// The cause in the user's text of a naga error that names no location (a validation error of the composed
+/// module, a parser failure), as `FILE:LINE:COLUMN: message` with naga's own words beside it: a derivative
+/// (naga: "Uses operations forbidden at this stage"), an array sized by an `override` (naga: "... Override is
+/// either not present, or inaccessible yet"), the most deeply nested parentheses (naga's parser: "internal WGSL
+/// front end error"). `user(line, file)` says whether a line is the user's (not brdfprof's own).
+fn cause(report: &str, files: &[(String, String)], user: impl Fn(&usize, &str) -> bool) -> Option<String> {
+    let naga = report.lines().find_map(|l| l.strip_prefix("error: ")).unwrap_or("").trim();
+    let code = |line: &str| line.split("//").next().unwrap_or("").to_string();
+    let lines = || {
+        files
+            .iter()
+            .flat_map(|(f, t)| t.lines().enumerate().map(move |(i, l)| (f.as_str(), i + 1, l)))
+            .filter(|(f, n, _)| user(n, f))
+    };
+    let at = |f: &str, n: usize, l: &str, k: usize| format!("{f}:{n}:{}", l[..k].chars().count() + 1);
+    let call = |l: &str, name: &str| {
+        let ident = |c: char| c.is_ascii_alphanumeric() || c == '_';
+        l.match_indices(name)
+            .map(|(k, _)| k)
+            .find(|&k| !l[..k].ends_with(ident) && l[k + name.len()..].trim_start().starts_with('('))
+    };
+    if report.contains("Uses operations forbidden at this stage") {
+        return lines().find_map(|(f, n, l)| {
+            let l = code(l);
+            DERIVATIVES.iter().find_map(|d| call(&l, d).map(|k| (d, k))).map(|(d, k)| {
+                format!("{}: `{d}` needs a fragment stage's derivatives, and brdfprof runs the BRDF in a compute kernel, which has none; pass the value in as a parameter (naga: the compute stage forbids the operation)", at(f, n, &l, k))
+            })
+        });
+    }
+    if report.contains("Override is either not present") {
+        let overrides: Vec<String> = lines()
+            .filter_map(|(_, _, l)| {
+                code(l)
+                    .trim_start()
+                    .strip_prefix("override ")
+                    .map(|r| r.trim_start().chars().take_while(|c| c.is_ascii_alphanumeric() || *c == '_').collect())
+            })
+            .collect();
+        return lines().find_map(|(f, n, l)| {
+            let l = code(l);
+            let k = l.find("array<")?;
+            let size = l[k..].split('>').next()?.rsplit(',').next()?.trim().to_string();
+            overrides.contains(&size).then(|| {
+                format!("{}: `{}>` is sized by the override `{size}`, which naga cannot size an array by here; make `{size}` a `const` (naga: {naga})", at(f, n, &l, k), l[k..].split('>').next().unwrap_or(""))
+            })
+        });
+    }
+    if report.contains("internal WGSL front end error") {
+        let deepest = lines()
+            .map(|(f, n, l)| {
+                let (mut depth, mut max, mut where_) = (0usize, 0usize, 0usize);
+                for (k, c) in l.char_indices() {
+                    match c {
+                        '(' => {
+                            depth += 1;
+                            if depth > max {
+                                (max, where_) = (depth, k);
+                            }
+                        }
+                        ')' => depth = depth.saturating_sub(1),
+                        _ => {}
+                    }
+                }
+                (max, f, n, l, where_)
+            })
+            .max_by_key(|(max, ..)| *max)?;
+        let (max, f, n, l, k) = deepest;
+        return (max > 0).then(|| {
+            format!("{}: an expression nested {max} parentheses deep, past the depth naga's WGSL parser handles; split it into `let`s (naga: {naga})", at(f, n, l, k))
+        });
+    }
+    None
 }
 
 /// The shader defs `files` (name, text) use and `defs` lacks, each at its first use: `#if NAME ...` (naga_oil
@@ -428,7 +519,7 @@ pub fn compose(model: &Path, top: &Top, defines: &[(String, String)], includes: 
             _ => String::new(),
         };
         let graph: Vec<(String, String)> = std::iter::once((shown.clone(), top.text.clone())).chain(m.files.clone()).collect();
-        anyhow!("{}{hint}{}", located(&e, &m.composer, Some((&shown, top))), missing_defs_note(&graph, &m.defs))
+        anyhow!("{}{hint}{}", located(&e, &m.composer, Some((&shown, top)), &graph), missing_defs_note(&graph, &m.defs))
     })?;
     Ok(Composed { module, files: m.files })
 }
