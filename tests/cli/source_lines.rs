@@ -131,3 +131,33 @@ fn an_hlsl_models_lines_are_its_front_ends_glsl_with_their_text() {
         "every front-end line has its GLSL text: {own:?}"
     );
 }
+
+/// A GLSL file with non-ASCII text in a comment: glslang's `-g` build cuts the embedded source by bytes, which
+/// left strings no UTF-8 reader accepts; the lines are still named, each at the file's own line.
+#[test]
+fn a_non_ascii_comment_keeps_the_lines() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = dir.path().join("umlaut.brdf");
+    let comment = "// Rauhigkeit nach Burley (gr\u{f6}\u{df}er = rauer, \u{2264} 1)";
+    std::fs::write(
+        &model,
+        format!("analytic\n::begin shader\n{comment}\nvec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) {{\n    float nl = max(dot(N, L), 0.0);\n    return vec3(nl * nl);\n}}\n::end shader\n"),
+    )
+    .unwrap();
+    let all = inspect_json(
+        dir.path(),
+        "umlaut",
+        &["nvidia:sm_89"],
+        &["--lines", "--model", model.to_str().unwrap()],
+        "Cost per source line",
+    );
+    let report = all.get("reports").map_or(&all, |r| &r[0]);
+    let k = report["lines"].as_array().unwrap().iter().find(|k| k["model"] == "umlaut").unwrap().clone();
+    let named: Vec<(String, u64)> = k["lines"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|l| (l["file"].as_str().unwrap().to_string(), l["line"].as_u64().unwrap()))
+        .collect();
+    assert!(named.iter().any(|(f, n)| f.ends_with("umlaut.brdf") && *n == 5), "{named:?}");
+}
