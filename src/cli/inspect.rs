@@ -122,6 +122,17 @@ pub fn inspect(args: &InspectArgs) -> Result<ExitCode> {
         markdown.display(),
         args.chart.as_ref().map_or(String::new(), |c| format!("\nChart: {}", c.display()))
     );
+    // A model that failed on a target has its reason under that target's cost table; the others were costed.
+    let failed: Vec<String> = result
+        .reports
+        .iter()
+        .filter_map(|r| r.cost.as_ref())
+        .flat_map(|c| c.failed.iter().map(move |(m, _)| format!("{m} on {}", c.target.as_deref().unwrap_or(&c.device))))
+        .collect();
+    if !failed.is_empty() {
+        eprintln!("brdfprof: inspect: not costed: {} (each reason under its cost table); exit 1", failed.join(", "));
+        return Ok(ExitCode::from(1));
+    }
     Ok(ExitCode::SUCCESS)
 }
 

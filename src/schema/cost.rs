@@ -53,6 +53,10 @@ pub struct TargetCost {
     /// the table so that no column drops a model silently.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub absent: Vec<(String, String)>,
+    /// Models whose kernel failed for this target (its translation check, its compile), with the reason: the
+    /// other models and targets go on, and the command exits 1.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub failed: Vec<(String, String)>,
 }
 
 /// The note beside a net cost at or below zero.
@@ -159,6 +163,9 @@ impl TargetCost {
         out += &self.terms_note();
         for (model, why) in &self.absent {
             out += &format!("\n{model}: not compiled for this target ({why}), so no figure.\n");
+        }
+        for (model, why) in &self.failed {
+            out += &format!("\n**{model}: failed, so no figure**: {why}\n");
         }
         for r in self.rows.iter().filter(|r| r.net_cycles_per_eval.is_some_and(|v| v <= 0.0)) {
             out += &format!("\n{}: {}\n", r.model, NEGATIVE_NET);

@@ -131,22 +131,30 @@ impl<C: Translator> Translated<C> {
         // Compiles are independent (NVRTC's API is thread-safe; ocloc is a process): one job per core.
         use rayon::prelude::*;
         let (sources, precise): (Vec<&str>, bool) = (checked.iter().map(|c| c.source.as_str()).collect(), req.precise);
-        let compiled: Vec<Result<C::Binary>> =
-            jobs.par_iter().map(|&(f, k)| C::compile(sources[k], families[f], precise)).collect();
-        // A family without what a kernel needs leaves it out with the reason; any other failure stops.
-        let compiled: Vec<std::result::Result<C::Binary, String>> = compiled
-            .into_iter()
-            .map(|r| r.map(Ok).or_else(|e| C::unsupported(&e).map(Err).ok_or(e)))
-            .collect::<Result<_>>()?;
+        // A model whose translation failed its check is not compiled.
+        let compiled: Vec<Option<Result<C::Binary>>> = jobs
+            .par_iter()
+            .map(|&(f, k)| checked[k].failed.is_none().then(|| C::compile(sources[k], families[f], precise)))
+            .collect();
+        // A family without what a kernel needs leaves it out with the reason; a model's failure is its row's;
+        // the memory-only kernel's stops the family, which has no net figure without it.
         let mut reports = Vec::new();
         for (f, family) in families.iter().enumerate() {
             let mut rows = statics.clone();
-            let mut left_out = Vec::new();
+            let (mut left_out, mut failed) = (Vec::new(), Vec::new());
             for (k, row) in rows.iter_mut().enumerate() {
                 let binary = match &compiled[f * checked.len() + k] {
-                    Ok(b) => b,
-                    Err(why) => {
-                        left_out.push((row.model.clone(), why.clone()));
+                    Some(Ok(b)) => b,
+                    Some(Err(e)) => {
+                        match C::unsupported(e) {
+                            Some(why) => left_out.push((row.model.clone(), why)),
+                            None if row.model == crate::model::BASELINE_LABEL => return Err(anyhow!("{e:#}")),
+                            None => failed.push((row.model.clone(), format!("{e:#}"))),
+                        }
+                        continue;
+                    }
+                    None => {
+                        failed.push((row.model.clone(), checked[k].failed.clone().unwrap_or_default()));
                         continue;
                     }
                 };
@@ -156,9 +164,13 @@ impl<C: Translator> Translated<C> {
                     write_isa::<C>(dir, family, &row.model, &checked[k].source, binary, tools)?;
                 }
             }
-            rows.retain(|r| !left_out.iter().any(|(m, _)| *m == r.model));
+            rows.retain(|r| !left_out.iter().chain(&failed).any(|(m, _)| *m == r.model));
             let compilation = C::compilation(family, device_name::<C>(family), tools, req.precise);
             let mut report = translated_report(self, compilation, rows, req);
+            if let Some(cost) = &mut report.cost {
+                cost.absent = left_out.clone();
+                cost.failed = failed;
+            }
             if !left_out.is_empty() {
                 let note = format!(
                     "not compiled for {}:{}: {}",
@@ -261,6 +273,7 @@ impl<C: Translator> Vendor for Translated<C> {
             columns: C::SHOWN.iter().map(|s| s.to_string()).collect(),
             rows: Vec::new(),
             absent: Vec::new(),
+            failed: Vec::new(),
         };
         cost::schedule_table(report, header, |stats| Some((Schedule::of(stats)?, C::lanes(stats)?)))
     }
@@ -287,28 +300,39 @@ pub struct Checked {
     pub source: String,
     /// The row note: the device checked on and the worst difference.
     pub agreement: String,
+    /// Why the translation is not compiled: its check failed (a model's kernel only).
+    pub failed: Option<String>,
 }
 
 /// Every kernel of `req` (the models' and the memory-only one) translated into `dialect`, after the
-/// translation (its body is the same text in every dialect) agreed with the Vulkan kernel on `gpu`.
+/// translation (its body is the same text in every dialect) agreed with the Vulkan kernel on `gpu`; a model
+/// whose translation does not is `failed` with the reason (the memory-only kernel's stops the run).
 fn checked_translations(req: &Request, gpu: &Gpu, dialect: Dialect) -> Result<Vec<Checked>> {
+    let check = |m: Option<&Model>| -> Result<Checked> {
+        let agreements = crate::translate::verify::check_cached(gpu, m, req.lights, req.shaders)?;
+        let source = crate::translate::prepare::shade_kernel(m, req.lights, req.shaders)?.source(dialect);
+        let agreement = agreements
+            .iter()
+            .map(|a| format!("{}{}", a.summary(), a.note().map_or_else(String::new, |n| format!(": {n}"))))
+            .collect::<Vec<_>>()
+            .join("; ");
+        Ok(Checked {
+            source,
+            agreement: format!(
+                "translation checked on the host against {} and the translation's f64 evaluation: {agreement}",
+                gpu.info.name
+            ),
+            failed: None,
+        })
+    };
     kernels_of(req.models)
         .into_iter()
-        .map(|m| {
-            let agreements = crate::translate::verify::check_cached(gpu, m, req.lights, req.shaders)?;
-            let source = crate::translate::prepare::shade_kernel(m, req.lights, req.shaders)?.source(dialect);
-            let agreement = agreements
-                .iter()
-                .map(|a| format!("{}{}", a.summary(), a.note().map_or_else(String::new, |n| format!(": {n}"))))
-                .collect::<Vec<_>>()
-                .join("; ");
-            Ok(Checked {
-                source,
-                agreement: format!(
-                    "translation checked on the host against {} and the translation's f64 evaluation: {agreement}",
-                    gpu.info.name
-                ),
-            })
+        .map(|m| match (check(m), m) {
+            (Err(e), Some(model)) => {
+                crate::messages::warning(&format!("{}: not costed on this vendor's targets: {e:#}", model.label()));
+                Ok(Checked { source: String::new(), agreement: String::new(), failed: Some(format!("{e:#}")) })
+            }
+            (result, _) => result,
         })
         .collect()
 }
@@ -359,7 +383,7 @@ fn raw_translations(vendor: &dyn Vendor, kernels: &[RawKernel], dialect: Dialect
             stats: BTreeMap::new(),
             notes: [("translation".to_string(), t.agreement.clone())].into(),
         });
-        checked.push(Checked { source: t.translation.source(dialect), agreement: t.agreement.clone() });
+        checked.push(Checked { source: t.translation.source(dialect), agreement: t.agreement.clone(), failed: None });
     }
     Ok((rows, checked))
 }
@@ -382,7 +406,7 @@ fn add_lines<F>(
     }
     for (report, family) in reports.iter_mut().zip(families) {
         let mut per_model = Vec::new();
-        for (m, checked) in req.models.iter().zip(checked) {
+        for (m, checked) in req.models.iter().zip(checked).filter(|(_, c)| c.failed.is_none()) {
             let source = crate::translate::prepare::shade_kernel_with_lines(Some(m), req.lights, req.shaders)?
                 .source_with_lines(dialect);
             let LineCompile { mut lines, costed, annotated } = lines(m, &source, &checked.source, family)?;

@@ -45,16 +45,21 @@ impl HostKernel {
 
     /// `compile` with preprocessor definitions (`-DNAME`) for the prelude's variants.
     pub fn compile_with(t: &Translation, defines: &[&str]) -> Result<Self> {
-        Self::build(t, &t.source(Dialect::Host), defines)
+        Self::build(t, &t.source(Dialect::Host), defines, &[])
+    }
+
+    /// `compile` with further compiler flags (`-ftrivial-auto-var-init=zero`).
+    pub fn compile_with_flags(t: &Translation, flags: &[&str]) -> Result<Self> {
+        Self::build(t, &t.source(Dialect::Host), &[], flags)
     }
 
     /// The f64 reference of `t` (`Translation::reference_source`): every f32 value computed in double with its
     /// Vulkan precision bound; a writable binding takes 4 x its bytes (`eval_reference`).
     pub fn compile_reference(t: &Translation, defines: &[&str]) -> Result<Self> {
-        Self::build(t, &t.reference_source(), defines)
+        Self::build(t, &t.reference_source(), defines, &[])
     }
 
-    fn build(t: &Translation, source: &str, defines: &[&str]) -> Result<Self> {
+    fn build(t: &Translation, source: &str, defines: &[&str], flags: &[&str]) -> Result<Self> {
         let dir = crate::cleanup::TempDir::new().context("cannot create a temporary directory for the host build")?;
         let src = dir.path().join("kernel.cpp");
         let lib = dir.path().join("kernel.so");
@@ -62,6 +67,7 @@ impl HostKernel {
         let mut cmd = crate::cleanup::command(HOST_COMPILER);
         // g++'s own temporaries (cc*.s) go into the build's directory, removed with it even on a signal.
         cmd.args(HOST_FLAGS)
+            .args(flags)
             .args(defines.iter().map(|d| format!("-D{d}")))
             .arg("-o")
             .arg(&lib)

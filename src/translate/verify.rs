@@ -74,6 +74,13 @@ pub struct Agreement {
     /// as srem, as lavapipe does (`srem_note`).
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub srem: bool,
+    /// Where the fp32 translation's worst was (`worst_at`'s form).
+    #[serde(default)]
+    pub translation_worst_at: String,
+    /// The kernel reads a value nothing wrote: what shows it (`reads_undefined`), where the translation is
+    /// beyond its bound.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub undefined: Option<String>,
 }
 
 impl Agreement {
@@ -109,12 +116,15 @@ impl Agreement {
             unbounded: device.unbounded,
             device: gpu.info.name.clone(),
             srem,
+            translation_worst_at: translation.worst_at.clone(),
+            undefined: None,
         }
     }
 }
 
-/// The version of `Agreement`'s cached form (4: judged against the f64 reference), part of the cache key.
-const AGREEMENT_SCHEMA: &str = "4";
+/// The version of `Agreement`'s cached form (5: where the translation's worst was, undefined reads), part of
+/// the cache key.
+const AGREEMENT_SCHEMA: &str = "5";
 
 /// The prelude variant that computes OpSMod as lavapipe does (srem).
 const SMOD_AS_SREM: &str = "BRDFPROF_SMOD_AS_SREM";
@@ -338,14 +348,44 @@ pub fn shade_agreement(gpu: &Gpu, model: Option<&Model>, lights: u32, shaders: &
     Ok(Agreement::of("shade", &device, &host, gpu, srem))
 }
 
-/// Both comparisons for `model` (the shade one alone for the memory-only kernel).
+/// Both comparisons for `model` (the shade one alone for the memory-only kernel); where the translation is
+/// beyond its bound, whether the kernel reads a value nothing wrote (`reads_undefined`).
 pub fn measure(gpu: &Gpu, model: Option<&Model>, lights: u32, shaders: &Shaders) -> Result<Vec<Agreement>> {
     let mut out = Vec::new();
     if let Some(m) = model {
         out.push(eval_agreement(gpu, m, shaders)?);
     }
     out.push(shade_agreement(gpu, model, lights, shaders)?);
+    if out.iter().any(|a| !(a.translation_worst <= a.tolerance)) {
+        let undefined = reads_undefined(model, lights, shaders)?;
+        out.iter_mut().for_each(|a| a.undefined.clone_from(&undefined));
+    }
     Ok(out)
+}
+
+/// Whether the profiling kernel of `model` reads memory nothing wrote (an uninitialised variable or struct
+/// field of the model's code): its fp32 host build run twice over the check's G-buffer, g++ filling every
+/// uninitialised local with zeros and then with a pattern (`-ftrivial-auto-var-init`); C gives such a read no
+/// value, as SPIR-V gives OpUndef none, so the f32 and f64 builds may differ by anything there. Some(what
+/// changed) where the two runs differ.
+pub fn reads_undefined(model: Option<&Model>, lights: u32, shaders: &Shaders) -> Result<Option<String>> {
+    let (w, h) = SHADE_SIZE;
+    let g = check_gbuffer(w, h);
+    let light_data = gbuffer::lights(crate::kernels::shade::steady_block(lights).0);
+    let translation = prepare::shade_kernel(model, lights, shaders)?;
+    let run = |init: &str| -> Result<Vec<u32>> {
+        let flag = format!("-ftrivial-auto-var-init={init}");
+        let kernel = host::HostKernel::compile_with_flags(&translation, &[&flag])?;
+        Ok(bytemuck::pod_collect_to_vec(&shade_on_host(&kernel, &g, &light_data, 4)?))
+    };
+    let (zero, pattern) = (run("zero")?, run("pattern")?);
+    let differ = zero.iter().zip(&pattern).filter(|(a, b)| a != b).count();
+    Ok((differ > 0).then(|| {
+        format!(
+            "{differ} of {} pixels change when the host build's uninitialised locals start as zeros instead of a fill pattern (g++ -ftrivial-auto-var-init)",
+            zero.len()
+        )
+    }))
 }
 
 /// The verdict on `measure`'s comparisons: an error when one is beyond its tolerance, naming the kernel, the
@@ -353,11 +393,20 @@ pub fn measure(gpu: &Gpu, model: Option<&Model>, lights: u32, shaders: &Shaders)
 pub fn verdict(model: Option<&Model>, agreements: &[Agreement]) -> Result<()> {
     let label = model.map_or_else(|| crate::model::BASELINE_LABEL.to_string(), Model::label);
     for a in agreements {
+        if let (false, Some(undefined)) = (a.translation_worst <= a.tolerance, &a.undefined) {
+            bail!(
+                "{label}: the {} kernel reads a value the model's code never wrote (an uninitialised variable or struct field; {undefined}), so its fp32 and f64 evaluations differ by anything ({:.3e} times the Vulkan precision bound; worst {}): initialise it; not costed",
+                a.kernel,
+                a.translation_worst,
+                a.translation_worst_at
+            );
+        }
         if !(a.translation_worst <= a.tolerance) {
             bail!(
-                "{label}: the fp32 C translation of the {} kernel, run on the host, is {:.3e} times the Vulkan precision bound away from its own f64 evaluation: brdfprof's translation or its bound is wrong (a translator defect); its cost is not reported. Please report it with the model",
+                "{label}: the fp32 C translation of the {} kernel, run on the host, is {:.3e} times the Vulkan precision bound away from its own f64 evaluation (worst {}), and no uninitialised read explains it: brdfprof's translation or its bound is wrong (a translator defect); its cost is not reported. Please report it with the model",
                 a.kernel,
-                a.translation_worst
+                a.translation_worst,
+                a.translation_worst_at
             );
         }
         if a.srem {

@@ -209,7 +209,10 @@ fn a_construct_the_translation_lacks_is_refused_at_the_files_line() {
         "--markdown",
         dir.path().join("x.md").to_str().unwrap(),
     ]);
-    r.fails(2, &format!("{}:8: the C translation cannot express the GLSL.std.450 function Determinant (GLSL's determinant) (in function `frame_volume`)", file.display()));
+    // The model fails on the target alone: the others would be costed, the outputs are written, exit 1.
+    r.fails(1, &format!("{}:8: the C translation cannot express the GLSL.std.450 function Determinant (GLSL's determinant) (in function `frame_volume`)", file.display()));
+    let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(report["cost"]["failed"][0][0], "volume", "{}", report["cost"]);
     // The same file runs on Vulkan: the refusal is the translation's, not the file's.
     let csv = dir.path().join("in.csv");
     std::fs::write(

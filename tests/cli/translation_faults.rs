@@ -538,3 +538,41 @@ fn sweep_cost_tables_hold_every_model_by_its_label() {
         .unwrap();
     assert!(md.lines().any(|l| l.starts_with("| mine ")) && md.lines().any(|l| l.starts_with("| ggx ")), "{md}");
 }
+
+/// A model that reads a struct field it never wrote (as kajiya's `BrdfValue::invalid()` leaves one): its f32 and
+/// f64 translations differ by anything, which is the model's doing, not the translator's. `inspect` says so on
+/// the targets that compile the translation, costs the other models there and the model itself where the SPIR-V
+/// is compiled directly, writes every output, and exits 1.
+#[test]
+fn a_model_reading_an_unwritten_field_fails_alone_and_named_as_such() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(
+        d.join("unwritten.brdf"),
+        "analytic\n::begin shader\nstruct Value { vec3 value; float pdf; };\nValue invalid_value() { Value v; v.pdf = -1.0; return v; }\nvec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) {\n    Value v = invalid_value();\n    if (dot(N, L) > 0.5) { v.value = vec3(dot(N, L)); }\n    return v.value;\n}\n::end shader\n",
+    )
+    .unwrap();
+    let out = common::brdfprof()
+        .args(["inspect", "--no-callgrind", "--model", "unwritten.brdf", "--model", "blinn"])
+        .args(["--device", "nvidia:sm_89", "--device", "radv:navi21", "--json", "i.json", "--markdown", "i.md"])
+        .current_dir(d)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("reads a value the model's code never wrote"), "{stderr}");
+    assert!(!stderr.contains("translator defect"), "{stderr}");
+    let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(d.join("i.json")).unwrap()).unwrap();
+    let cost = |target: &str| {
+        json["reports"].as_array().unwrap().iter().find(|r| r["cost"]["target"] == target).unwrap()["cost"].clone()
+    };
+    let models = |c: &serde_json::Value| -> Vec<String> {
+        c["rows"].as_array().unwrap().iter().map(|r| r["model"].as_str().unwrap().to_string()).collect()
+    };
+    let nvidia = cost("nvidia:sm_89");
+    assert_eq!(nvidia["failed"][0][0], "unwritten", "{nvidia}");
+    assert!(models(&nvidia).contains(&"blinn".to_string()) && !models(&nvidia).contains(&"unwritten".to_string()));
+    assert!(models(&cost("radv:navi21")).contains(&"unwritten".to_string()), "ACO compiles the SPIR-V itself");
+    let md = std::fs::read_to_string(d.join("i.md")).unwrap();
+    assert!(md.contains("**unwritten: failed, so no figure**"), "{md}");
+}

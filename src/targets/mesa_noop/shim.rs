@@ -81,6 +81,7 @@ impl Shim {
             columns: columns.iter().map(|c| c.to_string()).collect(),
             rows: Vec::new(),
             absent: Vec::new(),
+            failed: Vec::new(),
         }
     }
 }

@@ -122,6 +122,7 @@ impl super::Vendor for Radv {
             columns: SHOWN.iter().map(|s| s.to_string()).collect(),
             rows: Vec::new(),
             absent: Vec::new(),
+            failed: Vec::new(),
         };
         // ACO's per-instruction schedule where the report has it (the compile-only targets), else (a real
         // RADV GPU) its Inverse Throughput, branch weights and all.
