@@ -89,6 +89,7 @@ mod tests {
             binding: cycles,
             schedule: 0.0,
             text: text.into(),
+            harness: false,
         }
     }
 

@@ -417,6 +417,7 @@ fn add_lines<F>(
                     costed.len()
                 );
             }
+            lines.mark_harness(matches!(m, Model::File(_)));
             if let Model::File(f) = m {
                 // An HLSL or WGSL shader's lines are those of the GLSL its front end wrote: their text is the file
                 // model's, not on disk.

@@ -160,4 +160,13 @@ fn a_non_ascii_comment_keeps_the_lines() {
         .map(|l| (l["file"].as_str().unwrap().to_string(), l["line"].as_u64().unwrap()))
         .collect();
     assert!(named.iter().any(|(f, n)| f.ends_with("umlaut.brdf") && *n == 5), "{named:?}");
+    // The harness's lines (glsl/, for a model of the user's files) are marked and ranked apart from the model's.
+    for l in k["lines"].as_array().unwrap() {
+        let harness = l["harness"].as_bool().unwrap_or(false);
+        assert_eq!(harness, l["file"].as_str().unwrap().starts_with("glsl/"), "{l}");
+    }
+    let md = std::fs::read_to_string(dir.path().join("umlaut.md")).unwrap();
+    let section = &md[md.find("#### umlaut: the costliest source lines of the model").expect("the model's table")..];
+    let table = section.split("\n\n").nth(1).unwrap();
+    assert!(!table.contains("glsl/shade.glsl") && section.contains("The harness's own lines"), "{section}");
 }

@@ -39,6 +39,7 @@ pub fn per_line(model: &str, instructions: &[Attributed], binding_pipe: &str) ->
             binding: 0.0,
             schedule: 0.0,
             text: String::new(),
+            harness: false,
         });
         entry.instructions += 1;
         entry.schedule += i.schedule;
