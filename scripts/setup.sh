@@ -5,7 +5,8 @@
 # on the CPU); Intel's OpenCL compiler (ocloc/IGC) and PoCL (OpenCL on the CPU) for the intel: targets; Chromium
 # (the HTML report is tested in it, headless); npm (Debian's nodejs), and from the npm registry Microsoft's SARIF
 # Multitool into .tools/sarif (about 100 MB; the tests validate `check --sarif` with it); and,
-# from PyPI, NVIDIA's NVRTC and nvdisasm for the nvidia: targets, into .tools/nvidia (about 150 MB).
+# from PyPI, NVIDIA's NVRTC and nvdisasm for the nvidia: targets, into .tools/nvidia (about 150 MB), and Slang's
+# slangc (the HLSL front end for what glslang's cannot take) into .tools/slang (about 50 MB).
 # As root with apt-get it installs what is missing; otherwise it says exactly what to install and fails.
 # Mesa's noop drivers (adreno:, mali:, anv:) are not built here: `make mesa` (scripts/mesa-noop.sh), ~20 min once.
 set -eu
@@ -58,6 +59,16 @@ if [ ! -f "$nv/nvidia/cu13/lib/libnvrtc.so.13" ] || [ ! -x "$nv/nvidia/cu13/bin/
     # shellcheck disable=SC2086
     python3 -m pip install --quiet --disable-pip-version-check --root-user-action=ignore --no-deps --target "$nv" $wheels
     echo "$wheels" > "$nv/.wheels"
+fi
+# Slang's compiler (slangc, the second HLSL front end for what glslang's cannot take): the pinned slangtorch wheel
+# of scripts/slang-wheel.txt (it ships slangc and its libraries; no PyTorch is needed to run slangc), project-local.
+sl="$root/.tools/slang"
+slang_wheel=$(cat "$root/scripts/slang-wheel.txt")
+if [ ! -x "$sl/slangtorch/bin/slangc" ] || [ "$(cat "$sl/.wheels" 2>/dev/null)" != "$slang_wheel" ]; then
+    echo "brdfprof setup: installing $slang_wheel (slangc) into $sl" >&2
+    rm -rf "$sl"
+    python3 -m pip install --quiet --disable-pip-version-check --root-user-action=ignore --no-deps --target "$sl" "$slang_wheel"
+    echo "$slang_wheel" > "$sl/.wheels"
 fi
 # ocloc disassembles only where it can dlopen libiga64.so; Debian ships libiga64.so.1 alone: a private link.
 iga=$(ls /usr/lib/x86_64-linux-gnu/libiga64.so.1 /usr/lib/*/libiga64.so.1 2>/dev/null | head -n 1)

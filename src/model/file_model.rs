@@ -429,7 +429,7 @@ impl FileModel {
         let (options, params): (Vec<String>, Vec<String>) = items.into_iter().partition(|i| is_shader_option(i));
         let (defines, includes) = shader_options(path, &[], &Includes::default(), &options)?;
         let file = brdf_file::load_shader(Path::new(path), &defines, &includes)?;
-        crate::model::front::record(path, file.language);
+        crate::model::front::record(path, file.language, file.front_end.as_deref());
         if file.has_is_func {
             crate::messages::input_note(format!(
                 "{path}: its isFunc section (importance sampling) is ignored: brdfprof integrates with its own estimator"

@@ -1120,12 +1120,24 @@ fn front_end_errors_without_a_location_are_named_at_the_users_line() {
             "entry.brdf:3: `entry light(N, L, V, 0.5 // roughness)`: a `//` comment inside the argument list",
         ),
     ];
+    // glslang's own messages: without Slang's slangc, which takes a non-ASCII HLSL identifier (below).
+    let no_slang = d.join("no-slang");
+    std::fs::create_dir(&no_slang).unwrap();
     for (model, needle) in cases {
-        let out = run_in(d, &["eval", "--model", model, "--input", "in.csv", "--output", "x.csv"]).fails(2, needle);
+        let out = common::brdfprof()
+            .args(["eval", "--model", model, "--input", "in.csv", "--output", "x.csv"])
+            .current_dir(d)
+            .env("BRDFPROF_SLANG_DIR", &no_slang)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{model}: {stderr}");
+        assert!(stderr.contains(needle), "{model}: expected `{needle}` in {stderr}");
         for internal in ["/tmp/", "brdfprof_stub", "glsl/generated", "\u{fffd}"] {
-            assert!(!out.stderr.contains(internal), "{model}: names `{internal}`: {}", out.stderr);
+            assert!(!stderr.contains(internal), "{model}: names `{internal}`: {stderr}");
         }
     }
+    run_in(d, &["eval", "--model", "ascii.hlsl", "--input", "in.csv", "--output", "slang.csv"]).ok();
     // A comment after the closing parenthesis is the directive's own.
     std::fs::write(
         d.join("after.brdf"),
@@ -1133,4 +1145,73 @@ fn front_end_errors_without_a_location_are_named_at_the_users_line() {
     )
     .unwrap();
     run_in(d, &["eval", "--model", "after.brdf", "--input", "in.csv", "--output", "after.csv"]).ok();
+}
+
+/// DXC-era HLSL (static factories returning their own struct, inheritance, select(), a member calling a static
+/// member unqualified) goes through Slang's slangc where glslang refuses it or crashes: the same values as its
+/// GLSL twin, the front end named in the report; without slangc, glslang's refusal (a crash named with its
+/// signal) and `make setup`, exit 2.
+#[test]
+fn dxc_era_hlsl_goes_through_slang_where_glslang_refuses_or_crashes() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write_rows(&d.join("in.csv"), 400);
+    let slang = |f: &str| root().join("tests/fixtures/hlsl/slang").join(f).display().to_string();
+    let out = run_in(d, &["eval", "--model", &slang("dxc-era.hlsl"), "--input", "in.csv", "--output", "h.csv"]).ok();
+    assert!(
+        out.stderr.contains("refused the shader") && out.stderr.contains("Slang's slangc compiled it"),
+        "{}",
+        out.stderr
+    );
+    run_in(d, &["eval", "--model", &slang("dxc-era-twin.brdf"), "--input", "in.csv", "--output", "g.csv"]).ok();
+    let (h, g) = (common::csv_values(&d.join("h.csv")), common::csv_values(&d.join("g.csv")));
+    assert!(g.iter().filter(|v| v[0] > 0.0).count() > 20, "lit rows");
+    for (x, y) in h.iter().zip(&g) {
+        for c in 0..3 {
+            assert!(common::rel_err(x[c], y[c]) <= 1e-6, "{x:?} against the twin's {y:?}");
+        }
+    }
+    // The report names the front end that compiled it.
+    run_in(
+        d,
+        &[
+            "inspect",
+            "--no-callgrind",
+            "--device",
+            "nvidia:sm_89",
+            "--model",
+            &slang("dxc-era.hlsl"),
+            "--json",
+            "i.json",
+            "--markdown",
+            "i.md",
+        ],
+    )
+    .ok();
+    let md = std::fs::read_to_string(d.join("i.md")).unwrap();
+    assert!(md.contains("HLSL: Slang's slangc") && md.contains("glslang refused the shader"), "{md}");
+    // glslang crashes on a member calling a static member unqualified: named as a crash, and Slang takes it.
+    write(
+        d,
+        &[(
+            "crash.hlsl",
+            "struct Ndf {\n    float a2;\n    static float square(float x) { return x * x; }\n    float eval(float c) { return a2 / square(c); }\n};\nfloat3 BRDF(float3 L, float3 V, float3 N, float3 X, float3 Y) {\n    Ndf n; n.a2 = 0.25;\n    return n.eval(max(dot(N, L), 0.5)).xxx;\n}\n",
+        )],
+    );
+    run_in(d, &["eval", "--model", "crash.hlsl", "--input", "in.csv", "--output", "c.csv"]).ok();
+    let empty = d.join("no-slang");
+    std::fs::create_dir(&empty).unwrap();
+    for (model, needle) in
+        [("crash.hlsl", "crashed (signal 11 SIGSEGV)"), (&slang("dxc-era.hlsl"), "'member type' : Expected")]
+    {
+        let out = common::brdfprof()
+            .args(["eval", "--model", model, "--input", "in.csv", "--output", "x.csv"])
+            .current_dir(d)
+            .env("BRDFPROF_SLANG_DIR", &empty)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{stderr}");
+        assert!(stderr.contains(needle) && stderr.contains("run `make setup`"), "{stderr}");
+    }
 }

@@ -43,9 +43,12 @@ fn translate_here(file: &mut BrdfFile) -> Result<Vec<(usize, String)>> {
     }
     check_reserved_names(file)?;
     check_param_spelling(file)?;
-    let (spirv, source) = match file.language {
+    let (spirv, source, front_end) = match file.language {
         Language::Hlsl => hlsl_spirv(file)?,
-        _ => wgsl_spirv(file)?,
+        _ => {
+            let (spirv, source) = wgsl_spirv(file)?;
+            (spirv, source, None)
+        }
     };
     let text = cross::to_glsl(&spirv, &file.path)?;
     check_param_names(file, &text)?;
@@ -60,7 +63,7 @@ fn translate_here(file: &mut BrdfFile) -> Result<Vec<(usize, String)>> {
     for (k, e) in file.entries.iter_mut().enumerate() {
         e.glue = Some(glue_name(k));
     }
-    file.front_end = Some(front::describe(file.language));
+    file.front_end = Some(front_end.unwrap_or_else(|| front::describe(file.language)));
     Ok(glsl.into_iter().enumerate().map(|(i, l)| (i + 1, l)).collect())
 }
 
@@ -207,8 +210,9 @@ fn glue(k: usize, e: &Entry, types: &[Option<String>]) -> Glue {
 /// (`front::includes`; each `#line` dropped with a warning, as in a GLSL shader), then each entry's glue and
 /// the stub, each line brdfprof writes named by what it stands for in messages. BRDF Explorer's entry and the
 /// declared entries are checked on glslang's preprocessed text (where every macro and `#if` is resolved), at
-/// their files' lines.
-fn hlsl_spirv(file: &mut BrdfFile) -> Result<(Vec<u32>, Source)> {
+/// their files' lines. Where glslang refuses the shader (or crashes), Slang's slangc compiles it with a stub of
+/// its own (`slang`), and the front end's description says so (the third value).
+fn hlsl_spirv(file: &mut BrdfFile) -> Result<(Vec<u32>, Source, Option<String>)> {
     let mut x = Expanded::new(&file.path);
     for p in &file.params {
         if hlsl::is_keyword(&p.name) {
@@ -232,14 +236,47 @@ fn hlsl_spirv(file: &mut BrdfFile) -> Result<(Vec<u32>, Source)> {
     for (g, e) in glues.iter().zip(&file.entries) {
         x.push_generated(hlsl::glue(g), e.line, format!("entry `{}`", e.name));
     }
+    let calls = stub_calls(file, &glues);
     x.push_generated(
-        hlsl::stub(&stub_calls(file, &glues)),
+        hlsl::stub(&calls),
         file.shader_begin,
         format!("the shader's `BRDF` as brdfprof calls it, `{}`", globals::HLSL_SIGNATURE.text),
     );
-    let spirv = hlsl::compile(&x, &file.defines, &file.path)?.map_err(|m| anyhow!("{m}"))?;
+    let (spirv, front_end) = match hlsl::compile(&x, &file.defines, &file.path)? {
+        Ok(words) => (words, None),
+        Err(refused) => slang_spirv(file, &x, &calls, &refused)?,
+    };
     let source = x.lines.iter().zip(&x.origins).map(|(l, &(f, n))| (x.files[f].clone(), n, l.clone())).collect();
-    Ok((spirv, source))
+    Ok((spirv, source, front_end))
+}
+
+/// The shader glslang refused (`refused`: its messages) compiled by Slang's slangc, with the front end's
+/// description; an error with both front ends' messages where slangc refuses it too, or naming `make setup`
+/// where slangc is not installed.
+fn slang_spirv(file: &BrdfFile, x: &Expanded, calls: &[String], refused: &str) -> Result<(Vec<u32>, Option<String>)> {
+    let mut s = x.clone();
+    if let Some(stub) = s.lines.last_mut() {
+        *stub = front::slang::stub(calls);
+    }
+    let first = refused.lines().next().unwrap_or_default();
+    match front::slang::compile(&s, &file.defines, &file.path)? {
+        Some(Ok(words)) => {
+            crate::messages::note_once(format!(
+                "{}: glslang's HLSL front end refused the shader ({first}); Slang's slangc compiled it",
+                file.path.display()
+            ));
+            let described = format!(
+                "HLSL: {} (glslang refused the shader: {first}); {}",
+                front::slang::describe(),
+                cross::describe()
+            );
+            Ok((words, Some(described)))
+        }
+        Some(Err(slang)) => bail!("{refused}\n(Slang's slangc, tried after glslang, refused the shader too:\n{slang})"),
+        None => bail!(
+            "{refused}\n(glslang's HLSL front end refused the shader; Slang's slangc, which takes DXC-era HLSL, is not installed: run `make setup`)"
+        ),
+    }
 }
 
 /// On the preprocessed HLSL `pre` (line for line with `x`): the loops, `BRDF`'s signature, each entry

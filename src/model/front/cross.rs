@@ -139,8 +139,14 @@ pub fn view(glsl: &str, params: &[&str], model: &Path) -> Result<Vec<String>> {
     let mut i = 0;
     while i < lines.len() {
         let l = lines[i];
+        let closing = lines[i..].iter().position(|s| s.starts_with('}')).map(|k| i + k);
         if l.starts_with("#version") || l.starts_with("layout(local_size") {
             i += 1;
+        } else if let Some(end) = closing
+            .filter(|&e| l.starts_with("layout(") && lines[e].contains(&format!("}} {};", super::slang::OUT_BUFFER)))
+        {
+            // Slang's stub stores into a buffer of brdfprof's (`slang::OUT_BUFFER`): dropped with the stub.
+            i = end + 1;
         } else if l.starts_with("layout(") || l.starts_with("uniform ") || l.starts_with("buffer ") {
             bail!(Resource {
                 name: resource_name(l).to_string(),

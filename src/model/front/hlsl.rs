@@ -234,6 +234,17 @@ fn run(
         Err(e) => return Err(e),
     };
     let stdout = String::from_utf8_lossy(&result.stdout).into_owned();
+    if let Some(signal) = std::os::unix::process::ExitStatusExt::signal(&result.status) {
+        let name = match signal {
+            6 => " SIGABRT",
+            11 => " SIGSEGV",
+            _ => "",
+        };
+        return Ok(Err(format!(
+            "{}: glslang's HLSL front end crashed (signal {signal}{name}) on the shader",
+            x.files.first().map_or("?", String::as_str)
+        )));
+    }
     if !result.status.success() {
         return Ok(Err(stdout + &String::from_utf8_lossy(&result.stderr)));
     }

@@ -12,6 +12,7 @@
 pub mod cross;
 pub mod hlsl;
 pub mod includes;
+pub mod slang;
 pub mod wgsl;
 
 use std::collections::BTreeMap;
@@ -171,10 +172,11 @@ pub const STUB: &str = "brdfprof_stub";
 /// Front ends used by this process, model path -> what translated it (`describe`), for reports' provenance.
 static USED: Mutex<BTreeMap<String, String>> = Mutex::new(BTreeMap::new());
 
-/// Records that `path`'s shader went through `language`'s front end.
-pub fn record(path: &str, language: Language) {
+/// Records that `path`'s shader went through `language`'s front end (`front_end`: which, where the file says).
+pub fn record(path: &str, language: Language, front_end: Option<&str>) {
     if language != Language::Glsl {
-        USED.lock().unwrap().insert(path.to_string(), describe(language));
+        let described = front_end.map_or_else(|| describe(language), str::to_string);
+        USED.lock().unwrap().insert(path.to_string(), described);
     }
 }
 
