@@ -34,16 +34,7 @@ const SHOWN: [&str; 6] = [
 ];
 
 const fn family(name: &'static str, gpu_id: &'static str, products: &'static str, detail: &'static str) -> ShimFamily {
-    ShimFamily {
-        name,
-        gpu_id,
-        architecture: "Adreno 6xx",
-        products,
-        detail,
-        default: true,
-        build: &MESA_DEBIAN,
-        without_validation: None,
-    }
+    ShimFamily::on(&MESA_DEBIAN, name, gpu_id, "Adreno 6xx", products, detail)
 }
 
 /// An a7xx GPU: Mesa 22.3's Turnip has none; bookworm-backports' Mesa 25.0 compiles for them.
@@ -53,16 +44,7 @@ const fn family_a7xx(
     products: &'static str,
     detail: &'static str,
 ) -> ShimFamily {
-    ShimFamily {
-        name,
-        gpu_id,
-        architecture: "Adreno 7xx",
-        products,
-        detail,
-        default: true,
-        build: &MESA_BACKPORTS,
-        without_validation: Some(MESA_25_UNVALIDATED),
-    }
+    ShimFamily::on(&MESA_BACKPORTS, name, gpu_id, "Adreno 7xx", products, detail).unvalidated(MESA_25_UNVALIDATED)
 }
 
 pub static ADRENO: Shim = Shim {

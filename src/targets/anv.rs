@@ -15,6 +15,7 @@
 //! critical path with no other thread hiding it: kept as a column of its own, not the cost.
 
 use super::cost;
+use super::mesa_noop::MESA_DEBIAN;
 use super::mesa_noop::shim::{Shim, ShimFamily};
 use crate::gpu::{CompilerLog, DriverStat};
 use crate::schema::InspectReport;
@@ -40,25 +41,6 @@ fn intel_family(anv: &str) -> Option<&'static super::intel::Family> {
     super::intel::FAMILIES.iter().find(|f| f.name == name)
 }
 
-const fn family(
-    name: &'static str,
-    gpu_id: &'static str,
-    architecture: &'static str,
-    products: &'static str,
-    detail: &'static str,
-) -> ShimFamily {
-    ShimFamily {
-        name,
-        gpu_id,
-        architecture,
-        products,
-        detail,
-        default: true,
-        build: &super::mesa_noop::MESA_DEBIAN,
-        without_validation: None,
-    }
-}
-
 pub static ANV: Shim = Shim {
     prefix: "anv",
     vendor: "Intel",
@@ -73,11 +55,39 @@ pub static ANV: Shim = Shim {
     // statistics) would come back from it the second time without brw printing its listing.
     extra_env: &[("INTEL_DEBUG", "cs"), ("VK_ENABLE_PIPELINE_CACHE", "0")],
     families: &[
-        family("skl", "skl", "Gen9", "Skylake HD/Iris Graphics 5xx", "INTEL_STUB_GPU_PLATFORM=skl, Gen9"),
-        family("icl", "icl", "Gen11", "Ice Lake Iris Plus", "INTEL_STUB_GPU_PLATFORM=icl, Gen11"),
-        family("tgl", "tgl", "Gen12LP (Xe-LP)", "Tiger Lake Iris Xe", "INTEL_STUB_GPU_PLATFORM=tgl, Gen12LP"),
-        family("adl", "adl", "Gen12LP (Xe-LP)", "Alder Lake UHD/Iris Xe", "INTEL_STUB_GPU_PLATFORM=adl, Gen12LP"),
-        family("dg2", "dg2", "Xe-HPG (Gen12.5)", "Arc A-series (Alchemist)", "INTEL_STUB_GPU_PLATFORM=dg2, Gen12.5"),
+        ShimFamily::on(
+            &MESA_DEBIAN,
+            "skl",
+            "skl",
+            "Gen9",
+            "Skylake HD/Iris Graphics 5xx",
+            "INTEL_STUB_GPU_PLATFORM=skl, Gen9",
+        ),
+        ShimFamily::on(&MESA_DEBIAN, "icl", "icl", "Gen11", "Ice Lake Iris Plus", "INTEL_STUB_GPU_PLATFORM=icl, Gen11"),
+        ShimFamily::on(
+            &MESA_DEBIAN,
+            "tgl",
+            "tgl",
+            "Gen12LP (Xe-LP)",
+            "Tiger Lake Iris Xe",
+            "INTEL_STUB_GPU_PLATFORM=tgl, Gen12LP",
+        ),
+        ShimFamily::on(
+            &MESA_DEBIAN,
+            "adl",
+            "adl",
+            "Gen12LP (Xe-LP)",
+            "Alder Lake UHD/Iris Xe",
+            "INTEL_STUB_GPU_PLATFORM=adl, Gen12LP",
+        ),
+        ShimFamily::on(
+            &MESA_DEBIAN,
+            "dg2",
+            "dg2",
+            "Xe-HPG (Gen12.5)",
+            "Arc A-series (Alchemist)",
+            "INTEL_STUB_GPU_PLATFORM=dg2, Gen12.5",
+        ),
     ],
     cost: cost_table,
     compiler_log: Some(CompilerLog { read: read_listing, beside_properties: true }),

@@ -14,6 +14,7 @@
 
 use super::cost;
 use super::mesa_noop::shim::{Shim, ShimFamily};
+use super::mesa_noop::{MESA_25_UNVALIDATED, MESA_NVK};
 use super::nvidia::{self, SassStats, sass};
 use crate::gpu::RepresentationStats;
 use crate::schema::InspectReport;
@@ -31,25 +32,6 @@ const REGISTERS: &str = "Number of GPRs";
 /// The internal representation NAK's assembly comes as.
 pub const ASSEMBLY: &str = "NAK assembly";
 
-const fn family(
-    name: &'static str,
-    gpu_id: &'static str,
-    architecture: &'static str,
-    products: &'static str,
-    detail: &'static str,
-) -> ShimFamily {
-    ShimFamily {
-        name,
-        gpu_id,
-        architecture,
-        products,
-        detail,
-        default: true,
-        build: &super::mesa_noop::MESA_NVK,
-        without_validation: Some(super::mesa_noop::MESA_25_UNVALIDATED),
-    }
-}
-
 pub static NAK: Shim = Shim {
     prefix: "nak",
     vendor: "NVIDIA",
@@ -64,8 +46,17 @@ pub static NAK: Shim = Shim {
     // Chip ids the stock shim enumerates (Mesa 25.0.7): Turing TU104 and Ampere GA102. Ada and later need a
     // patched shim (its class tables stop at 0x17x).
     families: &[
-        family("sm_75", "164", "Turing", "GeForce RTX 2080 (TU104)", "NOUVEAU_CHIPSET=164, SM 7.5"),
-        family("sm_86", "172", "Ampere (GA10x)", "GeForce RTX 3080/3090 (GA102)", "NOUVEAU_CHIPSET=172, SM 8.6"),
+        ShimFamily::on(&MESA_NVK, "sm_75", "164", "Turing", "GeForce RTX 2080 (TU104)", "NOUVEAU_CHIPSET=164, SM 7.5")
+            .unvalidated(MESA_25_UNVALIDATED),
+        ShimFamily::on(
+            &MESA_NVK,
+            "sm_86",
+            "172",
+            "Ampere (GA10x)",
+            "GeForce RTX 3080/3090 (GA102)",
+            "NOUVEAU_CHIPSET=172, SM 8.6",
+        )
+        .unvalidated(MESA_25_UNVALIDATED),
     ],
     cost: cost_table,
     compiler_log: None,

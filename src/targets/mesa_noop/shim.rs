@@ -28,6 +28,25 @@ pub struct ShimFamily {
     pub without_validation: Option<&'static str>,
 }
 
+impl ShimFamily {
+    /// A family in `PREFIX:all` whose driver `build` made, validated by the Khronos layer.
+    pub const fn on(
+        build: &'static mesa_noop::MesaBuild,
+        name: &'static str,
+        gpu_id: &'static str,
+        architecture: &'static str,
+        products: &'static str,
+        detail: &'static str,
+    ) -> ShimFamily {
+        ShimFamily { name, gpu_id, architecture, products, detail, default: true, build, without_validation: None }
+    }
+
+    /// The same, compiled without the validation layer, for `why`.
+    pub const fn unvalidated(self, why: &'static str) -> ShimFamily {
+        ShimFamily { without_validation: Some(why), ..self }
+    }
+}
+
 /// A driver on a noop drm-shim.
 pub struct Shim {
     pub prefix: &'static str,
