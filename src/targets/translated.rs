@@ -420,10 +420,15 @@ fn add_lines<F>(
             lines.mark_harness(matches!(m, Model::File(_)));
             if let Model::File(f) = m {
                 // An HLSL or WGSL shader's lines are those of the GLSL its front end wrote: their text is the file
-                // model's, not on disk.
+                // model's, not on disk; where the front end's line information names the user's file and line
+                // (HLSL through glslang), the cost moves there.
                 for l in lines.lines.iter_mut().filter(|l| l.text.is_empty()) {
                     l.text = f.file.front_end_line(&l.file, l.line).unwrap_or_default().to_string();
                 }
+                super::cost::lines::moved(&mut lines, |l| {
+                    let (file, line, text) = f.file.front_end_origin(&l.file, l.line)?;
+                    Some((file.clone(), *line as u32, text.clone()))
+                });
             }
             per_model.push(lines);
         }

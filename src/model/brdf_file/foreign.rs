@@ -51,6 +51,10 @@ fn translate_here(file: &mut BrdfFile) -> Result<Vec<(usize, String)>> {
         }
     };
     let text = cross::to_glsl(&spirv, &file.path)?;
+    let at = match file.language {
+        Language::Hlsl => cross::line_origins(&spirv, &text, &file.path)?,
+        _ => Vec::new(),
+    };
     check_param_names(file, &text)?;
     let params: Vec<&str> = file.params.iter().map(|p| p.name.as_str()).collect();
     let glsl = cross::view(&text, &params, &file.path).map_err(|e| match e.downcast::<cross::Resource>() {
@@ -64,7 +68,32 @@ fn translate_here(file: &mut BrdfFile) -> Result<Vec<(usize, String)>> {
         e.glue = Some(glue_name(k));
     }
     file.front_end = Some(front_end.unwrap_or_else(|| front::describe(file.language)));
+    file.front_end_origins = origins(&text, &at, &glsl, &source);
     Ok(glsl.into_iter().enumerate().map(|(i, l)| (i + 1, l)).collect())
+}
+
+/// The user's file, line and text of each line of `view` (the kept lines of spirv-cross's output `plain`, in
+/// order, each as it was there): `at[k]` is the expanded text's line of `plain`'s line k, `source` that text's
+/// origins. A line `view` moved (an initialiser) or spirv-cross wrote without a location has none.
+fn origins(
+    plain: &str,
+    at: &[Option<usize>],
+    view: &[String],
+    source: &Source,
+) -> Vec<Option<(String, usize, String)>> {
+    if at.is_empty() {
+        return Vec::new();
+    }
+    let lines: Vec<&str> = plain.lines().collect();
+    let mut next = 0;
+    view.iter()
+        .map(|v| {
+            let k = (next..lines.len()).find(|&k| lines[k] == v)?;
+            next = k + 1;
+            let (file, line, text) = source.get(at[k]?.checked_sub(1)?)?;
+            Some((file.clone(), *line, text.trim().to_string()))
+        })
+        .collect()
 }
 
 /// Refuses a name of the section's code starting with `brdfprof_` (in any case): brdfprof writes such names into

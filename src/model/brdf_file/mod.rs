@@ -92,6 +92,9 @@ pub struct BrdfFile {
     /// `source` after glslang's preprocessor (`preprocess`), line for line: what every later step reads. The
     /// same as `source` when it has no directive and no define is given.
     pub shader: Vec<(usize, String)>,
+    /// For an HLSL shader: the user's file, line and text each line of `shader` (by index) came from, where the
+    /// front end's line information names one (`foreign::origins`); empty otherwise.
+    pub front_end_origins: Vec<Option<(String, usize, String)>>,
     /// The line of `::begin shader`.
     shader_begin: usize,
     /// Functions declared in the `brdfprof` section to call instead of `BRDF` (`entry ...`), in order.
@@ -282,6 +285,7 @@ fn empty(path: &Path, bytes: &[u8], language: Language) -> BrdfFile {
         includes: Includes::default(),
         front_end: None,
         shader: Vec::new(),
+        front_end_origins: Vec::new(),
         shader_begin: 0,
         entries: Vec::new(),
         defines_brdf: false,
@@ -305,6 +309,13 @@ impl BrdfFile {
     /// composed kernel's `#line` directive names it: `directive_name`), where `file` is that name as a compiler
     /// reported it (perhaps made absolute or relative to the working directory); None for a GLSL shader, whose
     /// file can be read.
+    /// The user's file, line and text line `line` of the front end's GLSL (named `file` by a compiler) came from,
+    /// where the front end's line information says (HLSL through glslang).
+    pub fn front_end_origin(&self, file: &str, line: u32) -> Option<&(String, usize, String)> {
+        self.front_end_line(file, line)?;
+        self.front_end_origins.get((line as usize).checked_sub(1)?)?.as_ref()
+    }
+
     pub fn front_end_line(&self, file: &str, line: u32) -> Option<&str> {
         let name = self.directive_name();
         let same = file == name || name.ends_with(file) || file.ends_with(&name);

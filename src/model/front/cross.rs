@@ -15,12 +15,35 @@ pub const FLAGS: [&str; 4] = ["--version", "450", "--vulkan-semantics", "--force
 
 /// spirv-cross on `words`: its GLSL.
 pub fn to_glsl(words: &[u32], model: &Path) -> Result<String> {
+    to_glsl_with(words, model, &[])
+}
+
+/// The source location (`#line N "FILE"`: N) of each line of `to_glsl`'s output, by index: spirv-cross's
+/// `--emit-line-directives` output of the same SPIR-V is that output with `#line` directives (and the extension
+/// they need) between its lines. None where a line has none; empty where the two do not line up.
+pub fn line_origins(words: &[u32], plain: &str, model: &Path) -> Result<Vec<Option<usize>>> {
+    let directed = to_glsl_with(words, model, &["--emit-line-directives"])?;
+    let mut at = None;
+    let mut out = Vec::new();
+    let mut text = Vec::new();
+    for l in directed.lines() {
+        if let Some(rest) = l.trim_start().strip_prefix("#line ") {
+            at = rest.split_whitespace().next().and_then(|n| n.parse().ok());
+        } else if !l.contains("GL_GOOGLE_cpp_style_line_directive") {
+            out.push(at);
+            text.push(l);
+        }
+    }
+    Ok(if text == plain.lines().collect::<Vec<_>>() { out } else { Vec::new() })
+}
+
+fn to_glsl_with(words: &[u32], model: &Path, extra: &[&str]) -> Result<String> {
     let dir = crate::cleanup::TempDir::new().context("cannot create a temporary directory for spirv-cross")?;
     let path = dir.path().join("shader.spv");
     std::fs::write(&path, words.iter().flat_map(|w| w.to_le_bytes()).collect::<Vec<u8>>())
         .with_context(|| format!("cannot write {}", path.display()))?;
     let mut cmd = crate::cleanup::command("spirv-cross");
-    cmd.arg(&path).args(FLAGS);
+    cmd.arg(&path).args(FLAGS).args(extra);
     let what = format!("{} (spirv-cross)", model.display());
     let out = match crate::launch::output(&mut cmd, &what) {
         Ok(o) => o,

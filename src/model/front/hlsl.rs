@@ -13,7 +13,7 @@ use std::path::Path;
 
 /// glslang's flags for the compilation: HLSL, a compute stage with the stub as its entry, no SPIR-V
 /// optimisation (whose HLSL legalisation would inline every function into the stub).
-pub const FLAGS: [&str; 5] = ["-D", "-V", "-Od", "-S", "comp"];
+pub const FLAGS: [&str; 6] = ["-D", "-V", "-Od", "-g", "-S", "comp"];
 
 /// A parameter as an HLSL global: `static` (a private global, as a GLSL global is), of its type.
 pub fn param_decl(name: &str, glsl_type: &str) -> String {

@@ -23,6 +23,39 @@ pub struct Attributed {
 pub const ISSUE: &str = "issue";
 
 /// Sums `instructions` per source line; `binding_pipe` is the kernel's busiest pipe (`schedule::Schedule`).
+/// The lines' order: cycles on the binding pipe, then schedule cycles, then file and line.
+pub fn costliest_first(a: &LineCost, b: &LineCost) -> std::cmp::Ordering {
+    b.binding
+        .total_cmp(&a.binding)
+        .then(b.schedule.total_cmp(&a.schedule))
+        .then(a.file.cmp(&b.file))
+        .then(a.line.cmp(&b.line))
+}
+
+/// `lines` with each line `to` names moved to the line it gives (file, line, text), lines that land on one
+/// merged (instructions and cycles summed), in `costliest_first` order.
+pub fn moved(lines: &mut crate::schema::lines::KernelLines, to: impl Fn(&LineCost) -> Option<(String, u32, String)>) {
+    let mut out: Vec<LineCost> = Vec::new();
+    for mut l in std::mem::take(&mut lines.lines) {
+        if let Some((file, line, text)) = to(&l) {
+            (l.file, l.line, l.text) = (file, line, text);
+        }
+        match out.iter_mut().find(|o| o.file == l.file && o.line == l.line) {
+            Some(o) => {
+                o.instructions += l.instructions;
+                o.binding += l.binding;
+                o.schedule += l.schedule;
+                for (pipe, cycles) in l.pipes {
+                    *o.pipes.entry(pipe).or_default() += cycles;
+                }
+            }
+            None => out.push(l),
+        }
+    }
+    out.sort_by(costliest_first);
+    lines.lines = out;
+}
+
 pub fn per_line(model: &str, instructions: &[Attributed], binding_pipe: &str) -> KernelLines {
     let mut by_line: BTreeMap<(String, u32), LineCost> = BTreeMap::new();
     let mut unattributed = 0;
@@ -52,13 +85,7 @@ pub fn per_line(model: &str, instructions: &[Attributed], binding_pipe: &str) ->
         entry.binding = entry.pipes.get(binding_pipe).copied().unwrap_or(0.0);
     }
     let mut lines: Vec<LineCost> = by_line.into_values().collect();
-    lines.sort_by(|a, b| {
-        b.binding
-            .total_cmp(&a.binding)
-            .then(b.schedule.total_cmp(&a.schedule))
-            .then(a.file.cmp(&b.file))
-            .then(a.line.cmp(&b.line))
-    });
+    lines.sort_by(costliest_first);
     for l in &mut lines {
         l.text = source_text(&l.file, l.line);
         l.file = short(&l.file);
