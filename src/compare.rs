@@ -159,7 +159,7 @@ pub fn inspect_columns(report: &InspectReport, source: &str) -> Vec<CostColumn> 
     let device = device_name(report);
     if let Some(cost) = report.cost.clone().or_else(|| crate::targets::cost_of(report)) {
         out.push(CostColumn {
-            name: cost.column_name(),
+            name: crate::targets::column_name(&cost),
             unit: format!("{} {} per evaluation ({})", cost.compiler, cost.unit, cost.model),
             source: format!("{source}{device}, {}", crate::targets::mesa_noop::driver_version(report)),
             gross: cost.rows.iter().map(|r| (r.model.clone(), r.cycles_per_eval)).collect(),

@@ -275,3 +275,29 @@ pub fn first_line_of(cmd: &mut Command) -> Option<String> {
     let text = String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr);
     text.lines().map(str::trim).find(|l| !l.is_empty()).map(str::to_string)
 }
+
+/// `words` without the source text a `-g` build embeds (OpSource's source operand, OpSourceContinued): glslang
+/// cuts that text into instructions by bytes, so a non-ASCII character (in a comment, say) can straddle two and
+/// neither string is UTF-8 any more, which SPIR-V requires and rspirv checks. OpString and OpLine keep every
+/// file and line.
+pub fn without_source_text(words: &[u32]) -> Vec<u32> {
+    const SOURCE_CONTINUED: u32 = 2;
+    const SOURCE: u32 = 3;
+    let mut out = words[..words.len().min(5)].to_vec();
+    let mut i = 5;
+    while i < words.len() {
+        let (op, len) = (words[i] & 0xffff, (words[i] >> 16) as usize);
+        let len = len.max(1).min(words.len() - i);
+        match op {
+            SOURCE_CONTINUED => {}
+            // Language, version and the file's id; the text after them dropped.
+            SOURCE if len > 4 => {
+                out.push((4 << 16) | SOURCE);
+                out.extend_from_slice(&words[i + 1..i + 4]);
+            }
+            _ => out.extend_from_slice(&words[i..i + len]),
+        }
+        i += len;
+    }
+    out
+}

@@ -748,7 +748,7 @@ impl FileModel {
         let (source_file, defines) = tree.entry(&kernel_name)?;
         let kernel_source = tree.read(Path::new(&source_file)).with_context(|| format!("cannot read {source_file}"))?;
         let composed = self.compose(kind, &kernel_source)?;
-        let words = crate::spirv::without_source_text(&self.compile(&tree, kind, &composed, &defines, &["-g"])?);
+        let words = crate::shaders::without_source_text(&self.compile(&tree, kind, &composed, &defines, &["-g"])?);
         Ok(Spirv { name: format!("{}:{kernel_name}", self.path), words: words.into() })
     }
 

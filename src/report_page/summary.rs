@@ -114,10 +114,10 @@ fn inspect_columns(s: &mut Summary, reports: &[crate::schema::InspectReport]) {
         }
         let device = r.provenance["device"]["name"].as_str().unwrap_or("?");
         let reference = crate::brdf::spec::REFERENCE_MODEL;
-        let family = cost.column_name().split_whitespace().next().unwrap_or("?").to_string();
+        let family = crate::targets::column_name(&cost).split_whitespace().next().unwrap_or("?").to_string();
         s.column(
             format!("{family} x {reference} {MODELLED}"),
-            format!("{} vs {reference} ({device}, modelled)", cost.column_name()),
+            format!("{} vs {reference} ({device}, modelled)", crate::targets::column_name(&cost)),
             cells,
         );
     }

@@ -103,15 +103,10 @@ impl TargetCost {
         }
     }
 
-    /// The column name in cross-device tables: "navi21 cycles/eval"; a family name two vendors share (sm_86:
-    /// ptxas' and NAK's) by its target, "nak:sm_86 cycles/eval".
+    /// The column name in cross-device tables: "navi21 cycles/eval" (`targets::column_name` names a family two
+    /// vendors share by its target).
     pub fn column_name(&self) -> String {
-        let name = match (&self.family, &self.target) {
-            (Some(f), Some(t)) if crate::targets::shared_family_name(f) => t.clone(),
-            (Some(f), _) => f.clone(),
-            _ => self.device.clone(),
-        };
-        format!("{name} cycles/eval")
+        format!("{} cycles/eval", self.family.clone().unwrap_or_else(|| self.device.clone()))
     }
 
     pub fn row(&self, model: &str) -> Option<&CostRow> {

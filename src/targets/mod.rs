@@ -136,6 +136,15 @@ pub fn shared_family_name(name: &str) -> bool {
     VENDORS.iter().filter(|v| v.families().iter().any(|f| f.name == name)).count() > 1
 }
 
+/// A cost table's column name in cross-device tables (`TargetCost::column_name`), a family name two vendors
+/// share named by its target: "nak:sm_86 cycles/eval".
+pub fn column_name(cost: &TargetCost) -> String {
+    match (&cost.family, &cost.target) {
+        (Some(f), Some(t)) if shared_family_name(f) => format!("{t} cycles/eval"),
+        _ => cost.column_name(),
+    }
+}
+
 /// One family of one vendor.
 #[derive(Clone, Copy)]
 pub struct Target {
