@@ -107,39 +107,56 @@ fn lines_need_a_target_whose_compiler_names_them() {
 /// front end's GLSL; the few lines spirv-cross wrote with no location keep the front end's GLSL text.
 #[test]
 fn an_hlsl_models_lines_are_its_own_files_lines_with_their_text() {
-    let dir = tempfile::tempdir().unwrap();
     let ue = common::repo_root().join("tests/fixtures/hlsl/ue");
     let at = |p: &str| ue.join(p).display().to_string();
     let engine = format!("/Engine={}", at("Engine"));
-    let all = inspect_json(
-        dir.path(),
-        "hlsl",
-        &["nvidia:sm_89"],
-        &["--lines", "--model", &at("ue-ggx.brdf"), "--include-dir", &at("Shaders"), "--include-map", &engine],
-        "Cost per source line",
-    );
+    let args = ["--model", &at("ue-ggx.brdf"), "--include-dir", &at("Shaders"), "--include-map", &engine];
+    let files = [at("Shaders/SpecularTerms.ush"), at("Engine/Private/Common.ush")];
+    lines_land_on_the_users_files("ue-ggx", &args, &files, "(its HLSL as GLSL)");
+}
+
+/// A WGSL model's cost per line lands on its imported modules' files and lines (naga's statement spans, placed
+/// by naga_oil's module tags, through naga's `OpLine`s and spirv-cross's `#line` directives), with their text.
+#[test]
+fn a_wgsl_models_lines_are_its_modules_lines_with_their_text() {
+    let bevy = common::repo_root().join("tests/fixtures/wgsl/bevy");
+    let at = |p: &str| bevy.join(p).display().to_string();
+    let args = ["--model", &at("bevy-ggx.brdf"), "--include-dir", &at("shaders")];
+    let files = [at("shaders/pbr_lighting.wgsl"), at("shaders/utils.wgsl")];
+    lines_land_on_the_users_files("bevy-ggx", &args, &files, "(its WGSL as GLSL)");
+}
+
+/// `inspect --lines` on NVIDIA of model `name` (`args`): its costliest line is one of `files`', each of those files' lines is shown with its own text, every file has lines, at most a fifth of
+/// the lines are left on the front end's GLSL (named with `glsl_suffix`), and every instruction counts once.
+fn lines_land_on_the_users_files(name: &str, args: &[&str], files: &[String], glsl_suffix: &str) {
+    let dir = tempfile::tempdir().unwrap();
+    let mut extra = vec!["--lines"];
+    extra.extend(args);
+    let all = inspect_json(dir.path(), name, &["nvidia:sm_89"], &extra, "Cost per source line");
     // One device: the JSON is its report.
-    let k = all["lines"].as_array().unwrap().iter().find(|k| k["model"] == "ue-ggx").unwrap().clone();
+    let k = all["lines"].as_array().unwrap().iter().find(|k| k["model"] == name).unwrap().clone();
     let lines = k["lines"].as_array().unwrap();
     let model: Vec<&serde_json::Value> = lines.iter().filter(|l| !l["harness"].as_bool().unwrap_or(false)).collect();
     let file = |l: &serde_json::Value| l["file"].as_str().unwrap().to_string();
-    assert!(file(model[0]).ends_with("Shaders/SpecularTerms.ush"), "the costliest line is a header's: {}", model[0]);
-    let specular = std::fs::read_to_string(at("Shaders/SpecularTerms.ush")).unwrap();
-    for l in model.iter().filter(|l| file(l).ends_with("SpecularTerms.ush")) {
-        let n = l["line"].as_u64().unwrap() as usize;
-        assert_eq!(l["text"].as_str().unwrap(), specular.lines().nth(n - 1).unwrap().trim(), "{l}");
+    assert!(files.iter().any(|f| file(model[0]) == *f), "{name}: the costliest line is one of {files:?}: {}", model[0]);
+    for f in files {
+        let text = std::fs::read_to_string(f).unwrap();
+        let on: Vec<_> = model.iter().filter(|l| file(l) == *f).collect();
+        assert!(!on.is_empty(), "{name}: {f} has lines");
+        for l in on {
+            let n = l["line"].as_u64().unwrap() as usize;
+            assert_eq!(l["text"].as_str().unwrap(), text.lines().nth(n - 1).unwrap().trim(), "{l}");
+        }
     }
-    assert!(model.iter().any(|l| file(l).ends_with("Engine/Private/Common.ush")), "the common header's lines too");
-    let glsl = model.iter().filter(|l| file(l).ends_with("(its HLSL as GLSL)")).count();
+    let glsl = model.iter().filter(|l| file(l).ends_with(glsl_suffix)).count();
     assert!(
         glsl * 5 < model.len(),
-        "most lines are the user's: {glsl} of {} left on the front end's GLSL",
+        "{name}: most lines are the user's: {glsl} of {} left on the front end's GLSL",
         model.len()
     );
-    // Every instruction counted once still.
     let counted: u64 =
         lines.iter().map(|l| l["instructions"].as_u64().unwrap()).sum::<u64>() + k["unattributed"].as_u64().unwrap();
-    assert_eq!(counted, k["instructions"].as_u64().unwrap());
+    assert_eq!(counted, k["instructions"].as_u64().unwrap(), "{name}: every instruction counted once");
 }
 
 /// A GLSL file with non-ASCII text in a comment: glslang's `-g` build cuts the embedded source by bytes, which

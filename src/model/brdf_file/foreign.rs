@@ -43,18 +43,20 @@ fn translate_here(file: &mut BrdfFile) -> Result<Vec<(usize, String)>> {
     }
     check_reserved_names(file)?;
     check_param_spelling(file)?;
-    let (spirv, source, front_end) = match file.language {
-        Language::Hlsl => hlsl_spirv(file)?,
+    // `places[k]`: the user's place of SPIR-V line k + 1 (the expanded HLSL's lines; a WGSL statement's own).
+    let (spirv, source, places, front_end) = match file.language {
+        Language::Hlsl => {
+            let (spirv, source, front_end) = hlsl_spirv(file)?;
+            let places = source.iter().cloned().map(Some).collect();
+            (spirv, source, places, front_end)
+        }
         _ => {
-            let (spirv, source) = wgsl_spirv(file)?;
-            (spirv, source, None)
+            let (spirv, source, places) = wgsl_spirv(file)?;
+            (spirv, source, places, None)
         }
     };
     let text = cross::to_glsl(&spirv, &file.path)?;
-    let at = match file.language {
-        Language::Hlsl => cross::line_origins(&spirv, &text, &file.path)?,
-        _ => Vec::new(),
-    };
+    let at = cross::line_origins(&spirv, &text, &file.path)?;
     check_param_names(file, &text)?;
     let params: Vec<&str> = file.params.iter().map(|p| p.name.as_str()).collect();
     let glsl = cross::view(&text, &params, &file.path).map_err(|e| match e.downcast::<cross::Resource>() {
@@ -68,18 +70,18 @@ fn translate_here(file: &mut BrdfFile) -> Result<Vec<(usize, String)>> {
         e.glue = Some(glue_name(k));
     }
     file.front_end = Some(front_end.unwrap_or_else(|| front::describe(file.language)));
-    file.front_end_origins = origins(&text, &at, &glsl, &source);
+    file.front_end_origins = origins(&text, &at, &glsl, &places);
     Ok(glsl.into_iter().enumerate().map(|(i, l)| (i + 1, l)).collect())
 }
 
 /// The user's file, line and text of each line of `view` (the kept lines of spirv-cross's output `plain`, in
-/// order, each as it was there): `at[k]` is the expanded text's line of `plain`'s line k, `source` that text's
-/// origins. A line `view` moved (an initialiser) or spirv-cross wrote without a location has none.
+/// order, each as it was there): `at[k]` is the SPIR-V's line of `plain`'s line k, `places` the user's place of
+/// each SPIR-V line. A line `view` moved (an initialiser) or spirv-cross wrote without a location has none.
 fn origins(
     plain: &str,
     at: &[Option<usize>],
     view: &[String],
-    source: &Source,
+    places: &[Option<(String, usize, String)>],
 ) -> Vec<Option<(String, usize, String)>> {
     if at.is_empty() {
         return Vec::new();
@@ -90,7 +92,7 @@ fn origins(
         .map(|v| {
             let k = (next..lines.len()).find(|&k| lines[k] == v)?;
             next = k + 1;
-            let (file, line, text) = source.get(at[k]?.checked_sub(1)?)?;
+            let (file, line, text) = places.get(at[k]?.checked_sub(1)?)?.as_ref()?;
             Some((file.clone(), *line, text.trim().to_string()))
         })
         .collect()
@@ -342,7 +344,11 @@ fn check_hlsl(file: &mut BrdfFile, x: &Expanded, pre: &str) -> Result<Vec<Glue>>
 /// The WGSL shader composed and compiled: the section, the parameters as private globals, each entry's glue
 /// and the stub, through naga_oil and naga (`front::wgsl`). The shader with its parameters alone is composed
 /// first: `BRDF`'s signature and the entries' parameter types are read from naga's module of it.
-fn wgsl_spirv(file: &mut BrdfFile) -> Result<(Vec<u32>, Source)> {
+/// The WGSL shader's SPIR-V, its lines (as messages locate a declaration) and the user's place of each SPIR-V
+/// line (`wgsl::emit_spirv`).
+type WgslSpirv = (Vec<u32>, Source, Vec<Option<(String, usize, String)>>);
+
+fn wgsl_spirv(file: &mut BrdfFile) -> Result<WgslSpirv> {
     check_statement_sizes(file)?;
     let mut top = wgsl::Top::new(&file.source);
     for p in &file.params {
@@ -362,10 +368,8 @@ fn wgsl_spirv(file: &mut BrdfFile) -> Result<(Vec<u32>, Source)> {
     let composed = wgsl::compose(&file.path, &top, &file.defines, &file.includes)?;
     file.loops = wgsl_loops_of(file, &top, &composed)?;
     let model = file.path.display().to_string();
-    Ok((
-        wgsl::emit_spirv(&composed.module, &file.path)?,
-        file.source.iter().map(|(n, l)| (model.clone(), *n, l.clone())).collect(),
-    ))
+    let (spirv, places) = wgsl::emit_spirv(&composed, &file.path)?;
+    Ok((spirv, file.source.iter().map(|(n, l)| (model.clone(), *n, l.clone())).collect(), places))
 }
 
 /// The most operators (and opening brackets) one WGSL statement may hold: naga's front end recurses once per

@@ -14,6 +14,7 @@ pub mod hlsl;
 pub mod includes;
 pub mod slang;
 pub mod wgsl;
+pub mod wgsl_lines;
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};

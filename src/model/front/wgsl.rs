@@ -488,6 +488,8 @@ fn missing_defs_note(files: &[(String, String)], defs: &HashMap<String, ShaderDe
 pub struct Composed {
     pub module: naga::Module,
     pub files: Vec<(String, String)>,
+    /// Where its statements lie in the user's files.
+    pub places: super::wgsl_lines::Places,
 }
 
 /// naga_oil's composition of `top` (the model's section plus brdfprof's lines) under `defines`, its imports
@@ -521,7 +523,9 @@ pub fn compose(model: &Path, top: &Top, defines: &[(String, String)], includes: 
         let graph: Vec<(String, String)> = std::iter::once((shown.clone(), top.text.clone())).chain(m.files.clone()).collect();
         anyhow!("{}{hint}{}", located(&e, &m.composer, Some((&shown, top)), &graph), missing_defs_note(&graph, &m.defs))
     })?;
-    Ok(Composed { module, files: m.files })
+    let generated = top.generated.keys().copied().collect();
+    let places = super::wgsl_lines::Places::new(&m.composer, (&shown, &top.text, generated), &m.defs, &m.files);
+    Ok(Composed { module, files: m.files, places })
 }
 
 /// What naga may accept in a user's WGSL: its defaults (multisampled shading, cube array textures) and `enable f16` (the kernels run where the device has
@@ -548,8 +552,11 @@ pub fn preprocessed(text: &str, defines: &[(String, String)], model: &Path) -> S
 
 /// The module's SPIR-V for its stub entry: naga's validation, `override`s at their defaults, and naga's SPIR-V
 /// writer with every name kept (`DEBUG`), no index clamping (`Unchecked`, naga's default) and no loop
-/// bounding; integer division keeps WGSL's defined result for a zero divisor (naga's wrapper).
-pub fn emit_spirv(module: &naga::Module, model: &Path) -> Result<Vec<u32>> {
+/// bounding; integer division keeps WGSL's defined result for a zero divisor (naga's wrapper). Each statement
+/// carries an `OpLine` whose line is its index in the returned table of the user's places
+/// (`wgsl_lines::Places::relabel`).
+pub fn emit_spirv(composed: &Composed, model: &Path) -> Result<(Vec<u32>, Vec<Option<super::wgsl_lines::Origin>>)> {
+    let module = &composed.module;
     use naga::valid::{ValidationFlags, Validator};
     let what = model.display();
     let info = Validator::new(ValidationFlags::all(), SHADER_CAPABILITIES)
@@ -557,15 +564,24 @@ pub fn emit_spirv(module: &naga::Module, model: &Path) -> Result<Vec<u32>> {
         .map_err(|e| anyhow!("{what}: naga's validation: {}", e.emit_to_string("")))?;
     let (module, info) = naga::back::pipeline_constants::process_overrides(module, &info, None, &Default::default())
         .map_err(|e| anyhow!("{what}: the overrides at their defaults: {e}"))?;
+    let mut module = module.into_owned();
+    let (lines, table) = composed.places.relabel(&mut module);
+    let file_name = model.display().to_string();
     let options = naga::back::spv::Options {
         flags: naga::back::spv::WriterFlags::DEBUG,
         force_loop_bounding: false,
+        debug_info: Some(naga::back::spv::DebugInfo {
+            source_code: &lines,
+            file_name: &file_name,
+            language: naga::back::spv::SourceLanguage::Unknown,
+        }),
         ..Default::default()
     };
     let pipeline =
         naga::back::spv::PipelineOptions { shader_stage: naga::ShaderStage::Compute, entry_point: STUB.to_string() };
-    naga::back::spv::write_vec(&module, &info, &options, Some(&pipeline))
-        .with_context(|| format!("{what}: naga's SPIR-V writer"))
+    let words = naga::back::spv::write_vec(&module, &info, &options, Some(&pipeline))
+        .with_context(|| format!("{what}: naga's SPIR-V writer"))?;
+    Ok((words, table))
 }
 
 /// A naga type as WGSL writes it (scalars, vectors, matrices, structs by their undecorated name).
