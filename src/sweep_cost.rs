@@ -61,10 +61,14 @@ pub struct CostSweep {
 pub fn build(sweep: &SweepReport, target: &str, cost: &TargetCost, note: Option<&str>) -> Result<CostSweep> {
     let mut rows: Vec<CostSweepRow> = Vec::new();
     let mut skipped = Vec::new();
+    let mut failed = Vec::new();
     for r in &sweep.rows {
         // The target's rows are named by the model's label (a file's `name=`, or its stem), as every table is.
         let Some(a) = cost.row(&r.label).or_else(|| cost.row(&r.spec)) else {
-            skipped.push(r.spec.clone());
+            match cost.failed.iter().find(|(m, _)| *m == r.label || *m == r.spec) {
+                Some((_, why)) => failed.push(format!("{} failed on {target}: {why}", r.spec)),
+                None => skipped.push(r.spec.clone()),
+            }
             continue;
         };
         rows.push(CostSweepRow {
@@ -104,8 +108,14 @@ pub fn build(sweep: &SweepReport, target: &str, cost: &TargetCost, note: Option<
         fastest: rows.first().map(|r| r.spec.clone()).unwrap_or_default(),
         rows,
         // The child's note names each spec with the reason; without one, the specs alone.
-        skipped: (!skipped.is_empty())
-            .then(|| note.map_or_else(|| format!("not compiled for {target}: {}", skipped.join(", ")), str::to_string)),
+        // A spec that failed on the target (its translation's check, its compile) is named with its reason.
+        skipped: {
+            let not_compiled = (!skipped.is_empty()).then(|| {
+                note.map_or_else(|| format!("not compiled for {target}: {}", skipped.join(", ")), str::to_string)
+            });
+            let all: Vec<String> = not_compiled.into_iter().chain(failed).collect();
+            (!all.is_empty()).then(|| all.join("; "))
+        },
         against: sweep.against.clone(),
         error_axis: crate::sweep::error_axis(sweep.exact, &sweep.rows),
     })

@@ -25,11 +25,18 @@ pub const TIMING_RULE: Rule = Rule {
     full: "brdfprof check timed the model interleaved with the reference model: its per-round cost ratio rose past the noise threshold with a significant Mann-Whitney U test (alpha 0.05).",
 };
 
+pub const FAILED_RULE: Rule = Rule {
+    id: "brdfprof/model-failed",
+    name: "Model not measured",
+    short: "A model failed on the check's target, so the check has no figures for it.",
+    full: "brdfprof check could not measure the model on the target: its translation failed its check against the Vulkan device, or the vendor's compiler refused it. The other models were measured and compared; the check fails until this one is measured again.",
+};
+
 /// Statistics a finding's message names (the largest relative changes).
 const MESSAGE_CHANGES: usize = 3;
 
 /// Every rule a finding may name, in SARIF's `rules` order.
-pub const RULES: [&Rule; 2] = [&COUNT_RULE, &TIMING_RULE];
+pub const RULES: [&Rule; 3] = [&COUNT_RULE, &TIMING_RULE, &FAILED_RULE];
 
 /// What the run was measured on: the compile-only target (`nvidia:sm_89`) or the device, and the compiler.
 pub fn measured_on(new: &Baseline) -> (String, String) {
@@ -38,6 +45,29 @@ pub fn measured_on(new: &Baseline) -> (String, String) {
         Some(c) => (c.target.clone().unwrap_or(device), c.compiler.clone()),
         None => (device, new.inspect.tools.iter().map(|(k, v)| format!("{k} {v}")).collect::<Vec<_>>().join(", ")),
     }
+}
+
+/// One finding per model that failed on the target of `new` (its cost section's `failed`), at its file where
+/// it is one of `models`.
+pub fn failed(new: &Baseline, models: &[Model]) -> Vec<Finding> {
+    let (target, compiler) = measured_on(new);
+    let Some(cost) = &new.inspect.cost else { return Vec::new() };
+    cost.failed
+        .iter()
+        .map(|(model, why)| {
+            let file = models.iter().find(|m| m.label() == *model).and_then(|m| m.file().map(|f| f.path.clone()));
+            Finding {
+                rule: &FAILED_RULE,
+                message: format!("{model} on {target}: failed, so no figures: {why}"),
+                places: file
+                    .into_iter()
+                    .map(|f| Place { file: f, line: None, text: String::new(), note: String::new() })
+                    .collect(),
+                identity: format!("{target}\n{model}\nfailed"),
+                properties: json!({ "model": model, "target": target, "compiler": compiler, "failed": why }),
+            }
+        })
+        .collect()
 }
 
 /// The model file behind row `model` of `new`, where it is one.

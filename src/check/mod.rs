@@ -181,9 +181,10 @@ fn run_measured(options: &CheckOptions, measure: impl FnOnce(Vec<Model>, u32) ->
     }
     let old = options.baseline.as_deref().map(load).transpose()?;
     let (specs, lights) = plan(options, old.as_ref())?;
+    let models = specs.clone();
     let new = measure(specs, lights)?;
     let measured_on = findings::measured_on(&new);
-    let outcome = match (&old, &options.baseline) {
+    let mut outcome = match (&old, &options.baseline) {
         (Some(old), Some(path)) => {
             let cmp = compare(old, &new, &options.thresholds, options.force);
             let findings = findings::findings(&cmp, &new);
@@ -196,6 +197,17 @@ fn run_measured(options: &CheckOptions, measure: impl FnOnce(Vec<Model>, u32) ->
             measured_on,
         },
     };
+    // A model that failed on the target (its translation's check, its compile) has no figures to gate: the
+    // others are compared, and the check fails naming it, never passing over it.
+    let failed = findings::failed(&new, &models);
+    if !failed.is_empty() {
+        outcome.text += &format!(
+            "\n\n## Models with no figures\n\n{}\n",
+            failed.iter().map(|f| format!("- {}", f.message)).collect::<Vec<_>>().join("\n")
+        );
+        outcome.exit = outcome.exit.max(1);
+        outcome.findings.extend(failed);
+    }
     if let Some(path) = &options.save {
         json::write_report(path, json::Kind::Baseline, &new)?;
         crate::messages::progress(format!("check: baseline saved to {}", path.display()));

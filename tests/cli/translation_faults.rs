@@ -547,11 +547,7 @@ fn sweep_cost_tables_hold_every_model_by_its_label() {
 fn a_model_reading_an_unwritten_field_fails_alone_and_named_as_such() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    std::fs::write(
-        d.join("unwritten.brdf"),
-        "analytic\n::begin shader\nstruct Value { vec3 value; float pdf; };\nValue invalid_value() { Value v; v.pdf = -1.0; return v; }\nvec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) {\n    Value v = invalid_value();\n    if (dot(N, L) > 0.5) { v.value = vec3(dot(N, L)); }\n    return v.value;\n}\n::end shader\n",
-    )
-    .unwrap();
+    write_unwritten(d);
     let out = common::brdfprof()
         .args(["inspect", "--no-callgrind", "--model", "unwritten.brdf", "--model", "blinn"])
         .args(["--device", "nvidia:sm_89", "--device", "radv:navi21", "--json", "i.json", "--markdown", "i.md"])
@@ -575,4 +571,42 @@ fn a_model_reading_an_unwritten_field_fails_alone_and_named_as_such() {
     assert!(models(&cost("radv:navi21")).contains(&"unwritten".to_string()), "ACO compiles the SPIR-V itself");
     let md = std::fs::read_to_string(d.join("i.md")).unwrap();
     assert!(md.contains("**unwritten: failed, so no figure**"), "{md}");
+}
+
+/// A model that reads a struct field it never wrote (kajiya's `BrdfValue::invalid()` in brdfprof's own words).
+fn write_unwritten(d: &std::path::Path) {
+    std::fs::write(
+        d.join("unwritten.brdf"),
+        "analytic\n::begin shader\nstruct Value { vec3 value; float pdf; };\nValue invalid_value() { Value v; v.pdf = -1.0; return v; }\nvec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) {\n    Value v = invalid_value();\n    if (dot(N, L) > 0.5) { v.value = vec3(dot(N, L)); }\n    return v.value;\n}\n::end shader\n",
+    )
+    .unwrap();
+}
+
+/// `check` on a target where one model fails its translation's check: the other model is measured and saved,
+/// the failed one is named with its reason in the report and as a SARIF result at its file, and the gate fails
+/// (exit 1) rather than passing over a model it could not measure.
+#[test]
+fn check_fails_naming_a_model_it_could_not_measure() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write_unwritten(d);
+    let out = common::brdfprof()
+        .args(["check", "--device", "nvidia:sm_89", "--model", "unwritten.brdf", "--model", "blinn"])
+        .args(["--save-baseline", "b.json", "--sarif", "s.sarif"])
+        .current_dir(d)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(1), "{stdout}\n{}", String::from_utf8_lossy(&out.stderr));
+    let section = &stdout[stdout.find("## Models with no figures").expect("the report names the failed model")..];
+    assert!(section.contains("unwritten on nvidia:sm_89") && section.contains("never wrote"), "{section}");
+    let baseline: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d.join("b.json")).unwrap()).unwrap();
+    let rows = baseline["inspect"]["cost"]["rows"].as_array().unwrap();
+    assert!(rows.iter().any(|r| r["model"] == "blinn"), "the other model is measured: {rows:?}");
+    let sarif: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(d.join("s.sarif")).unwrap()).unwrap();
+    let results = sarif["runs"][0]["results"].as_array().unwrap();
+    let failed = results.iter().find(|r| r["ruleId"] == "brdfprof/model-failed").expect("a SARIF result for it");
+    let uri = failed["locations"][0]["physicalLocation"]["artifactLocation"]["uri"].as_str().unwrap();
+    assert!(uri.ends_with("unwritten.brdf"), "{failed}");
 }
