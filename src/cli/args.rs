@@ -116,6 +116,10 @@ pub struct ModelArgs {
     /// "/Engine/Private/BRDF.ush"` reads UE/Engine/Shaders/Private/BRDF.ush (`include-map=` in the spec).
     #[arg(long = "include-map", value_name = "VIRTUAL=DIR")]
     pub include_maps: Vec<String>,
+    /// Which front end compiles an HLSL shader: glslang, and Slang's slangc where glslang refuses or crashes
+    /// (auto); or one of them alone (`hlsl-front-end=` in the model's spec; docs/hlsl.md).
+    #[arg(long = "hlsl-front-end", value_name = "auto|glslang|slang", value_parser = ["auto", "glslang", "slang"])]
+    pub hlsl_front_end: Option<String>,
 }
 
 impl ModelArgs {
@@ -126,6 +130,7 @@ impl ModelArgs {
             ("--define", model::file_model::DEFINE, &self.defines),
             ("--include-dir", model::file_model::INCLUDE, &self.include_dirs),
             ("--include-map", model::file_model::INCLUDE_MAP, &self.include_maps),
+            ("--hlsl-front-end", model::file_model::HLSL_FRONT_END, &self.hlsl_front_end.iter().cloned().collect()),
         ] {
             if let Some(v) = values.iter().find(|v| v.contains(',')) {
                 bail!(
@@ -144,6 +149,7 @@ impl ModelArgs {
                 ("--define", &self.defines),
                 ("--include-dir", &self.include_dirs),
                 ("--include-map", &self.include_maps),
+                ("--hlsl-front-end", &self.hlsl_front_end.iter().cloned().collect()),
             ]
             .into_iter()
             .find_map(|(f, v)| v.first().map(|v| format!("{f} {v}")))

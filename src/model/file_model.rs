@@ -12,7 +12,7 @@
 //! glslang's and brdfprof's versions.
 
 use super::KernelKind;
-use super::brdf_file::{self, BrdfFile, FileParam, FileParamKind, Includes, Returns, glsl_float};
+use super::brdf_file::{self, BrdfFile, FileParam, FileParamKind, HlslFrontEnd, Includes, Returns, glsl_float};
 use crate::shaders::{self, Shaders, Spirv};
 use anyhow::{Context, Result, anyhow, bail};
 use glam::DVec3;
@@ -302,8 +302,12 @@ pub const RETURNS: &str = "returns";
 pub const INCLUDE: &str = "include";
 pub const INCLUDE_MAP: &str = "include-map";
 
+/// The key of a model text that chooses an HLSL shader's front end (`hlsl-front-end=auto|glslang|slang`, as
+/// `--hlsl-front-end`).
+pub const HLSL_FRONT_END: &str = "hlsl-front-end";
+
 /// The keys of a model text brdfprof reads itself (no parameter may take one's name).
-const KEYS: [&str; 5] = [DEFINE, ENTRY, RETURNS, INCLUDE, INCLUDE_MAP];
+const KEYS: [&str; 6] = [DEFINE, ENTRY, RETURNS, INCLUDE, INCLUDE_MAP, HLSL_FRONT_END];
 
 /// The entry and its parameters as BRDF Explorer's files name them: no macro may take these names.
 const ENTRY_NAMES: [&str; 6] = ["BRDF", "L", "V", "N", "X", "Y"];
@@ -312,9 +316,27 @@ fn is_define(item: &str) -> bool {
     item.split_once('=').is_some_and(|(k, _)| k.trim() == DEFINE)
 }
 
-/// A `define=`, `include=` or `include-map=` item: what prepares the shader.
+/// A `define=`, `include=`, `include-map=` or `hlsl-front-end=` item: what prepares the shader.
 fn is_shader_option(item: &str) -> bool {
-    item.split_once('=').is_some_and(|(k, _)| [DEFINE, INCLUDE, INCLUDE_MAP].contains(&k.trim()))
+    item.split_once('=').is_some_and(|(k, _)| [DEFINE, INCLUDE, INCLUDE_MAP, HLSL_FRONT_END].contains(&k.trim()))
+}
+
+/// The HLSL front end `hlsl-front-end=` items choose over `old`: one choice given twice is one, two different
+/// ones are refused, naming both.
+fn front_end_option(path: &str, old: HlslFrontEnd, items: &[String]) -> Result<HlslFrontEnd> {
+    let mut chosen: Option<(HlslFrontEnd, &String)> = None;
+    for item in items {
+        let value = item.split_once('=').map_or("", |(_, v)| v.trim());
+        let front = HlslFrontEnd::parse(value)
+            .ok_or_else(|| anyhow!("{path}: `{item}`: expected {HLSL_FRONT_END}={}", HlslFrontEnd::NAMES.join("|")))?;
+        if let Some((first, first_item)) = chosen
+            && first != front
+        {
+            bail!("{path}: `{first_item}` and `{item}` choose two HLSL front ends; give one");
+        }
+        chosen = Some((front, item));
+    }
+    Ok(chosen.map_or(old, |(f, _)| f))
 }
 
 /// `include=DIR` and `include-map=VIRTUAL=DIR` items over `old`: a directory given again is not repeated, a
@@ -356,15 +378,21 @@ fn merge_includes(path: &str, old: &Includes, items: &[String]) -> Result<Includ
     Ok(out)
 }
 
-/// The file's shader options under `items` (`define=`, `include=`, `include-map=`) over `file`'s own.
+/// The file's shader options under `items` (`define=`, `include=`, `include-map=`, `hlsl-front-end=`) over the
+/// file's own.
 fn shader_options(
     path: &str,
-    defines: &[(String, String)],
-    includes: &Includes,
+    (defines, includes, front): (&[(String, String)], &Includes, HlslFrontEnd),
     items: &[String],
-) -> Result<(Vec<(String, String)>, Includes)> {
-    let (defs, incs): (Vec<String>, Vec<String>) = items.iter().cloned().partition(|i| is_define(i));
-    Ok((merge_defines(path, defines, &defs)?, merge_includes(path, includes, &incs)?))
+) -> Result<(Vec<(String, String)>, Includes, HlslFrontEnd)> {
+    let is_front = |i: &String| i.split_once('=').is_some_and(|(k, _)| k.trim() == HLSL_FRONT_END);
+    let (fronts, items): (Vec<String>, Vec<String>) = items.iter().cloned().partition(is_front);
+    let (defs, incs): (Vec<String>, Vec<String>) = items.into_iter().partition(|i| is_define(i));
+    Ok((
+        merge_defines(path, defines, &defs)?,
+        merge_includes(path, includes, &incs)?,
+        front_end_option(path, front, &fronts)?,
+    ))
 }
 
 /// `defines` (`define=NAME[=VALUE]` items) over `old`: a name given again replaces its value; a name given
@@ -427,8 +455,9 @@ impl FileModel {
         })?;
         let items = split_params(&fields)?;
         let (options, params): (Vec<String>, Vec<String>) = items.into_iter().partition(|i| is_shader_option(i));
-        let (defines, includes) = shader_options(path, &[], &Includes::default(), &options)?;
-        let file = brdf_file::load_shader(Path::new(path), &defines, &includes)?;
+        let (defines, includes, front) =
+            shader_options(path, (&[], &Includes::default(), HlslFrontEnd::Auto), &options)?;
+        let file = brdf_file::load_shader(Path::new(path), &defines, &includes, front)?;
         crate::model::front::record(path, file.language, file.front_end.as_deref());
         if file.has_is_func {
             crate::messages::input_note(format!(
@@ -497,8 +526,9 @@ impl FileModel {
         let (options, params): (Vec<&String>, Vec<&String>) = params.iter().partition(|i| is_shader_option(i));
         if !options.is_empty() {
             let options: Vec<String> = options.into_iter().cloned().collect();
-            let (defines, includes) = shader_options(&self.path, &self.file.defines, &self.file.includes, &options)?;
-            m.file = self.file.with_options(&defines, &includes)?;
+            let old = (self.file.defines.as_slice(), &self.file.includes, self.file.hlsl_front_end);
+            let (defines, includes, front) = shader_options(&self.path, old, &options)?;
+            m.file = self.file.with_options(&defines, &includes, front)?;
             m.warn_new(Some(self));
         }
         let mut given: Vec<&str> = Vec::new();

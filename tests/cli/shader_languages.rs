@@ -1215,3 +1215,55 @@ fn dxc_era_hlsl_goes_through_slang_where_glslang_refuses_or_crashes() {
         assert!(stderr.contains(needle) && stderr.contains("run `make setup`"), "{stderr}");
     }
 }
+
+/// `--hlsl-front-end` / `hlsl-front-end=` chooses one HLSL front end alone: Slang's slangc for a shader glslang
+/// takes gives the same values and is named in the report; glslang alone reports its own refusal of DXC-era
+/// HLSL without trying Slang; two different choices, an unknown one, and slangc chosen but not installed are
+/// refused (exit 2), naming the spec item or `make setup`.
+#[test]
+fn the_hlsl_front_end_can_be_chosen() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write_rows(&d.join("in.csv"), 200);
+    write(
+        d,
+        &[(
+            "plain.hlsl",
+            "static const float PI = 3.14159265;\nfloat3 BRDF(float3 L, float3 V, float3 N, float3 X, float3 Y) {\n    float3 H = normalize(L + V);\n    float NoH = saturate(dot(N, H));\n    return (pow(NoH, 32.0) * 34.0 / (8.0 * PI)).xxx;\n}\n",
+        )],
+    );
+    let eval = |args: &[&str], out: &str| {
+        let mut all = vec!["eval", "--input", "in.csv", "--output", out];
+        all.extend(args);
+        run_in(d, &all)
+    };
+    eval(&["--model", "plain.hlsl"], "g.csv").ok();
+    eval(&["--model", "plain.hlsl", "--hlsl-front-end", "slang"], "s.csv").ok();
+    let (g, s) = (common::csv_values(&d.join("g.csv")), common::csv_values(&d.join("s.csv")));
+    assert!(g.iter().filter(|v| v[0] > 0.0).count() > 20, "lit rows");
+    for (x, y) in s.iter().zip(&g) {
+        assert!(common::rel_err(x[0], y[0]) <= 1e-6, "slangc's {x:?} against glslang's {y:?}");
+    }
+    let inspect = ["inspect", "--no-callgrind", "--device", "nvidia:sm_89", "--json", "i.json", "--markdown", "i.md"];
+    run_in(d, &[&inspect[..], &["--model", "plain.hlsl,hlsl-front-end=slang"]].concat()).ok();
+    let md = std::fs::read_to_string(d.join("i.md")).unwrap();
+    assert!(md.contains("HLSL: Slang's slangc") && md.contains("chosen: hlsl-front-end=slang"), "{md}");
+    let dxc = root().join("tests/fixtures/hlsl/slang/dxc-era.hlsl").display().to_string();
+    let refused =
+        eval(&["--model", &format!("{dxc},hlsl-front-end=glslang")], "x.csv").fails(2, "'member type' : Expected");
+    assert!(!refused.stderr.contains("Slang"), "glslang alone: {}", refused.stderr);
+    eval(&["--model", "plain.hlsl,hlsl-front-end=glslang", "--hlsl-front-end", "slang"], "x.csv")
+        .fails(2, "`hlsl-front-end=glslang` and `hlsl-front-end=slang` choose two HLSL front ends");
+    eval(&["--model", "plain.hlsl,hlsl-front-end=dxc"], "x.csv").fails(2, "expected hlsl-front-end=auto|glslang|slang");
+    let empty = d.join("no-slang");
+    std::fs::create_dir(&empty).unwrap();
+    let out = common::brdfprof()
+        .args(["eval", "--model", "plain.hlsl", "--hlsl-front-end", "slang", "--input", "in.csv", "--output", "x.csv"])
+        .current_dir(d)
+        .env("BRDFPROF_SLANG_DIR", &empty)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("hlsl-front-end=slang: Slang's slangc is not installed: run `make setup`"), "{stderr}");
+}

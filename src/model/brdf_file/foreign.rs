@@ -273,24 +273,48 @@ fn hlsl_spirv(file: &mut BrdfFile) -> Result<(Vec<u32>, Source, Option<String>)>
         file.shader_begin,
         format!("the shader's `BRDF` as brdfprof calls it, `{}`", globals::HLSL_SIGNATURE.text),
     );
-    let (spirv, front_end) = match hlsl::compile(&x, &file.defines, &file.path)? {
-        Ok(words) => (words, None),
-        Err(refused) => slang_spirv(file, &x, &calls, &refused)?,
+    let (spirv, front_end) = match file.hlsl_front_end {
+        HlslFrontEnd::Slang => slang_spirv(file, &x, &calls, None)?,
+        HlslFrontEnd::Glslang => (hlsl::compile(&x, &file.defines, &file.path)?.map_err(|m| anyhow!("{m}"))?, None),
+        HlslFrontEnd::Auto => match hlsl::compile(&x, &file.defines, &file.path)? {
+            Ok(words) => (words, None),
+            Err(refused) => slang_spirv(file, &x, &calls, Some(&refused))?,
+        },
     };
     let source = x.lines.iter().zip(&x.origins).map(|(l, &(f, n))| (x.files[f].clone(), n, l.clone())).collect();
     Ok((spirv, source, front_end))
 }
 
-/// The shader glslang refused (`refused`: its messages) compiled by Slang's slangc, with the front end's
-/// description; an error with both front ends' messages where slangc refuses it too, or naming `make setup`
-/// where slangc is not installed.
-fn slang_spirv(file: &BrdfFile, x: &Expanded, calls: &[String], refused: &str) -> Result<(Vec<u32>, Option<String>)> {
+/// The shader compiled by Slang's slangc, chosen (`refused` None: `hlsl-front-end=slang`) or after glslang
+/// refused it (`refused`: glslang's messages), with the front end's description; an error with both front ends'
+/// messages where slangc refuses it too, or naming `make setup` where slangc is not installed.
+fn slang_spirv(
+    file: &BrdfFile,
+    x: &Expanded,
+    calls: &[String],
+    refused: Option<&str>,
+) -> Result<(Vec<u32>, Option<String>)> {
     let mut s = x.clone();
     if let Some(stub) = s.lines.last_mut() {
         *stub = front::slang::stub(calls);
     }
+    let compiled = front::slang::compile(&s, &file.defines, &file.path)?;
+    let Some(refused) = refused else {
+        let chosen = format!("{}=slang", crate::model::file_model::HLSL_FRONT_END);
+        return match compiled {
+            Some(Ok(words)) => Ok((
+                words,
+                Some(format!("HLSL: {} (chosen: {chosen}); {}", front::slang::describe(), cross::describe())),
+            )),
+            Some(Err(slang)) => bail!("{slang}\n(Slang's slangc, chosen by {chosen}, refused the shader)"),
+            None => bail!(
+                "{}: {chosen}: Slang's slangc is not installed: run `make setup` (or leave the choice to brdfprof: glslang, then slangc where it is installed)",
+                file.path.display()
+            ),
+        };
+    };
     let first = refused.lines().next().unwrap_or_default();
-    match front::slang::compile(&s, &file.defines, &file.path)? {
+    match compiled {
         Some(Ok(words)) => {
             crate::messages::note_once(format!(
                 "{}: glslang's HLSL front end refused the shader ({first}); Slang's slangc compiled it",

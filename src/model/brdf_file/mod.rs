@@ -62,7 +62,7 @@ pub use format::is_identifier;
 pub use inits::Initialiser;
 pub use loops::LAVAPIPE_LOOP_LIMIT;
 
-pub use crate::model::front::{Includes, Language};
+pub use crate::model::front::{HlslFrontEnd, Includes, Language};
 
 use anyhow::{Result, anyhow, bail};
 use sha2::{Digest, Sha256};
@@ -87,6 +87,8 @@ pub struct BrdfFile {
     pub language: Language,
     /// Where an HLSL shader's `#include` and a WGSL shader's `#import` look (`include=`, `include-map=`).
     pub includes: Includes,
+    /// Which front end compiles an HLSL shader (`hlsl-front-end=`).
+    pub hlsl_front_end: HlslFrontEnd,
     /// What translated an HLSL or WGSL shader into the GLSL the kernels compose (`front::describe`).
     pub front_end: Option<String>,
     /// `source` after glslang's preprocessor (`preprocess`), line for line: what every later step reads. The
@@ -225,12 +227,18 @@ pub fn load(path: &Path) -> Result<BrdfFile> {
 /// Reads and parses `path`, its shader preprocessed under `defines` (as `BrdfFile::with_defines`), in one pass:
 /// a file whose own defaults do not preprocess (an `#error` unless a macro is given) is read with its macros.
 pub fn load_with(path: &Path, defines: &[(String, String)]) -> Result<BrdfFile> {
-    load_shader(path, defines, &Includes::default())
+    load_shader(path, defines, &Includes::default(), HlslFrontEnd::Auto)
 }
 
 /// Reads and parses `path`: a `.brdf` file, or a plain HLSL or WGSL shader file (`.hlsl`, `.hlsli`, `.ush`,
 /// `.usf`, `.wgsl`: a shader section without parameters), its includes or imports found through `includes`.
-pub fn load_shader(path: &Path, defines: &[(String, String)], includes: &Includes) -> Result<BrdfFile> {
+/// `front` chooses the front end of an HLSL shader.
+pub fn load_shader(
+    path: &Path,
+    defines: &[(String, String)],
+    includes: &Includes,
+    front: HlslFrontEnd,
+) -> Result<BrdfFile> {
     let bytes = crate::io::read_input(path)?;
     let plain = path.extension().and_then(|e| Language::of_extension(&e.to_string_lossy()));
     let mut file = match plain {
@@ -242,6 +250,7 @@ pub fn load_shader(path: &Path, defines: &[(String, String)], includes: &Include
         file.shader_begin = 1;
     }
     file.includes = includes.clone();
+    file.hlsl_front_end = front;
     file.set_defines(defines)?;
     file.prepare_shader()?;
     Ok(file)
@@ -283,6 +292,7 @@ fn empty(path: &Path, bytes: &[u8], language: Language) -> BrdfFile {
         defines: Vec::new(),
         language,
         includes: Includes::default(),
+        hlsl_front_end: HlslFrontEnd::Auto,
         front_end: None,
         shader: Vec::new(),
         front_end_origins: Vec::new(),
@@ -338,13 +348,19 @@ impl BrdfFile {
     /// The same file with its shader preprocessed under `defines` (`NAME`, `VALUE`; an empty value defines
     /// NAME as glslang's `-DNAME` does).
     pub fn with_defines(&self, defines: &[(String, String)]) -> Result<BrdfFile> {
-        self.with_options(defines, &self.includes)
+        self.with_options(defines, &self.includes, self.hlsl_front_end)
     }
 
-    /// The same file with its shader prepared again under `defines` and `includes`.
-    pub fn with_options(&self, defines: &[(String, String)], includes: &Includes) -> Result<BrdfFile> {
+    /// The same file with its shader prepared again under `defines`, `includes` and HLSL front end `front`.
+    pub fn with_options(
+        &self,
+        defines: &[(String, String)],
+        includes: &Includes,
+        front: HlslFrontEnd,
+    ) -> Result<BrdfFile> {
         let mut file = self.clone();
         file.includes = includes.clone();
+        file.hlsl_front_end = front;
         file.set_defines(defines)?;
         file.prepare_shader()?;
         Ok(file)

@@ -57,6 +57,29 @@ impl Language {
     }
 }
 
+/// Which front end compiles an HLSL shader (`hlsl-front-end=` in a model spec, `--hlsl-front-end`): glslang,
+/// and Slang's slangc where glslang refuses or crashes (`Auto`, the default), or one of them alone.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum HlslFrontEnd {
+    #[default]
+    Auto,
+    Glslang,
+    Slang,
+}
+
+impl HlslFrontEnd {
+    pub const NAMES: [&str; 3] = ["auto", "glslang", "slang"];
+
+    pub fn parse(text: &str) -> Option<HlslFrontEnd> {
+        match text {
+            "auto" => Some(HlslFrontEnd::Auto),
+            "glslang" => Some(HlslFrontEnd::Glslang),
+            "slang" => Some(HlslFrontEnd::Slang),
+            _ => None,
+        }
+    }
+}
+
 /// The extensions a model text may name a shader file by: `.brdf`, then plain shader files.
 pub const FILE_EXTENSIONS: [&str; 6] = ["brdf", "hlsl", "hlsli", "ush", "usf", "wgsl"];
 
