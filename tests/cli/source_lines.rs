@@ -197,3 +197,66 @@ fn a_non_ascii_comment_keeps_the_lines() {
     let table = section.split("\n\n").nth(1).unwrap();
     assert!(!table.contains("glsl/shade.glsl") && section.contains("The harness's own lines"), "{section}");
 }
+
+/// Files with classic Mac line ends (a lone `\r`, as some editors still write) keep each line's number and its
+/// text, in GLSL, HLSL and WGSL alike: every line a compiler counts is one line of the report.
+#[test]
+fn lone_cr_line_ends_keep_each_lines_number_and_text() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let body = ["    float a = max(dot(N, L), 0.0);", "    float b = pow(a, 7.3);"];
+    let files = [
+        (
+            "cr-glsl.brdf",
+            format!(
+                "analytic\r::begin shader\rvec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) {{\r{}\r{}\r    return vec3(a * b);\r}}\r::end shader\r",
+                body[0], body[1]
+            ),
+            4,
+        ),
+        (
+            "cr-hlsl.hlsl",
+            format!(
+                "float3 BRDF(float3 L, float3 V, float3 N, float3 X, float3 Y) {{\r{}\r{}\r    return (a * b).xxx;\r}}\r",
+                body[0], body[1]
+            ),
+            2,
+        ),
+        (
+            "cr-wgsl.wgsl",
+            format!(
+                "fn BRDF(L: vec3<f32>, V: vec3<f32>, N: vec3<f32>, X: vec3<f32>, Y: vec3<f32>) -> vec3<f32> {{\r{}\r{}\r    return vec3<f32>(a * b);\r}}\r",
+                body[0].replace("float", "let"),
+                body[1].replace("float", "let")
+            ),
+            2,
+        ),
+    ];
+    let mut args = vec!["--lines".to_string()];
+    for (name, text, _) in &files {
+        std::fs::write(d.join(name), text).unwrap();
+        args.extend(["--model".to_string(), d.join(name).display().to_string()]);
+    }
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let all = inspect_json(d, "cr", &["nvidia:sm_89"], &args, "Cost per source line");
+    for (name, text, first) in &files {
+        let lines: Vec<&str> = text.split('\r').collect();
+        let k = all["lines"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|k| k["model"] == name.split('.').next().unwrap())
+            .unwrap_or_else(|| panic!("{name}: no lines"));
+        let named: Vec<(u64, String)> = k["lines"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|l| l["file"].as_str().unwrap().ends_with(name))
+            .map(|l| (l["line"].as_u64().unwrap(), l["text"].as_str().unwrap_or("").to_string()))
+            .collect();
+        for n in [*first, first + 1] {
+            let want = lines[n as usize - 1].trim();
+            assert!(named.iter().any(|(m, t)| *m == n && t == want), "{name}: line {n} `{want}` in {named:?}");
+        }
+    }
+}

@@ -19,11 +19,12 @@ const SPAN_SHIFT: u32 = 21;
 pub type Origin = (String, usize, String);
 
 /// One module of the composition: the file as messages name it, its text as naga parsed it (the preprocessor
-/// keeps every line in place), its own text, and the lines of it that brdfprof wrote (no user line).
+/// keeps every line in place), its own lines (ended as naga_oil ends them, a lone `\r` included), and the lines
+/// of it that brdfprof wrote (no user line).
 struct Module {
     file: String,
     parsed: String,
-    text: String,
+    lines: Vec<String>,
     generated: Vec<usize>,
     /// The byte offset of each line's start in `parsed`.
     starts: Vec<usize>,
@@ -32,7 +33,7 @@ struct Module {
 impl Module {
     fn new(file: String, parsed: String, text: String, generated: Vec<usize>) -> Module {
         let starts = std::iter::once(0).chain(parsed.match_indices('\n').map(|(k, _)| k + 1)).collect();
-        Module { file, parsed, text, generated, starts }
+        Module { file, parsed, lines: super::includes::split_lines(&text), generated, starts }
     }
 
     /// The 1-based line of byte `at` of `parsed`.
@@ -159,7 +160,7 @@ impl Ids {
             return 0;
         }
         *self.by_place.entry((index, line)).or_insert_with(|| {
-            let text = m.text.lines().nth(line - 1).unwrap_or("").trim().to_string();
+            let text = m.lines.get(line - 1).map_or("", |l| l.trim()).to_string();
             self.table.push(Some((m.file.clone(), line, text)));
             self.table.len() - 1
         })

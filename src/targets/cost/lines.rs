@@ -100,7 +100,8 @@ pub fn per_line(model: &str, instructions: &[Attributed], binding_pipe: &str) ->
     }
 }
 
-/// Line `line` of `file` trimmed, or empty where it cannot be read.
+/// Line `line` of `file` trimmed (lines ended as a compiler counts them, a lone `\r` included), or empty where
+/// it cannot be read.
 fn source_text(file: &str, line: u32) -> String {
     let path = std::path::Path::new(file);
     let embedded =
@@ -109,7 +110,12 @@ fn source_text(file: &str, line: u32) -> String {
         .ok()
         .map(|b| String::from_utf8_lossy(&b).into_owned())
         .or_else(embedded);
-    text.and_then(|t| t.lines().nth(line.saturating_sub(1) as usize).map(|l| l.trim().to_string())).unwrap_or_default()
+    let nth = |t: String| {
+        crate::model::front::includes::split_lines(&t)
+            .get(line.saturating_sub(1) as usize)
+            .map(|l| l.trim().to_string())
+    };
+    text.and_then(nth).unwrap_or_default()
 }
 /// A file name as reports give it: glsl/'s (compiled from a temporary copy) by their name in the tree, a user's
 /// file relative to the working directory where it lies below it.
