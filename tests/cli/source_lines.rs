@@ -126,6 +126,14 @@ fn a_wgsl_models_lines_are_its_modules_lines_with_their_text() {
     lines_land_on_the_users_files("bevy-ggx", &args, &files, "(its WGSL as GLSL)");
 }
 
+/// DXC-era HLSL that Slang's slangc compiles (glslang refuses it): its lines too are the file's own, through
+/// slangc's line tables (`-g1`).
+#[test]
+fn a_slang_compiled_models_lines_are_its_own_files_lines() {
+    let file = common::repo_root().join("tests/fixtures/hlsl/slang/dxc-era.hlsl").display().to_string();
+    lines_land_on_the_users_files("dxc-era", &["--model", &file], &[file.clone()], "(its HLSL as GLSL)");
+}
+
 /// `inspect --lines` on NVIDIA of model `name` (`args`): its costliest line is one of `files`', each of those files' lines is shown with its own text, every file has lines, at most a fifth of
 /// the lines are left on the front end's GLSL (named with `glsl_suffix`), and every instruction counts once.
 fn lines_land_on_the_users_files(name: &str, args: &[&str], files: &[String], glsl_suffix: &str) {

@@ -18,9 +18,11 @@ pub const DIR_VAR: &str = "BRDFPROF_SLANG_DIR";
 pub const OUT_BUFFER: &str = "brdfprof_out";
 
 /// slangc's flags: SPIR-V emitted directly (no GLSL on the way), no optimisation (spirv-cross and the kernels'
-/// compilers see the shader as written), the stub as the compute entry.
-pub const FLAGS: [&str; 8] =
-    ["-target", "spirv", "-emit-spirv-directly", "-O0", "-entry", super::STUB, "-stage", "compute"];
+/// compilers see the shader as written), line tables (`-g1`: an `OpLine` per statement, which per-line cost
+/// reads as it reads glslang's `-g`; the same code as without, where `-g` adds a copy of every variable), the
+/// stub as the compute entry.
+pub const FLAGS: [&str; 9] =
+    ["-target", "spirv", "-emit-spirv-directly", "-O0", "-g1", "-entry", super::STUB, "-stage", "compute"];
 
 /// `half` and the minimum-precision types as 32-bit floats (`-Dhalf=float`, ...): DXC's default without
 /// `-enable-16bit-types`, as glslang's HLSL front end reads them; Slang's own `half` is always fp16.
