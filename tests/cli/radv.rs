@@ -327,3 +327,28 @@ fn a_family_without_fp16_leaves_out_the_fp16_models_and_says_why() {
         "{note}"
     );
 }
+
+/// A driver that crashes on one model's kernel stops only that model: the child is run again per model, the
+/// others are costed on the target, the crashed one is named with its signal under the table, and inspect exits
+/// 1 with every output written.
+#[test]
+fn a_child_crashing_on_one_model_leaves_the_others_costed() {
+    let dir = tempfile::tempdir().unwrap();
+    let json = dir.path().join("r.json");
+    let out = common::brdfprof()
+        .args(["inspect", "--no-callgrind", "--model", "ggx", "--model", "blinn", "--device", "radv:navi21"])
+        .args(["--json", json.to_str().unwrap(), "--markdown", dir.path().join("r.md").to_str().unwrap()])
+        .env(brdfprof::targets::mesa_noop::CRASH_ON_MODEL, "blinn")
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(json).unwrap()).unwrap();
+    let cost = &report["cost"];
+    let rows: Vec<&str> = cost["rows"].as_array().unwrap().iter().map(|r| r["model"].as_str().unwrap()).collect();
+    assert!(rows.contains(&"ggx") && !rows.contains(&"blinn"), "{rows:?}");
+    assert_eq!(cost["failed"][0][0], "blinn", "{cost}");
+    assert!(cost["failed"][0][1].as_str().unwrap().contains("SIGSEGV"), "{cost}");
+    let md = std::fs::read_to_string(dir.path().join("r.md")).unwrap();
+    assert!(md.contains("**blinn: failed, so no figure**"), "{md}");
+}

@@ -145,6 +145,11 @@ pub fn child_main(request_json: &str) -> Result<()> {
     crate::gpu::mark_compile_only_process();
     let models =
         req.models.iter().map(|s| Model::parse(s).map_err(|e| anyhow!("{s}: {e:#}"))).collect::<Result<Vec<_>>>()?;
+    if let Some(label) = std::env::var_os(CRASH_ON_MODEL)
+        && models.iter().any(|m| std::ffi::OsStr::new(&m.label()) == label)
+    {
+        crash();
+    }
     let shaders = match &req.glsl {
         Some(dir) => Shaders::from_glsl(dir)?,
         None => Shaders::embedded(),
@@ -247,14 +252,19 @@ fn reply(reply: NoopReply) -> Result<()> {
     if std::env::var_os(CRASH_AFTER_REPLY).is_some() {
         use std::io::Write;
         std::io::stdout().flush()?;
-        // SAFETY: raising a signal on this process; the test of crash containment asks for it.
-        // The default action (Rust's own SIGSEGV handler is for stack overflows and would return).
-        unsafe {
-            libc::signal(libc::SIGSEGV, libc::SIG_DFL);
-            libc::raise(libc::SIGSEGV);
-        }
+        crash();
     }
     Ok(())
+}
+
+/// Dies of SIGSEGV, as a driver that crashes does: for the tests of crash containment.
+fn crash() {
+    // SAFETY: raising a signal on this process; the test of crash containment asks for it.
+    // The default action (Rust's own SIGSEGV handler is for stack overflows and would return).
+    unsafe {
+        libc::signal(libc::SIGSEGV, libc::SIG_DFL);
+        libc::raise(libc::SIGSEGV);
+    }
 }
 
 /// The request's raw kernels compiled on the compile-only device, one row each with the compiler's statistics, as one report
@@ -317,6 +327,11 @@ fn raw_report(
 /// Set in a child's environment, it dies of SIGSEGV after printing its report, as Mesa 22.3's teardown of
 /// RADV's null device did (vkDeviceWaitIdle through a null pointer): the test that the parent contains such a crash.
 pub const CRASH_AFTER_REPLY: &str = "BRDFPROF_TEST_NOOP_CHILD_CRASH";
+
+/// Set in a child's environment to a model's label, a child whose request holds that model dies of SIGSEGV
+/// before it compiles anything, as a driver that crashes on one model's kernel would: the test that the other
+/// models are still costed.
+pub const CRASH_ON_MODEL: &str = "BRDFPROF_TEST_NOOP_CHILD_CRASH_ON";
 
 /// Compiles one kernel with CAPTURE_INTERNAL_REPRESENTATIONS and writes each text representation
 /// (RADV: NIR, ACO IR, disassembly; Turnip: NIR, IR3 assembly; ANV: NIR, GEN assembly) to
@@ -414,7 +429,7 @@ fn run(
     let environment = driver.environment(family)?;
     let key = request.cache_digest.as_deref().map(|digest| cache::key(digest, &name, &environment, request.validate));
     let Some(key) = key else {
-        let (run, messages) = spawn(driver, family, models, raw, request, environment)?;
+        let (run, messages) = spawn_isolating(driver, family, models, raw, request, environment)?;
         messages.iter().for_each(|m| crate::messages::line(m));
         return Ok(run);
     };
@@ -430,7 +445,7 @@ fn run(
     let mut teardown_note = None;
     let mut built = false;
     let bytes = crate::cache::get_or_build(store.as_ref(), cache::KIND, &key, &what, valid, || {
-        let (run, messages) = spawn(driver, family, models, raw, request, environment)?;
+        let (run, messages) = spawn_isolating(driver, family, models, raw, request, environment)?;
         teardown_note = run.teardown_note;
         built = true;
         Ok(serde_json::to_vec(&CachedChild { target: name.clone(), report: run.report, messages })?)
@@ -487,6 +502,48 @@ fn teardown_note(
             );
         }
     })
+}
+
+/// `spawn`, and where the child fails with several models: one child per model finds those the driver fails
+/// on (a crash, a compile past the limit, a validation message), the others are compiled together again, and the
+/// failed ones are named in the report's cost (`failed`) with the child's error, so one model never stops the
+/// others. The first error where every model alone succeeds (the failure is not one model's) or none does.
+fn spawn_isolating(
+    driver: &'static dyn NoopDriver,
+    family: usize,
+    models: &[Model],
+    raw: &[super::RawKernel],
+    request: &Job,
+    environment: Vec<(String, String)>,
+) -> Result<(ChildRun, Vec<String>)> {
+    let first = match spawn(driver, family, models, raw, request, environment.clone()) {
+        Ok(done) => return Ok(done),
+        Err(e) if models.len() < 2 || !raw.is_empty() => return Err(e),
+        Err(e) => e,
+    };
+    let name = Target { vendor: driver, family }.name();
+    crate::messages::progress(format!("{name}: the child failed; compiling each model in a child of its own"));
+    let mut good = Vec::new();
+    let mut failed = Vec::new();
+    for m in models {
+        match spawn(driver, family, std::slice::from_ref(m), raw, request, environment.clone()) {
+            Ok(_) => good.push(m.clone()),
+            // The driver is installed (the others compiled): its installation hint would mislead.
+            Err(e) => failed.push((
+                m.label(),
+                format!("{e:#}").replace(&driver.install_hint(), "").trim().trim_end_matches(':').to_string(),
+            )),
+        }
+    }
+    if failed.is_empty() || good.is_empty() {
+        return Err(first);
+    }
+    let (mut run, messages) = spawn(driver, family, &good, raw, request, environment)?;
+    match &mut run.report.cost {
+        Some(cost) => cost.failed.extend(failed),
+        None => return Err(first),
+    }
+    Ok((run, messages))
 }
 
 /// Runs the child for one target: its report, and the lines of its stderr meant for the user.
@@ -616,7 +673,10 @@ pub fn compile(prefix: &str, families: &[usize], raw: &[super::RawKernel], reque
     let models: &[Model] = if raw.is_empty() { request.models } else { &[] };
     // A child that writes files (--isa) or is asked to crash (the containment test) always runs; any other
     // report is cached under a key whose kernels' part is computed once here, for every family.
-    let cache_digest = match request.isa_dir.is_some() || std::env::var_os(CRASH_AFTER_REPLY).is_some() {
+    let cache_digest = match request.isa_dir.is_some()
+        || std::env::var_os(CRASH_AFTER_REPLY).is_some()
+        || std::env::var_os(CRASH_ON_MODEL).is_some()
+    {
         true => None,
         false => Some(cache::request_digest(models, raw, request.lights, request.validate, request.shaders)?),
     };
@@ -661,11 +721,13 @@ pub fn compile(prefix: &str, families: &[usize], raw: &[super::RawKernel], reque
             if let Some(note) = &run.teardown_note {
                 add_driver_note(&mut report, note.clone());
             }
-            // The cost is the parent's rule; the models the child could not compile stay named under it.
-            let absent = report.cost.take().map(|c| c.absent).unwrap_or_default();
+            // The cost is the parent's rule; the models the child could not compile, and those it failed on,
+            // stay named under it.
+            let (absent, failed) = report.cost.take().map(|c| (c.absent, c.failed)).unwrap_or_default();
             report.cost = driver.cost(&report);
             if let Some(cost) = &mut report.cost {
                 cost.absent = absent;
+                cost.failed = failed;
             }
             Ok(Run {
                 target: Target { vendor: driver, family },
