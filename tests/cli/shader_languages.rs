@@ -1121,17 +1121,8 @@ fn front_end_errors_without_a_location_are_named_at_the_users_line() {
         ),
     ];
     // glslang's own messages: without Slang's slangc, which takes a non-ASCII HLSL identifier (below).
-    let no_slang = d.join("no-slang");
-    std::fs::create_dir(&no_slang).unwrap();
     for (model, needle) in cases {
-        let out = common::brdfprof()
-            .args(["eval", "--model", model, "--input", "in.csv", "--output", "x.csv"])
-            .current_dir(d)
-            .env("BRDFPROF_SLANG_DIR", &no_slang)
-            .output()
-            .unwrap();
-        let stderr = String::from_utf8_lossy(&out.stderr);
-        assert_eq!(out.status.code(), Some(2), "{model}: {stderr}");
+        let stderr = eval_without_slang(d, &["--model", model]);
         assert!(stderr.contains(needle), "{model}: expected `{needle}` in {stderr}");
         for internal in ["/tmp/", "brdfprof_stub", "glsl/generated", "\u{fffd}"] {
             assert!(!stderr.contains(internal), "{model}: names `{internal}`: {stderr}");
@@ -1199,19 +1190,10 @@ fn dxc_era_hlsl_goes_through_slang_where_glslang_refuses_or_crashes() {
         )],
     );
     run_in(d, &["eval", "--model", "crash.hlsl", "--input", "in.csv", "--output", "c.csv"]).ok();
-    let empty = d.join("no-slang");
-    std::fs::create_dir(&empty).unwrap();
     for (model, needle) in
         [("crash.hlsl", "crashed (signal 11 SIGSEGV)"), (&slang("dxc-era.hlsl"), "'member type' : Expected")]
     {
-        let out = common::brdfprof()
-            .args(["eval", "--model", model, "--input", "in.csv", "--output", "x.csv"])
-            .current_dir(d)
-            .env("BRDFPROF_SLANG_DIR", &empty)
-            .output()
-            .unwrap();
-        let stderr = String::from_utf8_lossy(&out.stderr);
-        assert_eq!(out.status.code(), Some(2), "{stderr}");
+        let stderr = eval_without_slang(d, &["--model", model]);
         assert!(stderr.contains(needle) && stderr.contains("run `make setup`"), "{stderr}");
     }
 }
@@ -1255,15 +1237,24 @@ fn the_hlsl_front_end_can_be_chosen() {
     eval(&["--model", "plain.hlsl,hlsl-front-end=glslang", "--hlsl-front-end", "slang"], "x.csv")
         .fails(2, "`hlsl-front-end=glslang` and `hlsl-front-end=slang` choose two HLSL front ends");
     eval(&["--model", "plain.hlsl,hlsl-front-end=dxc"], "x.csv").fails(2, "expected hlsl-front-end=auto|glslang|slang");
-    let empty = d.join("no-slang");
-    std::fs::create_dir(&empty).unwrap();
+    let stderr = eval_without_slang(d, &["--model", "plain.hlsl", "--hlsl-front-end", "slang"]);
+    assert!(stderr.contains("hlsl-front-end=slang: Slang's slangc is not installed: run `make setup`"), "{stderr}");
+}
+
+/// `brdfprof eval ARGS --input in.csv --output x.csv` in `d` without Slang's slangc (an empty
+/// `BRDFPROF_SLANG_DIR`): its exit status, which must be 2, and its stderr.
+fn eval_without_slang(d: &Path, args: &[&str]) -> String {
+    let none = d.join("no-slang");
+    std::fs::create_dir_all(&none).unwrap();
     let out = common::brdfprof()
-        .args(["eval", "--model", "plain.hlsl", "--hlsl-front-end", "slang", "--input", "in.csv", "--output", "x.csv"])
+        .arg("eval")
+        .args(args)
+        .args(["--input", "in.csv", "--output", "x.csv"])
         .current_dir(d)
-        .env("BRDFPROF_SLANG_DIR", &empty)
+        .env("BRDFPROF_SLANG_DIR", &none)
         .output()
         .unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(2), "{stderr}");
-    assert!(stderr.contains("hlsl-front-end=slang: Slang's slangc is not installed: run `make setup`"), "{stderr}");
+    let stderr = String::from_utf8_lossy(&out.stderr).to_string();
+    assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
+    stderr
 }

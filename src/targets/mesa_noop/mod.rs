@@ -518,7 +518,7 @@ fn spawn_isolating(
 ) -> Result<(ChildRun, Vec<String>)> {
     let first = match spawn(driver, family, models, raw, request, environment.clone()) {
         Ok(done) => return Ok(done),
-        Err(e) if models.len() < 2 || !raw.is_empty() => return Err(e),
+        Err(e) if models.len() < 2 || !raw.is_empty() || e.downcast_ref::<ChildFailed>().is_none() => return Err(e),
         Err(e) => e,
     };
     let name = Target { vendor: driver, family }.name();
@@ -544,6 +544,23 @@ fn spawn_isolating(
         None => return Err(first),
     }
     Ok((run, messages))
+}
+
+/// A child that ended without its report (a crash, an error, the limit): what a model of its request may have
+/// caused, unlike a report the parent refuses (another kernel than it composed), which no model alone explains.
+#[derive(Debug)]
+struct ChildFailed(String);
+
+impl std::fmt::Display for ChildFailed {
+    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for ChildFailed {}
+
+fn child_failed(e: anyhow::Error) -> anyhow::Error {
+    anyhow::Error::new(ChildFailed(format!("{e:#}")))
 }
 
 /// Runs the child for one target: its report, and the lines of its stderr meant for the user.
@@ -587,7 +604,8 @@ fn spawn(
     let limit = crate::launch::limit() * kernels + std::time::Duration::from_secs(10);
     let what = format!("the kernels for {name} ({}, in a child process)", driver.compiler());
     let output = crate::launch::output_within(&mut cmd, &what, limit)
-        .with_context(|| format!("cannot run brdfprof's {name} child"))?;
+        .with_context(|| format!("cannot run brdfprof's {name} child"))
+        .map_err(child_failed)?;
     let stdout = String::from_utf8_lossy(&output.stdout);
     let stderr = String::from_utf8_lossy(&output.stderr);
     let reply: Option<NoopReply> = stdout.lines().rev().find_map(|l| serde_json::from_str(l).ok());
@@ -599,7 +617,7 @@ fn spawn(
         .filter(|l| reply.is_some() && !is_banner(l) && !is_shim_notice(l) && !driver.is_noise(l))
         .map(str::to_string)
         .collect();
-    let teardown_note = teardown_note(driver, &name, reply.is_some(), output.status, &stderr)?;
+    let teardown_note = teardown_note(driver, &name, reply.is_some(), output.status, &stderr).map_err(child_failed)?;
     let reply = reply.expect("checked above");
     if reply.target != name {
         bail!("the compile-only child answered for {} instead of {name}", reply.target);
