@@ -111,6 +111,12 @@ pub struct Tally {
     pub bound_max: f64,
 }
 
+/// A value as a message shows it: as Rust writes it, in scientific form (9 significant digits, an f32's
+/// round trip) far from 1, where the decimal form of a subnormal runs to hundreds of digits.
+fn readable(v: f64) -> String {
+    if v != 0.0 && v.is_finite() && !(1e-4..1e9).contains(&v.abs()) { format!("{v:.8e}") } else { format!("{v}") }
+}
+
 /// Judges every `xs[i]` against `refs[i]` (`extra(i)`: the format's rounding there).
 pub fn tally(xs: &[f32], refs: &[Bounded], extra: impl Fn(usize) -> f64, per_item: usize) -> Tally {
     let mut t = Tally { values: xs.len(), ..Tally::default() };
@@ -124,10 +130,11 @@ pub fn tally(xs: &[f32], refs: &[Bounded], extra: impl Fn(usize) -> f64, per_ite
                 if m > t.worst || (m.is_nan() && !t.worst.is_nan()) {
                     t.worst = m;
                     t.worst_at = format!(
-                        "value {i} (item {}, channel {}): {x} against {} +- {:.2e}",
+                        "value {i} (item {}, channel {}): {} against {} +- {:.2e}",
                         i / per_item,
                         i % per_item,
-                        r.value,
+                        readable(f64::from(x)),
+                        readable(r.value),
                         r.bound + extra(i)
                     );
                 }
@@ -147,6 +154,15 @@ mod tests {
 
     fn b(value: f64, bound: f64) -> Bounded {
         Bounded { value, bound }
+    }
+
+    /// A subnormal reference (an uninitialised read's garbage) is named in a few characters, not hundreds.
+    #[test]
+    fn the_worst_value_is_named_readably() {
+        let t = tally(&[-1.3615041e13], &[b(6.916220881493e-310, 6.92e-310)], |_| 0.0, 3);
+        assert!(t.worst_at.contains("-1.36150411e13 against 6.91622088e-310 +- 6.92e-310"), "{}", t.worst_at);
+        let t = tally(&[0.25], &[b(0.5, 1e-7)], |_| 0.0, 3);
+        assert!(t.worst_at.contains("0.25 against 0.5"), "{}", t.worst_at);
     }
 
     #[test]

@@ -145,11 +145,7 @@ pub fn child_main(request_json: &str) -> Result<()> {
     crate::gpu::mark_compile_only_process();
     let models =
         req.models.iter().map(|s| Model::parse(s).map_err(|e| anyhow!("{s}: {e:#}"))).collect::<Result<Vec<_>>>()?;
-    if let Some(label) = std::env::var_os(CRASH_ON_MODEL)
-        && models.iter().any(|m| std::ffi::OsStr::new(&m.label()) == label)
-    {
-        crash();
-    }
+    crash_if_asked(&models);
     let shaders = match &req.glsl {
         Some(dir) => Shaders::from_glsl(dir)?,
         None => Shaders::embedded(),
@@ -255,6 +251,15 @@ fn reply(reply: NoopReply) -> Result<()> {
         crash();
     }
     Ok(())
+}
+
+/// Dies of SIGSEGV where `CRASH_ON_MODEL` names one of `models`.
+fn crash_if_asked(models: &[Model]) {
+    if let Some(label) = std::env::var_os(CRASH_ON_MODEL)
+        && models.iter().any(|m| std::ffi::OsStr::new(&m.label()) == label)
+    {
+        crash();
+    }
 }
 
 /// Dies of SIGSEGV, as a driver that crashes does: for the tests of crash containment.
