@@ -365,13 +365,13 @@ fn check_hlsl(file: &mut BrdfFile, x: &Expanded, pre: &str) -> Result<Vec<Glue>>
     Ok(glues)
 }
 
-/// The WGSL shader composed and compiled: the section, the parameters as private globals, each entry's glue
-/// and the stub, through naga_oil and naga (`front::wgsl`). The shader with its parameters alone is composed
-/// first: `BRDF`'s signature and the entries' parameter types are read from naga's module of it.
 /// The WGSL shader's SPIR-V, its lines (as messages locate a declaration) and the user's place of each SPIR-V
 /// line (`wgsl::emit_spirv`).
 type WgslSpirv = (Vec<u32>, Source, Vec<Option<(String, usize, String)>>);
 
+/// The WGSL shader composed and compiled: the section, the parameters as private globals, each entry's glue
+/// and the stub, through naga_oil and naga (`front::wgsl`). The shader with its parameters alone is composed
+/// first: `BRDF`'s signature and the entries' parameter types are read from naga's module of it.
 fn wgsl_spirv(file: &mut BrdfFile) -> Result<WgslSpirv> {
     check_statement_sizes(file)?;
     let mut top = wgsl::Top::new(&file.source);
@@ -389,7 +389,7 @@ fn wgsl_spirv(file: &mut BrdfFile) -> Result<WgslSpirv> {
         file.shader_begin,
         &format!("the shader's `BRDF` as brdfprof calls it, `{WGSL_BRDF}`"),
     );
-    let composed = wgsl::compose(&file.path, &top, &file.defines, &file.includes)?;
+    let composed = wgsl::compose_placed(&file.path, &top, &file.defines, &file.includes)?;
     file.loops = wgsl_loops_of(file, &top, &composed)?;
     let model = file.path.display().to_string();
     let (spirv, places) = wgsl::emit_spirv(&composed, &file.path)?;

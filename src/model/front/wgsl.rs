@@ -488,13 +488,28 @@ fn missing_defs_note(files: &[(String, String)], defs: &HashMap<String, ShaderDe
 pub struct Composed {
     pub module: naga::Module,
     pub files: Vec<(String, String)>,
-    /// Where its statements lie in the user's files.
+    /// Where its statements lie in the user's files (`compose_placed`; none from `compose`).
     pub places: super::wgsl_lines::Places,
 }
 
 /// naga_oil's composition of `top` (the model's section plus brdfprof's lines) under `defines`, its imports
 /// found through `includes` and the model's directory: the naga module, or Err(messages at FILE:LINE:COLUMN).
 pub fn compose(model: &Path, top: &Top, defines: &[(String, String)], includes: &Includes) -> Result<Composed> {
+    compose_with(model, top, (defines, includes), false)
+}
+
+/// `compose`, with the places of its statements in the user's files (`Composed::places`), which `emit_spirv`
+/// numbers for per-line cost.
+pub fn compose_placed(model: &Path, top: &Top, defines: &[(String, String)], includes: &Includes) -> Result<Composed> {
+    compose_with(model, top, (defines, includes), true)
+}
+
+fn compose_with(
+    model: &Path,
+    top: &Top,
+    (defines, includes): (&[(String, String)], &Includes),
+    placed: bool,
+) -> Result<Composed> {
     let model_dir = super::dir_of(model);
     let shader_defs = shader_defs(defines, model)?;
     let shown = model.display().to_string();
@@ -523,8 +538,13 @@ pub fn compose(model: &Path, top: &Top, defines: &[(String, String)], includes: 
         let graph: Vec<(String, String)> = std::iter::once((shown.clone(), top.text.clone())).chain(m.files.clone()).collect();
         anyhow!("{}{hint}{}", located(&e, &m.composer, Some((&shown, top)), &graph), missing_defs_note(&graph, &m.defs))
     })?;
-    let generated = top.generated.keys().copied().collect();
-    let places = super::wgsl_lines::Places::new(&m.composer, (&shown, &top.text, generated), &m.defs, &m.files);
+    let places = match placed {
+        true => {
+            let generated = top.generated.keys().copied().collect();
+            super::wgsl_lines::Places::new(&m.composer, (&shown, &top.text, generated), &m.defs, &m.files)
+        }
+        false => Default::default(),
+    };
     Ok(Composed { module, files: m.files, places })
 }
 
@@ -556,8 +576,8 @@ pub fn preprocessed(text: &str, defines: &[(String, String)], model: &Path) -> S
 /// carries an `OpLine` whose line is its index in the returned table of the user's places
 /// (`wgsl_lines::Places::relabel`).
 pub fn emit_spirv(composed: &Composed, model: &Path) -> Result<(Vec<u32>, Vec<Option<super::wgsl_lines::Origin>>)> {
-    let module = &composed.module;
     use naga::valid::{ValidationFlags, Validator};
+    let module = &composed.module;
     let what = model.display();
     let info = Validator::new(ValidationFlags::all(), SHADER_CAPABILITIES)
         .validate(module)

@@ -433,10 +433,24 @@ fn run(
     // The driver's environment first: a driver that is not built stops here, naming what to run.
     let environment = driver.environment(family)?;
     let key = request.cache_digest.as_deref().map(|digest| cache::key(digest, &name, &environment, request.validate));
-    let Some(key) = key else {
-        let (run, messages) = spawn_isolating(driver, family, models, raw, request, environment)?;
+    // A child that failed is not cached, nor is what isolating its models finds (a compile past the limit is
+    // no property of the kernels), so a later run tries them again.
+    let isolated = |first: anyhow::Error, environment| {
+        if !isolable(&first, models, raw) {
+            return Err(first);
+        }
+        let (run, messages) = isolate(driver, family, models, request, environment, first)?;
         messages.iter().for_each(|m| crate::messages::line(m));
-        return Ok(run);
+        Ok(run)
+    };
+    let Some(key) = key else {
+        return match spawn(driver, family, models, raw, request, environment.clone()) {
+            Ok((run, messages)) => {
+                messages.iter().for_each(|m| crate::messages::line(m));
+                Ok(run)
+            }
+            Err(first) => isolated(first, environment),
+        };
     };
     let store = crate::cache::Store::open_default();
     let what = format!("the report of the {name} child");
@@ -449,12 +463,16 @@ fn run(
     };
     let mut teardown_note = None;
     let mut built = false;
-    let bytes = crate::cache::get_or_build(store.as_ref(), cache::KIND, &key, &what, valid, || {
-        let (run, messages) = spawn_isolating(driver, family, models, raw, request, environment)?;
+    let built_run = crate::cache::get_or_build(store.as_ref(), cache::KIND, &key, &what, valid, || {
+        let (run, messages) = spawn(driver, family, models, raw, request, environment.clone())?;
         teardown_note = run.teardown_note;
         built = true;
         Ok(serde_json::to_vec(&CachedChild { target: name.clone(), report: run.report, messages })?)
-    })?;
+    });
+    let bytes = match built_run {
+        Ok(bytes) => bytes,
+        Err(first) => return isolated(first, environment),
+    };
     let mut cached: CachedChild = serde_json::from_slice(&bytes)?;
     cached.messages.iter().for_each(|m| crate::messages::line(m));
     if let (false, Some(store)) = (built, &store) {
@@ -509,29 +527,30 @@ fn teardown_note(
     })
 }
 
-/// `spawn`, and where the child fails with several models: one child per model finds those the driver fails
-/// on (a crash, a compile past the limit, a validation message), the others are compiled together again, and the
+/// Whether the child's failure `e` may be one model's: it ended without its report (not a report the parent
+/// refused) and held several models and no raw kernel.
+fn isolable(e: &anyhow::Error, models: &[Model], raw: &[super::RawKernel]) -> bool {
+    models.len() > 1 && raw.is_empty() && e.downcast_ref::<ChildFailed>().is_some()
+}
+
+/// After the child of all `models` failed (`first`): one child per model finds those the driver fails on (a
+/// crash, a compile past the limit, a validation message), the others are compiled together again, and the
 /// failed ones are named in the report's cost (`failed`) with the child's error, so one model never stops the
-/// others. The first error where every model alone succeeds (the failure is not one model's) or none does.
-fn spawn_isolating(
+/// others. `first` where every model alone succeeds (the failure is not one model's) or none does.
+fn isolate(
     driver: &'static dyn NoopDriver,
     family: usize,
     models: &[Model],
-    raw: &[super::RawKernel],
     request: &Job,
     environment: Vec<(String, String)>,
+    first: anyhow::Error,
 ) -> Result<(ChildRun, Vec<String>)> {
-    let first = match spawn(driver, family, models, raw, request, environment.clone()) {
-        Ok(done) => return Ok(done),
-        Err(e) if models.len() < 2 || !raw.is_empty() || e.downcast_ref::<ChildFailed>().is_none() => return Err(e),
-        Err(e) => e,
-    };
     let name = Target { vendor: driver, family }.name();
     crate::messages::progress(format!("{name}: the child failed; compiling each model in a child of its own"));
     let mut good = Vec::new();
     let mut failed = Vec::new();
     for m in models {
-        match spawn(driver, family, std::slice::from_ref(m), raw, request, environment.clone()) {
+        match spawn(driver, family, std::slice::from_ref(m), &[], request, environment.clone()) {
             Ok(_) => good.push(m.clone()),
             // The driver is installed (the others compiled): its installation hint would mislead.
             Err(e) => failed.push((
@@ -543,7 +562,7 @@ fn spawn_isolating(
     if failed.is_empty() || good.is_empty() {
         return Err(first);
     }
-    let (mut run, messages) = spawn(driver, family, &good, raw, request, environment)?;
+    let (mut run, messages) = spawn(driver, family, &good, &[], request, environment)?;
     match &mut run.report.cost {
         Some(cost) => cost.failed.extend(failed),
         None => return Err(first),
