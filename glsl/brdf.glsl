@@ -136,6 +136,13 @@ real Vis_SchlickBeckmann(real NoV, real NoL, real NoH, real VoH, real a) { retur
 // Schlick-GGX [Karis 2013]: k = a/2
 real Vis_SchlickGgx(real NoV, real NoL, real NoH, real VoH, real a) { return vis_schlick(NoV, NoL, a * real(0.5)); }
 
+// Schlick-GGX with Karis' remap for analytic lights [Karis 2013, p. 3; de Vries, LearnOpenGL "PBR: Theory" 2014]:
+// k = (r + 1)^2 / 8, r = sqrt(a)
+real Vis_SchlickGgxKaris(real NoV, real NoL, real NoH, real VoH, real a) {
+    real r1 = sqrt(a) + real(1);
+    return vis_schlick(NoV, NoL, r1 * r1 * real(0.125));
+}
+
 // Smith GGX separable, exact [Walter et al. 2007, eq. 34]:
 // 1 / ((NoV + sqrt(NoV (NoV - NoV a2) + a2)) (NoL + sqrt(NoL (NoL - NoL a2) + a2)))
 real Vis_SmithGgxSeparable(real NoV, real NoL, real NoH, real VoH, real a) {

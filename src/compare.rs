@@ -340,7 +340,9 @@ impl CostTable {
 
     /// The "net vs ggx" cell: the ratio, "unresolved" for a measured model without one, else "-".
     fn relative_cell(&self, column: &CostColumn, model: &str) -> String {
+        let measured = column.measured_ratios.is_some();
         match self.relative(column, model) {
+            Some(r) if r <= 0.0 && !measured => crate::schema::cost::HARNESS_BOUND.into(),
             Some(r) => format!("{r:.2}"),
             None if column.measured_ratios.is_some() && column.net.contains_key(model) => "unresolved".into(),
             None => "-".into(),
@@ -436,10 +438,14 @@ impl CostTable {
             }
             at += cols.len();
         }
-        let cells =
-            models.iter().map(|m| picked.iter().map(|&j| self.relative(&self.columns[j], m)).collect()).collect();
+        // A modelled net at or below 0 is harness-bound, no ratio: left grey, never drawn as "cheapest".
+        let cell = |j: usize, m: &str| {
+            let c = &self.columns[j];
+            self.relative(c, m).filter(|r| *r > 0.0 || c.measured_ratios.is_some())
+        };
+        let cells = models.iter().map(|m| picked.iter().map(|&j| cell(j, m)).collect()).collect();
         let table = crate::export::heat_table::HeatTable {
-            title: "BRDF cost net of the memory-only kernel, relative to ggx in each column".into(),
+            title: "BRDF cost net of the memory-only kernel, relative to ggx in each column (grey: no figure, or harness-bound)".into(),
             groups,
             rows: models.iter().map(|m| m.to_string()).collect(),
             cells,

@@ -29,6 +29,7 @@ real Vis_term(real NoV, real NoL, real NoH, real VoH, real a) {
     case VIS_SMITH_BECKMANN_SEPARABLE: return Vis_SmithBeckmannSeparable(NoV, NoL, NoH, VoH, a);
     case VIS_SMITH_BECKMANN_CORRELATED: return Vis_SmithBeckmannCorrelated(NoV, NoL, NoH, VoH, a);
     case VIS_SMITH_BECKMANN_WALTER: return Vis_SmithBeckmannWalter(NoV, NoL, NoH, VoH, a);
+    case VIS_SCHLICK_GGX_KARIS: return Vis_SchlickGgxKaris(NoV, NoL, NoH, VoH, a);
     }
     return real(not_a_term());
 }

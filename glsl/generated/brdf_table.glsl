@@ -31,6 +31,7 @@ layout(constant_id = 4) const int METAL = 0; // metal of the conductor Fresnel t
 #define VIS_SMITH_BECKMANN_SEPARABLE 11
 #define VIS_SMITH_BECKMANN_CORRELATED 12
 #define VIS_SMITH_BECKMANN_WALTER 13
+#define VIS_SCHLICK_GGX_KARIS 14
 // F ids
 #define F_NONE 0
 #define F_SCHLICK 1

@@ -1,7 +1,7 @@
 //! `brdfprof stability`: the hard-case catalogue, dense grids, reciprocity and energy checks on the GPU.
 
 use super::args::{DeviceArgs, HtmlArg, ModelArgs, cosine_range, reference_spec, roughness_range};
-use super::{just_measured, on_device, out_dir, written};
+use super::{checked_outputs, just_measured, model_inputs, on_device, out_dir, written};
 use anyhow::Result;
 use brdfprof::model::Model;
 use brdfprof::stability;
@@ -39,6 +39,12 @@ pub struct StabilityArgs {
     /// refused where that would overwrite a file git tracks).
     #[arg(long)]
     pub out: Option<PathBuf>,
+    /// Also write the JSON report to FILE (as the other commands' `--json`; --out still holds its copy).
+    #[arg(long, value_name = "FILE")]
+    pub json: Option<PathBuf>,
+    /// Also write the Markdown report to FILE.
+    #[arg(long, value_name = "FILE")]
+    pub markdown: Option<PathBuf>,
     #[command(flatten)]
     pub html: HtmlArg,
     #[command(flatten)]
@@ -47,12 +53,17 @@ pub struct StabilityArgs {
 
 pub fn stability(args: &StabilityArgs) -> Result<ExitCode> {
     let out = out_dir(args.out.as_deref(), &["stability-*", "furnace-*.png", "albedo-*.png"])?;
-    args.html.check()?;
     let models = if args.model.models.is_empty() {
         stability::default_specs().into_iter().map(Model::spec).collect()
     } else {
         args.model.models(&[])?
     };
+    let asked = [
+        ("--json", args.json.as_deref()),
+        ("--markdown", args.markdown.as_deref()),
+        ("--html", args.html.html.as_deref()),
+    ];
+    let outs = checked_outputs(&asked, &model_inputs(&models))?;
     let options = stability::StabilityOptions {
         models: if args.unguarded { stability::with_guard_variants(models) } else { models },
         energy: !args.no_energy,
@@ -64,9 +75,19 @@ pub fn stability(args: &StabilityArgs) -> Result<ExitCode> {
     let (gpu, result) = on_device(&args.device, |gpu, progress| stability::run(gpu, &options, progress))?;
     let slug = brdfprof::targets::device_slug(&gpu.info);
     let mut files = result.write(&out, &slug)?;
+    for (flag, path) in &outs {
+        match *flag {
+            "--json" => {
+                brdfprof::export::json::write_report_compact(path, brdfprof::export::json::Kind::Stability, &result)?
+            }
+            "--markdown" => brdfprof::io::write_markdown(path, &result.markdown())?,
+            _ => continue,
+        }
+        files.push(path.clone());
+    }
     files.extend(args.html.write(&[just_measured(&out.join(format!("stability-{slug}.json")), &result)?], Some(&gpu))?);
-    print!("{}", result.markdown());
-    println!("\n{}", written(&files));
+    out!("{}", result.markdown());
+    outln!("\n{}", written(&files));
     let failing = result.failing();
     if failing.is_empty() {
         return Ok(ExitCode::SUCCESS);

@@ -198,11 +198,16 @@ pub fn as_f(model: &Model, values: Vec<[f32; 3]>, samples: &[Sample]) -> Vec<[f3
 }
 
 /// f_s from an entry's f_s N.L (`returns f_nol`), divided on the host so that no kernel holds the division:
-/// N.L of the unit n and l in f64; where N.L <= 0 a zero stays zero and anything else is divided as it is
-/// (light from below the horizon shows as a negative or infinite f_s, which `stability` counts).
+/// N.L of the unit n and l in f64. Where N.L <= 0 there is no f_s to recover (the light is below the horizon):
+/// the value is kept as the entry returned it, f_s N.L, which must be finite, non-negative and about 0 there
+/// (an engine's `max(NoL, 1e-8)` returns a tiny positive value; dividing it by a negative N.L would call it a
+/// negative f_s).
 pub fn f_from_f_nol(g: [f32; 3], s: &Sample) -> [f32; 3] {
     let unit = |v: [f32; 3]| glam::DVec3::new(v[0].into(), v[1].into(), v[2].into()).normalize_or_zero();
     let nol = unit(s.n).dot(unit(s.l));
+    if nol <= 0.0 {
+        return g;
+    }
     g.map(|x| if x == 0.0 { 0.0 } else { (f64::from(x) / nol) as f32 })
 }
 

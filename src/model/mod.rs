@@ -202,7 +202,8 @@ impl Model {
                 let stem = Some(part(path.file_stem()))
                     .filter(|s| ModelSpec::parse(s).is_err())
                     .unwrap_or_else(|| part(path.file_name()));
-                stem + &name[f.path.len()..]
+                // A file's name is the user's (or a pull request's): no control character of it reaches a table.
+                crate::messages::escape_line(&(stem + &name[f.path.len()..]))
             }
         }
     }
@@ -369,12 +370,19 @@ pub fn models_from_args(models: &[String], params: &[String], default: &[&str]) 
         .and_then(|models| check_labels(&models, "--model").map(|_| models))
 }
 
-/// The models with the reference (plain ggx) first when they lack it: what every cost is compared with.
+/// The models with the reference (plain ggx) first when they lack it: what every cost is compared with; where
+/// a model is a shader file (an engine's own code, with fewer guards than a preset), `ggx,guards=off` after it,
+/// so that the tables also say what the same formula costs without brdfprof's guards.
 pub fn with_reference(models: &[Model]) -> Vec<Model> {
     let reference = Model::reference();
     let mut all = models.to_vec();
     if !all.contains(&reference) {
-        all.insert(0, reference);
+        all.insert(0, reference.clone());
+    }
+    let unguarded = Model::parse(crate::brdf::spec::UNGUARDED_REFERENCE_MODEL).expect("a built-in spec");
+    if all.iter().any(|m| m.file().is_some()) && !all.iter().any(|m| m.canonical() == unguarded.canonical()) {
+        let at = all.iter().position(|m| *m == reference).map_or(0, |i| i + 1);
+        all.insert(at, unguarded);
     }
     all
 }

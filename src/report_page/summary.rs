@@ -123,6 +123,39 @@ fn inspect_columns(s: &mut Summary, reports: &[crate::schema::InspectReport]) {
     }
 }
 
+/// A diff's two columns: the unsigned max relative difference, and the signed figure that says how the model
+/// is wrong (its best-fit scale against the reference, and the shares of values brighter and darker).
+fn diff_columns(s: &mut Summary, against: &str, diffs: Vec<(String, &crate::diff::DiffReport)>) {
+    let max = diffs.iter().map(|(k, d)| (k.clone(), num_cell(finite(d.difference.max_rel)))).collect();
+    s.column(format!("max diff. vs {against}"), format!("max relative difference vs {against}"), max);
+    let signed = diffs
+        .iter()
+        .map(|(k, d)| {
+            let g = &d.signed;
+            let cell = match g.best_fit_scale {
+                Some(scale) => Cell::num(
+                    scale,
+                    format!(
+                        "x{} ({:.0}% brighter, {:.0}% darker)",
+                        crate::export::markdown::sig_compact(scale, 3),
+                        100.0 * g.brighter,
+                        100.0 * g.darker
+                    ),
+                ),
+                None => Cell::text("-"),
+            };
+            (k.clone(), cell)
+        })
+        .collect();
+    s.column(
+        format!("signed vs {against}"),
+        format!(
+            "best-fit scale against {against} (1: right on average; above 1 brighter), and the shares of values brighter and darker"
+        ),
+        signed,
+    );
+}
+
 /// Gathers the rows and columns: models from every report but stability first, then the specs stability
 /// failed (guard variants left out); a stability column fills in for the models it checked.
 fn gather(inputs: &[Input]) -> Summary {
@@ -143,23 +176,11 @@ fn gather(inputs: &[Input]) -> Summary {
             Loaded::Diff(d) => {
                 s.model(&d.a.canonical, &d.a.name);
                 let key = s.model(&d.b.canonical, &d.b.name);
-                s.column(
-                    format!("max diff. vs {}", d.a.name),
-                    format!("max relative difference vs {}", d.a.name),
-                    vec![(key, num_cell(finite(d.difference.max_rel)))],
-                );
+                diff_columns(&mut s, &d.a.name, vec![(key, &**d)]);
             }
             Loaded::DiffSet(d) => {
-                let cells = d
-                    .diffs
-                    .iter()
-                    .map(|x| (s.model(&x.b.canonical, &x.b.name), num_cell(finite(x.difference.max_rel))))
-                    .collect();
-                s.column(
-                    format!("max diff. vs {}", d.reference.name),
-                    format!("max relative difference vs {}", d.reference.name),
-                    cells,
-                );
+                let cells = d.diffs.iter().map(|x| (s.model(&x.b.canonical, &x.b.name), x)).collect();
+                diff_columns(&mut s, &d.reference.name, cells);
             }
             Loaded::Stability(_) | Loaded::Costs(_) => {}
         }

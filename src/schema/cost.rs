@@ -59,8 +59,21 @@ pub struct TargetCost {
     pub failed: Vec<(String, String)>,
 }
 
+/// What a net cost at or below zero reads as in a ratio column: the memory-only kernel's bound sets it, not
+/// the BRDF (`NEGATIVE_NET` says why), so it is no ratio at all.
+pub const HARNESS_BOUND: &str = "harness-bound";
+
+/// A "net vs REFERENCE" cell: the ratio of the nets, "harness-bound" where this kernel's net is not above 0.
+pub fn ratio_cell(net: Option<f64>, reference: Option<f64>) -> String {
+    match (net, reference) {
+        (Some(v), Some(_)) if v <= 0.0 => HARNESS_BOUND.into(),
+        (Some(v), Some(g)) if g > 0.0 => format!("{:.2}", v / g),
+        _ => "-".into(),
+    }
+}
+
 /// The note beside a net cost at or below zero.
-pub const NEGATIVE_NET: &str = "net cost not above zero: the kernel's bound is not above the memory-only kernel's (a constant BRDF, or the BRDF's work hidden under a pipe both kernels bind on, such as Mali's load/store); its net figure measures that, and the breakdown by term says what the BRDF's code adds";
+pub const NEGATIVE_NET: &str = "net cost not above zero (harness-bound): the kernel's bound is not above the memory-only kernel's (a constant BRDF, or the BRDF's work hidden under a pipe both kernels bind on, such as Mali's load/store); its net figure measures that, and the breakdown by term says what the BRDF's code adds";
 
 impl TargetCost {
     /// The reference model's cycles taken apart (its terms per wave, the binding one named), where the rule
@@ -124,7 +137,11 @@ impl TargetCost {
             super::fold_constant(&all, |c| self.rows.iter().map(|r| r.stats.get(*c).copied()).collect());
         let mut headers: Vec<String> = vec!["model".into()];
         headers.extend(columns.iter().map(|c| c.to_string()));
+        let unguarded = self.row(crate::brdf::spec::UNGUARDED_REFERENCE_MODEL).and_then(|r| r.net_cycles_per_eval);
         headers.extend(["cycles/eval".into(), "net cycles/eval".into(), "net vs ggx".into()]);
+        if unguarded.is_some() {
+            headers.push(format!("net vs {}", crate::brdf::spec::UNGUARDED_REFERENCE_MODEL));
+        }
         let bound = self.rows.iter().any(|r| r.bound.is_some());
         if bound {
             headers.push("bound by".into());
@@ -136,10 +153,10 @@ impl TargetCost {
             cells.extend(columns.iter().map(|c| r.stats.get(*c).map_or("-".into(), |v| super::format_value(*v))));
             cells.push(sig(r.cycles_per_eval, 4));
             cells.push(r.net_cycles_per_eval.map_or("-".into(), |v| sig(v, 4)));
-            cells.push(match (r.net_cycles_per_eval, reference) {
-                (Some(v), Some(g)) if g > 0.0 => format!("{:.2}", v / g),
-                _ => "-".into(),
-            });
+            cells.push(ratio_cell(r.net_cycles_per_eval, reference));
+            if unguarded.is_some() {
+                cells.push(ratio_cell(r.net_cycles_per_eval, unguarded));
+            }
             if bound {
                 cells.push(r.bound.clone().unwrap_or_else(|| "-".into()));
             }

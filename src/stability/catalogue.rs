@@ -131,6 +131,51 @@ pub fn hard_cases() -> Vec<HardCase> {
     cases
 }
 
+/// The f32 nearest `x` on the inside of a bound (`up`: at or above it), so that the case is within the domain.
+fn inside(x: f64, up: bool) -> f32 {
+    let y = x as f32;
+    match (f64::from(y) < x, f64::from(y) > x, up) {
+        (true, _, true) => y.next_up(),
+        (_, true, false) => y.next_down(),
+        _ => y,
+    }
+}
+
+/// Hard cases at a domain's own bounds, which the catalogue's fixed values may all miss: at the roughness
+/// minimum and maximum the peak (N = H), the peak at grazing (the smallest cosines the domain allows, else
+/// 1e-4) and off the peak; at the N.V and N.L minimum a grazing view and a grazing light. Named with the bound.
+pub fn at_domain_bounds(checks: &super::Checks) -> Vec<HardCase> {
+    let mut cases = Vec::new();
+    let mut add = |name: String, sample: Sample| {
+        if !cases.iter().any(|c: &HardCase| c.sample == sample) {
+            cases.push(HardCase { name, sample, overrides: Vec::new(), expect: Expect::Twin });
+        }
+    };
+    let lowest = |range: Option<(f64, f64)>| range.map(|(lo, _)| lo).filter(|lo| *lo > 0.0);
+    let grazing = [lowest(checks.nov), lowest(checks.nol)]
+        .into_iter()
+        .flatten()
+        .fold(None, |m: Option<f64>, x| Some(m.map_or(x, |m| m.max(x))))
+        .unwrap_or(1e-4);
+    let (r_lo, r_hi) = checks.roughness.unwrap_or((0.0, 1.0));
+    let middle = inside(0.5f64.clamp(r_lo, r_hi), true);
+    if let Some((lo, hi)) = checks.roughness {
+        for (end, bound, r) in [("minimum", lo, inside(lo, true)), ("maximum", hi, inside(hi, false))] {
+            let at = format!("at the domain's roughness {end} {bound}");
+            add(format!("{at}, N = H"), mirror(0.6, r));
+            add(format!("{at}, N = H at grazing, NoV = NoL = {grazing:e}"), mirror(grazing, r));
+            add(format!("{at}, off the peak"), sample(0.6, 0.8, PI / 2.0, r));
+        }
+    }
+    if let Some(lo) = lowest(checks.nov) {
+        add(format!("at the domain's NoV minimum {lo}"), sample(lo, 0.7, PI / 3.0, middle));
+    }
+    if let Some(lo) = lowest(checks.nol) {
+        add(format!("at the domain's NoL minimum {lo}"), sample(0.7, lo, PI / 3.0, middle));
+    }
+    cases
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

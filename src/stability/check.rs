@@ -2,13 +2,14 @@
 
 use super::catalogue::{Expect, HardCase};
 use super::failures::{self, Failures};
-use super::{CaseResult, SpecStability, Worst, base_tolerance, grid, tolerance};
+use super::{BoundCase, CaseResult, SpecStability, Worst, base_tolerance, grid, tolerance};
 use crate::accuracy::FLOOR;
-use crate::brdf::{ModelSpec, Sample};
+use crate::brdf::{ModelSpec, Precision, Sample};
 use crate::gpu::Gpu;
 use crate::kernels::{self, RunLimits};
 use crate::model::Model;
 use anyhow::Result;
+use glam::DVec3;
 use rayon::prelude::*;
 
 /// NaN, Inf and negative results on valid inputs, and non-finite or negative ones from invalid inputs.
@@ -25,15 +26,18 @@ fn bad(x: f32) -> bool {
 }
 
 impl Tally {
-    fn add(&mut self, x: f32, valid: bool) {
-        if !valid {
-            self.poisoned += bad(x) as usize;
-        } else if x.is_nan() {
-            self.nan += 1;
-        } else if x.is_infinite() {
-            self.inf += 1;
-        } else if x < 0.0 {
-            self.negative += 1;
+    /// One valid input's channels: NaN and negative values always count, Inf ones unless the exact value is
+    /// beyond fp32's range (`counts_bad`).
+    fn add(&mut self, got: &[f32; 3], value: &Result<[f64; 3], NoValue>) {
+        let inf_ok = matches!(value, Err(NoValue::BeyondFp32(_)));
+        for &x in got {
+            if x.is_nan() {
+                self.nan += 1;
+            } else if x.is_infinite() {
+                self.inf += usize::from(!inf_ok);
+            } else if x < 0.0 {
+                self.negative += 1;
+            }
         }
     }
 }
@@ -68,15 +72,78 @@ pub struct Checks<'a> {
 /// are left out of the checks and counted as outside its domain.
 pub const F_NOL_ZERO: f64 = 1e-9;
 
+/// What a model's results are checked against: its f64 twin (its guards and floors: the limit brdfprof defines
+/// for a built-in spec), or a reference's formula exactly at the inputs the model was given
+/// (`ModelSpec::eval_reference`: no roughness or cosine floor, the evaluation `diff --reference` uses), with the
+/// tolerance of the checked model's precision.
+#[derive(Clone, Copy, Debug)]
+pub struct Expected {
+    pub spec: ModelSpec,
+    /// The reference's formula (`eval_reference`) rather than a twin (`eval`).
+    pub formula: bool,
+    /// The precision of the model checked, which sets the tolerance.
+    pub precision: Precision,
+}
+
+/// Why an input has no value to check against: none exists, or fp32 cannot hold it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum NoValue {
+    /// Roughness 0: the reference's D is a Dirac delta.
+    Singular,
+    /// The exact value is beyond fp32's range (an Inf result is then no failure of the model).
+    BeyondFp32(f64),
+}
+
+impl NoValue {
+    pub fn why(self) -> String {
+        match self {
+            NoValue::Singular => "no exact value: the reference's D is a Dirac delta at roughness 0".into(),
+            NoValue::BeyondFp32(x) => format!("the exact value {x:.3e} is beyond fp32's range (3.4e38)"),
+        }
+    }
+}
+
+impl Expected {
+    pub fn twin(spec: ModelSpec) -> Self {
+        Expected { spec, formula: false, precision: spec.precision }
+    }
+
+    /// The expected values at `s`, or why there are none to check a fp32 or fp16 result against. A twin's values
+    /// are always expected (an infinite one is the spec's own formula failing, which its guards are for); a
+    /// reference's formula beyond fp32's range is not a value fp32 code can be held to.
+    pub fn at(&self, s: &Sample) -> Result<[f64; 3], NoValue> {
+        let (n, v, l) =
+            (crate::brdf::guards::unit(s.n), crate::brdf::guards::unit(s.v), crate::brdf::guards::unit(s.l));
+        let e = self.at_unit(n, v, l, f64::from(s.roughness), s.f0.map(f64::from)).ok_or(NoValue::Singular)?;
+        match e.iter().copied().find(|x| !(x.abs() <= f64::from(f32::MAX))).filter(|_| self.formula) {
+            Some(x) => Err(NoValue::BeyondFp32(x)),
+            None => Ok(e),
+        }
+    }
+
+    /// The expected values for unit vectors as given (None where the reference has none).
+    pub fn at_unit(&self, n: DVec3, v: DVec3, l: DVec3, roughness: f64, f0: [f64; 3]) -> Option<[f64; 3]> {
+        if self.formula {
+            self.spec.eval_reference_unit(n, v, l, roughness, f0)
+        } else {
+            Some(self.spec.eval_unit(n, v, l, roughness, f0))
+        }
+    }
+}
+
 impl Checks<'_> {
-    /// The spec whose f64 values a case's results are checked against: the twin of the case's model, else
-    /// the reference (as it is: a file does not read the case's parameter values).
-    fn expected(&self, model: &Model, case: Option<&HardCase>) -> Option<ModelSpec> {
+    /// What a case's results are checked against: the twin of the case's model, else the reference's formula
+    /// (as it is: a file does not read the case's parameter values).
+    pub fn expected(&self, model: &Model, case: Option<&HardCase>) -> Option<Expected> {
         let twin = match case {
             Some(c) => case_model(model, c).twin().copied(),
             None => model.twin().copied(),
         };
-        twin.or(self.reference.copied())
+        twin.map(Expected::twin).or(self.reference.map(|&spec| Expected {
+            spec,
+            formula: true,
+            precision: model.precision(),
+        }))
     }
 
     fn in_domain(&self, s: &Sample) -> bool {
@@ -148,10 +215,10 @@ fn run_cases(gpu: &Gpu, model: &Model, cases: &[HardCase]) -> Result<Vec<[f32; 3
 }
 
 /// |got - expected| / tolerance, the largest over the channels (NaN counts as infinite).
-fn deviation(spec: &ModelSpec, s: &Sample, got: &[f32; 3], expected: [f64; 3], seed: u64) -> f64 {
+fn deviation(expected: &Expected, s: &Sample, got: &[f32; 3], value: [f64; 3], seed: u64) -> f64 {
     (0..3)
         .map(|c| {
-            let d = (got[c] as f64 - expected[c]).abs() / tolerance(spec, s, c, expected[c], seed);
+            let d = (got[c] as f64 - value[c]).abs() / tolerance(expected, s, c, value[c], seed);
             if d.is_nan() { f64::INFINITY } else { d }
         })
         .fold(0.0, f64::max)
@@ -165,58 +232,98 @@ fn worst_at(deviation: f64, got: &[f32; 3], expected: [f64; 3], input: String) -
     Worst { deviation, got: got[c], expected: expected[c], input }
 }
 
+/// Whether a result counts as NaN, Inf or negative on a valid input: an Inf where the exact value is beyond
+/// fp32's range is what fp32 holds of it, not a failure.
+fn counts_bad(got: &[f32; 3], value: &Result<[f64; 3], NoValue>) -> bool {
+    let inf_ok = matches!(value, Err(NoValue::BeyondFp32(_)));
+    got.iter().any(|x| x.is_nan() || *x < 0.0 || x.is_infinite() && !inf_ok)
+}
+
+/// The hard cases' verdicts, and which of them count as a NaN, Inf or negative result on a valid input.
+struct Judged {
+    /// Per case: None for a valid case outside the domain (not run as far as the report goes).
+    results: Vec<Option<CaseResult>>,
+    bad: Vec<bool>,
+    /// Valid cases with nothing to check their value against, and why (`NoValue`).
+    without_value: Vec<String>,
+}
+
 /// Each case's verdict: against the twin or reference (within tolerance) for valid input, finite and
 /// non-negative for invalid input; without either, a valid case fails only on a NaN, Inf or negative value.
-/// None for a valid case outside the roughness domain (not run as far as the report goes).
+/// Cases from `first_bound` on sit at the domain's own bounds and are always counted.
 fn judge_cases(
     model: &Model,
     checks: &Checks,
     cases: &[HardCase],
+    first_bound: usize,
     out: &[[f32; 3]],
     tally: &mut Tally,
     worst: &mut Worst,
-) -> Vec<Option<CaseResult>> {
-    cases
-        .iter()
-        .zip(out)
-        .enumerate()
-        .map(|(i, (case, got))| {
-            let valid = case.expect == Expect::Twin;
-            if valid && !checks.in_domain(&case.sample) {
-                return None;
+) -> Judged {
+    let mut judged = Judged { results: Vec::new(), bad: Vec::new(), without_value: Vec::new() };
+    for (i, (case, got)) in cases.iter().zip(out).enumerate() {
+        let valid = case.expect == Expect::Twin;
+        if valid && i < first_bound && !checks.in_domain(&case.sample) {
+            judged.results.push(None);
+            judged.bad.push(false);
+            continue;
+        }
+        let poisoned = if got.iter().any(|&x| bad(x)) { f64::INFINITY } else { 0.0 };
+        let expected = checks.expected(model, Some(case)).filter(|_| valid);
+        let value = expected.map(|x| x.at(&case.sample));
+        let value_or_none = value.as_ref().unwrap_or(&Ok([0.0; 3]));
+        let is_bad = counts_bad(got, value_or_none);
+        if valid {
+            tally.add(got, value_or_none);
+        } else {
+            tally.poisoned += got.iter().filter(|&&x| bad(x)).count();
+        }
+        let (shown, deviation) = match (expected, value) {
+            (Some(x), Some(Ok(e))) => (Some(e), deviation(&x, &case.sample, got, e, i as u64)),
+            (Some(_), Some(Err(why))) => {
+                judged.without_value.push(format!("case `{}`: {}", case.name, why.why()));
+                (None, if is_bad { f64::INFINITY } else { 0.0 })
             }
-            got.iter().for_each(|&x| tally.add(x, valid));
-            let poisoned = if got.iter().any(|&x| bad(x)) { f64::INFINITY } else { 0.0 };
-            let (expected, deviation) = match (valid, checks.expected(model, Some(case))) {
-                (true, Some(s)) => {
-                    let e = s.eval(&case.sample);
-                    (Some(e), deviation(&s, &case.sample, got, e, i as u64))
-                }
-                (true, None) | (false, _) => (None, poisoned),
-            };
-            if let (Some(e), true) = (expected, deviation > worst.deviation) {
-                *worst = worst_at(deviation, got, e, format!("case `{}`: {:?}", case.name, case.sample));
-            }
-            Some(CaseResult { case: case.name.clone(), expected, got: *got, deviation, ok: deviation <= 1.0 })
-        })
-        .collect()
+            _ => (None, poisoned),
+        };
+        let inputs = failures::describe(&case.sample);
+        if let (Some(e), true) = (shown, deviation > worst.deviation) {
+            *worst = worst_at(deviation, got, e, format!("case `{}`: {inputs}", case.name));
+        }
+        judged.bad.push(valid && is_bad);
+        judged.results.push(Some(CaseResult {
+            case: case.name.clone(),
+            inputs,
+            expected: shown,
+            got: *got,
+            deviation,
+            ok: deviation <= 1.0,
+        }));
+    }
+    judged
 }
 
-/// Per grid point, the deviation from the twin in tolerances (the tolerance computed only where the base
-/// tolerance is exceeded: it can only grow).
-fn grid_deviations(spec: &ModelSpec, grid: &[Sample], out: &[[f32; 3]], twin: &[[f64; 3]]) -> Vec<f64> {
+/// Per grid point, the deviation from the expected values in tolerances (the tolerance computed only where
+/// the base tolerance is exceeded: it can only grow); 0 where there is no value to check against.
+fn grid_deviations(
+    expected: &Expected,
+    grid: &[Sample],
+    out: &[[f32; 3]],
+    values: &[Result<[f64; 3], NoValue>],
+) -> Vec<f64> {
     grid.par_iter()
         .enumerate()
         .map(|(i, s)| {
+            let Ok(value) = values[i] else { return 0.0 };
             (0..3)
                 .map(|c| {
-                    let (g, e) = (out[i][c] as f64, twin[i][c]);
+                    let (g, e) = (out[i][c] as f64, value[c]);
                     let diff = (g - e).abs();
                     if diff.is_nan() {
                         return f64::INFINITY;
                     }
-                    let base = base_tolerance(spec.precision) * e.abs().max(FLOOR);
-                    if diff <= base { diff / base } else { diff / tolerance(spec, s, c, e, i as u64) }
+                    let base = base_tolerance(expected.precision) * e.abs().max(FLOOR);
+                    if diff <= base { diff / base } else { diff / tolerance(expected, s, c, e, i as u64) }
                 })
                 .fold(0.0, f64::max)
         })
@@ -224,18 +331,26 @@ fn grid_deviations(spec: &ModelSpec, grid: &[Sample], out: &[[f32; 3]], twin: &[
 }
 
 /// Bad values (NaN, Inf, negative) per [roughness][NoV] grid cell, all tallied (points outside the domain
-/// neither).
-fn bad_cells(out: &[[f32; 3]], in_domain: &[bool], tally: &mut Tally) -> Vec<Vec<u32>> {
+/// neither), and whether each point counts as one.
+fn bad_cells(
+    out: &[[f32; 3]],
+    in_domain: &[bool],
+    values: Option<&[Result<[f64; 3], NoValue>]>,
+    tally: &mut Tally,
+) -> (Vec<Vec<u32>>, Vec<bool>) {
     let mut cells = vec![vec![0u32; grid::COSINES.len()]; grid::ROUGHNESS.len()];
+    let mut is_bad = vec![false; out.len()];
     for (i, g) in out.iter().enumerate().filter(|(i, _)| in_domain[*i]) {
-        g.iter().for_each(|&x| tally.add(x, true));
-        if g.iter().any(|&x| bad(x)) {
+        let value = values.map_or(&Ok([0.0; 3]), |v| &v[i]);
+        is_bad[i] = counts_bad(g, value);
+        tally.add(g, value);
+        if is_bad[i] {
             let r = i / (grid::AZIMUTHS * grid::COSINES.len() * grid::COSINES.len());
             let v = (i / grid::COSINES.len()) % grid::COSINES.len();
             cells[r][v] += 1;
         }
     }
-    cells
+    (cells, is_bad)
 }
 
 /// Steps in f_s NoL (the radiance a renderer accumulates) along NoV, NoL and roughness (channel 0, lit points
@@ -318,17 +433,17 @@ fn reciprocity_error(forward: &[[f32; 3]], backward: &[[f32; 3]]) -> (Option<f64
     (worst, nonfinite)
 }
 
-/// Each grid sample's deviation from the expected values (`spec`'s, `twin` on the grid), 0 outside the domain
-/// and where nothing is expected.
+/// Each grid sample's deviation from the expected values (`values`, of `expected`), 0 outside the domain and
+/// where nothing is expected.
 fn domain_deviations(
-    spec: Option<&ModelSpec>,
-    twin: Option<&[[f64; 3]]>,
+    expected: Option<&Expected>,
+    values: Option<&[Result<[f64; 3], NoValue>]>,
     grid: &[Sample],
     grid_out: &[[f32; 3]],
     in_domain: &[bool],
 ) -> Vec<f64> {
-    match (spec, twin) {
-        (Some(s), Some(t)) => grid_deviations(s, grid, grid_out, t)
+    match (expected, values) {
+        (Some(x), Some(v)) => grid_deviations(x, grid, grid_out, v)
             .into_iter()
             .zip(in_domain)
             .map(|(d, &inside)| if inside { d } else { 0.0 })
@@ -353,8 +468,8 @@ fn worst_or_first_failure(worst: Worst, failures: &Failures) -> Worst {
     worst
 }
 
-/// Checks one model: catalogue, grid, discontinuities, reciprocity and where it fails (energy is added by
-/// `run`).
+/// Checks one model: catalogue, the cases at its domain's bounds, grid, discontinuities, reciprocity and where
+/// it fails (energy is added by `run`).
 pub fn check_model(
     gpu: &Gpu,
     model: &Model,
@@ -363,7 +478,9 @@ pub fn check_model(
     grid: &[Sample],
     reciprocity: &[Sample],
 ) -> Result<SpecStability> {
-    let case_out = run_cases(gpu, model, cases)?;
+    let mut cases_here = cases.to_vec();
+    cases_here.extend(super::catalogue::at_domain_bounds(checks));
+    let case_out = run_cases(gpu, model, &cases_here)?;
     let mut all: Vec<Sample> = grid.to_vec();
     all.extend_from_slice(reciprocity);
     all.extend(reciprocity.iter().map(|s| Sample { v: s.l, l: s.v, ..*s }));
@@ -373,22 +490,22 @@ pub fn check_model(
     let in_domain: Vec<bool> = grid.iter().map(|s| checks.in_domain(s)).collect();
 
     let (mut tally, mut worst) = (Tally::default(), Worst::default());
-    let judged = judge_cases(model, checks, cases, &case_out, &mut tally, &mut worst);
-    let spec = checks.expected(model, None);
-    let twin: Option<Vec<[f64; 3]>> = spec.map(|s| grid.par_iter().map(|x| s.eval(x)).collect());
-    let deviations = domain_deviations(spec.as_ref(), twin.as_deref(), grid, grid_out, &in_domain);
-    let cells = bad_cells(grid_out, &in_domain, &mut tally);
-    if let (Some(t), Some((i, &d))) = (&twin, deviations.iter().enumerate().max_by(|a, b| a.1.total_cmp(b.1))) {
-        if d > worst.deviation {
-            worst = worst_at(d, &grid_out[i], t[i], format!("grid: {}", failures::describe(&grid[i])));
-        }
-    }
-    let steps = scan_steps(grid, grid_out, twin.as_deref(), &deviations, &in_domain);
+    let judged = judge_cases(model, checks, &cases_here, cases.len(), &case_out, &mut tally, &mut worst);
+    let expected = checks.expected(model, None);
+    let values: Option<Vec<Result<[f64; 3], NoValue>>> = expected.map(|x| grid.par_iter().map(|s| x.at(s)).collect());
+    let deviations = domain_deviations(expected.as_ref(), values.as_deref(), grid, grid_out, &in_domain);
+    let (cells, grid_bad) = bad_cells(grid_out, &in_domain, values.as_deref(), &mut tally);
+    let plain: Option<Vec<[f64; 3]>> = values.as_ref().map(|v| v.iter().map(|x| x.unwrap_or([f64::NAN; 3])).collect());
+    worst_of_grid(&mut worst, plain.as_deref(), &deviations, grid, grid_out);
+    let steps = scan_steps(grid, grid_out, plain.as_deref(), &deviations, &in_domain);
     let any_bad = cells.iter().flatten().any(|&n| n > 0);
     let (reciprocity, reciprocity_nonfinite) = reciprocity_error(forward, backward);
-    let failures = locate_failures(gpu, model, cases, &case_out, &judged, grid, grid_out, &in_domain)?;
+    let failures = locate_failures(gpu, model, &cases_here, &case_out, &judged.bad, grid, grid_out, &grid_bad)?;
     let worst = worst_or_first_failure(worst, &failures);
-    let results: Vec<CaseResult> = judged.iter().flatten().cloned().collect();
+    let bounds = bound_results(expected.as_ref(), &cases_here[cases.len()..], &judged.results[cases.len()..]);
+    let results: Vec<CaseResult> = judged.results.iter().flatten().cloned().collect();
+    let grid_without_value =
+        values.as_ref().map_or(0, |v| v.iter().zip(&in_domain).filter(|(x, inside)| **inside && x.is_err()).count());
     Ok(SpecStability {
         label: model.label(),
         spec: model.name(),
@@ -396,18 +513,20 @@ pub fn check_model(
         has_twin: model.twin().is_some(),
         expected_from: expected_from(model, checks),
         domain: checks.has_domain().then(|| checks.domain_text()),
-        cases_outside_domain: judged.iter().filter(|r| r.is_none()).count(),
+        cases_outside_domain: judged.results.iter().filter(|r| r.is_none()).count(),
         grid_outside_domain: in_domain.iter().filter(|d| !**d).count(),
         nan: tally.nan,
         inf: tally.inf,
         negative: tally.negative,
         invalid_input_poisoned: tally.poisoned,
         cases_run: results.len(),
-        case_deviation: judged.iter().map(|r| r.as_ref().map_or(0.0, |r| r.deviation)).collect(),
+        case_deviation: judged.results[..cases.len()].iter().map(|r| r.as_ref().map_or(0.0, |r| r.deviation)).collect(),
         cases_out_of_tolerance: results.into_iter().filter(|r| !r.ok).collect(),
+        cases_without_value: judged.without_value,
+        grid_without_value,
         grid_out_of_tolerance: deviations.iter().filter(|d| **d > 1.0).count(),
         worst,
-        jumps_checked: twin.is_some(),
+        jumps_checked: plain.is_some(),
         discontinuities: steps.discontinuities,
         discontinuity_examples: steps.examples,
         model_jumps: steps.model_jumps,
@@ -415,39 +534,79 @@ pub fn check_model(
         reciprocity_nonfinite,
         bad_cells: any_bad.then_some(cells),
         bad_cell_triples: None,
+        at_domain_bounds: bounds,
         failures,
         energy: None,
     })
+}
+
+/// `worst` where a grid point deviates more than every hard case.
+fn worst_of_grid(
+    worst: &mut Worst,
+    values: Option<&[[f64; 3]]>,
+    deviations: &[f64],
+    grid: &[Sample],
+    out: &[[f32; 3]],
+) {
+    if let (Some(t), Some((i, &d))) = (values, deviations.iter().enumerate().max_by(|a, b| a.1.total_cmp(b.1))) {
+        if d > worst.deviation {
+            *worst = worst_at(d, &out[i], t[i], format!("grid: {}", failures::describe(&grid[i])));
+        }
+    }
+}
+
+/// The cases at the domain's bounds as the report gives them: each result with its signed difference from the
+/// formula's exact value (what fp32 or fp16 loses there, said even within tolerance).
+fn bound_results(expected: Option<&Expected>, cases: &[HardCase], results: &[Option<CaseResult>]) -> Vec<BoundCase> {
+    cases
+        .iter()
+        .zip(results)
+        .filter_map(|(case, r)| {
+            let r = r.as_ref()?;
+            let exact = expected.and_then(|x| x.spec.eval_reference(&case.sample));
+            let c = (0..3).max_by(|&a, &b| {
+                let rel = |k: usize| exact.map_or(0.0, |e| ((r.got[k] as f64 - e[k]) / e[k]).abs());
+                rel(a).total_cmp(&rel(b))
+            })?;
+            Some(BoundCase {
+                case: case.name.clone(),
+                inputs: r.inputs.clone(),
+                got: f64::from(r.got[c]),
+                exact: exact.map(|e| e[c]),
+                loss: exact.map(|e| r.got[c] as f64 / e[c] - 1.0).filter(|x| x.is_finite()),
+                deviation: r.deviation,
+                ok: r.ok,
+            })
+        })
+        .collect()
 }
 
 /// Where the expected values come from, as the report says it.
 fn expected_from(model: &Model, checks: &Checks) -> Option<String> {
     match (model.twin(), checks.reference) {
         (Some(_), _) => Some("twin".into()),
-        (None, Some(r)) => Some(format!("reference `{}`", r.name())),
+        (None, Some(r)) => Some(format!("reference `{}` (its formula exactly, no floor)", r.name())),
         (None, None) => None,
     }
 }
 
-/// The valid inputs in the domain with a NaN, Inf or negative result, and the input guards that remove them.
+/// The valid inputs in the domain that count as a NaN, Inf or negative result (`case_bad`, `grid_bad`), and
+/// the input guards that remove them.
 #[allow(clippy::too_many_arguments)]
 fn locate_failures(
     gpu: &Gpu,
     model: &Model,
     cases: &[HardCase],
     case_out: &[[f32; 3]],
-    judged: &[Option<CaseResult>],
+    case_bad: &[bool],
     grid: &[Sample],
     grid_out: &[[f32; 3]],
-    in_domain: &[bool],
+    grid_bad: &[bool],
 ) -> Result<Failures> {
     let case_models: Vec<(Model, &str, Sample)> =
         cases.iter().map(|c| (case_model(model, c), c.name.as_str(), c.sample)).collect();
-    // Invalid-input cases and those outside the domain are not failures of a valid input.
-    let counted = |i: usize| cases[i].expect == Expect::Twin && judged[i].is_some();
-    let case_out: Vec<[f32; 3]> =
-        case_out.iter().enumerate().map(|(i, g)| if counted(i) { *g } else { [0.0; 3] }).collect();
-    let grid_out: Vec<[f32; 3]> =
-        grid_out.iter().zip(in_domain).map(|(g, &inside)| if inside { *g } else { [0.0; 3] }).collect();
-    failures::locate(gpu, &case_models, &case_out, model, grid, &grid_out)
+    let only_bad = |out: &[[f32; 3]], bad: &[bool]| -> Vec<[f32; 3]> {
+        out.iter().zip(bad).map(|(g, &b)| if b { *g } else { [0.0; 3] }).collect()
+    };
+    failures::locate(gpu, &case_models, &only_bad(case_out, case_bad), model, grid, &only_bad(grid_out, grid_bad))
 }

@@ -9,7 +9,7 @@ pub mod energy;
 pub mod failures;
 pub mod grid;
 
-pub use check::{Checks, check_model};
+pub use check::{Checks, Expected, check_model};
 
 use crate::accuracy::FLOOR;
 use crate::brdf::guards::{GuardSet, SWITCHES, unit};
@@ -64,15 +64,16 @@ fn base_tolerance(p: Precision) -> f64 {
     }
 }
 
-/// How far the f64 result moves when the kernel's unit vectors carry the rounding of its arithmetic: the largest
-/// change over 8 random perturbations of every unit-vector component by +-epsilon (absolute; not renormalised,
-/// as the kernel adds V + L without renormalising them) and of roughness and F0 by +-epsilon (relative). Where
-/// the half vector is ill-conditioned (V near -L, |V + L| small) or a lobe is razor-thin, this is what any
-/// implementation at that precision can promise.
-fn sensitivity(spec: &ModelSpec, s: &Sample, channel: usize, epsilon: f64, seed: u64) -> f64 {
+/// How far the expected f64 result moves when the kernel's unit vectors carry the rounding of its arithmetic:
+/// the largest change over 8 random perturbations of every unit-vector component by +-epsilon (absolute; not
+/// renormalised, as the kernel adds V + L without renormalising them) and of roughness and F0 by +-epsilon
+/// (relative). Where the half vector is ill-conditioned (V near -L, |V + L| small), a lobe is razor-thin or a
+/// cosine is near 0 (the exact formula's 1/NoV), this is what any implementation at that precision can promise.
+fn sensitivity(expected: &Expected, s: &Sample, channel: usize, epsilon: f64, seed: u64) -> f64 {
     let (n, v, l) = (unit(s.n), unit(s.v), unit(s.l));
     let (r, f0) = (f64::from(s.roughness), s.f0.map(f64::from));
-    let base = spec.eval_unit(n, v, l, r, f0)[channel];
+    let Some(base) = expected.at_unit(n, v, l, r, f0) else { return 0.0 };
+    let base = base[channel];
     let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
     let mut sign = || if rng.random::<bool>() { 1.0 } else { -1.0 };
     (0..8)
@@ -81,16 +82,16 @@ fn sensitivity(spec: &ModelSpec, s: &Sample, channel: usize, epsilon: f64, seed:
             let (pn, pv, pl) = (shift(n), shift(v), shift(l));
             let pr = r * (1.0 + epsilon * sign());
             let pf = f0.map(|x| x * (1.0 + epsilon * sign()));
-            (spec.eval_unit(pn, pv, pl, pr, pf)[channel] - base).abs()
+            expected.at_unit(pn, pv, pl, pr, pf).map_or(0.0, |e| (e[channel] - base).abs())
         })
         .fold(0.0, f64::max)
 }
 
-/// The tolerance for one value: the base tolerance of the precision, or four times what the rounding of the
-/// kernel's unit vectors alone moves the f64 result, whichever is larger.
-pub fn tolerance(spec: &ModelSpec, s: &Sample, channel: usize, expected: f64, seed: u64) -> f64 {
-    let base = base_tolerance(spec.precision) * expected.abs().max(FLOOR);
-    base.max(4.0 * sensitivity(spec, s, channel, unit_epsilon(spec.precision), seed))
+/// The tolerance for one value: the base tolerance of the model's precision, or four times what the rounding
+/// of the kernel's unit vectors alone moves the expected f64 result, whichever is larger.
+pub fn tolerance(expected: &Expected, s: &Sample, channel: usize, value: f64, seed: u64) -> f64 {
+    let base = base_tolerance(expected.precision) * value.abs().max(FLOOR);
+    base.max(4.0 * sensitivity(expected, s, channel, unit_epsilon(expected.precision), seed))
 }
 
 /// A stability report is read back (`report`, `--html`) as these same types: what no reader shows is skipped,
@@ -99,6 +100,9 @@ pub fn tolerance(spec: &ModelSpec, s: &Sample, channel: usize, expected: f64, se
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct CaseResult {
     pub case: String,
+    /// The input as a reader checks it (`failures::describe`; empty in a report written before it).
+    #[serde(default)]
+    pub inputs: String,
     #[serde(skip_deserializing)]
     pub expected: Option<[f64; 3]>,
     #[serde(skip_deserializing)]
@@ -107,6 +111,23 @@ pub struct CaseResult {
     #[serde(default = "crate::io::nan", deserialize_with = "crate::io::nan_if_null")]
     pub deviation: f64,
     #[serde(skip_deserializing)]
+    pub ok: bool,
+}
+
+/// A hard case at the model's declared domain's own bounds (`catalogue::at_domain_bounds`), with what its
+/// precision loses there against the formula's exact value, said even within tolerance.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct BoundCase {
+    pub case: String,
+    pub inputs: String,
+    /// The channel furthest from the exact value (relatively).
+    #[serde(default = "crate::io::nan", deserialize_with = "crate::io::nan_if_null")]
+    pub got: f64,
+    pub exact: Option<f64>,
+    /// got / exact - 1, signed (negative: low).
+    pub loss: Option<f64>,
+    #[serde(default = "crate::io::nan", deserialize_with = "crate::io::nan_if_null")]
+    pub deviation: f64,
     pub ok: bool,
 }
 
@@ -159,6 +180,13 @@ pub struct SpecStability {
     /// Largest deviation per hard case, in catalogue order (for the per-case summary).
     #[serde(skip)]
     pub case_deviation: Vec<f64>,
+    /// Valid hard cases with no value to check against, each with why (`NoValue`): the reference's D is
+    /// singular there, or its exact value is beyond fp32's range.
+    #[serde(default)]
+    pub cases_without_value: Vec<String>,
+    /// Grid points in the domain likewise.
+    #[serde(default)]
+    pub grid_without_value: usize,
     /// Grid points out of tolerance.
     pub grid_out_of_tolerance: usize,
     #[serde(default = "no_worst")]
@@ -193,6 +221,9 @@ pub struct SpecStability {
     /// input values and the input guards that remove it (empty in a report written before they were listed).
     #[serde(default)]
     pub failures: failures::Failures,
+    /// The cases at the declared domain's bounds (empty without a domain).
+    #[serde(default)]
+    pub at_domain_bounds: Vec<BoundCase>,
     pub energy: Option<energy::Energy>,
 }
 
@@ -363,7 +394,7 @@ impl StabilityReport {
         let stem = out.join(format!("stability-{device}"));
         let mut written = vec![stem.with_extension("md"), stem.with_extension("json")];
         crate::export::json::write_report_compact(&written[1], crate::export::json::Kind::Stability, self)?;
-        crate::io::write_output(&written[0], self.markdown().as_bytes())?;
+        crate::io::write_markdown(&written[0], &self.markdown())?;
         let entries = self.energy_entries();
         if !entries.is_empty() {
             let furnace = out.join(format!("furnace-{device}.png"));
@@ -438,6 +469,16 @@ fn axis_value(x: Option<f64>) -> String {
     }
 }
 
+/// A signed relative difference as a reader says it: "20% low", "3.1e-05 high", "exact".
+pub fn loss_text(x: f64) -> String {
+    let side = if x < 0.0 { "low" } else { "high" };
+    match x.abs() {
+        0.0 => "exact".into(),
+        a if a >= 1e-3 => format!("{}% {side}", crate::export::markdown::sig(100.0 * a, 3)),
+        a => format!("{a:.1e} {side}"),
+    }
+}
+
 /// The worst deviation as a table cell: in tolerances, or what the value was when it is not a number.
 fn worst_cell(w: &Worst) -> String {
     if w.got.is_nan() {
@@ -482,8 +523,9 @@ impl StabilityReport {
         let mut out = format!(
             "# brdfprof stability\n\n{} ({}), {} specs; {} hard cases and {} grid points each.\n\n\
              NaN/Inf/neg: results on valid inputs (a spec with any fails, and the command exits 1). Out of tolerance: cases and \
-             grid points whose result is further from the expected value (the f64 twin, which applies the same guards) than \
-             max(base, 4 x what rounding the inputs at the kernel's precision alone moves the f64 result), base = 1e-3 (fp32) \
+             grid points whose result is further from the expected value (a built-in spec's f64 twin, which applies the same guards; \
+             a model without one: its reference's formula exactly at the same inputs, with no roughness or cosine floor, where \
+             an input with no exact value (roughness 0) or one beyond fp32's range is said, not judged) than max(base, 4 x what rounding the inputs at the kernel's precision alone moves the f64 result), base = 1e-3 (fp32) \
              or 2e-2 (fp16) relative; worst: that distance in tolerances. Jumps: steps in f_s NoL along NoV, NoL or roughness \
              that the f64 model does not take. Reciprocity: max |f(v,l) - f(l,v)| / max(|f|, 1e-3) over finite pairs (NaN/Inf \
              values are counted, never taken for agreement). E: directional albedo with F = 1 (max over the finite cells of \
@@ -539,10 +581,86 @@ impl StabilityReport {
         }
         out += &t.markdown();
         out += &self.expectations_markdown();
+        out += &self.out_of_tolerance_markdown();
+        out += &self.bounds_markdown();
         out += &self.cases_markdown();
         out += &self.guard_savings_markdown();
         out += &self.failing_markdown();
         out
+    }
+
+    /// Where each spec checked against a reference or twin is out of tolerance: its worst value and every
+    /// hard case out of tolerance, each with its inputs, what it got and what was expected.
+    fn out_of_tolerance_markdown(&self) -> String {
+        let mut out = String::new();
+        for s in self.specs.iter().filter(|s| s.checked()) {
+            let cases: Vec<&CaseResult> = s.cases_out_of_tolerance.iter().filter(|c| c.expected.is_some()).collect();
+            if cases.is_empty() && s.grid_out_of_tolerance == 0 {
+                continue;
+            }
+            out += &format!(
+                "- `{}`: {} hard cases and {} grid points out of tolerance; the worst, {} x tolerance, at {}: got {}, expected {}\n",
+                crate::export::escape_line(s.label()),
+                cases.len(),
+                s.grid_out_of_tolerance,
+                worst_cell(&s.worst),
+                s.worst.input,
+                crate::export::markdown::sig(f64::from(s.worst.got), 4),
+                crate::export::markdown::sig(s.worst.expected, 4)
+            );
+            for c in cases {
+                let worst = (0..3)
+                    .max_by(|&a, &b| {
+                        let e = c.expected.unwrap_or_default();
+                        (f64::from(c.got[a]) - e[a]).abs().total_cmp(&(f64::from(c.got[b]) - e[b]).abs())
+                    })
+                    .unwrap_or(0);
+                out += &format!(
+                    "  - `{}` at {}: got {}, expected {} ({:.2e} x tolerance)\n",
+                    c.case,
+                    c.inputs,
+                    crate::export::markdown::sig(f64::from(c.got[worst]), 4),
+                    crate::export::markdown::sig(c.expected.unwrap_or_default()[worst], 4),
+                    c.deviation
+                );
+            }
+        }
+        if out.is_empty() {
+            return out;
+        }
+        format!(
+            "\n## Out of tolerance: where\n\nEach spec's worst value and every hard case out of tolerance, with its inputs (the channel furthest from the expected value).\n\n{out}"
+        )
+    }
+
+    /// The cases at each declared domain's bounds, with what the precision loses there against the formula's
+    /// exact value, within tolerance or not.
+    fn bounds_markdown(&self) -> String {
+        use crate::export::markdown::{Table, sig};
+        let mut t = Table::new(["spec", "case", "inputs", "got", "exact", "loss", "x tol.", "verdict"]);
+        let mut any = false;
+        for s in &self.specs {
+            for b in &s.at_domain_bounds {
+                any = true;
+                t.row([
+                    crate::export::escape_line(s.label()),
+                    b.case.clone(),
+                    b.inputs.clone(),
+                    sig(b.got, 4),
+                    b.exact.map_or("-".into(), |e| sig(e, 4)),
+                    b.loss.map_or("-".into(), loss_text),
+                    if b.deviation.is_finite() { format!("{:.2e}", b.deviation) } else { "-".into() },
+                    if b.ok { "within".into() } else { "out of tolerance".into() },
+                ]);
+            }
+        }
+        if !any {
+            return String::new();
+        }
+        format!(
+            "\n## At the domain's bounds\n\nEach declared domain's own ends (roughness minimum and maximum: the peak N = H, the peak at grazing, off the peak; the NoV and NoL minimum), which the catalogue's fixed values may miss: the result against the formula's exact value there (no floor), and what the kernel's precision loses, said even within tolerance.\n\n{}",
+            t.markdown()
+        )
     }
 
     /// The hard-case table: how many specs each case puts out of tolerance, and the worst.
@@ -607,7 +725,7 @@ impl StabilityReport {
         let mut lines = Vec::new();
         for s in &self.specs {
             let against = match (&s.expected_from, s.has_twin) {
-                (Some(e), false) => Some(format!("checked against the {e}'s f64 values")),
+                (Some(e), false) => Some(format!("checked against the {e}, in f64")),
                 _ => None,
             };
             let domain = s.domain.as_ref().map(|d| {
@@ -616,9 +734,20 @@ impl StabilityReport {
                     s.cases_outside_domain, s.grid_outside_domain
                 )
             });
-            let said: Vec<String> = against.into_iter().chain(domain).collect();
+            let without = (!s.cases_without_value.is_empty() || s.grid_without_value > 0).then(|| {
+                format!(
+                    "nothing to check the value against (NaN and negative values still count) at {} grid points and {}",
+                    s.grid_without_value,
+                    if s.cases_without_value.is_empty() {
+                        "no hard case".to_string()
+                    } else {
+                        s.cases_without_value.join("; ")
+                    }
+                )
+            });
+            let said: Vec<String> = against.into_iter().chain(domain).chain(without).collect();
             if !said.is_empty() {
-                lines.push(format!("- `{}`: {}\n", s.label, said.join("; ")));
+                lines.push(format!("- `{}`: {}\n", crate::export::escape_line(&s.label), said.join("; ")));
             }
         }
         if lines.is_empty() { String::new() } else { format!("\n{}", lines.concat()) }
@@ -660,13 +789,17 @@ impl StabilityReport {
     pub fn heatmaps(&self, path: &std::path::Path) -> Result<bool> {
         use plotters::prelude::*;
         let all = self.failing();
-        if all.is_empty() {
+        // Every failing spec whose grid failed gets a panel (one that failed only in hard cases has no map, and
+        // where none did there is no picture).
+        let failing: Vec<&SpecStability> = all.iter().copied().filter(|s| s.bad_cells.is_some()).collect();
+        if failing.is_empty() {
             return Ok(false);
         }
-        // Every failing spec whose grid failed gets a panel (one that failed only in hard cases has no map).
-        let failing: Vec<&SpecStability> = all.iter().copied().filter(|s| s.bad_cells.is_some()).collect();
-        let title =
-            format!("Failing specs ({}): NaN, Inf or negative results per (NoV, roughness) grid cell", failing.len());
+        let title = format!(
+            "{} of {} failing specs: NaN, Inf or negative results per (NoV, roughness) grid cell",
+            failing.len(),
+            all.len()
+        );
         let columns = 6usize.min(failing.len());
         // The title fits the figure's width: about 0.55 em per character.
         let title_size = (300.0 * columns as f64 / (0.55 * title.len() as f64)).min(20.0) as u32;

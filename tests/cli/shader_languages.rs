@@ -252,7 +252,9 @@ fn profile_stability_sweep_and_report_take_them_and_state_the_front_end() {
     assert!(out.stdout.contains("Front ends: "), "{}", out.stdout);
     // ue-light.brdf declares its reference and its engine's roughness domain, which stability honours.
     assert!(
-        out.stdout.contains("- `ue-light`: checked against the reference `ggx`'s f64 values; roughness in [0.045, 1]"),
+        out.stdout.contains(
+            "- `ue-light`: checked against the reference `ggx` (its formula exactly, no floor), in f64; roughness in [0.045, 1]"
+        ),
         "{}",
         out.stdout
     );

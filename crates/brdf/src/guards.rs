@@ -136,6 +136,10 @@ impl Default for GuardSet {
 impl GuardSet {
     pub const ALL: GuardSet = GuardSet(31);
     pub const NONE: GuardSet = GuardSet(0);
+    /// What a reference keeps (`ModelSpec::eval_reference`): the lit mask (f_s is defined above the horizon
+    /// only), the safe H, |N x H|^2 and the F0 clamp (exact in f64, or no-ops on valid inputs); not the cosine
+    /// floor, which changes the formula's value below MIN_COSINE.
+    pub const FORMULA: GuardSet = GuardSet(GuardSet::ALL.0 & !SWITCHES[2].bit);
 
     /// Whether the guard `name` (a name of `SWITCHES`) is on.
     pub fn on(self, name: &str) -> bool {
@@ -292,5 +296,19 @@ mod tests {
         // All at once: the cosine floor lifts V and L off the horizon first, so the others let it through.
         let all = apply_all_input_guards(&s, MIN_ROUGHNESS_F32).expect("called once the cosines are floored");
         assert_eq!((all.roughness, all.f0, all.v, all.l), (MIN_ROUGHNESS_F32 as f32, [1.0, 0.0, 0.5], up.v, up.l));
+    }
+}
+
+#[cfg(test)]
+mod formula_tests {
+    use super::*;
+
+    #[test]
+    fn the_formulas_guards_are_all_but_the_cosine_floor() {
+        assert!(!GuardSet::FORMULA.on("cosine-floor"));
+        for s in SWITCHES.iter().filter(|s| s.name != "cosine-floor") {
+            assert!(GuardSet::FORMULA.on(s.name), "{}", s.name);
+        }
+        assert_eq!(GuardSet::FORMULA.cosine(1e-7), 1e-7, "a cosine below MIN_COSINE is kept");
     }
 }

@@ -106,6 +106,13 @@ pub const PRESETS: &[Preset] = &[
         f: F::Schlick,
         source: "Filament low quality: GGX, V_SmithGGXCorrelated_Fast (Hammon), Schlick f90 = 1",
     },
+    Preset {
+        name: "learnopengl",
+        d: D::Ggx,
+        vis: Vis::SchlickGgxKaris,
+        f: F::Schlick,
+        source: "LearnOpenGL PBR (de Vries 2014) and UE4's 2013 course notes' direct-light remap: GGX, Schlick-GGX with k = (r+1)^2/8, Schlick",
+    },
 ];
 
 /// The four models of the thesis, in its order.
@@ -113,6 +120,10 @@ pub const THESIS_MODELS: [&str; 4] = ["ggx", "blinn", "cook-torrance", "burley"]
 
 /// The reference every cost is compared with: the thesis' (and UE's) GGX.
 pub const REFERENCE_MODEL: &str = "ggx";
+
+/// The reference without brdfprof's guards: engine code carries fewer guards than the presets (docs/guards.md),
+/// so an engine's own function is also compared with this, what the same formula costs unguarded.
+pub const UNGUARDED_REFERENCE_MODEL: &str = "ggx,guards=off";
 
 /// Keys of a spec besides the parameters.
 const TERM_KEYS: [&str; 5] = ["d", "vis", "f", "precision", "guards"];
@@ -318,17 +329,23 @@ impl ModelSpec {
         self.eval_unit(unit(n), unit(v), unit(l), roughness, f0)
     }
 
-    /// The formula itself as a reference, at the sampled roughness: `eval` without the roughness floor (the
-    /// floor is a guard of fp32 kernels and engines, not of the mathematics; a reference that applied it would
-    /// blame a model for the rows below it). None at roughness 0, where D is singular (a Dirac delta): such a
-    /// row has no reference value.
+    /// The formula itself as a reference, at the sampled roughness and cosines: `eval` without the roughness
+    /// floor and without the cosine floor (`GuardSet::FORMULA`; both are guards of fp32 kernels and engines, not
+    /// of the mathematics: a reference that applied them would blame a model for the inputs below them). None
+    /// at roughness 0, where D is singular (a Dirac delta): such an input has no reference value.
     pub fn eval_reference(&self, s: &Sample) -> Option<[f64; 3]> {
-        let r = f64::from(s.roughness).min(1.0);
+        let (n, v, l) = (guards::unit(s.n), guards::unit(s.v), guards::unit(s.l));
+        self.eval_reference_unit(n, v, l, f64::from(s.roughness), s.f0.map(f64::from))
+    }
+
+    /// `eval_reference` for N, V, L taken as given (the stability suite perturbs them to find what rounding
+    /// alone moves the value).
+    pub fn eval_reference_unit(&self, n: DVec3, v: DVec3, l: DVec3, roughness: f64, f0: [f64; 3]) -> Option<[f64; 3]> {
+        let r = roughness.min(1.0);
         if r.is_nan() || r <= 0.0 {
             return None;
         }
-        let (n, v, l) = (guards::unit(s.n), guards::unit(s.v), guards::unit(s.l));
-        Some(match cosines_with(n, v, l, s.f0.map(f64::from), self.guards) {
+        Some(match cosines_with(n, v, l, f0, GuardSet::FORMULA) {
             Some((c, f0)) => self.from_cosines(&c, r * r, f0),
             None => [0.0; 3],
         })
@@ -436,6 +453,38 @@ fn unknown(key: &str, value: &str, valid: &[impl AsRef<str>]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The reference is the formula at the inputs: below the 1e-4 cosine floor (N.V = N.L = 1e-5, a mirror
+    /// configuration) GGX with the exact correlated Smith term grows as 1/NoV, ten times the floored twin's value.
+    #[test]
+    fn a_reference_has_no_cosine_floor() {
+        let ggx = ModelSpec::parse("d=ggx,vis=smith-ggx-correlated,f=schlick").unwrap();
+        let c = 1e-5f64;
+        let s = (1.0 - c * c).sqrt();
+        let (n, v, l) = (DVec3::Z, DVec3::new(s, 0.0, c), DVec3::new(-s, 0.0, c));
+        let exact = ggx.eval_reference_unit(n, v, l, 0.5, [0.04; 3]).unwrap()[0];
+        let floored = ggx.eval_unit(n, v, l, 0.5, [0.04; 3])[0];
+        // At N = H: D = 1 / (pi a2), Vis = 0.5 / (2 NoV sqrt(NoV^2 (1 - a2) + a2)), F at VoH = c.
+        let (a2, f) = (0.0625f64, 0.04 + 0.96 * (1.0 - c).powi(5));
+        let formula = 1.0 / (std::f64::consts::PI * a2) * 0.5 / (2.0 * c * (c * c * (1.0 - a2) + a2).sqrt()) * f;
+        assert!((exact / formula - 1.0).abs() < 1e-9, "{exact} vs the formula's {formula}");
+        assert!((exact / floored - 10.0).abs() < 0.01, "{exact} against the floored twin's {floored}");
+        assert_eq!(ggx.eval_reference_unit(n, v, l, 0.0, [0.04; 3]), None, "roughness 0: D is a Dirac delta");
+        assert_eq!(ggx.eval_reference_unit(n, v, -l, 0.5, [0.04; 3]), Some([0.0; 3]), "light below the horizon");
+    }
+
+    /// Karis' remap for analytic lights: k = (r + 1)^2 / 8 in Schlick's G1 = x / (x (1 - k) + k).
+    #[test]
+    fn schlick_ggx_karis_remaps_the_roughness() {
+        let spec = ModelSpec::parse("d=ggx,vis=schlick-ggx-karis,f=none").unwrap();
+        let (r, nov, nol) = (0.5f64, 0.3f64, 0.8f64);
+        let k = (r + 1.0) * (r + 1.0) / 8.0;
+        let g = nov / (nov * (1.0 - k) + k) * nol / (nol * (1.0 - k) + k);
+        let c = Cosines { nov, nol, noh: 0.9, voh: 0.7, sin2h: 0.19 };
+        let vis = spec.vis.eval(&c, r * r);
+        assert!((vis - g / (4.0 * nov * nol)).abs() < 1e-15, "{vis}");
+        assert_eq!(ModelSpec::preset("learnopengl").unwrap().vis, Vis::SchlickGgxKaris);
+    }
 
     #[test]
     fn presets_and_overrides_round_trip() {

@@ -301,6 +301,8 @@ term_table! {
             VisRow { eval: vis_smith_beckmann_correlated, family: Some(Family::Beckmann), exact_for: Some(D::Beckmann) };
         SmithBeckmannWalter = 13, "smith-beckmann-walter", "Smith Beckmann, Walter's rational G1 [Walter et al. 2007, eq. 27]: (3.535c + 2.181c^2)/(1 + 2.276c + 2.577c^2) for c < 1.6, separable",
             VisRow { eval: vis_smith_beckmann_walter, family: Some(Family::Beckmann), exact_for: None };
+        SchlickGgxKaris = 14, "schlick-ggx-karis", "Schlick-GGX with Karis' remap for analytic lights [Karis 2013, p. 3; de Vries, LearnOpenGL \"PBR: Theory\" 2014]: G1 = x / (x (1-k) + k), k = (r + 1)^2 / 8, r = sqrt(a)",
+            VisRow { eval: vis_schlick_ggx_karis, family: Some(Family::Ggx), exact_for: None };
     }
 }
 
@@ -503,6 +505,12 @@ fn vis_schlick_beckmann(c: &Cosines, a: f64) -> f64 {
 
 fn vis_schlick_ggx(c: &Cosines, a: f64) -> f64 {
     vis_schlick(c.nov, c.nol, a * 0.5)
+}
+
+/// Karis' k = a'/2 with a' = ((r + 1) / 2)^2: the roughness remapped for punctual lights (perceptual r = sqrt(a)).
+fn vis_schlick_ggx_karis(c: &Cosines, a: f64) -> f64 {
+    let r1 = a.sqrt() + 1.0;
+    vis_schlick(c.nov, c.nol, r1 * r1 * 0.125)
 }
 
 /// sqrt(x^2 (1 - a2) + a2), written x (x - x a2) + a2 as in the GLSL.
