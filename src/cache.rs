@@ -313,9 +313,12 @@ impl Store {
         static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
         let n = NEXT.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
         let tmp = self.dir.join(format!(".{}.{kind}.{}.{n}.tmp", key.hex(), std::process::id()));
-        let _guard = crate::cleanup::PathGuard::new(&tmp);
-        let result =
-            std::fs::write(&tmp, encode(kind, key, payload)).and_then(|_| std::fs::rename(&tmp, self.path(kind, key)));
+        let made = crate::cleanup::PathGuard::create(&tmp, || std::fs::File::create(&tmp));
+        let result = made.and_then(|(_guard, mut f)| {
+            std::io::Write::write_all(&mut f, &encode(kind, key, payload))?;
+            drop(f);
+            std::fs::rename(&tmp, self.path(kind, key))
+        });
         if result.is_err() {
             let _ = std::fs::remove_file(&tmp);
         }

@@ -175,6 +175,7 @@ pub fn glslang_with(
     let out_dir = crate::cleanup::TempDir::new().context("cannot create a temporary directory for glslang's output")?;
     let out = out_dir.path().join("out.spv");
     let mut cmd = crate::cleanup::command("glslangValidator");
+    crate::launch::bound_memory(&mut cmd)?;
     cmd.args(GLSLANG_FLAGS).args(extra);
     for d in defines {
         cmd.arg(format!("-D{d}"));
@@ -211,6 +212,7 @@ pub fn glslang_preprocess(text: &str, defines: &[String], what: &str) -> Result<
     let source = dir.path().join("shader.comp");
     std::fs::write(&source, text).with_context(|| format!("cannot write {}", source.display()))?;
     let mut cmd = crate::cleanup::command("glslangValidator");
+    crate::launch::bound_memory(&mut cmd)?;
     cmd.arg("-E").arg("-DVULKAN=100");
     for d in defines {
         cmd.arg(format!("-D{d}"));

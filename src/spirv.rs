@@ -186,6 +186,7 @@ pub fn spec_default_values(words: &[u32], constants: &SpecConstants) -> Result<S
 /// Runs spirv-opt with `args` on `words` (through stdin and stdout), under the compile limit.
 pub fn spirv_opt(words: &[u32], args: &[String]) -> Result<Vec<u32>> {
     let mut cmd = crate::cleanup::command("spirv-opt");
+    crate::launch::bound_memory(&mut cmd)?;
     cmd.args(args).args(["-", "-o", "-"]);
     let bytes: Vec<u8> = words.iter().flat_map(|w| w.to_le_bytes()).collect();
     let shown = if args.len() > 3 { format!("{} ...", args[..3].join(" ")) } else { args.join(" ") };

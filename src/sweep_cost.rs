@@ -305,7 +305,7 @@ A spec is on a target's frontier when no other spec is both cheaper there (its c
     pub fn write(&self, stem: &Path) -> Result<Vec<PathBuf>> {
         let (md, json) = (stem.with_extension("md"), stem.with_extension("json"));
         json::write_report_compact(&json, json::Kind::SweepFrontiers, self)?;
-        crate::io::write_output(&md, self.markdown().as_bytes())?;
+        crate::io::write_markdown(&md, &self.markdown())?;
         Ok(vec![md, json])
     }
 }

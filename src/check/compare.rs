@@ -236,8 +236,12 @@ pub fn compare(old: &Baseline, new: &Baseline, thresholds: &Thresholds, force: b
             regressed.push(model);
         }
     }
+    // Per-line cost is a target's own: lines measured on another target (an nvidia: baseline checked on
+    // intel:) would read as new cost on every line.
+    let same_target = super::findings::measured_on(old).0 == super::findings::measured_on(new).0;
     let lines = regressed
         .iter()
+        .filter(|_| same_target)
         .filter_map(|&model| {
             let changes = super::lines::changes(&old.inspect.lines, &new.inspect.lines, model)?;
             let pipe = new.inspect.lines.iter().find(|k| k.model == model)?.binding_pipe.clone();

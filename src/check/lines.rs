@@ -22,6 +22,13 @@ impl LineChange {
     }
 }
 
+/// A file name as lines are matched by it: `./shaders/x` and `shaders/x` are one file.
+fn same_path(file: &str) -> String {
+    let parts: Vec<&str> = file.split('/').filter(|p| *p != "." && !p.is_empty()).collect();
+    let joined = parts.join("/");
+    if file.starts_with('/') { format!("/{joined}") } else { joined }
+}
+
 /// A line's cycles on `pipe`.
 fn cycles(l: &LineCost, pipe: &str) -> f64 {
     l.pipes.get(pipe).copied().unwrap_or(0.0)
@@ -41,7 +48,8 @@ pub fn changes(old: &[KernelLines], new: &[KernelLines], model: &str) -> Option<
     let mut unmatched: Vec<Option<LineCost>> = ordered(old).into_iter().map(Some).collect();
     let mut out = Vec::new();
     for n in ordered(new) {
-        let key = |l: &LineCost| (l.file.clone(), if l.text.is_empty() { l.line.to_string() } else { l.text.clone() });
+        let key =
+            |l: &LineCost| (same_path(&l.file), if l.text.is_empty() { l.line.to_string() } else { l.text.clone() });
         let found = unmatched.iter_mut().find(|o| o.as_ref().is_some_and(|o| key(o) == key(&n))).and_then(Option::take);
         out.push(LineChange {
             file: n.file.clone(),
@@ -122,5 +130,16 @@ mod tests {
         assert_eq!((cheaper.before, cheaper.after), (3.0, 1.0), "the k-th occurrence with the k-th");
         assert_eq!(risen(&c, 5).len(), 1);
         assert!(changes(&[], &[kernel(vec![])], "m").is_none(), "no lines in the baseline: nothing to say");
+    }
+
+    /// `./shaders/x` in this run and `shaders/x` in the baseline are one file: no line reads as new cost.
+    #[test]
+    fn a_path_written_with_dot_slash_is_the_same_file() {
+        let old = kernel(vec![LineCost { file: "shaders/m.brdf".into(), ..line(3, "a = b;", 2.0) }]);
+        let new = kernel(vec![LineCost { file: "./shaders//m.brdf".into(), ..line(3, "a = b;", 2.0) }]);
+        let c = changes(&[old], &[new], "m").unwrap();
+        assert_eq!(c.len(), 1);
+        assert_eq!((c[0].before, c[0].after), (2.0, 2.0));
+        assert_eq!(same_path("/abs/./x.brdf"), "/abs/x.brdf");
     }
 }

@@ -62,7 +62,24 @@ pub struct Outcome {
     pub measured_on: (String, String),
 }
 
-/// The models and lights a check measures: those asked for, else the baseline's, else the defaults.
+/// The baseline's rows whose shader file is gone (renamed or deleted since it was saved), each as "`label`
+/// (path)": not measured, named in the report, the other models compared.
+fn missing_files(old: Option<&Baseline>) -> Vec<String> {
+    let Some(b) = old else { return Vec::new() };
+    b.inspect
+        .rows
+        .iter()
+        .filter_map(|r| {
+            let (path, _) = crate::model::file_model::split_path(r.spec.as_deref()?, std::path::Path::new(""))?;
+            (!std::path::Path::new(path).exists()).then(|| {
+                format!("`{}` ({})", crate::messages::escape_line(&r.model), crate::messages::escape_line(path))
+            })
+        })
+        .collect()
+}
+
+/// The models and lights a check measures: those asked for, else the baseline's (but those whose file is
+/// gone: `missing_files`), else the defaults.
 fn plan(options: &CheckOptions, old: Option<&Baseline>) -> Result<(Vec<Model>, u32)> {
     let lights = match (options.lights, old) {
         (Some(l), Some(b)) if l != b.inspect.lights => {
@@ -85,6 +102,10 @@ fn plan(options: &CheckOptions, old: Option<&Baseline>) -> Result<(Vec<Model>, u
             .rows
             .iter()
             .filter_map(|r| r.spec.as_deref())
+            .filter(|s| {
+                crate::model::file_model::split_path(s, std::path::Path::new(""))
+                    .is_none_or(|(path, _)| std::path::Path::new(path).exists())
+            })
             .map(|s| Model::parse(s).map_err(|e| anyhow!("{s}: {e}")))
             .collect::<Result<_>>()?
     } else {
@@ -197,6 +218,17 @@ fn run_measured(options: &CheckOptions, measure: impl FnOnce(Vec<Model>, u32) ->
             measured_on,
         },
     };
+    let missing = missing_files(old.as_ref());
+    if !missing.is_empty() {
+        crate::messages::warning(format!(
+            "check: the baseline names shader files that are gone, not compared: {}; save a new baseline (--save-baseline) to drop them",
+            missing.join(", ")
+        ));
+        outcome.text += &format!(
+            "\n\n## Shader files the baseline names that are gone\n\nRenamed or deleted since the baseline was saved, so not measured (the other models are compared); `--save-baseline` writes a baseline without them.\n\n{}\n",
+            missing.iter().map(|m| format!("- {m}")).collect::<Vec<_>>().join("\n")
+        );
+    }
     // A model that failed on the target (its translation's check, its compile) has no figures to gate: the
     // others are compared, and the check fails naming it, never passing over it.
     let failed = findings::failed(&new, &models);
@@ -445,6 +477,15 @@ mod tests {
             e.contains("b.json: corrupt (row `ggx`: statistic spirv/total is -1; a count cannot be negative)"),
             "{e}"
         );
+        // Per-line cycles are counts too (they set each line's share of a regression).
+        let e = refused(&|v: &mut serde_json::Value| {
+            v["inspect"]["lines"] = serde_json::json!([{"model": "ggx", "binding_pipe": "FMA", "unattributed": 0, "instructions": 1,
+                "lines": [{"file": "m.brdf", "line": 3, "instructions": 1, "pipes": {"FMA": -4.0}, "binding": -4.0, "schedule": 0.0}]}]);
+        });
+        assert!(e.contains("m.brdf:3 has -4 cycles on FMA"), "{e}");
+        // A row naming a shader file that is gone is no corruption: the file is named as missing when checked.
+        let gone = |v: &mut serde_json::Value| v["inspect"]["rows"][0]["spec"] = "gone/missing.brdf".into();
+        assert_eq!(refused(&gone), "accepted");
         let e = refused(&stat("callgrind/ir-per-eval", -67.5));
         assert!(e.contains("statistic callgrind/ir-per-eval is -67.5; a count cannot be negative"), "{e}");
         let e = refused(&stat("naga/expressions", 1.5));

@@ -32,7 +32,7 @@ fn origin() -> &'static str {
 
 pub fn cache(args: &CacheArgs) -> Result<ExitCode> {
     let Some(store) = Store::open_default() else {
-        println!(
+        outln!(
             "the disk cache is off (BRDFPROF_CACHE_DIR is empty, or no home directory is known): nothing to show or clear"
         );
         return Ok(ExitCode::SUCCESS);
@@ -41,7 +41,7 @@ pub fn cache(args: &CacheArgs) -> Result<ExitCode> {
         CacheAction::Show => show(&store),
         CacheAction::Clear => {
             let (files, bytes) = store.clear()?;
-            println!(
+            outln!(
                 "removed {files} cache entr{} ({bytes} bytes) from {}",
                 if files == 1 { "y" } else { "ies" },
                 store.dir().display()
@@ -62,20 +62,16 @@ fn show(store: &Store) {
         let kind = if e.legacy { format!("{} (older brdfprof, unused)", e.kind) } else { e.kind.clone() };
         *kinds.entry(kind).or_default() += 1;
     }
-    println!("directory: {} ({})", store.dir().display(), origin());
+    outln!("directory: {} ({})", store.dir().display(), origin());
     let per_kind = kinds.iter().map(|(k, n)| format!("{k}: {n}")).collect::<Vec<_>>().join(", ");
-    println!(
-        "entries: {}{}",
-        entries.len(),
-        if per_kind.is_empty() { String::new() } else { format!(" ({per_kind})") }
-    );
+    outln!("entries: {}{}", entries.len(), if per_kind.is_empty() { String::new() } else { format!(" ({per_kind})") });
     let human = if bytes >= 1 << 20 {
         format!("{:.1} MiB", bytes as f64 / (1u64 << 20) as f64)
     } else {
         format!("{:.1} KiB", bytes as f64 / 1024.0)
     };
-    println!("total size: {bytes} bytes ({human})");
+    outln!("total size: {bytes} bytes ({human})");
     for e in entries.iter().filter(|e| e.damaged.is_some()) {
-        println!("damaged (replaced when next used): {} ({})", e.path.display(), e.damaged.as_deref().unwrap_or(""));
+        outln!("damaged (replaced when next used): {} ({})", e.path.display(), e.damaged.as_deref().unwrap_or(""));
     }
 }

@@ -59,13 +59,18 @@ pub struct CheckArgs {
 }
 
 pub fn check(args: &CheckArgs) -> Result<ExitCode> {
-    for (flag, path) in
-        [("--save-baseline", &args.save_baseline), ("--sarif", &args.sarif), ("--summary", &args.summary)]
-    {
-        if let Some(p) = path {
-            io::check_output_path(flag, p)?;
-        }
-    }
+    let models = args.model.models(&[]).map_err(|e| anyhow!("{e:#}"))?;
+    let mut inputs = super::model_inputs(&models);
+    let asked = [
+        ("--save-baseline", args.save_baseline.as_deref()),
+        ("--sarif", args.sarif.as_deref()),
+        ("--summary", args.summary.as_deref()),
+    ];
+    super::checked_outputs(&asked, &inputs)?;
+    // `--save-baseline` may replace the baseline it was compared with (the documented refresh); the CI outputs
+    // never.
+    inputs.extend(args.baseline.as_deref().map(|b| ("--baseline", b)));
+    super::checked_outputs(&asked[1..], &inputs)?;
     fresh_compilation(args.shader_cache);
     let (width, height) = parse_size("--timing-size", &args.timing_size)?;
     let options = CheckOptions {
@@ -73,7 +78,7 @@ pub fn check(args: &CheckArgs) -> Result<ExitCode> {
         save: args.save_baseline.clone(),
         thresholds: Thresholds::parse(&args.thresholds)?,
         force: args.force,
-        models: args.model.models(&[]).map_err(|e| anyhow!("{e:#}"))?,
+        models,
         lights: args.counts.lights,
         callgrind: args.counts.callgrind(args.device.validation())?,
         timing: TimingOptions { width, height, lights: 0, rounds: args.rounds, reps: args.reps, seed: 1 },
@@ -95,7 +100,7 @@ pub fn check(args: &CheckArgs) -> Result<ExitCode> {
         ),
         None => check::run(&options, &shaders, || args.device.open_with(true))?,
     };
-    print!("{}", outcome.text);
+    out!("{}", outcome.text);
     write_ci_outputs(args, &outcome)?;
     Ok(ExitCode::from(outcome.exit))
 }

@@ -29,11 +29,12 @@ pub fn compare(args: &CompareArgs) -> Result<ExitCode> {
     check_output("--json", args.json.as_deref(), "results", "compare.json")?;
     check_output("--markdown", args.markdown.as_deref(), "results", "compare.md")?;
     check_output("--chart", args.chart.as_deref(), "results", "compare.png")?;
-    for (flag, out) in [("--json", &args.json), ("--markdown", &args.markdown), ("--chart", &args.chart)] {
-        if let Some(out) = out {
-            io::check_not_input(flag, out, &args.files.iter().map(|f| ("FILE", f.as_path())).collect::<Vec<_>>())?;
-        }
-    }
+    let asked = [
+        ("--json", args.json.as_deref()),
+        ("--markdown", args.markdown.as_deref()),
+        ("--chart", args.chart.as_deref()),
+    ];
+    super::checked_outputs(&asked, &args.files.iter().map(|f| ("FILE", f.as_path())).collect::<Vec<_>>())?;
     let table = compare::from_files(&args.files)?;
     let json = args.json.clone().unwrap_or_else(|| PathBuf::from("results/compare.json"));
     let markdown = args.markdown.clone().unwrap_or_else(|| PathBuf::from("results/compare.md"));
@@ -41,9 +42,9 @@ pub fn compare(args: &CompareArgs) -> Result<ExitCode> {
     let files: Vec<String> = args.files.iter().map(|f| f.display().to_string()).collect();
     let text = format!("# brdfprof compare\n\n{}\n\n{}", files.join(", "), table.markdown());
     json::write_report(&json, json::Kind::Compare, &table)?;
-    io::write_output(&markdown, text.as_bytes())?;
+    io::write_markdown(&markdown, &text)?;
     table.chart(&chart)?;
-    print!("{text}");
-    println!("{}", super::written(&[json, markdown, chart]));
+    out!("{text}");
+    outln!("{}", super::written(&[json, markdown, chart]));
     Ok(ExitCode::SUCCESS)
 }

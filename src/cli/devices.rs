@@ -44,7 +44,7 @@ fn targets_table() -> String {
 
 pub fn devices(args: &DevicesArgs) -> Result<ExitCode> {
     if args.targets {
-        print!("{}", targets_table());
+        out!("{}", targets_table());
         return Ok(ExitCode::SUCCESS);
     }
     let infos = gpu::list_devices()?;
@@ -86,6 +86,6 @@ pub fn devices(args: &DevicesArgs) -> Result<ExitCode> {
             d.pipeline_executable_properties.to_string(),
         ]);
     }
-    print!("{}", t.markdown());
+    out!("{}", t.markdown());
     Ok(ExitCode::SUCCESS)
 }

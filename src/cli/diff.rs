@@ -88,18 +88,15 @@ fn tolerance(text: &str) -> Result<f64, String> {
 
 /// The outputs asked for, each checked writable, none an input, no two the same path.
 fn outputs(args: &DiffArgs, models: &[Model]) -> Result<Vec<(&'static str, PathBuf)>> {
-    let asked = [("--csv", &args.csv), ("--json", &args.json), ("--png", &args.png), ("--html", &args.html.html)];
-    let outs: Vec<(&'static str, PathBuf)> = asked.into_iter().filter_map(|(f, p)| p.clone().map(|p| (f, p))).collect();
+    let asked = [
+        ("--csv", args.csv.as_deref()),
+        ("--json", args.json.as_deref()),
+        ("--png", args.png.as_deref()),
+        ("--html", args.html.html.as_deref()),
+    ];
     let mut inputs: Vec<(&str, &Path)> = args.input.iter().map(|p| ("--input", p.as_path())).collect();
-    inputs.extend(models.iter().filter_map(Model::file).map(|f| ("--model", Path::new(&f.path))));
-    for (i, (flag, path)) in outs.iter().enumerate() {
-        io::check_output_path(flag, path)?;
-        io::check_not_input(flag, path, &inputs)?;
-        if let Some((other, _)) = outs[..i].iter().find(|(_, p)| p == path) {
-            bail!("{flag} {}: is also given to {other}; give each output its own path", path.display());
-        }
-    }
-    Ok(outs)
+    inputs.extend(super::model_inputs(models));
+    super::checked_outputs(&asked, &inputs)
 }
 
 pub fn diff(args: &DiffArgs) -> Result<ExitCode> {
@@ -157,9 +154,9 @@ pub fn diff(args: &DiffArgs) -> Result<ExitCode> {
     // The page reads the result back through its JSON view, as `brdfprof report` reads a saved one.
     let label = args.json.clone().unwrap_or_else(|| PathBuf::from("diff.json"));
     args.html.write(&[super::just_measured(&label, &result)?], Some(&gpu))?;
-    print!("{}", result.markdown());
+    out!("{}", result.markdown());
     if !outs.is_empty() {
-        println!("\n{}", super::written(&outs.iter().map(|(_, p)| p.clone()).collect::<Vec<_>>()));
+        outln!("\n{}", super::written(&outs.iter().map(|(_, p)| p.clone()).collect::<Vec<_>>()));
     }
     Ok(if result.within_tolerance { ExitCode::SUCCESS } else { ExitCode::from(1) })
 }
@@ -216,9 +213,9 @@ fn diff_set(args: &DiffArgs, reference: &Model, models: &[Model]) -> Result<Exit
     }
     let label = args.json.clone().unwrap_or_else(|| PathBuf::from("diff.json"));
     args.html.write(&[super::just_measured(&label, &result)?], Some(&gpu))?;
-    print!("{}", result.markdown());
+    out!("{}", result.markdown());
     if !outs.is_empty() {
-        println!("\n{}", super::written(&outs.iter().map(|(_, p)| p.clone()).collect::<Vec<_>>()));
+        outln!("\n{}", super::written(&outs.iter().map(|(_, p)| p.clone()).collect::<Vec<_>>()));
     }
     Ok(if result.within_tolerance { ExitCode::SUCCESS } else { ExitCode::from(1) })
 }

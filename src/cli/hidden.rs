@@ -32,7 +32,7 @@ pub fn generate_glsl(dir: &Path) -> Result<ExitCode> {
     for (name, text) in brdfprof::kernels::generated_glsl() {
         let path = dir.join(name);
         brdfprof::io::write_output(&path, text.as_bytes())?;
-        println!("{}", path.display());
+        outln!("{}", path.display());
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -75,12 +75,12 @@ pub fn inspect(args: &InspectArgs) -> Result<ExitCode> {
     }
     let validate = DeviceArgs { device: None, validate: args.validate }.validation();
     let plan = across_devices::plan(&args.devices)?;
-    check_outputs(args, &plan)?;
     let models = if args.sweep_specs {
         brdfprof::sweep::default_specs().into_iter().map(brdfprof::model::Model::spec).collect()
     } else {
         args.model.models(&THESIS_MODELS)?
     };
+    check_outputs(args, &plan, &models)?;
     let options = InspectOptions { models, lights, callgrind: args.counts.callgrind(validate)? };
     let profile = args.profile.as_deref().map(inspect::correlate::load_profile).transpose()?;
     let shaders = args.counts.shaders()?;
@@ -110,13 +110,13 @@ pub fn inspect(args: &InspectArgs) -> Result<ExitCode> {
         args.html.write(&[input], Some(&gpu))?;
         gpu.check_validation()?;
     }
-    io::write_output(&markdown, result.markdown.as_bytes())?;
+    io::write_markdown(&markdown, &result.markdown)?;
     args.bench.write(&result.bench_entries())?;
     if let (Some(chart), Some(multi)) = (&args.chart, &result.multi) {
         multi.costs.chart(chart)?;
     }
-    print!("{}", result.markdown);
-    println!(
+    out!("{}", result.markdown);
+    outln!(
         "JSON: {}\nMarkdown: {}{}",
         json.display(),
         markdown.display(),
@@ -137,7 +137,21 @@ pub fn inspect(args: &InspectArgs) -> Result<ExitCode> {
 }
 
 /// Refuses, before anything runs, options that `plan`'s devices cannot serve and outputs that cannot be written.
-fn check_outputs(args: &InspectArgs, plan: &[across_devices::Planned]) -> Result<()> {
+fn check_outputs(
+    args: &InspectArgs,
+    plan: &[across_devices::Planned],
+    models: &[brdfprof::model::Model],
+) -> Result<()> {
+    let mut inputs = super::model_inputs(models);
+    inputs.extend(args.profile.as_deref().map(|p| ("--profile", p)));
+    let asked = [
+        ("--json", args.json.as_deref()),
+        ("--markdown", args.markdown.as_deref()),
+        ("--chart", args.chart.as_deref()),
+        ("--html", args.html.html.as_deref()),
+        ("--bench-json", args.bench.bench_json.as_deref()),
+    ];
+    super::checked_outputs(&asked, &inputs)?;
     if args.lines
         && !plan.iter().any(|p| matches!(p, across_devices::Planned::Target(t) if brdfprof::targets::names_lines(t)))
     {

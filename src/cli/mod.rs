@@ -3,6 +3,22 @@
 //! layer (`on_device`), and the checks and names of their outputs. Each public command is in its own file,
 //! `cli/<command>.rs`; the hidden ones are in `hidden`.
 
+/// `print!` for what a command reports on stdout: through `messages::safe_text`, so that no name or text from
+/// an input starts a line of its own there (a GitHub workflow command, a forged table row).
+macro_rules! out {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = write!(std::io::stdout().lock(), "{}", brdfprof::messages::safe_text(&format!($($arg)*)));
+    }};
+}
+
+/// `println!` through `messages::safe_text` (`out!`).
+macro_rules! outln {
+    ($($arg:tt)*) => {{
+        out!("{}\n", format!($($arg)*))
+    }};
+}
+
 pub mod args;
 pub mod cache;
 pub mod check;
@@ -186,6 +202,39 @@ pub fn check_output(flag: &str, path: Option<&Path>, default_dir: &str, default_
             io::refuse_tracked_default(flag, Path::new(default_dir), &[default_name.replace("<device>", "*")])
         }
     }
+}
+
+/// The file outputs a command was asked for (flag, path), each checked the same way for every command before
+/// anything is measured: a path it may write (`io::check_output_path`), none of the command's `inputs` (the
+/// same file after links, hard links included: `io::check_not_input`), and no path given to two flags.
+pub fn checked_outputs(
+    asked: &[(&'static str, Option<&Path>)],
+    inputs: &[(&str, &Path)],
+) -> Result<Vec<(&'static str, PathBuf)>> {
+    let outs: Vec<(&'static str, PathBuf)> =
+        asked.iter().filter_map(|(f, p)| p.map(|p| (*f, p.to_path_buf()))).collect();
+    for (i, (flag, path)) in outs.iter().enumerate() {
+        io::check_output_path(flag, path)?;
+        io::check_not_input(flag, path, inputs)?;
+        if let Some((other, _)) = outs[..i].iter().find(|(_, p)| p == path || io::same_file(p, path)) {
+            anyhow::bail!("{flag} {}: is also given to {other}; give each output its own path", path.display());
+        }
+    }
+    Ok(outs)
+}
+
+/// Each model file, and every file it includes, as an input a command must not overwrite (`checked_outputs`).
+pub fn model_inputs(models: &[Model]) -> Vec<(&'static str, &Path)> {
+    let mut inputs: Vec<(&'static str, &Path)> = Vec::new();
+    for f in models.iter().filter_map(Model::file) {
+        inputs.push(("--model", Path::new(&f.path)));
+        for (file, _, _) in f.file.front_end_origins.iter().flatten() {
+            if !inputs.iter().any(|(_, p)| *p == Path::new(file)) {
+                inputs.push(("an included file of --model", Path::new(file)));
+            }
+        }
+    }
+    inputs
 }
 
 /// "written: a, b, c" for a command's outputs.

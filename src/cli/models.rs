@@ -73,6 +73,6 @@ pub fn models_text() -> String {
 }
 
 pub fn models() -> Result<ExitCode> {
-    print!("{}", models_text());
+    out!("{}", models_text());
     Ok(ExitCode::SUCCESS)
 }

@@ -68,8 +68,14 @@ pub fn profile(args: &ProfileArgs) -> Result<ExitCode> {
     args.bench.check()?;
     fresh_compilation(args.timing.shader_cache);
     let size = args.size.as_deref().unwrap_or("960x540");
-    let options =
-        args.timing.options(args.model.models(&THESIS_MODELS)?, size, args.reps, args.budget, args.target_ci)?;
+    let models = args.model.models(&THESIS_MODELS)?;
+    let asked = [
+        ("--json", args.json.as_deref()),
+        ("--html", args.html.html.as_deref()),
+        ("--bench-json", args.bench.bench_json.as_deref()),
+    ];
+    super::checked_outputs(&asked, &super::model_inputs(&models))?;
+    let options = args.timing.options(models, size, args.reps, args.budget, args.target_ci)?;
     let (gpu, result) = on_device(&args.device, |gpu, progress| profile::run(gpu, &options, progress))?;
     let path = args.json.clone().unwrap_or_else(|| {
         PathBuf::from(format!("{}/profile-{}.json", super::DEFAULT_OUT, brdfprof::targets::device_slug(&gpu.info)))
@@ -77,16 +83,16 @@ pub fn profile(args: &ProfileArgs) -> Result<ExitCode> {
     json::write_report(&path, json::Kind::Profile, &result)?;
     args.html.write(&[just_measured(&path, &result)?], Some(&gpu))?;
     args.bench.write(&result.bench_entries("profile"))?;
-    println!("{}\n", result.summary());
-    print!("{}{}{}", result.table().markdown(), result.interval_notes(), result.placement_notes());
+    outln!("{}\n", result.summary());
+    out!("{}{}{}", result.table().markdown(), result.interval_notes(), result.placement_notes());
     if let Some(t) = result.light_table() {
-        println!("\nns/eval by light count (net of the baseline; the baseline gross):\n\n{}", t.markdown());
+        outln!("\nns/eval by light count (net of the baseline; the baseline gross):\n\n{}", t.markdown());
     }
     let harness = result.harness_warning();
     if let Some(text) = harness.trim_end().strip_prefix("warning: ") {
         brdfprof::messages::warning(text);
     }
-    println!("\nJSON: {}", path.display());
+    outln!("\nJSON: {}", path.display());
     Ok(ExitCode::SUCCESS)
 }
 
@@ -138,8 +144,8 @@ fn profile_scene(args: &ProfileArgs, path: &std::path::Path) -> Result<ExitCode>
         ))
     });
     json::write_report(&path, json::Kind::SceneProfile, &result)?;
-    println!("{}\n", result.summary());
-    print!("{}", result.markdown());
-    println!("\nJSON: {}", path.display());
+    outln!("{}\n", result.summary());
+    out!("{}", result.markdown());
+    outln!("\nJSON: {}", path.display());
     Ok(ExitCode::SUCCESS)
 }

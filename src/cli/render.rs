@@ -35,6 +35,6 @@ pub fn render(args: &RenderArgs) -> Result<ExitCode> {
     for w in &result.warnings {
         brdfprof::messages::warning(w);
     }
-    println!("{}", written(&result.files));
+    outln!("{}", written(&result.files));
     Ok(ExitCode::SUCCESS)
 }

@@ -34,6 +34,6 @@ pub fn report(args: &ReportArgs) -> Result<ExitCode> {
     if let Some(gpu) = &gpu {
         gpu.check_validation()?;
     }
-    println!("{} ({bytes} bytes) from {} report(s)", args.out.display(), inputs.len());
+    outln!("{} ({bytes} bytes) from {} report(s)", args.out.display(), inputs.len());
     Ok(ExitCode::SUCCESS)
 }

@@ -17,8 +17,8 @@ pub struct SceneArgs {
 
 pub fn scene(args: &SceneArgs) -> Result<ExitCode> {
     match (&args.file, args.explain) {
-        (_, true) => print!("{}", scene::explain()),
-        (Some(f), false) => print!("{}", scene::check(f)?),
+        (_, true) => out!("{}", scene::explain()),
+        (Some(f), false) => out!("{}", scene::check(f)?),
         (None, false) => bail!("give a scene file to check, or --explain"),
     }
     Ok(ExitCode::SUCCESS)

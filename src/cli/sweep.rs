@@ -93,6 +93,8 @@ pub fn sweep(args: &SweepArgs) -> Result<ExitCode> {
     } else {
         args.model.models(&[])?
     };
+    let asked = [("--html", args.html.html.as_deref()), ("--bench-json", args.bench.bench_json.as_deref())];
+    super::checked_outputs(&asked, &super::model_inputs(&models))?;
     let reference = args
         .reference
         .as_deref()
@@ -142,9 +144,9 @@ pub fn sweep(args: &SweepArgs) -> Result<ExitCode> {
     let mut files = result.write(&out, &slug)?;
     files.extend(args.html.write(&[just_measured(&out.join(format!("sweep-{slug}.json")), &result)?], Some(&gpu))?);
     args.bench.write(&result.profile.bench_entries("sweep"))?;
-    print!("{}", result.markdown());
+    out!("{}", result.markdown());
     let missing = write_cost_tables(&result, &costs, &out, &slug, &mut files)?;
-    println!("\n{}", written(&files));
+    outln!("\n{}", written(&files));
     Ok(if missing { ExitCode::from(1) } else { ExitCode::SUCCESS })
 }
 
@@ -176,13 +178,13 @@ fn write_cost_tables(
         }
         let family = table.family.clone().unwrap_or_else(|| name.replace(':', "-"));
         files.extend(swept.write(&out.join(format!("sweep-{slug}-{}-{family}", table.compiler.to_ascii_lowercase())))?);
-        print!("\n{}", swept.markdown());
+        out!("\n{}", swept.markdown());
         swept_all.push(swept);
     }
     if swept_all.len() > 1 {
         let frontiers = brdfprof::sweep_cost::Frontiers::of(&swept_all);
         files.extend(frontiers.write(&out.join(format!("sweep-{slug}-frontiers")))?);
-        print!("\n{}", frontiers.markdown());
+        out!("\n{}", frontiers.markdown());
     }
     Ok(missing)
 }

@@ -39,29 +39,39 @@ pub fn annotations(findings: &[Finding]) -> String {
     out
 }
 
-/// Appends `markdown` to the step summary `path` (written whole and atomically, its earlier content kept),
-/// cut with a note where the file would pass `MAX_SUMMARY_BYTES`.
+/// Appends `markdown` to the step summary `path` (through `messages::safe_text`) in one write to a file opened
+/// for appending, as GitHub's runner and other steps append to it: reports of concurrent steps all stay, and
+/// what the file held is not read or rewritten (non-UTF-8 bytes included). Cut with a note where the file would
+/// pass `MAX_SUMMARY_BYTES`; where it is already too full for the note, nothing is appended and a warning names
+/// `--summary` (the report is on stdout, and the command's verdict and other outputs stand).
 pub fn append_summary(path: &Path, markdown: &str) -> Result<()> {
-    let mut text = match std::fs::metadata(path) {
-        Ok(m) if m.is_file() => {
-            String::from_utf8_lossy(&crate::io::read_bounded(path, MAX_SUMMARY_BYTES as u64)?).into_owned()
-        }
-        _ => String::new(),
-    };
+    use std::io::Write;
+    let markdown = crate::messages::safe_text(markdown);
+    let held = std::fs::metadata(path).map_or(0, |m| if m.is_file() { m.len() as usize } else { 0 });
     const CUT: &str =
         "\n\n(cut here: GitHub takes at most 1 MiB of step summary; the full report is brdfprof's stdout)\n";
-    let room = MAX_SUMMARY_BYTES.saturating_sub(text.len());
-    if markdown.len() <= room {
-        text += markdown;
+    let room = MAX_SUMMARY_BYTES.saturating_sub(held);
+    let text = if markdown.len() <= room {
+        markdown
     } else if room > CUT.len() {
         let mut end = room - CUT.len();
         while !markdown.is_char_boundary(end) {
             end -= 1;
         }
-        text += &markdown[..end];
-        text += CUT;
-    }
-    crate::io::write_output(path, text.as_bytes())
+        format!("{}{CUT}", &markdown[..end])
+    } else {
+        crate::messages::warning(format!(
+            "--summary {}: the step summary already holds {held} bytes, and GitHub takes at most {MAX_SUMMARY_BYTES}: this report is not appended (it is on stdout)",
+            crate::messages::escape_line(&path.display().to_string())
+        ));
+        return Ok(());
+    };
+    let mut f = std::fs::OpenOptions::new()
+        .append(true)
+        .create(true)
+        .open(path)
+        .map_err(|e| anyhow::anyhow!("--summary {}: cannot open it to append: {e}", path.display()))?;
+    f.write_all(text.as_bytes()).map_err(|e| anyhow::anyhow!("--summary {}: cannot append: {e}", path.display()))
 }
 
 #[cfg(test)]
@@ -96,5 +106,30 @@ mod tests {
         append_summary(&path, &"é".repeat(MAX_SUMMARY_BYTES)).unwrap();
         let text = std::fs::read_to_string(&path).unwrap();
         assert!(text.len() <= MAX_SUMMARY_BYTES && text.ends_with("stdout)\n"), "{}", text.len());
+        // Full: nothing appended, no error (the verdict and the other outputs stand).
+        append_summary(&path, "# one more\n").unwrap();
+        assert_eq!(std::fs::read_to_string(&path).unwrap(), text);
+    }
+
+    /// Appenders running at once all keep their report, and what the file held stays byte for byte.
+    #[test]
+    fn concurrent_appends_keep_every_report_and_the_earlier_bytes() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("summary.md");
+        std::fs::write(&path, b"earlier \xff\xfe\n").unwrap();
+        std::thread::scope(|s| {
+            for i in 0..6 {
+                let path = &path;
+                s.spawn(move || append_summary(path, &format!("# report {i}\n{}\n", "x".repeat(20_000))).unwrap());
+            }
+        });
+        let bytes = std::fs::read(&path).unwrap();
+        assert!(bytes.starts_with(b"earlier \xff\xfe\n"));
+        let text = String::from_utf8_lossy(&bytes);
+        for i in 0..6 {
+            assert_eq!(text.matches(&format!("# report {i}\n")).count(), 1, "report {i}");
+        }
+        append_summary(&path, "x\n::stop-commands::T\n").unwrap();
+        assert!(!String::from_utf8_lossy(&std::fs::read(&path).unwrap()).lines().any(|l| l.starts_with("::")));
     }
 }

@@ -81,7 +81,7 @@ pub fn write_md_json_png(
 ) -> Result<Vec<std::path::PathBuf>> {
     let (md, json, png) = (stem.with_extension("md"), stem.with_extension("json"), stem.with_extension("png"));
     write_report_compact(&json, kind, value)?;
-    crate::io::write_output(&md, markdown.as_bytes())?;
+    crate::io::write_markdown(&md, markdown)?;
     chart(&png)?;
     Ok(vec![md, json, png])
 }

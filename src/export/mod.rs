@@ -22,3 +22,5 @@ pub fn name_slug(name: &str) -> String {
     let slug = slug.trim_matches('-').to_string();
     if slug.is_empty() { "device".into() } else { slug }
 }
+
+pub use crate::messages::{escape_line, safe_text};

@@ -158,6 +158,12 @@ pub fn write_output(path: &Path, bytes: &[u8]) -> Result<()> {
     }
 }
 
+/// Writes a Markdown report (`write_output`) through `messages::safe_text`: no name from an input starts a line
+/// of its own in it, as on stdout.
+pub fn write_markdown(path: &Path, text: &str) -> Result<()> {
+    write_output(path, crate::messages::safe_text(text).as_bytes())
+}
+
 /// A written temporary waiting for `commit_outputs` to be renamed over its target.
 struct Staged {
     tmp: PathBuf,
@@ -239,11 +245,11 @@ fn write_atomic(path: &Path, bytes: &[u8], permissions: Option<std::fs::Permissi
     static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
     let n = NEXT.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
     let tmp = dir.join(format!(".{}.{}.{n}.tmp", file_name.to_string_lossy(), std::process::id()));
-    // Registered, so that an interrupted write leaves no temporary behind either.
-    let guard = crate::cleanup::PathGuard::new(&tmp);
+    // Registered before it exists, so that an interrupted write leaves no temporary behind either.
+    let (guard, mut f) = crate::cleanup::PathGuard::create(&tmp, || std::fs::File::create(&tmp))
+        .with_context(|| format!("cannot write {}", path.display()))?;
     let staging = STAGING.load(std::sync::atomic::Ordering::SeqCst);
     let result = (|| -> Result<()> {
-        let mut f = std::fs::File::create(&tmp)?;
         f.write_all(bytes)?;
         if let Some(p) = permissions {
             f.set_permissions(p)?;
@@ -362,6 +368,15 @@ pub fn check_not_input(flag: &str, output: &Path, inputs: &[(&str, &Path)]) -> R
         }
     }
     Ok(())
+}
+
+/// Whether two paths name one existing file (after links; hard links included).
+pub fn same_file(a: &Path, b: &Path) -> bool {
+    use std::os::unix::fs::MetadataExt;
+    match (std::fs::metadata(a), std::fs::metadata(b)) {
+        (Ok(x), Ok(y)) => (x.dev(), x.ino()) == (y.dev(), y.ino()),
+        _ => false,
+    }
 }
 
 /// No such path (ENOENT), or a file where a directory should be on the way (ENOTDIR: found by `creatable`).

@@ -65,6 +65,7 @@ impl HostKernel {
         let lib = dir.path().join("kernel.so");
         std::fs::write(&src, source).with_context(|| format!("cannot write {}", src.display()))?;
         let mut cmd = crate::cleanup::command(HOST_COMPILER);
+        crate::launch::bound_memory(&mut cmd)?;
         // g++'s own temporaries (cc*.s) go into the build's directory, removed with it even on a signal.
         cmd.args(HOST_FLAGS)
             .args(flags)

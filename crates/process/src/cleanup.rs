@@ -133,6 +133,29 @@ impl PathGuard {
         registry().paths.push(path.to_path_buf());
         PathGuard(path.to_path_buf())
     }
+
+    /// Registers `path`, then runs `create` (which makes it) with the registry held: `stop` takes the
+    /// registry only after it marks the process stopping, so a path is either made before `stop` looks (and
+    /// removed by it) or not made at all (the caller waits for the process to end), never made after the
+    /// cleanup (a worker thread's temporary directory created while the signal handler ran).
+    pub fn create<T>(path: &Path, create: impl FnOnce() -> std::io::Result<T>) -> std::io::Result<(PathGuard, T)> {
+        let mut r = registry();
+        if interrupted() {
+            // The process is ending (`stop` exits it); nothing more is made.
+            drop(r);
+            loop {
+                std::thread::park();
+            }
+        }
+        r.paths.push(path.to_path_buf());
+        match create() {
+            Ok(made) => Ok((PathGuard(path.to_path_buf()), made)),
+            Err(e) => {
+                r.paths.retain(|p| p != path);
+                Err(e)
+            }
+        }
+    }
 }
 
 impl Drop for PathGuard {
@@ -155,21 +178,40 @@ pub fn forget_created_dirs() -> Vec<PathBuf> {
     std::mem::take(&mut registry().created_dirs)
 }
 
-/// A temporary directory (under TMPDIR), removed when dropped and by the signal handler.
+/// A temporary directory (under TMPDIR), removed when dropped and by the signal handler; registered before it
+/// is created (`PathGuard::create`).
 pub struct TempDir {
-    // Field order: the registration goes first, then the directory is removed.
+    path: PathBuf,
     _guard: PathGuard,
-    dir: tempfile::TempDir,
 }
 
 impl TempDir {
     pub fn new() -> std::io::Result<TempDir> {
-        let dir = tempfile::Builder::new().prefix("brdfprof-").tempdir()?;
-        Ok(TempDir { _guard: PathGuard::new(dir.path()), dir })
+        use std::hash::{BuildHasher, Hasher};
+        static COUNT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+        let parent = std::env::temp_dir();
+        loop {
+            let mut h = std::collections::hash_map::RandomState::new().build_hasher();
+            h.write_u64(COUNT.fetch_add(1, Ordering::SeqCst));
+            h.write_u32(std::process::id());
+            let path = parent.join(format!("brdfprof-{:016x}", h.finish()));
+            match PathGuard::create(&path, || std::fs::create_dir(&path)) {
+                Ok((guard, ())) => return Ok(TempDir { path, _guard: guard }),
+                Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
+                Err(e) => return Err(e),
+            }
+        }
     }
 
     pub fn path(&self) -> &Path {
-        self.dir.path()
+        &self.path
+    }
+}
+
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        // Removed while still registered; the guard unregisters it after.
+        let _ = std::fs::remove_dir_all(&self.path);
     }
 }
 
@@ -195,12 +237,15 @@ impl Drop for ChildGuard {
 /// `Command::new(program)` whose child dies with brdfprof. PR_SET_PDEATHSIG fires when the spawning thread
 /// ends, so spawn from the thread that waits for the child (as every caller here does). In brdfprof itself
 /// the child leads a process group of its own, which `kill_group` kills whole: what a tool starts (cc1plus
-/// and as under g++, ocloc's children, a brdfprof child's own tools) goes with it. In a brdfprof child
-/// process the tools stay in the child's group, so that killing the child's group reaches them too.
+/// and as under g++, ocloc's children, a brdfprof child's own tools) goes with it, and a sentinel in that
+/// group kills the rest of it once the tool is gone, so that what it started dies with it even where brdfprof
+/// was killed (SIGKILL: no handler runs, and the death signal reaches only the tool itself). In a brdfprof
+/// child process the tools stay in the child's group, so that killing the child's group reaches them too.
 pub fn command(program: &str) -> Command {
     let mut cmd = Command::new(program);
-    die_with_parent(&mut cmd);
-    if !crate::messages::is_child_process() {
+    let leads = !crate::messages::is_child_process();
+    die_with_parent(&mut cmd, leads);
+    if leads {
         std::os::unix::process::CommandExt::process_group(&mut cmd, 0);
     }
     cmd
@@ -221,12 +266,12 @@ pub fn kill_group(pid: u32) {
 }
 
 #[cfg(target_os = "linux")]
-fn die_with_parent(cmd: &mut Command) {
+fn die_with_parent(cmd: &mut Command, leads_group: bool) {
     use std::os::unix::process::CommandExt;
     // SAFETY: getpid() is async-signal-safe; it runs before the fork.
     let parent = unsafe { libc::getpid() };
     // SAFETY: the closure runs between fork and exec and calls only async-signal-safe functions (prctl,
-    // getppid), allocating nothing.
+    // getppid, getpid, fork, waitpid, and in the sentinel close, kill, nanosleep, _exit), allocating nothing.
     unsafe {
         cmd.pre_exec(move || {
             if libc::prctl(libc::PR_SET_PDEATHSIG, libc::SIGKILL) == -1 {
@@ -236,13 +281,54 @@ fn die_with_parent(cmd: &mut Command) {
             if libc::getppid() != parent {
                 return Err(std::io::Error::other("brdfprof exited before its child started"));
             }
+            if leads_group {
+                start_sentinel();
+            }
             Ok(())
         });
     }
 }
 
+/// In a tool's process (between fork and exec, already its process group's leader): starts a sentinel, a
+/// grandchild of the tool that no one waits for (its intermediate parent exits at once and the tool reaps it,
+/// so the tool sees no child it did not start). The sentinel closes every descriptor (it holds no pipe of
+/// brdfprof's open), then checks every 50 ms whether the tool is gone (exited and reaped, or killed with
+/// brdfprof by its death signal) and then kills the tool's process group, itself included: whatever the tool
+/// left running goes with it.
+///
+/// SAFETY: call only between fork and exec; it uses async-signal-safe calls only.
+#[cfg(target_os = "linux")]
+unsafe fn start_sentinel() {
+    // SAFETY: as the function's contract says.
+    unsafe {
+        let tool = libc::getpid();
+        let middle = libc::fork();
+        if middle == 0 {
+            if libc::fork() == 0 {
+                if libc::syscall(libc::SYS_close_range, 0u32, u32::MAX, 0u32) != 0 {
+                    for fd in 0..4096 {
+                        libc::close(fd);
+                    }
+                }
+                let pause = libc::timespec { tv_sec: 0, tv_nsec: 50_000_000 };
+                // The tool's pid names its group as long as the group has a member (this one), so it is not
+                // reused while this loop runs.
+                while !(libc::kill(tool, 0) == -1 && *libc::__errno_location() == libc::ESRCH) {
+                    libc::nanosleep(&pause, std::ptr::null_mut());
+                }
+                libc::kill(-tool, libc::SIGKILL);
+                libc::_exit(0);
+            }
+            libc::_exit(0);
+        }
+        if middle > 0 {
+            libc::waitpid(middle, std::ptr::null_mut(), 0);
+        }
+    }
+}
+
 #[cfg(not(target_os = "linux"))]
-fn die_with_parent(_cmd: &mut Command) {}
+fn die_with_parent(_cmd: &mut Command, _leads_group: bool) {}
 
 /// Gives `cmd` a TMPDIR of its own, inside a directory of this process that is removed when the guard is
 /// dropped (after the child is reaped) and by the signal handler: what a child leaves there when it is
@@ -256,6 +342,70 @@ pub fn child_tmpdir(cmd: &mut Command) -> Result<TempDir> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// What a tool starts dies with brdfprof even where brdfprof is killed: a stand-in for brdfprof (this test
+    /// binary, run again as `sentinel_helper`) starts `sh`, which starts a `sleep` and waits; SIGKILL of the
+    /// stand-in kills `sh` (its death signal), and the sentinel then kills the `sleep` it left.
+    #[test]
+    fn a_tools_own_children_die_when_brdfprof_is_killed() {
+        use std::io::BufRead;
+        let mut helper = Command::new(std::env::current_exe().unwrap())
+            .args(["--exact", "cleanup::tests::sentinel_helper", "--nocapture", "--test-threads", "1"])
+            .env("BRDFPROF_SENTINEL_HELPER", "1")
+            .stdout(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        let mut lines = std::io::BufReader::new(helper.stdout.take().unwrap()).lines();
+        let sleep: i32 = loop {
+            let line = lines.next().expect("the helper prints the grandchild's pid").unwrap();
+            // libtest's own "test ... " may begin the line.
+            if let Some((_, pid)) = line.split_once("grandchild ") {
+                break pid.trim().parse().unwrap();
+            }
+        };
+        // SAFETY: signals to processes this test started.
+        let alive = |pid: i32| unsafe { libc::kill(pid, 0) == 0 };
+        assert!(alive(sleep));
+        helper.kill().unwrap();
+        helper.wait().unwrap();
+        let start = Instant::now();
+        while alive(sleep) && start.elapsed() < Duration::from_secs(5) {
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        let zombie = std::fs::read_to_string(format!("/proc/{sleep}/stat")).is_ok_and(|s| s.contains(") Z "));
+        assert!(!alive(sleep) || zombie, "the tool's child {sleep} outlived brdfprof");
+    }
+
+    #[test]
+    fn sentinel_helper() {
+        if std::env::var_os("BRDFPROF_SENTINEL_HELPER").is_none() {
+            return;
+        }
+        let out = command("sh")
+            .args(["-c", "sleep 60 & echo grandchild $!; wait"])
+            .stdout(std::process::Stdio::inherit())
+            .spawn()
+            .unwrap();
+        std::thread::sleep(Duration::from_secs(60));
+        drop(out);
+    }
+
+    /// A tool that ends leaves its sentinel nothing to do but end too: no process of its group is left, and
+    /// its output is read to the end at once (the sentinel holds no pipe).
+    #[test]
+    fn a_tool_that_ends_leaves_nothing_running() {
+        let start = Instant::now();
+        let out = command("sh").args(["-c", "echo $$"]).output().unwrap();
+        assert!(start.elapsed() < Duration::from_secs(2));
+        let group: i32 = String::from_utf8_lossy(&out.stdout).trim().parse().unwrap();
+        let start = Instant::now();
+        // SAFETY: a signal 0 probe of a process group this test started.
+        while unsafe { libc::kill(-group, 0) } == 0 && start.elapsed() < Duration::from_secs(5) {
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        // SAFETY: as above.
+        assert_ne!(unsafe { libc::kill(-group, 0) }, 0, "a process of the tool's group is still running");
+    }
 
     #[test]
     fn guards_register_while_they_live() {

@@ -80,6 +80,53 @@ pub fn export(cmd: &mut Command) -> &mut Command {
     cmd.env(ENV, format!("{}", limit().as_secs_f64()))
 }
 
+/// The variable that sets the address-space bound of a compiler process, in MiB (`bound_memory`).
+pub const MEMORY_ENV: &str = "BRDFPROF_CHILD_MEMORY_MB";
+
+/// The address-space bound of a compiler process in bytes: `MEMORY_ENV` where set (a number of MiB, at least
+/// 64), else half the machine's memory, within [1, 8] GiB: a runaway compiler (slangc unrolling nested loops
+/// reached 6 GB) fails on its own allocation instead of taking the machine (a 7 GB CI runner) with it.
+pub fn memory_bound() -> Result<u64> {
+    if let Some(text) = std::env::var(MEMORY_ENV).ok().filter(|t| !t.trim().is_empty()) {
+        return match text.trim().parse::<u64>() {
+            Ok(mb) if (64..=1 << 30).contains(&mb) => Ok(mb << 20),
+            _ => bail!("{MEMORY_ENV}={text}: give MiB, a whole number from 64"),
+        };
+    }
+    // SAFETY: sysconf has no preconditions.
+    let (pages, size) = unsafe { (libc::sysconf(libc::_SC_PHYS_PAGES), libc::sysconf(libc::_SC_PAGE_SIZE)) };
+    let total = (pages.max(0) as u64).saturating_mul(size.max(0) as u64);
+    Ok((total / 2).clamp(1 << 30, 8 << 30))
+}
+
+/// Bounds `cmd`'s address space at `memory_bound()` (RLIMIT_AS, set between fork and exec; no cgroup needed).
+/// For the compilers brdfprof runs (glslang, slangc, spirv-opt, spirv-cross, g++, ocloc, nvdisasm); not for
+/// valgrind, whose tool reserves the client's address space, nor for brdfprof's own children, whose Vulkan
+/// drivers map the device's.
+pub fn bound_memory(cmd: &mut Command) -> Result<&mut Command> {
+    use std::os::unix::process::CommandExt;
+    let bound = memory_bound()?;
+    // SAFETY: setrlimit is async-signal-safe; the closure allocates nothing.
+    unsafe {
+        cmd.pre_exec(move || {
+            let limit = libc::rlimit { rlim_cur: bound as libc::rlim_t, rlim_max: bound as libc::rlim_t };
+            if libc::setrlimit(libc::RLIMIT_AS, &limit) != 0 {
+                return Err(std::io::Error::last_os_error());
+            }
+            Ok(())
+        });
+    }
+    Ok(cmd)
+}
+
+/// What a bounded compiler's failure may owe to its memory bound, said after its own message.
+pub fn memory_note() -> String {
+    let bound = memory_bound().map_or(0, |b| b >> 20);
+    format!(
+        "(compilers run with their address space bounded at {bound} MiB; where one ran out of memory, {MEMORY_ENV} raises the bound)"
+    )
+}
+
 /// "60 s" / "0.5 s".
 fn seconds(d: Duration) -> String {
     format!("{} s", (d.as_secs_f64() * 1000.0).round() / 1000.0)

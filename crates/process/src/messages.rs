@@ -17,11 +17,55 @@ type Printer = Arc<dyn Fn(&str) + Send + Sync>;
 static PRINTER: Mutex<Option<Printer>> = Mutex::new(None);
 static CHILD: AtomicBool = AtomicBool::new(false);
 
-/// Prints `line` on stderr as it is (every other function here adds the prefix first).
+/// Text from an input (a path, a label, shader text) as one line of our output may hold it: every control
+/// character (newline, CR, escape, the C1 controls, ...) written as its Rust escape (`\n`, `\u{1b}`), so that no
+/// input ends our line and starts one of its own. Other characters, non-ASCII ones included, are kept.
+pub fn escape_line(text: &str) -> String {
+    if !text.chars().any(char::is_control) {
+        return text.to_string();
+    }
+    text.chars().map(|c| if c.is_control() { c.escape_debug().to_string() } else { c.to_string() }).collect()
+}
+
+/// Text as brdfprof writes it to stdout, stderr, a step summary or a Markdown file: its own line breaks (and
+/// tabs) kept, every other control character escaped (`escape_line`), and no line left that GitHub's runner
+/// would take for a workflow command: one that starts with `::` after its leading blanks (the runner trims
+/// them) gets a backslash first (`\::`, which Markdown shows as `::`), and a legacy `##[` becomes `##\[`.
+/// brdfprof's own annotations (`export::github`) are the only lines that start with `::`, and are written
+/// without it. This is the last line of defence; names are escaped where they are formatted too.
+pub fn safe_text(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    for (i, line) in text.split('\n').enumerate() {
+        if i > 0 {
+            out.push('\n');
+        }
+        let blank = line.len() - line.trim_start().len();
+        let (lead, rest) = line.split_at(blank);
+        out += &lead
+            .chars()
+            .map(|c| if c == '\t' || !c.is_control() { c.to_string() } else { c.escape_debug().to_string() })
+            .collect::<String>();
+        if rest.starts_with("::") {
+            out.push('\\');
+        }
+        for c in rest.chars() {
+            if c.is_control() && c != '\t' {
+                out += &c.escape_debug().to_string();
+            } else {
+                out.push(c);
+            }
+        }
+    }
+    out.replace("##[", "##\\[")
+}
+
+/// Prints `line` on stderr (`safe_text`: no input can start a line of its own there; every other function here
+/// adds the prefix first).
 pub fn line(line: &str) {
+    let line = safe_text(line);
     let printer = PRINTER.lock().unwrap_or_else(|e| e.into_inner()).clone();
     match printer {
-        Some(p) => p(line),
+        Some(p) => p(&line),
         None => eprintln!("{line}"),
     }
 }
@@ -113,6 +157,20 @@ impl Drop for ProgressGuard {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn no_input_starts_a_workflow_command() {
+        let planted = "model x\n::stop-commands::TOKEN\r\n  ::error::forged\u{1b}[31m\n##[set-env name=X]y\tz";
+        let safe = safe_text(planted);
+        for line in safe.lines() {
+            assert!(!line.trim_start().starts_with("::"), "{line:?}");
+            assert!(!line.contains("##[") && !line.chars().any(|c| c.is_control() && c != '\t'), "{line:?}");
+        }
+        assert_eq!(safe.lines().count(), planted.split('\n').count(), "its own line breaks kept");
+        assert!(safe.contains("\\::stop-commands::TOKEN\\r") && safe.contains("\\u{1b}[31m"), "{safe}");
+        assert_eq!(safe_text("| a | b |\n\n- café"), "| a | b |\n\n- café");
+        assert_eq!(escape_line("a\nb"), "a\\nb");
+    }
 
     #[test]
     fn once_means_once_per_text() {

@@ -43,6 +43,7 @@ fn to_glsl_with(words: &[u32], model: &Path, extra: &[&str]) -> Result<String> {
     std::fs::write(&path, words.iter().flat_map(|w| w.to_le_bytes()).collect::<Vec<u8>>())
         .with_context(|| format!("cannot write {}", path.display()))?;
     let mut cmd = crate::cleanup::command("spirv-cross");
+    crate::launch::bound_memory(&mut cmd)?;
     cmd.arg(&path).args(FLAGS).args(extra);
     let what = format!("{} (spirv-cross)", model.display());
     let out = match crate::launch::output(&mut cmd, &what) {

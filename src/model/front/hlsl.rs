@@ -222,6 +222,7 @@ fn run(
     std::fs::write(&source, x.text()).with_context(|| format!("cannot write {}", source.display()))?;
     let out = dir.path().join("shader.spv");
     let mut cmd = crate::cleanup::command("glslangValidator");
+    crate::launch::bound_memory(&mut cmd)?;
     cmd.args(args).args(["-e", STUB]).args(define_flags(defines)).arg(&source);
     if args.contains(&"-V") {
         cmd.arg("-o").arg(&out);

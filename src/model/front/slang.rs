@@ -93,34 +93,56 @@ pub fn compile(
     std::fs::write(&source, x.text()).with_context(|| format!("cannot write {}", source.display()))?;
     let out = dir.path().join("shader.spv");
     let mut cmd = crate::cleanup::command(&slangc.to_string_lossy());
+    crate::launch::bound_memory(&mut cmd)?;
     cmd.arg(&source).args(FLAGS).args(float_defines()).arg("-o").arg(&out);
     cmd.args(defines.iter().map(|(n, v)| if v.is_empty() { format!("-D{n}") } else { format!("-D{n}={v}") }));
     let what = format!("{} (Slang's slangc)", model.display());
     let result = crate::launch::output(&mut cmd, &what)?;
     let log = String::from_utf8_lossy(&result.stdout).to_string() + &String::from_utf8_lossy(&result.stderr);
     if let Some(signal) = std::os::unix::process::ExitStatusExt::signal(&result.status) {
-        return Ok(Some(Err(format!("slangc crashed (signal {signal}) on the shader"))));
+        return Ok(Some(Err(format!(
+            "slangc crashed (signal {signal}) on the shader {}",
+            crate::launch::memory_note()
+        ))));
     }
     if !result.status.success() || !out.is_file() {
-        return Ok(Some(Err(messages(&log, x))));
+        let mut text = messages(&log, x, &source);
+        if ["bad_alloc", "out of memory", "Out of memory"].iter().any(|m| log.contains(m)) {
+            text += &format!(" {}", crate::launch::memory_note());
+        }
+        return Ok(Some(Err(text)));
     }
     let bytes = crate::io::read_bounded(&out, crate::launch::MAX_OUTPUT_BYTES as u64).context("slangc's SPIR-V")?;
     Ok(Some(Ok(crate::shaders::Spirv::from_bytes(&what, &bytes)?.words.to_vec())))
 }
 
-/// slangc's errors (`error[E30015]: undefined identifier`, then ` --> shader.hlsl:2:12` and a caret line's
-/// detail) at the user's files' lines; a line brdfprof wrote is named by what it stands for. The whole log
-/// where none is located.
-pub fn messages(log: &str, x: &Expanded) -> String {
+/// The most errors of one shader said; the rest are counted.
+const MAX_MESSAGES: usize = 20;
+
+/// slangc's errors (`error[E30015]: undefined identifier` or `fatal error[...]`, then ` --> shader.hlsl:2:12`
+/// and a caret line's detail: a line of blanks, `|` and carets, then the detail) at the user's files' lines; a
+/// line brdfprof wrote is named by what it stands for. The first `MAX_MESSAGES`, the rest counted. Where none
+/// is located, the log, with the temporary file's name (`source`, gone by the time anyone reads it) replaced by
+/// "the expanded shader".
+pub fn messages(log: &str, x: &Expanded, source: &Path) -> String {
     let lines: Vec<&str> = log.lines().collect();
     let mut out: Vec<String> = Vec::new();
+    let error = |l: &str| {
+        let l = l.strip_prefix("fatal ").unwrap_or(l);
+        l.strip_prefix("error").and_then(|r| r.split_once("]: ").map(|(_, m)| m.to_string()))
+    };
     for (i, l) in lines.iter().enumerate() {
-        let Some(message) = l.strip_prefix("error").and_then(|r| r.split_once("]: ").map(|(_, m)| m)) else { continue };
+        let Some(message) = error(l) else { continue };
         let at = lines.get(i + 1).and_then(|a| a.trim().strip_prefix("--> "));
+        // A caret line is blanks and `|` then carets; a source line slangc quotes starts with its number.
+        fn caret(d: &str) -> Option<&str> {
+            let lead = d.trim_start_matches([' ', '\t', '|']);
+            lead.starts_with('^').then(|| lead.trim_start_matches('^').trim())
+        }
         let detail = lines[i + 1..]
             .iter()
-            .take_while(|d| !d.starts_with("error") && !d.starts_with("warning"))
-            .find_map(|d| d.split_once('^').map(|(_, r)| r.trim_start_matches('^').trim()))
+            .take_while(|d| error(d).is_none() && !d.starts_with("warning"))
+            .find_map(|d| caret(d))
             .filter(|d| !d.is_empty());
         let tail = detail.map_or_else(String::new, |d| format!(" ({d})"));
         let located = at.and_then(|a| {
@@ -134,7 +156,15 @@ pub fn messages(log: &str, x: &Expanded) -> String {
         });
         out.push(located.unwrap_or_else(|| format!("{message}{tail}")));
     }
-    if out.is_empty() { log.trim().to_string() } else { out.join("\n") }
+    if out.is_empty() {
+        return log.trim().replace(&source.display().to_string(), "the expanded shader");
+    }
+    let more = out.len().saturating_sub(MAX_MESSAGES);
+    out.truncate(MAX_MESSAGES);
+    if more > 0 {
+        out.push(format!("... and {more} more errors"));
+    }
+    out.join("\n")
 }
 
 /// The front end, with slangc's version, as reports state it.
@@ -149,6 +179,20 @@ pub fn describe() -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn messages_are_located_counted_and_never_a_source_line() {
+        let x = Expanded::default();
+        let log = "error[E1]: undefined identifier\n --> /tmp/brdfprof-1/shader.hlsl:2:3\n2 | float y = a ^ b;\n  |   ^ here\n"
+            .to_string()
+            + &"fatal error[E2]: too many errors\n".repeat(30);
+        let m = messages(&log, &x, Path::new("/tmp/brdfprof-1/shader.hlsl"));
+        assert!(m.starts_with("undefined identifier (here)"), "{m}");
+        assert!(m.contains("too many errors") && m.ends_with("... and 11 more errors"), "{m}");
+        let raw =
+            messages("slangc: cannot open /tmp/brdfprof-1/shader.hlsl", &x, Path::new("/tmp/brdfprof-1/shader.hlsl"));
+        assert_eq!(raw, "slangc: cannot open the expanded shader");
+    }
 
     #[test]
     fn the_stub_stores_what_it_computes_in_one_line() {

@@ -137,6 +137,7 @@ impl Tools {
         dump: Option<&Path>,
     ) -> Result<std::process::Output> {
         let mut cmd = crate::cleanup::command(self.ocloc.to_str().unwrap_or("ocloc"));
+        crate::launch::bound_memory(&mut cmd)?;
         cmd.args(args).current_dir(cwd).env("LD_LIBRARY_PATH", &self.iga_dir);
         if let Some(dir) = dump {
             // IGC's debug knobs (read from the environment): its shader dumps, into `dir`.

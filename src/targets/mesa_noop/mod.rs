@@ -245,7 +245,7 @@ fn models_report(
 /// Prints the reply as the child's last stdout line.
 fn reply(reply: NoopReply) -> Result<()> {
     println!("{}", serde_json::to_string(&reply)?);
-    if std::env::var_os(CRASH_AFTER_REPLY).is_some() {
+    if test_hook(CRASH_AFTER_REPLY).is_some() {
         use std::io::Write;
         std::io::stdout().flush()?;
         crash();
@@ -255,7 +255,7 @@ fn reply(reply: NoopReply) -> Result<()> {
 
 /// Dies of SIGSEGV where `CRASH_ON_MODEL` names one of `models`.
 fn crash_if_asked(models: &[Model]) {
-    if let Some(label) = std::env::var_os(CRASH_ON_MODEL)
+    if let Some(label) = test_hook(CRASH_ON_MODEL)
         && models.iter().any(|m| std::ffi::OsStr::new(&m.label()) == label)
     {
         crash();
@@ -332,6 +332,11 @@ fn raw_report(
 /// Set in a child's environment, it dies of SIGSEGV after printing its report, as Mesa 22.3's teardown of
 /// RADV's null device did (vkDeviceWaitIdle through a null pointer): the test that the parent contains such a crash.
 pub const CRASH_AFTER_REPLY: &str = "BRDFPROF_TEST_NOOP_CHILD_CRASH";
+
+/// A test hook's variable: read only in a build with the `test-hooks` feature (the tests'), inert otherwise.
+fn test_hook(name: &str) -> Option<std::ffi::OsString> {
+    if cfg!(feature = "test-hooks") { std::env::var_os(name) } else { None }
+}
 
 /// Set in a child's environment to a model's label, a child whose request holds that model dies of SIGSEGV
 /// before it compiles anything, as a driver that crashes on one model's kernel would: the test that the other
@@ -676,7 +681,7 @@ fn check_kernels(report: &InspectReport, kernels: &[(String, String)], models: &
 pub const HOLD_BEFORE_CHILDREN: &str = "BRDFPROF_TEST_NOOP_HOLD";
 
 fn hold_before_children() {
-    let Some(path) = std::env::var_os(HOLD_BEFORE_CHILDREN).map(PathBuf::from) else { return };
+    let Some(path) = test_hook(HOLD_BEFORE_CHILDREN).map(PathBuf::from) else { return };
     let _ = std::fs::write(path.with_extension("waiting"), b"");
     let start = std::time::Instant::now();
     while !path.exists() && start.elapsed() < std::time::Duration::from_secs(120) {
@@ -716,8 +721,8 @@ pub fn compile(prefix: &str, families: &[usize], raw: &[super::RawKernel], reque
     // A child that writes files (--isa) or is asked to crash (the containment test) always runs; any other
     // report is cached under a key whose kernels' part is computed once here, for every family.
     let cache_digest = match request.isa_dir.is_some()
-        || std::env::var_os(CRASH_AFTER_REPLY).is_some()
-        || std::env::var_os(CRASH_ON_MODEL).is_some()
+        || test_hook(CRASH_AFTER_REPLY).is_some()
+        || test_hook(CRASH_ON_MODEL).is_some()
     {
         true => None,
         false => Some(cache::request_digest(models, raw, request.lights, request.validate, request.shaders)?),

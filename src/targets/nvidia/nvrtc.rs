@@ -183,6 +183,7 @@ impl Tools {
         let path = dir.path().join("kernel.cubin");
         std::fs::write(&path, cubin).with_context(|| format!("cannot write {}", path.display()))?;
         let mut cmd = crate::cleanup::command(self.nvdisasm.to_str().unwrap_or("nvdisasm"));
+        crate::launch::bound_memory(&mut cmd)?;
         cmd.args(DISASSEMBLE_OPTIONS).args(line_info.then_some(LINE_INFO)).arg(&path);
         let out = crate::launch::output(&mut cmd, "a cubin's SASS (nvdisasm)")
             .with_context(|| format!("cannot run {}", self.nvdisasm.display()))?;
