@@ -463,6 +463,15 @@ pub fn load_columns(path: &Path) -> Result<Vec<CostColumn>> {
     let value: serde_json::Value =
         serde_json::from_str(&text).map_err(|e| anyhow!("{}: not valid JSON ({e})", path.display()))?;
     let source = format!("{}: ", path.display());
+    // A report of another command is named as what it is, with where its figures go instead.
+    let kind = value.get("kind").and_then(|k| k.as_str()).unwrap_or_default();
+    if ["diff", "stability"].contains(&kind) || value.get("grid_points").is_some() {
+        let kind = if kind.is_empty() { "stability" } else { kind };
+        bail!(
+            "{}: a `{kind}` report, which holds no cost per evaluation to compare; give profile or inspect reports (or a check baseline); `brdfprof report` draws a `{kind}` report",
+            path.display()
+        );
+    }
     let inspect_of = |v: &serde_json::Value| -> Result<InspectReport> {
         serde_json::from_value(v.clone())
             .map_err(|e| anyhow!("{}: not a brdfprof inspect report ({e})", path.display()))

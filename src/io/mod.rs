@@ -370,6 +370,43 @@ pub fn check_not_input(flag: &str, output: &Path, inputs: &[(&str, &Path)]) -> R
     Ok(())
 }
 
+/// A file name as a `#line` directive's string gives it to glslang, which garbles any byte above 0x7f there (it
+/// wrote `caf\xc3\xa9\xff\xff\xff` for `café.brdf`, which is not UTF-8, so no SPIR-V reader took the module):
+/// non-ASCII bytes, `%`, `"` and control characters percent-encoded (`caf%C3%A9.brdf`), the rest as it is.
+/// `from_directive_name` reads it back exactly.
+pub fn directive_name(name: &str) -> String {
+    let mut out = String::with_capacity(name.len());
+    for b in name.bytes() {
+        if b.is_ascii() && !b.is_ascii_control() && b != b'%' && b != b'"' {
+            out.push(b as char);
+        } else {
+            out += &format!("%{b:02X}");
+        }
+    }
+    out
+}
+
+/// The file name `directive_name` encoded (a name it did not encode, with no `%`, comes back as it is).
+pub fn from_directive_name(name: &str) -> String {
+    let b = name.as_bytes();
+    let mut out = Vec::with_capacity(b.len());
+    let mut i = 0;
+    while i < b.len() {
+        let hex = |k: usize| b.get(k).and_then(|c| (*c as char).to_digit(16));
+        match (b[i], hex(i + 1), hex(i + 2)) {
+            (b'%', Some(h), Some(l)) => {
+                out.push((h * 16 + l) as u8);
+                i += 3;
+            }
+            (c, _, _) => {
+                out.push(c);
+                i += 1;
+            }
+        }
+    }
+    String::from_utf8_lossy(&out).into_owned()
+}
+
 /// Whether two paths name one existing file (after links; hard links included).
 pub fn same_file(a: &Path, b: &Path) -> bool {
     use std::os::unix::fs::MetadataExt;
@@ -412,6 +449,16 @@ fn writable(flag: &str, output: &Path, dir: &Path) -> Result<()> {
 mod tests {
     use super::*;
     use std::os::unix::fs::{FileTypeExt, MetadataExt};
+
+    #[test]
+    fn directive_names_are_ascii_and_read_back() {
+        for name in ["café.brdf", "shäders/lobe.brdf", "a\"b%c\nd.brdf", "plain/x.brdf"] {
+            let d = directive_name(name);
+            assert!(d.is_ascii() && !d.contains('"') && !d.chars().any(|c| c.is_control()), "{d}");
+            assert_eq!(from_directive_name(&d), name);
+        }
+        assert_eq!(directive_name("café.brdf"), "caf%C3%A9.brdf");
+    }
 
     #[test]
     fn a_regular_file_is_replaced_atomically() {

@@ -203,3 +203,16 @@ fn a_baseline_naming_a_renamed_shader_names_it_and_compares_the_rest() {
     let r = run_in(d, &["check", "--device", "radv:navi21", "--baseline", "base.json"]).ok();
     assert!(!r.stderr.contains("gone"), "{}", r.stderr);
 }
+
+/// The smaller ones: `compare` given a diff report says so, and a tiny `--f0` bound does not write 300 digits.
+#[test]
+fn a_diff_report_given_to_compare_is_named_and_tiny_bounds_are_short() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    run_in(d, &["diff", "--model", "ggx", "--model", "blinn", "--samples", "100", "--json", "d.json"]).no_validation();
+    let profile = common::repo_root().join("results/profile-llvmpipe.json");
+    run_in(d, &["compare", "d.json", profile.to_str().unwrap()])
+        .fails(2, "d.json: a `diff` report, which holds no cost per evaluation");
+    let r = run_in(d, &["diff", "--model", "ggx", "--model", "blinn", "--samples", "50", "--f0", "1e-400..1e-300"]);
+    assert!(r.stdout.contains("F0 in [0, 1e-300]^3"), "{}", r.stdout);
+}

@@ -268,3 +268,36 @@ fn lone_cr_line_ends_keep_each_lines_number_and_text() {
         }
     }
 }
+
+/// A non-ASCII character in a model's path (`café.brdf`, `shäders/lobe.brdf`): glslang garbles any byte above
+/// 0x7f in a `#line` directive's file name, so brdfprof gives it the name percent-encoded and reads it back; the
+/// lines are named at the user's file with their text on nvidia: and intel:.
+#[test]
+fn a_non_ascii_path_keeps_the_lines() {
+    let dir = tempfile::tempdir().unwrap();
+    let folder = dir.path().join("sh\u{e4}ders");
+    std::fs::create_dir(&folder).unwrap();
+    let model = folder.join("caf\u{e9}.brdf");
+    std::fs::write(
+        &model,
+        "analytic\n::begin shader\nvec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) {\n    float nl = max(dot(N, L), 0.0);\n    return vec3(pow(nl, 3.5));\n}\n::end shader\n",
+    )
+    .unwrap();
+    let all = inspect_json(
+        dir.path(),
+        "accents",
+        &["nvidia:sm_89", "intel:gen12lp"],
+        &["--lines", "--model", model.to_str().unwrap()],
+        "Cost per source line",
+    );
+    for report in all["reports"].as_array().unwrap() {
+        let k = report["lines"].as_array().unwrap().iter().find(|k| k["model"] == "caf\u{e9}").unwrap().clone();
+        let line = k["lines"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|l| l["file"].as_str().unwrap().ends_with("sh\u{e4}ders/caf\u{e9}.brdf") && l["line"] == 5)
+            .unwrap_or_else(|| panic!("{}: no line 5 of the file: {k}", report["provenance"]["target"]));
+        assert_eq!(line["text"], "return vec3(pow(nl, 3.5));");
+    }
+}

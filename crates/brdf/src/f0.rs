@@ -50,6 +50,12 @@ impl Default for F0Set {
     }
 }
 
+/// A bound as a label writes it: as typed for ordinary values, in exponent form for the tiny (1e-300 would
+/// otherwise run to 300 digits).
+fn num(x: f64) -> String {
+    if x == 0.0 || x >= 1e-4 { format!("{x}") } else { format!("{x:e}") }
+}
+
 impl F0Set {
     /// `materials`, `uniform` ([0, 1]^3), `MIN..MAX` (every channel) or `R0..R1,G0..G1,B0..B1`, within [0, 1].
     pub fn parse(text: &str) -> Result<F0Set, String> {
@@ -82,10 +88,16 @@ impl F0Set {
                 DIELECTRICS.len(),
                 METALS.len()
             ),
-            F0Set::Uniform([r, g, b]) if r == g && g == b => format!("F0 in [{}, {}]^3", r.0, r.1),
-            F0Set::Uniform([r, g, b]) => {
-                format!("F0 in [{}, {}] x [{}, {}] x [{}, {}]", r.0, r.1, g.0, g.1, b.0, b.1)
-            }
+            F0Set::Uniform([r, g, b]) if r == g && g == b => format!("F0 in [{}, {}]^3", num(r.0), num(r.1)),
+            F0Set::Uniform([r, g, b]) => format!(
+                "F0 in [{}, {}] x [{}, {}] x [{}, {}]",
+                num(r.0),
+                num(r.1),
+                num(g.0),
+                num(g.1),
+                num(b.0),
+                num(b.1)
+            ),
         }
     }
 
@@ -106,6 +118,13 @@ impl F0Set {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_tiny_bound_is_written_short() {
+        let d = F0Set::parse("1e-400..1e-300").unwrap().describe();
+        assert!(d.len() < 40, "{d}");
+        assert_eq!(F0Set::parse("0.02..0.05").unwrap().describe(), "F0 in [0.02, 0.05]^3");
+    }
 
     #[test]
     fn sets_parse_and_keep_every_f0_within_them() {

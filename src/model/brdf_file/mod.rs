@@ -327,8 +327,10 @@ impl BrdfFile {
     }
 
     pub fn front_end_line(&self, file: &str, line: u32) -> Option<&str> {
-        let name = self.directive_name();
-        let same = file == name || name.ends_with(file) || file.ends_with(&name);
+        // Named as the directive gave it, or read back from it (`io::from_directive_name`).
+        let same = [self.directive_name(), crate::io::from_directive_name(&self.directive_name())]
+            .iter()
+            .any(|name| file == name || name.ends_with(file) || file.ends_with(name.as_str()));
         if self.language == Language::Glsl || !same {
             return None;
         }

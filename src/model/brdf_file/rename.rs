@@ -71,14 +71,15 @@ impl BrdfFile {
             .collect()
     }
 
-    /// The name the composed source's `#line` directive gives the file: its path, with the characters a
-    /// directive's string cannot hold (`"`, control characters) replaced.
+    /// The name the composed source's `#line` directive gives the file: its path, the characters glslang cannot
+    /// take in a directive's string (non-ASCII, `"`, control characters) percent-encoded (`io::directive_name`;
+    /// per-line cost reads it back with `io::from_directive_name`).
     pub(crate) fn directive_name(&self) -> String {
         let shown = match self.language {
             Language::Glsl => self.path.display().to_string(),
             other => format!("{} (its {} as GLSL)", self.path.display(), other.name()),
         };
-        shown.chars().map(|c| if c == '"' || c.is_control() { '_' } else { c }).collect()
+        crate::io::directive_name(&shown)
     }
 
     /// The function that calls a declared entry as BRDF Explorer's `BRDF(L, V, N, X, Y)` is called, and its

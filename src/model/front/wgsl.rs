@@ -294,7 +294,8 @@ impl Modules<'_> {
                 let (line, col) = import_at(text, &import);
                 anyhow!("{shown}:{line}:{col}: {e:#}")
             })?;
-            let file = path.display().to_string();
+            // naga_oil names the module by it in its messages: no control character of a file name there.
+            let file = crate::messages::escape_line(&path.display().to_string());
             self.stack.push(import.clone());
             self.add_imports_of(&source, &file, &super::dir_of(&path))?;
             self.stack.pop();

@@ -87,6 +87,8 @@ pub fn per_line(model: &str, instructions: &[Attributed], binding_pipe: &str) ->
     let mut lines: Vec<LineCost> = by_line.into_values().collect();
     lines.sort_by(costliest_first);
     for l in &mut lines {
+        // A user's file is named in the compiled code as its `#line` directive gave it (`io::directive_name`).
+        l.file = crate::io::from_directive_name(&l.file);
         l.text = source_text(&l.file, l.line);
         l.file = short(&l.file);
     }
