@@ -216,3 +216,27 @@ fn a_diff_report_given_to_compare_is_named_and_tiny_bounds_are_short() {
     let r = run_in(d, &["diff", "--model", "ggx", "--model", "blinn", "--samples", "50", "--f0", "1e-400..1e-300"]);
     assert!(r.stdout.contains("F0 in [0, 1e-300]^3"), "{}", r.stdout);
 }
+
+/// A compiler running away is bounded in memory: nested `[ForceUnroll]` loops made slangc take 8 GB; under a
+/// 512 MiB bound it fails within seconds, and the message names the bound and how to raise it.
+#[test]
+fn a_runaway_compiler_stops_at_its_memory_bound() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let body = "    [ForceUnroll] for (int i = 0; i < 400; i++)\n        [ForceUnroll] for (int j = 0; j < 400; j++)\n            [ForceUnroll] for (int k = 0; k < 400; k++)\n                s = select(s > 0.5, s * 0.5, s + 0.25);\n";
+    let text = format!(
+        "float3 BRDF(float3 L, float3 V, float3 N, float3 X, float3 Y)\n{{\n    float s = dot(N, L);\n{body}    return float3(s, s, s);\n}}\n"
+    );
+    std::fs::write(d.join("runaway.hlsl"), text).unwrap();
+    let start = std::time::Instant::now();
+    let out = common::brdfprof()
+        .args(["diff", "--model", "runaway.hlsl", "--hlsl-front-end", "slang", "--reference", "ggx", "--samples", "10"])
+        .env("BRDFPROF_CHILD_MEMORY_MB", "512")
+        .current_dir(d)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("bounded at 512 MiB") && stderr.contains("BRDFPROF_CHILD_MEMORY_MB"), "{stderr}");
+    assert!(start.elapsed() < std::time::Duration::from_secs(55), "stopped by the bound, not the time limit");
+}

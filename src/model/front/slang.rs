@@ -107,7 +107,8 @@ pub fn compile(
     }
     if !result.status.success() || !out.is_file() {
         let mut text = messages(&log, x, &source);
-        if ["bad_alloc", "out of memory", "Out of memory"].iter().any(|m| log.contains(m)) {
+        // slangc says "internal error" where an allocation failed under the bound.
+        if ["bad_alloc", "out of memory", "Out of memory", "internal error"].iter().any(|m| log.contains(m)) {
             text += &format!(" {}", crate::launch::memory_note());
         }
         return Ok(Some(Err(text)));
