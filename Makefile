@@ -3,16 +3,27 @@
 CARGO ?= cargo
 BIN := target/release/brdfprof
 
-.PHONY: setup mesa build run test test-crates spv baseline
+.PHONY: setup setup-tests mesa mesa-adreno mesa-mali mesa-anv mesa-nak mesa-key build run test test-crates spv baseline install
 
-# System packages and NVIDIA's compiler wheels: all that `make run` needs (it builds no Mesa).
+# System packages and the compiler wheels (NVRTC, slangc): all that brdfprof needs to run (`make run` builds no
+# Mesa). apt-get runs as root or through sudo; nothing else needs root.
 setup:
 	@sh scripts/setup.sh
 
-# Mesa's Turnip, PanVK and ANV on noop drm-shims, for the adreno:, mali: and anv: targets only: ~20 min on 2 cores,
-# once per machine (cached in ~/.cache/brdfprof), so `run` does not wait for it; `test` and `baseline` use them.
+# What only the tests need besides (Chromium, npm and the SARIF Multitool).
+setup-tests: setup
+	@sh scripts/setup-tests.sh
+
+# Mesa's drivers on noop drm-shims for the adreno:, mali:, anv: and nak: targets: once per machine (cached in
+# ~/.cache/brdfprof), so `run` does not wait for it; `test` and `baseline` use them. `make mesa VENDORS="adreno
+# nak"` or `make mesa-adreno` builds only what those families load; `make mesa-key` prints the cache key (docs/ci.md).
+VENDORS ?= adreno mali anv nak
 mesa: setup
-	@sh scripts/mesa-noop.sh
+	@BRDFPROF_MESA_VENDORS="$(VENDORS)" sh scripts/mesa-noop.sh
+mesa-adreno mesa-mali mesa-anv mesa-nak: setup
+	@BRDFPROF_MESA_VENDORS="$(@:mesa-%=%)" sh scripts/mesa-noop.sh
+mesa-key:
+	@BRDFPROF_MESA_VENDORS="$(VENDORS)" sh scripts/mesa-noop.sh --key
 
 build: setup
 	$(CARGO) build --release --locked
@@ -24,8 +35,20 @@ run: build
 	$(BIN) profile --json $(RUN_JSON)
 
 # The tests compile on every target, the adreno:, mali: and anv: ones included, so they need `mesa`.
-test: setup mesa
+test: setup-tests mesa
 	$(CARGO) test --release --locked --workspace
+
+# The binary into PREFIX/bin, its man page and shell completions beside it; it finds its tools (the wheels of
+# `make setup`, the Mesa builds of `make mesa`) in the per-user data directory, not in this checkout, so the
+# checkout may move or go. `cargo install --path .` installs the same binary (without the man page).
+PREFIX ?= $(HOME)/.local
+install: build
+	install -Dm755 $(BIN) "$(PREFIX)/bin/brdfprof"
+	mkdir -p "$(PREFIX)/share/man/man1" "$(PREFIX)/share/bash-completion/completions" "$(PREFIX)/share/zsh/site-functions" "$(PREFIX)/share/fish/vendor_completions.d"
+	$(BIN) __man "$(PREFIX)/share/man/man1"
+	$(BIN) completions bash > "$(PREFIX)/share/bash-completion/completions/brdfprof"
+	$(BIN) completions zsh > "$(PREFIX)/share/zsh/site-functions/_brdfprof"
+	$(BIN) completions fish > "$(PREFIX)/share/fish/vendor_completions.d/brdfprof.fish"
 
 # The leaf crates' own tests (BRDF mathematics, process layer, SPIR-V to C writer): no Vulkan driver, no Mesa,
 # none of ash, naga or plotters to compile; the quick loop for changes below the application.

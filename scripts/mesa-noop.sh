@@ -10,10 +10,29 @@
 #   driver needs libclc and LLVM's SPIR-V translator (docs/targets/mesa-noop.md).
 # Each build lives outside the checkout, in $BRDFPROF_MESA_CACHE (default ~/.cache/brdfprof), keyed on the
 # source version and the options; a second run finds the key and does nothing.
+# BRDFPROF_MESA_VENDORS (`make mesa VENDORS=...`, `make mesa-adreno`, ...) builds only what those target
+# families load: adreno and mali need Mesa 22.3 and 25.0, anv 22.3, nak NVK (default: all four). `--key` prints
+# the cache key of what they need (for a CI cache, docs/ci.md) and builds nothing.
+# Each build is linked into the per-user data directory's tools folder (brdfprof finds it there from any binary,
+# `cargo install` or `make install` ones included) and into the checkout's .tools.
 set -eu
 
 root=$(cd "$(dirname "$0")/.." && pwd)
 cache=${BRDFPROF_MESA_CACHE:-${XDG_CACHE_HOME:-$HOME/.cache}/brdfprof}
+data=${XDG_DATA_HOME:-$HOME/.local/share}/brdfprof/tools
+vendors=${BRDFPROF_MESA_VENDORS:-adreno mali anv nak}
+for v in $vendors; do
+    case "$v" in adreno|mali|anv|nak) ;; *) echo "brdfprof mesa: unknown vendor '$v' in VENDORS: give adreno, mali, anv or nak" >&2; exit 2 ;; esac
+done
+wants() { for v in $vendors; do for w in "$@"; do [ "$v" = "$w" ] && return 0; done; done; return 1; }
+key_only=false
+[ "${1:-}" = "--key" ] && key_only=true
+# link NAME BUILD: the build as the tools folder NAME, in the data directory and in the checkout.
+link() {
+    mkdir -p "$data" "$root/.tools"
+    ln -sfn "$2" "$data/$1"
+    ln -sfn "$2" "$root/.tools/$1"
+}
 options="-Dbuildtype=release -Dvulkan-drivers=freedreno,panfrost,intel -Dgallium-drivers= -Dtools=drm-shim,intel \
 -Dplatforms= -Dglx=disabled -Degl=disabled -Dgbm=disabled -Dopengl=false -Dgles1=disabled -Dgles2=disabled \
 -Dllvm=disabled -Dshared-glapi=disabled -Dvalgrind=disabled -Dlibunwind=disabled -Dzstd=enabled -Dvideo-codecs="
@@ -69,7 +88,7 @@ version=$(dpkg-query -W -f='${Version}' mesa-vulkan-drivers 2>/dev/null) || {
 key="$version $(printf '%s' "$options" | sha256sum | cut -c1-16)"
 dir="$cache/mesa-noop-$(printf '%s' "$key" | tr ' +:~' '----')"
 
-if ! built "$key" "$dir" "$products"; then
+if ! $key_only && wants adreno mali anv && ! built "$key" "$dir" "$products"; then
     as_root "$dir"
     export DEBIAN_FRONTEND=noninteractive
     # Debian's deb-src entry beside the deb one: the source package of the installed Mesa.
@@ -89,9 +108,10 @@ if ! built "$key" "$dir" "$products"; then
     [ -n "$srcdir" ] || { echo "brdfprof mesa: apt-get source mesa=$version unpacked nothing in $dir" >&2; exit 1; }
     build "Turnip, PanVK, ANV and their noop shims from Mesa $version (about 1000 steps, ~8 min on 2 cores)" "$key" "$dir" "$options" "$products" meson "$srcdir"
 fi
-mkdir -p "$root/.tools"
-ln -sfn "$dir/build" "$root/.tools/mesa"
-echo "brdfprof mesa: Mesa noop drivers present ($key) in $dir" >&2
+if ! $key_only && wants adreno mali anv; then
+    link mesa "$dir/build"
+    echo "brdfprof mesa: Mesa noop drivers present ($key) in $dir" >&2
+fi
 
 # bookworm-backports' Mesa, pinned (docs/targets/mesa-noop.md's figures are this build's): its source package's upstream
 # tarball, checked against the SHA-256 of Debian's signed Sources index (apt-get source --print-uris); Debian's
@@ -142,12 +162,12 @@ backports_build() {
         "python3 $dir25/meson/bin/meson" "$src25"
 }
 
-if ! built "$key25" "$dir25" "$products25"; then
+if ! $key_only && wants adreno mali && ! built "$key25" "$dir25" "$products25"; then
     # In a subshell: build's `exit` on failure ends it, not the setup.
     ( backports_build ) || echo "brdfprof mesa: warning: bookworm-backports' Mesa $version25 was not built; adreno:a730/a740/a750 and mali:g610 are unavailable (the other targets are not affected); make mesa tries again" >&2
 fi
-if built "$key25" "$dir25" "$products25"; then
-    ln -sfn "$dir25/build" "$root/.tools/mesa25"
+if ! $key_only && wants adreno mali && built "$key25" "$dir25" "$products25"; then
+    link mesa25 "$dir25/build"
     echo "brdfprof mesa: Mesa noop drivers present ($key25) in $dir25" >&2
 fi
 
@@ -210,10 +230,19 @@ nvk_build() {
     rm -rf "$dirnvk"/cargo-home "$dirnvk"/fetch-*
 }
 
-if ! built "$keynvk" "$dirnvk" "$products_nvk"; then
+if ! $key_only && wants nak && ! built "$keynvk" "$dirnvk" "$products_nvk"; then
     ( nvk_build ) || echo "brdfprof mesa: warning: NVK from Mesa $version25 was not built; the nak: targets are unavailable (the other targets are not affected); make mesa tries again" >&2
 fi
-if built "$keynvk" "$dirnvk" "$products_nvk"; then
-    ln -sfn "$dirnvk/build" "$root/.tools/mesa25-nvk"
+if ! $key_only && wants nak && built "$keynvk" "$dirnvk" "$products_nvk"; then
+    link mesa25-nvk "$dirnvk/build"
     echo "brdfprof mesa: NVK noop driver present ($keynvk) in $dirnvk" >&2
+fi
+
+# The cache key of the builds the vendors need, one line (a CI cache of $BRDFPROF_MESA_CACHE keys on it).
+if $key_only; then
+    k=""
+    wants adreno mali anv && k="$k $key"
+    wants adreno mali && k="$k $key25"
+    wants nak && k="$k $keynvk"
+    printf 'brdfprof-mesa-%s\n' "$(printf '%s' "$k" | sha256sum | cut -c1-16)"
 fi

@@ -1,14 +1,17 @@
 #!/bin/sh
-# Installs what brdfprof needs (Debian 12 names): the Vulkan loader, lavapipe (Mesa's CPU Vulkan driver), the
+# Installs what brdfprof needs to run (Debian 12 names): the Vulkan loader, lavapipe (Mesa's CPU Vulkan driver), the
 # Khronos validation layer, glslang, SPIRV-Tools, spirv-cross (HLSL and WGSL models' SPIR-V back to GLSL,
-# docs/hlsl.md), vulkaninfo and valgrind; g++ (runs the kernels' C translation
-# on the CPU); Intel's OpenCL compiler (ocloc/IGC) and PoCL (OpenCL on the CPU) for the intel: targets; Chromium
-# (the HTML report is tested in it, headless); npm (Debian's nodejs), and from the npm registry Microsoft's SARIF
-# Multitool into .tools/sarif (about 100 MB; the tests validate `check --sarif` with it); and,
-# from PyPI, NVIDIA's NVRTC and nvdisasm for the nvidia: targets, into .tools/nvidia (about 150 MB), and Slang's
-# slangc (the HLSL front end for what glslang's cannot take) into .tools/slang (about 50 MB).
-# As root with apt-get it installs what is missing; otherwise it says exactly what to install and fails.
-# Mesa's noop drivers (adreno:, mali:, anv:) are not built here: `make mesa` (scripts/mesa-noop.sh), ~20 min once.
+# docs/hlsl.md), vulkaninfo and valgrind (inspect's callgrind counts); g++ (runs the kernels' C translation on the
+# CPU); Intel's OpenCL compiler (ocloc/IGC) and PoCL (OpenCL on the CPU) for the intel: targets; and, from PyPI,
+# NVIDIA's NVRTC and nvdisasm for the nvidia: targets (about 150 MB) and Slang's slangc (the HLSL front end for what
+# glslang's cannot take; about 50 MB). What only brdfprof's own tests need (Chromium, npm and Microsoft's SARIF
+# Multitool) is scripts/setup-tests.sh's, which `make test` runs.
+# The PyPI wheels and the link to IGA's library go into the per-user data directory's tools folder
+# ($XDG_DATA_HOME/brdfprof/tools, default ~/.local/share/brdfprof/tools), where brdfprof finds them from any binary
+# (`make install`, `cargo install --path .`), and are linked into the checkout's .tools.
+# System packages: as root with apt-get it installs what is missing; as another user it runs apt-get through sudo
+# (the apt part alone; nothing else needs root, cargo least of all); otherwise it says exactly what to install.
+# Mesa's noop drivers (adreno:, mali:, anv:, nak:) are not built here: `make mesa` (scripts/mesa-noop.sh).
 set -eu
 
 missing=""
@@ -27,30 +30,40 @@ command -v g++ >/dev/null 2>&1 || missing="$missing g++"
 command -v ocloc >/dev/null 2>&1 || missing="$missing intel-opencl-icd"
 have_file /etc/OpenCL/vendors/pocl.icd || missing="$missing pocl-opencl-icd"
 have_lib 'libOpenCL.so.1' || missing="$missing ocl-icd-libopencl1"
-have_file /usr/bin/chromium || missing="$missing chromium"
-command -v npm >/dev/null 2>&1 || missing="$missing npm"
 
+# apt-get as root, else through sudo (never the rest of the setup: it needs no root).
+as_root=""
+[ "$(id -u)" = 0 ] || as_root="sudo"
 if [ -n "$missing" ]; then
-    if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
-        echo "brdfprof setup: installing$missing" >&2
-        export DEBIAN_FRONTEND=noninteractive
-        apt-get update -qq
+    if command -v apt-get >/dev/null 2>&1 && { [ -z "$as_root" ] || command -v sudo >/dev/null 2>&1; }; then
+        echo "brdfprof setup: installing$missing${as_root:+ (apt-get through sudo)}" >&2
+        $as_root env DEBIAN_FRONTEND=noninteractive apt-get update -qq
         # shellcheck disable=SC2086
-        apt-get install -y -qq $missing >/dev/null
+        $as_root env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $missing >/dev/null
     else
         echo "brdfprof setup: missing system packages:$missing" >&2
         echo "  install them as root on Debian/Ubuntu:  apt-get install$missing" >&2
         echo "  (other systems: the Vulkan loader, Mesa's lavapipe driver, the Khronos validation layer," >&2
-        echo "   glslang, SPIRV-Tools, spirv-cross, vulkan-tools, valgrind, g++, Intel's compute runtime (ocloc), PoCL, the" >&2
-        echo "   OpenCL ICD loader, Chromium and npm from your package manager)" >&2
+        echo "   glslang, SPIRV-Tools, spirv-cross, vulkan-tools, valgrind, g++, Intel's compute runtime (ocloc), PoCL and" >&2
+        echo "   the OpenCL ICD loader from your package manager)" >&2
         exit 1
     fi
 fi
-command -v cargo >/dev/null 2>&1 || { echo "brdfprof setup: cargo not found; install Rust (https://rustup.rs)" >&2; exit 1; }
-
-# NVIDIA's compiler (no GPU or driver needed): the pinned wheels of scripts/nvidia-wheels.txt, project-local.
 root=$(cd "$(dirname "$0")/.." && pwd)
-nv="$root/.tools/nvidia"
+data=${XDG_DATA_HOME:-$HOME/.local/share}/brdfprof/tools
+mkdir -p "$data" "$root/.tools"
+# place NAME: the data directory's folder NAME, where a real .tools/NAME of an older setup is moved (not fetched
+# again), linked back as .tools/NAME.
+place() {
+    if [ -d "$root/.tools/$1" ] && [ ! -L "$root/.tools/$1" ]; then
+        if [ -e "$data/$1" ]; then rm -rf "$root/.tools/$1"; else mv "$root/.tools/$1" "$data/$1"; fi
+    fi
+    ln -sfn "$data/$1" "$root/.tools/$1"
+    printf '%s\n' "$data/$1"
+}
+
+# NVIDIA's compiler (no GPU or driver needed): the pinned wheels of scripts/nvidia-wheels.txt.
+nv=$(place nvidia)
 wheels=$(cat "$root/scripts/nvidia-wheels.txt")
 if [ ! -f "$nv/nvidia/cu13/lib/libnvrtc.so.13" ] || [ ! -x "$nv/nvidia/cu13/bin/nvdisasm" ] || [ "$(cat "$nv/.wheels" 2>/dev/null)" != "$wheels" ]; then
     python3 -m pip --version >/dev/null 2>&1 || { echo "brdfprof setup: python3 -m pip not found; install python3-pip (needed for NVIDIA's NVRTC wheels)" >&2; exit 1; }
@@ -61,8 +74,8 @@ if [ ! -f "$nv/nvidia/cu13/lib/libnvrtc.so.13" ] || [ ! -x "$nv/nvidia/cu13/bin/
     echo "$wheels" > "$nv/.wheels"
 fi
 # Slang's compiler (slangc, the second HLSL front end for what glslang's cannot take): the pinned slangtorch wheel
-# of scripts/slang-wheel.txt (it ships slangc and its libraries; no PyTorch is needed to run slangc), project-local.
-sl="$root/.tools/slang"
+# of scripts/slang-wheel.txt (it ships slangc and its libraries; no PyTorch is needed to run slangc).
+sl=$(place slang)
 slang_wheel=$(cat "$root/scripts/slang-wheel.txt")
 if [ ! -x "$sl/slangtorch/bin/slangc" ] || [ "$(cat "$sl/.wheels" 2>/dev/null)" != "$slang_wheel" ]; then
     echo "brdfprof setup: installing $slang_wheel (slangc) into $sl" >&2
@@ -73,20 +86,8 @@ fi
 # ocloc disassembles only where it can dlopen libiga64.so; Debian ships libiga64.so.1 alone: a private link.
 iga=$(ls /usr/lib/x86_64-linux-gnu/libiga64.so.1 /usr/lib/*/libiga64.so.1 2>/dev/null | head -n 1)
 if [ -n "$iga" ]; then
-    mkdir -p "$root/.tools/intel"
-    ln -sf "$iga" "$root/.tools/intel/libiga64.so"
-fi
-# Microsoft's SARIF Multitool validates `check --sarif` in the tests: the pinned npm package, project-local.
-sarif="$root/.tools/sarif"
-multitool=$(cat "$root/scripts/sarif-multitool.txt")
-tool="$sarif/node_modules/@microsoft/sarif-multitool-linux/Sarif.Multitool"
-if [ ! -x "$tool" ] || [ "$(cat "$sarif/.package" 2>/dev/null)" != "$multitool" ]; then
-    echo "brdfprof setup: installing $multitool into $sarif" >&2
-    rm -rf "$sarif"
-    mkdir -p "$sarif"
-    npm install --silent --no-audit --no-fund --prefix "$sarif" "$multitool" >/dev/null
-    # npm may skip the package's install script, which only makes the binary executable.
-    chmod u+x "$tool"
-    echo "$multitool" > "$sarif/.package"
+    intel=$(place intel)
+    mkdir -p "$intel"
+    ln -sf "$iga" "$intel/libiga64.so"
 fi
 echo "brdfprof setup: system packages present" >&2

@@ -4,7 +4,7 @@
 //! `gpu`) -> the measurement protocol (`profile`) -> reports (`report`).
 
 pub use brdfprof_brdf as brdf;
-pub use brdfprof_process::{cleanup, launch, messages};
+pub use brdfprof_process::{cleanup, launch, messages, tools};
 pub use brdfprof_vulkan as gpu;
 
 pub mod accuracy;

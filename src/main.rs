@@ -5,7 +5,7 @@
 
 mod cli;
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, Parser, Subcommand};
 use std::process::ExitCode;
 
 #[derive(Parser)]
@@ -24,7 +24,7 @@ enum Command {
     /// List Vulkan devices with the properties that matter for profiling.
     Devices(cli::devices::DevicesArgs),
     /// List the terms (with citations) and presets that model specs can name.
-    Models,
+    Models(cli::models::ModelsArgs),
     /// Evaluate f_s of one model on the GPU for every row of a CSV file.
     Eval(cli::eval::EvalArgs),
     /// Evaluate two models on the same inputs (a CSV or seeded samples) and report how far B is from A: per
@@ -62,6 +62,14 @@ enum Command {
     Render(cli::render::RenderArgs),
     /// The disk cache of compiled kernels: `show` (directory, entries, size) or `clear`.
     Cache(cli::cache::CacheArgs),
+    /// Print a completion script for SHELL on stdout (`make install` installs bash's, zsh's and fish's).
+    Completions {
+        #[arg(value_enum)]
+        shell: clap_complete::Shell,
+    },
+    /// Writes the man pages (brdfprof.1 and one per command) into DIR (`make install` runs it).
+    #[command(name = "__man", hide = true)]
+    Man { dir: std::path::PathBuf },
     #[command(name = "__callgrind-child", hide = true)]
     CallgrindChild { request: String },
     #[command(name = "__noop-child", hide = true)]
@@ -93,7 +101,7 @@ fn main() -> ExitCode {
     }
     let result = match cli.command {
         Command::Devices(args) => cli::devices::devices(&args),
-        Command::Models => cli::models::models(),
+        Command::Models(args) => cli::models::models(&args),
         Command::Eval(args) => cli::eval::eval(&args),
         Command::Diff(args) => cli::diff::diff(&args),
         Command::Profile(args) => cli::profile::profile(&args),
@@ -106,6 +114,11 @@ fn main() -> ExitCode {
         Command::Scene(args) => cli::scene::scene(&args),
         Command::Render(args) => cli::render::render(&args),
         Command::Cache(args) => cli::cache::cache(&args),
+        Command::Completions { shell } => {
+            clap_complete::generate(shell, &mut Cli::command(), "brdfprof", &mut std::io::stdout());
+            Ok(ExitCode::SUCCESS)
+        }
+        Command::Man { dir } => cli::hidden::man(Cli::command(), &dir),
         Command::CallgrindChild { request } => cli::hidden::callgrind_child(&request),
         Command::NoopChild { request } => cli::hidden::noop_child(&request),
         Command::RunTranslation { dir } => cli::hidden::run_translation(&dir),

@@ -22,6 +22,17 @@ pub struct Baseline {
     pub environment: BTreeMap<String, BTreeMap<String, String>>,
 }
 
+impl Baseline {
+    /// What the run was measured on: the compile-only target (`nvidia:sm_89`) or the device, and the compiler.
+    pub fn measured_on(&self) -> (String, String) {
+        let device = self.inspect.provenance["device"]["name"].as_str().unwrap_or("?").to_string();
+        match &self.inspect.cost {
+            Some(c) => (c.target.clone().unwrap_or(device), c.compiler.clone()),
+            None => (device, self.inspect.tools.iter().map(|(k, v)| format!("{k} {v}")).collect::<Vec<_>>().join(", ")),
+        }
+    }
+}
+
 /// Reads and checks a baseline file; every error names the file and what is wrong with it.
 pub fn load(path: &Path) -> Result<Baseline> {
     let name = path.display();

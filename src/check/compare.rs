@@ -3,7 +3,7 @@
 use super::baseline::Baseline;
 use super::environment::{JIT_FEATURES, MESA};
 use super::lines::LineChange;
-use super::thresholds::{ALPHA, GROUPS, MIN_TIMING_ROUNDS, TIMING_KEY, Thresholds, group_of, is_gated};
+use super::thresholds::{ALPHA, COST_KEYS, GROUPS, MIN_TIMING_ROUNDS, TIMING_KEY, Thresholds, group_of, is_gated};
 use crate::inspect::timing::TimingRun;
 use crate::stats;
 use std::collections::BTreeMap;
@@ -91,6 +91,29 @@ pub struct Comparison {
     pub lines: Vec<ModelLines>,
 }
 
+impl Comparison {
+    /// How large a model's regression is, for ordering findings (the largest first): the change of its modelled
+    /// cycles per evaluation where it has one (what the cost tables headline), else its largest regressed
+    /// statistic's change with a finite rule for one that appears (0 -> n counts as n, not +inf: a first `pow`
+    /// is no larger than a tripled loop), else its timing change.
+    pub fn size(&self, model: &str) -> f64 {
+        let cmp = self;
+        let mine = || cmp.changes.iter().filter(move |c| c.model == model);
+        if let Some(c) = mine().find(|c| c.key == COST_KEYS[0] && c.new > c.old) {
+            return c.rel;
+        }
+        let finite = |c: &Change| (c.new - c.old) / c.old.abs().max(1.0);
+        let counts = mine().filter(|c| c.is_regression()).map(finite).fold(f64::NEG_INFINITY, f64::max);
+        let timing = cmp
+            .timing
+            .iter()
+            .filter(|t| t.model == model && t.is_regression())
+            .map(|t| t.change)
+            .fold(f64::NEG_INFINITY, f64::max);
+        counts.max(timing)
+    }
+}
+
 /// One model's per-line changes.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ModelLines {
@@ -105,18 +128,25 @@ fn differences(old: Option<&BTreeMap<String, String>>, new: Option<&BTreeMap<Str
     let (empty_old, empty_new) = (BTreeMap::new(), BTreeMap::new());
     let (old, new) = (old.unwrap_or(&empty_old), new.unwrap_or(&empty_new));
     let none = String::from("(none)");
+    // A key the baseline does not hold was not recorded when it was saved (a tool version added since): no
+    // difference to name.
     let diffs: Vec<String> = old
         .keys()
         .chain(new.keys())
         .collect::<std::collections::BTreeSet<_>>()
         .into_iter()
-        .filter(|k| old.get(*k) != new.get(*k))
+        .filter(|k| old.contains_key(*k) && old.get(*k) != new.get(*k))
         .map(|k| match k.as_str() {
             MESA => format!("Mesa {} vs {}", old.get(k).unwrap_or(&none), new.get(k).unwrap_or(&none)),
             _ => format!("{k}: baseline `{}`, now `{}`", old.get(k).unwrap_or(&none), new.get(k).unwrap_or(&none)),
         })
         .collect();
     (!diffs.is_empty()).then(|| diffs.join("; "))
+}
+
+/// The environment a group's figures depend on: the cost group's are the compiler's (`driver`).
+fn env_group(group: &str) -> &str {
+    if group == "cost" { "driver" } else { group }
 }
 
 fn has_group(b: &Baseline, group: &str) -> bool {
@@ -144,7 +174,9 @@ fn group_status(old: &Baseline, new: &Baseline, force: bool) -> Vec<(String, Gro
                     }
                 }
                 (true, false) => GroupStatus::Absent(absent_reason(new, g)),
-                (true, true) => match differences(old.environment.get(g), new.environment.get(g)) {
+                // The cost rule reads the compiler's listing: comparable where the compiler's figures are.
+                (true, true) => match differences(old.environment.get(env_group(g)), new.environment.get(env_group(g)))
+                {
                     None => GroupStatus::Compared,
                     Some(d) if force => GroupStatus::Forced(d),
                     Some(d) => GroupStatus::NotComparable(d),
@@ -180,8 +212,28 @@ pub(super) fn rel_change(old: f64, new: f64) -> f64 {
     }
 }
 
+/// `b` with its cost table's figures as the `cost` group's statistics of each row (`COST_KEYS`), so that they
+/// are compared, gated and reported as every other statistic is (a baseline saved before they were stats has
+/// them in its cost table too).
+fn with_cost_stats(b: &Baseline) -> Baseline {
+    let mut b = b.clone();
+    let Some(cost) = b.inspect.cost.clone() else { return b };
+    for row in &mut b.inspect.rows {
+        let Some(c) = cost.row(&row.model) else { continue };
+        row.stats.insert(COST_KEYS[0].into(), c.cycles_per_eval);
+        if let Some(net) = c.net_cycles_per_eval {
+            row.stats.insert(COST_KEYS[1].into(), net);
+        }
+    }
+    let mut columns: Vec<String> = COST_KEYS.iter().map(|k| k.to_string()).collect();
+    columns.extend(b.inspect.columns.iter().filter(|c| !COST_KEYS.contains(&c.as_str())).cloned());
+    b.inspect.columns = columns;
+    b
+}
+
 /// Compares two runs statistic by statistic.
 pub fn compare(old: &Baseline, new: &Baseline, thresholds: &Thresholds, force: bool) -> Comparison {
+    let (old, new) = (&with_cost_stats(old), &with_cost_stats(new));
     let groups = group_status(old, new, force);
     let compared = |g: &str| {
         groups.iter().any(|(name, s)| name == g && matches!(s, GroupStatus::Compared | GroupStatus::Forced(_)))
@@ -212,7 +264,8 @@ pub fn compare(old: &Baseline, new: &Baseline, thresholds: &Thresholds, force: b
                 new: n,
                 rel: rel_change(o, n),
                 threshold: thresholds.get(key),
-                gated: is_gated(key),
+                // A net at or below 0 is harness-bound: no ratio to gate on.
+                gated: is_gated(key) && !(key == COST_KEYS[1] && o <= 0.0),
             });
         }
         if compared("naga") && old_row.notes.get("naga") != new_row.notes.get("naga") {
@@ -238,10 +291,9 @@ pub fn compare(old: &Baseline, new: &Baseline, thresholds: &Thresholds, force: b
     }
     // Per-line cost is a target's own: lines measured on another target (an nvidia: baseline checked on
     // intel:) would read as new cost on every line.
-    let same_target = super::findings::measured_on(old).0 == super::findings::measured_on(new).0;
     let lines = regressed
         .iter()
-        .filter(|_| same_target)
+        .filter(|_| old.measured_on().0 == new.measured_on().0)
         .filter_map(|&model| {
             let changes = super::lines::changes(&old.inspect.lines, &new.inspect.lines, model)?;
             let pipe = new.inspect.lines.iter().find(|k| k.model == model)?.binding_pipe.clone();

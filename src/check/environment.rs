@@ -37,7 +37,14 @@ pub fn environment(inspect: &InspectReport, timing: Option<&TimingRun>) -> BTree
         m
     };
     let mut out = BTreeMap::new();
-    out.insert("spirv".into(), BTreeMap::new());
+    // The front ends that compile a shader file's kernels at run time (glslang; slangc, naga_oil where used).
+    let front: BTreeMap<String, String> = inspect
+        .tools
+        .iter()
+        .filter(|(k, _)| *k == "glslang" || k.starts_with("front end of "))
+        .map(|(k, v)| (k.clone(), v.clone()))
+        .collect();
+    out.insert("spirv".into(), front);
     out.insert("naga".into(), BTreeMap::new());
     out.insert(
         "spirv-O".into(),

@@ -15,7 +15,8 @@ pub const COUNT_RULE: Rule = Rule {
     id: "brdfprof/count-regression",
     name: "Shader cost regression",
     short: "A model's instruction counts or modelled cycles grew past the check's threshold.",
-    full: "brdfprof check compared the model's kernel with the saved baseline: a gated statistic (SPIR-V, driver or compiler statistics, modelled cycles per evaluation, callgrind) grew by more than its threshold (--threshold). The locations are the source lines whose cost on the kernel's binding pipe rose most.",
+    full: "brdfprof check compared the model's kernel with the saved baseline: its modelled cycles per evaluation on a compile-only target (the cost group, default threshold 2%) or a gated statistic (SPIR-V, driver or compiler statistics, callgrind) grew by more than its threshold (--threshold). The locations are the source lines whose cost on the kernel's binding pipe rose most.",
+    help: "The model's shader costs more than the baseline recorded. Look at the lines named (their cost on the kernel's binding pipe rose most) and at the report's 'Modelled cycles per evaluation' table. If the change is intended, save a new baseline: `brdfprof check --baseline B --save-baseline B` (docs/gate.md).",
 };
 
 pub const TIMING_RULE: Rule = Rule {
@@ -23,6 +24,7 @@ pub const TIMING_RULE: Rule = Rule {
     name: "Shader timing regression",
     short: "A model's measured cost relative to the reference model rose significantly past the threshold.",
     full: "brdfprof check timed the model interleaved with the reference model: its per-round cost ratio rose past the noise threshold with a significant Mann-Whitney U test (alpha 0.05).",
+    help: "The model's measured cost relative to the reference rose. Rerun to rule out a noisy machine (the test already accounts for the rounds' spread); if the change is intended, save a new baseline with --save-baseline (docs/gate.md).",
 };
 
 pub const FAILED_RULE: Rule = Rule {
@@ -30,6 +32,7 @@ pub const FAILED_RULE: Rule = Rule {
     name: "Model not measured",
     short: "A model failed on the check's target, so the check has no figures for it.",
     full: "brdfprof check could not measure the model on the target: its translation failed its check against the Vulkan device, or the vendor's compiler refused it. The other models were measured and compared; the check fails until this one is measured again.",
+    help: "The message gives the compiler's or the translation check's reason. Fix the shader (or report a brdfprof defect where the reason says so); the check passes again once the model is measured.",
 };
 
 /// Statistics a finding's message names (the largest relative changes).
@@ -38,13 +41,9 @@ const MESSAGE_CHANGES: usize = 3;
 /// Every rule a finding may name, in SARIF's `rules` order.
 pub const RULES: [&Rule; 3] = [&COUNT_RULE, &TIMING_RULE, &FAILED_RULE];
 
-/// What the run was measured on: the compile-only target (`nvidia:sm_89`) or the device, and the compiler.
+/// What `new` was measured on (`Baseline::measured_on`).
 pub fn measured_on(new: &Baseline) -> (String, String) {
-    let device = new.inspect.provenance["device"]["name"].as_str().unwrap_or("?").to_string();
-    match &new.inspect.cost {
-        Some(c) => (c.target.clone().unwrap_or(device), c.compiler.clone()),
-        None => (device, new.inspect.tools.iter().map(|(k, v)| format!("{k} {v}")).collect::<Vec<_>>().join(", ")),
-    }
+    new.measured_on()
 }
 
 /// One finding per model that failed on the target of `new` (its cost section's `failed`), at its file where
@@ -79,17 +78,15 @@ fn model_file(new: &Baseline, model: &str) -> Option<String> {
 /// One finding per regressed model, the largest relative change first.
 pub fn findings(cmp: &Comparison, new: &Baseline) -> Vec<Finding> {
     let (target, compiler) = measured_on(new);
-    let mut models: Vec<(String, f64)> = Vec::new();
-    let regressions = cmp.changes.iter().filter(|c| c.is_regression()).map(|c| (&c.model, c.rel));
-    for (model, rel) in regressions.chain(cmp.timing.iter().filter(|t| t.is_regression()).map(|t| (&t.model, t.change)))
-    {
-        match models.iter_mut().find(|(m, _)| m == model) {
-            Some((_, worst)) => *worst = worst.max(rel),
-            None => models.push((model.clone(), rel)),
+    let mut models: Vec<String> = Vec::new();
+    let regressions = cmp.changes.iter().filter(|c| c.is_regression()).map(|c| &c.model);
+    for model in regressions.chain(cmp.timing.iter().filter(|t| t.is_regression()).map(|t| &t.model)) {
+        if !models.contains(model) {
+            models.push(model.clone());
         }
     }
-    models.sort_by(|a, b| b.1.total_cmp(&a.1));
-    models.iter().map(|(model, _)| finding(cmp, new, model, &target, &compiler)).collect()
+    models.sort_by(|a, b| cmp.size(b).total_cmp(&cmp.size(a)).then(a.cmp(b)));
+    models.iter().map(|model| finding(cmp, new, model, &target, &compiler)).collect()
 }
 
 fn finding(cmp: &Comparison, new: &Baseline, model: &str, target: &str, compiler: &str) -> Finding {

@@ -65,7 +65,10 @@ impl Comparison {
 
     /// The shader-db-style report.
     pub fn report(&self, baseline_path: &Path, new: &Baseline) -> String {
-        let mut out = format!("# brdfprof check against {}\n\n{}\n\n", baseline_path.display(), new.inspect.summary());
+        let mut out = format!("# brdfprof check against {}\n\n", baseline_path.display());
+        out += &self.verdict_head();
+        out += &format!("{}\n\n", new.inspect.summary());
+        out += &self.cost_section();
         out += &self.groups_section();
         out += &self.changes_section();
         out += &self.helped_hurt_section();
@@ -86,6 +89,71 @@ impl Comparison {
         }
         out += &self.verdict_section();
         out
+    }
+
+    /// The verdict in the report's first lines, so that a reader (or a step summary cut at its limit) sees it
+    /// first: regressed or not, how many models, the worst one with its modelled cycles per evaluation.
+    pub fn verdict_head(&self) -> String {
+        let mut models: Vec<&str> =
+            self.changes.iter().filter(|c| c.is_regression()).map(|c| c.model.as_str()).collect();
+        models.extend(self.timing.iter().filter(|t| t.is_regression()).map(|t| t.model.as_str()));
+        models.sort();
+        models.dedup();
+        let missing = self.not_measured();
+        if models.is_empty() {
+            let verdict = if missing.is_empty() { "no regression" } else { "COULD NOT MEASURE" };
+            return format!("**Verdict: {verdict}** ({} models compared)\n\n", self.models().len());
+        }
+        let worst = *models.iter().max_by(|a, b| self.size(a).total_cmp(&self.size(b))).expect("a regressed model");
+        let cost = self.changes.iter().find(|c| c.model == worst && c.key == super::thresholds::COST_KEYS[0]);
+        let detail = match cost {
+            Some(c) => format!(
+                "cycles per evaluation {} -> {} ({})",
+                markdown::sig(c.old, 4),
+                markdown::sig(c.new, 4),
+                percent(c.rel)
+            ),
+            None => self
+                .regressions()
+                .into_iter()
+                .find(|r| r.starts_with(&format!("{worst} ")))
+                .map_or_else(String::new, |r| r[worst.len() + 1..].to_string()),
+        };
+        format!(
+            "**Verdict: REGRESSED**: {} of {} models; the worst, `{worst}`: {detail}\n\n",
+            models.len(),
+            self.models().len()
+        )
+    }
+
+    /// Each model's modelled cycles per evaluation before and after (a compile-only target's one rule, gross and
+    /// net of the memory-only kernel): the figure the cost tables headline, gated by the `cost` group.
+    fn cost_section(&self) -> String {
+        let [gross, net] = super::thresholds::COST_KEYS;
+        let of = |m: &str, k: &str| self.changes.iter().find(|c| c.model == m && c.key == k);
+        let models: Vec<&str> = self.models().into_iter().filter(|m| of(m, gross).is_some()).collect();
+        if models.is_empty() {
+            return String::new();
+        }
+        let mut t = Table::new(["model", "cycles/eval", "change", "net cycles/eval", "change", "verdict"]);
+        for m in &models {
+            let g = of(m, gross).expect("filtered");
+            let n = of(m, net);
+            let verdict = if g.is_regression() || n.is_some_and(Change::is_regression) { "REGRESSION" } else { "-" };
+            t.row([
+                m.to_string(),
+                format!("{} -> {}", markdown::sig(g.old, 4), markdown::sig(g.new, 4)),
+                percent(g.rel),
+                n.map_or("-".into(), |n| format!("{} -> {}", markdown::sig(n.old, 4), markdown::sig(n.new, 4))),
+                n.map_or("-".into(), |n| if n.gated { percent(n.rel) } else { "harness-bound".into() }),
+                verdict.into(),
+            ]);
+        }
+        format!(
+            "## Modelled cycles per evaluation\n\nEach model's cycles per BRDF evaluation under the target's one cost rule, before -> after, gated at {} by default (`--threshold cost=FRACTION`); instruction counts follow as secondary findings.\n\n{}\n",
+            percent(super::thresholds::DEFAULT_COST_THRESHOLD).trim_start_matches('+'),
+            t.markdown()
+        )
     }
 
     fn groups_section(&self) -> String {

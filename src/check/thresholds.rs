@@ -8,8 +8,13 @@ pub const ALPHA: f64 = 0.05;
 pub const MIN_TIMING_ROUNDS: usize = 9;
 pub const DEFAULT_COUNT_THRESHOLD: f64 = 0.01;
 pub const DEFAULT_TIMING_THRESHOLD: f64 = 0.05;
+/// A compile-only target's modelled cycles per evaluation (`COST_KEYS`): the figure its reports headline.
+pub const DEFAULT_COST_THRESHOLD: f64 = 0.02;
 /// Statistic groups (the part of a key before '/').
-pub const GROUPS: [&str; 6] = ["spirv", "spirv-O", "naga", "driver", "callgrind", "timing"];
+pub const GROUPS: [&str; 7] = ["cost", "spirv", "spirv-O", "naga", "driver", "callgrind", "timing"];
+/// The cost group's keys: a compile-only target's modelled cycles per evaluation under its one rule, gross and net
+/// of the memory-only kernel (`schema::cost::CostRow`), compared as the other statistics are.
+pub const COST_KEYS: [&str; 2] = ["cost/cycles-per-eval", "cost/net-cycles-per-eval"];
 /// The timing statistic of each model.
 pub const TIMING_KEY: &str = "timing/cost-ratio";
 /// Driver statistics that cost more when they grow (the aliases); other driver statistics are reported only.
@@ -75,10 +80,10 @@ impl Thresholds {
     /// The threshold of `key`: its own, else its group's, else the default.
     pub fn get(&self, key: &str) -> f64 {
         let find = |k: &str| self.entries.iter().rev().find(|(e, _)| e == k).map(|(_, v)| *v);
-        find(key).or_else(|| find(group_of(key))).unwrap_or(if group_of(key) == "timing" {
-            DEFAULT_TIMING_THRESHOLD
-        } else {
-            DEFAULT_COUNT_THRESHOLD
+        find(key).or_else(|| find(group_of(key))).unwrap_or(match group_of(key) {
+            "timing" => DEFAULT_TIMING_THRESHOLD,
+            "cost" => DEFAULT_COST_THRESHOLD,
+            _ => DEFAULT_COUNT_THRESHOLD,
         })
     }
 }

@@ -7,20 +7,56 @@ use std::process::ExitCode;
 
 #[derive(Args)]
 pub struct DevicesArgs {
-    /// List the compile-only targets (`--device radv:FAMILY`, `nvidia:FAMILY`, `intel:FAMILY`) instead: each vendor's compiler
-    /// for GPU families this machine does not have.
+    /// List the compile-only targets (`--device radv:FAMILY`, `nvidia:FAMILY`, `intel:FAMILY`, ...) instead: each
+    /// vendor's compiler for GPU families this machine does not have, and where each of brdfprof's tools was found.
     #[arg(long)]
     pub targets: bool,
+    /// Also write the list as JSON to FILE (`-`: stdout, which then holds only the JSON; the table goes to stderr).
+    #[arg(long, value_name = "FILE")]
+    pub json: Option<std::path::PathBuf>,
 }
 
-/// `devices --targets`: every vendor's families (`targets::VENDORS`) and whether its compiler is installed.
-fn targets_table() -> String {
+/// Where each of brdfprof's own tools was found (`tools::locate`), or that it is missing and the one command
+/// that installs it.
+fn tools_table() -> (String, Vec<serde_json::Value>) {
+    let mut t = markdown::Table::new(["tool", "found", "where", "installed by"]);
+    let mut json = Vec::new();
+    for (name, var, install) in brdfprof::tools::TOOLS {
+        let (dir, how) = brdfprof::tools::locate(name);
+        let found = dir.exists();
+        t.row([
+            name.to_string(),
+            if found { how.clone() } else { "missing".into() },
+            dir.display().to_string(),
+            format!("`{install}` (or ${var})"),
+        ]);
+        json.push(serde_json::json!({"tool": name, "found": found, "how": how, "dir": dir, "install": install, "variable": var}));
+    }
+    let text = format!(
+        "## Tools\n\nbrdfprof's own tools, each found in the first of: its variable's folder, `share/brdfprof/tools` beside the binary (`make install`), the per-user data directory (`make setup`, `make mesa`), the build checkout's `.tools`.\n\n{}\n",
+        t.markdown()
+    );
+    (text, json)
+}
+
+/// `devices --targets`: every vendor's families (`targets::VENDORS`) and whether its compiler is installed, and
+/// the same as JSON.
+fn targets_table() -> (String, serde_json::Value) {
+    let mut json = Vec::new();
     let mut out = String::from(
         "Compile-only targets: each vendor's production compiler for GPU families this machine does not have (no GPU \
          needed; nothing executes). Commands that compile take them: inspect, check, sweep --cost-device, profile --scene --cost-device.\n\n",
     );
     for v in brdfprof::targets::VENDORS {
         let status = v.status().unwrap_or_else(|e| format!("{e:#}"));
+        json.push(serde_json::json!({
+            "prefix": v.prefix(),
+            "title": v.title(),
+            "compiler": status,
+            "families": v.families().iter().map(|f| serde_json::json!({
+                "device": format!("{}:{}", v.prefix(), f.name), "architecture": f.architecture, "products": f.products,
+                "compiler": f.detail, "in_all": f.default})).collect::<Vec<_>>(),
+        }));
         let mut t = markdown::Table::new([
             "--device",
             "architecture",
@@ -39,15 +75,25 @@ fn targets_table() -> String {
         }
         out += &format!("## {}\n\n{}\n\nCompiler: {status}\n\n{}\n", v.prefix(), v.title(), t.markdown());
     }
-    out
+    let (tools, tools_json) = tools_table();
+    out += &tools;
+    (out, serde_json::json!({"targets": json, "tools": tools_json}))
 }
 
 pub fn devices(args: &DevicesArgs) -> Result<ExitCode> {
+    let outs = super::checked_outputs(&[("--json", args.json.as_deref())], &[])?;
     if args.targets {
-        out!("{}", targets_table());
+        let (text, json) = targets_table();
+        for (_, path) in &outs {
+            brdfprof::export::json::write_json(path, &json)?;
+        }
+        out!("{text}");
         return Ok(ExitCode::SUCCESS);
     }
     let infos = gpu::list_devices()?;
+    for (_, path) in &outs {
+        brdfprof::export::json::write_json(path, &serde_json::json!({ "devices": infos }))?;
+    }
     let default = gpu::select_device(&infos, None).ok();
     let mut t = markdown::Table::new([
         "index",

@@ -36,3 +36,22 @@ pub fn generate_glsl(dir: &Path) -> Result<ExitCode> {
     }
     Ok(ExitCode::SUCCESS)
 }
+
+/// `__man DIR`: brdfprof.1 and a page per command (`brdfprof-COMMAND.1`), from the same argument definitions
+/// as `--help` (clap_mangen).
+pub fn man(cmd: clap::Command, dir: &Path) -> Result<ExitCode> {
+    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    let mut pages = vec![("brdfprof.1".to_string(), cmd.clone())];
+    for sub in cmd.get_subcommands().filter(|s| !s.is_hide_set()) {
+        // clap names commands by &'static str; a page's name lives as long as the process, once.
+        let name: &'static str = Box::leak(format!("brdfprof-{}", sub.get_name()).into_boxed_str());
+        let named = sub.clone().name(name);
+        pages.push((format!("brdfprof-{}.1", sub.get_name()), named));
+    }
+    for (name, page) in pages {
+        let mut bytes = Vec::new();
+        clap_mangen::Man::new(page).render(&mut bytes).with_context(|| format!("cannot render {name}"))?;
+        brdfprof::io::write_output(&dir.join(&name), &bytes)?;
+    }
+    Ok(ExitCode::SUCCESS)
+}

@@ -8,7 +8,13 @@
 macro_rules! out {
     ($($arg:tt)*) => {{
         use std::io::Write as _;
-        let _ = write!(std::io::stdout().lock(), "{}", brdfprof::messages::safe_text(&format!($($arg)*)));
+        let text = brdfprof::messages::safe_text(&format!($($arg)*));
+        // With `--json -`, stdout carries the JSON alone and the report goes to stderr.
+        if brdfprof::io::stdout_claimed() {
+            let _ = write!(std::io::stderr().lock(), "{text}");
+        } else {
+            let _ = write!(std::io::stdout().lock(), "{text}");
+        }
     }};
 }
 
@@ -119,7 +125,15 @@ pub fn on_device_with<T>(
     progress.enable_steady_tick(Duration::from_millis(200));
     let bar = progress.clone();
     let messages = brdfprof::messages::ProgressGuard::new(move |print| bar.suspend(print));
+    // A CI log shows no progress bar: what it shows, every 10 s there.
+    let p = progress.clone();
+    let heartbeat = brdfprof::messages::Heartbeat::start(move || {
+        let of = p.length().filter(|l| *l > 0).map_or(String::new(), |l| format!(" of {l}"));
+        let what = p.message();
+        format!("{}: {}{of}", if what.is_empty() { "working" } else { what.as_str() }, p.position())
+    });
     let result = work(&gpu, &progress);
+    drop(heartbeat);
     drop(messages);
     progress.finish_and_clear();
     let result = result?;
@@ -195,6 +209,7 @@ pub const DEFAULT_OUT: &str = "results";
 /// has the default's name.
 pub fn check_output(flag: &str, path: Option<&Path>, default_dir: &str, default_name: &str) -> Result<()> {
     match path {
+        Some(p) if io::is_stdout(p) => Ok(()),
         Some(p) => io::check_output_path(flag, p),
         None => {
             io::check_output_dir(&format!("{flag} (default {default_dir}/{default_name})"), Path::new(default_dir))?;
@@ -214,6 +229,16 @@ pub fn checked_outputs(
     let outs: Vec<(&'static str, PathBuf)> =
         asked.iter().filter_map(|(f, p)| p.map(|p| (*f, p.to_path_buf()))).collect();
     for (i, (flag, path)) in outs.iter().enumerate() {
+        if io::is_stdout(path) {
+            if !flag.ends_with("json") {
+                anyhow::bail!("{flag} -: only JSON goes to stdout (--json -); give {flag} a file");
+            }
+            if let Some((other, _)) = outs[..i].iter().find(|(_, p)| io::is_stdout(p)) {
+                anyhow::bail!("{flag} -: {other} already writes to stdout; one output can");
+            }
+            io::claim_stdout();
+            continue;
+        }
         io::check_output_path(flag, path)?;
         io::check_not_input(flag, path, inputs)?;
         if let Some((other, _)) = outs[..i].iter().find(|(_, p)| p == path || io::same_file(p, path)) {

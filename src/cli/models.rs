@@ -72,7 +72,45 @@ pub fn models_text() -> String {
     out
 }
 
-pub fn models() -> Result<ExitCode> {
+#[derive(clap::Args)]
+pub struct ModelsArgs {
+    /// Also write the terms, parameters, metals and presets as JSON to FILE (`-`: stdout, which then holds only
+    /// the JSON; the table goes to stderr).
+    #[arg(long, value_name = "FILE")]
+    pub json: Option<std::path::PathBuf>,
+}
+
+/// The term tables as JSON: each term's name, GLSL id and citation; each preset's terms and source.
+fn models_json() -> serde_json::Value {
+    let terms = |names: Vec<&str>, ids: Vec<u32>, cites: Vec<&str>| -> Vec<serde_json::Value> {
+        names
+            .into_iter()
+            .zip(ids)
+            .zip(cites)
+            .map(|((n, id), c)| serde_json::json!({"name": n, "id": id, "citation": c}))
+            .collect()
+    };
+    let presets: Vec<serde_json::Value> = spec::PRESETS
+        .iter()
+        .map(|p| {
+            serde_json::json!({"name": p.name, "d": p.d.name(), "vis": p.vis.name(), "f": p.f.name(), "source": p.source,
+                "spec": ModelSpec::preset(p.name).expect("a preset").canonical()})
+        })
+        .collect();
+    serde_json::json!({
+        "d": terms(D::names(), D::ALL.iter().map(|t| t.id()).collect(), D::ALL.iter().map(|t| t.citation()).collect()),
+        "vis": terms(Vis::names(), Vis::ALL.iter().map(|t| t.id()).collect(), Vis::ALL.iter().map(|t| t.citation()).collect()),
+        "f": terms(F::names(), F::ALL.iter().map(|t| t.id()).collect(), F::ALL.iter().map(|t| t.citation()).collect()),
+        "metals": Metal::names(),
+        "presets": presets,
+    })
+}
+
+pub fn models(args: &ModelsArgs) -> Result<ExitCode> {
+    let outs = super::checked_outputs(&[("--json", args.json.as_deref())], &[])?;
+    for (_, path) in &outs {
+        brdfprof::export::json::write_json(path, &models_json())?;
+    }
     out!("{}", models_text());
     Ok(ExitCode::SUCCESS)
 }

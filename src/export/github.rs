@@ -22,7 +22,8 @@ fn property(text: &str) -> String {
     data(text).replace(':', "%3A").replace(',', "%2C")
 }
 
-/// One `::error` line per finding (the first `MAX_ANNOTATIONS`), at its primary place.
+/// One `::error` line per finding (the first `MAX_ANNOTATIONS`, the largest first as the caller orders them),
+/// at its primary place, and a `::notice` counting those left out.
 pub fn annotations(findings: &[Finding]) -> String {
     let mut out = String::new();
     for f in findings.iter().take(MAX_ANNOTATIONS) {
@@ -35,6 +36,12 @@ pub fn annotations(findings: &[Finding]) -> String {
         }
         props.push(format!("title={}", property(f.rule.name)));
         out += &format!("::error {}::{}\n", props.join(","), data(&f.message));
+    }
+    if findings.len() > MAX_ANNOTATIONS {
+        out += &format!(
+            "::notice title=brdfprof::{} more findings not annotated (GitHub shows at most {MAX_ANNOTATIONS} per step): the report, the step summary and the SARIF log list every one\n",
+            findings.len() - MAX_ANNOTATIONS
+        );
     }
     out
 }
@@ -79,7 +86,7 @@ mod tests {
     use super::*;
     use crate::export::sarif::{Place, Rule};
 
-    const RULE: Rule = Rule { id: "r", name: "Cost, rose: 100%", short: "", full: "" };
+    const RULE: Rule = Rule { id: "r", name: "Cost, rose: 100%", short: "", full: "", help: "" };
 
     #[test]
     fn workflow_commands_escape_their_data_and_properties() {

@@ -10,6 +10,8 @@ pub struct Rule {
     pub name: &'static str,
     pub short: &'static str,
     pub full: &'static str,
+    /// What to do about it (SARIF's `help`, which GitHub's code scanning shows and its upload requires).
+    pub help: &'static str,
 }
 
 /// A place a finding points at: a file, and a line of it where one is known.
@@ -80,7 +82,13 @@ fn result(f: &Finding, rules: &[&Rule], root: &Path) -> Value {
         "ruleIndex": rules.iter().position(|x| x.id == f.rule.id).unwrap_or(0),
         "level": "error",
         "message": { "text": f.message },
-        "partialFingerprints": { "brdfprofFinding/v1": digest(&format!("{}\n{}", f.rule.id, f.identity)) },
+        // GitHub matches an alert across runs by primaryLocationLineHash (it computes one from the line's text
+        // where a log has none): the finding's own identity (rule, model, target) keeps one alert per regression
+        // as the lines above it move.
+        "partialFingerprints": {
+            "brdfprofFinding/v1": digest(&format!("{}\n{}", f.rule.id, f.identity)),
+            "primaryLocationLineHash": format!("{}:1", &digest(&format!("{}\n{}", f.rule.id, f.identity))[..16]),
+        },
         "properties": f.properties,
     });
     if let Some((first, rest)) = f.places.split_first() {
@@ -112,6 +120,7 @@ pub fn log(version: &str, rules: &[&Rule], findings: &[Finding], root: &Path, pr
                 "name": r.name,
                 "shortDescription": { "text": r.short },
                 "fullDescription": { "text": r.full },
+                "help": { "text": r.help, "markdown": r.help },
                 "defaultConfiguration": { "level": "error" },
             })
         })

@@ -143,6 +143,11 @@ fn link_target(path: &Path) -> Result<PathBuf> {
 /// (`stage_outputs`), the rename waits for `commit_outputs`.
 pub fn write_output(path: &Path, bytes: &[u8]) -> Result<()> {
     crate::cleanup::park_if_interrupted();
+    if is_stdout(path) {
+        use std::io::Write as _;
+        let mut out = std::io::stdout().lock();
+        return out.write_all(bytes).and_then(|_| out.flush()).context("cannot write the JSON to stdout");
+    }
     let target = link_target(path)?;
     match std::fs::metadata(&target) {
         Ok(m) if m.is_dir() => bail!("cannot write {}: it is a directory", path.display()),
@@ -156,6 +161,24 @@ pub fn write_output(path: &Path, bytes: &[u8]) -> Result<()> {
         Ok(m) => write_atomic(&target, bytes, Some(m.permissions())),
         Err(_) => write_atomic(&target, bytes, None),
     }
+}
+
+/// `-` as an output path: stdout, which then carries that output alone (`claim_stdout`).
+pub fn is_stdout(path: &Path) -> bool {
+    path.as_os_str() == "-"
+}
+
+static STDOUT_CLAIMED: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// An output goes to stdout (`--json -`): from now on what a command reports for people goes to stderr, so that
+/// stdout carries the JSON alone.
+pub fn claim_stdout() {
+    STDOUT_CLAIMED.store(true, std::sync::atomic::Ordering::SeqCst);
+}
+
+/// Whether an output took stdout (`claim_stdout`).
+pub fn stdout_claimed() -> bool {
+    STDOUT_CLAIMED.load(std::sync::atomic::Ordering::SeqCst)
 }
 
 /// Writes a Markdown report (`write_output`) through `messages::safe_text`: no name from an input starts a line

@@ -127,13 +127,13 @@ fn emitted_keys(rows: &mut [Row]) -> Vec<String> {
     emitted
 }
 
-/// The tools every report names: spirv-opt, and glslang when the kernels were compiled at run time.
-fn tool_versions(shaders: &Shaders) -> BTreeMap<String, String> {
+/// The tools every report names: spirv-opt and glslang (which compiles a shader file's kernels, and with
+/// `--glsl DIR` every kernel, at run time; a baseline records it, so that its counts are not compared with
+/// another glslang's unseen).
+fn tool_versions(_shaders: &Shaders) -> BTreeMap<String, String> {
     let mut tools = BTreeMap::new();
     tools.insert("spirv-opt".into(), spirv::spirv_opt_version().unwrap_or_else(|| "not found".into()));
-    if shaders.glsl_dir().is_some() {
-        tools.insert("glslang".into(), crate::shaders::glslang_version().unwrap_or_else(|| "not found".into()));
-    }
+    tools.insert("glslang".into(), crate::shaders::glslang_version().unwrap_or_else(|| "not found".into()));
     // An HLSL or WGSL model's front end (docs/hlsl.md, docs/wgsl.md).
     tools.extend(crate::model::front::used().into_iter().map(|(path, front)| (format!("front end of {path}"), front)));
     tools

@@ -258,7 +258,17 @@ fn vendor_by_vendor(
 /// Compiles the models' kernels for every target; results in `targets` order, each report's driver note with
 /// its harness share (`harness_note`).
 pub fn compile_all(targets: &[Target], request: &Request) -> Result<Vec<Run>> {
+    let at = std::sync::Arc::new(std::sync::Mutex::new(String::new()));
+    let said = std::sync::Arc::clone(&at);
+    let _heartbeat = crate::messages::Heartbeat::start(move || {
+        format!("compiling for the compile-only targets: {}", said.lock().unwrap_or_else(|e| e.into_inner()))
+    });
+    let total = targets.len();
+    let mut done = 0;
     let mut runs = vendor_by_vendor(targets, |vendor, families| {
+        *at.lock().unwrap_or_else(|e| e.into_inner()) =
+            format!("{} ({} families; {done} of {total} targets done)", vendor.prefix(), families.len());
+        done += families.len();
         if vendor.needs_verification() && request.verify_on.is_none() {
             bail!(
                 "{}: its costs are of a translation that must first run against a Vulkan device, and none was opened",

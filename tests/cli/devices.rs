@@ -92,3 +92,59 @@ fn gpu_check_refuses_a_wrong_mode_and_a_measure_before_prepare() {
     assert_eq!(early.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&early.stderr).contains("gpu-check.sh prepare"), "{early:?}");
 }
+
+/// An installed binary finds its tools without its build checkout: beside it (`<prefix>/share/brdfprof/tools`,
+/// `make install`) first, then in the per-user data directory (`make setup`, `make mesa`); `devices --targets`
+/// says where each was found, and `--json -` gives it as JSON on stdout alone.
+#[test]
+fn an_installed_binary_finds_its_tools_beside_it_or_in_the_data_directory() {
+    let dir = tempfile::tempdir().unwrap();
+    let prefix = dir.path().join("prefix");
+    std::fs::create_dir_all(prefix.join("bin")).unwrap();
+    std::fs::create_dir_all(prefix.join("share/brdfprof/tools")).unwrap();
+    std::fs::copy(env!("CARGO_BIN_EXE_brdfprof"), prefix.join("bin/brdfprof")).unwrap();
+    let nvidia = brdfprof::tools::dir("nvidia");
+    std::os::unix::fs::symlink(&nvidia, prefix.join("share/brdfprof/tools/nvidia")).unwrap();
+    let data = dir.path().join("data");
+    std::fs::create_dir_all(data.join("brdfprof/tools")).unwrap();
+    std::os::unix::fs::symlink(brdfprof::tools::dir("slang"), data.join("brdfprof/tools/slang")).unwrap();
+    let out = std::process::Command::new(prefix.join("bin/brdfprof"))
+        .args(["devices", "--targets", "--json", "-"])
+        .env("XDG_DATA_HOME", &data)
+        .env_remove("BRDFPROF_NVIDIA_DIR")
+        .env_remove("BRDFPROF_SLANG_DIR")
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).expect("stdout holds the JSON alone");
+    let tool = |name: &str| json["tools"].as_array().unwrap().iter().find(|t| t["tool"] == name).unwrap().clone();
+    assert_eq!(tool("nvidia")["how"], "beside the binary (make install)", "{json}");
+    assert_eq!(tool("slang")["how"], "the per-user data directory", "{json}");
+    assert!(String::from_utf8_lossy(&out.stderr).contains("## Tools"), "the table goes to stderr");
+    // It compiles with them: NVRTC from beside the binary.
+    let out = std::process::Command::new(prefix.join("bin/brdfprof"))
+        .args(["inspect", "--device", "nvidia:sm_89", "--model", "ggx", "--json", "-"])
+        .env("XDG_DATA_HOME", &data)
+        .env("BRDFPROF_VALIDATION", "1")
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert!(report["cost"]["rows"].as_array().is_some_and(|r| !r.is_empty()), "{report}");
+}
+
+/// `brdfprof completions SHELL` prints a completion script; `models --json -` the term tables.
+#[test]
+fn completions_and_json_listings() {
+    let r = common::run(&["completions", "bash"]).ok();
+    assert!(
+        r.stdout.contains("_brdfprof()") && r.stdout.contains("stability"),
+        "{}",
+        &r.stdout[..200.min(r.stdout.len())]
+    );
+    let r = common::run(&["models", "--json", "-"]).ok();
+    let json: serde_json::Value = serde_json::from_str(&r.stdout).expect("stdout holds the JSON alone");
+    assert!(json["vis"].as_array().unwrap().iter().any(|v| v["name"] == "schlick-ggx-karis"));
+    assert!(r.stderr.contains("Presets"), "the tables go to stderr");
+}

@@ -23,6 +23,7 @@ mod engine_entries;
 mod eval;
 mod eval_csv;
 mod fuzz;
+mod gate;
 mod hostile;
 mod intel;
 mod limits;

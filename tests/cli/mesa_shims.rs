@@ -493,7 +493,7 @@ fn setup_builds_every_file_each_shim_driver_loads() {
             "scripts/mesa-noop.sh's {list} and the files of the Shims' families on {} differ",
             build.what
         );
-        assert!(script.contains(&format!("\"$root/{}\"", build.link)), "the script links {}", build.link);
+        assert!(script.contains(&format!("link {} ", build.link)), "the script links {}", build.link);
     }
     // Every shim driver is in VENDORS.
     for s in shims {

@@ -136,6 +136,41 @@ pub fn input_note(text: impl Display) {
     }
 }
 
+/// How often a `Heartbeat` speaks.
+pub const HEARTBEAT_EVERY: std::time::Duration = std::time::Duration::from_secs(10);
+
+/// While it lives, and only where stderr is not a terminal (a CI log, which shows no progress bar), a progress
+/// line every `HEARTBEAT_EVERY` saying what `what` says and for how long, so that a long command is never silent.
+pub struct Heartbeat {
+    stop: Option<std::sync::mpsc::Sender<()>>,
+    thread: Option<std::thread::JoinHandle<()>>,
+}
+
+impl Heartbeat {
+    pub fn start(what: impl Fn() -> String + Send + 'static) -> Heartbeat {
+        if std::io::IsTerminal::is_terminal(&std::io::stderr()) {
+            return Heartbeat { stop: None, thread: None };
+        }
+        let (stop, stopped) = std::sync::mpsc::channel::<()>();
+        let started = std::time::Instant::now();
+        let thread = std::thread::spawn(move || {
+            while let Err(std::sync::mpsc::RecvTimeoutError::Timeout) = stopped.recv_timeout(HEARTBEAT_EVERY) {
+                progress(format!("{}, {} s", what(), started.elapsed().as_secs()));
+            }
+        });
+        Heartbeat { stop: Some(stop), thread: Some(thread) }
+    }
+}
+
+impl Drop for Heartbeat {
+    fn drop(&mut self) {
+        drop(self.stop.take());
+        if let Some(t) = self.thread.take() {
+            let _ = t.join();
+        }
+    }
+}
+
 /// While it lives, messages are printed through `suspend` (a progress bar's `suspend`, which hides the bar,
 /// runs the print and draws the bar again).
 pub struct ProgressGuard(());

@@ -40,12 +40,10 @@ pub fn float_defines() -> Vec<String> {
     out
 }
 
-/// The folder of the wheel's files.
+/// The folder of the wheel's files (`tools::locate`: `$BRDFPROF_SLANG_DIR`, beside the binary, the data
+/// directory, the build checkout).
 pub fn install_dir() -> PathBuf {
-    match std::env::var_os(DIR_VAR).filter(|d| !d.is_empty()) {
-        Some(d) => PathBuf::from(d),
-        None => Path::new(env!("CARGO_MANIFEST_DIR")).join(".tools/slang"),
-    }
+    crate::tools::dir("slang")
 }
 
 /// slangc, where `make setup` installed it.

@@ -26,13 +26,10 @@ fn ocloc_path() -> PathBuf {
     }
 }
 
-/// Where `make setup` links `libiga64.so`: `$BRDFPROF_INTEL_DIR`, else `.tools/intel` in the checkout brdfprof
-/// was built from.
+/// Where `make setup` links `libiga64.so` (`tools::locate`: `$BRDFPROF_INTEL_DIR`, beside the binary, the data
+/// directory, the build checkout).
 pub fn iga_dir() -> PathBuf {
-    match std::env::var_os("BRDFPROF_INTEL_DIR").filter(|d| !d.is_empty()) {
-        Some(d) => PathBuf::from(d),
-        None => Path::new(env!("CARGO_MANIFEST_DIR")).join(".tools/intel"),
-    }
+    crate::tools::dir("intel")
 }
 
 fn not_installed(why: &str) -> String {

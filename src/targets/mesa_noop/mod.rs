@@ -812,7 +812,7 @@ pub fn driver_version(report: &InspectReport) -> String {
 
 /// A Mesa build `make mesa` makes (scripts/mesa-noop.sh), which some families' drivers load.
 pub struct MesaBuild {
-    /// Its link in the checkout, `.tools/mesa`.
+    /// Its tools folder (`tools::TOOLS`: `mesa`, a link into the build cache).
     pub link: &'static str,
     /// The variable that names another build directory instead.
     pub var: &'static str,
@@ -824,7 +824,7 @@ pub struct MesaBuild {
 
 /// The installed Mesa's own source package (Debian 12: 22.3.6).
 pub static MESA_DEBIAN: MesaBuild = MesaBuild {
-    link: ".tools/mesa",
+    link: "mesa",
     var: "BRDFPROF_MESA_DIR",
     what: "the installed Mesa (Debian 12: 22.3)",
     drivers: "Turnip, PanVK and ANV from Debian's source package of the installed Mesa, ~8 minutes on 2 cores",
@@ -835,7 +835,7 @@ pub const MESA_25_UNVALIDATED: &str = "Debian 12's validation layer warns, on Me
 
 /// bookworm-backports' Mesa (25.0): Adreno 7xx and Mali Valhall.
 pub static MESA_BACKPORTS: MesaBuild = MesaBuild {
-    link: ".tools/mesa25",
+    link: "mesa25",
     var: "BRDFPROF_MESA25_DIR",
     what: "bookworm-backports' Mesa 25.0",
     drivers: "Turnip and PanVK from Debian's bookworm-backports source package of Mesa 25.0, ~12 minutes on 2 cores",
@@ -844,19 +844,17 @@ pub static MESA_BACKPORTS: MesaBuild = MesaBuild {
 /// The same Mesa 25.0 source again, its NVK alone (NAK is Rust, so this build needs cargo-installed bindgen and
 /// cbindgen and Mesa's Rust subprojects): NVIDIA Turing and Ampere.
 pub static MESA_NVK: MesaBuild = MesaBuild {
-    link: ".tools/mesa25-nvk",
+    link: "mesa25-nvk",
     var: "BRDFPROF_MESA25_NVK_DIR",
     what: "bookworm-backports' Mesa 25.0 (NVK)",
     drivers: "NVK from Debian's bookworm-backports source package of Mesa 25.0, ~12 minutes on 2 cores after ~7 minutes of cargo install for bindgen and cbindgen",
 };
 
 impl MesaBuild {
-    /// Its directory: `$VAR`, else the link of the checkout brdfprof was built from (into the build cache).
+    /// Its directory (`tools::locate`: `$VAR`, beside the binary, the data directory, the build checkout; each
+    /// a link `make mesa` makes into its build cache).
     pub fn dir(&self) -> PathBuf {
-        match std::env::var_os(self.var).filter(|v| !v.is_empty()) {
-            Some(dir) => PathBuf::from(dir),
-            None => Path::new(env!("CARGO_MANIFEST_DIR")).join(self.link),
-        }
+        crate::tools::dir(self.link)
     }
 
     /// A file of the build, or an error naming what is missing and what to run.

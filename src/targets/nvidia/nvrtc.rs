@@ -4,7 +4,7 @@
 
 use anyhow::{Context, Result, anyhow, bail};
 use std::ffi::{CStr, CString, c_char, c_int, c_void};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::OnceLock;
 
 type Program = *mut c_void;
@@ -43,13 +43,10 @@ pub struct Tools {
 /// The pinned wheel versions `make setup` installs (scripts/setup.sh reads the same line of the Makefile).
 pub const WHEELS: &str = "nvidia-cuda-nvrtc==13.5.37 nvidia-cuda-nvdisasm==13.5.37";
 
-/// Where `make setup` installs the wheels: `$BRDFPROF_NVIDIA_DIR`, else `.tools/nvidia` in the checkout
-/// brdfprof was built from.
+/// Where the wheels `make setup` installs are (`tools::locate`: `$BRDFPROF_NVIDIA_DIR`, beside the binary, the
+/// data directory, the build checkout).
 pub fn install_dir() -> PathBuf {
-    match std::env::var_os("BRDFPROF_NVIDIA_DIR").filter(|d| !d.is_empty()) {
-        Some(d) => PathBuf::from(d),
-        None => Path::new(env!("CARGO_MANIFEST_DIR")).join(".tools/nvidia"),
-    }
+    crate::tools::dir("nvidia")
 }
 
 fn not_installed(why: &str) -> String {
