@@ -93,6 +93,7 @@ impl Inspected {
                         unit: format!("{}/eval", cost.unit),
                         value: r.cycles_per_eval,
                         range: None,
+                        interval: None,
                         extra: format!("modelled, not measured: {} ({})", cost.model, cost.compiler),
                     }));
                 }
@@ -103,6 +104,7 @@ impl Inspected {
                             unit: "instructions/eval (callgrind)".into(),
                             value: *r.stats.get("callgrind/ir-per-eval")?,
                             range: None,
+                            interval: None,
                             extra: format!(
                                 "CPU instructions per evaluation of lavapipe's JIT code under callgrind, on {device}"
                             ),

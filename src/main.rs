@@ -17,6 +17,10 @@ struct Cli {
     /// before the command stops with exit status 2, naming it (default 60; also BRDFPROF_COMPILE_TIMEOUT).
     #[arg(long, global = true, value_name = "SECONDS", value_parser = cli::args::compile_timeout)]
     compile_timeout: Option<std::time::Duration>,
+    /// Every note about the models' files on its own line (by default alike notes are one line with a count,
+    /// and those that need nothing done, such as a loop within lavapipe's limit, are left out).
+    #[arg(long, global = true)]
+    verbose: bool,
 }
 
 #[derive(Subcommand)]
@@ -89,6 +93,7 @@ enum Command {
 fn main() -> ExitCode {
     cli::command_started();
     let cli = Cli::parse();
+    brdfprof::messages::set_verbose(cli.verbose);
     let child = matches!(
         cli.command,
         Command::CallgrindChild { .. }

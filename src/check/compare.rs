@@ -218,11 +218,14 @@ pub(super) fn rel_change(old: f64, new: f64) -> f64 {
 fn with_cost_stats(b: &Baseline) -> Baseline {
     let mut b = b.clone();
     let Some(cost) = b.inspect.cost.clone() else { return b };
+    // To 9 significant digits: a rule's sums over pipes may differ in their last bits between runs, which is
+    // no change of the kernel.
+    let round = |x: f64| if x == 0.0 || !x.is_finite() { x } else { format!("{x:.8e}").parse().unwrap_or(x) };
     for row in &mut b.inspect.rows {
         let Some(c) = cost.row(&row.model) else { continue };
-        row.stats.insert(COST_KEYS[0].into(), c.cycles_per_eval);
+        row.stats.insert(COST_KEYS[0].into(), round(c.cycles_per_eval));
         if let Some(net) = c.net_cycles_per_eval {
-            row.stats.insert(COST_KEYS[1].into(), net);
+            row.stats.insert(COST_KEYS[1].into(), round(net));
         }
     }
     let mut columns: Vec<String> = COST_KEYS.iter().map(|k| k.to_string()).collect();

@@ -116,6 +116,10 @@ pub struct ModelArgs {
     /// "/Engine/Private/BRDF.ush"` reads UE/Engine/Shaders/Private/BRDF.ush (`include-map=` in the spec).
     #[arg(long = "include-map", value_name = "VIRTUAL=DIR")]
     pub include_maps: Vec<String>,
+    /// A file used wherever the shader includes NAME, beside the including file or through the search path
+    /// (repeatable; `include-override=NAME=FILE` in the spec): a stub for an engine's globals header.
+    #[arg(long = "include-override", value_name = "NAME=FILE")]
+    pub include_overrides: Vec<String>,
     /// Which front end compiles an HLSL shader: glslang, and Slang's slangc where glslang refuses or crashes
     /// (auto); or one of them alone (`hlsl-front-end=` in the model's spec; docs/hlsl.md).
     #[arg(long = "hlsl-front-end", value_name = "auto|glslang|slang", value_parser = ["auto", "glslang", "slang"])]
@@ -130,6 +134,7 @@ impl ModelArgs {
             ("--define", model::file_model::DEFINE, &self.defines),
             ("--include-dir", model::file_model::INCLUDE, &self.include_dirs),
             ("--include-map", model::file_model::INCLUDE_MAP, &self.include_maps),
+            ("--include-override", model::file_model::INCLUDE_OVERRIDE, &self.include_overrides),
             ("--hlsl-front-end", model::file_model::HLSL_FRONT_END, &self.hlsl_front_end.iter().cloned().collect()),
         ] {
             if let Some(v) = values.iter().find(|v| v.contains(',')) {
@@ -149,6 +154,7 @@ impl ModelArgs {
                 ("--define", &self.defines),
                 ("--include-dir", &self.include_dirs),
                 ("--include-map", &self.include_maps),
+                ("--include-override", &self.include_overrides),
                 ("--hlsl-front-end", &self.hlsl_front_end.iter().cloned().collect()),
             ]
             .into_iter()
@@ -337,6 +343,10 @@ pub struct BenchArg {
     /// range from the interval where there is one), for a benchmark dashboard's trend (docs/ci.md).
     #[arg(long, value_name = "FILE")]
     pub bench_json: Option<PathBuf>,
+    /// The list's format: `github` (github-action-benchmark's customSmallerIsBetter list) or `bmf` (Bencher's
+    /// Metric Format, an object keyed by benchmark).
+    #[arg(long, value_name = "FORMAT", default_value = "github", value_parser = brdfprof::export::bench::FORMATS)]
+    pub bench_format: String,
 }
 
 impl BenchArg {
@@ -347,7 +357,7 @@ impl BenchArg {
 
     pub fn write(&self, entries: &[brdfprof::export::bench::Entry]) -> Result<()> {
         let Some(path) = &self.bench_json else { return Ok(()) };
-        brdfprof::export::bench::write(path, entries)?;
+        brdfprof::export::bench::write(path, entries, &self.bench_format)?;
         brdfprof::messages::progress(format!("benchmark JSON: {} ({} entries)", path.display(), entries.len()));
         Ok(())
     }

@@ -301,13 +301,15 @@ pub const RETURNS: &str = "returns";
 /// `#include` and a WGSL shader's `#import`.
 pub const INCLUDE: &str = "include";
 pub const INCLUDE_MAP: &str = "include-map";
+/// `include-override=NAME=FILE` (as `--include-override`): FILE wherever NAME would be included.
+pub const INCLUDE_OVERRIDE: &str = "include-override";
 
 /// The key of a model text that chooses an HLSL shader's front end (`hlsl-front-end=auto|glslang|slang`, as
 /// `--hlsl-front-end`).
 pub const HLSL_FRONT_END: &str = "hlsl-front-end";
 
 /// The keys of a model text brdfprof reads itself (no parameter may take one's name).
-const KEYS: [&str; 6] = [DEFINE, ENTRY, RETURNS, INCLUDE, INCLUDE_MAP, HLSL_FRONT_END];
+const KEYS: [&str; 7] = [DEFINE, ENTRY, RETURNS, INCLUDE, INCLUDE_MAP, INCLUDE_OVERRIDE, HLSL_FRONT_END];
 
 /// The entry and its parameters as BRDF Explorer's files name them: no macro may take these names.
 const ENTRY_NAMES: [&str; 6] = ["BRDF", "L", "V", "N", "X", "Y"];
@@ -318,7 +320,8 @@ fn is_define(item: &str) -> bool {
 
 /// A `define=`, `include=`, `include-map=` or `hlsl-front-end=` item: what prepares the shader.
 fn is_shader_option(item: &str) -> bool {
-    item.split_once('=').is_some_and(|(k, _)| [DEFINE, INCLUDE, INCLUDE_MAP, HLSL_FRONT_END].contains(&k.trim()))
+    item.split_once('=')
+        .is_some_and(|(k, _)| [DEFINE, INCLUDE, INCLUDE_MAP, INCLUDE_OVERRIDE, HLSL_FRONT_END].contains(&k.trim()))
 }
 
 /// The HLSL front end `hlsl-front-end=` items choose over `old`: one choice given twice is one, two different
@@ -347,6 +350,23 @@ fn merge_includes(path: &str, old: &Includes, items: &[String]) -> Result<Includ
     let mut mapped: Vec<(&str, &str, &String)> = Vec::new();
     for item in items {
         let (key, value) = item.split_once('=').map(|(k, v)| (k.trim(), v.trim())).unwrap_or((item, ""));
+        if key == INCLUDE_OVERRIDE {
+            let Some((name, file)) = value
+                .split_once('=')
+                .map(|(n, f)| (n.trim(), f.trim()))
+                .filter(|(n, f)| !n.is_empty() && !f.is_empty())
+            else {
+                bail!("{path}: `{item}`: expected {INCLUDE_OVERRIDE}=NAME=FILE");
+            };
+            if !Path::new(file).is_file() {
+                bail!("{path}: `{item}`: {file} is not a file");
+            }
+            match out.overrides.iter_mut().find(|(n, _)| n == name) {
+                Some(slot) => slot.1 = PathBuf::from(file),
+                None => out.overrides.push((name.to_string(), PathBuf::from(file))),
+            }
+            continue;
+        }
         let (virtual_prefix, dir) = match key {
             INCLUDE_MAP => value.split_once('=').map(|(v, d)| (Some(v.trim()), d.trim())).unwrap_or((None, "")),
             _ => (None, value),
@@ -505,13 +525,23 @@ impl FileModel {
 
     /// Prints the file's warnings and loop warnings that `before` (the model it was made from) did not have.
     fn warn_new(&self, before: Option<&FileModel>) {
-        let loops = |m: &FileModel| m.file.loops.iter().map(|l| loop_warning(&m.path, l)).collect::<Vec<_>>();
+        // A loop within lavapipe's limit needs nothing done: said with --verbose only.
+        let loops = |m: &FileModel| {
+            m.file
+                .loops
+                .iter()
+                .filter(|l| {
+                    crate::messages::verbose() || l.trip_count.is_none_or(|n| n > brdf_file::LAVAPIPE_LOOP_LIMIT)
+                })
+                .map(|l| loop_warning(&m.path, l))
+                .collect::<Vec<_>>()
+        };
         let old: Vec<String> =
             before.map(|b| b.file.warnings.iter().cloned().chain(loops(b)).collect()).unwrap_or_default();
-        for w in self.file.warnings.iter().cloned().chain(loops(self)) {
-            if !old.contains(&w) {
-                crate::messages::input_warning(w);
-            }
+        let new: Vec<String> =
+            self.file.warnings.iter().cloned().chain(loops(self)).filter(|w| !old.contains(w)).collect();
+        for w in crate::messages::grouped(&new) {
+            crate::messages::input_warning(w);
         }
     }
 
@@ -614,6 +644,13 @@ impl FileModel {
                 .maps
                 .iter()
                 .map(|(v, d)| format!(",{INCLUDE_MAP}={v}={}", d.display()))
+                .collect::<String>();
+            s += &self
+                .file
+                .includes
+                .overrides
+                .iter()
+                .map(|(n, f)| format!(",{INCLUDE_OVERRIDE}={n}={}", f.display()))
                 .collect::<String>();
         }
         let default_entry = self.file.entries.first().map_or("BRDF", |e| e.name.as_str());

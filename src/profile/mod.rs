@@ -143,6 +143,7 @@ impl ProfileReport {
                     unit: "ns/eval".into(),
                     value: e.median,
                     range: crate::export::bench::Entry::range_of(e.median, e.lo, e.hi),
+                    interval: Some((e.lo, e.hi)),
                     extra: format!(
                         "median of {} rounds, interval [{}, {}] of coverage {:.3}, {} lights, on {}",
                         e.n,

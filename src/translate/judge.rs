@@ -58,6 +58,21 @@ pub fn judge(x: f32, r: Bounded, extra: f64) -> Judgement {
     })
 }
 
+/// The largest finite value of an R11G11B10F channel with a `mantissa`-bit mantissa: 65024 (6 bits, red and
+/// green), 64512 (5 bits, blue).
+pub fn r11g11b10_max(mantissa: u32) -> f64 {
+    32768.0 * (2.0 - 2f64.powi(-(mantissa as i32)))
+}
+
+/// A reference value as the R11G11B10F store holds it: saturated at the channel's largest finite value, as
+/// the kernels' packing writes it (a radiance of 3.5e5 is stored as 65024 by the device and the translation
+/// alike; the unsaturated reference called that a translator defect).
+pub fn r11g11b10_saturated(r: Bounded, mantissa: u32) -> Bounded {
+    let max = r11g11b10_max(mantissa);
+    let (lo, hi) = ((r.value - r.bound).min(max), (r.value + r.bound).min(max));
+    Bounded { value: 0.5 * (lo + hi), bound: 0.5 * (hi - lo) }
+}
+
 /// The rounding R11G11B10F's conversion may add to a value of magnitude up to `m` (one step of its 6-bit,
 /// blue's 5-bit, mantissa: the Vulkan spec lets the conversion round either way), plus the value itself where
 /// it is negative (stored as 0).

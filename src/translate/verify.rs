@@ -330,7 +330,12 @@ pub fn shade_agreement(gpu: &Gpu, model: Option<&Model>, lights: u32, shaders: &
     let on_host = flat(&packed.into_iter().map(gbuffer::unpack_r11g11b10).collect::<Vec<_>>());
     let reference = |defines: &[&str]| -> Result<Vec<Bounded>> {
         let bytes = shade_on_host(&host::HostKernel::compile_reference(&translation, defines)?, &g, &light_data, 64)?;
-        Ok(host::pairs(&bytes).chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect())
+        let rgb = host::pairs(&bytes).chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect::<Vec<_>>();
+        Ok(rgb
+            .into_iter()
+            .enumerate()
+            .map(|(i, b)| judge::r11g11b10_saturated(b, if i % 3 == 2 { 5 } else { 6 }))
+            .collect())
     };
     let r = reference(&[])?;
     let n = on_device.len();

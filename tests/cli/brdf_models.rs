@@ -453,12 +453,36 @@ fn loops_are_warned_about_with_their_bounds() {
         "{}",
         r.stderr
     );
-    assert!(r.stderr.contains("loops.brdf:7: a `for` loop of 8 iterations: within the 65535"), "{}", r.stderr);
     assert!(
         r.stderr.contains("loops.brdf:8: a `while` loop whose iterations brdfprof cannot bound from the source"),
         "{}",
         r.stderr
     );
+    // A loop within the limit needs nothing done: said with --verbose only.
+    assert!(!r.stderr.contains("loops.brdf:7:"), "{}", r.stderr);
+    let args = ["eval", "--verbose", "--model", "loops.brdf", "--input", "in.csv", "--output", "out.csv"];
+    let r = run_in(dir.path(), &args).ok();
+    assert!(r.stderr.contains("loops.brdf:7: a `for` loop of 8 iterations: within the 65535"), "{}", r.stderr);
+}
+
+/// Alike notes about one file are one line with a count (`uniform` dropped from eight globals), each on its
+/// own line with --verbose.
+#[test]
+fn alike_notes_are_one_line_with_a_count() {
+    let dir = tempfile::tempdir().unwrap();
+    write_csv(&dir.path().join("in.csv"), 4, &[1.0]);
+    let globals: String = (0..8).map(|k| format!("uniform float u{k};\n")).collect();
+    let shader = format!(
+        "::begin shader\n{globals}vec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y)\n{{\n    return vec3(u0 + u7);\n}}\n::end shader\n"
+    );
+    std::fs::write(dir.path().join("u.brdf"), format!("analytic\n{shader}")).unwrap();
+    let r = run_in(dir.path(), &["eval", "--model", "u.brdf", "--input", "in.csv", "--output", "out.csv"]).ok();
+    let said: Vec<&str> = r.stderr.lines().filter(|l| l.contains("`uniform` dropped")).collect();
+    assert_eq!(said.len(), 1, "{}", r.stderr);
+    assert!(said[0].contains("and 7 more alike") && said[0].contains("`u7`"), "{}", said[0]);
+    let args = ["eval", "--verbose", "--model", "u.brdf", "--input", "in.csv", "--output", "out.csv"];
+    let r = run_in(dir.path(), &args).ok();
+    assert_eq!(r.stderr.lines().filter(|l| l.contains("`uniform` dropped")).count(), 8, "{}", r.stderr);
 }
 
 /// Smaller checks of `.brdf` models, each as the user meets it: parameters as CSV columns, a key given twice,

@@ -205,3 +205,20 @@ fn profile_bench_json_gives_each_models_median_and_interval() {
         assert!((range - half).abs() <= 0.01 * half, "{range} against {half}");
     }
 }
+
+/// `--bench-format bmf`: Bencher's Metric Format, an object keyed by benchmark name, each figure under its
+/// measure (the unit), with its interval as lower and upper values where it has one.
+#[test]
+fn bench_json_in_bencher_metric_format() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let args = ["profile", "--model", "ggx", "--size", "64x64", "--budget", "3", "--json", "p.json"];
+    common::run_in(d, &[&args[..], &["--bench-json", "b.json", "--bench-format", "bmf"]].concat()).ok();
+    let bmf: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(d.join("b.json")).unwrap()).unwrap();
+    let entries = bmf.as_object().expect("an object keyed by benchmark");
+    let ggx = entries.iter().find(|(k, _)| k.ends_with("/ggx")).expect("ggx's entry").1;
+    let m = &ggx["ns-eval"];
+    let (v, lo, hi) =
+        (m["value"].as_f64().unwrap(), m["lower_value"].as_f64().unwrap(), m["upper_value"].as_f64().unwrap());
+    assert!(lo <= v && v <= hi, "{m}");
+}

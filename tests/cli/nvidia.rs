@@ -232,3 +232,21 @@ fn a_construct_the_translation_lacks_is_refused_at_the_files_line() {
     ])
     .ok();
 }
+
+/// A correct model whose values run past 1e5 (a power of a sum) is priced: the profiling kernel's R11G11B10F
+/// store saturates at 65024 on the device and in the translation alike, and the f64 reference is held to that
+/// store, not to the unsaturated value (which called the translation a defect).
+#[test]
+fn a_model_past_the_stores_range_is_priced() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(
+        d.join("big.brdf"),
+        "analytic\n::begin shader\nvec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y)\n{\n    float s = max(dot(N, L), 0.0) + max(dot(N, V), 0.0);\n    return vec3(pow(s + 1.0, 12.0), pow(s + 1.0, 11.0), pow(s, 16.0));\n}\n::end shader\n",
+    )
+    .unwrap();
+    let r = common::run_in(d, &["inspect", "--device", "nvidia:sm_89", "--model", "big.brdf", "--json", "i.json"]).ok();
+    assert!(!r.stdout.contains("failed, so no figure"), "{}", r.stdout);
+    assert_eq!(brdfprof::translate::judge::r11g11b10_max(6), 65024.0);
+    assert_eq!(brdfprof::translate::judge::r11g11b10_max(5), 64512.0);
+}

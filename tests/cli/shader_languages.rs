@@ -1260,3 +1260,107 @@ fn eval_without_slang(d: &Path, args: &[&str]) -> String {
     assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
     stderr
 }
+
+/// DXC's minimum-precision overloads (distinct types for overloading, 32-bit with 16-bit types off): a
+/// `min16float` overload beside its `float` twin, written directly or made by a macro as engines' headers do,
+/// evaluates in both front ends, the 32-bit one taken, the dropped one said once at its line.
+#[test]
+fn min16float_overloads_beside_their_float_twins_evaluate_in_both_front_ends() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let seven = "float Sq(float x) { return x * x; }\nmin16float Sq(min16float x) { return x * x; }\nfloat3 BRDF(float3 L, float3 V, float3 N, float3 X, float3 Y)\n{\n    float nl = max(dot(N, L), 0.0);\n    return float3(Sq(nl), Sq(nl), Sq(nl));\n}\n";
+    std::fs::write(d.join("seven.hlsl"), seven).unwrap();
+    let macro_made = "#define TWIN(NAME, BODY) float NAME(float x) { BODY } min16float NAME(min16float x) { BODY }\nTWIN(Sq, return x * x;)\nfloat3 BRDF(float3 L, float3 V, float3 N, float3 X, float3 Y)\n{\n    float nl = max(dot(N, L), 0.0);\n    return float3(Sq(nl), Sq(nl), Sq(nl));\n}\n";
+    std::fs::write(d.join("macro.hlsl"), macro_made).unwrap();
+    write_rows(&d.join("in.csv"), 50);
+    let rows: Vec<[f64; 3]> = {
+        let text = std::fs::read_to_string(d.join("in.csv")).unwrap();
+        text.lines()
+            .skip(1)
+            .map(|l| {
+                let v: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
+                let n = glam::DVec3::new(v[0], v[1], v[2]).normalize();
+                let l = glam::DVec3::new(v[6], v[7], v[8]).normalize();
+                let nl = n.dot(l).max(0.0);
+                [nl * nl; 3]
+            })
+            .collect()
+    };
+    for (file, front) in [("seven.hlsl", "glslang"), ("seven.hlsl", "slang"), ("macro.hlsl", "glslang")] {
+        let out = format!("{file}-{front}.csv");
+        let r = common::run_in(
+            d,
+            &["eval", "--model", file, "--hlsl-front-end", front, "--input", "in.csv", "--output", &out],
+        )
+        .ok();
+        assert!(
+            r.stderr.contains(":2: `Sq(float)` is defined again once minimum-precision types are 32-bit"),
+            "{}",
+            r.stderr
+        );
+        for (got, want) in common::csv_values(&d.join(&out)).iter().zip(&rows) {
+            assert!((got[0] - want[0]).abs() <= 1e-5 * want[0].max(1e-3), "{file} {front}: {got:?} against {want:?}");
+        }
+    }
+}
+
+/// An engine's header beside the including file is replaced by a stub (`--include-override NAME=FILE`): the
+/// stub is used although the header is found first beside the file, the front-end line names it, and the model
+/// evaluates; without it the header's engine-only code is refused.
+#[test]
+fn a_header_beside_the_file_is_replaced_by_a_stub() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::create_dir(d.join("shaders")).unwrap();
+    std::fs::write(
+        d.join("shaders/globals.hlsli"),
+        "#pragma once\nTexture2D<float4> gBindless[] : register(t0, space1);\ntemplate<typename T> T engine_only(T x) { return gBindless[0].Load(int3(0, 0, 0)).x * x; }\nstatic const float SPECULAR_SCALE = 7.0;\n",
+    )
+    .unwrap();
+    std::fs::write(d.join("stub.hlsli"), "#pragma once\nstatic const float SPECULAR_SCALE = 0.5;\n").unwrap();
+    std::fs::write(
+        d.join("shaders/lobe.hlsl"),
+        "#include \"globals.hlsli\"\nfloat3 BRDF(float3 L, float3 V, float3 N, float3 X, float3 Y)\n{\n    float nl = max(dot(N, L), 0.0);\n    return float3(nl, nl, nl) * SPECULAR_SCALE;\n}\n",
+    )
+    .unwrap();
+    write_rows(&d.join("in.csv"), 20);
+    let r = common::run_in(
+        d,
+        &[
+            "diff",
+            "--model",
+            "shaders/lobe.hlsl",
+            "--include-override",
+            "globals.hlsli=stub.hlsli",
+            "--reference",
+            "ggx",
+            "--input",
+            "in.csv",
+        ],
+    );
+    assert!(matches!(r.code, Some(0 | 1)), "{}", r.stderr);
+    assert!(r.stdout.contains("headers replaced: `globals.hlsli` by stub.hlsli"), "{}", r.stdout);
+    let out = "out.csv";
+    common::run_in(
+        d,
+        &[
+            "eval",
+            "--model",
+            "shaders/lobe.hlsl",
+            "--include-override",
+            "globals.hlsli=stub.hlsli",
+            "--input",
+            "in.csv",
+            "--output",
+            out,
+        ],
+    )
+    .ok();
+    let text = std::fs::read_to_string(d.join("in.csv")).unwrap();
+    for (row, got) in text.lines().skip(1).zip(common::csv_values(&d.join(out))) {
+        let v: Vec<f64> = row.split(',').map(|x| x.parse().unwrap()).collect();
+        let nl =
+            glam::DVec3::new(v[0], v[1], v[2]).normalize().dot(glam::DVec3::new(v[6], v[7], v[8]).normalize()).max(0.0);
+        assert!((got[0] - 0.5 * nl).abs() <= 1e-6, "{got:?} against {}", 0.5 * nl);
+    }
+}

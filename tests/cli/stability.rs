@@ -198,3 +198,25 @@ fn the_report_summary_says_how_a_diffed_model_is_wrong() {
     let summary = &html[html.find("id=\"summary\"").expect("a summary")..];
     assert!(summary.contains("signed vs") && summary.contains("% brighter"), "no signed figure in the summary");
 }
+
+/// A LearnOpenGL-style fragment shader pasted whole, its stage interface (`in`, `out`, `layout(location)`,
+/// `flat`) and uniforms included, evaluates: they are dropped as private globals (said once with a count) and
+/// it matches its reference within 2e-3.
+#[test]
+fn a_fragment_shader_pasted_whole_evaluates() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = common::repo_root().join("tests/fixtures/brdf/engine/learnopengl-pasted.brdf").display().to_string();
+    let args =
+        ["diff", "--model", &file, "--nov", "0.2..1", "--nol", "0.2..1", "--roughness", "0.1..1", "--json", "r.json"];
+    let r = run_in(dir.path(), &args).ok();
+    let said: Vec<&str> = r.stderr.lines().filter(|l| l.contains("dropped from")).collect();
+    assert!(
+        said.iter()
+            .any(|l| l.contains("`layout(location=0) out` dropped from `FragColor`") && l.contains("more alike")),
+        "{}",
+        r.stderr
+    );
+    let report: Value = serde_json::from_str(&std::fs::read_to_string(dir.path().join("r.json")).unwrap()).unwrap();
+    let max = report["diffs"][0]["difference"]["max_rel"].as_f64().unwrap();
+    assert!(max < 2e-3, "max rel {max}");
+}

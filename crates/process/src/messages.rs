@@ -16,6 +16,65 @@ type Printer = Arc<dyn Fn(&str) + Send + Sync>;
 
 static PRINTER: Mutex<Option<Printer>> = Mutex::new(None);
 static CHILD: AtomicBool = AtomicBool::new(false);
+static VERBOSE: AtomicBool = AtomicBool::new(false);
+
+/// `--verbose`: every note about the user's input, each on its own line (by default alike ones are one line
+/// with a count, and notes that need no action are left out).
+pub fn set_verbose(on: bool) {
+    VERBOSE.store(on, Ordering::SeqCst);
+}
+
+pub fn verbose() -> bool {
+    VERBOSE.load(Ordering::SeqCst)
+}
+
+/// `lines` (each `FILE:LINE: message`) with those alike (the same message but for its backquoted names) said
+/// once: the first, then "and N more alike" with each other's line and name; `--verbose` keeps them all.
+pub fn grouped(lines: &[String]) -> Vec<String> {
+    if verbose() {
+        return lines.to_vec();
+    }
+    let shape = |l: &str| -> (String, String) {
+        let (at, message) = match l.match_indices(": ").next() {
+            Some((i, _)) => (l[..i].to_string(), l[i + 2..].to_string()),
+            None => (String::new(), l.to_string()),
+        };
+        let file = at.rsplit_once(':').map_or(at.clone(), |(f, _)| f.to_string());
+        let mut key = String::new();
+        for (k, part) in message.split('`').enumerate() {
+            key += if k % 2 == 1 { "`_`" } else { part };
+        }
+        (file, key)
+    };
+    let mut out: Vec<(String, (String, String), Vec<String>)> = Vec::new();
+    for l in lines {
+        let s = shape(l);
+        match out.iter_mut().find(|(_, k, _)| *k == s) {
+            Some((_, _, more)) => more.push(l.clone()),
+            None => out.push((l.clone(), s, Vec::new())),
+        }
+    }
+    out.into_iter()
+        .map(|(first, _, more)| {
+            if more.is_empty() {
+                return first;
+            }
+            // Each other's line, and the first backquoted name in which it differs from the first.
+            let quoted = |l: &str| l.split('`').skip(1).step_by(2).map(str::to_string).collect::<Vec<_>>();
+            let first_names = quoted(&first);
+            let named: Vec<String> = more
+                .iter()
+                .map(|m| {
+                    let line = m.split(": ").next().and_then(|a| a.rsplit(':').next()).unwrap_or("?");
+                    let names = quoted(m);
+                    let name = names.iter().zip(&first_names).find(|(a, b)| a != b).map_or("", |(a, _)| a.as_str());
+                    format!("line {line} `{name}`")
+                })
+                .collect();
+            format!("{first} (and {} more alike: {}; --verbose says each)", more.len(), named.join(", "))
+        })
+        .collect()
+}
 
 /// Text from an input (a path, a label, shader text) as one line of our output may hold it: every control
 /// character (newline, CR, escape, the C1 controls, ...) written as its Rust escape (`\n`, `\u{1b}`), so that no

@@ -69,7 +69,11 @@ fn translate_here(file: &mut BrdfFile) -> Result<Vec<(usize, String)>> {
     for (k, e) in file.entries.iter_mut().enumerate() {
         e.glue = Some(glue_name(k));
     }
-    file.front_end = Some(front_end.unwrap_or_else(|| front::describe(file.language)));
+    let replaced: Vec<String> =
+        file.includes.overrides.iter().map(|(n, f)| format!("`{n}` by {}", f.display())).collect();
+    let replaced =
+        if replaced.is_empty() { String::new() } else { format!("; headers replaced: {}", replaced.join(", ")) };
+    file.front_end = Some(front_end.unwrap_or_else(|| front::describe(file.language)) + &replaced);
     file.front_end_origins = origins(&text, &at, &glsl, &places);
     Ok(glsl.into_iter().enumerate().map(|(i, l)| (i + 1, l)).collect())
 }
@@ -263,6 +267,7 @@ fn hlsl_spirv(file: &mut BrdfFile) -> Result<(Vec<u32>, Source, Option<String>)>
         file.warnings.push(dropped_hash_line(Path::new(&x.files[*f]), *n, text));
     }
     let pre = hlsl::preprocess(&x, &file.defines, &file.path)?.map_err(|m| anyhow!("{m}"))?;
+    let pre = narrow_overloads(file, &mut x, &pre)?;
     let glues = check_hlsl(file, &x, &pre)?;
     for (g, e) in glues.iter().zip(&file.entries) {
         x.push_generated(hlsl::glue(g), e.line, format!("entry `{}`", e.name));
@@ -283,6 +288,27 @@ fn hlsl_spirv(file: &mut BrdfFile) -> Result<(Vec<u32>, Source, Option<String>)>
     };
     let source = x.lines.iter().zip(&x.origins).map(|(l, &(f, n))| (x.files[f].clone(), n, l.clone())).collect();
     Ok((spirv, source, front_end))
+}
+
+/// DXC's minimum-precision overloads that collide once 32-bit (`front::overloads`): each dropped from the
+/// text both front ends compile (its lines replaced by their preprocessed text with the definition blanked),
+/// said once at its file's line. Returns the preprocessed text the checks read, line for line with `x`.
+fn narrow_overloads(file: &BrdfFile, x: &mut Expanded, pre: &str) -> Result<String> {
+    let numbered: Vec<(usize, String)> = (1..=x.lines.len()).map(|n| (n, String::new())).collect();
+    let lines = number_lines(&file.path, &numbered, pre.lines(), 1)?;
+    let text: String = lines.iter().map(|(_, l)| format!("{l}\n")).collect();
+    let Some((out, dropped)) = front::overloads::drop_narrow_collisions(&text) else { return Ok(pre.to_string()) };
+    for ((n, old), new) in lines.iter().zip(out.lines()) {
+        if old != new {
+            x.lines[n - 1] = new.to_string();
+        }
+    }
+    for d in dropped {
+        let k = text[..d.offset].matches('\n').count();
+        let (f, line) = lines.get(k).and_then(|(n, _)| x.origin(n - 1)).unwrap_or(("?", 0));
+        crate::messages::input_note(format!("{f}:{line}: {}", d.note));
+    }
+    Ok(out)
 }
 
 /// The shader compiled by Slang's slangc, chosen (`refused` None: `hlsl-front-end=slang`) or after glslang

@@ -9,7 +9,12 @@ use std::path::Path;
 /// The shader section must exist and define `BRDF`; its globals must not take a parameter's name; a `uniform`
 /// qualifier on a global is dropped (renamed_shader) with a warning.
 pub(super) fn check_shader(file: &mut BrdfFile, begin: usize, tokens: &[Token], scan: &Scan) -> Result<()> {
-    if let Some(t) = tokens.iter().find(|t| t.kind == Kind::Ident && t.text == "layout") {
+    // A stage interface's `layout(location = N)` is dropped with its `in`/`out` (`Scan::interface`); any other
+    // layout would be the kernel's.
+    let dropped = |i: usize| scan.uniform_tokens.contains(&i);
+    if let Some((_, t)) =
+        tokens.iter().enumerate().find(|(i, t)| t.kind == Kind::Ident && t.text == "layout" && !dropped(*i))
+    {
         bail!(at(
             &file.path,
             file.shader[t.line].0,
@@ -32,6 +37,9 @@ pub(super) fn check_shader(file: &mut BrdfFile, begin: usize, tokens: &[Token], 
     }
     for &(line, ref name) in &scan.uniforms {
         file.warnings.push(at(&file.path, line, format!("`uniform` dropped from `{name}`: Vulkan GLSL has no uniforms outside blocks, so it is a private global nothing sets (declare it as a parameter instead)")));
+    }
+    for (line, qualifier, name) in &scan.interface {
+        file.warnings.push(at(&file.path, *line, format!("`{qualifier}` dropped from `{name}`: a fragment or vertex stage's interface, not the BRDF's inputs (brdfprof calls the BRDF function with N, V, L and its parameters), so it is a private global here")));
     }
     for (name, _, line) in &file.binds {
         if !params.contains_key(name.as_str()) {
@@ -249,6 +257,8 @@ pub(super) struct Scan {
     pub(super) globals: Vec<Global>,
     /// (file line, variable) of each dropped `uniform`.
     pub(super) uniforms: Vec<(usize, String)>,
+    /// (file line, the qualifier as written, variable) of each dropped stage interface qualifier.
+    pub(super) interface: Vec<(usize, String, String)>,
     pub(super) uniform_tokens: Vec<usize>,
 }
 
@@ -280,7 +290,8 @@ pub(super) const QUALIFIERS: &[&str] = &[
 ];
 
 pub(super) fn scan_globals(path: &Path, lines: &[(usize, String)], tokens: &[Token]) -> Result<Scan> {
-    let mut scan = Scan { globals: Vec::new(), uniforms: Vec::new(), uniform_tokens: Vec::new() };
+    let mut scan =
+        Scan { globals: Vec::new(), uniforms: Vec::new(), interface: Vec::new(), uniform_tokens: Vec::new() };
     let mut i = 0;
     while i < tokens.len() {
         let (end, body) = item_end(path, lines, tokens, i)?;
@@ -394,15 +405,29 @@ fn declare_variables(scan: &mut Scan, lines: &[(usize, String)], header: &[Token
     let line_of = |t: &Token| lines[t.line].0;
     let mut p = 0;
     let mut uniform = None;
+    // A fragment or vertex stage's interface (`in`, `out`, `varying`, `attribute`, `layout(location = N)`): not
+    // the BRDF's inputs, dropped as `uniform` is, so that a shader pasted whole compiles.
+    let mut interface: Vec<(usize, usize)> = Vec::new();
     while p < header.len() && (QUALIFIERS.contains(&header[p].text.as_str()) || header[p].text == "layout") {
         if header[p].text == "uniform" {
             uniform = Some(p);
         }
-        p = if header[p].text == "layout" && header.get(p + 1).is_some_and(|t| t.is("(")) {
+        let next = if header[p].text == "layout" && header.get(p + 1).is_some_and(|t| t.is("(")) {
             matching(header, p + 1) + 1
         } else {
             p + 1
         };
+        if ["in", "out", "layout", "flat", "smooth", "noperspective", "centroid", "sample"]
+            .contains(&header[p].text.as_str())
+        {
+            interface.push((p, next));
+        }
+        p = next;
+    }
+    // Only a stage's `in`/`out` brings its layout and interpolation qualifiers along; another layout (a
+    // specialisation constant's) is the kernel's, and refused (`check_shader`).
+    if !interface.iter().any(|&(k, _)| ["in", "out"].contains(&header[k].text.as_str())) {
+        interface.clear();
     }
     if p >= header.len() || header[p].kind != Kind::Ident {
         return;
@@ -417,6 +442,14 @@ fn declare_variables(scan: &mut Scan, lines: &[(usize, String)], header: &[Token
     if let Some(u) = uniform {
         scan.uniforms.push((line_of(name), name.text.clone()));
         scan.uniform_tokens.push(first + u);
+    }
+    if !interface.is_empty() {
+        let what: Vec<String> =
+            interface.iter().map(|&(from, to)| header[from..to].iter().map(|t| t.text.as_str()).collect()).collect();
+        scan.interface.push((line_of(name), what.join(" "), name.text.clone()));
+        for &(from, to) in &interface {
+            scan.uniform_tokens.extend((from..to).map(|k| first + k));
+        }
     }
     let mut push =
         |t: &Token| scan.globals.push(Global { name: t.text.clone(), line: line_of(t), kind: GlobalKind::Variable });

@@ -453,7 +453,7 @@ mod tests {
             "#pragma once\n#include \"/Engine/Private/Common.ush\"\nfloat D() { return PI; }\n",
         )
         .unwrap();
-        let inc = Includes { dirs: vec![], maps: vec![("/Engine".into(), d.join("engine"))] };
+        let inc = Includes { dirs: vec![], maps: vec![("/Engine".into(), d.join("engine"))], overrides: vec![] };
         let x = expand(d, "#include \"brdf.ush\"\n#include \"brdf.ush\"\nfloat3 BRDF();\n", &inc);
         let text = x.text();
         assert_eq!(text.matches("float D()").count(), 1, "{text}");

@@ -12,6 +12,7 @@
 pub mod cross;
 pub mod hlsl;
 pub mod includes;
+pub mod overloads;
 pub mod slang;
 pub mod wgsl;
 pub mod wgsl_lines;
@@ -83,17 +84,27 @@ impl HlslFrontEnd {
 /// The extensions a model text may name a shader file by: `.brdf`, then plain shader files.
 pub const FILE_EXTENSIONS: [&str; 6] = ["brdf", "hlsl", "hlsli", "ush", "usf", "wgsl"];
 
-/// Where `#include` (HLSL) and `#import` (WGSL) look: `--include-dir DIR` in order, and `--include-map
-/// VIRTUAL=DIR` (a name under the virtual prefix VIRTUAL is found under DIR).
+/// Where `#include` (HLSL) and `#import` (WGSL) look: `--include-override NAME=FILE` first (FILE wherever NAME
+/// would be included, beside the includer or through the search path: a stub for an engine's header), then
+/// `--include-map VIRTUAL=DIR` (a name under the virtual prefix VIRTUAL is found under DIR), then beside the
+/// including file (quoted includes) and `--include-dir DIR` in order.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Includes {
     pub dirs: Vec<PathBuf>,
     pub maps: Vec<(String, PathBuf)>,
+    pub overrides: Vec<(String, PathBuf)>,
 }
 
 impl Includes {
     pub fn is_empty(&self) -> bool {
-        self.dirs.is_empty() && self.maps.is_empty()
+        self.dirs.is_empty() && self.maps.is_empty() && self.overrides.is_empty()
+    }
+
+    /// The file that replaces `name` (`--include-override`): given as written (`Common/Globals.ush`), or by its
+    /// file name alone where the override names no folder (`globals.hlsli` replaces `../globals.hlsli` too).
+    pub fn overridden(&self, name: &str) -> Option<&PathBuf> {
+        let file_name = name.rsplit(['/', '\\']).next().unwrap_or(name);
+        self.overrides.iter().find(|(n, _)| n == name || (!n.contains(['/', '\\']) && n == file_name)).map(|(_, f)| f)
     }
 
     /// The longest mapped prefix `name` lies under (`/Engine` for `/Engine/Private/BRDF.ush`), with the rest of
@@ -114,6 +125,9 @@ impl Includes {
     /// by name when it is read, not passed over for another file.
     pub fn find(&self, name: &str, beside: Option<&Path>) -> Option<PathBuf> {
         let found = |p: &PathBuf| p.metadata().is_ok_and(|m| !m.is_dir());
+        if let Some(file) = self.overridden(name) {
+            return Some(file.clone()).filter(found);
+        }
         if let Some(((_, dir), rest)) = self.mapped(name) {
             return Some(dir.join(rest)).filter(|p| stays_under(rest) && found(p));
         }
@@ -236,6 +250,7 @@ mod tests {
     fn the_longest_virtual_prefix_maps_a_name() {
         let inc = Includes {
             dirs: vec![],
+            overrides: vec![],
             maps: vec![
                 ("/Engine".into(), "a".into()),
                 ("/Engine/Private".into(), "b".into()),
