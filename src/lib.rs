@@ -1,7 +1,7 @@
 //! brdfprof: evaluates and profiles specular BRDFs in Vulkan compute kernels.
 //!
 //! Data flows CLI (`main.rs`, `cli/`) -> models (`model`: a `brdf` spec) -> kernels (`kernels`, `shaders`, on
-//! `gpu`) -> the measurement protocol (`profile`) -> reports (`report`).
+//! `gpu`) -> the measurement protocol (`profile`) -> reports (`report_page`).
 
 pub use brdfprof_brdf as brdf;
 pub use brdfprof_process::{cleanup, launch, messages, tools};

@@ -7,7 +7,7 @@ use crate::schema::callgrind::CallgrindRun;
 use anyhow::{Context, Result, anyhow, bail};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// The `format` field of a baseline file.
 pub const FORMAT: &str = "brdfprof-check-baseline/1";
@@ -50,9 +50,72 @@ pub fn load(path: &Path) -> Result<Baseline> {
         ),
         None => bail!("baseline {name}: not a brdfprof check baseline (no `format` field; expected `{FORMAT}`)"),
     }
-    let baseline: Baseline = serde_json::from_value(value).map_err(|e| anyhow!("baseline {name}: corrupt ({e})"))?;
+    let mut baseline: Baseline =
+        serde_json::from_value(value).map_err(|e| anyhow!("baseline {name}: corrupt ({e})"))?;
     validate(&baseline).map_err(|e| anyhow!("baseline {name}: corrupt ({e})"))?;
+    let dir = path.parent().unwrap_or(Path::new(""));
+    map_file_paths(&mut baseline, |p| {
+        let beside = dir.join(p);
+        (Path::new(p).is_relative() && beside.is_file()).then(|| normal(&beside).display().to_string())
+    });
     Ok(baseline)
+}
+
+/// `b` as a baseline file at `path` holds it: each shader file's path relative to the baseline's own folder
+/// (where the file exists), so that `check` run from another folder, or the repository checked out elsewhere,
+/// finds it (`load` resolves them back; a baseline saved before keeps paths relative to where it was saved,
+/// which `load` leaves as they are where the baseline's folder does not hold them).
+pub fn with_paths_relative_to(b: &Baseline, path: &Path) -> Baseline {
+    let mut out = b.clone();
+    let dir = std::path::absolute(path.parent().unwrap_or(Path::new(""))).unwrap_or_default();
+    map_file_paths(&mut out, |p| {
+        let file = std::path::absolute(p).ok().filter(|f| f.is_file())?;
+        Some(relative(&normal(&dir), &normal(&file)).display().to_string())
+    });
+    out
+}
+
+/// Applies `f` to the path of each row's spec that names a shader file, replacing it where `f` answers.
+fn map_file_paths(b: &mut Baseline, f: impl Fn(&str) -> Option<String>) {
+    for row in &mut b.inspect.rows {
+        let Some(spec) = row.spec.clone() else { continue };
+        let Some((p, _)) = crate::model::file_model::split_path(&spec, Path::new("")) else { continue };
+        let Some(at) = spec.find(p) else { continue };
+        if let Some(new) = f(p) {
+            row.spec = Some(format!("{}{new}{}", &spec[..at], &spec[at + p.len()..]));
+        }
+    }
+}
+
+/// `p` with `.` dropped and `..` taken back where it can be (no file system access).
+fn normal(p: &Path) -> PathBuf {
+    let mut out = PathBuf::new();
+    for c in p.components() {
+        match c {
+            std::path::Component::CurDir => {}
+            std::path::Component::ParentDir
+                if matches!(out.components().next_back(), Some(std::path::Component::Normal(_))) =>
+            {
+                out.pop();
+            }
+            other => out.push(other),
+        }
+    }
+    out
+}
+
+/// `to` relative to the folder `from` (both absolute and normal).
+fn relative(from: &Path, to: &Path) -> PathBuf {
+    let (a, b): (Vec<_>, Vec<_>) = (from.components().collect(), to.components().collect());
+    let common = a.iter().zip(&b).take_while(|(x, y)| x == y).count();
+    let mut out = PathBuf::new();
+    for _ in common..a.len() {
+        out.push("..");
+    }
+    for c in &b[common..] {
+        out.push(c);
+    }
+    out
 }
 
 /// What serde cannot check: models that parse, statistics a measurement can give (finite; counts whole and

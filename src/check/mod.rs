@@ -241,7 +241,7 @@ fn run_measured(options: &CheckOptions, measure: impl FnOnce(Vec<Model>, u32) ->
         outcome.findings.extend(failed);
     }
     if let Some(path) = &options.save {
-        json::write_report(path, json::Kind::Baseline, &new)?;
+        json::write_report(path, json::Kind::Baseline, &baseline::with_paths_relative_to(&new, path))?;
         crate::messages::progress(format!("check: baseline saved to {}", path.display()));
     }
     Ok(outcome)

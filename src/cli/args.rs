@@ -95,7 +95,8 @@ pub struct ModelArgs {
     /// Model spec: a preset (ggx, blinn, cook-torrance, burley, ue-default-lit, filament-high, filament-low)
     /// or d=..,vis=..,f=..,precision=..; see `brdfprof models`. Or a model file,
     /// PATH[,NAME=VALUE|@roughness|@alpha|@f0|@basecolor|@metallic...]: a BRDF Explorer .brdf file (its shader
-    /// in GLSL, HLSL or WGSL), or a plain HLSL (.hlsl, .hlsli, .ush, .usf) or WGSL (.wgsl) shader file.
+    /// in GLSL, HLSL, Slang or WGSL), or a plain HLSL (.hlsl, .hlsli, .ush, .usf), Slang (.slang) or WGSL
+    /// (.wgsl) shader file.
     #[arg(long = "model")]
     pub models: Vec<String>,
     /// Parameter override applied to every model that takes it, e.g. gamma=1.5 (GTR exponent), metal=copper,
@@ -108,8 +109,9 @@ pub struct ModelArgs {
     /// same as `define=NAME=VALUE` in the file's spec (docs/brdf-files.md, docs/wgsl.md).
     #[arg(long = "define", value_name = "NAME[=VALUE]")]
     pub defines: Vec<String>,
-    /// A directory an HLSL shader's `#include` and a WGSL shader's `#import` search, after the model file's
-    /// own (repeatable, in order; `include=DIR` in the model's spec; docs/hlsl.md, docs/wgsl.md).
+    /// A directory a shader's `#include` (GLSL, HLSL, Slang), a Slang shader's `import` and a WGSL shader's
+    /// `#import` search, after the model file's own (repeatable, in order; `include=DIR` in the model's spec;
+    /// docs/hlsl.md, docs/slang.md, docs/wgsl.md).
     #[arg(long = "include-dir", value_name = "DIR")]
     pub include_dirs: Vec<String>,
     /// A virtual include prefix and the directory it stands for, e.g. /Engine=UE/Engine/Shaders: `#include
@@ -161,7 +163,7 @@ impl ModelArgs {
             .find_map(|(f, v)| v.first().map(|v| format!("{f} {v}")))
             .unwrap_or_default();
             bail!(
-                "{flag}: it is for a shader file's model, and no --model is a .brdf file, nor an .hlsl, .ush or .wgsl file"
+                "{flag}: it is for a shader file's model, and no --model is a .brdf file, nor an .hlsl, .ush, .slang or .wgsl file"
             );
         }
         let with: Vec<String> = self

@@ -42,8 +42,9 @@ pub struct InspectArgs {
     pub isa: Option<PathBuf>,
     /// Device, repeatable: an index or name substring (see `brdfprof devices`), or a compile-only target
     /// (`radv:FAMILY`: Mesa RADV's compiler for an AMD family; `nvidia:FAMILY`: NVIDIA's compiler for a compute
-    /// capability; `intel:FAMILY`: Intel's IGC for a GPU generation; `PREFIX:all` for the default set; see `devices --targets`). Default: the first discrete or
-    /// integrated GPU, else lavapipe.
+    /// capability; `intel:FAMILY`: Intel's IGC for a GPU generation; `adreno:`, `mali:`, `anv:` and `nak:`:
+    /// Mesa's Freedreno, Panfrost, ANV and NVK compilers on its noop drm-shim; `PREFIX:all` for the default set;
+    /// see `devices --targets`). Default: the first discrete or integrated GPU, else lavapipe.
     #[arg(long = "device", value_name = "DEVICE", value_parser = device_name)]
     pub devices: Vec<String>,
     /// Run under the Khronos validation layer and fail on any message (also BRDFPROF_VALIDATION=1).

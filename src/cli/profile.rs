@@ -37,8 +37,8 @@ pub struct ProfileArgs {
     #[arg(long)]
     pub scene: Option<PathBuf>,
     /// With --scene: also compile every kernel the scene profile times (each kernel as compiled and without
-    /// each effect) for a compile-only target (radv:FAMILY, nvidia:FAMILY, intel:FAMILY, PREFIX:all;
-    /// repeatable; see `devices --targets`): modelled cycles per pixel and per effect beside the measured ns.
+    /// each effect) for a compile-only target (radv:, nvidia:, intel:, adreno:, mali:, anv: or nak:FAMILY,
+    /// PREFIX:all; repeatable; see `devices --targets`): modelled cycles per pixel and per effect beside the measured ns.
     #[arg(long = "cost-device", value_name = "DEVICE", value_parser = device_name)]
     pub cost_devices: Vec<String>,
     /// With --cost-device: write each kernel's compiler output per target as `inspect --isa` does

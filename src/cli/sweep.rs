@@ -60,7 +60,8 @@ pub struct SweepArgs {
     #[arg(long, value_parser = brdfprof::diff::F0Set::parse)]
     pub f0: Option<brdfprof::diff::F0Set>,
     /// Also draw the table, JSON and Pareto chart with a compile-only target's modelled cycles per evaluation
-    /// as the cost (radv:FAMILY, nvidia:FAMILY, intel:FAMILY, PREFIX:all; repeatable; see `devices --targets`):
+    /// as the cost (radv:, nvidia:, intel:, adreno:, mali:, anv: or nak:FAMILY, PREFIX:all; repeatable; see
+    /// `devices --targets`):
     /// sweep-<device>-<compiler>-<family>.* (aco, ptxas, igc); with several, sweep-<device>-frontiers.md/.json:
     /// the specs on every target's frontier, and those on some only.
     #[arg(long = "cost-device", value_name = "DEVICE", value_parser = device_name)]

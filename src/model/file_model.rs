@@ -306,7 +306,7 @@ pub const INCLUDE_OVERRIDE: &str = "include-override";
 
 /// The key of a model text that chooses an HLSL shader's front end (`hlsl-front-end=auto|glslang|slang`, as
 /// `--hlsl-front-end`).
-pub const HLSL_FRONT_END: &str = "hlsl-front-end";
+pub const HLSL_FRONT_END: &str = HlslFrontEnd::KEY;
 
 /// The keys of a model text brdfprof reads itself (no parameter may take one's name).
 const KEYS: [&str; 7] = [DEFINE, ENTRY, RETURNS, INCLUDE, INCLUDE_MAP, INCLUDE_OVERRIDE, HLSL_FRONT_END];
@@ -1074,7 +1074,7 @@ mod tests {
         assert_eq!(FileModel::parse(&m.name()).unwrap(), m);
         assert_eq!(FileModel::parse(&path).unwrap().name(), path, "defaults are not repeated in the name");
         let e = format!("{:#}", FileModel::parse("m.txt,r=1").unwrap_err());
-        assert!(e.contains("names no model file (.brdf, .hlsl, .hlsli, .ush, .usf, .wgsl)"), "{e}");
+        assert!(e.contains("names no model file (.brdf, .hlsl, .hlsli, .ush, .usf, .slang, .wgsl)"), "{e}");
     }
 
     #[test]

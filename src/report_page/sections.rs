@@ -563,6 +563,88 @@ pub fn stability_html(i: usize, st: &StabilityReport, path: &str) -> Result<Stri
             maps += &heat_map(s, cells)?;
         }
     }
+    let located = located_failures(st) + &out_of_tolerance_html(st) + &bounds_html(st);
+    let maps = if maps.is_empty() {
+        "<p class=\"note\">No spec gives a bad value on the grid.</p>".to_string()
+    } else {
+        format!(
+            "<h3>Where the bad values are (grid of NoV x roughness, all azimuths and NoL)</h3><div class=\"heat\">{maps}</div>"
+        )
+    };
+    Ok(format!(
+        "<h3>{path}</h3><p class=\"note\">{} specs, {failing} failing (NaN, Inf or negative on valid inputs); {} hard cases; {} grid points. Deviation in units of the tolerance.</p>{}{maps}{located}",
+        st.specs.len(),
+        st.cases.len(),
+        st.grid_points,
+        t.html()
+    ))
+}
+
+/// Where each spec checked against a twin or reference is out of tolerance: its worst value's inputs and each
+/// hard case out of tolerance with its inputs, as the Markdown's "Out of tolerance: where".
+fn out_of_tolerance_html(st: &StabilityReport) -> String {
+    let mut items = String::new();
+    for s in st.specs.iter().filter(|s| s.checked()) {
+        let cases: Vec<&crate::stability::CaseResult> =
+            s.cases_out_of_tolerance.iter().filter(|c| !c.inputs.is_empty()).collect();
+        if cases.is_empty() && s.grid_out_of_tolerance == 0 {
+            continue;
+        }
+        let each: String = cases
+            .iter()
+            .map(|c| format!("<li>{} at {} ({:.2e} x tolerance)</li>", esc(&c.case), esc(&c.inputs), c.deviation))
+            .collect();
+        items += &format!(
+            "<li><b>{}</b>: {} hard cases and {} grid points out of tolerance; the worst ({:.2e} x tolerance) at {}<ul>{each}</ul></li>",
+            esc(s.label()),
+            cases.len(),
+            s.grid_out_of_tolerance,
+            s.worst.deviation,
+            esc(&s.worst.input)
+        );
+    }
+    if items.is_empty() {
+        return items;
+    }
+    format!("<details><summary>Out of tolerance: where</summary><ul class=\"failures\">{items}</ul></details>")
+}
+
+/// The cases at each declared domain's bounds with what the precision loses there (`BoundCase`).
+fn bounds_html(st: &StabilityReport) -> String {
+    let mut t = HtmlTable::new(&[
+        ("spec", "spec"),
+        ("case", "case"),
+        ("inputs", "inputs"),
+        ("loss", "loss against the exact value"),
+        ("verdict", "verdict"),
+    ]);
+    let mut any = false;
+    for s in &st.specs {
+        for (k, b) in s.at_domain_bounds.iter().enumerate() {
+            any = true;
+            t.row(
+                format!("bounds/{}/{k}", s.spec),
+                vec![
+                    Cell::text(s.label().to_string()),
+                    Cell::text(b.case.clone()),
+                    Cell::text(b.inputs.clone()),
+                    b.loss.map_or(Cell::text("-"), |l| Cell::num(l, crate::stability::loss_text(l))),
+                    Cell::text(if b.ok { "within" } else { "out of tolerance" }),
+                ],
+            );
+        }
+    }
+    if !any {
+        return String::new();
+    }
+    format!(
+        "<h3>At the domain's bounds</h3><p class=\"note\">Each declared domain's own ends, against the formula's exact value (no floor), with what the kernel's precision loses there, said even within tolerance.</p>{}",
+        t.html()
+    )
+}
+
+/// Each failing spec's failing inputs and the input guards that remove them.
+fn located_failures(st: &StabilityReport) -> String {
     let mut located = String::new();
     for s in st.specs.iter().filter(|s| s.fails()) {
         let f = &s.failures;
@@ -578,20 +660,7 @@ pub fn stability_html(i: usize, st: &StabilityReport, path: &str) -> Result<Stri
             "<h3>Where the failing specs fail</h3><p class=\"note\">Each failing hard case with its inputs, the grid's failing points, and the input guards (roughness floor, cosine floor, safe half vector, lit mask, F0 clamp, as a caller could apply them) that remove each.</p><ul class=\"failures\">{located}</ul>"
         );
     }
-    let maps = if maps.is_empty() {
-        "<p class=\"note\">No spec gives a bad value on the grid.</p>".to_string()
-    } else {
-        format!(
-            "<h3>Where the bad values are (grid of NoV x roughness, all azimuths and NoL)</h3><div class=\"heat\">{maps}</div>"
-        )
-    };
-    Ok(format!(
-        "<h3>{path}</h3><p class=\"note\">{} specs, {failing} failing (NaN, Inf or negative on valid inputs); {} hard cases; {} grid points. Deviation in units of the tolerance.</p>{}{maps}{located}",
-        st.specs.len(),
-        st.cases.len(),
-        st.grid_points,
-        t.html()
-    ))
+    located
 }
 
 pub fn stability(inputs: &[Input]) -> Result<String> {

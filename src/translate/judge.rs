@@ -44,8 +44,9 @@ pub fn judge(x: f32, r: Bounded, extra: f64) -> Judgement {
     }
     let flushed = if r.value.abs() < f64::from(f32::MIN_POSITIVE) { r.value.abs() } else { 0.0 };
     let rounding = extra + flushed + REFERENCE_ROUNDING * r.value.abs();
-    let overflows = r.value.abs() + r.bound + rounding >= f64::from(f32::MAX);
-    if x.is_infinite() && overflows && x.signum() == r.value.signum() {
+    // fp32 overflows to an infinity of the sign of whichever end of the range lies past its largest value.
+    let reach = if x > 0.0 { r.value + r.bound + rounding } else { -(r.value - r.bound - rounding) };
+    if x.is_infinite() && reach >= f64::from(f32::MAX) {
         return Judgement::Measured(0.0);
     }
     let beyond = (x - r.value).abs() - rounding;
@@ -66,10 +67,15 @@ pub fn r11g11b10_max(mantissa: u32) -> f64 {
 
 /// A reference value as the R11G11B10F store holds it: saturated at the channel's largest finite value, as
 /// the kernels' packing writes it (a radiance of 3.5e5 is stored as 65024 by the device and the translation
-/// alike; the unsaturated reference called that a translator defect).
+/// alike; the unsaturated reference called that a translator defect). An upper end past fp32's largest value
+/// is kept: fp32 overflows there to Inf, which the format stores as Inf.
 pub fn r11g11b10_saturated(r: Bounded, mantissa: u32) -> Bounded {
+    if !(r.value + r.bound).is_finite() {
+        return r;
+    }
     let max = r11g11b10_max(mantissa);
-    let (lo, hi) = ((r.value - r.bound).min(max), (r.value + r.bound).min(max));
+    let hi = r.value + r.bound;
+    let (lo, hi) = ((r.value - r.bound).min(max), if hi >= f64::from(f32::MAX) { hi } else { hi.min(max) });
     Bounded { value: 0.5 * (lo + hi), bound: 0.5 * (hi - lo) }
 }
 
@@ -198,6 +204,10 @@ mod tests {
         assert_eq!(judge(f32::INFINITY, b(3.4e38, 1e36), 0.0), Judgement::Measured(0.0));
         assert_eq!(judge(f32::NEG_INFINITY, b(3.4e38, 1e36), 0.0), Judgement::Measured(f64::INFINITY));
         assert_eq!(judge(f32::INFINITY, b(f64::INFINITY, 0.0), 0.0), Judgement::Measured(0.0));
+        // A range of either sign reaching past fp32's largest value allows the infinity of that side.
+        assert_eq!(judge(f32::INFINITY, b(-7.3e101, 2.2e102), 0.0), Judgement::Measured(0.0));
+        assert_eq!(judge(f32::NEG_INFINITY, b(-7.3e101, 2.2e102), 0.0), Judgement::Measured(0.0));
+        assert_eq!(judge(f32::NEG_INFINITY, b(7.3e101, 1e100), 0.0), Judgement::Measured(f64::INFINITY));
         assert_eq!(judge(1.0, b(f64::NAN, 0.0), 0.0), Judgement::Undefined);
         assert_eq!(judge(1.0, b(1.0, f64::INFINITY), 0.0), Judgement::Unbounded);
     }
@@ -207,6 +217,17 @@ mod tests {
         let t = Tally { worst: f64::INFINITY, bound_max: f64::NAN, ..Tally::default() };
         let back: Tally = serde_json::from_str(&serde_json::to_string(&t).unwrap()).unwrap();
         assert!(back.worst == f64::INFINITY && back.bound_max.is_nan());
+    }
+
+    #[test]
+    fn the_saturated_reference_keeps_an_end_that_overflows_fp32() {
+        let within = r11g11b10_saturated(b(3.5e5, 4e3), 6);
+        assert_eq!((within.value + within.bound, within.value - within.bound), (65024.0, 65024.0));
+        let overflowing = r11g11b10_saturated(b(-7.3e101, 2.2e102), 6);
+        assert!(overflowing.value + overflowing.bound > 1e102);
+        assert_eq!(judge(f32::INFINITY, overflowing, 0.0), Judgement::Measured(0.0));
+        assert!(matches!(judge(65024.0, overflowing, 0.0), Judgement::Measured(m) if m <= 1.0));
+        assert_eq!(r11g11b10_saturated(b(f64::INFINITY, 0.0), 6).value, f64::INFINITY);
     }
 
     #[test]

@@ -148,3 +148,15 @@ fn completions_and_json_listings() {
     assert!(json["vis"].as_array().unwrap().iter().any(|v| v["name"] == "schlick-ggx-karis"));
     assert!(r.stderr.contains("Presets"), "the tables go to stderr");
 }
+
+/// Each flag that takes a compile-only target says every prefix there is (`targets::VENDORS`, listed once).
+#[test]
+fn the_help_of_every_cost_device_flag_names_every_prefix() {
+    let prefixes = brdfprof::targets::prefixes();
+    for command in ["inspect", "profile", "sweep"] {
+        let help = common::run(&[command, "--help"]).ok().stdout;
+        for p in prefixes.split(", ") {
+            assert!(help.contains(p), "`{command} --help` names no `{p}` target:\n{help}");
+        }
+    }
+}

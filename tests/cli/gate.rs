@@ -55,3 +55,22 @@ fn the_gate_ranks_regressions_by_their_cycles_per_evaluation() {
     let head: Vec<&str> = summary.lines().take(5).collect();
     assert!(head.iter().any(|l| l.contains("Verdict: REGRESSED") && l.contains("thirty-two")), "{head:#?}");
 }
+
+/// A baseline keeps its shader files' paths relative to its own folder: `check` run from a subdirectory (or
+/// the repository checked out elsewhere) finds them, where paths relative to the folder it was saved from were
+/// called corrupt or gone.
+#[test]
+fn a_baseline_finds_its_shaders_from_another_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    for sub in ["shaders", "ci", "sub"] {
+        std::fs::create_dir(d.join(sub)).unwrap();
+    }
+    model(&d.join("shaders"), "lobe.brdf", 1);
+    run_in(d, &["check", "--device", "radv:navi21", "--model", "shaders/lobe.brdf", "--save-baseline", "ci/b.json"])
+        .ok();
+    let saved = std::fs::read_to_string(d.join("ci/b.json")).unwrap();
+    assert!(saved.contains("../shaders/lobe.brdf"), "the path relative to the baseline's folder");
+    let r = run_in(&d.join("sub"), &["check", "--device", "radv:navi21", "--baseline", "../ci/b.json"]).ok();
+    assert!(!r.stderr.contains("gone") && r.stdout.contains("lobe"), "{}\n{}", r.stdout, r.stderr);
+}

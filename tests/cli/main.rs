@@ -35,6 +35,7 @@ mod radv;
 mod report;
 mod shader_languages;
 mod signals;
+mod slang_and_includes;
 mod source_lines;
 mod stability;
 mod swiftshader;

@@ -134,6 +134,27 @@ fn a_slang_compiled_models_lines_are_its_own_files_lines() {
     lines_land_on_the_users_files("dxc-era", &["--model", &file], &[file.clone()], "(its HLSL as GLSL)");
 }
 
+/// A Slang model's lines are its own file's and those of the module it imports (slangc's line tables name
+/// the module by its path); a GLSL model's those of the header it includes.
+#[test]
+fn slang_modules_and_glsl_includes_keep_their_files_lines() {
+    let dir = common::repo_root().join("tests/fixtures/slang");
+    let file = |name: &str| dir.join(name).display().to_string();
+    let include = dir.display().to_string();
+    lines_land_on_the_users_files(
+        "ggx-d",
+        &["--model", &file("ggx-d.slang"), "--include-dir", &include],
+        &[file("ggx-d.slang"), file("Rendering/Microfacet.slang")],
+        "(its Slang as GLSL)",
+    );
+    lines_land_on_the_users_files(
+        "ggx-d-glsl",
+        &["--model", &file("ggx-d-glsl.brdf")],
+        &[file("ggx-d-glsl.brdf"), file("common.glsl")],
+        "(its GLSL and includes as GLSL)",
+    );
+}
+
 /// `inspect --lines` on NVIDIA of model `name` (`args`): its costliest line is one of `files`', each of those files' lines is shown with its own text, every file has lines, at most a fifth of
 /// the lines are left on the front end's GLSL (named with `glsl_suffix`), and every instruction counts once.
 fn lines_land_on_the_users_files(name: &str, args: &[&str], files: &[String], glsl_suffix: &str) {

@@ -220,3 +220,18 @@ fn a_fragment_shader_pasted_whole_evaluates() {
     let max = report["diffs"][0]["difference"]["max_rel"].as_f64().unwrap();
     assert!(max < 2e-3, "max rel {max}");
 }
+
+/// The HTML page names what the Markdown names: each out-of-tolerance value with its inputs, and the cases at
+/// the domain's bounds with the loss there.
+#[test]
+fn the_html_names_the_inputs_out_of_tolerance_and_the_loss_at_the_bounds() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let file = fixture("floor-002-ggx.brdf");
+    let r =
+        run_in(d, &["stability", "--no-energy", "--model", &file, "--out", "st", "--html", "s.html"]).no_validation();
+    assert_eq!(r.code, Some(0), "{}", r.stderr);
+    let html = std::fs::read_to_string(d.join("s.html")).unwrap();
+    assert!(html.contains("Out of tolerance: where") && html.contains("NoV "), "no out-of-tolerance inputs");
+    assert!(html.contains("At the domain") && html.contains("% low"), "no loss at the domain's bounds");
+}

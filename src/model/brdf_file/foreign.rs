@@ -6,7 +6,8 @@
 //! name its files and lines.
 
 use super::*;
-use crate::model::front::{self, Glue, GlueArg, cross, hlsl, includes::Expanded, wgsl};
+use crate::model::front::{self, Glue, GlueArg, cross, hlsl, includes::Expanded, slang, wgsl};
+use std::collections::HashMap;
 
 /// The stack the front ends run on. naga's WGSL front end recurses once per operand of an expression (a
 /// 20,000-term sum overflowed the main thread's 8 MiB and aborted the process); generated shaders (fitted
@@ -44,11 +45,21 @@ fn translate_here(file: &mut BrdfFile) -> Result<Vec<(usize, String)>> {
     check_reserved_names(file)?;
     check_param_spelling(file)?;
     // `places[k]`: the user's place of SPIR-V line k + 1 (the expanded HLSL's lines; a WGSL statement's own).
-    let (spirv, source, places, front_end) = match file.language {
+    let (spirv, source, mut places, front_end) = match file.language {
         Language::Hlsl => {
             let (spirv, source, front_end) = hlsl_spirv(file)?;
             let places = source.iter().cloned().map(Some).collect();
             (spirv, source, places, front_end)
+        }
+        Language::Glsl => {
+            let (spirv, source) = glsl_spirv(file)?;
+            let places = source.iter().cloned().map(Some).collect();
+            (spirv, source, places, Some(front::glsl::describe()))
+        }
+        Language::Slang => {
+            let (spirv, source) = slang_language_spirv(file)?;
+            let places = source.iter().cloned().map(Some).collect();
+            (spirv, source, places, None)
         }
         _ => {
             let (spirv, source, places) = wgsl_spirv(file)?;
@@ -56,7 +67,10 @@ fn translate_here(file: &mut BrdfFile) -> Result<Vec<(usize, String)>> {
         }
     };
     let text = cross::to_glsl(&spirv, &file.path)?;
-    let at = cross::line_origins(&spirv, &text, &file.path)?;
+    let at = match file.language {
+        Language::Slang => module_places(&cross::line_files(&spirv, &text, &file.path)?, &mut places),
+        _ => cross::line_origins(&spirv, &text, &file.path)?,
+    };
     check_param_names(file, &text)?;
     let params: Vec<&str> = file.params.iter().map(|p| p.name.as_str()).collect();
     let glsl = cross::view(&text, &params, &file.path).map_err(|e| match e.downcast::<cross::Resource>() {
@@ -290,6 +304,96 @@ fn hlsl_spirv(file: &mut BrdfFile) -> Result<(Vec<u32>, Source, Option<String>)>
     Ok((spirv, source, front_end))
 }
 
+/// A Slang shader compiled by slangc as Slang: the parameters as `static` globals, the section with its
+/// `#include`s expanded (`--include-override` and `--include-map` as for HLSL; `import`ed modules are slangc's
+/// to find, in the model's folder and the include directories), each entry's glue and the stub. slangc's own
+/// preprocessor reads the text (variadic macros, `__VA_ARGS__`); `BRDF` and the entries are checked on the
+/// text with its directives blanked, as slangc's preprocessor writes no line-for-line text to read them on (a
+/// `BRDF` a macro defines is not seen: declare entries for it).
+fn slang_language_spirv(file: &mut BrdfFile) -> Result<(Vec<u32>, Source)> {
+    let mut x = Expanded::new(&file.path);
+    for p in &file.params {
+        if hlsl::is_keyword(&p.name) {
+            bail!(at(
+                &file.path,
+                p.line,
+                format!("parameter `{}`: a keyword of Slang's HLSL syntax; give the parameter another name", p.name)
+            ));
+        }
+        x.push_generated(hlsl::param_decl(&p.name, p.glsl_type()), p.line, format!("parameter `{}`", p.name));
+    }
+    x.include_section(&file.path, &file.source, &file.includes)?;
+    for (f, n, text) in &x.dropped {
+        file.warnings.push(dropped_hash_line(Path::new(&x.files[*f]), *n, text));
+    }
+    let code = front::includes::code_lines(&x.lines.iter().cloned().enumerate().collect::<Vec<_>>());
+    let mut continued = false;
+    let blanked: Vec<String> = x
+        .lines
+        .iter()
+        .zip(&code)
+        .map(|(l, c)| {
+            let directive = continued || c.text.trim_start().starts_with('#');
+            continued = directive && l.trim_end().ends_with('\\');
+            if directive { String::new() } else { l.clone() }
+        })
+        .collect();
+    let glues = check_hlsl(file, &x, &(blanked.join("\n") + "\n"))?;
+    for (g, e) in glues.iter().zip(&file.entries) {
+        x.push_generated(hlsl::glue(g), e.line, format!("entry `{}`", e.name));
+    }
+    let calls = stub_calls(file, &glues);
+    x.push_generated(
+        slang::stub(&calls),
+        file.shader_begin,
+        format!("the shader's `BRDF` as brdfprof calls it, `{}`", globals::HLSL_SIGNATURE.text),
+    );
+    let search: Vec<PathBuf> =
+        std::iter::once(front::dir_of(&file.path)).chain(file.includes.dirs.iter().cloned()).collect();
+    let spirv = match slang::compile(&x, &file.defines, &file.path, slang::Dialect::Slang, &search)? {
+        Some(Ok(words)) => words,
+        Some(Err(messages)) => bail!("{messages}\n(Slang's slangc refused the shader)"),
+        None => bail!(
+            "{}: a Slang shader needs Slang's slangc, which is not installed: run `make setup`",
+            file.path.display()
+        ),
+    };
+    let source = x.lines.iter().zip(&x.origins).map(|(l, &(f, n))| (x.files[f].clone(), n, l.clone())).collect();
+    Ok((spirv, source))
+}
+
+/// The SPIR-V line of each line of spirv-cross's output as an index into `places` (1-based), from the file and
+/// line slangc's line table gives it (`named`): the expanded text's lines are `places`' own; a module slangc
+/// imported has its lines appended, each with its text as the file has it.
+fn module_places(
+    named: &[Option<(String, usize)>],
+    places: &mut Vec<Option<(String, usize, String)>>,
+) -> Vec<Option<usize>> {
+    let mut added: HashMap<(String, usize), usize> = HashMap::new();
+    let mut texts: HashMap<String, Vec<String>> = HashMap::new();
+    named
+        .iter()
+        .map(|n| {
+            let (file, line) = n.as_ref()?;
+            if file.starts_with(slang::MAIN_NAME) {
+                return Some(*line);
+            }
+            if let Some(&k) = added.get(&(file.clone(), *line)) {
+                return Some(k);
+            }
+            let lines = texts.entry(file.clone()).or_insert_with(|| {
+                crate::io::read_bounded(Path::new(file), crate::io::MAX_INPUT_BYTES)
+                    .map(|b| String::from_utf8_lossy(&b).lines().map(str::to_string).collect())
+                    .unwrap_or_default()
+            });
+            let text = lines.get(line.checked_sub(1)?)?.clone();
+            places.push(Some((file.clone(), *line, text)));
+            added.insert((file.clone(), *line), places.len());
+            Some(places.len())
+        })
+        .collect()
+}
+
 /// DXC's minimum-precision overloads that collide once 32-bit (`front::overloads`): each dropped from the
 /// text both front ends compile (its lines replaced by their preprocessed text with the definition blanked),
 /// said once at its file's line. Returns the preprocessed text the checks read, line for line with `x`.
@@ -324,9 +428,9 @@ fn slang_spirv(
     if let Some(stub) = s.lines.last_mut() {
         *stub = front::slang::stub(calls);
     }
-    let compiled = front::slang::compile(&s, &file.defines, &file.path)?;
+    let compiled = front::slang::compile(&s, &file.defines, &file.path, slang::Dialect::Hlsl, &[])?;
     let Some(refused) = refused else {
-        let chosen = format!("{}=slang", crate::model::file_model::HLSL_FRONT_END);
+        let chosen = format!("{}=slang", HlslFrontEnd::KEY);
         return match compiled {
             Some(Ok(words)) => Ok((
                 words,
@@ -363,10 +467,27 @@ fn slang_spirv(
 /// On the preprocessed HLSL `pre` (line for line with `x`): the loops, `BRDF`'s signature, each entry
 /// (`check_entry`, with HLSL's `float3`), and the glue of each.
 fn check_hlsl(file: &mut BrdfFile, x: &Expanded, pre: &str) -> Result<Vec<Glue>> {
+    Ok(check_expanded(file, x, pre, &globals::HLSL_SIGNATURE)?.glues)
+}
+
+/// What the checks of an expanded text read: its preprocessed lines, their tokens and globals, and the glue.
+struct Checked {
+    lines: Vec<(usize, String)>,
+    tokens: Vec<Token>,
+    scan: Scan,
+    glues: Vec<Glue>,
+}
+
+/// `check_hlsl` in the language of `sig`.
+fn check_expanded(file: &mut BrdfFile, x: &Expanded, pre: &str, sig: &globals::Signature) -> Result<Checked> {
     let numbered: Vec<(usize, String)> = (1..=x.lines.len()).map(|n| (n, String::new())).collect();
     let lines = number_lines(&file.path, &numbered, pre.lines(), 1)?;
-    let tokens = tokenize(&file.path, &lines)?;
-    let scan = scan_globals(&file.path, &lines, &tokens)?;
+    // The directives the preprocessor passes through (`#version`, `#extension`, `#pragma`) are no declarations.
+    let code: Vec<(usize, String)> = (lines.iter())
+        .map(|(n, l)| (*n, if l.trim_start().starts_with('#') { String::new() } else { l.clone() }))
+        .collect();
+    let tokens = tokenize(&file.path, &code)?;
+    let scan = scan_globals(&file.path, &code, &tokens)?;
     let model = file.path.display().to_string();
     let origin = |n: usize| x.origin(n.saturating_sub(1)).map_or((model.clone(), n), |(f, l)| (f.to_string(), l));
     file.loops = loops(&lines, &tokens)
@@ -378,17 +499,71 @@ fn check_hlsl(file: &mut BrdfFile, x: &Expanded, pre: &str) -> Result<Vec<Glue>>
         .collect();
     let path = file.path.clone();
     let scanned = globals::Lines { path: &path, origin: Some(&origin) };
-    let brdf = globals::check_brdf(&scanned, file.shader_begin, &scan.globals, &globals::HLSL_SIGNATURE);
+    let brdf = globals::check_brdf(&scanned, file.shader_begin, &scan.globals, sig);
     file.defines_brdf = brdf.is_ok();
     if file.entries.is_empty() {
         brdf?;
     }
     let mut glues = Vec::new();
     for (k, e) in file.entries.iter().enumerate() {
-        let types = globals::check_entry(&scanned, e, &scan.globals, &globals::HLSL_SIGNATURE)?;
+        let types = globals::check_entry(&scanned, e, &scan.globals, sig)?;
         glues.push(glue(k, e, &types.into_iter().map(Some).collect::<Vec<_>>()));
     }
-    Ok(glues)
+    Ok(Checked { lines, tokens, scan, glues })
+}
+
+/// A GLSL shader that includes files: the version line, the parameters as globals, the section with its
+/// includes expanded (`front::includes`), glslang's preprocessor, the checks on its text (as HLSL's), each
+/// entry's glue and the `main` stub, compiled by glslang's GLSL front end (`front::glsl`). A `uniform` or a
+/// stage's `in`/`out` qualifier is dropped from a global as in a GLSL shader composed as written, said at its
+/// file's line.
+fn glsl_spirv(file: &mut BrdfFile) -> Result<(Vec<u32>, Source)> {
+    let mut x = Expanded::new(&file.path);
+    x.push_generated(front::glsl::VERSION, file.shader_begin, "the kernel's `#version 450`");
+    for p in &file.params {
+        x.push_generated(front::glsl::param_decl(&p.name, p.glsl_type()), p.line, format!("parameter `{}`", p.name));
+    }
+    x.include_section(&file.path, &file.source, &file.includes)?;
+    for (f, n, text) in &x.dropped {
+        file.warnings.push(dropped_hash_line(Path::new(&x.files[*f]), *n, text));
+    }
+    let pre = front::glsl::preprocess(&x, &file.defines, &file.path)?.map_err(|m| anyhow!("{m}"))?;
+    let checked = check_expanded(file, &x, &pre, &globals::GLSL_SIGNATURE)?;
+    let mut lines: Vec<String> = checked.lines.iter().map(|(_, l)| l.clone()).collect();
+    let place = |k: usize| x.origin(k).map_or_else(|| file.path.display().to_string(), |(f, l)| format!("{f}:{l}"));
+    let line_of_global = |name: &str| {
+        checked.tokens.iter().find(|t| t.kind == Kind::Ident && t.text == name).map(|t| t.line).unwrap_or(0)
+    };
+    for (_, name) in &checked.scan.uniforms {
+        file.warnings.push(format!("{}: `uniform` dropped from `{name}`: Vulkan GLSL has no uniforms outside blocks, so it is a private global nothing sets (declare it as a parameter instead)", place(line_of_global(name))));
+    }
+    for (_, qualifier, name) in &checked.scan.interface {
+        file.warnings.push(format!("{}: `{qualifier}` dropped from `{name}`: a fragment or vertex stage's interface, not the BRDF's inputs (brdfprof calls the BRDF function with N, V, L and its parameters), so it is a private global here", place(line_of_global(name))));
+    }
+    // Dropped from the last token of a line to the first, so that earlier byte ranges stay valid.
+    let mut dropped: Vec<&Token> = checked.scan.uniform_tokens.iter().map(|&i| &checked.tokens[i]).collect();
+    dropped.sort_by_key(|t| std::cmp::Reverse((t.line, t.start)));
+    for t in dropped {
+        lines[t.line].replace_range(t.start..t.end, &" ".repeat(t.end - t.start));
+    }
+    let mut compiled = x.clone();
+    compiled.lines = lines;
+    compiled.lines[0] = front::glsl::VERSION.to_string();
+    for (g, e) in checked.glues.iter().zip(&file.entries) {
+        compiled.push_generated(front::glsl::glue(g), e.line, format!("entry `{}`", e.name));
+    }
+    let calls = stub_calls(file, &checked.glues);
+    compiled.push_generated(
+        front::glsl::stub(&calls),
+        file.shader_begin,
+        format!("the shader's `BRDF` as brdfprof calls it, `{}`", globals::GLSL_SIGNATURE.text),
+    );
+    let spirv = front::glsl::compile(&compiled, &file.defines, &file.path)?.map_err(|m| anyhow!("{m}"))?;
+    // The user's lines as written (before the preprocessor), then the lines brdfprof wrote.
+    let source = (compiled.lines.iter().enumerate().zip(&compiled.origins))
+        .map(|((k, l), &(f, n))| (compiled.files[f].clone(), n, x.lines.get(k).unwrap_or(l).clone()))
+        .collect();
+    Ok((spirv, source))
 }
 
 /// The WGSL shader's SPIR-V, its lines (as messages locate a declaration) and the user's place of each SPIR-V

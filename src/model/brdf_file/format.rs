@@ -69,19 +69,16 @@ pub(super) fn directive_of(line: &str) -> &str {
     line[1..].trim_start().split(|c: char| !c.is_ascii_alphanumeric() && c != '_').next().unwrap_or("")
 }
 
-/// Whether a `#` line of the shader section stays for the preprocessor; `#include` is refused (the file is
-/// composed alone, so nothing could be found), any other line is dropped (`dropped_hash_line`).
-pub(super) fn keeps_directive(path: &Path, n: usize, line: &str) -> Result<bool> {
-    match directive_of(line) {
-        "include" => bail!(at(
-            path,
-            n,
-            format!(
-                "`{line}`: a .brdf shader is composed alone, so it cannot include files; paste the included code into the file"
-            )
-        )),
-        d => Ok(PREPROCESSOR_DIRECTIVES.contains(&d)),
-    }
+/// Whether a `#` line of the shader section stays for the preprocessor (`#include` too: a shader that includes
+/// files goes through glslang's GLSL front end, `foreign` and `front::glsl`); any other line is dropped
+/// (`dropped_hash_line`).
+pub(super) fn keeps_directive(line: &str) -> bool {
+    directive_of(line) == "include" || PREPROCESSOR_DIRECTIVES.contains(&directive_of(line))
+}
+
+/// Whether a GLSL shader includes files.
+pub(super) fn includes_files(source: &[(usize, String)]) -> bool {
+    source.iter().any(|(_, l)| l.trim_start().starts_with('#') && directive_of(l.trim_start()) == "include")
 }
 
 /// A `#` line of the shader that is no directive brdfprof keeps is dropped, as BRDF Explorer drops every `#`
@@ -106,7 +103,7 @@ fn push_blank_or_hash_line(file: &mut BrdfFile, n: usize, raw: &str) -> Result<(
         return Ok(());
     }
     let trimmed = raw.trim();
-    let kept = trimmed.starts_with('#') && keeps_directive(&file.path, n, trimmed)?;
+    let kept = trimmed.starts_with('#') && keeps_directive(trimmed);
     file.source.push((n, if kept { raw.to_string() } else { String::new() }));
     if trimmed.starts_with('#') && !kept {
         let warning = dropped_hash_line(&file.path, n, trimmed);

@@ -21,7 +21,7 @@ pub(super) fn check_shader(file: &mut BrdfFile, begin: usize, tokens: &[Token], 
             "`layout(...)` is not supported in a .brdf shader: the kernel the file is composed into sets its own layout (work-group size, bindings); declare values in the parameters section"
         ));
     }
-    if file.language == Language::Glsl {
+    if !file.translated() {
         file.loops = loops(&file.shader, tokens);
     }
     let params: std::collections::HashMap<&str, usize> =

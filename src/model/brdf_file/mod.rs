@@ -315,6 +315,12 @@ fn empty(path: &Path, bytes: &[u8], language: Language) -> BrdfFile {
 }
 
 impl BrdfFile {
+    /// Whether the shader reaches the kernels through a front end's translation (HLSL, Slang, WGSL, and GLSL
+    /// that includes files), not as written.
+    pub fn translated(&self) -> bool {
+        self.language != Language::Glsl || includes_files(&self.source)
+    }
+
     /// The text of line `line` of the GLSL an HLSL or WGSL shader's front end wrote (`shader`, numbered as the
     /// composed kernel's `#line` directive names it: `directive_name`), where `file` is that name as a compiler
     /// reported it (perhaps made absolute or relative to the working directory); None for a GLSL shader, whose
@@ -331,7 +337,7 @@ impl BrdfFile {
         let same = [self.directive_name(), crate::io::from_directive_name(&self.directive_name())]
             .iter()
             .any(|name| file == name || name.ends_with(file) || file.ends_with(name.as_str()));
-        if self.language == Language::Glsl || !same {
+        if !self.translated() || !same {
             return None;
         }
         self.shader.iter().find(|(n, _)| *n == line as usize).map(|(_, text)| text.trim())
@@ -396,7 +402,7 @@ impl BrdfFile {
     fn prepare_shader(&mut self) -> Result<()> {
         self.warnings = self.format_warnings.clone();
         self.shader = match self.language {
-            Language::Glsl => preprocess(&self.path, &self.source, &self.defines)?,
+            Language::Glsl if !includes_files(&self.source) => preprocess(&self.path, &self.source, &self.defines)?,
             // The translation's GLSL through the same preprocessor (spirv-cross writes macros for control-flow
             // attributes); the user's defines were the front end's.
             _ => {

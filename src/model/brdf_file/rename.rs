@@ -76,7 +76,8 @@ impl BrdfFile {
     /// per-line cost reads it back with `io::from_directive_name`).
     pub(crate) fn directive_name(&self) -> String {
         let shown = match self.language {
-            Language::Glsl => self.path.display().to_string(),
+            _ if !self.translated() => self.path.display().to_string(),
+            Language::Glsl => format!("{} (its GLSL and includes as GLSL)", self.path.display()),
             other => format!("{} (its {} as GLSL)", self.path.display(), other.name()),
         };
         crate::io::directive_name(&shown)
@@ -163,8 +164,7 @@ impl BrdfFile {
     /// "compilation terminated", link errors that follow a failed compile) are dropped.
     pub fn remap_log(&self, renamed: &RenamedShader, log: &str, line_of: impl Fn(usize) -> Option<usize>) -> String {
         // A translated shader's lines are its GLSL's, named so.
-        let shown =
-            if self.language == Language::Glsl { self.path.display().to_string() } else { self.directive_name() };
+        let shown = if self.translated() { self.directive_name() } else { self.path.display().to_string() };
         let ours = [self.path.display().to_string(), self.directive_name()];
         let mut out = String::new();
         for line in log.lines().map(str::trim) {

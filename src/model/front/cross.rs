@@ -22,15 +22,21 @@ pub fn to_glsl(words: &[u32], model: &Path) -> Result<String> {
 /// `--emit-line-directives` output of the same SPIR-V is that output with `#line` directives (and the extension
 /// they need) between its lines. None where a line has none; empty where the two do not line up.
 pub fn line_origins(words: &[u32], plain: &str, model: &Path) -> Result<Vec<Option<usize>>> {
+    Ok(line_files(words, plain, model)?.into_iter().map(|l| l.map(|(_, n)| n)).collect())
+}
+
+/// `line_origins` with each line's file as the SPIR-V's line table names it (`#line N "FILE"`).
+pub fn line_files(words: &[u32], plain: &str, model: &Path) -> Result<Vec<Option<(String, usize)>>> {
     let directed = to_glsl_with(words, model, &["--emit-line-directives"])?;
     let mut at = None;
     let mut out = Vec::new();
     let mut text = Vec::new();
     for l in directed.lines() {
         if let Some(rest) = l.trim_start().strip_prefix("#line ") {
-            at = rest.split_whitespace().next().and_then(|n| n.parse().ok());
+            let (n, file) = rest.split_once(' ').unwrap_or((rest, ""));
+            at = n.trim().parse().ok().map(|n| (file.trim().trim_matches('"').to_string(), n));
         } else if !l.contains("GL_GOOGLE_cpp_style_line_directive") {
-            out.push(at);
+            out.push(at.clone());
             text.push(l);
         }
     }

@@ -211,7 +211,7 @@ fn define_flags(defines: &[(String, String)]) -> Vec<String> {
 
 /// Runs glslangValidator on `x`'s text written to a temporary `shader.hlsl`, with `args` then the defines:
 /// Ok(Ok(stdout, the output file's bytes)) or Ok(Err(its log)) when it refuses the shader.
-fn run(
+pub(super) fn run(
     x: &Expanded,
     defines: &[(String, String)],
     args: &[&str],
@@ -223,7 +223,11 @@ fn run(
     let out = dir.path().join("shader.spv");
     let mut cmd = crate::cleanup::command("glslangValidator");
     crate::launch::bound_memory(&mut cmd)?;
-    cmd.args(args).args(["-e", STUB]).args(define_flags(defines)).arg(&source);
+    cmd.args(args).args(define_flags(defines)).arg(&source);
+    // HLSL's entry is the stub; GLSL's is always `main` (which the GLSL stub is).
+    if args.contains(&"-D") {
+        cmd.args(["-e", STUB]);
+    }
     if args.contains(&"-V") {
         cmd.arg("-o").arg(&out);
     }

@@ -1,15 +1,19 @@
-//! Front ends for a model written in HLSL or WGSL (docs/hlsl.md, docs/wgsl.md): the user's shader, its includes
-//! or imports resolved, compiled to SPIR-V by its language's own front end (glslang's HLSL front end; naga_oil
-//! and naga for WGSL), and brought back as GLSL by spirv-cross, so that it composes into brdfprof's kernels as
+//! Front ends for a model written in HLSL, Slang or WGSL (docs/hlsl.md, docs/slang.md, docs/wgsl.md), or in GLSL
+//! that includes files: the user's shader, its includes or imports resolved, compiled to SPIR-V by its
+//! language's own front end (glslang's GLSL and HLSL front ends; Slang's slangc; naga_oil and naga for WGSL),
+//! and brought back as GLSL by spirv-cross, so that it composes into brdfprof's kernels as
 //! a GLSL shader does (src/model/brdf_file/foreign.rs orchestrates; this module knows nothing of `.brdf` files).
 //!
-//! - `includes`: C `#include` for HLSL, with `#pragma once`, include guards, virtual paths and cycles.
-//! - `hlsl`: glslang's HLSL preprocessor and compiler, their messages at FILE:LINE:COLUMN.
+//! - `includes`: C `#include` for HLSL, Slang and GLSL, with `#pragma once`, include guards, virtual paths and
+//!   cycles.
+//! - `hlsl`: glslang's HLSL (and GLSL) preprocessor and compiler, their messages at FILE:LINE:COLUMN.
+//! - `slang`: slangc, for Slang code and for HLSL glslang refuses, its SPIR-V cached by its sources.
 //! - `wgsl`: naga_oil's `#import`/`#ifdef` composition over the include directories, naga's validation and
 //!   SPIR-V, their messages at FILE:LINE:COLUMN.
 //! - `cross`: spirv-cross, and the GLSL it writes cut down to the shader's own declarations and functions.
 
 pub mod cross;
+pub mod glsl;
 pub mod hlsl;
 pub mod includes;
 pub mod overloads;
@@ -26,6 +30,7 @@ use std::sync::Mutex;
 pub enum Language {
     Glsl,
     Hlsl,
+    Slang,
     Wgsl,
 }
 
@@ -34,6 +39,7 @@ impl Language {
         match self {
             Language::Glsl => "GLSL",
             Language::Hlsl => "HLSL",
+            Language::Slang => "Slang",
             Language::Wgsl => "WGSL",
         }
     }
@@ -43,15 +49,18 @@ impl Language {
         match word.map(str::to_ascii_lowercase).as_deref() {
             None | Some("glsl") => Some(Language::Glsl),
             Some("hlsl") => Some(Language::Hlsl),
+            Some("slang") => Some(Language::Slang),
             Some("wgsl") => Some(Language::Wgsl),
             Some(_) => None,
         }
     }
 
-    /// The language of a plain shader file, by its extension (`.hlsl`, `.hlsli`, `.ush`, `.usf`, `.wgsl`).
+    /// The language of a plain shader file, by its extension (`.hlsl`, `.hlsli`, `.ush`, `.usf`, `.slang`,
+    /// `.wgsl`).
     pub fn of_extension(ext: &str) -> Option<Language> {
         match ext.to_ascii_lowercase().as_str() {
             "hlsl" | "hlsli" | "ush" | "usf" => Some(Language::Hlsl),
+            "slang" => Some(Language::Slang),
             "wgsl" => Some(Language::Wgsl),
             _ => None,
         }
@@ -70,6 +79,8 @@ pub enum HlslFrontEnd {
 
 impl HlslFrontEnd {
     pub const NAMES: [&str; 3] = ["auto", "glslang", "slang"];
+    /// The model-spec key that chooses it.
+    pub const KEY: &str = "hlsl-front-end";
 
     pub fn parse(text: &str) -> Option<HlslFrontEnd> {
         match text {
@@ -82,7 +93,7 @@ impl HlslFrontEnd {
 }
 
 /// The extensions a model text may name a shader file by: `.brdf`, then plain shader files.
-pub const FILE_EXTENSIONS: [&str; 6] = ["brdf", "hlsl", "hlsli", "ush", "usf", "wgsl"];
+pub const FILE_EXTENSIONS: [&str; 7] = ["brdf", "hlsl", "hlsli", "ush", "usf", "slang", "wgsl"];
 
 /// Where `#include` (HLSL) and `#import` (WGSL) look: `--include-override NAME=FILE` first (FILE wherever NAME
 /// would be included, beside the includer or through the search path: a stub for an engine's header), then
@@ -212,7 +223,7 @@ static USED: Mutex<BTreeMap<String, String>> = Mutex::new(BTreeMap::new());
 
 /// Records that `path`'s shader went through `language`'s front end (`front_end`: which, where the file says).
 pub fn record(path: &str, language: Language, front_end: Option<&str>) {
-    if language != Language::Glsl {
+    if language != Language::Glsl || front_end.is_some() {
         let described = front_end.map_or_else(|| describe(language), str::to_string);
         USED.lock().unwrap().insert(path.to_string(), described);
     }
@@ -228,6 +239,7 @@ pub fn describe(language: Language) -> String {
     match language {
         Language::Glsl => format!("GLSL, {}", crate::shaders::glslang_version().unwrap_or_else(|| "glslang".into())),
         Language::Hlsl => format!("HLSL: {}; {}", hlsl::describe(), cross::describe()),
+        Language::Slang => format!("Slang: {}; {}", slang::describe_slang(), cross::describe()),
         Language::Wgsl => format!("WGSL: {}; {}", wgsl::describe(), cross::describe()),
     }
 }
@@ -243,6 +255,8 @@ mod tests {
         assert_eq!(Language::of_section(Some("wgsl")), Some(Language::Wgsl));
         assert_eq!(Language::of_section(Some("metal")), None);
         assert_eq!(Language::of_extension("ush"), Some(Language::Hlsl));
+        assert_eq!(Language::of_section(Some("Slang")), Some(Language::Slang));
+        assert_eq!(Language::of_extension("slang"), Some(Language::Slang));
         assert_eq!(Language::of_extension("brdf"), None);
     }
 

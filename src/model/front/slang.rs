@@ -1,14 +1,39 @@
-//! Slang's compiler (slangc) as the second HLSL front end: what DXC-era engine HLSL holds and glslang's HLSL front
-//! end refuses or crashes on (static member functions returning their own struct, struct inheritance, `select`,
-//! a member function calling a static member unqualified). `make setup` installs slangc from the pinned
-//! slangtorch wheel (scripts/slang-wheel.txt) into .tools/slang; brdfprof runs it on the same expanded text as
-//! glslang, with a stub of its own, when glslang refuses the shader, and spirv-cross writes its SPIR-V back as
-//! GLSL as it does glslang's (`cross`).
+//! Slang's compiler (slangc), the front end of Slang models and the second HLSL front end: what DXC-era engine
+//! HLSL holds and glslang's HLSL front end refuses or crashes on (static member functions returning their own
+//! struct, struct inheritance, `select`, a member function calling a static member unqualified). `make setup`
+//! installs slangc from the pinned slangtorch wheel (scripts/slang-wheel.txt) into the tools folder; brdfprof
+//! runs it on the include-expanded text with a stub of its own (for HLSL: the text glslang refused), and
+//! spirv-cross writes its SPIR-V back as GLSL as it does glslang's (`cross`). slangc's own preprocessor reads
+//! the text (variadic macros and all); `import`ed modules are found in the model's folder and the include
+//! directories. Its SPIR-V is cached (in memory and on disk, `crate::cache`) under everything that reaches it,
+//! the modules it read checked by content on every use.
 
 use super::includes::Expanded;
 use anyhow::{Context, Result};
+use std::collections::HashMap;
 use std::path::{Path, PathBuf};
-use std::sync::OnceLock;
+use std::sync::{Mutex, OnceLock};
+
+/// How slangc reads the text: as DXC-era HLSL (`half` and the minimum-precision types as float, `.hlsl`), or
+/// as Slang (its own fp16 `half`, modules, interfaces and generics, `.slang`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Dialect {
+    Hlsl,
+    Slang,
+}
+
+impl Dialect {
+    fn extension(self) -> &'static str {
+        match self {
+            Dialect::Hlsl => "hlsl",
+            Dialect::Slang => "slang",
+        }
+    }
+}
+
+/// The name the expanded text is compiled under (a `#line` directive gives it): the SPIR-V's line table and
+/// slangc's messages name the text by it, apart from the modules it imports, which keep their own paths.
+pub const MAIN_NAME: &str = "brdfprof-shader";
 
 /// The variable that names another folder holding the wheel's files (`slangtorch/bin/slangc`).
 pub const DIR_VAR: &str = "BRDFPROF_SLANG_DIR";
@@ -78,22 +103,82 @@ pub fn stub(calls: &[String]) -> String {
     )
 }
 
-/// The shader compiled by slangc: None where slangc is not installed, Some(Err(its messages at the user's files'
-/// lines)) where it refuses the shader (or crashes), else the SPIR-V.
+/// The attributes that make slangc inline a function at every call even at -O0 (`[ForceInline]`), blanked
+/// column for column: the stub's call would take `BRDF` and the entries' functions out of the SPIR-V, where
+/// spirv-cross and the composition look for them. Inlining changes no value; the kernels' compilers inline as
+/// they choose.
+pub fn without_forced_inlining(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    let mut rest = text;
+    while let Some(open) = rest.find('[') {
+        let (before, from) = rest.split_at(open);
+        out.push_str(before);
+        let close = from.find(']').map(|c| c + 1).unwrap_or(from.len());
+        let inner = from[1..close.saturating_sub(1).max(1)].trim();
+        if close > 1 && FORCED_INLINING.contains(&inner) {
+            out.extend(std::iter::repeat_n(' ', from[..close].chars().count()));
+        } else {
+            out.push('[');
+            rest = &from[1..];
+            continue;
+        }
+        rest = &from[close..];
+    }
+    out.push_str(rest);
+    out
+}
+
+/// Slang's attributes that force inlining.
+const FORCED_INLINING: [&str; 2] = ["ForceInline", "__unsafeForceInlineEarly"];
+
+/// What one compilation gives: the SPIR-V, or slangc's messages at the user's files' lines.
+pub type Compiled = std::result::Result<Vec<u32>, String>;
+
+/// The shader compiled by slangc as `dialect`, modules searched for in `search`: None where slangc is not
+/// installed, Some(Err(its messages at the user's files' lines)) where it refuses the shader (or crashes),
+/// else the SPIR-V (from the cache where everything that reaches slangc is unchanged).
 pub fn compile(
     x: &Expanded,
     defines: &[(String, String)],
     model: &Path,
-) -> Result<Option<std::result::Result<Vec<u32>, String>>> {
+    dialect: Dialect,
+    search: &[PathBuf],
+) -> Result<Option<Compiled>> {
     let Some(slangc) = slangc() else { return Ok(None) };
+    let text = format!("#line 1 \"{MAIN_NAME}.{}\"\n{}", dialect.extension(), without_forced_inlining(&x.text()));
+    let mut args: Vec<String> = FLAGS.iter().map(|f| f.to_string()).collect();
+    if dialect == Dialect::Hlsl {
+        args.extend(float_defines());
+    }
+    args.extend(defines.iter().map(|(n, v)| if v.is_empty() { format!("-D{n}") } else { format!("-D{n}={v}") }));
+    for dir in search {
+        args.push("-I".into());
+        args.push(if dir.as_os_str().is_empty() { ".".into() } else { dir.display().to_string() });
+    }
+    let key = crate::cache::KeyBuilder::new(CACHE_KIND)
+        .part("brdfprof", env!("CARGO_PKG_VERSION"))
+        .part("slangc", version())
+        .part("args", args.join("\0"))
+        .part("dialect", dialect.extension())
+        .part("text", &text);
+    // A relative folder (`-I .`) is another folder from another working directory.
+    let key = search
+        .iter()
+        .fold(key, |k, d| {
+            let d = if d.as_os_str().is_empty() { Path::new(".") } else { d.as_path() };
+            k.part("folder", std::fs::canonicalize(d).unwrap_or_else(|_| d.to_path_buf()).to_string_lossy().as_bytes())
+        })
+        .finish();
+    if let Some(words) = cached(&key) {
+        return Ok(Some(Ok(words)));
+    }
     let dir = crate::cleanup::TempDir::new().context("cannot create a temporary directory for slangc")?;
-    let source = dir.path().join("shader.hlsl");
-    std::fs::write(&source, x.text()).with_context(|| format!("cannot write {}", source.display()))?;
-    let out = dir.path().join("shader.spv");
+    let source = dir.path().join(format!("shader.{}", dialect.extension()));
+    std::fs::write(&source, &text).with_context(|| format!("cannot write {}", source.display()))?;
+    let (out, depfile) = (dir.path().join("shader.spv"), dir.path().join("shader.d"));
     let mut cmd = crate::cleanup::command(&slangc.to_string_lossy());
     crate::launch::bound_memory(&mut cmd)?;
-    cmd.arg(&source).args(FLAGS).args(float_defines()).arg("-o").arg(&out);
-    cmd.args(defines.iter().map(|(n, v)| if v.is_empty() { format!("-D{n}") } else { format!("-D{n}={v}") }));
+    cmd.arg(&source).args(&args).arg("-o").arg(&out).arg("-depfile").arg(&depfile);
     let what = format!("{} (Slang's slangc)", model.display());
     let result = crate::launch::output(&mut cmd, &what)?;
     let log = String::from_utf8_lossy(&result.stdout).to_string() + &String::from_utf8_lossy(&result.stderr);
@@ -112,7 +197,99 @@ pub fn compile(
         return Ok(Some(Err(text)));
     }
     let bytes = crate::io::read_bounded(&out, crate::launch::MAX_OUTPUT_BYTES as u64).context("slangc's SPIR-V")?;
-    Ok(Some(Ok(crate::shaders::Spirv::from_bytes(&what, &bytes)?.words.to_vec())))
+    let words = crate::shaders::Spirv::from_bytes(&what, &bytes)?.words.to_vec();
+    let deps = std::fs::read_to_string(&depfile).map(|d| depfile_paths(&d)).unwrap_or_default();
+    let deps: Vec<PathBuf> = deps.into_iter().filter(|p| p != &source).collect();
+    store(&key, &deps, &bytes);
+    Ok(Some(Ok(words)))
+}
+
+/// The cache's kind for slangc's SPIR-V.
+const CACHE_KIND: &str = "slang_spv";
+
+/// A cached compilation: the files it read besides its text (the imported modules) with their contents' hash.
+type Entry = (Vec<(PathBuf, String)>, Vec<u8>);
+
+fn memory() -> &'static Mutex<HashMap<crate::cache::Key, Entry>> {
+    static CACHE: OnceLock<Mutex<HashMap<crate::cache::Key, Entry>>> = OnceLock::new();
+    CACHE.get_or_init(Mutex::default)
+}
+
+/// The hash of a module's content, None where it cannot be read.
+fn content_hash(path: &Path) -> Option<String> {
+    let bytes = crate::io::read_bounded(path, crate::io::MAX_INPUT_BYTES).ok()?;
+    Some(crate::cache::KeyBuilder::new("module").part("content", bytes).finish().hex().to_string())
+}
+
+/// The cached SPIR-V of `key`, where every module it read still has the content it had.
+fn cached(key: &crate::cache::Key) -> Option<Vec<u32>> {
+    let fresh = |e: &Entry| e.0.iter().all(|(p, h)| content_hash(p).as_deref() == Some(h.as_str()));
+    let in_memory = memory().lock().unwrap().get(key).cloned();
+    let entry = match in_memory {
+        Some(e) => e,
+        None => {
+            let store = crate::cache::Store::open_default()?;
+            let crate::cache::Lookup::Hit(payload) = store.get(CACHE_KIND, key) else { return None };
+            let entry = decode(&payload)?;
+            memory().lock().unwrap().insert(key.clone(), entry.clone());
+            entry
+        }
+    };
+    if !fresh(&entry) {
+        return None;
+    }
+    crate::shaders::Spirv::from_bytes("cached slangc SPIR-V", &entry.1).ok().map(|s| s.words.to_vec())
+}
+
+/// Records a compilation in memory and on disk (a store that cannot be written costs a compilation next time).
+fn store(key: &crate::cache::Key, deps: &[PathBuf], spirv: &[u8]) {
+    let Some(hashed) = deps.iter().map(|p| content_hash(p).map(|h| (p.clone(), h))).collect::<Option<Vec<_>>>() else {
+        return;
+    };
+    let entry = (hashed, spirv.to_vec());
+    if let Some(store) = crate::cache::Store::open_default() {
+        let _ = store.put(CACHE_KIND, key, &encode(&entry));
+    }
+    memory().lock().unwrap().insert(key.clone(), entry);
+}
+
+/// An entry as stored: one JSON line of [path, hash] pairs, then the SPIR-V's bytes.
+fn encode(entry: &Entry) -> Vec<u8> {
+    let deps: Vec<(String, &String)> = entry.0.iter().map(|(p, h)| (p.display().to_string(), h)).collect();
+    let mut out = serde_json::to_vec(&deps).unwrap_or_default();
+    out.push(b'\n');
+    out.extend_from_slice(&entry.1);
+    out
+}
+
+fn decode(payload: &[u8]) -> Option<Entry> {
+    let split = payload.iter().position(|&b| b == b'\n')?;
+    let deps: Vec<(String, String)> = serde_json::from_slice(&payload[..split]).ok()?;
+    Some((deps.into_iter().map(|(p, h)| (PathBuf::from(p), h)).collect(), payload[split + 1..].to_vec()))
+}
+
+/// The prerequisites of a Make-style depfile (`out: a b\ c`), a backslash escaping a space.
+fn depfile_paths(text: &str) -> Vec<PathBuf> {
+    let text = text.replace("\\\n", " ");
+    let Some((_, deps)) = text.split_once(": ") else { return Vec::new() };
+    let mut out = Vec::new();
+    let mut current = String::new();
+    let mut chars = deps.chars();
+    while let Some(c) = chars.next() {
+        match c {
+            '\\' => current.extend(chars.next()),
+            c if c.is_whitespace() => {
+                if !current.is_empty() {
+                    out.push(PathBuf::from(std::mem::take(&mut current)));
+                }
+            }
+            c => current.push(c),
+        }
+    }
+    if !current.is_empty() {
+        out.push(PathBuf::from(current));
+    }
+    out
 }
 
 /// The most errors of one shader said; the rest are counted.
@@ -147,6 +324,11 @@ pub fn messages(log: &str, x: &Expanded, source: &Path) -> String {
         let located = at.and_then(|a| {
             let mut parts = a.rsplitn(3, ':');
             let (col, line) = (parts.next()?.parse::<usize>().ok()?, parts.next()?.parse::<usize>().ok()?);
+            let file = parts.next()?;
+            // A module slangc imported keeps its own path; the text brdfprof wrote is numbered as expanded.
+            if !file.starts_with(MAIN_NAME) && !file.ends_with(&*source.to_string_lossy()) {
+                return Some(format!("{file}:{line}:{col}: {message}{tail}"));
+            }
             let origin = *x.origins.get(line.checked_sub(1)?)?;
             Some(match x.generated.get(&(line - 1)) {
                 Some(what) => format!("{}:{}:1: {what}: {message}{tail}", x.files[origin.0], origin.1),
@@ -166,7 +348,12 @@ pub fn messages(log: &str, x: &Expanded, source: &Path) -> String {
     out.join("\n")
 }
 
-/// The front end, with slangc's version, as reports state it.
+/// The front end of Slang models, with slangc's version, as reports state it.
+pub fn describe_slang() -> String {
+    format!("Slang's slangc {} ({}; the slangtorch wheel of `make setup`)", version(), FLAGS.join(" "))
+}
+
+/// The front end of HLSL glslang refused, with slangc's version, as reports state it.
 pub fn describe() -> String {
     format!(
         "Slang's slangc {} ({}; `half` and min16float as float, -Dhalf=float ...; the slangtorch wheel of `make setup`)",
@@ -191,6 +378,33 @@ mod tests {
         let raw =
             messages("slangc: cannot open /tmp/brdfprof-1/shader.hlsl", &x, Path::new("/tmp/brdfprof-1/shader.hlsl"));
         assert_eq!(raw, "slangc: cannot open the expanded shader");
+        let module = messages(
+            "error[E30015]: undefined identifier\n --> /src/common.slang:4:9\n",
+            &x,
+            Path::new("/tmp/brdfprof-1/shader.slang"),
+        );
+        assert_eq!(module, "/src/common.slang:4:9: undefined identifier");
+    }
+
+    #[test]
+    fn forced_inlining_is_blanked_column_for_column() {
+        let text = "[ForceInline]\nfloat3 f() { return a[0]; }\n[ForceInline ] [numthreads(1, 1, 1)]";
+        let out = without_forced_inlining(text);
+        assert_eq!(out, "             \nfloat3 f() { return a[0]; }\n               [numthreads(1, 1, 1)]");
+    }
+
+    #[test]
+    fn a_depfile_names_each_prerequisite_once_with_escaped_spaces() {
+        let deps = depfile_paths("out.spv: /a/shader.slang /b/my\\ module.slang \\\n  /c/x.slang\n");
+        let deps: Vec<String> = deps.iter().map(|p| p.display().to_string()).collect();
+        assert_eq!(deps, ["/a/shader.slang", "/b/my module.slang", "/c/x.slang"]);
+    }
+
+    #[test]
+    fn a_cache_entry_reads_back_as_written() {
+        let entry = (vec![(PathBuf::from("/a b/c.slang"), "00ff".to_string())], vec![3, 2, 0x23, 7]);
+        assert_eq!(decode(&encode(&entry)), Some(entry));
+        assert_eq!(decode(b"not json"), None);
     }
 
     #[test]
