@@ -19,7 +19,7 @@
 # minutes per round). BRDFPROF=path uses that binary for `prepare` (default target/release/brdfprof, built if
 # missing). DIR must travel to the GPU machine (the device tool's `carry`): `prepare` checks it stays under
 # 64 MiB. Every step runs under its own time limit and the next one runs whatever it returned; measure's
-# limits add up to 460 s, inside one 10-minute command. Exit status: that of the first step that failed (2:
+# limits add up to 530 s, inside one 10-minute command. Exit status: that of the first step that failed (2:
 # could not measure; 124: over its time limit), else 0. Never part of CI.
 set -u
 
@@ -84,6 +84,15 @@ prepare() {
     # same binary (so the same kernels: `compare` checks their hashes).
     step targets 300 "$OUT/brdfprof" inspect --device nvidia:sm_90 --device radv:all --no-callgrind \
         --json "$OUT/targets.json" --markdown "$OUT/targets.md"
+    # The measured-reference suite's throughput kernels (docs/measured.md), priced here and timed there, so that
+    # a lent GPU measures exactly the ratios the suite models.
+    rm -rf "$OUT/measured"
+    mkdir -p "$OUT/measured"
+    cp tests/fixtures/brdf/measured/*-t8.brdf tests/fixtures/brdf/measured/*-t16.brdf "$OUT/measured/"
+    set --
+    for f in "$OUT"/measured/*.brdf; do set -- "$@" --model "$f"; done
+    step measured-targets 200 "$OUT/brdfprof" inspect --device nvidia:sm_90 --device radv:gfx1100 --no-callgrind \
+        --lights 8 "$@" --json "$OUT/measured-targets.json" --markdown "$OUT/measured-targets.md"
     # The lent machine may have no Vulkan loader; it cannot reach a registry to fetch one.
     rm -rf "$OUT/debs"
     mkdir -p "$OUT/debs"
@@ -154,6 +163,14 @@ measure() {
     # The driver's own statistics (VK_KHR_pipeline_executable_properties, where the driver reports them).
     step inspect 50 "$bin" inspect "$@" --no-callgrind --profile "$OUT/profile.json" \
         --json "$OUT/inspect.json" --markdown "$OUT/inspect.md"
+    # The measured-reference kernels timed on this GPU at 8 lights: each kind's -t16 less its -t8 is 64
+    # operations, the ratios docs/measured.md compares with the rule's (measured-targets.json).
+    set --
+    [ -z "$DEVICE" ] || set -- --device "$DEVICE"
+    for f in "$OUT"/measured/*.brdf; do [ -f "$f" ] && set -- "$@" --model "$f"; done
+    step measured 70 "$bin" profile "$@" --size 1024x1024 --lights 8 --budget 60 --json "$OUT/measured.json"
+    set --
+    [ -z "$DEVICE" ] || set -- --device "$DEVICE"
     # Measured ns/eval beside the compile-only targets' modelled cycles/eval, and their rank correlation.
     set -- "$OUT/profile.json"
     [ -f "$OUT/targets.json" ] && set -- "$@" "$OUT/targets.json"

@@ -57,6 +57,9 @@ pub struct TargetCost {
     /// other models and targets go on, and the command exits 1.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub failed: Vec<(String, String)>,
+    /// How the vendor's rule fares against published measurements (`targets::cost::measured::line`), one line.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub checked: Option<String>,
 }
 
 /// What a net cost at or below zero reads as in a ratio column: the memory-only kernel's bound sets it, not
@@ -172,6 +175,9 @@ impl TargetCost {
             t.markdown()
         );
         out += &super::constant_note(constant.iter().map(|(c, v)| (c.as_str(), *v)));
+        if let Some(checked) = &self.checked {
+            out += &format!("\n{checked}\n");
+        }
         out += &self.terms_note();
         for (model, why) in &self.absent {
             out += &format!("\n{model}: not compiled for this target ({why}), so no figure.\n");

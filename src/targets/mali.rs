@@ -168,20 +168,36 @@ pub fn read_shaderdb(log: &str) -> Result<(Vec<DriverStat>, Vec<String>)> {
 
 type Stats = std::collections::BTreeMap<String, f64>;
 
-/// Evaluations one pass through the program stands for: the compiler counts a loop's body once, so where it
-/// kept a loop (the light loop, which shade.glsl asks to be unrolled and Bifrost keeps rolled) one pass is one
-/// light's evaluation, the body's trip count being the lights per kernel; an unrolled program holds them all.
-fn evaluations_per_pass(stats: &Stats, lights: u32) -> f64 {
-    if cost::driver_stat(stats, "Loops").unwrap_or(0.0) > 0.0 { 1.0 } else { f64::from(lights) }
+/// Whether the compiler kept a loop (the light loop, which shade.glsl asks to be unrolled and Bifrost keeps
+/// rolled): it counts a loop's body once, so one pass through the program is then one light's evaluation.
+fn rolled(stats: &Stats) -> bool {
+    cost::driver_stat(stats, "Loops").unwrap_or(0.0) > 0.0
 }
 
-/// The pipes the compiler reported for a kernel (its architecture's), as a bound with no latency term, and the
-/// evaluations one pass stands for.
-fn pipes_of(stats: &Stats, lights: u32) -> Option<(Schedule, f64)> {
+/// The per-pipe cycles the compiler reported for a kernel (its architecture's).
+fn pipes(stats: &Stats) -> Option<Vec<(String, f64)>> {
     let pipes: Vec<(String, f64)> =
         PIPES.iter().filter_map(|(stat, pipe)| cost::driver_stat(stats, stat).map(|v| (pipe.to_string(), v))).collect();
-    let schedule = Schedule { pipes, latency: None, resident_waves: None };
-    (!schedule.pipes.is_empty()).then(|| (schedule, evaluations_per_pass(stats, lights)))
+    (!pipes.is_empty()).then_some(pipes)
+}
+
+/// A kernel's pipes as a bound with no latency term, and the evaluations they stand for. An unrolled program
+/// holds every light's evaluation (/ lights). A rolled one counts one light's body and, once, the per-pixel
+/// loads and store outside the loop: the per-pixel part is `per_pixel` (the memory-only kernel's own figures,
+/// where it kept its loop too: its body does no BRDF work), charged 1 / lights per evaluation, the rest whole.
+fn pipes_of(stats: &Stats, lights: u32, per_pixel: Option<&[(String, f64)]>) -> Option<(Schedule, f64)> {
+    let mut pipes = pipes(stats)?;
+    if !rolled(stats) {
+        return Some((Schedule { pipes, latency: None, resident_waves: None }, f64::from(lights)));
+    }
+    if let Some(per_pixel) = per_pixel {
+        let shared = 1.0 - 1.0 / f64::from(lights.max(1));
+        for (name, v) in &mut pipes {
+            let p = per_pixel.iter().find(|(n, _)| n == name).map_or(0.0, |(_, x)| *x);
+            *v = (*v - p * shared).max(0.0);
+        }
+    }
+    Some((Schedule { pipes, latency: None, resident_waves: None }, 1.0))
 }
 
 fn cost_table(shim: &Shim, family: &ShimFamily, report: &InspectReport) -> Option<TargetCost> {
@@ -198,10 +214,17 @@ fn cost_table(shim: &Shim, family: &ShimFamily, report: &InspectReport) -> Optio
         )
     };
     let rule = format!(
-        "{rule}; per evaluation = / lights per kernel where the light loop is unrolled, / 1 where the compiler keeps a loop (Loops > 0: its body, one light, counted once; the per-pixel loads and store outside it are then charged to every light, an upper bound)"
+        "{rule}; per evaluation = / lights per kernel where the light loop is unrolled; where the compiler keeps it (Loops > 0: its body, one light, counted once), the per-pixel work (the memory-only kernel's pipes) / lights and the rest whole"
     );
     let unit = if valhall { "Valhall cycles per thread" } else { "Bifrost cycles per thread" };
-    cost::bound_table(report, shim.header(family, report, rule, unit, shown), pipes_of)
+    let per_pixel = report
+        .rows
+        .iter()
+        .find(|r| r.model == crate::model::BASELINE_LABEL && rolled(&r.stats))
+        .and_then(|r| pipes(&r.stats));
+    cost::bound_table(report, shim.header(family, report, rule, unit, shown), |stats, lights| {
+        pipes_of(stats, lights, per_pixel.as_deref())
+    })
 }
 
 #[cfg(test)]
@@ -325,5 +348,32 @@ mod tests {
         assert_eq!(t.rows[1].net_cycles_per_eval, Some(12.0 - 8.0 / lights));
         assert_eq!(t.rows[1].bound.as_deref(), Some("arithmetic"));
         assert!(t.markdown().contains("bound by"));
+    }
+
+    #[test]
+    fn a_rolled_loop_charges_the_per_pixel_work_once_per_pixel() {
+        let row = |model: &str, arith: f64, ldst: f64| {
+            pipe_row(
+                model,
+                &[
+                    ("Arithmetic cycles", arith),
+                    ("Texture cycles", 0.0),
+                    ("Varying cycles", 0.0),
+                    ("Load-store cycles", ldst),
+                    ("Bound cycles", arith.max(ldst)),
+                    ("Loops", 1.0),
+                ],
+            )
+        };
+        let t = cost_of("mali:g52", "Mali-G52 (Panfrost)", vec![row("small", 3.5, 8.0), row(BASELINE_LABEL, 1.5, 8.0)]);
+        let lights = f64::from(t.lights_per_kernel);
+        assert!(lights > 1.0);
+        // The memory-only kernel: its loads and store once per pixel, / lights.
+        assert_eq!(t.rows[1].cycles_per_eval, 8.0 / lights);
+        // A BRDF's 2 arithmetic cycles are the light's whole: it no longer hides under the per-pixel loads.
+        let small = 2.0 + 1.5 / lights;
+        assert_eq!(t.rows[0].cycles_per_eval, small);
+        assert_eq!(t.rows[0].net_cycles_per_eval, Some(small - 8.0 / lights));
+        assert_eq!(t.rows[0].bound.as_deref(), Some("arithmetic"));
     }
 }

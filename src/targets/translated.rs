@@ -274,6 +274,7 @@ impl<C: Translator> Vendor for Translated<C> {
             rows: Vec::new(),
             absent: Vec::new(),
             failed: Vec::new(),
+            checked: None,
         };
         cost::schedule_table(report, header, |stats| Some((Schedule::of(stats)?, C::lanes(stats)?)))
     }

@@ -27,6 +27,7 @@ mod gate;
 mod hostile;
 mod intel;
 mod limits;
+mod measured;
 mod mesa_shims;
 mod microkernels;
 mod nvidia;

@@ -1,6 +1,6 @@
 //! The layer order of src/: no module names (`crate::X`, in a `use` line or a path) a top-level module above
-//! it, and no two files of one folder name each other (`super::X` / `crate::DIR::X`). Below src/, the leaf
-//! crates of crates/ are kept apart by the compiler; the test here holds what each may depend on.
+//! it, and no circle runs among the files and folders of any folder (`super::X` / `crate::DIR::X`, through any
+//! number of steps). Below src/, the leaf crates of crates/ are kept apart by the compiler; the test here holds what each may depend on.
 
 use crate::common;
 use std::collections::{BTreeMap, BTreeSet};
@@ -104,30 +104,152 @@ fn no_module_uses_one_above_it() {
     assert!(bad.is_empty(), "arrows running back up:\n{}", bad.join("\n"));
 }
 
-#[test]
-fn no_two_files_of_a_folder_use_each_other() {
-    let mut edges: BTreeMap<(String, String), BTreeSet<String>> = BTreeMap::new();
-    for (rel, text) in sources() {
-        let Some(dir) = rel.parent().filter(|d| !d.as_os_str().is_empty()) else { continue };
-        let stem = rel.file_stem().unwrap().to_string_lossy().to_string();
-        if stem == "mod" {
-            continue;
-        }
-        let dir = dir.to_string_lossy().replace('/', "::");
-        let mut used = names_after(&text, "super::");
-        used.extend(names_after(&text, &format!("crate::{dir}::")));
-        used.remove(&stem);
-        edges.insert((dir, stem), used);
+/// A file's module path under src/ (`model/brdf_file/mod.rs` -> [model, brdf_file]).
+fn module_path(rel: &Path) -> Vec<String> {
+    let mut parts: Vec<String> = rel.with_extension("").iter().map(|p| p.to_string_lossy().to_string()).collect();
+    if parts.last().is_some_and(|l| l == "mod") || parts == ["lib"] || parts == ["main"] {
+        parts.pop();
     }
-    let mut circles = Vec::new();
-    for ((dir, a), used) in &edges {
-        for b in used {
-            if a < b && edges.get(&(dir.clone(), b.clone())).is_some_and(|u| u.contains(a)) {
-                circles.push(format!("src/{dir}: {a} and {b} use each other"));
+    parts
+}
+
+/// Every module path `text` names: `crate::a::b`, `super::a` (from module `own`), and each of a `{a, b::c}` group.
+fn paths_named(text: &str, own: &[String]) -> BTreeSet<Vec<String>> {
+    let mut out = BTreeSet::new();
+    let ident = |s: &str| s.chars().take_while(|c| c.is_ascii_alphanumeric() || *c == '_').collect::<String>();
+    for line in text.lines().map(|l| l.split("//").next().unwrap_or("")) {
+        for (i, _) in line.match_indices("crate::").chain(line.match_indices("super::")) {
+            // Only the start of a path: `super::super::x` is read once, from its first `super::`.
+            if line[..i].ends_with("super::") || line[..i].ends_with("crate::") {
+                continue;
+            }
+            let (mut base, mut rest) = (Vec::new(), &line[i..]);
+            if let Some(r) = rest.strip_prefix("crate::") {
+                rest = r;
+            } else {
+                base = own.to_vec();
+                while let Some(r) = rest.strip_prefix("super::") {
+                    base.pop();
+                    rest = r;
+                }
+            }
+            loop {
+                if let Some(group) = rest.strip_prefix('{') {
+                    for part in group.split('}').next().unwrap_or("").split(',') {
+                        let n = ident(part.trim());
+                        if !n.is_empty() && n != "self" {
+                            out.insert([base.clone(), vec![n]].concat());
+                        }
+                    }
+                    out.insert(base.clone());
+                    break;
+                }
+                let n = ident(rest);
+                if n.is_empty() {
+                    out.insert(base.clone());
+                    break;
+                }
+                base.push(n.clone());
+                match rest[n.len()..].strip_prefix("::") {
+                    Some(r) => rest = r,
+                    None => {
+                        out.insert(base.clone());
+                        break;
+                    }
+                }
             }
         }
     }
-    assert!(circles.is_empty(), "{}", circles.join("\n"));
+    out
+}
+
+/// The circles among the children (files and folders) of every folder of src/: A uses B when a file in or
+/// under A names a module in or under B. Tarjan's strongly connected components, per folder.
+#[test]
+fn no_circle_among_the_files_and_folders_of_any_folder() {
+    let files = sources();
+    let modules: BTreeSet<Vec<String>> = files.iter().map(|(rel, _)| module_path(rel)).collect();
+    let mut edges: BTreeMap<Vec<String>, BTreeMap<String, BTreeSet<String>>> = BTreeMap::new();
+    for (rel, text) in &files {
+        let own = module_path(rel);
+        for named in paths_named(text, &own) {
+            // The longest module the path names (the rest are items in it).
+            let Some(target) = (0..=named.len()).rev().map(|k| &named[..k]).find(|p| modules.contains(*p)) else {
+                continue;
+            };
+            let common = own.iter().zip(target).take_while(|(a, b)| a == b).count();
+            if common == own.len() || common == target.len() {
+                continue; // a module and its own parent or child
+            }
+            let folder = own[..common].to_vec();
+            edges.entry(folder).or_default().entry(own[common].clone()).or_default().insert(target[common].clone());
+        }
+    }
+    let mut circles = Vec::new();
+    for (folder, graph) in &edges {
+        for component in strongly_connected(graph).into_iter().filter(|c| c.len() > 1) {
+            circles.push(format!("src/{}: {} use each other", folder.join("/"), component.join(", ")));
+        }
+    }
+    assert!(circles.is_empty(), "circles among modules:\n{}", circles.join("\n"));
+}
+
+fn strongly_connected(graph: &BTreeMap<String, BTreeSet<String>>) -> Vec<Vec<String>> {
+    struct State<'a> {
+        graph: &'a BTreeMap<String, BTreeSet<String>>,
+        index: BTreeMap<&'a str, (usize, usize)>,
+        stack: Vec<&'a str>,
+        out: Vec<Vec<String>>,
+    }
+    fn visit<'a>(s: &mut State<'a>, v: &'a str) {
+        let i = s.index.len();
+        s.index.insert(v, (i, i));
+        s.stack.push(v);
+        for w in s.graph.get(v).into_iter().flatten() {
+            match s.index.get(w.as_str()) {
+                None => {
+                    visit(s, w);
+                    let low = s.index[w.as_str()].1.min(s.index[v].1);
+                    s.index.get_mut(v).unwrap().1 = low;
+                }
+                Some(&(wi, _)) if s.stack.contains(&w.as_str()) => {
+                    let low = wi.min(s.index[v].1);
+                    s.index.get_mut(v).unwrap().1 = low;
+                }
+                _ => {}
+            }
+        }
+        if s.index[v].0 == s.index[v].1 {
+            let at = s.stack.iter().rposition(|x| *x == v).unwrap();
+            let mut component: Vec<String> = s.stack.drain(at..).map(String::from).collect();
+            component.sort();
+            s.out.push(component);
+        }
+    }
+    let mut s = State { graph, index: BTreeMap::new(), stack: Vec::new(), out: Vec::new() };
+    for v in graph.keys() {
+        if !s.index.contains_key(v.as_str()) {
+            visit(&mut s, v);
+        }
+    }
+    s.out
+}
+
+#[test]
+fn the_circle_search_finds_a_circle_across_folders() {
+    let a = paths_named(
+        "use crate::model::file_model::X;\nuse super::{front, brdf_file::{self, Y}};",
+        &["model".into(), "brdf_file".into()],
+    );
+    assert!(a.contains(&vec!["model".to_string(), "file_model".to_string(), "X".to_string()]), "{a:?}");
+    assert!(a.contains(&vec!["model".to_string(), "front".to_string()]), "{a:?}");
+    let graph: BTreeMap<String, BTreeSet<String>> =
+        [("brdf_file", &["file_model", "front"][..]), ("file_model", &["brdf_file"][..]), ("front", &[][..])]
+            .into_iter()
+            .map(|(k, v)| (k.to_string(), v.iter().map(|x| x.to_string()).collect()))
+            .collect();
+    let circles: Vec<_> = strongly_connected(&graph).into_iter().filter(|c| c.len() > 1).collect();
+    assert_eq!(circles, vec![vec!["brdf_file".to_string(), "file_model".to_string()]]);
 }
 
 /// The crates below the application and the heavy dependencies each may name: only the Vulkan backend touches

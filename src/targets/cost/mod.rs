@@ -4,6 +4,7 @@
 //! Intel's pipes and schedules, ...); this module turns them into the table every report shows.
 
 pub mod lines;
+pub mod measured;
 pub mod schedule;
 
 use crate::kernels::shade::steady_block;
@@ -34,7 +35,8 @@ pub fn table(
     cycles: impl Fn(&std::collections::BTreeMap<String, f64>, u32) -> Option<f64>,
 ) -> Option<TargetCost> {
     let lights = steady_block(report.lights).0;
-    let mut t = TargetCost { lights_per_kernel: lights, rows: Vec::new(), ..header };
+    let checked = header.target.as_deref().and_then(measured::line);
+    let mut t = TargetCost { lights_per_kernel: lights, rows: Vec::new(), checked, ..header };
     for r in &report.rows {
         let Some(c) = cycles(&r.stats, lights) else { continue };
         let stats = t.columns.iter().map(|name| (name.clone(), driver_stat(&r.stats, name).unwrap_or(0.0))).collect();

@@ -101,6 +101,7 @@ impl Shim {
             rows: Vec::new(),
             absent: Vec::new(),
             failed: Vec::new(),
+            checked: None,
         }
     }
 }

@@ -123,6 +123,7 @@ impl super::Vendor for Radv {
             rows: Vec::new(),
             absent: Vec::new(),
             failed: Vec::new(),
+            checked: None,
         };
         // ACO's per-instruction schedule where the report has it (the compile-only targets), else (a real
         // RADV GPU) its Inverse Throughput, branch weights and all.

@@ -1,0 +1,143 @@
+//! The measured-reference suite: every check of `targets::cost::measured::CHECKS` rerun on its family, the
+//! modelled ratio of the suite's own kernel pair (tests/fixtures/brdf/measured/) against the published
+//! measurement. It fails naming the family, the pair and the source when the rule leaves a measurement's
+//! tolerance (unless the difference is a named, documented one), when a named difference has come within
+//! tolerance (its note is then false), or when the rule's figure has left the one recorded beside the check.
+
+use crate::compile_only::inspect_json;
+use brdfprof::targets::cost::measured::{CHECKS, Check, Figure};
+use std::collections::{BTreeMap, BTreeSet};
+
+/// Throughput pairs are read at 8 lights (the light loop unrolled, as a shading pass runs it); latency chains
+/// at 1 light (one chain per wave, as the latency microbenchmarks run it).
+const THROUGHPUT_LIGHTS: u32 = 8;
+const LATENCY_LIGHTS: u32 = 1;
+
+/// The kernels one check needs: (target, lights, kernel file stem).
+fn kernels(c: &Check) -> Vec<(&'static str, u32, String)> {
+    match &c.figure {
+        Figure::Throughput { a, b, b_target } => {
+            let bt = b_target.unwrap_or(c.target);
+            ["t8", "t16"]
+                .iter()
+                .flat_map(|s| {
+                    [(c.target, THROUGHPUT_LIGHTS, format!("{a}-{s}")), (bt, THROUGHPUT_LIGHTS, format!("{b}-{s}"))]
+                })
+                .collect()
+        }
+        Figure::Latency { kind, .. } => {
+            ["c32", "c96"].iter().map(|s| (c.target, LATENCY_LIGHTS, format!("{kind}-{s}"))).collect()
+        }
+    }
+}
+
+/// (target, lights, model) -> the cost row's JSON.
+type Rows = BTreeMap<(String, u32, String), serde_json::Value>;
+
+fn price(dir: &std::path::Path) -> Rows {
+    let mut wanted: BTreeMap<(&str, u32), BTreeSet<String>> = BTreeMap::new();
+    for c in CHECKS {
+        for (t, lights, k) in kernels(c) {
+            wanted.entry((t, lights)).or_default().insert(k);
+        }
+    }
+    let folder = crate::common::repo_root().join("tests/fixtures/brdf/measured");
+    let mut rows = Rows::new();
+    for ((target, lights), models) in &wanted {
+        let files: Vec<String> =
+            models.iter().map(|m| folder.join(format!("{m}.brdf")).display().to_string()).collect();
+        let lights_text = lights.to_string();
+        let mut extra = vec!["--lights", lights_text.as_str()];
+        for f in &files {
+            extra.extend(["--model", f.as_str()]);
+        }
+        let name = format!("measured-{}-{lights}", target.replace(':', "-"));
+        let report = inspect_json(dir, &name, &[target], &extra, "statistics");
+        // One device: the report itself; several: `reports`.
+        let reports = report["reports"].as_array().cloned().unwrap_or_else(|| vec![report.clone()]);
+        for r in &reports {
+            let cost = &r["cost"];
+            assert_eq!(cost["target"].as_str(), Some(*target), "{target}: a report without its cost table: {r}");
+            for row in cost["rows"].as_array().unwrap() {
+                let model = row["model"].as_str().unwrap().to_string();
+                rows.insert((target.to_string(), *lights, model), row.clone());
+            }
+        }
+    }
+    rows
+}
+
+/// The check's modelled figure from the priced rows.
+fn modelled(c: &Check, rows: &Rows) -> f64 {
+    let row = |t: &str, lights: u32, m: &str| {
+        rows.get(&(t.to_string(), lights, m.to_string()))
+            .unwrap_or_else(|| panic!("{t}: no row {m} at {lights} lights"))
+    };
+    let net = |t: &str, m: &str| {
+        row(t, THROUGHPUT_LIGHTS, m)["net_cycles_per_eval"]
+            .as_f64()
+            .unwrap_or_else(|| panic!("{t} {m}: no net cycles/eval"))
+    };
+    match &c.figure {
+        Figure::Throughput { a, b, b_target } => {
+            let bt = b_target.unwrap_or(c.target);
+            let slope_a = net(c.target, &format!("{a}-t16")) - net(c.target, &format!("{a}-t8"));
+            let slope_b = net(bt, &format!("{b}-t16")) - net(bt, &format!("{b}-t8"));
+            assert!(slope_b > 0.0, "{bt} {b}: 64 more operations cost {slope_b} cycles/eval");
+            slope_a / slope_b
+        }
+        Figure::Latency { kind, stat } => {
+            let s = |m: &str| {
+                row(c.target, LATENCY_LIGHTS, m)["stats"][*stat]
+                    .as_f64()
+                    .unwrap_or_else(|| panic!("{} {m}: no statistic {stat}", c.target))
+            };
+            (s(&format!("{kind}-c96")) - s(&format!("{kind}-c32"))) / 64.0
+        }
+    }
+}
+
+#[test]
+fn the_cost_rule_holds_against_published_measurements_or_names_the_difference() {
+    let dir = tempfile::tempdir().unwrap();
+    let rows = price(dir.path());
+    let mut failures = Vec::new();
+    let mut table = Vec::new();
+    for c in CHECKS {
+        let m = modelled(c, &rows);
+        let pair = match &c.figure {
+            Figure::Throughput { a, b, b_target } => {
+                format!("{a}-t16/t8 over {b}-t16/t8{}", b_target.map_or(String::new(), |t| format!(" on {t}")))
+            }
+            Figure::Latency { kind, stat } => format!("{kind}-c96 less {kind}-c32, {stat}"),
+        };
+        let error = m / c.measured - 1.0;
+        table.push(format!(
+            "{} {} [{}]: modelled {m:.3} measured {:.3} ({:+.1}%){}",
+            c.source,
+            c.target,
+            pair,
+            c.measured,
+            100.0 * error,
+            if c.known.is_some() { " known" } else { "" }
+        ));
+        let named = format!(
+            "{} ({}, {pair}; {}): modelled {m:.3} against measured {:.3}",
+            c.target, c.what, c.source, c.measured
+        );
+        match (c.within(m), c.known) {
+            (false, None) => {
+                failures.push(format!("{named}: {:+.1}%, beyond {:.0}%", 100.0 * error, 100.0 * c.tolerance))
+            }
+            (true, Some(_)) => {
+                failures.push(format!("{named}: within tolerance now; its known difference in measured.rs is false"))
+            }
+            _ => {}
+        }
+        if !(m / c.modelled - 1.0).abs().le(&0.01) {
+            failures.push(format!("{named}: src/targets/cost/measured.rs records {} (update it)", c.modelled));
+        }
+    }
+    eprintln!("{}", table.join("\n"));
+    assert!(failures.is_empty(), "the cost rule against published measurements:\n{}", failures.join("\n"));
+}
