@@ -85,3 +85,49 @@ pub fn every_preset_and_example() -> Vec<String> {
     models.extend(files.iter().map(|p| format!("{},roughness=@roughness,f0=@f0", p.display())));
     models
 }
+
+/// The one rule on a translated target's cost table (NVIDIA, Intel): per row, cycles/eval = max(busiest pipe,
+/// latency / resident waves) / (`lanes(row)` x 8 lights), no pipe busier than the serial sum of the same rates
+/// (Issue Cycles), and every BRDF above the memory-only kernel.
+pub fn assert_translated_costs(family: &str, cost: &serde_json::Value, lanes: impl Fn(&serde_json::Value) -> f64) {
+    for c in cost["rows"].as_array().unwrap() {
+        let stat = |k: &str| c["stats"][k].as_f64().unwrap();
+        let per_wave = stat("busiest pipe (cycles/wave)").max(stat("latency / waves"));
+        assert!(
+            (c["cycles_per_eval"].as_f64().unwrap() - per_wave / (lanes(c) * 8.0)).abs() < 1e-9,
+            "{family} {}: {c}",
+            c["model"]
+        );
+        assert!(
+            stat("busiest pipe (cycles/wave)") <= stat("Issue Cycles"),
+            "{family} {}: a pipe busier than the serial sum",
+            c["model"]
+        );
+        if c["model"] != "baseline" {
+            assert!(c["net_cycles_per_eval"].as_f64().unwrap() > 0.0, "{family} {}", c["model"]);
+        }
+    }
+}
+
+/// A translated target's statistics are the same on a second run with a cache of its own, and without the
+/// translation's fast-maths option (`fast_option`, gone from the compiler's options under --precise-math)
+/// the IEEE forms of pow, division and square root cost Blinn-Phong more than 1.2x.
+pub fn assert_deterministic_and_precise_costs_more(target: &str, section: &str, fast_option: &str) {
+    let dir = tempfile::tempdir().unwrap();
+    let fast = inspect_json(dir.path(), "fast", &[target], &["--model", "blinn"], section);
+    let again = inspect_json_afresh(dir.path(), "again", &[target], &["--model", "blinn"], section);
+    for (a, b) in fast["rows"].as_array().unwrap().iter().zip(again["rows"].as_array().unwrap()) {
+        for (key, value) in a["stats"].as_object().unwrap().iter().filter(|(k, _)| k.starts_with("driver/")) {
+            assert_eq!(&b["stats"][key], value, "{target} {} {key} changed between runs", a["model"]);
+        }
+    }
+    let precise = inspect_json(dir.path(), "precise", &[target], &["--model", "blinn", "--precise-math"], section);
+    assert!(!precise["provenance"]["compiler"]["options"].as_str().unwrap().contains(fast_option));
+    let net = |r: &serde_json::Value| r["cost"]["rows"][0]["net_cycles_per_eval"].as_f64().unwrap();
+    assert!(
+        net(&precise) > 1.2 * net(&fast),
+        "{target}: IEEE pow, division and square root cost more: {} vs {}",
+        net(&precise),
+        net(&fast)
+    );
+}

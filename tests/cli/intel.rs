@@ -60,56 +60,14 @@ fn every_preset_and_example_file_gets_igc_statistics_on_all_five_families() {
                 .unwrap_or_else(|| panic!("{} {}: no translation check", family.name, row["model"]));
             assert!(note.contains("translation checked on the host against"), "{note}");
         }
-        // A BRDF costs more than the memory-only kernel; cycles/eval = max(busiest pipe, latency / resident
-        // threads) / (SIMD x 8 lights), never above the serial sum of the same rates.
-        for c in r["cost"]["rows"].as_array().unwrap() {
-            let stat = |k: &str| c["stats"][k].as_f64().unwrap();
-            let per_thread = stat("busiest pipe (cycles/wave)").max(stat("latency / waves"));
-            assert!(
-                (c["cycles_per_eval"].as_f64().unwrap() - per_thread / (stat("SIMD Width") * 8.0)).abs() < 1e-9,
-                "{} {}: {c}",
-                family.name,
-                c["model"]
-            );
-            assert!(
-                stat("busiest pipe (cycles/wave)") <= stat("Issue Cycles"),
-                "{} {}: a pipe busier than the serial sum",
-                family.name,
-                c["model"]
-            );
-            if c["model"] != "baseline" {
-                assert!(c["net_cycles_per_eval"].as_f64().unwrap() > 0.0, "{} {}", family.name, c["model"]);
-            }
-        }
+        compile_only::assert_translated_costs(family.name, &r["cost"], |c| c["stats"]["SIMD Width"].as_f64().unwrap());
     }
     assert_eq!(report["costs"]["correlations"].as_array().unwrap().len(), 10);
 }
 
 #[test]
 fn the_statistics_are_deterministic_and_the_precise_forms_cost_more() {
-    let dir = tempfile::tempdir().unwrap();
-    let fast = inspect_json(dir.path(), "fast", &["intel:gen12lp"], &["--model", "blinn"]);
-    let again = compile_only::inspect_json_afresh(
-        dir.path(),
-        "again",
-        &["intel:gen12lp"],
-        &["--model", "blinn"],
-        "IGC statistics",
-    );
-    for (a, b) in fast["rows"].as_array().unwrap().iter().zip(again["rows"].as_array().unwrap()) {
-        for (key, value) in a["stats"].as_object().unwrap().iter().filter(|(k, _)| k.starts_with("driver/")) {
-            assert_eq!(&b["stats"][key], value, "{} {key} changed between runs", a["model"]);
-        }
-    }
-    let precise = inspect_json(dir.path(), "precise", &["intel:gen12lp"], &["--model", "blinn", "--precise-math"]);
-    assert!(!precise["provenance"]["compiler"]["options"].as_str().unwrap().contains("-cl-mad-enable"));
-    let net = |r: &serde_json::Value| r["cost"]["rows"][0]["net_cycles_per_eval"].as_f64().unwrap();
-    assert!(
-        net(&precise) > 1.2 * net(&fast),
-        "IEEE pow, division and square root cost more: {} vs {}",
-        net(&precise),
-        net(&fast)
-    );
+    compile_only::assert_deterministic_and_precise_costs_more("intel:gen12lp", "IGC statistics", "-cl-mad-enable");
 }
 
 #[test]

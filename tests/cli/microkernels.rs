@@ -59,9 +59,7 @@ fn costs_at(dir: &std::path::Path, lights: u32) -> Costs {
                     row["cycles_per_eval"].as_f64().unwrap(),
                     row["net_cycles_per_eval"].as_f64(),
                     row["stats"]["Resident Waves"].as_f64(),
-                    row["net_terms"]
-                        .as_array()
-                        .and_then(|t| t.iter().filter_map(|x| x[1].as_f64()).reduce(f64::max)),
+                    row["net_terms"].as_array().and_then(|t| t.iter().filter_map(|x| x[1].as_f64()).reduce(f64::max)),
                 ),
             );
         }
