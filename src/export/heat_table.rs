@@ -31,11 +31,13 @@ const CELL_H: i32 = 38;
 const NAME_W: i32 = 190;
 const GROUP_H: i32 = 40;
 const TITLE_H: i32 = 50;
-const BAR_W: i32 = 170;
+const BAR_W: i32 = 200;
 const MARGIN: i32 = 16;
 /// The colour bar's height: 2x at the top to 0.5x at the bottom.
 const BAR_H: i32 = 240;
 const CELL_FONT: u32 = 24;
+/// The height of the triangles beyond the bar's ends that say it is clamped.
+const CLAMP_H: i32 = 10;
 const HEAD_FONT: u32 = 20;
 
 /// Colour of a ratio: log2 clamped to [-1, 1], white at 0.
@@ -46,7 +48,18 @@ pub fn colour(ratio: f64) -> RGBColor {
     RGBColor(mix(to.0), mix(to.1), mix(to.2))
 }
 
-/// A text to draw: its box (top-left, size), anchor point, size, rotation.
+/// The text colour that reads best on `fill`: white or black, whichever has the higher contrast ratio (WCAG 2's
+/// relative luminance of the sRGB colour).
+pub fn text_colour(fill: RGBColor) -> RGBColor {
+    let linear = |c: u8| {
+        let c = f64::from(c) / 255.0;
+        if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
+    };
+    let l = 0.2126 * linear(fill.0) + 0.7152 * linear(fill.1) + 0.0722 * linear(fill.2);
+    if 1.05 / (l + 0.05) > (l + 0.05) / 0.05 { WHITE } else { BLACK }
+}
+
+/// A text to draw: its box (top-left, size), anchor point, size, rotation, and the colour it is drawn in.
 #[derive(Clone, Debug)]
 pub struct Placed {
     pub text: String,
@@ -55,6 +68,7 @@ pub struct Placed {
     pub vertical: bool,
     pub bold: bool,
     pub rect: Rect,
+    pub colour: RGBColor,
 }
 
 fn group_of(table: &HeatTable) -> Vec<(usize, usize)> {
@@ -157,44 +171,47 @@ pub fn layout(table: &HeatTable, measure: &dyn Fn(&str, u32, bool) -> (i32, i32)
     let width = right + BAR_W + MARGIN;
     let height = grid_top + (table.rows.len() as i32 * CELL_H).max(BAR_H + 12) + MARGIN;
     let mut out = Vec::new();
-    let mut put = |text: String, at: (i32, i32), size: u32, vertical: bool, bold: bool, centre: bool| {
+    let mut put_in = |text: String, at: (i32, i32), size: u32, vertical: bool, bold: bool, centre: bool, colour| {
         let (w, h) = measure(&text, size, bold);
         let (w, h) = if vertical { (h, w) } else { (w, h) };
         let left = if centre { at.0 - w / 2 } else { at.0 };
         let top = if vertical { at.1 - h } else { at.1 - h / 2 };
         let rect = Rect { x0: left as f64, y0: top as f64, x1: (left + w) as f64, y1: (top + h) as f64 };
-        out.push(Placed { text, at, size, vertical, bold, rect });
+        out.push(Placed { text, at, size, vertical, bold, rect, colour });
     };
-    put(table.title.clone(), (MARGIN, TITLE_H / 2), 26, false, true, false);
+    put_in(table.title.clone(), (MARGIN, TITLE_H / 2), 26, false, true, false, BLACK);
     for (g, ((_, cols), lines)) in table.groups.iter().zip(&headers).enumerate() {
         let centre = (col_x(g, 0) + col_x(g, cols.len())) / 2;
         // The header's last line sits on the group's rule.
         let first = TITLE_H + group_h - GROUP_H / 2 - (lines.len() as i32 - 1) * line_h;
         for (l, line) in lines.iter().enumerate() {
-            put(line.clone(), (centre, first + l as i32 * line_h), HEAD_FONT, false, true, true);
+            put_in(line.clone(), (centre, first + l as i32 * line_h), HEAD_FONT, false, true, true, BLACK);
         }
         for (k, c) in cols.iter().enumerate() {
-            put(c.clone(), (col_x(g, k) + cell_w[g] / 2, grid_top - 8), HEAD_FONT, true, false, true);
+            put_in(c.clone(), (col_x(g, k) + cell_w[g] / 2, grid_top - 8), HEAD_FONT, true, false, true, BLACK);
         }
     }
     for (i, row) in table.rows.iter().enumerate() {
         let y = grid_top + i as i32 * CELL_H + CELL_H / 2;
-        put(row.clone(), (MARGIN, y), CELL_FONT, false, false, false);
+        put_in(row.clone(), (MARGIN, y), CELL_FONT, false, false, false, BLACK);
         let mut j = 0;
         for (g, (_, n)) in group_of(table).iter().enumerate() {
             for k in 0..*n {
-                let text = table.cells[i].get(j + k).copied().flatten().map_or("-".into(), |r| format!("{r:.2}"));
-                put(text, (col_x(g, k) + cell_w[g] / 2, y), CELL_FONT, false, false, true);
+                let ratio = table.cells[i].get(j + k).copied().flatten();
+                let text = ratio.map_or("-".into(), |r| format!("{r:.2}"));
+                let ink = ratio.map_or(BLACK, |r| text_colour(colour(r)));
+                put_in(text, (col_x(g, k) + cell_w[g] / 2, y), CELL_FONT, false, false, true, ink);
             }
             j += n;
         }
     }
     let bar_x = width - BAR_W - MARGIN + 40;
-    // The bar runs from 2x at its top to 0.5x at its bottom, log2-even: a label every quarter.
-    for (k, v) in [2.0, 1.41, 1.0, 0.71, 0.5].iter().enumerate() {
-        put(format!("{v}"), (bar_x + 34, grid_top + k as i32 * BAR_H / 4), HEAD_FONT, false, false, false);
+    // The bar runs from 2x at its top to 0.5x at its bottom, log2-even: a label every quarter. Its ends are the
+    // clamp (a triangle beyond each end, as a colour bar extended past its range draws it): 3.8x reads as 2x.
+    for (k, v) in [">= 2", "1.41", "1", "0.71", "<= 0.5"].iter().enumerate() {
+        put_in(v.to_string(), (bar_x + 34, grid_top + k as i32 * BAR_H / 4), HEAD_FONT, false, false, false, BLACK);
     }
-    put(table.scale_name.clone(), (bar_x + 100, grid_top + BAR_H), HEAD_FONT, true, false, true);
+    put_in(table.scale_name.clone(), (bar_x + 130, grid_top + BAR_H), HEAD_FONT, true, false, true, BLACK);
     let rule_y = TITLE_H + group_h - 4;
     Layout { size: (width as u32, height as u32), grid_top, group_left, cell_w, rule_y, bar_x, texts: out }
 }
@@ -239,10 +256,15 @@ pub fn draw(path: &Path, table: &HeatTable) -> Result<()> {
             root.draw(&Rectangle::new([(bar_x, grid_top + p), (bar_x + 24, grid_top + p + 1)], colour(ratio).filled()))
                 .map_err(e)?;
         }
+        let (top, bottom) = (grid_top, grid_top + BAR_H);
+        for (tip, base, ratio) in [(top - CLAMP_H, top, 2.0), (bottom + CLAMP_H, bottom, 0.5)] {
+            let points = vec![(bar_x, base), (bar_x + 24, base), (bar_x + 12, tip)];
+            root.draw(&Polygon::new(points, colour(ratio).filled())).map_err(e)?;
+        }
         for t in &texts {
             let style = font(t.size, t.bold);
             let style = if t.vertical { style.transform(FontTransform::Rotate270) } else { style };
-            let style = style.color(&BLACK).pos(Pos::new(HPos::Left, VPos::Top));
+            let style = style.color(&t.colour).pos(Pos::new(HPos::Left, VPos::Top));
             let at = (t.rect.x0 as i32, if t.vertical { t.rect.y1 } else { t.rect.y0 } as i32);
             root.draw(&Text::new(t.text.clone(), at, style)).map_err(e)?;
         }
@@ -280,6 +302,14 @@ mod tests {
             }
         }
         assert_eq!(colour(1.0), RGBColor(255, 255, 255));
+        // Dark cells carry white text, light ones black; the bar's ends say they clamp.
+        assert_eq!(
+            (text_colour(colour(3.83)), text_colour(colour(1.1)), text_colour(colour(0.5))),
+            (WHITE, BLACK, WHITE)
+        );
+        let cell = |t: &str| texts.iter().find(|p| p.text == t).unwrap_or_else(|| panic!("no {t}")).colour;
+        assert_eq!((cell("1.90"), cell("1.00")), (WHITE, BLACK));
+        assert!(texts.iter().any(|p| p.text == ">= 2") && texts.iter().any(|p| p.text == "<= 0.5"));
         let (cheap, dear) = (colour(0.5), colour(2.0));
         assert!(cheap.2 > cheap.0 && dear.0 > dear.2, "blue below 1, red above");
     }

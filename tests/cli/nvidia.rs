@@ -208,3 +208,40 @@ fn a_model_past_the_stores_range_is_priced() {
     assert_eq!(brdfprof::translate::judge::r11g11b10_max(6), 65024.0);
     assert_eq!(brdfprof::translate::judge::r11g11b10_max(5), 64512.0);
 }
+
+/// A 64-entry constant table read 16 times is read in place (the table one object in constant memory), not
+/// copied to local memory before every lookup: no local stores in its SASS, and its net over 32 FMAs' within 2x
+/// of the same on navi21, whose ACO compiles the SPIR-V itself.
+#[test]
+fn a_constant_table_is_read_in_place_as_the_spirv_holds_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let root = crate::common::repo_root().join("tests/fixtures/brdf");
+    let (table, fma) = (root.join("table/lookup-64.brdf"), root.join("micro/fma-32.brdf"));
+    let isa = dir.path().join("isa");
+    let report = compile_only::inspect_json(
+        dir.path(),
+        "table",
+        &["nvidia:sm_89", "radv:navi21"],
+        &["--model", table.to_str().unwrap(), "--model", fma.to_str().unwrap(), "--isa", isa.to_str().unwrap()],
+        "ptxas statistics",
+    );
+    let sass = std::fs::read_to_string(isa.join("nvidia-sm_89/lookup-64.sass")).unwrap();
+    assert_eq!(sass.matches("STL").count(), 0, "local stores in the table's SASS");
+    let ratio = |target: &str| {
+        let cost = report["reports"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|r| &r["cost"])
+            .find(|c| c["target"] == target)
+            .unwrap_or_else(|| panic!("no cost table of {target}"));
+        let net = |m: &str| {
+            cost["rows"].as_array().unwrap().iter().find(|r| r["model"] == m).unwrap()["net_cycles_per_eval"]
+                .as_f64()
+                .unwrap()
+        };
+        net("lookup-64") / net("fma-32")
+    };
+    let (nvidia, amd) = (ratio("nvidia:sm_89"), ratio("radv:navi21"));
+    assert!(nvidia <= 2.0 * amd && amd <= 2.0 * nvidia, "table over 32 FMAs: sm_89 {nvidia}, navi21 {amd}");
+}

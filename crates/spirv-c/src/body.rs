@@ -43,6 +43,8 @@ pub(super) struct FunctionWriter<'m> {
     ret: Word,
     id: Word,
     pub name: String,
+    /// Function variables that only ever hold one lookup table (`tables`), by the table constant.
+    tables: HashMap<Word, Word>,
 }
 
 impl<'m> FunctionWriter<'m> {
@@ -76,6 +78,7 @@ impl<'m> FunctionWriter<'m> {
             ret: def.result_type.unwrap_or(0),
             id,
             name: function_name(m, id),
+            tables: tables(m, f),
         }
     }
 
@@ -329,6 +332,18 @@ impl<'m> FunctionWriter<'m> {
             return Err(self.err(format!("a function-level variable in {class:?} memory")));
         }
         let ty = self.m.c_type(pointee)?;
+        if let Some(table) = self.tables.get(&id) {
+            // The table itself where the dialect keeps it as one object (read only: `tables`), else a copy.
+            self.decls.push(format!(
+                "#ifdef BRDFPROF_CONST_TABLE\n#define BRDFPROF_V{id} (({ty}*)&k_{table}_v)\n#else\n  {ty} v{id};\n#define BRDFPROF_V{id} (&v{id})\n#endif"
+            ));
+            if inst.operands.get(1).is_some() {
+                let e = self.v(*table)?;
+                writeln!(self.body, "#ifndef BRDFPROF_CONST_TABLE\n  v{id} = {e};\n#endif").unwrap();
+            }
+            self.vals.insert(id, Val::Local { ptr: format!("BRDFPROF_V{id}"), pointee });
+            return Ok(());
+        }
         self.decls.push(format!("{ty} v{id};"));
         if let Some(Operand::IdRef(init)) = inst.operands.get(1) {
             let e = self.v(*init)?;
@@ -375,6 +390,12 @@ impl<'m> FunctionWriter<'m> {
 
     fn store(&mut self, inst: &Instruction) -> Result<(), TranslateError> {
         let value = self.v(Self::id(inst, 1))?;
+        if self.tables.contains_key(&Self::id(inst, 0)) {
+            self.body += "#ifndef BRDFPROF_CONST_TABLE\n";
+            self.store_ptr(Self::id(inst, 0), &value)?;
+            self.body += "#endif\n";
+            return Ok(());
+        }
         self.store_ptr(Self::id(inst, 0), &value)
     }
 
@@ -778,4 +799,56 @@ fn absolute_source(file: &str) -> String {
         path.to_path_buf()
     };
     path.to_string_lossy().replace('\\', "/").replace('"', "")
+}
+
+/// The function variables of `f` that only ever hold one lookup table (`constants::is_table`): each store to
+/// the variable stores that table, whole (or it is the variable's initializer), and the variable and every
+/// access chain into it are only loaded or chained further (never stored through, passed or copied). GLSL's
+/// `const float T[64] = ...; T[i]` is such a variable in glslang's SPIR-V; read in place, it is the table.
+fn tables(m: &ModuleInfo, f: &Function) -> HashMap<Word, Word> {
+    let insts: Vec<&Instruction> = f.blocks.iter().flat_map(|b| &b.instructions).collect();
+    let ids = |i: &Instruction| -> Vec<Word> {
+        i.operands.iter().filter_map(|o| if let Operand::IdRef(x) = o { Some(*x) } else { None }).collect()
+    };
+    let mut out = HashMap::new();
+    for var in insts.iter().filter(|i| i.class.opcode == Op::Variable) {
+        let id = var.result_id.unwrap_or(0);
+        let mut table = ids(var).first().copied();
+        let mut derived: HashSet<Word> = [id].into();
+        let mut ok = table.is_none_or(|t| super::constants::is_table(m, t));
+        // Chains into the variable first (a chain of a chain included), then every use of them.
+        loop {
+            let before = derived.len();
+            for i in &insts {
+                if matches!(i.class.opcode, Op::AccessChain | Op::InBoundsAccessChain)
+                    && ids(i).first().is_some_and(|b| derived.contains(b))
+                {
+                    derived.insert(i.result_id.unwrap_or(0));
+                }
+            }
+            if derived.len() == before {
+                break;
+            }
+        }
+        for i in insts.iter().filter(|i| i.result_id != Some(id)) {
+            let used: Vec<Word> = ids(i);
+            if !used.iter().any(|u| derived.contains(u)) {
+                continue;
+            }
+            ok &= match i.class.opcode {
+                Op::Load | Op::AccessChain | Op::InBoundsAccessChain => !used[1..].iter().any(|u| derived.contains(u)),
+                Op::Store if used.first() == Some(&id) && !derived.contains(&used[1]) => {
+                    let t = used[1];
+                    let same = table.is_none_or(|x| x == t) && super::constants::is_table(m, t);
+                    table = Some(t);
+                    same
+                }
+                _ => false,
+            };
+        }
+        if let (true, Some(t)) = (ok, table) {
+            out.insert(id, t);
+        }
+    }
+    out
 }

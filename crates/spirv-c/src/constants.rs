@@ -3,7 +3,7 @@
 
 use super::TranslateError;
 use super::ctypes::Scalar;
-use super::module::{Constant, ModuleInfo};
+use super::module::{Constant, ModuleInfo, Type};
 use rspirv::spirv::{Op, Word};
 
 /// A C literal of the scalar `bits` of type `s` that the C compiler reads back exactly.
@@ -34,7 +34,9 @@ pub fn expr(m: &ModuleInfo, id: Word) -> Result<String, TranslateError> {
     match m.constants.get(&id) {
         Some(Constant::Scalar { ty, bits }) => Ok(literal(m.scalar(*ty)?, *bits)),
         Some(Constant::Bool { value, .. }) => Ok(value.to_string()),
-        Some(Constant::Composite { parts, .. }) if parts.len() as u32 > super::ctypes::MAX_CONSTRUCTOR_MEMBERS => {
+        Some(Constant::Composite { parts, .. })
+            if parts.len() as u32 > super::ctypes::MAX_CONSTRUCTOR_MEMBERS || is_table(m, id) =>
+        {
             Ok(format!("k_{id}()"))
         }
         Some(Constant::Composite { ty, parts }) => {
@@ -123,10 +125,18 @@ fn define_large(
     for p in parts {
         define_large(m, *p, done, out)?;
     }
-    if parts.len() as u32 <= super::ctypes::MAX_CONSTRUCTOR_MEMBERS {
+    let table = initializer(m, id).filter(|_| is_table(m, id));
+    if parts.len() as u32 <= super::ctypes::MAX_CONSTRUCTOR_MEMBERS && table.is_none() {
         return Ok(());
     }
     let c = m.c_type(*ty)?;
+    // A lookup table is also one constant object where the dialect has one (BRDFPROF_CONST_TABLE: CUDA's
+    // constant memory, the host's static storage), which the function variables that only ever hold it read in
+    // place (`body::tables`): built member by member into a copy at every use, 16 lookups into a 64-entry table
+    // cost 515 STL.64 on sm_75. OpenCL C cannot point a private pointer at __constant memory: it keeps the copy.
+    if let Some(init) = &table {
+        out.push_str(&format!("#ifdef BRDFPROF_CONST_TABLE\nBRDFPROF_CONST_TABLE {c} k_{id}_v = {init};\n#endif\n"));
+    }
     let sets = m
         .members(*ty)
         .iter()
@@ -135,4 +145,34 @@ fn define_large(
         .collect::<Result<String, TranslateError>>()?;
     out.push_str(&format!("BRDFPROF_FN {c} k_{id}(void) {{ {c} r;{sets} return r; }}\n"));
     Ok(())
+}
+
+/// Whether constant `id` is a lookup table: an array each scalar of which has a constant-expression literal.
+pub fn is_table(m: &ModuleInfo, id: Word) -> bool {
+    matches!(m.constants.get(&id), Some(Constant::Composite { ty, .. }) if matches!(m.ty(*ty), Type::Array { .. }))
+        && initializer(m, id).is_some()
+}
+
+/// Constant `id` as a C aggregate initializer of its struct (`{ { e0, e1, ... } }` for the `c[N]` of a vector,
+/// matrix or array, `{ f0, f1, ... }` for a struct), None where a scalar has no constant-expression literal
+/// (half, booleans, non-finite floats: their literals are function calls or differ by dialect).
+fn initializer(m: &ModuleInfo, id: Word) -> Option<String> {
+    match m.constants.get(&id)? {
+        Constant::Scalar { ty, bits } => {
+            let s = m.scalar(*ty).ok()?;
+            let exact = match s {
+                Scalar::F32 => f32::from_bits(*bits as u32).is_finite(),
+                Scalar::F64 => f64::from_bits(*bits).is_finite(),
+                Scalar::I32 | Scalar::U32 => true,
+                Scalar::Bool | Scalar::F16 => false,
+            };
+            exact.then(|| literal(s, *bits))
+        }
+        Constant::Composite { ty, parts } => {
+            let parts = parts.iter().map(|p| initializer(m, *p)).collect::<Option<Vec<_>>>()?.join(", ");
+            let array = matches!(m.ty(*ty), Type::Vector { .. } | Type::Matrix { .. } | Type::Array { .. });
+            Some(if array { format!("{{ {{ {parts} }} }}") } else { format!("{{ {parts} }}") })
+        }
+        _ => None,
+    }
 }

@@ -10,6 +10,8 @@ typedef int i32;
 typedef unsigned long long u64;
 #define GLOBAL
 #define BRDFPROF_FN static inline
+// A lookup table as one object read in place (constants.rs, `define_large`).
+#define BRDFPROF_CONST_TABLE static const
 // An invocation stops after 2^20 loop iterations and flags itself (lavapipe stops every loop at 65535).
 #define BRDFPROF_LOOP_LIMIT(env) (++(env)->loop_iterations > (1u << 20) && ((env)->flags |= 1u))
 
