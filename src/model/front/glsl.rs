@@ -4,8 +4,8 @@
 //! function, and spirv-cross back to GLSL, so that messages and per-line cost name the included files' lines.
 //! A GLSL shader without an `#include` is composed as written (src/model/brdf_file).
 
+use super::Glue;
 use super::includes::Expanded;
-use super::{Glue, GlueArg};
 use anyhow::{Result, bail};
 use std::path::Path;
 
@@ -24,28 +24,9 @@ pub fn param_decl(name: &str, glsl_type: &str) -> String {
 /// `@out`/`@scratch` argument (zero-initialised where its type has a one-argument constructor) and the `@out`
 /// one returned.
 pub fn glue(g: &Glue) -> String {
-    let mut locals = String::new();
-    let mut out = None;
-    let mut args = Vec::new();
-    for (k, a) in g.args.iter().enumerate() {
-        let local = format!("brdfprof_arg{k}");
-        match a {
-            GlueArg::Expr(e) => args.push(e.clone()),
-            GlueArg::Out(ty) | GlueArg::Scratch(ty) => {
-                locals += &if is_numeric(ty) { format!("{ty} {local} = {ty}(0); ") } else { format!("{ty} {local}; ") };
-                if matches!(a, GlueArg::Out(_)) {
-                    out = Some(local.clone());
-                }
-                args.push(local);
-            }
-        }
-    }
-    let call = format!("{}({})", g.callee, args.join(", "));
-    let body = match out {
-        Some(o) => format!("{locals}{call}; return {o};"),
-        None => format!("{locals}return {call};"),
-    };
-    format!("vec3 {}(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) {{ {body} }}", g.name)
+    let local =
+        |ty: &str, l: &str| if is_numeric(ty) { format!("{ty} {l} = {ty}(0); ") } else { format!("{ty} {l}; ") };
+    g.write(&format!("vec3 {}(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y)", g.name), local, str::to_string)
 }
 
 /// Whether `T(0)` makes a zero of GLSL type `ty`.
@@ -97,6 +78,7 @@ pub fn describe() -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::model::front::GlueArg;
 
     #[test]
     fn glue_and_stub_are_one_line_of_glsl() {

@@ -6,7 +6,7 @@
 //! else from the token its message names on that line.
 
 use super::includes::Expanded;
-use super::{Glue, GlueArg, STUB};
+use super::{Glue, STUB};
 use anyhow::{Context, Result, bail};
 use std::collections::HashMap;
 use std::path::Path;
@@ -174,28 +174,9 @@ fn is_numeric(ty: &str) -> bool {
 /// A glue function, on one line: `float3 NAME(float3 L, ...) { return CALLEE(ARGS); }`, with a local for each
 /// `@out`/`@scratch` argument (zero where its type is numeric) and the `@out` one returned.
 pub fn glue(g: &Glue) -> String {
-    let mut locals = String::new();
-    let mut out = None;
-    let mut args = Vec::new();
-    for (k, a) in g.args.iter().enumerate() {
-        let local = format!("brdfprof_arg{k}");
-        match a {
-            GlueArg::Expr(e) => args.push(e.clone()),
-            GlueArg::Out(ty) | GlueArg::Scratch(ty) => {
-                locals += &if is_numeric(ty) { format!("{ty} {local} = ({ty})0; ") } else { format!("{ty} {local}; ") };
-                if matches!(a, GlueArg::Out(_)) {
-                    out = Some(local.clone());
-                }
-                args.push(local);
-            }
-        }
-    }
-    let call = format!("{}({})", g.callee, args.join(", "));
-    let body = match out {
-        Some(o) => format!("{locals}{call}; return {o};"),
-        None => format!("{locals}return {call};"),
-    };
-    format!("float3 {}(float3 L, float3 V, float3 N, float3 X, float3 Y) {{ {body} }}", g.name)
+    let local =
+        |ty: &str, l: &str| if is_numeric(ty) { format!("{ty} {l} = ({ty})0; ") } else { format!("{ty} {l}; ") };
+    g.write(&format!("float3 {}(float3 L, float3 V, float3 N, float3 X, float3 Y)", g.name), local, str::to_string)
 }
 
 /// The compute entry that calls each of `calls` (functions of (L, V, N, X, Y) returning float3), on one line.
@@ -456,6 +437,7 @@ pub fn describe() -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::model::front::GlueArg;
 
     #[test]
     fn glue_and_stub_text() {

@@ -211,6 +211,41 @@ pub enum GlueArg {
     Scratch(String),
 }
 
+impl Glue {
+    /// The glue on one line in a language: `signature { return CALLEE(ARGS); }`, a local declared by
+    /// `local(type, name)` for each `@out`/`@scratch` argument and passed as `pass(name)`, the `@out` one
+    /// returned.
+    pub fn write(
+        &self,
+        signature: &str,
+        local: impl Fn(&str, &str) -> String,
+        pass: impl Fn(&str) -> String,
+    ) -> String {
+        let mut locals = String::new();
+        let mut out = None;
+        let mut args = Vec::new();
+        for (k, a) in self.args.iter().enumerate() {
+            let name = format!("{GENERATED_PREFIX}arg{k}");
+            match a {
+                GlueArg::Expr(e) => args.push(e.clone()),
+                GlueArg::Out(ty) | GlueArg::Scratch(ty) => {
+                    locals += &local(ty, &name);
+                    args.push(pass(&name));
+                    if matches!(a, GlueArg::Out(_)) {
+                        out = Some(name);
+                    }
+                }
+            }
+        }
+        let call = format!("{}({})", self.callee, args.join(", "));
+        let body = match out {
+            Some(o) => format!("{locals}{call}; return {o};"),
+            None => format!("{locals}return {call};"),
+        };
+        format!("{signature} {{ {body} }}")
+    }
+}
+
 /// The names a front end generates: none of the shader's own may start with this.
 pub const GENERATED_PREFIX: &str = "brdfprof_";
 

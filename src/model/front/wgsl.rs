@@ -5,7 +5,7 @@
 //! GLSL. Messages come back at FILE:LINE:COLUMN as naga_oil locates them (its preprocessor keeps every line in
 //! place); lines brdfprof appends to the shader (parameters, glue, stub) name what they came from.
 
-use super::{Glue, GlueArg, Includes, STUB};
+use super::{Glue, Includes, STUB};
 use anyhow::{Context, Result, anyhow, bail};
 use naga_oil::compose::{
     ComposableModuleDescriptor, Composer, ComposerError, NagaModuleDescriptor, ShaderDefValue, ShaderLanguage,
@@ -71,31 +71,9 @@ pub fn param_decl(name: &str, glsl_type: &str) -> String {
 /// A glue function on one line (`hlsl::glue`'s WGSL form): an `@out`/`@scratch` argument is a pointer to a
 /// local of the parameter's type, starting at its zero value.
 pub fn glue(g: &Glue) -> String {
-    let mut locals = String::new();
-    let mut out = None;
-    let mut args = Vec::new();
-    for (k, a) in g.args.iter().enumerate() {
-        let local = format!("brdfprof_arg{k}");
-        match a {
-            GlueArg::Expr(e) => args.push(e.clone()),
-            GlueArg::Out(ty) | GlueArg::Scratch(ty) => {
-                locals += &format!("var {local}: {ty} = {ty}(); ");
-                if matches!(a, GlueArg::Out(_)) {
-                    out = Some(local.clone());
-                }
-                args.push(format!("&{local}"));
-            }
-        }
-    }
-    let call = format!("{}({})", g.callee, args.join(", "));
-    let body = match out {
-        Some(o) => format!("{locals}{call}; return {o};"),
-        None => format!("{locals}return {call};"),
-    };
-    format!(
-        "fn {}(L: vec3<f32>, V: vec3<f32>, N: vec3<f32>, X: vec3<f32>, Y: vec3<f32>) -> vec3<f32> {{ {body} }}",
-        g.name
-    )
+    let signature =
+        format!("fn {}(L: vec3<f32>, V: vec3<f32>, N: vec3<f32>, X: vec3<f32>, Y: vec3<f32>) -> vec3<f32>", g.name);
+    g.write(&signature, |ty, l| format!("var {l}: {ty} = {ty}(); "), |l| format!("&{l}"))
 }
 
 /// The compute entry that calls each of `calls`, on one line.
@@ -707,6 +685,7 @@ pub fn describe() -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::model::front::GlueArg;
 
     /// The version Cargo.lock pins for `package`.
     fn locked(package: &str) -> String {
