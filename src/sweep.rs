@@ -380,6 +380,7 @@ impl SweepReport {
                 label: r.label.clone(),
                 group: group(r),
                 highlight: r.pareto || thesis.contains(&r.spec),
+                edge: false,
             })
             .collect();
         let mut front: Vec<(f64, f64)> = self
@@ -419,6 +420,23 @@ impl SweepReport {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The committed sweep chart, drawn from the committed JSON (`BRDFPROF_BLESS=1` writes it back to
+    /// results/, so the picture always shows the JSON's figures).
+    #[test]
+    fn the_committed_sweep_chart_draws_from_its_json() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+        let text = std::fs::read_to_string(root.join("results/sweep-llvmpipe.json")).unwrap();
+        let report: SweepReport = serde_json::from_str(&text).unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        let out = match std::env::var_os("BRDFPROF_BLESS") {
+            Some(_) => root.join("results/sweep-llvmpipe.png"),
+            None => dir.path().join("sweep.png"),
+        };
+        report.chart(&out).unwrap();
+        let img = image::open(&out).unwrap();
+        assert!(img.width() > 1000 && img.height() > 800);
+    }
 
     #[test]
     fn default_sweep_covers_every_term() {

@@ -197,6 +197,7 @@ impl CostSweep {
                 label: r.label.clone(),
                 group: group(r),
                 highlight: r.pareto || thesis.contains(&r.spec),
+                edge: false,
             })
             .collect();
         let front: Vec<(f64, f64)> =

@@ -6,7 +6,7 @@
 use crate::accuracy::rel_err;
 use crate::brdf::Sample;
 use crate::export::png;
-use crate::export::raster::{LOBE_PANEL, blit, colour_bar, draw_lobes, label, tone_map, viridis};
+use crate::export::raster::{LOBE_PANEL, blit, draw_lobes, label, log_colour_bar, log_position, tone_map, viridis};
 use crate::gpu::Gpu;
 use crate::kernels::{self, RunLimits};
 use crate::model::Model;
@@ -92,10 +92,13 @@ pub fn pixels(gpu: &Gpu, a: &Model, b: &Model) -> Result<(u32, u32, Vec<u8>)> {
     let panels = kernels::lobe_curves(gpu, &[a.clone(), b.clone()], &ROUGHNESS)?;
     let names = [a.label(), b.label()];
     let width = LOBE_PANEL.0 * ROUGHNESS.len() as u32;
-    let size = (width + 70, TOP + LOBE_PANEL.1 + 40);
+    // The map's log scale: three decades below the largest difference (none below 1e-5), so that small
+    // differences spread over the colours instead of all reading as the darkest.
+    let floor = (scale / 1000.0).max(1e-5);
+    let size = (width + 90, TOP + LOBE_PANEL.1 + 40);
     let px = png::pixels(size.0, size.1, |root| {
         let title = format!(
-            "B = {} against A = {}: lit spheres and |B - A| / max(|A|, 1e-3) (largest channel)",
+            "B = {} against A = {}: lit spheres and |B - A| / max(|A|, 1e-3) (largest channel, log scale)",
             names[1], names[0]
         );
         label(root, &title, 10, 8, 18, BLACK)?;
@@ -105,7 +108,7 @@ pub fn pixels(gpu: &Gpu, a: &Model, b: &Model) -> Result<(u32, u32, Vec<u8>)> {
                 .iter()
                 .map(|d| {
                     d.map_or(BACKGROUND, |x| {
-                        if x.is_finite() { viridis(if scale > 0.0 { x / scale } else { 0.0 }) } else { [255, 0, 255] }
+                        if x.is_finite() { viridis(log_position(x, floor, scale)) } else { [255, 0, 255] }
                     })
                 })
                 .collect();
@@ -116,7 +119,7 @@ pub fn pixels(gpu: &Gpu, a: &Model, b: &Model) -> Result<(u32, u32, Vec<u8>)> {
                 blit(root, x, 62, TILE, px)?;
             }
         }
-        colour_bar(root, width as i32 + 8, 62, TILE as i32, scale)?;
+        log_colour_bar(root, (width as i32 + 8, 62, TILE as i32), floor, scale.max(floor))?;
         let (_, below) = root.split_vertically(TOP);
         let (lobes, _) = below.split_horizontally(width);
         draw_lobes(&lobes, &names, &panels)

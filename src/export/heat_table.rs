@@ -6,10 +6,9 @@
 //! them, so a test checks that none overlaps another.
 
 use crate::export::labels::Rect;
-use crate::export::png::{FONT, render};
+use crate::export::png::render;
 use anyhow::{Result, anyhow};
 use plotters::prelude::*;
-use plotters::style::text_anchor::{HPos, Pos, VPos};
 use std::path::Path;
 
 /// What the picture shows.
@@ -100,10 +99,6 @@ pub struct Layout {
 
 /// Pixels between two groups of columns.
 const GAP: i32 = 8;
-
-fn font(size: u32, bold: bool) -> FontDesc<'static> {
-    if bold { (FONT, size).into_font().style(FontStyle::Bold) } else { (FONT, size).into_font() }
-}
 
 /// A group header's words as lines no wider than `width` (a word wider than that on a line of its own).
 fn wrap(name: &str, width: i32, measure: &dyn Fn(&str, u32, bool) -> (i32, i32)) -> Vec<String> {
@@ -218,15 +213,8 @@ pub fn layout(table: &HeatTable, measure: &dyn Fn(&str, u32, bool) -> (i32, i32)
 
 /// Draws the table to `path` as PNG.
 pub fn draw(path: &Path, table: &HeatTable) -> Result<()> {
-    let mut laid = None;
-    crate::export::png::pixels(1, 1, |root| {
-        let measure = |t: &str, s: u32, bold: bool| {
-            root.estimate_text_size(t, &TextStyle::from(font(s, bold))).map_or((0, 0), |(w, h)| (w as i32, h as i32))
-        };
-        laid = Some(layout(table, &measure));
-        Ok(())
-    })?;
-    let Layout { size, grid_top, group_left, cell_w, rule_y, bar_x, texts } = laid.expect("the layout ran");
+    let Layout { size, grid_top, group_left, cell_w, rule_y, bar_x, texts } =
+        layout(table, &crate::export::text::measure);
     let e = |e: DrawingAreaErrorKind<_>| anyhow!("{}: {e}", path.display());
     render(path, size.0, size.1, |root| {
         for (((start, n), left), cell_w) in group_of(table).into_iter().zip(group_left).zip(cell_w) {
@@ -262,11 +250,10 @@ pub fn draw(path: &Path, table: &HeatTable) -> Result<()> {
             root.draw(&Polygon::new(points, colour(ratio).filled())).map_err(e)?;
         }
         for t in &texts {
-            let style = font(t.size, t.bold);
-            let style = if t.vertical { style.transform(FontTransform::Rotate270) } else { style };
-            let style = style.color(&t.colour).pos(Pos::new(HPos::Left, VPos::Top));
             let at = (t.rect.x0 as i32, if t.vertical { t.rect.y1 } else { t.rect.y0 } as i32);
-            root.draw(&Text::new(t.text.clone(), at, style)).map_err(e)?;
+            let style =
+                crate::export::text::Style { size: t.size, bold: t.bold, colour: t.colour, vertical: t.vertical };
+            crate::export::text::draw(root, &t.text, at, style)?;
         }
         Ok(())
     })

@@ -1,5 +1,5 @@
 //! Every output format in one place: Markdown tables (markdown), saved JSON reports (json), self-contained
-//! HTML pages (html), PNG charts (png), the label placement charts share (labels) and the pixel helpers pictures share (raster), SARIF for code scanning
+//! HTML pages (html), PNG charts (png), the label placement charts share (labels) and the pixel helpers pictures share (raster), text drawn into PNGs (text), SARIF for code scanning
 //! (sarif), GitHub's workflow commands and step summary (github), benchmark-dashboard JSON (bench). What a command measured
 //! stays with the command; only how it is written out lives here.
 
@@ -13,6 +13,7 @@ pub mod markdown;
 pub mod png;
 pub mod raster;
 pub mod sarif;
+pub mod text;
 
 /// The file-name form of a device name: its first words, lower case ("llvmpipe (LLVM 15.0.6, 256 bits)" ->
 /// "llvmpipe").

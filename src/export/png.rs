@@ -82,7 +82,7 @@ pub fn palette(i: usize) -> RGBColor {
 /// One point of the accuracy-against-cost scatter: x with its confidence interval (drawn as a horizontal
 /// whisker; lo = hi = x for a deterministic cost), y, its group (colour) and label. Highlighted points carry
 /// their label next to them; the others carry a number, listed with its label in the key beside the plot.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Default)]
 pub struct Point {
     pub x: f64,
     pub x_lo: f64,
@@ -91,6 +91,9 @@ pub struct Point {
     pub label: String,
     pub group: usize,
     pub highlight: bool,
+    /// Drawn at the plot's edge (an outlier below the fitted range, or a non-finite value at the top): a
+    /// triangle pointing out, its value in its label.
+    pub edge: bool,
 }
 
 /// What the scatter draws: the title and axis names, the frontier through `line`, the groups' legend, and the
@@ -109,18 +112,34 @@ const Y_FLOOR: f64 = 1e-8;
 const CHAR_W: i32 = 8;
 const TEXT_H: i32 = 16;
 
-/// Points as drawn: y floored at Y_FLOOR for the log axis, a non-finite y pinned to the top edge and labelled so.
-fn pinned(points: &[Point], y_top: f64) -> Vec<Point> {
+/// The log y range drawn: from the data's top down to its bottom, but no further than 2.5 decades below its
+/// 10th percentile, so that a few specs far below the rest (an exact dielectric at 5e-7 among errors of 0.1)
+/// do not leave most of the plot empty; those are drawn at the bottom edge and marked (`pinned`).
+pub fn fit_log_range(ys: &[f64]) -> (f64, f64) {
+    let mut v: Vec<f64> = ys.iter().copied().filter(|y| y.is_finite()).map(|y| y.max(Y_FLOOR)).collect();
+    if v.is_empty() {
+        return (Y_FLOOR, 1.0);
+    }
+    v.sort_by(f64::total_cmp);
+    let bulk = v[v.len() / 10] / 10f64.powf(2.5);
+    (v[0].max(bulk) / 3.0, v[v.len() - 1] * 3.0)
+}
+
+/// Points as drawn: a y below the range at the bottom edge and a non-finite y at the top edge, each marked
+/// (`edge`) and its label saying so.
+fn pinned(points: &[Point], (y_lo, y_top): (f64, f64)) -> Vec<Point> {
     points
         .iter()
         .filter(|p| p.x.is_finite())
         .map(|p| {
-            let (y, label) = if p.y.is_finite() {
-                (p.y.max(Y_FLOOR), p.label.clone())
+            let (y, label, edge) = if !p.y.is_finite() {
+                (y_top / 1.5, format!("{} (non-finite)", p.label), true)
+            } else if p.y.max(Y_FLOOR) < y_lo {
+                (y_lo * 1.25, format!("{} ({:.1e}, below)", p.label, p.y), true)
             } else {
-                (y_top / 1.5, format!("{} (non-finite)", p.label))
+                (p.y.max(Y_FLOOR), p.label.clone(), false)
             };
-            Point { y, label, ..p.clone() }
+            Point { y, label, edge, ..p.clone() }
         })
         .collect()
 }
@@ -167,12 +186,13 @@ fn scatter_panel(
         .map_err(|e| err(&e))?;
     if main {
         chart
-            .draw_series(LineSeries::new(spec.line.iter().map(|&(x, y)| (x, y.max(Y_FLOOR))), RED.stroke_width(3)))
-            .map_err(|e| err(&e))?
-            .label("Pareto frontier")
-            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 30, y)], RED.stroke_width(3)));
+            .draw_series(LineSeries::new(
+                spec.line.iter().map(|&(x, y)| (x, if y.max(Y_FLOOR) < y0 { y0 * 1.25 } else { y.max(Y_FLOOR) })),
+                RED.stroke_width(3),
+            ))
+            .map_err(|e| err(&e))?;
     }
-    for (group, name) in spec.legend {
+    for (group, _) in spec.legend {
         let colour = palette(*group);
         let members: Vec<&&Point> = pts.iter().filter(|p| p.group == *group).collect();
         chart
@@ -180,24 +200,26 @@ fn scatter_panel(
                 members.iter().map(|p| PathElement::new(vec![(p.x_lo, p.y), (p.x_hi, p.y)], colour.stroke_width(2))),
             )
             .map_err(|e| err(&e))?;
-        let series = chart
-            .draw_series(members.iter().map(|p| Circle::new((p.x, p.y), 7, colour.filled())))
+        chart
+            .draw_series(members.iter().filter(|p| !p.edge).map(|p| Circle::new((p.x, p.y), 7, colour.filled())))
             .map_err(|e| err(&e))?;
-        if main {
-            series.label(name.clone()).legend(move |(x, y)| Circle::new((x + 15, y), 7, colour.filled()));
+        // A point at the edge: a triangle pointing off the plot (down below the range, up at the top).
+        for p in members.iter().filter(|p| p.edge) {
+            let (cx, cy) = chart.backend_coord(&(p.x, p.y));
+            let down = p.y < (y0 * y1).sqrt();
+            let (tip, base) = if down { (cy + 9, cy - 7) } else { (cy - 9, cy + 7) };
+            let base_pixel = area.get_base_pixel();
+            let pts = vec![(cx - 9, base), (cx + 9, base), (cx, tip)]
+                .into_iter()
+                .map(|(x, y)| (x - base_pixel.0, y - base_pixel.1))
+                .collect::<Vec<_>>();
+            area.draw(&Polygon::new(pts, colour.filled())).map_err(|e| err(&e))?;
         }
     }
-    draw_labels(area, pts, numbers, |p| chart.backend_coord(&(p.x, p.y)))?;
-    if main {
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .label_font((FONT, 22))
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()
-            .map_err(|e| err(&e))?;
-    }
+    // Labels stay inside the plotting area (not over the axes' ticks); the groups' key is beside the plots.
+    let (xs, ys) = chart.plotting_area().get_pixel_range();
+    let inside = Rect { x0: xs.start as f64, y0: ys.start as f64, x1: xs.end as f64, y1: ys.end as f64 };
+    draw_labels(area, inside, pts, numbers, |p| chart.backend_coord(&(p.x, p.y)))?;
     Ok(())
 }
 
@@ -206,13 +228,12 @@ fn scatter_panel(
 /// is still drawn, and listed in the key or the table). `coord` is a point's pixel in the chart.
 fn draw_labels(
     area: &Area,
+    inside: Rect,
     pts: &[&Point],
     numbers: &[(usize, &Point)],
     coord: impl Fn(&Point) -> (i32, i32),
 ) -> Result<()> {
-    let (xs, ys) = area.get_pixel_range();
-    let mut placer =
-        Placer::new(Rect { x0: xs.start as f64, y0: ys.start as f64, x1: xs.end as f64, y1: ys.end as f64 });
+    let mut placer = Placer::new(inside);
     for p in pts {
         let (x, y) = coord(p);
         let r = 8.0;
@@ -235,21 +256,38 @@ fn draw_labels(
             let leader = vec![(x - base.0, y - base.1), (nx as i32 - base.0, ny as i32 - base.1)];
             area.draw(&PathElement::new(leader, palette(p.group).mix(0.6))).map_err(|e| anyhow!("chart: {e}"))?;
         }
-        let font = (FONT, if p.highlight { 16 } else { 14 }).into_font().color(&palette(p.group).mix(0.95));
-        let at = (b.x0 as i32 - base.0, b.y0 as i32 - base.1);
-        area.draw(&Text::new(text, at, font)).map_err(|e| anyhow!("chart: {e}"))?;
+        let style = crate::export::text::Style {
+            size: if p.highlight { 16 } else { 14 },
+            bold: false,
+            colour: palette(p.group),
+            vertical: false,
+        };
+        crate::export::text::draw(area, &text, (b.x0 as i32 - base.0, b.y0 as i32 - base.1), style)?;
     }
     Ok(())
 }
 
-/// The key: each numbered point's number and label, in its group's colour.
-fn scatter_key(area: &Area, numbers: &[(usize, &Point)]) -> Result<()> {
+/// The key beside the plots, outside the data: the frontier's line and each group's colour, then each
+/// numbered point's number and label in its group's colour.
+fn scatter_key(area: &Area, legend: &[(usize, String)], numbers: &[(usize, &Point)]) -> Result<()> {
     let err = |e: &dyn std::fmt::Display| anyhow!("chart: {e}");
-    area.draw(&Text::new("Numbered points", (10, 30), (FONT, 20).into_font())).map_err(|e| err(&e))?;
-    let line = ((area.dim_in_pixel().1 as i32 - 80) / numbers.len().max(1) as i32).clamp(10, 22);
+    let ink = |size: u32, colour: RGBColor| crate::export::text::Style { size, bold: false, colour, vertical: false };
+    let mut y = 16;
+    area.draw(&PathElement::new(vec![(10, y + 10), (40, y + 10)], RED.stroke_width(3))).map_err(|e| err(&e))?;
+    crate::export::text::draw(area, "Pareto frontier", (48, y), ink(18, BLACK))?;
+    for (group, name) in legend {
+        y += 24;
+        area.draw(&Circle::new((25, y + 10), 7, palette(*group).filled())).map_err(|e| err(&e))?;
+        crate::export::text::draw(area, name, (48, y), ink(18, BLACK))?;
+    }
+    y += 44;
+    crate::export::text::draw(area, "Numbered points", (10, y), ink(20, BLACK))?;
+    let top = y + 32;
+    let line = ((area.dim_in_pixel().1 as i32 - top - 20) / numbers.len().max(1) as i32).clamp(10, 22);
     for (i, (n, p)) in numbers.iter().enumerate() {
-        let font = (FONT, (line - 4).min(16)).into_font().color(&palette(p.group));
-        area.draw(&Text::new(format!("{n}  {}", p.label), (10, 60 + i as i32 * line), font)).map_err(|e| err(&e))?;
+        let size = (line - 4).min(16) as u32;
+        let at = (10, top + i as i32 * line);
+        crate::export::text::draw(area, &format!("{n}  {}", p.label), at, ink(size, palette(p.group)))?;
     }
     Ok(())
 }
@@ -264,11 +302,8 @@ pub fn scatter_log_y(path: &Path, spec: &Scatter, points: &[Point]) -> Result<()
     if finite.is_empty() {
         return Err(anyhow!("chart {}: no point with finite coordinates", path.display()));
     }
-    let ys = (
-        finite.iter().copied().fold(f64::INFINITY, f64::min) / 3.0,
-        finite.iter().copied().fold(f64::NEG_INFINITY, f64::max) * 3.0,
-    );
-    let pinned = pinned(points, ys.1);
+    let ys = fit_log_range(&finite);
+    let pinned = pinned(points, ys);
     let split = spec.split_x.filter(|s| pinned.iter().any(|p| p.x > *s));
     let (main_pts, side_pts): (Vec<&Point>, Vec<&Point>) = pinned.iter().partition(|p| split.is_none_or(|s| p.x <= s));
     let numbers: Vec<(usize, &Point)> =
@@ -283,7 +318,7 @@ pub fn scatter_log_y(path: &Path, spec: &Scatter, points: &[Point]) -> Result<()
             scatter_panel(&left, spec, &main_pts, &numbers, ys, true)?;
             scatter_panel(&right, spec, &side_pts, &numbers, ys, false)?;
         }
-        scatter_key(&key, &numbers)
+        scatter_key(&key, spec.legend, &numbers)
     })
 }
 
@@ -385,6 +420,28 @@ pub fn line_panels(
 mod tests {
     use super::*;
 
+    /// Two specs five decades below the rest are drawn at the bottom edge, marked, with their value; the
+    /// range keeps every other point.
+    #[test]
+    fn the_error_axis_fits_the_bulk_and_pins_far_outliers_to_its_edge() {
+        let mut ys: Vec<f64> = (0..60).map(|k| 0.08 + 0.01 * f64::from(k % 30)).collect();
+        ys.extend([5e-7, 5.2e-7]);
+        let (lo, hi) = fit_log_range(&ys);
+        assert!(lo > 1e-4 && lo < 0.08 / 300.0 && hi >= 0.37 * 3.0 - 1e-9, "{lo} {hi}");
+        let points: Vec<Point> = ys
+            .iter()
+            .map(|&y| Point { x: 1.0, x_lo: 1.0, x_hi: 1.0, y, label: "p".into(), ..Point::default() })
+            .collect();
+        let drawn = pinned(&points, (lo, hi));
+        let edge: Vec<&Point> = drawn.iter().filter(|p| p.edge).collect();
+        assert_eq!(edge.len(), 2, "the two far below");
+        assert!(edge.iter().all(|p| p.y > lo && p.y < 2.0 * lo && p.label.contains("e-7, below")), "{edge:?}");
+        assert!(drawn.iter().filter(|p| !p.edge).all(|p| p.y >= 0.08), "the rest where they are");
+        // Without outliers the range is the data's own.
+        let (lo2, _) = fit_log_range(&ys[..60]);
+        assert!((lo2 - 0.08 / 3.0).abs() < 1e-12, "{lo2}");
+    }
+
     #[test]
     fn scatter_with_non_finite_points_finishes() {
         let dir = tempfile::tempdir().unwrap();
@@ -396,6 +453,7 @@ mod tests {
             label: label.into(),
             group,
             highlight,
+            edge: false,
         };
         let points = vec![
             point(1.0, 0.1, "a", 0, true),

@@ -47,7 +47,8 @@ pub fn label(
     size: i32,
     colour: RGBColor,
 ) -> Result<()> {
-    root.draw(&Text::new(text.to_string(), (x, y), (FONT, size).into_font().color(&colour))).map_err(|e| anyhow!("{e}"))
+    let style = crate::export::text::Style { size: size.max(1) as u32, bold: false, colour, vertical: false };
+    crate::export::text::draw(root, text, (x, y), style)
 }
 
 /// Viridis colour map (matplotlib's, 9 control points, linear in between) for t in [0, 1].
@@ -69,22 +70,45 @@ pub fn viridis(t: f32) -> [u8; 3] {
     [0, 1, 2].map(|c| (P[i][c] * (1.0 - f) + P[i + 1][c] * f).round() as u8)
 }
 
-/// A vertical viridis bar from 0 (bottom) to `scale` (top), the top labelled with `markdown::sig` (three
-/// significant figures: a scale of 0.003 reads 0.003, not 0.00).
-pub fn colour_bar(
+/// Where `v` falls on a log scale from `floor` (0) to `top` (1); 0 below the floor.
+pub fn log_position(v: f32, floor: f32, top: f32) -> f32 {
+    if v < floor {
+        return 0.0;
+    }
+    if top <= floor {
+        return 1.0;
+    }
+    ((v / floor).ln() / (top / floor).ln()).clamp(0.0, 1.0)
+}
+
+/// A vertical viridis bar on a log scale from `floor` (bottom) to `top`, labelled at `top`, at each decade
+/// between (where the labels keep apart) and, at the bottom, "< floor" for values under it.
+pub fn log_colour_bar(
     root: &DrawingArea<BitMapBackend, plotters::coord::Shift>,
-    x0: i32,
-    y0: i32,
-    h: i32,
-    scale: f32,
+    (x0, y0, h): (i32, i32, i32),
+    floor: f32,
+    top: f32,
 ) -> Result<()> {
     for y in 0..h {
         let c = viridis(1.0 - y as f32 / (h - 1) as f32);
         root.draw(&Rectangle::new([(x0, y0 + y), (x0 + 14, y0 + y + 1)], RGBColor(c[0], c[1], c[2]).filled()))
             .map_err(|e| anyhow!("{e}"))?;
     }
-    label(root, &sig(f64::from(scale), 3), x0 + 16, y0, 12, BLACK)?;
-    label(root, "0", x0 + 16, y0 + h - 12, 12, BLACK)
+    let at = |v: f32| y0 + ((1.0 - log_position(v, floor, top)) * (h - 1) as f32).round() as i32;
+    let mut marks: Vec<(i32, String)> =
+        vec![(y0, sig(f64::from(top), 2)), (y0 + h - 12, format!("<{}", sig(f64::from(floor), 2)))];
+    let mut decade = 10f32.powf(floor.log10().ceil());
+    while decade < top {
+        let y = at(decade) - 6;
+        if marks.iter().all(|(m, _)| (m - y).abs() >= 16) {
+            marks.push((y, sig(f64::from(decade), 1)));
+        }
+        decade *= 10.0;
+    }
+    for (y, text) in marks {
+        label(root, &text, x0 + 18, y, 12, BLACK)?;
+    }
+    Ok(())
 }
 
 /// One lobe panel's size in pixels (`draw_lobes` adds a 40-pixel title).
@@ -146,4 +170,20 @@ pub fn draw_lobes(
             .map_err(|e| err(&e))?;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::log_position;
+
+    #[test]
+    fn the_log_scale_spreads_decades_evenly_and_zeroes_below_its_floor() {
+        let (floor, top) = (1e-3f32, 1.0f32);
+        assert_eq!(log_position(1e-4, floor, top), 0.0);
+        assert!((log_position(1e-3, floor, top)).abs() < 1e-6);
+        assert!((log_position(1e-2, floor, top) - 1.0 / 3.0).abs() < 1e-5);
+        assert!((log_position(1e-1, floor, top) - 2.0 / 3.0).abs() < 1e-5);
+        assert_eq!(log_position(5.0, floor, top), 1.0);
+        assert_eq!(log_position(0.5, 1.0, 1.0), 0.0, "below a floor that is the top");
+    }
 }

@@ -56,7 +56,7 @@ pub struct Row {
     pub spec: Option<String>,
     /// Lights per pixel of this row's workload, and the evaluations one run of it makes.
     pub lights: u32,
-    #[serde(skip_deserializing)]
+    #[serde(default)]
     pub evaluations_per_dispatch: u64,
     pub ns_per_eval: Estimate,
     #[serde(skip_deserializing)]

@@ -198,8 +198,14 @@ pub fn profiles(inputs: &[Input]) -> String {
     s
 }
 
-/// A cost table across devices: net cost and net relative to ggx per column; rows keyed `devices/<model>`,
-/// columns `c<j>` (net) and `c<j>r` (relative); the rank correlations after it.
+/// A cost column's device: its name without the unit ("navi21 cycles/eval" -> "navi21").
+fn device_of(column: &str) -> &str {
+    column.rsplit_once(' ').map_or(column, |(d, _)| d)
+}
+
+/// A cost table across devices, folded under its one-line finding: the table (net cost and net relative to
+/// ggx per column; rows keyed `devices/<model>`, columns `c<j>` and `c<j>r`), the cost rules said once per
+/// unit, and the rank correlations as a matrix.
 pub fn cost_table_html(table: &CostTable) -> String {
     let mut columns: Vec<(String, String)> = vec![("model".into(), "model".into())];
     for (j, c) in table.columns.iter().enumerate() {
@@ -208,51 +214,121 @@ pub fn cost_table_html(table: &CostTable) -> String {
     }
     let refs: Vec<(&str, &str)> = columns.iter().map(|(k, h)| (k.as_str(), h.as_str())).collect();
     let mut t = HtmlTable::new(&refs);
+    let mut spread: Vec<(f64, &str, &str)> = Vec::new();
     for m in &table.models {
         let mut cells = vec![Cell::text(m.clone())];
         for c in &table.columns {
             cells.push(num_cell(c.net.get(m).copied()));
-            cells.push(num_cell(table.relative(c, m)));
+            let r = table.relative(c, m);
+            if let Some(r) = r.filter(|r| *r > 0.0 && m != crate::brdf::spec::REFERENCE_MODEL) {
+                spread.push((r, m, device_of(&c.name)));
+            }
+            cells.push(num_cell(r));
         }
         t.row(format!("devices/{m}"), cells);
     }
-    let mut corr = HtmlTable::new(&[
-        ("a", "device A"),
-        ("b", "device B"),
-        ("models", "models"),
-        ("rho", "Spearman rho (net)"),
-        ("ci", "95% CI"),
-        ("discordant", "discordant pairs"),
-    ]);
-    let ci = |p: &crate::compare::PairCorrelation| {
-        Cell::text(p.spearman_ci.map_or("-".into(), |(lo, hi)| format!("[{lo:.2}, {hi:.2}]")))
-    };
-    for (k, p) in table.correlations.iter().chain(&table.spirv_baseline).enumerate() {
-        // A rho without its CI (too few models) is not shown.
-        corr.row(
-            format!("rho/{k}"),
-            vec![
-                Cell::text(p.a.clone()),
-                Cell::text(p.b.clone()),
-                count_cell(p.models),
-                num_cell(p.spearman_net.filter(|_| p.spearman_ci.is_some())),
-                ci(p),
-                Cell::text(p.discordant_cell()),
-            ],
-        );
+    // Each rule once: the columns that share a unit's text (one vendor's families) are named together.
+    let mut units: Vec<(&str, Vec<&str>)> = Vec::new();
+    for c in &table.columns {
+        match units.iter_mut().find(|(u, _)| *u == c.unit) {
+            Some((_, names)) => names.push(device_of(&c.name)),
+            None => units.push((&c.unit, vec![device_of(&c.name)])),
+        }
     }
-    let units: Vec<String> = table
-        .columns
+    let rules: String = units
         .iter()
-        .map(|c| format!("<b>{}</b>: {} ({})", esc(&c.name), esc(&c.unit), esc(&c.source)))
+        .map(|(unit, names)| format!("<li><b>{}</b>: {}</li>", esc(&names.join(", ")), esc(unit)))
         .collect();
+    let sources: Vec<String> =
+        table.columns.iter().map(|c| format!("{}: {}", esc(device_of(&c.name)), esc(&c.source))).collect();
+    spread.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let range = match (spread.first(), spread.last()) {
+        (Some(lo), Some(hi)) => format!(
+            "; net x ggx from {} ({} on {}) to {} ({} on {})",
+            sig(lo.0, DIGITS),
+            esc(lo.1),
+            esc(lo.2),
+            sig(hi.0, DIGITS),
+            esc(hi.1),
+            esc(hi.2)
+        ),
+        _ => String::new(),
+    };
+    let (matrix, agreement) = rank_matrix(table);
+    let models = table.models.iter().filter(|m| *m != crate::model::BASELINE_LABEL).count();
     format!(
-        "{}<p class=\"note\">{}</p><h3>Rank correlations</h3>{}<p class=\"note\">{}</p>",
-        t.html(),
-        units.join("<br>"),
-        corr.html(),
-        crate::compare::RHO_NOTE
+        "<p class=\"note\"><b>{models} models on {} devices{range}.</b> {agreement}</p>{}{}{}",
+        table.columns.len(),
+        html::fold(
+            &format!("The cost table: net cost and x ggx on each of {} devices", table.columns.len()),
+            &t.html()
+        ),
+        html::fold(
+            &format!("The cost rules, once per unit ({} rules)", units.len()),
+            &format!("<ul class=\"note\">{rules}</ul><p class=\"note\">Sources: {}</p>", sources.join("; "))
+        ),
+        html::fold("Rank correlations between devices (Spearman rho, matrix)", &matrix)
     )
+}
+
+/// The rank correlations as a devices x devices matrix (rows keyed `rho/<device>`, each cell's `data-v` its
+/// rho), a rho whose CI includes 0 or that has none greyed; and the one-line agreement finding.
+fn rank_matrix(table: &CostTable) -> (String, String) {
+    let pairs: Vec<&crate::compare::PairCorrelation> = table.correlations.iter().chain(&table.spirv_baseline).collect();
+    let mut names: Vec<&str> = Vec::new();
+    for p in &pairs {
+        for n in [p.a.as_str(), p.b.as_str()] {
+            if !names.contains(&n) {
+                names.push(n);
+            }
+        }
+    }
+    let certain = |p: &crate::compare::PairCorrelation| p.spearman_ci.is_some_and(|(lo, hi)| lo > 0.0 || hi < 0.0);
+    let mut rhos: Vec<f64> = pairs.iter().filter_map(|p| p.spearman_net.filter(|_| p.spearman_ci.is_some())).collect();
+    rhos.sort_by(f64::total_cmp);
+    let sure = pairs.iter().filter(|p| certain(p)).count();
+    let agreement = match rhos.len() {
+        0 => "Too few models in common to rank the devices against each other.".to_string(),
+        n => format!(
+            "Rank agreement between devices: median Spearman rho {:.2} over {n} pairs; {sure} of them with a 95% CI that excludes 0.",
+            rhos[n / 2]
+        ),
+    };
+    let mut s = String::from("<table class=\"matrix\"><thead><tr><th></th>");
+    for n in &names {
+        let _ = write!(s, "<th><span>{}</span></th>", esc(device_of(n)));
+    }
+    s += "</tr></thead><tbody>\n";
+    for a in &names {
+        let _ = write!(s, "<tr data-row=\"rho/{}\"><td>{}</td>", esc(a), esc(device_of(a)));
+        for b in &names {
+            let p = pairs.iter().find(|p| (p.a == *a && p.b == *b) || (p.a == *b && p.b == *a));
+            match p.and_then(|p| p.spearman_net.filter(|_| p.spearman_ci.is_some()).map(|r| (p, r))) {
+                Some((p, r)) => {
+                    let (lo, hi) = p.spearman_ci.unwrap_or((-1.0, 1.0));
+                    let _ = write!(
+                        s,
+                        "<td data-col=\"{}\" data-v=\"{r:e}\" class=\"n{}\" title=\"{} / {}: rho {r:.2}, 95% CI [{lo:.2}, {hi:.2}], {} models, discordant pairs {}\">{r:.2}</td>",
+                        esc(b),
+                        if certain(p) { "" } else { " uncertain" },
+                        esc(a),
+                        esc(b),
+                        p.models,
+                        esc(&p.discordant_cell())
+                    );
+                }
+                None => s += "<td></td>",
+            }
+        }
+        s += "</tr>\n";
+    }
+    s += "</tbody></table>";
+    let _ = write!(
+        s,
+        "<p class=\"note\">Greyed: a rho whose 95% CI includes 0 (too few models to tell the order apart). Hover a cell for its CI, model count and discordant pairs. {}</p>",
+        crate::compare::RHO_NOTE
+    );
+    (s, agreement)
 }
 
 /// Cost per source line (`inspect --lines`): per device and model, the costliest lines with their share of
@@ -366,7 +442,22 @@ pub fn sweep_chart(w: &SweepReport) -> String {
                 err_text(&r.accuracy.vs_exact)
             );
             let half = r.canonical.contains("precision=f16");
-            (Point { x: cost.median, y: err, label: r.label.clone(), tip, emphasis: r.pareto }, half)
+            (Point { x: cost.median, y: err, label: r.label.clone(), tip, emphasis: r.pareto, edge: false }, half)
+        })
+        .collect();
+    // The error axis fitted to the bulk of the specs (as the PNG's): one far below the rest sits at its
+    // bottom edge, marked, its value in its label.
+    let (lo, hi) = crate::export::png::fit_log_range(&points.iter().map(|(p, _)| p.y).collect::<Vec<_>>());
+    let points: Vec<(Point, bool)> = points
+        .into_iter()
+        .map(|(mut p, half)| {
+            if p.y.is_finite() && p.y > 0.0 && p.y < lo {
+                p.label = format!("{} ({:.1e}, below)", p.label, p.y);
+                p.tip += "\n(drawn at the axis's bottom edge: below its range)";
+                p.y = lo * 1.25;
+                p.edge = true;
+            }
+            (p, half)
         })
         .collect();
     let drawable = |p: &Point| p.x.is_finite() && p.x > 0.0 && p.y.is_finite() && p.y > 0.0;
@@ -377,10 +468,12 @@ pub fn sweep_chart(w: &SweepReport) -> String {
         (m.into_iter().map(|(p, _)| p).collect(), s.into_iter().map(|(p, _)| p).collect())
     };
     let xs = |pts: &[Point]| Axis::fit(pts.iter().filter(|p| drawable(p)).map(|p| p.x), true);
-    let (Some(y), Some(x)) = (
-        Axis::fit(main.iter().chain(&side).filter(|p| drawable(p)).map(|p| p.y), true),
-        xs(&main).or_else(|| xs(&side)),
-    ) else {
+    let fitted = Axis::fit(main.iter().chain(&side).filter(|p| drawable(p)).map(|p| p.y), true).map(|a| Axis {
+        lo: a.lo.max(lo),
+        hi: a.hi.min(hi).max(a.lo.max(lo) * 10.0),
+        log: true,
+    });
+    let (Some(y), Some(x)) = (fitted, xs(&main).or_else(|| xs(&side))) else {
         return "<p class=\"note\">No spec has a finite, positive cost and error to draw.</p>".into();
     };
     let (x_label, y_label) = ("net ns per evaluation (log)", "RMS relative error vs exact (log)");
@@ -447,7 +540,7 @@ pub fn sweep_html(i: usize, w: &SweepReport, path: &str) -> String {
         esc(&w.sample_set),
         esc(&w.fastest),
         sweep_chart(w),
-        t.html()
+        html::fold(&format!("Every spec's cost and accuracy ({} rows)", w.rows.len()), &t.html())
     )
 }
 
@@ -549,8 +642,104 @@ fn heat_map(s: &SpecStability, triples: &[[u32; 3]]) -> Result<String> {
     ))
 }
 
-/// One stability report: the summary table (rows keyed `stability<i>/<spec>`) and a heat map per spec with
-/// bad values.
+/// What a failing result is: NaN before Inf before negative (the text `Failure::result` writes).
+fn result_class(result: &str) -> &'static str {
+    if result.contains("NaN") {
+        "NaN"
+    } else if result.contains("inf") {
+        "Inf"
+    } else {
+        "negative"
+    }
+}
+
+/// Causes shown before the fold.
+const CAUSES_SHOWN: usize = 10;
+
+/// The failing specs grouped by cause: one row per (hard case or the grid, what it gives, the input guards that
+/// remove it), with the specs that fail so, most specs first (rows keyed `cause<i>/<k>`); and how many causes.
+fn failure_causes(i: usize, st: &StabilityReport) -> (String, usize) {
+    // (case, result, removed by) -> spec labels
+    let mut causes: Vec<((String, &'static str, String), Vec<&str>)> = Vec::new();
+    for spec in st.specs.iter().filter(|x| x.fails() && !super::summary::is_guard_variant(&x.spec)) {
+        let f = &spec.failures;
+        let mut keys: Vec<(String, &'static str, String)> = f
+            .cases
+            .iter()
+            .map(|c| (c.at.clone(), result_class(&c.result), crate::stability::failures::removed_text(c)))
+            .collect();
+        if f.grid_points > 0 {
+            let all: Vec<String> = f
+                .grid_removed_by
+                .iter()
+                .filter(|g| g.removes == f.grid_points && g.guard != crate::stability::failures::ALL_GUARDS)
+                .map(|g| format!("`{}`", g.guard))
+                .collect();
+            let class = f.grid_examples.first().map_or("bad value", |e| result_class(&e.result));
+            let removed = if all.is_empty() {
+                "no input guard alone removes every point".to_string()
+            } else {
+                format!("removed by {}", all.join(", "))
+            };
+            keys.push(("the grid (NoV x roughness)".to_string(), class, removed));
+        }
+        keys.dedup();
+        for key in keys {
+            match causes.iter_mut().find(|(k, _)| *k == key) {
+                Some((_, specs)) => specs.push(spec.label()),
+                None => causes.push((key, vec![spec.label()])),
+            }
+        }
+    }
+    causes.sort_by(|a, b| b.1.len().cmp(&a.1.len()));
+    let table = |rows: &[((String, &'static str, String), Vec<&str>)], from: usize| {
+        let mut t = HtmlTable::new(&[
+            ("case", "where"),
+            ("result", "gives"),
+            ("removed", "input guards"),
+            ("specs", "specs"),
+            ("which", "which (hover for all)"),
+        ]);
+        for (k, ((case, class, removed), specs)) in rows.iter().enumerate() {
+            let few: Vec<&str> = specs.iter().take(4).copied().collect();
+            let more =
+                if specs.len() > few.len() { format!(" +{} more", specs.len() - few.len()) } else { String::new() };
+            t.row(
+                format!("cause{i}/{}", from + k),
+                vec![
+                    Cell::text(case.clone()),
+                    Cell::text(class.to_string()),
+                    Cell::text(removed.replace('`', "")),
+                    count_cell(specs.len()),
+                    Cell::text(format!("{}{more}", few.join(", "))),
+                ],
+            );
+        }
+        // Every spec of a cause in its row's tooltip.
+        let mut h = t.html();
+        for (k, (_, specs)) in rows.iter().enumerate() {
+            let row = format!("<tr data-row=\"cause{i}/{}\">", from + k);
+            let tip = format!("<tr data-row=\"cause{i}/{}\" data-tip=\"{}\">", from + k, esc(&specs.join("\n")));
+            h = h.replacen(&row, &tip, 1);
+        }
+        h
+    };
+    if causes.is_empty() {
+        return (String::new(), 0);
+    }
+    let (first, rest) = causes.split_at(causes.len().min(CAUSES_SHOWN));
+    let mut s = format!(
+        "<h3>The failures by cause</h3><p class=\"note\">Each hard case (or the grid) that gives NaN, Inf or a negative value, with the input guards (as a caller could apply them) that remove it, and the specs that fail there; a spec failing several cases is under each.</p>{}",
+        table(first, 0)
+    );
+    if !rest.is_empty() {
+        s += &html::fold(&format!("{} more cause(s)", rest.len()), &table(rest, first.len()));
+    }
+    (s, causes.len())
+}
+
+/// One stability report: its finding, the failures by cause, then folded the summary table (rows keyed
+/// `stability<i>/<spec>`), a heat map per spec with bad values, and where each spec fails.
 pub fn stability_html(i: usize, st: &StabilityReport, path: &str) -> Result<String> {
     let mut t = HtmlTable::new(&STABILITY_COLUMNS);
     for s in &st.specs {
@@ -558,25 +747,35 @@ pub fn stability_html(i: usize, st: &StabilityReport, path: &str) -> Result<Stri
     }
     let failing = st.specs.iter().filter(|s| s.fails()).count();
     let mut maps = String::new();
+    let mut drawn = 0;
     for s in &st.specs {
         if let Some(cells) = s.bad_cell_triples.as_ref().filter(|c| !c.is_empty()) {
             maps += &heat_map(s, cells)?;
+            drawn += 1;
         }
     }
-    let located = located_failures(st) + &out_of_tolerance_html(st) + &bounds_html(st);
+    let (causes, n_causes) = failure_causes(i, st);
     let maps = if maps.is_empty() {
         "<p class=\"note\">No spec gives a bad value on the grid.</p>".to_string()
     } else {
-        format!(
-            "<h3>Where the bad values are (grid of NoV x roughness, all azimuths and NoL)</h3><div class=\"heat\">{maps}</div>"
+        html::fold(
+            &format!("Where the bad values are: {drawn} heat map(s) of NoV x roughness (all azimuths and NoL)"),
+            &format!("<div class=\"heat\">{maps}</div>"),
         )
     };
+    let out_of_tolerance = st.specs.iter().filter(|s| s.checked() && s.grid_out_of_tolerance > 0).count();
+    let located = located_failures(st) + &out_of_tolerance_html(st) + &bounds_html(st);
+    let verdict = if failing == 0 {
+        "none fails".to_string()
+    } else {
+        format!("{failing} fail (NaN, Inf or negative on valid inputs), from {n_causes} cause(s)")
+    };
     Ok(format!(
-        "<h3>{path}</h3><p class=\"note\">{} specs, {failing} failing (NaN, Inf or negative on valid inputs); {} hard cases; {} grid points. Deviation in units of the tolerance.</p>{}{maps}{located}",
+        "<h3>{path}</h3><p class=\"note\"><b>{} specs: {verdict}; {out_of_tolerance} out of tolerance on the grid.</b> {} hard cases; {} grid points; deviation in units of the tolerance.</p>{causes}{}{maps}{located}",
         st.specs.len(),
         st.cases.len(),
         st.grid_points,
-        t.html()
+        html::fold(&format!("Every spec's figures ({} rows)", st.specs.len()), &t.html()),
     ))
 }
 
@@ -637,9 +836,12 @@ fn bounds_html(st: &StabilityReport) -> String {
     if !any {
         return String::new();
     }
-    format!(
-        "<h3>At the domain's bounds</h3><p class=\"note\">Each declared domain's own ends, against the formula's exact value (no floor), with what the kernel's precision loses there, said even within tolerance.</p>{}",
-        t.html()
+    html::fold(
+        "At the domain's bounds: what the precision loses at each declared domain's ends",
+        &format!(
+            "<p class=\"note\">Each declared domain's own ends, against the formula's exact value (no floor), with what the kernel's precision loses there, said even within tolerance.</p>{}",
+            t.html()
+        ),
     )
 }
 
@@ -656,8 +858,11 @@ fn located_failures(st: &StabilityReport) -> String {
         located += &format!("<li><b>{}</b><ul>{items}</ul></li>", esc(s.label()));
     }
     if !located.is_empty() {
-        located = format!(
-            "<h3>Where the failing specs fail</h3><p class=\"note\">Each failing hard case with its inputs, the grid's failing points, and the input guards (roughness floor, cosine floor, safe half vector, lit mask, F0 clamp, as a caller could apply them) that remove each.</p><ul class=\"failures\">{located}</ul>"
+        located = html::fold(
+            "Where each failing spec fails: every case's inputs and result",
+            &format!(
+                "<p class=\"note\">Each failing hard case with its inputs, the grid's failing points, and the input guards (roughness floor, cosine floor, safe half vector, lit mask, F0 clamp, as a caller could apply them) that remove each.</p><ul class=\"failures\">{located}</ul>"
+            ),
         );
     }
     located

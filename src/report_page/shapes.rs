@@ -279,7 +279,7 @@ fn overlay_svg(lobes: &[(String, Vec<[f32; 3]>)]) -> String {
     let legend: Vec<String> = lobes
         .iter()
         .enumerate()
-        .map(|(k, (label, _))| format!("<span style=\"color:{}\">&#9632; {}</span>", html::colour(k), esc(label)))
+        .map(|(k, (label, _))| format!("<span class=\"key\">{}{}</span>", html::series_swatch(k), esc(label)))
         .collect();
     format!(
         "<div class=\"model overlay\" data-model=\"overlay\"><h3>All models overlaid</h3><p class=\"note\">One scale for all models: the rim is the largest f_s of any model at that incidence, so a model brighter or darker than another draws so.</p><figure data-scale=\"common\"><div class=\"row\">{}</div><figcaption>{}</figcaption></figure><details><summary>Each model scaled to its own peak (shapes only)</summary><figure data-scale=\"peak\"><div class=\"row\">{}</div></figure></details></div>",
@@ -293,7 +293,7 @@ fn overlay_svg(lobes: &[(String, Vec<[f32; 3]>)]) -> String {
 /// says why in its place).
 pub fn section(gpu: &Gpu, models: &[(String, String)]) -> Result<String> {
     let mut s = format!(
-        "<p class=\"note\">Evaluated now on {} by the same kernels that were measured. Lobes: f_s in the plane of incidence, roughness {LOBE_ROUGHNESS}, F0 {}, light at each incidence angle on the left (dashed), view over the plane; each card's plots scaled to that model's peak, the overlay of all models to one common scale. Spheres: f_s NoL pi, F0 ({}, {}, {}), one directional light, tone-mapped (ACES, sRGB); magenta where a value is NaN or Inf. Albedo: E(NoV) with F = 1.</p><div class=\"models\">",
+        "<p class=\"note\">Evaluated now on {} by the same kernels that were measured. Lobes: f_s in the plane of incidence, roughness {LOBE_ROUGHNESS}, F0 {}, light at each incidence angle on the left (dashed), view over the plane; each card's plots scaled to that model's peak, the overlay of all models to one common scale. Spheres: f_s NoL pi, F0 ({}, {}, {}), one directional light, tone-mapped (ACES, sRGB); magenta where a value is NaN or Inf. Albedo: E(NoV) with F = 1.</p>",
         esc(&gpu.info.name),
         LOBE_F0[0],
         SPHERE_F0[0],
@@ -322,7 +322,19 @@ pub fn section(gpu: &Gpu, models: &[(String, String)]) -> Result<String> {
     if lobes.len() > 1 {
         s += &overlay_svg(&lobes);
     }
-    s += &cards;
+    let drawn = models.len().min(MAX_MODELS);
+    let cards = format!("<div class=\"models\">{cards}</div>");
+    // With one model its card is the section; with several the overlay says the most, the cards fold.
+    if drawn > 1 {
+        s += &crate::export::html::fold(
+            &format!(
+                "One card per model ({drawn}): lobes at 0, 30, 60 and 80 degrees, lit spheres, directional albedo"
+            ),
+            &cards,
+        );
+    } else {
+        s += &cards;
+    }
     if models.len() > MAX_MODELS {
         let _ = write!(
             s,
@@ -330,7 +342,7 @@ pub fn section(gpu: &Gpu, models: &[(String, String)]) -> Result<String> {
             models.len() - MAX_MODELS
         );
     }
-    Ok(s + "</div>")
+    Ok(s)
 }
 
 #[cfg(test)]

@@ -9,7 +9,7 @@ use super::gbuffer::{self, GBuffer};
 use super::plan;
 use super::run;
 use crate::export::png;
-use crate::export::raster::{LOBE_PANEL, blit, colour_bar, draw_lobes, label, tone_map, viridis};
+use crate::export::raster::{LOBE_PANEL, blit, draw_lobes, label, log_colour_bar, log_position, tone_map, viridis};
 use crate::gpu::Gpu;
 use crate::kernels::{self, RunLimits};
 use crate::model::Model as BrdfModel;
@@ -67,7 +67,11 @@ fn display(hdr: &[[f32; 3]], exposure: f32) -> (Vec<[u8; 3]>, usize) {
 }
 
 /// Difference heat maps against the reference model, in displayed luminance (what a viewer sees), one shared
-/// scale per scene.
+/// log scale per scene from one display level (1/255: what a viewer can see at all) to the largest
+/// difference, so that small differences spread over the colours instead of all reading as the darkest.
+/// One step of an 8-bit display: the smallest difference a viewer can see.
+const LEVEL: f32 = 1.0 / 255.0;
+
 fn difference_maps(g: &GBuffer, models: &[BrdfModel], displayed: &[Vec<[u8; 3]>], out: &Path) -> Result<Vec<PathBuf>> {
     let reference = models.iter().position(|m| *m == BrdfModel::reference()).unwrap_or(0);
     let luma = |c: &[u8; 3]| (0.2126 * c[0] as f32 + 0.7152 * c[1] as f32 + 0.0722 * c[2] as f32) / 255.0;
@@ -79,15 +83,15 @@ fn difference_maps(g: &GBuffer, models: &[BrdfModel], displayed: &[Vec<[u8; 3]>]
     let mut files = Vec::new();
     for (i, d) in &diffs {
         let path = out.join(format!("diff-{}-vs-{}.png", slug(&models[*i]), slug(&models[reference])));
-        let px: Vec<[u8; 3]> = d.iter().map(|x| viridis(x / scale)).collect();
-        let bar = 60;
-        let title = format!("|{} - {}| in displayed luminance", models[*i].label(), models[reference].label());
+        let px: Vec<[u8; 3]> = d.iter().map(|&x| viridis(log_position(x, LEVEL, scale))).collect();
+        let bar = 80;
+        let title = format!("|{} - {}| in displayed luminance (log)", models[*i].label(), models[reference].label());
         let mean = d.iter().sum::<f32>() / d.len() as f32;
         png::render(&path, g.width + bar, g.height, |root| {
             blit(root, 0, 0, g.width, &px)?;
             label(root, &title, 8, 6, 16.max(g.height as i32 / 28), WHITE)?;
             label(root, &format!("mean {mean:.4}"), 8, g.height as i32 - 26, 16, WHITE)?;
-            colour_bar(root, g.width as i32 + 8, 10, g.height as i32 - 20, scale)
+            log_colour_bar(root, (g.width as i32 + 8, 10, g.height as i32 - 20), LEVEL, scale)
         })?;
         files.push(path);
     }

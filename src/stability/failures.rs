@@ -195,7 +195,7 @@ fn distinct(all: impl Iterator<Item = Failure>) -> Vec<Failure> {
 }
 
 /// The guards that remove a failure, as a sentence's end.
-fn removed_text(f: &Failure) -> String {
+pub fn removed_text(f: &Failure) -> String {
     let alone: Vec<&str> = f.removed_by.iter().map(String::as_str).filter(|n| *n != ALL_GUARDS).collect();
     match (alone.as_slice(), f.removed_by.iter().any(|n| n == ALL_GUARDS)) {
         ([], false) => "no input guard removes it".into(),

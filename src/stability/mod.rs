@@ -261,6 +261,21 @@ impl SpecStability {
         self.nan + self.inf + self.negative > 0
     }
 
+    /// The bad values per (roughness, NoV) grid cell, as measured or as read back from a report's triples.
+    pub fn dense_bad_cells(&self) -> Option<Vec<Vec<u32>>> {
+        if let Some(c) = &self.bad_cells {
+            return Some(c.clone());
+        }
+        let triples = self.bad_cell_triples.as_ref().filter(|t| !t.is_empty())?;
+        let mut cells = vec![vec![0u32; grid::COSINES.len()]; grid::ROUGHNESS.len()];
+        for &[r, v, n] in triples {
+            if let Some(c) = cells.get_mut(r as usize).and_then(|row| row.get_mut(v as usize)) {
+                *c = n;
+            }
+        }
+        Some(cells)
+    }
+
     /// What to call it: its label, or its spec in a report written before labels.
     pub fn label(&self) -> &str {
         if self.label.is_empty() { &self.spec } else { &self.label }
@@ -458,6 +473,50 @@ pub fn cases_cell(out: usize, run: usize, checked: bool) -> String {
 /// The jumps cell, as the Markdown and the HTML page both write it.
 pub fn jumps_cell(n: usize, checked: bool) -> String {
     if checked { n.to_string() } else { "- (no reference)".into() }
+}
+
+/// A heat-map cell's colour: light grey for none, then yellow to red by `n / most`.
+fn heat_colour(n: usize, most: f64) -> plotters::style::RGBColor {
+    use plotters::style::RGBColor;
+    if n == 0 {
+        return RGBColor(235, 235, 235);
+    }
+    let t = (n as f64 / most).clamp(0.0, 1.0);
+    RGBColor(255, (200.0 * (1.0 - t)) as u8, (60.0 * (1.0 - t)) as u8)
+}
+
+/// A panel's caption in at most two lines no wider than `width`: the largest size from 13 px down to 9 that
+/// fits, the spec split at the comma nearest its middle; past that, shortened in the middle with an ellipsis.
+fn fit_caption(label: &str, width: i32) -> (Vec<String>, u32) {
+    use crate::export::text::measure;
+    let fits = |t: &str, z: u32| measure(t, z, false).0 <= width;
+    let halves = || {
+        let commas: Vec<usize> = label.match_indices(',').map(|(i, _)| i).collect();
+        let mid = label.len() / 2;
+        commas
+            .into_iter()
+            .min_by_key(|&i| i.abs_diff(mid))
+            .map(|i| (label[..=i].to_string(), label[i + 1..].to_string()))
+    };
+    for z in (9..=13).rev() {
+        if fits(label, z) {
+            return (vec![label.to_string()], z);
+        }
+        if let Some((a, b)) = halves().filter(|(a, b)| fits(a, z) && fits(b, z)) {
+            return (vec![a, b], z);
+        }
+    }
+    let chars: Vec<char> = label.chars().collect();
+    let mut keep = chars.len();
+    while keep > 4 {
+        keep -= 1;
+        let t: String =
+            chars[..keep / 2].iter().chain(['\u{2026}'].iter()).chain(&chars[chars.len() - keep / 2..]).collect();
+        if fits(&t, 9) {
+            return (vec![t], 9);
+        }
+    }
+    (vec![label.to_string()], 9)
 }
 
 /// A heat-map cell's value on its axis (the grid's spacing is not even: each cell is labelled with its value).
@@ -785,34 +844,66 @@ impl StabilityReport {
         )
     }
 
-    /// A heat map per failing spec over (NoV, roughness): bad values per grid cell, one panel each.
+    /// A heat map per failing spec over (NoV, roughness): bad values per grid cell, one panel each, under a
+    /// title that counts what the Markdown counts and a colour key.
     pub fn heatmaps(&self, path: &std::path::Path) -> Result<bool> {
+        use crate::export::text::{self, Style};
         use plotters::prelude::*;
         let all = self.failing();
         // Every failing spec whose grid failed gets a panel (one that failed only in hard cases has no map, and
         // where none did there is no picture).
-        let failing: Vec<&SpecStability> = all.iter().copied().filter(|s| s.bad_cells.is_some()).collect();
+        let grids: Vec<(&SpecStability, Vec<Vec<u32>>)> =
+            all.iter().filter_map(|s| s.dense_bad_cells().map(|c| (*s, c))).collect();
+        let failing: Vec<&SpecStability> = grids.iter().map(|(s, _)| *s).collect();
         if failing.is_empty() {
             return Ok(false);
         }
+        let only_cases = all.len() - failing.len();
         let title = format!(
-            "{} of {} failing specs: NaN, Inf or negative results per (NoV, roughness) grid cell",
+            "{} failing specs (NaN, Inf or negative on valid inputs): a panel for each of the {} that fail on the (NoV, roughness) grid{}",
+            all.len(),
             failing.len(),
-            all.len()
+            if only_cases > 0 { format!("; {only_cases} fail only in hard cases") } else { String::new() }
         );
         let columns = 6usize.min(failing.len());
-        // The title fits the figure's width: about 0.55 em per character.
-        let title_size = (300.0 * columns as f64 / (0.55 * title.len() as f64)).min(20.0) as u32;
         let rows = failing.len().div_ceil(columns);
-        let (pw, ph) = (300u32, 230u32);
-        crate::export::png::render(path, pw * columns as u32, ph * rows as u32 + 40, |root| {
+        let (pw, ph, head, caption) = (300u32, 250u32, 76u32, 34u32);
+        let width = pw * columns as u32;
+        let ink = |size: u32, bold: bool| Style { size, bold, colour: BLACK, vertical: false };
+        crate::export::png::render(path, width, ph * rows as u32 + head, |root| {
             let err = |e: &dyn std::fmt::Display| anyhow::anyhow!("heat map: {e}");
-            let root = root.titled(&title, (crate::export::png::FONT, title_size)).map_err(|e| err(&e))?;
-            for (area, s) in root.split_evenly((rows, columns)).iter().zip(&failing) {
-                let cells = s.bad_cells.as_ref().expect("filtered above");
+            let (top, body) = root.split_vertically(head);
+            let size = (10..=20).rev().find(|&z| text::measure(&title, z, false).0 <= width as i32 - 20).unwrap_or(10);
+            text::draw(&top, &title, (10, 6), ink(size, false))?;
+            // The key: grey for none, then yellow to red up to each panel's own most.
+            let (kx, ky, kw) = (10, 42, 260);
+            top.draw(&Rectangle::new([(kx, ky), (kx + 22, ky + 14)], heat_colour(0, 1.0).filled()))
+                .map_err(|e| err(&e))?;
+            text::draw(&top, "none", (kx + 26, ky - 1), ink(13, false))?;
+            let gx = kx + 70;
+            for i in 0..kw {
+                let n = 1 + (i as usize * 999) / (kw as usize - 1);
+                let c = heat_colour(n, 1000.0);
+                top.draw(&Rectangle::new([(gx + i, ky), (gx + i + 1, ky + 14)], c.filled())).map_err(|e| err(&e))?;
+            }
+            text::draw(&top, "one bad value", (gx, ky + 16), ink(12, false))?;
+            let most = "the most in that panel";
+            text::draw(&top, most, (gx + kw - text::measure(most, 12, false).0, ky + 16), ink(12, false))?;
+            text::draw(&top, "bad values per cell (linear in each panel)", (gx + kw + 16, ky - 1), ink(13, false))?;
+            for (area, (s, cells)) in body.split_evenly((rows, columns)).iter().zip(&grids) {
                 let max = cells.iter().flatten().copied().max().unwrap_or(1).max(1) as f64;
-                let mut chart = ChartBuilder::on(area)
-                    .caption(&s.label, (crate::export::png::FONT, 12))
+                let (label_area, plot) = area.split_vertically(caption);
+                let (lines, size) = fit_caption(&s.label, pw as i32 - 12);
+                for (k, line) in lines.iter().enumerate() {
+                    let w = text::measure(line, size, false).0;
+                    text::draw(
+                        &label_area,
+                        line,
+                        ((pw as i32 - w) / 2, 2 + k as i32 * (size as i32 + 2)),
+                        ink(size, false),
+                    )?;
+                }
+                let mut chart = ChartBuilder::on(&plot)
                     .margin(6)
                     .x_label_area_size(28)
                     .y_label_area_size(36)
@@ -833,13 +924,7 @@ impl StabilityReport {
                 chart
                     .draw_series(cells.iter().enumerate().flat_map(|(r, row)| {
                         row.iter().enumerate().map(move |(v, &n)| {
-                            let t = n as f64 / max;
-                            let colour = if n == 0 {
-                                RGBColor(235, 235, 235)
-                            } else {
-                                RGBColor(255, (200.0 * (1.0 - t)) as u8, (60.0 * (1.0 - t)) as u8)
-                            };
-                            Rectangle::new([(v, r), (v + 1, r + 1)], colour.filled())
+                            Rectangle::new([(v, r), (v + 1, r + 1)], heat_colour(n as usize, max).filled())
                         })
                     }))
                     .map_err(|e| err(&e))?;
@@ -884,5 +969,43 @@ impl StabilityReport {
             entries.retain(|(_, w, _)| presets.contains(w));
         }
         entries.into_iter().map(|(label, _, e)| (label, e)).chain(files).collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The committed failures picture, drawn from the committed JSON (`BRDFPROF_BLESS=1` writes it back to
+    /// results/): one panel per spec that fails on the grid, read back from the report's sparse cells.
+    #[test]
+    fn the_committed_failures_picture_draws_from_its_json() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+        let text = std::fs::read_to_string(root.join("results/stability-llvmpipe.json")).unwrap();
+        let report: StabilityReport = serde_json::from_str(&text).unwrap();
+        let grids = report.failing().iter().filter(|s| s.dense_bad_cells().is_some()).count();
+        assert!(grids > 0 && grids <= report.failing().len());
+        let dir = tempfile::tempdir().unwrap();
+        let out = match std::env::var_os("BRDFPROF_BLESS") {
+            Some(_) => root.join("results/stability-llvmpipe-failures.png"),
+            None => dir.path().join("failures.png"),
+        };
+        assert!(report.heatmaps(&out).unwrap());
+        let img = image::open(&out).unwrap();
+        assert_eq!(img.height(), 250 * grids.div_ceil(6) as u32 + 76, "a row of six panels per six specs");
+    }
+
+    /// A long spec's caption fits its panel: in one line, or two split at a comma, or shortened.
+    #[test]
+    fn captions_fit_their_panel() {
+        use crate::export::text::measure;
+        for label in
+            ["ggx", "d=ggx,vis=smith-ggx-joint-approx,f=conductor,metal=aluminium,precision=f16", &"x".repeat(200)]
+        {
+            let (lines, size) = fit_caption(label, 288);
+            assert!(lines.len() <= 2 && (9..=13).contains(&size), "{label}: {lines:?}");
+            assert!(lines.iter().all(|l| measure(l, size, false).0 <= 288), "{label}: {lines:?} at {size}");
+        }
+        assert_eq!(fit_caption("ggx", 288), (vec!["ggx".to_string()], 13));
     }
 }

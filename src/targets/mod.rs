@@ -188,6 +188,11 @@ fn vendor_of(device: &str) -> Option<(&'static dyn Vendor, &str)> {
     VENDORS.iter().copied().find(|v| v.prefix().eq_ignore_ascii_case(prefix.trim())).map(|v| (v, rest))
 }
 
+/// The vendor of a `--device` target ("nvidia:sm_75" -> "NVIDIA"; "nak:sm_86" -> "NVIDIA").
+pub fn vendor_name(target: &str) -> Option<&'static str> {
+    vendor_of(target).map(|(v, _)| v.name())
+}
+
 /// Whether a `--device` value names compile-only targets.
 pub fn is_compile_only(device: &str) -> bool {
     vendor_of(device).is_some()

@@ -141,6 +141,58 @@ fn a_report_of_profile_sweep_inspect_and_stability_opens_in_chromium_with_the_js
     assert!(colours.len() > 64, "the screenshot has {} colours: blank", colours.len());
 }
 
+/// The page a user opens after a profile, the default sweep, the default stability run and the 23-device
+/// inspect behind README's headline table, in Chromium at 1400 x 900: at most 12 screens tall; the summary
+/// first, ending within the first screen, with stability's verdict as its first figure column and the
+/// failures in it; long sections folded; no table wider than its section without its first column in view;
+/// no two text boxes of any picture overlapping (folded pictures measured open).
+#[test]
+fn the_four_report_page_is_taken_in_at_a_glance() {
+    let dir = tempfile::tempdir().unwrap();
+    let page = dir.path().join("report.html");
+    let inputs = [INPUTS[0], INPUTS[1], INPUTS[2], "results/targets/inspect-thesis.json"];
+    let mut args = vec!["report".to_string()];
+    args.extend(inputs.iter().map(|p| common::repo_root().join(p).display().to_string()));
+    args.extend(["--out".into(), page.display().to_string()]);
+    let r = common::run(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    assert_eq!(r.code, Some(0), "{}", r.stderr);
+
+    let (dom, console) = headless(&page, &dir.path().join("profile"), &["--dump-dom", "--window-size=1400,900"]);
+    assert!(console.is_empty(), "console messages:\n{}", console.join("\n"));
+    readable_at_1400_px(&dom);
+    let body = dom.find("<body").unwrap();
+    let height = attr_at(&dom, body, "data-page-height").expect("page.js measured the page");
+    assert!(height <= 12.0 * 900.0, "the page is {height} px tall: {:.1} screens of 900", height / 900.0);
+    let unsticky = attr_at(&dom, body, "data-wide-unsticky").expect("page.js measured the tables");
+    assert_eq!(unsticky, 0.0, "wide tables whose first column scrolls away: {}", &dom[body..body + 400]);
+
+    let first = dom.find("<section id=").unwrap();
+    assert!(dom[first..].starts_with("<section id=\"summary\""), "the summary comes first");
+    let bottom = attr_of(&dom, "<section id=\"summary\"", "data-bottom");
+    assert!(bottom <= 900.0, "the summary ends at {bottom} px: below the first screen of 900");
+    let summary = &dom[first..first + dom[first..].find("</section>").unwrap()];
+    let headers: Vec<&str> = summary
+        .match_indices("<th ")
+        .map(|(i, _)| {
+            let h = &summary[i..];
+            let open = h.find('>').unwrap() + 1;
+            &h[open..h.find("</th>").unwrap()]
+        })
+        .collect();
+    assert_eq!(headers.get(1).copied(), Some("stability"), "stability's verdict first: {headers:?}");
+    let shown_rows = &summary[..summary.find("<details").unwrap_or(summary.len())];
+    assert!(shown_rows.contains("FAIL ("), "failing models on the first screen");
+    for vendor in ["AMD", "NVIDIA", "Intel", "Qualcomm", "Arm"] {
+        assert!(headers.iter().any(|h| h.starts_with(vendor)), "a column for {vendor}: {headers:?}");
+    }
+    let folds = dom.matches("<details class=\"fold\"").count();
+    assert!(folds >= 6, "{folds} folded sections");
+    // The failures grouped by cause, each cause naming how many specs fail so.
+    assert!(dom.contains("The failures by cause") && dom.contains("data-row=\"cause2/0\""), "failures by cause");
+    // The rank correlations as a matrix, uncertain ones greyed.
+    assert!(dom.contains("<table class=\"matrix\""), "the rank correlation matrix");
+}
+
 /// A `brdfprof diff` result in the report (from `report d.json` and from `diff --html`): in Chromium, every
 /// channel's max/RMS, every worst row's difference and every histogram count is the JSON's, and the picture is
 /// there.

@@ -156,6 +156,35 @@ pub fn colour(i: usize) -> &'static str {
     P[i % P.len()]
 }
 
+/// Series `i`'s line: its colour and its dash pattern (SVG `stroke-dasharray`, empty for solid). The ten
+/// colours solid, then dashed, then dotted: 30 series before a style repeats, so 16 overlaid models stay apart.
+pub fn series_style(i: usize) -> (&'static str, &'static str) {
+    const DASHES: [&str; 3] = ["", "7 3", "2 2.5"];
+    (colour(i), DASHES[(i / 10) % DASHES.len()])
+}
+
+/// `stroke="..." stroke-dasharray="..."` of series `i`.
+pub fn series_stroke(i: usize) -> String {
+    let (c, dash) = series_style(i);
+    if dash.is_empty() { format!("stroke=\"{c}\"") } else { format!("stroke=\"{c}\" stroke-dasharray=\"{dash}\"") }
+}
+
+/// A legend entry's line sample in series `i`'s style, for legends in HTML (CSS borders: solid, dashed, dotted).
+pub fn series_swatch(i: usize) -> String {
+    let (c, dash) = series_style(i);
+    let style = match dash {
+        "" => "solid",
+        "7 3" => "dashed",
+        _ => "dotted",
+    };
+    format!("<span class=\"swatch\" style=\"border-top: 3px {style} {c}\"></span>")
+}
+
+/// A folded block: `finding` (HTML), the one line a reader sees, and `body` behind it.
+pub fn fold(finding: &str, body: &str) -> String {
+    format!("<details class=\"fold\"><summary>{finding}</summary>{body}</details>")
+}
+
 /// A table cell: its text, and for a number the value a sort uses (and a test reads back).
 #[derive(Clone, Debug)]
 pub struct Cell {
@@ -304,6 +333,8 @@ pub struct Point {
     pub label: String,
     pub tip: String,
     pub emphasis: bool,
+    /// Drawn at the bottom edge of a fitted axis (its value below the range, in its label): a triangle.
+    pub edge: bool,
 }
 
 const M: (f64, f64, f64, f64) = (62.0, 14.0, 14.0, 44.0); // left, right, top, bottom
@@ -400,12 +431,27 @@ pub fn scatter_svg(
         let (px, py) = at(p);
         placer.occupy(Rect { x0: px - 5.0, y0: py - 5.0, x1: px + 5.0, y1: py + 5.0 });
         let class = if p.emphasis { "pt em" } else { "pt" };
-        let _ = write!(
-            s,
-            "<circle cx=\"{px:.1}\" cy=\"{py:.1}\" r=\"5\" class=\"{class}\" data-tip=\"{}\"><title>{}</title></circle>",
-            esc(&p.tip),
-            esc(&p.tip)
-        );
+        if p.edge {
+            // A triangle pointing down off the plot: the value lies below the axis's range.
+            let _ = write!(
+                s,
+                "<path d=\"M {:.1} {:.1} L {:.1} {:.1} L {px:.1} {:.1} Z\" class=\"{class}\" data-tip=\"{}\"><title>{}</title></path>",
+                px - 6.0,
+                py - 5.0,
+                px + 6.0,
+                py - 5.0,
+                py + 6.0,
+                esc(&p.tip),
+                esc(&p.tip)
+            );
+        } else {
+            let _ = write!(
+                s,
+                "<circle cx=\"{px:.1}\" cy=\"{py:.1}\" r=\"5\" class=\"{class}\" data-tip=\"{}\"><title>{}</title></circle>",
+                esc(&p.tip),
+                esc(&p.tip)
+            );
+        }
     }
     let mut labelled: Vec<&&Point> = drawn.iter().filter(|p| p.emphasis).collect();
     labelled.sort_by(|a, b| b.y.total_cmp(&a.y));
@@ -436,14 +482,19 @@ pub struct Curve {
     pub points: Vec<(f64, f64)>,
 }
 
+/// Width of a legend column beside a chart for `labels` (10.5 px text: about 6.2 px a character).
+fn legend_width(labels: &[&str]) -> f64 {
+    28.0 + 6.2 * labels.iter().map(|l| l.chars().count()).max().unwrap_or(0) as f64
+}
+
 fn legend(s: &mut String, labels: &[&str], x0: f64, y0: f64) {
     for (i, label) in labels.iter().enumerate() {
         let y = y0 + 16.0 * i as f64;
         let _ = write!(
             s,
-            "<line x1=\"{x0}\" y1=\"{y}\" x2=\"{}\" y2=\"{y}\" stroke=\"{}\" stroke-width=\"2.5\"/><text x=\"{}\" y=\"{}\" class=\"tick\">{}</text>",
+            "<line x1=\"{x0}\" y1=\"{y}\" x2=\"{}\" y2=\"{y}\" {} stroke-width=\"2.5\"/><text x=\"{}\" y=\"{}\" class=\"tick\">{}</text>",
             x0 + 18.0,
-            colour(i),
+            series_stroke(i),
             x0 + 22.0,
             y + 4.0,
             esc(label)
@@ -456,7 +507,11 @@ fn legend(s: &mut String, labels: &[&str], x0: f64, y0: f64) {
 pub fn lines_svg(curves: &[Curve], x: Axis, y: Axis, x_label: &str, y_label: &str, size: Size) -> String {
     let (l, r, t, b) = M;
     let Size { w: W, h: H } = size;
-    let mut s = format!("<svg class=\"chart\" viewBox=\"0 0 {W} {H}\" width=\"{W}\" height=\"{H}\" role=\"img\">");
+    // The legend in a column of its own right of the frame, never over a curve.
+    let labels: Vec<&str> = curves.iter().map(|c| c.label.as_str()).collect();
+    let total = W + legend_width(&labels);
+    let mut s =
+        format!("<svg class=\"chart\" viewBox=\"0 0 {total} {H}\" width=\"{total}\" height=\"{H}\" role=\"img\">");
     frame(&mut s, &x, &y, x_label, y_label, size);
     for (i, c) in curves.iter().enumerate() {
         let pts: Vec<String> = c
@@ -473,14 +528,14 @@ pub fn lines_svg(curves: &[Curve], x: Axis, y: Axis, x_label: &str, y_label: &st
             .collect();
         let _ = write!(
             s,
-            "<polyline fill=\"none\" stroke=\"{}\" stroke-width=\"2\" points=\"{}\" data-tip=\"{}\"><title>{}</title></polyline>",
-            colour(i),
+            "<polyline fill=\"none\" {} stroke-width=\"2\" points=\"{}\" data-tip=\"{}\"><title>{}</title></polyline>",
+            series_stroke(i),
             pts.join(" "),
             esc(&c.label),
             esc(&c.label)
         );
     }
-    legend(&mut s, &curves.iter().map(|c| c.label.as_str()).collect::<Vec<_>>(), l + 10.0, t + 14.0);
+    legend(&mut s, &labels, W + 6.0, t + 8.0);
     s + "</svg>"
 }
 
@@ -524,8 +579,8 @@ pub fn polar_svg(title: &str, curves: &[Curve], marks: &[(f64, &str)], log_decad
             .collect();
         let _ = write!(
             s,
-            "<polyline fill=\"none\" stroke=\"{}\" stroke-width=\"1.8\" points=\"{}\" data-tip=\"{}\"><title>{}</title></polyline>",
-            colour(i),
+            "<polyline fill=\"none\" {} stroke-width=\"1.8\" points=\"{}\" data-tip=\"{}\"><title>{}</title></polyline>",
+            series_stroke(i),
             pts.join(" "),
             esc(&c.label),
             esc(&c.label)

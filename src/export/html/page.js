@@ -43,8 +43,12 @@
     sec.setAttribute("data-top", String(Math.round(r.top + window.scrollY)));
     sec.setAttribute("data-bottom", String(Math.round(r.bottom + window.scrollY)));
   });
+  document.body.setAttribute("data-page-height", String(document.documentElement.scrollHeight));
   // Layout facts a reader would notice, recorded for tests: text boxes of one picture that overlap (by more
-  // than a pixel each way), and how wide each table is against the page.
+  // than a pixel each way), and how wide each table is against the page. Folded blocks are opened while they
+  // are measured (a closed one lays nothing out) and closed again.
+  var folded = Array.prototype.slice.call(document.querySelectorAll("details:not([open])"));
+  folded.forEach(function (d) { d.open = true; });
   function overlaps(a, b) {
     return Math.min(a.right, b.right) - Math.max(a.left, b.left) > 1 &&
       Math.min(a.bottom, b.bottom) - Math.max(a.top, b.top) > 1;
@@ -63,9 +67,19 @@
     svg.setAttribute("data-overlaps", String(pairs.length));
     if (pairs.length) svg.setAttribute("data-overlap-pairs", pairs.slice(0, 5).join(" | "));
   });
+  // A table wider than its section scrolls inside it: its first column must stay in view (sticky).
+  var unsticky = [];
   document.querySelectorAll("table").forEach(function (t) {
-    t.setAttribute("data-width", String(Math.round(t.getBoundingClientRect().width)));
+    var w = t.getBoundingClientRect().width;
+    t.setAttribute("data-width", String(Math.round(w)));
+    var sec = t.closest("section");
+    var first = t.querySelector("tr > :first-child");
+    if (sec && w > sec.clientWidth && !(first && getComputedStyle(first).position === "sticky"))
+      unsticky.push(t.querySelector("tr") ? t.querySelector("tr").textContent.slice(0, 40) : "?");
   });
+  document.body.setAttribute("data-wide-unsticky", String(unsticky.length));
+  if (unsticky.length) document.body.setAttribute("data-wide-unsticky-tables", unsticky.join(" | "));
+  folded.forEach(function (d) { d.open = false; });
   document.body.setAttribute("data-page-width", String(document.documentElement.clientWidth));
   document.body.setAttribute("data-ready", "1");
 })();

@@ -265,17 +265,11 @@ pub const CHECKS: &[Check] = &[
     },
 ];
 
-/// The vendor of a `--device` target ("nvidia:sm_75" -> "NVIDIA").
-fn vendor_of(target: &str) -> Option<&'static str> {
-    let prefix = target.split(':').next()?;
-    super::super::VENDORS.iter().find(|v| v.prefix() == prefix).map(|v| v.name())
-}
-
 /// The line a compile-only report of `target` prints: how many published measurements its vendor's rule is
 /// checked against and how far it is from them.
 pub fn line(target: &str) -> Option<String> {
-    let vendor = vendor_of(target)?;
-    let checks: Vec<&Check> = CHECKS.iter().filter(|c| vendor_of(c.target) == Some(vendor)).collect();
+    let vendor = crate::targets::vendor_name(target)?;
+    let checks: Vec<&Check> = CHECKS.iter().filter(|c| crate::targets::vendor_name(c.target) == Some(vendor)).collect();
     if checks.is_empty() {
         return Some(format!(
             "Measured reference: none found; no published measurement of {vendor}'s hardware is held against this rule (docs/measured.md)."
@@ -309,7 +303,7 @@ mod tests {
     fn every_check_names_a_source_and_a_vendor() {
         for c in CHECKS {
             assert!(SOURCES.iter().any(|s| s.id == c.source), "{}: no source {}", c.target, c.source);
-            assert!(vendor_of(c.target).is_some(), "{}: no vendor", c.target);
+            assert!(crate::targets::vendor_name(c.target).is_some(), "{}: no vendor", c.target);
             assert!(c.modelled.is_finite() && c.measured > 0.0, "{} {}: no figure", c.target, c.what);
             assert!(c.within(c.modelled) || c.known.is_some(), "{} {}: out of tolerance, not named", c.target, c.what);
         }
