@@ -1,7 +1,7 @@
 //! brdfprof: evaluates and profiles specular BRDFs in Vulkan compute kernels.
 //!
 //! Data flows CLI (`main.rs`, `cli/`) -> models (`model`: a `brdf` spec) -> kernels (`kernels`, `shaders`, on
-//! `gpu`) -> the measurement protocol (`profile`) -> reports (`report_page`).
+//! `gpu`) -> the measurement protocol (`measure`) and the commands (`profile`, ...) -> reports (`report`).
 
 pub use brdfprof_brdf as brdf;
 pub use brdfprof_process::{cleanup, launch, messages, tools};
@@ -19,9 +19,10 @@ pub mod inspect;
 pub mod io;
 pub mod kernel_stats;
 pub mod kernels;
+pub mod measure;
 pub mod model;
 pub mod profile;
-pub mod report_page;
+pub mod report;
 pub mod scene;
 pub mod schema;
 pub mod shaders;
@@ -29,6 +30,5 @@ pub mod spirv;
 pub mod stability;
 pub mod stats;
 pub mod sweep;
-pub mod sweep_cost;
 pub mod targets;
 pub mod translate;

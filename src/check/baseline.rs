@@ -1,6 +1,6 @@
 //! The baseline file: every count, the timing ratios and the environment they were measured in.
 
-use crate::inspect::timing::TimingRun;
+use crate::check::timing::TimingRun;
 use crate::model::Model;
 use crate::schema::InspectReport;
 use crate::schema::callgrind::CallgrindRun;

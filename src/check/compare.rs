@@ -4,7 +4,7 @@ use super::baseline::Baseline;
 use super::environment::{JIT_FEATURES, MESA};
 use super::lines::LineChange;
 use super::thresholds::{ALPHA, COST_KEYS, GROUPS, MIN_TIMING_ROUNDS, TIMING_KEY, Thresholds, group_of, is_gated};
-use crate::inspect::timing::TimingRun;
+use crate::check::timing::TimingRun;
 use crate::stats;
 use std::collections::BTreeMap;
 

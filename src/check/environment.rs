@@ -1,7 +1,7 @@
 //! What each statistic group depends on: its fingerprint, compared before its figures are.
 
+use crate::check::timing::TimingRun;
 use crate::inspect::callgrind;
-use crate::inspect::timing::TimingRun;
 use crate::schema::InspectReport;
 use std::collections::BTreeMap;
 

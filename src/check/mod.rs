@@ -18,6 +18,7 @@ pub mod findings;
 pub mod lines;
 mod report;
 mod thresholds;
+pub mod timing;
 
 pub use baseline::{Baseline, FORMAT, load};
 pub use compare::{Change, Comparison, GroupStatus, ModelLines, TimingChange, compare};
@@ -32,11 +33,11 @@ use crate::export::json;
 use crate::gpu::Gpu;
 use crate::inspect::InspectOptions;
 use crate::inspect::callgrind::CallgrindOptions;
-use crate::inspect::timing::{self, TimingOptions};
 use crate::model::Model;
 use crate::shaders::Shaders;
 use anyhow::{Result, anyhow, bail};
 use std::path::PathBuf;
+use timing::TimingOptions;
 
 /// Everything `check` measures.
 pub struct CheckOptions {
@@ -249,9 +250,9 @@ fn run_measured(options: &CheckOptions, measure: impl FnOnce(Vec<Model>, u32) ->
 
 #[cfg(test)]
 mod tests {
+    use super::timing::TimingRun;
     use super::*;
     use crate::export::json;
-    use crate::inspect::timing::TimingRun;
     use crate::schema::{InspectReport, Row};
     use std::collections::BTreeMap;
     use std::path::Path;

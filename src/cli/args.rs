@@ -7,10 +7,10 @@ use anyhow::{Result, anyhow, bail};
 use brdfprof::gpu::{Gpu, GpuOptions};
 use brdfprof::inspect::callgrind::CallgrindOptions;
 use brdfprof::io;
+use brdfprof::measure::protocol::ProtocolOptions;
 use brdfprof::model::{self, Model};
 use brdfprof::profile::ProfileOptions;
-use brdfprof::profile::protocol::ProtocolOptions;
-use brdfprof::report_page::{self, Input};
+use brdfprof::report::{self, Input};
 use brdfprof::shaders::Shaders;
 use brdfprof::targets;
 use clap::Args;
@@ -248,7 +248,7 @@ impl TimingArgs {
         target_ci: f64,
     ) -> Result<ProfileOptions> {
         let (width, height) = parse_size("--size", size)?;
-        use brdfprof::profile::workload::MAX_LIGHTS;
+        use brdfprof::measure::workload::MAX_LIGHTS;
         if self.lights.iter().any(|&l| l == 0 || l > MAX_LIGHTS) {
             bail!(
                 "--lights {}: each count must be 1 to {MAX_LIGHTS}",
@@ -382,7 +382,7 @@ impl HtmlArg {
     /// Writes the page of `inputs` (lobes and spheres on `gpu`) where asked; returns its path.
     pub fn write(&self, inputs: &[Input], gpu: Option<&Gpu>) -> Result<Option<PathBuf>> {
         let Some(path) = &self.html else { return Ok(None) };
-        let bytes = report_page::write(inputs, path, gpu)?;
+        let bytes = report::write(inputs, path, gpu)?;
         brdfprof::messages::progress(format!("HTML report: {} ({bytes} bytes)", path.display()));
         Ok(Some(path.clone()))
     }

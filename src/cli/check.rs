@@ -3,8 +3,8 @@
 use super::args::{CountArgs, DeviceArgs, ModelArgs, parse_size};
 use super::fresh_compilation;
 use anyhow::{Result, anyhow, bail};
+use brdfprof::check::timing::TimingOptions;
 use brdfprof::check::{self, CheckOptions, Thresholds};
-use brdfprof::inspect::timing::TimingOptions;
 use brdfprof::io;
 use clap::Args;
 use std::path::PathBuf;

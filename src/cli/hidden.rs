@@ -12,7 +12,7 @@ pub fn callgrind_child(request: &str) -> Result<ExitCode> {
 
 /// `__noop-child REQUEST`: every kernel compiled by a Mesa driver on its noop drm-shim (`targets::mesa_noop`).
 pub fn noop_child(request: &str) -> Result<ExitCode> {
-    brdfprof::targets::mesa_noop::child_main(request).map(|_| ExitCode::SUCCESS)
+    brdfprof::targets::mesa_noop::child::child_main(request).map(|_| ExitCode::SUCCESS)
 }
 
 /// `__run-translation DIR`: a translated kernel run (g++ build or PoCL) outside brdfprof's process

@@ -47,7 +47,7 @@ use args::DeviceArgs;
 use brdfprof::gpu::Gpu;
 use brdfprof::io;
 use brdfprof::model::Model;
-use brdfprof::report_page::{self, Input};
+use brdfprof::report::Input;
 use brdfprof::targets;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::{Path, PathBuf};
@@ -301,5 +301,5 @@ pub fn cost_targets(devices: &[String]) -> Result<Vec<brdfprof::targets::Target>
 
 /// The report just measured, read back as its saved JSON would be.
 pub fn just_measured(json: &Path, report: &impl serde::Serialize) -> Result<Input> {
-    report_page::from_report(json, report)
+    brdfprof::report::from_report(json, report)
 }

@@ -4,7 +4,7 @@
 use super::args::DeviceArgs;
 use anyhow::Result;
 use brdfprof::io;
-use brdfprof::report_page;
+use brdfprof::report;
 use clap::Args;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -28,9 +28,9 @@ pub fn report(args: &ReportArgs) -> Result<ExitCode> {
     io::check_output_path("--out", &args.out)?;
     io::check_not_input("--out", &args.out, &args.files.iter().map(|f| ("RESULTS", f.as_path())).collect::<Vec<_>>())?;
     brdfprof::compare::refuse_repeated_reports(&args.files, "a report given twice would draw its sections twice")?;
-    let inputs = args.files.iter().map(|f| report_page::load(f)).collect::<Result<Vec<_>>>()?;
+    let inputs = args.files.iter().map(|f| report::load(f)).collect::<Result<Vec<_>>>()?;
     let gpu = if args.no_gpu { None } else { Some(args.device.open()?) };
-    let bytes = report_page::write(&inputs, &args.out, gpu.as_ref())?;
+    let bytes = report::write(&inputs, &args.out, gpu.as_ref())?;
     if let Some(gpu) = &gpu {
         gpu.check_validation()?;
     }

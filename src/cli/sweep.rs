@@ -171,7 +171,7 @@ fn write_cost_tables(
             .ok_or_else(|| anyhow::anyhow!("{name}: the compiler reported no statistics the cost model reads"))?;
         let note =
             run.report.section_notes.get("driver/").map(String::as_str).filter(|n| n.starts_with("not compiled"));
-        let swept = brdfprof::sweep_cost::build(result, &name, &table, note)?;
+        let swept = brdfprof::sweep::cost::build(result, &name, &table, note)?;
         if let Some(skipped) = &swept.skipped {
             // Every model asked for is in every table, or the command says which is not, and exits 1.
             brdfprof::messages::warning(format!("{skipped}: those specs have no {name} figure"));
@@ -183,7 +183,7 @@ fn write_cost_tables(
         swept_all.push(swept);
     }
     if swept_all.len() > 1 {
-        let frontiers = brdfprof::sweep_cost::Frontiers::of(&swept_all);
+        let frontiers = brdfprof::sweep::cost::Frontiers::of(&swept_all);
         files.extend(frontiers.write(&out.join(format!("sweep-{slug}-frontiers")))?);
         out!("\n{}", frontiers.markdown());
     }

@@ -172,16 +172,17 @@ fn scatter_panel(
         .y_label_area_size(if main { 110 } else { 20 })
         .build_cartesian_2d(x0..x1, (y0..y1).log_scale())
         .map_err(|e| err(&e))?;
+    let plot_width = chart.plotting_area().dim_in_pixel().0 as f64;
     chart
         .configure_mesh()
         .x_desc(if main { spec.x_desc } else { "cost relative to the fastest spec" })
         .y_desc(if main { spec.y_desc } else { "" })
-        // The side panel is a quarter of the main one's width: fewer ticks, so that their labels never touch.
-        .x_labels(if main { 10 } else { 3 })
-        .x_label_formatter(&|x| format!("{x:.3}").trim_end_matches('0').trim_end_matches('.').to_string())
+        // As many ticks as the panel's width holds without two labels touching (the side panel is narrow).
+        .x_labels(x_tick_count(x0..x1, plot_width, if main { 10 } else { 6 }))
+        .x_label_formatter(&|x| x_tick_label(*x))
         .y_label_formatter(&|y| format!("{y:.0e}"))
         .axis_desc_style((FONT, 24))
-        .label_style((FONT, 20))
+        .label_style((FONT, TICK_FONT))
         .draw()
         .map_err(|e| err(&e))?;
     if main {
@@ -221,6 +222,48 @@ fn scatter_panel(
     let inside = Rect { x0: xs.start as f64, y0: ys.start as f64, x1: xs.end as f64, y1: ys.end as f64 };
     draw_labels(area, inside, pts, numbers, |p| chart.backend_coord(&(p.x, p.y)))?;
     Ok(())
+}
+
+/// A cost axis tick's label: three decimals at most, trailing zeros dropped.
+fn x_tick_label(x: f64) -> String {
+    format!("{x:.3}").trim_end_matches('0').trim_end_matches('.').to_string()
+}
+
+/// Pixels between two tick labels at the least, and the labels' size.
+const TICK_GAP: f64 = 12.0;
+const TICK_FONT: u32 = 20;
+
+/// The most x ticks, up to `wanted`, whose labels (at plotters' own key points for that many, `key_points`)
+/// keep `TICK_GAP` apart across a plot `width` pixels wide; at least 2.
+fn x_tick_count(range: std::ops::Range<f64>, width: f64, wanted: usize) -> usize {
+    let apart = |n: usize| tick_boxes(range.clone(), width, n).windows(2).all(|p| p[1].0 - p[0].1 >= TICK_GAP);
+    (2..=wanted.max(2)).rev().find(|&n| apart(n)).unwrap_or(2)
+}
+
+/// The (left, right) pixels of each x tick label plotters draws for a hint of `n` (its `key_points`).
+fn tick_boxes(range: std::ops::Range<f64>, width: f64, n: usize) -> Vec<(f64, f64)> {
+    use plotters::coord::ranged1d::Ranged;
+    use plotters::coord::types::RangedCoordf64;
+    let coord: RangedCoordf64 = range.clone().into();
+    coord
+        .key_points(n)
+        .iter()
+        .map(|&k| {
+            let centre = (k - range.start) / (range.end - range.start) * width;
+            let w = f64::from(crate::export::text::measure(&x_tick_label(k), TICK_FONT, false).0);
+            (centre - w / 2.0, centre + w / 2.0)
+        })
+        .collect()
+}
+
+/// Where a test draws a committed picture: back into results/ under `BLESS=1` (so the committed
+/// picture is what its committed JSON draws), else into `scratch`.
+#[cfg(test)]
+pub fn blessed_or_scratch(results_name: &str, scratch: &Path) -> std::path::PathBuf {
+    match std::env::var_os("BLESS") {
+        Some(_) => Path::new(env!("CARGO_MANIFEST_DIR")).join("results").join(results_name),
+        None => scratch.join(results_name),
+    }
 }
 
 /// Labels (highlighted points) and numbers (the rest), placed greedily from the top down by `labels::Placer`
@@ -440,6 +483,18 @@ mod tests {
         // Without outliers the range is the data's own.
         let (lo2, _) = fit_log_range(&ys[..60]);
         assert!((lo2 - 0.08 / 3.0).abs() < 1e-12, "{lo2}");
+    }
+
+    /// The fp16 side panel of the committed sweep (costs 8.3 to 13.5 over about 300 px) and the main panel:
+    /// at plotters' key points for the count chosen, no two tick labels come within `TICK_GAP`.
+    #[test]
+    fn tick_labels_keep_apart_in_a_narrow_panel() {
+        for (range, width) in [(8.1..14.3, 300.0), (0.97..2.13, 1200.0)] {
+            let n = x_tick_count(range.clone(), width, 10);
+            let boxes = tick_boxes(range.clone(), width, n);
+            assert!(n > 2 && boxes.len() > 2, "{range:?}: {n} ticks");
+            assert!(boxes.windows(2).all(|p| p[1].0 - p[0].1 >= TICK_GAP), "{range:?}: {boxes:?}");
+        }
     }
 
     #[test]

@@ -47,8 +47,12 @@ pub fn label(
     size: i32,
     colour: RGBColor,
 ) -> Result<()> {
-    let style = crate::export::text::Style { size: size.max(1) as u32, bold: false, colour, vertical: false };
-    crate::export::text::draw(root, text, (x, y), style)
+    let size = size.max(1) as u32;
+    let style = crate::export::text::Style { size, bold: false, colour, vertical: false };
+    // Placed as plotters places text at (x, y), its baseline half a size below y: the pictures' layouts (and
+    // the tests that read a picture below its title) keep their positions.
+    let top = y + size as i32 / 2 - crate::export::text::ascent(size, false);
+    crate::export::text::draw(root, text, (x, top), style)
 }
 
 /// Viridis colour map (matplotlib's, 9 control points, linear in between) for t in [0, 1].

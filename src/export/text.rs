@@ -31,6 +31,11 @@ pub fn measure(text: &str, size: u32, bold: bool) -> (i32, i32) {
     (width.ceil() as i32, (s.ascent() - s.descent()).ceil() as i32)
 }
 
+/// The font's ascent at `size` px: from a text box's top to its baseline.
+pub fn ascent(size: u32, bold: bool) -> i32 {
+    face(bold).as_scaled(PxScale::from(size as f32)).ascent().round() as i32
+}
+
 /// How a text is drawn.
 #[derive(Clone, Copy)]
 pub struct Style {
@@ -82,10 +87,12 @@ mod tests {
     #[test]
     fn letters_are_evenly_spaced() {
         let (w, h) = measure("lavapipe", 40, false);
-        let rgb = crate::export::png::pixels(w as u32, h as u32, |root| {
-            draw(root, "lavapipe", (0, 0), Style { size: 40, bold: false, colour: BLACK, vertical: false })
-        })
-        .unwrap();
+        let mut rgb = vec![255u8; (w * h * 3) as usize];
+        {
+            let root = BitMapBackend::with_buffer(&mut rgb, (w as u32, h as u32)).into_drawing_area();
+            draw(&root, "lavapipe", (0, 0), Style { size: 40, bold: false, colour: BLACK, vertical: false }).unwrap();
+            root.present().unwrap();
+        }
         let inked: Vec<bool> = (0..w).map(|x| (0..h).any(|y| rgb[((y * w + x) * 3) as usize] < 128)).collect();
         // Runs of blank columns between inked ones.
         let mut gaps = Vec::new();

@@ -14,10 +14,10 @@
 use crate::cleanup;
 use crate::gpu::{Gpu, GpuOptions};
 use crate::kernels::shade::{GBufferFormat, kernel_hash};
+use crate::measure::gbuffer;
+use crate::measure::protocol::Timed;
+use crate::measure::workload::{Variant, Workload};
 use crate::model::Model;
-use crate::profile::gbuffer;
-use crate::profile::protocol::Timed;
-use crate::profile::workload::{Variant, Workload};
 use crate::schema::callgrind::{CallgrindRun, KernelIr};
 use crate::shaders::Shaders;
 use anyhow::{Context, Result, anyhow, bail};
@@ -193,7 +193,8 @@ pub fn run(models: &[Model], lights: u32, shaders: &Shaders, options: &Callgrind
         validate: options.validate,
         glsl: shaders.glsl_dir().map(Path::to_path_buf),
     };
-    let exe = std::env::current_exe().context("cannot find brdfprof's own executable")?;
+    // valgrind runs brdfprof itself (the one executable `cleanup::own_executable` finds).
+    let exe = cleanup::own_executable()?;
     // --vgdb=no: no vgdb FIFOs in TMPDIR, which a killed valgrind would leave behind.
     let mut cmd = cleanup::command("valgrind");
     cmd.args([

@@ -7,7 +7,6 @@
 
 pub mod callgrind;
 pub mod correlate;
-pub mod timing;
 
 use crate::gpu::Gpu;
 use crate::kernel_stats;

@@ -1,15 +1,12 @@
 //! `brdfprof profile`: what each model costs per BRDF evaluation on a device, measured by the protocol in
-//! `protocol` over the synthetic G-buffer of `gbuffer`, and reported with confidence intervals, as ratios to
+//! `measure::protocol` over the synthetic G-buffer of `measure::gbuffer`, and reported with confidence intervals, as ratios to
 //! a reference model measured in the same rounds, and net of a memory-only baseline kernel.
-
-pub mod gbuffer;
-pub mod protocol;
-pub mod workload;
 
 use crate::export::json::Provenance;
 use crate::export::markdown::{self, Table};
 use crate::gpu::Gpu;
 use crate::host_cpu::HostCpu;
+use crate::measure::{gbuffer, protocol, workload};
 use crate::model::Model;
 use crate::shaders::Shaders;
 use crate::stats::{self, Estimate};

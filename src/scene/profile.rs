@@ -1,6 +1,6 @@
 //! `brdfprof profile --scene FILE`: what the scene compiles in, and what each effect costs, measured by toggling
 //! it. Every kernel of the plan runs as compiled and, for each effect it compiles in, compiled without that
-//! effect; all variants run interleaved in rounds under the profile protocol (`profile::protocol::measure`),
+//! effect; all variants run interleaved in rounds under the profile protocol (`measure::protocol::measure`),
 //! and an effect's cost is, per round, (time with it - time without it) / pixels of its kernel, reported as a
 //! median with a distribution-free 95% CI over rounds.
 
@@ -14,9 +14,9 @@ use crate::export::json::Provenance;
 use crate::export::markdown::{self, Table};
 use crate::gpu::Gpu;
 use crate::kernels::{self, RunLimits};
+use crate::measure::protocol::{self, ProtocolOptions, RawTimes};
 use crate::model::KernelKind;
 use crate::profile::LEVEL;
-use crate::profile::protocol::{self, ProtocolOptions, RawTimes};
 use crate::stats::{self, Estimate};
 use anyhow::Result;
 use indicatif::ProgressBar;

@@ -10,8 +10,8 @@ use super::plan::ScenePlan;
 use super::terms::{ETable, Switches};
 use crate::gpu::{Binding, Buffer, ChunkPlan, Commands, Gpu, MemoryKind};
 use crate::kernels::{self, RunLimits};
+use crate::measure::protocol::{Dispatch, Pipelines, Timed};
 use crate::model::KernelKind;
-use crate::profile::protocol::{Dispatch, Pipelines, Timed};
 use anyhow::Result;
 
 /// glsl/scene.comp's interface: storage buffers 0..5 of set 0 (pixels, radiance, lights, extras, E table) and
@@ -144,7 +144,7 @@ impl<'g> SceneWork<'g> {
 }
 
 /// Kernel `k` of a plan compiled with `switches`, bound to the uploaded scene, as one or more independently
-/// compiled pipelines (`profile::protocol::Pipelines`: an effect's cost is a difference of two kernels, so a
+/// compiled pipelines (`measure::protocol::Pipelines`: an effect's cost is a difference of two kernels, so a
 /// badly placed compilation of either would take the whole error).
 pub struct SceneVariant<'g> {
     pub label: String,

@@ -14,7 +14,8 @@ pub const ALIASES: &[(&str, &[&str])] = &[
     ("scalar-registers", &["SGPRs", "numUsedSgprs"]),
     ("instructions", &["Instructions", "Instruction Count"]),
     ("code-bytes", &["Code size", "Binary Size"]),
-    ("spills", &["Spilled VGPRs", "Spilled SGPRs", "Spill Count"]),
+    // ANV's Spill Count counts spilled values; NVIDIA's Spill Bytes (ptxas) is their bytes: either says a kernel spills.
+    ("spills", &["Spilled VGPRs", "Spilled SGPRs", "Spill Count", "Spill Bytes"]),
     ("fills", &["Fill Count"]),
     ("scratch-bytes", &["Scratch size", "Scratch Memory Size"]),
     ("branches", &["Branches"]),

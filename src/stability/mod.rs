@@ -475,6 +475,83 @@ pub fn jumps_cell(n: usize, checked: bool) -> String {
     if checked { n.to_string() } else { "- (no reference)".into() }
 }
 
+/// A stability run's spec with some of brdfprof's guards off (`--unguarded`): a variant, not a model.
+pub fn is_guard_variant(spec: &str) -> bool {
+    Model::parse(spec).ok().and_then(|m| m.twin().map(|s| s.guards != GuardSet::ALL)).unwrap_or(false)
+}
+
+/// The failures picture's colour key under its title: grey for none, then yellow to red up to each panel's
+/// own most.
+fn draw_heat_key(
+    top: &plotters::drawing::DrawingArea<plotters::prelude::BitMapBackend, plotters::coord::Shift>,
+) -> Result<()> {
+    use crate::export::text::{self, Style};
+    use plotters::prelude::*;
+    let err = |e: &dyn std::fmt::Display| anyhow::anyhow!("heat map: {e}");
+    let ink = |size: u32, bold: bool| Style { size, bold, colour: BLACK, vertical: false };
+    // The key: grey for none, then yellow to red up to each panel's own most.
+    let (kx, ky, kw) = (10, 42, 260);
+    top.draw(&Rectangle::new([(kx, ky), (kx + 22, ky + 14)], heat_colour(0, 1.0).filled())).map_err(|e| err(&e))?;
+    text::draw(&top, "none", (kx + 26, ky - 1), ink(13, false))?;
+    let gx = kx + 70;
+    for i in 0..kw {
+        let n = 1 + (i as usize * 999) / (kw as usize - 1);
+        let c = heat_colour(n, 1000.0);
+        top.draw(&Rectangle::new([(gx + i, ky), (gx + i + 1, ky + 14)], c.filled())).map_err(|e| err(&e))?;
+    }
+    text::draw(&top, "one bad value", (gx, ky + 16), ink(12, false))?;
+    let most = "the most in that panel";
+    text::draw(&top, most, (gx + kw - text::measure(most, 12, false).0, ky + 16), ink(12, false))?;
+    text::draw(&top, "bad values per cell (linear in each panel)", (gx + kw + 16, ky - 1), ink(13, false))?;
+    Ok(())
+}
+
+/// One failing spec's panel: its caption (`fit_caption`) over its grid of bad values per cell.
+fn draw_heat_panel(
+    area: &plotters::drawing::DrawingArea<plotters::prelude::BitMapBackend, plotters::coord::Shift>,
+    label: &str,
+    cells: &[Vec<u32>],
+    (pw, caption): (u32, u32),
+) -> Result<()> {
+    use crate::export::text::{self, Style};
+    use plotters::prelude::*;
+    let err = |e: &dyn std::fmt::Display| anyhow::anyhow!("heat map: {e}");
+    let ink = |size: u32, bold: bool| Style { size, bold, colour: BLACK, vertical: false };
+    let max = cells.iter().flatten().copied().max().unwrap_or(1).max(1) as f64;
+    let (label_area, plot) = area.split_vertically(caption);
+    let (lines, size) = fit_caption(label, pw as i32 - 12);
+    for (k, line) in lines.iter().enumerate() {
+        let w = text::measure(line, size, false).0;
+        text::draw(&label_area, line, ((pw as i32 - w) / 2, 2 + k as i32 * (size as i32 + 2)), ink(size, false))?;
+    }
+    let mut chart = ChartBuilder::on(&plot)
+        .margin(6)
+        .x_label_area_size(28)
+        .y_label_area_size(36)
+        .build_cartesian_2d(0..grid::COSINES.len(), 0..grid::ROUGHNESS.len())
+        .map_err(|e| err(&e))?;
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .x_desc("NoV")
+        .y_desc("roughness")
+        .x_labels(8)
+        .y_labels(8)
+        .x_label_formatter(&|i| axis_value(grid::COSINES.get(*i).copied()))
+        .y_label_formatter(&|i| axis_value(grid::ROUGHNESS.get(*i).map(|&r| f64::from(r))))
+        .label_style((crate::export::png::FONT, 10))
+        .draw()
+        .map_err(|e| err(&e))?;
+    chart
+        .draw_series(cells.iter().enumerate().flat_map(|(r, row)| {
+            row.iter()
+                .enumerate()
+                .map(move |(v, &n)| Rectangle::new([(v, r), (v + 1, r + 1)], heat_colour(n as usize, max).filled()))
+        }))
+        .map_err(|e| err(&e))?;
+    Ok(())
+}
+
 /// A heat-map cell's colour: light grey for none, then yellow to red by `n / most`.
 fn heat_colour(n: usize, most: f64) -> plotters::style::RGBColor {
     use plotters::style::RGBColor;
@@ -871,63 +948,12 @@ impl StabilityReport {
         let width = pw * columns as u32;
         let ink = |size: u32, bold: bool| Style { size, bold, colour: BLACK, vertical: false };
         crate::export::png::render(path, width, ph * rows as u32 + head, |root| {
-            let err = |e: &dyn std::fmt::Display| anyhow::anyhow!("heat map: {e}");
             let (top, body) = root.split_vertically(head);
             let size = (10..=20).rev().find(|&z| text::measure(&title, z, false).0 <= width as i32 - 20).unwrap_or(10);
             text::draw(&top, &title, (10, 6), ink(size, false))?;
-            // The key: grey for none, then yellow to red up to each panel's own most.
-            let (kx, ky, kw) = (10, 42, 260);
-            top.draw(&Rectangle::new([(kx, ky), (kx + 22, ky + 14)], heat_colour(0, 1.0).filled()))
-                .map_err(|e| err(&e))?;
-            text::draw(&top, "none", (kx + 26, ky - 1), ink(13, false))?;
-            let gx = kx + 70;
-            for i in 0..kw {
-                let n = 1 + (i as usize * 999) / (kw as usize - 1);
-                let c = heat_colour(n, 1000.0);
-                top.draw(&Rectangle::new([(gx + i, ky), (gx + i + 1, ky + 14)], c.filled())).map_err(|e| err(&e))?;
-            }
-            text::draw(&top, "one bad value", (gx, ky + 16), ink(12, false))?;
-            let most = "the most in that panel";
-            text::draw(&top, most, (gx + kw - text::measure(most, 12, false).0, ky + 16), ink(12, false))?;
-            text::draw(&top, "bad values per cell (linear in each panel)", (gx + kw + 16, ky - 1), ink(13, false))?;
+            draw_heat_key(&top)?;
             for (area, (s, cells)) in body.split_evenly((rows, columns)).iter().zip(&grids) {
-                let max = cells.iter().flatten().copied().max().unwrap_or(1).max(1) as f64;
-                let (label_area, plot) = area.split_vertically(caption);
-                let (lines, size) = fit_caption(&s.label, pw as i32 - 12);
-                for (k, line) in lines.iter().enumerate() {
-                    let w = text::measure(line, size, false).0;
-                    text::draw(
-                        &label_area,
-                        line,
-                        ((pw as i32 - w) / 2, 2 + k as i32 * (size as i32 + 2)),
-                        ink(size, false),
-                    )?;
-                }
-                let mut chart = ChartBuilder::on(&plot)
-                    .margin(6)
-                    .x_label_area_size(28)
-                    .y_label_area_size(36)
-                    .build_cartesian_2d(0..grid::COSINES.len(), 0..grid::ROUGHNESS.len())
-                    .map_err(|e| err(&e))?;
-                chart
-                    .configure_mesh()
-                    .disable_mesh()
-                    .x_desc("NoV")
-                    .y_desc("roughness")
-                    .x_labels(8)
-                    .y_labels(8)
-                    .x_label_formatter(&|i| axis_value(grid::COSINES.get(*i).copied()))
-                    .y_label_formatter(&|i| axis_value(grid::ROUGHNESS.get(*i).map(|&r| f64::from(r))))
-                    .label_style((crate::export::png::FONT, 10))
-                    .draw()
-                    .map_err(|e| err(&e))?;
-                chart
-                    .draw_series(cells.iter().enumerate().flat_map(|(r, row)| {
-                        row.iter().enumerate().map(move |(v, &n)| {
-                            Rectangle::new([(v, r), (v + 1, r + 1)], heat_colour(n as usize, max).filled())
-                        })
-                    }))
-                    .map_err(|e| err(&e))?;
+                draw_heat_panel(area, &s.label, cells, (pw, caption))?;
             }
             Ok(())
         })?;
@@ -976,7 +1002,7 @@ impl StabilityReport {
 mod tests {
     use super::*;
 
-    /// The committed failures picture, drawn from the committed JSON (`BRDFPROF_BLESS=1` writes it back to
+    /// The committed failures picture, drawn from the committed JSON (`BLESS=1` writes it back to
     /// results/): one panel per spec that fails on the grid, read back from the report's sparse cells.
     #[test]
     fn the_committed_failures_picture_draws_from_its_json() {
@@ -986,10 +1012,7 @@ mod tests {
         let grids = report.failing().iter().filter(|s| s.dense_bad_cells().is_some()).count();
         assert!(grids > 0 && grids <= report.failing().len());
         let dir = tempfile::tempdir().unwrap();
-        let out = match std::env::var_os("BRDFPROF_BLESS") {
-            Some(_) => root.join("results/stability-llvmpipe-failures.png"),
-            None => dir.path().join("failures.png"),
-        };
+        let out = crate::export::png::blessed_or_scratch("stability-llvmpipe-failures.png", dir.path());
         assert!(report.heatmaps(&out).unwrap());
         let img = image::open(&out).unwrap();
         assert_eq!(img.height(), 250 * grids.div_ceil(6) as u32 + 76, "a row of six panels per six specs");

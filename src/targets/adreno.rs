@@ -17,8 +17,8 @@
 //! pipe: a lower bound on those pipes, whose results' waits the schedule latency carries.
 
 use super::cost;
+use super::mesa_noop::builds::{MESA_25_UNVALIDATED, MESA_BACKPORTS, MESA_DEBIAN};
 use super::mesa_noop::shim::{Shim, ShimFamily};
-use super::mesa_noop::{MESA_25_UNVALIDATED, MESA_BACKPORTS, MESA_DEBIAN};
 use crate::schema::InspectReport;
 use crate::schema::cost::TargetCost;
 use cost::schedule::Schedule;

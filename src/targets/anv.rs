@@ -15,7 +15,7 @@
 //! critical path with no other thread hiding it: kept as a column of its own, not the cost.
 
 use super::cost;
-use super::mesa_noop::MESA_DEBIAN;
+use super::mesa_noop::builds::MESA_DEBIAN;
 use super::mesa_noop::shim::{Shim, ShimFamily};
 use crate::gpu::{CompilerLog, DriverStat};
 use crate::schema::InspectReport;

@@ -19,8 +19,8 @@
 
 use super::cost;
 use super::cost::schedule::Schedule;
+use super::mesa_noop::builds::{MESA_25_UNVALIDATED, MESA_BACKPORTS, MESA_DEBIAN};
 use super::mesa_noop::shim::{Shim, ShimFamily};
-use super::mesa_noop::{MESA_25_UNVALIDATED, MESA_BACKPORTS, MESA_DEBIAN};
 use crate::gpu::{CompilerLog, DriverStat};
 use crate::schema::InspectReport;
 use crate::schema::cost::TargetCost;

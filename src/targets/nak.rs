@@ -13,8 +13,8 @@
 //! and the hardware honours them as written.
 
 use super::cost;
+use super::mesa_noop::builds::{MESA_25_UNVALIDATED, MESA_NVK};
 use super::mesa_noop::shim::{Shim, ShimFamily};
-use super::mesa_noop::{MESA_25_UNVALIDATED, MESA_NVK};
 use super::nvidia::{self, SassStats, sass};
 use crate::gpu::RepresentationStats;
 use crate::schema::InspectReport;

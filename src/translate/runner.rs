@@ -56,22 +56,6 @@ pub struct Ran {
     pub device: String,
 }
 
-/// brdfprof's executable: this process' own, or, in a test binary of the same build, the `brdfprof` beside
-/// its `deps/` directory (cargo's layout).
-fn executable() -> Result<PathBuf> {
-    let own = std::env::current_exe().context("cannot find brdfprof's own executable")?;
-    if own.file_stem().is_some_and(|s| s == "brdfprof") {
-        return Ok(own);
-    }
-    let sibling = own.parent().and_then(Path::parent).map(|d| d.join("brdfprof"));
-    match sibling {
-        Some(s) if s.is_file() => Ok(s),
-        _ => {
-            bail!("cannot find the brdfprof executable to run a translated kernel in (looked beside {})", own.display())
-        }
-    }
-}
-
 /// Runs `engine` over `buffers` (copied back in place) in a child, `what` naming the kernel in messages.
 pub fn run(
     engine: Engine,
@@ -88,10 +72,10 @@ pub fn run(
     let request = Request { engine, local_size, groups, buffers: buffers.iter().map(|b| b.len()).collect() };
     std::fs::write(dir.path().join("request.json"), serde_json::to_vec(&request)?)
         .context("cannot write a translated kernel's request")?;
-    let mut cmd = cleanup::command(&executable()?.to_string_lossy());
+    let mut cmd = cleanup::self_command(CHILD_COMMAND)?;
     // PoCL's kernel cache too: it leaves empty `tempfile_*` behind in it on every build, which would pile up
     // in the user's ~/.cache/pocl; in the run's directory they go with it.
-    cmd.arg(CHILD_COMMAND).arg(dir.path()).env("TMPDIR", dir.path()).env("POCL_CACHE_DIR", dir.path().join("pocl"));
+    cmd.arg(dir.path()).env("TMPDIR", dir.path()).env("POCL_CACHE_DIR", dir.path().join("pocl"));
     crate::launch::export(&mut cmd);
     let out = crate::launch::output(&mut cmd, what).with_context(|| format!("{what}: cannot run the child process"))?;
     if !out.status.success() {

@@ -156,9 +156,9 @@ fn without_a_mesa_build_every_shim_target_exits_2_naming_make_mesa() {
                 "r.md",
             ])
             .current_dir(d)
-            .env(targets::mesa_noop::MESA_DEBIAN.var, &empty)
-            .env(targets::mesa_noop::MESA_BACKPORTS.var, &empty)
-            .env(targets::mesa_noop::MESA_NVK.var, &empty)
+            .env(targets::mesa_noop::builds::MESA_DEBIAN.var, &empty)
+            .env(targets::mesa_noop::builds::MESA_BACKPORTS.var, &empty)
+            .env(targets::mesa_noop::builds::MESA_NVK.var, &empty)
             .output()
             .unwrap();
         let stderr = String::from_utf8_lossy(&out.stderr);
@@ -173,9 +173,9 @@ fn without_a_mesa_build_every_shim_target_exits_2_naming_make_mesa() {
     // devices --targets says so too.
     let out = common::brdfprof()
         .args(["devices", "--targets"])
-        .env(targets::mesa_noop::MESA_DEBIAN.var, &empty)
-        .env(targets::mesa_noop::MESA_BACKPORTS.var, &empty)
-        .env(targets::mesa_noop::MESA_NVK.var, &empty)
+        .env(targets::mesa_noop::builds::MESA_DEBIAN.var, &empty)
+        .env(targets::mesa_noop::builds::MESA_BACKPORTS.var, &empty)
+        .env(targets::mesa_noop::builds::MESA_NVK.var, &empty)
         .output()
         .unwrap();
     let stdout = String::from_utf8_lossy(&out.stdout);
@@ -221,7 +221,7 @@ fn a_missing_or_broken_build_exits_2_naming_make_mesa() {
                 "r.md",
             ])
             .current_dir(d)
-            .env(targets::mesa_noop::BUILD_DIR_VAR, build)
+            .env(targets::mesa_noop::builds::BUILD_DIR_VAR, build)
             .output()
             .unwrap();
         (out.status.code(), String::from_utf8_lossy(&out.stderr).into_owned())
@@ -249,7 +249,7 @@ fn a_missing_or_broken_build_exits_2_naming_make_mesa() {
                 "r.md",
             ])
             .current_dir(d)
-            .env(targets::mesa_noop::MESA_BACKPORTS.var, d.join("nothing"))
+            .env(targets::mesa_noop::builds::MESA_BACKPORTS.var, d.join("nothing"))
             .output()
             .unwrap();
         let stderr = String::from_utf8_lossy(&out.stderr);
@@ -263,7 +263,7 @@ fn a_missing_or_broken_build_exits_2_naming_make_mesa() {
         );
     }
     // The driver and its ICD file present, the shim absent.
-    let real = targets::mesa_noop::build_dir();
+    let real = targets::mesa_noop::builds::build_dir();
     let partial = d.join("partial");
     for f in ["src/intel/vulkan/intel_devenv_icd.x86_64.json", "src/intel/vulkan/libvulkan_intel.so"] {
         std::fs::create_dir_all(partial.join(f).parent().unwrap()).unwrap();
@@ -283,7 +283,7 @@ fn a_missing_or_broken_build_exits_2_naming_make_mesa() {
     // devices --targets says which vendor is not ready and why.
     let out = common::brdfprof()
         .args(["devices", "--targets"])
-        .env(targets::mesa_noop::BUILD_DIR_VAR, d.join("nothing"))
+        .env(targets::mesa_noop::builds::BUILD_DIR_VAR, d.join("nothing"))
         .output()
         .unwrap();
     let stdout = String::from_utf8_lossy(&out.stdout);
@@ -476,9 +476,9 @@ fn setup_builds_every_file_each_shim_driver_loads() {
     };
     let shims = [&targets::adreno::ADRENO, &targets::mali::MALI, &targets::anv::ANV, &targets::nak::NAK];
     for (build, list) in [
-        (&targets::mesa_noop::MESA_DEBIAN, "products"),
-        (&targets::mesa_noop::MESA_BACKPORTS, "products25"),
-        (&targets::mesa_noop::MESA_NVK, "products_nvk"),
+        (&targets::mesa_noop::builds::MESA_DEBIAN, "products"),
+        (&targets::mesa_noop::builds::MESA_BACKPORTS, "products25"),
+        (&targets::mesa_noop::builds::MESA_NVK, "products_nvk"),
     ] {
         let mut loaded: Vec<String> = shims
             .iter()

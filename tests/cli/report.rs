@@ -147,7 +147,7 @@ fn a_report_of_profile_sweep_inspect_and_stability_opens_in_chromium_with_the_js
 /// failures in it; long sections folded; no table wider than its section without its first column in view;
 /// no two text boxes of any picture overlapping (folded pictures measured open).
 #[test]
-fn the_four_report_page_is_taken_in_at_a_glance() {
+fn the_four_report_is_taken_in_at_a_glance() {
     let dir = tempfile::tempdir().unwrap();
     let page = dir.path().join("report.html");
     let inputs = [INPUTS[0], INPUTS[1], INPUTS[2], "results/targets/inspect-thesis.json"];

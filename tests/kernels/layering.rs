@@ -20,6 +20,7 @@ const LAYERS: &[&str] = &[
     "export",
     "schema",
     "kernel_stats",
+    "measure",
     "profile",
     "translate",
     "targets",
@@ -28,11 +29,10 @@ const LAYERS: &[&str] = &[
     "across_devices",
     "check",
     "sweep",
-    "sweep_cost",
     "stability",
     "scene",
     "diff",
-    "report_page",
+    "report",
 ];
 
 pub fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {

@@ -5,10 +5,10 @@
 
 use crate::common;
 use brdfprof::brdf::THESIS_MODELS;
+use brdfprof::measure::gbuffer::{self, Camera, GBufferFormat, LIGHT_FLOATS, R11G11B10_REL_ERROR, Surface};
+use brdfprof::measure::protocol::Timed;
+use brdfprof::measure::workload::{Variant, Workload, light_blocks};
 use brdfprof::model::Model;
-use brdfprof::profile::gbuffer::{self, Camera, GBufferFormat, LIGHT_FLOATS, R11G11B10_REL_ERROR, Surface};
-use brdfprof::profile::protocol::Timed;
-use brdfprof::profile::workload::{Variant, Workload, light_blocks};
 use glam::DVec3;
 
 const W: u32 = 96;

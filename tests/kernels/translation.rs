@@ -223,7 +223,7 @@ fn flattening_and_cse_change_no_value() {
     }
     let (w, h) = verify::SHADE_SIZE;
     let g = verify::check_gbuffer(w, h);
-    let lights = brdfprof::profile::gbuffer::lights(8);
+    let lights = brdfprof::measure::gbuffer::lights(8);
     let shade_models: Vec<Option<Model>> = std::iter::once(None)
         .chain(brdfprof::brdf::THESIS_MODELS.iter().map(|m| Some(Model::parse(m).unwrap())))
         .collect();

@@ -99,9 +99,9 @@ fn default_profile_is_fast_resolved_and_repeatable() {
 #[test]
 fn protocol_keeps_the_faster_instance_and_reports_the_spread() {
     let _serial = crate::serial();
-    use brdfprof::profile::gbuffer;
-    use brdfprof::profile::protocol::{self, ProtocolOptions, Timed};
-    use brdfprof::profile::workload::{Variant, Workload};
+    use brdfprof::measure::gbuffer;
+    use brdfprof::measure::protocol::{self, ProtocolOptions, Timed};
+    use brdfprof::measure::workload::{Variant, Workload};
 
     struct Uneven<'g>(Variant<'g>);
     impl Timed for Uneven<'_> {

@@ -251,6 +251,28 @@ pub fn command(program: &str) -> Command {
     cmd
 }
 
+/// brdfprof's own executable, for the children it starts of itself (`__noop-child`, `__callgrind-child`,
+/// `__run-translation`, `__probe-vulkan`): this process' executable, or, in a test binary of the same build,
+/// the `brdfprof` beside its `deps/` folder (cargo's layout).
+pub fn own_executable() -> Result<PathBuf> {
+    let own = std::env::current_exe().context("cannot find brdfprof's own executable")?;
+    if own.file_stem().is_some_and(|s| s == "brdfprof") {
+        return Ok(own);
+    }
+    match own.parent().and_then(Path::parent).map(|d| d.join("brdfprof")) {
+        Some(sibling) if sibling.is_file() => Ok(sibling),
+        _ => anyhow::bail!("cannot find the brdfprof executable to run a child of (looked beside {})", own.display()),
+    }
+}
+
+/// brdfprof itself running the hidden command `subcommand`, as `command` makes every child: the one way
+/// brdfprof starts itself.
+pub fn self_command(subcommand: &str) -> Result<Command> {
+    let mut cmd = command(&own_executable()?.to_string_lossy());
+    cmd.arg(subcommand);
+    Ok(cmd)
+}
+
 /// SIGKILL to `pid`'s process group (which `command` made it lead) and to `pid` itself, whose group it may
 /// not lead (a command built without `command`).
 pub fn kill_group(pid: u32) {
@@ -416,5 +438,23 @@ mod tests {
         assert!(!registry().paths.contains(&path) && !path.exists());
         let out = command("sh").args(["-c", "echo $PPID"]).output().unwrap();
         assert_eq!(String::from_utf8_lossy(&out.stdout).trim(), std::process::id().to_string());
+    }
+}
+
+#[cfg(test)]
+mod own_executable_tests {
+    /// In this test binary (not brdfprof) the executable is the `brdfprof` beside `deps/` when the build made
+    /// one, and otherwise an error that says where it looked.
+    #[test]
+    fn a_test_binary_finds_the_brdfprof_beside_its_deps_folder_or_says_where_it_looked() {
+        let own = std::env::current_exe().unwrap();
+        let sibling = own.parent().and_then(std::path::Path::parent).unwrap().join("brdfprof");
+        match super::own_executable() {
+            Ok(found) => assert_eq!(found, sibling),
+            Err(e) => {
+                assert!(!sibling.is_file());
+                assert!(format!("{e:#}").contains("looked beside"), "{e:#}");
+            }
+        }
     }
 }

@@ -1,6 +1,6 @@
 //! A self-contained HTML page: sections, sortable tables, SVG charts (scatter, polar, lines) and PNG images as
 //! data: URIs, with its CSS and script inline, so that it opens from file:// with no network. Knows nothing of
-//! BRDFs: `report_page` decides what goes in.
+//! BRDFs: `report` decides what goes in.
 
 use crate::export::labels::{Placer, Rect};
 use anyhow::Result;
@@ -430,28 +430,7 @@ pub fn scatter_svg(
     for p in &drawn {
         let (px, py) = at(p);
         placer.occupy(Rect { x0: px - 5.0, y0: py - 5.0, x1: px + 5.0, y1: py + 5.0 });
-        let class = if p.emphasis { "pt em" } else { "pt" };
-        if p.edge {
-            // A triangle pointing down off the plot: the value lies below the axis's range.
-            let _ = write!(
-                s,
-                "<path d=\"M {:.1} {:.1} L {:.1} {:.1} L {px:.1} {:.1} Z\" class=\"{class}\" data-tip=\"{}\"><title>{}</title></path>",
-                px - 6.0,
-                py - 5.0,
-                px + 6.0,
-                py - 5.0,
-                py + 6.0,
-                esc(&p.tip),
-                esc(&p.tip)
-            );
-        } else {
-            let _ = write!(
-                s,
-                "<circle cx=\"{px:.1}\" cy=\"{py:.1}\" r=\"5\" class=\"{class}\" data-tip=\"{}\"><title>{}</title></circle>",
-                esc(&p.tip),
-                esc(&p.tip)
-            );
-        }
+        s += &point_mark(p, (px, py));
     }
     let mut labelled: Vec<&&Point> = drawn.iter().filter(|p| p.emphasis).collect();
     labelled.sort_by(|a, b| b.y.total_cmp(&a.y));
@@ -473,6 +452,27 @@ pub fn scatter_svg(
         }
     }
     s + "</svg>"
+}
+
+/// A point's mark with its hover text: a circle, or at a fitted axis's bottom edge (`edge`) a triangle pointing
+/// down off the plot (its value lies below the axis's range).
+fn point_mark(p: &Point, (px, py): (f64, f64)) -> String {
+    let class = if p.emphasis { "pt em" } else { "pt" };
+    let tip = esc(&p.tip);
+    if p.edge {
+        format!(
+            "<path d=\"M {:.1} {:.1} L {:.1} {:.1} L {px:.1} {:.1} Z\" class=\"{class}\" data-tip=\"{tip}\"><title>{tip}</title></path>",
+            px - 6.0,
+            py - 5.0,
+            px + 6.0,
+            py - 5.0,
+            py + 6.0
+        )
+    } else {
+        format!(
+            "<circle cx=\"{px:.1}\" cy=\"{py:.1}\" r=\"5\" class=\"{class}\" data-tip=\"{tip}\"><title>{tip}</title></circle>"
+        )
+    }
 }
 
 /// A named curve of (x, y) points.

@@ -502,7 +502,7 @@ impl IsaStats {
             stat("Register Count", f64::from(self.grf)),
             stat("Large GRF Mode", if self.grf > 128 { 1.0 } else { 0.0 }),
             stat("Instruction Count", f64::from(self.instructions)),
-            stat("Spill Count", f64::from(self.scratch_bytes)),
+            // IGC's scratch is its spill space (and private arrays), in bytes: one statistic, not a count.
             stat("Scratch Memory Size", f64::from(self.scratch_bytes)),
             stat("Binary Size", f64::from(self.binary_bytes)),
         ];
@@ -639,7 +639,7 @@ impl Translator for Intel {
     const UNIT: &'static str = "EU cycles";
     const RULE: &'static str = "a thread's pipes at THROUGHPUT's lanes per clock (Intel's documents; extended math: IGC's scheduling model), its latency in IGC's instruction order at IGC's scheduler latencies, threads per EU from the registers; / (SIMD width x lights per kernel); Issue Cycles: the old serial sum";
     const SHOWN: &'static [&'static str] =
-        &["SIMD Width", "Register Count", "Spill Count", "Instruction Count", "Extended math", "Issue Cycles"];
+        &["SIMD Width", "Register Count", "Scratch Memory Size", "Instruction Count", "Extended math", "Issue Cycles"];
     const ISA_EXTENSIONS: (&'static str, &'static str) = ("cl", "asm");
 
     fn families() -> &'static [Family] {

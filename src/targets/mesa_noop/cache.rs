@@ -14,7 +14,7 @@
 //! - brdfprof's executable by size and modification time (the child's analyses are its code).
 //!
 //! A request that writes files (`--isa`) or asks the child to crash (the containment test) is never cached
-//! (`mesa_noop::compile` decides).
+//! (`mesa_noop::parent::compile` decides).
 
 use crate::cache::{Key, KeyBuilder};
 use crate::kernels::shade::{GBufferFormat, kernel_hash};
@@ -88,7 +88,7 @@ pub fn request_digest(
     validate: bool,
     shaders: &Shaders,
 ) -> Result<String> {
-    let exe = std::env::current_exe()?;
+    let exe = crate::cleanup::own_executable()?;
     let mut key = KeyBuilder::new(KIND)
         .part("brdfprof", env!("CARGO_PKG_VERSION"))
         .part("executable", identity(&exe))

@@ -23,7 +23,7 @@ pub struct ShimFamily {
     /// In `PREFIX:all`.
     pub default: bool,
     /// The Mesa build whose driver compiles for it.
-    pub build: &'static mesa_noop::MesaBuild,
+    pub build: &'static mesa_noop::builds::MesaBuild,
     /// Why the validation layer cannot judge the driver's compilations for it, where it cannot.
     pub without_validation: Option<&'static str>,
 }
@@ -31,7 +31,7 @@ pub struct ShimFamily {
 impl ShimFamily {
     /// A family in `PREFIX:all` whose driver `build` made, validated by the Khronos layer.
     pub const fn on(
-        build: &'static mesa_noop::MesaBuild,
+        build: &'static mesa_noop::builds::MesaBuild,
         name: &'static str,
         gpu_id: &'static str,
         architecture: &'static str,
@@ -57,7 +57,7 @@ pub struct Shim {
     pub driver: &'static str,
     /// The compiler ("ir3").
     pub compiler: &'static str,
-    /// Under the build directory (`mesa_noop::build_dir`): the driver's devenv ICD file, the driver library it
+    /// Under the build directory (`mesa_noop::builds::build_dir`): the driver's devenv ICD file, the driver library it
     /// names and the shim (scripts/mesa-noop.sh builds exactly these; a test ties the two lists).
     pub icd: &'static str,
     pub library: &'static str,
@@ -136,7 +136,7 @@ impl Vendor for Shim {
         // Per Mesa build: its families are ready, or why not; the vendor is ready where any build is.
         let mut ready: Vec<String> = Vec::new();
         let mut missing: Vec<(String, anyhow::Error)> = Vec::new();
-        let mut seen: Vec<&mesa_noop::MesaBuild> = Vec::new();
+        let mut seen: Vec<&mesa_noop::builds::MesaBuild> = Vec::new();
         for (k, f) in self.families.iter().enumerate() {
             if seen.iter().any(|b| std::ptr::eq(*b, f.build)) {
                 continue;
@@ -178,7 +178,7 @@ impl Vendor for Shim {
     }
 
     fn compile(&self, families: &[usize], request: &Request) -> Result<Vec<Run>> {
-        mesa_noop::compile(self.prefix, families, &[], request)
+        mesa_noop::parent::compile(self.prefix, families, &[], request)
     }
 
     fn compile_raw(
@@ -190,7 +190,7 @@ impl Vendor for Shim {
         if kernels.is_empty() {
             anyhow::bail!("{}: no raw kernel to compile", self.prefix);
         }
-        mesa_noop::compile(self.prefix, families, kernels, request)
+        mesa_noop::parent::compile(self.prefix, families, kernels, request)
     }
 
     fn cost(&self, report: &InspectReport) -> Option<TargetCost> {
@@ -220,7 +220,7 @@ impl NoopDriver for Shim {
         let mut extra: Vec<(&str, String)> = vec![(self.gpu_var, self.families[family].gpu_id.to_string())];
         extra.extend(self.extra_env.iter().map(|(k, v)| (*k, v.to_string())));
         let f = &self.families[family];
-        mesa_noop::shim_environment(
+        mesa_noop::builds::shim_environment(
             &format!("{}:{} (Mesa's {})", self.prefix, f.name, self.driver),
             f.build,
             self.icd,

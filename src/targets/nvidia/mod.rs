@@ -395,7 +395,8 @@ impl SassStats {
         let mut out = vec![
             stat("Instruction Count", f64::from(self.instructions)),
             stat("Register Count", f64::from(self.registers)),
-            stat("Spill Count", f64::from(self.spill_bytes)),
+            // ptxas reports spill stores in bytes, not a count of spilled values.
+            stat("Spill Bytes", f64::from(self.spill_bytes)),
             stat("Scratch Memory Size", f64::from(self.stack_bytes)),
             stat("Binary Size", f64::from(self.cubin_bytes)),
             stat("Warps per SM", f64::from(self.warps_per_sm(family))),
@@ -535,7 +536,7 @@ impl Translator for Nvidia {
     const UNIT: &'static str = "SM cycles";
     const RULE: &'static str = "a warp's pipes at the CUDA guide's throughputs (Nsight Compute's pipe assignment), its latency by ptxas' stall counts and scoreboards, warps per SM from the registers; / (32 x lights per kernel); Issue Cycles: the old serial sum";
     const SHOWN: &'static [&'static str] =
-        &["Instruction Count", "Register Count", "Spill Count", "MUFU (special functions)", "Issue Cycles"];
+        &["Instruction Count", "Register Count", "Spill Bytes", "MUFU (special functions)", "Issue Cycles"];
     const ISA_EXTENSIONS: (&'static str, &'static str) = ("cu", "sass");
 
     fn families() -> &'static [Family] {

@@ -35,9 +35,8 @@ pub fn sanitise() -> Result<()> {
 /// Whether a child enumerating Vulkan devices with `RADV_FORCE_FAMILY=value` dies of a signal (an exit
 /// status, a failure without RADV, does not count).
 fn aborts(value: &str) -> Result<bool> {
-    let exe = std::env::current_exe().context("cannot find brdfprof's own executable")?;
-    let mut cmd = crate::cleanup::command(&exe.to_string_lossy());
-    cmd.arg(PROBE_COMMAND).env(FORCE_FAMILY_VAR, value);
+    let mut cmd = crate::cleanup::self_command(PROBE_COMMAND)?;
+    cmd.env(FORCE_FAMILY_VAR, value);
     let out = crate::launch::output_quick(&mut cmd, "brdfprof's Vulkan probe")
         .context("cannot run brdfprof's Vulkan probe")?;
     Ok(out.status.code().is_none())

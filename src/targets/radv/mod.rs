@@ -98,14 +98,14 @@ impl super::Vendor for Radv {
     }
 
     fn compile(&self, families: &[usize], request: &Request) -> Result<Vec<Run>> {
-        mesa_noop::compile("radv", families, &[], request)
+        mesa_noop::parent::compile("radv", families, &[], request)
     }
 
     fn compile_raw(&self, families: &[usize], kernels: &[super::RawKernel], request: &Request) -> Result<Vec<Run>> {
         if kernels.is_empty() {
             anyhow::bail!("radv: no raw kernel to compile");
         }
-        mesa_noop::compile("radv", families, kernels, request)
+        mesa_noop::parent::compile("radv", families, kernels, request)
     }
 
     fn cost(&self, report: &InspectReport) -> Option<TargetCost> {

@@ -3,11 +3,11 @@
 //! time. Those figures are deterministic: no CI, no noise, the same on every machine with the same compiler.
 //! The accuracy is the sweep's own (measured on the device that executed it).
 
+use super::{SweepReport, pareto_front};
 use crate::export::json;
 use crate::export::markdown::{self, Table};
 use crate::export::png::{self, Point};
 use crate::schema::cost::TargetCost;
-use crate::sweep::{SweepReport, pareto_front};
 use anyhow::Result;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
@@ -117,7 +117,7 @@ pub fn build(sweep: &SweepReport, target: &str, cost: &TargetCost, note: Option<
             (!all.is_empty()).then(|| all.join("; "))
         },
         against: sweep.against.clone(),
-        error_axis: crate::sweep::error_axis(sweep.exact, &sweep.rows),
+        error_axis: super::error_axis(sweep.exact, &sweep.rows),
     })
 }
 

@@ -10,13 +10,13 @@
 //! from the models' arithmetic). The price: a change that slows every model by the same factor cancels in
 //! these ratios; the instruction counts (SPIR-V, callgrind) catch that kind of change.
 
-use super::BASELINE_LABEL;
 use crate::gpu::Gpu;
 use crate::kernels::shade::GBufferFormat;
+use crate::measure::gbuffer;
+use crate::measure::protocol::{self, ProtocolOptions};
+use crate::measure::workload::{Variant, Workload};
+use crate::model::BASELINE_LABEL;
 use crate::model::Model;
-use crate::profile::gbuffer;
-use crate::profile::protocol::{self, ProtocolOptions};
-use crate::profile::workload::{Variant, Workload};
 use crate::shaders::Shaders;
 use crate::stats;
 use anyhow::{Result, bail};

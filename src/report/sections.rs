@@ -420,6 +420,23 @@ fn err_text(e: &ErrorStats) -> String {
     }
 }
 
+/// The error axis fitted to the bulk of the specs (as the PNG's, `png::fit_log_range`): a point below `lo` sits
+/// at the axis's bottom edge, marked (`edge`), its value in its label.
+fn pin_below(points: Vec<(Point, bool)>, lo: f64) -> Vec<(Point, bool)> {
+    points
+        .into_iter()
+        .map(|(mut p, half)| {
+            if p.y.is_finite() && p.y > 0.0 && p.y < lo {
+                p.label = format!("{} ({:.1e}, below)", p.label, p.y);
+                p.tip += "\n(drawn at the axis's bottom edge: below its range)";
+                p.y = lo * 1.25;
+                p.edge = true;
+            }
+            (p, half)
+        })
+        .collect()
+}
+
 /// The sweep's error-against-cost chart: net ns/eval (gross where there is no net) against the RMS relative
 /// error against the exact reference, both log; the Pareto frontier labelled and joined. fp16 specs (and any
 /// spec costlier than every fp32 one) go to a narrow panel of their own beside it on the same error axis, so
@@ -445,21 +462,8 @@ pub fn sweep_chart(w: &SweepReport) -> String {
             (Point { x: cost.median, y: err, label: r.label.clone(), tip, emphasis: r.pareto, edge: false }, half)
         })
         .collect();
-    // The error axis fitted to the bulk of the specs (as the PNG's): one far below the rest sits at its
-    // bottom edge, marked, its value in its label.
     let (lo, hi) = crate::export::png::fit_log_range(&points.iter().map(|(p, _)| p.y).collect::<Vec<_>>());
-    let points: Vec<(Point, bool)> = points
-        .into_iter()
-        .map(|(mut p, half)| {
-            if p.y.is_finite() && p.y > 0.0 && p.y < lo {
-                p.label = format!("{} ({:.1e}, below)", p.label, p.y);
-                p.tip += "\n(drawn at the axis's bottom edge: below its range)";
-                p.y = lo * 1.25;
-                p.edge = true;
-            }
-            (p, half)
-        })
-        .collect();
+    let points = pin_below(points, lo);
     let drawable = |p: &Point| p.x.is_finite() && p.x > 0.0 && p.y.is_finite() && p.y > 0.0;
     let left_out = points.iter().filter(|(p, _)| !drawable(p)).count();
     let fp32_top = points.iter().filter(|(p, half)| !half && drawable(p)).map(|(p, _)| p.x).fold(0.0, f64::max);
@@ -656,14 +660,15 @@ fn result_class(result: &str) -> &'static str {
 /// Causes shown before the fold.
 const CAUSES_SHOWN: usize = 10;
 
-/// The failing specs grouped by cause: one row per (hard case or the grid, what it gives, the input guards that
-/// remove it), with the specs that fail so, most specs first (rows keyed `cause<i>/<k>`); and how many causes.
-fn failure_causes(i: usize, st: &StabilityReport) -> (String, usize) {
-    // (case, result, removed by) -> spec labels
-    let mut causes: Vec<((String, &'static str, String), Vec<&str>)> = Vec::new();
-    for spec in st.specs.iter().filter(|x| x.fails() && !super::summary::is_guard_variant(&x.spec)) {
+/// A cause of failure: the hard case (or the grid), what it gives, the input guards that remove it.
+type Cause = (String, &'static str, String);
+
+/// Each failing spec's causes (guard variants left out), with the specs that fail so, most specs first.
+fn causes_of(st: &StabilityReport) -> Vec<(Cause, Vec<&str>)> {
+    let mut causes: Vec<(Cause, Vec<&str>)> = Vec::new();
+    for spec in st.specs.iter().filter(|x| x.fails() && !crate::stability::is_guard_variant(&x.spec)) {
         let f = &spec.failures;
-        let mut keys: Vec<(String, &'static str, String)> = f
+        let mut keys: Vec<Cause> = f
             .cases
             .iter()
             .map(|c| (c.at.clone(), result_class(&c.result), crate::stability::failures::removed_text(c)))
@@ -692,48 +697,55 @@ fn failure_causes(i: usize, st: &StabilityReport) -> (String, usize) {
         }
     }
     causes.sort_by(|a, b| b.1.len().cmp(&a.1.len()));
-    let table = |rows: &[((String, &'static str, String), Vec<&str>)], from: usize| {
-        let mut t = HtmlTable::new(&[
-            ("case", "where"),
-            ("result", "gives"),
-            ("removed", "input guards"),
-            ("specs", "specs"),
-            ("which", "which (hover for all)"),
-        ]);
-        for (k, ((case, class, removed), specs)) in rows.iter().enumerate() {
-            let few: Vec<&str> = specs.iter().take(4).copied().collect();
-            let more =
-                if specs.len() > few.len() { format!(" +{} more", specs.len() - few.len()) } else { String::new() };
-            t.row(
-                format!("cause{i}/{}", from + k),
-                vec![
-                    Cell::text(case.clone()),
-                    Cell::text(class.to_string()),
-                    Cell::text(removed.replace('`', "")),
-                    count_cell(specs.len()),
-                    Cell::text(format!("{}{more}", few.join(", "))),
-                ],
-            );
-        }
-        // Every spec of a cause in its row's tooltip.
-        let mut h = t.html();
-        for (k, (_, specs)) in rows.iter().enumerate() {
-            let row = format!("<tr data-row=\"cause{i}/{}\">", from + k);
-            let tip = format!("<tr data-row=\"cause{i}/{}\" data-tip=\"{}\">", from + k, esc(&specs.join("\n")));
-            h = h.replacen(&row, &tip, 1);
-        }
-        h
-    };
+    causes
+}
+
+/// The causes' table (rows keyed `cause<i>/<k>` from `from`), each row's specs all on hover.
+fn causes_table(i: usize, rows: &[(Cause, Vec<&str>)], from: usize) -> String {
+    let mut t = HtmlTable::new(&[
+        ("case", "where"),
+        ("result", "gives"),
+        ("removed", "input guards"),
+        ("specs", "specs"),
+        ("which", "which (hover for all)"),
+    ]);
+    for (k, ((case, class, removed), specs)) in rows.iter().enumerate() {
+        let few: Vec<&str> = specs.iter().take(4).copied().collect();
+        let more = if specs.len() > few.len() { format!(" +{} more", specs.len() - few.len()) } else { String::new() };
+        t.row(
+            format!("cause{i}/{}", from + k),
+            vec![
+                Cell::text(case.clone()),
+                Cell::text(class.to_string()),
+                Cell::text(removed.replace('`', "")),
+                count_cell(specs.len()),
+                Cell::text(format!("{}{more}", few.join(", "))),
+            ],
+        );
+    }
+    let mut h = t.html();
+    for (k, (_, specs)) in rows.iter().enumerate() {
+        let row = format!("<tr data-row=\"cause{i}/{}\">", from + k);
+        let tip = format!("<tr data-row=\"cause{i}/{}\" data-tip=\"{}\">", from + k, esc(&specs.join("\n")));
+        h = h.replacen(&row, &tip, 1);
+    }
+    h
+}
+
+/// The failing specs grouped by cause (`causes_of`): the first `CAUSES_SHOWN` in a table, the rest folded;
+/// and how many causes there are.
+fn failure_causes(i: usize, st: &StabilityReport) -> (String, usize) {
+    let causes = causes_of(st);
     if causes.is_empty() {
         return (String::new(), 0);
     }
     let (first, rest) = causes.split_at(causes.len().min(CAUSES_SHOWN));
     let mut s = format!(
         "<h3>The failures by cause</h3><p class=\"note\">Each hard case (or the grid) that gives NaN, Inf or a negative value, with the input guards (as a caller could apply them) that remove it, and the specs that fail there; a spec failing several cases is under each.</p>{}",
-        table(first, 0)
+        causes_table(i, first, 0)
     );
     if !rest.is_empty() {
-        s += &html::fold(&format!("{} more cause(s)", rest.len()), &table(rest, first.len()));
+        s += &html::fold(&format!("{} more cause(s)", rest.len()), &causes_table(i, rest, first.len()));
     }
     (s, causes.len())
 }
@@ -859,7 +871,7 @@ fn located_failures(st: &StabilityReport) -> String {
     }
     if !located.is_empty() {
         located = html::fold(
-            "Where each failing spec fails: every case's inputs and result",
+            "Where the failing specs fail: each case's inputs and result",
             &format!(
                 "<p class=\"note\">Each failing hard case with its inputs, the grid's failing points, and the input guards (roughness floor, cosine floor, safe half vector, lit mask, F0 clamp, as a caller could apply them) that remove each.</p><ul class=\"failures\">{located}</ul>"
             ),

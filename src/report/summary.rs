@@ -4,7 +4,6 @@
 
 use super::sections::{estimate_cell, num_cell};
 use super::{Input, Loaded};
-use crate::brdf::guards::GuardSet;
 use crate::export::html::{self, Cell, HtmlTable, esc};
 use crate::io::finite;
 use crate::model::Model;
@@ -26,11 +25,6 @@ const STABILITY: &str = "stability";
 /// file's where the file is still there), else the text as written.
 pub fn model_key(spec: &str) -> String {
     Model::parse(spec).map(|m| m.canonical()).unwrap_or_else(|_| spec.to_string())
-}
-
-/// A stability run's spec with some of brdfprof's guards off (`--unguarded`): a variant, not a model.
-pub fn is_guard_variant(spec: &str) -> bool {
-    Model::parse(spec).ok().and_then(|m| m.twin().map(|s| s.guards != GuardSet::ALL)).unwrap_or(false)
 }
 
 struct Column {
@@ -277,7 +271,7 @@ fn gather(inputs: &[Input]) -> Summary {
     }
     for input in inputs {
         if let Loaded::Stability(st) = &input.loaded {
-            for spec in st.specs.iter().filter(|x| x.fails() && !is_guard_variant(&x.spec)) {
+            for spec in st.specs.iter().filter(|x| x.fails() && !crate::stability::is_guard_variant(&x.spec)) {
                 let key = s.model(&spec.spec, spec.label());
                 s.mark(&key, |w| w.failing = true);
             }
@@ -285,7 +279,7 @@ fn gather(inputs: &[Input]) -> Summary {
             let cells = st
                 .specs
                 .iter()
-                .filter(|x| !is_guard_variant(&x.spec))
+                .filter(|x| !crate::stability::is_guard_variant(&x.spec))
                 .map(|x| (model_key(&x.spec), stability_cell(x)))
                 .filter(|(k, _)| known.contains(k))
                 .collect();
@@ -316,6 +310,21 @@ fn numbered_labels(models: &[(String, String)]) -> Vec<String> {
             }
         })
         .collect()
+}
+
+/// The fold's line: how many more models, how many of them fail and how many are on the frontier.
+fn folded_finding(s: &Summary, folded: &[usize]) -> String {
+    let count = |f: fn(&Why) -> bool| folded.iter().filter(|&&i| s.why.get(&s.models[i].0).is_some_and(f)).count();
+    let (failing, pareto) = (count(|w| w.failing), count(|w| w.pareto));
+    let mut what = Vec::new();
+    if failing > 0 {
+        what.push(format!("{failing} failing stability"));
+    }
+    if pareto > 0 {
+        what.push(format!("{pareto} on the sweep's Pareto frontier"));
+    }
+    let what = if what.is_empty() { String::new() } else { format!(": {}", what.join(", ")) };
+    format!("{} more model(s){what}", folded.len())
 }
 
 /// The summary section's body, or None when no report names a model.
@@ -361,20 +370,8 @@ pub fn summary(inputs: &[Input]) -> Option<String> {
         }
         t.html()
     };
-    let mut more = String::new();
-    if !folded.is_empty() {
-        let count = |f: fn(&Why) -> bool| folded.iter().filter(|&&i| s.why.get(&s.models[i].0).is_some_and(f)).count();
-        let (failing, pareto) = (count(|w| w.failing), count(|w| w.pareto));
-        let mut what = Vec::new();
-        if failing > 0 {
-            what.push(format!("{failing} failing stability"));
-        }
-        if pareto > 0 {
-            what.push(format!("{pareto} on the sweep's Pareto frontier"));
-        }
-        let what = if what.is_empty() { String::new() } else { format!(": {}", what.join(", ")) };
-        more += &html::fold(&format!("{} more model(s){what}", folded.len()), &rows(folded));
-    }
+    let mut more =
+        if folded.is_empty() { String::new() } else { html::fold(&folded_finding(&s, folded), &rows(folded)) };
     if s.columns.len() > MAX_COLUMNS {
         more +=
             &format!("<p class=\"note\">{} more column(s) in the sections below.</p>", s.columns.len() - MAX_COLUMNS);

@@ -2,6 +2,8 @@
 //! profile protocol) and measured for accuracy (`accuracy`), and the result is a table, a JSON file and a chart
 //! of error against cost with the Pareto frontier.
 
+pub mod cost;
+
 use crate::accuracy::{self, Accuracy, ExactCache, SampleSet};
 use crate::brdf::exact::ExactFresnel;
 use crate::brdf::samples::SampleDomain;
@@ -421,7 +423,7 @@ impl SweepReport {
 mod tests {
     use super::*;
 
-    /// The committed sweep chart, drawn from the committed JSON (`BRDFPROF_BLESS=1` writes it back to
+    /// The committed sweep chart, drawn from the committed JSON (`BLESS=1` writes it back to
     /// results/, so the picture always shows the JSON's figures).
     #[test]
     fn the_committed_sweep_chart_draws_from_its_json() {
@@ -429,10 +431,7 @@ mod tests {
         let text = std::fs::read_to_string(root.join("results/sweep-llvmpipe.json")).unwrap();
         let report: SweepReport = serde_json::from_str(&text).unwrap();
         let dir = tempfile::tempdir().unwrap();
-        let out = match std::env::var_os("BRDFPROF_BLESS") {
-            Some(_) => root.join("results/sweep-llvmpipe.png"),
-            None => dir.path().join("sweep.png"),
-        };
+        let out = crate::export::png::blessed_or_scratch("sweep-llvmpipe.png", dir.path());
         report.chart(&out).unwrap();
         let img = image::open(&out).unwrap();
         assert!(img.width() > 1000 && img.height() > 800);

@@ -60,7 +60,7 @@ pub fn models_of(inputs: &[Input]) -> Vec<(String, String)> {
             Loaded::Stability(st) => st
                 .specs
                 .iter()
-                .filter(|s| s.fails() && !super::summary::is_guard_variant(&s.spec))
+                .filter(|s| s.fails() && !crate::stability::is_guard_variant(&s.spec))
                 .for_each(|s| add(&s.spec, s.label())),
             Loaded::Diff(d) => [&d.a, &d.b].into_iter().for_each(|m| add(&m.canonical, &m.name)),
             Loaded::DiffSet(d) => std::iter::once(&d.reference)
