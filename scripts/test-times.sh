@@ -10,6 +10,9 @@ root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root"
 log=${1:-$(mktemp)}
 : > "$log"
+# Built first on its own, so that a test that does not compile stops the script (its binary would otherwise be
+# missing from the list below, and the run would look green).
+cargo test --release --locked --workspace --no-run
 list=$(cargo test --release --locked --workspace --no-run --message-format=json 2>/dev/null |
     python3 -c '
 import json, sys

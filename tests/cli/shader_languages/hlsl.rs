@@ -342,24 +342,6 @@ fn the_hlsl_front_end_can_be_chosen() {
     assert!(stderr.contains("hlsl-front-end=slang: Slang's slangc is not installed: run `make setup`"), "{stderr}");
 }
 
-/// `brdfprof eval ARGS --input in.csv --output x.csv` in `d` without Slang's slangc (an empty
-/// `BRDFPROF_SLANG_DIR`): its exit status, which must be 2, and its stderr.
-fn eval_without_slang(d: &Path, args: &[&str]) -> String {
-    let none = d.join("no-slang");
-    std::fs::create_dir_all(&none).unwrap();
-    let out = common::brdfprof()
-        .arg("eval")
-        .args(args)
-        .args(["--input", "in.csv", "--output", "x.csv"])
-        .current_dir(d)
-        .env("BRDFPROF_SLANG_DIR", &none)
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr).to_string();
-    assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
-    stderr
-}
-
 /// DXC's minimum-precision overloads (distinct types for overloading, 32-bit with 16-bit types off): a
 /// `min16float` overload beside its `float` twin, written directly or made by a macro as engines' headers do,
 /// evaluates in both front ends, the 32-bit one taken, the dropped one said once at its line.

@@ -739,3 +739,21 @@ fn front_end_errors_without_a_location_are_named_at_the_users_line() {
     .unwrap();
     run_in(d, &["eval", "--model", "after.brdf", "--input", "in.csv", "--output", "after.csv"]).ok();
 }
+
+/// `brdfprof eval ARGS --input in.csv --output x.csv` in `d` without Slang's slangc (an empty
+/// `BRDFPROF_SLANG_DIR`): its exit status, which must be 2, and its stderr.
+fn eval_without_slang(d: &Path, args: &[&str]) -> String {
+    let none = d.join("no-slang");
+    std::fs::create_dir_all(&none).unwrap();
+    let out = common::brdfprof()
+        .arg("eval")
+        .args(args)
+        .args(["--input", "in.csv", "--output", "x.csv"])
+        .current_dir(d)
+        .env("BRDFPROF_SLANG_DIR", &none)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr).to_string();
+    assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
+    stderr
+}
