@@ -320,6 +320,9 @@ impl Model {
         if half && !info.shader_float16 {
             bail!("{self}: device `{}` has no shaderFloat16, so fp16 arithmetic cannot run there", info.name);
         }
+        if matches!(self, Model::File(f) if f.file.uses_float64()) && !info.shader_float64 {
+            bail!("{self}: device `{}` has no shaderFloat64, so fp64 arithmetic cannot run there", info.name);
+        }
         Ok(())
     }
 }

@@ -347,10 +347,24 @@ impl BrdfFile {
     /// precision (`float16_t`, `f16vec*`, `f16mat*`: WGSL's `enable f16`, GLSL's explicit 16-bit types), which a
     /// device without shaderFloat16 cannot run.
     pub fn uses_float16(&self) -> bool {
-        self.shader.iter().any(|(_, line)| {
-            line.split(|c: char| !(c.is_ascii_alphanumeric() || c == '_'))
-                .any(|w| w == "float16_t" || w.starts_with("f16vec") || w.starts_with("f16mat"))
+        self.uses_word(|w| w == "float16_t" || w.starts_with("f16vec") || w.starts_with("f16mat"))
+    }
+
+    /// Whether the shader, as the kernels compose it, computes in double precision (`double`, `dvec*`,
+    /// `dmat*`, `float64_t`, `f64vec*`, `f64mat*`), which a device without shaderFloat64 cannot run (Mesa's
+    /// Turnip and PanVK crash compiling it rather than refuse it).
+    pub fn uses_float64(&self) -> bool {
+        self.uses_word(|w| {
+            w == "double"
+                || w == "float64_t"
+                || ["dvec", "dmat", "f64vec", "f64mat"]
+                    .iter()
+                    .any(|p| w.strip_prefix(p).is_some_and(|d| d.starts_with(['2', '3', '4'])))
         })
+    }
+
+    fn uses_word(&self, is: impl Fn(&str) -> bool) -> bool {
+        self.shader.iter().any(|(_, line)| line.split(|c: char| !(c.is_ascii_alphanumeric() || c == '_')).any(&is))
     }
 
     /// The same file with its shader preprocessed under `defines` (`NAME`, `VALUE`; an empty value defines
