@@ -9,9 +9,12 @@ use anyhow::{Result, anyhow};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-fn face(bold: bool) -> FontRef<'static> {
-    let bytes = if bold { dejavu::sans::bold() } else { dejavu::sans::regular() };
-    FontRef::try_from_slice(bytes).expect("the embedded DejaVu Sans parses")
+/// The embedded DejaVu Sans, parsed once per weight (layouts measure many texts).
+fn face(bold: bool) -> &'static FontRef<'static> {
+    static REGULAR: std::sync::OnceLock<FontRef<'static>> = std::sync::OnceLock::new();
+    static BOLD: std::sync::OnceLock<FontRef<'static>> = std::sync::OnceLock::new();
+    let (cell, bytes) = if bold { (&BOLD, dejavu::sans::bold()) } else { (&REGULAR, dejavu::sans::regular()) };
+    cell.get_or_init(|| FontRef::try_from_slice(bytes).expect("the embedded DejaVu Sans parses"))
 }
 
 /// The width and height in pixels of `text` at `size` px (the font's ascent to descent), as `draw` lays it.

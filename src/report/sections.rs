@@ -284,14 +284,13 @@ fn rank_matrix(table: &CostTable) -> (String, String) {
         }
     }
     let certain = |p: &crate::compare::PairCorrelation| p.spearman_ci.is_some_and(|(lo, hi)| lo > 0.0 || hi < 0.0);
-    let mut rhos: Vec<f64> = pairs.iter().filter_map(|p| p.spearman_net.filter(|_| p.spearman_ci.is_some())).collect();
-    rhos.sort_by(f64::total_cmp);
+    let rhos: Vec<f64> = pairs.iter().filter_map(|p| p.spearman_net.filter(|_| p.spearman_ci.is_some())).collect();
     let sure = pairs.iter().filter(|p| certain(p)).count();
     let agreement = match rhos.len() {
         0 => "Too few models in common to rank the devices against each other.".to_string(),
         n => format!(
             "Rank agreement between devices: median Spearman rho {:.2} over {n} pairs; {sure} of them with a 95% CI that excludes 0.",
-            rhos[n / 2]
+            crate::stats::median(&rhos)
         ),
     };
     let mut s = String::from("<table class=\"matrix\"><thead><tr><th></th>");

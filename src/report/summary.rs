@@ -190,7 +190,7 @@ fn range_cell(v: &[f64]) -> Cell {
     }
     v.sort_by(f64::total_cmp);
     let n = v.len();
-    let median = if n % 2 == 1 { v[n / 2] } else { 0.5 * (v[n / 2 - 1] + v[n / 2]) };
+    let median = crate::stats::median(&v);
     let f = |x: f64| crate::export::markdown::sig_compact(x, 3);
     if n == 1 || v[0] == v[n - 1] {
         Cell::num(median, f(median))
