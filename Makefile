@@ -52,7 +52,7 @@ install: build
 
 # The leaf crates' own tests (BRDF mathematics, process layer, SPIR-V to C writer): no Vulkan driver, no Mesa,
 # none of ash, naga or plotters to compile; the quick loop for changes below the application.
-LEAF_CRATES := brdfprof-brdf brdfprof-process brdfprof-spirv-c
+LEAF_CRATES := brdfprof-brdf brdfprof-files brdfprof-front brdfprof-isa-cost brdfprof-process brdfprof-spirv-c
 test-crates:
 	$(CARGO) test --release --locked $(addprefix -p ,$(LEAF_CRATES))
 

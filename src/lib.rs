@@ -4,12 +4,12 @@
 //! `gpu`) -> the measurement protocol (`measure`) and the commands (`profile`, ...) -> reports (`report`).
 
 pub use brdfprof_brdf as brdf;
+pub use brdfprof_files::cache;
 pub use brdfprof_process::{cleanup, launch, messages, tools};
 pub use brdfprof_vulkan as gpu;
 
 pub mod accuracy;
 pub mod across_devices;
-pub mod cache;
 pub mod check;
 pub mod compare;
 pub mod diff;

@@ -6,9 +6,9 @@
 //! never shows it.
 
 pub mod brdf_file;
+pub use brdfprof_front as front;
 pub mod csv_rows;
 pub mod file_model;
-pub mod front;
 pub mod labels;
 
 use crate::brdf::terms::{PARAMS, ParamValue};

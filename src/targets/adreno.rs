@@ -21,7 +21,6 @@ use super::mesa_noop::builds::{MESA_25_UNVALIDATED, MESA_BACKPORTS, MESA_DEBIAN}
 use super::mesa_noop::shim::{Shim, ShimFamily};
 use crate::schema::InspectReport;
 use crate::schema::cost::TargetCost;
-use cost::schedule::Schedule;
 
 /// The statistics shown beside cycles/eval (Turnip's names).
 const SHOWN: [&str; 6] = [
@@ -72,32 +71,10 @@ pub static ADRENO: Shim = Shim {
     representation_stats: None,
 };
 
-/// ir3's instruction categories by pipe (`instrs_per_cat`, statistics "catN instructions").
-const PIPES: [(&str, &[u8]); 5] =
-    [("ALU", &[1, 2, 3]), ("SFU", &[4]), ("texture", &[5]), ("load/store", &[6]), ("control", &[0, 7])];
-
-/// The rule's figures of one wave, and its fibres.
-fn schedule_of(stats: &Stats) -> Option<(Schedule, f64)> {
-    let stat = |name: &str| cost::driver_stat(stats, name);
+/// The rule's figures of one wave (`ir3::schedule_of`), at the subgroup size the driver reported.
+fn schedule_of(stats: &Stats) -> Option<(brdfprof_isa_cost::schedule::Schedule, f64)> {
     let fibres = stats.get(crate::schema::driver::SUBGROUP_SIZE).copied().filter(|s| *s > 0.0)?;
-    let instructions = stat("Instruction Count")?;
-    let nops = stat("NOPs Count").unwrap_or(0.0);
-    let cat = |k: &u8| stat(&format!("cat{k} instructions"));
-    // ir3 older than its per-category statistics: no pipes to price.
-    (0..8).try_for_each(|k| cat(&k).map(|_| ()))?;
-    let passes = fibres / 64.0;
-    let pipes = PIPES
-        .iter()
-        .map(|(name, cats)| {
-            let issued: f64 = cats.iter().filter_map(cat).sum::<f64>() - if cats.contains(&0) { nops } else { 0.0 };
-            let per_issue = if *name == "ALU" { passes.max(1.0) } else { 1.0 };
-            (name.to_string(), issued.max(0.0) * per_issue)
-        })
-        .collect();
-    let stalls =
-        stat("Estimated cycles stalled on SS").unwrap_or(0.0) + stat("Estimated cycles stalled on SY").unwrap_or(0.0);
-    let schedule = Schedule { pipes, latency: Some(instructions + stalls), resident_waves: stat("Max Waves Per Core") };
-    Some((schedule, fibres))
+    brdfprof_isa_cost::ir3::schedule_of(stats, fibres)
 }
 
 type Stats = std::collections::BTreeMap<String, f64>;

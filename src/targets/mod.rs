@@ -131,6 +131,23 @@ pub trait Vendor: Sync {
 pub static VENDORS: [&dyn Vendor; 7] =
     [&radv::RADV, &nvidia::NVIDIA, &intel::INTEL, &adreno::ADRENO, &mali::MALI, &anv::ANV, &nak::NAK];
 
+/// Statistics a compiler's listing gave, as the driver statistics of `executable`.
+pub fn driver_stats(executable: &str, stats: Vec<brdfprof_isa_cost::Stat>) -> Vec<crate::gpu::DriverStat> {
+    let executable = executable.to_string();
+    let stat = |s: brdfprof_isa_cost::Stat| crate::gpu::DriverStat {
+        executable: executable.clone(),
+        name: s.name,
+        description: s.description,
+        value: s.value,
+    };
+    stats.into_iter().map(stat).collect()
+}
+
+/// Statistics read from a compiler's log, as those of the executable logs stand for (`gpu::LOGGED_EXECUTABLE`).
+pub fn logged(stats: Vec<brdfprof_isa_cost::Stat>) -> Vec<crate::gpu::DriverStat> {
+    driver_stats(crate::gpu::LOGGED_EXECUTABLE, stats)
+}
+
 /// Whether more than one vendor has a family of this name (`sm_86`: `nvidia:` and `nak:`).
 pub fn shared_family_name(name: &str) -> bool {
     VENDORS.iter().filter(|v| v.families().iter().any(|f| f.name == name)).count() > 1

@@ -15,7 +15,7 @@ const TARGETS: [&str; 7] =
 /// The targets whose hardware runs two fp16 results where it runs one fp32 result, by their documents: RDNA's packed
 /// v_pk_fma_f16 (AMD's RDNA whitepaper, "packed math"), NVIDIA's HFMA2 (two results per instruction: the CUDA
 /// guide's FP16 row, at FP32's results per clock on 8.9 but half its issue slots), Intel Xe-LP's FP16 at 16 lanes
-/// per clock against FP32's 8 (`intel::THROUGHPUT`, tests/fixtures/intel-throughput.tsv), for IGC and brw alike.
+/// per clock against FP32's 8 (`intel::THROUGHPUT`, crates/isa-cost/fixtures/intel-throughput.tsv), for IGC and brw alike.
 /// Not ir3 (no fp16 rate in ir3 or Qualcomm's public documents: the rule counts its instructions), not Bifrost on
 /// PanVK 22.3 (no fp16 at all) and not NAK 25.0 (its code adds an HADD2 per HFMA2: docs/targets/nak.md).
 const PACKED_FP16: [&str; 4] = ["radv:navi21", "nvidia:sm_89", "intel:gen12lp", "anv:tgl"];

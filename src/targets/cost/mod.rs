@@ -5,7 +5,8 @@
 
 pub mod lines;
 pub mod measured;
-pub mod schedule;
+
+pub use brdfprof_isa_cost::{driver_stat, schedule};
 
 use crate::kernels::shade::steady_block;
 use crate::model::BASELINE_LABEL;
@@ -15,17 +16,6 @@ use schedule::{LATENCY, RESIDENT_WAVES, Schedule};
 
 /// A row's statistics by key.
 type Stats = std::collections::BTreeMap<String, f64>;
-
-/// The value of driver statistic `name` of any executable, summed (a compute pipeline has one).
-pub fn driver_stat(stats: &std::collections::BTreeMap<String, f64>, name: &str) -> Option<f64> {
-    let suffix = format!("/{name}");
-    let v: Vec<f64> = stats
-        .iter()
-        .filter(|(k, _)| k.starts_with("driver/") && k.ends_with(&suffix) && k.matches('/').count() == 2)
-        .map(|(_, v)| *v)
-        .collect();
-    (!v.is_empty()).then(|| v.iter().sum())
-}
 
 /// A cost table of `report` from a per-kernel rule: `cycles(stats, lights per kernel)` (None: the kernel has no
 /// figure, e.g. the driver reported none) and the statistics `columns` shown beside it.

@@ -11,9 +11,9 @@
 //! 64 invocations whatever the wave size, so one evaluation (one invocation x one light) costs
 //! `Inverse Throughput / (64 x lights per kernel)` SIMD cycles.
 
-pub mod aco_perfinfo;
 pub mod env;
-pub mod families;
+
+pub use brdfprof_isa_cost::{aco as aco_perfinfo, amd as families};
 
 use super::cost;
 use super::cost::schedule::Schedule;
@@ -54,6 +54,12 @@ pub fn schedule(stats: &BTreeMap<String, f64>, family: &Family) -> Option<Schedu
         latency: Some(cost::driver_stat(stats, CLOCKS)?),
         resident_waves: Some(cost::driver_stat(stats, WAVES)?),
     })
+}
+
+/// A pipeline's stderr under ACO_DEBUG=perfinfo, as the logged executable's statistics (`aco_perfinfo::read`).
+fn read_log(log: &str) -> Result<(Vec<crate::gpu::DriverStat>, Vec<String>)> {
+    let (stats, rest) = aco_perfinfo::read(log)?;
+    Ok((super::logged(stats), rest))
 }
 
 pub struct Radv;
@@ -177,7 +183,7 @@ impl NoopDriver for Radv {
     }
 
     fn compiler_log(&self) -> Option<CompilerLog> {
-        Some(CompilerLog { read: aco_perfinfo::read, beside_properties: true })
+        Some(CompilerLog { read: read_log, beside_properties: true })
     }
 
     fn is_noise(&self, line: &str) -> bool {

@@ -9,7 +9,7 @@
 //! own table (`get_perf_info`). On a kernel without branches or loops both agree with ACO's totals exactly
 //! (tested).
 
-use crate::gpu::DriverStat;
+use crate::Stat;
 use anyhow::{Result, bail};
 
 /// An instruction class of ACO's (`instr_class` in aco_opcodes.py), as far as its cost model distinguishes
@@ -422,19 +422,14 @@ pub fn count_name(class: Class) -> String {
 /// A `CompilerLog` for RADV with ACO_DEBUG=perfinfo: the one program compiled in this pipeline creation as
 /// statistics (clocks summed, waves, instructions per class, and ACO's own weighted totals as
 /// `perfinfo: weighted <name>`), and the lines that are not perfinfo's.
-pub fn read(log: &str) -> Result<(Vec<DriverStat>, Vec<String>)> {
+pub fn read(log: &str) -> Result<(Vec<Stat>, Vec<String>)> {
     let (programs, rest) = split(log);
     let program = match programs.as_slice() {
         [one] => one,
         [] => bail!("ACO printed no perfinfo program (is ACO_DEBUG=perfinfo reaching RADV?)"),
         many => bail!("ACO printed {} perfinfo programs for one pipeline", many.len()),
     };
-    let stat = |name: String, value: f64| DriverStat {
-        executable: crate::gpu::LOGGED_EXECUTABLE.into(),
-        description: format!("ACO_DEBUG=perfinfo: {name}"),
-        name,
-        value,
-    };
+    let stat = |name: String, value: f64| Stat { description: format!("ACO_DEBUG=perfinfo: {name}"), name, value };
     let mut stats = vec![stat(CLOCKS.into(), program.instructions.iter().map(|(c, _)| c).sum())];
     for c in Class::ALL {
         stats.push(stat(count_name(c), program.instructions.iter().filter(|(_, m)| class(m) == c).count() as f64));

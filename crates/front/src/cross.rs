@@ -258,9 +258,9 @@ pub fn describe() -> String {
     static V: OnceLock<String> = OnceLock::new();
     V.get_or_init(|| {
         let revision =
-            crate::shaders::first_line_of(crate::cleanup::command("spirv-cross").arg("--revision")).unwrap_or_default();
+            crate::glslang::first_line_of(crate::cleanup::command("spirv-cross").arg("--revision")).unwrap_or_default();
         let package = || {
-            crate::shaders::first_line_of(crate::cleanup::command("dpkg-query").args([
+            crate::glslang::first_line_of(crate::cleanup::command("dpkg-query").args([
                 "-W",
                 "-f=${Version}",
                 "spirv-cross",

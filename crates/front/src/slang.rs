@@ -197,7 +197,7 @@ pub fn compile(
         return Ok(Some(Err(text)));
     }
     let bytes = crate::io::read_bounded(&out, crate::launch::MAX_OUTPUT_BYTES as u64).context("slangc's SPIR-V")?;
-    let words = crate::shaders::Spirv::from_bytes(&what, &bytes)?.words.to_vec();
+    let words = crate::glslang::Spirv::from_bytes(&what, &bytes)?.words.to_vec();
     let deps = std::fs::read_to_string(&depfile).map(|d| depfile_paths(&d)).unwrap_or_default();
     let deps: Vec<PathBuf> = deps.into_iter().filter(|p| p != &source).collect();
     store(&key, &deps, &bytes);
@@ -238,7 +238,7 @@ fn cached(key: &crate::cache::Key) -> Option<Vec<u32>> {
     if !fresh(&entry) {
         return None;
     }
-    crate::shaders::Spirv::from_bytes("cached slangc SPIR-V", &entry.1).ok().map(|s| s.words.to_vec())
+    crate::glslang::Spirv::from_bytes("cached slangc SPIR-V", &entry.1).ok().map(|s| s.words.to_vec())
 }
 
 /// Records a compilation in memory and on disk (a store that cannot be written costs a compilation next time).

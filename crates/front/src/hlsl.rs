@@ -262,7 +262,7 @@ pub fn compile(
     let what = format!("{} (glslang's HLSL front end)", model.display());
     Ok(match run(x, defines, &FLAGS, &what)? {
         Ok((_, Some(bytes))) => {
-            let mut words = crate::shaders::Spirv::from_bytes(&what, &bytes)?.words.to_vec();
+            let mut words = crate::glslang::Spirv::from_bytes(&what, &bytes)?.words.to_vec();
             c_remainders(&mut words);
             Ok(words)
         }
@@ -426,7 +426,7 @@ fn definition(x: &Expanded, function: &str) -> Option<(String, usize, usize)> {
 
 /// The front end, with glslang's version, as reports state it.
 pub fn describe() -> String {
-    let v = crate::shaders::glslang_version()
+    let v = crate::glslang::glslang_version()
         .map_or_else(|| "(version unknown)".into(), |v| v.trim_start_matches("Glslang Version:").trim().to_string());
     format!(
         "glslang {v}'s HLSL front end (glslangValidator {}; `half` is 32-bit float, as DXC without -enable-16bit-types)",
@@ -437,7 +437,7 @@ pub fn describe() -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::front::GlueArg;
+    use crate::GlueArg;
 
     #[test]
     fn glue_and_stub_text() {

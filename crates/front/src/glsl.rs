@@ -62,7 +62,7 @@ pub fn compile(
 ) -> Result<std::result::Result<Vec<u32>, String>> {
     let what = format!("{} (glslang's GLSL front end)", model.display());
     Ok(match super::hlsl::run(x, defines, &FLAGS, &what)? {
-        Ok((_, Some(bytes))) => Ok(crate::shaders::Spirv::from_bytes(&what, &bytes)?.words.to_vec()),
+        Ok((_, Some(bytes))) => Ok(crate::glslang::Spirv::from_bytes(&what, &bytes)?.words.to_vec()),
         Ok((_, None)) => bail!("{what}: glslang wrote no SPIR-V"),
         Err(log) => Err(super::hlsl::messages(&log, x)),
     })
@@ -70,7 +70,7 @@ pub fn compile(
 
 /// The front end as reports state it.
 pub fn describe() -> String {
-    let v = crate::shaders::glslang_version()
+    let v = crate::glslang::glslang_version()
         .map_or_else(|| "(version unknown)".into(), |v| v.trim_start_matches("Glslang Version:").trim().to_string());
     format!("GLSL with includes: glslang {v} (glslangValidator {}; includes expanded by brdfprof)", FLAGS.join(" "))
 }
@@ -78,7 +78,7 @@ pub fn describe() -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::front::GlueArg;
+    use crate::GlueArg;
 
     #[test]
     fn glue_and_stub_are_one_line_of_glsl() {

@@ -14,6 +14,7 @@
 
 pub mod cross;
 pub mod glsl;
+pub mod glslang;
 pub mod hlsl;
 pub mod includes;
 pub mod overloads;
@@ -21,6 +22,8 @@ pub mod slang;
 pub mod wgsl;
 pub mod wgsl_lines;
 
+use brdfprof_files::{cache, io};
+use brdfprof_process::{cleanup, launch, messages, tools};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
@@ -272,7 +275,7 @@ pub fn used() -> BTreeMap<String, String> {
 /// What translates a language, with versions: what reports state.
 pub fn describe(language: Language) -> String {
     match language {
-        Language::Glsl => format!("GLSL, {}", crate::shaders::glslang_version().unwrap_or_else(|| "glslang".into())),
+        Language::Glsl => format!("GLSL, {}", crate::glslang::glslang_version().unwrap_or_else(|| "glslang".into())),
         Language::Hlsl => format!("HLSL: {}; {}", hlsl::describe(), cross::describe()),
         Language::Slang => format!("Slang: {}; {}", slang::describe_slang(), cross::describe()),
         Language::Wgsl => format!("WGSL: {}; {}", wgsl::describe(), cross::describe()),

@@ -685,11 +685,11 @@ pub fn describe() -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::front::GlueArg;
+    use crate::GlueArg;
 
     /// The version Cargo.lock pins for `package`.
     fn locked(package: &str) -> String {
-        let lock = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/Cargo.lock")).unwrap();
+        let lock = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../../Cargo.lock")).unwrap();
         let entry =
             lock.split("[[package]]").find(|e| e.lines().any(|l| l.trim() == format!("name = \"{package}\""))).unwrap();
         entry.lines().find_map(|l| l.trim().strip_prefix("version = \"")).unwrap().trim_end_matches('"').to_string()
