@@ -9,7 +9,6 @@ pub use brdfprof_process::{cleanup, launch, messages, tools};
 pub use brdfprof_vulkan as gpu;
 
 pub mod accuracy;
-pub mod across_devices;
 pub mod check;
 pub mod compare;
 pub mod diff;

@@ -23,8 +23,27 @@ struct Cli {
     verbose: bool,
 }
 
-#[derive(Subcommand)]
-enum Command {
+/// The one list of commands: clap derives the command line from it (each variant's doc comment is its help),
+/// and `commands!` the dispatch, through each arguments type's `cli::Run`. A new command is a line here and its
+/// file `cli/<command>.rs`.
+macro_rules! commands {
+    ($($(#[$meta:meta])* $variant:ident($args:ty),)*) => {
+        #[derive(Subcommand)]
+        enum Command {
+            $($(#[$meta])* $variant($args),)*
+        }
+
+        impl Command {
+            fn args(&self) -> &dyn cli::Run {
+                match self {
+                    $(Command::$variant(a) => a,)*
+                }
+            }
+        }
+    };
+}
+
+commands! {
     /// List Vulkan devices with the properties that matter for profiling.
     Devices(cli::devices::DevicesArgs),
     /// List the terms (with citations) and presets that model specs can name.
@@ -67,68 +86,50 @@ enum Command {
     /// The disk cache of compiled kernels: `show` (directory, entries, size) or `clear`.
     Cache(cli::cache::CacheArgs),
     /// Print a completion script for SHELL on stdout (`make install` installs bash's, zsh's and fish's).
-    Completions {
-        #[arg(value_enum)]
-        shell: clap_complete::Shell,
-    },
+    Completions(Completions),
     /// Writes the man pages (brdfprof.1 and one per command) into DIR (`make install` runs it).
     #[command(name = "__man", hide = true)]
-    Man { dir: std::path::PathBuf },
+    Man(cli::hidden::Man),
     #[command(name = "__callgrind-child", hide = true)]
-    CallgrindChild { request: String },
+    CallgrindChild(cli::hidden::CallgrindChild),
     #[command(name = "__noop-child", hide = true)]
-    NoopChild { request: String },
+    NoopChild(cli::hidden::NoopChild),
     #[command(name = "__run-translation", hide = true)]
-    RunTranslation { dir: String },
+    RunTranslation(cli::hidden::RunTranslation),
     #[command(name = "__probe-vulkan", hide = true)]
-    ProbeVulkan,
+    ProbeVulkan(cli::hidden::ProbeVulkan),
     /// Writes glsl/generated/ from the Rust term tables (`make spv` runs it).
     #[command(name = "__generate-glsl", hide = true)]
-    GenerateGlsl {
-        #[arg(default_value = "glsl/generated")]
-        dir: std::path::PathBuf,
-    },
+    GenerateGlsl(cli::hidden::GenerateGlsl),
+}
+
+/// `completions SHELL`, here with the whole command line it describes.
+#[derive(clap::Args)]
+struct Completions {
+    #[arg(value_enum)]
+    shell: clap_complete::Shell,
+}
+
+impl cli::Run for Completions {
+    fn run(&self) -> anyhow::Result<ExitCode> {
+        clap_complete::generate(self.shell, &mut Cli::command(), "brdfprof", &mut std::io::stdout());
+        Ok(ExitCode::SUCCESS)
+    }
+}
+
+impl cli::Run for cli::hidden::Man {
+    fn run(&self) -> anyhow::Result<ExitCode> {
+        cli::hidden::man(Cli::command(), &self.dir)
+    }
 }
 
 fn main() -> ExitCode {
     cli::command_started();
     let cli = Cli::parse();
     brdfprof::messages::set_verbose(cli.verbose);
-    let child = matches!(
-        cli.command,
-        Command::CallgrindChild { .. }
-            | Command::NoopChild { .. }
-            | Command::RunTranslation { .. }
-            | Command::ProbeVulkan
-    );
-    if let Err(e) = cli::prepare(child, cli.compile_timeout) {
+    let args = cli.command.args();
+    if let Err(e) = cli::prepare(args.child(), cli.compile_timeout) {
         return cli::finish(Err(e));
     }
-    let result = match cli.command {
-        Command::Devices(args) => cli::devices::devices(&args),
-        Command::Models(args) => cli::models::models(&args),
-        Command::Eval(args) => cli::eval::eval(&args),
-        Command::Diff(args) => cli::diff::diff(&args),
-        Command::Profile(args) => cli::profile::profile(&args),
-        Command::Sweep(args) => cli::sweep::sweep(&args),
-        Command::Stability(args) => cli::stability::stability(&args),
-        Command::Inspect(args) => cli::inspect::inspect(&args),
-        Command::Check(args) => cli::check::check(&args),
-        Command::Compare(args) => cli::compare::compare(&args),
-        Command::Report(args) => cli::report::report(&args),
-        Command::Scene(args) => cli::scene::scene(&args),
-        Command::Render(args) => cli::render::render(&args),
-        Command::Cache(args) => cli::cache::cache(&args),
-        Command::Completions { shell } => {
-            clap_complete::generate(shell, &mut Cli::command(), "brdfprof", &mut std::io::stdout());
-            Ok(ExitCode::SUCCESS)
-        }
-        Command::Man { dir } => cli::hidden::man(Cli::command(), &dir),
-        Command::CallgrindChild { request } => cli::hidden::callgrind_child(&request),
-        Command::NoopChild { request } => cli::hidden::noop_child(&request),
-        Command::RunTranslation { dir } => cli::hidden::run_translation(&dir),
-        Command::ProbeVulkan => cli::hidden::probe_vulkan(),
-        Command::GenerateGlsl { dir } => cli::hidden::generate_glsl(&dir),
-    };
-    cli::finish(result)
+    cli::finish(args.run())
 }

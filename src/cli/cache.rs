@@ -30,6 +30,12 @@ fn origin() -> &'static str {
     }
 }
 
+impl super::Run for CacheArgs {
+    fn run(&self) -> Result<ExitCode> {
+        cache(self)
+    }
+}
+
 pub fn cache(args: &CacheArgs) -> Result<ExitCode> {
     let Some(store) = Store::open_default() else {
         outln!(

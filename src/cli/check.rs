@@ -58,6 +58,12 @@ pub struct CheckArgs {
     pub summary: Option<PathBuf>,
 }
 
+impl super::Run for CheckArgs {
+    fn run(&self) -> Result<ExitCode> {
+        check(self)
+    }
+}
+
 pub fn check(args: &CheckArgs) -> Result<ExitCode> {
     let models = args.model.models(&[]).map_err(|e| anyhow!("{e:#}"))?;
     let mut inputs = super::model_inputs(&models);

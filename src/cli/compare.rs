@@ -25,6 +25,12 @@ pub struct CompareArgs {
     pub chart: Option<PathBuf>,
 }
 
+impl super::Run for CompareArgs {
+    fn run(&self) -> Result<ExitCode> {
+        compare(self)
+    }
+}
+
 pub fn compare(args: &CompareArgs) -> Result<ExitCode> {
     check_output("--json", args.json.as_deref(), "results", "compare.json")?;
     check_output("--markdown", args.markdown.as_deref(), "results", "compare.md")?;

@@ -80,6 +80,12 @@ fn targets_table() -> (String, serde_json::Value) {
     (out, serde_json::json!({"targets": json, "tools": tools_json}))
 }
 
+impl super::Run for DevicesArgs {
+    fn run(&self) -> Result<ExitCode> {
+        devices(self)
+    }
+}
+
 pub fn devices(args: &DevicesArgs) -> Result<ExitCode> {
     let outs = super::checked_outputs(&[("--json", args.json.as_deref())], &[])?;
     if args.targets {

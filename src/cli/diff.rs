@@ -99,6 +99,12 @@ fn outputs(args: &DiffArgs, models: &[Model]) -> Result<Vec<(&'static str, PathB
     super::checked_outputs(&asked, &inputs)
 }
 
+impl super::Run for DiffArgs {
+    fn run(&self) -> Result<ExitCode> {
+        diff(self)
+    }
+}
+
 pub fn diff(args: &DiffArgs) -> Result<ExitCode> {
     let models = args.model.models(&[])?;
     if let Some(reference) = &args.reference {

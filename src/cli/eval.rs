@@ -27,6 +27,12 @@ pub struct EvalArgs {
     pub device: DeviceArgs,
 }
 
+impl super::Run for EvalArgs {
+    fn run(&self) -> Result<ExitCode> {
+        eval(self)
+    }
+}
+
 pub fn eval(args: &EvalArgs) -> Result<ExitCode> {
     io::check_output_path("--output", &args.output)?;
     let models = args.model.models(&[])?;

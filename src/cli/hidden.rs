@@ -1,9 +1,87 @@
 //! The hidden commands: the child processes brdfprof starts of itself (callgrind, Mesa's noop drivers, a
 //! translated kernel's runner, the Vulkan probe) and the GLSL generator `make spv` runs.
 
+use super::Run;
 use anyhow::{Context, Result};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+
+/// `__callgrind-child REQUEST`.
+#[derive(clap::Args)]
+pub struct CallgrindChild {
+    request: String,
+}
+
+/// `__noop-child REQUEST`.
+#[derive(clap::Args)]
+pub struct NoopChild {
+    request: String,
+}
+
+/// `__run-translation DIR`.
+#[derive(clap::Args)]
+pub struct RunTranslation {
+    dir: String,
+}
+
+/// `__probe-vulkan`.
+#[derive(clap::Args)]
+pub struct ProbeVulkan {}
+
+/// `__generate-glsl [DIR]`.
+#[derive(clap::Args)]
+pub struct GenerateGlsl {
+    #[arg(default_value = "glsl/generated")]
+    dir: PathBuf,
+}
+
+/// `__man DIR` (run from main.rs, which has the whole command line to render).
+#[derive(clap::Args)]
+pub struct Man {
+    pub dir: PathBuf,
+}
+
+impl Run for CallgrindChild {
+    fn run(&self) -> Result<ExitCode> {
+        callgrind_child(&self.request)
+    }
+    fn child(&self) -> bool {
+        true
+    }
+}
+
+impl Run for NoopChild {
+    fn run(&self) -> Result<ExitCode> {
+        noop_child(&self.request)
+    }
+    fn child(&self) -> bool {
+        true
+    }
+}
+
+impl Run for RunTranslation {
+    fn run(&self) -> Result<ExitCode> {
+        run_translation(&self.dir)
+    }
+    fn child(&self) -> bool {
+        true
+    }
+}
+
+impl Run for ProbeVulkan {
+    fn run(&self) -> Result<ExitCode> {
+        probe_vulkan()
+    }
+    fn child(&self) -> bool {
+        true
+    }
+}
+
+impl Run for GenerateGlsl {
+    fn run(&self) -> Result<ExitCode> {
+        generate_glsl(&self.dir)
+    }
+}
 
 /// `__callgrind-child REQUEST`: each kernel measured under valgrind's callgrind (`inspect::callgrind`).
 pub fn callgrind_child(request: &str) -> Result<ExitCode> {

@@ -3,9 +3,9 @@
 use super::args::{BenchArg, CountArgs, DeviceArgs, HtmlArg, ModelArgs, device_name};
 use super::{check_output, just_measured, on_device_with};
 use anyhow::{Result, bail};
-use brdfprof::across_devices;
 use brdfprof::brdf::THESIS_MODELS;
 use brdfprof::gpu::Gpu;
+use brdfprof::inspect::devices as across_devices;
 use brdfprof::inspect::{self, InspectOptions};
 use brdfprof::{export::json, io};
 use clap::Args;
@@ -67,6 +67,12 @@ pub struct InspectArgs {
     pub html: HtmlArg,
     #[command(flatten)]
     pub bench: BenchArg,
+}
+
+impl super::Run for InspectArgs {
+    fn run(&self) -> Result<ExitCode> {
+        inspect(self)
+    }
 }
 
 pub fn inspect(args: &InspectArgs) -> Result<ExitCode> {

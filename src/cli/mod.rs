@@ -25,6 +25,16 @@ macro_rules! outln {
     }};
 }
 
+/// A command's arguments, run: each `cli/<command>.rs` implements it for its arguments type, and main.rs's one
+/// list of commands (`commands!`) derives both the command line and the dispatch from those types.
+pub trait Run {
+    fn run(&self) -> Result<std::process::ExitCode>;
+    /// A child process brdfprof starts of itself (`prepare` sets it up as one).
+    fn child(&self) -> bool {
+        false
+    }
+}
+
 pub mod args;
 pub mod cache;
 pub mod check;

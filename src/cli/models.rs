@@ -106,6 +106,12 @@ fn models_json() -> serde_json::Value {
     })
 }
 
+impl super::Run for ModelsArgs {
+    fn run(&self) -> Result<ExitCode> {
+        models(self)
+    }
+}
+
 pub fn models(args: &ModelsArgs) -> Result<ExitCode> {
     let outs = super::checked_outputs(&[("--json", args.json.as_deref())], &[])?;
     for (_, path) in &outs {

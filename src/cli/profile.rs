@@ -53,6 +53,12 @@ pub struct ProfileArgs {
     pub device: DeviceArgs,
 }
 
+impl super::Run for ProfileArgs {
+    fn run(&self) -> Result<ExitCode> {
+        profile(self)
+    }
+}
+
 pub fn profile(args: &ProfileArgs) -> Result<ExitCode> {
     if let Some(path) = &args.scene {
         return profile_scene(args, path);

@@ -18,6 +18,12 @@ pub struct RenderArgs {
     pub device: DeviceArgs,
 }
 
+impl super::Run for RenderArgs {
+    fn run(&self) -> Result<ExitCode> {
+        render(self)
+    }
+}
+
 pub fn render(args: &RenderArgs) -> Result<ExitCode> {
     let scene = scene::Scene::load(&args.scene)?;
     let out = args.out.clone().unwrap_or_else(|| PathBuf::from("results/scenes").join(scene.name()));

@@ -24,6 +24,12 @@ pub struct ReportArgs {
     pub device: DeviceArgs,
 }
 
+impl super::Run for ReportArgs {
+    fn run(&self) -> Result<ExitCode> {
+        report(self)
+    }
+}
+
 pub fn report(args: &ReportArgs) -> Result<ExitCode> {
     io::check_output_path("--out", &args.out)?;
     io::check_not_input("--out", &args.out, &args.files.iter().map(|f| ("RESULTS", f.as_path())).collect::<Vec<_>>())?;

@@ -15,6 +15,12 @@ pub struct SceneArgs {
     pub explain: bool,
 }
 
+impl super::Run for SceneArgs {
+    fn run(&self) -> Result<ExitCode> {
+        scene(self)
+    }
+}
+
 pub fn scene(args: &SceneArgs) -> Result<ExitCode> {
     match (&args.file, args.explain) {
         (_, true) => out!("{}", scene::explain()),

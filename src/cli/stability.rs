@@ -51,6 +51,12 @@ pub struct StabilityArgs {
     pub device: DeviceArgs,
 }
 
+impl super::Run for StabilityArgs {
+    fn run(&self) -> Result<ExitCode> {
+        stability(self)
+    }
+}
+
 pub fn stability(args: &StabilityArgs) -> Result<ExitCode> {
     let out = out_dir(args.out.as_deref(), &["stability-*", "furnace-*.png", "albedo-*.png"])?;
     let models = if args.model.models.is_empty() {

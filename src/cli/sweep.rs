@@ -80,6 +80,12 @@ fn exact_fresnel(text: &str) -> Result<brdfprof::brdf::exact::ExactFresnel, Stri
         .ok_or_else(|| format!("`{text}`: give one of {}", brdfprof::brdf::exact::ExactFresnel::NAMES.join(", ")))
 }
 
+impl super::Run for SweepArgs {
+    fn run(&self) -> Result<ExitCode> {
+        sweep(self)
+    }
+}
+
 pub fn sweep(args: &SweepArgs) -> Result<ExitCode> {
     let out = out_dir(args.out.as_deref(), &["sweep-*"])?;
     args.html.check()?;

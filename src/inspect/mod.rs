@@ -7,6 +7,7 @@
 
 pub mod callgrind;
 pub mod correlate;
+pub mod devices;
 
 use crate::gpu::Gpu;
 use crate::kernel_stats;

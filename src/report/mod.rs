@@ -124,7 +124,7 @@ pub fn from_json(path: &Path, text: &str) -> Result<Input> {
             Kind::Stability => Loaded::Stability(parse(path, &text, "stability")?),
             Kind::Inspect => Loaded::Inspect(vec![parse(path, &text, "inspect")?], None),
             Kind::InspectDevices => {
-                let m: crate::across_devices::MultiReport = parse(path, &text, "inspect (several devices)")?;
+                let m: crate::inspect::devices::MultiReport = parse(path, &text, "inspect (several devices)")?;
                 Loaded::Inspect(m.reports, Some(m.costs))
             }
             Kind::Compare => Loaded::Costs(parse(path, &text, "compare")?),
@@ -141,7 +141,7 @@ pub fn from_json(path: &Path, text: &str) -> Result<Input> {
     } else if probe.grid_points.is_some() {
         Loaded::Stability(parse(path, &text, "stability")?)
     } else if probe.reports.is_some() {
-        let m: crate::across_devices::MultiReport = parse(path, &text, "inspect (several devices)")?;
+        let m: crate::inspect::devices::MultiReport = parse(path, &text, "inspect (several devices)")?;
         Loaded::Inspect(m.reports, Some(m.costs))
     } else if probe.kernels.is_some() {
         Loaded::Inspect(vec![parse(path, &text, "inspect")?], None)
