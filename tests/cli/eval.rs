@@ -173,10 +173,10 @@ fn bad_input_fails_clearly_with_exit_2_and_no_output() {
 }
 
 /// `eval --device opencl` runs the OpenCL C translation on PoCL: the same CSV out as on Vulkan, within 1e-5
-/// relative (1e-3 floor) for every thesis model and each example `.brdf`, so a user can diff two independent
-/// executions of one BRDF source.
+/// relative (1e-3 floor) for every thesis model, each example `.brdf` and a constant lookup table (read in place
+/// from __constant memory), so a user can diff two independent executions of one BRDF source.
 #[test]
-fn eval_on_opencl_agrees_with_vulkan_for_the_thesis_models_and_the_example_files() {
+fn eval_on_opencl_agrees_with_vulkan_for_the_thesis_models_the_example_files_and_a_table() {
     let dir = tempfile::tempdir().unwrap();
     let input = dir.path().join("in.csv");
     write_csv(&input, &samples::well_conditioned(5_000, 13, 0.05, 0.2..1.0));
@@ -190,6 +190,7 @@ fn eval_on_opencl_agrees_with_vulkan_for_the_thesis_models_and_the_example_files
     files.sort();
     assert!(!files.is_empty());
     models.extend(files);
+    models.push(common::repo_root().join("tests/fixtures/brdf/table/lookup-64.brdf").display().to_string());
     let read = |p: &Path| -> Vec<f64> {
         std::fs::read_to_string(p)
             .unwrap()

@@ -45,6 +45,9 @@ pub(super) struct FunctionWriter<'m> {
     pub name: String,
     /// Function variables that only ever hold one lookup table (`tables`), by the table constant.
     tables: HashMap<Word, Word>,
+    /// The table variables and the chains into them: pointers into the dialect's table space
+    /// (BRDFPROF_TABLE_SPACE: OpenCL's __constant) where it keeps the table as one object.
+    table_pointers: HashSet<Word>,
 }
 
 impl<'m> FunctionWriter<'m> {
@@ -79,6 +82,7 @@ impl<'m> FunctionWriter<'m> {
             id,
             name: function_name(m, id),
             tables: tables(m, f),
+            table_pointers: HashSet::new(),
         }
     }
 
@@ -335,13 +339,14 @@ impl<'m> FunctionWriter<'m> {
         if let Some(table) = self.tables.get(&id) {
             // The table itself where the dialect keeps it as one object (read only: `tables`), else a copy.
             self.decls.push(format!(
-                "#ifdef BRDFPROF_CONST_TABLE\n#define BRDFPROF_V{id} (({ty}*)&k_{table}_v)\n#else\n  {ty} v{id};\n#define BRDFPROF_V{id} (&v{id})\n#endif"
+                "#ifdef BRDFPROF_CONST_TABLE\n#define BRDFPROF_V{id} ((BRDFPROF_TABLE_SPACE {ty}*)&k_{table}_v)\n#else\n  {ty} v{id};\n#define BRDFPROF_V{id} (&v{id})\n#endif"
             ));
             if inst.operands.get(1).is_some() {
                 let e = self.v(*table)?;
                 writeln!(self.body, "#ifndef BRDFPROF_CONST_TABLE\n  v{id} = {e};\n#endif").unwrap();
             }
             self.vals.insert(id, Val::Local { ptr: format!("BRDFPROF_V{id}"), pointee });
+            self.table_pointers.insert(id);
             return Ok(());
         }
         self.decls.push(format!("{ty} v{id};"));
@@ -419,7 +424,14 @@ impl<'m> FunctionWriter<'m> {
             Val::Local { ptr, pointee } => {
                 let (lvalue, ty) = self.local_chain(format!("(*{ptr})"), pointee, &indices)?;
                 let c = self.m.c_type(ty)?;
-                self.decls.push(format!("{c}* _{id};"));
+                if self.table_pointers.contains(&Self::id(inst, 0)) {
+                    self.table_pointers.insert(id);
+                    self.decls.push(format!(
+                        "#ifdef BRDFPROF_CONST_TABLE\n  BRDFPROF_TABLE_SPACE {c}* _{id};\n#else\n  {c}* _{id};\n#endif"
+                    ));
+                } else {
+                    self.decls.push(format!("{c}* _{id};"));
+                }
                 self.declared.insert(id);
                 writeln!(self.body, "  _{id} = &{lvalue};").unwrap();
                 Val::Local { ptr: format!("_{id}"), pointee: ty }

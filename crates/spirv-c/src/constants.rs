@@ -130,10 +130,10 @@ fn define_large(
         return Ok(());
     }
     let c = m.c_type(*ty)?;
-    // A lookup table is also one constant object where the dialect has one (BRDFPROF_CONST_TABLE: CUDA's
-    // constant memory, the host's static storage), which the function variables that only ever hold it read in
-    // place (`body::tables`): built member by member into a copy at every use, 16 lookups into a 64-entry table
-    // cost 515 STL.64 on sm_75. OpenCL C cannot point a private pointer at __constant memory: it keeps the copy.
+    // A lookup table is also one constant object (BRDFPROF_CONST_TABLE: CUDA's and OpenCL's constant memory,
+    // the host's static storage), which the function variables that only ever hold it read in place
+    // (`body::tables`, through BRDFPROF_TABLE_SPACE pointers): built member by member into a copy at every use,
+    // 16 lookups into a 64-entry table cost 515 STL.64 on sm_75.
     if let Some(init) = &table {
         out.push_str(&format!("#ifdef BRDFPROF_CONST_TABLE\nBRDFPROF_CONST_TABLE {c} k_{id}_v = {init};\n#endif\n"));
     }

@@ -10,6 +10,7 @@ typedef unsigned long long u64;
 #define BRDFPROF_FN static __device__ __forceinline__
 // A lookup table as one object read in place (constants.rs, `define_large`).
 #define BRDFPROF_CONST_TABLE static __constant__ const
+#define BRDFPROF_TABLE_SPACE
 #define BRDFPROF_LOOP_LIMIT(env) 0
 
 // fp16 as its bits, with PTX's f16 instructions (sm_53 and later): add, sub, mul, fma and negation in half

@@ -12,6 +12,7 @@ typedef unsigned long long u64;
 #define BRDFPROF_FN static inline
 // A lookup table as one object read in place (constants.rs, `define_large`).
 #define BRDFPROF_CONST_TABLE static const
+#define BRDFPROF_TABLE_SPACE
 // An invocation stops after 2^20 loop iterations and flags itself (lavapipe stops every loop at 65535).
 #define BRDFPROF_LOOP_LIMIT(env) (++(env)->loop_iterations > (1u << 20) && ((env)->flags |= 1u))
 

@@ -7,6 +7,10 @@ typedef uint u32;
 typedef int i32;
 typedef ulong u64;
 #define GLOBAL __global
+// A lookup table as one object in constant memory read in place (constants.rs, `define_large`), through
+// pointers into __constant space: OpenCL C keeps its address spaces apart.
+#define BRDFPROF_CONST_TABLE __constant
+#define BRDFPROF_TABLE_SPACE __constant
 // inspect --lines defines BRDFPROF_FN first (the helpers without debug information) and BRDFPROF_LINED_FN
 // (the module's own functions, which carry #line directives): Translation::source_with_lines.
 #ifndef BRDFPROF_FN
