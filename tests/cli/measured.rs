@@ -5,7 +5,7 @@
 //! tolerance (its note is then false), or when the rule's figure has left the one recorded beside the check.
 
 use crate::compile_only::inspect_json;
-use brdfprof::targets::cost::measured::{CHECKS, Check, Figure};
+use brdfprof::targets::cost::measured::{CHECKS, Check, Figure, own_estimate};
 use std::collections::{BTreeMap, BTreeSet};
 
 /// Throughput pairs are read at 8 lights (the light loop unrolled, as a shading pass runs it); latency chains
@@ -65,6 +65,29 @@ fn price(dir: &std::path::Path) -> Rows {
         }
     }
     rows
+}
+
+/// The check's pair read through the compiler's own estimate `stat` (`OWN_ESTIMATES`): the same slopes or chain
+/// as the rule's figure, of that statistic.
+fn own(c: &Check, rows: &Rows, stat: &str) -> f64 {
+    let s = |t: &str, lights: u32, m: &str| {
+        rows.get(&(t.to_string(), lights, m.to_string()))
+            .and_then(|r| r["stats"][stat].as_f64())
+            .unwrap_or_else(|| panic!("{t} {m} at {lights} lights: no statistic {stat}"))
+    };
+    match &c.figure {
+        Figure::Throughput { a, b, b_target } => {
+            let bt = b_target.unwrap_or(c.target);
+            let slope = |t: &str, k: &str| {
+                s(t, THROUGHPUT_LIGHTS, &format!("{k}-t16")) - s(t, THROUGHPUT_LIGHTS, &format!("{k}-t8"))
+            };
+            slope(c.target, a) / slope(bt, b)
+        }
+        Figure::Latency { kind, .. } => {
+            (s(c.target, LATENCY_LIGHTS, &format!("{kind}-c96")) - s(c.target, LATENCY_LIGHTS, &format!("{kind}-c32")))
+                / 64.0
+        }
+    }
 }
 
 /// The check's modelled figure from the priced rows.
@@ -133,6 +156,16 @@ fn the_cost_rule_holds_against_published_measurements_or_names_the_difference() 
                 failures.push(format!("{named}: within tolerance now; its known difference in measured.rs is false"))
             }
             _ => {}
+        }
+        if let Some((stat, what)) = own_estimate(c.target) {
+            let o = own(c, &rows, stat);
+            table.push(format!("    {what}: {o:.3} ({:+.1}%)", 100.0 * (o / c.measured - 1.0)));
+            match c.own {
+                Some(recorded) if (o / recorded - 1.0).abs() <= 0.01 => {}
+                _ => {
+                    failures.push(format!("{named}: {what} gives {o:.3}; measured.rs records {:?} (update it)", c.own))
+                }
+            }
         }
         if !(m / c.modelled - 1.0).abs().le(&0.01) {
             failures.push(format!("{named}: src/targets/cost/measured.rs records {} (update it)", c.modelled));
