@@ -82,7 +82,8 @@ fn read_assembly(text: &str) -> Result<Vec<(String, f64)>> {
         bail!("NAK's assembly has no instruction");
     }
     let mut out = vec![("Assembly Instructions".to_string(), instructions.len() as f64)];
-    out.extend(SassStats::of_instructions(&instructions).rule_stats(child_family()?)?);
+    let family = child_family()?;
+    out.extend(SassStats::of_instructions(&instructions, family).rule_stats(family)?);
     Ok(out)
 }
 

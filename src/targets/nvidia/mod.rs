@@ -87,13 +87,13 @@ pub fn compile_as(source: &str, family: &Family, precise: bool, lines: bool) -> 
 pub fn line_costs(model: &str, sass: &Sass, family: &Family) -> Result<crate::schema::lines::KernelLines> {
     use super::cost::lines::{Attributed, per_line};
     let instructions = sass::instructions(&sass.listing)?;
-    let stats = SassStats::of(&sass.listing, &sass.log, sass.cubin_bytes)?;
+    let stats = SassStats::of(&sass.listing, &sass.log, sass.cubin_bytes, family)?;
     let binding = stats
         .pipes(family)?
         .into_iter()
         .fold(("-".to_string(), f64::NEG_INFINITY), |b, p| if p.1 > b.1 { p } else { b })
         .0;
-    let times = sass::issue_times(&instructions);
+    let times = sass::issue_times(&instructions, family.memory);
     let mut attributed = Vec::new();
     let mut previous_end = 0.0;
     for (k, i) in instructions.iter().enumerate() {
@@ -165,7 +165,7 @@ impl Translator for Nvidia {
     fn driver_stats(sass: &Sass, family: &Family) -> Result<Vec<DriverStat>> {
         Ok(super::driver_stats(
             "SASS",
-            SassStats::of(&sass.listing, &sass.log, sass.cubin_bytes)?.driver_stats(family)?,
+            SassStats::of(&sass.listing, &sass.log, sass.cubin_bytes, family)?.driver_stats(family)?,
         ))
     }
 

@@ -25,6 +25,8 @@ pub struct Family {
     pub max_warps: u32,
     /// Resident blocks (workgroups) per SM at most (the same table).
     pub max_blocks: u32,
+    /// A global load's latency: the family's measured DRAM figure where one was found (docs/measured.md).
+    pub memory: &'static sass::VariableLatency,
 }
 
 pub const FAMILIES: [Family; 5] = [
@@ -36,6 +38,7 @@ pub const FAMILIES: [Family; 5] = [
         column: 0,
         max_warps: 32,
         max_blocks: 16,
+        memory: &sass::MEMORY,
     },
     Family {
         name: "sm_86",
@@ -45,6 +48,7 @@ pub const FAMILIES: [Family; 5] = [
         column: 1,
         max_warps: 48,
         max_blocks: 16,
+        memory: &sass::MEMORY,
     },
     Family {
         name: "sm_89",
@@ -54,6 +58,7 @@ pub const FAMILIES: [Family; 5] = [
         column: 2,
         max_warps: 48,
         max_blocks: 24,
+        memory: &sass::MEMORY_SM89,
     },
     Family {
         name: "sm_90",
@@ -63,6 +68,7 @@ pub const FAMILIES: [Family; 5] = [
         column: 3,
         max_warps: 64,
         max_blocks: 32,
+        memory: &sass::MEMORY_SM90,
     },
     Family {
         name: "sm_120",
@@ -72,6 +78,7 @@ pub const FAMILIES: [Family; 5] = [
         column: 4,
         max_warps: 48,
         max_blocks: 32,
+        memory: &sass::MEMORY,
     },
 ];
 
@@ -301,8 +308,8 @@ fn ptxas_figure(log: &str, what: &str) -> u32 {
 impl SassStats {
     /// Counts the `-hex` listing: every instruction up to the kernel's last EXIT (nvdisasm pads the section
     /// with a branch to itself and NOPs after it), NOPs left out of the counts (not of the schedule).
-    pub fn of(listing: &str, ptxas_log: &str, cubin_bytes: usize) -> Result<Self> {
-        let mut s = Self::of_instructions(&sass::instructions(listing)?);
+    pub fn of(listing: &str, ptxas_log: &str, cubin_bytes: usize, family: &Family) -> Result<Self> {
+        let mut s = Self::of_instructions(&sass::instructions(listing)?, family);
         s.cubin_bytes = cubin_bytes as u32;
         s.registers = ptxas_figure(ptxas_log, "registers");
         s.stack_bytes = ptxas_figure(ptxas_log, "bytes stack frame");
@@ -313,8 +320,9 @@ impl SassStats {
     /// The counts and the schedule latency of one warp's instructions in issue order, whichever compiler
     /// scheduled them (ptxas' SASS, NAK's assembly), NOPs left out of the counts (not of the schedule); no
     /// registers, stack or code size.
-    pub fn of_instructions(instructions: &[sass::Instruction]) -> Self {
-        let mut s = SassStats { schedule_latency: sass::schedule_latency(instructions), ..Default::default() };
+    pub fn of_instructions(instructions: &[sass::Instruction], family: &Family) -> Self {
+        let schedule_latency = sass::schedule_latency(instructions, family.memory);
+        let mut s = SassStats { schedule_latency, ..Default::default() };
         for i in instructions.iter().filter(|i| i.mnemonic() != "NOP") {
             let (class, row, pipe) = classify(&i.opcode);
             s.instructions += 1;

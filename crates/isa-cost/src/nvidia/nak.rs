@@ -84,8 +84,9 @@ mod tests {
         assert_eq!((is[5].control.read_barrier, is[5].control.write_barrier), (Some(3), Some(4)));
         assert_eq!((is[6].control.wait_mask, is[6].control.yield_hint), (0b010100, true));
         // The same rule as ptxas' SASS: FFMA on the FMA pipe, MUFU on XU, the load on the LSU.
-        let s = SassStats::of_instructions(&is);
-        let pipes = s.pipes(FAMILIES.iter().find(|f| f.name == "sm_86").unwrap()).unwrap();
+        let sm86 = FAMILIES.iter().find(|f| f.name == "sm_86").unwrap();
+        let s = SassStats::of_instructions(&is, sm86);
+        let pipes = s.pipes(sm86).unwrap();
         let pipe = |n: &str| pipes.iter().find(|p| p.0 == n).map(|p| p.1);
         assert_eq!((pipe("FMA"), pipe("XU (MUFU, conversions)")), (Some(0.5), Some(2.0)));
         // S2R at 0 (scoreboard 0 at 21), LDC at 1 (scoreboard 1 at 31), the first FFMA waits for both (31),

@@ -10,7 +10,7 @@
 //! its predecessor's stall count and once the scoreboards it waits for are released. Fixed-latency results
 //! are inside the stall counts (ptxas computed them); a variable-latency result's wait needs a latency, which
 //! no NVIDIA document gives, so `VARIABLE_LATENCY` states the figures brdfprof assumes and where each comes
-//! from (memory: one figure for every vendor, so that memory cannot make two vendors differ).
+//! from (memory: the family's measured DRAM latency where one was found, `Family::memory`, else ACO's figure).
 
 use anyhow::{Result, anyhow, bail};
 
@@ -121,17 +121,33 @@ fn line_info(line: &str) -> Option<(String, u32)> {
 
 /// The latency brdfprof assumes for a variable-latency result (released through a scoreboard), in cycles,
 /// with its source, by the producing instruction.
+#[derive(Debug, PartialEq)]
 pub struct VariableLatency {
     pub what: &'static str,
     pub cycles: f64,
     pub source: &'static str,
 }
 
-/// Global and local memory loads.
+// Every figure is a finite constant: the equality is total (so `Family`, which names one, is `Eq`).
+impl Eq for VariableLatency {}
+
+/// Global and local memory loads, where no measurement of the family was found (`Family::memory`).
 pub const MEMORY: VariableLatency = VariableLatency {
     what: "global/local memory load",
     cycles: 320.0,
-    source: "ACO's vector-memory figure (Mesa's aco_statistics.cpp), used for every vendor's memory loads",
+    source: "ACO's vector-memory figure (Mesa's aco_statistics.cpp), for every family without a measured one",
+};
+/// Ada's (sm_89) global loads: the G-buffer streams from DRAM, each pixel's read once.
+pub const MEMORY_SM89: VariableLatency = VariableLatency {
+    what: "global/local memory load (DRAM)",
+    cycles: 632.0,
+    source: "M6: te42kyfo/gpu-benches gpu-latency/l40.txt, L40 pointer chase, DRAM ~632 cycles (L2 277)",
+};
+/// Hopper's (sm_90) global loads, as `MEMORY_SM89`.
+pub const MEMORY_SM90: VariableLatency = VariableLatency {
+    what: "global/local memory load (DRAM)",
+    cycles: 484.0,
+    source: "M5: Luo et al., arXiv 2501.12084, reproduced on an H100 (Johnsonms/NVIDIA-Hopper-Benchmark), DRAM 484 cycles (L2 272)",
 };
 /// Constant and uniform loads.
 pub const CONSTANT: VariableLatency = VariableLatency {
@@ -152,8 +168,8 @@ pub const SOURCES_READ: VariableLatency = VariableLatency {
     source: "assumed: the FP32 pipe latency (Accel-Sim's SM86 sp latency 4)",
 };
 
-/// The variable latency of `instruction`'s result.
-pub fn variable_latency(instruction: &Instruction) -> &'static VariableLatency {
+/// The variable latency of `instruction`'s result, a memory load's `memory` (the family's).
+pub fn variable_latency(instruction: &Instruction, memory: &'static VariableLatency) -> &'static VariableLatency {
     let m = instruction.mnemonic();
     if ["LDC", "ULDC", "LDCU"].contains(&m) {
         &CONSTANT
@@ -164,7 +180,7 @@ pub fn variable_latency(instruction: &Instruction) -> &'static VariableLatency {
         || m.starts_with("TLD")
         || m.starts_with("SULD")
     {
-        &MEMORY
+        memory
     } else {
         &SFU
     }
@@ -173,14 +189,14 @@ pub fn variable_latency(instruction: &Instruction) -> &'static VariableLatency {
 /// One warp's cycles through `instructions` alone: each issues `stall` cycles (at least one) after its
 /// predecessor and not before the scoreboards it waits for are released; a result released through a
 /// scoreboard takes `variable_latency`. Every instruction once (a branch's both sides; no loop repeated).
-pub fn schedule_latency(instructions: &[Instruction]) -> f64 {
-    let times = issue_times(instructions);
+pub fn schedule_latency(instructions: &[Instruction], memory: &'static VariableLatency) -> f64 {
+    let times = issue_times(instructions, memory);
     times.last().copied().unwrap_or(0.0)
 }
 
 /// The cycle each instruction issues at in `schedule_latency`'s schedule, and after them the cycle the warp
 /// ends (the last instruction's issue plus its stall).
-pub fn issue_times(instructions: &[Instruction]) -> Vec<f64> {
+pub fn issue_times(instructions: &[Instruction], memory: &'static VariableLatency) -> Vec<f64> {
     let mut times = Vec::with_capacity(instructions.len() + 1);
     let mut released = [0.0f64; 6];
     let mut t = 0.0f64;
@@ -191,7 +207,7 @@ pub fn issue_times(instructions: &[Instruction]) -> Vec<f64> {
             }
         }
         if let Some(b) = i.control.write_barrier.filter(|b| *b < 6) {
-            released[b as usize] = released[b as usize].max(t + variable_latency(i).cycles);
+            released[b as usize] = released[b as usize].max(t + variable_latency(i, memory).cycles);
         }
         if let Some(b) = i.control.read_barrier.filter(|b| *b < 6) {
             released[b as usize] = released[b as usize].max(t + SOURCES_READ.cycles);
@@ -246,7 +262,8 @@ mod tests {
         assert_eq!(is[3].control.wait_mask, 0b101);
         // MOV at 0 (stall 2), LDG at 2 (stall 1; scoreboard 2 at 2 + 320), MUFU at 3 (scoreboard 0 at
         // 3 + 21), FADD waits for both: 322, then stall 5, EXIT at 327 and its stall 5.
-        assert_eq!(schedule_latency(&is), 322.0 + 5.0 + 5.0);
+        assert_eq!(schedule_latency(&is, &MEMORY), 322.0 + 5.0 + 5.0);
+        assert_eq!(schedule_latency(&is, &MEMORY_SM89), 634.0 + 5.0 + 5.0);
         assert!(instructions("/*0000*/ MOV R1, R2 ;\n").unwrap_err().to_string().contains("-hex"));
     }
 }
