@@ -300,3 +300,54 @@ fn the_application_holds_at_most_70_percent_of_the_rust_lines() {
     let share = app as f64 / (app + leaves) as f64;
     assert!(share <= 0.70, "src/ holds {app} of {} Rust lines ({:.1}%)", app + leaves, share * 100.0);
 }
+
+/// Every dependency a manifest declares is named in its crate's code (comments left out): the application's
+/// in src/, build.rs or tests/, a leaf crate's in its src/ or tests/.
+#[test]
+fn every_dependency_is_used() {
+    let root = common::repo_root();
+    let mut crates = vec![(root.join("Cargo.toml"), vec![root.join("src"), root.join("tests"), root.join("build.rs")])];
+    for e in std::fs::read_dir(root.join("crates")).unwrap() {
+        let dir = e.unwrap().path();
+        crates.push((dir.join("Cargo.toml"), vec![dir.join("src"), dir.join("tests")]));
+    }
+    let mut unused = Vec::new();
+    for (manifest, places) in crates {
+        let text = std::fs::read_to_string(&manifest).unwrap();
+        let mut code = String::new();
+        for place in places.iter().filter(|p| p.exists()) {
+            let mut files = Vec::new();
+            if place.is_dir() {
+                rust_files(place, &mut files);
+            } else {
+                files.push(place.clone());
+            }
+            for f in files {
+                for line in std::fs::read_to_string(f).unwrap().lines() {
+                    code.push_str(line.split("//").next().unwrap_or(""));
+                    code.push('\n');
+                }
+            }
+        }
+        for section in ["[dependencies]", "[dev-dependencies]"] {
+            let deps = text.split(section).nth(1).unwrap_or("").split("\n[").next().unwrap_or("");
+            for line in deps.lines().filter(|l| !l.trim().is_empty() && !l.starts_with('#')) {
+                let dep = line.split(|c: char| c == '=' || c == '.' || c.is_whitespace()).next().unwrap_or("");
+                // The application's own test-only features are the dev-dependency on itself.
+                if dep.is_empty() || dep == "brdfprof" {
+                    continue;
+                }
+                let ident = dep.replace('-', "_");
+                // A path into the crate (`name::`) or a `use name as ...`, not its name in a string or a comment.
+                let path = format!("{ident}::");
+                let named = code.match_indices(&path).any(|(i, _)| {
+                    code[..i].chars().next_back().is_none_or(|c| !c.is_alphanumeric() && c != '_' && c != '"')
+                }) || code.contains(&format!("use {ident} as "));
+                if !named {
+                    unused.push(format!("{}: {dep} ({section})", manifest.strip_prefix(&root).unwrap().display()));
+                }
+            }
+        }
+    }
+    assert!(unused.is_empty(), "dependencies no code names:\n{}", unused.join("\n"));
+}
