@@ -1,6 +1,6 @@
 //! Published measurements the cost rule is held against: each check names a measured ratio, the pair of the
 //! suite's own kernels (tests/fixtures/brdf/measured/) whose modelled ratio on one family stands for it, the
-//! tolerance, and the rule's figure when last run. tests/cli/measured.rs reruns every check and fails when the
+//! tolerance, and the rule's figure when last run. tests/targets/measured.rs reruns every check and fails when the
 //! rule leaves a measurement's tolerance or its recorded figure here; docs/measured.md gives the sources.
 //! Every compile-only report says how its vendor's rule fares (`line`).
 

@@ -1,6 +1,7 @@
-//! What the tests of the compile-only targets (tests/cli/radv.rs, nvidia.rs, intel.rs and the rest) share: an
-//! inspect run with the binary's kernel cache or a cache of its own, a compiler statistic of a row, and the
-//! models every target must take (every preset and each example `.brdf` file).
+//! What the tests of the compile-only targets (tests/targets/radv.rs, nvidia.rs, intel.rs and the rest, and the
+//! tests/cli tests that price a model on a target) share: an inspect run with the binary's kernel cache or a cache
+//! of its own, a compiler statistic of a row, and the models every target must take (every preset and each example
+//! `.brdf` file).
 
 use crate::common;
 use std::path::{Path, PathBuf};
@@ -12,7 +13,7 @@ use std::sync::OnceLock;
 fn shared_cache() -> &'static Path {
     static DIR: OnceLock<PathBuf> = OnceLock::new();
     DIR.get_or_init(|| {
-        let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("cli-kernel-cache");
+        let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(concat!(env!("CARGO_CRATE_NAME"), "-kernel-cache"));
         let _ = std::fs::remove_dir_all(&dir);
         std::fs::create_dir_all(&dir).unwrap();
         dir
