@@ -6,36 +6,37 @@ use anyhow::{Context, Result};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-/// `__callgrind-child REQUEST`.
+/// `__callgrind-child REQUEST`: each kernel measured under valgrind's callgrind (`inspect::callgrind`).
 #[derive(clap::Args)]
 pub struct CallgrindChild {
     request: String,
 }
 
-/// `__noop-child REQUEST`.
+/// `__noop-child REQUEST`: every kernel compiled by a Mesa driver on its noop drm-shim (`targets::mesa_noop`).
 #[derive(clap::Args)]
 pub struct NoopChild {
     request: String,
 }
 
-/// `__run-translation DIR`.
+/// `__run-translation DIR`: a translated kernel run (g++ build or PoCL) outside brdfprof's process
+/// (`translate::runner`).
 #[derive(clap::Args)]
 pub struct RunTranslation {
     dir: String,
 }
 
-/// `__probe-vulkan`.
+/// `__probe-vulkan`: the devices enumerated, where RADV might abort the process (`targets::radv::env`).
 #[derive(clap::Args)]
 pub struct ProbeVulkan {}
 
-/// `__generate-glsl [DIR]`.
+/// `__generate-glsl [DIR]`: writes glsl/generated/ (`make spv`).
 #[derive(clap::Args)]
 pub struct GenerateGlsl {
     #[arg(default_value = "glsl/generated")]
     dir: PathBuf,
 }
 
-/// `__man DIR` (run from main.rs, which has the whole command line to render).
+/// `__man DIR` (run from main.rs, which has the whole command line to render: `man`).
 #[derive(clap::Args)]
 pub struct Man {
     pub dir: PathBuf,
@@ -43,7 +44,7 @@ pub struct Man {
 
 impl Run for CallgrindChild {
     fn run(&self) -> Result<ExitCode> {
-        callgrind_child(&self.request)
+        brdfprof::inspect::callgrind::child_main(&self.request).map(|_| ExitCode::SUCCESS)
     }
     fn child(&self) -> bool {
         true
@@ -52,7 +53,7 @@ impl Run for CallgrindChild {
 
 impl Run for NoopChild {
     fn run(&self) -> Result<ExitCode> {
-        noop_child(&self.request)
+        brdfprof::targets::mesa_noop::child::child_main(&self.request).map(|_| ExitCode::SUCCESS)
     }
     fn child(&self) -> bool {
         true
@@ -61,7 +62,7 @@ impl Run for NoopChild {
 
 impl Run for RunTranslation {
     fn run(&self) -> Result<ExitCode> {
-        run_translation(&self.dir)
+        brdfprof::translate::runner::child_main(&self.dir).map(|_| ExitCode::SUCCESS)
     }
     fn child(&self) -> bool {
         true
@@ -70,7 +71,7 @@ impl Run for RunTranslation {
 
 impl Run for ProbeVulkan {
     fn run(&self) -> Result<ExitCode> {
-        probe_vulkan()
+        brdfprof::targets::radv::env::probe_main().map(|_| ExitCode::SUCCESS)
     }
     fn child(&self) -> bool {
         true
@@ -79,40 +80,15 @@ impl Run for ProbeVulkan {
 
 impl Run for GenerateGlsl {
     fn run(&self) -> Result<ExitCode> {
-        generate_glsl(&self.dir)
+        let dir = &self.dir;
+        std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+        for (name, text) in brdfprof::kernels::generated_glsl() {
+            let path = dir.join(name);
+            brdfprof::io::write_output(&path, text.as_bytes())?;
+            outln!("{}", path.display());
+        }
+        Ok(ExitCode::SUCCESS)
     }
-}
-
-/// `__callgrind-child REQUEST`: each kernel measured under valgrind's callgrind (`inspect::callgrind`).
-pub fn callgrind_child(request: &str) -> Result<ExitCode> {
-    brdfprof::inspect::callgrind::child_main(request).map(|_| ExitCode::SUCCESS)
-}
-
-/// `__noop-child REQUEST`: every kernel compiled by a Mesa driver on its noop drm-shim (`targets::mesa_noop`).
-pub fn noop_child(request: &str) -> Result<ExitCode> {
-    brdfprof::targets::mesa_noop::child::child_main(request).map(|_| ExitCode::SUCCESS)
-}
-
-/// `__run-translation DIR`: a translated kernel run (g++ build or PoCL) outside brdfprof's process
-/// (`translate::runner`).
-pub fn run_translation(dir: &str) -> Result<ExitCode> {
-    brdfprof::translate::runner::child_main(dir).map(|_| ExitCode::SUCCESS)
-}
-
-/// `__probe-vulkan`: the devices enumerated, where RADV might abort the process (`targets::radv::env`).
-pub fn probe_vulkan() -> Result<ExitCode> {
-    brdfprof::targets::radv::env::probe_main().map(|_| ExitCode::SUCCESS)
-}
-
-/// Writes glsl/generated/ (`make spv`).
-pub fn generate_glsl(dir: &Path) -> Result<ExitCode> {
-    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
-    for (name, text) in brdfprof::kernels::generated_glsl() {
-        let path = dir.join(name);
-        brdfprof::io::write_output(&path, text.as_bytes())?;
-        outln!("{}", path.display());
-    }
-    Ok(ExitCode::SUCCESS)
 }
 
 /// `__man DIR`: brdfprof.1 and a page per command (`brdfprof-COMMAND.1`), from the same argument definitions

@@ -67,57 +67,51 @@ fn price(dir: &std::path::Path) -> Rows {
     rows
 }
 
-/// The check's pair read through the compiler's own estimate `stat` (`OWN_ESTIMATES`): the same slopes or chain
-/// as the rule's figure, of that statistic.
-fn own(c: &Check, rows: &Rows, stat: &str) -> f64 {
-    let s = |t: &str, lights: u32, m: &str| {
-        rows.get(&(t.to_string(), lights, m.to_string()))
-            .and_then(|r| r["stats"][stat].as_f64())
-            .unwrap_or_else(|| panic!("{t} {m} at {lights} lights: no statistic {stat}"))
-    };
+/// The check's pair read through `value` (a row's figure: target, lights, model): the slopes' ratio of a
+/// throughput pair (64 operations apart), the cycles per link of a latency chain.
+fn pair(c: &Check, value: impl Fn(&str, u32, &str) -> f64) -> f64 {
     match &c.figure {
         Figure::Throughput { a, b, b_target } => {
             let bt = b_target.unwrap_or(c.target);
             let slope = |t: &str, k: &str| {
-                s(t, THROUGHPUT_LIGHTS, &format!("{k}-t16")) - s(t, THROUGHPUT_LIGHTS, &format!("{k}-t8"))
+                value(t, THROUGHPUT_LIGHTS, &format!("{k}-t16")) - value(t, THROUGHPUT_LIGHTS, &format!("{k}-t8"))
             };
-            slope(c.target, a) / slope(bt, b)
+            let (slope_a, slope_b) = (slope(c.target, a), slope(bt, b));
+            assert!(slope_b > 0.0, "{bt} {b}: 64 more operations cost {slope_b}");
+            slope_a / slope_b
         }
         Figure::Latency { kind, .. } => {
-            (s(c.target, LATENCY_LIGHTS, &format!("{kind}-c96")) - s(c.target, LATENCY_LIGHTS, &format!("{kind}-c32")))
-                / 64.0
+            let at = |m: String| value(c.target, LATENCY_LIGHTS, &m);
+            (at(format!("{kind}-c96")) - at(format!("{kind}-c32"))) / 64.0
         }
     }
 }
 
-/// The check's modelled figure from the priced rows.
-fn modelled(c: &Check, rows: &Rows) -> f64 {
-    let row = |t: &str, lights: u32, m: &str| {
+/// Statistic `stat` of a priced row.
+fn stat<'a>(rows: &'a Rows, stat: &'a str) -> impl Fn(&str, u32, &str) -> f64 + 'a {
+    move |t, lights, m| {
         rows.get(&(t.to_string(), lights, m.to_string()))
-            .unwrap_or_else(|| panic!("{t}: no row {m} at {lights} lights"))
-    };
-    let net = |t: &str, m: &str| {
-        row(t, THROUGHPUT_LIGHTS, m)["net_cycles_per_eval"]
-            .as_f64()
-            .unwrap_or_else(|| panic!("{t} {m}: no net cycles/eval"))
-    };
-    match &c.figure {
-        Figure::Throughput { a, b, b_target } => {
-            let bt = b_target.unwrap_or(c.target);
-            let slope_a = net(c.target, &format!("{a}-t16")) - net(c.target, &format!("{a}-t8"));
-            let slope_b = net(bt, &format!("{b}-t16")) - net(bt, &format!("{b}-t8"));
-            assert!(slope_b > 0.0, "{bt} {b}: 64 more operations cost {slope_b} cycles/eval");
-            slope_a / slope_b
-        }
-        Figure::Latency { kind, stat } => {
-            let s = |m: &str| {
-                row(c.target, LATENCY_LIGHTS, m)["stats"][*stat]
-                    .as_f64()
-                    .unwrap_or_else(|| panic!("{} {m}: no statistic {stat}", c.target))
-            };
-            (s(&format!("{kind}-c96")) - s(&format!("{kind}-c32"))) / 64.0
-        }
+            .and_then(|r| r["stats"][stat].as_f64())
+            .unwrap_or_else(|| panic!("{t} {m} at {lights} lights: no statistic {stat}"))
     }
+}
+
+/// The check's modelled figure from the priced rows: net cycles/eval for a throughput pair, the check's
+/// statistic for a latency chain.
+fn modelled(c: &Check, rows: &Rows) -> f64 {
+    match &c.figure {
+        Figure::Throughput { .. } => pair(c, |t, lights, m| {
+            rows.get(&(t.to_string(), lights, m.to_string()))
+                .and_then(|r| r["net_cycles_per_eval"].as_f64())
+                .unwrap_or_else(|| panic!("{t} {m}: no net cycles/eval at {lights} lights"))
+        }),
+        Figure::Latency { stat: s, .. } => pair(c, stat(rows, s)),
+    }
+}
+
+/// The check's pair read through the compiler's own estimate `s` (`OWN_ESTIMATES`).
+fn own(c: &Check, rows: &Rows, s: &str) -> f64 {
+    pair(c, stat(rows, s))
 }
 
 #[test]
