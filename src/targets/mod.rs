@@ -278,27 +278,51 @@ fn vendor_by_vendor(
 }
 
 /// Compiles the models' kernels for every target; results in `targets` order, each report's driver note with
-/// its harness share (`harness_note`).
+/// its harness share (`harness_note`). The vendors that check a translation on the Vulkan device (NVIDIA's,
+/// Intel's: host builds, then their compilers) run beside the others (Mesa's compilers in their children), so
+/// that a cold run keeps both of a 2-core machine's cores busy; each side goes vendor by vendor.
 pub fn compile_all(targets: &[Target], request: &Request) -> Result<Vec<Run>> {
-    let at = std::sync::Arc::new(std::sync::Mutex::new(String::new()));
+    let at = std::sync::Arc::new(std::sync::Mutex::new(Vec::<String>::new()));
     let said = std::sync::Arc::clone(&at);
     let _heartbeat = crate::messages::Heartbeat::start(move || {
-        format!("compiling for the compile-only targets: {}", said.lock().unwrap_or_else(|e| e.into_inner()))
+        format!("compiling for the compile-only targets: {}", said.lock().unwrap_or_else(|e| e.into_inner()).join(", "))
     });
     let total = targets.len();
-    let mut done = 0;
-    let mut runs = vendor_by_vendor(targets, |vendor, families| {
-        *at.lock().unwrap_or_else(|e| e.into_inner()) =
-            format!("{} ({} families; {done} of {total} targets done)", vendor.prefix(), families.len());
-        done += families.len();
+    let done = std::sync::atomic::AtomicUsize::new(0);
+    let compile = |vendor: &dyn Vendor, families: &[usize], request: &Request| -> Result<Vec<Run>> {
+        let before = done.fetch_add(families.len(), std::sync::atomic::Ordering::Relaxed);
+        let now = format!("{} ({} families; {before} of {total} targets done)", vendor.prefix(), families.len());
+        at.lock().unwrap_or_else(|e| e.into_inner()).push(now.clone());
         if vendor.needs_verification() && request.verify_on.is_none() {
             bail!(
                 "{}: its costs are of a translation that must first run against a Vulkan device, and none was opened",
                 vendor.prefix()
             );
         }
-        vendor.compile(families, request)
-    })?;
+        let out = vendor.compile(families, request);
+        at.lock().unwrap_or_else(|e| e.into_inner()).retain(|a| *a != now);
+        out
+    };
+    let checked: Vec<usize> = (0..targets.len()).filter(|&k| targets[k].vendor.needs_verification()).collect();
+    let others: Vec<usize> = (0..targets.len()).filter(|k| !checked.contains(k)).collect();
+    let pick = |ks: &[usize]| ks.iter().map(|&k| targets[k]).collect::<Vec<Target>>();
+    let (checked_targets, other_targets) = (pick(&checked), pick(&others));
+    // The Vulkan device stays on this thread; the other side's request has none.
+    let Request { models, lights, shaders, validate, isa_dir, precise, lines, .. } = *request;
+    let (mine, theirs) = std::thread::scope(|scope| {
+        let other_side = scope.spawn(|| {
+            let request = Request { models, lights, shaders, validate, isa_dir, precise, verify_on: None, lines };
+            vendor_by_vendor(&other_targets, |vendor, families| compile(vendor, families, &request))
+        });
+        let mine = vendor_by_vendor(&checked_targets, |vendor, families| compile(vendor, families, request));
+        (mine, other_side.join())
+    });
+    let theirs = theirs.unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+    let mut runs: Vec<Option<Run>> = targets.iter().map(|_| None).collect();
+    for (k, run) in checked.into_iter().zip(mine?).chain(others.into_iter().zip(theirs?)) {
+        runs[k] = Some(run);
+    }
+    let mut runs: Vec<Run> = runs.into_iter().map(|r| r.expect("every target compiled")).collect();
     for run in &mut runs {
         if let Some(note) = run.report.cost.as_ref().and_then(harness_note) {
             let driver = run.report.section_notes.entry("driver/".into()).or_default();

@@ -13,6 +13,11 @@ pub const HOST_COMPILER: &str = "g++";
 pub const HOST_FLAGS: [&str; 6] =
     ["-std=c++17", "-O2", "-fPIC", "-shared", "-ffp-contract=off", "-fno-strict-aliasing"];
 
+/// The f64 reference's optimisation level, after HOST_FLAGS': its builds are the check's cold cost (g++ -O2
+/// took 2.8 s for the 8-light profiling kernel's reference on a 2-core AMD EPYC VM, -O0 0.5 s) and it runs a few
+/// thousand invocations; IEEE double arithmetic without contraction is the same at every level.
+pub const REFERENCE_FLAGS: [&str; 1] = ["-O0"];
+
 /// What a host build depends on besides the source, for cache keys: the compiler's version line and the flags
 /// (another g++ may round the maths libraries differently).
 pub fn build_identity() -> String {
@@ -25,7 +30,7 @@ pub fn build_identity() -> String {
                 .ok()
                 .and_then(|o| String::from_utf8_lossy(&o.stdout).lines().next().map(str::to_string))
                 .unwrap_or_else(|| format!("{HOST_COMPILER} (version unknown)"));
-            format!("{version} {}", HOST_FLAGS.join(" "))
+            format!("{version} {} (reference: {})", HOST_FLAGS.join(" "), REFERENCE_FLAGS.join(" "))
         })
         .clone()
 }
@@ -53,10 +58,17 @@ impl HostKernel {
         Self::build(t, &t.source(Dialect::Host), &[], flags)
     }
 
+    /// `compile` and `compile_reference(t, &[])`, built side by side (two g++ processes: the check's cold
+    /// cost is mostly these builds).
+    pub fn compile_with_reference(t: &Translation) -> Result<(Self, Self)> {
+        let (fp32, reference) = rayon::join(|| Self::compile(t), || Self::compile_reference(t, &[]));
+        Ok((fp32?, reference?))
+    }
+
     /// The f64 reference of `t` (`Translation::reference_source`): every f32 value computed in double with its
     /// Vulkan precision bound; a writable binding takes 4 x its bytes (`eval_reference`).
     pub fn compile_reference(t: &Translation, defines: &[&str]) -> Result<Self> {
-        Self::build(t, &t.reference_source(), defines, &[])
+        Self::build(t, &t.reference_source(), defines, &REFERENCE_FLAGS)
     }
 
     fn build(t: &Translation, source: &str, defines: &[&str], flags: &[&str]) -> Result<Self> {

@@ -254,16 +254,14 @@ pub fn eval_agreement(gpu: &Gpu, model: &Model, shaders: &Shaders) -> Result<Agr
     let extras = EvalExtras { tangents: None, rows: &rows, row_floats };
     let translation = prepare::eval_kernel(&checked, shaders)?;
     let on_device = flat(&kernels::eval_from(gpu, &checked, shaders, &samples, &extras, RunLimits::default())?);
-    let on_host = flat(&kernels::as_f(
-        &checked,
-        host::eval(&host::HostKernel::compile(&translation)?, &samples, &extras)?,
-        &samples,
-    ));
-    let reference = |defines: &[&str]| -> Result<Vec<Bounded>> {
-        let r = host::eval_reference(&host::HostKernel::compile_reference(&translation, defines)?, &samples, &extras)?;
-        Ok(flat(&reference_as_f(&checked, r, &samples)))
+    let (fp32, f64_build) = host::HostKernel::compile_with_reference(&translation)?;
+    let on_host = flat(&kernels::as_f(&checked, host::eval(&fp32, &samples, &extras)?, &samples));
+    let run_reference = |kernel: &host::HostKernel| -> Result<Vec<Bounded>> {
+        Ok(flat(&reference_as_f(&checked, host::eval_reference(kernel, &samples, &extras)?, &samples)))
     };
-    let r = reference(&[])?;
+    let reference =
+        |defines: &[&str]| run_reference(&host::HostKernel::compile_reference(&translation, defines)?);
+    let r = run_reference(&f64_build)?;
     let device = judge::tally(&on_device, &r, |_| 0.0, 3);
     let host = judge::tally(&on_host, &r, |_| 0.0, 3);
     let srem = srem_explains(&translation, device.worst, TOLERANCE, |d| {
@@ -325,11 +323,11 @@ pub fn shade_agreement(gpu: &Gpu, model: Option<&Model>, lights: u32, shaders: &
     gpu.submit(|cmd| variant.record(cmd, 0))?;
     let on_device = flat(&work.radiance()?);
     let translation = prepare::shade_kernel(model, lights, shaders)?;
-    let packed: Vec<u32> =
-        bytemuck::pod_collect_to_vec(&shade_on_host(&host::HostKernel::compile(&translation)?, &g, &light_data, 4)?);
+    let (fp32, f64_build) = host::HostKernel::compile_with_reference(&translation)?;
+    let packed: Vec<u32> = bytemuck::pod_collect_to_vec(&shade_on_host(&fp32, &g, &light_data, 4)?);
     let on_host = flat(&packed.into_iter().map(gbuffer::unpack_r11g11b10).collect::<Vec<_>>());
-    let reference = |defines: &[&str]| -> Result<Vec<Bounded>> {
-        let bytes = shade_on_host(&host::HostKernel::compile_reference(&translation, defines)?, &g, &light_data, 64)?;
+    let run_reference = |kernel: &host::HostKernel| -> Result<Vec<Bounded>> {
+        let bytes = shade_on_host(kernel, &g, &light_data, 64)?;
         let rgb = host::pairs(&bytes).chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect::<Vec<_>>();
         Ok(rgb
             .into_iter()
@@ -337,7 +335,9 @@ pub fn shade_agreement(gpu: &Gpu, model: Option<&Model>, lights: u32, shaders: &
             .map(|(i, b)| judge::r11g11b10_saturated(b, if i % 3 == 2 { 5 } else { 6 }))
             .collect())
     };
-    let r = reference(&[])?;
+    let reference =
+        |defines: &[&str]| run_reference(&host::HostKernel::compile_reference(&translation, defines)?);
+    let r = run_reference(&f64_build)?;
     let n = on_device.len();
     let step = |r: &[Bounded]| -> Vec<f64> {
         r.iter().enumerate().map(|(i, b)| judge::r11g11b10_step(*b, if i % 3 == 2 { 5 } else { 6 })).collect()
