@@ -208,7 +208,7 @@ pub fn spirv_opt(words: &[u32], args: &[String]) -> Result<Vec<u32>> {
         }
     };
     let store = crate::cache::Store::open_default();
-    let out = crate::cache::get_or_build(store.as_ref(), "spirv-opt", &key, "spirv-opt's output", valid, || {
+    let out = crate::cache::get_or_build(store.as_ref(), "spirv_opt", &key, "spirv-opt's output", valid, || {
         Ok(bytemuck::cast_slice(&run_spirv_opt(words, args)?).to_vec())
     })?;
     let out: Vec<u32> = out.chunks_exact(4).map(|c| u32::from_le_bytes(c.try_into().unwrap())).collect();
