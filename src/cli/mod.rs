@@ -263,7 +263,7 @@ pub fn model_inputs(models: &[Model]) -> Vec<(&'static str, &Path)> {
     let mut inputs: Vec<(&'static str, &Path)> = Vec::new();
     for f in models.iter().filter_map(Model::file) {
         inputs.push(("--model", Path::new(&f.path)));
-        for (file, _, _) in f.file.front_end_origins.iter().flatten() {
+        for file in f.file.front_end_origins.iter().flatten().map(|o| &o.0) {
             if !inputs.iter().any(|(_, p)| *p == Path::new(file)) {
                 inputs.push(("an included file of --model", Path::new(file)));
             }

@@ -259,8 +259,7 @@ pub fn eval_agreement(gpu: &Gpu, model: &Model, shaders: &Shaders) -> Result<Agr
     let run_reference = |kernel: &host::HostKernel| -> Result<Vec<Bounded>> {
         Ok(flat(&reference_as_f(&checked, host::eval_reference(kernel, &samples, &extras)?, &samples)))
     };
-    let reference =
-        |defines: &[&str]| run_reference(&host::HostKernel::compile_reference(&translation, defines)?);
+    let reference = |defines: &[&str]| run_reference(&host::HostKernel::compile_reference(&translation, defines)?);
     let r = run_reference(&f64_build)?;
     let device = judge::tally(&on_device, &r, |_| 0.0, 3);
     let host = judge::tally(&on_host, &r, |_| 0.0, 3);
@@ -335,8 +334,7 @@ pub fn shade_agreement(gpu: &Gpu, model: Option<&Model>, lights: u32, shaders: &
             .map(|(i, b)| judge::r11g11b10_saturated(b, if i % 3 == 2 { 5 } else { 6 }))
             .collect())
     };
-    let reference =
-        |defines: &[&str]| run_reference(&host::HostKernel::compile_reference(&translation, defines)?);
+    let reference = |defines: &[&str]| run_reference(&host::HostKernel::compile_reference(&translation, defines)?);
     let r = run_reference(&f64_build)?;
     let n = on_device.len();
     let step = |r: &[Bounded]| -> Vec<f64> {

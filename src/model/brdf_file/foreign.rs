@@ -100,18 +100,23 @@ fn origins(
     at: &[Option<usize>],
     view: &[String],
     places: &[Option<(String, usize, String)>],
-) -> Vec<Option<(String, usize, String)>> {
+) -> Vec<Option<std::sync::Arc<(String, usize, String)>>> {
     if at.is_empty() {
         return Vec::new();
     }
+    let shared: Vec<Option<std::sync::Arc<(String, usize, String)>>> = places
+        .iter()
+        .map(|p| {
+            p.as_ref().map(|(file, line, text)| std::sync::Arc::new((file.clone(), *line, text.trim().to_string())))
+        })
+        .collect();
     let lines: Vec<&str> = plain.lines().collect();
     let mut next = 0;
     view.iter()
         .map(|v| {
             let k = (next..lines.len()).find(|&k| lines[k] == v)?;
             next = k + 1;
-            let (file, line, text) = places.get(at[k]?.checked_sub(1)?)?.as_ref()?;
-            Some((file.clone(), *line, text.trim().to_string()))
+            shared.get(at[k]?.checked_sub(1)?)?.clone()
         })
         .collect()
 }
