@@ -67,6 +67,11 @@ pub trait Translator: Sync + 'static {
     fn driver_stats(binary: &Self::Binary, family: &Self::Family) -> Result<Vec<DriverStat>>;
     /// The lanes of one wave (what the rule's per-wave figures divide by), from a row's statistics.
     fn lanes(stats: &BTreeMap<String, f64>) -> Option<f64>;
+    /// What the family's rule takes that other families' does not (NVIDIA: its memory latency and its source),
+    /// appended to the cost table's rule line.
+    fn rule_note(_family: &Self::Family) -> Option<String> {
+        None
+    }
     /// What a family's report says of the compiler, the device (named `device`) and the options.
     fn compilation(family: &Self::Family, device: String, tools: &Self::Tools, precise: bool) -> Compilation;
     /// The `--isa` listing of a compiled kernel.
@@ -267,7 +272,10 @@ impl<C: Translator> Vendor for Translated<C> {
             family: Some(family.name.to_string()),
             architecture: Some(family.architecture.to_string()),
             compiler: C::COMPILER.into(),
-            model: format!("{}; {}", schedule::RULE, C::RULE),
+            model: match C::rule_note(row) {
+                Some(note) => format!("{}; {}; {note}", schedule::RULE, C::RULE),
+                None => format!("{}; {}", schedule::RULE, C::RULE),
+            },
             unit: C::UNIT.into(),
             lights_per_kernel: 0,
             columns: C::SHOWN.iter().map(|s| s.to_string()).collect(),

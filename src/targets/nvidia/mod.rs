@@ -169,6 +169,11 @@ impl Translator for Nvidia {
         ))
     }
 
+    fn rule_note(family: &Self::Family) -> Option<String> {
+        let m = family.memory;
+        Some(format!("{} latency {} cycles ({})", m.what, m.cycles, m.source))
+    }
+
     fn lanes(_: &BTreeMap<String, f64>) -> Option<f64> {
         Some(32.0)
     }
