@@ -110,10 +110,33 @@ void store_radiance(uint i, vec3 c) {
 #endif
 }
 
+#if defined(BRDF_FILE_KEEPS_LOOPS)
+// One light's weighted f_s of a file's BRDF, as the loop below computes it.
+vec3 file_light(Pixel p, vec3 L) {
+#if defined(BRDF_FILE_RETURNS_F_NOL)
+    return specular_brdf_unit(p.N, p.V, L, p.roughness, p.f0);
+#else
+    vec3 fs = (BASELINE != 0) ? vec3(1.0) : specular_brdf_unit(p.N, p.V, L, p.roughness, p.f0);
+    return fs * max(dot(p.N, L), 0.0);
+#endif
+}
+#endif
+
 void main() {
     uint i = gl_GlobalInvocationID.x;
     Pixel p = load_pixel(i);
     vec3 acc = vec3(0.0);
+#if defined(BRDF_FILE_KEEPS_LOOPS)
+    // The file's BRDF has a loop no compiler can count (a data-dependent trip count). A loop holding a kept
+    // loop is kept too ([[unroll]] and NIR unroll innermost loops only; ptxas kept it as well), and a kept light
+    // loop is one light's work per pass where every cost rule divides by the block's lights: so the block is
+    // written out, one call per light, each guarded by the block's size (folded by the specialisation).
+#define ONE_LIGHT(j) if ((j) < NUM_LIGHTS) acc += file_light(p, lights[2 * (j)].xyz) * lights[2 * (j) + 1].rgb;
+    ONE_LIGHT(0) ONE_LIGHT(1) ONE_LIGHT(2) ONE_LIGHT(3) ONE_LIGHT(4) ONE_LIGHT(5) ONE_LIGHT(6) ONE_LIGHT(7)
+#if LIGHT_BLOCK != 8
+#error "ONE_LIGHT is written out for a LIGHT_BLOCK of 8"
+#endif
+#else
     [[unroll]] for (int j = 0; j < NUM_LIGHTS; ++j) {
         vec3 L = lights[2 * j].xyz;
         vec3 colour = lights[2 * j + 1].rgb;
@@ -131,6 +154,7 @@ void main() {
         acc += fs * (NoL * colour);
 #endif
     }
+#endif
     acc += float(pc.keep_inputs) * (p.f0 + vec3(p.roughness) + p.V);
     if (ACCUMULATE != 0) acc += load_radiance(i);
     store_radiance(i, acc);

@@ -768,6 +768,11 @@ impl FileModel {
         if entry.returns == Returns::FNoL {
             s += "#define BRDF_FILE_RETURNS_F_NOL 1\n";
         }
+        // A loop of unknown trip count: shade.glsl writes the light block out (a kept inner loop keeps the
+        // light loop around it, which the cost rules would read as every light's work).
+        if self.file.loops.iter().any(|l| l.trip_count.is_none()) {
+            s += "#define BRDF_FILE_KEEPS_LOOPS 1\n";
+        }
         s += &format!("{}\n{}", self.file.line_directive(), renamed.text());
         if let Some((_, text)) = &glue {
             s += text;

@@ -106,13 +106,16 @@ fn cost_table(shim: &Shim, family: &ShimFamily, report: &InspectReport) -> Optio
         )
     };
     let rule = format!(
-        "{rule}; per evaluation = / lights per kernel where the light loop is unrolled; where the compiler keeps it (Loops > 0: its body, one light, counted once), the per-pixel work (the memory-only kernel's pipes) / lights and the rest whole"
+        "{rule}; per evaluation = / lights per kernel where the light loop is unrolled; where the compiler keeps it (Loops > 0 and not a multiple of the lights: its body, one light, counted once), the per-pixel work (the memory-only kernel's pipes) / lights and the rest whole"
     );
     let unit = if valhall { "Valhall cycles per thread" } else { "Bifrost cycles per thread" };
     let per_pixel = report
         .rows
         .iter()
-        .find(|r| r.model == crate::model::BASELINE_LABEL && rolled(&r.stats))
+        .find(|r| {
+            r.model == crate::model::BASELINE_LABEL
+                && rolled(&r.stats, crate::kernels::shade::steady_block(report.lights).0)
+        })
         .and_then(|r| pipes(&r.stats));
     cost::bound_table(report, shim.header(family, report, rule, unit, shown), |stats, lights| {
         pipes_of(stats, lights, per_pixel.as_deref())

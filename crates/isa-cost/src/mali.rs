@@ -88,10 +88,14 @@ pub fn read_shaderdb(log: &str) -> Result<(Vec<Stat>, Vec<String>)> {
 
 type Stats = std::collections::BTreeMap<String, f64>;
 
-/// Whether the compiler kept a loop (the light loop, which shade.glsl asks to be unrolled and Bifrost keeps
-/// rolled): it counts a loop's body once, so one pass through the program is then one light's evaluation.
-pub fn rolled(stats: &Stats) -> bool {
-    driver_stat(stats, "Loops").unwrap_or(0.0) > 0.0
+/// Whether the compiler kept the light loop (which shade.glsl asks to be unrolled and Bifrost keeps rolled): it
+/// counts a loop's body once, so one pass through the program is then one light's evaluation. A BRDF's own kept
+/// loops come `lights` times over (shade.glsl writes the block out for a file with a loop of unknown trip count),
+/// a kept light loop once with its body's: a loop count that is not a multiple of the lights. (Read wrongly
+/// where a kept light loop holds lights - 1 kept loops of a BRDF whose trip counts are literals.)
+pub fn rolled(stats: &Stats, lights: u32) -> bool {
+    let loops = driver_stat(stats, "Loops").unwrap_or(0.0);
+    loops > 0.0 && (lights <= 1 || loops % f64::from(lights) != 0.0)
 }
 
 /// The per-pipe cycles the compiler reported for a kernel (its architecture's).
@@ -107,7 +111,7 @@ pub fn pipes(stats: &Stats) -> Option<Vec<(String, f64)>> {
 /// where it kept its loop too: its body does no BRDF work), charged 1 / lights per evaluation, the rest whole.
 pub fn pipes_of(stats: &Stats, lights: u32, per_pixel: Option<&[(String, f64)]>) -> Option<(Schedule, f64)> {
     let mut pipes = pipes(stats)?;
-    if !rolled(stats) {
+    if !rolled(stats, lights) {
         return Some((Schedule { pipes, latency: None, resident_waves: None }, f64::from(lights)));
     }
     if let Some(per_pixel) = per_pixel {
@@ -125,6 +129,16 @@ mod tests {
     use super::*;
 
     const GGX: &str = "SHADER-DB: MESA_SHADER_COMPUTE shader: 174 inst, 145 tuples, 23 clauses, 8.000000 cycles, 5.750000 arith, 0.000000 texture, 0.000000 vary, 8.000000 ldst, 121 quadwords, 2 threads, 3 preloads, 0 loops, 1:2 spills:fills";
+
+    #[test]
+    fn a_loop_count_that_is_a_multiple_of_the_lights_is_the_brdfs_not_the_light_loop() {
+        let stats = |loops: f64| Stats::from([("driver/Compute Shader/Loops".to_string(), loops)]);
+        assert!(!rolled(&stats(0.0), 8));
+        assert!(rolled(&stats(1.0), 8), "the light loop kept");
+        assert!(rolled(&stats(2.0), 8), "the light loop kept around one loop of the BRDF's");
+        assert!(!rolled(&stats(8.0), 8), "the block written out, the BRDF's loop in each light");
+        assert!(!rolled(&stats(16.0), 8));
+    }
 
     #[test]
     fn reads_the_compute_line_and_passes_the_rest_on() {
