@@ -712,6 +712,20 @@ impl FileModel {
         self.file.params.iter().position(|p| p.name == name).map(|k| self.bindings[k])
     }
 
+    /// The kernels' switches for the entry's form and the file's loops.
+    fn shape_defines(&self, returns: Returns) -> String {
+        let mut s = String::new();
+        if returns == Returns::FNoL {
+            s += "#define BRDF_FILE_RETURNS_F_NOL 1\n";
+        }
+        // A loop of unknown trip count: shade.glsl writes the light block out (a kept inner loop keeps the
+        // light loop around it, which the cost rules would read as every light's work).
+        if self.file.loops.iter().any(|l| l.trip_count.is_none()) {
+            s += "#define BRDF_FILE_KEEPS_LOOPS 1\n";
+        }
+        s
+    }
+
     /// The source composed for `kind`: the preamble, the file, then the kernel's own source (from `glsl/`).
     fn compose(&self, kind: KernelKind, kernel_source: &str) -> Result<String> {
         let renamed = self.file.renamed_shader();
@@ -765,14 +779,7 @@ impl FileModel {
         let glue = entry.declared.map(|e| self.file.entry_glue(e));
         let function = glue.as_ref().map_or_else(|| self.file.glsl_name("BRDF"), |(name, _)| name.clone());
         s += &format!("#define BRDF_FILE_FUNCTION {function}\n");
-        if entry.returns == Returns::FNoL {
-            s += "#define BRDF_FILE_RETURNS_F_NOL 1\n";
-        }
-        // A loop of unknown trip count: shade.glsl writes the light block out (a kept inner loop keeps the
-        // light loop around it, which the cost rules would read as every light's work).
-        if self.file.loops.iter().any(|l| l.trip_count.is_none()) {
-            s += "#define BRDF_FILE_KEEPS_LOOPS 1\n";
-        }
+        s += &self.shape_defines(entry.returns);
         s += &format!("{}\n{}", self.file.line_directive(), renamed.text());
         if let Some((_, text)) = &glue {
             s += text;
