@@ -132,3 +132,21 @@ pub fn assert_deterministic_and_precise_costs_more(target: &str, section: &str, 
         net(&fast)
     );
 }
+
+/// `inspect --device DEVICE` with the vendor's compiler pointed at nowhere (`variable` set to `nowhere`, a path
+/// under a temporary folder): exit 2, `vendor`'s "compiler not installed: run `make setup`", no output written.
+pub fn a_missing_compiler_says_make_setup(device: &str, variable: &str, nowhere: &str, vendor: &str) {
+    let dir = tempfile::tempdir().unwrap();
+    let out = common::brdfprof()
+        .args(["inspect", "--no-callgrind", "--device", device, "--model", "ggx", "--json"])
+        .arg(dir.path().join("x.json"))
+        // Outside the checkout: its committed results/inspect-*.md would refuse the default --markdown first.
+        .current_dir(dir.path())
+        .env(variable, dir.path().join(nowhere))
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains(&format!("{vendor} compiler not installed: run `make setup`")), "{stderr}");
+    assert!(!dir.path().join("x.json").exists());
+}

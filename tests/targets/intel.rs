@@ -113,19 +113,7 @@ fn commands_that_execute_refuse_an_intel_target_and_unknown_families_are_named()
 
 #[test]
 fn a_missing_compiler_says_make_setup() {
-    let dir = tempfile::tempdir().unwrap();
-    let out = common::brdfprof()
-        .args(["inspect", "--no-callgrind", "--device", "intel:gen12lp", "--model", "ggx", "--json"])
-        .arg(dir.path().join("x.json"))
-        // Outside the checkout: its committed results/inspect-*.md would refuse the default --markdown first.
-        .current_dir(dir.path())
-        .env("BRDFPROF_OCLOC", dir.path().join("nowhere/ocloc"))
-        .output()
-        .unwrap();
-    assert_eq!(out.status.code(), Some(2));
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(stderr.contains("Intel compiler not installed: run `make setup`"), "{stderr}");
-    assert!(!dir.path().join("x.json").exists());
+    compile_only::a_missing_compiler_says_make_setup("intel:gen12lp", "BRDFPROF_OCLOC", "nowhere/ocloc", "Intel");
 }
 
 /// `inspect --chart` draws the cost table across devices as compare does: one colour per

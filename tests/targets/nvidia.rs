@@ -131,19 +131,7 @@ fn commands_that_execute_refuse_an_nvidia_target_and_unknown_families_are_named(
 
 #[test]
 fn a_missing_compiler_says_make_setup() {
-    let dir = tempfile::tempdir().unwrap();
-    let out = common::brdfprof()
-        .args(["inspect", "--no-callgrind", "--device", "nvidia:sm_89", "--model", "ggx", "--json"])
-        .arg(dir.path().join("x.json"))
-        // Outside the checkout: its committed results/inspect-*.md would refuse the default --markdown first.
-        .current_dir(dir.path())
-        .env("BRDFPROF_NVIDIA_DIR", dir.path().join("nowhere"))
-        .output()
-        .unwrap();
-    assert_eq!(out.status.code(), Some(2));
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(stderr.contains("NVIDIA compiler not installed: run `make setup`"), "{stderr}");
-    assert!(!dir.path().join("x.json").exists());
+    compile_only::a_missing_compiler_says_make_setup("nvidia:sm_89", "BRDFPROF_NVIDIA_DIR", "nowhere", "NVIDIA");
 }
 
 #[test]
