@@ -54,7 +54,11 @@ impl Dialect {
         match self {
             Dialect::Cuda => include_str!("prelude/cuda.h"),
             Dialect::OpenCl => include_str!("prelude/opencl.h"),
-            Dialect::Host => concat!(include_str!("prelude/host.h"), include_str!("prelude/host_doubles.h")),
+            Dialect::Host => concat!(
+                include_str!("prelude/host_maths.h"),
+                include_str!("prelude/host.h"),
+                include_str!("prelude/host_doubles.h")
+            ),
         }
     }
 }
@@ -62,7 +66,11 @@ impl Dialect {
 /// The C text shared by every dialect's prelude (after the dialect's own part).
 const COMMON_PRELUDE: &str = include_str!("prelude/common.h");
 /// The f64 reference's prelude (before the common part) and what it defines after it.
-const REFERENCE_PRELUDE: &str = concat!(include_str!("prelude/reference.h"), include_str!("prelude/host_doubles.h"));
+const REFERENCE_PRELUDE: &str = concat!(
+    include_str!("prelude/host_maths.h"),
+    include_str!("prelude/reference.h"),
+    include_str!("prelude/host_doubles.h")
+);
 const REFERENCE_TAIL: &str = include_str!("prelude/reference_tail.h");
 
 /// Texel formats of the texel buffers the translation reads and writes.

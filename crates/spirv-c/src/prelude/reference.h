@@ -22,9 +22,6 @@
 // whose argument's range crosses an integer, and a bit cast of an inexact value can go either way in a
 // conforming implementation: the invocation is marked unbounded, and every value it stores has an infinite
 // bound (not judged). Stores of writable bindings write (v, e) pairs at four times the offset (see host.rs).
-#include <cmath>
-#include <cstring>
-#include <limits>
 typedef unsigned char u8;
 typedef unsigned short u16;
 typedef unsigned int u32;
@@ -36,7 +33,7 @@ typedef unsigned long long u64;
 #define BRDFPROF_OWN_HALF_MATHS 1
 #define BRDFPROF_OWN_TEXELS 1
 
-static const double BRDFPROF_INF = std::numeric_limits<double>::infinity();
+static const double BRDFPROF_INF = __builtin_huge_val();
 static bool brdfprof_unbounded = false;
 #define BRDFPROF_INVOCATION_BEGIN() (brdfprof_unbounded = false)
 BRDFPROF_FN void unbounded() { brdfprof_unbounded = true; }
@@ -56,17 +53,17 @@ template <> struct Rules<16> {
 template <int P> BRDFPROF_FN double ulp_at(double m) {
   if (!(m < BRDFPROF_INF)) return BRDFPROF_INF;
   int ex = 0;
-  std::frexp(m, &ex);
+  hm::frexp(m, &ex);
   int e = (m == 0.0 || ex - 1 < Rules<P>::min_exponent) ? Rules<P>::min_exponent : ex - 1;
-  return std::ldexp(1.0, e - Rules<P>::mantissa);
+  return hm::ldexp(1.0, e - Rules<P>::mantissa);
 }
 // n ULP at the magnitude of a result r whose operands' bounds move it by p, plus what flushing may take where
 // the range reaches below the smallest normal (a result there may be flushed to 0). An exact infinity (from
 // exact infinities) has no allowance.
 template <int P> BRDFPROF_FN double allow(double n, double r, double p) {
-  double m = std::fabs(r) + p, smallest = std::ldexp(1.0, Rules<P>::min_exponent);
-  if (std::isinf(m)) return 0.0;
-  return n * ulp_at<P>(m) + (std::fabs(r) - p < smallest ? std::fmin(m, smallest) : 0.0);
+  double m = hm::fabs(r) + p, smallest = hm::ldexp(1.0, Rules<P>::min_exponent);
+  if (hm::isinf(m)) return 0.0;
+  return n * ulp_at<P>(m) + (hm::fabs(r) - p < smallest ? hm::fmin(m, smallest) : 0.0);
 }
 // A correctly rounded operation: exact where its result is exact and representable, else one ULP (the rounding
 // mode is unspecified: either neighbour) and the flush allowance.
@@ -74,10 +71,10 @@ template <int P> BRDFPROF_FN bool representable(double r);
 template <> inline bool representable<32>(double r) { return (double)(float)r == r; }
 template <> inline bool representable<16>(double r) { return (double)(_Float16)r == r; }
 template <int P> BRDFPROF_FN double rounded(double r, double p) {
-  return (p == 0.0 && representable<P>(r) && !(r != 0.0 && std::fabs(r) < std::ldexp(1.0, Rules<P>::min_exponent))) ? 0.0 : allow<P>(1.0, r, p);
+  return (p == 0.0 && representable<P>(r) && !(r != 0.0 && hm::fabs(r) < hm::ldexp(1.0, Rules<P>::min_exponent))) ? 0.0 : allow<P>(1.0, r, p);
 }
 // |x| e, with 0 where e is 0 (an exact operand moves nothing, even next to an infinity).
-BRDFPROF_FN double moved(double x, double e) { return e == 0.0 ? 0.0 : std::fabs(x) * e; }
+BRDFPROF_FN double moved(double x, double e) { return e == 0.0 ? 0.0 : hm::fabs(x) * e; }
 
 template <int P> struct E {
   double v, e;
@@ -85,17 +82,17 @@ template <int P> struct E {
   E(float x) : v(x), e(0.0) {}
   // A conversion from double or from an integer: correctly rounded.
   E(double x) : v(x), e(rounded<P>(x, 0.0)) {}
-  E(int x) : v(x), e(std::fabs((double)x) < std::ldexp(1.0, Rules<P>::mantissa + 1) ? 0.0 : rounded<P>(x, 0.0)) {}
-  E(unsigned x) : v(x), e((double)x < std::ldexp(1.0, Rules<P>::mantissa + 1) ? 0.0 : rounded<P>(x, 0.0)) {}
+  E(int x) : v(x), e(hm::fabs((double)x) < hm::ldexp(1.0, Rules<P>::mantissa + 1) ? 0.0 : rounded<P>(x, 0.0)) {}
+  E(unsigned x) : v(x), e((double)x < hm::ldexp(1.0, Rules<P>::mantissa + 1) ? 0.0 : rounded<P>(x, 0.0)) {}
   static E of(double v, double e) { E r; r.v = v; r.e = e; return r; }
   explicit operator double() const { if (e > 0.0) unbounded(); return v; }
   explicit operator int() const { return (int)to_integer(-2147483648.0, 2147483647.0); }
   explicit operator unsigned() const { return (unsigned)to_integer(0.0, 4294967295.0); }
   // A conversion to an integer truncates: it goes either way where the range crosses an integer.
   double to_integer(double lo, double hi) const {
-    if (e > 0.0 && std::trunc(v - e) != std::trunc(v + e)) unbounded();
+    if (e > 0.0 && hm::trunc(v - e) != hm::trunc(v + e)) unbounded();
     if (!(v >= lo && v <= hi)) { unbounded(); return v != v ? 0.0 : (v < lo ? lo : hi); }
-    return std::trunc(v);
+    return hm::trunc(v);
   }
   friend E operator+(E a, E b) { double r = a.v + b.v, p = a.e + b.e; return of(r, p + rounded<P>(r, p)); }
   friend E operator-(E a, E b) { double r = a.v - b.v, p = a.e + b.e; return of(r, p + rounded<P>(r, p)); }
@@ -105,7 +102,7 @@ template <int P> struct E {
     return of(r, p + rounded<P>(r, p));
   }
   // Operands within their bounds of each other compare either way in a conforming implementation.
-  static void near(E a, E b) { double s = a.e + b.e; if (s > 0.0 && !(std::fabs(a.v - b.v) > s)) unbounded(); }
+  static void near(E a, E b) { double s = a.e + b.e; if (s > 0.0 && !(hm::fabs(a.v - b.v) > s)) unbounded(); }
   friend bool operator<(E a, E b) { near(a, b); return a.v < b.v; }
   friend bool operator<=(E a, E b) { near(a, b); return a.v <= b.v; }
   friend bool operator>(E a, E b) { near(a, b); return a.v > b.v; }
@@ -120,34 +117,34 @@ typedef E<16> half_t;
 template <typename F> BRDFPROF_FN double monotone_move(F f, double v, double e, double lo_limit) {
   if (e == 0.0) return 0.0;
   double lo = v - e < lo_limit ? lo_limit : v - e;
-  return std::fmax(std::fabs(f(v + e) - f(v)), std::fabs(f(v) - f(lo)));
+  return hm::fmax(hm::fabs(f(v + e) - f(v)), hm::fabs(f(v) - f(lo)));
 }
 
 template <int P> BRDFPROF_FN E<P> t_div(E<P> a, E<P> b) {
-  double r = a.v / b.v, lo = std::fabs(b.v) - b.e, hi = std::fabs(b.v) + b.e;
+  double r = a.v / b.v, lo = hm::fabs(b.v) - b.e, hi = hm::fabs(b.v) + b.e;
   if (!(lo >= Rules<P>::div_lo && hi <= Rules<P>::div_hi)) return E<P>::of(r, BRDFPROF_INF);
   double p = (a.e + moved(r, b.e)) / lo;
   return E<P>::of(r, p + allow<P>(2.5, r, p));
 }
 template <int P> BRDFPROF_FN E<P> t_exp2(E<P> x, bool natural) {
-  auto f = [natural](double t) { return natural ? std::exp(t) : std::exp2(t); };
+  auto f = [natural](double t) { return natural ? hm::exp(t) : hm::exp2(t); };
   double r = f(x.v);
-  if (x.e == 0.0 && std::isinf(x.v)) return E<P>::of(r, 0.0);  // exp(-inf) = 0, exp(inf) = inf: exact
+  if (x.e == 0.0 && hm::isinf(x.v)) return E<P>::of(r, 0.0);  // exp(-inf) = 0, exp(inf) = inf: exact
   double p = monotone_move(f, x.v, x.e, -BRDFPROF_INF);
-  return E<P>::of(r, p + allow<P>(Rules<P>::exp_base + 2.0 * (std::fabs(x.v) + x.e), r, p));
+  return E<P>::of(r, p + allow<P>(Rules<P>::exp_base + 2.0 * (hm::fabs(x.v) + x.e), r, p));
 }
 template <int P> BRDFPROF_FN E<P> t_log2(E<P> x, bool natural) {
-  auto f = [natural](double t) { return natural ? std::log(t) : std::log2(t); };
+  auto f = [natural](double t) { return natural ? hm::log(t) : hm::log2(t); };
   double r = f(x.v), lo = x.v - x.e, hi = x.v + x.e;
   if (x.e == 0.0 && !(x.v > 0.0)) return E<P>::of(r, 0.0);  // log(0) = -inf and log of a negative: exact
   if (!(lo > 0.0)) return E<P>::of(r, hi < 0.0 ? 0.0 : BRDFPROF_INF);
   double p = monotone_move(f, x.v, x.e, 0.0), rule = 0.0;
   if (hi >= 0.5 && lo <= 2.0) rule = Rules<P>::log_inside;
-  if (lo < 0.5 || hi > 2.0) rule = std::fmax(rule, allow<P>(3.0, r, p));
+  if (lo < 0.5 || hi > 2.0) rule = hm::fmax(rule, allow<P>(3.0, r, p));
   return E<P>::of(r, p + rule);
 }
 template <int P> BRDFPROF_FN E<P> t_rsqrt(E<P> x) {
-  auto f = [](double t) { return 1.0 / std::sqrt(t); };
+  auto f = [](double t) { return 1.0 / hm::sqrt(t); };
   double r = f(x.v);
   if (x.e == 0.0 && !(x.v > 0.0)) return E<P>::of(r, 0.0);
   if (!(x.v - x.e > 0.0)) return E<P>::of(r, x.v + x.e < 0.0 ? 0.0 : BRDFPROF_INF);
@@ -155,20 +152,20 @@ template <int P> BRDFPROF_FN E<P> t_rsqrt(E<P> x) {
   return E<P>::of(r, p + allow<P>(2.0, r, p));
 }
 template <int P> BRDFPROF_FN E<P> t_sqrt(E<P> x) {
-  double r = std::sqrt(x.v);
+  double r = hm::sqrt(x.v);
   if (x.v < 0.0 && x.v + x.e >= 0.0) { unbounded(); return E<P>::of(r, BRDFPROF_INF); }
-  double p = monotone_move([](double t) { return std::sqrt(t); }, x.v, x.e, 0.0);
+  double p = monotone_move([](double t) { return hm::sqrt(t); }, x.v, x.e, 0.0);
   return E<P>::of(r, p + allow<P>(6.5, r, p));
 }
 template <int P> BRDFPROF_FN E<P> t_sin_cos(E<P> x, bool cosine) {
-  double r = cosine ? std::cos(x.v) : std::sin(x.v);
-  if (!(std::fabs(x.v) + x.e <= 3.14159265358979323846)) return E<P>::of(r, BRDFPROF_INF);
+  double r = cosine ? hm::cos(x.v) : hm::sin(x.v);
+  if (!(hm::fabs(x.v) + x.e <= 3.14159265358979323846)) return E<P>::of(r, BRDFPROF_INF);
   return E<P>::of(r, x.e + Rules<P>::sin_cos);
 }
 template <int P> BRDFPROF_FN E<P> t_atan2(E<P> y, E<P> x) {
-  double r = std::atan2(y.v, x.v), s = x.e + y.e, rho = std::hypot(x.v, y.v);
+  double r = hm::atan2(y.v, x.v), s = x.e + y.e, rho = hm::hypot(x.v, y.v);
   if (s > 0.0 && !(rho > s)) return E<P>::of(r, BRDFPROF_INF);
-  if (y.e > 0.0 && std::fabs(y.v) <= y.e && x.v - x.e < 0.0) unbounded();  // the branch cut at +-pi
+  if (y.e > 0.0 && hm::fabs(y.v) <= y.e && x.v - x.e < 0.0) unbounded();  // the branch cut at +-pi
   double p = s > 0.0 ? s / (rho - s) : 0.0;
   return E<P>::of(r, p + allow<P>(Rules<P>::atan, r, p));
 }
@@ -177,11 +174,11 @@ template <int P> BRDFPROF_FN E<P> t_atan2(E<P> y, E<P> x) {
 // [0, pow(hi, y)] over the range, plus the rule's rounding at its top.
 template <int P> BRDFPROF_FN E<P> t_pow(E<P> x, E<P> y) {
   if (!(x.v - x.e <= 0.0 && x.v >= 0.0 && y.v - y.e > 0.0)) return t_exp2(y * t_log2(x, false), false);
-  double r = std::pow(x.v, y.v), top = x.v + x.e;
+  double r = hm::pow(x.v, y.v), top = x.v + x.e;
   if (top == 0.0) return E<P>::of(r, 0.0);
-  double hi = std::fmax(std::pow(top, y.v - y.e), std::pow(top, y.v + y.e));
-  double n = Rules<P>::exp_base + 2.0 * std::fabs((y.v + y.e) * std::log2(top));
-  return E<P>::of(r, std::fmax(hi - r, r) + allow<P>(n, r, hi));
+  double hi = hm::fmax(hm::pow(top, y.v - y.e), hm::pow(top, y.v + y.e));
+  double n = Rules<P>::exp_base + 2.0 * hm::fabs((y.v + y.e) * hm::log2(top));
+  return E<P>::of(r, hm::fmax(hi - r, r) + allow<P>(n, r, hi));
 }
 // floor, ceil, trunc, round, rint: exact, but a range across a step goes either way.
 template <int P, typename F> BRDFPROF_FN E<P> t_step(E<P> x, F f) {
@@ -193,12 +190,12 @@ template <int P, typename F> BRDFPROF_FN E<P> t_step(E<P> x, F f) {
 template <int P> BRDFPROF_FN E<P> t_fmin(E<P> a, E<P> b) {
   if (a.v + a.e < b.v - b.e) return a;
   if (b.v + b.e < a.v - a.e) return b;
-  return E<P>::of(std::fmin(a.v, b.v), std::fmax(a.e, b.e));
+  return E<P>::of(hm::fmin(a.v, b.v), hm::fmax(a.e, b.e));
 }
 template <int P> BRDFPROF_FN E<P> t_fmax(E<P> a, E<P> b) {
   if (a.v - a.e > b.v + b.e) return a;
   if (b.v - b.e > a.v + a.e) return b;
-  return E<P>::of(std::fmax(a.v, b.v), std::fmax(a.e, b.e));
+  return E<P>::of(hm::fmax(a.v, b.v), hm::fmax(a.e, b.e));
 }
 
 #define BRDFPROF_BOTH1(name, body) \
@@ -228,21 +225,21 @@ BRDFPROF_BOTH1(m_tanh, T a = t_exp2(x, true); T b = t_exp2(-x, true); return t_d
 BRDFPROF_BOTH1(m_asinh, return t_log2(x + t_sqrt(x * x + T(1.0f)), true);)
 BRDFPROF_BOTH1(m_acosh, return t_log2(x + t_sqrt(x * x - T(1.0f)), true);)
 BRDFPROF_BOTH1(m_atanh, return t_log2(t_div(T(1.0f) + x, T(1.0f) - x), true) * T(0.5f);)
-BRDFPROF_BOTH1(m_floor, return t_step(x, [](double t) { return std::floor(t); });)
-BRDFPROF_BOTH1(m_ceil, return t_step(x, [](double t) { return std::ceil(t); });)
-BRDFPROF_BOTH1(m_trunc, return t_step(x, [](double t) { return std::trunc(t); });)
-BRDFPROF_BOTH1(m_round, return t_step(x, [](double t) { return std::round(t); });)
-BRDFPROF_BOTH1(m_rint, return t_step(x, [](double t) { return std::rint(t); });)
-BRDFPROF_BOTH1(m_fabs, return T::of(std::fabs(x.v), x.e);)
+BRDFPROF_BOTH1(m_floor, return t_step(x, [](double t) { return hm::floor(t); });)
+BRDFPROF_BOTH1(m_ceil, return t_step(x, [](double t) { return hm::ceil(t); });)
+BRDFPROF_BOTH1(m_trunc, return t_step(x, [](double t) { return hm::trunc(t); });)
+BRDFPROF_BOTH1(m_round, return t_step(x, [](double t) { return hm::round(t); });)
+BRDFPROF_BOTH1(m_rint, return t_step(x, [](double t) { return hm::rint(t); });)
+BRDFPROF_BOTH1(m_fabs, return T::of(hm::fabs(x.v), x.e);)
 BRDFPROF_BOTH2(m_fmin, return t_fmin(x, y);)
 BRDFPROF_BOTH2(m_fmax, return t_fmax(x, y);)
 BRDFPROF_FN Ef m_fma(Ef a, Ef b, Ef c) { return a * b + c; }
-BRDFPROF_FN Ef m_ldexp(Ef x, i32 n) { double r = std::ldexp(x.v, n); return Ef::of(r, std::ldexp(x.e, n) + rounded<32>(r, std::ldexp(x.e, n))); }
-BRDFPROF_FN half_t m_ldexp_h(half_t x, i32 n) { double r = std::ldexp(x.v, n); return half_t::of(r, std::ldexp(x.e, n) + rounded<16>(r, std::ldexp(x.e, n))); }
+BRDFPROF_FN Ef m_ldexp(Ef x, i32 n) { double r = hm::ldexp(x.v, n); return Ef::of(r, hm::ldexp(x.e, n) + rounded<32>(r, hm::ldexp(x.e, n))); }
+BRDFPROF_FN half_t m_ldexp_h(half_t x, i32 n) { double r = hm::ldexp(x.v, n); return half_t::of(r, hm::ldexp(x.e, n) + rounded<16>(r, hm::ldexp(x.e, n))); }
 // OpFRem: inherited from x - y trunc(x / y).
 BRDFPROF_FN Ef m_fmod(Ef x, Ef y) { return x - y * m_trunc(m_fdiv(x, y)); }
-BRDFPROF_FN bool m_isnan(Ef x) { return std::isnan(x.v); }
-BRDFPROF_FN bool m_isinf(Ef x) { return std::isinf(x.v); }
+BRDFPROF_FN bool m_isnan(Ef x) { return hm::isnan(x.v); }
+BRDFPROF_FN bool m_isinf(Ef x) { return hm::isinf(x.v); }
 
 // Halves: h_ operations under half precision's rules; conversions from f32 round (1 ULP of half).
 BRDFPROF_FN half_t h_from_bits(u32 b) { u16 x = (u16)b; _Float16 h; memcpy(&h, &x, 2); return half_t((float)h); }
@@ -271,7 +268,7 @@ BRDFPROF_FN double f64_from_bits(u64 b) { double x; memcpy(&x, &b, 8); return x;
 // Memory. Read-only and constant bindings hold the kernel's input bytes; a writable binding holds 16 bytes
 // for every 4 of the Vulkan kernel's (a float as its value and bound in double, an integer as its 4 bytes).
 BRDFPROF_FN double stored_bound(double e) { return brdfprof_unbounded ? BRDFPROF_INF : e; }
-BRDFPROF_FN Ef input_f32(float x) { return Ef::of(x, (x != 0.0f && std::fabs(x) < 0x1p-126f) ? std::fabs((double)x) : 0.0); }
+BRDFPROF_FN Ef input_f32(float x) { return Ef::of(x, (x != 0.0f && hm::fabs(x) < 0x1p-126f) ? hm::fabs((double)x) : 0.0); }
 BRDFPROF_FN u32 ldro_u32(const u8* p, u32 off) { u32 v; memcpy(&v, p + off, 4); return v; }
 BRDFPROF_FN i32 ldro_i32(const u8* p, u32 off) { i32 v; memcpy(&v, p + off, 4); return v; }
 BRDFPROF_FN Ef ldro_f32(const u8* p, u32 off) { float v; memcpy(&v, p + off, 4); return input_f32(v); }
