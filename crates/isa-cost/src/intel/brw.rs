@@ -103,7 +103,18 @@ pub fn instruction(line: &str, grf: u32) -> Option<Instruction> {
             reads.extend(registers(o, exec_size, grf, length, false));
         }
     }
-    Some(Instruction { mnemonic, function, exec_size, dst_type, reads, writes })
+    let constant = is_send && reads_constant_data(desc);
+    Some(Instruction { mnemonic, function, exec_size, dst_type, reads, writes, constant })
+}
+
+/// Whether a send's descriptor (`const MsgDesc: (bti 4, ...)`) reads constant data: the constant cache's
+/// messages (SFID `const`: uniform blocks, the lights), and A64 reads (`dp data 1 MsgDesc: (DC A64 untyped
+/// surface read, ...)`), which in brdfprof's kernels read only the shader's constant data: ANV 22.3 moves a
+/// constant array indexed at run time into it (`load_global_constant` in the final NIR), while the G-buffer
+/// is sampled and the output written as an image.
+fn reads_constant_data(desc: &str) -> bool {
+    let sfid = desc.split_once("MsgDesc:").map_or("", |(s, _)| s.trim());
+    sfid == "const" || desc.contains("A64 untyped surface read")
 }
 
 /// `mad(16)` as ("mad", Some(16)); `math` as ("math", None).
@@ -241,5 +252,30 @@ NIR (from SPIR-V) for MESA_SHADER_COMPUTE shader:\n\tmul(16) g1<1>F g2<8,8,1>F g
                 .to_string()
                 .contains("states 5")
         );
+    }
+
+    #[test]
+    fn a_send_reads_constant_data_through_the_constant_cache_or_an_a64_read() {
+        let send = |desc: &str| {
+            let line = format!(
+                "send(16)        g118UD          g25UD           nullUD          0x02280304                0x00000000{DESCRIPTOR}{desc}"
+            );
+            instruction(&line, 32).unwrap()
+        };
+        let family = super::super::FAMILIES.iter().find(|f| f.name == "gen12lp").unwrap();
+        let ubo = send(
+            "const MsgDesc: (bti 4, msg_ctrl 3, msg_type 0, write_commit 0) mlen 1 ex_mlen 0 rlen 2 { align1 WE_all 1H @1 $8 };",
+        );
+        let table = send(
+            "dp data 1 MsgDesc: (DC A64 untyped surface read, Surface = 253, SIMD16, Mask = 0xe) mlen 4 ex_mlen 0 rlen 2 { align1 1H @1 $10 };",
+        );
+        let gbuffer =
+            send("sampler MsgDesc: ld_lz SIMD16 Surface = 2 Sampler = 0 mlen 2 ex_mlen 2 rlen 6 { align1 1H @1 $0 };");
+        let ugm = send(
+            "ugm MsgDesc: ( load, a32, d32, V64, transpose, L1STATE_L3MOCS dst_len = 8, src0_len = 1, src1_len = 0 flat ) base_offset 0  { align1 WE_all 1N $0 };",
+        );
+        assert!(ubo.constant && table.constant && !gbuffer.constant && !ugm.constant);
+        let cycles = |i: &Instruction| super::super::latency(i, family);
+        assert_eq!([cycles(&ubo), cycles(&table), cycles(&gbuffer)], [30.0, 30.0, 320.0]);
     }
 }

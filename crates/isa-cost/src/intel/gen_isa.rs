@@ -34,6 +34,10 @@ pub struct Instruction {
     pub dst_type: String,
     pub reads: Vec<Reg>,
     pub writes: Vec<Reg>,
+    /// A send that reads constant data, which every invocation reads and the cache holds: priced at the rule's
+    /// constant-load latency, not a memory load's (`intel::latency`). Only brw's listing names it (`brw`); IGA's
+    /// data-cache sends do not say what they read, so IGC's are all memory loads.
+    pub constant: bool,
 }
 
 /// Bytes of a type.
@@ -149,7 +153,15 @@ pub fn instruction(line: &str, grf: u32) -> Option<Instruction> {
             reads.extend(registers(o, exec_size, grf, length.filter(|_| is_send), false));
         }
     }
-    Some(Instruction { mnemonic: mnemonic.into(), function: function.into(), exec_size, dst_type, reads, writes })
+    Some(Instruction {
+        mnemonic: mnemonic.into(),
+        function: function.into(),
+        exec_size,
+        dst_type,
+        reads,
+        writes,
+        constant: false,
+    })
 }
 
 /// Every instruction of a listing.

@@ -232,12 +232,15 @@ pub fn pipe_cycles(i: &gen_isa::Instruction, family: &Family) -> Result<Vec<(Pip
     })
 }
 
-/// Cycles until an instruction's result can be read, by IGC's scheduler tables (`XE_*`, `LEGACY_*`).
+/// Cycles until an instruction's result can be read, by IGC's scheduler tables (`XE_*`, `LEGACY_*`); a send's, the
+/// memory load's latency or, where it reads constant data, the constant load's, as on every vendor (`sass::MEMORY`,
+/// `sass::CONSTANT`).
 pub fn latency(i: &gen_isa::Instruction, family: &Family) -> f64 {
     let class = classify(&i.mnemonic);
     let two_source = TWO_SOURCE_FUNCTIONS.contains(&i.function.as_str());
     if class == Class::Send {
-        return crate::nvidia::sass::MEMORY.cycles;
+        let v = if i.constant { &crate::nvidia::sass::CONSTANT } else { &crate::nvidia::sass::MEMORY };
+        return v.cycles;
     }
     if family.legacy_latency {
         return match class {
