@@ -82,8 +82,11 @@ fn running_on_valgrind() -> bool {
 /// What the parent asks the child to measure (passed as one JSON argument).
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct ChildRequest {
-    /// Models by `Model::name` (label included, so the child labels them alike); the memory-only baseline kernel is measured after them.
+    /// Models by `Model::name` (label included, so the child labels them alike); the memory-only baseline kernel is measured after them
+    /// where `baseline` says so.
     pub models: Vec<String>,
+    #[serde(default = "measures_the_baseline")]
+    pub baseline: bool,
     pub lights: u32,
     pub width: u32,
     pub height: u32,
@@ -103,6 +106,10 @@ pub struct ChildReply {
     /// Each model's kernel hash (`kernel_hash`, packed) as the child composed it from the files it read.
     #[serde(default)]
     pub kernels: Vec<String>,
+}
+
+fn measures_the_baseline() -> bool {
+    true
 }
 
 pub use crate::host_cpu::cpu_features;
@@ -129,7 +136,9 @@ pub fn child_main(request_json: &str) -> Result<()> {
         None,
     )?;
     let mut all: Vec<Option<&Model>> = models.iter().map(Some).collect();
-    all.push(None);
+    if req.baseline {
+        all.push(None);
+    }
     let mut labels = Vec::new();
     for (i, model) in all.into_iter().enumerate() {
         let variant = Variant::new(&gpu, &work, model, &shaders, 1)?;
@@ -175,17 +184,81 @@ pub fn valgrind_version() -> Result<String> {
         })
 }
 
-/// Runs the child under callgrind and reads what it dumped. Labels follow `Model::name`.
+/// Runs the children under callgrind and reads what they dumped. Labels follow `Model::name`. The kernels are
+/// split between one child per core (contiguous groups, the baseline kernel in the last): each kernel's count is
+/// its own dispatch's, whatever else its process measured, and valgrind runs one thread, so one child left a
+/// core idle (the 4 presets and the baseline on lavapipe: 17.5 s wall in one child on a 2-core VM).
 pub fn run(models: &[Model], lights: u32, shaders: &Shaders, options: &CallgrindOptions) -> Result<CallgrindRun> {
     if !cfg!(target_arch = "x86_64") {
         bail!("callgrind client requests are implemented for x86-64 only");
     }
     let valgrind = valgrind_version()?;
+    let cores = std::thread::available_parallelism().map_or(1, usize::from);
+    let groups = split(models.len() + 1, cores);
+    let runs: Vec<Result<ChildRun>> = std::thread::scope(|scope| {
+        let handles: Vec<_> = groups
+            .iter()
+            .enumerate()
+            .map(|(k, range)| {
+                let last = k + 1 == groups.len();
+                let chunk = &models[range.start..range.end.min(models.len())];
+                scope.spawn(move || run_child(chunk, last, lights, shaders, options))
+            })
+            .collect();
+        handles.into_iter().map(|h| h.join().unwrap_or_else(|_| Err(anyhow!("a callgrind run panicked")))).collect()
+    });
+    let mut kernels = Vec::new();
+    let mut first: Option<ChildRun> = None;
+    for run in runs {
+        let run = run?;
+        if let Some(f) = &first
+            && (f.evaluations != run.evaluations || f.jit_cpu_features != run.jit_cpu_features)
+        {
+            bail!("the callgrind children measured different workloads or CPU features; run again");
+        }
+        kernels.extend(run.kernels.iter().cloned());
+        first.get_or_insert(run);
+    }
+    let first = first.ok_or_else(|| anyhow!("no callgrind run"))?;
+    Ok(CallgrindRun { kernels, evaluations: first.evaluations, jit_cpu_features: first.jit_cpu_features, valgrind })
+}
+
+/// `n` kernels in at most `parts` contiguous groups of sizes differing by at most one, the larger first.
+fn split(n: usize, parts: usize) -> Vec<std::ops::Range<usize>> {
+    let parts = parts.clamp(1, n.max(1));
+    let (size, extra) = (n / parts, n % parts);
+    let mut start = 0;
+    (0..parts)
+        .map(|k| {
+            let len = size + usize::from(k < extra);
+            let r = start..start + len;
+            start += len;
+            r
+        })
+        .collect()
+}
+
+/// What one callgrind child measured.
+struct ChildRun {
+    kernels: Vec<KernelIr>,
+    evaluations: u64,
+    jit_cpu_features: Vec<String>,
+}
+
+/// One child under callgrind: `models`' kernels, then the baseline kernel's where `baseline`.
+fn run_child(
+    models: &[Model],
+    baseline: bool,
+    lights: u32,
+    shaders: &Shaders,
+    options: &CallgrindOptions,
+) -> Result<ChildRun> {
     // Registered, so that an interrupted run leaves no callgrind files behind.
     let dir = cleanup::TempDir::new().context("cannot create a directory for callgrind's output")?;
     let out_file = dir.path().join("callgrind.out");
     let req = ChildRequest {
         models: models.iter().map(Model::name).collect(),
+        baseline,
         lights,
         width: options.width,
         height: options.height,
@@ -239,13 +312,22 @@ pub fn run(models: &[Model], lights: u32, shaders: &Shaders, options: &Callgrind
         }
     }
     let dumps = read_dumps(dir.path())?;
-    let kernels = kernel_irs(models, &reply.labels, &dumps)?;
-    Ok(CallgrindRun { kernels, evaluations: reply.evaluations, jit_cpu_features: reply.jit_cpu_features, valgrind })
+    let kernels = kernel_irs(models, baseline, &reply.labels, &dumps)?;
+    Ok(ChildRun { kernels, evaluations: reply.evaluations, jit_cpu_features: reply.jit_cpu_features })
 }
 
-/// Each kernel's Ir of JIT code: the dump labelled `labels[i]` is `models[i]`'s (the baseline's last).
-fn kernel_irs(models: &[Model], labels: &[String], dumps: &BTreeMap<String, u64>) -> Result<Vec<KernelIr>> {
-    let names: Vec<String> = models.iter().map(Model::label).chain([super::BASELINE_LABEL.to_string()]).collect();
+/// Each kernel's Ir of JIT code: the dump labelled `labels[i]` is `models[i]`'s (the baseline's last where measured).
+fn kernel_irs(
+    models: &[Model],
+    baseline: bool,
+    labels: &[String],
+    dumps: &BTreeMap<String, u64>,
+) -> Result<Vec<KernelIr>> {
+    let base = baseline.then(|| super::BASELINE_LABEL.to_string());
+    let names: Vec<String> = models.iter().map(Model::label).chain(base).collect();
+    if labels.len() != names.len() {
+        bail!("the callgrind child measured {} kernels where {} were asked", labels.len(), names.len());
+    }
     labels
         .iter()
         .zip(names)
@@ -366,6 +448,14 @@ pub fn parse_dump(text: &str) -> Result<Dump> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn kernels_split_into_contiguous_groups_one_per_core() {
+        assert_eq!(split(5, 2), [0..3, 3..5]);
+        assert_eq!(split(5, 1), [0..5]);
+        assert_eq!(split(2, 8), [0..1, 1..2]);
+        assert_eq!(split(7, 3), [0..3, 3..5, 5..7]);
+    }
 
     #[test]
     fn natively_client_requests_do_nothing() {
