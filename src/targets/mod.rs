@@ -323,14 +323,44 @@ pub fn compile_all(targets: &[Target], request: &Request) -> Result<Vec<Run>> {
         runs[k] = Some(run);
     }
     let mut runs: Vec<Run> = runs.into_iter().map(|r| r.expect("every target compiled")).collect();
+    let loops = kept_loops_note(request.models);
     for run in &mut runs {
-        if let Some(note) = run.report.cost.as_ref().and_then(harness_note) {
+        let harness = run.report.cost.as_ref().and_then(harness_note);
+        for note in harness.iter().chain(run.report.cost.as_ref().and(loops.as_ref())) {
             let driver = run.report.section_notes.entry("driver/".into()).or_default();
             *driver = if driver.is_empty() { note.clone() } else { format!("{driver}\n\n{note}") };
+        }
+        if let Some(note) = harness {
             run.report.section_notes.insert(HARNESS_NOTE.into(), note);
         }
     }
     Ok(runs)
+}
+
+/// The models with a loop whose trip count no compiler can know (`for` with a bound from the inputs, `while`,
+/// `do`), with each such loop's line: every rule counts a kept loop's body once, so their cycles/eval stand for
+/// one pass of each such loop, which the cost table must say beside the figure.
+pub fn kept_loops_note(models: &[Model]) -> Option<String> {
+    let named: Vec<String> = models
+        .iter()
+        .filter_map(|m| {
+            let f = m.file()?;
+            let at: Vec<String> = f
+                .file
+                .loops
+                .iter()
+                .filter(|l| l.trip_count.is_none())
+                .map(|l| format!("{}:{}", crate::messages::escape_line(l.file.as_deref().unwrap_or(&f.path)), l.line))
+                .collect();
+            (!at.is_empty()).then(|| format!("{} ({})", crate::messages::escape_line(&m.label()), at.join(", ")))
+        })
+        .collect();
+    (!named.is_empty()).then(|| {
+        format!(
+            "Loops of unknown trip count: {}. No compiler knows how often such a loop runs and every rule counts a kept loop's body once, so these models' cycles/eval stand for one pass of each such loop, not its trip count (docs/measured.md, \"A BRDF's own loops\").",
+            named.join("; ")
+        )
+    })
 }
 
 /// The report's section note that holds `harness_note`.
