@@ -712,6 +712,12 @@ impl FileModel {
         self.file.params.iter().position(|p| p.name == name).map(|k| self.bindings[k])
     }
 
+    /// The file's loops whose trip count brdfprof cannot read from the source (`for` with a bound that is not a
+    /// literal, `while`, `do`): a compiler may keep them, and no cost rule counts a kept loop's iterations.
+    pub fn uncounted_loops(&self) -> impl Iterator<Item = &crate::model::brdf_file::Loop> {
+        self.file.loops.iter().filter(|l| l.trip_count.is_none())
+    }
+
     /// The kernels' switches for the entry's form and the file's loops.
     fn shape_defines(&self, returns: Returns) -> String {
         let mut s = String::new();
@@ -720,7 +726,7 @@ impl FileModel {
         }
         // A loop of unknown trip count: shade.glsl writes the light block out (a kept inner loop keeps the
         // light loop around it, which the cost rules would read as every light's work).
-        if self.file.loops.iter().any(|l| l.trip_count.is_none()) {
+        if self.uncounted_loops().next().is_some() {
             s += "#define BRDF_FILE_KEEPS_LOOPS 1\n";
         }
         s

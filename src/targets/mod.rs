@@ -323,7 +323,7 @@ pub fn compile_all(targets: &[Target], request: &Request) -> Result<Vec<Run>> {
         runs[k] = Some(run);
     }
     let mut runs: Vec<Run> = runs.into_iter().map(|r| r.expect("every target compiled")).collect();
-    let loops = kept_loops_note(request.models);
+    let loops = kept_loops_note(request.models, request.shaders);
     for run in &mut runs {
         let harness = run.report.cost.as_ref().and_then(harness_note);
         for note in harness.iter().chain(run.report.cost.as_ref().and(loops.as_ref())) {
@@ -337,27 +337,31 @@ pub fn compile_all(targets: &[Target], request: &Request) -> Result<Vec<Run>> {
     Ok(runs)
 }
 
-/// The models with a loop whose trip count no compiler can know (`for` with a bound from the inputs, `while`,
-/// `do`), with each such loop's line: every rule counts a kept loop's body once, so their cycles/eval stand for
-/// one pass of each such loop, which the cost table must say beside the figure.
-pub fn kept_loops_note(models: &[Model]) -> Option<String> {
+/// The models with a loop brdfprof cannot count from the source (`FileModel::uncounted_loops`), with each such
+/// loop's line and how often the model's loops run (the host translation's count): where a compiler keeps such a
+/// loop, every rule counts its body once, which the cost table must say beside the figure.
+pub fn kept_loops_note(models: &[Model], shaders: &Shaders) -> Option<String> {
     let named: Vec<String> = models
         .iter()
         .filter_map(|m| {
             let f = m.file()?;
             let at: Vec<String> = f
-                .file
-                .loops
-                .iter()
-                .filter(|l| l.trip_count.is_none())
+                .uncounted_loops()
                 .map(|l| format!("{}:{}", crate::messages::escape_line(l.file.as_deref().unwrap_or(&f.path)), l.line))
                 .collect();
-            (!at.is_empty()).then(|| format!("{} ({})", crate::messages::escape_line(&m.label()), at.join(", ")))
+            if at.is_empty() {
+                return None;
+            }
+            let passes = match crate::translate::verify::loop_passes(m, shaders) {
+                Ok(p) => format!("with {p:.1} loop-header passes per evaluation on the translation check's samples"),
+                Err(e) => format!("(passes not counted: {})", crate::messages::escape_line(&format!("{e:#}"))),
+            };
+            Some(format!("{} ({}) {passes}", crate::messages::escape_line(&m.label()), at.join(", ")))
         })
         .collect();
     (!named.is_empty()).then(|| {
         format!(
-            "Loops of unknown trip count: {}. No compiler knows how often such a loop runs and every rule counts a kept loop's body once, so these models' cycles/eval stand for one pass of each such loop, not its trip count (docs/measured.md, \"A BRDF's own loops\").",
+            "Loops brdfprof cannot count from the source: {}. Where a compiler keeps such a loop, every rule counts its body once, so these models' cycles/eval stand for one pass of it, not its trip count (docs/measured.md, \"A BRDF's own loops\").",
             named.join("; ")
         )
     })

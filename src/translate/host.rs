@@ -115,11 +115,17 @@ impl HostKernel {
     /// constants last) in a child process; returns the invocations' flags (1: one stopped at the host's loop
     /// limit).
     pub fn run(&self, buffers: &mut [&mut [u8]], groups: [u32; 3]) -> Result<u32> {
+        Ok(self.run_counted(buffers, groups)?.0)
+    }
+
+    /// `run`, with the loop headers every invocation passed, summed.
+    pub fn run_counted(&self, buffers: &mut [&mut [u8]], groups: [u32; 3]) -> Result<(u32, u64)> {
         if buffers.len() != self.bindings.len() {
             bail!("the host kernel takes {} bindings, {} given", self.bindings.len(), buffers.len());
         }
         let engine = super::runner::Engine::Host { library: self.library.clone() };
-        Ok(super::runner::run(engine, self.local_size, buffers, groups, "the translated kernel on the host")?.flags)
+        let ran = super::runner::run(engine, self.local_size, buffers, groups, "the translated kernel on the host")?;
+        Ok((ran.flags, ran.loop_passes))
     }
 
     pub fn local_size(&self) -> [u32; 3] {
@@ -139,6 +145,20 @@ pub fn eval(kernel: &HostKernel, samples: &[Sample], extras: &EvalExtras) -> Res
     }
     let floats: Vec<f32> = bytemuck::pod_collect_to_vec(&output);
     Ok(floats.chunks_exact(4).map(|c| [c[0], c[1], c[2]]).collect())
+}
+
+/// Loop headers the translated eval kernel passes per evaluation over `samples` (every pass: each iteration's
+/// and the exit test's): how often the kernel's loops run, which no compiler's listing states.
+pub fn loop_passes(kernel: &HostKernel, samples: &[Sample], extras: &EvalExtras) -> Result<f64> {
+    let mut input = crate::kernels::pack_samples(samples, extras);
+    let mut output = vec![0u8; samples.len() * 16];
+    let mut push = (samples.len() as u32).to_ne_bytes().to_vec();
+    let groups = (samples.len() as u32).div_ceil(kernel.local_size[0].max(1));
+    let (flags, passes) = kernel.run_counted(&mut [&mut input, &mut output, &mut push], [groups, 1, 1])?;
+    if flags & 1 != 0 {
+        bail!("the host run stopped an evaluation at its loop limit (2^20 iterations)");
+    }
+    Ok(passes as f64 / samples.len().max(1) as f64)
 }
 
 /// One value of the f64 reference: the kernel's own operations in double, and the bound the Vulkan precision

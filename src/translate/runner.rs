@@ -47,6 +47,9 @@ struct Reply {
     flags: u32,
     /// The device it ran on ("host" for the host build).
     device: String,
+    /// Loop headers passed, over every invocation (the host build counts them; 0 elsewhere).
+    #[serde(default)]
+    loop_passes: u64,
 }
 
 /// What a run returned besides the buffers.
@@ -54,6 +57,7 @@ struct Reply {
 pub struct Ran {
     pub flags: u32,
     pub device: String,
+    pub loop_passes: u64,
 }
 
 /// Runs `engine` over `buffers` (copied back in place) in a child, `what` naming the kernel in messages.
@@ -96,7 +100,7 @@ pub fn run(
         }
         b.copy_from_slice(&bytes);
     }
-    Ok(Ran { flags: reply.flags, device: reply.device })
+    Ok(Ran { flags: reply.flags, device: reply.device, loop_passes: reply.loop_passes })
 }
 
 /// The message of a child that failed: a fault by its signal, an error by the child's own words.
@@ -151,7 +155,8 @@ pub fn child_main(dir: &str) -> Result<()> {
     let mut buffers: Vec<&mut [u8]> = owned.iter_mut().map(Vec::as_mut_slice).collect();
     let reply = match &request.engine {
         Engine::Host { library } => {
-            Reply { flags: run_host(library, &mut buffers, request.groups)?, device: "host".into() }
+            let (flags, loop_passes) = run_host(library, &mut buffers, request.groups)?;
+            Reply { flags, device: "host".into(), loop_passes }
         }
         Engine::OpenCl { source, options, wanted } => {
             let text = String::from_utf8_lossy(
@@ -160,7 +165,7 @@ pub fn child_main(dir: &str) -> Result<()> {
             )
             .into_owned();
             let device = run_opencl(&text, options, wanted, request.local_size, &mut buffers, request.groups)?;
-            Reply { flags: 0, device }
+            Reply { flags: 0, device, loop_passes: 0 }
         }
     };
     for (k, b) in owned.iter().enumerate() {
@@ -255,10 +260,11 @@ fn run_opencl(
     Ok(name)
 }
 
-type RunFn = unsafe extern "C" fn(*const *mut u8, u32, u32, u32) -> u32;
+type RunFn = unsafe extern "C" fn(*const *mut u8, u32, u32, u32, *mut u64) -> u32;
 
 /// The child's half of `host::HostKernel::run`: loads `library` and runs its kernel over `buffers`.
-fn run_host(library: &std::path::Path, buffers: &mut [&mut [u8]], groups: [u32; 3]) -> Result<u32> {
+/// The invocations' flags and the loop headers they passed.
+fn run_host(library: &std::path::Path, buffers: &mut [&mut [u8]], groups: [u32; 3]) -> Result<(u32, u64)> {
     // SAFETY: the library is the one `HostKernel::compile` built from the translation; loading runs no
     // constructors of ours (the prelude defines none).
     let lib =
@@ -270,6 +276,8 @@ fn run_host(library: &std::path::Path, buffers: &mut [&mut [u8]], groups: [u32; 
     unsafe {
         let run: libloading::Symbol<RunFn> =
             lib.get(b"brdfprof_host_run\0").context("the host build has no brdfprof_host_run")?;
-        Ok(run(pointers.as_ptr(), groups[0], groups[1], groups[2]))
+        let mut loop_passes = 0u64;
+        let flags = run(pointers.as_ptr(), groups[0], groups[1], groups[2], &mut loop_passes);
+        Ok((flags, loop_passes))
     }
 }

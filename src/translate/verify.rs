@@ -248,6 +248,15 @@ fn flat<T: Copy>(v: &[[T; 3]]) -> Vec<T> {
     v.iter().flatten().copied().collect()
 }
 
+/// Loop headers `model`'s eval kernel passes per evaluation on the check's samples, counted by its fp32
+/// translation on the host (no Vulkan device needed).
+pub fn loop_passes(model: &Model, shaders: &Shaders) -> Result<f64> {
+    let (checked, samples, rows, row_floats) = check_inputs(model);
+    let extras = EvalExtras { tangents: None, rows: &rows, row_floats };
+    let kernel = host::HostKernel::compile(&prepare::eval_kernel(&checked, shaders)?)?;
+    host::loop_passes(&kernel, &samples, &extras)
+}
+
 /// The eval kernel of `model` against its f64 reference, on `gpu` and as the fp32 translation on the host.
 pub fn eval_agreement(gpu: &Gpu, model: &Model, shaders: &Shaders) -> Result<Agreement> {
     let (checked, samples, rows, row_floats) = check_inputs(model);

@@ -275,7 +275,7 @@ impl EnvLayout {
             }
         };
         let mut s = String::from(
-            "extern \"C\" u32 brdfprof_host_run(u8* const* bindings, u32 nx, u32 ny, u32 nz) {\n  u32 flags = 0u;\n",
+            "extern \"C\" u32 brdfprof_host_run(u8* const* bindings, u32 nx, u32 ny, u32 nz, u64* loop_passes) {\n  u32 flags = 0u;\n",
         );
         for (k, b) in self.bindings.iter().enumerate() {
             writeln!(s, "  u8* {} = bindings[{k}];", b.field).unwrap();
@@ -288,7 +288,7 @@ impl EnvLayout {
         .unwrap();
         writeln!(s, "  for (u32 lz = 0u; lz < {z}u; ++lz) for (u32 ly = 0u; ly < {y}u; ++ly) for (u32 lx = 0u; lx < {x}u; ++lx) {{\n  Env env;").unwrap();
         s += &self.fill(m, Dialect::Host, &ids, local_size)?;
-        s += "  flags |= env.flags;\n  }\n  return flags;\n}\n";
+        s += "  flags |= env.flags;\n  *loop_passes += env.loop_iterations;\n  }\n  return flags;\n}\n";
         Ok(s)
     }
 }

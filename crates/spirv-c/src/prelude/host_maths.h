@@ -1,6 +1,6 @@
 // ---- brdfprof prelude, both host builds: the C library's maths as libstdc++'s <cmath> defines its float and
 // double overloads (the same GCC builtins, so the same code and libm calls), without <cmath>'s 20,000 lines,
-// whose parsing was about 70 ms of every g++ build (a third of a translation check's host build). A call
+// whose parsing was about 70 ms of every g++ build (half of a small translation's). A call
 // whose argument types match neither overload is ambiguous and fails to compile, not silently converted. ----
 #include <cstring>
 namespace hm {
@@ -50,8 +50,8 @@ inline float rint(float x) { return __builtin_rintf(x); }
 inline double rint(double x) { return __builtin_rint(x); }
 inline float fabs(float x) { return __builtin_fabsf(x); }
 inline double fabs(double x) { return __builtin_fabs(x); }
-inline float atan2(float x, float y) { return __builtin_atan2f(x, y); }
-inline double atan2(double x, double y) { return __builtin_atan2(x, y); }
+inline float atan2(float y, float x) { return __builtin_atan2f(y, x); }
+inline double atan2(double y, double x) { return __builtin_atan2(y, x); }
 inline float pow(float x, float y) { return __builtin_powf(x, y); }
 inline double pow(double x, double y) { return __builtin_pow(x, y); }
 inline float fmin(float x, float y) { return __builtin_fminf(x, y); }
@@ -66,6 +66,7 @@ inline float fma(float x, float y, float z) { return __builtin_fmaf(x, y, z); }
 inline double fma(double x, double y, double z) { return __builtin_fma(x, y, z); }
 inline float ldexp(float x, int e) { return __builtin_ldexpf(x, e); }
 inline double ldexp(double x, int e) { return __builtin_ldexp(x, e); }
+inline float frexp(float x, int* e) { return __builtin_frexpf(x, e); }
 inline double frexp(double x, int* e) { return __builtin_frexp(x, e); }
 inline bool isnan(float x) { return __builtin_isnan(x); }
 inline bool isnan(double x) { return __builtin_isnan(x); }
