@@ -108,13 +108,18 @@ pub fn instruction(line: &str, grf: u32) -> Option<Instruction> {
 }
 
 /// Whether a send's descriptor (`const MsgDesc: (bti 4, ...)`) reads constant data: the constant cache's
-/// messages (SFID `const`: uniform blocks, the lights), and A64 reads (`dp data 1 MsgDesc: (DC A64 untyped
-/// surface read, ...)`), which in brdfprof's kernels read only the shader's constant data: ANV 22.3 moves a
-/// constant array indexed at run time into it (`load_global_constant` in the final NIR), while the G-buffer
-/// is sampled and the output written as an image.
+/// messages (SFID `const`: uniform blocks, the lights), LSC's transposed block loads (`ugm MsgDesc: ( load, a32,
+/// d32, V16, transpose, ...`: one block for every lane, how Xe-HPG reads a uniform block), and A64 reads (`DC A64
+/// untyped surface read`, LSC's `ugm MsgDesc: ( load_cmask, a64, ...`), which in brdfprof's kernels read only
+/// the shader's constant data: ANV 22.3 moves a constant array indexed at run time into it
+/// (`load_global_constant` in the final NIR), while the G-buffer is sampled and the output written as an image.
 fn reads_constant_data(desc: &str) -> bool {
-    let sfid = desc.split_once("MsgDesc:").map_or("", |(s, _)| s.trim());
-    sfid == "const" || desc.contains("A64 untyped surface read")
+    let (sfid, message) = desc.split_once("MsgDesc:").map_or(("", ""), |(s, m)| (s.trim(), m));
+    let lsc: Vec<&str> = message.trim_start().trim_start_matches('(').split(',').map(str::trim).collect();
+    let lsc_load = sfid == "ugm" && lsc.first().is_some_and(|op| op.starts_with("load"));
+    sfid == "const"
+        || desc.contains("A64 untyped surface read")
+        || (lsc_load && (lsc.contains(&"transpose") || lsc.contains(&"a64")))
 }
 
 /// `mad(16)` as ("mad", Some(16)); `math` as ("math", None).
@@ -271,10 +276,20 @@ NIR (from SPIR-V) for MESA_SHADER_COMPUTE shader:\n\tmul(16) g1<1>F g2<8,8,1>F g
         );
         let gbuffer =
             send("sampler MsgDesc: ld_lz SIMD16 Surface = 2 Sampler = 0 mlen 2 ex_mlen 2 rlen 6 { align1 1H @1 $0 };");
-        let ugm = send(
-            "ugm MsgDesc: ( load, a32, d32, V64, transpose, L1STATE_L3MOCS dst_len = 8, src0_len = 1, src1_len = 0 flat ) base_offset 0  { align1 WE_all 1N $0 };",
+        let block = send(
+            "ugm MsgDesc: ( load, a32, d32, V16, transpose, L1STATE_L3MOCS dst_len = 2, src0_len = 1, src1_len = 0 bti ) BTI 4 base_offset 0  { align1 WE_all 1N $0 };",
         );
-        assert!(ubo.constant && table.constant && !gbuffer.constant && !ugm.constant);
+        let lsc_table = send(
+            "ugm MsgDesc: ( load_cmask, a64, d32, x, L1STATE_L3MOCS dst_len = 2, src0_len = 4, src1_len = 0 flat ) base_offset 0  { align1 1H $1 };",
+        );
+        let per_lane = send(
+            "ugm MsgDesc: ( load, a32, d32, V1, L1STATE_L3MOCS dst_len = 2, src0_len = 2, src1_len = 0 bti ) BTI 5 base_offset 0  { align1 1H $2 };",
+        );
+        let store = send(
+            "ugm MsgDesc: ( store, a64, d32, V1, L1STATE_L3MOCS dst_len = 0, src0_len = 4, src1_len = 2 flat ) base_offset 0  { align1 1H $3 };",
+        );
+        assert!(ubo.constant && table.constant && block.constant && lsc_table.constant);
+        assert!(!gbuffer.constant && !per_lane.constant && !store.constant);
         let cycles = |i: &Instruction| super::super::latency(i, family);
         assert_eq!([cycles(&ubo), cycles(&table), cycles(&gbuffer)], [30.0, 30.0, 320.0]);
     }
