@@ -1,7 +1,7 @@
 //! Executed CPU instructions per BRDF evaluation of lavapipe's JIT-compiled kernels, under valgrind's
 //! callgrind: a deterministic cost figure where wall time is noise.
 //!
-//! brdfprof runs itself under `valgrind --tool=callgrind` as a child (`brdfprof __callgrind-child`), with
+//! brdfprof runs itself under `valgrind --tool=callgrind` as children (`brdfprof __callgrind-child`), with
 //! one compute thread (LP_NUM_THREADS=0) and Mesa's shader cache off. Instrumentation starts off; for each
 //! kernel the child makes an untimed dispatch (llvmpipe JIT-compiles at the first dispatch), then turns
 //! instrumentation on, zeroes the counters, dispatches again and dumps the counters under the kernel's
@@ -187,13 +187,13 @@ pub fn valgrind_version() -> Result<String> {
 /// Runs the children under callgrind and reads what they dumped. Labels follow `Model::name`. The kernels are
 /// split between one child per core (contiguous groups, the baseline kernel in the last): each kernel's count is
 /// its own dispatch's, whatever else its process measured, and valgrind runs one thread, so one child left a
-/// core idle (the 4 presets and the baseline on lavapipe: 17.5 s wall in one child on a 2-core VM).
+/// core idle (docs/gate.md). At most `MAX_CHILDREN`: each holds a Vulkan device and LLVM under valgrind.
 pub fn run(models: &[Model], lights: u32, shaders: &Shaders, options: &CallgrindOptions) -> Result<CallgrindRun> {
     if !cfg!(target_arch = "x86_64") {
         bail!("callgrind client requests are implemented for x86-64 only");
     }
     let valgrind = valgrind_version()?;
-    let cores = std::thread::available_parallelism().map_or(1, usize::from);
+    let cores = std::thread::available_parallelism().map_or(1, usize::from).min(MAX_CHILDREN);
     let groups = split(models.len() + 1, cores);
     let runs: Vec<Result<ChildRun>> = std::thread::scope(|scope| {
         let handles: Vec<_> = groups
@@ -222,6 +222,9 @@ pub fn run(models: &[Model], lights: u32, shaders: &Shaders, options: &Callgrind
     let first = first.ok_or_else(|| anyhow!("no callgrind run"))?;
     Ok(CallgrindRun { kernels, evaluations: first.evaluations, jit_cpu_features: first.jit_cpu_features, valgrind })
 }
+
+/// The most callgrind children one run starts, whatever the cores.
+const MAX_CHILDREN: usize = 4;
 
 /// `n` kernels in at most `parts` contiguous groups of sizes differing by at most one, the larger first.
 fn split(n: usize, parts: usize) -> Vec<std::ops::Range<usize>> {
@@ -289,13 +292,14 @@ fn run_child(
     let _tmp = cleanup::child_tmpdir(&mut cmd)?;
     // The child compiles and runs every kernel under valgrind, each compilation under the scaled limit.
     let limit = crate::launch::limit() * VALGRIND_SLOWDOWN * (models.len() as u32 + 2);
-    let output =
-        crate::launch::output_within(&mut cmd, "the callgrind run (valgrind)", limit).context("cannot run valgrind")?;
+    let names = crate::messages::escape_line(&kernel_names(models, baseline).join(", "));
+    let what = format!("the callgrind run of {names} (valgrind)");
+    let output = crate::launch::output_within(&mut cmd, &what, limit).context("cannot run valgrind")?;
     let stdout = String::from_utf8_lossy(&output.stdout);
     let stderr = String::from_utf8_lossy(&output.stderr);
     if !output.status.success() {
         let tail: Vec<&str> = stderr.lines().rev().take(15).collect::<Vec<_>>().into_iter().rev().collect();
-        bail!("the callgrind run failed ({}):\n{}", output.status, tail.join("\n"));
+        bail!("{what} failed ({}):\n{}", output.status, tail.join("\n"));
     }
     let reply: ChildReply = stdout
         .lines()
@@ -323,8 +327,7 @@ fn kernel_irs(
     labels: &[String],
     dumps: &BTreeMap<String, u64>,
 ) -> Result<Vec<KernelIr>> {
-    let base = baseline.then(|| super::BASELINE_LABEL.to_string());
-    let names: Vec<String> = models.iter().map(Model::label).chain(base).collect();
+    let names = kernel_names(models, baseline);
     if labels.len() != names.len() {
         bail!("the callgrind child measured {} kernels where {} were asked", labels.len(), names.len());
     }
@@ -342,6 +345,12 @@ fn kernel_irs(
             Ok(KernelIr { label, jit_ir })
         })
         .collect()
+}
+
+/// The labels of a child's kernels: `models`', then the baseline's where it measures it.
+fn kernel_names(models: &[Model], baseline: bool) -> Vec<String> {
+    let base = baseline.then(|| super::BASELINE_LABEL.to_string());
+    models.iter().map(Model::label).chain(base).collect()
 }
 
 /// Every client-request dump in `dir`: its label -> Ir of the JIT code.
