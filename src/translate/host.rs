@@ -133,16 +133,29 @@ impl HostKernel {
     }
 }
 
-/// f_s of the translated eval kernel on the host for every sample (as `kernels::eval_with` on a device).
-pub fn eval(kernel: &HostKernel, samples: &[Sample], extras: &EvalExtras) -> Result<Vec<[f32; 3]>> {
+/// Runs the translated eval kernel over `samples` with `value_bytes` of output per sample; its output and the
+/// loop headers its invocations passed. `what` names the build in the loop-limit error.
+fn run_eval(
+    kernel: &HostKernel,
+    samples: &[Sample],
+    extras: &EvalExtras,
+    value_bytes: usize,
+    what: &str,
+) -> Result<(Vec<u8>, u64)> {
     let mut input = crate::kernels::pack_samples(samples, extras);
-    let mut output = vec![0u8; samples.len() * 16];
+    let mut output = vec![0u8; samples.len() * value_bytes];
     let mut push = (samples.len() as u32).to_ne_bytes().to_vec();
     let groups = (samples.len() as u32).div_ceil(kernel.local_size[0].max(1));
-    let flags = kernel.run(&mut [&mut input, &mut output, &mut push], [groups, 1, 1])?;
+    let (flags, passes) = kernel.run_counted(&mut [&mut input, &mut output, &mut push], [groups, 1, 1])?;
     if flags & 1 != 0 {
-        bail!("the host run stopped an evaluation at its loop limit (2^20 iterations)");
+        bail!("{what} stopped an evaluation at its loop limit (2^20 iterations)");
     }
+    Ok((output, passes))
+}
+
+/// f_s of the translated eval kernel on the host for every sample (as `kernels::eval_with` on a device).
+pub fn eval(kernel: &HostKernel, samples: &[Sample], extras: &EvalExtras) -> Result<Vec<[f32; 3]>> {
+    let (output, _) = run_eval(kernel, samples, extras, 16, "the host run")?;
     let floats: Vec<f32> = bytemuck::pod_collect_to_vec(&output);
     Ok(floats.chunks_exact(4).map(|c| [c[0], c[1], c[2]]).collect())
 }
@@ -150,14 +163,7 @@ pub fn eval(kernel: &HostKernel, samples: &[Sample], extras: &EvalExtras) -> Res
 /// Loop headers the translated eval kernel passes per evaluation over `samples` (every pass: each iteration's
 /// and the exit test's): how often the kernel's loops run, which no compiler's listing states.
 pub fn loop_passes(kernel: &HostKernel, samples: &[Sample], extras: &EvalExtras) -> Result<f64> {
-    let mut input = crate::kernels::pack_samples(samples, extras);
-    let mut output = vec![0u8; samples.len() * 16];
-    let mut push = (samples.len() as u32).to_ne_bytes().to_vec();
-    let groups = (samples.len() as u32).div_ceil(kernel.local_size[0].max(1));
-    let (flags, passes) = kernel.run_counted(&mut [&mut input, &mut output, &mut push], [groups, 1, 1])?;
-    if flags & 1 != 0 {
-        bail!("the host run stopped an evaluation at its loop limit (2^20 iterations)");
-    }
+    let (_, passes) = run_eval(kernel, samples, extras, 16, "the host run")?;
     Ok(passes as f64 / samples.len().max(1) as f64)
 }
 
@@ -178,13 +184,6 @@ pub fn pairs(bytes: &[u8]) -> Vec<Bounded> {
 
 /// f_s of the translated eval kernel's f64 reference for every sample (`eval` in double, with bounds).
 pub fn eval_reference(kernel: &HostKernel, samples: &[Sample], extras: &EvalExtras) -> Result<Vec<[Bounded; 3]>> {
-    let mut input = crate::kernels::pack_samples(samples, extras);
-    let mut output = vec![0u8; samples.len() * 16 * 4];
-    let mut push = (samples.len() as u32).to_ne_bytes().to_vec();
-    let groups = (samples.len() as u32).div_ceil(kernel.local_size[0].max(1));
-    let flags = kernel.run(&mut [&mut input, &mut output, &mut push], [groups, 1, 1])?;
-    if flags & 1 != 0 {
-        bail!("the f64 reference stopped an evaluation at its loop limit (2^20 iterations)");
-    }
+    let (output, _) = run_eval(kernel, samples, extras, 16 * 4, "the f64 reference")?;
     Ok(pairs(&output).chunks_exact(4).map(|c| [c[0], c[1], c[2]]).collect())
 }
