@@ -119,6 +119,7 @@ mod tests {
             vs_profile: None,
             cost: None,
             lines: Vec::new(),
+            loop_trips: Vec::new(),
         }
     }
 

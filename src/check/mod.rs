@@ -286,6 +286,7 @@ mod tests {
             vs_profile: None,
             cost: None,
             lines: Vec::new(),
+            loop_trips: Vec::new(),
         };
         let mut environment = BTreeMap::new();
         for g in ["callgrind", "timing"] {

@@ -164,6 +164,7 @@ pub fn compiled_report(
         vs_profile: None,
         cost: None,
         lines: Vec::new(),
+        loop_trips: Vec::new(),
     }
 }
 
@@ -223,6 +224,7 @@ pub fn device_report(
         vs_profile: None,
         cost: None,
         lines: Vec::new(),
+        loop_trips: Vec::new(),
     };
     Ok(report)
 }

@@ -141,6 +141,8 @@ pub struct FileModel {
     pub returns: Option<Returns>,
     /// Each parameter's default binding (`bind` in the file, else its value): what names leave out.
     pub defaults: Vec<Binding>,
+    /// `loop-passes=N` (`LOOP_PASSES`).
+    pub loop_passes: Option<u32>,
 }
 
 /// The function the kernels call for f_s: `BRDF`, or a declared entry (`entry NAME(ARG, ...)` in the file).
@@ -308,8 +310,16 @@ pub const INCLUDE_OVERRIDE: &str = "include-override";
 /// `--hlsl-front-end`).
 pub const HLSL_FRONT_END: &str = HlslFrontEnd::KEY;
 
+/// `loop-passes=N`: every loop of the file's shader runs N header passes per entry, a pass counter in place of its
+/// exit tests (`spirv::loops`): the kernel compiled for its cost at that trip count, its results not the file's.
+/// `targets::trips` prices a model's loops from two such compiles.
+pub const LOOP_PASSES: &str = "loop-passes";
+/// spirv-opt's `--loop-unroll` writes out no loop of a single pass (none of a `for` loop's iterations).
+const MIN_LOOP_PASSES: u32 = 2;
+const MAX_LOOP_PASSES: u32 = 1 << 16;
+
 /// The keys of a model text brdfprof reads itself (no parameter may take one's name).
-const KEYS: [&str; 7] = [DEFINE, ENTRY, RETURNS, INCLUDE, INCLUDE_MAP, INCLUDE_OVERRIDE, HLSL_FRONT_END];
+const KEYS: [&str; 8] = [DEFINE, ENTRY, RETURNS, INCLUDE, INCLUDE_MAP, INCLUDE_OVERRIDE, HLSL_FRONT_END, LOOP_PASSES];
 
 /// The entry and its parameters as BRDF Explorer's files name them: no macro may take these names.
 const ENTRY_NAMES: [&str; 6] = ["BRDF", "L", "V", "N", "X", "Y"];
@@ -502,6 +512,7 @@ impl FileModel {
             entry: None,
             returns: None,
             defaults,
+            loop_passes: None,
         };
         model.warn_new(None);
         model.with_params(&params)
@@ -584,6 +595,17 @@ impl FileModel {
                 })?);
                 continue;
             }
+            if name == LOOP_PASSES {
+                let n = value.trim().parse().ok().filter(|n| (MIN_LOOP_PASSES..=MAX_LOOP_PASSES).contains(n));
+                m.loop_passes = Some(n.ok_or_else(|| {
+                    anyhow!(
+                        "{}: `{LOOP_PASSES}={}`: expected a whole number of passes, {MIN_LOOP_PASSES} to {MAX_LOOP_PASSES}",
+                        self.path,
+                        value.trim()
+                    )
+                })?);
+                continue;
+            }
             let k = self.file.params.iter().position(|q| q.name == name).ok_or_else(|| {
                 let known = self.file.params.iter().map(|q| q.name.as_str()).collect::<Vec<_>>();
                 anyhow!(
@@ -660,6 +682,9 @@ impl FileModel {
         let declared = self.entry().declared.map_or(Returns::F, |e| e.returns);
         if let Some(r) = self.returns.filter(|r| all || *r != declared) {
             s += &format!(",{RETURNS}={}", r.text());
+        }
+        if let Some(n) = self.loop_passes {
+            s += &format!(",{LOOP_PASSES}={n}");
         }
         for ((p, b), d) in self.file.params.iter().zip(&self.bindings).zip(&self.defaults) {
             let text = match b {
@@ -813,8 +838,8 @@ impl FileModel {
         let composed = self.compose(kind, &kernel_source)?;
         let key = cache_key(&composed, &defines, &tree);
         let name = format!("{}:{}", self.path, kernel_name);
-        if let Some(words) = memory_cache().lock().unwrap().get(&key) {
-            return Ok(Spirv { name, words: words.clone() });
+        if let Some(words) = memory_cache().lock().unwrap().get(&key).cloned() {
+            return Ok(Spirv { name, words: self.with_loop_passes(kind, &words)?.into() });
         }
         let store = crate::cache::Store::open_default();
         let valid = |bytes: &[u8]| Spirv::from_bytes(&name, bytes).map(|_| ());
@@ -822,7 +847,36 @@ impl FileModel {
         let bytes = crate::cache::get_or_build(store.as_ref(), SPIRV_KIND, &key, &name, valid, compile)?;
         let words: Arc<[u32]> = Spirv::from_bytes(&name, &bytes)?.words;
         memory_cache().lock().unwrap().insert(key, words.clone());
-        Ok(Spirv { name, words })
+        Ok(Spirv { name, words: self.with_loop_passes(kind, &words)?.into() })
+    }
+
+    /// `words` with the loops at `loop-passes=`' count, where given, and but in the eval kernel (whose loop
+    /// passes `targets::trips` counts as the model's) written out by spirv-opt's `--loop-unroll` (Mesa 22.3's
+    /// Bifrost compiler keeps even a loop of 2 passes): every loop of the module is the file's (a file with such
+    /// a loop has the light block written out), which the count of loops set checks.
+    fn with_loop_passes(&self, kind: KernelKind, words: &[u32]) -> Result<Vec<u32>> {
+        let Some(passes) = self.loop_passes else { return Ok(words.to_vec()) };
+        let unroll = kind != KernelKind::Eval;
+        let (words, set) = crate::spirv::loops::at_passes(words, passes, unroll)
+            .with_context(|| format!("{}: {LOOP_PASSES}={passes}", self.path))?;
+        if set != self.file.loops.len() {
+            bail!(
+                "{}: {LOOP_PASSES}={passes}: the kernel has {set} loops where the file has {}: only the file's own loops can be set",
+                self.path,
+                self.file.loops.len()
+            );
+        }
+        if !unroll {
+            return Ok(words);
+        }
+        let words = crate::spirv::spirv_opt(&words, &["--loop-unroll".to_string()])?;
+        if crate::spirv::loops::count(&words)? > 0 {
+            bail!(
+                "{}: {LOOP_PASSES}={passes}: spirv-opt cannot write out the file's loops (it writes out a loop whose exit test precedes its body: a `for` or `while`, not a `do`)",
+                self.path
+            );
+        }
+        Ok(words)
     }
 
     /// The file's kernel of `kind` compiled again with glslang's line information (`-g`), never cached: what
@@ -834,7 +888,7 @@ impl FileModel {
         let kernel_source = tree.read(Path::new(&source_file)).with_context(|| format!("cannot read {source_file}"))?;
         let composed = self.compose(kind, &kernel_source)?;
         let words = crate::shaders::without_source_text(&self.compile(&tree, kind, &composed, &defines, &["-g"])?);
-        Ok(Spirv { name: format!("{}:{kernel_name}", self.path), words: words.into() })
+        Ok(Spirv { name: format!("{}:{kernel_name}", self.path), words: self.with_loop_passes(kind, &words)?.into() })
     }
 
     /// glslang on the composed source: written beside a copy of the embedded tree (or with `--glsl DIR` on the

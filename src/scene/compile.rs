@@ -287,6 +287,8 @@ fn agreement(
 /// reason is in the notes).
 fn target_report(run: targets::Run, specs: &[VariantSpec], p: &ScenePlan) -> Result<SceneTargetReport> {
     let name = run.target.name();
+    let models: Vec<crate::model::Model> = p.kernels.iter().map(|k| k.model.clone()).collect();
+    let loops = targets::trips::counted_once_note(&models);
     let cost = run
         .report
         .cost
@@ -327,6 +329,7 @@ fn target_report(run: targets::Run, specs: &[VariantSpec], p: &ScenePlan) -> Res
         .into_iter()
         .collect();
     notes.extend(run.note);
+    notes.extend(loops);
     Ok(SceneTargetReport {
         target: name,
         device: cost.device.clone(),

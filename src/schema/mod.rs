@@ -73,6 +73,28 @@ pub struct InspectReport {
     /// Cost per source line (`inspect --lines`), per model, where the compiler names lines.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub lines: Vec<lines::KernelLines>,
+    /// The models whose loops the cost table prices at their trip count (`targets::trips`), with the
+    /// compiles it extrapolates from.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub loop_trips: Vec<LoopTrips>,
+}
+
+/// A model's loops at their trip count: its loop-header passes per evaluation, and its kernel compiled with the
+/// loops at fixed passes per entry (`loop-passes=`), each with its passes per evaluation and statistics.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct LoopTrips {
+    pub model: String,
+    pub passes: f64,
+    pub fixed: Vec<FixedPasses>,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct FixedPasses {
+    /// Passes per entry (`loop-passes=`).
+    pub loop_passes: u32,
+    /// Passes per evaluation, counted as the model's are.
+    pub passes: f64,
+    pub stats: BTreeMap<String, f64>,
 }
 
 /// The row note that names a file's parameters compiled in as constants (`FileModel::folded`).
@@ -215,6 +237,7 @@ pub(crate) mod tests {
             vs_profile: None,
             cost: None,
             lines: vec![],
+            loop_trips: Vec::new(),
         }
     }
 }

@@ -20,6 +20,7 @@ pub mod nak;
 pub mod nvidia;
 pub mod radv;
 pub mod translated;
+pub mod trips;
 
 use crate::gpu::Gpu;
 use crate::model::Model;
@@ -287,6 +288,9 @@ pub fn compile_all(targets: &[Target], request: &Request) -> Result<Vec<Run>> {
     let _heartbeat = crate::messages::Heartbeat::start(move || {
         format!("compiling for the compile-only targets: {}", said.lock().unwrap_or_else(|e| e.into_inner()).join(", "))
     });
+    let trips = trips::Trips::of(request.models, request.shaders);
+    let models: Vec<Model> = request.models.iter().cloned().chain(trips::Trips::twins(&trips)).collect();
+    let request = &Request { models: &models, ..*request };
     let total = targets.len();
     let done = std::sync::atomic::AtomicUsize::new(0);
     let compile = |vendor: &dyn Vendor, families: &[usize], request: &Request| -> Result<Vec<Run>> {
@@ -323,8 +327,9 @@ pub fn compile_all(targets: &[Target], request: &Request) -> Result<Vec<Run>> {
         runs[k] = Some(run);
     }
     let mut runs: Vec<Run> = runs.into_iter().map(|r| r.expect("every target compiled")).collect();
-    let loops = kept_loops_note(request.models, request.shaders);
+    let loops = trips::Trips::note(&trips);
     for run in &mut runs {
+        trips::Trips::attach(&trips, run);
         let harness = run.report.cost.as_ref().and_then(harness_note);
         for note in harness.iter().chain(run.report.cost.as_ref().and(loops.as_ref())) {
             let driver = run.report.section_notes.entry("driver/".into()).or_default();
@@ -335,36 +340,6 @@ pub fn compile_all(targets: &[Target], request: &Request) -> Result<Vec<Run>> {
         }
     }
     Ok(runs)
-}
-
-/// The models with a loop brdfprof cannot count from the source (`FileModel::uncounted_loops`), with each such
-/// loop's line and how often the model's loops run (the host translation's count): where a compiler keeps such a
-/// loop, every rule counts its body once, which the cost table must say beside the figure.
-pub fn kept_loops_note(models: &[Model], shaders: &Shaders) -> Option<String> {
-    let named: Vec<String> = models
-        .iter()
-        .filter_map(|m| {
-            let f = m.file()?;
-            let at: Vec<String> = f
-                .uncounted_loops()
-                .map(|l| format!("{}:{}", crate::messages::escape_line(l.file.as_deref().unwrap_or(&f.path)), l.line))
-                .collect();
-            if at.is_empty() {
-                return None;
-            }
-            let passes = match crate::translate::verify::loop_passes(m, shaders) {
-                Ok(p) => format!("with {p:.1} loop-header passes per evaluation on the translation check's samples"),
-                Err(e) => format!("(passes not counted: {})", crate::messages::escape_line(&format!("{e:#}"))),
-            };
-            Some(format!("{} ({}) {passes}", crate::messages::escape_line(&m.label()), at.join(", ")))
-        })
-        .collect();
-    (!named.is_empty()).then(|| {
-        format!(
-            "Loops brdfprof cannot count from the source: {}. Where a compiler keeps such a loop, every rule counts its body once, so these models' cycles/eval stand for one pass of it, not its trip count (docs/measured.md, \"A BRDF's own loops\").",
-            named.join("; ")
-        )
-    })
 }
 
 /// The report's section note that holds `harness_note`.

@@ -264,6 +264,22 @@ fn profile_scene_cost_devices_compile_every_variant_on_each_vendor() {
         out.contains("| burley,precision=f16 ") && out.contains(" - "),
         "a kernel tahiti left out is `-` in its column:\n{out}"
     );
+    // A material whose BRDF has a loop brdfprof cannot count: its scene kernel counts the loop's body once, and
+    // the target's notes say so, naming the loop's line.
+    let loop16 = common::repo_root().join("tests/fixtures/brdf/micro/loop-16.brdf");
+    let looped = SMALL.replace(r#""model": "blinn""#, &format!(r#""model": "{}""#, loop16.display()));
+    let looped = write(dir.path(), "loop.json", &looped);
+    let args = ["profile", "--scene", &looped, "--budget", "2", "--min-rounds", "2", "--json", json.to_str().unwrap()];
+    let (code, _, err) = run(&[&args[..], &["--cost-device", "radv:navi21"]].concat());
+    assert_eq!(code, 0, "{err}");
+    let report: Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let notes = report["targets"][0]["notes"].to_string();
+    assert!(
+        notes.contains("Loops brdfprof cannot count from the source: loop-16 (")
+            && notes.contains("loop-16.brdf:15)")
+            && notes.contains("counts each loop's body once"),
+        "{notes}"
+    );
     // The cost devices are compile-only targets, and only a scene profile takes them.
     let (code, _, err) = run(&["profile", "--scene", &f, "--cost-device", "llvmpipe"]);
     assert_eq!(code, 2, "{err}");

@@ -2,8 +2,10 @@
 //! vendor's module takes from its compiler's own output (`targets::radv`, `nvidia`, `intel`):
 //!
 //! - **pipes**: the cycles one wave (warp, hardware thread) keeps each execution pipe busy, every instruction
-//!   of the listing counted once (both sides of a branch, a loop's body once: no vendor's branch or trip-count
-//!   weights, so that vendors differ only where their compilers' code does);
+//!   of the listing counted once (both sides of a branch: no vendor's branch weights, so that vendors differ
+//!   only where their compilers' code does); a BRDF's own loop of unknown trip count is priced at the passes
+//!   its eval kernel counts, extrapolated from two compiles with it at fixed passes (`Schedule::extrapolated`;
+//!   the application's `targets::trips`);
 //! - **schedule latency**: the cycles one wave takes alone, by the compiler's own schedule (ACO's per-instruction
 //!   clocks, ptxas' stall counts and scoreboard waits, IGC's instruction order over its latency table);
 //! - **resident waves**: how many waves the register allocation lets the unit hold, which hide that latency.
@@ -30,7 +32,7 @@ pub const RESIDENT_WAVES: &str = "Resident Waves";
 pub const LATENCY_TERM: &str = "latency / resident waves";
 
 /// The rule, one line, as every report states it.
-pub const RULE: &str = "cycles per wave = max(busiest pipe, schedule latency / resident waves), every instruction counted once; net = kernel's cycles - memory-only kernel's (each term's difference beside it)";
+pub const RULE: &str = "cycles per wave = max(busiest pipe, schedule latency / resident waves), every instruction counted once (a BRDF's loops of unknown trip count: at their counted passes, from two compiles at fixed passes); net = kernel's cycles - memory-only kernel's (each term's difference beside it)";
 
 /// One kernel's figures under the rule.
 #[derive(Clone, Debug, PartialEq)]
@@ -68,6 +70,32 @@ impl Schedule {
             latency: self.latency.map(|l| l * factor),
             resident_waves: self.resident_waves,
         }
+    }
+
+    /// The figures at `passes` on the line through `(pa, a)` and `(pb, b)` (`pa != pb`), each pipe and the
+    /// latency on its own, none below zero: a kernel whose loops run `passes` header passes, from two compiles
+    /// of it with its loops at fixed passes (the application's `targets::trips`). The resident waves are given.
+    pub fn extrapolated(
+        (pa, a): (f64, &Schedule),
+        (pb, b): (f64, &Schedule),
+        passes: f64,
+        resident_waves: Option<f64>,
+    ) -> Schedule {
+        let at = |x: f64, y: f64| (x + (passes - pa) / (pb - pa) * (y - x)).max(0.0);
+        let of = |s: &Schedule, name: &str| s.pipes.iter().find(|(n, _)| n == name).map_or(0.0, |p| p.1);
+        let mut names: Vec<&String> = a.pipes.iter().chain(&b.pipes).map(|(n, _)| n).collect();
+        names.dedup();
+        let mut pipes: Vec<(String, f64)> = Vec::new();
+        for n in names {
+            if !pipes.iter().any(|(p, _)| p == n) {
+                pipes.push((n.clone(), at(of(a, n), of(b, n))));
+            }
+        }
+        let latency = match (a.latency, b.latency) {
+            (Some(x), Some(y)) => Some(at(x, y)),
+            _ => None,
+        };
+        Schedule { pipes, latency, resident_waves }
     }
 
     /// Latency over resident waves, where both are known.
@@ -144,6 +172,22 @@ mod tests {
         let few = Schedule { resident_waves: Some(4.0), ..s.clone() };
         assert_eq!(few.cycles(), (LATENCY_TERM.to_string(), 200.0));
         assert_eq!(Schedule::of(&stats(&[(LATENCY, 1.0)])), None);
+    }
+
+    #[test]
+    fn a_loop_at_its_passes_is_on_the_line_through_two_fixed_counts() {
+        let s = |fma: f64, lat: f64, waves: f64| Schedule {
+            pipes: vec![("FMA".into(), fma), ("SFU".into(), 2.0)],
+            latency: Some(lat),
+            resident_waves: Some(waves),
+        };
+        // 2 passes: 10 FMA cycles, 3 passes: 14; 17 passes adds 15 more bodies of 4.
+        let at = Schedule::extrapolated((2.0, &s(10.0, 100.0, 8.0)), (3.0, &s(14.0, 116.0, 6.0)), 17.0, Some(5.0));
+        assert_eq!(at.pipes, [("FMA".to_string(), 70.0), ("SFU".to_string(), 2.0)]);
+        assert_eq!((at.latency, at.resident_waves), (Some(340.0), Some(5.0)));
+        // A term that fell between the two compiles stops at zero.
+        let down = Schedule::extrapolated((2.0, &s(10.0, 100.0, 8.0)), (3.0, &s(9.0, 90.0, 8.0)), 40.0, None);
+        assert_eq!((down.pipes[0].1, down.latency), (0.0, Some(0.0)));
     }
 
     #[test]

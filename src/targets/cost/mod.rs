@@ -10,8 +10,8 @@ pub use brdfprof_isa_cost::{driver_stat, schedule};
 
 use crate::kernels::shade::steady_block;
 use crate::model::BASELINE_LABEL;
-use crate::schema::InspectReport;
 use crate::schema::cost::{CostRow, TargetCost};
+use crate::schema::{InspectReport, Row};
 use schedule::{LATENCY, RESIDENT_WAVES, Schedule};
 
 /// A row's statistics by key.
@@ -22,13 +22,13 @@ type Stats = std::collections::BTreeMap<String, f64>;
 pub fn table(
     report: &InspectReport,
     header: TargetCost,
-    cycles: impl Fn(&std::collections::BTreeMap<String, f64>, u32) -> Option<f64>,
+    cycles: impl Fn(&Row, u32) -> Option<f64>,
 ) -> Option<TargetCost> {
     let lights = steady_block(report.lights).0;
     let checked = header.target.as_deref().and_then(measured::line);
     let mut t = TargetCost { lights_per_kernel: lights, rows: Vec::new(), checked, ..header };
     for r in &report.rows {
-        let Some(c) = cycles(&r.stats, lights) else { continue };
+        let Some(c) = cycles(r, lights) else { continue };
         let stats = t.columns.iter().map(|name| (name.clone(), driver_stat(&r.stats, name).unwrap_or(0.0))).collect();
         t.rows.push(CostRow {
             model: r.model.clone(),
@@ -77,10 +77,11 @@ pub fn bound_table(
     evaluations_of: impl Fn(&Stats, u32) -> Option<(Schedule, f64)>,
 ) -> Option<TargetCost> {
     let lights = steady_block(report.lights).0;
-    let per_eval = |stats: &Stats| evaluations_of(stats, lights).map(|(s, evals)| (s.scaled(1.0 / evals), s));
-    let figures = |model: &str| report.rows.iter().find(|r| r.model == model).and_then(|r| per_eval(&r.stats));
+    let evaluations_of = |stats: &Stats| evaluations_of(stats, lights);
+    let per_eval = |row: &Row| priced(report, row, &evaluations_of);
+    let figures = |model: &str| report.rows.iter().find(|r| r.model == model).and_then(per_eval);
     let base = figures(BASELINE_LABEL).map(|(e, _)| e);
-    let latency = report.rows.iter().any(|r| per_eval(&r.stats).is_some_and(|(_, w)| w.latency.is_some()));
+    let latency = report.rows.iter().any(|r| per_eval(r).is_some_and(|(_, w)| w.latency.is_some()));
     let added: &[&str] =
         if latency { &[BUSIEST_PIPE, LATENCY, RESIDENT_WAVES, HIDDEN_LATENCY] } else { &[BUSIEST_PIPE] };
     for c in added {
@@ -88,7 +89,7 @@ pub fn bound_table(
             header.columns.push(c.to_string());
         }
     }
-    let mut t = table(report, header, |stats, _| per_eval(stats).map(|(e, _)| e.cycles().1))?;
+    let mut t = table(report, header, |row, _| per_eval(row).map(|(e, _)| e.cycles().1))?;
     for row in &mut t.rows {
         let Some((eval, wave)) = figures(&row.model) else { continue };
         row.stats.insert(BUSIEST_PIPE.into(), wave.throughput().1);
@@ -110,4 +111,30 @@ pub fn bound_table(
         row.terms = wave.terms();
     }
     Some(t)
+}
+
+/// A row's figures per evaluation and per wave: its own, or where the report prices its loops at their trip
+/// count (`InspectReport::loop_trips`, `targets::trips`), each term per evaluation extrapolated from the two
+/// fixed-pass compiles to the model's passes, the resident waves its own.
+fn priced(
+    report: &InspectReport,
+    row: &Row,
+    evaluations_of: &impl Fn(&Stats) -> Option<(Schedule, f64)>,
+) -> Option<(Schedule, Schedule)> {
+    let (own, evals) = evaluations_of(&row.stats)?;
+    let Some(trips) = report.loop_trips.iter().find(|t| t.model == row.model) else {
+        return Some((own.scaled(1.0 / evals), own));
+    };
+    let fixed: Vec<(f64, Schedule, f64)> = trips
+        .fixed
+        .iter()
+        .filter_map(|f| evaluations_of(&f.stats).map(|(s, e)| (f.passes, s.scaled(1.0 / e), e)))
+        .collect();
+    let [(pa, a, evals_a), (pb, b, _)] = fixed.as_slice() else { return Some((own.scaled(1.0 / evals), own)) };
+    if pa == pb {
+        return Some((own.scaled(1.0 / evals), own));
+    }
+    let eval = Schedule::extrapolated((*pa, a), (*pb, b), trips.passes, own.resident_waves);
+    let wave = eval.scaled(*evals_a);
+    Some((eval, wave))
 }

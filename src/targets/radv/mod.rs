@@ -145,8 +145,8 @@ impl super::Vendor for Radv {
             None => cost::table(
                 report,
                 header("cycles/eval = Inverse Throughput / (64 x lights per kernel)".into()),
-                |stats, lights| {
-                    cost::driver_stat(stats, "Inverse Throughput")
+                |row, lights| {
+                    cost::driver_stat(&row.stats, "Inverse Throughput")
                         .map(|it| it / (THROUGHPUT_INVOCATIONS * f64::from(lights)))
                 },
             ),
