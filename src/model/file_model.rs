@@ -316,7 +316,8 @@ pub const HLSL_FRONT_END: &str = HlslFrontEnd::KEY;
 pub const LOOP_PASSES: &str = "loop-passes";
 /// spirv-opt's `--loop-unroll` writes out no loop of a single pass (none of a `for` loop's iterations).
 const MIN_LOOP_PASSES: u32 = 2;
-const MAX_LOOP_PASSES: u32 = 1 << 16;
+/// Every pass is a copy of the loop's body in the compiled kernel.
+const MAX_LOOP_PASSES: u32 = 256;
 
 /// The keys of a model text brdfprof reads itself (no parameter may take one's name).
 const KEYS: [&str; 8] = [DEFINE, ENTRY, RETURNS, INCLUDE, INCLUDE_MAP, INCLUDE_OVERRIDE, HLSL_FRONT_END, LOOP_PASSES];
@@ -601,7 +602,7 @@ impl FileModel {
                     anyhow!(
                         "{}: `{LOOP_PASSES}={}`: expected a whole number of passes, {MIN_LOOP_PASSES} to {MAX_LOOP_PASSES}",
                         self.path,
-                        value.trim()
+                        crate::messages::escape_line(value.trim())
                     )
                 })?);
                 continue;
@@ -872,7 +873,7 @@ impl FileModel {
         let words = crate::spirv::spirv_opt(&words, &["--loop-unroll".to_string()])?;
         if crate::spirv::loops::count(&words)? > 0 {
             bail!(
-                "{}: {LOOP_PASSES}={passes}: spirv-opt cannot write out the file's loops (it writes out a loop whose exit test precedes its body: a `for` or `while`, not a `do`)",
+                "{}: {LOOP_PASSES}={passes}: spirv-opt cannot write out the file's loops (it writes out a loop whose one exit is a test before its body: a `for` or `while` without `break`, `continue` or `return` in it, not a `do`)",
                 self.path
             );
         }

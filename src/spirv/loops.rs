@@ -43,7 +43,10 @@ pub fn at_passes(words: &[u32], passes: u32, unroll: bool) -> Result<(Vec<u32>, 
             set_loop(&mut function.blocks, at, merge, Ids { uint, boolean, zero, one, last }, &mut fresh)?;
             if unroll {
                 let control = function.blocks[at].instructions.iter_mut().find(|i| i.class.opcode == Op::LoopMerge);
-                control.expect("a loop header").operands[2] = Operand::LoopControl(rspirv::spirv::LoopControl::UNROLL);
+                let merge = control.expect("a loop header");
+                // Unroll takes no literal: a control's parameters (DependencyLength, ...) go with it.
+                merge.operands.truncate(2);
+                merge.operands.push(Operand::LoopControl(rspirv::spirv::LoopControl::UNROLL));
             }
             set += 1;
         }

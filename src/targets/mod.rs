@@ -327,9 +327,9 @@ pub fn compile_all(targets: &[Target], request: &Request) -> Result<Vec<Run>> {
         runs[k] = Some(run);
     }
     let mut runs: Vec<Run> = runs.into_iter().map(|r| r.expect("every target compiled")).collect();
-    let loops = trips::Trips::note(&trips);
     for run in &mut runs {
-        trips::Trips::attach(&trips, run);
+        let attached = trips::Trips::attach(&trips, run);
+        let loops = trips::Trips::note(&trips, &attached);
         let harness = run.report.cost.as_ref().and_then(harness_note);
         for note in harness.iter().chain(run.report.cost.as_ref().and(loops.as_ref())) {
             let driver = run.report.section_notes.entry("driver/".into()).or_default();

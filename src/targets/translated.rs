@@ -415,7 +415,9 @@ fn add_lines<F>(
     }
     for (report, family) in reports.iter_mut().zip(families) {
         let mut per_model = Vec::new();
-        for (m, checked) in req.models.iter().zip(checked).filter(|(_, c)| c.failed.is_none()) {
+        // A fixed-pass twin's cost is the model's, whose lines these are.
+        let costed = req.models.iter().zip(checked).filter(|(m, c)| c.failed.is_none() && !super::trips::is_twin(m));
+        for (m, checked) in costed {
             let source = crate::translate::prepare::shade_kernel_with_lines(Some(m), req.lights, req.shaders)?
                 .source_with_lines(dialect);
             let LineCompile { mut lines, costed, annotated } = lines(m, &source, &checked.source, family)?;

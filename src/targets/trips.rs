@@ -43,7 +43,13 @@ impl Trips {
                 }
                 let counted = |m: &Model| crate::translate::verify::loop_passes(m, shaders);
                 let passes = counted(m).map_err(|e| crate::messages::escape_line(&format!("{e:#}")));
+                let loops = f.file.loops.len();
                 let fixed = passes.is_ok().then(|| {
+                    if loops > 1 {
+                        // The host counts every loop's passes in one sum and a twin sets every loop alike: one
+                        // slope cannot price loops of different counts, nor a loop inside another.
+                        return Err(format!("the file has {loops} loops, and one count of passes prices one loop"));
+                    }
                     FIXED_PASSES
                         .iter()
                         .map(|&n| {
@@ -64,15 +70,19 @@ impl Trips {
         trips.iter().filter_map(|t| t.fixed.as_ref()?.as_ref().ok()).flatten().map(|(_, m, _)| m.clone()).collect()
     }
 
-    /// The driver note of the cost tables: each model, its loops' lines, its passes and whether it is priced at them.
-    pub fn note(trips: &[Trips]) -> Option<String> {
+    /// The driver note of one run's cost table: each model, its loops' lines, its passes and whether it is
+    /// priced at them there (`attached`: the models `attach` priced so on this target).
+    pub fn note(trips: &[Trips], attached: &[String]) -> Option<String> {
         let named: Vec<String> = trips
             .iter()
             .map(|t| {
                 let label = crate::messages::escape_line(&t.model.label());
                 let at = t.at.join(", ");
                 match (&t.passes, &t.fixed) {
-                    (Ok(p), Some(Ok(_))) => format!("{label} ({at}) with {p:.1} loop-header passes per evaluation, priced at them"),
+                    (Ok(p), Some(Ok(_))) if attached.contains(&t.model.label()) => {
+                        format!("{label} ({at}) with {p:.1} loop-header passes per evaluation, priced at them")
+                    }
+                    (Ok(p), Some(Ok(_))) => format!("{label} ({at}) with {p:.1} loop-header passes per evaluation, each loop's body counted once (its compiles at fixed passes were not both priced on this target)"),
                     (Ok(p), Some(Err(e))) => format!("{label} ({at}) with {p:.1} loop-header passes per evaluation, each loop's body counted once ({e})"),
                     (Ok(p), None) => format!("{label} ({at}) with {p:.1} loop-header passes per evaluation, each loop's body counted once"),
                     (Err(e), _) => format!("{label} ({at}), each loop's body counted once (passes not counted: {e})"),
@@ -92,10 +102,11 @@ impl Trips {
     /// Moves the fixed-pass twins' rows (and lines) of a run's report into its `loop_trips` and prices the
     /// run's rows again with them; a twin the target left out or failed is no model of the user's, so its
     /// entries go from the table's lists (its model is then priced with its loops' body once).
-    pub fn attach(trips: &[Trips], run: &mut Run) {
+    pub fn attach(trips: &[Trips], run: &mut Run) -> Vec<String> {
         let report = &mut run.report;
-        let twins: Vec<String> = Trips::twins(trips).iter().map(Model::label).collect();
-        let mut attached = false;
+        let twins: Vec<Model> = Trips::twins(trips);
+        let is_twin = |m: &str| twins.iter().any(|t| t.label() == m || t.name() == m);
+        let mut attached = Vec::new();
         for t in trips {
             let (Ok(passes), Some(Ok(fixed))) = (&t.passes, &t.fixed) else { continue };
             let rows: Vec<FixedPasses> = fixed
@@ -108,21 +119,33 @@ impl Trips {
                 .collect();
             if rows.len() == fixed.len() {
                 report.loop_trips.push(LoopTrips { model: t.model.label(), passes: *passes, fixed: rows });
-                attached = true;
+                attached.push(t.model.label());
             }
         }
-        report.rows.retain(|r| !twins.contains(&r.model));
-        report.lines.retain(|l| !twins.contains(&l.model));
-        let Some(mut cost) = report.cost.take() else { return };
-        if attached && let Some(priced) = super::cost_of(report) {
-            cost.rows = priced.rows;
+        report.rows.retain(|r| !is_twin(&r.model));
+        report.lines.retain(|l| !is_twin(&l.model));
+        if let Some(mut cost) = report.cost.take() {
+            if !attached.is_empty()
+                && let Some(priced) = super::cost_of(report)
+            {
+                cost.rows = priced.rows;
+            }
+            cost.rows.retain(|r| !is_twin(&r.model));
+            cost.absent.retain(|(m, _)| !is_twin(m));
+            cost.failed.retain(|(m, _)| !is_twin(m));
+            report.cost = Some(cost);
         }
-        cost.rows.retain(|r| !twins.contains(&r.model));
-        cost.absent.retain(|(m, _)| !twins.iter().any(|t| m.contains(t.as_str())));
-        cost.failed.retain(|(m, _)| !twins.iter().any(|t| m.contains(t.as_str())));
-        report.cost = Some(cost);
+        attached
     }
 }
+
+/// Whether `model` is a fixed-pass twin `Trips::of` made (a user's `loop-passes=` model is not).
+pub fn is_twin(model: &Model) -> bool {
+    model.file().is_some_and(|f| f.loop_passes.is_some() && f.label.as_deref().is_some_and(|l| l.contains(TWIN_MARK)))
+}
+
+/// What a twin's label carries after its model's: `.loop-passes=`.
+const TWIN_MARK: &str = ".loop-passes=";
 
 /// The note of a cost table that counts each loop's body once (a scene's kernels): the models with loops
 /// brdfprof cannot count, and each such loop's line.
@@ -159,8 +182,7 @@ fn fixed_twin(f: &crate::model::file_model::FileModel, passes: u32, labels: &mut
         .take(40)
         .collect();
     let stem = stem.trim_start_matches(['-', '.']);
-    let base =
-        format!("{}.{}={passes}", if stem.is_empty() { "model" } else { stem }, crate::model::file_model::LOOP_PASSES);
+    let base = format!("{}{TWIN_MARK}{passes}", if stem.is_empty() { "model" } else { stem });
     let label = (0..)
         .map(|k| if k == 0 { base.clone() } else { format!("{base}.{k}") })
         .find(|l| !labels.contains(l))

@@ -64,12 +64,51 @@ fn a_files_loops_run_the_passes_asked_and_are_written_out_for_the_compilers() {
 #[test]
 fn a_count_of_passes_out_of_range_is_refused_naming_the_file_and_the_key() {
     let file = crate::common::repo_root().join("tests/fixtures/brdf/micro/loop-16.brdf");
-    for bad in ["1", "x", "70000"] {
+    for bad in ["1", "x", "257"] {
         let text = format!("{},loop-passes={bad}", file.display());
         let e = format!("{:#}", Model::parse(&text).unwrap_err());
         assert!(
-            e.contains("loop-16.brdf") && e.contains(&format!("`loop-passes={bad}`")) && e.contains("2 to 65536"),
+            e.contains("loop-16.brdf") && e.contains(&format!("`loop-passes={bad}`")) && e.contains("2 to 256"),
             "{e}"
         );
     }
+}
+
+/// `targets::trips` makes twins of a file of one loop brdfprof cannot count (loop-16: its passes 17, the twins'
+/// 2 and 3, labelled after the model) and none of a file of two loops, whose passes one count cannot price: that
+/// model is named with the reason and its loops' body counted once.
+#[test]
+fn a_model_is_priced_at_its_passes_only_where_one_count_prices_its_loops() {
+    use brdfprof::targets::trips::{Trips, is_twin};
+    let shaders = Shaders::embedded();
+    let dir = tempfile::tempdir().unwrap();
+    let two = dir.path().join("two-loops.brdf");
+    std::fs::write(
+        &two,
+        "analytic\n::begin shader\nvec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y) {\n    float x = dot(N, L);\n    int n = 4 + int(step(4.0, x));\n    for (int i = 0; i < n; i++) { x = x * 0.5 + dot(N, V); }\n    for (int i = 0; i < n; i++) { x = x * 0.25 + dot(N, V); }\n    return vec3(x);\n}\n::end shader\n",
+    )
+    .unwrap();
+    let loop16 = crate::common::repo_root().join("tests/fixtures/brdf/micro/loop-16.brdf");
+    let models = [Model::parse(loop16.to_str().unwrap()).unwrap(), Model::parse(two.to_str().unwrap()).unwrap()];
+    let trips = Trips::of(&models, &shaders);
+    assert_eq!(trips.len(), 2);
+    let twins = trips[0].fixed.as_ref().unwrap().as_ref().unwrap();
+    let counts: Vec<(u32, String, f64)> = twins.iter().map(|(n, m, p)| (*n, m.label(), *p)).collect();
+    assert_eq!(counts, [(2, "loop-16.loop-passes=2".to_string(), 2.0), (3, "loop-16.loop-passes=3".to_string(), 3.0)]);
+    assert!(twins.iter().all(|(_, m, _)| is_twin(m)) && !is_twin(&models[0]));
+    assert_eq!(trips[0].passes, Ok(17.0));
+    let why = trips[1].fixed.as_ref().unwrap().as_ref().unwrap_err();
+    assert!(why.contains("2 loops"), "{why}");
+    let note = Trips::note(&trips, &["loop-16".to_string()]).unwrap();
+    assert!(note.contains("loop-16 (") && note.contains("evaluation, priced at them"), "{note}");
+    assert!(
+        note.contains("two-loops (") && note.contains("each loop's body counted once (the file has 2 loops"),
+        "{note}"
+    );
+    // On a target that did not price loop-16's twins, its note says so.
+    let note = Trips::note(&trips, &[]).unwrap();
+    assert!(
+        !note.contains("evaluation, priced at them") && note.contains("were not both priced on this target"),
+        "{note}"
+    );
 }

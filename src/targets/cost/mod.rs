@@ -130,11 +130,12 @@ fn priced(
         .iter()
         .filter_map(|f| evaluations_of(&f.stats).map(|(s, e)| (f.passes, s.scaled(1.0 / e), e)))
         .collect();
-    let [(pa, a, evals_a), (pb, b, _)] = fixed.as_slice() else { return Some((own.scaled(1.0 / evals), own)) };
-    if pa == pb {
+    // Two compiles of one width (Intel's SIMD width may differ between compiles) at two counts of passes.
+    let [(pa, a, evals_a), (pb, b, evals_b)] = fixed.as_slice() else { return Some((own.scaled(1.0 / evals), own)) };
+    if pa == pb || evals_a != evals_b {
         return Some((own.scaled(1.0 / evals), own));
     }
     let eval = Schedule::extrapolated((*pa, a), (*pb, b), trips.passes, own.resident_waves);
-    let wave = eval.scaled(*evals_a);
+    let wave = eval.scaled(evals);
     Some((eval, wave))
 }
