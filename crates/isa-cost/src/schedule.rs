@@ -83,10 +83,8 @@ impl Schedule {
     ) -> Schedule {
         let at = |x: f64, y: f64| (x + (passes - pa) / (pb - pa) * (y - x)).max(0.0);
         let of = |s: &Schedule, name: &str| s.pipes.iter().find(|(n, _)| n == name).map_or(0.0, |p| p.1);
-        let mut names: Vec<&String> = a.pipes.iter().chain(&b.pipes).map(|(n, _)| n).collect();
-        names.dedup();
         let mut pipes: Vec<(String, f64)> = Vec::new();
-        for n in names {
+        for (n, _) in a.pipes.iter().chain(&b.pipes) {
             if !pipes.iter().any(|(p, _)| p == n) {
                 pipes.push((n.clone(), at(of(a, n), of(b, n))));
             }

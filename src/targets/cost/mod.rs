@@ -122,20 +122,21 @@ fn priced(
     evaluations_of: &impl Fn(&Stats) -> Option<(Schedule, f64)>,
 ) -> Option<(Schedule, Schedule)> {
     let (own, evals) = evaluations_of(&row.stats)?;
-    let Some(trips) = report.loop_trips.iter().find(|t| t.model == row.model) else {
-        return Some((own.scaled(1.0 / evals), own));
-    };
-    let fixed: Vec<(f64, Schedule, f64)> = trips
-        .fixed
-        .iter()
-        .filter_map(|f| evaluations_of(&f.stats).map(|(s, e)| (f.passes, s.scaled(1.0 / e), e)))
-        .collect();
     // Two compiles of one width (Intel's SIMD width may differ between compiles) at two counts of passes.
-    let [(pa, a, evals_a), (pb, b, evals_b)] = fixed.as_slice() else { return Some((own.scaled(1.0 / evals), own)) };
-    if pa == pb || evals_a != evals_b {
-        return Some((own.scaled(1.0 / evals), own));
-    }
-    let eval = Schedule::extrapolated((*pa, a), (*pb, b), trips.passes, own.resident_waves);
+    let at_passes = report.loop_trips.iter().find(|t| t.model == row.model).and_then(|trips| {
+        let fixed: Vec<(f64, Schedule, f64)> = trips
+            .fixed
+            .iter()
+            .filter_map(|f| evaluations_of(&f.stats).map(|(s, e)| (f.passes, s.scaled(1.0 / e), e)))
+            .collect();
+        match fixed.as_slice() {
+            [(pa, a, ea), (pb, b, eb)] if pa != pb && ea == eb => {
+                Some(Schedule::extrapolated((*pa, a), (*pb, b), trips.passes, own.resident_waves))
+            }
+            _ => None,
+        }
+    });
+    let Some(eval) = at_passes else { return Some((own.scaled(1.0 / evals), own)) };
     let wave = eval.scaled(evals);
     Some((eval, wave))
 }
